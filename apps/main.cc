@@ -1,0 +1,38 @@
+// spritestation: the one executable. Exit codes: 0 success, 1 the work failed,
+// 2 bad usage or bad input. Errors name the file or field and the reason.
+#include <cstdio>
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+#include "apps/commands.h"
+#include "core/error.h"
+#include "core/log.h"
+
+int main(int argc, char** argv) {
+  CLI::App app{"SpriteStation: live capture and recording of video sprites"};
+  app.require_subcommand(1);
+  std::string log_level = "info";
+  app.add_option("--log-level", log_level, "trace, debug, info, warn, error, off")
+      ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "critical", "off"}));
+  app.parse_complete_callback([&] { ss::SetLogLevel(log_level); });
+
+  ss::apps::AddBenchCommand(app);
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int code = app.exit(e);
+    return code == 0 ? 0 : 2;
+  } catch (const ss::InputError& e) {
+    std::fprintf(stderr, "spritestation: error: %s\n", e.what());
+    return 2;
+  } catch (const ss::WorkError& e) {
+    std::fprintf(stderr, "spritestation: failed: %s\n", e.what());
+    return 1;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "spritestation: failed: %s\n", e.what());
+    return 1;
+  }
+  return 0;
+}

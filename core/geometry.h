@@ -1,0 +1,55 @@
+#pragma once
+// Ground geometry. One convention everywhere: `b_from_a` maps a point in frame a
+// to frame b (x_b = R x_a + t). The ground frame is the world: z up, z = 0 is
+// the floor, metres.
+#include <optional>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+namespace ss {
+
+struct Rigid3 {
+  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d translation = Eigen::Vector3d::Zero();
+
+  Eigen::Vector3d operator*(const Eigen::Vector3d& p) const { return rotation * p + translation; }
+  Rigid3 operator*(const Rigid3& o) const { return {rotation * o.rotation, rotation * o.translation + translation}; }
+  Rigid3 Inverse() const { return {rotation.transpose(), -(rotation.transpose() * translation)}; }
+  // mrcal's rt form: Rodrigues rotation vector r then translation t.
+  static Rigid3 FromRt(const double rt[6]);
+  void ToRt(double rt[6]) const;
+};
+
+// A ray in the ground frame: origin + s * direction, s >= 0.
+struct Ray {
+  Eigen::Vector3d origin;
+  Eigen::Vector3d direction;
+};
+
+// Where the ray meets the floor z = 0 in front of its origin; nullopt when it
+// runs parallel to the floor or points away from it.
+std::optional<Eigen::Vector3d> IntersectGround(const Ray& ray);
+
+// A simple polygon on the floor (ground x, y in metres), vertices in order.
+class GroundPolygon {
+ public:
+  GroundPolygon() = default;
+  explicit GroundPolygon(std::vector<Eigen::Vector2d> vertices);
+
+  const std::vector<Eigen::Vector2d>& vertices() const { return vertices_; }
+  bool empty() const { return vertices_.size() < 3; }
+  // Inside (or on the boundary) by the even-odd rule.
+  bool Contains(const Eigen::Vector2d& point_in_ground) const;
+  // Distance to the nearest edge; positive inside, negative outside.
+  double SignedDistance(const Eigen::Vector2d& point_in_ground) const;
+  // Inset by `margin` metres (convex polygons exactly; a conservative test otherwise).
+  bool ContainsWithMargin(const Eigen::Vector2d& point_in_ground, double margin) const;
+  double Area() const;
+
+ private:
+  std::vector<Eigen::Vector2d> vertices_;
+};
+
+}  // namespace ss

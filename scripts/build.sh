@@ -1,0 +1,20 @@
+#!/usr/bin/env bash
+# Configures and builds SpriteStation into build/ (or $SPRITESTATION_BUILD_DIR).
+#   SPRITESTATION_SANITIZE=asan|tsan   build with sanitizers into build-asan/ or build-tsan/
+set -euo pipefail
+top="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+sanitize="${SPRITESTATION_SANITIZE:-}"
+extra=()
+case "$sanitize" in
+  "") build="${SPRITESTATION_BUILD_DIR:-$top/build}" ;;
+  asan) build="${SPRITESTATION_BUILD_DIR:-$top/build-asan}"; extra+=(-DSPRITESTATION_ASAN=ON -DCMAKE_BUILD_TYPE=Debug) ;;
+  tsan) build="${SPRITESTATION_BUILD_DIR:-$top/build-tsan}"; extra+=(-DSPRITESTATION_TSAN=ON -DCMAKE_BUILD_TYPE=Debug) ;;
+  *) echo "build.sh: SPRITESTATION_SANITIZE must be asan or tsan, got '$sanitize'" >&2; exit 2 ;;
+esac
+generator=()
+command -v ninja >/dev/null && generator=(-G Ninja)
+if [ ! -f "$build/CMakeCache.txt" ]; then
+  cmake -S "$top" -B "$build" "${generator[@]}" -DCMAKE_BUILD_TYPE=RelWithDebInfo "${extra[@]}"
+fi
+cmake --build "$build" -j "$(nproc)"
+echo "$build"

@@ -1,0 +1,21 @@
+#!/usr/bin/env bash
+# The README's main command: installs what is missing, builds, and runs the main
+# job on the sample session (recordings/sample, rendered by `spritestation synth`
+# the first time), printing what each stage did.
+set -euo pipefail
+top="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+"$top/scripts/install-deps.sh"
+build="$("$top/scripts/build.sh" | tail -n 1)"
+ss="$build/apps/spritestation"
+sample="$top/recordings/sample"
+out="$top/recordings/demo-output"
+mkdir -p "$out"
+
+if [ ! -f "$sample/session.json" ]; then
+  echo "== no recorded sample: rendering a synthetic one into $sample"
+  rm -rf "$sample"
+  "$ss" synth --out "$sample" --kind animal --seconds 10 --fps 30 --size 640x480 --cameras 2 --subjects 1 --seed 7
+fi
+
+echo "== replaying $sample"
+"$ss" replay "$sample"

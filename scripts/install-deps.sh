@@ -1,0 +1,39 @@
+#!/usr/bin/env bash
+# Installs every Debian package SpriteStation needs to build, test and run.
+# Idempotent: packages already present are left alone; safe to run on every build.
+set -euo pipefail
+
+PACKAGES=(
+  # toolchain
+  build-essential cmake ninja-build pkgconf ccache git
+  # vision and geometry
+  libopencv-dev libopencv-contrib-dev libeigen3-dev
+  libmrcal-dev mrcal
+  # cameras
+  libaravis-dev aravis-tools libv4l-dev libcamera-dev
+  # recordings (FFmpeg's libraries; the ffmpeg CLI is used by benchmarks only)
+  libavformat-dev libavcodec-dev libavutil-dev libswscale-dev libavfilter-dev ffmpeg
+  # storage, config, CLI, logging, HTTP
+  libsqlite3-dev sqlite3 libyaml-cpp-dev nlohmann-json3-dev libcli11-dev
+  libspdlog-dev libfmt-dev libcpp-httplib-dev libsystemd-dev libpng-dev libzstd-dev
+  # tests and benchmarks
+  libgtest-dev libgmock-dev libbenchmark-dev
+)
+
+missing=()
+for p in "${PACKAGES[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "install-deps: all ${#PACKAGES[@]} packages present"
+  exit 0
+fi
+
+SUDO=""
+if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
+echo "install-deps: installing ${#missing[@]} packages: ${missing[*]}"
+export DEBIAN_FRONTEND=noninteractive
+$SUDO apt-get update -qq
+$SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
+echo "install-deps: done"
