@@ -25,16 +25,18 @@ void Rigid3::ToRt(double rt[6]) const {
 }
 
 std::optional<Eigen::Vector3d> IntersectGround(const Ray& ray) {
+  if (!ray.origin.allFinite() || !ray.direction.allFinite()) return std::nullopt;
   const double dz = ray.direction.z();
-  if (std::abs(dz) < 1e-12) return std::nullopt;
+  if (std::abs(dz) < 1e-12 * ray.direction.norm()) return std::nullopt;
   const double s = -ray.origin.z() / dz;
-  if (s < 0) return std::nullopt;
+  if (!(s >= 0)) return std::nullopt;
   Eigen::Vector3d p = ray.origin + s * ray.direction;
   p.z() = 0.0;
   return p;
 }
 
-GroundPolygon::GroundPolygon(std::vector<Eigen::Vector2d> vertices) : vertices_(std::move(vertices)) {}
+GroundPolygon::GroundPolygon(std::vector<Eigen::Vector2d> vertices)
+    : vertices_(std::move(vertices)) {}
 
 bool GroundPolygon::Contains(const Eigen::Vector2d& p) const { return SignedDistance(p) >= 0.0; }
 
@@ -69,6 +71,59 @@ double GroundPolygon::SignedDistance(const Eigen::Vector2d& p) const {
 
 bool GroundPolygon::ContainsWithMargin(const Eigen::Vector2d& p, double margin) const {
   return SignedDistance(p) >= margin;
+}
+
+namespace {
+
+// Sign of the turn a -> b -> c: +1 left, -1 right, 0 collinear.
+int Orientation(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector2d& c) {
+  const double cross = (b - a).x() * (c - a).y() - (b - a).y() * (c - a).x();
+  return (cross > 0) - (cross < 0);
+}
+
+bool OnSegment(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector2d& p) {
+  return std::min(a.x(), b.x()) <= p.x() && p.x() <= std::max(a.x(), b.x()) &&
+         std::min(a.y(), b.y()) <= p.y() && p.y() <= std::max(a.y(), b.y());
+}
+
+// Closed segments ab and cd share at least one point.
+bool SegmentsMeet(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector2d& c,
+                  const Eigen::Vector2d& d) {
+  const int o1 = Orientation(a, b, c), o2 = Orientation(a, b, d);
+  const int o3 = Orientation(c, d, a), o4 = Orientation(c, d, b);
+  if (o1 != o2 && o3 != o4) return true;
+  return (o1 == 0 && OnSegment(a, b, c)) || (o2 == 0 && OnSegment(a, b, d)) ||
+         (o3 == 0 && OnSegment(c, d, a)) || (o4 == 0 && OnSegment(c, d, b));
+}
+
+}  // namespace
+
+bool GroundPolygon::IsSimple() const {
+  const size_t n = vertices_.size();
+  if (n < 3) return false;
+  for (const auto& v : vertices_) {
+    if (!v.allFinite()) return false;
+  }
+  for (size_t i = 0; i < n; ++i) {
+    const Eigen::Vector2d& a = vertices_[i];
+    const Eigen::Vector2d& b = vertices_[(i + 1) % n];
+    if (a == b) return false;  // a repeated vertex makes a zero-length edge
+    for (size_t j = i + 1; j < n; ++j) {
+      const Eigen::Vector2d& c = vertices_[j];
+      const Eigen::Vector2d& d = vertices_[(j + 1) % n];
+      const bool adjacent = j == i + 1 || (i == 0 && j == n - 1);
+      if (adjacent) {
+        // Neighbours share one vertex; they must not fold back onto each other.
+        const Eigen::Vector2d& shared = j == i + 1 ? b : a;
+        const Eigen::Vector2d& p = j == i + 1 ? a : b;  // far end of edge i
+        const Eigen::Vector2d& q = j == i + 1 ? d : c;  // far end of edge j
+        if (Orientation(p, shared, q) == 0 && (p - shared).dot(q - shared) > 0) return false;
+        continue;
+      }
+      if (SegmentsMeet(a, b, c, d)) return false;
+    }
+  }
+  return Area() > 0;
 }
 
 double GroundPolygon::Area() const {

@@ -15,11 +15,16 @@ struct Rigid3 {
   Eigen::Vector3d translation = Eigen::Vector3d::Zero();
 
   Eigen::Vector3d operator*(const Eigen::Vector3d& p) const { return rotation * p + translation; }
-  Rigid3 operator*(const Rigid3& o) const { return {rotation * o.rotation, rotation * o.translation + translation}; }
+  Rigid3 operator*(const Rigid3& o) const {
+    return {rotation * o.rotation, rotation * o.translation + translation};
+  }
   Rigid3 Inverse() const { return {rotation.transpose(), -(rotation.transpose() * translation)}; }
-  // mrcal's rt form: Rodrigues rotation vector r then translation t.
+  // mrcal's rt form: Rodrigues rotation vector r (axis * angle, |r| <= pi) then translation t.
   static Rigid3 FromRt(const double rt[6]);
   void ToRt(double rt[6]) const;
+  bool operator==(const Rigid3& o) const {
+    return rotation == o.rotation && translation == o.translation;
+  }
 };
 
 // A ray in the ground frame: origin + s * direction, s >= 0.
@@ -29,7 +34,7 @@ struct Ray {
 };
 
 // Where the ray meets the floor z = 0 in front of its origin; nullopt when it
-// runs parallel to the floor or points away from it.
+// runs parallel to the floor, points away from it or is not finite (NaN).
 std::optional<Eigen::Vector3d> IntersectGround(const Ray& ray);
 
 // A simple polygon on the floor (ground x, y in metres), vertices in order.
@@ -44,9 +49,13 @@ class GroundPolygon {
   bool Contains(const Eigen::Vector2d& point_in_ground) const;
   // Distance to the nearest edge; positive inside, negative outside.
   double SignedDistance(const Eigen::Vector2d& point_in_ground) const;
-  // Inset by `margin` metres (convex polygons exactly; a conservative test otherwise).
+  // Inside and at least `margin` metres from every edge (exact for any simple polygon).
   bool ContainsWithMargin(const Eigen::Vector2d& point_in_ground, double margin) const;
-  double Area() const;
+  double Area() const;  // square metres, whatever the vertex order
+  // At least 3 finite vertices, no two edges crossing or touching except
+  // neighbours at their shared vertex, and a non-zero area.
+  bool IsSimple() const;
+  bool operator==(const GroundPolygon& o) const { return vertices_ == o.vertices_; }
 
  private:
   std::vector<Eigen::Vector2d> vertices_;

@@ -1,0 +1,508 @@
+#include "core/bank.h"
+
+#include <algorithm>
+#include <filesystem>
+#include <system_error>
+#include <utility>
+
+#include <opencv2/core.hpp>
+
+#include "core/bank_pixels.h"
+#include "core/bank_schema.h"
+#include "core/bank_sqlite.h"
+#include "core/error.h"
+
+namespace ss {
+namespace {
+
+namespace fs = std::filesystem;
+
+// The sprite columns in the order ReadSprite reads them.
+constexpr const char* kSpriteColumns =
+    "id, clip_id, camera_id, track_id, frame, timestamp_ns, mirrored, mirror_of, ground_x_m, ground_y_m, "
+    "velocity_x_m_s, velocity_y_m_s, mean_r, mean_g, mean_b, area_px, eccentricity, bbox_x, bbox_y, bbox_w, "
+    "bbox_h, billboard_w_px, billboard_h_px, px_per_m, anchor_x_px, anchor_y_px";
+
+SpriteRecord ReadSprite(const sql::Stmt& s) {
+  SpriteRecord r;
+  r.id = s.Int(0);
+  r.clip_id = s.Int(1);
+  r.camera_id = s.Int(2);
+  r.track_id = s.Int(3);
+  r.frame = s.Int(4);
+  r.timestamp_ns = s.Int(5);
+  r.mirrored = s.Int(6) != 0;
+  r.mirror_of = s.IsNull(7) ? 0 : s.Int(7);
+  r.ground_x_m = s.Real(8);
+  r.ground_y_m = s.Real(9);
+  r.velocity_x_m_s = s.Real(10);
+  r.velocity_y_m_s = s.Real(11);
+  r.mean_r = s.Real(12);
+  r.mean_g = s.Real(13);
+  r.mean_b = s.Real(14);
+  r.area_px = s.Real(15);
+  r.eccentricity = s.Real(16);
+  r.bbox_in_image = cv::Rect(static_cast<int>(s.Int(17)), static_cast<int>(s.Int(18)), static_cast<int>(s.Int(19)),
+                             static_cast<int>(s.Int(20)));
+  r.billboard_width_px = static_cast<int>(s.Int(21));
+  r.billboard_height_px = static_cast<int>(s.Int(22));
+  r.px_per_m = s.Real(23);
+  r.anchor_x_px = s.Real(24);
+  r.anchor_y_px = s.Real(25);
+  return r;
+}
+
+ClipRecord ReadClip(const sql::Stmt& s) {
+  ClipRecord c;
+  c.id = s.Int(0);
+  c.camera_id = s.Int(1);
+  c.track_id = s.Int(2);
+  c.first_frame = s.Int(3);
+  c.last_frame = s.Int(4);
+  c.complete = s.Int(5) != 0;
+  c.complete_seq = s.IsNull(6) ? 0 : s.Int(6);
+  return c;
+}
+
+constexpr const char* kClipColumns = "id, camera_id, track_id, first_frame, last_frame, complete, complete_seq";
+
+int64_t FileBytes(const std::string& path) {
+  std::error_code ec;
+  const auto size = fs::file_size(path, ec);
+  return ec ? 0 : static_cast<int64_t>(size);
+}
+
+}  // namespace
+
+struct Bank::ReadCache {
+  sql::Stmt pixels;
+  PixelCodec codec;
+};
+
+Bank::Bank(const std::string& path) : Bank(path, Mode::kReadOnly) {}
+
+Bank::Bank(const std::string& path, Mode mode) : path_(path) {
+  std::error_code ec;
+  if (mode == Mode::kReadOnly) {
+    if (!fs::exists(path, ec)) throw InputError(path, "no such sprite bank");
+    if (!fs::is_regular_file(path, ec)) throw InputError(path, "not a sprite bank (not a regular file)");
+  }
+  const int flags = (mode == Mode::kReadOnly ? SQLITE_OPEN_READONLY : SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE) |
+                    SQLITE_OPEN_NOMUTEX;
+  db_ = std::make_unique<sql::Db>(path, flags);
+  PrepareBankSchema(*db_, mode == Mode::kReadWrite);
+}
+
+Bank::~Bank() = default;
+Bank::Bank(Bank&&) noexcept = default;
+Bank& Bank::operator=(Bank&&) noexcept = default;
+
+Bank::ReadCache& Bank::cache() const {
+  if (!cache_) {
+    cache_ = std::unique_ptr<ReadCache>(new ReadCache{
+        db_->Prepare("SELECT s.mirrored, p.width_px, p.height_px, p.codec, p.data FROM sprites s "
+                     "LEFT JOIN sprite_pixels p ON p.sprite_id = coalesce(s.mirror_of, s.id) WHERE s.id = ?"),
+        {}});
+  }
+  return *cache_;
+}
+
+int Bank::schema_version() const { return static_cast<int>(db_->QueryInt("PRAGMA user_version")); }
+
+std::vector<SessionRecord> Bank::ListSessions() const {
+  std::vector<SessionRecord> out;
+  auto s = db_->Prepare("SELECT id, uid, name, created, source FROM sessions ORDER BY id");
+  while (s.Step()) out.push_back({s.Int(0), s.Text(1), s.Text(2), s.Text(3), s.Text(4)});
+  return out;
+}
+
+std::vector<CameraRecord> Bank::ListCameras() const {
+  std::vector<CameraRecord> out;
+  auto s = db_->Prepare("SELECT id, session_id, name, cameramodel, width, height FROM cameras ORDER BY id");
+  while (s.Step()) {
+    out.push_back({s.Int(0), s.Int(1), s.Text(2), s.Text(3), static_cast<int>(s.Int(4)), static_cast<int>(s.Int(5))});
+  }
+  return out;
+}
+
+std::vector<ClipRecord> Bank::ListClips(int64_t completed_after_seq) const {
+  std::vector<ClipRecord> out;
+  auto s = db_->Prepare(std::string("SELECT ") + kClipColumns +
+                        " FROM clips WHERE complete = 1 AND complete_seq > ? ORDER BY complete_seq");
+  s.Bind(1, completed_after_seq);
+  while (s.Step()) out.push_back(ReadClip(s));
+  return out;
+}
+
+std::vector<ClipRecord> Bank::ListAllClips() const {
+  std::vector<ClipRecord> out;
+  auto s = db_->Prepare(std::string("SELECT ") + kClipColumns + " FROM clips ORDER BY id");
+  while (s.Step()) out.push_back(ReadClip(s));
+  return out;
+}
+
+std::vector<SpriteFeatures> Bank::LoadFeatures(int64_t completed_after_seq) const {
+  std::vector<SpriteFeatures> out;
+  out.reserve(static_cast<size_t>(
+      db_->QueryInt("SELECT count(*) FROM sprites s JOIN clips c ON c.id = s.clip_id WHERE c.complete = 1")));
+  auto s = db_->Prepare(
+      "SELECT s.id, s.clip_id, s.frame, s.timestamp_ns, s.mirror_of, s.mirrored, s.ground_x_m, s.ground_y_m, "
+      "s.velocity_x_m_s, s.velocity_y_m_s, s.mean_r, s.mean_g, s.mean_b, s.area_px, s.eccentricity "
+      "FROM clips c JOIN sprites s ON s.clip_id = c.id WHERE c.complete = 1 AND c.complete_seq > ? "
+      "ORDER BY s.clip_id, s.mirrored, s.frame");
+  s.Bind(1, completed_after_seq);
+  while (s.Step()) {
+    SpriteFeatures f;
+    f.id = s.Int(0);
+    f.clip_id = s.Int(1);
+    f.frame = s.Int(2);
+    f.timestamp_ns = s.Int(3);
+    f.mirror_of = s.IsNull(4) ? 0 : s.Int(4);
+    f.mirrored = s.Int(5) != 0;
+    f.ground_x_m = static_cast<float>(s.Real(6));
+    f.ground_y_m = static_cast<float>(s.Real(7));
+    f.velocity_x_m_s = static_cast<float>(s.Real(8));
+    f.velocity_y_m_s = static_cast<float>(s.Real(9));
+    f.mean_r = static_cast<float>(s.Real(10));
+    f.mean_g = static_cast<float>(s.Real(11));
+    f.mean_b = static_cast<float>(s.Real(12));
+    f.area_px = static_cast<float>(s.Real(13));
+    f.eccentricity = static_cast<float>(s.Real(14));
+    if (!out.empty()) {
+      SpriteFeatures& before = out.back();
+      if (before.clip_id == f.clip_id && before.mirrored == f.mirrored && before.frame + 1 == f.frame) {
+        f.prev = static_cast<int32_t>(out.size() - 1);
+        before.next = static_cast<int32_t>(out.size());
+      }
+    }
+    out.push_back(f);
+  }
+  return out;
+}
+
+SpriteRecord Bank::LoadSprite(int64_t id) const {
+  auto s = db_->Prepare(std::string("SELECT ") + kSpriteColumns + " FROM sprites WHERE id = ?");
+  s.Bind(1, id);
+  if (!s.Step()) throw InputError(path_, "no sprite with id " + std::to_string(id));
+  SpriteRecord r = ReadSprite(s);
+  auto tags = db_->Prepare("SELECT tag FROM sprite_tags WHERE sprite_id = ? ORDER BY tag");
+  tags.Bind(1, id);
+  while (tags.Step()) r.tags.push_back(tags.Text(0));
+  return r;
+}
+
+SpritePixels Bank::LoadPixels(int64_t id) const {
+  ReadCache& c = cache();
+  sql::Stmt& s = c.pixels;
+  s.Reset();
+  s.Bind(1, id);
+  if (!s.Step()) throw InputError(path_, "no sprite with id " + std::to_string(id));
+  if (s.IsNull(1)) throw WorkError(path_, "sprite " + std::to_string(id) + " has no pixels");
+  const bool mirrored = s.Int(0) != 0;
+  SpritePixels pixels;
+  try {
+    pixels = c.codec.Decode(s.Blob(4), s.Bytes(4), static_cast<int>(s.Int(1)), static_cast<int>(s.Int(2)), s.Text(3));
+  } catch (const WorkError& e) {
+    s.Reset();
+    throw WorkError(path_, "sprite " + std::to_string(id) + ": " + e.what());
+  }
+  s.Reset();
+  if (mirrored) {
+    cv::flip(pixels.bgra, pixels.bgra, 1);
+    cv::flip(pixels.shadow, pixels.shadow, 1);
+  }
+  return pixels;
+}
+
+std::vector<TransitionRecord> Bank::LoadTransitions() const {
+  std::vector<TransitionRecord> out;
+  out.reserve(static_cast<size_t>(db_->QueryInt("SELECT count(*) FROM transitions")));
+  auto s = db_->Prepare("SELECT from_sprite, to_sprite, d, cost FROM transitions ORDER BY from_sprite, to_sprite");
+  while (s.Step()) out.push_back({s.Int(0), s.Int(1), s.Real(2), s.Real(3)});
+  return out;
+}
+
+std::vector<TransitionRecord> Bank::LoadTransitionsFrom(int64_t from_sprite) const {
+  std::vector<TransitionRecord> out;
+  auto s = db_->Prepare("SELECT from_sprite, to_sprite, d, cost FROM transitions WHERE from_sprite = ? "
+                        "ORDER BY to_sprite");
+  s.Bind(1, from_sprite);
+  while (s.Step()) out.push_back({s.Int(0), s.Int(1), s.Real(2), s.Real(3)});
+  return out;
+}
+
+std::vector<int64_t> Bank::SpritesTagged(const std::string& tag) const {
+  std::vector<int64_t> out;
+  auto s = db_->Prepare("SELECT sprite_id FROM sprite_tags WHERE tag = ? ORDER BY sprite_id");
+  s.Bind(1, tag);
+  while (s.Step()) out.push_back(s.Int(0));
+  return out;
+}
+
+std::optional<std::string> Bank::GetMeta(const std::string& key) const {
+  auto s = db_->Prepare("SELECT value FROM meta WHERE key = ?");
+  s.Bind(1, key);
+  if (!s.Step()) return std::nullopt;
+  return s.Text(0);
+}
+
+BankCounts Bank::Counts() const {
+  // One read transaction so that the figures agree with each other.
+  db_->Exec("BEGIN");
+  BankCounts c;
+  try {
+    c.schema_version = schema_version();
+    c.sessions = db_->QueryInt("SELECT count(*) FROM sessions");
+    c.cameras = db_->QueryInt("SELECT count(*) FROM cameras");
+    c.clips = db_->QueryInt("SELECT count(*) FROM clips");
+    c.clips_complete = db_->QueryInt("SELECT count(*) FROM clips WHERE complete = 1");
+    c.sprites = db_->QueryInt("SELECT count(*) FROM sprites");
+    c.mirrors = db_->QueryInt("SELECT count(*) FROM sprites WHERE mirrored = 1");
+    c.sprites_visible =
+        db_->QueryInt("SELECT count(*) FROM sprites s JOIN clips c ON c.id = s.clip_id WHERE c.complete = 1");
+    c.pixel_rows = db_->QueryInt("SELECT count(*) FROM sprite_pixels");
+    c.pixel_bytes = db_->QueryInt("SELECT coalesce(sum(length(data)), 0) FROM sprite_pixels");
+    c.transitions = db_->QueryInt("SELECT count(*) FROM transitions");
+    c.tags = db_->QueryInt("SELECT count(DISTINCT tag) FROM sprite_tags");
+    c.tagged_sprites = db_->QueryInt("SELECT count(DISTINCT sprite_id) FROM sprite_tags");
+  } catch (...) {
+    sqlite3_exec(db_->get(), "ROLLBACK", nullptr, nullptr, nullptr);
+    throw;
+  }
+  db_->Exec("COMMIT");
+  c.file_bytes = FileBytes(path_);
+  c.wal_bytes = FileBytes(path_ + "-wal");
+  return c;
+}
+
+// ---------------------------------------------------------------------------------------------
+
+struct BankWriter::Impl {
+  explicit Impl(sql::Db& db)
+      : find_clip(db.Prepare(std::string("SELECT ") + kClipColumns +
+                             " FROM clips WHERE camera_id = ? AND track_id = ? AND first_frame = ?")),
+        insert_clip(db.Prepare("INSERT INTO clips (camera_id, track_id, first_frame, last_frame) VALUES (?, ?, ?, ?)")),
+        extend_clip(db.Prepare("UPDATE clips SET last_frame = ? WHERE id = ? AND last_frame < ?")),
+        complete_clip(db.Prepare("UPDATE clips SET complete = 1, complete_seq = "
+                                 "(SELECT coalesce(max(complete_seq), 0) + 1 FROM clips) "
+                                 "WHERE id = ? AND complete = 0")),
+        insert_sprite(db.Prepare(
+            std::string("INSERT INTO sprites (") + kSpriteColumns +
+            ") VALUES (NULL, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?) "
+            "ON CONFLICT (camera_id, frame, track_id, mirrored) DO NOTHING")),
+        find_sprite(db.Prepare("SELECT id FROM sprites WHERE camera_id = ? AND frame = ? AND track_id = ? "
+                               "AND mirrored = ?")),
+        insert_pixels(db.Prepare("INSERT OR REPLACE INTO sprite_pixels (sprite_id, width_px, height_px, codec, data) "
+                                 "VALUES (?, ?, ?, ?, ?)")),
+        insert_tag(db.Prepare("INSERT OR IGNORE INTO sprite_tags (sprite_id, tag) VALUES (?, ?)")),
+        upsert_transition(db.Prepare("INSERT OR REPLACE INTO transitions (from_sprite, to_sprite, d, cost) "
+                                     "VALUES (?, ?, ?, ?)")) {}
+
+  sql::Stmt find_clip, insert_clip, extend_clip, complete_clip;
+  sql::Stmt insert_sprite, find_sprite, insert_pixels, insert_tag, upsert_transition;
+  PixelCodec codec;
+};
+
+BankWriter::BankWriter(const std::string& path)
+    : Bank(path, Mode::kReadWrite), impl_(std::make_unique<Impl>(db())) {}
+
+BankWriter::~BankWriter() = default;
+BankWriter::BankWriter(BankWriter&&) noexcept = default;
+BankWriter& BankWriter::operator=(BankWriter&&) noexcept = default;
+
+int64_t BankWriter::AddSession(const SessionRecord& session) {
+  if (session.uid.empty()) throw WorkError(path(), "a session needs a non-empty uid");
+  sql::Transaction tx(db());
+  auto insert = db().Prepare(
+      "INSERT INTO sessions (uid, name, created, source) VALUES (?, ?, ?, ?) ON CONFLICT (uid) DO NOTHING");
+  insert.Bind(1, session.uid).Bind(2, session.name).Bind(3, session.created).Bind(4, session.source).Step();
+  auto find = db().Prepare("SELECT id FROM sessions WHERE uid = ?");
+  find.Bind(1, session.uid).Step();
+  const int64_t id = find.Int(0);
+  find.Reset();
+  tx.Commit();
+  return id;
+}
+
+int64_t BankWriter::AddCamera(int64_t session_id, const CameraRecord& camera) {
+  if (camera.name.empty()) throw WorkError(path(), "a camera needs a non-empty name");
+  sql::Transaction tx(db());
+  auto session = db().Prepare("SELECT 1 FROM sessions WHERE id = ?");
+  if (!session.Bind(1, session_id).Step()) {
+    throw WorkError(path(), "camera '" + camera.name + "': no session with id " + std::to_string(session_id));
+  }
+  session.Reset();
+  auto insert = db().Prepare(
+      "INSERT INTO cameras (session_id, name, cameramodel, width, height) VALUES (?, ?, ?, ?, ?) "
+      "ON CONFLICT (session_id, name) DO NOTHING");
+  insert.Bind(1, session_id)
+      .Bind(2, camera.name)
+      .Bind(3, camera.cameramodel)
+      .Bind(4, static_cast<int64_t>(camera.width))
+      .Bind(5, static_cast<int64_t>(camera.height))
+      .Step();
+  auto find = db().Prepare("SELECT id FROM cameras WHERE session_id = ? AND name = ?");
+  find.Bind(1, session_id).Bind(2, camera.name).Step();
+  const int64_t id = find.Int(0);
+  find.Reset();
+  tx.Commit();
+  return id;
+}
+
+AppendResult BankWriter::AppendClipBatch(const ClipRecord& clip, const std::vector<SpriteRecord>& sprites) {
+  const std::string where = path() + ": clip (camera " + std::to_string(clip.camera_id) + ", track " +
+                            std::to_string(clip.track_id) + ", first frame " + std::to_string(clip.first_frame) + ")";
+  int64_t last_frame = std::max(clip.first_frame, clip.last_frame);
+  for (const SpriteRecord& s : sprites) {
+    const std::string who = where + ", frame " + std::to_string(s.frame) + (s.mirrored ? " (mirrored)" : "");
+    if (s.frame < clip.first_frame) throw WorkError(who, "sprite is before the clip's first frame");
+    if (s.billboard_width_px <= 0 || s.billboard_height_px <= 0 || !(s.px_per_m > 0)) {
+      throw WorkError(who, "billboard size and px_per_m must be positive");
+    }
+    if (!s.mirrored && (s.pixels.bgra.cols != s.billboard_width_px || s.pixels.bgra.rows != s.billboard_height_px)) {
+      throw WorkError(who, "an original sprite needs billboard pixels of its billboard size (" +
+                               std::to_string(s.billboard_width_px) + "x" + std::to_string(s.billboard_height_px) +
+                               ", got " + std::to_string(s.pixels.bgra.cols) + "x" +
+                               std::to_string(s.pixels.bgra.rows) + ")");
+    }
+    last_frame = std::max(last_frame, s.frame);
+  }
+
+  Impl& w = *impl_;
+  sql::Transaction tx(db());
+  AppendResult result;
+  w.find_clip.Reset();
+  w.find_clip.Bind(1, clip.camera_id).Bind(2, clip.track_id).Bind(3, clip.first_frame);
+  if (w.find_clip.Step()) {
+    const ClipRecord stored = ReadClip(w.find_clip);
+    w.find_clip.Reset();
+    result.clip_id = stored.id;
+    if (stored.complete && last_frame > stored.last_frame) {
+      throw WorkError(where, "the clip is complete up to frame " + std::to_string(stored.last_frame) +
+                                 "; a batch reaches frame " + std::to_string(last_frame));
+    }
+    w.extend_clip.Reset();
+    w.extend_clip.Bind(1, last_frame).Bind(2, stored.id).Bind(3, last_frame).Step();
+  } else {
+    w.find_clip.Reset();
+    auto camera = db().Prepare("SELECT 1 FROM cameras WHERE id = ?");
+    if (!camera.Bind(1, clip.camera_id).Step()) throw WorkError(where, "no camera with that id");
+    camera.Reset();
+    w.insert_clip.Reset();
+    w.insert_clip.Bind(1, clip.camera_id).Bind(2, clip.track_id).Bind(3, clip.first_frame).Bind(4, last_frame).Step();
+    result.clip_id = sqlite3_last_insert_rowid(db().get());
+  }
+
+  result.sprite_ids.assign(sprites.size(), 0);
+  auto find = [&](int64_t frame, bool mirrored) -> int64_t {
+    w.find_sprite.Reset();
+    w.find_sprite.Bind(1, clip.camera_id).Bind(2, frame).Bind(3, clip.track_id).Bind(4, int64_t{mirrored});
+    const int64_t id = w.find_sprite.Step() ? w.find_sprite.Int(0) : 0;
+    w.find_sprite.Reset();
+    return id;
+  };
+  // Originals first, so that mirrors in the same batch find them.
+  for (int pass = 0; pass < 2; ++pass) {
+    for (size_t i = 0; i < sprites.size(); ++i) {
+      const SpriteRecord& s = sprites[i];
+      if (s.mirrored != (pass == 1)) continue;
+      int64_t mirror_of = 0;
+      if (s.mirrored) {
+        mirror_of = find(s.frame, false);
+        if (mirror_of == 0) {
+          throw WorkError(where + ", frame " + std::to_string(s.frame),
+                          "a mirrored sprite needs its original (same camera, track and frame) in the bank or batch");
+        }
+      }
+      sql::Stmt& q = w.insert_sprite;
+      q.Reset();
+      q.Bind(1, result.clip_id).Bind(2, clip.camera_id).Bind(3, clip.track_id).Bind(4, s.frame);
+      q.Bind(5, s.timestamp_ns).Bind(6, int64_t{s.mirrored});
+      if (s.mirrored) {
+        q.Bind(7, mirror_of);
+      } else {
+        q.BindNull(7);
+      }
+      q.Bind(8, s.ground_x_m).Bind(9, s.ground_y_m).Bind(10, s.velocity_x_m_s).Bind(11, s.velocity_y_m_s);
+      q.Bind(12, s.mean_r).Bind(13, s.mean_g).Bind(14, s.mean_b).Bind(15, s.area_px).Bind(16, s.eccentricity);
+      q.Bind(17, int64_t{s.bbox_in_image.x}).Bind(18, int64_t{s.bbox_in_image.y});
+      q.Bind(19, int64_t{s.bbox_in_image.width}).Bind(20, int64_t{s.bbox_in_image.height});
+      q.Bind(21, int64_t{s.billboard_width_px}).Bind(22, int64_t{s.billboard_height_px}).Bind(23, s.px_per_m);
+      q.Bind(24, s.anchor_x_px).Bind(25, s.anchor_y_px);
+      q.Step();
+      int64_t id = 0;
+      if (sqlite3_changes(db().get()) == 1) {
+        id = sqlite3_last_insert_rowid(db().get());
+        ++result.inserted;
+        if (!s.mirrored) {
+          std::vector<uint8_t> const* blob = nullptr;
+          try {
+            blob = &w.codec.Encode(s.pixels);
+          } catch (const WorkError& e) {
+            throw WorkError(where + ", frame " + std::to_string(s.frame), e.what());
+          }
+          w.insert_pixels.Reset();
+          w.insert_pixels.Bind(1, id).Bind(2, int64_t{s.pixels.bgra.cols}).Bind(3, int64_t{s.pixels.bgra.rows});
+          w.insert_pixels.Bind(4, std::string_view(kPixelCodec)).BindBlob(5, blob->data(), blob->size()).Step();
+        }
+      } else {
+        id = find(s.frame, s.mirrored);
+      }
+      result.sprite_ids[i] = id;
+      for (const std::string& tag : s.tags) {
+        w.insert_tag.Reset();
+        w.insert_tag.Bind(1, id).Bind(2, tag).Step();
+      }
+    }
+  }
+  if (clip.complete) {
+    w.complete_clip.Reset();
+    w.complete_clip.Bind(1, result.clip_id).Step();
+  }
+  tx.Commit();
+  return result;
+}
+
+void BankWriter::UpsertTransitions(const std::vector<TransitionRecord>& transitions) {
+  sql::Transaction tx(db());
+  sql::Stmt& q = impl_->upsert_transition;
+  for (const TransitionRecord& t : transitions) {
+    q.Reset();
+    q.Bind(1, t.from_sprite).Bind(2, t.to_sprite).Bind(3, t.d).Bind(4, t.cost).Step();
+  }
+  tx.Commit();
+}
+
+void BankWriter::ClearTransitions() { db().Exec("DELETE FROM transitions"); }
+
+void BankWriter::Tag(const std::vector<int64_t>& sprite_ids, const std::string& tag) {
+  if (tag.empty()) throw InputError(path(), "a tag must not be empty");
+  sql::Transaction tx(db());
+  auto exists = db().Prepare("SELECT 1 FROM sprites WHERE id = ?");
+  for (int64_t id : sprite_ids) {
+    exists.Reset();
+    if (!exists.Bind(1, id).Step()) throw InputError(path(), "no sprite with id " + std::to_string(id));
+    impl_->insert_tag.Reset();
+    impl_->insert_tag.Bind(1, id).Bind(2, tag).Step();
+  }
+  exists.Reset();
+  tx.Commit();
+}
+
+void BankWriter::Untag(const std::vector<int64_t>& sprite_ids, const std::string& tag) {
+  sql::Transaction tx(db());
+  auto remove = db().Prepare("DELETE FROM sprite_tags WHERE sprite_id = ? AND tag = ?");
+  for (int64_t id : sprite_ids) {
+    remove.Reset();
+    remove.Bind(1, id).Bind(2, tag).Step();
+  }
+  tx.Commit();
+}
+
+void BankWriter::SetMeta(const std::string& key, const std::string& value) {
+  if (key == "schema_version" || key == "application") throw WorkError(path(), "meta key '" + key + "' is reserved");
+  auto q = db().Prepare("INSERT OR REPLACE INTO meta (key, value) VALUES (?, ?)");
+  q.Bind(1, key).Bind(2, value).Step();
+}
+
+}  // namespace ss

@@ -1,0 +1,118 @@
+#pragma once
+// The sprite bank: one SQLite file in WAL mode (schema in docs/bank.md).
+// One writer (BankWriter) appends clips batch by batch; any number of readers
+// (Bank, each its own connection, in threads or processes) read meanwhile and
+// see only complete clips. A Bank object is one connection: use it from one
+// thread at a time.
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/bank_records.h"
+
+namespace ss {
+
+namespace sql {
+class Db;
+}
+
+// Figures for `bank info`.
+struct BankCounts {
+  int schema_version = 0;
+  int64_t sessions = 0, cameras = 0;
+  int64_t clips = 0, clips_complete = 0;
+  int64_t sprites = 0, mirrors = 0;       // all rows; `mirrors` of them are mirrored copies
+  int64_t sprites_visible = 0;            // sprites in complete clips (what readers see)
+  int64_t pixel_rows = 0, pixel_bytes = 0;  // compressed billboard bytes
+  int64_t transitions = 0;
+  int64_t tags = 0, tagged_sprites = 0;   // distinct tag names, sprites with a tag
+  int64_t file_bytes = 0, wal_bytes = 0;
+};
+
+class Bank {
+ public:
+  // Opens an existing bank read-only. InputError naming the file when it is missing,
+  // not a SQLite database, not a sprite bank, or of another schema version.
+  explicit Bank(const std::string& path);
+  virtual ~Bank();
+  Bank(Bank&&) noexcept;
+  Bank& operator=(Bank&&) noexcept;
+
+  const std::string& path() const { return path_; }
+  int schema_version() const;
+
+  std::vector<SessionRecord> ListSessions() const;
+  std::vector<CameraRecord> ListCameras() const;
+  // Complete clips ordered by complete_seq; only those completed after `completed_after_seq`.
+  std::vector<ClipRecord> ListClips(int64_t completed_after_seq = 0) const;
+  // Every clip, complete or not (for verify and diagnostics).
+  std::vector<ClipRecord> ListAllClips() const;
+  // Features of the sprites of complete clips completed after `completed_after_seq`.
+  std::vector<SpriteFeatures> LoadFeatures(int64_t completed_after_seq = 0) const;
+  // One sprite with every field and its tags (pixels not loaded). InputError if unknown.
+  SpriteRecord LoadSprite(int64_t id) const;
+  // A sprite's billboard, decompressed (a mirrored sprite's is its original's, flipped).
+  SpritePixels LoadPixels(int64_t id) const;
+  std::vector<TransitionRecord> LoadTransitions() const;
+  // Transitions leaving `from_sprite`.
+  std::vector<TransitionRecord> LoadTransitionsFrom(int64_t from_sprite) const;
+  std::vector<int64_t> SpritesTagged(const std::string& tag) const;
+  std::optional<std::string> GetMeta(const std::string& key) const;
+  BankCounts Counts() const;
+
+ protected:
+  enum class Mode { kReadOnly, kReadWrite };
+  Bank(const std::string& path, Mode mode);
+  sql::Db& db() const { return *db_; }
+
+ private:
+  struct ReadCache;  // prepared statements and the pixel codec, made on first use
+  ReadCache& cache() const;
+
+  std::string path_;
+  std::unique_ptr<sql::Db> db_;
+  mutable std::unique_ptr<ReadCache> cache_;
+};
+
+// What one appended batch did.
+struct AppendResult {
+  int64_t clip_id = 0;
+  std::vector<int64_t> sprite_ids;  // in the order of the batch
+  int64_t inserted = 0;             // new sprites; the rest were already in the bank
+};
+
+// The writer: creates the bank if needed and upgrades an older schema in place.
+// Each call is one transaction: after a crash every call that returned is in the bank.
+class BankWriter : public Bank {
+ public:
+  explicit BankWriter(const std::string& path);
+  ~BankWriter() override;
+  BankWriter(BankWriter&&) noexcept;
+  BankWriter& operator=(BankWriter&&) noexcept;
+
+  // Registers a session (by uid) and returns its id; the same uid returns the same id.
+  int64_t AddSession(const SessionRecord& session);
+  // Registers a camera of a session (by name) and returns its id.
+  int64_t AddCamera(int64_t session_id, const CameraRecord& camera);
+  // Appends one batch of a clip's sprites. The clip (camera_id, track_id, first_frame)
+  // is created by its first batch; last_frame grows to cover the batch; clip.complete
+  // marks this batch as the clip's last. Sprites already stored (same camera, frame,
+  // track, mirrored) are kept as they are. A mirrored sprite is linked to the original
+  // of its frame (in this batch or stored before). Throws WorkError on a bad batch.
+  AppendResult AppendClipBatch(const ClipRecord& clip, const std::vector<SpriteRecord>& sprites);
+  // Inserts or replaces transitions, all in one transaction.
+  void UpsertTransitions(const std::vector<TransitionRecord>& transitions);
+  void ClearTransitions();
+  // Adds/removes a tag on sprites; InputError naming the first unknown sprite id.
+  void Tag(const std::vector<int64_t>& sprite_ids, const std::string& tag);
+  void Untag(const std::vector<int64_t>& sprite_ids, const std::string& tag);
+  void SetMeta(const std::string& key, const std::string& value);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace ss

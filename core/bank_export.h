@@ -1,0 +1,21 @@
+#pragma once
+// `bank export`: a bank's visible sprites as PNG billboards plus one CSV of every field.
+#include <cstdint>
+#include <string>
+
+#include "core/bank.h"
+
+namespace ss {
+
+struct BankExportOptions {
+  std::string tag;              // only sprites with this tag; empty = all
+  bool include_mirrors = true;  // mirrored copies too (their flipped pixels)
+};
+
+// Writes DIR/sprites.csv (one row per sprite of a complete clip, every column of the
+// sprites table plus tags) and DIR/sprite_<id>.png (BGRA billboard) and
+// DIR/sprite_<id>_shadow.png. Returns the number of sprites written.
+// WorkError naming the file when one cannot be written.
+int64_t ExportBank(const Bank& bank, const std::string& dir, const BankExportOptions& options);
+
+}  // namespace ss

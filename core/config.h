@@ -1,0 +1,152 @@
+#pragma once
+// The station config: one YAML file (docs/config.md, docs/station.example.yaml).
+// Loading answers Valid / Adjusted (with what was adjusted) / Invalid (with
+// every reason, each naming the field path and YAML line, e.g.
+// `station.yaml:14: cameras[1].fps: expected a positive number, got "fast"`).
+// Unknown keys are refused by name. Relative paths are resolved against the
+// config file's folder.
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/geometry.h"
+
+namespace ss {
+
+inline constexpr int kConfigVersion = 1;
+
+struct WhiteBalanceConfig {
+  std::string mode = "device";  // "device" (leave as is) | "once" (auto once, then lock) | "manual"
+  double red_gain = 1.0;        // manual: red/green and blue/green balance ratios
+  double blue_gain = 1.0;
+  bool operator==(const WhiteBalanceConfig&) const = default;
+};
+
+struct CameraConfig {
+  std::string name;            // unique; the stem of its recorded files
+  std::string source;          // "replay" | "v4l2" | "aravis" | "libcamera"
+  std::string session;         // replay: session folder (absolute)
+  std::string session_camera;  // replay: camera within the session (default: name)
+  bool loop = false;           // replay: start over at the end
+  bool realtime = true;        // replay: paced by the device timestamps
+  std::string device;          // v4l2: "/dev/video0"
+  std::string camera_id;       // aravis / libcamera: the device id
+  std::string address;         // aravis: IP address of a GigE Vision camera
+  bool packet_resend = true;   // aravis
+  int packet_size = 0;         // aravis: GigE packet size in bytes, 0 = negotiate
+  std::string pixel_format;    // core/frame.h names ("yuyv", "bayer_rg8"...); "" = device default
+  int width = 0, height = 0;   // 0 = device default
+  double fps = 0;              // 0 = device default
+  std::optional<double> exposure_us;  // unset = keep the device's current value, locked
+  std::optional<double> gain_db;      // unset = keep the device's current value, locked
+  WhiteBalanceConfig white_balance;
+  std::string model;  // .cameramodel (absolute); "" = the session's, or none
+  bool operator==(const CameraConfig&) const = default;
+};
+
+struct KeyingConfig {
+  std::string method = "chroma";  // "chroma" | "clean_plate"
+  int training_frames = 30;       // empty-enclosure frames to learn from
+  double chroma_low = 20;      // chroma: key difference (8-bit levels) where alpha starts to fall
+  double chroma_high = 60;     // chroma: ... and where it reaches 0 (fully background)
+  double plate_low_sigma = 3;  // clean_plate: difference in noise sigmas where alpha starts to rise
+  double plate_high_sigma = 6;  // clean_plate: ... and where it reaches 1
+  bool despill = true;
+  double despill_strength = 1.0;  // 0..1
+  bool shadow = true;             // keep the contact-shadow layer
+  double shadow_min_darkening =
+      0.08;                           // fraction of plate brightness below which there is no shadow
+  double shadow_max_darkening = 0.7;  // darkening that counts as full shadow
+  double shadow_reach_m = 0.5;        // shadow kept this far around the subject's foot
+  bool operator==(const KeyingConfig&) const = default;
+};
+
+struct EnclosureConfig {
+  GroundPolygon floor;         // ground metres, vertices in order
+  double wall_height_m = 0.0;  // walls occlude the floor behind them up to this height
+  bool operator==(const EnclosureConfig&) const = default;
+};
+
+struct PipelineConfig {
+  int min_area_px = 400;         // smaller blobs are noise
+  int border_margin_px = 2;      // distance to keep from the image border
+  int floor_margin_px = 3;       // floor pixels required around the silhouette
+  double wall_margin_m = 0.005;  // contact point distance to keep from the floor polygon's edge
+  double still_speed_m_per_s = 0.05;  // slower than this counts as not moving
+  double max_still_s = 2.0;           // still periods longer than this are discarded
+  int min_clip_frames = 5;            // shorter clips are discarded
+  double px_per_m = 800;              // billboard scale, the same for the whole bank
+  int workers = 0;                    // pipeline threads; 0 = one per core
+  int queue_frames = 8;               // per-camera queue between capture and pipeline
+  bool operator==(const PipelineConfig&) const = default;
+};
+
+struct StorageConfig {
+  std::string bank;                          // the sprite bank (absolute)
+  std::string recording_dir;                 // where recorded sessions go (absolute)
+  std::string recording = "off";             // "off" | "all" | "usable"
+  std::string recording_codec = "ffv1";      // "ffv1" | "mjpeg" | "h264"
+  int64_t stop_recording_below_mib = 20480;  // free disk under which raw recording stops
+  int64_t stop_sprites_below_mib = 2048;     // ... and under which sprite storage stops
+  bool operator==(const StorageConfig&) const = default;
+};
+
+struct ControlConfig {
+  std::string address = "127.0.0.1";
+  int port = 8360;    // 0 = any free port (reported at start)
+  std::string token;  // required when address is not loopback (>= 16 chars)
+  bool operator==(const ControlConfig&) const = default;
+};
+
+struct LoggingConfig {
+  std::string level = "info";                     // trace debug info warn error critical off
+  std::map<std::string, std::string> components;  // per component, e.g. capture.aravis: debug
+  bool operator==(const LoggingConfig&) const = default;
+};
+
+struct StationConfig {
+  int version = kConfigVersion;
+  std::vector<CameraConfig> cameras;
+  KeyingConfig keying;
+  EnclosureConfig enclosure;
+  PipelineConfig pipeline;
+  StorageConfig storage;
+  ControlConfig control;
+  LoggingConfig logging;
+  bool operator==(const StationConfig&) const = default;
+};
+
+enum class ConfigStatus { kValid, kAdjusted, kInvalid };
+
+struct ConfigReport {
+  ConfigStatus status = ConfigStatus::kValid;
+  std::vector<std::string> adjustments;  // "FILE:LINE: FIELD: what was changed"
+  std::vector<std::string> errors;       // "FILE:LINE: FIELD: reason"
+  std::string Summary() const;           // one line per adjustment or error
+};
+
+struct ConfigOptions {
+  bool check_files = true;  // the model, session and token files must exist
+};
+
+// Loads and validates. Throws InputError (every error, one per line) when the
+// file is missing, not YAML, has unknown keys, wrong types or invalid values.
+// Adjustments are logged ("core.config") and returned in `report`.
+StationConfig LoadStationConfig(const std::string& path, ConfigReport* report = nullptr,
+                                const ConfigOptions& options = {});
+// The same from YAML text; `origin` names it in messages, `base_dir` resolves relative paths.
+StationConfig ParseStationConfig(const std::string& yaml, const std::string& origin,
+                                 const std::string& base_dir, ConfigReport* report = nullptr,
+                                 const ConfigOptions& options = {});
+// Checks values and cross-field rules of a config however it was built; fixes
+// what can be fixed (status kAdjusted). `lines` maps field paths to YAML lines.
+ConfigReport ValidateStationConfig(StationConfig& config, const std::string& origin = "config",
+                                   const std::map<std::string, int>& lines = {},
+                                   const ConfigOptions& options = {});
+
+// True for 127.0.0.0/8, ::1 and "localhost".
+bool IsLoopbackAddress(const std::string& address);
+
+}  // namespace ss

@@ -1,0 +1,431 @@
+// The station config: a complete file parses into every field, defaults are
+// filled, and each kind of mistake is refused naming the field and its line.
+#include "core/config.h"
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+
+#include <gtest/gtest.h>
+
+#include "core/error.h"
+#include "tests/support/test_support.h"
+
+namespace ss {
+namespace {
+
+using ss::testing::ScratchDir;
+namespace fs = std::filesystem;
+
+const std::string kExample =
+    (fs::path(__FILE__).parent_path() / "../../docs/station.example.yaml").lexically_normal();
+
+ConfigOptions NoFileChecks() {
+  ConfigOptions o;
+  o.check_files = false;
+  return o;
+}
+
+StationConfig Parse(const std::string& yaml, ConfigReport* report = nullptr) {
+  return ParseStationConfig(yaml, "station.yaml", "/studio", report, NoFileChecks());
+}
+
+// The InputError message for `yaml`; fails the test when it parses.
+std::string ErrorOf(const std::string& yaml, const ConfigOptions& options = NoFileChecks()) {
+  try {
+    ParseStationConfig(yaml, "station.yaml", "/studio", nullptr, options);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "expected InputError for:\n" << yaml;
+  return {};
+}
+
+const std::string kOneCamera =
+    "cameras:\n  - name: cam0\n    source: v4l2\n    device: /dev/video0\n";
+
+TEST(StationConfig, ExampleParsesIntoEveryField) {
+  ConfigReport report;
+  const StationConfig cfg = LoadStationConfig(kExample, &report, NoFileChecks());
+  EXPECT_EQ(report.status, ConfigStatus::kValid) << report.Summary();
+  const std::string dir = fs::path(kExample).parent_path().string();
+  ASSERT_EQ(cfg.cameras.size(), 3u);
+
+  const CameraConfig& replay = cfg.cameras[0];
+  EXPECT_EQ(replay.name, "cam0");
+  EXPECT_EQ(replay.source, "replay");
+  EXPECT_EQ(replay.session, dir + "/recordings/sample");
+  EXPECT_EQ(replay.session_camera, "cam0");
+  EXPECT_TRUE(replay.loop);
+  EXPECT_TRUE(replay.realtime);
+  EXPECT_EQ(replay.model, "");
+
+  const CameraConfig& v4l2 = cfg.cameras[1];
+  EXPECT_EQ(v4l2.source, "v4l2");
+  EXPECT_EQ(v4l2.device, "/dev/video0");
+  EXPECT_EQ(v4l2.pixel_format, "yuyv");
+  EXPECT_EQ(v4l2.width, 1280);
+  EXPECT_EQ(v4l2.height, 720);
+  EXPECT_EQ(v4l2.fps, 30);
+  EXPECT_EQ(v4l2.exposure_us, 8000);
+  EXPECT_EQ(v4l2.gain_db, 0);
+  EXPECT_EQ(v4l2.white_balance.mode, "once");
+  EXPECT_EQ(v4l2.model, dir + "/models/side.cameramodel");
+
+  const CameraConfig& gige = cfg.cameras[2];
+  EXPECT_EQ(gige.source, "aravis");
+  EXPECT_EQ(gige.address, "192.168.10.21");
+  EXPECT_TRUE(gige.packet_resend);
+  EXPECT_EQ(gige.packet_size, 8192);
+  EXPECT_EQ(gige.pixel_format, "bayer_rg8");
+  EXPECT_EQ(gige.fps, 60);
+  EXPECT_EQ(gige.exposure_us, 4000);
+  EXPECT_EQ(gige.gain_db, 2.5);
+  EXPECT_EQ(gige.white_balance.mode, "manual");
+  EXPECT_EQ(gige.white_balance.red_gain, 1.42);
+  EXPECT_EQ(gige.white_balance.blue_gain, 1.87);
+
+  EXPECT_EQ(cfg.keying.method, "chroma");
+  EXPECT_EQ(cfg.keying.training_frames, 30);
+  EXPECT_EQ(cfg.keying.chroma_low, 20);
+  EXPECT_EQ(cfg.keying.chroma_high, 60);
+  EXPECT_EQ(cfg.keying.plate_low_sigma, 3);
+  EXPECT_EQ(cfg.keying.plate_high_sigma, 6);
+  EXPECT_TRUE(cfg.keying.despill);
+  EXPECT_EQ(cfg.keying.despill_strength, 1.0);
+  EXPECT_TRUE(cfg.keying.shadow);
+  EXPECT_EQ(cfg.keying.shadow_min_darkening, 0.08);
+  EXPECT_EQ(cfg.keying.shadow_max_darkening, 0.7);
+  EXPECT_EQ(cfg.keying.shadow_reach_m, 0.5);
+
+  ASSERT_EQ(cfg.enclosure.floor.vertices().size(), 4u);
+  EXPECT_EQ(cfg.enclosure.floor.vertices()[2], Eigen::Vector2d(1.2, 0.8));
+  EXPECT_NEAR(cfg.enclosure.floor.Area(), 2.4 * 1.6, 1e-12);
+  EXPECT_EQ(cfg.enclosure.wall_height_m, 0.6);
+
+  EXPECT_EQ(cfg.pipeline.min_area_px, 400);
+  EXPECT_EQ(cfg.pipeline.border_margin_px, 2);
+  EXPECT_EQ(cfg.pipeline.floor_margin_px, 3);
+  EXPECT_EQ(cfg.pipeline.wall_margin_m, 0.005);
+  EXPECT_EQ(cfg.pipeline.still_speed_m_per_s, 0.05);
+  EXPECT_EQ(cfg.pipeline.max_still_s, 2.0);
+  EXPECT_EQ(cfg.pipeline.min_clip_frames, 5);
+  EXPECT_EQ(cfg.pipeline.px_per_m, 800);
+  EXPECT_EQ(cfg.pipeline.workers, 0);
+  EXPECT_EQ(cfg.pipeline.queue_frames, 8);
+
+  EXPECT_EQ(cfg.storage.bank, dir + "/station.bank");
+  EXPECT_EQ(cfg.storage.recording_dir, dir + "/recordings");
+  EXPECT_EQ(cfg.storage.recording, "usable");
+  EXPECT_EQ(cfg.storage.recording_codec, "ffv1");
+  EXPECT_EQ(cfg.storage.stop_recording_below_mib, 20480);
+  EXPECT_EQ(cfg.storage.stop_sprites_below_mib, 2048);
+
+  EXPECT_EQ(cfg.control.address, "127.0.0.1");
+  EXPECT_EQ(cfg.control.port, 8360);
+  EXPECT_EQ(cfg.control.token, "");
+  EXPECT_EQ(cfg.logging.level, "info");
+  EXPECT_EQ(cfg.logging.components.at("capture.aravis"), "debug");
+}
+
+TEST(StationConfig, DefaultsAreFilled) {
+  ConfigReport report;
+  const StationConfig cfg = Parse(kOneCamera, &report);
+  EXPECT_EQ(report.status, ConfigStatus::kValid);
+  StationConfig expected;
+  CameraConfig cam;
+  cam.name = "cam0";
+  cam.source = "v4l2";
+  cam.device = "/dev/video0";
+  expected.cameras = {cam};
+  expected.storage.bank = "/studio/station.bank";
+  expected.storage.recording_dir = "/studio/recordings";
+  EXPECT_EQ(cfg, expected);
+  EXPECT_FALSE(cfg.cameras[0].exposure_us.has_value());  // unset: the device's value, locked
+  EXPECT_EQ(cfg.control.address, "127.0.0.1");
+  EXPECT_EQ(cfg.keying.method, "chroma");
+  EXPECT_TRUE(cfg.enclosure.floor.empty());
+}
+
+TEST(StationConfig, ReplayCameraDefaultsToItsOwnNameInTheSession) {
+  const StationConfig cfg =
+      Parse("cameras:\n  - {name: left, source: replay, session: /data/s1}\n");
+  EXPECT_EQ(cfg.cameras[0].session, "/data/s1");
+  EXPECT_EQ(cfg.cameras[0].session_camera, "left");
+  EXPECT_TRUE(cfg.cameras[0].realtime);
+  EXPECT_FALSE(cfg.cameras[0].loop);
+}
+
+TEST(StationConfig, WrongTypeNamesFieldAndLine) {
+  const std::string yaml = kOneCamera +
+                           "  - name: cam1\n"    // line 5
+                           "    source: v4l2\n"  // line 6
+                           "    device: /dev/video1\n"
+                           "    fps: fast\n";  // line 8
+  EXPECT_EQ(ErrorOf(yaml),
+            "station.yaml:8: cameras[1].fps: expected a positive number, got \"fast\"");
+  EXPECT_EQ(ErrorOf("pipeline:\n  min_area_px: 12.5\n"),
+            "station.yaml:2: pipeline.min_area_px: expected an area in pixels, got \"12.5\"");
+  EXPECT_EQ(ErrorOf("keying:\n  despill:\n    enabled: maybe\n"),
+            "station.yaml:3: keying.despill.enabled: expected true or false, got \"maybe\"");
+  EXPECT_EQ(ErrorOf("cameras: cam0\n"),
+            "station.yaml:1: cameras: expected a list of cameras, got \"cam0\"");
+  EXPECT_EQ(ErrorOf("storage:\n  bank: [a, b]\n"),
+            "station.yaml:2: storage.bank: expected a path, got a list");
+  EXPECT_EQ(ErrorOf("pipeline: 3\n"),
+            "station.yaml:1: pipeline: expected a mapping of keys, got \"3\"");
+}
+
+TEST(StationConfig, UnknownKeysAreRefusedByName) {
+  const std::string yaml =
+      "cameras:\n  - name: cam0\n    source: v4l2\n    device: /dev/video0\n    fsp: 30\n";
+  EXPECT_EQ(ErrorOf(yaml), "station.yaml:5: cameras[0].fsp: unknown key (did you mean \"fps\"?)");
+  EXPECT_EQ(ErrorOf("pipline:\n  px_per_m: 500\n"),
+            "station.yaml:1: pipline: unknown key (did you mean \"pipeline\"?)");
+  EXPECT_EQ(ErrorOf("control:\n  colour: blue\n"), "station.yaml:2: control.colour: unknown key");
+  // A key of another source is named as such.
+  EXPECT_EQ(
+      ErrorOf("cameras:\n  - name: c\n    source: aravis\n    address: 10.0.0.2\n    device: "
+              "/dev/video0\n"),
+      "station.yaml:5: cameras[0].device: only for source v4l2 (this camera's source is aravis)");
+  EXPECT_EQ(ErrorOf("cameras:\n  - name: c\n    source: replay\n    session: s\n    fps: 30\n"),
+            "station.yaml:5: cameras[0].fps: only for source v4l2 or aravis or libcamera (this "
+            "camera's source is "
+            "replay)");
+}
+
+TEST(StationConfig, ValueErrorsNameFieldAndLine) {
+  struct Case {
+    std::string yaml, error;
+  };
+  const std::vector<Case> cases = {
+      {"cameras:\n  - name: c\n    source: usb\n",
+       "station.yaml:3: cameras[0].source: expected one of replay, v4l2, aravis, libcamera, got "
+       "\"usb\""},
+      {"cameras:\n  - name: c\n    source: v4l2\n",
+       "station.yaml:2: cameras[0].device: a v4l2 camera needs its device, e.g. /dev/video0"},
+      {"cameras:\n  - source: v4l2\n    device: /dev/video0\n",
+       "station.yaml:2: cameras[0].name: every camera needs a name"},
+      {"cameras:\n  - name: c\n    source: aravis\n",
+       "station.yaml:2: cameras[0].camera_id: an aravis camera needs "
+       "camera_id or address"},
+      {"cameras:\n  - name: c\n    source: aravis\n    address: 10.0.0.300\n",
+       "station.yaml:4: cameras[0].address: expected an IP address, got \"10.0.0.300\""},
+      {kOneCamera + "    pixel_format: rgb24\n",
+       "station.yaml:5: cameras[0].pixel_format: expected one of mono8, bayer_rg8, bayer_gr8, "
+       "bayer_gb8, bayer_bg8, "
+       "rgb8, bgr8, yuyv, nv12, mjpeg, got \"rgb24\""},
+      {kOneCamera + "    fps: -30\n",
+       "station.yaml:5: cameras[0].fps: expected a positive number, got -30"},
+      {kOneCamera + "    width: 640\n",
+       "station.yaml:2: cameras[0].height: give width and height together"},
+      {kOneCamera + "    exposure_us: 0\n",
+       "station.yaml:5: cameras[0].exposure_us: expected a positive number, got 0"},
+      {kOneCamera + "    white_balance: {mode: once, red_gain: 1.2}\n",
+       "station.yaml:5: cameras[0].white_balance.red_gain: only applies with mode: manual"},
+      {kOneCamera + kOneCamera.substr(9),
+       "station.yaml:5: cameras[1].name: \"cam0\" is already the name of cameras[0]"},
+      {"keying:\n  chroma: {low: 80, high: 40}\n",
+       "station.yaml:2: keying.chroma.high: must be above keying.chroma.low (80), got 40"},
+      {"keying:\n  method: luma\n",
+       "station.yaml:2: keying.method: expected one of chroma, clean_plate, got \"luma\""},
+      {"pipeline:\n  px_per_m: 0\n",
+       "station.yaml:2: pipeline.px_per_m: expected a positive number, got 0"},
+      {"pipeline:\n  min_area_px: 0\n",
+       "station.yaml:2: pipeline.min_area_px: expected at least 1 pixel, got 0"},
+      {"storage:\n  recording: some\n",
+       "station.yaml:2: storage.recording: expected one of off, all, usable, got \"some\""},
+      {"control:\n  port: 70000\n",
+       "station.yaml:2: control.port: expected a port number 0..65535, got 70000"},
+      {"logging:\n  level: verbose\n",
+       "station.yaml:2: logging.level: expected one of trace, debug, info, warn, error, critical, "
+       "off, got \"verbose\""},
+      {"version: 2\n",
+       "station.yaml:1: version: written for a newer SpriteStation (config version 2); this one "
+       "reads "
+       "version 1"},
+      {"enclosure:\n  floor: [[0, 0], [1, 1], [1, 0], [0, 1]]\n",
+       "station.yaml:2: enclosure.floor: the polygon crosses itself, repeats a point, has a "
+       "non-finite point or has "
+       "no area (list the corners in order around the floor)"},
+      {"enclosure:\n  floor:\n    - [0, 0]\n    - [1, 0, 2]\n    - [1, 1]\n",
+       "station.yaml:4: enclosure.floor[1]: expected a point [x, y] in metres, got a list of 3"},
+      {"enclosure:\n  floor: [[0, 0], [1, 0]]\n",
+       "station.yaml:2: enclosure.floor: a floor polygon needs at least 3 points, got 2"},
+      {kOneCamera + "    fps:\n",
+       "station.yaml:5: cameras[0].fps: has no value (remove the key to use the default)"},
+      {"pipeline:\n  px_per_m: 500\n  px_per_m: 600\n",
+       "station.yaml:3: pipeline.px_per_m: given twice (lines 2 and 3)"},
+  };
+  for (const Case& c : cases) EXPECT_EQ(ErrorOf(c.yaml), c.error) << c.yaml;
+}
+
+TEST(StationConfig, EveryErrorIsReportedAtOnce) {
+  const std::string yaml =
+      "cameras:\n"
+      "  - name: cam0\n"
+      "    source: v4l2\n"
+      "    device: /dev/video0\n"
+      "    fps: fast\n"  // 5
+      "pipeline:\n"
+      "  px_per_m: -1\n"     // 7
+      "  min_aera_px: 3\n";  // 8
+  EXPECT_EQ(ErrorOf(yaml),
+            "station.yaml:5: cameras[0].fps: expected a positive number, got \"fast\"\n"
+            "station.yaml:8: pipeline.min_aera_px: unknown key (did you mean \"min_area_px\"?)\n"
+            "station.yaml:7: pipeline.px_per_m: expected a positive number, got -1");
+}
+
+TEST(StationConfig, SyntaxErrorsAndBadFiles) {
+  const std::string msg = ErrorOf("cameras:\n  - name: [unclosed\n");
+  EXPECT_EQ(msg.rfind("station.yaml:", 0), 0u) << msg;
+  EXPECT_NE(msg.find("not valid YAML"), std::string::npos) << msg;
+  EXPECT_EQ(
+      ErrorOf(""),
+      "station.yaml: the config is empty (expected sections such as cameras, enclosure, storage)");
+  EXPECT_EQ(ErrorOf("- a\n- b\n"),
+            "station.yaml:1: (top level): expected a mapping of keys, got a list");
+
+  ScratchDir dir;
+  try {
+    LoadStationConfig(dir / "missing.yaml");
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind(dir / "missing.yaml" + ": cannot open the config", 0), 0u)
+        << e.what();
+  }
+}
+
+TEST(StationConfig, FilesAreCheckedWhenAsked) {
+  ScratchDir dir;
+  const std::string yaml =
+      "cameras:\n  - name: cam0\n    source: replay\n    session: s1\n    model: "
+      "cam0.cameramodel\n";
+  std::ofstream(dir / "station.yaml") << yaml;
+  try {
+    LoadStationConfig(dir / "station.yaml");
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    const std::string path = dir / "station.yaml";
+    EXPECT_EQ(std::string(e.what()), path + ":4: cameras[0].session: " + (dir / "s1/session.json") +
+                                         ": no such recorded session (session.json)\n" + path +
+                                         ":5: cameras[0].model: " + (dir / "cam0.cameramodel") +
+                                         ": no such camera model");
+  }
+  fs::create_directories(dir / "s1");
+  std::ofstream(dir / "s1/session.json") << "{}";
+  std::ofstream(dir / "cam0.cameramodel") << "{}";
+  const StationConfig cfg = LoadStationConfig(dir / "station.yaml");
+  EXPECT_EQ(cfg.cameras[0].session, dir / "s1");
+  EXPECT_EQ(cfg.cameras[0].model, dir / "cam0.cameramodel");
+}
+
+TEST(StationConfig, AdjustmentsAreReported) {
+  ConfigReport report;
+  const StationConfig cfg = Parse(
+      "cameras:\n  - {name: c, source: v4l2, device: /dev/video0, pixel_format: nv12, width: 1281, "
+      "height: 721}\n"
+      "keying:\n  despill: {strength: 1.5}\n"
+      "storage:\n  stop_recording_below_mib: 100\n  stop_sprites_below_mib: 500\n",
+      &report);
+  EXPECT_EQ(report.status, ConfigStatus::kAdjusted);
+  EXPECT_EQ(cfg.cameras[0].width, 1280);
+  EXPECT_EQ(cfg.cameras[0].height, 720);
+  EXPECT_EQ(cfg.keying.despill_strength, 1.0);
+  EXPECT_EQ(cfg.storage.stop_recording_below_mib, 500);
+  EXPECT_EQ(cfg.storage.stop_sprites_below_mib, 500);
+  ASSERT_EQ(report.adjustments.size(), 4u) << report.Summary();
+  EXPECT_EQ(
+      report.adjustments[0],
+      "station.yaml:2: cameras[0].width: 1281 is odd, which nv12 cannot carry; lowered to 1280");
+  EXPECT_EQ(report.adjustments[2],
+            "station.yaml:4: keying.despill.strength: 1.5 is outside 0..1; clamped to 1");
+  EXPECT_EQ(report.adjustments[3],
+            "station.yaml:6: storage.stop_recording_below_mib: 100 is below "
+            "stop_sprites_below_mib; raised to 500 so "
+            "that raw recording stops before sprite storage");
+  // Validating the adjusted config again finds nothing left to adjust.
+  StationConfig again = cfg;
+  EXPECT_EQ(ValidateStationConfig(again, "again", {}, NoFileChecks()).status, ConfigStatus::kValid);
+  EXPECT_EQ(again, cfg);
+}
+
+TEST(StationConfig, TokenRequiredAwayFromLoopback) {
+  EXPECT_EQ(ErrorOf("control:\n  address: 0.0.0.0\n"),
+            "station.yaml:2: control.token: required when control.address (0.0.0.0) is not "
+            "loopback; set token or "
+            "token_file");
+  EXPECT_EQ(ErrorOf("control:\n  address: 192.168.1.5\n  token: short\n"),
+            "station.yaml:3: control.token: too short: use at least 16 characters (got 5)");
+  EXPECT_EQ(ErrorOf("control:\n  address: studio-host\n"),
+            "station.yaml:2: control.address: expected an IP address (or localhost), got "
+            "\"studio-host\"");
+  EXPECT_EQ(Parse("control:\n  address: 0.0.0.0\n  token: 0123456789abcdef\n").control.token,
+            "0123456789abcdef");
+  EXPECT_EQ(Parse("control:\n  address: 127.0.0.2\n").control.token, "");
+  EXPECT_EQ(Parse("control:\n  address: '::1'\n").control.address, "::1");
+  EXPECT_EQ(Parse("control:\n  address: localhost\n  port: 0\n").control.port, 0);
+
+  ScratchDir dir;
+  std::ofstream(dir / "token") << "s3cret-s3cret-s3cret\n";
+  std::ofstream(dir / "station.yaml") << "control:\n  address: '::'\n  token_file: token\n";
+  EXPECT_EQ(LoadStationConfig(dir / "station.yaml").control.token, "s3cret-s3cret-s3cret");
+  std::ofstream(dir / "station.yaml") << "control:\n  address: '::'\n  token_file: nope\n";
+  EXPECT_THROW(LoadStationConfig(dir / "station.yaml"), InputError);
+}
+
+TEST(StationConfig, LoopbackAddresses) {
+  EXPECT_TRUE(IsLoopbackAddress("127.0.0.1"));
+  EXPECT_TRUE(IsLoopbackAddress("127.10.0.1"));
+  EXPECT_TRUE(IsLoopbackAddress("::1"));
+  EXPECT_TRUE(IsLoopbackAddress("::ffff:127.0.0.1"));
+  EXPECT_TRUE(IsLoopbackAddress("localhost"));
+  EXPECT_FALSE(IsLoopbackAddress("0.0.0.0"));
+  EXPECT_FALSE(IsLoopbackAddress("::"));
+  EXPECT_FALSE(IsLoopbackAddress("10.0.0.1"));
+  EXPECT_FALSE(IsLoopbackAddress("128.0.0.1"));
+  EXPECT_FALSE(IsLoopbackAddress("127.0.0.1.evil.com"));
+}
+
+TEST(StationConfig, ValidatesConfigsBuiltInCode) {
+  StationConfig cfg;
+  cfg.storage.bank = "/b";
+  cfg.storage.recording_dir = "/r";
+  EXPECT_EQ(ValidateStationConfig(cfg, "code", {}, NoFileChecks()).status, ConfigStatus::kValid);
+  cfg.pipeline.px_per_m = -5;
+  cfg.control.address = "0.0.0.0";
+  const ConfigReport report = ValidateStationConfig(cfg, "code", {}, NoFileChecks());
+  EXPECT_EQ(report.status, ConfigStatus::kInvalid);
+  ASSERT_EQ(report.errors.size(), 2u);
+  EXPECT_EQ(report.errors[0], "code: pipeline.px_per_m: expected a positive number, got -5");
+  EXPECT_EQ(report.errors[1].rfind("code: control.token: required", 0), 0u) << report.errors[1];
+}
+
+// `spritestation config check`: exit codes and messages of the real executable.
+TEST(StationConfig, CheckCommand) {
+  if (std::getenv("SPRITESTATION_BIN") == nullptr)
+    GTEST_SKIP() << "SPRITESTATION_BIN not set (run through ctest)";
+  ScratchDir dir;
+  auto r = ss::testing::RunSpritestation("config check --no-file-checks " + kExample);
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find(kExample + ": valid (3 cameras)"), std::string::npos) << r.output;
+
+  const std::string bad = dir / "bad.yaml";
+  std::ofstream(bad) << kOneCamera << "    fps: fast\n";
+  r = ss::testing::RunSpritestation("config check " + bad);
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find(bad + ":5: cameras[0].fps: expected a positive number, got \"fast\""),
+            std::string::npos)
+      << r.output;
+
+  r = ss::testing::RunSpritestation("config check --json " + bad);
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("\"status\": \"invalid\""), std::string::npos) << r.output;
+
+  r = ss::testing::RunSpritestation("config check " + (dir / "missing.yaml"));
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find(dir / "missing.yaml"), std::string::npos) << r.output;
+}
+
+}  // namespace
+}  // namespace ss
