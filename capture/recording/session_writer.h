@@ -2,8 +2,11 @@
 // Writes a recorded session (core/session.h) through FFmpeg's libraries: per
 // camera a Matroska video (FFV1 lossless by default) and a per-frame CSV, the
 // camera models, session.json. Built to survive `kill -9`: session.json is on
-// disk from the first camera on, CSV rows are flushed per frame and the video
-// is flushed at least once a second, so all but the last second stays readable.
+// disk from the start, and every flush_interval_ms (from the writing thread and
+// from a background flusher when frames stop coming) the video's Matroska
+// cluster is closed and handed to the OS, then the CSV rows of those frames are
+// written. So all but the last ~0.4 s stays readable, and the CSV never lists a
+// frame the video lost (the video may hold a few frames more than the CSV).
 #include <memory>
 #include <string>
 
@@ -15,13 +18,15 @@
 namespace ss {
 
 struct RecordingOptions {
-  std::string codec = "ffv1";   // "ffv1" (lossless), "mjpeg", "h264"
+  std::string codec = "ffv1";   // "ffv1" (lossless), "mjpeg", "h264"; an MJPEG camera is always stored as mjpeg
   bool synthetic = false;       // marks session.json; truth/ is written by the caller
+  int flush_interval_ms = 250;  // longest time a written frame waits before it is on disk (0: every frame)
 };
 
 class SessionWriter {
  public:
-  // Creates DIR (which must not exist or be empty); WorkError naming DIR otherwise.
+  // Creates DIR (which must not exist or be empty) and writes session.json;
+  // WorkError naming DIR otherwise, InputError for a bad option.
   SessionWriter(const std::string& dir, const std::string& name, RecordingOptions options = {});
   ~SessionWriter();  // Close()s; never throws
   SessionWriter(const SessionWriter&) = delete;
@@ -30,8 +35,9 @@ class SessionWriter {
   // Adds a camera and returns its index (the Frame::camera to write with).
   // `model` may be null for an uncalibrated camera.
   int AddCamera(const SourceCamera& camera, const CameraModel* model);
-  // Appends one frame (its pixel format and size must match the camera's) and
-  // its CSV row. `drops_before` counts frames lost just before this one.
+  // Appends one frame (its pixel format and size must match the camera's;
+  // InputError otherwise) and its CSV row. `drops_before` counts frames lost
+  // just before this one. Cameras may be written from different threads.
   void Write(const Frame& frame, uint64_t drops_before = 0);
   // Finalizes every file. Idempotent.
   void Close();

@@ -1,0 +1,81 @@
+#include "capture/recording/ffmpeg_util.h"
+
+#include <cstdarg>
+#include <cstdio>
+#include <mutex>
+
+extern "C" {
+#include <libavutil/error.h>
+#include <libavutil/log.h>
+}
+
+#include "core/error.h"
+#include "core/log.h"
+
+namespace ss::av {
+namespace {
+
+void LogCallback(void* avcl, int level, const char* fmt, va_list args) {
+  if (level > AV_LOG_WARNING) return;
+  // FFmpeg builds one line from several calls; keep the prefix state per thread.
+  thread_local int print_prefix = 1;
+  thread_local std::string pending;
+  char line[1024];
+  av_log_format_line2(avcl, level, fmt, args, line, sizeof(line), &print_prefix);
+  pending += line;
+  if (pending.empty() || pending.back() != '\n') return;
+  pending.pop_back();
+  // Debug level: the damage FFmpeg complains about (a slice CRC mismatch, a
+  // truncated block) is reported by our readers with the file and frame named.
+  Log("capture.ffmpeg")->debug("{}", pending);
+  pending.clear();
+}
+
+}  // namespace
+
+FramePtr NewFrame() {
+  FramePtr f(av_frame_alloc());
+  if (!f) throw WorkError("ffmpeg", "out of memory allocating a frame");
+  return f;
+}
+
+PacketPtr NewPacket() {
+  PacketPtr p(av_packet_alloc());
+  if (!p) throw WorkError("ffmpeg", "out of memory allocating a packet");
+  return p;
+}
+
+std::string ErrorText(int code) {
+  char text[AV_ERROR_MAX_STRING_SIZE] = {0};
+  av_strerror(code, text, sizeof(text));
+  return text;
+}
+
+void InstallLogBridge() {
+  static std::once_flag once;
+  std::call_once(once, [] { av_log_set_callback(LogCallback); });
+}
+
+AVPixelFormat RawPixelFormat(PixelFormat format) {
+  switch (format) {
+    case PixelFormat::kMono8:
+    case PixelFormat::kBayerRG8:
+    case PixelFormat::kBayerGR8:
+    case PixelFormat::kBayerGB8:
+    case PixelFormat::kBayerBG8:
+      return AV_PIX_FMT_GRAY8;
+    case PixelFormat::kRGB8:
+      return AV_PIX_FMT_RGB24;
+    case PixelFormat::kBGR8:
+      return AV_PIX_FMT_BGR24;
+    case PixelFormat::kYUYV:
+      return AV_PIX_FMT_YUYV422;
+    case PixelFormat::kNV12:
+      return AV_PIX_FMT_NV12;
+    case PixelFormat::kMJPEG:
+      return AV_PIX_FMT_NONE;
+  }
+  return AV_PIX_FMT_NONE;
+}
+
+}  // namespace ss::av

@@ -1,0 +1,140 @@
+#include "capture/recording/pixel_layout.h"
+
+#include <cstring>
+
+#include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
+
+namespace ss::av {
+namespace {
+
+void CopyPlane(const uint8_t* src, int src_stride, uint8_t* dst, int dst_stride, int row_bytes, int rows) {
+  for (int y = 0; y < rows; ++y) {
+    std::memcpy(dst + static_cast<ptrdiff_t>(y) * dst_stride, src + static_cast<ptrdiff_t>(y) * src_stride,
+                static_cast<size_t>(row_bytes));
+  }
+}
+
+}  // namespace
+
+AVPixelFormat LosslessStorageFormat(PixelFormat format) {
+  switch (format) {
+    case PixelFormat::kBGR8:
+    case PixelFormat::kRGB8:
+      return AV_PIX_FMT_BGR0;
+    case PixelFormat::kMono8:
+    case PixelFormat::kBayerRG8:
+    case PixelFormat::kBayerGR8:
+    case PixelFormat::kBayerGB8:
+    case PixelFormat::kBayerBG8:
+      return AV_PIX_FMT_GRAY8;
+    case PixelFormat::kYUYV:
+      return AV_PIX_FMT_YUV422P;
+    case PixelFormat::kNV12:
+      return AV_PIX_FMT_YUV420P;
+    case PixelFormat::kMJPEG:
+      return AV_PIX_FMT_NONE;
+  }
+  return AV_PIX_FMT_NONE;
+}
+
+void RawToStorage(const uint8_t* src, PixelFormat format, int width, int height, AVFrame* dst) {
+  auto* s = const_cast<uint8_t*>(src);  // cv::Mat headers only; never written
+  switch (format) {
+    case PixelFormat::kBGR8:
+    case PixelFormat::kRGB8: {
+      cv::Mat in(height, width, CV_8UC3, s);
+      cv::Mat out(height, width, CV_8UC4, dst->data[0], static_cast<size_t>(dst->linesize[0]));
+      cv::cvtColor(in, out, format == PixelFormat::kBGR8 ? cv::COLOR_BGR2BGRA : cv::COLOR_RGB2BGRA);
+      return;
+    }
+    case PixelFormat::kMono8:
+    case PixelFormat::kBayerRG8:
+    case PixelFormat::kBayerGR8:
+    case PixelFormat::kBayerGB8:
+    case PixelFormat::kBayerBG8:
+      CopyPlane(src, width, dst->data[0], dst->linesize[0], width, height);
+      return;
+    case PixelFormat::kYUYV:
+      for (int y = 0; y < height; ++y) {
+        const uint8_t* row = src + static_cast<ptrdiff_t>(y) * width * 2;
+        uint8_t* py = dst->data[0] + static_cast<ptrdiff_t>(y) * dst->linesize[0];
+        uint8_t* pu = dst->data[1] + static_cast<ptrdiff_t>(y) * dst->linesize[1];
+        uint8_t* pv = dst->data[2] + static_cast<ptrdiff_t>(y) * dst->linesize[2];
+        for (int x = 0; x < width / 2; ++x) {
+          py[2 * x] = row[4 * x];
+          pu[x] = row[4 * x + 1];
+          py[2 * x + 1] = row[4 * x + 2];
+          pv[x] = row[4 * x + 3];
+        }
+      }
+      return;
+    case PixelFormat::kNV12: {
+      CopyPlane(src, width, dst->data[0], dst->linesize[0], width, height);
+      const uint8_t* uv = src + static_cast<ptrdiff_t>(width) * height;
+      for (int y = 0; y < height / 2; ++y) {
+        const uint8_t* row = uv + static_cast<ptrdiff_t>(y) * width;
+        uint8_t* pu = dst->data[1] + static_cast<ptrdiff_t>(y) * dst->linesize[1];
+        uint8_t* pv = dst->data[2] + static_cast<ptrdiff_t>(y) * dst->linesize[2];
+        for (int x = 0; x < width / 2; ++x) {
+          pu[x] = row[2 * x];
+          pv[x] = row[2 * x + 1];
+        }
+      }
+      return;
+    }
+    case PixelFormat::kMJPEG:
+      return;
+  }
+}
+
+void StorageToRaw(const AVFrame* src, PixelFormat format, int width, int height, uint8_t* dst) {
+  switch (format) {
+    case PixelFormat::kBGR8:
+    case PixelFormat::kRGB8: {
+      cv::Mat in(height, width, CV_8UC4, src->data[0], static_cast<size_t>(src->linesize[0]));
+      cv::Mat out(height, width, CV_8UC3, dst);
+      cv::cvtColor(in, out, format == PixelFormat::kBGR8 ? cv::COLOR_BGRA2BGR : cv::COLOR_BGRA2RGB);
+      return;
+    }
+    case PixelFormat::kMono8:
+    case PixelFormat::kBayerRG8:
+    case PixelFormat::kBayerGR8:
+    case PixelFormat::kBayerGB8:
+    case PixelFormat::kBayerBG8:
+      CopyPlane(src->data[0], src->linesize[0], dst, width, width, height);
+      return;
+    case PixelFormat::kYUYV:
+      for (int y = 0; y < height; ++y) {
+        uint8_t* row = dst + static_cast<ptrdiff_t>(y) * width * 2;
+        const uint8_t* py = src->data[0] + static_cast<ptrdiff_t>(y) * src->linesize[0];
+        const uint8_t* pu = src->data[1] + static_cast<ptrdiff_t>(y) * src->linesize[1];
+        const uint8_t* pv = src->data[2] + static_cast<ptrdiff_t>(y) * src->linesize[2];
+        for (int x = 0; x < width / 2; ++x) {
+          row[4 * x] = py[2 * x];
+          row[4 * x + 1] = pu[x];
+          row[4 * x + 2] = py[2 * x + 1];
+          row[4 * x + 3] = pv[x];
+        }
+      }
+      return;
+    case PixelFormat::kNV12: {
+      CopyPlane(src->data[0], src->linesize[0], dst, width, width, height);
+      uint8_t* uv = dst + static_cast<ptrdiff_t>(width) * height;
+      for (int y = 0; y < height / 2; ++y) {
+        uint8_t* row = uv + static_cast<ptrdiff_t>(y) * width;
+        const uint8_t* pu = src->data[1] + static_cast<ptrdiff_t>(y) * src->linesize[1];
+        const uint8_t* pv = src->data[2] + static_cast<ptrdiff_t>(y) * src->linesize[2];
+        for (int x = 0; x < width / 2; ++x) {
+          row[2 * x] = pu[x];
+          row[2 * x + 1] = pv[x];
+        }
+      }
+      return;
+    }
+    case PixelFormat::kMJPEG:
+      return;
+  }
+}
+
+}  // namespace ss::av
