@@ -1,0 +1,99 @@
+#include "animate/basic_costs.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "core/error.h"
+
+namespace ss {
+
+SmoothnessTerm::SmoothnessTerm(const TransitionGraph& graph, int sprite, double strength)
+    : StepSumTerm("smoothness", {sprite}, strength), graph_(graph) {}
+
+std::pair<int, int> SmoothnessTerm::Steps(Tracks tracks, const EvalRequest& /*request*/) const {
+  return {1, std::max(1, tracks[sprites()[0]]->size())};
+}
+
+double SmoothnessTerm::StepCost(Tracks tracks, int t) const {
+  const Track& track = *tracks[sprites()[0]];
+  if (t < 1 || t >= track.size()) return 0.0;
+  const std::optional<double> cost = graph_.EdgeCost(track.frames[t - 1], track.frames[t]);
+  // Sequences are built from real edges only; a missing one is a bug upstream.
+  return cost ? strength() * *cost : std::numeric_limits<double>::max();
+}
+
+FastFrameTerm::FastFrameTerm(int sprite, double reference_speed_m, double strength)
+    : StepSumTerm("fast", {sprite}, strength), reference_speed_m_(reference_speed_m) {
+  if (!(reference_speed_m > 0) || !std::isfinite(reference_speed_m)) {
+    throw InputError("fast.reference_speed", "must be > 0 metres per step");
+  }
+}
+
+std::pair<int, int> FastFrameTerm::Steps(Tracks tracks, const EvalRequest& /*request*/) const {
+  return {0, tracks[sprites()[0]]->size()};
+}
+
+double FastFrameTerm::StepCost(Tracks tracks, int t) const {
+  return strength() * std::max(0.0, reference_speed_m_ - tracks[sprites()[0]]->VelocityAt(t).norm());
+}
+
+LengthTerm::LengthTerm(int sprite, int min_frames, double strength)
+    : StepSumTerm("length", {sprite}, strength), min_frames_(min_frames) {
+  if (min_frames < 1) throw InputError("length.min_frames", "must be >= 1");
+}
+
+double LengthTerm::EndCost(Tracks tracks) const {
+  return strength() * std::max(0, min_frames_ - tracks[sprites()[0]]->size());
+}
+
+int LengthTerm::CountViolations(Tracks tracks) const {
+  return tracks[sprites()[0]]->size() < min_frames_ ? 1 : 0;
+}
+
+FrameTerm::FrameTerm(int sprite, std::shared_ptr<const std::vector<bool>> allowed,
+                     StepWindow window, double strength, std::optional<PathTrigger> trigger)
+    : StepSumTerm("frame",
+                  trigger && trigger->sprite != sprite ? std::vector<int>{sprite, trigger->sprite}
+                                                       : std::vector<int>{sprite},
+                  strength),
+      allowed_(std::move(allowed)),
+      window_(window),
+      trigger_(std::move(trigger)) {
+  if (!allowed_) throw InputError("frame.frames", "missing frame set");
+  if (trigger_ && trigger_->duration_steps < 1) {
+    throw InputError("frame.duration", "must be >= 1 step");
+  }
+}
+
+bool FrameTerm::Allowed(const Track& track, int t) const {
+  if (t >= track.size()) return false;  // the sprite is gone: the pose is not shown
+  const int f = track.frames[t];
+  return f < static_cast<int>(allowed_->size()) && (*allowed_)[f];
+}
+
+std::pair<int, int> FrameTerm::Steps(Tracks tracks, const EvalRequest& request) const {
+  if (!trigger_) return window_.Resolve(tracks[sprites()[0]]->size());
+  const Track& anchor = *tracks[trigger_->sprite];
+  int begin = PathCompletionStep(trigger_->path, anchor, request.cache, request.first_changed);
+  if (begin < 0) begin = anchor.size();
+  return {begin, begin + trigger_->duration_steps};
+}
+
+double FrameTerm::StepCost(Tracks tracks, int t) const {
+  return Allowed(*tracks[sprites()[0]], t) ? 0.0 : strength();
+}
+
+void FrameTerm::BuildCache(Tracks tracks, TermCache* cache) const {
+  StepSumTerm::BuildCache(tracks, cache);
+  if (trigger_) FillPathStates(trigger_->path, *tracks[trigger_->sprite], cache);
+}
+
+int FrameTerm::CountViolations(Tracks tracks) const {
+  const auto [begin, end] = Window(tracks);
+  int count = 0;
+  for (int t = begin; t < end; ++t) count += Allowed(*tracks[sprites()[0]], t) ? 0 : 1;
+  return count;
+}
+
+}  // namespace ss

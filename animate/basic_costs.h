@@ -1,0 +1,94 @@
+#pragma once
+// The per-sprite terms that need no geometry beyond the frames themselves:
+//   smoothness (seed 000 eq. 2)  c_t = α C(s_{t-1} -> s_t)
+//   frame/pose (eq. 10)          c_t = λ if s_t ∉ G (or the sequence has ended), else 0
+//   fast frames (§6.2)           c_t = ρ max(0, v_ref - |v(s_t)|)
+//   length (§6.2)                end cost λ max(0, N - n)
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "animate/cost_term.h"
+#include "animate/path_cost.h"
+#include "animate/transition_graph.h"
+
+namespace ss {
+
+class SmoothnessTerm : public StepSumTerm {
+ public:
+  SmoothnessTerm(const TransitionGraph& graph, int sprite, double strength);
+
+ protected:
+  std::pair<int, int> Steps(Tracks tracks, const EvalRequest& request) const override;
+  double StepCost(Tracks tracks, int t) const override;
+  bool FramesOnly() const override { return true; }
+  bool TimeInvariant() const override { return true; }
+
+ private:
+  const TransitionGraph& graph_;
+};
+
+class FastFrameTerm : public StepSumTerm {
+ public:
+  FastFrameTerm(int sprite, double reference_speed_m, double strength);
+
+ protected:
+  std::pair<int, int> Steps(Tracks tracks, const EvalRequest& request) const override;
+  double StepCost(Tracks tracks, int t) const override;
+  bool FramesOnly() const override { return true; }
+  bool TimeInvariant() const override { return true; }
+
+ private:
+  double reference_speed_m_;
+};
+
+class LengthTerm : public StepSumTerm {
+ public:
+  LengthTerm(int sprite, int min_frames, double strength);
+  int CountViolations(Tracks tracks) const override;
+
+ protected:
+  std::pair<int, int> Steps(Tracks, const EvalRequest&) const override { return {0, 0}; }
+  double StepCost(Tracks, int) const override { return 0.0; }
+  double EndCost(Tracks tracks) const override;
+  bool FramesOnly() const override { return true; }
+
+ private:
+  int min_frames_;
+};
+
+// Starts the frame window when a sprite passes the end of a path: "once the hamster reaches
+// the bottom of the path" (seed 000 §6.1). A path never passed starts it at that sprite's end.
+struct PathTrigger {
+  int sprite = 0;        // whose path (a follower may share its leader's trigger)
+  Polyline path;
+  int duration_steps = 1;
+};
+
+class FrameTerm : public StepSumTerm {
+ public:
+  // G = `allowed` (one flag per frame), over `window` or after `trigger`.
+  FrameTerm(int sprite, std::shared_ptr<const std::vector<bool>> allowed, StepWindow window,
+            double strength, std::optional<PathTrigger> trigger = std::nullopt);
+  void BuildCache(Tracks tracks, TermCache* cache) const override;
+  // Steps of the window not showing a frame of G.
+  int CountViolations(Tracks tracks) const override;
+  // The window [begin, end) for these tracks.
+  std::pair<int, int> Window(Tracks tracks) const { return Steps(tracks, EvalRequest{}); }
+  const std::vector<bool>& allowed() const { return *allowed_; }
+  const std::shared_ptr<const std::vector<bool>>& allowed_ptr() const { return allowed_; }
+
+ protected:
+  std::pair<int, int> Steps(Tracks tracks, const EvalRequest& request) const override;
+  double StepCost(Tracks tracks, int t) const override;
+  bool FramesOnly() const override { return true; }  // the window may still follow positions
+
+ private:
+  bool Allowed(const Track& track, int t) const;
+
+  std::shared_ptr<const std::vector<bool>> allowed_;
+  StepWindow window_;
+  std::optional<PathTrigger> trigger_;
+};
+
+}  // namespace ss

@@ -1,0 +1,205 @@
+#include "animate/skeleton/cost_rows.h"
+
+#include <algorithm>
+#include <cstring>
+#include <limits>
+
+#include "core/error.h"
+
+// GCC notes that 32-byte vector arguments change the ABI without AVX; these helpers are
+// inline and never cross a library boundary.
+#pragma GCC diagnostic ignored "-Wpsabi"
+
+namespace ss {
+
+DenseCostRows::DenseCostRows(int targets, int sources, std::vector<float> values)
+    : targets_(targets), sources_(sources), values_(std::move(values)) {
+  if (targets < 0 || sources <= 0 || values_.size() != static_cast<size_t>(targets) * sources) {
+    throw InputError("cost matrix", "expected " + std::to_string(targets) + " x " + std::to_string(sources) +
+                                        " values, got " + std::to_string(values_.size()));
+  }
+}
+
+void DenseCostRows::Compute(int t0, int n, float* out) const {
+  std::memcpy(out, values_.data() + static_cast<size_t>(t0) * sources_, sizeof(float) * n * sources_);
+}
+
+namespace {
+
+constexpr float kInf = std::numeric_limits<float>::infinity();
+constexpr int kLanes = 8;    // floats per vector
+constexpr int kChunk = 16;   // source frames per kernel step (two vectors)
+constexpr int kTile = 6;     // complete target frames per kernel step
+
+typedef float v8f __attribute__((vector_size(32)));
+
+inline v8f Load(const float* p) {
+  v8f v;
+  std::memcpy(&v, p, sizeof(v));
+  return v;
+}
+inline void Store(float* p, v8f v) { std::memcpy(p, &v, sizeof(v)); }
+inline v8f ClampPositive(v8f v) { return v > 0 ? v : v8f{}; }
+
+// out[t][s] = na[t] + nb[s] + sum_k a[t][k] * b[k][s] for TB targets and one chunk of
+// kChunk sources starting at s (`b`, `nb` already offset by s).
+template <int TB>
+__attribute__((always_inline)) inline void DenseChunk(const float* b, size_t stride, int dim, const float* nb,
+                                                      const float* a, const float* na, float* const* out) {
+  v8f acc0[TB], acc1[TB];
+  const v8f nb0 = Load(nb), nb1 = Load(nb + kLanes);
+  for (int t = 0; t < TB; ++t) {
+    acc0[t] = nb0 + na[t];
+    acc1[t] = nb1 + na[t];
+  }
+  for (int k = 0; k < dim; ++k) {
+    const v8f b0 = Load(b + k * stride), b1 = Load(b + k * stride + kLanes);
+    for (int t = 0; t < TB; ++t) {
+      const float at = a[t * dim + k];
+      acc0[t] += b0 * at;
+      acc1[t] += b1 * at;
+    }
+  }
+  for (int t = 0; t < TB; ++t) {
+    Store(out[t], ClampPositive(acc0[t]));
+    Store(out[t] + kLanes, ClampPositive(acc1[t]));
+  }
+}
+
+template <int TB>
+__attribute__((always_inline)) inline void DenseRows(const float* b, int padded, int dim, const float* nb,
+                                                     const float* a, const float* na, float* const* rows,
+                                                     int count) {
+  float* out[TB];
+  alignas(32) float tail[TB][kChunk];
+  for (int s = 0; s < padded; s += kChunk) {
+    const bool full = s + kChunk <= count;
+    for (int t = 0; t < TB; ++t) out[t] = full ? rows[t] + s : tail[t];
+    DenseChunk<TB>(b + s, padded, dim, nb + s, a, na, out);
+    if (!full) {
+      for (int t = 0; t < TB; ++t) std::memcpy(rows[t] + s, tail[t], sizeof(float) * (count - s));
+    }
+  }
+}
+
+// Complete targets against every source: see DenseChunk. 1 <= tb <= kTile.
+__attribute__((target_clones("arch=x86-64-v3", "default"))) void DenseKernel(
+    const float* b, int padded, int dim, const float* nb, const float* a, const float* na, int tb,
+    float* const* rows, int count) {
+  switch (tb) {
+    case 1: DenseRows<1>(b, padded, dim, nb, a, na, rows, count); break;
+    case 2: DenseRows<2>(b, padded, dim, nb, a, na, rows, count); break;
+    case 3: DenseRows<3>(b, padded, dim, nb, a, na, rows, count); break;
+    case 4: DenseRows<4>(b, padded, dim, nb, a, na, rows, count); break;
+    case 5: DenseRows<5>(b, padded, dim, nb, a, na, rows, count); break;
+    default: DenseRows<kTile>(b, padded, dim, nb, a, na, rows, count); break;
+  }
+}
+
+// One target with missing terms: out[s] = sum over its features k of w[k] (a[k] - b[k][s])^2.
+__attribute__((target_clones("arch=x86-64-v3", "default"))) void SparseKernel(
+    const float* b, int padded, const int* features, int nfeatures, const float* w, const float* a,
+    float* row, int count) {
+  alignas(32) float tail[kLanes];
+  for (int s = 0; s < padded; s += kLanes) {
+    v8f acc{};
+    for (int f = 0; f < nfeatures; ++f) {
+      const v8f d = Load(b + static_cast<size_t>(features[f]) * padded + s) - a[f];
+      acc += d * d * w[f];
+    }
+    if (s + kLanes <= count) {
+      Store(row + s, acc);
+    } else {
+      Store(tail, acc);
+      std::memcpy(row + s, tail, sizeof(float) * (count - s));
+    }
+  }
+}
+
+}  // namespace
+
+DescriptorCostRows::DescriptorCostRows(const PoseDescriptors& targets, const PoseDescriptors& sources,
+                                       float min_source_coverage)
+    : targets_(&targets), sources_(&sources) {
+  if (targets.layout.dim != sources.layout.dim || targets.layout.groups != sources.layout.groups) {
+    throw InputError("skeletons", "targets and sources have different descriptors (skeletons or options differ)");
+  }
+  const DescriptorLayout& layout = sources.layout;
+  const int count = sources.count;
+  padded_ = (count + kChunk - 1) / kChunk * kChunk;
+  source_features_.assign(static_cast<size_t>(layout.dim) * padded_, 0.0f);
+  for (int k = 0; k < layout.dim; ++k) {
+    std::copy_n(sources.features.begin() + static_cast<size_t>(k) * count, count,
+                source_features_.begin() + static_cast<size_t>(k) * padded_);
+  }
+  source_norm_.assign(padded_, 0.0f);
+  for (int s = 0; s < count; ++s) {
+    if (sources.coverage(s) < min_source_coverage || sources.present_weight[s] <= 0) {
+      excluded_.push_back(s);
+      continue;
+    }
+    if (!sources.complete(s)) incomplete_.push_back(s);
+    double norm = 0;
+    for (int k = 0; k < layout.dim; ++k) {
+      const double v = sources.feature(k, s);
+      norm += layout.feature_weight[k] * v * v;
+    }
+    source_norm_[s] = static_cast<float>(norm / layout.total_weight);
+  }
+}
+
+void DescriptorCostRows::Compute(int t0, int n, float* out) const {
+  const PoseDescriptors& tg = *targets_;
+  const PoseDescriptors& src = *sources_;
+  const DescriptorLayout& layout = tg.layout;
+  const int count = src.count;
+  const int dim = layout.dim;
+  std::vector<int> dense;  // complete targets of this block
+  for (int t = t0; t < t0 + n; ++t) {
+    float* row = out + static_cast<size_t>(t - t0) * count;
+    if (tg.complete(t)) {
+      dense.push_back(t);  // below, a few targets at a time
+      continue;
+    }
+    if (tg.present_weight[t] <= 0) {
+      std::fill(row, row + count, 0.0f);  // nothing to match: every source is as good
+    } else {
+      std::vector<int> features;
+      std::vector<float> w, a;
+      for (int k = 0; k < dim; ++k) {
+        if (!tg.has(layout.feature_group[k], t)) continue;
+        features.push_back(k);
+        w.push_back(layout.feature_weight[k] / tg.present_weight[t]);
+        a.push_back(tg.feature(k, t));
+      }
+      SparseKernel(source_features_.data(), padded_, features.data(), static_cast<int>(features.size()), w.data(),
+                   a.data(), row, count);
+    }
+    for (int s : incomplete_) row[s] = PoseCost(tg, t, src, s);
+    for (int s : excluded_) row[s] = kInf;
+  }
+  std::vector<float> a(static_cast<size_t>(kTile) * dim), na(kTile);
+  float* rows[kTile];
+  for (size_t first = 0; first < dense.size(); first += kTile) {
+    const int tb = static_cast<int>(std::min<size_t>(kTile, dense.size() - first));
+    for (int i = 0; i < tb; ++i) {
+      const int t = dense[first + i];
+      double norm = 0;
+      for (int k = 0; k < dim; ++k) {
+        const double v = tg.feature(k, t);
+        norm += layout.feature_weight[k] * v * v;
+        a[i * dim + k] = static_cast<float>(-2.0 * layout.feature_weight[k] * v / layout.total_weight);
+      }
+      na[i] = static_cast<float>(norm / layout.total_weight);
+      rows[i] = out + static_cast<size_t>(t - t0) * count;
+    }
+    DenseKernel(source_features_.data(), padded_, dim, source_norm_.data(), a.data(), na.data(), tb, rows, count);
+    for (int i = 0; i < tb; ++i) {
+      const int t = dense[first + i];
+      for (int s : incomplete_) rows[i][s] = PoseCost(tg, t, src, s);
+      for (int s : excluded_) rows[i][s] = kInf;
+    }
+  }
+}
+
+}  // namespace ss

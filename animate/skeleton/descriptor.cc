@@ -1,0 +1,192 @@
+#include "animate/skeleton/descriptor.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/error.h"
+
+namespace ss {
+
+bool DescriptorOptions::IsValid(std::string* why) const {
+  auto fail = [&](const char* reason) {
+    if (why) *why = reason;
+    return false;
+  };
+  if (!(angle_weight >= 0) || !(ratio_weight >= 0) || !(orientation_weight >= 0)) {
+    return fail("weights must be >= 0");
+  }
+  if (angle_weight + ratio_weight <= 0) return fail("angle_weight + ratio_weight must be > 0");
+  if (!(min_limb_px >= 0)) return fail("min_limb_px must be >= 0");
+  if (!(no_overlap_cost >= 0) || !std::isfinite(no_overlap_cost)) return fail("no_overlap_cost must be finite, >= 0");
+  return true;
+}
+
+DescriptorLayout MakeDescriptorLayout(const SkeletonDef& def, const DescriptorOptions& options) {
+  DescriptorLayout layout;
+  layout.pairs = static_cast<int>(def.pairs.size());
+  const bool orientation = options.orientation_weight > 0;
+  layout.groups = layout.pairs + (orientation ? 1 : 0);
+  layout.dim = 3 * layout.pairs + (orientation ? 2 : 0);
+  for (int p = 0; p < layout.pairs; ++p) {
+    layout.feature_weight.insert(layout.feature_weight.end(),
+                                 {options.angle_weight / 2, options.angle_weight / 2, options.ratio_weight});
+    layout.feature_group.insert(layout.feature_group.end(), {p, p, p});
+    layout.group_weight.push_back(options.angle_weight + options.ratio_weight);
+  }
+  if (orientation) {
+    layout.feature_weight.insert(layout.feature_weight.end(),
+                                 {options.orientation_weight / 2, options.orientation_weight / 2});
+    layout.feature_group.insert(layout.feature_group.end(), {layout.pairs, layout.pairs});
+    layout.group_weight.push_back(options.orientation_weight);
+  }
+  for (float w : layout.group_weight) layout.total_weight += w;
+  layout.no_overlap_cost = options.no_overlap_cost;
+  return layout;
+}
+
+namespace {
+
+struct Vec2 {
+  float x = 0, y = 0;
+};
+
+// The end of `limb` that is not `joint`.
+int OtherEnd(const Limb& limb, int joint) { return limb.from == joint ? limb.to : limb.from; }
+
+// Fills frame i's features of one clip into `out` (count = out.count, offset `i`).
+void Describe(const SkeletonDef& def, const SkeletonFrame& frame, const DescriptorOptions& options,
+              PoseDescriptors* out, int i) {
+  const DescriptorLayout& layout = out->layout;
+  const size_t n = out->count;
+  auto vec = [&](int from, int to, Vec2* v) {
+    const JointSample& a = frame.joints[from];
+    const JointSample& b = frame.joints[to];
+    if (!a.present || !b.present) return false;
+    v->x = b.x_px - a.x_px;
+    v->y = b.y_px - a.y_px;
+    return std::hypot(v->x, v->y) >= std::max(options.min_limb_px, 1e-6f);
+  };
+  float weight = 0;
+  for (int p = 0; p < layout.pairs; ++p) {
+    const LimbPair& pair = def.pairs[p];
+    Vec2 u, v;
+    const bool ok = vec(pair.joint, OtherEnd(def.limbs[pair.limb_a], pair.joint), &u) &&
+                    vec(pair.joint, OtherEnd(def.limbs[pair.limb_b], pair.joint), &v);
+    out->present[p * n + i] = ok ? 1 : 0;
+    if (!ok) continue;
+    const double lu = std::hypot(u.x, u.y), lv = std::hypot(v.x, v.y);
+    const double cos_angle = (static_cast<double>(u.x) * v.x + static_cast<double>(u.y) * v.y) / (lu * lv);
+    const double sin_angle = (static_cast<double>(u.x) * v.y - static_cast<double>(u.y) * v.x) / (lu * lv);
+    out->features[(3 * p) * n + i] = static_cast<float>(cos_angle);
+    out->features[(3 * p + 1) * n + i] = static_cast<float>(sin_angle);
+    out->features[(3 * p + 2) * n + i] = static_cast<float>(std::log(lv / lu));
+    weight += layout.group_weight[p];
+  }
+  if (layout.groups > layout.pairs) {
+    const int g = layout.pairs;
+    const Limb& root = def.limbs[def.root_limb];
+    Vec2 u;
+    const bool ok = vec(root.from, root.to, &u);
+    out->present[g * n + i] = ok ? 1 : 0;
+    if (ok) {
+      const double lu = std::hypot(u.x, u.y);
+      out->features[(3 * g) * n + i] = static_cast<float>(u.x / lu);
+      out->features[(3 * g + 1) * n + i] = static_cast<float>(u.y / lu);
+      weight += layout.group_weight[g];
+    }
+  }
+  out->present_weight[i] = weight;
+}
+
+// Subtracts, per pair, the median log ratio over frames [begin, end) that have it.
+void NormalizeRatios(PoseDescriptors* d, int begin, int end) {
+  const size_t n = d->count;
+  std::vector<float> values;
+  for (int p = 0; p < d->layout.pairs; ++p) {
+    values.clear();
+    float* ratio = &d->features[(3 * p + 2) * n];
+    for (int i = begin; i < end; ++i) {
+      if (d->present[p * n + i]) values.push_back(ratio[i]);
+    }
+    if (values.empty()) continue;
+    const size_t mid = values.size() / 2;
+    std::nth_element(values.begin(), values.begin() + mid, values.end());
+    float median = values[mid];
+    if (values.size() % 2 == 0) median = (median + *std::max_element(values.begin(), values.begin() + mid)) / 2;
+    for (int i = begin; i < end; ++i) {
+      if (d->present[p * n + i]) ratio[i] -= median;
+    }
+  }
+}
+
+}  // namespace
+
+PoseDescriptors ComputeDescriptors(const std::vector<const SkeletonSequence*>& clips,
+                                   const DescriptorOptions& options) {
+  std::string why;
+  if (!options.IsValid(&why)) throw InputError("descriptor options", why);
+  if (clips.empty()) throw InputError("skeletons", "no skeleton sequence given");
+  const SkeletonDef& def = clips.front()->skeleton;
+  PoseDescriptors d;
+  d.layout = MakeDescriptorLayout(def, options);
+  for (const auto* clip : clips) {
+    const auto& limbs = clip->skeleton.limbs;
+    const bool same_limbs = limbs.size() == def.limbs.size() &&
+                            std::equal(limbs.begin(), limbs.end(), def.limbs.begin(), [](const Limb& x, const Limb& y) {
+                              return x.from == y.from && x.to == y.to;
+                            });
+    if (clip->skeleton.joints != def.joints || !same_limbs) {
+      throw InputError(clip->clip.empty() ? "skeletons" : clip->clip,
+                       "skeleton '" + clip->skeleton.name + "' differs from '" + def.name +
+                           "': sources and targets need the same skeletal structure");
+    }
+    d.count += clip->size();
+  }
+  d.features.assign(static_cast<size_t>(d.layout.dim) * d.count, 0.0f);
+  d.present.assign(static_cast<size_t>(d.layout.groups) * d.count, 0);
+  d.present_weight.assign(d.count, 0.0f);
+  int i = 0;
+  for (const auto* clip : clips) {
+    const int begin = i;
+    for (const auto& frame : clip->frames) {
+      if (frame.joints.size() != def.joints.size()) {
+        throw InputError(clip->clip.empty() ? "skeletons" : clip->clip,
+                         "frame " + std::to_string(frame.frame) + " has " + std::to_string(frame.joints.size()) +
+                             " joints, skeleton '" + def.name + "' has " + std::to_string(def.joints.size()));
+      }
+      Describe(def, frame, options, &d, i++);
+    }
+    if (options.normalize_ratios) NormalizeRatios(&d, begin, i);
+  }
+  return d;
+}
+
+PoseDescriptors ComputeDescriptors(const SkeletonSequence& sequence, const DescriptorOptions& options) {
+  return ComputeDescriptors(std::vector<const SkeletonSequence*>{&sequence}, options);
+}
+
+float PoseCost(const PoseDescriptors& a, int i, const PoseDescriptors& b, int j) {
+  const DescriptorLayout& layout = a.layout;
+  if (a.present_weight[i] <= 0) return 0.0f;
+  double numerator = 0, denominator = 0;
+  for (int g = 0; g < layout.groups; ++g) {
+    if (!a.has(g, i) || !b.has(g, j)) continue;
+    denominator += layout.group_weight[g];
+  }
+  if (denominator <= 0) return layout.no_overlap_cost;
+  for (int k = 0; k < layout.dim; ++k) {
+    const int g = layout.feature_group[k];
+    if (!a.has(g, i) || !b.has(g, j)) continue;
+    const double diff = static_cast<double>(a.feature(k, i)) - b.feature(k, j);
+    numerator += layout.feature_weight[k] * diff * diff;
+  }
+  return static_cast<float>(numerator / denominator);
+}
+
+std::vector<float> SequentialCost(const PoseDescriptors& sequence) {
+  std::vector<float> cost;
+  for (int t = 0; t + 1 < sequence.count; ++t) cost.push_back(PoseCost(sequence, t, sequence, t + 1));
+  return cost;
+}
+
+}  // namespace ss

@@ -1,0 +1,42 @@
+#pragma once
+// Importers for the 2D keypoints other tools write (docs/skeletons.md): DeepLabCut CSV,
+// OpenPose per-frame JSON and COCO keypoint annotations. A JointMapping turns their
+// keypoints into the joints of a skeleton definition; keypoints below the confidence
+// threshold become missing joints.
+#include <optional>
+#include <string>
+
+#include "animate/skeleton/joint_mapping.h"
+#include "animate/skeleton/skeleton.h"
+
+namespace ss {
+
+struct ImportOptions {
+  // Keypoints with a lower confidence become missing joints. Unset: the mapping file's
+  // min_confidence, else the format's default (DeepLabCut 0.6 as its pcutoff, OpenPose 0.2,
+  // COCO 0.5, which keeps v=1 "labelled, hidden" as confidence 0.5 and v=2 as 1).
+  std::optional<float> min_confidence;
+  std::string individual;  // DeepLabCut multi-animal: which individual (empty: the first)
+  int person = 0;          // OpenPose: index into people[]
+  int category_id = -1;    // COCO: the category whose annotations are read (-1: the first with keypoints)
+};
+
+// DeepLabCut's CSV: header rows scorer / [individuals] / bodyparts / coords (x, y,
+// likelihood), then one row per frame starting with the frame index (or image path).
+SkeletonSequence ImportDeepLabCutCsv(const std::string& path, const JointMapping& mapping,
+                                     const ImportOptions& options = {});
+
+// OpenPose's per-frame files (*_keypoints.json) in a folder, or one such file:
+// people[person].pose_keypoints_2d = [x, y, c] * N. BODY_25 (N = 25) keypoints may be
+// mapped by name (Body25KeypointNames()), any layout by index. A frame without the person
+// has every joint missing.
+SkeletonSequence ImportOpenPoseJson(const std::string& path, const JointMapping& mapping,
+                                    const ImportOptions& options = {});
+
+// A COCO keypoint file: one frame per image (by increasing image id; frame = image id),
+// the annotation with the most labelled keypoints, keypoints = [x, y, v] * K with names
+// from categories[].keypoints (Coco17KeypointNames() if absent).
+SkeletonSequence ImportCocoKeypoints(const std::string& path, const JointMapping& mapping,
+                                     const ImportOptions& options = {});
+
+}  // namespace ss

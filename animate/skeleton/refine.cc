@@ -1,0 +1,113 @@
+#include "animate/skeleton/refine.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/error.h"
+
+namespace ss {
+
+std::vector<int> FindMovements(const std::vector<float>& sequential_cost, const MovementOptions& options) {
+  const int n = static_cast<int>(sequential_cost.size());  // frames - 1
+  std::vector<int> starts = {0};
+  if (n < 3) return starts;
+  // Smooth.
+  const int half = std::max(0, options.smoothing_window / 2);
+  std::vector<double> q(n);
+  for (int t = 0; t < n; ++t) {
+    double sum = 0;
+    int used = 0;
+    for (int u = std::max(0, t - half); u <= std::min(n - 1, t + half); ++u) {
+      sum += sequential_cost[u];
+      ++used;
+    }
+    q[t] = sum / used;
+  }
+  // Local maxima (the first frame of a plateau) and their prominence.
+  struct Peak {
+    int t;
+    double height;
+  };
+  std::vector<Peak> peaks;
+  for (int t = 1; t + 1 < n; ++t) {
+    if (!(q[t] > q[t - 1] && q[t] >= q[t + 1])) continue;
+    double left = q[t], right = q[t];
+    for (int u = t - 1; u >= 0 && q[u] <= q[t]; --u) left = std::min(left, q[u]);
+    for (int u = t + 1; u < n && q[u] <= q[t]; ++u) right = std::min(right, q[u]);
+    if (q[t] - std::max(left, right) >= options.min_prominence) peaks.push_back({t, q[t]});
+  }
+  // Highest first; a boundary (frame t + 1 starts the next movement) too close to a kept
+  // one or to either end is dropped.
+  std::sort(peaks.begin(), peaks.end(), [](const Peak& a, const Peak& b) { return a.height > b.height; });
+  const int frames = n + 1;
+  std::vector<int> kept;
+  for (const auto& p : peaks) {
+    const int boundary = p.t + 1;
+    if (boundary < options.min_length || frames - boundary < options.min_length) continue;
+    bool clear = true;
+    for (int k : kept) clear = clear && std::abs(k - boundary) >= options.min_length;
+    if (clear) kept.push_back(boundary);
+  }
+  starts.insert(starts.end(), kept.begin(), kept.end());
+  std::sort(starts.begin(), starts.end());
+  return starts;
+}
+
+std::vector<int> FindMovements(const PoseDescriptors& frames, const std::vector<int>& clip_starts,
+                               const MovementOptions& options) {
+  std::vector<int> starts;
+  for (size_t c = 0; c < clip_starts.size(); ++c) {
+    const int begin = clip_starts[c];
+    const int end = c + 1 < clip_starts.size() ? clip_starts[c + 1] : frames.count;
+    std::vector<float> q;
+    for (int t = begin; t + 1 < end; ++t) q.push_back(PoseCost(frames, t, frames, t + 1));
+    for (int s : FindMovements(q, options)) starts.push_back(begin + s);
+  }
+  return starts;
+}
+
+std::vector<int> AverageWithinSegments(const std::vector<int>& frames, const std::vector<int>& starts, int window) {
+  std::vector<int> out = frames;
+  const int half = std::max(0, window / 2);
+  if (half == 0) return out;
+  const int n = static_cast<int>(frames.size());
+  for (size_t g = 0; g < starts.size(); ++g) {
+    const int begin = starts[g];
+    const int end = g + 1 < starts.size() ? starts[g + 1] : n;
+    for (int t = begin; t < end; ++t) {
+      double sum = 0;
+      int used = 0;
+      for (int u = std::max(begin, t - half); u <= std::min(end - 1, t + half); ++u) {
+        sum += frames[u];
+        ++used;
+      }
+      out[t] = static_cast<int>(std::lround(sum / used));
+    }
+  }
+  return out;
+}
+
+RefineResult RefineMatch(const CostRows& costs, const PoseDescriptors& targets, const PoseDescriptors& sources,
+                         const std::vector<int>& clip_starts, const MatchOptions& options,
+                         const RefineOptions& refine) {
+  if (targets.count != costs.targets() || sources.count != costs.sources()) {
+    throw InputError("refine", "the descriptors do not match the cost rows");
+  }
+  if (refine.averaging_window < 1) throw InputError("refine", "averaging_window must be >= 1");
+  RefineResult result;
+  result.target_movements = FindMovements(SequentialCost(targets), refine.movements);
+  result.source_movements = FindMovements(sources, clip_starts, refine.movements);
+  MovementConstraint constraint;
+  constraint.target_starts = result.target_movements;
+  constraint.source_starts = result.source_movements;
+  constraint.jump_cost_per_frame = refine.jump_cost_per_frame;
+  if (targets.count == 0) return result;
+  result.second_pass = SolveMatch(costs, clip_starts, options, &constraint);
+  result.source_frames =
+      AverageWithinSegments(result.second_pass.source_frames, result.target_movements, refine.averaging_window);
+  result.stats = AnalyzePath(result.source_frames, clip_starts, options);
+  result.total_cost = PathCost(costs, clip_starts, options, &constraint, result.source_frames);
+  return result;
+}
+
+}  // namespace ss

@@ -1,0 +1,52 @@
+#pragma once
+// Matching refinement (seed 003 §2.3). Atomic movements are the stretches between local
+// maxima of the sequential matching cost cost(x_t, x_{t+1}) (the moments of fastest pose
+// change), found in the target and, clip by clip, in the source. A second DP pass keeps
+// the choice inside one source movement for the whole of a target movement, charges
+// jumps inside it per frame jumped, and an averaging window inside each target movement
+// smooths the chosen frame numbers.
+#include <vector>
+
+#include "animate/skeleton/descriptor.h"
+#include "animate/skeleton/match_dp.h"
+
+namespace ss {
+
+struct MovementOptions {
+  int smoothing_window = 3;      // centred moving average of the sequential cost first
+  int min_length = 8;            // frames; of two boundaries closer than this the weaker goes
+  float min_prominence = 0.01f;  // a peak's height over the higher of its two bases
+};
+
+// First frame of each movement (0 first) of one sequence, from its sequential cost.
+std::vector<int> FindMovements(const std::vector<float>& sequential_cost, const MovementOptions& options);
+// Of several clips laid end to end: every clip start, plus the movements inside each clip.
+std::vector<int> FindMovements(const PoseDescriptors& frames, const std::vector<int>& clip_starts,
+                               const MovementOptions& options);
+
+struct RefineOptions {
+  MovementOptions movements;
+  float jump_cost_per_frame = 0.01f;  // λ: a jump of d frames inside a movement costs λ|d| more
+  int averaging_window = 5;           // frames, centred, clipped to the movement; 1 = none
+};
+
+struct RefineResult {
+  std::vector<int> source_frames;     // the refined choice, after averaging
+  MatchResult second_pass;            // the constrained DP, before averaging
+  std::vector<int> target_movements;  // first frame of each target movement
+  std::vector<int> source_movements;  // first frame of each source movement
+  MatchStats stats;                   // of source_frames
+  double total_cost = 0;              // PathCost of source_frames under the constraint
+};
+
+// Runs the constrained second pass and the averaging. `targets` and `sources` are the
+// descriptors `costs` was built from (for the sequential costs).
+RefineResult RefineMatch(const CostRows& costs, const PoseDescriptors& targets, const PoseDescriptors& sources,
+                         const std::vector<int>& clip_starts, const MatchOptions& options,
+                         const RefineOptions& refine = {});
+
+// Centred moving average of `frames` inside each segment [starts[i], starts[i+1]),
+// rounded to the nearest frame.
+std::vector<int> AverageWithinSegments(const std::vector<int>& frames, const std::vector<int>& starts, int window);
+
+}  // namespace ss

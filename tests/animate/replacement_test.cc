@@ -1,0 +1,231 @@
+#include "animate/replacement.h"
+
+#include <gtest/gtest.h>
+
+#include <memory>
+
+#include "animate/basic_costs.h"
+#include "animate/collision_cost.h"
+#include "animate/location_cost.h"
+#include "animate/path_cost.h"
+#include "core/error.h"
+#include "tests/animate/animate_test_graphs.h"
+
+namespace ss {
+namespace {
+
+using Eigen::Vector2d;
+using testing::WalkingGraph;
+
+ReplacementOptions FastOptions(double seconds) {
+  ReplacementOptions options;
+  options.reach.set_size = 60;
+  options.time_budget_seconds = seconds;
+  options.max_tries = 400;
+  options.changes_per_turn = 50;
+  return options;
+}
+
+TEST(Replacement, EveryKeptMoveIsValidAndTheCostNeverIncreases) {
+  const TransitionGraph graph = WalkingGraph::Make();
+  Problem problem(graph);
+  SpriteSpec walker;
+  walker.initial_frames = 50;
+  walker.max_frames = 90;
+  problem.AddSprite(walker);
+  SpriteSpec free_sprite = walker;
+  free_sprite.anchor = Anchor::kFree;
+  free_sprite.anchor_m = Vector2d(1, 1);
+  problem.AddSprite(free_sprite);
+  SpriteSpec end_sprite = walker;
+  end_sprite.anchor = Anchor::kEnd;
+  end_sprite.anchor_m = Vector2d(0.5, 0.5);
+  problem.AddSprite(end_sprite);
+  const Polyline path({{0, 0}, {1.5, 0}, {1.5, 1.0}});
+  problem.AddTerm(std::make_unique<PathTerm>(0, path, PathStrengths{0.5, 4.0, 3.0}));
+  auto standing = std::make_shared<std::vector<bool>>(graph.FramesWithTag("standing"));
+  problem.AddTerm(std::make_unique<FrameTerm>(0, standing, StepWindow::All(), 1.0,
+                                              PathTrigger{0, path, 8}));
+  problem.AddTerm(std::make_unique<FrameTerm>(1, standing, StepWindow::All(), 1.0,
+                                              PathTrigger{0, path, 8}));
+  problem.AddTerm(std::make_unique<LocationTerm>(1, StepWindow::All(),
+                                                 LocationTarget::Follow(0, {-0.3, 0.2}), 2.0));
+  problem.AddTerm(std::make_unique<LocationTerm>(2, StepWindow::At(0),
+                                                 LocationTarget::Fixed({-0.5, 0}), 1.0));
+  for (int a = 0; a < 3; ++a) {
+    for (int b = a + 1; b < 3; ++b) {
+      problem.AddTerm(std::make_unique<CollisionTerm>(a, b, 0.2, 5.0));
+    }
+  }
+  problem.AddTerm(std::make_unique<LengthTerm>(2, 60, 0.5));
+
+  ReplacementOptions options = FastOptions(2.0);
+  int checked = 0;
+  int last_restart = 0;
+  double last_cost = std::numeric_limits<double>::infinity();
+  bool all_valid = true;
+  options.on_improvement = [&](const std::vector<Track>& tracks, const TracePoint& point) {
+    std::string why;
+    if (!problem.IsValid(tracks, &why)) {
+      all_valid = false;
+      ADD_FAILURE() << why;
+    }
+    const double full = problem.TotalCost(tracks);
+    EXPECT_NEAR(point.cost, full, 1e-7 * (1 + full));  // the incremental total is exact
+    if (point.restart == last_restart) {  // a restart begins again from random sequences
+      EXPECT_LE(full, last_cost + 1e-9 * (1 + last_cost));
+    }
+    last_restart = point.restart;
+    for (int s = 0; s < 3; ++s) {  // the states follow the frames and the anchors
+      const Track rebuilt = MakeTrack(graph, tracks[s].frames, s == 2 ? Anchor::kEnd : Anchor::kStart,
+                                      s == 2 ? Vector2d(0.5, 0.5) : tracks[s].positions_m[0]);
+      for (int t = 0; t < tracks[s].size(); ++t) {
+        if (!tracks[s].positions_m[t].isApprox(rebuilt.positions_m[t], 1e-9)) all_valid = false;
+      }
+    }
+    EXPECT_TRUE(tracks[0].positions_m[0].isZero());
+    last_cost = full;
+    ++checked;
+  };
+  Summary summary;
+  const std::vector<Track> tracks = OptimizeSequences(problem, options, &summary);
+  EXPECT_TRUE(all_valid);
+  EXPECT_GT(checked, 10);
+  EXPECT_EQ(checked, summary.moves_kept);
+  EXPECT_TRUE(problem.IsValid(tracks));
+  EXPECT_LT(summary.final_cost.total, summary.initial_cost.total);
+  for (size_t i = 1; i < summary.trace.size(); ++i) {
+    EXPECT_LE(summary.trace[i].best_cost, summary.trace[i - 1].best_cost + 1e-9);
+    if (summary.trace[i].restart == summary.trace[i - 1].restart) {
+      EXPECT_LE(summary.trace[i].cost, summary.trace[i - 1].cost + 1e-9);
+    }
+  }
+  EXPECT_NEAR(summary.trace.back().best_cost, summary.final_cost.total,
+              1e-7 * (1 + summary.final_cost.total));
+  EXPECT_NE(summary.FullReport().find("collision"), std::string::npos);
+}
+
+// Anticipation, where beam search has no look-ahead (seed 000 §4.1, §6.1, Figure 7b):
+// loiter near the centre, then be in the far corner at step 79. Beam search ranks partial
+// sequences by the steps so far, so the sequences that leave early enough fall out of the
+// beam; replacement optimizes the whole sequence and leaves in time.
+TEST(Replacement, AnticipatesALaterLocationBetterThanBeamSearchAtTheSameBudget) {
+  const TransitionGraph graph = WalkingGraph::Make();
+  Problem problem(graph);
+  SpriteSpec spec;
+  spec.initial_frames = 80;
+  spec.max_frames = 80;
+  problem.AddSprite(spec);
+  const Vector2d corner(1.5, 1.0);
+  problem.AddTerm(std::make_unique<LocationTerm>(0, StepWindow::Range(0, 78),
+                                                 LocationTarget::Fixed({0, 0}), 0.05));
+  problem.AddTerm(std::make_unique<LocationTerm>(0, StepWindow::At(79),
+                                                 LocationTarget::Fixed(corner), 100.0));
+  problem.AddTerm(std::make_unique<LengthTerm>(0, 80, 10.0));
+  constexpr double kBudget = 1.5;
+
+  Summary replacement_summary;
+  const auto replaced = OptimizeSequences(problem, FastOptions(kBudget), &replacement_summary);
+  BeamOptions beam;
+  beam.width = 8;
+  beam.time_budget_seconds = kBudget;
+  Summary beam_summary;
+  const auto beamed = BeamSearch(problem, beam, &beam_summary);
+
+  ASSERT_TRUE(problem.IsValid(replaced));
+  ASSERT_TRUE(problem.IsValid(beamed));
+  const double replaced_miss = (replaced[0].PositionAt(79) - corner).norm();
+  const double beamed_miss = (beamed[0].PositionAt(79) - corner).norm();
+  std::cout << "replacement: " << replacement_summary.BriefReport() << ", miss " << replaced_miss
+            << " m\nbeam:        " << beam_summary.BriefReport() << ", miss " << beamed_miss
+            << " m\n";
+  EXPECT_EQ(replaced[0].size(), 80);
+  EXPECT_LT(replaced_miss, 0.35);  // ~0.02 m when it has time for a few restarts
+  EXPECT_GT(beamed_miss, replaced_miss);
+  EXPECT_LT(replacement_summary.final_cost.total, 0.5 * beam_summary.final_cost.total);
+}
+
+TEST(Replacement, FollowsAPathToItsEnd) {
+  const TransitionGraph graph = WalkingGraph::Make();
+  Problem problem(graph);
+  SpriteSpec spec;
+  spec.initial_frames = 30;
+  spec.max_frames = 120;
+  problem.AddSprite(spec);
+  const Polyline path({{0, 0}, {1.2, 0}, {1.2, 1.2}});
+  auto term = std::make_unique<PathTerm>(0, path, PathStrengths{0.2, 20.0, 5.0});
+  const PathTerm* path_term = term.get();
+  problem.AddTerm(std::move(term));
+  Summary summary;
+  const auto tracks = OptimizeSequences(problem, FastOptions(2.0), &summary);
+  std::cout << summary.FullReport();
+  ASSERT_TRUE(problem.IsValid(tracks));
+  const auto view = TrackPointers(tracks);
+  EXPECT_EQ(path_term->CountViolations(view), 0) << "path not passed to its end";
+  EXPECT_LT(path_term->MaxDeviation(tracks[0]), 0.2);
+}
+
+TEST(Replacement, FreeStartsAndEndAnchorsMeetTheirLocations) {
+  const TransitionGraph graph = WalkingGraph::Make();
+  Problem problem(graph);
+  SpriteSpec free_spec;
+  free_spec.anchor = Anchor::kFree;
+  free_spec.initial_frames = 40;
+  free_spec.max_frames = 40;
+  problem.AddSprite(free_spec);
+  // Two targets 1.5 m apart along x, 39 steps apart: only a start near (-1, 0) walking
+  // +x can meet both.
+  problem.AddTerm(std::make_unique<LocationTerm>(0, StepWindow::At(0),
+                                                 LocationTarget::Fixed({-1, 0}), 10.0));
+  problem.AddTerm(std::make_unique<LocationTerm>(0, StepWindow::LastStep(),
+                                                 LocationTarget::Fixed({0.5, 0}), 10.0));
+  problem.AddTerm(std::make_unique<LengthTerm>(0, 40, 10.0));
+  Summary summary;
+  const auto tracks = OptimizeSequences(problem, FastOptions(1.5), &summary);
+  ASSERT_TRUE(problem.IsValid(tracks));
+  EXPECT_LT((tracks[0].positions_m.front() - Vector2d(-1, 0)).norm(), 0.15);
+  EXPECT_LT((tracks[0].positions_m.back() - Vector2d(0.5, 0)).norm(), 0.15);
+}
+
+TEST(Replacement, BeamStartAndOptionChecks) {
+  const TransitionGraph graph = WalkingGraph::Make();
+  Problem problem(graph);
+  SpriteSpec spec;
+  spec.initial_frames = 30;
+  problem.AddSprite(spec);
+  problem.AddTerm(std::make_unique<LocationTerm>(0, StepWindow::LastStep(),
+                                                 LocationTarget::Fixed({1, 0.5}), 1.0));
+  ReplacementOptions options = FastOptions(1.0);
+  options.start = StartMethod::kBeam;
+  options.beam.width = 4;
+  options.beam.time_budget_seconds = 0.2;
+  Summary summary;
+  const auto tracks = OptimizeSequences(problem, options, &summary);
+  EXPECT_EQ(summary.start, "beam");
+  EXPECT_TRUE(problem.IsValid(tracks));
+  EXPECT_LE(summary.final_cost.total, summary.initial_cost.total);
+
+  std::string why;
+  ReplacementOptions bad;
+  bad.middle_fraction = 0.9;
+  bad.begin_fraction = 0.2;
+  EXPECT_FALSE(bad.IsValid(&why));
+  EXPECT_NE(why.find("fraction"), std::string::npos);
+  bad = ReplacementOptions{};
+  bad.time_budget_seconds = 0;
+  EXPECT_FALSE(bad.IsValid(&why));
+  EXPECT_THROW(OptimizeSequences(problem, bad, &summary), InputError);
+  EXPECT_TRUE(ReplacementOptions{}.IsValid(&why));
+}
+
+TEST(Replacement, RandomSequencesFollowRealEdges) {
+  const TransitionGraph graph = WalkingGraph::Make();
+  for (uint64_t seed = 0; seed < 20; ++seed) {
+    const std::vector<int> frames = RandomSequence(graph, 100, seed);
+    EXPECT_EQ(frames.size(), 100u);
+    EXPECT_TRUE(graph.IsValidSequence(frames));
+  }
+}
+
+}  // namespace
+}  // namespace ss
