@@ -1,0 +1,359 @@
+// spritestation bench transitions: the two-stage transition search on a synthetic
+// hamster bank (seed 000 §3), against brute force measured in the same run.
+//   full build of N sprites on T threads; stage-2 evaluations vs all N(N-1)/2 pairs;
+//   recall of the pairs brute force accepts (exact on sampled rows); quality against
+//   the synthetic truth; incremental add of one sprite to a 60,000-sprite set.
+#include <benchmark/benchmark.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cstdio>
+#include <numeric>
+#include <random>
+#include <string>
+#include <thread>
+#include <unordered_set>
+
+#include <nlohmann/json.hpp>
+
+#include "bench/bench_registry.h"
+#include "core/error.h"
+#include "core/log.h"
+#include "pipeline/transitions/builder.h"
+#include "pipeline/transitions/synthetic.h"
+#include "pipeline/transitions/training.h"
+#include "pipeline/transitions/truth_labels.h"
+
+namespace ss::bench {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double Since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+
+struct Args {
+  int sprites = 30000;
+  int incremental_base = 60000;
+  int adds = 300;
+  int rows = 300;
+  int threads = 2;
+  int labels = 3000;
+  double stage1_recall = 0.995;
+  double near_miss = TruthLabelOptions{}.near_miss_fraction;
+  std::string weights_path, train_out;
+  bool incremental = true, micro = false, json = false;
+};
+
+Args Parse(const std::vector<std::string>& argv) {
+  Args a;
+  for (size_t k = 0; k < argv.size(); ++k) {
+    const std::string& s = argv[k];
+    auto value = [&]() -> std::string {
+      if (k + 1 >= argv.size()) throw InputError("bench transitions", s + " needs a value");
+      return argv[++k];
+    };
+    if (s == "--sprites") a.sprites = std::stoi(value());
+    else if (s == "--incremental-base") a.incremental_base = std::stoi(value());
+    else if (s == "--adds") a.adds = std::stoi(value());
+    else if (s == "--rows") a.rows = std::stoi(value());
+    else if (s == "--threads") a.threads = std::stoi(value());
+    else if (s == "--labels") a.labels = std::stoi(value());
+    else if (s == "--near-miss") a.near_miss = std::stod(value());
+    else if (s == "--stage1-recall") a.stage1_recall = std::stod(value());
+    else if (s == "--weights") a.weights_path = value();
+    else if (s == "--train-out") a.train_out = value();
+    else if (s == "--skip-incremental") a.incremental = false;
+    else if (s == "--micro") a.micro = true;
+    else if (s == "--json") a.json = true;
+    else throw InputError("bench transitions", "unknown argument '" + s + "' (see bench/transitions_bench.cc)");
+  }
+  if (a.sprites < 100 || a.rows < 1 || a.threads < 1) throw InputError("bench transitions", "bad sizes");
+  return a;
+}
+
+// A synthetic set in live order (each original followed by its mirror).
+std::vector<SyntheticSprite> LiveSet(int sprites, uint64_t seed) {
+  SyntheticSpriteOptions o;
+  o.frames = (sprites + 1) / 2;
+  o.seed = seed;
+  auto all = MakeSyntheticSprites(o);
+  const size_t half = all.size() / 2;
+  std::vector<SyntheticSprite> live;
+  live.reserve(all.size());
+  for (size_t k = 0; k < half; ++k) {
+    live.push_back(std::move(all[k]));
+    live.push_back(std::move(all[half + k]));
+  }
+  live.resize(sprites);
+  return live;
+}
+
+std::vector<int64_t> Ids(const std::vector<SyntheticSprite>& s) {
+  std::vector<int64_t> ids;
+  for (const auto& x : s) ids.push_back(x.id);
+  return ids;
+}
+std::vector<SpriteTruth> Truths(const std::vector<SyntheticSprite>& s) {
+  std::vector<SpriteTruth> t;
+  for (const auto& x : s) t.push_back(x.truth);
+  return t;
+}
+
+// Trains weights on a separate synthetic set (truth labels, then stage 1 calibrated as a
+// filter for stage 2) and writes them.
+TransitionWeights Train(const Args& a, nlohmann::json* out) {
+  const auto t0 = Clock::now();
+  const auto sprites = LiveSet(a.sprites, 1);
+  SpriteStore store(ComparisonWindow{}, SyntheticSpriteOptions{}.px_per_m);
+  store.Append(AsSpriteInputs(sprites), a.threads);
+  const auto ids = Ids(sprites);
+  const auto truth = Truths(sprites);
+  TruthLabelOptions label_options;
+  label_options.near_miss_fraction = a.near_miss;
+  const auto labels = LabelsFromTruth(ids, truth, a.labels, label_options, 1);
+  std::vector<PairFeatures> x;
+  std::vector<uint8_t> y;
+  for (const Label& l : labels) {
+    x.push_back(store.Features(*store.IndexOf(l.sprite_i), *store.IndexOf(l.sprite_j)));
+    y.push_back(l.accept);
+  }
+  TrainReport report;
+  TransitionWeights w = TrainWeights(x, y, ComparisonWindow{}, TrainOptions{}, &report);
+  const auto accepted = SampleStage2Accepted(store, TransitionClassifier(w), a.rows, 7, a.threads);
+  const double label_bias = CalibrateStage1(accepted, a.stage1_recall, &w);
+  nlohmann::json training = nlohmann::json::parse(w.training_json);
+  training["source"] = "spritestation bench transitions --train-out: synthetic hamster set, seed 1, " +
+                       std::to_string(a.sprites) + " sprites (pipeline/transitions/synthetic.cc), labels from truth";
+  training["stage1_calibration"] = {{"target_recall_of_stage2", a.stage1_recall},
+                                    {"stage2_accepted_pairs_sampled", accepted.size()},
+                                    {"sampled_rows", a.rows},
+                                    {"bias_from_labels", label_bias},
+                                    {"bias", w.stage1_bias}};
+  w.training_json = training.dump();
+  SaveWeights(w, a.train_out);
+  (*out)["training"] = training;
+  (*out)["training"]["seconds"] = Since(t0);
+  std::printf("trained on %zu labels (%lld accepts): stage 1 CV precision %.3f recall %.3f, stage 2 CV precision %.3f "
+              "recall %.3f; stage 1 calibrated on %zu stage-2 accepts -> %s\n",
+              labels.size(), static_cast<long long>(report.accepts), report.stage1.precision(),
+              report.stage1.recall(), report.stage2.precision(), report.stage2.recall(), accepted.size(),
+              a.train_out.c_str());
+  return w;
+}
+
+int Run(const std::vector<std::string>& argv) {
+  const Args a = Parse(argv);
+  SetLogLevel("warn");
+  nlohmann::json result;
+  TransitionWeights weights = a.weights_path.empty() ? DefaultWeights() : LoadWeights(a.weights_path);
+  if (!a.train_out.empty()) weights = Train(a, &result);
+  const double px_per_m = SyntheticSpriteOptions{}.px_per_m;
+
+  // ---- full build ----
+  auto t = Clock::now();
+  const auto sprites = LiveSet(a.sprites, 2);
+  const double seconds_generate = Since(t);
+  const auto inputs = AsSpriteInputs(sprites);
+  TransitionBuilder builder(weights, px_per_m);
+  t = Clock::now();
+  builder.BuildFromScratch(inputs, BuildOptions{.threads = a.threads});
+  const double seconds_pairs = Since(t);
+  t = Clock::now();
+  const auto transitions = builder.Transitions();
+  const double seconds_transitions = Since(t);
+  const double seconds_build = seconds_pairs + seconds_transitions;
+  const BuildStats& stats = builder.stats();
+  const int32_t n = builder.store().size();
+  const double all_pairs = 0.5 * n * (n - 1.0);
+
+  // ---- brute force on sampled rows: stage 2 against every sprite ----
+  const auto& store = builder.store();
+  const TransitionClassifier& classifier = builder.classifier();
+  std::vector<int32_t> rows(n);
+  std::iota(rows.begin(), rows.end(), 0);
+  std::mt19937_64 rng(3);
+  std::shuffle(rows.begin(), rows.end(), rng);
+  rows.resize(std::min<int32_t>(n, a.rows));
+  std::atomic<size_t> cursor{0};
+  std::atomic<int64_t> brute_accepted{0}, brute_kept{0}, truth_pos{0}, kept_total{0}, kept_true{0}, brute_true{0};
+  t = Clock::now();
+  auto work = [&] {
+    const TruthLabelOptions truth_options;
+    int64_t ba = 0, bk = 0, tp = 0, kt = 0, ktt = 0, btt = 0;
+    for (size_t r; (r = cursor.fetch_add(1)) < rows.size();) {
+      const int32_t i = rows[r];
+      for (int32_t j = 0; j < n; ++j) {
+        if (j == i) continue;
+        const bool brute = classifier.Stage2Accepts(classifier.Distance(store.Features(i, j)));
+        const bool kept = builder.KeptDistance(i, j) >= 0;
+        const bool truth = TruthAccepts(sprites[i].truth, sprites[j].truth, truth_options);
+        ba += brute;
+        bk += brute && kept;
+        tp += truth;
+        kt += kept;
+        ktt += kept && truth;
+        btt += brute && truth;
+      }
+    }
+    brute_accepted += ba;
+    brute_kept += bk;
+    truth_pos += tp;
+    kept_total += kt;
+    kept_true += ktt;
+    brute_true += btt;
+  };
+  std::vector<std::thread> pool;
+  for (int k = 1; k < a.threads; ++k) pool.emplace_back(work);
+  work();
+  for (auto& th : pool) th.join();
+  const double seconds_sample = Since(t);
+  const double evaluations = static_cast<double>(rows.size()) * (n - 1);
+  const double seconds_per_eval_core = seconds_sample * a.threads / evaluations;  // includes the truth check
+  const double brute_seconds_core = all_pairs * seconds_per_eval_core;
+  const double ratio = all_pairs / std::max<int64_t>(1, stats.stage1_candidates);
+  const double recall_vs_brute = brute_accepted > 0 ? static_cast<double>(brute_kept) / brute_accepted : 1.0;
+  const double precision_truth = kept_total > 0 ? static_cast<double>(kept_true) / kept_total : 0.0;
+  const double recall_truth = truth_pos > 0 ? static_cast<double>(kept_true) / truth_pos : 0.0;
+
+  // Transition-level quality against truth: i -> j is right when the truth accepts {i,j}, {i+1,j}, {i,j-1}.
+  const TruthLabelOptions truth_options;
+  std::unordered_set<int32_t> row_set(rows.begin(), rows.end());
+  int64_t t_found = 0, t_true = 0, t_truth_total = 0;
+  for (const Transition& tr : transitions) {
+    const int32_t i = *store.IndexOf(tr.from);
+    if (!row_set.count(i)) continue;
+    const int32_t j = *store.IndexOf(tr.to);
+    ++t_found;
+    t_true += TruthAccepts(sprites[i].truth, sprites[j].truth, truth_options) &&
+              TruthAccepts(sprites[store.next(i)].truth, sprites[j].truth, truth_options) &&
+              TruthAccepts(sprites[i].truth, sprites[store.prev(j)].truth, truth_options);
+  }
+  for (int32_t i : rows) {
+    const int32_t s = store.next(i);
+    if (s < 0) continue;
+    for (int32_t j = 0; j < n; ++j) {
+      const int32_t q = store.prev(j);
+      if (q < 0 || j == i || j == s) continue;
+      t_truth_total += TruthAccepts(sprites[i].truth, sprites[j].truth, truth_options) &&
+                       TruthAccepts(sprites[s].truth, sprites[j].truth, truth_options) &&
+                       TruthAccepts(sprites[i].truth, sprites[q].truth, truth_options);
+    }
+  }
+
+  std::printf("\n== transitions: full build, %d synthetic sprites (%lld clips, mirrors included), %d threads ==\n", n,
+              static_cast<long long>(stats.clips), a.threads);
+  std::printf("  build: %.2f s (images %.2f s, index %.3f s, stage 1 + stage 2 %.2f s, transitions %.2f s)"
+              "   goal <= 60 s: %s\n",
+              seconds_build, stats.seconds_images, stats.seconds_index, stats.seconds_pairs, seconds_transitions,
+              seconds_build <= 60 ? "met" : "MISSED");
+  std::printf("  stage-2 evaluations: %lld of %.0f pairs -> %.0fx fewer than brute force   goal >= 1000x: %s\n",
+              static_cast<long long>(stats.stage1_candidates), all_pairs, ratio, ratio >= 1000 ? "met" : "MISSED");
+  std::printf("  brute force (extrapolated from %zu sampled rows x %d = %.3g stage-2 evaluations, %.0f ns each on one "
+              "core): %.0f s on one core, %.0f s on %d; the two-stage build is %.0fx faster\n",
+              rows.size(), n - 1, evaluations, seconds_per_eval_core * 1e9, brute_seconds_core,
+              brute_seconds_core / a.threads, a.threads, brute_seconds_core / a.threads / seconds_build);
+  std::printf("  kept %lld pairs, %zu transitions; of the %lld pairs brute force accepts in the sampled rows, kept "
+              "%.4f   goal >= 0.99: %s\n",
+              static_cast<long long>(stats.kept_pairs), transitions.size(), static_cast<long long>(brute_accepted.load()),
+              recall_vs_brute, recall_vs_brute >= 0.99 ? "met" : "MISSED");
+  std::printf("  against synthetic truth (sampled rows; same pose, heading within %.0f deg, phase within %.2f cycles; "
+              "%.1f true partners per sprite): pairs precision %.3f recall %.3f; transitions precision %.3f recall %.3f\n",
+              truth_options.max_heading_difference_rad * 180 / M_PI, truth_options.max_phase_difference,
+              static_cast<double>(truth_pos) / rows.size(), precision_truth, recall_truth, t_found ? static_cast<double>(t_true) / t_found : 0.0,
+              t_truth_total ? static_cast<double>(t_true) / t_truth_total : 0.0);
+  result["full_build"] = {{"sprites", n},
+                          {"clips", stats.clips},
+                          {"threads", a.threads},
+                          {"seconds", seconds_build},
+                          {"seconds_generate_synthetic", seconds_generate},
+                          {"stage2_evaluations", stats.stage1_candidates},
+                          {"all_pairs", all_pairs},
+                          {"fewer_evaluations_ratio", ratio},
+                          {"kept_pairs", stats.kept_pairs},
+                          {"transitions", transitions.size()},
+                          {"brute_force_sampled_rows", rows.size()},
+                          {"brute_force_ns_per_evaluation_one_core", seconds_per_eval_core * 1e9},
+                          {"brute_force_seconds_extrapolated_one_core", brute_seconds_core},
+                          {"recall_of_brute_force_accepts", recall_vs_brute},
+                          {"brute_force_accepts_sampled", brute_accepted.load()},
+                          {"truth_pair_precision", precision_truth},
+                          {"truth_pair_recall", recall_truth},
+                          {"truth_transition_precision", t_found ? static_cast<double>(t_true) / t_found : 0.0},
+                          {"truth_transition_recall", t_truth_total ? static_cast<double>(t_true) / t_truth_total : 0.0}};
+
+  // ---- incremental ----
+  if (a.incremental) {
+    auto live = LiveSet(a.incremental_base + a.adds, 3);
+    const auto live_inputs = AsSpriteInputs(live);
+    TransitionBuilder inc(weights, px_per_m);
+    t = Clock::now();
+    inc.BuildFromScratch(std::span(live_inputs).first(a.incremental_base), BuildOptions{.threads = a.threads});
+    const double seconds_base = Since(t);
+    for (int k = 0; k < a.incremental_base; ++k) std::vector<uint8_t>().swap(live[k].billboard.rgba);
+    std::vector<double> ms;
+    int64_t new_transitions = 0, appended = 0;
+    const int64_t candidates_before = inc.stats().stage1_candidates;
+    for (int k = 0; k < a.adds; ++k) {
+      const SpriteInput& s = live_inputs[a.incremental_base + k];
+      const auto t0 = Clock::now();
+      const TransitionDelta d = inc.Add(std::span(&s, 1));
+      ms.push_back(Since(t0) * 1e3);
+      new_transitions += static_cast<int64_t>(d.transitions.size());
+      appended += inc.store().prev(inc.store().size() - 1) >= 0;
+    }
+    std::vector<double> sorted = ms;
+    std::sort(sorted.begin(), sorted.end());
+    const double median = sorted[sorted.size() / 2], p90 = sorted[sorted.size() * 9 / 10], worst = sorted.back();
+    std::printf("\n== transitions: incremental, one sprite at a time onto %d sprites (one core) ==\n",
+                a.incremental_base);
+    std::printf("  base build %.1f s; %d adds (%lld appended to an existing clip): median %.3f ms, p90 %.3f ms, max "
+                "%.3f ms (the max includes a k-d tree rebuild)   goal median <= 2 ms: %s\n",
+                seconds_base, a.adds, static_cast<long long>(appended), median, p90, worst,
+                median <= 2 ? "met" : "MISSED");
+    std::printf("  per add: %.1f stage-2 evaluations, %.2f new transitions\n",
+                static_cast<double>(inc.stats().stage1_candidates - candidates_before) / a.adds,
+                static_cast<double>(new_transitions) / a.adds);
+    result["incremental"] = {{"base_sprites", a.incremental_base}, {"adds", a.adds},         {"median_ms", median},
+                             {"p90_ms", p90},                      {"max_ms", worst},        {"base_build_seconds", seconds_base},
+                             {"appended_to_clip", appended}};
+  }
+  if (a.json) std::printf("%s\n", result.dump(2).c_str());
+  if (a.micro) return RunGoogleBenchmarks("BM_Transitions", {"--benchmark_min_time=0.2"});
+  return 0;
+}
+
+// The stage-2 pixel kernel on one pair of 32x32 comparison images: SIMD vs the plain loop.
+void Images(std::vector<uint8_t>* a, std::vector<uint8_t>* b, int* stride) {
+  const ComparisonWindow w;
+  *stride = w.PlaneStride();
+  std::mt19937 rng(1);
+  a->resize(w.ImageBytes());
+  b->resize(w.ImageBytes());
+  for (auto& v : *a) v = rng() % 256;
+  for (auto& v : *b) v = rng() % 256;
+}
+void BM_TransitionsPixelKernelSimd(benchmark::State& state) {
+  std::vector<uint8_t> a, b;
+  int stride;
+  Images(&a, &b, &stride);
+  for (auto _ : state) benchmark::DoNotOptimize(SumPixelDifferences(a.data(), b.data(), stride));
+  state.SetItemsProcessed(state.iterations());
+}
+void BM_TransitionsPixelKernelScalar(benchmark::State& state) {
+  std::vector<uint8_t> a, b;
+  int stride;
+  Images(&a, &b, &stride);
+  for (auto _ : state) benchmark::DoNotOptimize(SumPixelDifferencesScalar(a.data(), b.data(), stride));
+  state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_TransitionsPixelKernelSimd);
+BENCHMARK(BM_TransitionsPixelKernelScalar);
+
+const bool registered = RegisterSuite(
+    {"transitions",
+     "two-stage transition search on a synthetic 30k-sprite bank vs brute force; incremental add at 60k "
+     "[--sprites N --threads T --rows R --weights F --train-out F --skip-incremental --micro --json]",
+     &Run});
+
+}  // namespace
+}  // namespace ss::bench

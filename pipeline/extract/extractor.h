@@ -1,0 +1,65 @@
+#pragma once
+// Sprite candidates from a keyed frame: one per connected region of the
+// keyer's coarse grid (the connected components, found at 1/step resolution
+// by the keyer), cut to the subject's box. Blobs smaller than `min_area` are
+// noise: dropped and counted.
+#include <cstdint>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "pipeline/key/matte.h"
+
+namespace ss {
+
+struct Candidate {
+  int region = 0;            // the KeyRegion id it came from
+  cv::Rect bbox;             // frame pixels: subject box + margin, grown to hold its shadow
+  cv::Mat alpha;             // CV_8U, bbox-sized
+  cv::Mat colour;            // CV_8UC3, bbox-sized, spill removed
+  cv::Mat shadow;            // CV_8U, bbox-sized contact shadow (floor darkening, 255 = black)
+  cv::Point2d lowest_point;  // frame pixels: y where alpha falls through 1/2 below the lowest
+                             // row with alpha > 1/2; x the mean of that row's such pixels
+  double area = 0;           // sum of alpha / 255, pixels
+  bool touches_border = false;  // the subject (alpha >= alpha_min) reaches the frame's edge
+};
+
+struct ExtractorOptions {
+  double min_area = 40;  // pixels of alpha; smaller blobs are noise
+  int margin_px = 4;     // added around the subject's alpha box
+  int alpha_min = 16;    // alpha (of 255) that counts as subject for the box and the border test
+  int shadow_min = 16;   // shadow (of 255) that counts for the box
+};
+
+struct ExtractTotals {
+  uint64_t frames = 0;
+  uint64_t candidates = 0;
+  uint64_t noise_dropped = 0;  // blobs below min_area
+};
+
+class Extractor {
+ public:
+  explicit Extractor(ExtractorOptions options = {});
+  // The candidates of one keyed frame. They borrow the extractor's buffers,
+  // reused by the next call: clone what must outlive it.
+  const std::vector<Candidate>& Extract(const Matte& matte);
+  int dropped_last() const { return dropped_last_; }  // noise blobs dropped by the last call
+  const ExtractTotals& totals() const { return totals_; }
+  const ExtractorOptions& options() const { return options_; }
+
+ private:
+  struct Storage {  // grows, never shrinks: no allocation once warm
+    std::vector<uint8_t> alpha, colour, shadow;
+  };
+  // Builds candidate `index` from region `r`; false when it is noise.
+  bool Cut(const Matte& matte, const KeyRegion& r, size_t index);
+
+  ExtractorOptions options_;
+  std::vector<Candidate> candidates_;
+  std::vector<Storage> storage_;
+  cv::Mat masked_alpha_, masked_shadow_;  // scratch for regions whose boxes overlap
+  int dropped_last_ = 0;
+  ExtractTotals totals_;
+};
+
+}  // namespace ss

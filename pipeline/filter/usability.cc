@@ -1,0 +1,100 @@
+#include "pipeline/filter/usability.h"
+
+#include <opencv2/imgproc.hpp>
+
+namespace ss {
+
+const char* DiscardName(Discard reason) {
+  switch (reason) {
+    case Discard::kNone: return "kept";
+    case Discard::kTooSmall: return "too_small";
+    case Discard::kTouchesBorder: return "touches_border";
+    case Discard::kNoGroundHit: return "no_ground_hit";
+    case Discard::kLeavesFloor: return "leaves_floor";
+    case Discard::kTouchesWall: return "touches_wall";
+    case Discard::kStill: return "still";
+    case Discard::kShortClip: return "short_clip";
+    case Discard::kCount: break;
+  }
+  return "unknown";
+}
+
+FloorMask::FloorMask(const CameraModel& camera, const GroundPolygon& floor, const UsabilityOptions& options)
+    : floor_(floor), options_(options) {
+  mask_ = cv::Mat::zeros(camera.height(), camera.width(), CV_8U);
+  const Eigen::Vector3d centre = camera.CentreInGround();
+  for (int y = 0; y < camera.height(); ++y) {
+    auto* row = mask_.ptr<uint8_t>(y);
+    for (int x = 0; x < camera.width(); ++x) {
+      const Ray ray = camera.RayInGround(Eigen::Vector2d(x, y));
+      const auto g = IntersectGround(ray);
+      if (!g || !floor_.Contains(g->head<2>())) continue;
+      // Seen over the walls: where the ray passes wall height it must be inside too.
+      if (options_.wall_height_m > 0 && centre.z() > options_.wall_height_m) {
+        const double s = (centre.z() - options_.wall_height_m) / centre.z();
+        const Eigen::Vector3d top = centre + s * (*g - centre);
+        if (!floor_.Contains(top.head<2>())) continue;
+      }
+      row[x] = 255;
+    }
+  }
+  cv::integral(mask_ == 0, not_floor_integral_, CV_32S);
+  not_floor_integral_ /= 255;
+}
+
+Discard FloorMask::Check(const cv::Mat& alpha_crop, cv::Point offset, const Eigen::Vector2d& point_in_ground) const {
+  const cv::Rect box(offset, alpha_crop.size());
+  const int b = options_.border_margin_px;
+  if (box.x < b || box.y < b || box.x + box.width > mask_.cols - b || box.y + box.height > mask_.rows - b) {
+    return Discard::kTouchesBorder;
+  }
+  if (!floor_.ContainsWithMargin(point_in_ground, options_.wall_margin_m)) return Discard::kLeavesFloor;
+
+  // Fast path: the whole crop grown by the margin is floor.
+  const int m = options_.floor_margin_px;
+  const cv::Rect grown = cv::Rect(box.x - m, box.y - m, box.width + 2 * m, box.height + 2 * m) &
+                         cv::Rect(0, 0, mask_.cols, mask_.rows);
+  const auto at = [&](int y, int x) { return not_floor_integral_.at<int>(y, x); };
+  const int not_floor = at(grown.y + grown.height, grown.x + grown.width) - at(grown.y, grown.x + grown.width) -
+                        at(grown.y + grown.height, grown.x) + at(grown.y, grown.x);
+  if (not_floor == 0) return Discard::kNone;
+
+  // Slow path: the silhouette grown by the margin must not cover non-floor pixels.
+  cv::Mat solid = alpha_crop > 127;
+  cv::Mat padded;
+  cv::copyMakeBorder(solid, padded, m, m, m, m, cv::BORDER_CONSTANT, cv::Scalar(0));
+  cv::dilate(padded, padded, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * m + 1, 2 * m + 1)));
+  for (int y = 0; y < padded.rows; ++y) {
+    const int iy = box.y - m + y;
+    if (iy < 0 || iy >= mask_.rows) continue;
+    const auto* p = padded.ptr<uint8_t>(y);
+    const auto* f = mask_.ptr<uint8_t>(iy);
+    for (int x = 0; x < padded.cols; ++x) {
+      const int ix = box.x - m + x;
+      if (ix >= 0 && ix < mask_.cols && p[x] && !f[ix]) return Discard::kTouchesWall;
+    }
+  }
+  return Discard::kNone;
+}
+
+bool StillnessFilter::IsStill(int subject, int64_t timestamp_ns, const Eigen::Vector2d& point) {
+  auto [it, fresh] = subjects_.try_emplace(subject);
+  State& s = it->second;
+  if (fresh) {
+    s.anchor = point;
+    s.still_since_ns = timestamp_ns;
+    return false;
+  }
+  const double dt = (timestamp_ns - s.still_since_ns) * 1e-9;
+  // Still while the subject stays within the distance min_speed would cover in the period so far
+  // (at least 2 mm, the keying jitter of a contact point).
+  const double allowed = std::max(0.002, min_speed_ * dt);
+  if ((point - s.anchor).norm() > allowed) {
+    s.anchor = point;
+    s.still_since_ns = timestamp_ns;
+    return false;
+  }
+  return timestamp_ns - s.still_since_ns > max_still_ns_;
+}
+
+}  // namespace ss

@@ -1,0 +1,74 @@
+#pragma once
+// Which sprites are usable (seed 000 §2): entirely surrounded by floor in the
+// image (touching no wall, no image border), standing inside the floor
+// polygon, and not standing still for too long. Every discard has a reason.
+#include <array>
+#include <cstdint>
+#include <string>
+#include <unordered_map>
+
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
+
+#include "core/camera_model.h"
+#include "core/geometry.h"
+
+namespace ss {
+
+enum class Discard {
+  kNone = 0,
+  kTooSmall,       // a noise blob below the minimum area
+  kTouchesBorder,  // the sprite reaches the image border
+  kNoGroundHit,    // the lowest point's ray misses the floor
+  kLeavesFloor,    // the contact point lies outside the floor polygon (or within the wall margin)
+  kTouchesWall,    // the silhouette overlaps something that is not floor (a wall)
+  kStill,          // part of an extended period without motion
+  kShortClip,      // its clip was too short to give transitions
+  kCount,
+};
+const char* DiscardName(Discard reason);  // "too_small", "touches_border", ...
+
+// Counts by reason; `kNone` counts kept sprites.
+using DiscardCounts = std::array<uint64_t, static_cast<size_t>(Discard::kCount)>;
+
+struct UsabilityOptions {
+  int border_margin_px = 2;       // distance to keep from the image border
+  int floor_margin_px = 3;        // floor pixels required around the silhouette
+  double wall_margin_m = 0.005;   // contact point distance to keep from the polygon edge
+  double wall_height_m = 0.0;     // walls occlude the floor behind them up to this height
+};
+
+// Per camera: the image of the floor, computed once.
+class FloorMask {
+ public:
+  FloorMask(const CameraModel& camera, const GroundPolygon& floor, const UsabilityOptions& options);
+  // Usability of one sprite from its alpha crop at `offset` and its contact point.
+  Discard Check(const cv::Mat& alpha_crop, cv::Point offset, const Eigen::Vector2d& point_in_ground) const;
+  const cv::Mat& mask() const { return mask_; }  // 255 where the camera sees floor
+
+ private:
+  GroundPolygon floor_;
+  UsabilityOptions options_;
+  cv::Mat mask_;
+  cv::Mat not_floor_integral_;  // integral image of (mask_ == 0), for O(1) box tests
+};
+
+// Per subject: drops frames once the subject has been still for longer than allowed.
+class StillnessFilter {
+ public:
+  StillnessFilter(double min_speed_m_per_s, double max_still_s)
+      : min_speed_(min_speed_m_per_s), max_still_ns_(static_cast<int64_t>(max_still_s * 1e9)) {}
+  // True when the subject's frame at `timestamp_ns` is part of a too-long still period.
+  bool IsStill(int subject, int64_t timestamp_ns, const Eigen::Vector2d& point_in_ground);
+
+ private:
+  struct State {
+    Eigen::Vector2d anchor;       // where the current still period started
+    int64_t still_since_ns = -1;  // -1: moving
+  };
+  double min_speed_;
+  int64_t max_still_ns_;
+  std::unordered_map<int, State> subjects_;
+};
+
+}  // namespace ss

@@ -1,0 +1,64 @@
+#pragma once
+// Green-screen keyer by colour difference (docs/keying.md). For a pixel with
+// luma Y = (B + 2G + R) / 4 the key is k = (G - max(R, B)) / Y: it does not
+// change when the floor is merely darker (vignetting, a shadow). Training on
+// the empty enclosure learns, per coarse cell, the green's luma Y_bg, its key
+// k_bg and the key's noise; a pixel is background above
+// k_hi = k_bg - max(min_margin * k_bg, noise_z * sigma_k), and alpha ramps up
+// to 1 over ramp * k_bg below that. Despill limits G to max(R, B). The shadow
+// layer is the floor's darkening 1 - Y / Y_bg outside the subject.
+#include <cstdint>
+#include <vector>
+
+#include "pipeline/key/keyer.h"
+
+namespace ss {
+
+struct ChromaKeyerOptions {
+  GridOptions grid;
+  double noise_z = 5.0;         // background tolerance in noise std of the learned key...
+  double min_margin = 0.2;      // ...and at least this fraction of the learned key
+  double ramp = 0.6;            // alpha goes 0 -> 1 over this fraction of the learned key
+  double dark_floor = 0.2;      // luma below this fraction of the floor's counts as subject, not shadow
+  double shadow_min = 0.06;     // darkening below this is noise: no shadow
+  double coarse_alpha = 0.25;   // a sample with a larger alpha marks its cell as foreground
+  double coarse_shadow = 0.12;  // a sample darkened more marks its cell as shaded
+  double min_key = 0.1;         // training cells with a smaller key k_bg are not green and never keyed
+  double max_unkeyable = 0.5;   // training fails when more than this fraction of cells is not green
+  bool global_model = false;    // one reference for the whole frame: the naive keyer, for comparison
+};
+
+class ChromaKeyer : public Keyer {
+ public:
+  explicit ChromaKeyer(ChromaKeyerOptions options = {});
+  std::string name() const override { return "chroma"; }
+  void Train(const std::vector<cv::Mat>& empty_bgr) override;
+  const ChromaKeyerOptions& options() const { return options_; }
+  double unkeyable_fraction() const { return unkeyable_fraction_; }  // of cells, after Train
+
+ protected:
+  void SampleRow(const uint8_t* bgr_row, int cell_row, uint8_t* foreground, uint8_t* shade) const override;
+  void FineRow(const uint8_t* bgr_row, int y, int x0, int x1, uint8_t* alpha, uint8_t* shadow,
+               uint8_t* colour) const override;
+
+ private:
+  // The key's parameters at one place, in the units of the kernel (luma4 =
+  // B + 2G + R). Stored per cell for the coarse pass and, interpolated along x,
+  // per pixel of each cell row ("band") for the fine pass.
+  enum FloatParam { kKeyHi, kGain, kInvLuma, kShadowBase, kFloatParams };
+  struct Params {
+    const float* f[kFloatParams];  // indexed by FloatParam
+    const int32_t* luma_floor;
+  };
+  Params BandParams(int cell_row) const;
+  Params CellParams(int cell_row) const;
+
+  ChromaKeyerOptions options_;
+  std::vector<float> cell_f_;        // rows_ x kFloatParams x cols_: at each cell's sample
+  std::vector<int32_t> cell_floor_;  // rows_ x cols_
+  std::vector<float> band_f_;        // rows_ x kFloatParams x width: at every pixel of a cell row
+  std::vector<int32_t> band_floor_;  // rows_ x width
+  double unkeyable_fraction_ = 0;
+};
+
+}  // namespace ss

@@ -1,0 +1,129 @@
+#include "pipeline/key/clean_plate_keyer.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include <opencv2/imgproc.hpp>
+
+#include "core/error.h"
+#include "core/log.h"
+
+namespace ss {
+namespace {
+
+struct PixelKey {
+  int alpha;   // 0..255
+  int shadow;  // 0..255
+};
+
+// The clean-plate key of one pixel p against plate colour mu (docs/keying.md).
+// No branches and no floating-point min/max, so that loops of it vectorize.
+inline PixelKey PlatePixel(int b, int g, int r, int mu_b, int mu_g, int mu_r, float tolerance, float gain,
+                           float dark_floor, int shadow_min) {
+  const float pb = static_cast<float>(b), pg = static_cast<float>(g), pr = static_cast<float>(r);
+  const float ub = static_cast<float>(mu_b), ug = static_cast<float>(mu_g), ur = static_cast<float>(mu_r);
+  const float mu2 = ub * ub + ug * ug + ur * ur + 1.f;
+  const float ratio = (pb * ub + pg * ug + pr * ur) / mu2;  // brightness relative to the plate
+  const float eb = pb - ratio * ub, eg = pg - ratio * ug, er = pr - ratio * ur;
+  const float chroma = std::sqrt(eb * eb + eg * eg + er * er);  // levels off the plate's colour line
+  const float mu_norm = std::sqrt(mu2);
+  // Distance from "the plate, possibly in shadow", in quarter levels.
+  const int brighter = static_cast<int>((ratio - 1.f) * mu_norm * 4.f);
+  const int too_dark = static_cast<int>((dark_floor - ratio) * mu_norm * 4.f);
+  const int distance4 = std::max(static_cast<int>(chroma * 4.f), std::max(brighter, too_dark));
+  const int alpha =
+      std::clamp(static_cast<int>((static_cast<float>(distance4) * 0.25f - tolerance) * gain + 0.5f), 0, 255);
+  const int dark = static_cast<int>(255.f - ratio * 255.f + 0.5f);
+  const int shade = dark >= shadow_min ? dark : 0;
+  return {alpha, ((shade * (255 - alpha) + 128) * 257) >> 16};
+}
+
+__attribute__((target_clones("avx2", "ssse3", "default")))
+void PlateRow(const uint8_t* __restrict in, const uint8_t* __restrict plate, const float* __restrict tolerance,
+              int x0, int x1, float gain, float dark_floor, int shadow_min, uint8_t* __restrict alpha,
+              uint8_t* __restrict shadow, uint8_t* __restrict colour) {
+  for (int x = x0; x < x1; ++x) {
+    const PixelKey k = PlatePixel(in[3 * x], in[3 * x + 1], in[3 * x + 2], plate[3 * x], plate[3 * x + 1],
+                                  plate[3 * x + 2], tolerance[x], gain, dark_floor, shadow_min);
+    alpha[x] = static_cast<uint8_t>(k.alpha);
+    shadow[x] = static_cast<uint8_t>(k.shadow);
+  }
+  std::copy(in + 3 * x0, in + 3 * x1, colour + 3 * x0);  // no spill to remove on a non-green plate
+}
+
+}  // namespace
+
+CleanPlateKeyer::CleanPlateKeyer(CleanPlateKeyerOptions options) : Keyer(options.grid), options_(options) {
+  const auto& o = options_;
+  auto check = [](bool ok, const char* field, const char* reason) {
+    if (!ok) throw InputError(std::string("keying.clean_plate.") + field, reason);
+  };
+  check(o.noise_z >= 0, "noise_z", "must not be negative");
+  check(o.min_sigma > 0, "min_sigma", "must be positive");
+  check(o.ramp > 0, "ramp", "must be positive");
+  check(o.dark_floor >= 0 && o.dark_floor < 1, "dark_floor", "must be within [0, 1)");
+  check(o.shadow_min >= 0 && o.shadow_min < 1, "shadow_min", "must be within [0, 1)");
+  check(o.coarse_alpha > 0 && o.coarse_alpha < 1, "coarse_alpha", "must be within (0, 1)");
+  check(o.coarse_shadow > 0 && o.coarse_shadow < 1, "coarse_shadow", "must be within (0, 1)");
+}
+
+void CleanPlateKeyer::Train(const std::vector<cv::Mat>& empty_bgr) {
+  StartTraining(empty_bgr, "clean-plate keyer");
+  cv::Mat sum = cv::Mat::zeros(size_, CV_64FC3), sum_sq = cv::Mat::zeros(size_, CV_64FC3);
+  cv::Mat f64;
+  for (const cv::Mat& frame : empty_bgr) {
+    frame.convertTo(f64, CV_64FC3);
+    sum += f64;
+    sum_sq += f64.mul(f64);
+  }
+  const double n = static_cast<double>(empty_bgr.size());
+  cv::Mat mean = sum / n;
+  cv::Mat var = sum_sq / n - mean.mul(mean);
+  mean.convertTo(plate_, CV_8UC3);  // rounds
+  // One noise std per pixel: the root mean of the channel variances, floored,
+  // then the largest of each 3x3 neighbourhood (a camera shaking by a pixel
+  // at a texture edge would otherwise look like a subject).
+  cv::Mat var1;
+  cv::transform(var, var1, cv::Matx13d(1.0 / 3, 1.0 / 3, 1.0 / 3));
+  var1 = cv::max(var1, options_.min_sigma * options_.min_sigma);
+  cv::Mat sigma;
+  cv::sqrt(var1, sigma);
+  cv::dilate(sigma, sigma, cv::Mat::ones(3, 3, CV_8U));
+  sigma.convertTo(tolerance_, CV_32F, options_.noise_z);
+  if (empty_bgr.size() < 2) {
+    Log("pipeline.key")->warn("clean-plate keyer trained on one frame: noise std is the floor {:.1f}",
+                              options_.min_sigma);
+  }
+  Log("pipeline.key")->debug("clean-plate keyer trained on {} frames {}x{}, mean tolerance {:.1f} levels",
+                             empty_bgr.size(), size_.width, size_.height, cv::mean(tolerance_)[0]);
+}
+
+void CleanPlateKeyer::SampleRow(const uint8_t* bgr_row, int cell_row, uint8_t* foreground,
+                                uint8_t* shade) const {
+  const int y = SampleY(cell_row);
+  const uint8_t* plate = plate_.ptr<uint8_t>(y);
+  const float* tolerance = tolerance_.ptr<float>(y);
+  const float gain = static_cast<float>(255 / options_.ramp);
+  const float dark_floor = static_cast<float>(options_.dark_floor);
+  const int shadow_min = static_cast<int>(std::lround(255 * options_.shadow_min));
+  const int coarse_alpha = static_cast<int>(std::lround(255 * options_.coarse_alpha));
+  const int coarse_shadow = static_cast<int>(std::lround(255 * options_.coarse_shadow));
+  for (int cx = 0; cx < cols_; ++cx) {
+    const int x = SampleX(cx);
+    const uint8_t* p = bgr_row + 3 * x;
+    const uint8_t* u = plate + 3 * x;
+    const PixelKey k = PlatePixel(p[0], p[1], p[2], u[0], u[1], u[2], tolerance[x], gain, dark_floor, shadow_min);
+    foreground[cx] = k.alpha > coarse_alpha;
+    shade[cx] = k.shadow > coarse_shadow;
+  }
+}
+
+void CleanPlateKeyer::FineRow(const uint8_t* bgr_row, int y, int x0, int x1, uint8_t* alpha,
+                              uint8_t* shadow, uint8_t* colour) const {
+  PlateRow(bgr_row, plate_.ptr<uint8_t>(y), tolerance_.ptr<float>(y), x0, x1,
+           static_cast<float>(255 / options_.ramp), static_cast<float>(options_.dark_floor),
+           static_cast<int>(std::lround(255 * options_.shadow_min)), alpha, shadow, colour);
+}
+
+}  // namespace ss

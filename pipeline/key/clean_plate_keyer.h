@@ -1,0 +1,47 @@
+#pragma once
+// Keyer for backgrounds that are not green: difference against a clean plate
+// (the mean of empty-enclosure frames) with a per-pixel noise model (their
+// spread). The difference is split as in Horprasert et al. (1999): the plate
+// colour scaled by a brightness ratio a = (p . mu) / (mu . mu), and what is
+// left, the chromaticity distortion |p - a mu|. A shadow only changes a, so a
+// darkening 1 - a within the noise of the plate's colour is shadow, not
+// subject; colour changes, brightening, and darkening below `dark_floor` are
+// subject. See docs/keying.md.
+#include <vector>
+
+#include "pipeline/key/keyer.h"
+
+namespace ss {
+
+struct CleanPlateKeyerOptions {
+  GridOptions grid;
+  double noise_z = 4.0;         // differences within this many noise std are background
+  double min_sigma = 2.0;       // noise std floor, levels of 255 (a single empty frame has no spread)
+  double ramp = 30.0;           // alpha goes 0 -> 1 over this many levels beyond the tolerance
+  double dark_floor = 0.3;      // darker than this fraction of the plate is subject, not shadow
+  double shadow_min = 0.06;     // darkening below this is noise: no shadow
+  double coarse_alpha = 0.25;   // a sample with a larger alpha marks its cell as foreground
+  double coarse_shadow = 0.12;  // a sample darkened more marks its cell as shaded
+};
+
+class CleanPlateKeyer : public Keyer {
+ public:
+  explicit CleanPlateKeyer(CleanPlateKeyerOptions options = {});
+  std::string name() const override { return "clean-plate"; }
+  void Train(const std::vector<cv::Mat>& empty_bgr) override;
+  const CleanPlateKeyerOptions& options() const { return options_; }
+  const cv::Mat& plate() const { return plate_; }        // CV_8UC3, mean empty frame
+  const cv::Mat& tolerance() const { return tolerance_; }  // CV_32F, levels: noise_z * sigma per pixel
+
+ protected:
+  void SampleRow(const uint8_t* bgr_row, int cell_row, uint8_t* foreground, uint8_t* shade) const override;
+  void FineRow(const uint8_t* bgr_row, int y, int x0, int x1, uint8_t* alpha, uint8_t* shadow,
+               uint8_t* colour) const override;
+
+ private:
+  CleanPlateKeyerOptions options_;
+  cv::Mat plate_;
+  cv::Mat tolerance_;
+};
+
+}  // namespace ss

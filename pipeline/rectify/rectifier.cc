@@ -1,0 +1,153 @@
+#include "pipeline/rectify/rectifier.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <opencv2/imgproc.hpp>
+
+namespace ss {
+namespace {
+
+// Coarse grid step (billboard pixels) at which points go through the full lens
+// model; the dense remap is interpolated in between. Lens distortion varies
+// slowly, so 8 px keeps the interpolation error far below a pixel.
+constexpr int kGridStep = 8;
+
+// Builds a remap from a `size` target to image pixels minus `offset`, where
+// target pixel (u, v) is the ground-frame point `origin + u*du + v*dv`.
+void BuildPlaneMap(const CameraModel& camera, const Eigen::Vector3d& origin, const Eigen::Vector3d& du,
+                   const Eigen::Vector3d& dv, cv::Size size, cv::Point offset, cv::Mat& map) {
+  const int gw = (size.width + kGridStep - 1) / kGridStep + 1;
+  const int gh = (size.height + kGridStep - 1) / kGridStep + 1;
+  std::vector<Eigen::Vector2f> grid(static_cast<size_t>(gw) * gh);
+  for (int gy = 0; gy < gh; ++gy) {
+    for (int gx = 0; gx < gw; ++gx) {
+      const Eigen::Vector3d p = origin + (gx * kGridStep) * du + (gy * kGridStep) * dv;
+      const Eigen::Vector2d px = camera.ProjectGround(p);
+      grid[gy * gw + gx] = Eigen::Vector2f(static_cast<float>(px.x() - offset.x),
+                                           static_cast<float>(px.y() - offset.y));
+    }
+  }
+  map.create(size, CV_32FC2);
+  for (int v = 0; v < size.height; ++v) {
+    const int gy = v / kGridStep;
+    const float fy = static_cast<float>(v - gy * kGridStep) / kGridStep;
+    auto* row = map.ptr<cv::Vec2f>(v);
+    for (int u = 0; u < size.width; ++u) {
+      const int gx = u / kGridStep;
+      const float fx = static_cast<float>(u - gx * kGridStep) / kGridStep;
+      const Eigen::Vector2f& a = grid[gy * gw + gx];
+      const Eigen::Vector2f& b = grid[gy * gw + gx + 1];
+      const Eigen::Vector2f& c = grid[(gy + 1) * gw + gx];
+      const Eigen::Vector2f& d = grid[(gy + 1) * gw + gx + 1];
+      const Eigen::Vector2f p = (1 - fy) * ((1 - fx) * a + fx * b) + fy * ((1 - fx) * c + fx * d);
+      row[u] = cv::Vec2f(p.x(), p.y());
+    }
+  }
+}
+
+// Where the ray through `pixel` meets the vertical plane through `point` with normal `n` (horizontal).
+std::optional<Eigen::Vector3d> IntersectVerticalPlane(const CameraModel& camera, const Eigen::Vector2d& pixel,
+                                                      const Eigen::Vector3d& point, const Eigen::Vector3d& n) {
+  const Ray ray = camera.RayInGround(pixel);
+  const double denom = ray.direction.dot(n);
+  if (std::abs(denom) < 1e-12) return std::nullopt;
+  const double s = (point - ray.origin).dot(n) / denom;
+  if (s <= 0) return std::nullopt;
+  return ray.origin + s * ray.direction;
+}
+
+}  // namespace
+
+std::optional<Billboard> Rectifier::Rectify(const CameraModel& camera, const SpriteView& view) const {
+  if (view.bgr == nullptr || view.alpha == nullptr || view.bgr->empty() ||
+      view.bgr->size() != view.alpha->size()) {
+    return std::nullopt;
+  }
+  const auto contact = IntersectGround(camera.RayInGround(view.lowest_px));
+  if (!contact) return std::nullopt;
+
+  const Eigen::Vector3d centre = camera.CentreInGround();
+  Eigen::Vector2d toward(centre.x() - contact->x(), centre.y() - contact->y());
+  if (toward.norm() < 1e-9) return std::nullopt;  // camera straight above: no vertical billboard
+  toward.normalize();
+  // Seen from the camera, x runs to the right: right = view_direction x up.
+  const Eigen::Vector2d right(-toward.y(), toward.x());
+  const Eigen::Vector3d n(toward.x(), toward.y(), 0.0);
+  const Eigen::Vector3d right3(right.x(), right.y(), 0.0);
+  const Eigen::Vector3d up(0, 0, 1);
+
+  // The billboard's extent: the crop's corners and edge midpoints on the plane.
+  const double x0 = view.offset.x, y0 = view.offset.y;
+  const double x1 = x0 + view.bgr->cols, y1 = y0 + view.bgr->rows;
+  double min_r = 0, max_r = 0, max_h = 0;
+  bool any = false;
+  for (const Eigen::Vector2d px : {Eigen::Vector2d(x0, y0), Eigen::Vector2d(x1, y0), Eigen::Vector2d(x0, y1),
+                                   Eigen::Vector2d(x1, y1), Eigen::Vector2d((x0 + x1) / 2, y0),
+                                   Eigen::Vector2d(x0, (y0 + y1) / 2), Eigen::Vector2d(x1, (y0 + y1) / 2)}) {
+    const auto hit = IntersectVerticalPlane(camera, px, *contact, n);
+    if (!hit) continue;
+    const Eigen::Vector3d d = *hit - *contact;
+    min_r = any ? std::min(min_r, d.dot(right3)) : d.dot(right3);
+    max_r = any ? std::max(max_r, d.dot(right3)) : d.dot(right3);
+    max_h = std::max(max_h, d.z());
+    any = true;
+  }
+  if (!any || max_h <= 0) return std::nullopt;
+
+  const double s = options_.px_per_m;
+  const double half_w = std::max(-min_r, max_r) + options_.margin_m;
+  const int width = 2 * static_cast<int>(std::ceil(half_w * s)) + 1;
+  const int height = static_cast<int>(std::ceil((max_h + options_.margin_m) * s)) + 1;
+  if (width > options_.max_side_px || height > options_.max_side_px || width < 3 || height < 3) {
+    return std::nullopt;
+  }
+
+  Billboard out;
+  out.px_per_m = s;
+  out.point_in_ground = *contact;
+  out.right_in_ground = right;
+  out.toward_camera = toward;
+  out.anchor_px = Eigen::Vector2d((width - 1) / 2.0, height - 1.0);
+
+  // Billboard pixel (u, v) is the point contact + right*(u - a_u)/s + up*(a_v - v)/s.
+  const Eigen::Vector3d origin = *contact - right3 * (out.anchor_px.x() / s) + up * (out.anchor_px.y() / s);
+  cv::Mat map;
+  BuildPlaneMap(camera, origin, right3 / s, -up / s, cv::Size(width, height), view.offset, map);
+  cv::Mat bgr, alpha;
+  cv::remap(*view.bgr, bgr, map, cv::noArray(), cv::INTER_LINEAR, cv::BORDER_CONSTANT, cv::Scalar::all(0));
+  cv::remap(*view.alpha, alpha, map, cv::noArray(), cv::INTER_LINEAR, cv::BORDER_CONSTANT, cv::Scalar(0));
+  cv::Mat channels[4];
+  cv::split(bgr, channels);
+  channels[3] = alpha;
+  cv::merge(channels, 4, out.bgra);
+
+  // The shadow patch: ground axes `right` (u) and `-toward` (v, away from the camera).
+  const int side = 2 * static_cast<int>(std::ceil(options_.shadow_radius_m * s)) + 1;
+  if (view.shadow != nullptr && !view.shadow->empty()) {
+    const Eigen::Vector3d away(-toward.x(), -toward.y(), 0.0);
+    const double half = (side - 1) / 2.0 / s;
+    const Eigen::Vector3d sorigin = *contact - right3 * half - away * half;
+    BuildPlaneMap(camera, sorigin, right3 / s, away / s, cv::Size(side, side), view.offset, map);
+    cv::remap(*view.shadow, out.shadow, map, cv::noArray(), cv::INTER_LINEAR, cv::BORDER_CONSTANT,
+              cv::Scalar(0));
+  } else {
+    out.shadow = cv::Mat::zeros(side, side, CV_8U);
+  }
+  return out;
+}
+
+// The billboard keeps its place and axes; only its content is mirrored.
+Billboard Rectifier::Mirror(const Billboard& b) {
+  Billboard m = b;
+  cv::flip(b.bgra, m.bgra, 1);
+  cv::flip(b.shadow, m.shadow, 1);
+  m.anchor_px.x() = (b.bgra.cols - 1) - b.anchor_px.x();
+  return m;
+}
+
+Eigen::Vector2d Rectifier::MirrorVelocity(const Billboard& b, const Eigen::Vector2d& v) {
+  return v - 2.0 * v.dot(b.right_in_ground) * b.right_in_ground;
+}
+
+}  // namespace ss

@@ -1,0 +1,60 @@
+#pragma once
+// Perspective correction (seed 000 §2.1). The ray through the sprite's lowest
+// point meets the floor at its ground position; the sprite is resampled onto a
+// vertical billboard standing there and facing the camera, at a fixed metric
+// scale (px_per_m) shared by the whole bank, so near and far sprites look
+// alike. The contact shadow is resampled onto a horizontal ground patch around
+// the same point, so rendering can lay it on the virtual floor.
+#include <optional>
+
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
+
+#include "core/camera_model.h"
+
+namespace ss {
+
+struct RectifierOptions {
+  double px_per_m = 800.0;        // billboard and shadow-patch scale (1.25 mm per pixel)
+  double margin_m = 0.01;         // billboard border around the sprite's extent
+  double shadow_radius_m = 0.08;  // half-size of the square ground patch for the shadow
+  int max_side_px = 512;          // refuse absurd billboards (a sprite far above the floor)
+};
+
+// What the camera saw, cropped: pixels of the crop at (offset) in the full image.
+struct SpriteView {
+  const cv::Mat* bgr = nullptr;     // CV_8UC3 crop
+  const cv::Mat* alpha = nullptr;   // CV_8U crop, same size
+  const cv::Mat* shadow = nullptr;  // CV_8U crop, same size; may be null
+  cv::Point offset;                 // crop's top-left in the full image
+  Eigen::Vector2d lowest_px;        // lowest sprite point, full-image pixels
+};
+
+struct Billboard {
+  cv::Mat bgra;                     // CV_8UC4 straight alpha, billboard pixels
+  cv::Mat shadow;                   // CV_8U ground patch centred on the contact point
+  Eigen::Vector2d anchor_px;        // contact point on the billboard (bottom centre)
+  Eigen::Vector3d point_in_ground;  // contact point on the floor (z = 0)
+  Eigen::Vector2d right_in_ground;  // unit billboard x axis on the floor
+  Eigen::Vector2d toward_camera;    // unit floor direction from the sprite to the camera
+  double px_per_m = 0;
+};
+
+class Rectifier {
+ public:
+  explicit Rectifier(RectifierOptions options = {}) : options_(options) {}
+  // nullopt when the lowest point's ray misses the floor or the billboard is degenerate.
+  std::optional<Billboard> Rectify(const CameraModel& camera, const SpriteView& view) const;
+  // The horizontally mirrored billboard (seed 000 §2): the image flipped about
+  // its vertical axis and the anchor with it; place and axes unchanged.
+  static Billboard Mirror(const Billboard& billboard);
+  // A ground velocity seen in the mirror: its component along `right` flips.
+  static Eigen::Vector2d MirrorVelocity(const Billboard& billboard, const Eigen::Vector2d& velocity);
+
+  const RectifierOptions& options() const { return options_; }
+
+ private:
+  RectifierOptions options_;
+};
+
+}  // namespace ss

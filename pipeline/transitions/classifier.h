@@ -1,0 +1,51 @@
+#pragma once
+// TransitionWeights turned into the form the hot loops use: raw-unit weights u_k =
+// w_k / scale_k and thresholds T = sum_k w_k mean_k / scale_k - b, so that
+//   stage 1 accepts  sum_k u1_k |d_k| <= T1   (a weighted-L1 ball, velocity as a 2-D norm)
+//   stage 2 accepts  D = sum_k u2_k x_k <= T2 (D >= 0 is the visual difference D(i,j)).
+#include <array>
+
+#include "pipeline/transitions/features.h"
+#include "pipeline/transitions/weights.h"
+
+namespace ss {
+
+class TransitionClassifier {
+ public:
+  // Throws InputError("weights", reason) for invalid weights.
+  explicit TransitionClassifier(const TransitionWeights& weights);
+
+  // The stage-1 sum; the linear scan and the index both decide with exactly this.
+  double Stage1Sum(const CheapFeatures& a, const CheapFeatures& b) const {
+    const CheapDifference d = CheapDiff(a, b);
+    return u1_[0] * d[0] + u1_[1] * d[1] + u1_[2] * d[2] + u1_[3] * d[3];
+  }
+  bool Stage1Accepts(const CheapFeatures& a, const CheapFeatures& b) const {
+    return Stage1Sum(a, b) <= t1_;
+  }
+  // s1 = w.z + b of the standardized model (accept when <= 0).
+  double Stage1Value(const CheapDifference& d) const;
+
+  // D(i,j) = s2 - s2(0) >= 0; kept when D <= stage2_threshold().
+  double Distance(const PairFeatures& x) const {
+    double d = 0;
+    for (int k = 0; k < kPairFeatureCount; ++k) d += u2_[k] * x[k];
+    return d;
+  }
+  bool Stage2Accepts(double distance) const { return distance <= t2_; }
+
+  const CheapDifference& stage1_unit_weights() const { return u1_; }
+  double stage1_threshold() const { return t1_; }
+  const PairFeatures& stage2_unit_weights() const { return u2_; }
+  double stage2_threshold() const { return t2_; }
+  const TransitionWeights& weights() const { return weights_; }
+
+ private:
+  TransitionWeights weights_;
+  CheapDifference u1_{};
+  double t1_ = 0;
+  PairFeatures u2_{};
+  double t2_ = 0;
+};
+
+}  // namespace ss

@@ -1,0 +1,84 @@
+#include "pipeline/transitions/truth_labels.h"
+
+#include <algorithm>
+#include <random>
+#include <set>
+#include <unordered_map>
+
+#include "core/error.h"
+
+namespace ss {
+
+double HeadingDifference(double a, double b) {
+  double d = std::fmod(std::abs(a - b), 2.0 * M_PI);
+  return d > M_PI ? 2.0 * M_PI - d : d;
+}
+
+double PhaseDifference(double a, double b) {
+  double d = std::fmod(std::abs(a - b), 1.0);
+  return d > 0.5 ? 1.0 - d : d;
+}
+
+namespace {
+
+bool Within(const SpriteTruth& a, const SpriteTruth& b, const TruthLabelOptions& o, double factor) {
+  if (a.pose != b.pose) return false;
+  if (HeadingDifference(a.heading_rad, b.heading_rad) > factor * o.max_heading_difference_rad) return false;
+  const bool a_gait = !std::isnan(a.gait_phase), b_gait = !std::isnan(b.gait_phase);
+  if (a_gait != b_gait) return false;
+  return !a_gait || PhaseDifference(a.gait_phase, b.gait_phase) <= factor * o.max_phase_difference;
+}
+
+}  // namespace
+
+bool TruthAccepts(const SpriteTruth& a, const SpriteTruth& b, const TruthLabelOptions& options) {
+  return Within(a, b, options, 1.0);
+}
+
+std::vector<Label> LabelsFromTruth(std::span<const int64_t> ids, std::span<const SpriteTruth> truth, size_t count,
+                                   const TruthLabelOptions& options, uint64_t seed) {
+  const size_t n = truth.size();
+  if (ids.size() != n) throw WorkError("LabelsFromTruth: ids and truth disagree");
+  if (n < 2) throw InputError("truth", "at least two sprites are needed to make labels");
+  std::mt19937_64 rng(seed);
+  std::uniform_int_distribution<size_t> pick(0, n - 1);
+  std::set<std::pair<size_t, size_t>> used;
+  std::vector<Label> labels;
+  auto add = [&](size_t i, size_t j, bool accept) {
+    if (i == j || !used.emplace(std::min(i, j), std::max(i, j)).second) return false;
+    labels.push_back({ids[i], ids[j], accept});
+    return true;
+  };
+  const size_t want_accepts = count / 2, want_near = static_cast<size_t>((count - want_accepts) *
+                                                                          options.near_miss_fraction);
+  // Accepts and near misses: scan all partners of random sprites.
+  size_t accepts = 0, near = 0;
+  std::vector<size_t> partners, misses;
+  for (size_t attempt = 0; attempt < 20 * count && (accepts < want_accepts || near < want_near); ++attempt) {
+    const size_t i = pick(rng);
+    partners.clear();
+    misses.clear();
+    for (size_t j = 0; j < n; ++j) {
+      if (j == i) continue;
+      if (TruthAccepts(truth[i], truth[j], options)) {
+        partners.push_back(j);
+      } else if (Within(truth[i], truth[j], options, options.near_miss_factor)) {
+        misses.push_back(j);
+      }
+    }
+    if (accepts < want_accepts && !partners.empty()) {
+      accepts += add(i, partners[std::uniform_int_distribution<size_t>(0, partners.size() - 1)(rng)], true);
+    }
+    if (near < want_near && !misses.empty()) {
+      near += add(i, misses[std::uniform_int_distribution<size_t>(0, misses.size() - 1)(rng)], false);
+    }
+  }
+  // Uniform random rejects for the rest.
+  for (size_t attempt = 0; attempt < 20 * count && labels.size() < accepts + (count - want_accepts); ++attempt) {
+    const size_t i = pick(rng), j = pick(rng);
+    if (!TruthAccepts(truth[i], truth[j], options)) add(i, j, false);
+  }
+  return labels;
+}
+
+}  // namespace ss

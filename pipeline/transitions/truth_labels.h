@@ -1,0 +1,41 @@
+#pragma once
+// Labels from synthetic truth, so that tests and demos can train without a person:
+// a pair is "accept" when both sprites have the same pose label, their headings are
+// close and their gait phases are close (seed 000 §3 asks a person the same question).
+#include <cmath>
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "pipeline/transitions/training.h"
+
+namespace ss {
+
+struct SpriteTruth {
+  std::string pose;                 // "walk", "trot", "idle", "stand", ...
+  double heading_rad = 0;           // facing direction on the ground
+  double gait_phase = std::nan("");  // cycles in [0, 1); NaN when the pose has no gait
+};
+
+struct TruthLabelOptions {
+  double max_heading_difference_rad = 6.0 * M_PI / 180.0;
+  double max_phase_difference = 0.04;  // cycles, circular
+  // Rejects sampled as near misses (same pose, heading and phase within `near_miss_factor`
+  // times the tolerances) rather than uniformly; the rest are uniform random rejects.
+  double near_miss_fraction = 0.5;
+  double near_miss_factor = 3.0;
+};
+
+// Circular differences: headings in radians (0..pi), phases in cycles (0..0.5).
+double HeadingDifference(double a_rad, double b_rad);
+double PhaseDifference(double a, double b);
+
+bool TruthAccepts(const SpriteTruth& a, const SpriteTruth& b, const TruthLabelOptions& options);
+
+// About `count` labelled pairs of distinct sprites: half accepts (as many as exist), half
+// rejects. `ids[k]` is the bank id of the sprite with truth `truth[k]`. Deterministic per seed.
+std::vector<Label> LabelsFromTruth(std::span<const int64_t> ids, std::span<const SpriteTruth> truth, size_t count,
+                                   const TruthLabelOptions& options, uint64_t seed);
+
+}  // namespace ss

@@ -1,0 +1,193 @@
+#include "pipeline/transitions/weights.h"
+
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "core/error.h"
+
+namespace ss {
+
+namespace {
+
+using nlohmann::json;
+
+// Reads one field, naming it (dotted path) in every error.
+class FieldReader {
+ public:
+  FieldReader(const json& root, std::string source) : root_(root), source_(std::move(source)) {}
+
+  [[noreturn]] void Fail(const std::string& field, const std::string& reason) const {
+    throw InputError(source_, "field '" + field + "': " + reason);
+  }
+  const json& Get(const std::string& field) const {
+    const json* node = &root_;
+    std::string::size_type start = 0;
+    while (true) {
+      const auto dot = field.find('.', start);
+      const std::string key = field.substr(start, dot == std::string::npos ? std::string::npos : dot - start);
+      if (!node->is_object() || !node->contains(key)) Fail(field, "missing");
+      node = &(*node)[key];
+      if (dot == std::string::npos) return *node;
+      start = dot + 1;
+    }
+  }
+  double Number(const std::string& field) const {
+    const json& v = Get(field);
+    if (!v.is_number()) Fail(field, "expected a number, got " + v.dump());
+    const double x = v.get<double>();
+    if (!std::isfinite(x)) Fail(field, "expected a finite number");
+    return x;
+  }
+  int Integer(const std::string& field) const {
+    const json& v = Get(field);
+    if (!v.is_number_integer()) Fail(field, "expected an integer, got " + v.dump());
+    return v.get<int>();
+  }
+  template <size_t N>
+  std::array<double, N> Numbers(const std::string& field) const {
+    const json& v = Get(field);
+    if (!v.is_array() || v.size() != N) {
+      Fail(field, "expected an array of " + std::to_string(N) + " numbers, got " + v.dump());
+    }
+    std::array<double, N> out{};
+    for (size_t k = 0; k < N; ++k) {
+      if (!v[k].is_number() || !std::isfinite(v[k].get<double>())) {
+        Fail(field, "element " + std::to_string(k) + " is not a finite number: " + v[k].dump());
+      }
+      out[k] = v[k].get<double>();
+    }
+    return out;
+  }
+
+ private:
+  const json& root_;
+  std::string source_;
+};
+
+}  // namespace
+
+bool TransitionWeights::IsValid(std::string* why) const {
+  auto fail = [&](const std::string& field, const std::string& reason) {
+    if (why) *why = "field '" + field + "': " + reason;
+    return false;
+  };
+  std::string window_why;
+  if (!window.IsValid(&window_why)) return fail("comparison_window", window_why);
+  for (int k = 0; k < kPairFeatureCount; ++k) {
+    if (!std::isfinite(feature_mean[k])) return fail("feature_mean", "not finite");
+    if (!(feature_scale[k] > 0) || !std::isfinite(feature_scale[k])) {
+      return fail("feature_scale", "element " + std::to_string(k) + " must be positive");
+    }
+    if (!(stage2_weights[k] >= 0) || !std::isfinite(stage2_weights[k])) {
+      return fail("stage2.weights", "element " + std::to_string(k) + " must be a non-negative number");
+    }
+  }
+  for (int k = 0; k < kCheapFeatureCount; ++k) {
+    if (!(stage1_weights[k] >= 0) || !std::isfinite(stage1_weights[k])) {
+      return fail("stage1.weights", "element " + std::to_string(k) +
+                                        " must be non-negative (stage 1 must accept a weighted-L1 ball)");
+    }
+  }
+  if (!std::isfinite(stage1_bias)) return fail("stage1.bias", "not finite");
+  if (!std::isfinite(stage2_bias)) return fail("stage2.bias", "not finite");
+  return true;
+}
+
+TransitionWeights ParseWeights(const std::string& text, const std::string& source) {
+  json root;
+  try {
+    root = json::parse(text);
+  } catch (const json::parse_error& e) {
+    throw InputError(source, std::string("not valid JSON: ") + e.what());
+  }
+  if (!root.is_object()) throw InputError(source, "expected a JSON object at the top level");
+  FieldReader r(root, source);
+  const json& format = r.Get("format");
+  if (!format.is_string() || format.get<std::string>() != kWeightsFileFormat) {
+    r.Fail("format", std::string("expected \"") + kWeightsFileFormat + "\", got " + format.dump());
+  }
+  const int version = r.Integer("version");
+  if (version != kWeightsFileVersion) {
+    r.Fail("version", "this build reads version " + std::to_string(kWeightsFileVersion) + ", the file has " +
+                          std::to_string(version));
+  }
+  const json& names = r.Get("features");
+  json expected = json::array();
+  for (const auto& n : FeatureNames()) expected.push_back(n);
+  if (names != expected) r.Fail("features", "expected " + expected.dump() + ", got " + names.dump());
+
+  TransitionWeights w;
+  w.window.width_m = r.Number("comparison_window.width_m");
+  w.window.height_m = r.Number("comparison_window.height_m");
+  w.window.cells_x = r.Integer("comparison_window.cells_x");
+  w.window.cells_y = r.Integer("comparison_window.cells_y");
+  const json& align = r.Get("comparison_window.align");
+  if (align == "alpha_centroid") {
+    w.window.align = HorizontalAlignment::kAlphaCentroid;
+  } else if (align == "contact_point") {
+    w.window.align = HorizontalAlignment::kContactPoint;
+  } else {
+    r.Fail("comparison_window.align", "expected \"alpha_centroid\" or \"contact_point\", got " + align.dump());
+  }
+  w.feature_mean = r.Numbers<kPairFeatureCount>("feature_mean");
+  w.feature_scale = r.Numbers<kPairFeatureCount>("feature_scale");
+  w.stage1_weights = r.Numbers<kCheapFeatureCount>("stage1.weights");
+  w.stage1_bias = r.Number("stage1.bias");
+  w.stage2_weights = r.Numbers<kPairFeatureCount>("stage2.weights");
+  w.stage2_bias = r.Number("stage2.bias");
+  if (root.contains("training")) {
+    if (!root["training"].is_object()) r.Fail("training", "expected an object");
+    w.training_json = root["training"].dump();
+  }
+  std::string why;
+  if (!w.IsValid(&why)) throw InputError(source, why);
+  return w;
+}
+
+TransitionWeights LoadWeights(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path, "cannot open the weights file");
+  std::stringstream buffer;
+  buffer << in.rdbuf();
+  if (in.bad()) throw InputError(path, "cannot read the weights file");
+  return ParseWeights(buffer.str(), path);
+}
+
+std::string WeightsToJson(const TransitionWeights& w) {
+  json root;
+  root["format"] = kWeightsFileFormat;
+  root["version"] = kWeightsFileVersion;
+  root["features"] = FeatureNames();
+  root["comparison_window"] = {{"width_m", w.window.width_m},
+                               {"height_m", w.window.height_m},
+                               {"cells_x", w.window.cells_x},
+                               {"cells_y", w.window.cells_y},
+                               {"align", w.window.align == HorizontalAlignment::kAlphaCentroid ? "alpha_centroid"
+                                                                                              : "contact_point"}};
+  root["feature_mean"] = w.feature_mean;
+  root["feature_scale"] = w.feature_scale;
+  root["stage1"] = {{"weights", w.stage1_weights}, {"bias", w.stage1_bias}};
+  root["stage2"] = {{"weights", w.stage2_weights}, {"bias", w.stage2_bias}};
+  json training = json::parse(w.training_json, nullptr, false);
+  root["training"] = training.is_object() ? training : json::object();
+  return root.dump(2) + "\n";
+}
+
+void SaveWeights(const TransitionWeights& w, const std::string& path) {
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  if (!out) throw WorkError(path, "cannot open for writing");
+  out << WeightsToJson(w);
+  out.close();
+  if (!out) throw WorkError(path, "write failed");
+}
+
+const TransitionWeights& DefaultWeights() {
+  static const TransitionWeights weights =
+      ParseWeights(DefaultWeightsText(), "pipeline/transitions/default_weights.json (built in)");
+  return weights;
+}
+
+}  // namespace ss

@@ -1,0 +1,65 @@
+#include "pipeline/filter/usability.h"
+
+#include <gtest/gtest.h>
+#include <opencv2/imgproc.hpp>
+
+namespace ss {
+namespace {
+
+// A pinhole camera 1 m above the floor origin looking straight down... tilted a little,
+// so that the 0.6 x 0.4 m floor fills the middle of a 640x480 image.
+CameraModel DownCamera() {
+  Rigid3 cam_from_ground;
+  cam_from_ground.rotation << 1, 0, 0, 0, -1, 0, 0, 0, -1;  // x right, y down the image = -y ground, z down
+  cam_from_ground.translation = Eigen::Vector3d(0, 0, 1.0);
+  return CameraModel("LENSMODEL_PINHOLE", {500, 500, 320, 240}, 640, 480, cam_from_ground);
+}
+
+GroundPolygon Floor() {
+  return GroundPolygon({{-0.3, -0.2}, {0.3, -0.2}, {0.3, 0.2}, {-0.3, 0.2}});
+}
+
+TEST(FloorMask, MarksExactlyThePixelsThatSeeTheFloor) {
+  const CameraModel cam = DownCamera();
+  const FloorMask floor(cam, Floor(), {});
+  // 0.6 m at 1 m and f = 500 is 300 px wide, 200 px high, centred.
+  const cv::Rect box = cv::boundingRect(floor.mask());
+  EXPECT_NEAR(box.width, 300, 2);
+  EXPECT_NEAR(box.height, 200, 2);
+  EXPECT_NEAR(box.x, 170, 2);
+  EXPECT_NEAR(box.y, 140, 2);
+}
+
+TEST(FloorMask, ChecksBorderFloorAndWalls) {
+  const CameraModel cam = DownCamera();
+  const FloorMask floor(cam, Floor(), {});
+  const cv::Mat blob(20, 20, CV_8U, cv::Scalar(255));
+  EXPECT_EQ(floor.Check(blob, {310, 230}, {0.0, 0.0}), Discard::kNone);
+  EXPECT_EQ(floor.Check(blob, {0, 230}, {0.0, 0.0}), Discard::kTouchesBorder);
+  EXPECT_EQ(floor.Check(blob, {310, 230}, {0.35, 0.0}), Discard::kLeavesFloor);
+  // Silhouette over the floor's edge in the image: touches the wall.
+  EXPECT_EQ(floor.Check(blob, {460, 230}, {0.29, 0.0}), Discard::kTouchesWall);
+  // A crop whose corner is off the floor but whose silhouette (a thin line) is on it: kept.
+  cv::Mat line = cv::Mat::zeros(20, 20, CV_8U);
+  line.col(0).setTo(255);
+  EXPECT_EQ(floor.Check(line, {450, 230}, {0.25, 0.0}), Discard::kNone);
+}
+
+TEST(StillnessFilter, DropsOnlyTheTooLongStillPart) {
+  StillnessFilter still(0.02, 1.0);
+  const int64_t frame_ns = 33'333'333;
+  int dropped = 0;
+  for (int f = 0; f < 90; ++f) {  // 3 s standing still
+    dropped += still.IsStill(1, f * frame_ns, Eigen::Vector2d(0.1, 0.1)) ? 1 : 0;
+  }
+  EXPECT_NEAR(dropped, 60, 1);  // everything after the first second
+  // Walking again: kept at once.
+  EXPECT_FALSE(still.IsStill(1, 90 * frame_ns, Eigen::Vector2d(0.2, 0.1)));
+  // Walking steadily at 0.1 m/s is never still.
+  for (int f = 0; f < 90; ++f) {
+    EXPECT_FALSE(still.IsStill(2, f * frame_ns, Eigen::Vector2d(0.1 * f / 30.0, 0)));
+  }
+}
+
+}  // namespace
+}  // namespace ss
