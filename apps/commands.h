@@ -9,5 +9,6 @@ void AddSynthCommand(CLI::App& app);
 void AddReplayCommand(CLI::App& app);
 void AddBankCommand(CLI::App& app);
 void AddBenchCommand(CLI::App& app);
+void AddConfigCommand(CLI::App& app);
 
 }  // namespace ss::apps

@@ -17,7 +17,10 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "critical", "off"}));
   app.parse_complete_callback([&] { ss::SetLogLevel(log_level); });
 
+  ss::apps::AddReplayCommand(app);
+  ss::apps::AddBankCommand(app);
   ss::apps::AddBenchCommand(app);
+  ss::apps::AddConfigCommand(app);
 
   try {
     app.parse(argc, argv);
