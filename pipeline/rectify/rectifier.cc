@@ -140,8 +140,11 @@ std::optional<Billboard> Rectifier::Rectify(const CameraModel& camera, const Spr
 // The billboard keeps its place and axes; only its content is mirrored.
 Billboard Rectifier::Mirror(const Billboard& b) {
   Billboard m = b;
+  // cv::Mat copies share pixels: give the mirror its own buffers before flipping into them.
+  m.bgra = cv::Mat();
+  m.shadow = cv::Mat();
   cv::flip(b.bgra, m.bgra, 1);
-  cv::flip(b.shadow, m.shadow, 1);
+  if (!b.shadow.empty()) cv::flip(b.shadow, m.shadow, 1);
   m.anchor_px.x() = (b.bgra.cols - 1) - b.anchor_px.x();
   return m;
 }

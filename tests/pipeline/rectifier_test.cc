@@ -66,6 +66,18 @@ Render RenderCard(const CameraModel& cam, double w, double h) {
   return r;
 }
 
+// The crop an extractor would hand over: the sprite and its shadow plus a few pixels.
+struct Crop {
+  cv::Mat bgr, alpha, shadow;
+  cv::Point offset;
+  SpriteView View(const Eigen::Vector2d& lowest_px) const { return {&bgr, &alpha, &shadow, offset, lowest_px}; }
+};
+Crop CropOf(const Render& r) {
+  cv::Rect box = cv::boundingRect((r.alpha > 0) | (r.shadow > 0));
+  box = cv::Rect(box.x - 4, box.y - 4, box.width + 8, box.height + 8) & cv::Rect(0, 0, r.bgr.cols, r.bgr.rows);
+  return {r.bgr(box), r.alpha(box), r.shadow(box), box.tl()};
+}
+
 cv::Rect AlphaBox(const cv::Mat& bgra) {
   cv::Mat alpha;
   cv::extractChannel(bgra, alpha, 3);
@@ -79,8 +91,8 @@ TEST(Rectifier, BillboardHasTheSameMetricSizeNearAndFar) {
   for (double distance : {0.6, 1.4}) {
     const CameraModel cam = LookAtOrigin(distance, 0.8);
     const Render r = RenderCard(cam, w, h);
-    const SpriteView view{&r.bgr, &r.alpha, &r.shadow, cv::Point(0, 0), r.lowest_px};
-    const auto bb = rectifier.Rectify(cam, view);
+    const Crop crop = CropOf(r);
+    const auto bb = rectifier.Rectify(cam, crop.View(r.lowest_px));
     ASSERT_TRUE(bb.has_value()) << "distance " << distance;
     EXPECT_LT(bb->point_in_ground.head<2>().norm(), 0.003) << "distance " << distance;
     const cv::Rect box = AlphaBox(bb->bgra);
@@ -106,7 +118,8 @@ TEST(Rectifier, MirrorFlipsContentAndVelocityAcrossTheView) {
   // Paint the card's left half (as the camera sees it) blue.
   const cv::Rect full = cv::boundingRect(r.alpha);
   r.bgr(cv::Rect(full.x, full.y, full.width / 2, full.height)).setTo(cv::Scalar(255, 0, 0), r.alpha(cv::Rect(full.x, full.y, full.width / 2, full.height)));
-  const auto bb = Rectifier().Rectify(cam, {&r.bgr, &r.alpha, &r.shadow, cv::Point(0, 0), r.lowest_px});
+  const Crop crop = CropOf(r);
+  const auto bb = Rectifier().Rectify(cam, crop.View(r.lowest_px));
   ASSERT_TRUE(bb);
   const Billboard m = Rectifier::Mirror(*bb);
   const cv::Rect box = AlphaBox(bb->bgra);
@@ -114,6 +127,7 @@ TEST(Rectifier, MirrorFlipsContentAndVelocityAcrossTheView) {
   EXPECT_GT(bb->bgra.at<cv::Vec4b>(y, box.x + 2)[0], 200);                   // blue on the left
   EXPECT_GT(m.bgra.at<cv::Vec4b>(y, m.bgra.cols - 1 - (box.x + 2))[0], 200);  // on the right in the mirror
   EXPECT_NEAR(m.anchor_px.x(), bb->bgra.cols - 1 - bb->anchor_px.x(), 1e-9);
+  EXPECT_NE(m.bgra.data, bb->bgra.data);  // the original keeps its own pixels
   // Walking to the camera's right becomes walking to its left; toward the camera stays.
   const Eigen::Vector2d v = 0.3 * bb->right_in_ground + 0.1 * bb->toward_camera;
   const Eigen::Vector2d mv = Rectifier::MirrorVelocity(*bb, v);
@@ -130,3 +144,4 @@ TEST(Rectifier, RayAboveTheHorizonGivesNothing) {
 
 }  // namespace
 }  // namespace ss
+
