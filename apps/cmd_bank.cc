@@ -123,8 +123,9 @@ void AddBankCommand(CLI::App& app) {
   tag->add_flag("--remove", args->remove, "Remove the tag instead");
   tag->add_flag("--json", args->json, "Print JSON");
   tag->callback([args] {
-    // The writer would create a missing bank; tagging one is a user error instead.
-    if (!std::filesystem::exists(args->path)) throw InputError(args->path, "no such sprite bank");
+    // Opened read-only first: the writer would turn an empty file into a new bank
+    // and upgrade an older one in place; tagging does neither.
+    { const Bank check(args->path); }
     BankWriter writer(args->path);
     if (args->remove) {
       writer.Untag(args->sprites, args->tag);

@@ -51,6 +51,15 @@ void RunReplay(const std::string& dir, bool realtime, int loops, bool json) {
   const auto stats = source.camera_stats();
   const SourceStats totals = source.stats();
 
+  // The recorded span and frame rate of what each camera delivered.
+  auto span_s = [&](size_t i) {
+    return report[i].frames > 1 ? static_cast<double>(report[i].last_timestamp_ns - report[i].first_timestamp_ns) / 1e9
+                                : 0.0;
+  };
+  auto recorded_fps = [&](size_t i) {
+    const double span = span_s(i);
+    return span > 0 ? static_cast<double>(report[i].frames - 1) / span : 0.0;
+  };
   if (json) {
     nlohmann::json out;
     out["session"] = dir;
@@ -66,11 +75,15 @@ void RunReplay(const std::string& dir, bool realtime, int loops, bool json) {
                                 {"width", c.width},
                                 {"height", c.height},
                                 {"codec", source.session().cameras[i].codec},
+                                {"model", c.model_path},
                                 {"frames", r.frames},
                                 {"frames_in_csv", stats[i].frames_in_csv},
                                 {"first_timestamp_ns", r.first_timestamp_ns},
                                 {"last_timestamp_ns", r.last_timestamp_ns},
+                                {"span_s", span_s(i)},
+                                {"fps", recorded_fps(i)},
                                 {"sequence_gaps", r.sequence_gaps},
+                                {"recorded_drops", stats[i].recorded_drops},
                                 {"frames_unreadable", stats[i].frames_unreadable},
                                 {"frames_without_row", stats[i].frames_without_row},
                                 {"errors", stats[i].errors},
@@ -84,21 +97,24 @@ void RunReplay(const std::string& dir, bool realtime, int loops, bool json) {
   } else {
     std::printf("session %s ('%s'), %zu camera(s)%s\n", dir.c_str(), source.session().name.c_str(), cameras.size(),
                 realtime ? ", real time" : "");
-    std::printf("%-14s %-10s %-10s %-6s %8s %20s %20s %6s %6s\n", "camera", "format", "size", "codec", "frames",
-                "first_timestamp_ns", "last_timestamp_ns", "gaps", "errors");
+    std::printf("%-14s %-9s %-10s %-5s %7s %20s %9s %7s %5s %5s %6s\n", "camera", "format", "size", "codec",
+                "frames", "first_timestamp_ns", "span_s", "fps", "gaps", "drops", "errors");
     for (size_t i = 0; i < cameras.size(); ++i) {
       const auto& c = cameras[i];
       const auto& r = report[i];
       const std::string size = std::to_string(c.width) + "x" + std::to_string(c.height);
-      std::printf("%-14s %-10s %-10s %-6s %8llu %20lld %20lld %6llu %6llu\n", c.name.c_str(),
+      std::printf("%-14s %-9s %-10s %-5s %7llu %20lld %9.3f %7.2f %5llu %5llu %6llu\n", c.name.c_str(),
                   PixelFormatName(c.format).c_str(), size.c_str(), source.session().cameras[i].codec.c_str(),
-                  static_cast<unsigned long long>(r.frames), static_cast<long long>(r.first_timestamp_ns),
-                  static_cast<long long>(r.last_timestamp_ns), static_cast<unsigned long long>(r.sequence_gaps),
+                  static_cast<unsigned long long>(r.frames), static_cast<long long>(r.first_timestamp_ns), span_s(i),
+                  recorded_fps(i), static_cast<unsigned long long>(r.sequence_gaps),
+                  static_cast<unsigned long long>(stats[i].recorded_drops),
                   static_cast<unsigned long long>(stats[i].errors));
       for (const auto& p : stats[i].problems) std::printf("  ! %s\n", p.c_str());
     }
-    std::printf("total: %llu frames in %.3f s = %.1f frames/s\n", static_cast<unsigned long long>(total), seconds,
-                fps);
+    std::printf("(gaps: frames missing between delivered sequence numbers, lost at the device or unreadable; "
+                "drops: the recorder's drops_before)\n");
+    std::printf("total: %llu frames replayed in %.3f s = %.1f frames/s\n", static_cast<unsigned long long>(total),
+                seconds, fps);
   }
   std::fflush(stdout);
   if (totals.errors > 0) {

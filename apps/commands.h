@@ -6,9 +6,18 @@
 namespace ss::apps {
 
 void AddSynthCommand(CLI::App& app);
+void AddCalibrateCommand(CLI::App& app);
 void AddReplayCommand(CLI::App& app);
 void AddBankCommand(CLI::App& app);
 void AddBenchCommand(CLI::App& app);
+void AddIngestCommand(CLI::App& app);
 void AddConfigCommand(CLI::App& app);
+void AddAnimateCommand(CLI::App& app);
+void AddRenderCommand(CLI::App& app);
+void AddFakecamCommand(CLI::App& app);
+void AddCamerasCommand(CLI::App& app);
+void AddSkeletonCommand(CLI::App& app);
+void AddMatchCommand(CLI::App& app);
+void AddTransitionsCommand(CLI::App& app);
 
 }  // namespace ss::apps

@@ -17,10 +17,20 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "critical", "off"}));
   app.parse_complete_callback([&] { ss::SetLogLevel(log_level); });
 
+  ss::apps::AddSynthCommand(app);
+  ss::apps::AddCalibrateCommand(app);
   ss::apps::AddReplayCommand(app);
   ss::apps::AddBankCommand(app);
+  ss::apps::AddIngestCommand(app);
   ss::apps::AddBenchCommand(app);
   ss::apps::AddConfigCommand(app);
+  ss::apps::AddAnimateCommand(app);
+  ss::apps::AddRenderCommand(app);
+  ss::apps::AddFakecamCommand(app);
+  ss::apps::AddCamerasCommand(app);
+  ss::apps::AddSkeletonCommand(app);
+  ss::apps::AddMatchCommand(app);
+  ss::apps::AddTransitionsCommand(app);
 
   try {
     app.parse(argc, argv);

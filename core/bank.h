@@ -1,5 +1,5 @@
 #pragma once
-// The sprite bank: one SQLite file in WAL mode (schema in docs/bank.md).
+// The sprite bank: one SQLite file in WAL mode (schema in docs/formats.md).
 // One writer (BankWriter) appends clips batch by batch; any number of readers
 // (Bank, each its own connection, in threads or processes) read meanwhile and
 // see only complete clips. A Bank object is one connection: use it from one

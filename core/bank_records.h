@@ -1,5 +1,5 @@
 #pragma once
-// The records the sprite bank stores and returns (docs/bank.md has the schema).
+// The records the sprite bank stores and returns (docs/formats.md has the schema).
 // Ground frame: z up, z = 0 the floor, metres. Billboard: the perspective-corrected
 // sprite image at a fixed metric scale, x right, y down, pixels.
 #include <cstdint>

@@ -11,7 +11,7 @@
 namespace ss {
 namespace {
 
-// Version 1: the first schema. Column meanings: docs/bank.md.
+// Version 1: the first schema. Column meanings: docs/formats.md.
 constexpr const char* kSchemaV1 = R"sql(
 CREATE TABLE meta (
   key   TEXT PRIMARY KEY NOT NULL,

@@ -1,5 +1,5 @@
 #pragma once
-// The sprite bank's schema and its migrations (docs/bank.md).
+// The sprite bank's schema and its migrations (docs/formats.md).
 // Rule: a shipped migration is never edited. A new schema version appends one
 // migration that upgrades the previous version in place; a new bank is made by
 // running every migration from version 0, so new and upgraded banks are identical.

@@ -13,7 +13,7 @@ void Fail(sqlite3* db, int rc, const std::string& path, std::string_view what) {
     case SQLITE_NOTADB:
       throw InputError(path, "not a SQLite database (" + reason + ")");
     case SQLITE_CORRUPT:
-      throw WorkError(path, "the database is damaged (" + reason + ")");
+      throw CorruptError(path, "the database is damaged (" + reason + ")");
     default:
       throw WorkError(path, reason);
   }

@@ -1,14 +1,23 @@
 #pragma once
 // Small move-only RAII wrappers over the sqlite3 C API, used by the sprite bank.
-// Every failure throws: SQLITE_NOTADB -> InputError, anything else -> WorkError,
-// each naming the database file and SQLite's message.
+// Every failure throws: SQLITE_NOTADB -> InputError, SQLITE_CORRUPT -> CorruptError
+// (an InputError: the file is damaged), anything else -> WorkError, each naming the
+// database file and SQLite's message.
 #include <sqlite3.h>
 
 #include <cstdint>
 #include <string>
 #include <string_view>
 
+#include "core/error.h"
+
 namespace ss::sql {
+
+// The database file is damaged (SQLITE_CORRUPT): bad input, which `bank verify` reports as damage.
+class CorruptError : public InputError {
+ public:
+  using InputError::InputError;
+};
 
 // One prepared statement. Bind with 1-based indices, Step() until it returns false.
 class Stmt {

@@ -154,8 +154,11 @@ BankVerifyReport VerifyBank(const std::string& path) {
   sql::Db db(path, SQLITE_OPEN_READONLY | SQLITE_OPEN_NOMUTEX);
   try {
     report.schema_version = PrepareBankSchema(db, /*writable=*/false);
-  } catch (const WorkError& e) {
+  } catch (const sql::CorruptError& e) {
     // The header reads as a bank but the file is damaged beyond opening it.
+    report.problems.push_back(std::string("open: ") + e.what());
+    return report;
+  } catch (const WorkError& e) {
     report.problems.push_back(std::string("open: ") + e.what());
     return report;
   }

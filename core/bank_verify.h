@@ -1,5 +1,5 @@
 #pragma once
-// `bank verify`: checks a sprite bank's file, schema and invariants (docs/bank.md).
+// `bank verify`: checks a sprite bank's file, schema and invariants (docs/formats.md).
 #include <cstdint>
 #include <string>
 #include <vector>

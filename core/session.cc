@@ -139,19 +139,26 @@ SessionCamera ParseCamera(const std::string& path, const json& j, size_t i) {
     f.Fail("height", "nv12 needs an even height, got " + std::to_string(c.height));
   }
   c.fps = f.PositiveNumber("fps");
+  if (f.Has("frames")) {
+    const json& v = f.Get("frames");
+    if (!v.is_number_integer() || v.get<int64_t>() < 0) f.Fail("frames", "expected a non-negative integer");
+    c.frames = v.get<int64_t>();
+  }
   return c;
 }
 
 json CameraToJson(const SessionCamera& c) {
-  return json{{"name", c.name},
-              {"video", c.video},
-              {"frames_csv", c.frames_csv},
-              {"model", c.model},
-              {"width", c.width},
-              {"height", c.height},
-              {"pixel_format", PixelFormatName(c.pixel_format)},
-              {"codec", c.codec},
-              {"fps", c.fps}};
+  json j{{"name", c.name},
+         {"video", c.video},
+         {"frames_csv", c.frames_csv},
+         {"model", c.model},
+         {"width", c.width},
+         {"height", c.height},
+         {"pixel_format", PixelFormatName(c.pixel_format)},
+         {"codec", c.codec},
+         {"fps", c.fps}};
+  if (c.frames >= 0) j["frames"] = c.frames;
+  return j;
 }
 
 // Parses one CSV field as a base-10 integer of type T.

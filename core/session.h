@@ -26,6 +26,9 @@ struct SessionCamera {
   PixelFormat pixel_format = PixelFormat::kBGR8;  // as the camera delivered it, and as replay returns it
   std::string codec = "ffv1";                     // "ffv1" | "mjpeg" | "h264"
   double fps = 30.0;
+  // Frames recorded, written when the recording was closed; -1 while it runs or
+  // after it was killed (then the CSV is all there is).
+  int64_t frames = -1;
 };
 
 struct SessionInfo {

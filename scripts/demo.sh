@@ -19,3 +19,7 @@ fi
 
 echo "== replaying $sample"
 "$ss" replay "$sample"
+
+echo "== ingesting $sample into $out/sample.bank (the live pipeline, as fast as it runs)"
+"$ss" ingest "$sample" --bank "$out/sample.bank"
+"$ss" bank info "$out/sample.bank"

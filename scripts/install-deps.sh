@@ -10,7 +10,7 @@ PACKAGES=(
   libopencv-dev libopencv-contrib-dev libeigen3-dev
   libmrcal-dev mrcal
   # cameras
-  libaravis-dev aravis-tools libv4l-dev libcamera-dev
+  libaravis-dev aravis-tools libusb-1.0-0-dev libv4l-dev libcamera-dev
   # recordings (FFmpeg's libraries; the ffmpeg CLI is used by benchmarks only)
   libavformat-dev libavcodec-dev libavutil-dev libswscale-dev libavfilter-dev ffmpeg
   # storage, config, CLI, logging, HTTP
@@ -19,6 +19,12 @@ PACKAGES=(
   # tests and benchmarks
   libgtest-dev libgmock-dev libbenchmark-dev
 )
+# Optional: the `vivid` CTest test boots Debian's kernel under qemu to run the
+# V4L2 backend against the vivid driver (it skips without these). Set
+# SPRITESTATION_NO_VIVID=1 to leave them out (the kernel package takes minutes).
+if [ "${SPRITESTATION_NO_VIVID:-0}" != "1" ]; then
+  PACKAGES+=(linux-image-amd64 qemu-system-x86 busybox-static)
+fi
 
 missing=()
 for p in "${PACKAGES[@]}"; do

@@ -72,7 +72,7 @@ __attribute__((always_inline)) inline void DenseRows(const float* b, int padded,
                                                      int count) {
   float* out[TB];
   alignas(32) float tail[TB][kChunk];
-  for (int s = 0; s < padded; s += kChunk) {
+  for (int s = 0; s < count; s += kChunk) {
     const bool full = s + kChunk <= count;
     for (int t = 0; t < TB; ++t) out[t] = full ? rows[t] + s : tail[t];
     DenseChunk<TB>(b + s, padded, dim, nb + s, a, na, out);
@@ -101,7 +101,9 @@ __attribute__((target_clones("arch=x86-64-v3", "default"))) void SparseKernel(
     const float* b, int padded, const int* features, int nfeatures, const float* w, const float* a,
     float* row, int count) {
   alignas(32) float tail[kLanes];
-  for (int s = 0; s < padded; s += kLanes) {
+  // Up to `count` only: the last lanes of the padding may lie wholly past it (a negative
+  // tail length here once overwrote the row).
+  for (int s = 0; s < count; s += kLanes) {
     v8f acc{};
     for (int f = 0; f < nfeatures; ++f) {
       const v8f d = Load(b + static_cast<size_t>(features[f]) * padded + s) - a[f];

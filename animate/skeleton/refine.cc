@@ -23,6 +23,9 @@ std::vector<int> FindMovements(const std::vector<float>& sequential_cost, const 
     }
     q[t] = sum / used;
   }
+  std::vector<float> sorted = sequential_cost;
+  std::nth_element(sorted.begin(), sorted.begin() + n / 2, sorted.end());
+  const double threshold = std::max<double>(options.min_prominence, options.noise_factor * sorted[n / 2]);
   // Local maxima (the first frame of a plateau) and their prominence.
   struct Peak {
     int t;
@@ -34,7 +37,7 @@ std::vector<int> FindMovements(const std::vector<float>& sequential_cost, const 
     double left = q[t], right = q[t];
     for (int u = t - 1; u >= 0 && q[u] <= q[t]; --u) left = std::min(left, q[u]);
     for (int u = t + 1; u < n && q[u] <= q[t]; ++u) right = std::min(right, q[u]);
-    if (q[t] - std::max(left, right) >= options.min_prominence) peaks.push_back({t, q[t]});
+    if (q[t] - std::max(left, right) >= threshold) peaks.push_back({t, q[t]});
   }
   // Highest first; a boundary (frame t + 1 starts the next movement) too close to a kept
   // one or to either end is dropped.
@@ -53,15 +56,22 @@ std::vector<int> FindMovements(const std::vector<float>& sequential_cost, const 
   return starts;
 }
 
+std::vector<float> MovementCost(const PoseDescriptors& frames, int begin, int end, int lag) {
+  const int l = std::max(1, lag);
+  std::vector<float> q;
+  for (int t = begin; t + 1 < end; ++t) {
+    q.push_back(PoseCost(frames, std::max(begin, t + 1 - l), frames, std::min(end - 1, t + l)));
+  }
+  return q;
+}
+
 std::vector<int> FindMovements(const PoseDescriptors& frames, const std::vector<int>& clip_starts,
                                const MovementOptions& options) {
   std::vector<int> starts;
   for (size_t c = 0; c < clip_starts.size(); ++c) {
     const int begin = clip_starts[c];
     const int end = c + 1 < clip_starts.size() ? clip_starts[c + 1] : frames.count;
-    std::vector<float> q;
-    for (int t = begin; t + 1 < end; ++t) q.push_back(PoseCost(frames, t, frames, t + 1));
-    for (int s : FindMovements(q, options)) starts.push_back(begin + s);
+    for (int s : FindMovements(MovementCost(frames, begin, end, options.lag), options)) starts.push_back(begin + s);
   }
   return starts;
 }
@@ -95,7 +105,7 @@ RefineResult RefineMatch(const CostRows& costs, const PoseDescriptors& targets, 
   }
   if (refine.averaging_window < 1) throw InputError("refine", "averaging_window must be >= 1");
   RefineResult result;
-  result.target_movements = FindMovements(SequentialCost(targets), refine.movements);
+  result.target_movements = FindMovements(targets, {0}, refine.movements);
   result.source_movements = FindMovements(sources, clip_starts, refine.movements);
   MovementConstraint constraint;
   constraint.target_starts = result.target_movements;

@@ -13,13 +13,25 @@
 namespace ss {
 
 struct MovementOptions {
-  int smoothing_window = 3;      // centred moving average of the sequential cost first
+  // Frames each side of the gap between t and t+1 that the pose change is measured over:
+  // cost(x_{t+1-lag}, x_{t+lag}); 1 is the plain sequential cost. A wider lag lifts a
+  // movement's change above tracking noise, which is the same at every lag.
+  int lag = 4;
+  int smoothing_window = 5;      // centred moving average of the sequential cost first
   int min_length = 8;            // frames; of two boundaries closer than this the weaker goes
-  float min_prominence = 0.01f;  // a peak's height over the higher of its two bases
+  // A peak's height over the higher of its two bases must reach
+  // max(min_prominence, noise_factor * median cost): the median is the noise floor of
+  // tracked or imported joints, whose jitter alone makes peaks.
+  float min_prominence = 0.02f;
+  float noise_factor = 2.5f;
 };
 
-// First frame of each movement (0 first) of one sequence, from its sequential cost.
+// First frame of each movement (0 first) of one sequence, from its sequential cost
+// (`lag` is not used here: the costs are given).
 std::vector<int> FindMovements(const std::vector<float>& sequential_cost, const MovementOptions& options);
+// The pose change across each gap t | t+1 of frames [begin, end): cost(x_{t+1-lag}, x_{t+lag}),
+// clipped to the range (end - begin - 1 values).
+std::vector<float> MovementCost(const PoseDescriptors& frames, int begin, int end, int lag);
 // Of several clips laid end to end: every clip start, plus the movements inside each clip.
 std::vector<int> FindMovements(const PoseDescriptors& frames, const std::vector<int>& clip_starts,
                                const MovementOptions& options);

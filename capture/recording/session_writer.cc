@@ -54,7 +54,7 @@ struct SessionWriter::Impl {
     int64_t rows_written = 0;
     int64_t first_timestamp_ns = 0;
     int64_t last_pts_ms = -1;
-    Clock::time_point last_flush = Clock::now();
+    Clock::time_point oldest_pending;  // when the oldest frame in `pending` was written
     std::string failure;               // a background flush that failed; reported by the next Write
   };
 
@@ -79,7 +79,12 @@ struct SessionWriter::Impl {
       c.pending.pop_front();
       ++c.rows_written;
     }
-    c.last_flush = Clock::now();
+    if (!c.pending.empty()) c.oldest_pending = Clock::now();  // frames still inside the encoder
+  }
+
+  // True when the oldest frame not yet on disk has waited flush_interval_ms. Caller holds c.mutex.
+  bool FlushDue(const Camera& c, Clock::time_point now) const {
+    return !c.pending.empty() && now - c.oldest_pending >= std::chrono::milliseconds(options.flush_interval_ms);
   }
 
   // Flushes cameras whose oldest unflushed frame has waited flush_interval_ms.
@@ -96,8 +101,8 @@ struct SessionWriter::Impl {
       }
       for (Camera* c : list) {
         std::unique_lock<std::mutex> cl(c->mutex, std::try_to_lock);
-        if (!cl.owns_lock() || c->pending.empty() || !c->failure.empty()) continue;
-        continue;
+        // A camera the writing thread holds is flushed by that thread itself.
+        if (!cl.owns_lock() || !c->failure.empty() || !FlushDue(*c, Clock::now())) continue;
         try {
           Flush(*c);
         } catch (const std::exception& e) {
@@ -228,9 +233,11 @@ void SessionWriter::Write(const Frame& frame, uint64_t drops_before) {
   row.timestamp_ns = frame.timestamp_ns;
   row.sequence = frame.sequence;
   row.drops_before = drops_before;
+  const auto now = Clock::now();
+  if (cam->pending.empty()) cam->oldest_pending = now;
   cam->pending.push_back(row);
-  const auto interval = std::chrono::milliseconds(impl_->options.flush_interval_ms);
-  (void)interval;
+  // Steady writing flushes here; when frames stop coming the background flusher does it.
+  if (impl_->FlushDue(*cam, now)) Impl::Flush(*cam);
 }
 
 void SessionWriter::Close() {
@@ -262,6 +269,13 @@ void SessionWriter::Close() {
     }
   }
   if (!first_error.empty()) throw WorkError(first_error);
+  // The frame counts mark the recording as closed: a reader can now tell a
+  // truncated CSV from a killed recorder's.
+  std::lock_guard<std::mutex> lock(impl_->cameras_mutex);
+  for (size_t i = 0; i < impl_->cameras.size(); ++i) {
+    impl_->info.cameras[i].frames = impl_->cameras[i]->rows_written;
+  }
+  WriteSessionInfo(impl_->dir, impl_->info);
 }
 
 const std::string& SessionWriter::dir() const { return impl_->dir; }

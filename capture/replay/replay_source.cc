@@ -10,6 +10,7 @@
 
 #include "capture/recording/video_reader.h"
 #include "capture/recording/video_writer.h"
+#include "core/camera_model.h"
 #include "core/error.h"
 #include "core/log.h"
 
@@ -203,6 +204,7 @@ struct ReplaySource::Impl {
         if (cam.records.empty()) break;  // nothing to loop over
         std::lock_guard<std::mutex> lock(mutex);
         cam.stats.recorded_gaps += RecordedGaps(cam.records);
+        for (const auto& r : cam.records) cam.stats.recorded_drops += r.drops_before;
       }
     } catch (const std::exception& e) {
       Problem(cam, cam.video_path + ": replay stopped: " + e.what());
@@ -241,6 +243,12 @@ ReplaySource::ReplaySource(const std::string& dir, ReplayOptions options) : impl
     cam->csv_path = (root / cam->meta.frames_csv).string();
     cam->records = ReadFrameCsv(cam->csv_path);
     cam->pts_ms = VideoPtsForRecords(cam->records);
+    if (cam->meta.frames > static_cast<int64_t>(cam->records.size())) {
+      // Fewer rows than the closed recording wrote (more rows: the video check reports it).
+      s.Problem(*cam, cam->csv_path + ": lists " + std::to_string(cam->records.size()) + " frames, but the recording "
+                          "was closed with " + std::to_string(cam->meta.frames) + " (" +
+                          (root / "session.json").string() + "); the CSV is truncated");
+    }
     cam->stats.name = cam->meta.name;
     cam->stats.frames_in_csv = cam->records.size();
     if (!cam->records.empty()) {
@@ -262,7 +270,21 @@ ReplaySource::ReplaySource(const std::string& dir, ReplayOptions options) : impl
     sc.height = cam->meta.height;
     sc.format = cam->meta.pixel_format;
     sc.fps = cam->meta.fps;
-    if (!cam->meta.model.empty()) sc.model_path = (root / cam->meta.model).string();
+    if (!cam->meta.model.empty()) {
+      // A model that cannot be used is reported, and the camera replays uncalibrated.
+      const std::string model_path = (root / cam->meta.model).string();
+      try {
+        const CameraModel model = CameraModel::Read(model_path);
+        if (model.width() != sc.width || model.height() != sc.height) {
+          throw InputError(model_path, "imager is " + std::to_string(model.width()) + "x" +
+                                           std::to_string(model.height()) + ", the camera records " +
+                                           std::to_string(sc.width) + "x" + std::to_string(sc.height));
+        }
+        sc.model_path = model_path;
+      } catch (const InputError& e) {
+        s.Problem(*cam, std::string(e.what()) + " (camera '" + cam->meta.name + "' replays without its model)");
+      }
+    }
     s.source_cameras.push_back(sc);
     s.cams.push_back(std::move(cam));
   }

@@ -9,6 +9,8 @@
 // that cannot be opened is logged as [capture.replay] naming the file and the
 // frame, counted in stats(), and the readable rest is delivered. A bad
 // session.json or a malformed CSV is bad input: the constructor throws InputError.
+// A camera model that is missing or unreadable is reported the same way as a
+// damaged video (its camera replays without a model_path).
 #include <memory>
 #include <optional>
 #include <string>
@@ -35,6 +37,7 @@ struct ReplayCameraStats {
   uint64_t frames_unreadable = 0;   // rows whose frame was corrupt or missing from the video
   uint64_t frames_without_row = 0;  // video frames the CSV does not list (recording interrupted)
   uint64_t recorded_gaps = 0;       // frames the CSV's sequence numbers skip (lost before recording)
+  uint64_t recorded_drops = 0;      // sum of the CSV's drops_before (lost at the device or the recorder)
   uint64_t errors = 0;              // reported problems (one per corrupt frame / truncation / unopenable file)
   std::vector<std::string> problems;  // the first few messages, each naming the file and the frame
 };

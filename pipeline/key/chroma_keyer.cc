@@ -17,6 +17,27 @@ constexpr double kMinTrainingLuma = 8.0;
 constexpr float kNeverKey = -100.f;
 // shadow_base of a cell that is not green: never a shadow.
 constexpr float kNoShadow = -1000.f;
+// A pixel whose mean alpha over the empty enclosure exceeds this is not green
+// (the room behind a wall, a cable): it is never keyed.
+constexpr int kUnkeyableAlpha = 64;
+
+struct PixelKey {
+  int alpha;   // 0..255
+  int shadow;  // 0..255
+};
+
+// The key of one pixel (docs/keying.md), in integer-friendly units: no
+// branches and no floating-point min/max, so that loops of it vectorize.
+inline PixelKey KeyPixel(int b, int g, int r, float key_hi, float gain, int32_t luma_floor,
+                         float inv_luma, float shadow_base, int shadow_min) {
+  const int luma4 = b + 2 * g + r;
+  const float key4 = static_cast<float>(g - std::max(b, r)) / static_cast<float>(std::max(luma4, luma_floor));
+  const int alpha = std::clamp(static_cast<int>((key_hi - key4) * gain + 0.5f), 0, 255);
+  const int dark = static_cast<int>(shadow_base - static_cast<float>(luma4) * inv_luma + 0.5f);
+  const int shade = dark >= shadow_min ? dark : 0;
+  // shade * (255 - alpha) / 255, rounded: the shadow only shows where the subject does not.
+  return {alpha, ((shade * (255 - alpha) + 128) * 257) >> 16};
+}
 
 }  // namespace
 
@@ -34,6 +55,7 @@ ChromaKeyer::ChromaKeyer(ChromaKeyerOptions options) : Keyer(options.grid), opti
   check(o.coarse_shadow > 0 && o.coarse_shadow < 1, "coarse_shadow", "must be within (0, 1)");
   check(o.min_key > 0, "min_key", "must be positive");
   check(o.max_unkeyable >= 0 && o.max_unkeyable <= 1, "max_unkeyable", "must be within [0, 1]");
+  check(o.despill_bias >= 0 && o.despill_bias <= 1, "despill_bias", "must be within [0, 1]");
 }
 
 void ChromaKeyer::Train(const std::vector<cv::Mat>& empty_bgr) {
@@ -138,6 +160,35 @@ void ChromaKeyer::Train(const std::vector<cv::Mat>& empty_bgr) {
       band_floor_[static_cast<size_t>(cy) * w + x] = floor4;
     }
   }
+  // Pixels the model itself keys on the empty enclosure are not green (the
+  // global model, kept naive for comparison, skips this).
+  std::vector<uint32_t> alpha_sum(static_cast<size_t>(size_.width) * size_.height, 0);
+  const int shadow_min = static_cast<int>(std::lround(255 * o.shadow_min));
+  for (const cv::Mat& frame : empty_bgr) {
+    if (o.global_model) break;
+    for (int y = 0; y < size_.height; ++y) {
+      const Params p = BandParams(y / s);
+      const uint8_t* px = frame.ptr<uint8_t>(y);
+      uint32_t* sum = &alpha_sum[static_cast<size_t>(y) * w];
+      for (int x = 0; x < size_.width; ++x, px += 3) {
+        const PixelKey k = KeyPixel(px[0], px[1], px[2], p.f[kKeyHi][x], p.f[kGain][x], p.luma_floor[x],
+                                    p.f[kInvLuma][x], p.f[kShadowBase][x], shadow_min);
+        sum[x] += static_cast<uint32_t>(k.alpha);
+      }
+    }
+  }
+  keyable_.resize(alpha_sum.size());
+  size_t masked = 0;
+  const double n_frames = static_cast<double>(empty_bgr.size());
+  for (size_t i = 0; i < alpha_sum.size(); ++i) {
+    const bool keyable = alpha_sum[i] / n_frames <= kUnkeyableAlpha;
+    keyable_[i] = keyable ? 0xFF : 0;
+    masked += !keyable;
+  }
+  if (masked > 0) {
+    Log("pipeline.key")->info("chroma keyer: {} pixels ({:.2f}%) of the empty enclosure are not green, never keyed",
+                              masked, 100.0 * masked / alpha_sum.size());
+  }
   Log("pipeline.key")->debug("chroma keyer trained on {} frames {}x{}: key {:.3f}, luma {:.1f}, noise {:.4f}",
                              empty_bgr.size(), size_.width, size_.height, mean_key, mean_luma, mean_spread);
 }
@@ -160,65 +211,77 @@ ChromaKeyer::Params ChromaKeyer::CellParams(int cell_row) const {
 
 namespace {
 
-struct PixelKey {
-  int alpha;   // 0..255
-  int shadow;  // 0..255
-};
-
-// The key of one pixel (docs/keying.md), in integer-friendly units: no
-// branches and no floating-point min/max, so that loops of it vectorize.
-inline PixelKey KeyPixel(int b, int g, int r, float key_hi, float gain, int32_t luma_floor,
-                         float inv_luma, float shadow_base, int shadow_min) {
-  const int luma4 = b + 2 * g + r;
-  const float key4 = static_cast<float>(g - std::max(b, r)) / static_cast<float>(std::max(luma4, luma_floor));
-  const int alpha = std::clamp(static_cast<int>((key_hi - key4) * gain + 0.5f), 0, 255);
-  const int dark = static_cast<int>(shadow_base - static_cast<float>(luma4) * inv_luma + 0.5f);
-  const int shade = dark >= shadow_min ? dark : 0;
-  // shade * (255 - alpha) / 255, rounded: the shadow only shows where the subject does not.
-  return {alpha, ((shade * (255 - alpha) + 128) * 257) >> 16};
-}
-
-// The fine pass over one row span. Cloned per instruction set: the de-interleave
-// of BGR bytes needs SSSE3 shuffles to vectorize; plain SSE2 runs it scalar.
-__attribute__((target_clones("avx2", "ssse3", "default")))
-void ChromaRow(const uint8_t* __restrict in, int x0, int x1, const float* __restrict key_hi,
-               const float* __restrict gain, const int32_t* __restrict luma_floor,
-               const float* __restrict inv_luma, const float* __restrict shadow_base, int shadow_min,
-               uint8_t* __restrict alpha, uint8_t* __restrict shadow, uint8_t* __restrict colour) {
+// The fine pass over one row span; kRgb: the input is R G B, the colour
+// output B G R either way.
+template <bool kRgb>
+__attribute__((always_inline)) inline void ChromaRowImpl(
+    const uint8_t* __restrict in, int x0, int x1, const float* __restrict key_hi, const float* __restrict gain,
+    const int32_t* __restrict luma_floor, const float* __restrict inv_luma, const float* __restrict shadow_base,
+    int shadow_min, int despill256, const uint8_t* __restrict keyable, uint8_t* __restrict alpha,
+    uint8_t* __restrict shadow, uint8_t* __restrict colour) {
+  constexpr int kB = kRgb ? 2 : 0, kR = kRgb ? 0 : 2;
   for (int x = x0; x < x1; ++x) {
-    const int b = in[3 * x], g = in[3 * x + 1], r = in[3 * x + 2];
+    const int b = in[3 * x + kB], g = in[3 * x + 1], r = in[3 * x + kR];
     const PixelKey k =
         KeyPixel(b, g, r, key_hi[x], gain[x], luma_floor[x], inv_luma[x], shadow_base[x], shadow_min);
-    alpha[x] = static_cast<uint8_t>(k.alpha);
-    shadow[x] = static_cast<uint8_t>(k.shadow);
+    alpha[x] = static_cast<uint8_t>(k.alpha) & keyable[x];
+    shadow[x] = static_cast<uint8_t>(k.shadow) & keyable[x];
     colour[3 * x] = static_cast<uint8_t>(b);
-    colour[3 * x + 1] = static_cast<uint8_t>(std::min(g, std::max(b, r)));  // despill: G <= max(R, B)
+    // Despill: G <= max(R, B) - bias * (max(R, B) - min(R, B)).
+    const int hi = std::max(b, r), lo = std::min(b, r);
+    colour[3 * x + 1] = static_cast<uint8_t>(std::min(g, hi - (((hi - lo) * despill256 + 128) >> 8)));
     colour[3 * x + 2] = static_cast<uint8_t>(r);
   }
 }
 
+// Cloned per instruction set: the de-interleave of 3-byte pixels needs SSSE3
+// shuffles to vectorize; plain SSE2 runs it scalar.
+#define SS_CHROMA_ROW(NAME, RGB)                                                                              \
+  __attribute__((target_clones("avx2", "ssse3", "default"))) void NAME(                                     \
+      const uint8_t* __restrict in, int x0, int x1, const float* __restrict key_hi,                          \
+      const float* __restrict gain, const int32_t* __restrict luma_floor, const float* __restrict inv_luma, \
+      const float* __restrict shadow_base, int shadow_min, int despill256,                                  \
+      const uint8_t* __restrict keyable, uint8_t* __restrict alpha, uint8_t* __restrict shadow,              \
+      uint8_t* __restrict colour) {                                                                          \
+    ChromaRowImpl<RGB>(in, x0, x1, key_hi, gain, luma_floor, inv_luma, shadow_base, shadow_min, despill256, \
+                       keyable, alpha, shadow, colour);                                                      \
+  }
+SS_CHROMA_ROW(ChromaRowBgr, false)
+SS_CHROMA_ROW(ChromaRowRgb, true)
+#undef SS_CHROMA_ROW
+
 }  // namespace
 
-void ChromaKeyer::SampleRow(const uint8_t* bgr_row, int cell_row, uint8_t* foreground,
+void ChromaKeyer::SampleRow(const uint8_t* row, ChannelOrder /*order*/, int cell_row, uint8_t* foreground,
                             uint8_t* shade) const {
   const Params p = CellParams(cell_row);
   const int coarse_alpha = static_cast<int>(std::lround(255 * options_.coarse_alpha));
   const int coarse_shadow = static_cast<int>(std::lround(255 * options_.coarse_shadow));
   const int shadow_min = static_cast<int>(std::lround(255 * options_.shadow_min));
+  const uint8_t* keyable = &keyable_[static_cast<size_t>(SampleY(cell_row)) * size_.width];
   for (int cx = 0; cx < cols_; ++cx) {
-    const uint8_t* px = bgr_row + 3 * SampleX(cx);
+    const uint8_t* px = row + 3 * SampleX(cx);  // B and R may be swapped: the key is symmetric in them
     const PixelKey k = KeyPixel(px[0], px[1], px[2], p.f[kKeyHi][cx], p.f[kGain][cx], p.luma_floor[cx],
                                 p.f[kInvLuma][cx], p.f[kShadowBase][cx], shadow_min);
-    foreground[cx] = k.alpha > coarse_alpha;
-    shade[cx] = k.shadow > coarse_shadow;
+    const bool green = keyable[SampleX(cx)] != 0;
+    foreground[cx] = green && k.alpha > coarse_alpha;
+    shade[cx] = green && k.shadow > coarse_shadow;
   }
 }
 
-void ChromaKeyer::FineRow(const uint8_t* bgr_row, int y, int x0, int x1, uint8_t* alpha,
+void ChromaKeyer::FineRow(const uint8_t* row, ChannelOrder order, int y, int x0, int x1, uint8_t* alpha,
                           uint8_t* shadow, uint8_t* colour) const {
   const Params p = BandParams(std::min(y / grid_.step, rows_ - 1));
-  ChromaRow(bgr_row, x0, x1, p.f[kKeyHi], p.f[kGain], p.luma_floor, p.f[kInvLuma], p.f[kShadowBase],
-            static_cast<int>(std::lround(255 * options_.shadow_min)), alpha, shadow, colour);
+  const int shadow_min = static_cast<int>(std::lround(255 * options_.shadow_min));
+  const int despill256 = static_cast<int>(std::lround(256 * options_.despill_bias));
+  const uint8_t* keyable = &keyable_[static_cast<size_t>(y) * size_.width];
+  if (order == ChannelOrder::kRgb) {
+    ChromaRowRgb(row, x0, x1, p.f[kKeyHi], p.f[kGain], p.luma_floor, p.f[kInvLuma], p.f[kShadowBase], shadow_min,
+                 despill256, keyable, alpha, shadow, colour);
+  } else {
+    ChromaRowBgr(row, x0, x1, p.f[kKeyHi], p.f[kGain], p.luma_floor, p.f[kInvLuma], p.f[kShadowBase], shadow_min,
+                 despill256, keyable, alpha, shadow, colour);
+  }
 }
 
 }  // namespace ss

@@ -5,8 +5,11 @@
 // the empty enclosure learns, per coarse cell, the green's luma Y_bg, its key
 // k_bg and the key's noise; a pixel is background above
 // k_hi = k_bg - max(min_margin * k_bg, noise_z * sigma_k), and alpha ramps up
-// to 1 over ramp * k_bg below that. Despill limits G to max(R, B). The shadow
-// layer is the floor's darkening 1 - Y / Y_bg outside the subject.
+// to 1 over ramp * k_bg below that. Despill limits G to a blend of max(R, B)
+// and min(R, B) (`despill_bias`; 0.5: their mean). The shadow layer is the
+// floor's darkening 1 - Y / Y_bg outside the subject. Pixels of the empty
+// enclosure that the model itself keys (not green: the room behind a wall)
+// are never keyed.
 #include <cstdint>
 #include <vector>
 
@@ -24,7 +27,8 @@ struct ChromaKeyerOptions {
   double coarse_alpha = 0.25;   // a sample with a larger alpha marks its cell as foreground
   double coarse_shadow = 0.12;  // a sample darkened more marks its cell as shaded
   double min_key = 0.1;         // training cells with a smaller key k_bg are not green and never keyed
-  double max_unkeyable = 0.5;   // training fails when more than this fraction of cells is not green
+  double max_unkeyable = 0.9;   // training fails when more than this fraction of cells is not green
+  double despill_bias = 0.5;    // G <= max(R,B) - bias * (max(R,B) - min(R,B)): 0 keeps yellows, 0.5 = mean(R,B)
   bool global_model = false;    // one reference for the whole frame: the naive keyer, for comparison
 };
 
@@ -35,10 +39,11 @@ class ChromaKeyer : public Keyer {
   void Train(const std::vector<cv::Mat>& empty_bgr) override;
   const ChromaKeyerOptions& options() const { return options_; }
   double unkeyable_fraction() const { return unkeyable_fraction_; }  // of cells, after Train
-
  protected:
-  void SampleRow(const uint8_t* bgr_row, int cell_row, uint8_t* foreground, uint8_t* shade) const override;
-  void FineRow(const uint8_t* bgr_row, int y, int x0, int x1, uint8_t* alpha, uint8_t* shadow,
+  // Key and shadow are symmetric in R and B: only the colour layer minds the order.
+  void SampleRow(const uint8_t* row, ChannelOrder order, int cell_row, uint8_t* foreground,
+                 uint8_t* shade) const override;
+  void FineRow(const uint8_t* row, ChannelOrder order, int y, int x0, int x1, uint8_t* alpha, uint8_t* shadow,
                uint8_t* colour) const override;
 
  private:
@@ -58,6 +63,7 @@ class ChromaKeyer : public Keyer {
   std::vector<int32_t> cell_floor_;  // rows_ x cols_
   std::vector<float> band_f_;        // rows_ x kFloatParams x width: at every pixel of a cell row
   std::vector<int32_t> band_floor_;  // rows_ x width
+  std::vector<uint8_t> keyable_;     // width x height: 0xFF where the empty enclosure is green, else 0
   double unkeyable_fraction_ = 0;
 };
 

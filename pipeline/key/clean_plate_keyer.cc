@@ -39,18 +39,36 @@ inline PixelKey PlatePixel(int b, int g, int r, int mu_b, int mu_g, int mu_r, fl
   return {alpha, ((shade * (255 - alpha) + 128) * 257) >> 16};
 }
 
-__attribute__((target_clones("avx2", "ssse3", "default")))
-void PlateRow(const uint8_t* __restrict in, const uint8_t* __restrict plate, const float* __restrict tolerance,
-              int x0, int x1, float gain, float dark_floor, int shadow_min, uint8_t* __restrict alpha,
-              uint8_t* __restrict shadow, uint8_t* __restrict colour) {
+// The fine pass over one row span; kRgb: the input is R G B (the plate and
+// the colour output are B G R either way).
+template <bool kRgb>
+__attribute__((always_inline)) inline void PlateRowImpl(const uint8_t* __restrict in, const uint8_t* __restrict plate,
+                                                        const float* __restrict tolerance, int x0, int x1, float gain,
+                                                        float dark_floor, int shadow_min, uint8_t* __restrict alpha,
+                                                        uint8_t* __restrict shadow, uint8_t* __restrict colour) {
+  constexpr int kB = kRgb ? 2 : 0, kR = kRgb ? 0 : 2;
   for (int x = x0; x < x1; ++x) {
-    const PixelKey k = PlatePixel(in[3 * x], in[3 * x + 1], in[3 * x + 2], plate[3 * x], plate[3 * x + 1],
-                                  plate[3 * x + 2], tolerance[x], gain, dark_floor, shadow_min);
+    const int b = in[3 * x + kB], g = in[3 * x + 1], r = in[3 * x + kR];
+    const PixelKey k = PlatePixel(b, g, r, plate[3 * x], plate[3 * x + 1], plate[3 * x + 2], tolerance[x], gain,
+                                  dark_floor, shadow_min);
     alpha[x] = static_cast<uint8_t>(k.alpha);
     shadow[x] = static_cast<uint8_t>(k.shadow);
+    colour[3 * x] = static_cast<uint8_t>(b);  // no spill to remove on a non-green plate
+    colour[3 * x + 1] = static_cast<uint8_t>(g);
+    colour[3 * x + 2] = static_cast<uint8_t>(r);
   }
-  std::copy(in + 3 * x0, in + 3 * x1, colour + 3 * x0);  // no spill to remove on a non-green plate
 }
+
+#define SS_PLATE_ROW(NAME, RGB)                                                                              \
+  __attribute__((target_clones("avx2", "ssse3", "default"))) void NAME(                                    \
+      const uint8_t* __restrict in, const uint8_t* __restrict plate, const float* __restrict tolerance,     \
+      int x0, int x1, float gain, float dark_floor, int shadow_min, uint8_t* __restrict alpha,              \
+      uint8_t* __restrict shadow, uint8_t* __restrict colour) {                                             \
+    PlateRowImpl<RGB>(in, plate, tolerance, x0, x1, gain, dark_floor, shadow_min, alpha, shadow, colour);   \
+  }
+SS_PLATE_ROW(PlateRowBgr, false)
+SS_PLATE_ROW(PlateRowRgb, true)
+#undef SS_PLATE_ROW
 
 }  // namespace
 
@@ -90,7 +108,16 @@ void CleanPlateKeyer::Train(const std::vector<cv::Mat>& empty_bgr) {
   cv::Mat sigma;
   cv::sqrt(var1, sigma);
   cv::dilate(sigma, sigma, cv::Mat::ones(3, 3, CV_8U));
-  sigma.convertTo(tolerance_, CV_32F, options_.noise_z);
+  // The distance a pixel is tested on is mostly the chromaticity distortion,
+  // the length of a residual in the 2-D plane across the plate's colour line,
+  // and the plate carries the noise of its own n frames: a tolerance of
+  // noise_z std in one dimension would let through exp(-z^2/2) of the pixels
+  // instead of erfc(z/sqrt 2) (e.g. z = 4: 3e-4 instead of 6e-5, a speck per
+  // frame). Match the one-dimensional rate: z2 = sqrt(-2 ln erfc(z/sqrt 2)),
+  // on the std of (frame - plate), sigma * sqrt(1 + 1/n).
+  const double tail = std::erfc(options_.noise_z / std::sqrt(2.0));
+  const double z2 = tail > 0 && tail < 1 ? std::sqrt(-2.0 * std::log(tail)) : options_.noise_z;
+  sigma.convertTo(tolerance_, CV_32F, z2 * std::sqrt(1.0 + 1.0 / n));
   if (empty_bgr.size() < 2) {
     Log("pipeline.key")->warn("clean-plate keyer trained on one frame: noise std is the floor {:.1f}",
                               options_.min_sigma);
@@ -99,8 +126,9 @@ void CleanPlateKeyer::Train(const std::vector<cv::Mat>& empty_bgr) {
                              empty_bgr.size(), size_.width, size_.height, cv::mean(tolerance_)[0]);
 }
 
-void CleanPlateKeyer::SampleRow(const uint8_t* bgr_row, int cell_row, uint8_t* foreground,
+void CleanPlateKeyer::SampleRow(const uint8_t* row, ChannelOrder order, int cell_row, uint8_t* foreground,
                                 uint8_t* shade) const {
+  const int kb = order == ChannelOrder::kRgb ? 2 : 0;
   const int y = SampleY(cell_row);
   const uint8_t* plate = plate_.ptr<uint8_t>(y);
   const float* tolerance = tolerance_.ptr<float>(y);
@@ -111,19 +139,26 @@ void CleanPlateKeyer::SampleRow(const uint8_t* bgr_row, int cell_row, uint8_t* f
   const int coarse_shadow = static_cast<int>(std::lround(255 * options_.coarse_shadow));
   for (int cx = 0; cx < cols_; ++cx) {
     const int x = SampleX(cx);
-    const uint8_t* p = bgr_row + 3 * x;
+    const uint8_t* p = row + 3 * x;
     const uint8_t* u = plate + 3 * x;
-    const PixelKey k = PlatePixel(p[0], p[1], p[2], u[0], u[1], u[2], tolerance[x], gain, dark_floor, shadow_min);
+    const PixelKey k = PlatePixel(p[kb], p[1], p[2 - kb], u[0], u[1], u[2], tolerance[x], gain, dark_floor, shadow_min);
     foreground[cx] = k.alpha > coarse_alpha;
     shade[cx] = k.shadow > coarse_shadow;
   }
 }
 
-void CleanPlateKeyer::FineRow(const uint8_t* bgr_row, int y, int x0, int x1, uint8_t* alpha,
+void CleanPlateKeyer::FineRow(const uint8_t* row, ChannelOrder order, int y, int x0, int x1, uint8_t* alpha,
                               uint8_t* shadow, uint8_t* colour) const {
-  PlateRow(bgr_row, plate_.ptr<uint8_t>(y), tolerance_.ptr<float>(y), x0, x1,
-           static_cast<float>(255 / options_.ramp), static_cast<float>(options_.dark_floor),
-           static_cast<int>(std::lround(255 * options_.shadow_min)), alpha, shadow, colour);
+  const float gain = static_cast<float>(255 / options_.ramp);
+  const float dark_floor = static_cast<float>(options_.dark_floor);
+  const int shadow_min = static_cast<int>(std::lround(255 * options_.shadow_min));
+  if (order == ChannelOrder::kRgb) {
+    PlateRowRgb(row, plate_.ptr<uint8_t>(y), tolerance_.ptr<float>(y), x0, x1, gain, dark_floor, shadow_min, alpha,
+                shadow, colour);
+  } else {
+    PlateRowBgr(row, plate_.ptr<uint8_t>(y), tolerance_.ptr<float>(y), x0, x1, gain, dark_floor, shadow_min, alpha,
+                shadow, colour);
+  }
 }
 
 }  // namespace ss

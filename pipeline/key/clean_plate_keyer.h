@@ -15,7 +15,7 @@ namespace ss {
 
 struct CleanPlateKeyerOptions {
   GridOptions grid;
-  double noise_z = 4.0;         // differences within this many noise std are background
+  double noise_z = 4.0;         // background tolerance, noise std (the false-positive rate of a 1-D z test)
   double min_sigma = 2.0;       // noise std floor, levels of 255 (a single empty frame has no spread)
   double ramp = 30.0;           // alpha goes 0 -> 1 over this many levels beyond the tolerance
   double dark_floor = 0.3;      // darker than this fraction of the plate is subject, not shadow
@@ -31,11 +31,12 @@ class CleanPlateKeyer : public Keyer {
   void Train(const std::vector<cv::Mat>& empty_bgr) override;
   const CleanPlateKeyerOptions& options() const { return options_; }
   const cv::Mat& plate() const { return plate_; }        // CV_8UC3, mean empty frame
-  const cv::Mat& tolerance() const { return tolerance_; }  // CV_32F, levels: noise_z * sigma per pixel
+  const cv::Mat& tolerance() const { return tolerance_; }  // CV_32F, levels, per pixel (docs/keying.md)
 
  protected:
-  void SampleRow(const uint8_t* bgr_row, int cell_row, uint8_t* foreground, uint8_t* shade) const override;
-  void FineRow(const uint8_t* bgr_row, int y, int x0, int x1, uint8_t* alpha, uint8_t* shadow,
+  void SampleRow(const uint8_t* row, ChannelOrder order, int cell_row, uint8_t* foreground,
+                 uint8_t* shade) const override;
+  void FineRow(const uint8_t* row, ChannelOrder order, int y, int x0, int x1, uint8_t* alpha, uint8_t* shadow,
                uint8_t* colour) const override;
 
  private:

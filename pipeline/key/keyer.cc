@@ -43,32 +43,39 @@ void Keyer::StartTraining(const std::vector<cv::Mat>& empty_bgr, const std::stri
 }
 
 void Keyer::Key(const Frame& frame, cv::Mat& bgr_scratch, Matte& matte) const {
-  const size_t bgr_bytes = FrameBytes(PixelFormat::kBGR8, frame.width, frame.height);
-  if (frame.format == PixelFormat::kBGR8 && frame.data != nullptr && frame.size >= bgr_bytes &&
-      bgr_bytes > 0) {
-    // No copy: key the frame's own bytes.
+  const bool packed = frame.format == PixelFormat::kBGR8 || frame.format == PixelFormat::kRGB8;
+  const size_t bytes = FrameBytes(PixelFormat::kBGR8, frame.width, frame.height);
+  if (packed && frame.data != nullptr && frame.size >= bytes && bytes > 0) {
+    // No copy, no conversion: key the frame's own bytes.
     const cv::Mat view(frame.height, frame.width, CV_8UC3, const_cast<uint8_t*>(frame.data));
-    Key(view, matte);
+    Key(view, frame.format == PixelFormat::kRGB8 ? ChannelOrder::kRgb : ChannelOrder::kBgr, matte);
     return;
   }
+  if (frame.format == PixelFormat::kMono8) {
+    throw InputError("frame " + std::to_string(frame.sequence),
+                     "mono8 frames carry no colour for the " + name() +
+                         " keyer; a colour format is needed (rgb8, bgr8, bayer_*, yuyv, nv12, mjpeg)");
+  }
   ToBgr(frame, bgr_scratch);
-  Key(bgr_scratch, matte);
+  Key(bgr_scratch, ChannelOrder::kBgr, matte);
 }
 
-void Keyer::Key(const cv::Mat& bgr, Matte& matte) const {
+void Keyer::Key(const cv::Mat& image, ChannelOrder order, Matte& matte) const {
   if (!trained()) throw WorkError(name() + " keyer", "used before Train() saw the empty enclosure");
-  if (bgr.type() != CV_8UC3) throw InputError("frame", "expected 8-bit BGR (CV_8UC3) for " + name() + " keying");
-  if (bgr.size() != size_) {
-    throw InputError("frame", "size " + SizeText(bgr.size()) + " differs from the " + SizeText(size_) +
+  if (image.type() != CV_8UC3) {
+    throw InputError("frame", "expected 8-bit 3-channel pixels (CV_8UC3) for " + name() + " keying");
+  }
+  if (image.size() != size_) {
+    throw InputError("frame", "size " + SizeText(image.size()) + " differs from the " + SizeText(size_) +
                                   " the " + name() + " keyer was trained on");
   }
   Prepare(matte);
-  CoarsePass(bgr, matte.coarse);
+  CoarsePass(image, order, matte.coarse);
   FindRegions(matte.coarse, matte.regions);
   for (const KeyRegion& r : matte.regions) {
     const int x0 = r.box.x, x1 = r.box.x + r.box.width;
     for (int y = r.box.y; y < r.box.y + r.box.height; ++y) {
-      FineRow(bgr.ptr<uint8_t>(y), y, x0, x1, matte.alpha.ptr<uint8_t>(y), matte.shadow.ptr<uint8_t>(y),
+      FineRow(image.ptr<uint8_t>(y), order, y, x0, x1, matte.alpha.ptr<uint8_t>(y), matte.shadow.ptr<uint8_t>(y),
               matte.colour.ptr<uint8_t>(y));
     }
   }
@@ -104,9 +111,9 @@ void Keyer::Prepare(Matte& matte) const {
   g.queue.reserve(n);
 }
 
-void Keyer::CoarsePass(const cv::Mat& bgr, CoarseGrid& g) const {
+void Keyer::CoarsePass(const cv::Mat& image, ChannelOrder order, CoarseGrid& g) const {
   for (int cy = 0; cy < rows_; ++cy) {
-    SampleRow(bgr.ptr<uint8_t>(SampleY(cy)), cy, &g.foreground[static_cast<size_t>(cy) * cols_],
+    SampleRow(image.ptr<uint8_t>(SampleY(cy)), order, cy, &g.foreground[static_cast<size_t>(cy) * cols_],
               &g.shade[static_cast<size_t>(cy) * cols_]);
   }
 }

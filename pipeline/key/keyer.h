@@ -16,6 +16,10 @@
 
 namespace ss {
 
+// Byte order of 3-channel pixels. The keyers read either in place; the
+// matte's colour layer is BGR (OpenCV's order) either way.
+enum class ChannelOrder { kBgr, kRgb };
+
 struct GridOptions {
   int step = 8;                // coarse sampling step, px; anything >= step + 2 px across is sampled
   int margin_px = 6;           // added around each region's cell box
@@ -37,19 +41,25 @@ class Keyer {
   // Keys one BGR frame into `matte`, reusing its buffers. Const and free of
   // shared state: one keyer may serve several threads, each with its own Matte.
   // Throws InputError on a frame of the wrong type or size, WorkError if untrained.
-  void Key(const cv::Mat& bgr, Matte& matte) const;
-  // Any pixel format, converted to BGR in `bgr_scratch` first (core/frame.h ToBgr).
+  void Key(const cv::Mat& bgr, Matte& matte) const { Key(bgr, ChannelOrder::kBgr, matte); }
+  // The same for an 8-bit 3-channel image in either channel order, keyed in place.
+  void Key(const cv::Mat& image, ChannelOrder order, Matte& matte) const;
+  // Any pixel format: BGR8 and RGB8 keyed in place, the others converted to BGR
+  // in `bgr_scratch` first (core/frame.h ToBgr: bilinear demosaic, YUV 4:2:x).
+  // Throws InputError for mono8 (both keys need colour: in grey a chroma key
+  // has nothing to key and a darker subject looks like a shadow) and for a
+  // malformed frame.
   void Key(const Frame& frame, cv::Mat& bgr_scratch, Matte& matte) const;
 
  protected:
   explicit Keyer(GridOptions grid);
-  // Tests the samples of cell row `cell_row`; `bgr_row` is image row SampleY(cell_row).
-  // Sets foreground[cx] and shade[cx] to 0 or 1 for every cell of the row.
-  virtual void SampleRow(const uint8_t* bgr_row, int cell_row, uint8_t* foreground,
+  // Tests the samples of cell row `cell_row`; `row` is image row SampleY(cell_row)
+  // in channel order `order`. Sets foreground[cx] and shade[cx] to 0 or 1 for every cell.
+  virtual void SampleRow(const uint8_t* row, ChannelOrder order, int cell_row, uint8_t* foreground,
                          uint8_t* shade) const = 0;
   // Full-resolution key of pixels [x0, x1) of image row y. Output pointers
-  // address pixel 0 of the row (colour: 3 bytes per pixel).
-  virtual void FineRow(const uint8_t* bgr_row, int y, int x0, int x1, uint8_t* alpha,
+  // address pixel 0 of the row (colour: 3 bytes per pixel, BGR).
+  virtual void FineRow(const uint8_t* row, ChannelOrder order, int y, int x0, int x1, uint8_t* alpha,
                        uint8_t* shadow, uint8_t* colour) const = 0;
   // Checks training frames (non-empty, 8-bit BGR, one size); sets size_ and the grid shape.
   void StartTraining(const std::vector<cv::Mat>& empty_bgr, const std::string& keyer);
@@ -63,7 +73,7 @@ class Keyer {
 
  private:
   void Prepare(Matte& matte) const;
-  void CoarsePass(const cv::Mat& bgr, CoarseGrid& coarse) const;
+  void CoarsePass(const cv::Mat& image, ChannelOrder order, CoarseGrid& coarse) const;
   void FindRegions(CoarseGrid& coarse, std::vector<KeyRegion>& regions) const;
 };
 

@@ -7,7 +7,7 @@
 
 namespace ss {
 
-void ValidateBillboard(const Billboard& b) {
+void ValidateBillboard(const RgbaBillboard& b) {
   if (b.width <= 0 || b.height <= 0) {
     throw InputError("billboard", "size " + std::to_string(b.width) + "x" + std::to_string(b.height) +
                                       " is empty");
@@ -26,7 +26,7 @@ void ValidateBillboard(const Billboard& b) {
   }
 }
 
-CheapFeatures DescribeBillboard(const Billboard& b, double px_per_m) {
+CheapFeatures DescribeBillboard(const RgbaBillboard& b, double px_per_m) {
   ValidateBillboard(b);
   if (!(px_per_m > 0)) throw InputError("px_per_m", "must be positive");
   // Alpha-weighted sums, in pixel units; alpha in 0..1.
@@ -62,9 +62,9 @@ CheapFeatures DescribeBillboard(const Billboard& b, double px_per_m) {
   return f;
 }
 
-Billboard MirrorBillboard(const Billboard& b) {
+RgbaBillboard MirrorBillboard(const RgbaBillboard& b) {
   ValidateBillboard(b);
-  Billboard m = b;
+  RgbaBillboard m = b;
   m.anchor_x_px = (b.width - 1) - b.anchor_x_px;
   for (int y = 0; y < b.height; ++y) {
     for (int x = 0; x < b.width; ++x) {

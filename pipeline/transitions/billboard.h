@@ -15,7 +15,7 @@ namespace ss {
 // the rectifier and the bank store it; it may be fractional. Every feature is symmetric
 // in the three colour channels, so RGBA and the bank's BGRA give the same features
 // (only the names of CheapFeatures::colour[] change).
-struct Billboard {
+struct RgbaBillboard {
   int width = 0;
   int height = 0;
   double anchor_x_px = 0;
@@ -36,12 +36,12 @@ struct CheapFeatures {
 
 // Mean colour, area and eccentricity of a billboard (velocity is not a pixel property
 // and is left 0). Throws InputError("billboard", reason) for a malformed billboard.
-CheapFeatures DescribeBillboard(const Billboard& billboard, double px_per_m);
+CheapFeatures DescribeBillboard(const RgbaBillboard& billboard, double px_per_m);
 
 // Throws InputError("billboard", reason) unless sizes, anchor and byte count agree.
-void ValidateBillboard(const Billboard& billboard);
+void ValidateBillboard(const RgbaBillboard& billboard);
 
 // The horizontally mirrored billboard (anchor mirrored with it).
-Billboard MirrorBillboard(const Billboard& billboard);
+RgbaBillboard MirrorBillboard(const RgbaBillboard& billboard);
 
 }  // namespace ss

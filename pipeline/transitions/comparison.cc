@@ -52,7 +52,7 @@ std::vector<std::vector<Overlap>> AxisOverlaps(double start_px, double cell_px, 
 
 }  // namespace
 
-CellBox MakeComparisonImage(const Billboard& b, double px_per_m, const ComparisonWindow& window,
+CellBox MakeComparisonImage(const RgbaBillboard& b, double px_per_m, const ComparisonWindow& window,
                             uint8_t* image) {
   ValidateBillboard(b);
   std::string why;

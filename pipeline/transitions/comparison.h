@@ -49,7 +49,7 @@ inline int BoxArea(const CellBox& b) { return b.empty() ? 0 : (b.x1 - b.x0) * (b
 // cell alpha = mean alpha over the cell, cell colour = alpha-weighted mean colour.
 // Writes window.ImageBytes() bytes at `image` (planes A, R, G, B; padding zeroed);
 // returns the box of non-zero alpha cells.
-CellBox MakeComparisonImage(const Billboard& billboard, double px_per_m, const ComparisonWindow& window,
+CellBox MakeComparisonImage(const RgbaBillboard& billboard, double px_per_m, const ComparisonWindow& window,
                             uint8_t* image);
 
 // The two stage-2 pixel features of a sprite pair.

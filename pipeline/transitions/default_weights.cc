@@ -6,15 +6,88 @@ namespace ss {
 const char* DefaultWeightsText() {
   return R"json(
 {
+  "comparison_window": {
+    "align": "alpha_centroid",
+    "cells_x": 32,
+    "cells_y": 32,
+    "height_m": 0.16,
+    "width_m": 0.24
+  },
+  "feature_mean": [
+    0.05521502284936413,
+    12.344157430815166,
+    0.0006152389437908498,
+    0.0530209196180576,
+    0.11361554926020456,
+    9.822875121226325
+  ],
+  "feature_scale": [
+    0.07322843867733259,
+    9.965992984170116,
+    0.0007988898755441805,
+    0.09034583822170575,
+    0.1056912123329325,
+    6.953069034079575
+  ],
+  "features": [
+    "velocity",
+    "mean_colour",
+    "area",
+    "eccentricity",
+    "alpha",
+    "pixel_colour"
+  ],
   "format": "spritestation-transition-weights",
-  "version": 1,
-  "features": ["velocity", "mean_colour", "area", "eccentricity", "alpha", "pixel_colour"],
-  "comparison_window": {"width_m": 0.24, "height_m": 0.16, "cells_x": 32, "cells_y": 32, "align": "alpha_centroid"},
-  "feature_mean": [0, 0, 0, 0, 0, 0],
-  "feature_scale": [0.05, 20, 0.001, 0.05, 0.1, 20],
-  "stage1": {"weights": [1, 1, 1, 1], "bias": -1},
-  "stage2": {"weights": [1, 1, 1, 1, 1, 1], "bias": -1},
-  "training": {"note": "placeholder before training"}
+  "stage1": {
+    "bias": -0.9185983406821834,
+    "weights": [
+      1.364962493184733,
+      0.058383352773824344,
+      2.5917508056678127,
+      4.188599776084517
+    ]
+  },
+  "stage2": {
+    "bias": 4.270845235212679,
+    "weights": [
+      0.5576472055963501,
+      0.0,
+      0.0,
+      0.7883611057350219,
+      8.994708745567479,
+      0.6657760687009545
+    ]
+  },
+  "training": {
+    "accepts": 1500,
+    "cross_validation_folds": 5,
+    "samples": 3000,
+    "source": "spritestation bench transitions --train-out: synthetic hamster set, seed 1, 30000 sprites (pipeline/transitions/synthetic.cc), labels from truth",
+    "stage1_calibration": {
+      "bias": -0.9185983406821834,
+      "bias_from_labels": 2.4690613128921286,
+      "sampled_rows": 300,
+      "stage2_accepted_pairs_sampled": 69777,
+      "target_recall_of_stage2": 0.995
+    },
+    "stage1_cross_validated": {
+      "false_accept": 380,
+      "false_reject": 154,
+      "precision": 0.779837775202781,
+      "recall": 0.8973333333333333,
+      "true_accept": 1346,
+      "true_reject": 1120
+    },
+    "stage2_cross_validated": {
+      "false_accept": 182,
+      "false_reject": 100,
+      "precision": 0.8849557522123894,
+      "recall": 0.9333333333333333,
+      "true_accept": 1400,
+      "true_reject": 1318
+    }
+  },
+  "version": 1
 }
 )json";
 }

@@ -20,7 +20,7 @@ struct SpriteInput {
   int64_t id = 0;    // bank sprite id, unique
   int64_t clip = 0;  // bank clip id
   CheapFeatures cheap;
-  const Billboard* billboard = nullptr;  // borrowed for the call
+  const RgbaBillboard* billboard = nullptr;  // borrowed for the call
 };
 
 class SpriteStore {

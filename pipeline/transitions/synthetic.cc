@@ -38,8 +38,8 @@ class Canvas {
   void Rect(double x0, double z0, double x1, double z1, const Rgb& colour) {
     Span(x0, z0, x1, z1, [](double, double) { return true; }, [&](double, double) { return colour; });
   }
-  Billboard Resolve(std::mt19937_64& rng, int noise) const {
-    Billboard b;
+  RgbaBillboard Resolve(std::mt19937_64& rng, int noise) const {
+    RgbaBillboard b;
     b.width = width_px_;
     b.height = height_px_;
     b.rgba.assign(static_cast<size_t>(b.width) * b.height * 4, 0);
@@ -121,53 +121,55 @@ struct State {
   double size = 1;
 };
 
-// Renders the animal in state `s`.
-Billboard Render(const State& s, double px_per_m, std::mt19937_64& rng, int noise) {
-  Canvas canvas(px_per_m);
+// Where the animal's parts are in state `s`, in the billboard plane: x right (0 = the body
+// centre), z up (0 = the floor), metres; `depth` orders the painting (larger = farther).
+struct Geometry {
+  struct Leg {
+    double x, lift, depth;
+  };
+  double body_z = 0, body_ax = 0, body_az = 0;
+  double head_x = 0, head_z = 0, head_depth = 0;
+  std::vector<Leg> legs;  // walk/trot: 4, stand: the hind pair, idle: none
+};
+
+Geometry Layout(const State& s) {
+  Geometry g;
   const double c = std::cos(s.heading), sn = std::sin(s.heading), k = s.size;
-  const Rgb fur = Shade({205, 150, 85}, s.brightness), belly = Shade({236, 214, 176}, s.brightness);
-  const Rgb stripe = Shade({150, 100, 58}, s.brightness), leg = Shade({170, 120, 80}, s.brightness);
-  const Rgb face = Shade({240, 222, 192}, s.brightness), ear = Shade({215, 140, 130}, s.brightness);
-  const Rgb eye{25, 20, 20};
   const bool gait = s.pose == "walk" || s.pose == "trot";
   const double stretch = gait ? (s.pose == "trot" ? 0.12 : 0.06) * std::sin(4 * M_PI * s.phase) : 0.0;
-
-  struct Part {
-    double depth;  // larger = farther from the camera, painted first
-    std::function<void()> paint;
-  };
-  std::vector<Part> parts;
-  double body_z, body_ax, body_az, head_f, head_z;
+  double head_f;
   if (s.pose == "stand") {
     // Standing up, swaying: the head circles once per cycle.
     const double a = 2 * M_PI * s.phase;
-    body_z = 0.07 * k;
-    body_ax = k * 0.035 * (0.75 + 0.25 * std::abs(c));
-    body_az = 0.06 * k;
+    g.body_z = 0.07 * k;
+    g.body_ax = k * 0.035 * (0.75 + 0.25 * std::abs(c));
+    g.body_az = 0.06 * k;
     head_f = 0.012 * k + 0.012 * k * std::sin(a);
-    head_z = 0.135 * k + 0.006 * k * std::cos(a);
+    g.head_z = 0.135 * k + 0.006 * k * std::cos(a);
   } else {
     const double length = 0.13 * k * (1 + stretch), width = 0.075 * k;
     const double height = (s.pose == "idle" ? 0.072 : 0.065) * k * (1 - 0.5 * stretch);
-    body_z = (s.pose == "idle" ? 0.038 : 0.05) * k;
-    body_ax = std::sqrt(std::pow(0.5 * length * c, 2) + std::pow(0.5 * width * sn, 2));
-    body_az = 0.5 * height;
+    g.body_z = (s.pose == "idle" ? 0.038 : 0.05) * k;
+    g.body_ax = std::sqrt(std::pow(0.5 * length * c, 2) + std::pow(0.5 * width * sn, 2));
+    g.body_az = 0.5 * height;
     // Idle: sniffing, the head circles once per cycle.
     const double a = 2 * M_PI * s.phase;
     const bool idle = s.pose == "idle";
     head_f = 0.5 * length * 0.85 + (idle ? 0.008 * k * std::cos(a) : 0.0);
-    head_z = body_z + 0.012 * k + (idle ? 0.007 * k * std::sin(a) : 0.0);
+    g.head_z = g.body_z + 0.012 * k + (idle ? 0.007 * k * std::sin(a) : 0.0);
   }
+  g.head_x = head_f * c;
+  g.head_depth = head_f * sn - 1e-4;
   // Legs (walk and trot swing them; idle hides them; stand shows the hind pair).
-  const double body_bottom = body_z - body_az;
   if (s.pose != "idle") {
-    struct Leg {
+    struct LegSpec {
       double forward, lateral, offset;
     };
     const bool trot = s.pose == "trot";
-    const std::array<Leg, 4> legs = {Leg{0.04, 0.025, 0.0}, Leg{0.04, -0.025, 0.5},
-                                     Leg{-0.04, 0.025, trot ? 0.5 : 0.75}, Leg{-0.04, -0.025, trot ? 0.0 : 0.25}};
-    for (const Leg& l : legs) {
+    const std::array<LegSpec, 4> specs = {LegSpec{0.04, 0.025, 0.0}, LegSpec{0.04, -0.025, 0.5},
+                                          LegSpec{-0.04, 0.025, trot ? 0.5 : 0.75},
+                                          LegSpec{-0.04, -0.025, trot ? 0.0 : 0.25}};
+    for (const LegSpec& l : specs) {
       if (s.pose == "stand" && l.forward > 0) continue;
       double f = l.forward * k, lift = 0;
       if (gait) {
@@ -176,12 +178,46 @@ Billboard Render(const State& s, double px_per_m, std::mt19937_64& rng, int nois
         lift = 0.007 * k * std::max(0.0, std::cos(a));
       }
       if (s.pose == "stand") f = 0.0;
-      const double x = f * c - l.lateral * k * sn, depth = f * sn + l.lateral * k * c;
-      const double top = body_bottom + 0.012 * k;
-      parts.push_back({depth, [&canvas, x, lift, top, k, leg] {
-                         canvas.Rect(x - 0.006 * k, lift, x + 0.006 * k, top, leg);
-                       }});
+      g.legs.push_back({f * c - l.lateral * k * sn, lift, f * sn + l.lateral * k * c});
     }
+  }
+  return g;
+}
+
+// The visible key points of state `s` (billboard plane, metres, fixed order per pose):
+// head centre, the body's right and left extremes and top, each leg's foot.
+std::vector<double> Keypoints(const State& s) {
+  const Geometry g = Layout(s);
+  std::vector<double> p = {g.head_x, g.head_z, g.body_ax, g.body_z, -g.body_ax, g.body_z, 0.0, g.body_z + g.body_az};
+  for (const Geometry::Leg& l : g.legs) {
+    p.push_back(l.x);
+    p.push_back(l.lift);
+  }
+  return p;
+}
+
+// Renders the animal in state `s`.
+RgbaBillboard Render(const State& s, double px_per_m, std::mt19937_64& rng, int noise) {
+  Canvas canvas(px_per_m);
+  const Geometry g = Layout(s);
+  const double c = std::cos(s.heading), sn = std::sin(s.heading), k = s.size;
+  const Rgb fur = Shade({205, 150, 85}, s.brightness), belly = Shade({236, 214, 176}, s.brightness);
+  const Rgb stripe = Shade({150, 100, 58}, s.brightness), leg = Shade({170, 120, 80}, s.brightness);
+  const Rgb face = Shade({240, 222, 192}, s.brightness), ear = Shade({215, 140, 130}, s.brightness);
+  const Rgb eye{25, 20, 20};
+
+  struct Part {
+    double depth;  // larger = farther from the camera, painted first
+    std::function<void()> paint;
+  };
+  std::vector<Part> parts;
+  const double body_z = g.body_z, body_ax = g.body_ax, body_az = g.body_az, head_z = g.head_z;
+  const double top = body_z - body_az + 0.012 * k;
+  for (const Geometry::Leg& l : g.legs) {
+    const double x = l.x, lift = l.lift;
+    parts.push_back({l.depth, [&canvas, x, lift, top, k, leg] {
+                       canvas.Rect(x - 0.006 * k, lift, x + 0.006 * k, top, leg);
+                     }});
   }
   parts.push_back({0.0, [&canvas, body_z, body_ax, body_az, fur, belly, stripe] {
                      canvas.Ellipse(0, body_z, body_ax, body_az, [=](double, double z) {
@@ -190,7 +226,7 @@ Billboard Render(const State& s, double px_per_m, std::mt19937_64& rng, int nois
                        return fur;
                      });
                    }});
-  const double head_x = head_f * c, head_depth = head_f * sn - 1e-4, r = 0.028 * k;
+  const double head_x = g.head_x, head_depth = g.head_depth, r = 0.028 * k;
   const bool facing = sn < 0;  // the face is toward the camera
   parts.push_back({head_depth, [=, &canvas] {
                      canvas.Ellipse(head_x, head_z, r, r * 0.95, [=](double, double) { return fur; });
@@ -237,6 +273,7 @@ std::vector<SyntheticSprite> MakeSyntheticSprites(const SyntheticSpriteOptions& 
   std::vector<SyntheticSprite> out;
   out.reserve(o.mirrors ? 2 * o.frames : o.frames);
   std::vector<std::pair<int64_t, int64_t>> clip_ranges;  // [first, last] indices in out
+  std::vector<State> states;                             // of the originals, by index in out
   int64_t clip = 0;
   while (static_cast<int>(out.size()) < o.frames) {
     ++clip;
@@ -276,6 +313,8 @@ std::vector<SyntheticSprite> MakeSyntheticSprites(const SyntheticSpriteOptions& 
       sprite.truth.pose = s.pose;
       sprite.truth.heading_rad = s.heading;
       sprite.truth.gait_phase = s.phase;
+      sprite.truth.keypoints_m = Keypoints(s);
+      states.push_back(s);
       out.push_back(std::move(sprite));
     }
     clip_ranges.emplace_back(first, static_cast<int64_t>(out.size()) - 1);
@@ -299,6 +338,12 @@ std::vector<SyntheticSprite> MakeSyntheticSprites(const SyntheticSpriteOptions& 
         if (m.truth.pose == "walk" || m.truth.pose == "trot") {
           m.truth.gait_phase = std::fmod(m.truth.gait_phase + 0.5, 1.0);
         }
+        // The mirror image is the picture of the mirrored state (legs swap as noted above):
+        // its key points come from that state, so the legs keep their identities.
+        State mirrored = states[k];
+        mirrored.heading = m.truth.heading_rad;
+        mirrored.phase = m.truth.gait_phase;
+        m.truth.keypoints_m = Keypoints(mirrored);
         out.push_back(std::move(m));
       }
     }

@@ -30,7 +30,7 @@ struct SyntheticSprite {
   int64_t id = 0;    // 1-based, originals first in frame order, then mirrors
   int64_t clip = 0;  // 1-based
   CheapFeatures cheap;
-  Billboard billboard;
+  RgbaBillboard billboard;
   SpriteTruth truth;
   double speed_mps = 0;
 };

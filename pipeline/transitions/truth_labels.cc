@@ -19,10 +19,24 @@ double PhaseDifference(double a, double b) {
   return d > 0.5 ? 1.0 - d : d;
 }
 
+double KeypointDisplacement(const SpriteTruth& a, const SpriteTruth& b) {
+  if (a.keypoints_m.empty() || a.keypoints_m.size() != b.keypoints_m.size() || a.keypoints_m.size() % 2 != 0) {
+    return INFINITY;
+  }
+  double worst = 0;
+  for (size_t k = 0; k < a.keypoints_m.size(); k += 2) {
+    worst = std::max(worst, std::hypot(a.keypoints_m[k] - b.keypoints_m[k], a.keypoints_m[k + 1] - b.keypoints_m[k + 1]));
+  }
+  return worst;
+}
+
 namespace {
 
 bool Within(const SpriteTruth& a, const SpriteTruth& b, const TruthLabelOptions& o, double factor) {
   if (a.pose != b.pose) return false;
+  if (!a.keypoints_m.empty() && !b.keypoints_m.empty()) {
+    return KeypointDisplacement(a, b) <= factor * o.max_keypoint_displacement_m;
+  }
   if (HeadingDifference(a.heading_rad, b.heading_rad) > factor * o.max_heading_difference_rad) return false;
   const bool a_gait = !std::isnan(a.gait_phase), b_gait = !std::isnan(b.gait_phase);
   if (a_gait != b_gait) return false;

@@ -1,7 +1,12 @@
 #pragma once
-// Labels from synthetic truth, so that tests and demos can train without a person:
-// a pair is "accept" when both sprites have the same pose label, their headings are
-// close and their gait phases are close (seed 000 §3 asks a person the same question).
+// Labels from synthetic truth, so that tests and demos can train without a person
+// (seed 000 §3 asks a person whether a pair would make a smooth transition). A pair is
+// "accept" when both sprites have the same pose label and look alike:
+//  - when both truths carry key points (the synthetic sets of synthetic.h do): every
+//    visible key point moved at most max_keypoint_displacement_m in the billboard plane;
+//  - otherwise (e.g. a studio session's subjects.csv): headings and gait phases are close.
+// Key points measure closeness the way an eye does: a phase tolerance alone would call a
+// barely moving sniff "different" and a fast trot "alike" (docs/transitions.md).
 #include <cmath>
 #include <cstdint>
 #include <span>
@@ -16,16 +21,23 @@ struct SpriteTruth {
   std::string pose;                 // "walk", "trot", "idle", "stand", ...
   double heading_rad = 0;           // facing direction on the ground
   double gait_phase = std::nan("");  // cycles in [0, 1); NaN when the pose has no gait
+  // Optional: visible key points as (x, z) pairs in the billboard plane, metres, x from
+  // the body centre, z up from the floor; the same points in the same order per pose.
+  std::vector<double> keypoints_m;
 };
 
 struct TruthLabelOptions {
   double max_heading_difference_rad = 6.0 * M_PI / 180.0;
   double max_phase_difference = 0.04;  // cycles, circular
+  double max_keypoint_displacement_m = 0.004;  // when both truths have key points (1 px at 250 px/m)
   // Rejects sampled as near misses (same pose, heading and phase within `near_miss_factor`
   // times the tolerances) rather than uniformly; the rest are uniform random rejects.
   double near_miss_fraction = 0.5;
   double near_miss_factor = 3.0;
 };
+
+// The largest key-point displacement (metres); infinity when the sets do not correspond.
+double KeypointDisplacement(const SpriteTruth& a, const SpriteTruth& b);
 
 // Circular differences: headings in radians (0..pi), phases in cycles (0..0.5).
 double HeadingDifference(double a_rad, double b_rad);

@@ -47,6 +47,7 @@ struct SceneFrame {
   cv::Mat alpha;      // CV_32F true alpha 0..1
   cv::Mat darkening;  // CV_32F true shadow darkening 0..1 (of the floor, everywhere)
   cv::Mat rim;        // CV_8U 255 on subject pixels (alpha 1) within 4 px of the edge: spill
+  cv::Mat clean;      // CV_32FC3 the subject's own colour without spill (where alpha > 0)
 };
 
 class KeyScene {
@@ -95,6 +96,7 @@ class KeyScene {
     f.darkening = cv::Mat::zeros(o_.size, CV_32F);
     f.rim = cv::Mat::zeros(o_.size, CV_8U);
     cv::Mat colour(o_.size, CV_32FC3, cv::Scalar::all(0));
+    f.clean = cv::Mat::zeros(o_.size, CV_32FC3);
     cv::RNG rng(o_.seed * 7919 + static_cast<uint64_t>(index) + 1);
     for (const SceneSubject& s : subjects) {
       const cv::Mat fur = BlurredNoise(rng, 2.5);
@@ -110,6 +112,7 @@ class KeyScene {
           const double a = std::clamp(0.5 - sd / o_.edge_px, 0.0, 1.0);
           if (a <= 0) continue;
           cv::Vec3d c = s.colour * (1 + s.texture * fur.at<float>(y, x));
+          const cv::Vec3d own = c;
           const double rim = std::clamp(1 + sd / 4, 0.0, 1.0);  // 1 at the edge, 0 from 4 px inside
           c[1] += s.spill * rim;
           if (a >= 1 && sd > -4) f.rim.at<uint8_t>(y, x) = 255;
@@ -117,6 +120,7 @@ class KeyScene {
           if (a > fa) {
             fa = static_cast<float>(a);
             colour.at<cv::Vec3f>(y, x) = cv::Vec3f(c);
+            f.clean.at<cv::Vec3f>(y, x) = cv::Vec3f(own);
           }
         }
       }

@@ -14,8 +14,8 @@
 namespace ss {
 namespace {
 
-Billboard Dot() {
-  Billboard b;
+RgbaBillboard Dot() {
+  RgbaBillboard b;
   b.width = b.height = 2;
   b.anchor_x_px = 0.5;
   b.anchor_y_px = 1;
@@ -31,14 +31,14 @@ TransitionWeights VelocityOnly() {
   return w;
 }
 
-SpriteInput At(int64_t id, int64_t clip, double vx, const Billboard* b) {
+SpriteInput At(int64_t id, int64_t clip, double vx, const RgbaBillboard* b) {
   SpriteInput s{id, clip, {}, b};
   s.cheap.velocity_x_mps = vx;
   return s;
 }
 
 TEST(TransitionBuilder, CostMatchesFormulaOnHandMadeClips) {
-  const Billboard dot = Dot();
+  const RgbaBillboard dot = Dot();
   // Clip A: sprites 1 2 3 4 with v = 0, 0.6, 1.2, 1.8; clip B: 11 12 13 with v = 0.1, 0.7, 1.3.
   // Kept pairs (|dv| <= 1): {1,2} {2,3} {3,4} {11,12} {12,13} (0.6 each), {1,11} .1, {1,12} .7,
   // {2,11} .5, {2,12} .1, {2,13} .7, {3,12} .5, {3,13} .1, {4,13} .5.
@@ -78,7 +78,7 @@ TEST(TransitionBuilder, CostMatchesFormulaOnHandMadeClips) {
 }
 
 TEST(TransitionBuilder, ClipEndsAndRepeatsAreNotTransitions) {
-  const Billboard dot = Dot();
+  const RgbaBillboard dot = Dot();
   // One clip 1..5 with v = 0, .5, 0, .5, 0: every pair is kept.
   const std::vector<SpriteInput> in = {At(1, 7, 0, &dot), At(2, 7, .5, &dot), At(3, 7, 0, &dot), At(4, 7, .5, &dot),
                                        At(5, 7, 0, &dot)};
@@ -104,7 +104,7 @@ TEST(TransitionBuilder, EmptySetAndDuplicatesAreInputErrors) {
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("empty"), std::string::npos) << e.what();
   }
-  const Billboard dot = Dot();
+  const RgbaBillboard dot = Dot();
   const std::vector<SpriteInput> in = {At(1, 7, 0, &dot), At(1, 7, 5, &dot)};
   try {
     builder.BuildFromScratch(in);

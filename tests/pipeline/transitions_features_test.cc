@@ -16,8 +16,8 @@ namespace ss {
 namespace {
 
 // A billboard of `w` x `h` transparent pixels with its anchor at (ax, ay) (pixel centres).
-Billboard Blank(int w, int h, double ax, double ay) {
-  Billboard b;
+RgbaBillboard Blank(int w, int h, double ax, double ay) {
+  RgbaBillboard b;
   b.width = w;
   b.height = h;
   b.anchor_x_px = ax;
@@ -26,7 +26,7 @@ Billboard Blank(int w, int h, double ax, double ay) {
   return b;
 }
 
-void Paint(Billboard& b, int x, int y, uint8_t r, uint8_t g, uint8_t bl, uint8_t a) {
+void Paint(RgbaBillboard& b, int x, int y, uint8_t r, uint8_t g, uint8_t bl, uint8_t a) {
   uint8_t* p = b.rgba.data() + (static_cast<size_t>(y) * b.width + x) * 4;
   p[0] = r;
   p[1] = g;
@@ -36,7 +36,7 @@ void Paint(Billboard& b, int x, int y, uint8_t r, uint8_t g, uint8_t bl, uint8_t
 
 TEST(TransitionFeatures, DescribeRectangle) {
   // 4 x 2 opaque pixels at 100 px/m: area 8 px^2 = 8e-4 m^2; variances 15/12 and 3/12.
-  Billboard b = Blank(6, 4, 2, 3);
+  RgbaBillboard b = Blank(6, 4, 2, 3);
   for (int y = 1; y <= 2; ++y)
     for (int x = 1; x <= 4; ++x) Paint(b, x, y, 10, 20, 30, 255);
   const CheapFeatures f = DescribeBillboard(b, 100.0);
@@ -49,7 +49,7 @@ TEST(TransitionFeatures, DescribeRectangle) {
 }
 
 TEST(TransitionFeatures, MeanColourIsAlphaWeighted) {
-  Billboard b = Blank(2, 1, 0, 0);
+  RgbaBillboard b = Blank(2, 1, 0, 0);
   Paint(b, 0, 0, 200, 0, 0, 255);
   Paint(b, 1, 0, 0, 200, 0, 51);  // alpha 0.2
   const CheapFeatures f = DescribeBillboard(b, 10.0);
@@ -59,7 +59,7 @@ TEST(TransitionFeatures, MeanColourIsAlphaWeighted) {
 }
 
 TEST(TransitionFeatures, CircleHasZeroEccentricityAndMirrorKeepsFeatures) {
-  Billboard b = Blank(21, 21, 10, 20);
+  RgbaBillboard b = Blank(21, 21, 10, 20);
   for (int y = 0; y < 21; ++y)
     for (int x = 0; x < 21; ++x)
       if ((x - 10) * (x - 10) + (y - 10) * (y - 10) <= 81) Paint(b, x, y, x * 10, y * 10, 50, 255);
@@ -72,10 +72,10 @@ TEST(TransitionFeatures, CircleHasZeroEccentricityAndMirrorKeepsFeatures) {
 }
 
 TEST(TransitionFeatures, MalformedBillboardIsAnInputError) {
-  Billboard b = Blank(4, 4, 1, 1);
+  RgbaBillboard b = Blank(4, 4, 1, 1);
   b.rgba.pop_back();
   EXPECT_THROW(DescribeBillboard(b, 100), InputError);
-  Billboard c = Blank(4, 4, 3.6, 1);  // anchor outside (pixel 3 ends at 3.5)
+  RgbaBillboard c = Blank(4, 4, 3.6, 1);  // anchor outside (pixel 3 ends at 3.5)
   try {
     DescribeBillboard(c, 100);
     FAIL();
@@ -99,7 +99,7 @@ ComparisonWindow PixelWindow() {
 
 TEST(TransitionFeatures, ComparisonImageAlignedOnAnchor) {
   const ComparisonWindow w = PixelWindow();
-  Billboard b = Blank(5, 4, 2, 3.5);
+  RgbaBillboard b = Blank(5, 4, 2, 3.5);
   Paint(b, 1, 1, 10, 20, 30, 255);
   Paint(b, 3, 2, 40, 50, 60, 100);
   std::vector<uint8_t> image(w.ImageBytes(), 0xAB);
@@ -122,7 +122,7 @@ TEST(TransitionFeatures, ComparisonImageAlignedOnAnchor) {
 
   // The same sprite drawn further left in a wider billboard, with the anchor moved along:
   // the comparison image does not change.
-  Billboard shifted = Blank(9, 6, 5, 4.5);
+  RgbaBillboard shifted = Blank(9, 6, 5, 4.5);
   Paint(shifted, 4, 2, 10, 20, 30, 255);
   Paint(shifted, 6, 3, 40, 50, 60, 100);
   std::vector<uint8_t> image2(w.ImageBytes());
@@ -138,7 +138,7 @@ TEST(TransitionFeatures, ComparisonImageAveragesAreas) {
   w.cells_x = 1;
   w.cells_y = 1;
   w.align = HorizontalAlignment::kContactPoint;
-  Billboard b = Blank(2, 2, 0, 1.5);  // the window spans x in [-0.5, 1.5), y in [0, 2)
+  RgbaBillboard b = Blank(2, 2, 0, 1.5);  // the window spans x in [-0.5, 1.5), y in [0, 2)
   Paint(b, 0, 0, 200, 0, 0, 255);
   Paint(b, 0, 1, 0, 0, 200, 255);
   std::vector<uint8_t> image(w.ImageBytes());
@@ -155,8 +155,8 @@ TEST(TransitionFeatures, CentroidAlignmentIgnoresTheContactColumn) {
   // wherever its contact point is; centred on the contact point it does not.
   ComparisonWindow w = PixelWindow();
   w.align = HorizontalAlignment::kAlphaCentroid;
-  Billboard a = Blank(7, 4, 1, 3.5), b = Blank(7, 4, 5, 3.5);
-  for (Billboard* bb : {&a, &b}) {
+  RgbaBillboard a = Blank(7, 4, 1, 3.5), b = Blank(7, 4, 5, 3.5);
+  for (RgbaBillboard* bb : {&a, &b}) {
     for (int x = 2; x <= 4; ++x) Paint(*bb, x, 2, 90, 80, 70, 255);  // centroid at x = 3.5 (edges)
     Paint(*bb, 3, 3, 90, 80, 70, 255);
   }
@@ -173,7 +173,7 @@ TEST(TransitionFeatures, CentroidAlignmentIgnoresTheContactColumn) {
 
 TEST(TransitionFeatures, PixelDifferencesOnHandMadePair) {
   const ComparisonWindow w = PixelWindow();
-  Billboard a = Blank(5, 4, 2, 3.5), b = Blank(5, 4, 2, 3.5);
+  RgbaBillboard a = Blank(5, 4, 2, 3.5), b = Blank(5, 4, 2, 3.5);
   for (int y = 0; y < 4; ++y) {
     for (int x = 0; x < 3; ++x) Paint(a, x, y, 100, 100, 100, 255);
     for (int x = 1; x < 4; ++x) Paint(b, x, y, 110, 90, 100, 255);
@@ -194,7 +194,7 @@ TEST(TransitionFeatures, PixelDifferencesOnHandMadePair) {
   EXPECT_EQ(self.colour, 0);
 
   // No overlap at all: the colour difference is the maximum, 255.
-  Billboard c = Blank(5, 4, 2, 3.5);
+  RgbaBillboard c = Blank(5, 4, 2, 3.5);
   Paint(c, 4, 0, 1, 2, 3, 255);
   store.Append(std::vector<SpriteInput>{{3, 3, DescribeBillboard(c, 100), &c}});
   EXPECT_EQ(store.Pixels(0, 2).colour, 255.0);

@@ -1,6 +1,7 @@
 // Training (known separators, non-negativity, calibration), labels and weights files.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -172,6 +173,59 @@ TEST(TransitionTraining, TruthLabels) {
   }
   EXPECT_EQ(labels.size(), 400u);
   EXPECT_EQ(accepts, 200u);
+}
+
+TEST(TransitionTraining, KeypointTruth) {
+  // Key points decide when both truths have them: <= 4 mm apart everywhere is alike.
+  SpriteTruth a{"walk", 0.0, 0.1, {0.05, 0.06, 0.07, 0.05}};
+  SpriteTruth b = a;
+  b.keypoints_m[2] += 0.0039;
+  b.heading_rad = 1.0;  // heading and phase no longer matter
+  b.gait_phase = 0.6;
+  const TruthLabelOptions o;
+  EXPECT_NEAR(KeypointDisplacement(a, b), 0.0039, 1e-12);
+  EXPECT_TRUE(TruthAccepts(a, b, o));
+  b.keypoints_m[3] += 0.0015;  // now 4.18 mm
+  EXPECT_FALSE(TruthAccepts(a, b, o));
+  SpriteTruth c = a;
+  c.pose = "trot";
+  EXPECT_FALSE(TruthAccepts(a, c, o));
+  SpriteTruth d = a;
+  d.keypoints_m.push_back(0);  // sets that do not correspond are never alike
+  d.keypoints_m.push_back(0);
+  EXPECT_EQ(KeypointDisplacement(a, d), INFINITY);
+
+  // A synthetic mirror's key points are its original's mirrored (x -> -x), legs permuted.
+  SyntheticSpriteOptions so;
+  so.frames = 300;
+  const auto sprites = MakeSyntheticSprites(so);
+  ASSERT_EQ(sprites.size(), 600u);
+  for (size_t k = 0; k < 300; ++k) {
+    const auto& p = sprites[k].truth.keypoints_m;
+    const auto& m = sprites[300 + k].truth.keypoints_m;
+    ASSERT_EQ(p.size(), m.size());
+    ASSERT_GE(p.size(), 8u);
+    std::vector<std::pair<double, double>> want, got;
+    for (size_t i = 0; i < p.size(); i += 2) {
+      want.push_back({-p[i], p[i + 1]});
+      got.push_back({m[i], m[i + 1]});
+    }
+    // The head (0) and the body top (3) keep their places; the body's left and right
+    // extremes (1, 2) swap, and so may the feet (4...).
+    for (size_t i : {0, 3}) {
+      EXPECT_NEAR(got[i].first, want[i].first, 1e-9) << k;
+      EXPECT_NEAR(got[i].second, want[i].second, 1e-9) << k;
+    }
+    std::sort(want.begin() + 1, want.begin() + 3);
+    std::sort(got.begin() + 1, got.begin() + 3);
+    std::sort(want.begin() + 4, want.end());
+    std::sort(got.begin() + 4, got.end());
+    for (size_t i = 1; i < got.size(); ++i) {
+      if (i == 3) continue;
+      EXPECT_NEAR(got[i].first, want[i].first, 1e-9) << k << " " << sprites[k].truth.pose;
+      EXPECT_NEAR(got[i].second, want[i].second, 1e-9) << k << " " << sprites[k].truth.pose;
+    }
+  }
 }
 
 TEST(TransitionTraining, TrainsOnSyntheticTruth) {

@@ -1,0 +1,59 @@
+#pragma once
+// The renderer of seed 000 §6: each sprite's billboard stands upright at its ground
+// position facing the virtual camera, at the bank's metric scale (px_per_m, the scale the
+// rectifier made it at; pipeline/rectify/rectifier.h), and is projected through the
+// camera's full lens model. Sprites are depth sorted (far first) and composited with their
+// alpha over the background, after every contact shadow has been laid on the floor.
+// The bank's shadow layer is a ground patch at the same scale, centred on the contact
+// point: its pixel (u, v) is the floor point p + right (u - (W-1)/2) / s + away (v - (H-1)/2) / s
+// (right = the billboard's x axis, away = from the camera), as the rectifier samples it.
+#include <vector>
+
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
+
+#include "core/bank_records.h"
+#include "core/camera_model.h"
+
+namespace ss {
+
+// One sprite to draw; borrows the pixels for the call.
+struct PlacedSprite {
+  const SpritePixels* pixels = nullptr;  // billboard BGRA (straight alpha) + shadow layer
+  Eigen::Vector2d anchor_px = Eigen::Vector2d::Zero();  // contact point on the billboard
+  double px_per_m = 0;
+  Eigen::Vector2d ground_m = Eigen::Vector2d::Zero();  // contact point on the floor
+};
+
+struct RenderOptions {
+  bool shadows = true;
+  double shadow_opacity = 1.0;  // darkening at a full (255) shadow pixel
+  int grid_step_px = 8;         // the lens model is evaluated on this grid, interpolated between
+};
+
+class SpriteRenderer {
+ public:
+  // `background` BGR or BGRA of the camera's size, or empty for a transparent background.
+  // InputError when the camera is invalid or the background's size differs from it.
+  SpriteRenderer(CameraModel camera, cv::Mat background, RenderOptions options = {});
+
+  // One frame, CV_8UC4 BGRA (straight alpha; opaque where the background is).
+  cv::Mat Render(const std::vector<PlacedSprite>& sprites) const;
+
+  const CameraModel& camera() const { return camera_; }
+  // Floor direction from a ground point toward the camera (unit); the billboard's normal.
+  Eigen::Vector2d TowardCamera(const Eigen::Vector2d& ground_m) const;
+
+ private:
+  // Composites one planar layer into the premultiplied float canvas. `layer` is
+  // premultiplied CV_32FC4; layer pixel (u, v) is origin + u*du + v*dv in the ground frame.
+  void DrawPlane(const cv::Mat& layer, const Eigen::Vector3d& origin, const Eigen::Vector3d& du,
+                 const Eigen::Vector3d& dv, cv::Mat* canvas) const;
+
+  CameraModel camera_;
+  cv::Mat background_;  // premultiplied CV_32FC4, or empty
+  RenderOptions options_;
+  Eigen::Vector3d centre_in_ground_;
+};
+
+}  // namespace ss

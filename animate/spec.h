@@ -1,0 +1,120 @@
+#pragma once
+// The animation spec (docs/animation.md): one YAML file with the frame rate, the length,
+// the virtual camera, the background, the banks and per sprite its start and constraints
+// (seed 000 §5). Loading checks every field; a bad spec is refused with
+// `FILE:LINE: FIELD: reason` (an InputError). Relative paths are resolved against the
+// spec's folder. Times are seconds (converted to steps at the frame rate) or "end".
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "animate/cost_term.h"
+#include "animate/path_cost.h"
+#include "animate/track.h"
+
+namespace ss {
+
+inline constexpr int kAnimationSpecVersion = 1;
+
+// Where a spec item was written, for errors raised after parsing (unknown tag, sprite).
+struct SpecPlace {
+  int line = 0;
+  std::string field;  // "sprites[1].constraints[0].frames"
+};
+
+struct LocationSpec {  // eq. 7
+  SpecPlace place;
+  Eigen::Vector2d target_m = Eigen::Vector2d::Zero();  // fixed target, or the offset from `follow`
+  std::string follow;                                  // leader sprite name; "" = fixed target
+  bool offset_in_heading = true;  // offset is (along, left) of the leader's heading
+  StepWindow window = StepWindow::LastStep();
+  double strength = 1.0;  // γ
+};
+
+struct PathSpec {  // eq. 8
+  SpecPlace place;
+  std::vector<Eigen::Vector2d> points_m;
+  PathStrengths strengths;  // δ, φ, η
+};
+
+struct FrameSpec {  // eq. 10
+  SpecPlace place;
+  std::string tag;                  // G = the frames with this tag, or
+  std::vector<int64_t> sprite_ids;  // G = these bank sprites
+  StepWindow window = StepWindow::All();
+  std::string after_path_of;  // non-empty: the window starts when that sprite passes its path's end
+  int duration_steps = 1;     // ... and lasts this long
+  double strength = 1.0;      // λ
+};
+
+struct LengthSpec {  // §6.2: penalize sequences under min_frames
+  int min_frames = 0;
+  double strength = 1.0;  // per missing frame
+};
+
+struct FastFrameSpec {  // §6.2: prefer fast-moving frames
+  double reference_speed_m_s = 0.0;
+  double strength = 0.0;  // per (m/s) below the reference, per step
+};
+
+struct SpriteSpecEntry {
+  SpecPlace place;
+  std::string name;
+  Anchor anchor = Anchor::kStart;
+  Eigen::Vector2d anchor_m = Eigen::Vector2d::Zero();  // start (or end) position; free: first guess
+  double smoothness = 1.0;                             // α
+  std::vector<LocationSpec> locations;
+  std::optional<PathSpec> path;
+  std::vector<FrameSpec> frames;
+  std::optional<LengthSpec> length;     // overrides the spec's
+  std::optional<FastFrameSpec> fast;    // overrides the spec's
+};
+
+struct CollisionSpec {  // eq. 9, between every pair of the listed sprites
+  SpecPlace place;
+  std::vector<std::string> sprites;  // empty = all sprites
+  double min_distance_m = 0.1;
+  double strength = 1.0;  // µ
+};
+
+struct OptimizerSpec {
+  std::string method = "replace";  // "replace" | "beam"
+  double time_budget_s = 30.0;
+  uint64_t seed = 1;
+  int set_size = 200;          // N of the F/B sets
+  int threads = 2;
+  int changes_per_turn = 100;  // picks per sprite turn
+  int beam_width = 32;
+  double snapshot_every_s = 0.0;  // > 0: keep the sequences every so many seconds (stages video)
+};
+
+struct AnimationSpec {
+  std::string path;  // the spec file
+  int version = kAnimationSpecVersion;
+  double frame_rate = 30.0;
+  int fixed_frames = 0;  // > 0: every sequence has exactly this length
+  int max_frames = 0;    // free length: longest sequence; 0 = no limit
+  int initial_frames = 0;  // length of random initial sequences (default: derived)
+  std::optional<LengthSpec> length;  // free length: penalize sequences under N frames
+  std::optional<FastFrameSpec> fast;
+  std::string camera_path;      // .cameramodel (absolute)
+  std::string background_path;  // image (absolute) or ""
+  std::vector<std::string> bank_paths;  // absolute
+  std::vector<SpriteSpecEntry> sprites;
+  std::vector<CollisionSpec> collisions;
+  OptimizerSpec optimizer;
+
+  int Steps(double seconds) const;  // seconds -> steps at the frame rate
+  int SpriteIndex(const std::string& name) const;  // -1 if unknown
+  std::string Where(const SpecPlace& place) const;  // "FILE:LINE: FIELD"
+};
+
+// Parses spec text; `origin` names it in errors and gives the folder for relative paths.
+AnimationSpec ParseAnimationSpec(const std::string& yaml, const std::string& origin);
+// Reads and parses a spec file; InputError naming the file, line and field.
+AnimationSpec LoadAnimationSpec(const std::string& path);
+
+}  // namespace ss

@@ -1,0 +1,238 @@
+// spritestation calibrate intrinsics|ground|enclosure: camera calibration
+// (docs/calibration.md). The work lives in calib/workflow.h; this file parses
+// options and prints. Exit 1 when a camera's calibration is not trusted (the
+// report says why), 2 for bad input (no board of that spec anywhere, bad files).
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
+
+#include "apps/commands.h"
+#include "calib/board.h"
+#include "calib/enclosure.h"
+#include "calib/inputs.h"
+#include "calib/workflow.h"
+#include "core/camera_model.h"
+#include "core/error.h"
+
+namespace ss::apps {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct InputOptions {
+  std::vector<std::string> inputs;
+  std::string board;
+  std::vector<std::string> cameras;
+  int every = 0, max_views = 40, first = 0, count = 0;
+  double max_edge_width_px = 4.0;
+  int min_corners = 12;
+};
+
+void AddInputOptions(CLI::App* cmd, InputOptions* o, int default_max_views) {
+  o->max_views = default_max_views;
+  cmd->add_option("input", o->inputs, "A recorded session folder, or image files / a folder of images")->required();
+  cmd->add_option("--board", o->board, "Board: chessboard:COLSxROWS:SQUARE_M or charuco:COLSxROWS:SQUARE_M:MARKER_M[:DICT]")
+      ->required();
+  cmd->add_option("--camera", o->cameras, "Session: only this camera (repeat for several)");
+  cmd->add_option("--every", o->every, "Session: use every N-th frame (default: spread --max-views over the session)");
+  cmd->add_option("--max-views", o->max_views, "Session: views per camera");
+  cmd->add_option("--first", o->first, "Session: first frame to use");
+  cmd->add_option("--count", o->count, "Session: frames to use from --first (0: to the end)");
+  cmd->add_option("--max-edge-width", o->max_edge_width_px, "Reject views whose square edges rise over more pixels");
+  cmd->add_option("--min-corners", o->min_corners, "Reject views with fewer corners");
+}
+
+std::vector<calib::CameraViews> LoadViews(const InputOptions& o, const calib::BoardSpec& board) {
+  calib::DetectOptions detect;
+  detect.max_edge_width_px = o.max_edge_width_px;
+  detect.min_corners = o.min_corners;
+  if (o.inputs.size() == 1 && calib::IsSessionDir(o.inputs[0])) {
+    calib::SampleOptions sample;
+    sample.every = o.every;
+    sample.max_views = o.max_views;
+    sample.first = o.first;
+    sample.count = o.count;
+    sample.cameras = o.cameras;
+    return calib::DetectInSession(o.inputs[0], board, detect, sample);
+  }
+  return {calib::DetectInImages(o.inputs, board, detect, o.cameras.empty() ? "camera0" : o.cameras.front())};
+}
+
+void Print(const calib::JobOutcome& outcome, bool json) {
+  if (json) {
+    std::printf("%s\n", outcome.report.dump(2).c_str());
+  } else {
+    std::printf("%s", outcome.text.c_str());
+  }
+  std::fflush(stdout);
+}
+
+void AddIntrinsics(CLI::App& parent) {
+  auto* cmd = parent.add_subcommand("intrinsics", "Solve lens intrinsics (mrcal) from board views; several cameras jointly");
+  auto in = std::make_shared<InputOptions>();
+  auto out = std::make_shared<std::string>();
+  auto lensmodel = std::make_shared<std::string>("LENSMODEL_OPENCV8");
+  auto json = std::make_shared<bool>(false);
+  auto force = std::make_shared<bool>(false);
+  auto min_views = std::make_shared<int>(10);
+  auto max_rms = std::make_shared<double>(0.5);
+  AddInputOptions(cmd, in.get(), 40);
+  cmd->add_option("--out", *out, "Output folder: CAMERA.cameramodel, plots, intrinsics.json")->required();
+  cmd->add_option("--lensmodel", *lensmodel, "mrcal lens model, e.g. LENSMODEL_OPENCV8, LENSMODEL_SPLINED_STEREOGRAPHIC_order=3_Nx=16_Ny=12_fov_x_deg=100");
+  cmd->add_option("--min-views", *min_views, "Accepted views needed for a trusted model");
+  cmd->add_option("--max-rms", *max_rms, "Largest trusted RMS reprojection error, px");
+  cmd->add_flag("--write-rejected", *force, "Write models even when the verdict is 'rejected'");
+  cmd->add_flag("--json", *json, "Print the report as JSON");
+  cmd->callback([=] {
+    calib::IntrinsicsJob job;
+    job.board = calib::ParseBoardSpec(in->board);
+    job.solve.lensmodel = *lensmodel;
+    job.verdict.min_views = *min_views;
+    job.verdict.max_rms_px = *max_rms;
+    job.out_dir = *out;
+    job.write_rejected = *force;
+    const auto views = LoadViews(*in, job.board);
+    const calib::JobOutcome outcome = calib::RunIntrinsics(views, job);
+    Print(outcome, *json);
+    if (!outcome.any_board) {
+      throw InputError(in->inputs.front(), "no board " + job.board.ToString() + " found in any view (wrong --board?)");
+    }
+    if (!outcome.all_good) throw WorkError(*out, "calibration not trusted (see the reasons above)");
+  });
+}
+
+void AddGround(CLI::App& parent) {
+  auto* cmd = parent.add_subcommand("ground", "Pose every camera against the floor from a board lying flat on it");
+  auto in = std::make_shared<InputOptions>();
+  auto out = std::make_shared<std::string>();
+  auto models = std::make_shared<std::vector<std::string>>();
+  auto pose = std::make_shared<std::vector<double>>(std::vector<double>{0, 0, 0});
+  auto thickness = std::make_shared<double>(0.0);
+  auto still = std::make_shared<int>(5);
+  auto rigid = std::make_shared<bool>(false);
+  auto json = std::make_shared<bool>(false);
+  AddInputOptions(cmd, in.get(), 10);
+  cmd->add_option("--out", *out, "Output folder: CAMERA.cameramodel with cam_from_ground, ground.json")->required();
+  cmd->add_option("--models", *models,
+                  "Intrinsics: a folder with CAMERA.cameramodel, or one file per camera (default: the session's)");
+  cmd->add_option("--board-pose", *pose, "Board's top-left checkered corner on the floor: X Y YAW_DEG")->expected(3);
+  cmd->add_option("--board-thickness", *thickness, "Height of the printed surface above the floor, m");
+  cmd->add_option("--still-views", *still, "Accepted views of the still board averaged per camera");
+  cmd->add_flag("--rigid", *rigid, "Models share one reference (joint solve): cameras without a floor view follow");
+  cmd->add_flag("--json", *json, "Print the report as JSON");
+  cmd->callback([=] {
+    calib::GroundJob job;
+    job.board = calib::ParseBoardSpec(in->board);
+    job.ground_from_board = calib::FloorBoardPose((*pose)[0], (*pose)[1], (*pose)[2], *thickness);
+    job.out_dir = *out;
+    job.still_views = *still;
+    job.rigid = *rigid;
+    const auto views = LoadViews(*in, job.board);
+    std::vector<CameraModel> cams;
+    for (size_t c = 0; c < views.size(); ++c) {
+      std::string path;
+      if (models->size() == 1 && fs::is_directory((*models)[0])) {
+        path = (fs::path((*models)[0]) / (views[c].name + ".cameramodel")).string();
+      } else if (models->size() == views.size()) {
+        path = (*models)[c];
+      } else if (models->empty()) {
+        path = views[c].model_path;
+      } else {
+        throw InputError("--models", "give a folder, or one model per camera (" + std::to_string(views.size()) + ")");
+      }
+      if (path.empty()) throw InputError("--models", "no model for camera " + views[c].name);
+      cams.push_back(CameraModel::Read(path));
+    }
+    const calib::JobOutcome outcome = calib::RunGround(views, cams, job);
+    Print(outcome, *json);
+    if (!outcome.any_board) throw InputError(in->inputs.front(), "no board " + job.board.ToString() + " found on the floor");
+    if (!outcome.all_good) throw WorkError(*out, "not every camera could be posed (see above)");
+  });
+}
+
+void AddEnclosure(CLI::App& parent) {
+  auto* cmd = parent.add_subcommand("enclosure", "The usable floor polygon, in ground metres");
+  auto points = std::make_shared<std::string>();
+  auto pixels = std::make_shared<std::string>();
+  auto green = std::make_shared<std::string>();
+  auto model = std::make_shared<std::string>();
+  auto out = std::make_shared<std::string>();
+  auto config = std::make_shared<std::string>();
+  auto wall = std::make_shared<double>(0.0);
+  auto json = std::make_shared<bool>(false);
+  cmd->add_option("--points", *points, "Ground points \"x,y x,y ...\" in metres, in order");
+  cmd->add_option("--pixels", *pixels, "Image points \"u,v u,v ...\" of the floor's corners (needs --model)");
+  cmd->add_option("--green", *green, "Image of the empty enclosure: the largest green floor region (needs --model)");
+  cmd->add_option("--model", *model, "Posed .cameramodel (after calibrate ground)");
+  cmd->add_option("--wall-height", *wall, "enclosure.wall_height_m written with the polygon");
+  cmd->add_option("--out", *out, "Write the enclosure section (YAML) here");
+  cmd->add_option("--config", *config, "Station config whose enclosure.floor is replaced in place");
+  cmd->add_flag("--json", *json, "Print the polygon as JSON");
+  cmd->callback([=] {
+    const int sources = !points->empty() + !pixels->empty() + !green->empty();
+    if (sources != 1) throw InputError("calibrate enclosure", "give exactly one of --points, --pixels, --green");
+    GroundPolygon floor;
+    if (!points->empty()) {
+      floor = calib::FloorPolygonFromPoints(calib::ParsePointList(*points, "--points"), "--points");
+    } else {
+      if (model->empty()) throw InputError("--model", "needed with --pixels and --green");
+      const CameraModel m = CameraModel::Read(*model);
+      if (!pixels->empty()) {
+        floor = calib::FloorPolygonFromPixels(m, calib::ParsePointList(*pixels, "--pixels"), "--pixels");
+      } else {
+        const cv::Mat image = cv::imread(*green, cv::IMREAD_COLOR);
+        if (image.empty()) throw InputError(*green, "unreadable image");
+        floor = calib::FindGreenFloor(m, image);
+      }
+    }
+    const std::string yaml = calib::EnclosureYaml(floor, *wall);
+    if (!out->empty()) {
+      std::ofstream f(*out);
+      f << yaml;
+      if (!f) throw WorkError(*out, "cannot write");
+    }
+    if (!config->empty()) {
+      std::ifstream f(*config);
+      if (!f) throw InputError(*config, "cannot read the config");
+      std::stringstream text;
+      text << f.rdbuf();
+      const std::string updated = calib::ReplaceEnclosureFloor(text.str(), floor, *config);
+      const std::string tmp = *config + ".tmp";
+      {
+        std::ofstream o(tmp);
+        o << updated;
+        if (!o) throw WorkError(tmp, "cannot write");
+      }
+      fs::rename(tmp, *config);
+    }
+    if (*json) {
+      nlohmann::json j;
+      j["floor"] = nlohmann::json::array();
+      for (const auto& v : floor.vertices()) j["floor"].push_back({v.x(), v.y()});
+      j["area_m2"] = floor.Area();
+      j["wall_height_m"] = *wall;
+      std::printf("%s\n", j.dump(2).c_str());
+    } else {
+      std::printf("%s# %zu vertices, %.4f m^2\n", yaml.c_str(), floor.vertices().size(), floor.Area());
+    }
+  });
+}
+
+}  // namespace
+
+void AddCalibrateCommand(CLI::App& app) {
+  auto* cmd = app.add_subcommand("calibrate", "Camera calibration: intrinsics, ground plane, enclosure");
+  cmd->require_subcommand(1);
+  AddIntrinsics(*cmd);
+  AddGround(*cmd);
+  AddEnclosure(*cmd);
+}
+
+}  // namespace ss::apps

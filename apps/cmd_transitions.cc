@@ -1,0 +1,157 @@
+// spritestation transitions BANK | train LABELS --bank BANK --out WEIGHTS |
+//                label --from-truth SESSION --bank BANK --out LABELS
+// The transition table of a sprite bank (seed 000 §3; docs/transitions.md).
+#include <chrono>
+#include <cstdio>
+#include <memory>
+#include <mutex>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "apps/commands.h"
+#include "core/error.h"
+#include "pipeline/transitions/bank_training.h"
+#include "pipeline/transitions/bank_transitions.h"
+
+namespace ss::apps {
+namespace {
+
+struct Args {
+  std::string bank, weights, labels, out, session;
+  int threads = 2, folds = 5, count = 1000;
+  uint64_t seed = 1;
+  double stage1_recall = 0.995;
+  bool json = false, quiet = false;
+};
+
+TransitionWeights WeightsOf(const Args& a) { return a.weights.empty() ? DefaultWeights() : LoadWeights(a.weights); }
+
+// Progress on stderr, at most a few lines a second, always the last one of a stage.
+class Progress {
+ public:
+  explicit Progress(bool quiet) : quiet_(quiet) {}
+  void operator()(const std::string& stage, size_t done, size_t total) {
+    if (quiet_) return;
+    std::lock_guard<std::mutex> lock(mutex_);
+    const auto now = std::chrono::steady_clock::now();
+    if (done < total && stage == stage_ && now - last_ < std::chrono::milliseconds(250)) return;
+    stage_ = stage;
+    last_ = now;
+    const char* what = stage == "load" ? "reading sprites" : "finding transitions";
+    std::fprintf(stderr, "%s: %zu / %zu sprites (%.0f%%)\n", what, done, total,
+                 total ? 100.0 * static_cast<double>(done) / static_cast<double>(total) : 100.0);
+  }
+
+ private:
+  bool quiet_;
+  std::mutex mutex_;
+  std::string stage_;
+  std::chrono::steady_clock::time_point last_{};
+};
+
+void Build(const Args& a) {
+  if (a.bank.empty()) throw InputError("transitions", "a sprite bank is needed: spritestation transitions BANK");
+  BankUpdateOptions options;
+  options.weights = WeightsOf(a);
+  options.threads = a.threads;
+  auto progress = std::make_shared<Progress>(a.quiet || a.json);
+  options.progress = [progress](const std::string& stage, size_t done, size_t total) {
+    (*progress)(stage, done, total);
+  };
+  const BankUpdateSummary s = UpdateBankTransitions(a.bank, options);
+  std::printf("%s", a.json ? (s.ToJson() + "\n").c_str() : s.ToText().c_str());
+}
+
+void Train(const Args& a) {
+  BankTrainOptions options;
+  options.train.folds = a.folds;
+  options.train.seed = a.seed;
+  options.window = DefaultWeights().window;
+  options.stage1_recall = a.stage1_recall;
+  options.threads = a.threads;
+  const BankTrainResult r = TrainOnBank(a.labels, a.bank, options);
+  SaveWeights(r.weights, a.out);
+  if (a.json) {
+    nlohmann::json j = nlohmann::json::parse(r.weights.training_json);
+    j["out"] = a.out;
+    std::printf("%s\n", j.dump(2).c_str());
+    return;
+  }
+  const TrainReport& t = r.report;
+  std::printf("trained on %lld labelled pairs (%lld accepts), %d-fold cross-validated:\n",
+              static_cast<long long>(t.samples), static_cast<long long>(t.accepts), t.folds);
+  std::printf("  stage 1 (4 cheap features): precision %.3f, recall %.3f\n", t.stage1.precision(), t.stage1.recall());
+  std::printf("  stage 2 (all 6 features):   precision %.3f, recall %.3f\n", t.stage2.precision(), t.stage2.recall());
+  if (a.stage1_recall > 0) {
+    std::printf("  stage 1 then set to pass %.3f of %lld stage-2 accepts on the bank (bias %.4f -> %.4f)\n",
+                a.stage1_recall, static_cast<long long>(r.calibration_accepts), r.stage1_bias_from_labels,
+                r.weights.stage1_bias);
+  }
+  std::printf("weights written to %s\n", a.out.c_str());
+}
+
+void Label(const Args& a) {
+  const TruthLabelSummary s =
+      LabelBankFromTruth(a.session, a.bank, static_cast<size_t>(a.count), TruthLabelOptions{}, a.seed);
+  WriteLabelsCsv(s.labels, a.out);
+  size_t accepts = 0;
+  for (const auto& l : s.labels) accepts += l.accept ? 1 : 0;
+  if (a.json) {
+    std::printf("%s\n", nlohmann::json({{"out", a.out},
+                                        {"labels", s.labels.size()},
+                                        {"accepts", accepts},
+                                        {"sprites_matched", s.sprites_matched},
+                                        {"sprites_unmatched", s.sprites_unmatched},
+                                        {"mirrored_skipped", s.mirrored_skipped}})
+                            .dump(2)
+                            .c_str());
+  } else {
+    std::printf("%zu labels (%zu accepts) from the truth of %lld sprites (%lld unmatched, %lld mirrors left out) "
+                "written to %s\n",
+                s.labels.size(), accepts, static_cast<long long>(s.sprites_matched),
+                static_cast<long long>(s.sprites_unmatched), static_cast<long long>(s.mirrored_skipped),
+                a.out.c_str());
+  }
+}
+
+}  // namespace
+
+void AddTransitionsCommand(CLI::App& app) {
+  auto args = std::make_shared<Args>();
+  auto* cmd = app.add_subcommand("transitions",
+                                 "Build or bring up to date a bank's transitions; 'label' and 'train' the classifier");
+  cmd->add_option("bank", args->bank, "Sprite bank file (build or update its transitions)");
+  cmd->add_option("--weights", args->weights, "Classifier weights file (default: the shipped weights)");
+  cmd->add_option("--threads", args->threads, "Worker threads")->check(CLI::Range(1, 64));
+  cmd->add_flag("--quiet", args->quiet, "No progress lines");
+  cmd->add_flag("--json", args->json, "Print JSON");
+  cmd->callback([cmd, args] {
+    if (cmd->get_subcommands().empty()) Build(*args);
+  });
+
+  auto* train = cmd->add_subcommand("train", "Train both classifiers on labelled pairs; prints cross-validated "
+                                             "precision/recall");
+  train->add_option("labels", args->labels, "Labels CSV: sprite_i,sprite_j,accept")->required();
+  train->add_option("--bank", args->bank, "The bank the sprite ids belong to")->required();
+  train->add_option("--out", args->out, "Weights file to write")->required();
+  train->add_option("--folds", args->folds, "Cross-validation folds")->check(CLI::Range(2, 50));
+  train->add_option("--seed", args->seed, "Seed of the fold split and the calibration sample");
+  train->add_option("--stage1-recall", args->stage1_recall,
+                    "Share of stage-2 accepts stage 1 must pass on the bank (0: keep the label fit)")
+      ->check(CLI::Range(0.0, 1.0));
+  train->add_option("--threads", args->threads, "Worker threads")->check(CLI::Range(1, 64));
+  train->add_flag("--json", args->json, "Print JSON");
+  train->callback([args] { Train(*args); });
+
+  auto* label = cmd->add_subcommand("label", "Make labels from a synthetic session's truth");
+  label->add_option("--from-truth", args->session, "Synthetic session directory (with truth/)")->required();
+  label->add_option("--bank", args->bank, "The bank the session was ingested into")->required();
+  label->add_option("--out", args->out, "Labels CSV to write")->required();
+  label->add_option("--count", args->count, "About this many labels, half accepts")->check(CLI::Range(10, 1000000));
+  label->add_option("--seed", args->seed, "Seed of the pair sampling");
+  label->add_flag("--json", args->json, "Print JSON");
+  label->callback([args] { Label(*args); });
+}
+
+}  // namespace ss::apps

@@ -1,0 +1,98 @@
+#pragma once
+// One camera's live pipeline (docs/pipeline.md): every frame goes
+//   key -> extract -> track -> filter -> rectify -> describe -> clip batches
+// and what comes out are the batches the bank stores. One CameraPipeline
+// belongs to one thread; several cameras run side by side, each its own.
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "core/camera_model.h"
+#include "core/config.h"
+#include "core/frame.h"
+#include "core/geometry.h"
+#include "pipeline/extract/extractor.h"
+#include "pipeline/filter/usability.h"
+#include "pipeline/key/keyer.h"
+#include "pipeline/key/matte.h"
+#include "pipeline/rectify/rectifier.h"
+#include "pipeline/run/clip_batcher.h"
+#include "pipeline/track/tracker.h"
+
+namespace ss {
+
+// Everything a camera pipeline is tuned by, from the station config.
+struct CameraPipelineOptions {
+  std::string keying_method = "chroma";  // "chroma" | "clean_plate"
+  ExtractorOptions extract;
+  TrackerOptions track;
+  UsabilityOptions usability;
+  double still_speed_m_per_s = 0.05;
+  double max_still_s = 2.0;
+  RectifierOptions rectify;
+  ClipBatcherOptions batch;
+};
+CameraPipelineOptions PipelineOptionsFromConfig(const StationConfig& config);
+
+struct CameraPipelineStats {
+  uint64_t frames = 0;          // frames processed (training frames included)
+  uint64_t training_frames = 0; // of them, learnt as the empty enclosure
+  uint64_t candidates = 0;      // blobs the extractor found above the noise size
+  uint64_t sequence_gaps = 0;   // breaks in the sequence numbers (drops): open clips end there
+  DiscardCounts discards{};     // by reason; [kNone] counts usable sprites (in clips long enough so far)
+  uint64_t stored_sprites = 0;  // originals handed to the bank (mirrors not counted)
+  uint64_t clips = 0;           // complete clips handed to the bank
+  double seconds_key = 0, seconds_rest = 0;  // thread time in keying+extracting, in the rest
+};
+
+class CameraPipeline {
+ public:
+  // `camera_id` is the bank's id of the camera. Throws InputError when the model
+  // is missing or the options are invalid.
+  CameraPipeline(std::string name, int64_t camera_id, CameraModel model, GroundPolygon floor,
+                 CameraPipelineOptions options);
+  ~CameraPipeline();
+  CameraPipeline(CameraPipeline&&) noexcept;
+
+  // Learns the empty enclosure from BGR frames (InputError when they cannot be keyed).
+  void Train(const std::vector<cv::Mat>& empty_bgr);
+  bool trained() const;
+  // One frame through every stage; appends the batches it completed to `out`.
+  // A frame of another size than the model's: InputError naming the camera and frame.
+  void Process(const Frame& frame, std::vector<ClipBatch>* out);
+  // End of stream: every open clip is closed.
+  void Finish(std::vector<ClipBatch>* out);
+
+  const std::string& name() const { return name_; }
+  const CameraModel& model() const { return model_; }
+  const CameraPipelineStats& stats() const { return stats_; }
+  const FloorMask& floor_mask() const { return floor_mask_; }
+
+ private:
+  std::string name_;
+  int64_t camera_id_;
+  CameraModel model_;
+  CameraPipelineOptions options_;
+  std::unique_ptr<Keyer> keyer_;
+  FloorMask floor_mask_;
+  Extractor extractor_;
+  Tracker tracker_;
+  StillnessFilter stillness_;
+  ClipCutter cutter_;
+  Rectifier rectifier_;
+  ClipBatcher batcher_;
+  cv::Mat bgr_;
+  Matte matte_;
+  void UpdateClipStats();
+
+  std::optional<uint64_t> last_sequence_;
+  uint64_t usable_total_ = 0;  // sprites that passed the filters, short clips included
+  CameraPipelineStats stats_;
+};
+
+}  // namespace ss

@@ -1,0 +1,140 @@
+#include "pipeline/run/clip_batcher.h"
+
+#include <algorithm>
+
+#include "core/error.h"
+
+namespace ss {
+namespace {
+
+// The bank keeps the shadow billboard-sized: the rectifier's square ground
+// patch (centred on the contact point, rows running away from the camera) is
+// cropped or padded to the billboard's size, centre on centre
+// (docs/animation.md reads it back the same way).
+cv::Mat FitShadow(const cv::Mat& patch, cv::Size size) {
+  cv::Mat out = cv::Mat::zeros(size, CV_8UC1);
+  if (patch.empty()) return out;
+  const int dx = (size.width - 1) / 2 - (patch.cols - 1) / 2;
+  const int dy = (size.height - 1) / 2 - (patch.rows - 1) / 2;
+  const cv::Rect in_out = cv::Rect(dx, dy, patch.cols, patch.rows) & cv::Rect(0, 0, size.width, size.height);
+  if (in_out.empty()) return out;
+  patch(in_out - cv::Point(dx, dy)).copyTo(out(in_out));
+  return out;
+}
+
+SpriteRecord OriginalRecord(const MadeSprite& s, const Eigen::Vector2d& velocity) {
+  SpriteRecord r;
+  r.frame = s.frame;
+  r.timestamp_ns = s.timestamp_ns;
+  r.ground_x_m = s.billboard.point_in_ground.x();
+  r.ground_y_m = s.billboard.point_in_ground.y();
+  r.velocity_x_m_s = velocity.x();
+  r.velocity_y_m_s = velocity.y();
+  r.mean_r = s.description.mean_r;
+  r.mean_g = s.description.mean_g;
+  r.mean_b = s.description.mean_b;
+  r.area_px = s.description.area_px;
+  r.eccentricity = s.description.eccentricity;
+  r.bbox_in_image = s.bbox_in_image;
+  r.billboard_width_px = s.billboard.bgra.cols;
+  r.billboard_height_px = s.billboard.bgra.rows;
+  r.px_per_m = s.billboard.px_per_m;
+  r.anchor_x_px = s.billboard.anchor_px.x();
+  r.anchor_y_px = s.billboard.anchor_px.y();
+  r.pixels.bgra = s.billboard.bgra;
+  r.pixels.shadow = FitShadow(s.billboard.shadow, s.billboard.bgra.size());
+  return r;
+}
+
+// The mirrored copy: same place and time, the image flipped, velocity mirrored
+// across the billboard's vertical axis. Its pixels are its original's (the bank
+// flips them on load).
+SpriteRecord MirrorRecord(const SpriteRecord& original, const MadeSprite& s) {
+  SpriteRecord m = original;
+  m.mirrored = true;
+  m.pixels = {};
+  m.anchor_x_px = (original.billboard_width_px - 1) - original.anchor_x_px;
+  const Eigen::Vector2d v = Rectifier::MirrorVelocity(
+      s.billboard, Eigen::Vector2d(original.velocity_x_m_s, original.velocity_y_m_s));
+  m.velocity_x_m_s = v.x();
+  m.velocity_y_m_s = v.y();
+  return m;
+}
+
+}  // namespace
+
+ClipBatcher::ClipBatcher(int64_t camera_id, ClipBatcherOptions options)
+    : camera_id_(camera_id), options_(options) {
+  if (options_.min_clip_frames < 1) throw InputError("pipeline.min_clip_frames", "must be at least 1");
+  if (options_.batch_frames < 1) throw InputError("clip batch size", "must be at least 1");
+  options_.velocity_half_window = std::max(0, options_.velocity_half_window);
+}
+
+void ClipBatcher::Add(int64_t clip, int subject, MadeSprite sprite, std::vector<ClipBatch>* out) {
+  auto [it, inserted] = clips_.try_emplace(clip);
+  Open& open = it->second;
+  if (inserted) {
+    open.subject = subject;
+    open.first_frame = sprite.frame;
+  } else if (sprite.frame != open.first_frame + static_cast<int64_t>(open.points.size())) {
+    throw WorkError("clip " + std::to_string(clip), "frames of a clip must be consecutive");
+  }
+  open.timestamps_ns.push_back(sprite.timestamp_ns);
+  open.points.emplace_back(sprite.billboard.point_in_ground.x(), sprite.billboard.point_in_ground.y());
+  open.pending.push_back(std::move(sprite));
+
+  const size_t length = open.points.size();
+  // At least one sprite stays back so that the closing batch is never empty.
+  const size_t hold = std::max<size_t>(1, static_cast<size_t>(options_.velocity_half_window));
+  if (length < static_cast<size_t>(options_.min_clip_frames)) return;
+  if (open.pending.size() >= static_cast<size_t>(options_.batch_frames) + hold) {
+    Emit(open, open.pending.size() - hold, false, out);
+  }
+}
+
+void ClipBatcher::Close(int64_t clip, std::vector<ClipBatch>* out) {
+  const auto it = clips_.find(clip);
+  if (it == clips_.end()) return;
+  Open& open = it->second;
+  if (open.points.size() < static_cast<size_t>(options_.min_clip_frames)) {
+    short_clip_sprites_ += open.pending.size();
+  } else {
+    Emit(open, open.pending.size(), true, out);
+    ++clips_completed_;
+  }
+  clips_.erase(it);
+}
+
+void ClipBatcher::CloseAll(std::vector<ClipBatch>* out) {
+  while (!clips_.empty()) Close(clips_.begin()->first, out);
+}
+
+void ClipBatcher::Emit(Open& open, size_t count, bool complete, std::vector<ClipBatch>* out) {
+  const size_t first_index = open.points.size() - open.pending.size();
+  const std::vector<Eigen::Vector2d> velocities =
+      EstimateVelocities(open.timestamps_ns, open.points, options_.velocity_half_window);
+  ClipBatch batch;
+  batch.clip.camera_id = camera_id_;
+  batch.clip.track_id = open.subject;
+  batch.clip.first_frame = open.first_frame;
+  batch.clip.last_frame = open.first_frame + static_cast<int64_t>(first_index + count) - 1;
+  batch.clip.complete = complete;
+  batch.sprites.reserve(count * (options_.mirrors ? 2 : 1));
+  for (size_t k = 0; k < count; ++k) {
+    const MadeSprite& s = open.pending[k];
+    SpriteRecord original = OriginalRecord(s, velocities[first_index + k]);
+    if (options_.mirrors) {
+      SpriteRecord mirror = MirrorRecord(original, s);
+      batch.sprites.push_back(std::move(original));
+      batch.sprites.push_back(std::move(mirror));
+    } else {
+      batch.sprites.push_back(std::move(original));
+    }
+  }
+  open.pending.erase(open.pending.begin(), open.pending.begin() + static_cast<std::ptrdiff_t>(count));
+  stored_originals_ += count;
+  open.started = true;
+  if (!batch.sprites.empty() || complete) out->push_back(std::move(batch));
+}
+
+}  // namespace ss

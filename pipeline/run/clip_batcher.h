@@ -1,0 +1,79 @@
+#pragma once
+// Store (seed 000 §2, made incremental): collects each clip's sprites as the
+// pipeline makes them and hands them to the bank in batches, each batch one
+// transaction. A clip is held back until it is `min_clip_frames` long (shorter
+// clips give no transitions and are discarded, counted); after that it goes out
+// every `batch_frames` frames, keeping back the last `velocity_half_window`
+// frames whose velocity still needs frames to come. Every original sprite is
+// followed by its horizontally mirrored copy.
+#include <cstdint>
+#include <map>
+#include <vector>
+
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
+
+#include "core/bank_records.h"
+#include "pipeline/describe/sprite_description.h"
+#include "pipeline/rectify/rectifier.h"
+
+namespace ss {
+
+struct ClipBatcherOptions {
+  int min_clip_frames = 5;
+  int batch_frames = 60;          // sprites per batch once a clip is long enough
+  int velocity_half_window = 2;   // frames each side for the velocity slope
+  bool mirrors = true;            // store the mirrored copy of every sprite
+};
+
+// One usable sprite of a clip, as the pipeline made it.
+struct MadeSprite {
+  int64_t frame = 0;         // device sequence number (consecutive within a clip)
+  int64_t timestamp_ns = 0;
+  cv::Rect bbox_in_image;
+  Billboard billboard;
+  SpriteDescription description;
+};
+
+// One bank transaction: sprites of one clip, originals each followed by its mirror.
+struct ClipBatch {
+  ClipRecord clip;
+  std::vector<SpriteRecord> sprites;
+};
+
+class ClipBatcher {
+ public:
+  ClipBatcher(int64_t camera_id, ClipBatcherOptions options);
+  // Adds the next frame of clip `clip` (ClipCutter's id) of tracker subject `subject`.
+  void Add(int64_t clip, int subject, MadeSprite sprite, std::vector<ClipBatch>* out);
+  // The clip ended: its rest goes out as the complete batch, or it is dropped when short.
+  void Close(int64_t clip, std::vector<ClipBatch>* out);
+  // Closes every open clip.
+  void CloseAll(std::vector<ClipBatch>* out);
+
+  uint64_t short_clip_sprites() const { return short_clip_sprites_; }  // originals dropped in short clips
+  uint64_t stored_originals() const { return stored_originals_; }      // originals handed out in batches
+  uint64_t clips_completed() const { return clips_completed_; }
+  size_t open_clips() const { return clips_.size(); }
+
+ private:
+  struct Open {
+    int subject = 0;
+    int64_t first_frame = 0;
+    std::vector<int64_t> timestamps_ns;       // every frame of the clip so far
+    std::vector<Eigen::Vector2d> points;      // their contact points
+    std::vector<MadeSprite> pending;          // not yet handed out: the last pending.size() frames
+    bool started = false;                     // a first batch went out
+  };
+  // Hands out the first `count` pending sprites of `open`.
+  void Emit(Open& open, size_t count, bool complete, std::vector<ClipBatch>* out);
+
+  int64_t camera_id_;
+  ClipBatcherOptions options_;
+  std::map<int64_t, Open> clips_;
+  uint64_t short_clip_sprites_ = 0;
+  uint64_t stored_originals_ = 0;
+  uint64_t clips_completed_ = 0;
+};
+
+}  // namespace ss

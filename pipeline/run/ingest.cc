@@ -1,0 +1,236 @@
+#include "pipeline/run/ingest.h"
+
+#include <atomic>
+#include <chrono>
+#include <exception>
+#include <filesystem>
+#include <fstream>
+#include <mutex>
+#include <thread>
+
+#include <nlohmann/json.hpp>
+
+#include "capture/replay/replay_source.h"
+#include "core/bank.h"
+#include "core/error.h"
+#include "core/log.h"
+#include "pipeline/run/bounded_queue.h"
+
+namespace ss {
+namespace {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+// Reads {"floor": [[x, y], ...]} (ground metres).
+std::optional<GroundPolygon> ReadFloorJson(const fs::path& path) {
+  if (!fs::exists(path)) return std::nullopt;
+  std::ifstream in(path);
+  nlohmann::json j;
+  try {
+    in >> j;
+  } catch (const nlohmann::json::exception& e) {
+    throw InputError(path.string(), std::string("not valid JSON: ") + e.what());
+  }
+  const nlohmann::json* floor = nullptr;
+  for (const char* key : {"floor", "floor_polygon", "polygon"}) {
+    if (j.is_object() && j.contains(key)) {
+      floor = &j[key];
+      break;
+    }
+  }
+  if (floor != nullptr && floor->is_object() && floor->contains("vertices")) floor = &(*floor)["vertices"];
+  if (floor == nullptr || !floor->is_array()) throw InputError(path.string(), "expected a \"floor\" list of [x, y] points");
+  std::vector<Eigen::Vector2d> vertices;
+  for (const auto& p : *floor) {
+    if (p.is_array() && p.size() >= 2 && p[0].is_number() && p[1].is_number()) {
+      vertices.emplace_back(p[0].get<double>(), p[1].get<double>());
+    } else if (p.is_object() && p.contains("x") && p.contains("y")) {
+      vertices.emplace_back(p["x"].get<double>(), p["y"].get<double>());
+    } else {
+      throw InputError(path.string(), "floor: every point must be [x, y] in metres");
+    }
+  }
+  GroundPolygon polygon(std::move(vertices));
+  if (!polygon.IsSimple()) throw InputError(path.string(), "floor: not a simple polygon of at least 3 points");
+  return polygon;
+}
+
+struct CameraWork {
+  std::string name;
+  int64_t camera_id = 0;
+  std::unique_ptr<CameraPipeline> pipeline;
+  std::unique_ptr<BoundedQueue<Frame>> frames;
+  std::thread thread;
+};
+
+}  // namespace
+
+GroundPolygon FloorForSession(const std::string& session_dir, const StationConfig& config) {
+  if (!config.enclosure.floor.empty()) return config.enclosure.floor;
+  const fs::path dir(session_dir);
+  for (const fs::path& candidate : {dir / "enclosure.json", dir / "truth" / "floor.json"}) {
+    if (auto polygon = ReadFloorJson(candidate)) return *polygon;
+  }
+  throw InputError(session_dir, "no floor polygon: give enclosure.floor in the config (--config), or put "
+                                "enclosure.json in the session");
+}
+
+IngestSummary IngestSession(const IngestOptions& options) {
+  const auto start = Clock::now();
+  const StationConfig& config = options.config;
+  ReplayOptions replay_options;
+  replay_options.realtime = false;
+  replay_options.frames_ahead = 6;
+  ReplaySource source(options.session_dir, replay_options);
+  const SessionInfo& info = source.session();
+  const GroundPolygon floor = FloorForSession(options.session_dir, config);
+
+  // Everything that can be refused is checked before the bank is touched.
+  std::vector<CameraModel> models;
+  for (const SessionCamera& cam : info.cameras) {
+    if (cam.model.empty()) {
+      throw InputError(options.session_dir + "/session.json",
+                       "camera " + cam.name + " has no camera model; the pipeline needs it to find the ground");
+    }
+    models.push_back(CameraModel::Read((fs::path(options.session_dir) / cam.model).string()));
+    if (models.back().width() != cam.width || models.back().height() != cam.height) {
+      throw InputError((fs::path(options.session_dir) / cam.model).string(),
+                       "the model is for " + std::to_string(models.back().width()) + "x" +
+                           std::to_string(models.back().height()) + " images but camera " + cam.name + " records " +
+                           std::to_string(cam.width) + "x" + std::to_string(cam.height));
+    }
+  }
+  const CameraPipelineOptions pipeline_options = PipelineOptionsFromConfig(config);
+
+  BankWriter bank(options.bank_path);
+  IngestSummary summary;
+  summary.session_name = info.name;
+  SessionRecord session_record;
+  session_record.uid = info.name + "@" + info.created;
+  session_record.name = info.name;
+  session_record.created = info.created;
+  session_record.source = fs::absolute(options.session_dir).lexically_normal().string();
+  summary.session_id = bank.AddSession(session_record);
+
+  std::vector<CameraWork> cameras(info.cameras.size());
+  for (size_t c = 0; c < info.cameras.size(); ++c) {
+    const SessionCamera& cam = info.cameras[c];
+    CameraRecord record;
+    record.name = cam.name;
+    record.cameramodel = models[c].ToText();
+    record.width = cam.width;
+    record.height = cam.height;
+    cameras[c].name = cam.name;
+    cameras[c].camera_id = bank.AddCamera(summary.session_id, record);
+    cameras[c].pipeline = std::make_unique<CameraPipeline>(cam.name, cameras[c].camera_id, models[c], floor,
+                                                           pipeline_options);
+    cameras[c].frames = std::make_unique<BoundedQueue<Frame>>(4);
+  }
+
+  // Failures: the first one stops everything; batches already stored stay stored.
+  std::mutex failure_mutex;
+  std::exception_ptr failure;
+  std::atomic<bool> failed{false};
+  BoundedQueue<ClipBatch> batches(64);
+  const auto fail = [&](std::exception_ptr e) {
+    {
+      std::lock_guard lock(failure_mutex);
+      if (!failure) failure = e;
+    }
+    failed = true;
+    source.Stop();
+    batches.Close();
+    for (CameraWork& w : cameras) w.frames->Close();
+  };
+
+  std::atomic<uint64_t> frames_done{0}, rows_inserted{0}, batch_count{0}, stored{0};
+  std::thread writer([&] {
+    try {
+      while (auto batch = batches.Pop()) {
+        if (failed) break;
+        const AppendResult r = bank.AppendClipBatch(batch->clip, batch->sprites);
+        rows_inserted += static_cast<uint64_t>(r.inserted);
+        ++batch_count;
+        for (const SpriteRecord& s : batch->sprites) stored += s.mirrored ? 0 : 1;
+      }
+    } catch (...) {
+      fail(std::current_exception());
+    }
+  });
+
+  const int training_frames = std::max(1, config.keying.training_frames);
+  for (CameraWork& w : cameras) {
+    w.thread = std::thread([&, &w = w] {
+      try {
+        std::vector<cv::Mat> empty;
+        std::vector<ClipBatch> out;
+        while (auto frame = w.frames->Pop()) {
+          if (!w.pipeline->trained()) {
+            empty.push_back(ToBgr(*frame));
+            ++frames_done;
+            if (static_cast<int>(empty.size()) == training_frames) {
+              w.pipeline->Train(empty);
+              empty.clear();
+            }
+            continue;
+          }
+          w.pipeline->Process(*frame, &out);
+          ++frames_done;
+          for (ClipBatch& b : out) batches.Push(std::move(b));
+          out.clear();
+        }
+        if (failed) return;
+        if (!w.pipeline->trained() && !empty.empty()) w.pipeline->Train(empty);
+        w.pipeline->Finish(&out);
+        for (ClipBatch& b : out) batches.Push(std::move(b));
+      } catch (...) {
+        fail(std::current_exception());
+      }
+    });
+  }
+
+  // This thread reads the replay and hands each frame to its camera.
+  uint64_t frames_total = 0;
+  for (const ReplayCameraStats& s : source.camera_stats()) frames_total += s.frames_in_csv;
+  auto last_progress = Clock::now();
+  try {
+    while (!failed) {
+      std::optional<Frame> frame = source.Next();
+      if (!frame) break;
+      if (frame->camera < 0 || static_cast<size_t>(frame->camera) >= cameras.size()) {
+        throw WorkError(options.session_dir, "replay delivered a frame of an unknown camera");
+      }
+      cameras[frame->camera].frames->Push(std::move(*frame));
+      if (options.progress && Clock::now() - last_progress > std::chrono::milliseconds(250)) {
+        last_progress = Clock::now();
+        options.progress({frames_done.load(), frames_total, stored.load(),
+                          std::chrono::duration<double>(last_progress - start).count()});
+      }
+    }
+  } catch (...) {
+    fail(std::current_exception());
+  }
+  for (CameraWork& w : cameras) w.frames->Close();
+  for (CameraWork& w : cameras) w.thread.join();
+  batches.Close();
+  writer.join();
+  if (failure) std::rethrow_exception(failure);
+
+  summary.source = source.stats();
+  for (CameraWork& w : cameras) {
+    const CameraPipelineStats& s = w.pipeline->stats();
+    summary.cameras.push_back({w.name, w.camera_id, s});
+    summary.frames += s.frames;
+    summary.sprites_kept += s.stored_sprites;
+    for (size_t r = 0; r < summary.discards.size(); ++r) summary.discards[r] += s.discards[r];
+  }
+  summary.rows_inserted = rows_inserted;
+  summary.batches = batch_count;
+  summary.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  summary.frames_per_second = summary.seconds > 0 ? summary.frames / summary.seconds : 0;
+  if (options.progress) options.progress({frames_done.load(), frames_total, stored.load(), summary.seconds});
+  return summary;
+}
+
+}  // namespace ss

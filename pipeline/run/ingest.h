@@ -1,0 +1,62 @@
+#pragma once
+// `spritestation ingest`: a recorded session through the live pipeline into a
+// bank, as fast as the machine allows. The replay decodes each camera on its
+// own thread; each camera's pipeline runs on its own thread; one writer thread
+// stores the clip batches, so no stage waits on the disk. Ingesting the same
+// session twice stores nothing new (the bank knows the session and its sprites).
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "capture/frame_source.h"
+#include "core/config.h"
+#include "core/geometry.h"
+#include "pipeline/run/camera_pipeline.h"
+
+namespace ss {
+
+struct IngestProgress {
+  uint64_t frames_done = 0;
+  uint64_t frames_total = 0;  // rows of the session's frame CSVs
+  uint64_t sprites_stored = 0;
+  double seconds = 0;
+};
+
+struct IngestOptions {
+  std::string session_dir;
+  std::string bank_path;
+  StationConfig config;  // keying, enclosure and pipeline sections are used
+  std::function<void(const IngestProgress&)> progress;  // a few times a second, from the calling thread
+};
+
+struct IngestCamera {
+  std::string name;
+  int64_t bank_camera_id = 0;
+  CameraPipelineStats stats;
+};
+
+struct IngestSummary {
+  std::string session_name;
+  int64_t session_id = 0;
+  std::vector<IngestCamera> cameras;
+  uint64_t frames = 0;            // frames through the pipelines (training frames included)
+  uint64_t sprites_kept = 0;      // usable originals handed to the bank
+  uint64_t rows_inserted = 0;     // new sprite rows (originals + mirrors); 0 on a re-ingest
+  uint64_t batches = 0;
+  DiscardCounts discards{};       // summed over cameras
+  SourceStats source;             // what the replay could not read
+  double seconds = 0;
+  double frames_per_second = 0;
+};
+
+// The floor polygon for a session: the config's `enclosure.floor` when given,
+// else the session's own `enclosure.json` or (synthetic sessions) `truth/floor.json`.
+// InputError naming what was looked at when there is none.
+GroundPolygon FloorForSession(const std::string& session_dir, const StationConfig& config);
+
+// Runs the whole ingest. InputError for bad input (session, models, config),
+// WorkError when the work fails; batches stored before a failure stay stored.
+IngestSummary IngestSession(const IngestOptions& options);
+
+}  // namespace ss

@@ -1,0 +1,98 @@
+#include "pipeline/transitions/bank_sprites.h"
+
+#include <cstring>
+#include <set>
+
+#include "core/error.h"
+
+namespace ss {
+
+CheapFeatures CheapFromRecord(const SpriteRecord& s) {
+  CheapFeatures f;
+  f.velocity_x_mps = s.velocity_x_m_s;
+  f.velocity_y_mps = s.velocity_y_m_s;
+  f.colour[0] = s.mean_r;
+  f.colour[1] = s.mean_g;
+  f.colour[2] = s.mean_b;
+  f.area_m2 = s.px_per_m > 0 ? s.area_px / (s.px_per_m * s.px_per_m) : 0.0;
+  f.eccentricity = s.eccentricity;
+  return f;
+}
+
+RgbaBillboard BillboardFromPixels(const SpritePixels& pixels, double anchor_x_px, double anchor_y_px) {
+  if (pixels.bgra.type() != CV_8UC4) throw WorkError("billboard", "bank pixels are not 8-bit BGRA");
+  RgbaBillboard b;
+  b.width = pixels.bgra.cols;
+  b.height = pixels.bgra.rows;
+  b.anchor_x_px = anchor_x_px;
+  b.anchor_y_px = anchor_y_px;
+  b.rgba.resize(static_cast<size_t>(b.width) * b.height * 4);
+  const size_t row_bytes = static_cast<size_t>(b.width) * 4;
+  for (int y = 0; y < b.height; ++y) std::memcpy(b.rgba.data() + y * row_bytes, pixels.bgra.ptr(y), row_bytes);
+  return b;
+}
+
+int64_t SegmentKeys::Key(int64_t clip_id, bool mirrored, int64_t frame) {
+  auto [it, inserted] = last_.try_emplace({clip_id, mirrored}, Last{0, 0});
+  if (inserted || frame != it->second.frame + 1) it->second.key = next_key_++;
+  it->second.frame = frame;
+  return it->second.key;
+}
+
+namespace {
+
+// Appends one sprite (record + pixels) to `out`; checks the bank-wide scale.
+void AddSprite(const Bank& bank, const SpriteRecord& r, SegmentKeys* keys, BankSprites* out) {
+  const std::string who = "sprite " + std::to_string(r.id);
+  if (out->px_per_m == 0) out->px_per_m = r.px_per_m;
+  if (r.px_per_m != out->px_per_m) {
+    throw InputError(bank.path(), who + " has px_per_m " + std::to_string(r.px_per_m) + ", the others " +
+                                      std::to_string(out->px_per_m) + ": one bank must use one billboard scale");
+  }
+  RgbaBillboard b = BillboardFromPixels(bank.LoadPixels(r.id), r.anchor_x_px, r.anchor_y_px);
+  out->ids.push_back(r.id);
+  out->billboards.push_back(std::move(b));
+  out->inputs.push_back({r.id, keys->Key(r.clip_id, r.mirrored, r.frame), CheapFromRecord(r), nullptr});
+}
+
+void Link(BankSprites* out) {
+  for (size_t k = 0; k < out->inputs.size(); ++k) out->inputs[k].billboard = &out->billboards[k];
+}
+
+}  // namespace
+
+BankSprites LoadBankSprites(const Bank& bank, SegmentKeys* keys, const std::function<void(size_t, size_t)>& progress) {
+  const std::vector<SpriteFeatures> features = bank.LoadFeatures();  // ordered by (clip, mirrored, frame)
+  BankSprites out;
+  out.ids.reserve(features.size());
+  out.inputs.reserve(features.size());
+  out.billboards.reserve(features.size());
+  std::set<int64_t> clips;
+  for (size_t k = 0; k < features.size(); ++k) {
+    AddSprite(bank, bank.LoadSprite(features[k].id), keys, &out);
+    clips.insert(features[k].clip_id);
+    if (progress && (k % 512 == 511 || k + 1 == features.size())) progress(k + 1, features.size());
+  }
+  out.clips = static_cast<int64_t>(clips.size());
+  Link(&out);
+  return out;
+}
+
+BankSprites LoadBankSpritesById(const Bank& bank, std::span<const int64_t> ids, SegmentKeys* keys, double px_per_m) {
+  BankSprites out;
+  out.px_per_m = px_per_m;
+  out.ids.reserve(ids.size());
+  out.inputs.reserve(ids.size());
+  out.billboards.reserve(ids.size());
+  std::set<int64_t> clips;
+  for (int64_t id : ids) {
+    const SpriteRecord r = bank.LoadSprite(id);  // InputError naming the bank for an unknown id
+    AddSprite(bank, r, keys, &out);
+    clips.insert(r.clip_id);
+  }
+  out.clips = static_cast<int64_t>(clips.size());
+  Link(&out);
+  return out;
+}
+
+}  // namespace ss

@@ -1,0 +1,209 @@
+#include "pipeline/transitions/bank_training.h"
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+#include <unordered_map>
+
+#include <nlohmann/json.hpp>
+
+#include "core/bank.h"
+#include "core/error.h"
+#include "core/log.h"
+#include "pipeline/transitions/bank_sprites.h"
+
+namespace ss {
+
+namespace fs = std::filesystem;
+
+BankTrainResult TrainOnBank(const std::string& labels_path, const std::string& bank_path,
+                            const BankTrainOptions& options) {
+  const std::vector<Label> labels = ReadLabelsCsv(labels_path);
+  const Bank bank(bank_path);
+  // The labelled sprites, each once.
+  std::vector<int64_t> ids;
+  std::set<int64_t> seen;
+  for (const Label& l : labels) {
+    for (int64_t id : {l.sprite_i, l.sprite_j}) {
+      if (seen.insert(id).second) ids.push_back(id);
+    }
+  }
+  SegmentKeys keys;
+  BankSprites labelled;
+  try {
+    labelled = LoadBankSpritesById(bank, ids, &keys);
+  } catch (const InputError& e) {
+    throw InputError(labels_path, std::string("names a sprite the bank cannot give: ") + e.what());
+  }
+  SpriteStore store(options.window, labelled.px_per_m > 0 ? labelled.px_per_m : 1.0);
+  store.Append(labelled.inputs, options.threads);
+  std::vector<PairFeatures> x;
+  std::vector<uint8_t> y;
+  for (const Label& l : labels) {
+    x.push_back(store.Features(*store.IndexOf(l.sprite_i), *store.IndexOf(l.sprite_j)));
+    y.push_back(l.accept ? 1 : 0);
+  }
+  BankTrainResult result;
+  try {
+    result.weights = TrainWeights(x, y, options.window, options.train, &result.report);
+  } catch (const InputError& e) {
+    throw InputError(labels_path, e.what());
+  }
+  result.stage1_bias_from_labels = result.weights.stage1_bias;
+  nlohmann::json training = nlohmann::json::parse(result.weights.training_json);
+  training["source"] = "spritestation transitions train " + labels_path + " --bank " + bank_path;
+  if (options.stage1_recall > 0) {
+    // Stage 1 as a filter: judge every pair of some sprites with stage 2 (brute force) and
+    // let stage 1 pass the requested share of what stage 2 accepts.
+    SegmentKeys all_keys;
+    const BankSprites everything = LoadBankSprites(bank, &all_keys);
+    if (!everything.inputs.empty()) {
+      SpriteStore all(options.window, everything.px_per_m);
+      all.Append(everything.inputs, options.threads);
+      const auto accepted = SampleStage2Accepted(all, TransitionClassifier(result.weights), options.calibration_rows,
+                                                 options.train.seed, options.threads);
+      CalibrateStage1(accepted, options.stage1_recall, &result.weights);
+      result.calibration_accepts = static_cast<int64_t>(accepted.size());
+    }
+    training["stage1_calibration"] = {{"target_recall_of_stage2", options.stage1_recall},
+                                      {"stage2_accepted_pairs_sampled", result.calibration_accepts},
+                                      {"sampled_rows", options.calibration_rows},
+                                      {"bias_from_labels", result.stage1_bias_from_labels},
+                                      {"bias", result.weights.stage1_bias}};
+  }
+  result.weights.training_json = training.dump();
+  return result;
+}
+
+namespace {
+
+struct TruthRow {
+  double x = 0, y = 0;
+  SpriteTruth truth;
+};
+
+std::vector<std::string> SplitCsv(const std::string& line) {
+  std::vector<std::string> out;
+  std::stringstream ss(line);
+  std::string field;
+  while (std::getline(ss, field, ',')) out.push_back(field);
+  return out;
+}
+
+// truth/subjects.csv by timestamp.
+std::unordered_map<int64_t, std::vector<TruthRow>> ReadSubjects(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw InputError(path, "cannot open the session truth (is this a synthetic session?)");
+  std::string line;
+  if (!std::getline(in, line)) throw InputError(path, "empty");
+  const std::vector<std::string> header = SplitCsv(line);
+  auto column = [&](const std::string& name) {
+    for (size_t k = 0; k < header.size(); ++k) {
+      if (header[k] == name) return k;
+    }
+    throw InputError(path, "no column '" + name + "' in the header");
+  };
+  const size_t c_ts = column("timestamp_ns"), c_x = column("x"), c_y = column("y"), c_heading = column("heading_rad"),
+               c_phase = column("gait_phase"), c_pose = column("pose");
+  std::unordered_map<int64_t, std::vector<TruthRow>> rows;
+  int line_number = 1;
+  while (std::getline(in, line)) {
+    ++line_number;
+    if (line.empty()) continue;
+    const std::vector<std::string> f = SplitCsv(line);
+    if (f.size() < header.size()) {
+      throw InputError(path + ":" + std::to_string(line_number), "expected " + std::to_string(header.size()) +
+                                                                      " fields, got " + std::to_string(f.size()));
+    }
+    try {
+      TruthRow r;
+      r.x = std::stod(f[c_x]);
+      r.y = std::stod(f[c_y]);
+      r.truth.heading_rad = std::stod(f[c_heading]);
+      r.truth.gait_phase = std::stod(f[c_phase]);
+      r.truth.pose = f[c_pose];
+      rows[std::stoll(f[c_ts])].push_back(r);
+    } catch (const std::logic_error&) {
+      throw InputError(path + ":" + std::to_string(line_number), "a number does not parse: '" + line + "'");
+    }
+  }
+  return rows;
+}
+
+std::string Normal(const std::string& p) {
+  std::error_code ec;
+  const fs::path c = fs::weakly_canonical(fs::absolute(p), ec);
+  return (ec ? fs::absolute(p).lexically_normal() : c).string();
+}
+
+}  // namespace
+
+TruthLabelSummary LabelBankFromTruth(const std::string& session_dir, const std::string& bank_path, size_t count,
+                                     const TruthLabelOptions& options, uint64_t seed) {
+  const auto subjects = ReadSubjects((fs::path(session_dir) / "truth" / "subjects.csv").string());
+  const Bank bank(bank_path);
+  // The bank's record of this session: by its source directory, else the only session.
+  const std::vector<SessionRecord> sessions = bank.ListSessions();
+  int64_t session_id = 0;
+  for (const SessionRecord& s : sessions) {
+    if (Normal(s.source) == Normal(session_dir)) session_id = s.id;
+  }
+  if (session_id == 0 && sessions.size() == 1) {
+    session_id = sessions[0].id;
+    Log("pipeline.transitions")->warn("{}: its one session came from '{}', not '{}'; matching by timestamps", bank_path,
+                                      sessions[0].source, session_dir);
+  }
+  if (session_id == 0) {
+    throw InputError(bank_path, "holds no session ingested from '" + session_dir + "' (" +
+                                    std::to_string(sessions.size()) + " sessions)");
+  }
+  std::set<int64_t> cameras;
+  for (const CameraRecord& c : bank.ListCameras()) {
+    if (c.session_id == session_id) cameras.insert(c.id);
+  }
+  std::unordered_map<int64_t, int64_t> camera_of_clip;
+  for (const ClipRecord& c : bank.ListClips()) camera_of_clip[c.id] = c.camera_id;
+
+  TruthLabelSummary summary;
+  std::vector<int64_t> ids;
+  std::vector<SpriteTruth> truth;
+  for (const SpriteFeatures& f : bank.LoadFeatures()) {
+    if (!cameras.count(camera_of_clip[f.clip_id])) continue;
+    if (f.mirrored) {
+      ++summary.mirrored_skipped;
+      continue;
+    }
+    const auto it = subjects.find(f.timestamp_ns);
+    const TruthRow* best = nullptr;
+    double best_m = 0.15;
+    if (it != subjects.end()) {
+      for (const TruthRow& r : it->second) {
+        const double d = std::hypot(r.x - f.ground_x_m, r.y - f.ground_y_m);
+        if (d <= best_m) {
+          best_m = d;
+          best = &r;
+        }
+      }
+    }
+    if (!best) {
+      ++summary.sprites_unmatched;
+      continue;
+    }
+    ++summary.sprites_matched;
+    ids.push_back(f.id);
+    truth.push_back(best->truth);
+  }
+  if (ids.size() < 2) {
+    throw InputError(bank_path, std::to_string(ids.size()) + " sprites of session '" + session_dir +
+                                    "' match its truth (by timestamp and ground position within 0.15 m; " +
+                                    std::to_string(summary.sprites_unmatched) +
+                                    " do not): at least two are needed to make labels");
+  }
+  summary.labels = LabelsFromTruth(ids, truth, count, options, seed);
+  return summary;
+}
+
+}  // namespace ss

@@ -1,0 +1,50 @@
+#pragma once
+// Training and labelling against a real bank (`spritestation transitions train` and
+// `transitions label --from-truth`). See docs/transitions.md.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "pipeline/transitions/training.h"
+#include "pipeline/transitions/truth_labels.h"
+#include "pipeline/transitions/weights.h"
+
+namespace ss {
+
+struct BankTrainOptions {
+  TrainOptions train;
+  ComparisonWindow window;     // the pixel features' window (recorded in the weights)
+  double stage1_recall = 0.995;  // of stage-2 accepts that stage 1 must pass (0 = keep the label fit)
+  int calibration_rows = 300;  // sprites whose every pair stage 2 judges for the calibration
+  int threads = 2;
+};
+
+struct BankTrainResult {
+  TransitionWeights weights;
+  TrainReport report;  // cross-validated precision/recall of both stages on the labels
+  int64_t calibration_accepts = 0;  // stage-2 accepted pairs the stage-1 bias was set on
+  double stage1_bias_from_labels = 0;
+};
+
+// Trains both stages on the labelled pairs of `bank_path`'s sprites, then sets the
+// stage-1 bias so that stage 1 passes `stage1_recall` of what stage 2 accepts on the
+// bank (stage 1 is only a filter). InputError naming the labels file or the bank for an
+// unknown sprite, too few labels or one class only.
+BankTrainResult TrainOnBank(const std::string& labels_path, const std::string& bank_path,
+                            const BankTrainOptions& options);
+
+struct TruthLabelSummary {
+  int64_t sprites_matched = 0;    // originals of the session's cameras given a truth
+  int64_t sprites_unmatched = 0;  // no truth row at their time and place
+  int64_t mirrored_skipped = 0;
+  std::vector<Label> labels;
+};
+
+// Labels from a synthetic session's truth/subjects.csv for the sprites of that session in
+// the bank (matched by timestamp, then by nearest subject within 0.15 m). Mirrored
+// sprites are left out (their truth heading depends on the camera). InputError naming
+// the session or the bank when the truth is missing or no sprite matches.
+TruthLabelSummary LabelBankFromTruth(const std::string& session_dir, const std::string& bank_path, size_t count,
+                                     const TruthLabelOptions& options, uint64_t seed);
+
+}  // namespace ss

@@ -1,0 +1,62 @@
+#pragma once
+// A bank's transition table, built or brought up to date (`spritestation transitions
+// BANK`), and the transitions stored as a diff: only what changed is written, in one
+// transaction, so readers keep seeing a whole table. The bank's meta key
+// "transitions.weights" records which weights made the table; other weights replace it.
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <unordered_set>
+#include <vector>
+
+#include "core/bank.h"
+#include "pipeline/transitions/builder.h"
+#include "pipeline/transitions/weights.h"
+
+namespace ss {
+
+inline constexpr const char* kTransitionWeightsMetaKey = "transitions.weights";
+
+// A stable fingerprint of weights (FNV-1a of their JSON), as stored in the meta key.
+std::string WeightsFingerprint(const TransitionWeights& weights);
+
+// What storing a transition set did.
+struct StoreResult {
+  int64_t added = 0, changed = 0, unchanged = 0;
+  int64_t removed = 0;        // existing transitions the new set no longer has
+  int64_t outside = 0;        // existing transitions touching sprites outside the set: left alone
+  bool replaced_all = false;  // the table was cleared first (other weights, or removals)
+};
+
+// Stores `transitions` (sorted by (from, to)), all the transitions among `sprites`, made
+// with weights `fingerprint`: writes only the differences when the table was made with
+// the same weights and nothing must go; else clears the table and writes everything.
+StoreResult StoreTransitionTable(BankWriter& bank, const std::vector<Transition>& transitions,
+                                 const std::string& fingerprint, const std::unordered_set<int64_t>& sprites);
+
+std::vector<TransitionRecord> ToRecords(const std::vector<Transition>& transitions);
+
+struct BankUpdateOptions {
+  TransitionWeights weights = DefaultWeights();
+  int threads = 2;
+  // stage: "load" (sprites read and decoded) or "pairs" (sprites searched); from any thread.
+  std::function<void(const std::string& stage, size_t done, size_t total)> progress;
+};
+
+struct BankUpdateSummary {
+  std::string bank;
+  int64_t sprites = 0, clips = 0;
+  BuildStats build;
+  int64_t transitions = 0;
+  StoreResult store;
+  double seconds_load = 0, seconds_build = 0, seconds_store = 0;
+  std::vector<std::string> notes;
+  std::string ToJson() const;
+  std::string ToText() const;
+};
+
+// Finds the transitions of every sprite of the complete clips of `bank_path` and stores
+// them. InputError naming the bank when it is missing, not a bank, or holds no sprites.
+BankUpdateSummary UpdateBankTransitions(const std::string& bank_path, const BankUpdateOptions& options);
+
+}  // namespace ss

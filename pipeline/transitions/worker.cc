@@ -1,0 +1,155 @@
+#include "pipeline/transitions/worker.h"
+
+#include <chrono>
+#include <optional>
+#include <unordered_set>
+
+#include "core/bank.h"
+#include "core/error.h"
+#include "core/log.h"
+#include "pipeline/transitions/bank_sprites.h"
+#include "pipeline/transitions/bank_transitions.h"
+#include "pipeline/transitions/builder.h"
+
+namespace ss {
+
+// Everything the thread owns (connections are used from the worker thread only).
+struct TransitionWorker::State {
+  TransitionWeights weights;
+  int startup_threads = 1;
+  std::optional<Bank> reader;
+  std::optional<BankWriter> writer;
+  std::unique_ptr<TransitionBuilder> builder;  // made when the bank scale is known
+  SegmentKeys keys;
+};
+
+TransitionWorker::TransitionWorker(std::string bank_path, const TransitionWeights& weights, int startup_threads)
+    : bank_path_(std::move(bank_path)), state_(std::make_unique<State>()) {
+  const TransitionClassifier check(weights);  // InputError for invalid weights, in the caller's thread
+  state_->weights = weights;
+  state_->startup_threads = std::max(1, startup_threads);
+  thread_ = std::thread([this] { Run(); });
+}
+
+TransitionWorker::~TransitionWorker() { Stop(); }
+
+void TransitionWorker::Submit(std::span<const int64_t> sprite_ids) {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (stop_) return;
+    queue_.insert(queue_.end(), sprite_ids.begin(), sprite_ids.end());
+    stats_.queued = static_cast<int64_t>(queue_.size());
+  }
+  wake_.notify_one();
+}
+
+void TransitionWorker::WaitIdle() {
+  std::unique_lock<std::mutex> lock(mutex_);
+  idle_.wait(lock, [&] { return stop_ || (!busy_ && queue_.empty()); });
+}
+
+void TransitionWorker::Stop() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    stop_ = true;
+    queue_.clear();
+  }
+  wake_.notify_all();
+  idle_.notify_all();
+  if (thread_.joinable()) thread_.join();
+}
+
+TransitionWorkerStats TransitionWorker::stats() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return stats_;
+}
+
+void TransitionWorker::Run() {
+  auto log = Log("pipeline.transitions");
+  State& s = *state_;
+  auto fail = [&](const std::string& what) {
+    log->error("transition worker: {}", what);
+    std::lock_guard<std::mutex> lock(mutex_);
+    ++stats_.failed_rounds;
+    stats_.last_error = what;
+  };
+  // Start-up: the connections, then the table of the complete clips.
+  int64_t stored = 0, known = 0;
+  try {
+    s.reader.emplace(bank_path_);  // InputError when there is no bank: never create one here
+    s.writer.emplace(bank_path_);
+    const BankSprites sprites = LoadBankSprites(*s.reader, &s.keys);
+    if (!sprites.inputs.empty()) {
+      s.builder = std::make_unique<TransitionBuilder>(s.weights, sprites.px_per_m);
+      s.builder->BuildFromScratch(sprites.inputs, BuildOptions{.threads = s.startup_threads});
+      const auto transitions = s.builder->Transitions();
+      const std::unordered_set<int64_t> universe(sprites.ids.begin(), sprites.ids.end());
+      const StoreResult r = StoreTransitionTable(*s.writer, transitions, WeightsFingerprint(s.weights), universe);
+      stored = r.replaced_all ? static_cast<int64_t>(transitions.size()) : r.added + r.changed;
+      known = static_cast<int64_t>(sprites.inputs.size());
+    } else {
+      s.writer->SetMeta(kTransitionWeightsMetaKey, WeightsFingerprint(s.weights));
+    }
+    log->info("transition worker: {} sprites at start, {} transitions written", known, stored);
+  } catch (const std::exception& e) {
+    fail(std::string("start-up: ") + e.what());
+    s.reader.reset();
+    s.writer.reset();
+  }
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    stats_.ready = true;
+    stats_.sprites = known;
+    stats_.transitions_stored = stored;
+    busy_ = false;
+  }
+  idle_.notify_all();
+
+  std::vector<int64_t> round;
+  while (true) {
+    {
+      std::unique_lock<std::mutex> lock(mutex_);
+      wake_.wait(lock, [&] { return stop_ || !queue_.empty(); });
+      if (stop_) break;
+      round.assign(queue_.begin(), queue_.end());
+      queue_.clear();
+      busy_ = true;
+    }
+    const auto t0 = std::chrono::steady_clock::now();
+    int64_t added_sprites = 0, added_transitions = 0;
+    try {
+      if (!s.writer) throw WorkError(bank_path_, "the bank could not be opened at start-up");
+      // Skip ids already known (a clip completed before start-up and also submitted).
+      std::vector<int64_t> fresh;
+      std::unordered_set<int64_t> in_round;
+      for (int64_t id : round) {
+        if (s.builder && s.builder->store().IndexOf(id)) continue;
+        if (in_round.insert(id).second) fresh.push_back(id);
+      }
+      if (!fresh.empty()) {
+        const double scale = s.builder ? s.builder->store().px_per_m() : 0.0;
+        const BankSprites sprites = LoadBankSpritesById(*s.reader, fresh, &s.keys, scale);
+        if (!s.builder) s.builder = std::make_unique<TransitionBuilder>(s.weights, sprites.px_per_m);
+        const TransitionDelta delta = s.builder->Add(sprites.inputs);
+        if (!delta.transitions.empty()) s.writer->UpsertTransitions(ToRecords(delta.transitions));
+        added_sprites = static_cast<int64_t>(fresh.size());
+        added_transitions = static_cast<int64_t>(delta.transitions.size());
+      }
+    } catch (const std::exception& e) {
+      fail(e.what());
+    }
+    const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      ++stats_.rounds;
+      stats_.sprites += added_sprites;
+      stats_.transitions_stored += added_transitions;
+      stats_.last_round_ms = ms;
+      stats_.queued = static_cast<int64_t>(queue_.size());
+      busy_ = false;
+    }
+    idle_.notify_all();
+  }
+}
+
+}  // namespace ss

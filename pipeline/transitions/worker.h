@@ -1,0 +1,71 @@
+#pragma once
+// The incremental transition worker: a background thread that keeps a bank's transition
+// table current while the pipeline appends sprites. The pipeline hands it the ids of
+// newly stored sprites (AppendResult::sprite_ids, originals and mirrors, in the order
+// stored); Submit only queues them, so the writer never waits for transition finding.
+// The worker reads the sprites through its own connection, finds their transitions
+// against the whole bank in both directions (into the new sprites, and out of the clip
+// ends they extend; TransitionBuilder::Add), and stores each round as one short
+// transaction through its own writer connection.
+// On start it loads every sprite of the bank's complete clips and brings their table up
+// to date (UpdateBankTransitions' rules). Sprites of clips that were incomplete at start
+// and are never submitted are not seen (run `spritestation transitions BANK` later).
+// Errors never stop the thread: a round that fails is counted, logged and skipped.
+#include <condition_variable>
+#include <cstdint>
+#include <deque>
+#include <memory>
+#include <mutex>
+#include <span>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "pipeline/transitions/weights.h"
+
+namespace ss {
+
+struct TransitionWorkerStats {
+  bool ready = false;           // the start-up build is done
+  int64_t sprites = 0;          // sprites the worker knows (start-up + submitted)
+  int64_t queued = 0;           // submitted, not yet processed
+  int64_t rounds = 0;           // rounds of submitted sprites processed
+  int64_t transitions_stored = 0;  // written since start (start-up table included)
+  int64_t failed_rounds = 0;
+  std::string last_error;       // of the last failed round (or start-up)
+  double last_round_ms = 0;     // find + store time of the last round
+};
+
+class TransitionWorker {
+ public:
+  // Starts the thread. Invalid weights throw InputError here; a bank that cannot be
+  // opened shows up as stats().last_error (the thread then drops what is submitted).
+  TransitionWorker(std::string bank_path, const TransitionWeights& weights, int startup_threads = 1);
+  ~TransitionWorker();  // Stop()
+  TransitionWorker(const TransitionWorker&) = delete;
+  TransitionWorker& operator=(const TransitionWorker&) = delete;
+
+  // Queues newly stored sprites; returns at once. Ids the worker already knows are skipped.
+  void Submit(std::span<const int64_t> sprite_ids);
+  // Blocks until everything submitted before the call is processed (tests, shutdown).
+  void WaitIdle();
+  // Finishes the round in progress and joins the thread; queued ids are dropped.
+  void Stop();
+  TransitionWorkerStats stats() const;
+
+ private:
+  struct State;
+  void Run();
+
+  std::string bank_path_;
+  std::unique_ptr<State> state_;
+  mutable std::mutex mutex_;
+  std::condition_variable wake_, idle_;
+  std::deque<int64_t> queue_;
+  bool stop_ = false;
+  bool busy_ = true;  // until the start-up build is done
+  TransitionWorkerStats stats_;
+  std::thread thread_;
+};
+
+}  // namespace ss

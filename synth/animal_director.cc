@@ -1,0 +1,123 @@
+// Animals in the enclosure: one AnimalBehaviour per subject, stepped frame by frame.
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "core/error.h"
+#include "synth/animal.h"
+#include "synth/directors.h"
+#include "synth/random.h"
+
+namespace ss::synth {
+namespace {
+
+constexpr double kWallTouchM = 0.003;
+
+class AnimalDirector : public Director {
+ public:
+  AnimalDirector(const Studio& studio, const std::vector<SynthCamera>& cameras, const DirectorOptions& options)
+      : studio_(studio), options_(options) {
+    std::vector<Eigen::Vector3d> centres;
+    for (const auto& c : cameras) centres.push_back(c.CentreInGround());
+    Rng rng(StreamSeed(options.seed, "animal-placement"));
+    std::vector<Eigen::Vector2d> placed;
+    for (int i = 0; i < options.subjects; ++i) {
+      const AnimalLook look = RandomAnimalLook(StreamSeed(options.seed, "animal", static_cast<uint64_t>(i)));
+      // Starting places at least 0.2 m apart, away from the walls.
+      Eigen::Vector2d p = Eigen::Vector2d::Zero();
+      for (int attempt = 0; attempt < 200; ++attempt) {
+        p = {rng.Uniform(-studio.half_x + 0.16, studio.half_x - 0.16),
+             rng.Uniform(-studio.half_y + 0.16, studio.half_y - 0.16)};
+        bool apart = true;
+        for (const auto& q : placed) apart = apart && (p - q).norm() > 0.2;
+        if (apart) break;
+      }
+      placed.push_back(p);
+      animals_.emplace_back(studio, look, StreamSeed(options.seed, "animal-behaviour", static_cast<uint64_t>(i)), p,
+                            rng.Uniform(-M_PI, M_PI), centres);
+    }
+  }
+
+  int subjects() const override { return static_cast<int>(animals_.size()); }
+
+  void Frame(double time_s, FrameSnapshot* out) override {
+    out->scene = FrameScene{};
+    out->scene.subjects = subjects();
+    out->subjects.clear();
+    out->boards.clear();
+    const int slices = options_.motion_blur ? 4 : 1;
+    out->scene.slices = slices;
+    const double exposure = 0.5 / options_.fps;
+    // Slice s is the body at time_s - exposure * (slices - 1 - s) / slices; slice
+    // 0 (used for shadows and truth) must be the frame time, so slices are ordered last first.
+    for (int s = slices - 1; s >= 0; --s) {
+      const double t = time_s - exposure * s / slices;
+      AdvanceTo(t);
+      for (size_t i = 0; i < animals_.size(); ++i) {
+        auto prims = AnimalPrimitives(animals_[i].look(), animals_[i].state(), static_cast<int>(i), s);
+        out->scene.primitives.insert(out->scene.primitives.end(), prims.begin(), prims.end());
+      }
+    }
+    for (size_t i = 0; i < animals_.size(); ++i) {
+      const AnimalState& st = animals_[i].state();
+      SubjectTruth t;
+      t.kind = "animal";
+      t.position = st.position;
+      t.heading_rad = st.heading_rad;
+      t.speed_mps = st.speed_mps;
+      t.gait_phase = st.gait_phase;
+      t.pose = st.pose;
+      t.touches_wall = TouchesWall(studio_, out->scene.primitives, static_cast<int>(i), kWallTouchM);
+      t.leaves_floor = LeavesFloor(studio_, out->scene.primitives, static_cast<int>(i), kWallTouchM);
+      t.height_m = TopHeight(out->scene.primitives, static_cast<int>(i));
+      out->subjects.push_back(std::move(t));
+    }
+  }
+
+  std::string SubjectsJson() const override {
+    nlohmann::json list = nlohmann::json::array();
+    for (size_t i = 0; i < animals_.size(); ++i) {
+      const AnimalLook& l = animals_[i].look();
+      list.push_back({{"subject", i},
+                      {"kind", "animal"},
+                      {"scale", l.scale},
+                      {"length_m", 0.19 * l.scale},
+                      {"fur_bgr", {l.fur.x(), l.fur.y(), l.fur.z()}},
+                      {"belly_bgr", {l.belly.x(), l.belly.y(), l.belly.z()}}});
+    }
+    return list.dump();
+  }
+
+ private:
+  void AdvanceTo(double t) {
+    if (t <= now_) return;
+    const double dt = t - now_;
+    std::vector<Eigen::Vector2d> roots;
+    for (const auto& a : animals_) roots.push_back(a.state().position);
+    for (size_t i = 0; i < animals_.size(); ++i) {
+      std::vector<Eigen::Vector2d> others;
+      for (size_t j = 0; j < roots.size(); ++j) {
+        if (j != i) others.push_back(roots[j]);
+      }
+      animals_[i].Step(dt, others);
+    }
+    now_ = t;
+  }
+
+  const Studio& studio_;
+  DirectorOptions options_;
+  std::vector<AnimalBehaviour> animals_;
+  double now_ = 0.0;
+};
+
+}  // namespace
+
+std::unique_ptr<Director> MakeAnimalDirector(const Studio& studio, const std::vector<SynthCamera>& cameras,
+                                             const DirectorOptions& options) {
+  if (studio.kind != StudioKind::kEnclosure) throw InputError("kind", "animals live in the enclosure studio");
+  return std::make_unique<AnimalDirector>(studio, cameras, options);
+}
+
+}  // namespace ss::synth

@@ -1,0 +1,164 @@
+// Calibration sessions: the session time is split into one segment per camera
+// and board (the board held before that camera, moving through poses that it
+// holds still for a moment) and a last segment with both boards flat on the floor.
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include <Eigen/Geometry>
+#include <nlohmann/json.hpp>
+
+#include "synth/directors.h"
+#include "synth/random.h"
+
+namespace ss::synth {
+namespace {
+
+constexpr double kDeg = M_PI / 180.0;
+constexpr double kPoseSeconds = 0.8;  // one pose: move for 60 %, then hold still
+
+double Smooth(double t) {
+  t = std::clamp(t, 0.0, 1.0);
+  return t * t * (3.0 - 2.0 * t);
+}
+
+Rigid3 Interpolate(const Rigid3& a, const Rigid3& b, double s) {
+  const Eigen::Quaterniond qa(a.rotation), qb(b.rotation);
+  Rigid3 out;
+  out.rotation = qa.slerp(s, qb).toRotationMatrix();
+  out.translation = a.translation + s * (b.translation - a.translation);
+  return out;
+}
+
+struct Segment {
+  double start_s = 0, end_s = 0;
+  int board = 0;                 // index into specs
+  int camera = -1;               // -1: on the floor
+  std::vector<Rigid3> poses;     // ground_from_board, one per pose
+};
+
+class CalibrationDirector : public Director {
+ public:
+  CalibrationDirector(const Studio& studio, const std::vector<SynthCamera>& cameras, const DirectorOptions& options,
+                      double seconds)
+      : studio_(studio), cameras_(cameras) {
+    const bool stage = studio.kind == StudioKind::kStage;
+    specs_ = {ChessboardFor(stage), CharucoFor(stage)};
+    for (const auto& s : specs_) textures_.push_back(std::make_unique<BoardTexture>(s));
+    Rng rng(StreamSeed(options.seed, "calibration-boards"));
+    // Segments: camera 0 chessboard, camera 0 ChArUco, camera 1 ..., then the floor (one pose slot).
+    const int hand_segments = 2 * static_cast<int>(cameras.size());
+    const double floor_s = std::max(seconds * 0.1, std::min(1.0, seconds / (hand_segments + 1)));
+    const double hand_s = (seconds - floor_s) / hand_segments;
+    double t = 0;
+    for (size_t c = 0; c < cameras.size(); ++c) {
+      for (int b = 0; b < 2; ++b) {
+        Segment seg;
+        seg.start_s = t;
+        seg.end_s = t + hand_s;
+        seg.board = b;
+        seg.camera = static_cast<int>(c);
+        const int poses = std::max(2, static_cast<int>(std::ceil(hand_s / kPoseSeconds)) + 1);
+        for (int p = 0; p < poses; ++p) seg.poses.push_back(HeldPose(cameras[c], specs_[b], rng));
+        segments_.push_back(seg);
+        t += hand_s;
+      }
+    }
+    // On the floor: the chessboard's frame at the ground origin (x along ground x,
+    // y along -ground y, the print facing up), the ChArUco board beside it.
+    Segment floor;
+    floor.start_s = t;
+    floor.end_s = seconds + 1.0;
+    floor.camera = -1;
+    segments_.push_back(floor);
+    const BoardSpec& chess = specs_[0];
+    floor_poses_.resize(2);
+    const Eigen::Matrix3d face_up = Eigen::Vector3d(1, -1, -1).asDiagonal();
+    floor_poses_[0].rotation = face_up;
+    floor_poses_[0].translation = Eigen::Vector3d(-0.5 * chess.width_m(), 0.5 * chess.height_m(), 0.001);
+    const BoardSpec& charuco = specs_[1];
+    const double gap = chess.margin_m + charuco.margin_m + 0.02;
+    floor_poses_[1].rotation = face_up;
+    const double x1 = -0.5 * chess.width_m() + chess.width_m() + gap;
+    floor_poses_[1].translation = Eigen::Vector3d(x1, 0.5 * charuco.height_m(), 0.001);
+    if (x1 + charuco.width_m() > studio.half_x - 0.01) {  // not beside it: in front of it
+      floor_poses_[1].translation =
+          Eigen::Vector3d(-0.5 * charuco.width_m(), -0.5 * chess.height_m() - gap, 0.001);
+    }
+  }
+
+  int subjects() const override { return 0; }
+  const std::vector<BoardSpec>& board_specs() const override { return specs_; }
+
+  void Frame(double time_s, FrameSnapshot* out) override {
+    out->scene = FrameScene{};
+    out->subjects.clear();
+    out->boards.clear();
+    const Segment* seg = &segments_.back();
+    for (const auto& s : segments_) {
+      if (time_s >= s.start_s && time_s < s.end_s) {
+        seg = &s;
+        break;
+      }
+    }
+    if (seg->camera < 0) {
+      for (int b = 0; b < 2; ++b) Add(b, floor_poses_[static_cast<size_t>(b)], "floor", out);
+      return;
+    }
+    // Pose p is reached at start + (p + 0.6) * step and held until start + (p + 1) * step.
+    const double step = (seg->end_s - seg->start_s) / static_cast<double>(seg->poses.size() - 1);
+    const double u = (time_s - seg->start_s) / step;
+    const int p = std::min(static_cast<int>(seg->poses.size()) - 2, static_cast<int>(std::floor(u)));
+    const double s = Smooth((u - p) / 0.6);
+    Add(seg->board, Interpolate(seg->poses[static_cast<size_t>(p)], seg->poses[static_cast<size_t>(p + 1)], s),
+        "camera:" + cameras_[static_cast<size_t>(seg->camera)].name, out);
+  }
+
+  std::string SubjectsJson() const override { return "[]"; }
+
+ private:
+  // A pose of `spec` before `cam`: the print facing the camera, tilted up to
+  // 40 degrees, filling 35-65 % of the image width, anywhere in the view.
+  static Rigid3 HeldPose(const SynthCamera& cam, const BoardSpec& spec, Rng& rng) {
+    const double fill = rng.Uniform(0.35, 0.65);
+    const double depth = cam.lens.fx() * spec.width_m() / (fill * cam.width);
+    // Where the board's centre appears: within the middle of the image, leaving room for the board.
+    const double room_x = std::max(0.0, 0.5 - 0.5 * fill - 0.06), room_y = std::max(0.0, 0.5 - 0.5 * fill * 1.2 - 0.06);
+    const Eigen::Vector2d px(cam.width * (0.5 + rng.Uniform(-room_x, room_x)),
+                             cam.height * (0.5 + rng.Uniform(-room_y, room_y)));
+    const Eigen::Vector3d centre_in_cam = cam.lens.Unproject(px) / cam.lens.Unproject(px).z() * depth;
+    const Eigen::Matrix3d tilt =
+        (Eigen::AngleAxisd(rng.Uniform(-40, 40) * kDeg, Eigen::Vector3d::UnitX()) *
+         Eigen::AngleAxisd(rng.Uniform(-40, 40) * kDeg, Eigen::Vector3d::UnitY()) *
+         Eigen::AngleAxisd(rng.Uniform(-20, 20) * kDeg, Eigen::Vector3d::UnitZ()))
+            .toRotationMatrix();
+    Rigid3 cam_from_board;
+    cam_from_board.rotation = tilt;
+    cam_from_board.translation = centre_in_cam - tilt * Eigen::Vector3d(0.5 * spec.width_m(), 0.5 * spec.height_m(), 0);
+    return cam.cam_from_ground.Inverse() * cam_from_board;
+  }
+
+  void Add(int board, const Rigid3& ground_from_board, const std::string& placement, FrameSnapshot* out) const {
+    BoardInstance inst;
+    inst.texture = textures_[static_cast<size_t>(board)].get();
+    inst.ground_from_board = ground_from_board;
+    out->scene.boards.push_back(inst);
+    out->boards.push_back({board, ground_from_board, placement});
+  }
+
+  const Studio& studio_;
+  std::vector<SynthCamera> cameras_;
+  std::vector<BoardSpec> specs_;
+  std::vector<std::unique_ptr<BoardTexture>> textures_;
+  std::vector<Segment> segments_;
+  std::vector<Rigid3> floor_poses_;
+};
+
+}  // namespace
+
+std::unique_ptr<Director> MakeCalibrationDirector(const Studio& studio, const std::vector<SynthCamera>& cameras,
+                                                  const DirectorOptions& options, double seconds) {
+  return std::make_unique<CalibrationDirector>(studio, cameras, options, seconds);
+}
+
+}  // namespace ss::synth

@@ -1,0 +1,66 @@
+#pragma once
+// What a session's content (animals, figures, boards) contributes to one frame:
+// the scene to render and the camera-independent truth. Each kind of session
+// has a Director that produces one snapshot per frame, in order.
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "core/geometry.h"
+#include "synth/board.h"
+#include "synth/renderer.h"
+#include "synth/scene.h"
+
+namespace ss::synth {
+
+// Camera-independent truth of one subject at one frame.
+struct SubjectTruth {
+  std::string kind;              // "animal" | "figure"
+  Eigen::Vector2d position = Eigen::Vector2d::Zero();  // root on the floor, ground x y
+  double heading_rad = 0.0;
+  double speed_mps = 0.0;
+  double gait_phase = 0.0;       // [0, 1)
+  std::string pose;              // walk, trot, turn, idle, lean, stand, Y, M, C, A, ...
+  bool touches_wall = false;     // some part within 3 mm of a green wall
+  bool leaves_floor = false;     // some part's footprint reaches beyond the floor polygon
+  double height_m = 0.0;         // top of the subject above the floor
+  std::vector<Eigen::Vector3d> joints;  // figures: 3-D joints in JointNames() order
+};
+
+// A board in view and its pose.
+struct BoardTruth {
+  int board = 0;                 // index into the director's board specs
+  Rigid3 ground_from_board;
+  std::string placement;         // "camera:<name>" (held before a camera) | "floor"
+};
+
+struct FrameSnapshot {
+  FrameScene scene;
+  std::vector<SubjectTruth> subjects;
+  std::vector<BoardTruth> boards;
+};
+
+class Director {
+ public:
+  virtual ~Director() = default;
+  virtual int subjects() const = 0;
+  // Joint names of the figures (empty for other kinds).
+  virtual std::vector<std::string> joint_names() const { return {}; }
+  virtual const std::vector<BoardSpec>& board_specs() const {
+    static const std::vector<BoardSpec> none;
+    return none;
+  }
+  // Advances to time_s (non-decreasing) and fills the frame's snapshot.
+  virtual void Frame(double time_s, FrameSnapshot* out) = 0;
+  // A JSON description of the subjects (looks, proportions), for truth.json.
+  virtual std::string SubjectsJson() const = 0;
+};
+
+// Touch and floor tests shared by the directors.
+bool TouchesWall(const Studio& studio, const std::vector<Primitive>& prims, int subject, double tolerance_m);
+bool LeavesFloor(const Studio& studio, const std::vector<Primitive>& prims, int subject, double tolerance_m);
+double TopHeight(const std::vector<Primitive>& prims, int subject);
+
+}  // namespace ss::synth

@@ -1,0 +1,74 @@
+#pragma once
+// Renders a whole synthetic studio session: the recorded-session format
+// (capture/recording/session_writer.h: session.json, per camera an FFV1 video,
+// a frame CSV and the true .cameramodel) plus truth/ (docs/synth.md):
+//   truth/truth.json                 what the session holds, file patterns, options
+//   truth/floor.json                 the floor polygon and walls, ground frame
+//   truth/<cam>.cameramodel          the true camera models
+//   truth/subjects.csv               per frame and subject: position, heading, speed, gait, pose, ...
+//   truth/<cam>/views.csv            per frame, camera and subject: coverage, box, lowest point
+//   truth/<cam>/alpha_s<K>/<F>.png   per frame: subject K's alpha matte (8-bit, lossless)
+//   truth/<cam>/shadow/<F>.png       per frame: the contact-shadow matte (255 = black)
+//   (figure) truth/joints.csv, truth/<cam>/joints.csv; (calibration) truth/boards.json,
+//   truth/board_poses.csv, truth/<cam>/corners.csv
+#include <cstdint>
+#include <map>
+#include <string>
+
+#include "core/frame.h"
+
+namespace ss::synth {
+
+enum class SynthKind { kAnimal, kFigure, kCalibration };
+std::string SynthKindName(SynthKind kind);
+
+struct SynthOptions {
+  std::string out_dir;
+  SynthKind kind = SynthKind::kAnimal;
+  std::string studio;          // "enclosure" | "stage"; empty: stage for figures, else enclosure
+  double seconds = 10.0;
+  double fps = 30.0;
+  int width = 640;
+  int height = 480;
+  int cameras = 2;
+  int subjects = 1;
+  uint64_t seed = 1;
+  PixelFormat pixel_format = PixelFormat::kRGB8;
+  double noise = 1.0;          // sensor noise scale (0: none)
+  bool motion_blur = false;    // 4 time slices over half the frame interval
+  int figure_variant = 0;      // 0: the reference figure; 1: differently proportioned
+  int threads = 1;             // cameras rendered in parallel
+  bool write_mattes = true;    // the per-frame PNG mattes in truth/
+
+  // False with the reason when an option is out of range.
+  bool IsValid(std::string* why) const;
+  int frames() const;
+};
+
+struct SynthSummary {
+  std::string out_dir;
+  int frames = 0;
+  int cameras = 0;
+  int subjects = 0;
+  double fps = 0.0;
+  double wall_s = 0.0;          // whole run
+  double cpu_s = 0.0;           // whole run, CPU time of every thread (encoder threads included)
+  // Stages in CPU seconds of the threads that ran them:
+  double simulate_s = 0.0;      // behaviour and scene building
+  double render_s = 0.0;        // ray casting, summed over cameras
+  double sensor_s = 0.0;        // noise and pixel format
+  double encode_s = 0.0;        // video writer
+  double truth_s = 0.0;         // mattes and tables
+  std::map<std::string, int> pose_frames;  // subject-frames per pose label
+  int wall_touch_frames = 0;    // subject-frames touching a wall
+  // Seconds of footage per second of wall time (>= 1: all cameras kept up with real time).
+  double RealTimeFactor() const { return wall_s > 0 && fps > 0 ? frames / fps / wall_s : 0.0; }
+  // Camera-seconds of footage per CPU-second (>= 1: one core renders a camera in real time).
+  double CpuRealTimeFactor() const { return cpu_s > 0 && fps > 0 ? frames * cameras / fps / cpu_s : 0.0; }
+};
+
+// Renders the session into options.out_dir (which must not exist or be empty).
+// InputError for bad options, WorkError when writing fails.
+SynthSummary RenderStudioSession(const SynthOptions& options);
+
+}  // namespace ss::synth

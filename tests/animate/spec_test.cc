@@ -1,0 +1,211 @@
+// The animation spec: every field read, bad specs refused with the line and the field.
+#include "animate/spec.h"
+
+#include <filesystem>
+#include <fstream>
+#include <map>
+
+#include <gtest/gtest.h>
+
+#include "animate/scene.h"
+#include "animate_test_bank.h"
+#include "core/error.h"
+#include "tests/support/test_support.h"
+
+namespace ss {
+namespace {
+
+using testing::ScratchDir;
+
+class SpecTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    testing::WalkerBank::Write(dir_ / "walker.ssbank");
+    testing::LookAtCamera(320, 240, 300, {0, -4, 3}, {0, 0, 0}).Write(dir_ / "virtual.cameramodel");
+  }
+  std::string Origin() const { return dir_ / "scene.yaml"; }
+  // The message of the InputError the spec raises ("" if none).
+  std::string ErrorOf(const std::string& yaml) const {
+    try {
+      ParseAnimationSpec(yaml, Origin());
+    } catch (const InputError& e) {
+      return e.what();
+    }
+    return "";
+  }
+  ScratchDir dir_;
+};
+
+constexpr const char* kGood = R"(version: 1
+frame_rate: 25
+length: {min_frames: 100, max_frames: 300, strength: 2}
+camera: virtual.cameramodel
+banks: [walker.ssbank]
+fast_frames: {reference_speed_m_s: 1.0, strength: 0.5}
+optimizer: {method: replace, time_budget_s: 5, seed: 7, set_size: 50}
+sprites:
+  - name: lead
+    start: [0, 0]
+    constraints:
+      - path: {points: [[0, 0], [1, 0], [1, 1]], direction_strength: 2, distance_strength: 3, unreached_strength: 4}
+      - frames: {tag: standing, after_path: lead, duration: 2, strength: 5}
+      - location: {target: [1, 1], at: 4, strength: 6}
+  - name: follower
+    start: free
+    smoothness: 0.5
+    constraints:
+      - location: {follow: lead, offset: [-0.3, 0.2], from: 1, to: end, strength: 7}
+      - frames: {sprites: [3, 4], from: 2, to: 3}
+collisions:
+  - {sprites: all, min_distance_m: 0.25, strength: 100}
+)";
+
+TEST_F(SpecTest, ReadsEveryField) {
+  const AnimationSpec spec = ParseAnimationSpec(kGood, Origin());
+  EXPECT_EQ(spec.frame_rate, 25);
+  EXPECT_EQ(spec.fixed_frames, 0);
+  EXPECT_EQ(spec.max_frames, 300);
+  ASSERT_TRUE(spec.length);
+  EXPECT_EQ(spec.length->min_frames, 100);
+  EXPECT_EQ(spec.length->strength, 2);
+  EXPECT_EQ(spec.camera_path, dir_ / "virtual.cameramodel");
+  ASSERT_EQ(spec.bank_paths.size(), 1u);
+  EXPECT_EQ(spec.optimizer.seed, 7u);
+  EXPECT_EQ(spec.optimizer.set_size, 50);
+  ASSERT_EQ(spec.sprites.size(), 2u);
+  const SpriteSpecEntry& lead = spec.sprites[0];
+  EXPECT_EQ(lead.anchor, Anchor::kStart);
+  ASSERT_TRUE(lead.path);
+  EXPECT_EQ(lead.path->points_m.size(), 3u);
+  EXPECT_EQ(lead.path->strengths.direction, 2);
+  EXPECT_EQ(lead.path->strengths.distance, 3);
+  EXPECT_EQ(lead.path->strengths.unreached, 4);
+  ASSERT_EQ(lead.frames.size(), 1u);
+  EXPECT_EQ(lead.frames[0].after_path_of, "lead");
+  EXPECT_EQ(lead.frames[0].duration_steps, 50);  // 2 s at 25 fps
+  ASSERT_EQ(lead.locations.size(), 1u);
+  EXPECT_EQ(lead.locations[0].window.first, 100);  // 4 s
+  EXPECT_EQ(lead.locations[0].window.last, 100);
+  EXPECT_FALSE(lead.locations[0].window.last_from_end);
+  EXPECT_EQ(lead.locations[0].place.line, 14);
+  const SpriteSpecEntry& follower = spec.sprites[1];
+  EXPECT_EQ(follower.anchor, Anchor::kFree);
+  EXPECT_EQ(follower.smoothness, 0.5);
+  EXPECT_EQ(follower.locations[0].follow, "lead");
+  EXPECT_EQ(follower.locations[0].target_m, Eigen::Vector2d(-0.3, 0.2));
+  EXPECT_EQ(follower.locations[0].window.first, 25);
+  EXPECT_TRUE(follower.locations[0].window.last_from_end);
+  EXPECT_EQ(follower.frames[0].sprite_ids, (std::vector<int64_t>{3, 4}));
+  EXPECT_EQ(follower.frames[0].window.first, 50);
+  EXPECT_EQ(follower.frames[0].window.last, 75);
+  ASSERT_EQ(spec.collisions.size(), 1u);
+  EXPECT_TRUE(spec.collisions[0].sprites.empty());  // all
+  EXPECT_EQ(spec.collisions[0].min_distance_m, 0.25);
+}
+
+TEST_F(SpecTest, BuildsTheTermsOverTheBank) {
+  const auto scene = Scene::Load(ParseAnimationSpec(kGood, Origin()));
+  const Problem& p = scene->problem();
+  EXPECT_EQ(p.num_sprites(), 2);
+  std::map<std::string, int> kinds;
+  for (int k = 0; k < p.num_terms(); ++k) ++kinds[p.term(k).kind()];
+  EXPECT_EQ(kinds["smoothness"], 2);
+  EXPECT_EQ(kinds["path"], 1);
+  EXPECT_EQ(kinds["frame"], 2);
+  EXPECT_EQ(kinds["location"], 2);
+  EXPECT_EQ(kinds["collision"], 1);
+  EXPECT_EQ(kinds["length"], 2);
+  EXPECT_EQ(kinds["fast"], 2);
+  EXPECT_GT(scene->MakeReplacementOptions().slow_frame_cost, 0);
+}
+
+TEST_F(SpecTest, FixedLengthHoldsEverySequenceToIt) {
+  std::string yaml = kGood;
+  yaml.replace(yaml.find("length: {min_frames: 100, max_frames: 300, strength: 2}"),
+               std::string("length: {min_frames: 100, max_frames: 300, strength: 2}").size(),
+               "length: 90");
+  const AnimationSpec spec = ParseAnimationSpec(yaml, Origin());
+  EXPECT_EQ(spec.fixed_frames, 90);
+  EXPECT_EQ(spec.max_frames, 90);
+  EXPECT_EQ(spec.initial_frames, 90);
+  ASSERT_TRUE(spec.length);
+  EXPECT_EQ(spec.length->min_frames, 90);
+}
+
+// Replaces the first occurrence of `from` in the good spec.
+std::string Edit(const std::string& from, const std::string& to) {
+  std::string yaml = kGood;
+  const size_t at = yaml.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  return yaml.replace(at, from.size(), to);
+}
+
+TEST_F(SpecTest, BadSpecsNameTheLineAndTheField) {
+  const std::string o = Origin();
+  EXPECT_EQ(ErrorOf(Edit("frame_rate: 25", "frame_rate: fast")),
+            o + ":2: frame_rate: expected a number, got \"fast\"");
+  EXPECT_EQ(ErrorOf(Edit("frame_rate: 25", "frame_rate: -3")), o + ":2: frame_rate: must be > 0");
+  EXPECT_EQ(ErrorOf(Edit("frame_rate: 25", "frame_rat: 25")),
+            o + ":2: frame_rat: unknown field (expected one of: version, frame_rate, length, camera, "
+                "background, banks, sprites, collisions, fast_frames, optimizer)");
+  EXPECT_EQ(ErrorOf(Edit("camera: virtual.cameramodel", "camera: nowhere.cameramodel")),
+            o + ":4: camera: no such file: " + (dir_ / "nowhere.cameramodel"));
+  EXPECT_EQ(ErrorOf(Edit("direction_strength: 2", "direction_strength: -2")),
+            o + ":12: sprites[0].constraints[0].path.direction_strength: must be >= 0");
+  EXPECT_EQ(ErrorOf(Edit("[1, 1]], direction", "[1]], direction")),
+            o + ":12: sprites[0].constraints[0].path.points[2]: expected [x, y] in metres");
+  EXPECT_EQ(ErrorOf(Edit("follow: lead", "follow: nobody")),
+            o + ":19: sprites[1].constraints[0].location.follow: no sprite named nobody");
+  EXPECT_EQ(ErrorOf(Edit("at: 4,", "at: 4, from: 1,")),
+            o + ":14: sprites[0].constraints[2].location.at: give either at or from/to");
+  EXPECT_EQ(ErrorOf(Edit("from: 2, to: 3", "from: 3, to: 2")),
+            o + ":20: sprites[1].constraints[1].frames.to: ends before it starts");
+  EXPECT_EQ(ErrorOf(Edit("    start: free\n", "")),
+            o + ":15: sprites[1].start: required: [x, y], free, or end: [x, y] instead");
+  EXPECT_EQ(ErrorOf(Edit("- location: {target: [1, 1]", "- loiter: {target: [1, 1]")),
+            o + ":14: sprites[0].constraints[2].loiter: unknown constraint (expected location, path or "
+                "frames)");
+  EXPECT_EQ(ErrorOf(Edit("min_distance_m: 0.25", "min_distance_m: 0")),
+            o + ":22: collisions[0].min_distance_m: must be > 0");
+  EXPECT_EQ(ErrorOf(Edit("name: follower", "name: lead")),
+            o + ":15: sprites[1].name: another sprite is named lead");
+  EXPECT_NE(ErrorOf("sprites: [\n").find(o + ":"), std::string::npos);  // YAML syntax: a line too
+}
+
+TEST_F(SpecTest, ConstraintsTheBankCannotMeetNameTheirLine) {
+  try {
+    Scene::Load(ParseAnimationSpec(Edit("tag: standing", "tag: sitting"), Origin()));
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()), Origin() + ":13: sprites[0].constraints[1].frames.tag: no sprite "
+                                                "of the banks carries the tag sitting");
+  }
+}
+
+TEST_F(SpecTest, LoadsAFileAndRefusesAMissingOne) {
+  {
+    std::ofstream out(Origin());
+    out << kGood;
+  }
+  EXPECT_EQ(LoadAnimationSpec(Origin()).sprites.size(), 2u);
+  EXPECT_THROW(LoadAnimationSpec(dir_ / "missing.yaml"), InputError);
+}
+
+// Every example in docs/examples parses (with stand-ins for its bank, camera and image).
+TEST_F(SpecTest, TheDocumentedExamplesAreValid) {
+  namespace fs = std::filesystem;
+  const fs::path examples = (fs::path(__FILE__).parent_path() / "../../docs/examples").lexically_normal();
+  for (const char* name : {"hamster.ssbank", "fly.ssbank", "floor.png"}) std::ofstream(dir_ / name) << "x";
+  int count = 0;
+  for (const auto& entry : fs::directory_iterator(examples)) {
+    if (entry.path().extension() != ".yaml") continue;
+    const fs::path copy = fs::path(dir_.path()) / entry.path().filename();
+    fs::copy_file(entry.path(), copy, fs::copy_options::overwrite_existing);
+    EXPECT_NO_THROW(LoadAnimationSpec(copy.string())) << entry.path();
+    ++count;
+  }
+  EXPECT_GE(count, 5);
+}
+
+}  // namespace
+}  // namespace ss

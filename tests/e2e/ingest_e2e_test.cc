@@ -1,0 +1,80 @@
+// End to end: a synthetic session through `spritestation ingest` into a bank.
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include "tests/support/test_support.h"
+
+namespace ss {
+namespace {
+
+using testing::RunSpritestation;
+using testing::ScratchDir;
+
+// The JSON document in a command's output (logs may surround it).
+nlohmann::json JsonOf(const std::string& output) {
+  const size_t begin = output.find("\n{") == std::string::npos ? output.find('{') : output.find("\n{") + 1;
+  const size_t end = output.rfind('}');
+  if (begin == std::string::npos || end == std::string::npos || end < begin) return {};
+  return nlohmann::json::parse(output.substr(begin, end - begin + 1), nullptr, false);
+}
+
+class IngestEndToEnd : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = new ScratchDir();
+    const auto r = RunSpritestation("synth --out " + *dir_ / "session" +
+                                    " --kind animal --seconds 6 --fps 30 --size 480x360 --cameras 2 --subjects 1 --seed 11");
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+  }
+  static void TearDownTestSuite() { delete dir_; }
+  static ScratchDir* dir_;
+};
+ScratchDir* IngestEndToEnd::dir_ = nullptr;
+
+TEST_F(IngestEndToEnd, KeepsUsableSpritesAndCountsEveryDiscard) {
+  const std::string bank = *dir_ / "a.bank";
+  const auto r = RunSpritestation("--log-level warn ingest " + *dir_ / "session" + " --bank " + bank + " --json");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const nlohmann::json j = JsonOf(r.output);
+  ASSERT_TRUE(j.is_object()) << r.output;
+  EXPECT_EQ(j["frames"].get<int>(), 2 * 6 * 30);
+  EXPECT_GT(j["sprites_kept"].get<int>(), 30) << r.output;
+  EXPECT_EQ(j["rows_inserted"].get<int>(), 2 * j["sprites_kept"].get<int>());  // each with its mirror
+  for (const char* reason : {"too_small", "touches_border", "no_ground_hit", "leaves_floor", "touches_wall", "still",
+                             "short_clip"}) {
+    EXPECT_TRUE(j["discards"].contains(reason)) << reason;
+  }
+  ASSERT_EQ(j["cameras"].size(), 2u);
+
+  const auto info = RunSpritestation("--log-level warn bank info " + bank + " --json");
+  ASSERT_EQ(info.exit_code, 0) << info.output;
+  const nlohmann::json counts = JsonOf(info.output);
+  EXPECT_EQ(counts["sprites"].get<int>(), j["rows_inserted"].get<int>()) << info.output;
+  EXPECT_EQ(counts["mirrors"].get<int>(), j["sprites_kept"].get<int>()) << info.output;
+  const auto verify = RunSpritestation("--log-level warn bank verify " + bank);
+  EXPECT_EQ(verify.exit_code, 0) << verify.output;
+}
+
+TEST_F(IngestEndToEnd, IngestingTwiceStoresNothingNew) {
+  const std::string bank = *dir_ / "b.bank";
+  const std::string cmd = "--log-level warn ingest " + *dir_ / "session" + " --bank " + bank + " --json";
+  const auto first = RunSpritestation(cmd);
+  ASSERT_EQ(first.exit_code, 0) << first.output;
+  const auto second = RunSpritestation(cmd);
+  ASSERT_EQ(second.exit_code, 0) << second.output;
+  EXPECT_GT(JsonOf(first.output)["rows_inserted"].get<int>(), 0);
+  EXPECT_EQ(JsonOf(second.output)["rows_inserted"].get<int>(), 0);
+  EXPECT_EQ(JsonOf(second.output)["sprites_kept"], JsonOf(first.output)["sprites_kept"]);
+}
+
+TEST_F(IngestEndToEnd, BadInputNamesTheFile) {
+  const auto missing = RunSpritestation("ingest " + *dir_ / "nowhere" + " --bank " + *dir_ / "c.bank");
+  EXPECT_EQ(missing.exit_code, 2) << missing.output;
+  EXPECT_NE(missing.output.find("nowhere"), std::string::npos) << missing.output;
+  const auto no_bank = RunSpritestation("ingest " + *dir_ / "session");
+  EXPECT_EQ(no_bank.exit_code, 2) << no_bank.output;
+}
+
+}  // namespace
+}  // namespace ss
