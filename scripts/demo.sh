@@ -23,3 +23,28 @@ echo "== replaying $sample"
 echo "== ingesting $sample into $out/sample.bank (the live pipeline, as fast as it runs)"
 "$ss" ingest "$sample" --bank "$out/sample.bank"
 "$ss" bank info "$out/sample.bank"
+
+echo "== finding the bank's transitions (seed 000 §3)"
+"$ss" transitions "$out/sample.bank"
+
+echo "== animating: one sprite walks a straight path across the floor (seed 000 §4-5)"
+cat > "$out/walk.yaml" <<EOF
+version: 1
+frame_rate: 30
+length: {frames: 90}
+camera: $sample/cam0.cameramodel
+banks: [$out/sample.bank]
+optimizer: {method: replace, time_budget_s: 10}
+sprites:
+  - name: walker
+    start: [-0.3, 0.0]
+    constraints:
+      - path:
+          points: [[-0.3, 0.0], [0.3, 0.0]]
+          distance_strength: 50
+EOF
+"$ss" animate "$out/walk.yaml" --out "$out/walk.json"
+
+echo "== rendering the animation"
+"$ss" render "$out/walk.json" --out "$out/walk.mkv"
+echo "== done: the animation is $out/walk.mkv (cost plot: $out/walk.cost.png)"
