@@ -21,6 +21,7 @@ struct SynthArgs {
   std::string size = "640x480";
   std::string pixel_format = "rgb8";
   bool json = false;
+  double empty_lead_in_s = -1;  // < 0: the kind's default
 };
 
 void RunSynth(SynthArgs args) {
@@ -34,6 +35,7 @@ void RunSynth(SynthArgs args) {
   } else {
     throw InputError("--kind", "expected animal, figure or calibration, got '" + args.kind + "'");
   }
+  o.empty_lead_in_s = args.empty_lead_in_s >= 0 ? args.empty_lead_in_s : (args.kind == "animal" ? 1.0 : 0.0);
   int w = 0, h = 0;
   char tail = 0;
   if (std::sscanf(args.size.c_str(), "%dx%d%c", &w, &h, &tail) != 2) {
@@ -105,6 +107,9 @@ void AddSynthCommand(CLI::App& app) {
   cmd->add_flag("--motion-blur", o.motion_blur, "Blur moving subjects over half the frame interval");
   cmd->add_option("--figure-variant", o.figure_variant, "Figure proportions: 0 reference, 1 the other figure");
   cmd->add_option("--threads", o.threads, "Cameras rendered in parallel");
+  cmd->add_option("--empty-lead-in", args->empty_lead_in_s,
+                  "Seconds of empty enclosure before the subjects appear (keyer training; default 1 for animal "
+                  "sessions, 0 otherwise)");
   cmd->add_flag("--no-mattes", [&o](int64_t) { o.write_mattes = false; }, "Skip the per-frame matte PNGs in truth/");
   cmd->add_flag("--json", args->json, "Print the report as JSON");
   cmd->callback([args] { RunSynth(*args); });

@@ -405,6 +405,10 @@ SynthSummary RenderStudioSession(const SynthOptions& o) {
       stamps[static_cast<size_t>(i)] = static_cast<int64_t>(std::llround(frame * 1e9 / o.fps));
       FrameSnapshot& snap = chunk[static_cast<size_t>(i)];
       director->Frame(time_s, &snap);
+      if (time_s < o.empty_lead_in_s) {  // the empty enclosure: subjects not yet placed
+        snap.scene.primitives.clear();
+        for (SubjectTruth& st : snap.subjects) st.pose = "absent";
+      }
       for (size_t k = 0; k < snap.subjects.size(); ++k) {
         const SubjectTruth& st = snap.subjects[k];
         subjects_csv.Row("%d,%lld,%zu,%s,%.6f,%.6f,%.6f,%.6f,%.6f,%s,%d,%d,%.6f", frame,
