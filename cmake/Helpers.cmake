@@ -33,10 +33,12 @@ function(spritestation_add_library name)
   target_link_libraries(${name} PUBLIC ${ARG_DEPS} PRIVATE spritestation_flags)
 endfunction()
 
-# spritestation_add_test(NAME DIR DEPS dep...)
+# spritestation_add_test(NAME DIR DEPS dep... [LABELS l...] [LOCK resource])
 # One GoogleTest executable per tests/<folder>, each TEST registered with CTest.
+# LOCK: tests of this executable never run at the same time as each other
+# (e.g. they all serve an emulated GigE camera on 127.0.0.1:3956).
 function(spritestation_add_test name dir)
-  cmake_parse_arguments(ARG "" "" "DEPS;LABELS" ${ARGN})
+  cmake_parse_arguments(ARG "" "LOCK" "DEPS;LABELS" ${ARGN})
   file(GLOB sources CONFIGURE_DEPENDS ${dir}/*_test.cc)
   if(NOT sources)
     return()
@@ -47,6 +49,10 @@ function(spritestation_add_test name dir)
   if(ARG_LABELS)
     set(labels ${ARG_LABELS})
   endif()
+  set(lock_property)
+  if(ARG_LOCK)
+    set(lock_property RESOURCE_LOCK ${ARG_LOCK})
+  endif()
   gtest_discover_tests(${name} DISCOVERY_TIMEOUT 60
-    PROPERTIES LABELS "${labels}" ENVIRONMENT "SPRITESTATION_BIN=$<TARGET_FILE:spritestation>")
+    PROPERTIES LABELS "${labels}" ENVIRONMENT "SPRITESTATION_BIN=$<TARGET_FILE:spritestation>" ${lock_property})
 endfunction()
