@@ -50,30 +50,35 @@ SpriteDescription DescribeBillboard(const cv::Mat& bgra) {
   return d;
 }
 
+Eigen::Vector2d EstimateVelocity(const std::vector<int64_t>& timestamps_ns,
+                                 const std::vector<Eigen::Vector2d>& points_in_ground, int i, int half_window) {
+  const int n = static_cast<int>(points_in_ground.size());
+  const int lo = std::max(0, i - half_window), hi = std::min(n - 1, i + half_window);
+  if (hi <= lo) return Eigen::Vector2d::Zero();
+  // Least squares p = a + v t over the window, times relative to frame i in seconds.
+  double st = 0, stt = 0;
+  Eigen::Vector2d sp = Eigen::Vector2d::Zero(), stp = Eigen::Vector2d::Zero();
+  for (int k = lo; k <= hi; ++k) {
+    const double t = static_cast<double>(timestamps_ns[k] - timestamps_ns[i]) * 1e-9;
+    st += t;
+    stt += t * t;
+    sp += points_in_ground[k];
+    stp += t * points_in_ground[k];
+  }
+  const double m = hi - lo + 1;
+  const double denom = m * stt - st * st;
+  return denom > 0 ? Eigen::Vector2d((m * stp - st * sp) / denom) : Eigen::Vector2d::Zero();
+}
+
 std::vector<Eigen::Vector2d> EstimateVelocities(const std::vector<int64_t>& timestamps_ns,
                                                 const std::vector<Eigen::Vector2d>& points_in_ground,
                                                 int half_window) {
   if (timestamps_ns.size() != points_in_ground.size()) {
     throw InputError("velocities", "as many timestamps as points are needed");
   }
-  const int n = static_cast<int>(points_in_ground.size());
-  std::vector<Eigen::Vector2d> v(n, Eigen::Vector2d::Zero());
-  for (int i = 0; i < n; ++i) {
-    const int lo = std::max(0, i - half_window), hi = std::min(n - 1, i + half_window);
-    if (hi == lo) continue;
-    // Least squares p = a + v t over the window, times relative to frame i in seconds.
-    double st = 0, stt = 0;
-    Eigen::Vector2d sp = Eigen::Vector2d::Zero(), stp = Eigen::Vector2d::Zero();
-    for (int k = lo; k <= hi; ++k) {
-      const double t = static_cast<double>(timestamps_ns[k] - timestamps_ns[i]) * 1e-9;
-      st += t;
-      stt += t * t;
-      sp += points_in_ground[k];
-      stp += t * points_in_ground[k];
-    }
-    const double m = hi - lo + 1;
-    const double denom = m * stt - st * st;
-    if (denom > 0) v[i] = (m * stp - st * sp) / denom;
+  std::vector<Eigen::Vector2d> v(points_in_ground.size());
+  for (size_t i = 0; i < v.size(); ++i) {
+    v[i] = EstimateVelocity(timestamps_ns, points_in_ground, static_cast<int>(i), half_window);
   }
   return v;
 }

@@ -23,6 +23,9 @@ SpriteDescription DescribeBillboard(const cv::Mat& bgra);
 // Ground velocity (m/s) of every frame of a clip: the least-squares slope of
 // the contact points over a window of +-`half_window` frames (shrunk at the
 // clip's ends; a one-frame clip stands still). `timestamps_ns` must increase.
+// The same for frame `i` alone.
+Eigen::Vector2d EstimateVelocity(const std::vector<int64_t>& timestamps_ns,
+                                 const std::vector<Eigen::Vector2d>& points_in_ground, int i, int half_window = 2);
 std::vector<Eigen::Vector2d> EstimateVelocities(const std::vector<int64_t>& timestamps_ns,
                                                 const std::vector<Eigen::Vector2d>& points_in_ground,
                                                 int half_window = 2);

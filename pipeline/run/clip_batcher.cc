@@ -111,8 +111,6 @@ void ClipBatcher::CloseAll(std::vector<ClipBatch>* out) {
 
 void ClipBatcher::Emit(Open& open, size_t count, bool complete, std::vector<ClipBatch>* out) {
   const size_t first_index = open.points.size() - open.pending.size();
-  const std::vector<Eigen::Vector2d> velocities =
-      EstimateVelocities(open.timestamps_ns, open.points, options_.velocity_half_window);
   ClipBatch batch;
   batch.clip.camera_id = camera_id_;
   batch.clip.track_id = open.subject;
@@ -122,7 +120,10 @@ void ClipBatcher::Emit(Open& open, size_t count, bool complete, std::vector<Clip
   batch.sprites.reserve(count * (options_.mirrors ? 2 : 1));
   for (size_t k = 0; k < count; ++k) {
     const MadeSprite& s = open.pending[k];
-    SpriteRecord original = OriginalRecord(s, velocities[first_index + k]);
+    // Only the emitted frames' velocities: each needs its own +-window, not the whole clip.
+    SpriteRecord original = OriginalRecord(
+        s, EstimateVelocity(open.timestamps_ns, open.points, static_cast<int>(first_index + k),
+                            options_.velocity_half_window));
     if (options_.mirrors) {
       SpriteRecord mirror = MirrorRecord(original, s);
       batch.sprites.push_back(std::move(original));

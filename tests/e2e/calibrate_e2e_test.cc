@@ -15,15 +15,9 @@
 namespace ss {
 namespace {
 
+using testing::JsonInOutput;
 using testing::RunSpritestation;
 using testing::ScratchDir;
-
-nlohmann::json JsonOf(const std::string& output) {
-  const size_t begin = output.find("\n{") == std::string::npos ? output.find('{') : output.find("\n{") + 1;
-  const size_t end = output.rfind('}');
-  if (begin == std::string::npos || end == std::string::npos || end < begin) return {};
-  return nlohmann::json::parse(output.substr(begin, end - begin + 1), nullptr, false);
-}
 
 // The session: one camera, the chessboard held before it, then the ChArUco
 // board, then both boards on the floor (synth/calibration_director.cc).
@@ -55,7 +49,7 @@ TEST_F(CalibrateEndToEnd, IntrinsicsThenGroundMatchTheTruth) {
                                   " --camera cam0 --first 0 --count " + std::to_string(kChessFrames) +
                                   " --every 1 --min-views 8 --out " + *dir_ / "intrinsics" + " --json");
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  const nlohmann::json j = JsonOf(r.output);
+  const nlohmann::json j = JsonInOutput(r.output);
   ASSERT_TRUE(j.is_object()) << r.output;
   EXPECT_EQ(j["verdict"], "good");
   const CameraModel solved = CameraModel::Read(*dir_ / "intrinsics/cam0.cameramodel");

@@ -8,16 +8,9 @@
 namespace ss {
 namespace {
 
+using testing::JsonInOutput;
 using testing::RunSpritestation;
 using testing::ScratchDir;
-
-// The JSON document in a command's output (logs may surround it).
-nlohmann::json JsonOf(const std::string& output) {
-  const size_t begin = output.find("\n{") == std::string::npos ? output.find('{') : output.find("\n{") + 1;
-  const size_t end = output.rfind('}');
-  if (begin == std::string::npos || end == std::string::npos || end < begin) return {};
-  return nlohmann::json::parse(output.substr(begin, end - begin + 1), nullptr, false);
-}
 
 class IngestEndToEnd : public ::testing::Test {
  protected:
@@ -36,7 +29,7 @@ TEST_F(IngestEndToEnd, KeepsUsableSpritesAndCountsEveryDiscard) {
   const std::string bank = *dir_ / "a.bank";
   const auto r = RunSpritestation("--log-level warn ingest " + *dir_ / "session" + " --bank " + bank + " --json");
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  const nlohmann::json j = JsonOf(r.output);
+  const nlohmann::json j = JsonInOutput(r.output);
   ASSERT_TRUE(j.is_object()) << r.output;
   EXPECT_EQ(j["frames"].get<int>(), 2 * 6 * 30);
   EXPECT_GT(j["sprites_kept"].get<int>(), 30) << r.output;
@@ -49,7 +42,7 @@ TEST_F(IngestEndToEnd, KeepsUsableSpritesAndCountsEveryDiscard) {
 
   const auto info = RunSpritestation("--log-level warn bank info " + bank + " --json");
   ASSERT_EQ(info.exit_code, 0) << info.output;
-  const nlohmann::json counts = JsonOf(info.output);
+  const nlohmann::json counts = JsonInOutput(info.output);
   EXPECT_EQ(counts["sprites"].get<int>(), j["rows_inserted"].get<int>()) << info.output;
   EXPECT_EQ(counts["mirrors"].get<int>(), j["sprites_kept"].get<int>()) << info.output;
   const auto verify = RunSpritestation("--log-level warn bank verify " + bank);
@@ -63,9 +56,9 @@ TEST_F(IngestEndToEnd, IngestingTwiceStoresNothingNew) {
   ASSERT_EQ(first.exit_code, 0) << first.output;
   const auto second = RunSpritestation(cmd);
   ASSERT_EQ(second.exit_code, 0) << second.output;
-  EXPECT_GT(JsonOf(first.output)["rows_inserted"].get<int>(), 0);
-  EXPECT_EQ(JsonOf(second.output)["rows_inserted"].get<int>(), 0);
-  EXPECT_EQ(JsonOf(second.output)["sprites_kept"], JsonOf(first.output)["sprites_kept"]);
+  EXPECT_GT(JsonInOutput(first.output)["rows_inserted"].get<int>(), 0);
+  EXPECT_EQ(JsonInOutput(second.output)["rows_inserted"].get<int>(), 0);
+  EXPECT_EQ(JsonInOutput(second.output)["sprites_kept"], JsonInOutput(first.output)["sprites_kept"]);
 }
 
 TEST_F(IngestEndToEnd, BadInputNamesTheFile) {

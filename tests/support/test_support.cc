@@ -43,4 +43,12 @@ CommandResult RunSpritestation(const std::string& args) {
   return result;
 }
 
+nlohmann::json JsonInOutput(const std::string& output) {
+  const size_t line_start = output.find("\n{");
+  const size_t begin = line_start == std::string::npos ? output.find('{') : line_start + 1;
+  const size_t end = output.rfind('}');
+  if (begin == std::string::npos || end == std::string::npos || end < begin) return {};
+  return nlohmann::json::parse(output.substr(begin, end - begin + 1), nullptr, false);
+}
+
 }  // namespace ss::testing

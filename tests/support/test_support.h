@@ -3,6 +3,8 @@
 #include <filesystem>
 #include <string>
 
+#include <nlohmann/json.hpp>
+
 namespace ss::testing {
 
 // A fresh folder under the build tree's temp dir, removed when the object dies.
@@ -26,5 +28,8 @@ struct CommandResult {
 
 // Runs `spritestation ARGS` (the binary named by $SPRITESTATION_BIN) through the shell.
 CommandResult RunSpritestation(const std::string& args);
+
+// The JSON document in a command's output (log lines may surround it); null when there is none.
+nlohmann::json JsonInOutput(const std::string& output);
 
 }  // namespace ss::testing
