@@ -1,6 +1,8 @@
-// spritestation ingest SESSION --bank BANK [--config station.yaml] [--json]:
+// spritestation ingest SESSION --bank BANK [--config station.yaml] [--no-transitions]
+//                     [--transition-weights W] [--json]:
 // runs a recorded session through the live pipeline into a sprite bank as fast
-// as the machine allows and prints what it kept and what it discarded, by reason.
+// as the machine allows, keeps the bank's transitions current (unless
+// --no-transitions) and prints what it kept and what it discarded, by reason.
 #include <unistd.h>
 
 #include <cstdio>
@@ -33,10 +35,13 @@ nlohmann::json DiscardsJson(const DiscardCounts& counts) {
   return j;
 }
 
-void RunIngest(const std::string& session, const std::string& bank, const std::string& config_path, bool json) {
+void RunIngest(const std::string& session, const std::string& bank, const std::string& config_path, bool json,
+               bool transitions, const std::string& transition_weights) {
   IngestOptions options;
   options.session_dir = session;
   options.bank_path = bank;
+  options.transitions = transitions;
+  options.transition_weights = transition_weights;
   if (!config_path.empty()) {
     ConfigOptions config_options;
     config_options.check_files = false;  // ingest uses keying, enclosure and pipeline only
@@ -60,6 +65,13 @@ void RunIngest(const std::string& session, const std::string& bank, const std::s
     out["seconds"] = s.seconds;
     out["frames_per_second"] = s.frames_per_second;
     out["unreadable_frames"] = s.source.frames_dropped;
+    out["transitions"] = s.transitions;
+    if (s.transitions) {
+      out["transitions_stored"] = s.transitions_stored;
+      out["transition_sprites"] = s.transition_sprites;
+      out["seconds_transitions_wait"] = s.seconds_transitions_wait;
+      out["transitions_error"] = s.transitions_error;
+    }
     out["cameras"] = nlohmann::json::array();
     for (const IngestCamera& c : s.cameras) {
       out["cameras"].push_back({{"name", c.name},
@@ -98,6 +110,17 @@ void RunIngest(const std::string& session, const std::string& bank, const std::s
                 static_cast<unsigned long long>(c.stats.stored_sprites), static_cast<unsigned long long>(c.stats.clips),
                 c.stats.seconds_key, c.stats.seconds_rest);
   }
+  if (s.transitions) {
+    std::printf("  transitions: %lld stored (table of %lld sprites kept current; waited %.2f s at the end)\n",
+                static_cast<long long>(s.transitions_stored), static_cast<long long>(s.transition_sprites),
+                s.seconds_transitions_wait);
+    if (!s.transitions_error.empty()) {
+      std::printf("  transitions FAILED: %s (run 'spritestation transitions %s')\n", s.transitions_error.c_str(),
+                  bank.c_str());
+    }
+  } else {
+    std::printf("  transitions: not kept current (--no-transitions)\n");
+  }
   if (s.source.frames_dropped > 0) {
     std::printf("  %llu frames could not be read: %s\n", static_cast<unsigned long long>(s.source.frames_dropped),
                 s.source.last_error.c_str());
@@ -112,11 +135,16 @@ void AddIngestCommand(CLI::App& app) {
   auto bank = std::make_shared<std::string>();
   auto config = std::make_shared<std::string>();
   auto json = std::make_shared<bool>(false);
+  auto transitions = std::make_shared<bool>(true);
+  auto weights = std::make_shared<std::string>();
   cmd->add_option("SESSION", *session, "Recorded session folder")->required();
   cmd->add_option("--bank", *bank, "Sprite bank (created when missing)")->required();
   cmd->add_option("--config", *config, "Station config (keying, enclosure, pipeline sections)");
+  cmd->add_flag("--transitions,!--no-transitions", *transitions,
+                "Keep the bank's transition table current while ingesting (default on)");
+  cmd->add_option("--transition-weights", *weights, "Transition classifier weights (default: the shipped weights)");
   cmd->add_flag("--json", *json, "Print the summary as JSON");
-  cmd->callback([=] { RunIngest(*session, *bank, *config, *json); });
+  cmd->callback([=] { RunIngest(*session, *bank, *config, *json, *transitions, *weights); });
 }
 
 }  // namespace ss::apps

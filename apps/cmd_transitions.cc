@@ -21,7 +21,8 @@ struct Args {
   std::string bank, weights, labels, out, session;
   int threads = 2, folds = 5, count = 1000;
   uint64_t seed = 1;
-  double stage1_recall = 0.995;
+  double stage1_recall = 0.999;
+  double positive_rate = -1;
   bool json = false, quiet = false;
 };
 
@@ -69,6 +70,7 @@ void Train(const Args& a) {
   options.train.seed = a.seed;
   options.window = DefaultWeights().window;
   options.stage1_recall = a.stage1_recall;
+  options.positive_rate = a.positive_rate;
   options.threads = a.threads;
   const BankTrainResult r = TrainOnBank(a.labels, a.bank, options);
   SaveWeights(r.weights, a.out);
@@ -83,7 +85,21 @@ void Train(const Args& a) {
               static_cast<long long>(t.samples), static_cast<long long>(t.accepts), t.folds);
   std::printf("  stage 1 (4 cheap features): precision %.3f, recall %.3f\n", t.stage1.precision(), t.stage1.recall());
   std::printf("  stage 2 (all 6 features):   precision %.3f, recall %.3f\n", t.stage2.precision(), t.stage2.recall());
-  if (a.stage1_recall > 0) {
+  if (r.stage2_calibrated) {
+    std::printf("  stage 2 then set for the positive rate %.3g on the bank: %.1f accepts per sprite, estimated "
+                "precision %.3f, recall %.3f (threshold D <= %.4f)\n",
+                r.stage2.positive_rate, r.stage2.accepts_per_sprite, r.stage2.precision, r.stage2.recall,
+                r.stage2.threshold);
+  } else {
+    std::printf("  stage 2 keeps the labels' 50/50 operating point (no positive rate: give --positive-rate or make "
+                "labels with 'label --from-truth')\n");
+  }
+  if (a.stage1_recall > 0 && r.stage2_calibrated) {
+    std::printf("  stage 1 refitted as its filter to pass %.3f of %lld stage-2 accepts on the bank: %.1f candidates "
+                "per sprite (%.0fx fewer than all pairs)\n",
+                a.stage1_recall, static_cast<long long>(r.calibration_accepts), r.stage1.candidates_per_sprite,
+                r.stage1.fewer_than_all);
+  } else if (a.stage1_recall > 0) {
     std::printf("  stage 1 then set to pass %.3f of %lld stage-2 accepts on the bank (bias %.4f -> %.4f)\n",
                 a.stage1_recall, static_cast<long long>(r.calibration_accepts), r.stage1_bias_from_labels,
                 r.weights.stage1_bias);
@@ -94,24 +110,25 @@ void Train(const Args& a) {
 void Label(const Args& a) {
   const TruthLabelSummary s =
       LabelBankFromTruth(a.session, a.bank, static_cast<size_t>(a.count), TruthLabelOptions{}, a.seed);
-  WriteLabelsCsv(s.labels, a.out);
+  WriteLabelsCsv(s.labels, a.out, s.positive_rate > 0 ? s.positive_rate : -1);
   size_t accepts = 0;
   for (const auto& l : s.labels) accepts += l.accept ? 1 : 0;
   if (a.json) {
     std::printf("%s\n", nlohmann::json({{"out", a.out},
                                         {"labels", s.labels.size()},
                                         {"accepts", accepts},
+                                        {"positive_rate", s.positive_rate},
                                         {"sprites_matched", s.sprites_matched},
                                         {"sprites_unmatched", s.sprites_unmatched},
                                         {"mirrored_skipped", s.mirrored_skipped}})
                             .dump(2)
                             .c_str());
   } else {
-    std::printf("%zu labels (%zu accepts) from the truth of %lld sprites (%lld unmatched, %lld mirrors left out) "
-                "written to %s\n",
+    std::printf("%zu labels (%zu accepts) from the truth of %lld sprites (%lld unmatched, %lld mirrors left out; "
+                "%.3g of their pairs are true transitions) written to %s\n",
                 s.labels.size(), accepts, static_cast<long long>(s.sprites_matched),
                 static_cast<long long>(s.sprites_unmatched), static_cast<long long>(s.mirrored_skipped),
-                a.out.c_str());
+                s.positive_rate, a.out.c_str());
   }
 }
 
@@ -139,6 +156,10 @@ void AddTransitionsCommand(CLI::App& app) {
   train->add_option("--seed", args->seed, "Seed of the fold split and the calibration sample");
   train->add_option("--stage1-recall", args->stage1_recall,
                     "Share of stage-2 accepts stage 1 must pass on the bank (0: keep the label fit)")
+      ->check(CLI::Range(0.0, 1.0));
+  train->add_option("--positive-rate", args->positive_rate,
+                    "Share of all sprite pairs that are true transitions, to set stage 2's threshold for "
+                    "(default: the labels file's '# positive_rate=' line)")
       ->check(CLI::Range(0.0, 1.0));
   train->add_option("--threads", args->threads, "Worker threads")->check(CLI::Range(1, 64));
   train->add_flag("--json", args->json, "Print JSON");

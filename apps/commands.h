@@ -19,5 +19,6 @@ void AddCamerasCommand(CLI::App& app);
 void AddSkeletonCommand(CLI::App& app);
 void AddMatchCommand(CLI::App& app);
 void AddTransitionsCommand(CLI::App& app);
+void AddDaemonCommand(CLI::App& app);
 
 }  // namespace ss::apps

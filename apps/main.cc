@@ -31,6 +31,7 @@ int main(int argc, char** argv) {
   ss::apps::AddSkeletonCommand(app);
   ss::apps::AddMatchCommand(app);
   ss::apps::AddTransitionsCommand(app);
+  ss::apps::AddDaemonCommand(app);
 
   try {
     app.parse(argc, argv);

@@ -324,6 +324,19 @@ int64_t BankWriter::AddSession(const SessionRecord& session) {
   return id;
 }
 
+void BankWriter::RenameSession(int64_t session_id, const std::string& name) {
+  sql::Transaction tx(db());
+  auto update = db().Prepare("UPDATE sessions SET name = ? WHERE id = ?");
+  update.Bind(1, name).Bind(2, session_id).Step();
+  update.Reset();
+  auto find = db().Prepare("SELECT 1 FROM sessions WHERE id = ?");
+  if (!find.Bind(1, session_id).Step()) {
+    throw WorkError(path(), "no session with id " + std::to_string(session_id) + " to rename");
+  }
+  find.Reset();
+  tx.Commit();
+}
+
 int64_t BankWriter::AddCamera(int64_t session_id, const CameraRecord& camera) {
   if (camera.name.empty()) throw WorkError(path(), "a camera needs a non-empty name");
   sql::Transaction tx(db());

@@ -94,6 +94,8 @@ class BankWriter : public Bank {
 
   // Registers a session (by uid) and returns its id; the same uid returns the same id.
   int64_t AddSession(const SessionRecord& session);
+  // Renames a session (its uid stays); WorkError for an unknown id.
+  void RenameSession(int64_t session_id, const std::string& name);
   // Registers a camera of a session (by name) and returns its id.
   int64_t AddCamera(int64_t session_id, const CameraRecord& camera);
   // Appends one batch of a clip's sprites. The clip (camera_id, track_id, first_frame)

@@ -18,6 +18,8 @@ PACKAGES=(
   libspdlog-dev libfmt-dev libcpp-httplib-dev libsystemd-dev libpng-dev libzstd-dev
   # tests and benchmarks
   libgtest-dev libgmock-dev libbenchmark-dev
+  # the daemon tests give each test a private loopback with a second address (ip)
+  iproute2
 )
 # Optional: the `vivid` CTest test boots Debian's kernel under qemu to run the
 # V4L2 backend against the vivid driver (it skips without these). Set

@@ -18,6 +18,7 @@
 
 #include "capture/recording/session_writer.h"
 #include "core/camera_model.h"
+#include "core/contact_point.h"
 #include "core/error.h"
 #include "core/log.h"
 #include "synth/directors.h"
@@ -249,7 +250,7 @@ SynthSummary RenderStudioSession(const SynthOptions& o) {
     w.views = std::make_unique<CsvFile>(
         (w.truth_dir / "views.csv").string(),
         "frame,subject,visible_px,unoccluded_px,box_x,box_y,box_w,box_h,lowest_x,lowest_y,lowest_gx,lowest_gy,"
-        "lowest_gz,lowest_ray_gx,lowest_ray_gy,root_x,root_y");
+        "lowest_gz,lowest_ray_gx,lowest_ray_gy,root_x,root_y,contact_x,contact_y,contact_ray_gx,contact_ray_gy");
     if (!joint_names.empty()) {
       w.joints = std::make_unique<CsvFile>((w.truth_dir / "joints.csv").string(), "frame,subject,joint,name,x,y");
     }
@@ -361,11 +362,21 @@ SynthSummary RenderStudioSession(const SynthOptions& o) {
           if (hit) ray_ground = hit->head<2>();
         }
         const Eigen::Vector2d root_px = cam.ProjectGround({st.position.x(), st.position.y(), 0.0});
-        w.views->Row("%d,%d,%.4f,%.4f,%d,%d,%d,%d,%.4f,%.4f,%.6f,%.6f,%.6f,%.6f,%.6f,%.4f,%.4f", frame, k,
-                     w.image.visible_px[static_cast<size_t>(k)], w.image.unoccluded_px[static_cast<size_t>(k)],
+        // The contact point as the pipeline defines it (core/contact_point.h), from the true alpha.
+        Eigen::Vector2d contact_px(NAN, NAN), contact_ground(NAN, NAN);
+        cv::Point2d contact;
+        if (!layer.box.empty() && ContactPoint(layer.values, &contact)) {
+          contact_px = {layer.box.x + contact.x, layer.box.y + contact.y};
+          const auto hit = IntersectGround({cam.CentreInGround(), cam.RayDirectionInGround(contact_px)});
+          if (hit) contact_ground = hit->head<2>();
+        }
+        w.views->Row("%d,%d,%.4f,%.4f,%d,%d,%d,%d,%.4f,%.4f,%.6f,%.6f,%.6f,%.6f,%.6f,%.4f,%.4f,"
+                     "%.4f,%.4f,%.6f,%.6f",
+                     frame, k, w.image.visible_px[static_cast<size_t>(k)], w.image.unoccluded_px[static_cast<size_t>(k)],
                      layer.box.x, layer.box.y, layer.box.width, layer.box.height, low.px.x(), low.px.y(),
                      low.point_in_ground.x(), low.point_in_ground.y(), low.point_in_ground.z(), ray_ground.x(),
-                     ray_ground.y(), root_px.x(), root_px.y());
+                     ray_ground.y(), root_px.x(), root_px.y(), contact_px.x(), contact_px.y(), contact_ground.x(),
+                     contact_ground.y());
         if (w.joints) {
           for (size_t j = 0; j < st.joints.size(); ++j) {
             const Eigen::Vector2d px = cam.ProjectGround(st.joints[j]);

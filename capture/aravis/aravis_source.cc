@@ -59,6 +59,7 @@ struct AravisSource::Impl {
   mutable std::mutex mutex;  // guards the counters below
   SourceStats totals;
   uint64_t sequence_gaps = 0;
+  uint64_t incomplete_since_last = 0;  // incomplete frames since the last complete one
   bool have_last_id = false;
   uint64_t last_id = 0;
   uint64_t sequence = 0;
@@ -86,7 +87,8 @@ struct AravisSource::Impl {
     } else {
       delta = id + 0xffff - last_id;  // wrapped: ids run 65535, 1, 2, ...
     }
-    if (delta > 1) sequence_gaps += delta - 1;
+    if (delta > 1) sequence_gaps += delta - 1 - std::min<uint64_t>(delta - 1, incomplete_since_last);
+    incomplete_since_last = 0;
     last_id = id;
     sequence += delta;
     return sequence;
@@ -254,7 +256,12 @@ std::optional<Frame> AravisSource::Next() {
     const uint64_t id = arv_buffer_get_frame_id(buffer);
     std::unique_lock<std::mutex> lock(s.mutex);
     s.waited_us = 0;
-    const uint64_t sequence = s.Sequence(id);
+    // An incomplete frame's block id may be lost with its leader packet (Aravis gives 0):
+    // it is counted as dropped itself, and the next complete frame's gap does not count it again.
+    if (status != ARV_BUFFER_STATUS_SUCCESS) {
+      ++s.incomplete_since_last;
+    }
+    const uint64_t sequence = status == ARV_BUFFER_STATUS_SUCCESS ? s.Sequence(id) : s.sequence;
     size_t size = 0;
     const uint8_t* data = nullptr;
     int width = 0;

@@ -235,9 +235,22 @@ ReplaySource::ReplaySource(const std::string& dir, ReplayOptions options) : impl
   int64_t last = 0;
   int64_t period = 0;
   bool any = false;
+  if (!options.camera.empty()) {
+    bool found = false;
+    std::string names;
+    for (const SessionCamera& c : s.info.cameras) {
+      found = found || c.name == options.camera;
+      names += (names.empty() ? "" : ", ") + c.name;
+    }
+    if (!found) {
+      throw InputError((fs::path(dir) / "session.json").string(),
+                       "the session has no camera '" + options.camera + "' (it has " + names + ")");
+    }
+  }
   for (size_t i = 0; i < s.info.cameras.size(); ++i) {
+    if (!options.camera.empty() && s.info.cameras[i].name != options.camera) continue;
     auto cam = std::make_unique<Impl::Camera>();
-    cam->index = static_cast<int>(i);
+    cam->index = static_cast<int>(s.cams.size());
     cam->meta = s.info.cameras[i];
     cam->video_path = (root / cam->meta.video).string();
     cam->csv_path = (root / cam->meta.frames_csv).string();

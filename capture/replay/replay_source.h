@@ -25,6 +25,7 @@ struct ReplayOptions {
   bool realtime = false;     // keep the original inter-frame timing (else as fast as possible)
   int loops = 1;             // passes over the session; 0 = until Stop()
   int frames_ahead = 4;      // decoded frames each camera may hold ready
+  std::string camera;        // replay only this camera of the session ("" = every camera); it is then Frame::camera 0
   // Later passes shift timestamp_ns by the session's span (plus one frame) and
   // sequence by the camera's sequence span, so time never runs backwards.
 };

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <string>
 
+#include "core/contact_point.h"
 #include "core/error.h"
 
 namespace ss {
@@ -117,7 +118,7 @@ bool Extractor::Cut(const Matte& matte, const KeyRegion& r, size_t index) {
     shadow = masked_shadow_;
   }
 
-  // The subject: alpha box, area, lowest row with alpha > 1/2.
+  // The subject: alpha box, area, whether any alpha > 1/2.
   const int v = options_.alpha_min;
   int x0 = box.width, x1 = -1, y0 = -1, y1 = -1, lowest = -1;
   uint64_t sum = 0;
@@ -142,23 +143,6 @@ bool Extractor::Cut(const Matte& matte, const KeyRegion& r, size_t index) {
   c.touches_border = box.x + x0 == 0 || box.y + y0 == 0 || box.x + x1 == frame.width - 1 ||
                      box.y + y1 == frame.height - 1;
 
-  // Lowest point: x the mean of the lowest row's pixels above 1/2; y where
-  // alpha crosses 1/2 going down from them, interpolated.
-  {
-    const uint8_t* a = alpha.ptr<uint8_t>(lowest);
-    const uint8_t* below = lowest + 1 < box.height ? alpha.ptr<uint8_t>(lowest + 1) : nullptr;
-    double sx = 0, st = 0;
-    int n = 0;
-    for (int x = 0; x < box.width; ++x) {
-      if (a[x] <= 127) continue;
-      const double a1 = below ? below[x] : 0.0;
-      sx += x;
-      st += (a[x] - 127.5) / (a[x] - a1);
-      ++n;
-    }
-    c.lowest_point = {box.x + sx / n, box.y + lowest + st / n};
-  }
-
   // The box: subject + margin, grown to hold the shadow, within the region.
   const int m = options_.margin_px;
   cv::Rect local(cv::Point(x0 - m, y0 - m), cv::Point(x1 + 1 + m, y1 + 1 + m));
@@ -174,6 +158,11 @@ bool Extractor::Cut(const Matte& matte, const KeyRegion& r, size_t index) {
   alpha(local).copyTo(c.alpha);
   matte.colour(c.bbox).copyTo(c.colour);
   shadow(local).copyTo(c.shadow);
+
+  // The contact point (core/contact_point.h), from the subject's own alpha.
+  cv::Point2d contact;
+  ContactPoint(c.alpha, &contact, options_.contact);
+  c.contact_point = contact + cv::Point2d(c.bbox.tl());
   return true;
 }
 

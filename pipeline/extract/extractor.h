@@ -8,6 +8,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "core/contact_point.h"
 #include "pipeline/key/matte.h"
 
 namespace ss {
@@ -18,8 +19,8 @@ struct Candidate {
   cv::Mat alpha;             // CV_8U, bbox-sized
   cv::Mat colour;            // CV_8UC3, bbox-sized, spill removed
   cv::Mat shadow;            // CV_8U, bbox-sized contact shadow (floor darkening, 255 = black)
-  cv::Point2d lowest_point;  // frame pixels: y where alpha falls through 1/2 below the lowest
-                             // row with alpha > 1/2; x the mean of that row's such pixels
+  cv::Point2d contact_point;  // frame pixels: the sprite's contact point (core/contact_point.h):
+                              // y the lowest point, x the centre of the silhouette's bottom band
   double area = 0;           // sum of alpha / 255, pixels
   bool touches_border = false;  // the subject (alpha >= alpha_min) reaches the frame's edge
 };
@@ -29,6 +30,7 @@ struct ExtractorOptions {
   int margin_px = 4;     // added around the subject's alpha box
   int alpha_min = 16;    // alpha (of 255) that counts as subject for the box and the border test
   int shadow_min = 16;   // shadow (of 255) that counts for the box
+  ContactPointOptions contact;  // the contact point's bottom band
 };
 
 struct ExtractTotals {

@@ -2,6 +2,8 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "core/error.h"
+
 namespace ss {
 
 const char* DiscardName(Discard reason) {
@@ -42,6 +44,17 @@ FloorMask::FloorMask(const CameraModel& camera, const GroundPolygon& floor, cons
   not_floor_integral_ /= 255;
 }
 
+void FloorMask::Restrict(const cv::Mat& seen) {
+  if (seen.type() != CV_8U || seen.size() != mask_.size()) {
+    throw InputError("floor mask", "the restricting mask must be 8-bit and the image size");
+  }
+  if (geometric_.empty()) geometric_ = mask_.clone();
+  geometric_.copyTo(mask_);
+  mask_.setTo(0, seen == 0);
+  cv::integral(mask_ == 0, not_floor_integral_, CV_32S);
+  not_floor_integral_ /= 255;
+}
+
 Discard FloorMask::Check(const cv::Mat& alpha_crop, cv::Point offset, const Eigen::Vector2d& point_in_ground) const {
   const cv::Rect box(offset, alpha_crop.size());
   const int b = options_.border_margin_px;
@@ -78,22 +91,24 @@ Discard FloorMask::Check(const cv::Mat& alpha_crop, cv::Point offset, const Eige
 }
 
 bool StillnessFilter::IsStill(int subject, int64_t timestamp_ns, const Eigen::Vector2d& point) {
-  auto [it, fresh] = subjects_.try_emplace(subject);
-  State& s = it->second;
-  if (fresh) {
-    s.anchor = point;
-    s.still_since_ns = timestamp_ns;
+  State& s = subjects_[subject];
+  // Lost for longer than the window (or time went backwards): start afresh.
+  if (!s.history.empty() && (timestamp_ns - s.history.back().timestamp_ns > window_ns_ ||
+                             timestamp_ns <= s.history.back().timestamp_ns)) {
+    s.history.clear();
+    s.still_since_ns = -1;
+  }
+  s.history.push_back({timestamp_ns, point});
+  // Keep the newest sample at least a window old as the reference, nothing older.
+  while (s.history.size() > 2 && s.history[1].timestamp_ns <= timestamp_ns - window_ns_) s.history.pop_front();
+  const Sample& ref = s.history.front();
+  if (timestamp_ns - ref.timestamp_ns < window_ns_) return false;  // too little history: moving
+  const double dt = (timestamp_ns - ref.timestamp_ns) * 1e-9;
+  if ((point - ref.point).norm() > std::max(0.002, min_speed_ * dt)) {
+    s.still_since_ns = -1;
     return false;
   }
-  const double dt = (timestamp_ns - s.still_since_ns) * 1e-9;
-  // Still while the subject stays within the distance min_speed would cover in the period so far
-  // (at least 2 mm, the keying jitter of a contact point).
-  const double allowed = std::max(0.002, min_speed_ * dt);
-  if ((point - s.anchor).norm() > allowed) {
-    s.anchor = point;
-    s.still_since_ns = timestamp_ns;
-    return false;
-  }
+  if (s.still_since_ns < 0) s.still_since_ns = ref.timestamp_ns;
   return timestamp_ns - s.still_since_ns > max_still_ns_;
 }
 

@@ -4,6 +4,7 @@
 // polygon, and not standing still for too long. Every discard has a reason.
 #include <array>
 #include <cstdint>
+#include <deque>
 #include <string>
 #include <unordered_map>
 
@@ -45,29 +46,44 @@ class FloorMask {
   // Usability of one sprite from its alpha crop at `offset` and its contact point.
   Discard Check(const cv::Mat& alpha_crop, cv::Point offset, const Eigen::Vector2d& point_in_ground) const;
   const cv::Mat& mask() const { return mask_; }  // 255 where the camera sees floor
+  // Keeps as floor only the pixels of the geometric floor where `seen` (CV_8U, the image size) is
+  // non-zero: the keyer's green, so that a wall's outside or a cable in front of the floor is not
+  // floor. A later call replaces the earlier restriction.
+  void Restrict(const cv::Mat& seen);
 
  private:
   GroundPolygon floor_;
   UsabilityOptions options_;
   cv::Mat mask_;
+  cv::Mat geometric_;           // the floor polygon seen over the walls, before Restrict
   cv::Mat not_floor_integral_;  // integral image of (mask_ == 0), for O(1) box tests
 };
 
-// Per subject: drops frames once the subject has been still for longer than allowed.
+// Per subject: drops frames once the subject has been still for longer than allowed. A frame is
+// still when the subject moved less than min_speed over the last `window_s` (at least 2 mm, the
+// keying jitter of a contact point); a still period is a run of still frames, counted from the
+// start of the first one's window. Moving again ends it at once, however long it lasted.
 class StillnessFilter {
  public:
-  StillnessFilter(double min_speed_m_per_s, double max_still_s)
-      : min_speed_(min_speed_m_per_s), max_still_ns_(static_cast<int64_t>(max_still_s * 1e9)) {}
+  StillnessFilter(double min_speed_m_per_s, double max_still_s, double window_s = 0.5)
+      : min_speed_(min_speed_m_per_s),
+        max_still_ns_(static_cast<int64_t>(max_still_s * 1e9)),
+        window_ns_(static_cast<int64_t>(window_s * 1e9)) {}
   // True when the subject's frame at `timestamp_ns` is part of a too-long still period.
   bool IsStill(int subject, int64_t timestamp_ns, const Eigen::Vector2d& point_in_ground);
 
  private:
+  struct Sample {
+    int64_t timestamp_ns;
+    Eigen::Vector2d point;
+  };
   struct State {
-    Eigen::Vector2d anchor;       // where the current still period started
+    std::deque<Sample> history;   // the last window, and the newest sample before it
     int64_t still_since_ns = -1;  // -1: moving
   };
   double min_speed_;
   int64_t max_still_ns_;
+  int64_t window_ns_;
   std::unordered_map<int, State> subjects_;
 };
 

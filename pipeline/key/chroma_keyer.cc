@@ -56,6 +56,8 @@ ChromaKeyer::ChromaKeyer(ChromaKeyerOptions options) : Keyer(options.grid), opti
   check(o.min_key > 0, "min_key", "must be positive");
   check(o.max_unkeyable >= 0 && o.max_unkeyable <= 1, "max_unkeyable", "must be within [0, 1]");
   check(o.despill_bias >= 0 && o.despill_bias <= 1, "despill_bias", "must be within [0, 1]");
+  check(o.despill_strength >= 0 && o.despill_strength <= 1, "despill_strength", "must be within [0, 1]");
+  check(o.key_low_levels < 0 || o.key_high_levels > o.key_low_levels, "high", "must be above keying.chroma.low");
 }
 
 void ChromaKeyer::Train(const std::vector<cv::Mat>& empty_bgr) {
@@ -65,13 +67,16 @@ void ChromaKeyer::Train(const std::vector<cv::Mat>& empty_bgr) {
 
   // Per cell: mean luma, mean key and the key's spread over all pixels of all frames.
   std::vector<double> sum_y(cells, 0), sum_k(cells, 0), sum_kk(cells, 0), count(cells, 0);
+  std::vector<float> pixel_key(static_cast<size_t>(size_.width) * size_.height, 0.f);
   for (const cv::Mat& frame : empty_bgr) {
     for (int y = 0; y < size_.height; ++y) {
       const uint8_t* p = frame.ptr<uint8_t>(y);
       const size_t row = static_cast<size_t>(y / s) * cols;
+      float* pk = &pixel_key[static_cast<size_t>(y) * size_.width];
       for (int x = 0; x < size_.width; ++x, p += 3) {
         const double luma = (p[0] + 2.0 * p[1] + p[2]) / 4.0;
         const double key = (p[1] - std::max(p[0], p[2])) / std::max(luma, kMinTrainingLuma);
+        pk[x] += static_cast<float>(key);
         const size_t c = row + x / s;
         sum_y[c] += luma;
         sum_k[c] += key;
@@ -124,10 +129,15 @@ void ChromaKeyer::Train(const std::vector<cv::Mat>& empty_bgr) {
   // alpha and shadow in 0..255.
   const auto& o = options_;
   auto params = [&o](double l, double k, double sd, bool is_green, float* f, int32_t* luma_floor) {
-    f[kKeyHi] = is_green ? static_cast<float>((k - std::max(o.min_margin * k, o.noise_z * sd)) / 4) : kNeverKey;
-    f[kGain] = static_cast<float>(4 * 255 / (o.ramp * k));
+    double key_hi = k - std::max(o.min_margin * k, o.noise_z * sd), ramp = o.ramp * k;
+    if (o.key_low_levels >= 0 && o.key_high_levels > o.key_low_levels) {  // levels at the floor's luma l
+      key_hi = std::min(key_hi, o.key_high_levels / l);
+      ramp = std::max(key_hi - o.key_low_levels / l, 0.05 * k);
+    }
+    f[kKeyHi] = is_green ? static_cast<float>(key_hi / 4) : kNeverKey;
+    f[kGain] = static_cast<float>(4 * 255 / ramp);
     f[kInvLuma] = is_green ? static_cast<float>(255 / (4 * l)) : 0.f;
-    f[kShadowBase] = is_green ? 255.f : kNoShadow;
+    f[kShadowBase] = is_green && o.shadow ? 255.f : kNoShadow;
     *luma_floor = static_cast<int32_t>(std::lround(std::max(4 * o.dark_floor * l, 4.0)));
   };
   float f[kFloatParams];
@@ -178,11 +188,13 @@ void ChromaKeyer::Train(const std::vector<cv::Mat>& empty_bgr) {
     }
   }
   keyable_.resize(alpha_sum.size());
+  green_px_.resize(alpha_sum.size());
   size_t masked = 0;
   const double n_frames = static_cast<double>(empty_bgr.size());
   for (size_t i = 0; i < alpha_sum.size(); ++i) {
     const bool keyable = alpha_sum[i] / n_frames <= kUnkeyableAlpha;
     keyable_[i] = keyable ? 0xFF : 0;
+    green_px_[i] = keyable && pixel_key[i] / n_frames >= o.min_key ? 0xFF : 0;
     masked += !keyable;
   }
   if (masked > 0) {
@@ -191,6 +203,19 @@ void ChromaKeyer::Train(const std::vector<cv::Mat>& empty_bgr) {
   }
   Log("pipeline.key")->debug("chroma keyer trained on {} frames {}x{}: key {:.3f}, luma {:.1f}, noise {:.4f}",
                              empty_bgr.size(), size_.width, size_.height, mean_key, mean_luma, mean_spread);
+}
+
+cv::Mat ChromaKeyer::GreenMask() const {
+  cv::Mat mask = cv::Mat::zeros(size_, CV_8U);
+  for (int y = 0; y < size_.height; ++y) {
+    // Green itself, and keyed: a cell mixing green with something else has so wide a key spread
+    // that its threshold falls below 0 and nothing neutral (grey, brown) is keyed there.
+    const float* key_hi = BandParams(std::min(y / grid_.step, rows_ - 1)).f[kKeyHi];
+    const uint8_t* green = &green_px_[static_cast<size_t>(y) * size_.width];
+    uint8_t* m = mask.ptr<uint8_t>(y);
+    for (int x = 0; x < size_.width; ++x) m[x] = key_hi[x] > 0.f ? green[x] : 0;
+  }
+  return mask;
 }
 
 ChromaKeyer::Params ChromaKeyer::BandParams(int cell_row) const {
@@ -217,8 +242,8 @@ template <bool kRgb>
 __attribute__((always_inline)) inline void ChromaRowImpl(
     const uint8_t* __restrict in, int x0, int x1, const float* __restrict key_hi, const float* __restrict gain,
     const int32_t* __restrict luma_floor, const float* __restrict inv_luma, const float* __restrict shadow_base,
-    int shadow_min, int despill256, const uint8_t* __restrict keyable, uint8_t* __restrict alpha,
-    uint8_t* __restrict shadow, uint8_t* __restrict colour) {
+    int shadow_min, int despill256, int strength256, const uint8_t* __restrict keyable,
+    uint8_t* __restrict alpha, uint8_t* __restrict shadow, uint8_t* __restrict colour) {
   constexpr int kB = kRgb ? 2 : 0, kR = kRgb ? 0 : 2;
   for (int x = x0; x < x1; ++x) {
     const int b = in[3 * x + kB], g = in[3 * x + 1], r = in[3 * x + kR];
@@ -227,9 +252,10 @@ __attribute__((always_inline)) inline void ChromaRowImpl(
     alpha[x] = static_cast<uint8_t>(k.alpha) & keyable[x];
     shadow[x] = static_cast<uint8_t>(k.shadow) & keyable[x];
     colour[3 * x] = static_cast<uint8_t>(b);
-    // Despill: G <= max(R, B) - bias * (max(R, B) - min(R, B)).
+    // Despill: the share `strength` of G above max(R, B) - bias * (max(R, B) - min(R, B)) is removed.
     const int hi = std::max(b, r), lo = std::min(b, r);
-    colour[3 * x + 1] = static_cast<uint8_t>(std::min(g, hi - (((hi - lo) * despill256 + 128) >> 8)));
+    const int excess = std::max(g - (hi - (((hi - lo) * despill256 + 128) >> 8)), 0);
+    colour[3 * x + 1] = static_cast<uint8_t>(g - ((excess * strength256 + 128) >> 8));
     colour[3 * x + 2] = static_cast<uint8_t>(r);
   }
 }
@@ -240,11 +266,11 @@ __attribute__((always_inline)) inline void ChromaRowImpl(
   __attribute__((target_clones("avx2", "ssse3", "default"))) void NAME(                                     \
       const uint8_t* __restrict in, int x0, int x1, const float* __restrict key_hi,                          \
       const float* __restrict gain, const int32_t* __restrict luma_floor, const float* __restrict inv_luma, \
-      const float* __restrict shadow_base, int shadow_min, int despill256,                                  \
+      const float* __restrict shadow_base, int shadow_min, int despill256, int strength256,                 \
       const uint8_t* __restrict keyable, uint8_t* __restrict alpha, uint8_t* __restrict shadow,              \
       uint8_t* __restrict colour) {                                                                          \
     ChromaRowImpl<RGB>(in, x0, x1, key_hi, gain, luma_floor, inv_luma, shadow_base, shadow_min, despill256, \
-                       keyable, alpha, shadow, colour);                                                      \
+                       strength256, keyable, alpha, shadow, colour);                                         \
   }
 SS_CHROMA_ROW(ChromaRowBgr, false)
 SS_CHROMA_ROW(ChromaRowRgb, true)
@@ -274,13 +300,14 @@ void ChromaKeyer::FineRow(const uint8_t* row, ChannelOrder order, int y, int x0,
   const Params p = BandParams(std::min(y / grid_.step, rows_ - 1));
   const int shadow_min = static_cast<int>(std::lround(255 * options_.shadow_min));
   const int despill256 = static_cast<int>(std::lround(256 * options_.despill_bias));
+  const int strength256 = static_cast<int>(std::lround(256 * options_.despill_strength));
   const uint8_t* keyable = &keyable_[static_cast<size_t>(y) * size_.width];
   if (order == ChannelOrder::kRgb) {
     ChromaRowRgb(row, x0, x1, p.f[kKeyHi], p.f[kGain], p.luma_floor, p.f[kInvLuma], p.f[kShadowBase], shadow_min,
-                 despill256, keyable, alpha, shadow, colour);
+                 despill256, strength256, keyable, alpha, shadow, colour);
   } else {
     ChromaRowBgr(row, x0, x1, p.f[kKeyHi], p.f[kGain], p.luma_floor, p.f[kInvLuma], p.f[kShadowBase], shadow_min,
-                 despill256, keyable, alpha, shadow, colour);
+                 despill256, strength256, keyable, alpha, shadow, colour);
   }
 }
 

@@ -29,6 +29,13 @@ struct ChromaKeyerOptions {
   double min_key = 0.1;         // training cells with a smaller key k_bg are not green and never keyed
   double max_unkeyable = 0.9;   // training fails when more than this fraction of cells is not green
   double despill_bias = 0.5;    // G <= max(R,B) - bias * (max(R,B) - min(R,B)): 0 keeps yellows, 0.5 = mean(R,B)
+  double despill_strength = 1;  // share of the green above that limit removed: 0 = no despill, 1 = all
+  bool shadow = true;           // false: no contact-shadow layer (and no shaded cells)
+  // When both are >= 0 (the station config's keying.chroma.low/high): the key in 8-bit levels of
+  // G - max(R, B) at the floor's brightness, k * Y_bg, where alpha is 1 (<= low) and 0 (>= high);
+  // `high` never reaches into the floor's own noise (min_margin, noise_z). Else min_margin and ramp.
+  double key_low_levels = -1;
+  double key_high_levels = -1;
   bool global_model = false;    // one reference for the whole frame: the naive keyer, for comparison
 };
 
@@ -39,6 +46,9 @@ class ChromaKeyer : public Keyer {
   void Train(const std::vector<cv::Mat>& empty_bgr) override;
   const ChromaKeyerOptions& options() const { return options_; }
   double unkeyable_fraction() const { return unkeyable_fraction_; }  // of cells, after Train
+  // CV_8U, the trained size: 255 where the empty enclosure is green and keyed, 0 where it is
+  // not (the room, a wall's outside, a cable): no subject is ever seen against those pixels.
+  cv::Mat GreenMask() const;
  protected:
   // Key and shadow are symmetric in R and B: only the colour layer minds the order.
   void SampleRow(const uint8_t* row, ChannelOrder order, int cell_row, uint8_t* foreground,
@@ -64,6 +74,7 @@ class ChromaKeyer : public Keyer {
   std::vector<float> band_f_;        // rows_ x kFloatParams x width: at every pixel of a cell row
   std::vector<int32_t> band_floor_;  // rows_ x width
   std::vector<uint8_t> keyable_;     // width x height: 0xFF where the empty enclosure is green, else 0
+  std::vector<uint8_t> green_px_;    // width x height: 0xFF where the pixel's own training key is green
   double unkeyable_fraction_ = 0;
 };
 

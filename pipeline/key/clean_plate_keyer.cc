@@ -84,6 +84,11 @@ CleanPlateKeyer::CleanPlateKeyer(CleanPlateKeyerOptions options) : Keyer(options
   check(o.shadow_min >= 0 && o.shadow_min < 1, "shadow_min", "must be within [0, 1)");
   check(o.coarse_alpha > 0 && o.coarse_alpha < 1, "coarse_alpha", "must be within (0, 1)");
   check(o.coarse_shadow > 0 && o.coarse_shadow < 1, "coarse_shadow", "must be within (0, 1)");
+  check(o.ramp_sigma >= 0, "ramp_sigma", "must not be negative");
+}
+
+int CleanPlateKeyer::ShadowMin() const {
+  return options_.shadow ? static_cast<int>(std::lround(255 * options_.shadow_min)) : 256;
 }
 
 void CleanPlateKeyer::Train(const std::vector<cv::Mat>& empty_bgr) {
@@ -118,6 +123,10 @@ void CleanPlateKeyer::Train(const std::vector<cv::Mat>& empty_bgr) {
   const double tail = std::erfc(options_.noise_z / std::sqrt(2.0));
   const double z2 = tail > 0 && tail < 1 ? std::sqrt(-2.0 * std::log(tail)) : options_.noise_z;
   sigma.convertTo(tolerance_, CV_32F, z2 * std::sqrt(1.0 + 1.0 / n));
+  ramp_ = options_.ramp;
+  if (options_.ramp_sigma > 0) {
+    ramp_ = std::max(1.0, options_.ramp_sigma * cv::mean(sigma)[0] * std::sqrt(1.0 + 1.0 / n));
+  }
   if (empty_bgr.size() < 2) {
     Log("pipeline.key")->warn("clean-plate keyer trained on one frame: noise std is the floor {:.1f}",
                               options_.min_sigma);
@@ -132,9 +141,9 @@ void CleanPlateKeyer::SampleRow(const uint8_t* row, ChannelOrder order, int cell
   const int y = SampleY(cell_row);
   const uint8_t* plate = plate_.ptr<uint8_t>(y);
   const float* tolerance = tolerance_.ptr<float>(y);
-  const float gain = static_cast<float>(255 / options_.ramp);
+  const float gain = static_cast<float>(255 / ramp_);
   const float dark_floor = static_cast<float>(options_.dark_floor);
-  const int shadow_min = static_cast<int>(std::lround(255 * options_.shadow_min));
+  const int shadow_min = ShadowMin();
   const int coarse_alpha = static_cast<int>(std::lround(255 * options_.coarse_alpha));
   const int coarse_shadow = static_cast<int>(std::lround(255 * options_.coarse_shadow));
   for (int cx = 0; cx < cols_; ++cx) {
@@ -149,9 +158,9 @@ void CleanPlateKeyer::SampleRow(const uint8_t* row, ChannelOrder order, int cell
 
 void CleanPlateKeyer::FineRow(const uint8_t* row, ChannelOrder order, int y, int x0, int x1, uint8_t* alpha,
                               uint8_t* shadow, uint8_t* colour) const {
-  const float gain = static_cast<float>(255 / options_.ramp);
+  const float gain = static_cast<float>(255 / ramp_);
   const float dark_floor = static_cast<float>(options_.dark_floor);
-  const int shadow_min = static_cast<int>(std::lround(255 * options_.shadow_min));
+  const int shadow_min = ShadowMin();
   if (order == ChannelOrder::kRgb) {
     PlateRowRgb(row, plate_.ptr<uint8_t>(y), tolerance_.ptr<float>(y), x0, x1, gain, dark_floor, shadow_min, alpha,
                 shadow, colour);

@@ -22,6 +22,8 @@ struct CleanPlateKeyerOptions {
   double shadow_min = 0.06;     // darkening below this is noise: no shadow
   double coarse_alpha = 0.25;   // a sample with a larger alpha marks its cell as foreground
   double coarse_shadow = 0.12;  // a sample darkened more marks its cell as shaded
+  double ramp_sigma = 0;        // > 0: the ramp is this many of the plate's mean noise std instead of `ramp`
+  bool shadow = true;           // false: no contact-shadow layer (and no shaded cells)
 };
 
 class CleanPlateKeyer : public Keyer {
@@ -32,6 +34,7 @@ class CleanPlateKeyer : public Keyer {
   const CleanPlateKeyerOptions& options() const { return options_; }
   const cv::Mat& plate() const { return plate_; }        // CV_8UC3, mean empty frame
   const cv::Mat& tolerance() const { return tolerance_; }  // CV_32F, levels, per pixel (docs/keying.md)
+  double ramp_levels() const { return ramp_; }              // alpha's ramp beyond the tolerance (after Train)
 
  protected:
   void SampleRow(const uint8_t* row, ChannelOrder order, int cell_row, uint8_t* foreground,
@@ -43,6 +46,8 @@ class CleanPlateKeyer : public Keyer {
   CleanPlateKeyerOptions options_;
   cv::Mat plate_;
   cv::Mat tolerance_;
+  double ramp_ = 0;       // levels, set by Train
+  int ShadowMin() const;  // levels; 256 (never reached) when the shadow layer is off
 };
 
 }  // namespace ss

@@ -5,6 +5,8 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "core/log.h"
+
 namespace ss {
 namespace {
 
@@ -64,7 +66,7 @@ std::optional<Billboard> Rectifier::Rectify(const CameraModel& camera, const Spr
       view.bgr->size() != view.alpha->size()) {
     return std::nullopt;
   }
-  const auto contact = IntersectGround(camera.RayInGround(view.lowest_px));
+  const auto contact = IntersectGround(camera.RayInGround(view.contact_px));
   if (!contact) return std::nullopt;
 
   const Eigen::Vector3d centre = camera.CentreInGround();
@@ -82,7 +84,7 @@ std::optional<Billboard> Rectifier::Rectify(const CameraModel& camera, const Spr
   const double x1 = x0 + view.bgr->cols, y1 = y0 + view.bgr->rows;
   double min_r = 0, max_r = 0, max_h = 0;
   bool any = false;
-  for (const Eigen::Vector2d px : {Eigen::Vector2d(x0, y0), Eigen::Vector2d(x1, y0), Eigen::Vector2d(x0, y1),
+  for (const Eigen::Vector2d& px : {Eigen::Vector2d(x0, y0), Eigen::Vector2d(x1, y0), Eigen::Vector2d(x0, y1),
                                    Eigen::Vector2d(x1, y1), Eigen::Vector2d((x0 + x1) / 2, y0),
                                    Eigen::Vector2d(x0, (y0 + y1) / 2), Eigen::Vector2d(x1, (y0 + y1) / 2)}) {
     const auto hit = IntersectVerticalPlane(camera, px, *contact, n);
@@ -100,6 +102,9 @@ std::optional<Billboard> Rectifier::Rectify(const CameraModel& camera, const Spr
   const int width = 2 * static_cast<int>(std::ceil(half_w * s)) + 1;
   const int height = static_cast<int>(std::ceil((max_h + options_.margin_m) * s)) + 1;
   if (width > options_.max_side_px || height > options_.max_side_px || width < 3 || height < 3) {
+    Log("pipeline.rectify")->trace("billboard {}x{} px refused (max {}): crop {}x{}+{}+{}, contact ({:.1f}, {:.1f})",
+                                   width, height, options_.max_side_px, view.bgr->cols, view.bgr->rows, view.offset.x,
+                                   view.offset.y, view.contact_px.x(), view.contact_px.y());
     return std::nullopt;
   }
 

@@ -1,7 +1,8 @@
 #pragma once
-// Perspective correction (seed 000 §2.1). The ray through the sprite's lowest
-// point meets the floor at its ground position; the sprite is resampled onto a
-// vertical billboard standing there and facing the camera, at a fixed metric
+// Perspective correction (seed 000 §2.1). The ray through the sprite's contact
+// point (its lowest point, core/contact_point.h) meets the floor at its ground
+// position; the sprite is resampled onto a vertical billboard standing there
+// and facing the camera, at a fixed metric
 // scale (px_per_m) shared by the whole bank, so near and far sprites look
 // alike. The contact shadow is resampled onto a horizontal ground patch around
 // the same point, so rendering can lay it on the virtual floor.
@@ -27,7 +28,7 @@ struct SpriteView {
   const cv::Mat* alpha = nullptr;   // CV_8U crop, same size
   const cv::Mat* shadow = nullptr;  // CV_8U crop, same size; may be null
   cv::Point offset;                 // crop's top-left in the full image
-  Eigen::Vector2d lowest_px;        // lowest sprite point, full-image pixels
+  Eigen::Vector2d contact_px;       // contact point (core/contact_point.h), full-image pixels
 };
 
 struct Billboard {
@@ -43,7 +44,7 @@ struct Billboard {
 class Rectifier {
  public:
   explicit Rectifier(RectifierOptions options = {}) : options_(options) {}
-  // nullopt when the lowest point's ray misses the floor or the billboard is degenerate.
+  // nullopt when the contact point's ray misses the floor or the billboard is degenerate.
   std::optional<Billboard> Rectify(const CameraModel& camera, const SpriteView& view) const;
   // The horizontally mirrored billboard (seed 000 §2): the image flipped about
   // its vertical axis and the anchor with it; place and axes unchanged.

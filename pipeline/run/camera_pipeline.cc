@@ -1,6 +1,8 @@
 #include "pipeline/run/camera_pipeline.h"
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 
 #include "core/error.h"
 #include "core/log.h"
@@ -17,10 +19,32 @@ double SecondsSince(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
-std::unique_ptr<Keyer> MakeKeyer(const std::string& method) {
-  if (method == "chroma") return std::make_unique<ChromaKeyer>();
-  if (method == "clean_plate") return std::make_unique<CleanPlateKeyer>();
-  throw InputError("keying.method", "expected chroma or clean_plate, got \"" + method + "\"");
+// Image pixels per metre on the floor at the polygon's centre (0 when it cannot be seen).
+double FloorPixelsPerMetre(const CameraModel& model, const GroundPolygon& floor) {
+  if (floor.empty()) return 0;
+  Eigen::Vector2d centre = Eigen::Vector2d::Zero();
+  for (const Eigen::Vector2d& v : floor.vertices()) centre += v;
+  centre /= static_cast<double>(floor.vertices().size());
+  const double step = 0.01;
+  const Eigen::Vector2d p = model.ProjectGround({centre.x(), centre.y(), 0.0});
+  const Eigen::Vector2d px = model.ProjectGround({centre.x() + step, centre.y(), 0.0});
+  const Eigen::Vector2d py = model.ProjectGround({centre.x(), centre.y() + step, 0.0});
+  const double s = ((px - p).norm() + (py - p).norm()) / (2 * step);
+  return std::isfinite(s) ? s : 0.0;
+}
+
+std::unique_ptr<Keyer> MakeKeyer(const CameraPipelineOptions& o, const CameraModel& model,
+                                 const GroundPolygon& floor) {
+  ChromaKeyerOptions chroma = o.chroma;
+  CleanPlateKeyerOptions plate = o.clean_plate;
+  if (const double px_per_m = FloorPixelsPerMetre(model, floor); o.shadow_reach_m > 0 && px_per_m > 0) {
+    const int cells = static_cast<int>(std::ceil(o.shadow_reach_m * px_per_m / chroma.grid.step));
+    chroma.grid.shadow_reach_cells = std::clamp(cells, 1, 64);
+    plate.grid.shadow_reach_cells = std::clamp(cells, 1, 64);
+  }
+  if (o.keying_method == "chroma") return std::make_unique<ChromaKeyer>(chroma);
+  if (o.keying_method == "clean_plate") return std::make_unique<CleanPlateKeyer>(plate);
+  throw InputError("keying.method", "expected chroma or clean_plate, got \"" + o.keying_method + "\"");
 }
 
 }  // namespace
@@ -29,6 +53,17 @@ CameraPipelineOptions PipelineOptionsFromConfig(const StationConfig& config) {
   const PipelineConfig& p = config.pipeline;
   CameraPipelineOptions o;
   o.keying_method = config.keying.method;
+  // Keying (docs/keying.md, "From the station config").
+  const KeyingConfig& k = config.keying;
+  o.chroma.key_low_levels = k.chroma_low;
+  o.chroma.key_high_levels = k.chroma_high;
+  o.chroma.despill_strength = k.despill ? k.despill_strength : 0.0;
+  o.clean_plate.noise_z = k.plate_low_sigma;
+  o.clean_plate.ramp_sigma = k.plate_high_sigma - k.plate_low_sigma;
+  o.chroma.shadow = o.clean_plate.shadow = k.shadow;
+  o.chroma.shadow_min = o.clean_plate.shadow_min = k.shadow_min_darkening;
+  o.chroma.dark_floor = o.clean_plate.dark_floor = 1.0 - k.shadow_max_darkening;
+  o.shadow_reach_m = k.shadow_reach_m;
   o.extract.min_area = p.min_area_px;
   o.usability.border_margin_px = p.border_margin_px;
   o.usability.floor_margin_px = p.floor_margin_px;
@@ -49,13 +84,14 @@ CameraPipeline::CameraPipeline(std::string name, int64_t camera_id, CameraModel 
                            : throw InputError(name_, "the camera has no model: calibrate it first "
                                                      "(spritestation calibrate)")),
       options_(options),
-      keyer_(MakeKeyer(options.keying_method)),
+      keyer_(MakeKeyer(options, model_, floor)),
       floor_mask_(model_, floor, options.usability),
       extractor_(options.extract),
       tracker_(options.track),
       stillness_(options.still_speed_m_per_s, options.max_still_s),
       rectifier_(options.rectify),
-      batcher_(camera_id, options.batch) {}
+      batcher_(camera_id, options.batch),
+      log_(Log("pipeline.run")) {}
 
 CameraPipeline::~CameraPipeline() = default;
 CameraPipeline::CameraPipeline(CameraPipeline&&) noexcept = default;
@@ -69,6 +105,9 @@ void CameraPipeline::Train(const std::vector<cv::Mat>& empty_bgr) {
     }
   }
   keyer_->Train(empty_bgr);
+  // What is not green in the empty enclosure is not floor either: a wall's outside hiding the
+  // floor behind it, the room (whatever wall height the config says).
+  if (const auto* chroma = dynamic_cast<const ChromaKeyer*>(keyer_.get())) floor_mask_.Restrict(chroma->GreenMask());
   stats_.training_frames += empty_bgr.size();
   stats_.frames += empty_bgr.size();
 }
@@ -100,12 +139,12 @@ void CameraPipeline::Process(const Frame& frame, std::vector<ClipBatch>* out) {
   stats_.discards[static_cast<size_t>(Discard::kTooSmall)] += extractor_.dropped_last();
   stats_.candidates += candidates.size();
 
-  // Contact points: the ray through each candidate's lowest point meets the floor.
+  // Contact points: the ray through each candidate's contact point meets the floor.
   std::vector<const Candidate*> grounded;
   std::vector<Eigen::Vector2d> points;
   std::vector<TrackInput> inputs;
   for (const Candidate& c : candidates) {
-    const auto hit = IntersectGround(model_.RayInGround(Eigen::Vector2d(c.lowest_point.x, c.lowest_point.y)));
+    const auto hit = IntersectGround(model_.RayInGround(Eigen::Vector2d(c.contact_point.x, c.contact_point.y)));
     if (!hit) {
       ++stats_.discards[static_cast<size_t>(Discard::kNoGroundHit)];
       continue;
@@ -126,7 +165,7 @@ void CameraPipeline::Process(const Frame& frame, std::vector<ClipBatch>* out) {
     if (reason == Discard::kNone && still) reason = Discard::kStill;
     if (reason == Discard::kNone) {
       const SpriteView view{&c.colour, &c.alpha, &c.shadow, c.bbox.tl(),
-                            Eigen::Vector2d(c.lowest_point.x, c.lowest_point.y)};
+                            Eigen::Vector2d(c.contact_point.x, c.contact_point.y)};
       billboards[k] = rectifier_.Rectify(model_, view);
       if (!billboards[k]) reason = Discard::kNoGroundHit;
     }
@@ -135,6 +174,10 @@ void CameraPipeline::Process(const Frame& frame, std::vector<ClipBatch>* out) {
       ++usable_total_;
     } else {
       ++stats_.discards[static_cast<size_t>(reason)];
+    }
+    if (log_->should_log(spdlog::level::trace)) {
+      log_->trace("{} frame {} subject {} at ({:.4f}, {:.4f}) box {}x{}+{}+{}: {}", name_, frame.sequence, subjects[k],
+                  points[k].x(), points[k].y(), c.bbox.width, c.bbox.height, c.bbox.x, c.bbox.y, DiscardName(reason));
     }
   }
 
@@ -163,6 +206,12 @@ void CameraPipeline::Finish(std::vector<ClipBatch>* out) {
   for (const int64_t clip : cutter_.CloseAll()) batcher_.Close(clip, out);
   batcher_.CloseAll(out);
   UpdateClipStats();
+}
+
+void CameraPipeline::Retarget(int64_t camera_id, std::vector<ClipBatch>* out) {
+  Finish(out);
+  batcher_.set_camera_id(camera_id);
+  camera_id_ = camera_id;
 }
 
 void CameraPipeline::UpdateClipStats() {

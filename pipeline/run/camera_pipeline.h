@@ -11,6 +11,7 @@
 #include <vector>
 
 #include <opencv2/core.hpp>
+#include <spdlog/logger.h>
 
 #include "core/camera_model.h"
 #include "core/config.h"
@@ -18,6 +19,8 @@
 #include "core/geometry.h"
 #include "pipeline/extract/extractor.h"
 #include "pipeline/filter/usability.h"
+#include "pipeline/key/chroma_keyer.h"
+#include "pipeline/key/clean_plate_keyer.h"
 #include "pipeline/key/keyer.h"
 #include "pipeline/key/matte.h"
 #include "pipeline/rectify/rectifier.h"
@@ -29,6 +32,10 @@ namespace ss {
 // Everything a camera pipeline is tuned by, from the station config.
 struct CameraPipelineOptions {
   std::string keying_method = "chroma";  // "chroma" | "clean_plate"
+  ChromaKeyerOptions chroma;             // the keyer's options (config: keying.*)
+  CleanPlateKeyerOptions clean_plate;
+  double shadow_reach_m = 0;  // > 0: shaded cells join a subject this far (at the floor's centre), in
+                              // place of the keyers' grid.shadow_reach_cells
   ExtractorOptions extract;
   TrackerOptions track;
   UsabilityOptions usability;
@@ -67,11 +74,19 @@ class CameraPipeline {
   void Process(const Frame& frame, std::vector<ClipBatch>* out);
   // End of stream: every open clip is closed.
   void Finish(std::vector<ClipBatch>* out);
+  // A new capture session (the daemon): closes every open clip into `out`, then
+  // stores the clips to come under bank camera `camera_id`. The keyer stays trained.
+  void Retarget(int64_t camera_id, std::vector<ClipBatch>* out);
+
+  // The last processed frame in BGR and its matte (previews; valid until the next Process).
+  const cv::Mat& last_bgr() const { return bgr_; }
+  const Matte& last_matte() const { return matte_; }
 
   const std::string& name() const { return name_; }
   const CameraModel& model() const { return model_; }
   const CameraPipelineStats& stats() const { return stats_; }
   const FloorMask& floor_mask() const { return floor_mask_; }
+  const Keyer& keyer() const { return *keyer_; }  // as configured (PipelineOptionsFromConfig)
 
  private:
   std::string name_;
@@ -91,6 +106,7 @@ class CameraPipeline {
   void UpdateClipStats();
 
   std::optional<uint64_t> last_sequence_;
+  std::shared_ptr<spdlog::logger> log_;  // "pipeline.run": per-sprite decisions at trace level
   uint64_t usable_total_ = 0;  // sprites that passed the filters, short clips included
   CameraPipelineStats stats_;
 };

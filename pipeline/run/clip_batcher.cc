@@ -138,4 +138,9 @@ void ClipBatcher::Emit(Open& open, size_t count, bool complete, std::vector<Clip
   if (!batch.sprites.empty() || complete) out->push_back(std::move(batch));
 }
 
+void ClipBatcher::set_camera_id(int64_t camera_id) {
+  if (!clips_.empty()) throw WorkError("clip batcher", "cannot change the bank camera while clips are open");
+  camera_id_ = camera_id;
+}
+
 }  // namespace ss

@@ -51,6 +51,9 @@ class ClipBatcher {
   // Closes every open clip.
   void CloseAll(std::vector<ClipBatch>* out);
 
+  // The bank camera of the clips to come (a new capture session); only with no open clip.
+  void set_camera_id(int64_t camera_id);
+
   uint64_t short_clip_sprites() const { return short_clip_sprites_; }  // originals dropped in short clips
   uint64_t stored_originals() const { return stored_originals_; }      // originals handed out in batches
   uint64_t clips_completed() const { return clips_completed_; }

@@ -5,6 +5,7 @@
 #include <exception>
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <mutex>
 #include <thread>
 
@@ -15,6 +16,7 @@
 #include "core/error.h"
 #include "core/log.h"
 #include "pipeline/run/bounded_queue.h"
+#include "pipeline/transitions/worker.h"
 
 namespace ss {
 namespace {
@@ -102,6 +104,8 @@ IngestSummary IngestSession(const IngestOptions& options) {
     }
   }
   const CameraPipelineOptions pipeline_options = PipelineOptionsFromConfig(config);
+  const TransitionWeights transition_weights =
+      options.transition_weights.empty() ? DefaultWeights() : LoadWeights(options.transition_weights);
 
   BankWriter bank(options.bank_path);
   IngestSummary summary;
@@ -144,12 +148,18 @@ IngestSummary IngestSession(const IngestOptions& options) {
     for (CameraWork& w : cameras) w.frames->Close();
   };
 
+  // The transition worker reads and writes the bank through its own connections; the
+  // writer thread only queues each batch's ids with it.
+  std::unique_ptr<TransitionWorker> transitions;
+  if (options.transitions) transitions = std::make_unique<TransitionWorker>(options.bank_path, transition_weights, 1);
+
   std::atomic<uint64_t> frames_done{0}, rows_inserted{0}, batch_count{0}, stored{0};
   std::thread writer([&] {
     try {
       while (auto batch = batches.Pop()) {
         if (failed) break;
         const AppendResult r = bank.AppendClipBatch(batch->clip, batch->sprites);
+        if (transitions) transitions->Submit(r.sprite_ids);
         rows_inserted += static_cast<uint64_t>(r.inserted);
         ++batch_count;
         for (const SpriteRecord& s : batch->sprites) stored += s.mirrored ? 0 : 1;
@@ -215,7 +225,22 @@ IngestSummary IngestSession(const IngestOptions& options) {
   for (CameraWork& w : cameras) w.thread.join();
   batches.Close();
   writer.join();
-  if (failure) std::rethrow_exception(failure);
+  if (failure) std::rethrow_exception(failure);  // ~TransitionWorker stops it
+  if (transitions) {
+    const auto wait_start = Clock::now();
+    transitions->WaitIdle();
+    const TransitionWorkerStats t = transitions->stats();
+    transitions->Stop();
+    summary.transitions = true;
+    summary.transitions_stored = t.transitions_stored;
+    summary.transition_sprites = t.sprites;
+    summary.transitions_error = t.last_error;
+    summary.seconds_transitions_wait = std::chrono::duration<double>(Clock::now() - wait_start).count();
+    if (!t.last_error.empty()) {
+      Log("pipeline.ingest")->error("{}: the transition table may be incomplete ({}); run 'spritestation transitions "
+                                    "{}' to rebuild it", options.bank_path, t.last_error, options.bank_path);
+    }
+  }
 
   summary.source = source.stats();
   for (CameraWork& w : cameras) {

@@ -4,6 +4,9 @@
 // own thread; each camera's pipeline runs on its own thread; one writer thread
 // stores the clip batches, so no stage waits on the disk. Ingesting the same
 // session twice stores nothing new (the bank knows the session and its sprites).
+// With `transitions` on, a TransitionWorker (pipeline/transitions/worker.h) is handed
+// each stored batch's sprite ids and keeps the bank's transition table current; the
+// ingest waits for it at the end.
 #include <cstdint>
 #include <functional>
 #include <string>
@@ -28,6 +31,8 @@ struct IngestOptions {
   std::string bank_path;
   StationConfig config;  // keying, enclosure and pipeline sections are used
   std::function<void(const IngestProgress&)> progress;  // a few times a second, from the calling thread
+  bool transitions = true;         // keep the transition table current (TransitionWorker)
+  std::string transition_weights;  // weights file; empty: the shipped default weights
 };
 
 struct IngestCamera {
@@ -48,6 +53,11 @@ struct IngestSummary {
   SourceStats source;             // what the replay could not read
   double seconds = 0;
   double frames_per_second = 0;
+  bool transitions = false;           // the transition worker ran
+  int64_t transitions_stored = 0;     // transitions it wrote (its start-up table included)
+  int64_t transition_sprites = 0;     // sprites it knows at the end
+  double seconds_transitions_wait = 0;  // waiting for it after the last batch was stored
+  std::string transitions_error;      // its last error ("" when none): the table may be incomplete
 };
 
 // The floor polygon for a session: the config's `enclosure.floor` when given,

@@ -21,7 +21,9 @@ namespace fs = std::filesystem;
 
 BankTrainResult TrainOnBank(const std::string& labels_path, const std::string& bank_path,
                             const BankTrainOptions& options) {
-  const std::vector<Label> labels = ReadLabelsCsv(labels_path);
+  double file_rate = -1;
+  const std::vector<Label> labels = ReadLabelsCsv(labels_path, &file_rate);
+  const double positive_rate = options.positive_rate >= 0 ? options.positive_rate : file_rate;
   const Bank bank(bank_path);
   // The labelled sprites, each once.
   std::vector<int64_t> ids;
@@ -55,24 +57,51 @@ BankTrainResult TrainOnBank(const std::string& labels_path, const std::string& b
   result.stage1_bias_from_labels = result.weights.stage1_bias;
   nlohmann::json training = nlohmann::json::parse(result.weights.training_json);
   training["source"] = "spritestation transitions train " + labels_path + " --bank " + bank_path;
-  if (options.stage1_recall > 0) {
-    // Stage 1 as a filter: judge every pair of some sprites with stage 2 (brute force) and
-    // let stage 1 pass the requested share of what stage 2 accepts.
+  const bool calibrate_stage2 = positive_rate > 0;
+  if (calibrate_stage2 || options.stage1_recall > 0) {
+    // Judge every pair of some sprites with stage 2 (brute force): the population.
     SegmentKeys all_keys;
     const BankSprites everything = LoadBankSprites(bank, &all_keys);
     if (!everything.inputs.empty()) {
       SpriteStore all(options.window, everything.px_per_m);
       all.Append(everything.inputs, options.threads);
-      const auto accepted = SampleStage2Accepted(all, TransitionClassifier(result.weights), options.calibration_rows,
-                                                 options.train.seed, options.threads);
-      CalibrateStage1(accepted, options.stage1_recall, &result.weights);
-      result.calibration_accepts = static_cast<int64_t>(accepted.size());
+      if (calibrate_stage2) {
+        std::vector<double> positive_distances;
+        const TransitionClassifier label_fit(result.weights);
+        for (size_t k = 0; k < labels.size(); ++k) {
+          if (y[k]) positive_distances.push_back(label_fit.Distance(x[k]));
+        }
+        const PopulationSample sample = SamplePopulation(all, label_fit, options.calibration_rows, options.train.seed,
+                                                         options.threads);
+        result.stage2 = CalibrateStage2(positive_distances, sample, positive_rate, &result.weights);
+        result.stage2_calibrated = true;
+        training["stage2_calibration"] = {{"positive_rate", positive_rate},
+                                          {"sampled_rows", sample.rows.size()},
+                                          {"threshold", result.stage2.threshold},
+                                          {"accepts_per_sprite", result.stage2.accepts_per_sprite},
+                                          {"estimated_precision", result.stage2.precision},
+                                          {"estimated_recall", result.stage2.recall},
+                                          {"bias", result.weights.stage2_bias}};
+        if (options.stage1_recall > 0) {
+          result.stage1 = FitStage1Filter(all, sample, options.stage1_recall, options.train.seed, &result.weights);
+          result.calibration_accepts = result.stage1.stage2_accepts;
+        }
+      } else {
+        const auto accepted = SampleStage2Accepted(all, TransitionClassifier(result.weights),
+                                                   options.calibration_rows, options.train.seed, options.threads);
+        CalibrateStage1(accepted, options.stage1_recall, &result.weights);
+        result.calibration_accepts = static_cast<int64_t>(accepted.size());
+      }
     }
-    training["stage1_calibration"] = {{"target_recall_of_stage2", options.stage1_recall},
-                                      {"stage2_accepted_pairs_sampled", result.calibration_accepts},
-                                      {"sampled_rows", options.calibration_rows},
-                                      {"bias_from_labels", result.stage1_bias_from_labels},
-                                      {"bias", result.weights.stage1_bias}};
+    if (options.stage1_recall > 0) {
+      training["stage1_calibration"] = {{"target_recall_of_stage2", options.stage1_recall},
+                                        {"refitted_as_filter", result.stage2_calibrated},
+                                        {"stage2_accepted_pairs_sampled", result.calibration_accepts},
+                                        {"sampled_rows", options.calibration_rows},
+                                        {"candidates_per_sprite", result.stage1.candidates_per_sprite},
+                                        {"bias_from_labels", result.stage1_bias_from_labels},
+                                        {"bias", result.weights.stage1_bias}};
+    }
   }
   result.weights.training_json = training.dump();
   return result;
@@ -203,6 +232,7 @@ TruthLabelSummary LabelBankFromTruth(const std::string& session_dir, const std::
                                     " do not): at least two are needed to make labels");
   }
   summary.labels = LabelsFromTruth(ids, truth, count, options, seed);
+  summary.positive_rate = TruthPositiveRate(truth, options, 2000, seed);
   return summary;
 }
 

@@ -14,7 +14,10 @@ namespace ss {
 struct BankTrainOptions {
   TrainOptions train;
   ComparisonWindow window;     // the pixel features' window (recorded in the weights)
-  double stage1_recall = 0.995;  // of stage-2 accepts that stage 1 must pass (0 = keep the label fit)
+  double stage1_recall = 0.999;  // of stage-2 accepts stage 1 must pass in the sample (0 = keep the label fit)
+  // Share of all sprite pairs that are true transitions; < 0: the labels file's
+  // "# positive_rate=" line; none there: stage 2 keeps the label fit's (50/50) bias.
+  double positive_rate = -1;
   int calibration_rows = 300;  // sprites whose every pair stage 2 judges for the calibration
   int threads = 2;
 };
@@ -24,11 +27,16 @@ struct BankTrainResult {
   TrainReport report;  // cross-validated precision/recall of both stages on the labels
   int64_t calibration_accepts = 0;  // stage-2 accepted pairs the stage-1 bias was set on
   double stage1_bias_from_labels = 0;
+  bool stage2_calibrated = false;   // a positive rate was known
+  Stage2Calibration stage2;
+  Stage1Calibration stage1;         // when stage2_calibrated and stage1_recall > 0
 };
 
-// Trains both stages on the labelled pairs of `bank_path`'s sprites, then sets the
-// stage-1 bias so that stage 1 passes `stage1_recall` of what stage 2 accepts on the
-// bank (stage 1 is only a filter). InputError naming the labels file or the bank for an
+// Trains both stages on the labelled pairs of `bank_path`'s sprites. With a positive rate
+// (options or the labels file) stage 2's threshold is then set for it on a brute-force
+// sample of the bank (CalibrateStage2) and stage 1 refitted as its filter
+// (FitStage1Filter); without one, only the stage-1 bias is set so that stage 1 passes
+// `stage1_recall` of what stage 2 accepts on the bank. InputError naming the labels file or the bank for an
 // unknown sprite, too few labels or one class only.
 BankTrainResult TrainOnBank(const std::string& labels_path, const std::string& bank_path,
                             const BankTrainOptions& options);
@@ -37,6 +45,7 @@ struct TruthLabelSummary {
   int64_t sprites_matched = 0;    // originals of the session's cameras given a truth
   int64_t sprites_unmatched = 0;  // no truth row at their time and place
   int64_t mirrored_skipped = 0;
+  double positive_rate = 0;  // share of the matched sprites' pairs the truth accepts
   std::vector<Label> labels;
 };
 

@@ -78,11 +78,13 @@ void TransitionBuilder::BuildFromScratch(std::span<const SpriteInput> sprites, c
       for (int32_t i = begin; i < end; ++i) {
         hits.clear();
         index_.Query(store_.cheap(i), &hits);
-        for (int32_t j : hits) {
+        for (size_t h = 0; h < hits.size(); ++h) {
+          if (h + 8 < hits.size()) store_.PrefetchAlphaBlocks(hits[h + 8]);
+          const int32_t j = hits[h];
           if (j <= i) continue;
           ++local_candidates;
-          const double d = classifier_.Distance(store_.Features(i, j));
-          if (classifier_.Stage2Accepts(d)) local.push_back({i, j, d});
+          double d;
+          if (classifier_.Stage2(store_, i, j, &d)) local.push_back({i, j, d});
         }
       }
       std::lock_guard<std::mutex> lock(merge_mutex);
@@ -138,9 +140,11 @@ TransitionDelta TransitionBuilder::Add(std::span<const SpriteInput> sprites) {
     index_.Insert(store_.cheap(s));
     stats_.stage1_candidates += static_cast<int64_t>(hits.size());
     auto& mine = neighbours_[s];
-    for (int32_t j : hits) {
-      const double d = classifier_.Distance(store_.Features(s, j));
-      if (!classifier_.Stage2Accepts(d)) continue;
+    for (size_t h = 0; h < hits.size(); ++h) {
+      if (h + 8 < hits.size()) store_.PrefetchAlphaBlocks(hits[h + 8]);
+      const int32_t j = hits[h];
+      double d;
+      if (!classifier_.Stage2(store_, s, j, &d)) continue;
       mine.push_back({j, d});
       InsertNeighbour(j, s, d);
       const int64_t a = store_.id(s), b = store_.id(j);

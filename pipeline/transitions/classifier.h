@@ -6,6 +6,7 @@
 #include <array>
 
 #include "pipeline/transitions/features.h"
+#include "pipeline/transitions/sprite_store.h"
 #include "pipeline/transitions/weights.h"
 
 namespace ss {
@@ -33,6 +34,12 @@ class TransitionClassifier {
     return d;
   }
   bool Stage2Accepts(double distance) const { return distance <= t2_; }
+  // Stage 2 on store indices (i, j) with early exits: the sum of Distance() is built in
+  // its own order (the cheap terms, then alpha, then colour) and every term is >= 0, so
+  // once a partial sum exceeds the threshold the pair is rejected without reading the
+  // rest of the images. Decides exactly as Stage2Accepts(Distance(store.Features(i, j)))
+  // and, when accepted, sets *distance to that same value.
+  bool Stage2(const SpriteStore& store, int32_t i, int32_t j, double* distance) const;
 
   const CheapDifference& stage1_unit_weights() const { return u1_; }
   double stage1_threshold() const { return t1_; }

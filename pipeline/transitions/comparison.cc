@@ -219,7 +219,36 @@ __attribute__((target("avx2"))) PixelSums SumAvx2(const uint8_t* a, const uint8_
 using Kernel = PixelSums (*)(const uint8_t*, const uint8_t*, int);
 Kernel ChooseKernel() { return __builtin_cpu_supports("avx2") ? &SumAvx2 : &SumSse2; }
 
+// The alpha plane's SAD alone (the stride is a multiple of 64).
+uint64_t AlphaSse2(const uint8_t* a, const uint8_t* b, int stride) {
+  __m128i sad = _mm_setzero_si128();
+  for (int k = 0; k < stride; k += 16) {
+    sad = _mm_add_epi64(sad, _mm_sad_epu8(_mm_loadu_si128(reinterpret_cast<const __m128i*>(a + k)),
+                                          _mm_loadu_si128(reinterpret_cast<const __m128i*>(b + k))));
+  }
+  alignas(16) uint64_t s64[2];
+  _mm_store_si128(reinterpret_cast<__m128i*>(s64), sad);
+  return s64[0] + s64[1];
+}
+__attribute__((target("avx2"))) uint64_t AlphaAvx2(const uint8_t* a, const uint8_t* b, int stride) {
+  __m256i sad = _mm256_setzero_si256();
+  for (int k = 0; k < stride; k += 32) {
+    sad = _mm256_add_epi64(sad, _mm256_sad_epu8(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(a + k)),
+                                                _mm256_loadu_si256(reinterpret_cast<const __m256i*>(b + k))));
+  }
+  alignas(32) uint64_t s64[4];
+  _mm256_store_si256(reinterpret_cast<__m256i*>(s64), sad);
+  return s64[0] + s64[1] + s64[2] + s64[3];
+}
+using AlphaKernel = uint64_t (*)(const uint8_t*, const uint8_t*, int);
+AlphaKernel ChooseAlphaKernel() { return __builtin_cpu_supports("avx2") ? &AlphaAvx2 : &AlphaSse2; }
+
 }  // namespace
+
+uint64_t SumAlphaDifference(const uint8_t* a, const uint8_t* b, int stride) {
+  static const AlphaKernel kernel = ChooseAlphaKernel();
+  return kernel(a, b, stride);
+}
 
 PixelSums SumPixelDifferences(const uint8_t* a, const uint8_t* b, int stride) {
   static const Kernel kernel = ChooseKernel();

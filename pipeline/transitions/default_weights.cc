@@ -39,16 +39,16 @@ const char* DefaultWeightsText() {
   ],
   "format": "spritestation-transition-weights",
   "stage1": {
-    "bias": -0.9185983406821834,
+    "bias": 3.230914805450133,
     "weights": [
-      1.364962493184733,
-      0.058383352773824344,
-      2.5917508056678127,
-      4.188599776084517
+      2.4063328164520486,
+      0.3390324240198519,
+      7.223698509336171,
+      8.261038278365103
     ]
   },
   "stage2": {
-    "bias": 4.270845235212679,
+    "bias": 7.138560412642737,
     "weights": [
       0.5576472055963501,
       0.0,
@@ -64,11 +64,13 @@ const char* DefaultWeightsText() {
     "samples": 3000,
     "source": "spritestation bench transitions --train-out: synthetic hamster set, seed 1, 30000 sprites (pipeline/transitions/synthetic.cc), labels from truth",
     "stage1_calibration": {
-      "bias": -0.9185983406821834,
+      "bias": 3.230914805450133,
       "bias_from_labels": 2.4690613128921286,
+      "candidates_per_sprite": 2565.7566666666667,
+      "refitted_as_filter": true,
       "sampled_rows": 300,
-      "stage2_accepted_pairs_sampled": 69777,
-      "target_recall_of_stage2": 0.995
+      "stage2_accepted_pairs_sampled": 12188,
+      "target_recall_of_stage2": 0.999
     },
     "stage1_cross_validated": {
       "false_accept": 380,
@@ -77,6 +79,15 @@ const char* DefaultWeightsText() {
       "recall": 0.8973333333333333,
       "true_accept": 1346,
       "true_reject": 1120
+    },
+    "stage2_calibration": {
+      "accepts_per_sprite": 40.626666666666665,
+      "bias": 7.138560412642737,
+      "estimated_precision": 0.5474236954381358,
+      "estimated_recall": 0.512,
+      "positive_rate": 0.0014479649321644055,
+      "sampled_rows": 300,
+      "threshold": 4.354240417480469
     },
     "stage2_cross_validated": {
       "false_accept": 182,

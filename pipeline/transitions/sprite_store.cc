@@ -25,6 +25,7 @@ void SpriteStore::Clear() {
   next_.clear();
   cheap_.clear();
   boxes_.clear();
+  alpha_blocks_.clear();
   chunks_.clear();
   index_of_.clear();
   clip_last_.clear();
@@ -61,6 +62,7 @@ int32_t SpriteStore::Append(std::span<const SpriteInput> sprites, int threads) {
   next_.reserve(n);
   cheap_.reserve(n);
   boxes_.resize(n);
+  alpha_blocks_.resize(n);
   while (chunks_.size() * kChunkSize < n) {
     chunks_.emplace_back(new uint8_t[static_cast<size_t>(kChunkSize) * image_bytes_]);
   }
@@ -92,6 +94,14 @@ int32_t SpriteStore::Append(std::span<const SpriteInput> sprites, int threads) {
         const int32_t i = first + static_cast<int32_t>(k);
         try {
           boxes_[i] = MakeComparisonImage(*sprites[k].billboard, px_per_m_, window_, mutable_image(i));
+          const uint8_t* alpha = image(i);
+          auto& blocks = alpha_blocks_[i];
+          blocks.fill(0);
+          for (int v = 0; v < window_.cells_y; ++v) {
+            for (int u = 0; u < window_.cells_x; ++u) {
+              blocks[(v * 4 / window_.cells_y) * 4 + u * 4 / window_.cells_x] += alpha[v * window_.cells_x + u];
+            }
+          }
         } catch (...) {
           std::lock_guard<std::mutex> lock(error_mutex);
           if (!error) error = std::current_exception();

@@ -2,6 +2,7 @@
 // What the transition finder keeps per sprite: bank id, clip links, the cheap
 // features and the comparison image (stored once, contiguous, in chunks so that
 // appending never moves existing images). The bank fills it (SpriteInput).
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -44,6 +45,18 @@ class SpriteStore {
     return chunks_[i >> kChunkShift].get() + static_cast<size_t>(i & (kChunkSize - 1)) * image_bytes_;
   }
   const CellBox& box(int32_t i) const { return boxes_[i]; }
+  // The alpha plane summed over a 4 x 4 grid of cell blocks (64 bytes a sprite, contiguous):
+  // sum_b |S_i,b - S_j,b| <= sum_cells |A_i - A_j|, an exact lower bound of the alpha
+  // feature's numerator that stage 2 checks before reading a plane.
+  static constexpr int kAlphaBlocks = 16;
+  uint64_t AlphaLowerBound(int32_t i, int32_t j) const {
+    const uint32_t* a = alpha_blocks_[i].data();
+    const uint32_t* b = alpha_blocks_[j].data();
+    uint64_t sum = 0;
+    for (int k = 0; k < kAlphaBlocks; ++k) sum += a[k] > b[k] ? a[k] - b[k] : b[k] - a[k];
+    return sum;
+  }
+  void PrefetchAlphaBlocks(int32_t i) const { __builtin_prefetch(alpha_blocks_[i].data()); }
   std::optional<int32_t> IndexOf(int64_t id) const;
   size_t clip_count() const { return clip_last_.size(); }
   const ComparisonWindow& window() const { return window_; }
@@ -70,6 +83,7 @@ class SpriteStore {
   std::vector<int32_t> prev_, next_;
   std::vector<CheapFeatures> cheap_;
   std::vector<CellBox> boxes_;
+  std::vector<std::array<uint32_t, kAlphaBlocks>> alpha_blocks_;
   std::vector<std::unique_ptr<uint8_t[]>> chunks_;
   std::unordered_map<int64_t, int32_t> index_of_;
   std::unordered_map<int64_t, int32_t> clip_last_;

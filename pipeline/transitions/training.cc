@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <mutex>
 #include <numeric>
@@ -18,7 +19,8 @@ namespace ss {
 
 // ---- labels file ----
 
-std::vector<Label> ReadLabelsCsv(const std::string& path) {
+std::vector<Label> ReadLabelsCsv(const std::string& path, double* positive_rate) {
+  if (positive_rate) *positive_rate = -1;
   std::ifstream in(path);
   if (!in) throw InputError(path, "cannot open the labels file");
   std::string line;
@@ -28,8 +30,22 @@ std::vector<Label> ReadLabelsCsv(const std::string& path) {
   while (std::getline(in, line)) {
     ++line_number;
     if (!line.empty() && line.back() == '\r') line.pop_back();
-    if (line.empty() || line[0] == '#') continue;
     const std::string where = path + ":" + std::to_string(line_number);
+    if (!line.empty() && line[0] == '#') {
+      const std::string key = "# positive_rate=";
+      if (line.rfind(key, 0) == 0) {
+        try {
+          size_t used = 0;
+          const double rate = std::stod(line.substr(key.size()), &used);
+          if (used != line.size() - key.size() || !(rate > 0 && rate < 1)) throw std::invalid_argument("range");
+          if (positive_rate) *positive_rate = rate;
+        } catch (const std::exception&) {
+          throw InputError(where, "positive_rate must be a number in (0, 1): '" + line + "'");
+        }
+      }
+      continue;
+    }
+    if (line.empty()) continue;
     if (!header_seen) {
       if (line != "sprite_i,sprite_j,accept") {
         throw InputError(where, "expected the header 'sprite_i,sprite_j,accept', got '" + line + "'");
@@ -67,9 +83,14 @@ std::vector<Label> ReadLabelsCsv(const std::string& path) {
   return labels;
 }
 
-void WriteLabelsCsv(const std::vector<Label>& labels, const std::string& path) {
+void WriteLabelsCsv(const std::vector<Label>& labels, const std::string& path, double positive_rate) {
   std::ofstream out(path, std::ios::trunc);
   if (!out) throw WorkError(path, "cannot open for writing");
+  if (positive_rate >= 0) {
+    char text[64];
+    std::snprintf(text, sizeof(text), "# positive_rate=%.9g\n", positive_rate);
+    out << text;
+  }
   out << "sprite_i,sprite_j,accept\n";
   for (const Label& l : labels) out << l.sprite_i << ',' << l.sprite_j << ',' << (l.accept ? 1 : 0) << '\n';
   out.close();
@@ -350,6 +371,145 @@ std::vector<CheapDifference> SampleStage2Accepted(const SpriteStore& store, cons
   work();
   for (auto& t : pool) t.join();
   return out;
+}
+
+PopulationSample SamplePopulation(const SpriteStore& store, const TransitionClassifier& classifier, int rows,
+                                  uint64_t seed, int threads) {
+  PopulationSample out;
+  const int32_t n = store.size();
+  out.sprites = n;
+  std::vector<int32_t> sample(n);
+  std::iota(sample.begin(), sample.end(), 0);
+  std::mt19937_64 rng(seed);
+  std::shuffle(sample.begin(), sample.end(), rng);
+  sample.resize(std::min<int32_t>(n, std::max(0, rows)));
+  out.rows = sample;
+  out.distance.assign(sample.size() * static_cast<size_t>(n), INFINITY);
+  std::atomic<size_t> cursor{0};
+  auto work = [&] {
+    for (size_t r; (r = cursor.fetch_add(1)) < sample.size();) {
+      const int32_t i = sample[r];
+      float* row = &out.distance[r * n];
+      for (int32_t j = 0; j < n; ++j) {
+        if (j != i) row[j] = static_cast<float>(classifier.Distance(store.Features(i, j)));
+      }
+    }
+  };
+  std::vector<std::thread> pool;
+  for (int t = 1; t < threads; ++t) pool.emplace_back(work);
+  work();
+  for (auto& t : pool) t.join();
+  return out;
+}
+
+namespace {
+
+// The stage-2 threshold t2 = sum_k u2_k mean_k - b (TransitionClassifier), solved for b.
+void SetStage2Threshold(double threshold, TransitionWeights* w) {
+  double at_zero = 0;
+  for (int k = 0; k < kPairFeatureCount; ++k) at_zero += w->stage2_weights[k] / w->feature_scale[k] * w->feature_mean[k];
+  w->stage2_bias = at_zero - threshold;
+}
+
+}  // namespace
+
+Stage2Calibration CalibrateStage2(std::span<const double> positive_distances, const PopulationSample& sample,
+                                  double positive_rate, TransitionWeights* w) {
+  if (positive_distances.empty()) throw InputError("labels", "no accepted pair: stage 2 cannot be calibrated");
+  if (!(positive_rate > 0 && positive_rate < 1)) {
+    throw InputError("labels", "the positive rate must be in (0, 1), got " + std::to_string(positive_rate));
+  }
+  if (sample.rows.empty() || sample.sprites < 2) throw InputError("sprites", "no sample to calibrate stage 2 on");
+  std::vector<double> positives(positive_distances.begin(), positive_distances.end());
+  std::sort(positives.begin(), positives.end());
+  // Only the smallest distances can matter: at most a few times the expected positives.
+  const double pairs = sample.pairs();
+  const double expected_true = positive_rate * pairs;
+  const size_t keep = std::min<size_t>(sample.distance.size(), static_cast<size_t>(20 * expected_true) + 1000);
+  std::vector<float> d(sample.distance.begin(), sample.distance.end());
+  std::nth_element(d.begin(), d.begin() + (keep - 1), d.end());
+  d.resize(keep);
+  std::sort(d.begin(), d.end());
+  Stage2Calibration best;
+  best.positive_rate = positive_rate;
+  best.threshold = -1;
+  for (size_t k = 0; k < d.size(); ++k) {
+    if (!std::isfinite(d[k])) break;
+    if (k + 1 < d.size() && d[k + 1] == d[k]) continue;  // the last of equal values
+    const double t = d[k];
+    const double recall = static_cast<double>(std::upper_bound(positives.begin(), positives.end(), t) -
+                                              positives.begin()) / positives.size();
+    const double accepted = static_cast<double>(k + 1);
+    const double precision = std::min(1.0, expected_true * recall / accepted);
+    const double f1 = precision + recall > 0 ? 2 * precision * recall / (precision + recall) : 0.0;
+    if (f1 > best.f1) {
+      best.threshold = t;
+      best.precision = precision;
+      best.recall = recall;
+      best.f1 = f1;
+      best.accepts_per_sprite = accepted / sample.rows.size();
+    }
+  }
+  if (best.threshold < 0) throw InputError("labels", "no stage-2 threshold accepts a labelled transition");
+  // Nudge so that rounding keeps the chosen pairs inside.
+  SetStage2Threshold(best.threshold + 1e-7 * (1.0 + std::abs(best.threshold)), w);
+  return best;
+}
+
+Stage1Calibration FitStage1Filter(const SpriteStore& store, const PopulationSample& sample, double recall,
+                                  uint64_t seed, TransitionWeights* w) {
+  const TransitionClassifier classifier(*w);
+  const int32_t n = sample.sprites;
+  std::mt19937_64 rng(seed);
+  // Positives: every pair stage 2 accepts; negatives: about 20 per positive, at random.
+  int64_t positives = 0;
+  for (float d : sample.distance) positives += classifier.Stage2Accepts(d);
+  Stage1Calibration c;
+  c.recall = recall;
+  c.stage2_accepts = positives;
+  if (positives == 0) return c;
+  const double negative_share = std::min(1.0, 20.0 * positives / std::max(1.0, sample.pairs() - positives));
+  std::bernoulli_distribution take(negative_share);
+  std::vector<CheapDifference> x;
+  std::vector<uint8_t> y;
+  for (size_t r = 0; r < sample.rows.size(); ++r) {
+    const int32_t i = sample.rows[r];
+    for (int32_t j = 0; j < n; ++j) {
+      if (j == i) continue;
+      const bool accepted = classifier.Stage2Accepts(sample.distance[r * n + j]);
+      if (!accepted && !take(rng)) continue;
+      x.push_back(CheapDiff(store.cheap(i), store.cheap(j)));
+      y.push_back(accepted);
+    }
+  }
+  if (x.size() > static_cast<size_t>(positives)) {  // both classes present
+    std::vector<double> z(x.size() * kCheapFeatureCount);
+    for (size_t s = 0; s < x.size(); ++s) {
+      for (int k = 0; k < kCheapFeatureCount; ++k) {
+        z[s * kCheapFeatureCount + k] = (x[s][k] - w->feature_mean[k]) / w->feature_scale[k];
+      }
+    }
+    const LinearModel m = FitLogistic(z, kCheapFeatureCount, y, LogisticOptions{});
+    double total = 0;
+    for (double v : m.weights) total += v;
+    if (total > 0) {
+      for (int k = 0; k < kCheapFeatureCount; ++k) w->stage1_weights[k] = m.weights[k];
+    }
+  }
+  std::vector<CheapDifference> accepted;
+  for (size_t s = 0; s < x.size(); ++s) {
+    if (y[s]) accepted.push_back(x[s]);
+  }
+  CalibrateStage1(accepted, recall, w);
+  // Candidates per sprite with the new stage 1, on the same sample.
+  const TransitionClassifier filter(*w);
+  int64_t candidates = 0;
+  for (int32_t i : sample.rows) {
+    for (int32_t j = 0; j < n; ++j) candidates += j != i && filter.Stage1Accepts(store.cheap(i), store.cheap(j));
+  }
+  c.candidates_per_sprite = static_cast<double>(candidates) / sample.rows.size();
+  c.fewer_than_all = candidates > 0 ? sample.pairs() / candidates : INFINITY;
+  return c;
 }
 
 double CalibrateStage1(std::span<const CheapDifference> accepted, double recall, TransitionWeights* w) {

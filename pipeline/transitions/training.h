@@ -20,8 +20,11 @@ struct Label {
   bool accept = false;
 };
 // Throws InputError("PATH:LINE", reason) for a missing file, header or malformed line.
-std::vector<Label> ReadLabelsCsv(const std::string& path);
-void WriteLabelsCsv(const std::vector<Label>& labels, const std::string& path);
+// A comment line "# positive_rate=R" (written by `label --from-truth`) sets *positive_rate
+// (the share of all sprite pairs that are true transitions); -1 when the file has none.
+std::vector<Label> ReadLabelsCsv(const std::string& path, double* positive_rate = nullptr);
+// positive_rate >= 0 is written as the comment line above.
+void WriteLabelsCsv(const std::vector<Label>& labels, const std::string& path, double positive_rate = -1);
 
 struct LogisticOptions {
   double l2 = 1e-4;             // ridge on the weights (not the bias)
@@ -69,6 +72,43 @@ TransitionWeights TrainWeights(std::span<const PairFeatures> features, std::span
 // returns the cheap differences of the pairs it accepts.
 std::vector<CheapDifference> SampleStage2Accepted(const SpriteStore& store, const TransitionClassifier& classifier,
                                                   int rows, uint64_t seed, int threads);
+
+// Stage 2 (brute force) on every pair of `rows` random sprites against all others: the
+// population the labels cannot show (true transitions are rare: tens among tens of thousands).
+struct PopulationSample {
+  int32_t sprites = 0;          // n
+  std::vector<int32_t> rows;    // store indices of the sampled sprites
+  std::vector<float> distance;  // rows.size() x n: D(rows[r], j), +inf for j == rows[r]
+  double pairs() const { return static_cast<double>(rows.size()) * (sprites - 1); }
+};
+PopulationSample SamplePopulation(const SpriteStore& store, const TransitionClassifier& classifier, int rows,
+                                  uint64_t seed, int threads);
+
+struct Stage2Calibration {
+  double threshold = 0;           // D threshold T2
+  double positive_rate = 0;       // used
+  double accepts_per_sprite = 0;  // in the sample
+  double precision = 0, recall = 0, f1 = 0;  // estimated (see CalibrateStage2)
+};
+// Sets the stage-2 bias for the real positive rate: a pair is a true transition with
+// probability `positive_rate`, so at threshold T the expected true accepts are
+// positive_rate * pairs * r(T) (r = share of `positive_distances`, the D of accept labels,
+// at most T) against A(T) pairs of the sample accepted. Picks the T of the best estimated
+// F1. InputError("labels", ...) without positive labels or with a rate outside (0, 1).
+Stage2Calibration CalibrateStage2(std::span<const double> positive_distances, const PopulationSample& sample,
+                                  double positive_rate, TransitionWeights* weights);
+
+struct Stage1Calibration {
+  double recall = 0;               // asked share of stage-2 accepts
+  int64_t stage2_accepts = 0;      // in the sample
+  double candidates_per_sprite = 0;  // in the sample, with the new weights
+  double fewer_than_all = 0;       // all pairs / stage-1 candidates
+};
+// Refits stage 1 as a filter for stage 2: logistic regression (non-negative, balanced) on
+// the cheap differences of the sample, positives = the pairs stage 2 accepts, negatives a
+// random subset of the rest; then sets its bias so that `recall` of the positives pass.
+Stage1Calibration FitStage1Filter(const SpriteStore& store, const PopulationSample& sample, double recall,
+                                  uint64_t seed, TransitionWeights* weights);
 
 // Sets the stage-1 bias so that at least `recall` of `stage2_accepted` pass stage 1
 // (stage 1 only filters for stage 2). Returns the previous bias.

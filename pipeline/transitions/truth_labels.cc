@@ -1,6 +1,7 @@
 #include "pipeline/transitions/truth_labels.h"
 
 #include <algorithm>
+#include <numeric>
 #include <random>
 #include <set>
 #include <unordered_map>
@@ -47,6 +48,24 @@ bool Within(const SpriteTruth& a, const SpriteTruth& b, const TruthLabelOptions&
 
 bool TruthAccepts(const SpriteTruth& a, const SpriteTruth& b, const TruthLabelOptions& options) {
   return Within(a, b, options, 1.0);
+}
+
+double TruthPositiveRate(std::span<const SpriteTruth> truth, const TruthLabelOptions& options, int rows,
+                         uint64_t seed) {
+  const size_t n = truth.size();
+  if (n < 2) return 0.0;
+  std::vector<size_t> sample(n);
+  std::iota(sample.begin(), sample.end(), size_t{0});
+  if (rows > 0 && static_cast<size_t>(rows) < n) {
+    std::mt19937_64 rng(seed);
+    std::shuffle(sample.begin(), sample.end(), rng);
+    sample.resize(static_cast<size_t>(rows));
+  }
+  double positives = 0;
+  for (size_t i : sample) {
+    for (size_t j = 0; j < n; ++j) positives += j != i && TruthAccepts(truth[i], truth[j], options);
+  }
+  return positives / (static_cast<double>(sample.size()) * static_cast<double>(n - 1));
 }
 
 std::vector<Label> LabelsFromTruth(std::span<const int64_t> ids, std::span<const SpriteTruth> truth, size_t count,

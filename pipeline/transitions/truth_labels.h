@@ -45,6 +45,11 @@ double PhaseDifference(double a, double b);
 
 bool TruthAccepts(const SpriteTruth& a, const SpriteTruth& b, const TruthLabelOptions& options);
 
+// The share of sprite pairs the truth accepts, from `rows` random sprites against all
+// others (every pair when rows >= n): the prior stage 2 is calibrated for.
+double TruthPositiveRate(std::span<const SpriteTruth> truth, const TruthLabelOptions& options, int rows,
+                         uint64_t seed);
+
 // About `count` labelled pairs of distinct sprites: half accepts (as many as exist), half
 // rejects. `ids[k]` is the bank id of the sprite with truth `truth[k]`. Deterministic per seed.
 std::vector<Label> LabelsFromTruth(std::span<const int64_t> ids, std::span<const SpriteTruth> truth, size_t count,

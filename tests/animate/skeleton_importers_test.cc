@@ -20,7 +20,7 @@ namespace ss {
 namespace {
 
 std::string Data(const std::string& name) {
-  return (std::filesystem::path(__FILE__).parent_path().parent_path() / "data" / "skeleton" / name).string();
+  return ss::testing::SourcePath("tests/data/skeleton/" + name);
 }
 
 // Expects joint `name` of `frame` at (x, y).

@@ -22,7 +22,7 @@ namespace {
 using Script = std::vector<std::pair<Gesture, int>>;
 
 std::string Data(const std::string& name) {
-  return (std::filesystem::path(__FILE__).parent_path().parent_path() / "data" / "skeleton" / name).string();
+  return ss::testing::SourcePath("tests/data/skeleton/" + name);
 }
 
 // The target: YMCA and walking by the reference body. The source: the same gestures in

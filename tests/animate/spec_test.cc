@@ -194,7 +194,7 @@ TEST_F(SpecTest, LoadsAFileAndRefusesAMissingOne) {
 // Every example in docs/examples parses (with stand-ins for its bank, camera and image).
 TEST_F(SpecTest, TheDocumentedExamplesAreValid) {
   namespace fs = std::filesystem;
-  const fs::path examples = (fs::path(__FILE__).parent_path() / "../../docs/examples").lexically_normal();
+  const fs::path examples = fs::path(ss::testing::SourcePath("docs/examples"));
   for (const char* name : {"hamster.ssbank", "fly.ssbank", "floor.png"}) std::ofstream(dir_ / name) << "x";
   int count = 0;
   for (const auto& entry : fs::directory_iterator(examples)) {

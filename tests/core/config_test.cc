@@ -18,7 +18,7 @@ using ss::testing::ScratchDir;
 namespace fs = std::filesystem;
 
 const std::string kExample =
-    (fs::path(__FILE__).parent_path() / "../../docs/station.example.yaml").lexically_normal();
+    fs::path(ss::testing::SourcePath("docs/station.example.yaml"));
 
 ConfigOptions NoFileChecks() {
   ConfigOptions o;

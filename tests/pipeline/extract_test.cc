@@ -107,8 +107,8 @@ TEST_F(ExtractorTest, OneSubjectGivesItsBoxAlphaShadowAndLowestPoint) {
   // Area: the sum of true alpha; lowest point: where alpha falls through 1/2 at the bottom.
   EXPECT_NEAR(c.area, cv::sum(f.alpha)[0], 0.02 * cv::sum(f.alpha)[0]);
   const cv::Point2d low = KeyScene::LowestPoint(s);
-  EXPECT_NEAR(c.lowest_point.x, low.x, 1.0);
-  EXPECT_NEAR(c.lowest_point.y, low.y, 0.5);
+  EXPECT_NEAR(c.contact_point.x, low.x, 1.0);
+  EXPECT_NEAR(c.contact_point.y, low.y, 0.5);
   EXPECT_FALSE(c.touches_border);
   EXPECT_EQ(extractor.dropped_last(), 0);
 }
@@ -125,7 +125,7 @@ TEST_F(ExtractorTest, SeveralSubjectsEachGetTheirOwnCandidate) {
     ASSERT_NE(c, nullptr) << "no candidate at " << s.centre;
     const cv::Mat truth = TruthOf(scene_, s, 1);
     EXPECT_GE(testing::SoftIoU(truth, Pasted(*c, f.bgr.size())), 0.95) << "subject at " << s.centre;
-    EXPECT_NEAR(c->lowest_point.y, KeyScene::LowestPoint(s).y, 0.5) << "subject at " << s.centre;
+    EXPECT_NEAR(c->contact_point.y, KeyScene::LowestPoint(s).y, 0.5) << "subject at " << s.centre;
     // Spill greens the rim: the keyed edge sits about half a pixel inside the true one.
     const double perimeter = 2 * CV_PI * std::sqrt((s.rx * s.rx + s.ry * s.ry) / 2);
     EXPECT_NEAR(c->area, cv::sum(truth)[0], 0.6 * perimeter) << "subject at " << s.centre;

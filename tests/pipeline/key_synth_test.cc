@@ -13,6 +13,7 @@
 #include "core/frame.h"
 #include "pipeline/extract/extractor.h"
 #include "pipeline/key/chroma_keyer.h"
+#include "pipeline/run/camera_pipeline.h"
 #include "synth/directors.h"
 #include "synth/renderer.h"
 #include "synth/scene.h"
@@ -32,7 +33,8 @@ struct KeyedFrame {
 
 // Renders `frames` frames (every `stride`-th of a 30 fps session) of one animal
 // for one camera, keys them as `format` and scores each against the truth.
-std::vector<KeyedFrame> KeySynthSession(uint64_t seed, PixelFormat format, int frames, int stride) {
+std::vector<KeyedFrame> KeySynthSession(uint64_t seed, PixelFormat format, int frames, int stride,
+                                        const ChromaKeyerOptions& keyer_options = {}) {
   using namespace synth;
   const Studio studio = MakeStudio(StudioKind::kEnclosure, seed);
   const std::vector<SynthCamera> cameras = MakeCameras(studio, 1, kWidth, kHeight, seed);
@@ -46,7 +48,7 @@ std::vector<KeyedFrame> KeySynthSession(uint64_t seed, PixelFormat format, int f
                                  sensor.Capture(renderer.clean_plate(), format, 1'000'000 + static_cast<uint64_t>(i)));
     empty.push_back(ToBgr(f));
   }
-  ChromaKeyer keyer;
+  ChromaKeyer keyer(keyer_options);
   keyer.Train(empty);
   Extractor extractor;
 
@@ -108,6 +110,16 @@ TEST(KeySynth, MedianAlphaIoUOnAStudioSessionRgb) {
 TEST(KeySynth, MedianAlphaIoUOnAStudioSessionBayer) {
   const std::vector<KeyedFrame> frames = KeySynthSession(5, PixelFormat::kBayerRG8, 10, 11);
   EXPECT_GE(MedianIoU(frames, 200), 0.9);
+}
+
+// The keyer as the station's default config sets it up (PipelineOptionsFromConfig: chroma
+// low/high in levels, shadow thresholds, despill) keys the studio as well as the keyer's defaults.
+TEST(KeySynth, MedianAlphaIoUWithTheStationConfigDefaults) {
+  const ChromaKeyerOptions options = PipelineOptionsFromConfig(StationConfig{}).chroma;
+  const std::vector<KeyedFrame> frames = KeySynthSession(3, PixelFormat::kRGB8, 16, 7, options);
+  const double iou = MedianIoU(frames, 200);
+  RecordProperty("median_iou", std::to_string(iou));
+  EXPECT_GE(iou, 0.95);
 }
 
 }  // namespace

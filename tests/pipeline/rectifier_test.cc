@@ -24,7 +24,7 @@ CameraModel LookAtOrigin(double distance, double height) {
 
 struct Render {
   cv::Mat bgr, alpha, shadow;
-  Eigen::Vector2d lowest_px;
+  Eigen::Vector2d contact_px;
 };
 
 // Renders a flat red rectangle w x h metres standing on the floor at the
@@ -62,7 +62,7 @@ Render RenderCard(const CameraModel& cam, double w, double h) {
       }
     }
   }
-  r.lowest_px = Eigen::Vector2d(lowest_x_sum / lowest_count, lowest_y + 0.5);
+  r.contact_px = Eigen::Vector2d(lowest_x_sum / lowest_count, lowest_y + 0.5);
   return r;
 }
 
@@ -70,7 +70,7 @@ Render RenderCard(const CameraModel& cam, double w, double h) {
 struct Crop {
   cv::Mat bgr, alpha, shadow;
   cv::Point offset;
-  SpriteView View(const Eigen::Vector2d& lowest_px) const { return {&bgr, &alpha, &shadow, offset, lowest_px}; }
+  SpriteView View(const Eigen::Vector2d& contact_px) const { return {&bgr, &alpha, &shadow, offset, contact_px}; }
 };
 Crop CropOf(const Render& r) {
   cv::Rect box = cv::boundingRect((r.alpha > 0) | (r.shadow > 0));
@@ -92,7 +92,7 @@ TEST(Rectifier, BillboardHasTheSameMetricSizeNearAndFar) {
     const CameraModel cam = LookAtOrigin(distance, 0.8);
     const Render r = RenderCard(cam, w, h);
     const Crop crop = CropOf(r);
-    const auto bb = rectifier.Rectify(cam, crop.View(r.lowest_px));
+    const auto bb = rectifier.Rectify(cam, crop.View(r.contact_px));
     ASSERT_TRUE(bb.has_value()) << "distance " << distance;
     EXPECT_LT(bb->point_in_ground.head<2>().norm(), 0.003) << "distance " << distance;
     const cv::Rect box = AlphaBox(bb->bgra);
@@ -119,7 +119,7 @@ TEST(Rectifier, MirrorFlipsContentAndVelocityAcrossTheView) {
   const cv::Rect full = cv::boundingRect(r.alpha);
   r.bgr(cv::Rect(full.x, full.y, full.width / 2, full.height)).setTo(cv::Scalar(255, 0, 0), r.alpha(cv::Rect(full.x, full.y, full.width / 2, full.height)));
   const Crop crop = CropOf(r);
-  const auto bb = Rectifier().Rectify(cam, crop.View(r.lowest_px));
+  const auto bb = Rectifier().Rectify(cam, crop.View(r.contact_px));
   ASSERT_TRUE(bb);
   const Billboard m = Rectifier::Mirror(*bb);
   const cv::Rect box = AlphaBox(bb->bgra);

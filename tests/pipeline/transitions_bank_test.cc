@@ -304,6 +304,13 @@ TEST(TransitionBank, CommandLine) {
                                 (dir / "w.json") + " --threads 1");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("stage 2 (all 6 features):   precision"), std::string::npos) << r.output;
+  // The labels carry the truth's positive rate, so stage 2 is set for it and stage 1 refitted.
+  double rate = 0;
+  ReadLabelsCsv(dir / "labels.csv", &rate);
+  EXPECT_GT(rate, 0.0);
+  EXPECT_LT(rate, 0.5);
+  EXPECT_NE(r.output.find("stage 2 then set for the positive rate"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("stage 1 refitted as its filter"), std::string::npos) << r.output;
   EXPECT_NO_THROW(LoadWeights(dir / "w.json"));
   r = testing::RunSpritestation("transitions " + bank + " --weights " + (dir / "w.json") + " --json");
   ASSERT_EQ(r.exit_code, 0) << r.output;

@@ -314,7 +314,7 @@ TEST(TransitionWeightsFile, RoundTripAndDefault) {
   std::string why;
   EXPECT_TRUE(d.IsValid(&why)) << why;
   const std::filesystem::path shipped =
-      std::filesystem::path(__FILE__).parent_path().parent_path().parent_path() / "pipeline/transitions/default_weights.json";
+      std::filesystem::path(ss::testing::SourcePath("pipeline/transitions/default_weights.json"));
   std::ifstream in(shipped);
   ASSERT_TRUE(in) << shipped;
   EXPECT_EQ(nlohmann::json::parse(in), nlohmann::json::parse(DefaultWeightsText()))

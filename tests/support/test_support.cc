@@ -4,6 +4,11 @@
 #include <unistd.h>
 
 #include <array>
+#include <chrono>
+#include <csignal>
+#include <fstream>
+#include <sstream>
+#include <thread>
 #include <cstdio>
 #include <cstdlib>
 #include <random>
@@ -29,6 +34,10 @@ ScratchDir::~ScratchDir() {
   if (std::getenv("SPRITESTATION_KEEP_SCRATCH") == nullptr) std::filesystem::remove_all(path_, ec);
 }
 
+std::string SourcePath(const std::string& relative) {
+  return (std::filesystem::path(SPRITESTATION_SOURCE_DIR) / relative).string();
+}
+
 CommandResult RunSpritestation(const std::string& args) {
   const char* bin = std::getenv("SPRITESTATION_BIN");
   const std::string command = std::string(bin ? bin : "spritestation") + " " + args + " 2>&1";
@@ -41,6 +50,63 @@ CommandResult RunSpritestation(const std::string& args) {
   const int status = pclose(pipe);
   result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
   return result;
+}
+
+BackgroundCommand::BackgroundCommand(const std::string& args, const std::string& log_path) : log_path_(log_path) {
+  const char* bin = std::getenv("SPRITESTATION_BIN");
+  const std::string command = "exec " + std::string(bin ? bin : "spritestation") + " " + args + " > '" + log_path + "' 2>&1";
+  pid_ = fork();
+  if (pid_ == 0) {
+    execl("/bin/sh", "sh", "-c", command.c_str(), static_cast<char*>(nullptr));
+    _exit(127);
+  }
+}
+
+BackgroundCommand::~BackgroundCommand() {
+  if (running()) {
+    kill(pid_, SIGKILL);
+    Wait(10);
+  }
+}
+
+bool BackgroundCommand::running() {
+  if (pid_ <= 0 || status_ != -1) return false;
+  int status = 0;
+  if (waitpid(pid_, &status, WNOHANG) == pid_) {
+    status_ = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+    return false;
+  }
+  return true;
+}
+
+std::string BackgroundCommand::output() const {
+  std::ifstream in(log_path_);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+bool BackgroundCommand::WaitForOutput(const std::string& text, double timeout_s) {
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
+  while (std::chrono::steady_clock::now() < deadline) {
+    if (output().find(text) != std::string::npos) return true;
+    if (!running()) return output().find(text) != std::string::npos;
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  return false;
+}
+
+void BackgroundCommand::Signal(int signal) {
+  if (running()) kill(pid_, signal);
+}
+
+int BackgroundCommand::Wait(double timeout_s) {
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
+  while (running()) {
+    if (std::chrono::steady_clock::now() >= deadline) return -1;
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  return status_;
 }
 
 nlohmann::json JsonInOutput(const std::string& output) {

@@ -26,8 +26,35 @@ struct CommandResult {
   std::string output;  // stdout and stderr together
 };
 
+// A file of the source tree, by its path from the top ("docs/station.example.yaml"):
+// absolute, whatever the working directory or the compiler's idea of __FILE__.
+std::string SourcePath(const std::string& relative);
+
 // Runs `spritestation ARGS` (the binary named by $SPRITESTATION_BIN) through the shell.
 CommandResult RunSpritestation(const std::string& args);
+
+// `spritestation ARGS` running in the background (daemon, fakecam); stdout and
+// stderr go to `log_path`. Killed (SIGKILL) when the object dies.
+class BackgroundCommand {
+ public:
+  BackgroundCommand(const std::string& args, const std::string& log_path);
+  ~BackgroundCommand();
+  BackgroundCommand(const BackgroundCommand&) = delete;
+  BackgroundCommand& operator=(const BackgroundCommand&) = delete;
+
+  // Waits until the output holds `text`; false on timeout or when the process ended first.
+  bool WaitForOutput(const std::string& text, double timeout_s);
+  std::string output() const;
+  void Signal(int signal);
+  // Waits for the exit: the exit code, 128 + signal when killed, -1 on timeout.
+  int Wait(double timeout_s);
+  bool running();
+
+ private:
+  int pid_ = -1;
+  int status_ = -1;
+  std::string log_path_;
+};
 
 // The JSON document in a command's output (log lines may surround it); null when there is none.
 nlohmann::json JsonInOutput(const std::string& output);

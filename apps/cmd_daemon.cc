@@ -1,0 +1,156 @@
+// spritestation daemon --config station.yaml [--session NAME] [--duration S]
+// [--weights FILE] [--no-transitions] [--json]: the live station. Every camera
+// of the config streams through the live pipeline; sprites are stored in the
+// bank during a capture session (--session starts one at once; otherwise over
+// the control API), and transitions are kept current. Runs until SIGTERM or
+// SIGINT (a clean stop: open clips stored, recordings finalized, bank
+// committed), or --duration seconds. SIGHUP reloads the config where safe.
+// Under systemd (Type=notify) it reports READY, STOPPING and the watchdog.
+#include <signal.h>
+
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <memory>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "apps/commands.h"
+#include "core/config.h"
+#include "core/error.h"
+#include "core/log.h"
+#include "pipeline/station/camera_runner.h"
+#include "pipeline/station/control_server.h"
+#include "pipeline/station/station.h"
+#include "pipeline/station/station_status.h"
+#include "pipeline/transitions/weights.h"
+#ifdef SPRITESTATION_HAVE_SYSTEMD
+#include <systemd/sd-daemon.h>
+#endif
+
+namespace ss::apps {
+namespace {
+
+struct DaemonArgs {
+  std::string config;
+  std::string session;
+  double duration_s = 0;
+  std::string weights;
+  bool no_transitions = false;
+  double offline_after_s = 3.0;
+  bool json = false;
+};
+
+void Notify([[maybe_unused]] const std::string& state) {
+#ifdef SPRITESTATION_HAVE_SYSTEMD
+  sd_notify(0, state.c_str());
+#endif
+}
+
+// Microseconds between watchdog pings systemd asks for (0: none).
+uint64_t WatchdogUsec() {
+#ifdef SPRITESTATION_HAVE_SYSTEMD
+  uint64_t usec = 0;
+  if (sd_watchdog_enabled(0, &usec) > 0) return usec;
+#endif
+  return 0;
+}
+
+void RunDaemon(const DaemonArgs& a) {
+  ConfigReport report;
+  StationOptions options;
+  options.config = LoadStationConfig(a.config, &report);
+  if (!a.weights.empty()) options.weights = LoadWeights(a.weights);
+  options.transitions = !a.no_transitions;
+  if (!(a.offline_after_s > 0)) throw InputError("--offline-after", "expected a positive number of seconds");
+  options.offline_after_s = a.offline_after_s;
+
+  // Signals are taken by this thread alone (sigtimedwait below): block them before any thread starts.
+  sigset_t signals;
+  sigemptyset(&signals);
+  sigaddset(&signals, SIGINT);
+  sigaddset(&signals, SIGTERM);
+  sigaddset(&signals, SIGHUP);
+  pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+
+  Station station(options);
+  station.Start();
+  ControlServer control(station, options.config.control);
+  const int port = control.Start();
+  if (!a.session.empty()) station.StartSession(a.session);
+  // The ready line: scripts and tests read the port from it.
+  std::printf("daemon: control API on %s (port %d)\n", control.url().c_str(), port);
+  std::fflush(stdout);
+  Notify("READY=1\nSTATUS=running, control API on " + control.url());
+
+  const uint64_t watchdog_usec = WatchdogUsec();
+  const auto start = std::chrono::steady_clock::now();
+  auto log = Log("station");
+  while (true) {
+    if (watchdog_usec > 0) Notify("WATCHDOG=1");
+    timespec wait{0, 250'000'000};
+    const int sig = sigtimedwait(&signals, nullptr, &wait);
+    if (sig == SIGINT || sig == SIGTERM) {
+      log->info("{}: stopping", sig == SIGINT ? "SIGINT" : "SIGTERM");
+      break;
+    }
+    if (sig == SIGHUP) {
+      Notify("RELOADING=1");
+      try {
+        const StationConfig next = LoadStationConfig(a.config);
+        station.Reload(next);
+      } catch (const std::exception& e) {
+        log->error("SIGHUP: the config was not reloaded (the running one is kept): {}", e.what());
+      }
+      Notify("READY=1");
+    }
+    if (a.duration_s > 0 &&
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() >= a.duration_s) {
+      break;
+    }
+  }
+  Notify("STOPPING=1");
+  control.Stop();
+  station.Stop();
+  const StationStatus status = station.Status();
+  // Cameras that stopped answering are still being closed on threads of their own.
+  const bool cameras_closed = WaitForCameraCloses(2.0);
+  if (a.json) {
+    std::printf("%s\n", StatusToJson(status).dump(2).c_str());
+  } else {
+    std::printf("daemon: stopped; %llu sprites stored this run, bank %s\n",
+                static_cast<unsigned long long>(status.sprites_stored), status.bank_path.c_str());
+    for (const CameraStatus& c : status.cameras) {
+      std::printf("  %s: %llu frames, %llu processed, dropped %llu (queue full) + %llu (at the source), %llu reopens\n",
+                  c.name.c_str(), static_cast<unsigned long long>(c.frames_captured),
+                  static_cast<unsigned long long>(c.frames_processed),
+                  static_cast<unsigned long long>(c.dropped_queue_full),
+                  static_cast<unsigned long long>(c.dropped_at_source), static_cast<unsigned long long>(c.reopens));
+    }
+  }
+  if (!cameras_closed) {
+    // Everything of the station is stored and closed; only unanswered device closes remain.
+    log->warn("a camera that stopped answering is not closed yet; exiting without waiting for it");
+    std::fflush(stdout);
+    std::fflush(stderr);
+    std::_Exit(0);
+  }
+}
+
+}  // namespace
+
+void AddDaemonCommand(CLI::App& app) {
+  auto* cmd = app.add_subcommand("daemon", "Run the live station from a config file (cameras, pipeline, bank, HTTP control)");
+  auto a = std::make_shared<DaemonArgs>();
+  cmd->add_option("--config", a->config, "Station config (docs/config.md)")->required();
+  cmd->add_option("--session", a->session, "Start a capture session with this name at once");
+  cmd->add_option("--duration", a->duration_s, "Stop after this many seconds (0: until SIGTERM/SIGINT)");
+  cmd->add_option("--weights", a->weights, "Transition classifier weights (default: the shipped ones)");
+  cmd->add_flag("--no-transitions", a->no_transitions, "Do not keep the bank's transitions current");
+  cmd->add_option("--offline-after", a->offline_after_s, "A camera silent this many seconds is marked offline and reopened");
+  cmd->add_flag("--json", a->json, "Print the final status as JSON when stopped");
+  cmd->callback([a] { RunDaemon(*a); });
+}
+
+}  // namespace ss::apps

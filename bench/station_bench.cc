@@ -1,0 +1,168 @@
+// spritestation bench station [--cameras=N] [--size=WxH] [--fps=F] [--seconds=S]:
+// the live station on paced replay (the daemon's code: CameraRunner threads,
+// bank writer, TransitionWorker), as a Google Benchmark case run once for S
+// seconds of wall time. Cameras replay a synthetic animal session (made once,
+// cached under the temp dir) in real time, looping.
+//   station/live_NxWxH@F            counters: frames/s delivered, frames dropped (queue
+//                                   full / at source), capture-to-bank latency p50/p99,
+//                                   transitions pending (max), sprites/s stored
+//   station/baseline/decode_NxWxH   the same session replayed unpaced by ReplaySource:
+//                                   the machine's decode capacity for these cameras
+// The ratio printed: frames/s the cameras need / frames/s decoding alone gives.
+#include <benchmark/benchmark.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <thread>
+
+#include "bench/bench_registry.h"
+#include "capture/replay/replay_source.h"
+#include "pipeline/station/station.h"
+#include "synth/studio_session.h"
+
+namespace ss::bench {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct StationBenchArgs {
+  int cameras = 4;
+  int width = 1280, height = 720;
+  double fps = 30;
+  double seconds = 20;
+};
+StationBenchArgs g_args;
+
+std::string Tag() {
+  return std::to_string(g_args.cameras) + "x" + std::to_string(g_args.width) + "x" + std::to_string(g_args.height) +
+         "@" + std::to_string(static_cast<int>(g_args.fps));
+}
+
+// A synthetic session with as many cameras as asked, made once per shape.
+std::string Session() {
+  const fs::path dir = fs::temp_directory_path() / ("spritestation-station-bench-" + Tag());
+  if (fs::exists(dir / "session.json")) return dir.string();
+  fs::remove_all(dir);
+  synth::SynthOptions o;
+  o.out_dir = dir.string();
+  o.seconds = 6;
+  o.fps = g_args.fps;
+  o.width = g_args.width;
+  o.height = g_args.height;
+  o.cameras = g_args.cameras;
+  o.seed = 5;
+  o.empty_lead_in_s = 1.5;
+  o.write_mattes = false;
+  o.threads = 2;
+  std::fprintf(stderr, "bench station: rendering a %d-camera %dx%d session into %s (once)...\n", o.cameras, o.width,
+               o.height, o.out_dir.c_str());
+  synth::RenderStudioSession(o);
+  return dir.string();
+}
+
+void Decode(benchmark::State& state) {
+  const std::string session = Session();
+  uint64_t frames = 0;
+  for (auto _ : state) {
+    ReplaySource source(session, {});
+    while (auto f = source.Next()) {
+      benchmark::DoNotOptimize(f->data);
+      ++frames;
+    }
+  }
+  state.counters["frames_per_s"] = benchmark::Counter(static_cast<double>(frames), benchmark::Counter::kIsRate);
+}
+
+void Live(benchmark::State& state) {
+  const std::string session = Session();
+  const fs::path work = fs::temp_directory_path() / ("spritestation-station-bench-run-" + std::to_string(getpid()));
+  fs::remove_all(work);
+  fs::create_directories(work);
+  for (auto _ : state) {
+    StationOptions options;
+    StationConfig& config = options.config;
+    for (int c = 0; c < g_args.cameras; ++c) {
+      CameraConfig cam;
+      cam.name = "cam" + std::to_string(c);
+      cam.source = "replay";
+      cam.session = session;
+      cam.loop = true;
+      cam.realtime = true;
+      cam.fps = g_args.fps;
+      config.cameras.push_back(cam);
+    }
+    config.storage.bank = (work / "station.bank").string();
+    config.storage.recording_dir = (work / "recordings").string();
+    config.storage.stop_recording_below_mib = 0;
+    config.storage.stop_sprites_below_mib = 0;
+    config.logging.level = "warn";
+    Station station(options);
+    station.Start();
+    station.StartSession("bench");
+    int64_t pending_max = 0;
+    const auto start = std::chrono::steady_clock::now();
+    while (std::chrono::steady_clock::now() - start < std::chrono::duration<double>(g_args.seconds)) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(250));
+      pending_max = std::max(pending_max, station.Status().transitions_pending);
+    }
+    const StationStatus status = station.Status();
+    station.Stop();
+    uint64_t captured = 0, queue_full = 0, at_source = 0;
+    for (const CameraStatus& c : status.cameras) {
+      captured += c.frames_captured;
+      queue_full += c.dropped_queue_full;
+      at_source += c.dropped_at_source;
+    }
+    state.counters["frames_per_s"] = captured / g_args.seconds;
+    state.counters["dropped_queue_full"] = static_cast<double>(queue_full);
+    state.counters["dropped_at_source"] = static_cast<double>(at_source);
+    state.counters["latency_p50_ms"] = status.latency_p50_ms;
+    state.counters["latency_p99_ms"] = status.latency_p99_ms;
+    state.counters["transitions_pending_max"] = static_cast<double>(pending_max);
+    state.counters["sprites_per_s"] = status.sprites_stored / g_args.seconds;
+  }
+  fs::remove_all(work);
+}
+
+// Options come as --name=value (the bench command hands extras through in its own order).
+int Run(const std::vector<std::string>& args) {
+  std::vector<std::string> pass;
+  for (const std::string& a : args) {
+    const size_t eq = a.find('=');
+    const std::string key = a.substr(0, eq);
+    const std::string value = eq == std::string::npos ? "" : a.substr(eq + 1);
+    if (key == "--cameras") {
+      g_args.cameras = std::stoi(value);
+    } else if (key == "--size") {
+      std::sscanf(value.c_str(), "%dx%d", &g_args.width, &g_args.height);
+    } else if (key == "--fps") {
+      g_args.fps = std::stod(value);
+    } else if (key == "--seconds") {
+      g_args.seconds = std::stod(value);
+    } else {
+      pass.push_back(a);
+    }
+  }
+  benchmark::RegisterBenchmark(("station/baseline/decode_" + Tag()).c_str(), Decode)
+      ->Iterations(1)
+      ->Unit(benchmark::kSecond)
+      ->UseRealTime();
+  benchmark::RegisterBenchmark(("station/live_" + Tag()).c_str(), Live)
+      ->Iterations(1)
+      ->Unit(benchmark::kSecond)
+      ->UseRealTime();
+  const int rc = RunGoogleBenchmarks("station/", pass);
+  std::printf("cameras need %.0f frames/s (%d x %.0f)\n", g_args.cameras * g_args.fps, g_args.cameras, g_args.fps);
+  return rc;
+}
+
+const bool kRegistered =
+    RegisterSuite({"station", "the live station on paced replay: drops, latency, transitions lag (--cameras= --size= --fps= --seconds=)", &Run});
+
+}  // namespace
+}  // namespace ss::bench

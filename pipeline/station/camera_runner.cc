@@ -1,0 +1,506 @@
+#include "pipeline/station/camera_runner.h"
+
+#include <algorithm>
+#include <atomic>
+#include <condition_variable>
+#include <deque>
+#include <exception>
+#include <future>
+#include <mutex>
+#include <thread>
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "core/error.h"
+#include "core/log.h"
+#include "pipeline/run/bounded_queue.h"
+#include "pipeline/station/camera_source.h"
+
+namespace ss {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double Seconds(Clock::duration d) { return std::chrono::duration<double>(d).count(); }
+
+struct Captured {
+  Frame frame;
+  SteadyTime received;
+  uint64_t drops_before = 0;  // frames dropped (queue full) just before this one
+};
+
+std::atomic<int>& PendingCloses() {
+  static std::atomic<int> pending{0};
+  return pending;
+}
+
+}  // namespace
+
+bool WaitForCameraCloses(double timeout_s) {
+  const auto deadline = Clock::now() + std::chrono::duration<double>(timeout_s);
+  while (PendingCloses().load() > 0) {
+    if (Clock::now() >= deadline) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  return true;
+}
+
+const char* CameraStateName(CameraState state) {
+  switch (state) {
+    case CameraState::kStarting: return "starting";
+    case CameraState::kTraining: return "training";
+    case CameraState::kLive: return "live";
+    case CameraState::kOffline: return "offline";
+    case CameraState::kFinished: return "finished";
+    case CameraState::kError: return "error";
+  }
+  return "unknown";
+}
+
+struct CameraRunner::Impl {
+  int index = 0;
+  CameraRunnerOptions options;
+  BatchSink sink;
+  FrameTap tap;
+  std::shared_ptr<spdlog::logger> log = Log("station.camera");
+
+  std::unique_ptr<BoundedQueue<Captured>> queue;
+  std::thread capture_thread, pipeline_thread;
+  std::atomic<bool> stopping{false};
+
+  // The open source; the pipeline thread may Stop() it when it stalls.
+  mutable std::mutex source_mutex;
+  std::shared_ptr<FrameSource> source;
+  std::atomic<bool> stalled{false};
+  std::condition_variable backoff_wake;
+
+  // Status, under status_mutex.
+  mutable std::mutex status_mutex;
+  CameraStatus status;
+  std::deque<SteadyTime> recent_frames;  // arrival times over the last ~2 s (fps)
+  SteadyTime last_frame_time = Clock::now();
+  uint64_t source_dropped_base = 0, source_errors_base = 0;  // of the sources closed before
+  std::optional<SourceCamera> source_camera;
+
+  // Bank camera switching: wanted by the station, applied by the pipeline thread.
+  std::mutex target_mutex;
+  std::condition_variable target_applied;
+  int64_t wanted_camera_id = 0;
+  int64_t applied_camera_id = 0;
+
+  // Preview: the latest frame (BGR) and its matte, refreshed every preview_interval_s.
+  mutable std::mutex preview_mutex;
+  cv::Mat preview_bgr, preview_alpha, preview_shadow;
+  SteadyTime preview_time{};
+
+  void SetState(CameraState state, const std::string& message) {
+    std::lock_guard lock(status_mutex);
+    if (status.state != state || status.message != message) {
+      if (state == CameraState::kOffline || state == CameraState::kError) {
+        log->warn("{}: {}{}", options.camera.name, CameraStateName(state), message.empty() ? "" : ": " + message);
+      } else {
+        log->info("{}: {}", options.camera.name, CameraStateName(state));
+      }
+    }
+    status.state = state;
+    status.message = message;
+  }
+
+  // Sleeps for the backoff delay unless stopping.
+  void Backoff(double seconds) {
+    std::unique_lock lock(source_mutex);
+    backoff_wake.wait_for(lock, std::chrono::duration<double>(seconds), [&] { return stopping.load(); });
+  }
+
+  // Closes the source on a thread of its own: a device that stopped answering can take
+  // seconds to close (GigE Vision: 5 x 500 ms per unanswered register write), and neither
+  // reopening it nor stopping the station should wait for that.
+  void CloseSource() {
+    std::shared_ptr<FrameSource> old;
+    {
+      std::lock_guard lock(source_mutex);
+      old.swap(source);
+    }
+    if (!old) return;
+    const SourceStats s = old->stats();
+    {
+      std::lock_guard lock(status_mutex);
+      source_dropped_base += s.frames_dropped;
+      source_errors_base += s.errors;
+    }
+    PendingCloses().fetch_add(1);
+    std::thread([old = std::move(old)]() mutable {
+      old.reset();
+      PendingCloses().fetch_sub(1);
+      PendingCloses().notify_all();
+    }).detach();
+  }
+
+  void CaptureLoop() {
+    double backoff = options.backoff_min_s;
+    bool opened_once = false;
+    uint64_t pending_drops = 0;
+    while (!stopping) {
+      std::shared_ptr<FrameSource> src;
+      {
+        std::lock_guard lock(source_mutex);
+        src = source;
+      }
+      if (!src) {
+        try {
+          std::shared_ptr<FrameSource> opened = OpenCameraSource(options.camera, index);
+          {
+            std::lock_guard lock(status_mutex);
+            if (opened_once) ++status.reopens;
+            const SourceCamera& sc = opened->cameras().at(0);
+            status.width = sc.width;
+            status.height = sc.height;
+            status.pixel_format = PixelFormatName(sc.format);
+            source_camera = sc;
+            last_frame_time = Clock::now();
+          }
+          {
+            std::lock_guard lock(source_mutex);
+            source = opened;
+          }
+          opened_once = true;
+          stalled = false;
+          backoff = options.backoff_min_s;
+          SetState(CameraState::kTraining, "");
+          continue;
+        } catch (const std::exception& e) {
+          SetState(CameraState::kOffline, e.what());
+          Backoff(backoff);
+          backoff = std::min(backoff * 2, options.backoff_max_s);
+          continue;
+        }
+      }
+      std::optional<Frame> frame;
+      try {
+        frame = src->Next();
+      } catch (const std::exception& e) {
+        SetState(CameraState::kOffline, e.what());
+        CloseSource();
+        continue;
+      }
+      if (!frame) {
+        if (stopping) break;
+        if (stalled) {
+          SetState(CameraState::kOffline, "no frame for " + std::to_string(options.offline_after_s) + " s");
+          CloseSource();
+          Backoff(backoff);
+          continue;
+        }
+        // The end of a finite source (a replay that does not loop).
+        SetState(CameraState::kFinished, "the recording ended");
+        break;
+      }
+      const SteadyTime now = Clock::now();
+      {
+        std::lock_guard lock(status_mutex);
+        ++status.frames_captured;
+        last_frame_time = now;
+        recent_frames.push_back(now);
+        while (!recent_frames.empty() && Seconds(now - recent_frames.front()) > 2.0) recent_frames.pop_front();
+      }
+      frame->camera = index;
+      if (queue->TryPush(Captured{std::move(*frame), now, pending_drops})) {
+        pending_drops = 0;
+      } else {
+        ++pending_drops;
+        std::lock_guard lock(status_mutex);
+        ++status.dropped_queue_full;
+      }
+    }
+    queue->Close();
+  }
+
+  // Called by the pipeline thread while it waits: a source silent for too long is stopped.
+  void CheckStall() {
+    bool stale = false;
+    {
+      std::lock_guard lock(status_mutex);
+      stale = Seconds(Clock::now() - last_frame_time) > options.offline_after_s &&
+              status.state != CameraState::kOffline && status.state != CameraState::kFinished;
+    }
+    if (!stale) return;
+    std::lock_guard lock(source_mutex);
+    if (source && !stalled) {
+      stalled = true;
+      source->Stop();
+    }
+  }
+
+  void ApplyTarget(CameraPipeline* pipeline, std::vector<ClipBatch>* out) {
+    std::unique_lock lock(target_mutex);
+    if (wanted_camera_id == applied_camera_id) return;
+    const int64_t wanted = wanted_camera_id;
+    lock.unlock();
+    if (pipeline != nullptr) pipeline->Retarget(wanted, out);
+    lock.lock();
+    applied_camera_id = wanted;
+    target_applied.notify_all();
+  }
+
+  void Sink(std::vector<ClipBatch>& out, const std::deque<std::pair<int64_t, SteadyTime>>& arrivals) {
+    for (ClipBatch& b : out) {
+      if (b.clip.camera_id == 0) {
+        std::lock_guard lock(status_mutex);
+        ++status.batches_unstored;
+        continue;
+      }
+      StationBatch sb;
+      sb.camera = index;
+      sb.received.reserve(b.sprites.size());
+      for (const SpriteRecord& s : b.sprites) {
+        SteadyTime t = Clock::now();
+        for (auto it = arrivals.rbegin(); it != arrivals.rend(); ++it) {
+          if (it->first == s.frame) {
+            t = it->second;
+            break;
+          }
+        }
+        sb.received.push_back(t);
+      }
+      sb.batch = std::move(b);
+      sink(std::move(sb));
+    }
+    out.clear();
+  }
+
+  void UpdatePreview(const cv::Mat& bgr, const Matte* matte, SteadyTime now) {
+    std::lock_guard lock(preview_mutex);
+    if (preview_time != SteadyTime{} && Seconds(now - preview_time) < options.preview_interval_s) return;
+    preview_time = now;
+    bgr.copyTo(preview_bgr);
+    if (matte != nullptr && !matte->alpha.empty()) {
+      matte->alpha.copyTo(preview_alpha);
+      if (!matte->shadow.empty()) {
+        matte->shadow.copyTo(preview_shadow);
+      } else {
+        preview_shadow.release();
+      }
+    } else {
+      preview_alpha.release();
+      preview_shadow.release();
+    }
+  }
+
+  // Made before the camera opens (the floor mask takes a while), so the first frames find it ready.
+  std::unique_ptr<CameraPipeline> pipeline;
+
+  void PipelineLoop() {
+    bool pipeline_failed = pipeline == nullptr;
+    std::vector<cv::Mat> empty;
+    std::future<void> training;
+    std::vector<ClipBatch> out;
+    std::deque<std::pair<int64_t, SteadyTime>> arrivals;  // recent frames' sequence and arrival time
+    cv::Mat bgr;
+    while (true) {
+      ApplyTarget(pipeline_failed ? nullptr : pipeline.get(), &out);
+      Sink(out, arrivals);
+      std::optional<Captured> item = queue->PopFor(std::chrono::milliseconds(100));
+      if (!item) {
+        if (queue->size() == 0 && capture_done) break;
+        CheckStall();
+        continue;
+      }
+      const Frame& frame = item->frame;
+      bool usable = false;
+      try {
+        if (pipeline_failed) {
+          ToBgr(frame, bgr);
+          UpdatePreview(bgr, nullptr, item->received);
+        } else if (training.valid() || !pipeline->trained()) {
+          // Learning the empty enclosure takes a while: it runs beside this loop, which
+          // meanwhile keeps the queue empty (those frames only feed the preview).
+          if (training.valid() && training.wait_for(std::chrono::seconds(0)) == std::future_status::ready) {
+            training.get();  // rethrows what Train threw
+            SetState(CameraState::kLive, "");
+          }
+          ToBgr(frame, bgr);
+          UpdatePreview(bgr, nullptr, item->received);
+          if (!training.valid() && !pipeline->trained()) {
+            empty.push_back(bgr.clone());
+            if (static_cast<int>(empty.size()) >= options.training_frames) {
+              training = std::async(std::launch::async, [p = pipeline.get(), frames = std::move(empty)] {
+                p->Train(frames);
+              });
+              empty.clear();
+            }
+          }
+        } else {
+          arrivals.emplace_back(static_cast<int64_t>(frame.sequence), item->received);
+          while (arrivals.size() > 1024) arrivals.pop_front();
+          const uint64_t usable_before = pipeline->stats().discards[static_cast<size_t>(Discard::kNone)] + pipeline->stats().discards[static_cast<size_t>(Discard::kShortClip)];
+          pipeline->Process(frame, &out);
+          const CameraPipelineStats& s = pipeline->stats();
+          usable = s.discards[static_cast<size_t>(Discard::kNone)] + s.discards[static_cast<size_t>(Discard::kShortClip)] > usable_before;
+          UpdatePreview(pipeline->last_bgr(), &pipeline->last_matte(), item->received);
+          Sink(out, arrivals);
+        }
+      } catch (const InputError& e) {
+        // A frame the pipeline cannot take (size changed, malformed): the camera keeps
+        // streaming for preview and recording, and says why it stores no sprites.
+        SetState(CameraState::kError, e.what());
+        if (pipeline && !pipeline_failed) {
+          pipeline->Finish(&out);
+          Sink(out, arrivals);
+        }
+        pipeline_failed = true;
+      } catch (const std::exception& e) {
+        SetState(CameraState::kError, e.what());
+      }
+      {
+        std::lock_guard lock(status_mutex);
+        ++status.frames_processed;
+        if (pipeline) status.pipeline = pipeline->stats();
+      }
+      if (tap) tap(index, frame, item->drops_before, usable);
+    }
+    if (training.valid()) training.wait();
+    if (pipeline && !pipeline_failed && pipeline->trained()) {
+      pipeline->Finish(&out);
+      Sink(out, arrivals);
+      std::lock_guard lock(status_mutex);
+      status.pipeline = pipeline->stats();
+    }
+    std::lock_guard lock(target_mutex);
+    applied_camera_id = wanted_camera_id;  // nothing more will be made
+    pipeline_done = true;
+    target_applied.notify_all();
+  }
+
+  std::atomic<bool> capture_done{false};
+  bool pipeline_done = false;  // under target_mutex
+};
+
+CameraRunner::CameraRunner(int index, CameraRunnerOptions options, BatchSink sink, FrameTap tap)
+    : impl_(std::make_unique<Impl>()) {
+  Impl& s = *impl_;
+  s.index = index;
+  s.options = std::move(options);
+  s.sink = std::move(sink);
+  s.tap = std::move(tap);
+  s.queue = std::make_unique<BoundedQueue<Captured>>(static_cast<size_t>(std::max(1, s.options.queue_frames)));
+  s.status.name = s.options.camera.name;
+  s.status.source = s.options.camera.source;
+  s.status.has_model = s.options.model.has_value();
+  s.status.queue_capacity = s.queue->capacity();
+  if (s.options.model) {
+    try {
+      s.pipeline = std::make_unique<CameraPipeline>(s.options.camera.name, 0, *s.options.model, s.options.floor,
+                                                    s.options.pipeline);
+    } catch (const std::exception& e) {
+      s.SetState(CameraState::kError, e.what());
+    }
+  }
+}
+
+CameraRunner::~CameraRunner() { Stop(); }
+
+void CameraRunner::Start() {
+  Impl& s = *impl_;
+  if (s.capture_thread.joinable()) return;
+  s.capture_thread = std::thread([&s] {
+    try {
+      s.CaptureLoop();
+    } catch (const std::exception& e) {
+      s.SetState(CameraState::kError, e.what());
+    }
+    s.CloseSource();
+    s.queue->Close();
+    s.capture_done = true;
+  });
+  s.pipeline_thread = std::thread([&s] { s.PipelineLoop(); });
+}
+
+void CameraRunner::RequestStop() {
+  Impl& s = *impl_;
+  s.stopping = true;
+  std::lock_guard lock(s.source_mutex);
+  if (s.source) s.source->Stop();
+  s.backoff_wake.notify_all();
+}
+
+void CameraRunner::Stop() {
+  Impl& s = *impl_;
+  RequestStop();
+  if (s.capture_thread.joinable()) s.capture_thread.join();
+  if (s.pipeline_thread.joinable()) s.pipeline_thread.join();
+}
+
+void CameraRunner::SetBankCamera(int64_t camera_id) {
+  Impl& s = *impl_;
+  std::unique_lock lock(s.target_mutex);
+  s.wanted_camera_id = camera_id;
+  if (!s.pipeline_thread.joinable()) {
+    s.applied_camera_id = camera_id;  // not started: the pipeline starts with it
+    return;
+  }
+  s.target_applied.wait(lock, [&] { return s.pipeline_done || s.applied_camera_id == camera_id; });
+}
+
+CameraStatus CameraRunner::status() const {
+  const Impl& s = *impl_;
+  std::lock_guard lock(s.status_mutex);
+  CameraStatus out = s.status;
+  const double span = s.recent_frames.size() >= 2 ? Seconds(s.recent_frames.back() - s.recent_frames.front()) : 0;
+  out.fps = span > 0 ? (s.recent_frames.size() - 1) / span : 0;
+  if (Seconds(Clock::now() - s.last_frame_time) > 2.0) out.fps = 0;
+  out.dropped_at_source = s.source_dropped_base;
+  out.source_errors = s.source_errors_base;
+  {
+    std::lock_guard source_lock(s.source_mutex);
+    if (s.source) {
+      const SourceStats ss = s.source->stats();
+      out.dropped_at_source += ss.frames_dropped;
+      out.source_errors += ss.errors;
+      if (!ss.last_error.empty() && out.message.empty()) out.message = ss.last_error;
+    }
+  }
+  out.queue_depth = s.queue->size();
+  return out;
+}
+
+std::optional<std::vector<uint8_t>> CameraRunner::PreviewJpeg(bool keyed) const {
+  const Impl& s = *impl_;
+  cv::Mat image;
+  {
+    std::lock_guard lock(s.preview_mutex);
+    if (s.preview_bgr.empty()) return std::nullopt;
+    if (!keyed || s.preview_alpha.empty() || s.preview_alpha.size() != s.preview_bgr.size()) {
+      image = s.preview_bgr.clone();
+      if (keyed) {  // not keyed yet (learning the enclosure): say so by showing it dimmed
+        image *= 0.35;
+      }
+    } else {
+      // The subject over mid grey; the contact shadow darkens the grey.
+      image.create(s.preview_bgr.size(), CV_8UC3);
+      for (int y = 0; y < image.rows; ++y) {
+        const cv::Vec3b* src = s.preview_bgr.ptr<cv::Vec3b>(y);
+        const uint8_t* a = s.preview_alpha.ptr<uint8_t>(y);
+        const uint8_t* sh = s.preview_shadow.empty() ? nullptr : s.preview_shadow.ptr<uint8_t>(y);
+        cv::Vec3b* dst = image.ptr<cv::Vec3b>(y);
+        for (int x = 0; x < image.cols; ++x) {
+          const int grey = 128 * (255 - (sh ? sh[x] : 0)) / 255;
+          for (int c = 0; c < 3; ++c) dst[x][c] = static_cast<uint8_t>((src[x][c] * a[x] + grey * (255 - a[x])) / 255);
+        }
+      }
+    }
+  }
+  std::vector<uint8_t> jpeg;
+  cv::imencode(".jpg", image, jpeg, {cv::IMWRITE_JPEG_QUALITY, 80});
+  return jpeg;
+}
+
+const std::string& CameraRunner::name() const { return impl_->options.camera.name; }
+const std::optional<CameraModel>& CameraRunner::model() const { return impl_->options.model; }
+
+std::optional<SourceCamera> CameraRunner::source_camera() const {
+  std::lock_guard lock(impl_->status_mutex);
+  return impl_->source_camera;
+}
+
+}  // namespace ss

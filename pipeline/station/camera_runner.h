@@ -1,0 +1,112 @@
+#pragma once
+// One station camera, frame by frame from the device to the bank writer:
+//   capture thread:  source->Next() -> bounded queue (full: the frame is dropped
+//                    and counted; capture never waits on processing)
+//   pipeline thread: queue -> learn the empty enclosure -> CameraPipeline::Process
+//                    -> clip batches -> the station's sink (the bank writer)
+// A camera that stops delivering frames is marked offline and reopened with
+// backoff; nothing else in the station notices.
+#include <chrono>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "capture/frame_source.h"
+#include "core/camera_model.h"
+#include "core/config.h"
+#include "core/frame.h"
+#include "core/geometry.h"
+#include "pipeline/run/camera_pipeline.h"
+
+namespace ss {
+
+using SteadyTime = std::chrono::steady_clock::time_point;
+
+// A clip batch on its way to the bank, with when each sprite's frame arrived.
+struct StationBatch {
+  int camera = 0;                 // runner index
+  ClipBatch batch;
+  std::vector<SteadyTime> received;  // one per sprite of the batch
+};
+
+enum class CameraState { kStarting, kTraining, kLive, kOffline, kFinished, kError };
+const char* CameraStateName(CameraState state);
+
+struct CameraStatus {
+  std::string name;
+  std::string source;            // replay | v4l2 | aravis | libcamera
+  CameraState state = CameraState::kStarting;
+  std::string message;           // why it is offline / in error; the last source problem
+  int width = 0, height = 0;
+  std::string pixel_format;
+  double fps = 0;                // frames delivered per second over the last ~2 s
+  uint64_t frames_captured = 0;  // delivered by the source
+  uint64_t frames_processed = 0; // through the pipeline (training frames included)
+  uint64_t dropped_queue_full = 0;   // the pipeline queue was full
+  uint64_t dropped_at_source = 0;    // lost before delivery: incomplete frames, sequence gaps, unreadable
+  uint64_t source_errors = 0;        // recoverable source problems (timeouts, corrupt frames)
+  uint64_t batches_unstored = 0;     // batches made with no capture session (not stored)
+  size_t queue_depth = 0, queue_capacity = 0;
+  uint64_t reopens = 0;          // times the camera was opened again after going offline
+  bool has_model = false;        // without one no sprite is stored (preview and recording only)
+  CameraPipelineStats pipeline;
+};
+
+struct CameraRunnerOptions {
+  CameraConfig camera;
+  std::optional<CameraModel> model;
+  GroundPolygon floor;
+  CameraPipelineOptions pipeline;
+  int training_frames = 30;
+  int queue_frames = 8;
+  double offline_after_s = 3.0;  // no frame for this long: offline, closed and reopened
+  double backoff_min_s = 0.5;    // first reopen delay, doubled up to backoff_max_s
+  double backoff_max_s = 8.0;
+  double preview_interval_s = 0.2;
+};
+
+// Sources are closed on threads of their own (a dead device takes seconds to close):
+// waits until every close is done; false after `timeout_s` (then the process may end
+// without them: nothing of the station's data depends on them).
+bool WaitForCameraCloses(double timeout_s);
+
+class CameraRunner {
+ public:
+  // Called on the pipeline thread for every batch made while a bank camera is set.
+  using BatchSink = std::function<void(StationBatch)>;
+  // Called on the pipeline thread for every frame (the recorder); `usable`: it gave a usable sprite.
+  using FrameTap = std::function<void(int camera, const Frame& frame, uint64_t drops_before, bool usable)>;
+
+  CameraRunner(int index, CameraRunnerOptions options, BatchSink sink, FrameTap tap);
+  ~CameraRunner();  // Stop()
+  CameraRunner(const CameraRunner&) = delete;
+  CameraRunner& operator=(const CameraRunner&) = delete;
+
+  void Start();
+  // Asks the threads to stop and returns at once (to stop many cameras side by side).
+  void RequestStop();
+  // RequestStop(), then waits: queued frames are processed and open clips closed into the sink.
+  void Stop();
+  // Clips from now on go to bank camera `camera_id` (0: none, batches are not stored);
+  // open clips are closed first, under the previous camera. Returns once applied.
+  void SetBankCamera(int64_t camera_id);
+
+  CameraStatus status() const;
+  // The latest frame as JPEG: raw, or keyed (the subject over grey, shadow darkened).
+  // nullopt before the first frame.
+  std::optional<std::vector<uint8_t>> PreviewJpeg(bool keyed) const;
+  const std::string& name() const;
+  const std::optional<CameraModel>& model() const;
+  // The source's description once opened (size, format), for the recorder.
+  std::optional<SourceCamera> source_camera() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace ss

@@ -1,0 +1,24 @@
+#pragma once
+// Opens what a station camera's config names: its FrameSource (replay, v4l2,
+// aravis; libcamera is not built) and its camera model.
+#include <memory>
+#include <optional>
+
+#include "capture/frame_source.h"
+#include "core/camera_model.h"
+#include "core/config.h"
+
+namespace ss {
+
+// Opens and starts the camera; its frames carry Frame::camera = `camera_index`.
+// WorkError naming the camera when the device cannot be opened (absent, busy):
+// the station retries later. InputError naming the config field for a setting
+// the backend refuses or cannot express.
+std::unique_ptr<FrameSource> OpenCameraSource(const CameraConfig& camera, int camera_index);
+
+// The camera's model: the config's `model`, else (replay) the session camera's.
+// nullopt for an uncalibrated live camera. InputError naming the file when it
+// cannot be read.
+std::optional<CameraModel> ModelForCamera(const CameraConfig& camera);
+
+}  // namespace ss

@@ -1,0 +1,551 @@
+#include "pipeline/station/station.h"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <ctime>
+#include <deque>
+#include <filesystem>
+#include <mutex>
+#include <thread>
+
+#include "core/bank.h"
+#include "core/error.h"
+#include "core/log.h"
+#include "pipeline/run/bounded_queue.h"
+#include "pipeline/run/ingest.h"
+#include "pipeline/station/camera_source.h"
+#include "pipeline/station/recorder.h"
+#include "pipeline/transitions/worker.h"
+
+namespace ss {
+namespace {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+double Seconds(Clock::duration d) { return std::chrono::duration<double>(d).count(); }
+
+std::string UtcNow(const char* format = "%Y-%m-%dT%H:%M:%SZ") {
+  const std::time_t t = std::time(nullptr);
+  std::tm tm{};
+  gmtime_r(&t, &tm);
+  char text[64];
+  std::strftime(text, sizeof text, format, &tm);
+  return text;
+}
+
+// A session name: what a studio user types, kept usable as a folder name.
+std::string CheckSessionName(const std::string& name) {
+  if (name.empty() || name.size() > 100) throw InputError("name", "a session name needs 1 to 100 characters");
+  for (const char c : name) {
+    if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_' || c == '.' || c == ' ')) {
+      throw InputError("name", "\"" + name + "\": only letters, digits, space, '-', '_' and '.' are allowed");
+    }
+  }
+  if (name == "." || name == "..") throw InputError("name", "\"" + name + "\" is not a session name");
+  return name;
+}
+
+// Free MiB on the file system holding `path` (or its nearest existing parent).
+int64_t FreeMib(fs::path path) {
+  std::error_code ec;
+  while (!path.empty() && !fs::exists(path, ec)) path = path.parent_path();
+  if (path.empty()) path = ".";
+  const fs::space_info info = fs::space(path, ec);
+  if (ec) return -1;
+  return static_cast<int64_t>(info.available / (1024 * 1024));
+}
+
+void ApplyLogging(const LoggingConfig& logging) {
+  SetLogLevel(logging.level);
+  for (const auto& [component, level] : logging.components) Log(component)->set_level(spdlog::level::from_str(level));
+}
+
+}  // namespace
+
+struct Station::Impl {
+  StationOptions options;
+  std::shared_ptr<spdlog::logger> log = Log("station");
+  GroundPolygon floor;
+  std::vector<std::optional<CameraModel>> models;
+  SteadyTime started_at = Clock::now();
+  std::atomic<int> state{0};  // 0 starting, 1 running, 2 stopping, 3 stopped
+
+  std::mutex bank_mutex;  // BankWriter is one connection: one thread at a time
+  std::unique_ptr<BankWriter> bank;
+  std::unique_ptr<TransitionWorker> transitions;
+  std::vector<std::unique_ptr<CameraRunner>> runners;
+
+  BoundedQueue<StationBatch> batches{256};
+  std::thread writer_thread, monitor_thread;
+  std::mutex idle_mutex;
+  std::condition_variable idle_cv;
+  uint64_t batches_in = 0, batches_done = 0;  // under idle_mutex
+
+  // Under stats_mutex.
+  mutable std::mutex stats_mutex;
+  int64_t bank_sprites = 0;
+  uint64_t sprites_stored = 0, batches_stored = 0, batches_failed = 0, batches_refused = 0;
+  std::deque<double> latencies_ms;                         // last 10,000
+  std::deque<std::pair<SteadyTime, uint64_t>> stored_log;  // (time, sprites_stored) samples for sprites/s
+  std::string bank_error;
+  std::string storage_state = "ok";
+  int64_t disk_free_mib = -1;
+
+  // The capture session, under session_mutex (held across start/stop).
+  mutable std::mutex session_mutex;
+  SessionStatus session;
+  SteadyTime session_started{};
+  std::unique_ptr<StationRecorder> recorder;
+  mutable std::mutex recorder_mutex;  // guards `recorder` against the pipeline threads' taps
+  std::mutex control_mutex;           // one session start / stop / rename at a time
+  RecorderStats last_recording;
+
+  std::mutex monitor_mutex;
+  std::condition_variable monitor_wake;
+  bool monitor_stop = false;
+
+  void Store(StationBatch sb) {
+    {
+      std::lock_guard lock(idle_mutex);
+      ++batches_in;
+    }
+    if (!batches.Push(std::move(sb))) {
+      std::lock_guard lock(idle_mutex);
+      ++batches_done;
+    }
+  }
+
+  void WriterLoop() {
+    while (std::optional<StationBatch> sb = batches.Pop()) {
+      WriteBatch(*sb);
+      std::lock_guard lock(idle_mutex);
+      ++batches_done;
+      idle_cv.notify_all();
+    }
+  }
+
+  void WriteBatch(StationBatch& sb) {
+    {
+      std::lock_guard lock(stats_mutex);
+      if (storage_state == "sprites_stopped") {
+        ++batches_refused;
+        return;
+      }
+    }
+    AppendResult result;
+    try {
+      std::lock_guard lock(bank_mutex);
+      result = bank->AppendClipBatch(sb.batch.clip, sb.batch.sprites);
+    } catch (const std::exception& e) {
+      // A failed append is one rolled-back transaction: what was stored stays stored.
+      log->error("bank: {}", e.what());
+      std::lock_guard lock(stats_mutex);
+      ++batches_failed;
+      bank_error = e.what();
+      return;
+    }
+    const SteadyTime now = Clock::now();
+    uint64_t originals = 0;
+    {
+      std::lock_guard lock(stats_mutex);
+      for (size_t i = 0; i < sb.batch.sprites.size(); ++i) {
+        if (sb.batch.sprites[i].mirrored) continue;
+        ++originals;
+        latencies_ms.push_back(Seconds(now - sb.received[i]) * 1e3);
+        if (latencies_ms.size() > 10000) latencies_ms.pop_front();
+      }
+      sprites_stored += originals;
+      bank_sprites += result.inserted;
+      ++batches_stored;
+      stored_log.emplace_back(now, sprites_stored);
+      while (stored_log.size() > 2 && Seconds(now - stored_log.front().first) > 5.0) stored_log.pop_front();
+    }
+    {
+      std::lock_guard lock(session_mutex);
+      session.sprites_stored += originals;
+    }
+    if (transitions && result.inserted > 0) transitions->Submit(result.sprite_ids);
+  }
+
+  // Waits until every batch handed to the writer so far is stored (or refused).
+  void WaitWriterIdle() {
+    std::unique_lock lock(idle_mutex);
+    idle_cv.wait(lock, [&] { return batches_done >= batches_in; });
+  }
+
+  void Tap(int camera, const Frame& frame, uint64_t drops_before, bool usable) {
+    std::lock_guard lock(recorder_mutex);
+    if (!recorder) return;
+    const std::optional<SourceCamera> source = runners[static_cast<size_t>(camera)]->source_camera();
+    if (!source) return;
+    const std::optional<CameraModel>& model = models[static_cast<size_t>(camera)];
+    recorder->Offer(camera, *source, model ? &*model : nullptr, frame, drops_before, usable);
+  }
+
+  void StopRecording(const std::string& why) {
+    std::unique_ptr<StationRecorder> done;
+    {
+      std::lock_guard lock(recorder_mutex);
+      done.swap(recorder);
+    }
+    if (!done) return;
+    done->Close();
+    std::lock_guard lock(recorder_mutex);
+    last_recording = done->stats();
+    log->info("recording {} closed ({} frames, {} dropped){}", last_recording.dir, last_recording.frames_written,
+              last_recording.frames_dropped, why.empty() ? "" : ": " + why);
+  }
+
+  void MonitorLoop() {
+    std::unique_lock lock(monitor_mutex);
+    while (!monitor_stop) {
+      lock.unlock();
+      CheckDisk();
+      lock.lock();
+      monitor_wake.wait_for(lock, std::chrono::seconds(1), [&] { return monitor_stop; });
+    }
+  }
+
+  void CheckDisk() {
+    const StorageConfig storage = StorageSettings();
+    int64_t free_mib = FreeMib(fs::path(storage.bank).parent_path());
+    if (storage.recording != "off") {
+      const int64_t rec = FreeMib(storage.recording_dir);
+      if (rec >= 0 && (free_mib < 0 || rec < free_mib)) free_mib = rec;
+    }
+    std::string next = "ok";
+    if (free_mib >= 0 && free_mib < storage.stop_sprites_below_mib) {
+      next = "sprites_stopped";
+    } else if (free_mib >= 0 && free_mib < storage.stop_recording_below_mib) {
+      next = "recording_stopped";
+    }
+    std::string previous;
+    {
+      std::lock_guard lock(stats_mutex);
+      previous = storage_state;
+      storage_state = next;
+      disk_free_mib = free_mib;
+    }
+    if (next != "ok") {
+      bool recording = false;
+      {
+        std::lock_guard lock(recorder_mutex);
+        recording = recorder != nullptr;
+      }
+      if (recording) StopRecording("free disk space " + std::to_string(free_mib) + " MiB is below storage.stop_recording_below_mib");
+    }
+    if (next != previous) {
+      if (next == "ok") {
+        log->info("disk: {} MiB free, storage back to normal", free_mib);
+      } else {
+        log->warn("disk: {} MiB free: {}", free_mib,
+                  next == "sprites_stopped" ? "sprite storage stopped (storage.stop_sprites_below_mib)"
+                                            : "raw recording stopped (storage.stop_recording_below_mib)");
+      }
+    }
+  }
+
+  mutable std::mutex config_mutex;  // guards options.config.storage / logging for Reload
+  StorageConfig StorageSettings() const {
+    std::lock_guard lock(config_mutex);
+    return options.config.storage;
+  }
+};
+
+Station::Station(StationOptions options) : impl_(std::make_unique<Impl>()) {
+  Impl& s = *impl_;
+  s.options = std::move(options);
+  const StationConfig& config = s.options.config;
+  if (config.cameras.empty()) throw InputError("cameras", "the station needs at least one camera");
+  if (config.enclosure.floor.empty()) {
+    // A replay station may take the floor from its session, as ingest does.
+    const CameraConfig* replay = nullptr;
+    for (const CameraConfig& c : config.cameras) {
+      if (c.source == "replay") replay = &c;
+    }
+    if (replay == nullptr) throw InputError("enclosure.floor", "the station needs the floor polygon");
+    s.floor = FloorForSession(replay->session, config);
+  } else {
+    s.floor = config.enclosure.floor;
+  }
+  for (size_t i = 0; i < config.cameras.size(); ++i) {
+    const CameraConfig& c = config.cameras[i];
+    s.models.push_back(ModelForCamera(c));
+    if (!s.models.back()) {
+      s.log->warn("{}: no camera model: it streams for preview and recording but stores no sprites "
+                  "(calibrate it: spritestation calibrate)", c.name);
+    }
+  }
+  ApplyLogging(config.logging);
+}
+
+Station::~Station() { Stop(); }
+
+void Station::Start() {
+  Impl& s = *impl_;
+  const StationConfig& config = s.options.config;
+  s.bank = std::make_unique<BankWriter>(config.storage.bank);
+  s.bank_sprites = s.bank->Counts().sprites;
+  if (s.options.transitions) {
+    s.transitions = std::make_unique<TransitionWorker>(config.storage.bank,
+                                                      s.options.weights ? *s.options.weights : DefaultWeights());
+  }
+  s.writer_thread = std::thread([&s] { s.WriterLoop(); });
+
+  CameraPipelineOptions pipeline = PipelineOptionsFromConfig(config);
+  for (size_t i = 0; i < config.cameras.size(); ++i) {
+    const CameraConfig& c = config.cameras[i];
+    // Live batches are small (1/30 s of frames): a sprite reaches the bank as soon as its
+    // clip is min_clip_frames long and its velocity window is complete.
+    const double fps = c.fps > 0 ? c.fps : 30.0;
+    CameraPipelineOptions camera_pipeline = pipeline;
+    camera_pipeline.batch.batch_frames = std::max(1, static_cast<int>(fps / 30.0));
+    CameraRunnerOptions o;
+    o.camera = c;
+    o.model = s.models[i];
+    o.floor = s.floor;
+    o.pipeline = camera_pipeline;
+    o.training_frames = std::max(1, config.keying.training_frames);
+    o.queue_frames = config.pipeline.queue_frames;
+    o.offline_after_s = s.options.offline_after_s;
+    s.runners.push_back(std::make_unique<CameraRunner>(
+        static_cast<int>(i), std::move(o), [&s](StationBatch b) { s.Store(std::move(b)); },
+        [&s](int camera, const Frame& f, uint64_t drops, bool usable) { s.Tap(camera, f, drops, usable); }));
+  }
+  s.CheckDisk();  // before any session: a full disk refuses from the first frame
+  for (auto& r : s.runners) r->Start();
+  s.monitor_thread = std::thread([&s] { s.MonitorLoop(); });
+  s.state = 1;
+  s.log->info("station running: {} camera(s), bank {}", s.runners.size(), config.storage.bank);
+}
+
+void Station::Stop() {
+  Impl& s = *impl_;
+  if (s.state == 3 || (!s.writer_thread.joinable() && s.runners.empty())) {
+    s.state = 3;
+    return;
+  }
+  s.state = 2;
+  bool active = false;
+  {
+    std::lock_guard lock(s.session_mutex);
+    active = s.session.active;
+  }
+  if (active) {
+    try {
+      StopSession();
+    } catch (const std::exception& e) {
+      s.log->error("stopping the session: {}", e.what());
+    }
+  }
+  for (auto& r : s.runners) r->RequestStop();
+  for (auto& r : s.runners) r->Stop();
+  s.batches.Close();
+  if (s.writer_thread.joinable()) s.writer_thread.join();
+  {
+    std::lock_guard lock(s.monitor_mutex);
+    s.monitor_stop = true;
+    s.monitor_wake.notify_all();
+  }
+  if (s.monitor_thread.joinable()) s.monitor_thread.join();
+  s.StopRecording("the station stopped");
+  if (s.transitions) s.transitions->Stop();
+  s.transitions.reset();
+  {
+    std::lock_guard lock(s.bank_mutex);
+    s.bank.reset();  // the last connection closes: the bank is whole on disk
+  }
+  s.state = 3;
+  s.log->info("station stopped: {} sprites stored", s.sprites_stored);
+}
+
+SessionStatus Station::StartSession(const std::string& requested_name) {
+  Impl& s = *impl_;
+  const std::string name = CheckSessionName(requested_name);
+  std::lock_guard control(s.control_mutex);
+  std::unique_lock lock(s.session_mutex);
+  if (s.state != 1) throw InputError("session", "the station is not running");
+  if (s.session.active) throw InputError("session", "session \"" + s.session.name + "\" is running; stop it first");
+  const std::string created = UtcNow();
+  SessionRecord record;
+  record.uid = name + "@" + created;
+  record.name = name;
+  record.created = created;
+  record.source = "station";
+  std::vector<int64_t> camera_ids(s.runners.size(), 0);
+  {
+    std::lock_guard bank_lock(s.bank_mutex);
+    const int64_t session_id = s.bank->AddSession(record);
+    s.session = SessionStatus{};
+    s.session.bank_session_id = session_id;
+    for (size_t i = 0; i < s.runners.size(); ++i) {
+      if (!s.models[i]) continue;
+      CameraRecord camera;
+      camera.name = s.runners[i]->name();
+      camera.cameramodel = s.models[i]->ToText();
+      camera.width = s.models[i]->width();
+      camera.height = s.models[i]->height();
+      camera_ids[i] = s.bank->AddCamera(session_id, camera);
+    }
+  }
+  s.session.active = true;
+  s.session.name = name;
+  s.session.started = created;
+  s.session_started = Clock::now();
+  const StorageConfig storage = s.StorageSettings();
+  std::string storage_state;
+  {
+    std::lock_guard stats_lock(s.stats_mutex);
+    storage_state = s.storage_state;
+  }
+  if (storage.recording != "off" && storage_state == "ok") {
+    const fs::path dir = fs::path(storage.recording_dir) / (name + "-" + UtcNow("%Y%m%dT%H%M%SZ"));
+    RecordingOptions recording;
+    recording.codec = storage.recording_codec;
+    try {
+      auto recorder = std::make_unique<StationRecorder>(dir.string(), name, recording, storage.recording == "usable",
+                                                        static_cast<int>(s.runners.size()));
+      std::lock_guard rec_lock(s.recorder_mutex);
+      s.recorder = std::move(recorder);
+      s.session.recording_dir = dir.string();
+    } catch (const std::exception& e) {
+      s.log->error("recording: {}", e.what());
+      std::lock_guard rec_lock(s.recorder_mutex);
+      s.last_recording.error = e.what();
+    }
+  }
+  const SessionStatus out = s.session;
+  lock.unlock();  // the writer updates the session's counts meanwhile
+  for (size_t i = 0; i < s.runners.size(); ++i) s.runners[i]->SetBankCamera(camera_ids[i]);
+  s.log->info("session \"{}\" started (bank session {})", name, out.bank_session_id);
+  return out;
+}
+
+SessionStatus Station::StopSession() {
+  Impl& s = *impl_;
+  std::lock_guard control(s.control_mutex);
+  {
+    std::lock_guard lock(s.session_mutex);
+    if (!s.session.active) throw InputError("session", "no session is running");
+  }
+  // Every open clip closes into the writer queue under the session's cameras; then
+  // the writer stores them all before the session is reported stopped.
+  for (auto& r : s.runners) r->SetBankCamera(0);
+  s.WaitWriterIdle();
+  s.StopRecording("the session stopped");
+  std::lock_guard lock(s.session_mutex);
+  s.session.active = false;
+  s.session.seconds = Seconds(Clock::now() - s.session_started);
+  s.log->info("session \"{}\" stopped: {} sprites stored", s.session.name, s.session.sprites_stored);
+  return s.session;
+}
+
+SessionStatus Station::RenameSession(const std::string& requested_name) {
+  Impl& s = *impl_;
+  const std::string name = CheckSessionName(requested_name);
+  std::lock_guard control(s.control_mutex);
+  std::lock_guard lock(s.session_mutex);
+  if (!s.session.active) throw InputError("session", "no session is running");
+  {
+    std::lock_guard bank_lock(s.bank_mutex);
+    s.bank->RenameSession(s.session.bank_session_id, name);
+  }
+  s.log->info("session \"{}\" renamed \"{}\"", s.session.name, name);
+  s.session.name = name;
+  return s.session;
+}
+
+StationStatus Station::Status() const {
+  const Impl& s = *impl_;
+  StationStatus out;
+  static const char* kStates[] = {"starting", "running", "stopping", "stopped"};
+  out.state = kStates[std::clamp(s.state.load(), 0, 3)];
+  out.uptime_s = Seconds(Clock::now() - s.started_at);
+  {
+    std::lock_guard lock(s.session_mutex);
+    out.session = s.session;
+    if (out.session.active) out.session.seconds = Seconds(Clock::now() - s.session_started);
+  }
+  for (const auto& r : s.runners) out.cameras.push_back(r->status());
+  out.bank_path = s.options.config.storage.bank;
+  {
+    std::lock_guard lock(s.stats_mutex);
+    out.bank_sprites = s.bank_sprites;
+    out.sprites_stored = s.sprites_stored;
+    out.batches_stored = s.batches_stored;
+    out.batches_failed = s.batches_failed;
+    out.batches_refused = s.batches_refused;
+    out.bank_error = s.bank_error;
+    out.storage_state = s.storage_state;
+    out.disk_free_mib = s.disk_free_mib;
+    if (s.stored_log.size() >= 2) {
+      const double span = Seconds(s.stored_log.back().first - s.stored_log.front().first);
+      const double recent = Seconds(Clock::now() - s.stored_log.back().first);
+      if (span > 0 && recent < 5.0) {
+        out.sprites_per_second = (s.stored_log.back().second - s.stored_log.front().second) / span;
+      }
+    }
+    if (!s.latencies_ms.empty()) {
+      std::vector<double> sorted(s.latencies_ms.begin(), s.latencies_ms.end());
+      std::sort(sorted.begin(), sorted.end());
+      out.latency_p50_ms = sorted[sorted.size() / 2];
+      out.latency_p99_ms = sorted[std::min(sorted.size() - 1, sorted.size() * 99 / 100)];
+    }
+  }
+  out.writer_queue = s.batches.size();
+  out.transitions_enabled = s.transitions != nullptr;
+  if (s.transitions) {
+    const TransitionWorkerStats t = s.transitions->stats();
+    out.transitions_ready = t.ready;
+    out.transitions_pending = t.queued;
+    out.transitions_stored = t.transitions_stored;
+    out.transition_rounds_failed = t.failed_rounds;
+    out.transitions_last_round_ms = t.last_round_ms;
+  }
+  const StorageConfig storage = s.StorageSettings();
+  out.recording_mode = storage.recording;
+  {
+    std::lock_guard lock(s.recorder_mutex);
+    const RecorderStats r = s.recorder ? s.recorder->stats() : s.last_recording;
+    out.frames_recorded = r.frames_written;
+    out.frames_record_dropped = r.frames_dropped;
+    if (!r.error.empty()) out.recording_error = r.error;
+  }
+  return out;
+}
+
+std::optional<std::vector<uint8_t>> Station::PreviewJpeg(const std::string& camera, bool keyed) const {
+  for (const auto& r : impl_->runners) {
+    if (r->name() == camera) return r->PreviewJpeg(keyed);
+  }
+  throw InputError("camera", "no camera named \"" + camera + "\"");
+}
+
+std::vector<std::string> Station::Reload(const StationConfig& config) {
+  Impl& s = *impl_;
+  std::vector<std::string> needs_restart;
+  const StationConfig& old = s.options.config;
+  if (config.cameras != old.cameras) needs_restart.push_back("cameras: changed; restart the daemon to apply");
+  if (config.keying != old.keying) needs_restart.push_back("keying: changed; restart the daemon to apply");
+  if (config.enclosure != old.enclosure) needs_restart.push_back("enclosure: changed; restart the daemon to apply");
+  if (config.pipeline != old.pipeline) needs_restart.push_back("pipeline: changed; restart the daemon to apply");
+  if (config.control != old.control) needs_restart.push_back("control: changed; restart the daemon to apply");
+  if (config.storage.bank != old.storage.bank) needs_restart.push_back("storage.bank: changed; restart the daemon to apply");
+  {
+    std::lock_guard lock(s.config_mutex);
+    const std::string bank = s.options.config.storage.bank;
+    s.options.config.storage = config.storage;
+    s.options.config.storage.bank = bank;
+    s.options.config.logging = config.logging;
+  }
+  ApplyLogging(config.logging);
+  s.log->info("config reloaded (logging, storage limits and recording mode applied){}",
+              needs_restart.empty() ? "" : "; some sections need a restart");
+  for (const std::string& line : needs_restart) s.log->warn("{}", line);
+  return needs_restart;
+}
+
+}  // namespace ss

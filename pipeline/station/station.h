@@ -1,0 +1,62 @@
+#pragma once
+// The live station (`spritestation daemon`): every configured camera runs its
+// own CameraRunner (capture thread + pipeline thread); their clip batches meet
+// in one bank writer thread, which hands each stored sprite to the incremental
+// TransitionWorker. Sprites are stored only during a capture session (started
+// and stopped over the control API or at start); a session may also record the
+// raw frames. A monitor thread watches the disk: below
+// storage.stop_recording_below_mib raw recording stops, below
+// storage.stop_sprites_below_mib sprite storage stops too (the bank stays whole).
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/config.h"
+#include "pipeline/station/station_status.h"
+#include "pipeline/transitions/weights.h"
+
+namespace ss {
+
+struct StationOptions {
+  StationConfig config;                        // validated
+  std::optional<TransitionWeights> weights;    // unset: the shipped defaults
+  bool transitions = true;                     // keep the bank's transitions current
+  double offline_after_s = 3.0;                // a camera silent this long is reopened
+};
+
+class Station {
+ public:
+  // Checks what can be checked before anything starts (models, floor, bank):
+  // InputError naming the field or file.
+  explicit Station(StationOptions options);
+  ~Station();  // Stop()
+  Station(const Station&) = delete;
+  Station& operator=(const Station&) = delete;
+
+  // Opens the bank and starts every camera and worker.
+  void Start();
+  // Stops the session (its clips stored, its recording finalized), the cameras and the
+  // workers; the bank is committed. Idempotent.
+  void Stop();
+
+  // Capture sessions. StartSession: InputError when one is active or the name is bad.
+  SessionStatus StartSession(const std::string& name);
+  // Closes every open clip into the session, waits until the bank holds them, finalizes
+  // the recording. InputError when no session is active.
+  SessionStatus StopSession();
+  SessionStatus RenameSession(const std::string& name);
+
+  StationStatus Status() const;
+  // JPEG of a camera's latest frame; InputError for an unknown camera, nullopt before its first frame.
+  std::optional<std::vector<uint8_t>> PreviewJpeg(const std::string& camera, bool keyed) const;
+  // SIGHUP: applies what is safe to change live (logging, storage limits and recording
+  // mode, from the next session on); returns one line per section that needs a restart.
+  std::vector<std::string> Reload(const StationConfig& config);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace ss

@@ -1,0 +1,180 @@
+#include "pipeline/station/station_status.h"
+
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "pipeline/filter/usability.h"
+
+namespace ss {
+namespace {
+
+// Prometheus label values escape backslash, double quote and newline.
+std::string Label(const std::string& value) {
+  std::string out;
+  for (const char c : value) {
+    if (c == '\\' || c == '"') out += '\\';
+    if (c == '\n') {
+      out += "\\n";
+      continue;
+    }
+    out += c;
+  }
+  return out;
+}
+
+class Metrics {
+ public:
+  // One metric family: HELP and TYPE once, then its samples.
+  void Family(const std::string& name, const char* type, const std::string& help) {
+    out_ << "# HELP spritestation_" << name << " " << help << "\n# TYPE spritestation_" << name << " " << type << "\n";
+    name_ = name;
+  }
+  void Sample(double value, const std::string& labels = "") {
+    out_ << "spritestation_" << name_ << (labels.empty() ? "" : "{" + labels + "}") << " " << value << "\n";
+  }
+  std::string str() const { return out_.str(); }
+
+ private:
+  std::ostringstream out_;
+  std::string name_;
+};
+
+}  // namespace
+
+nlohmann::json SessionToJson(const SessionStatus& s) {
+  return {{"active", s.active},       {"name", s.name},
+          {"bank_session_id", s.bank_session_id}, {"started", s.started},
+          {"seconds", s.seconds},     {"sprites_stored", s.sprites_stored},
+          {"recording_dir", s.recording_dir}};
+}
+
+nlohmann::json StatusToJson(const StationStatus& st) {
+  nlohmann::json cameras = nlohmann::json::array();
+  for (const CameraStatus& c : st.cameras) {
+    nlohmann::json discards = nlohmann::json::object();
+    for (size_t r = 1; r < c.pipeline.discards.size(); ++r) {
+      discards[DiscardName(static_cast<Discard>(r))] = c.pipeline.discards[r];
+    }
+    cameras.push_back({{"name", c.name},
+                       {"source", c.source},
+                       {"state", CameraStateName(c.state)},
+                       {"message", c.message},
+                       {"width", c.width},
+                       {"height", c.height},
+                       {"pixel_format", c.pixel_format},
+                       {"fps", c.fps},
+                       {"frames_captured", c.frames_captured},
+                       {"frames_processed", c.frames_processed},
+                       {"dropped", {{"queue_full", c.dropped_queue_full},
+                                    {"at_source", c.dropped_at_source},
+                                    {"total", c.dropped_queue_full + c.dropped_at_source}}},
+                       {"source_errors", c.source_errors},
+                       {"queue_depth", c.queue_depth},
+                       {"queue_capacity", c.queue_capacity},
+                       {"reopens", c.reopens},
+                       {"has_model", c.has_model},
+                       {"usable_sprites", c.pipeline.discards[static_cast<size_t>(Discard::kNone)]},
+                       {"sprites_stored", c.pipeline.stored_sprites},
+                       {"clips", c.pipeline.clips},
+                       {"sequence_gaps", c.pipeline.sequence_gaps},
+                       {"batches_unstored", c.batches_unstored},
+                       {"discards", discards}});
+  }
+  return {{"state", st.state},
+          {"uptime_s", st.uptime_s},
+          {"session", SessionToJson(st.session)},
+          {"cameras", cameras},
+          {"bank", {{"path", st.bank_path},
+                    {"sprites", st.bank_sprites},
+                    {"sprites_stored", st.sprites_stored},
+                    {"sprites_per_second", st.sprites_per_second},
+                    {"batches_stored", st.batches_stored},
+                    {"batches_failed", st.batches_failed},
+                    {"batches_refused", st.batches_refused},
+                    {"writer_queue", st.writer_queue},
+                    {"latency_ms", {{"p50", st.latency_p50_ms}, {"p99", st.latency_p99_ms}}},
+                    {"error", st.bank_error}}},
+          {"transitions", {{"enabled", st.transitions_enabled},
+                           {"ready", st.transitions_ready},
+                           {"pending", st.transitions_pending},
+                           {"stored", st.transitions_stored},
+                           {"failed_rounds", st.transition_rounds_failed},
+                           {"last_round_ms", st.transitions_last_round_ms}}},
+          {"storage", {{"state", st.storage_state},
+                       {"disk_free_mib", st.disk_free_mib},
+                       {"recording", st.recording_mode},
+                       {"frames_recorded", st.frames_recorded},
+                       {"frames_record_dropped", st.frames_record_dropped},
+                       {"recording_error", st.recording_error}}},
+          {"control", {{"url", st.control_url}}}};
+}
+
+std::string StatusToPrometheus(const StationStatus& st) {
+  Metrics m;
+  m.Family("up", "gauge", "1 while the station runs");
+  m.Sample(st.state == "running" ? 1 : 0);
+  m.Family("uptime_seconds", "gauge", "seconds since the daemon started");
+  m.Sample(st.uptime_s);
+  m.Family("session_active", "gauge", "1 while a capture session runs");
+  m.Sample(st.session.active ? 1 : 0);
+
+  const auto per_camera = [&](const std::string& name, const char* type, const std::string& help, auto value) {
+    m.Family(name, type, help);
+    for (const CameraStatus& c : st.cameras) m.Sample(static_cast<double>(value(c)), "camera=\"" + Label(c.name) + "\"");
+  };
+  per_camera("camera_up", "gauge", "1 while the camera delivers frames (training or live)",
+             [](const CameraStatus& c) { return c.state == CameraState::kLive || c.state == CameraState::kTraining; });
+  per_camera("camera_fps", "gauge", "frames delivered per second over the last 2 s",
+             [](const CameraStatus& c) { return c.fps; });
+  per_camera("frames_captured_total", "counter", "frames delivered by the camera",
+             [](const CameraStatus& c) { return c.frames_captured; });
+  per_camera("frames_processed_total", "counter", "frames through the pipeline",
+             [](const CameraStatus& c) { return c.frames_processed; });
+  m.Family("frames_dropped_total", "counter", "frames lost, by cause");
+  for (const CameraStatus& c : st.cameras) {
+    m.Sample(static_cast<double>(c.dropped_queue_full), "camera=\"" + Label(c.name) + "\",cause=\"queue_full\"");
+    m.Sample(static_cast<double>(c.dropped_at_source), "camera=\"" + Label(c.name) + "\",cause=\"at_source\"");
+  }
+  per_camera("source_errors_total", "counter", "recoverable source problems (timeouts, corrupt frames)",
+             [](const CameraStatus& c) { return c.source_errors; });
+  per_camera("queue_depth", "gauge", "frames waiting for the pipeline", [](const CameraStatus& c) { return c.queue_depth; });
+  per_camera("camera_reopens_total", "counter", "times the camera was reopened after going offline",
+             [](const CameraStatus& c) { return c.reopens; });
+  m.Family("sprite_discards_total", "counter", "sprites not kept, by reason");
+  for (const CameraStatus& c : st.cameras) {
+    for (size_t r = 1; r < c.pipeline.discards.size(); ++r) {
+      m.Sample(static_cast<double>(c.pipeline.discards[r]),
+               "camera=\"" + Label(c.name) + "\",reason=\"" + DiscardName(static_cast<Discard>(r)) + "\"");
+    }
+  }
+  m.Family("sprites_stored_total", "counter", "original sprites stored in the bank since start");
+  m.Sample(static_cast<double>(st.sprites_stored));
+  m.Family("sprites_per_second", "gauge", "sprites stored per second over the last 5 s");
+  m.Sample(st.sprites_per_second);
+  m.Family("bank_sprites", "gauge", "sprite rows in the bank (originals and mirrors)");
+  m.Sample(static_cast<double>(st.bank_sprites));
+  m.Family("bank_batches_failed_total", "counter", "clip batches the bank could not store");
+  m.Sample(static_cast<double>(st.batches_failed));
+  m.Family("bank_batches_refused_total", "counter", "clip batches not stored because the disk is nearly full");
+  m.Sample(static_cast<double>(st.batches_refused));
+  m.Family("sprite_latency_seconds", "gauge", "frame arrival to sprite committed, over the last 10,000 sprites");
+  m.Sample(st.latency_p50_ms / 1e3, "quantile=\"0.5\"");
+  m.Sample(st.latency_p99_ms / 1e3, "quantile=\"0.99\"");
+  m.Family("transitions_pending", "gauge", "stored sprites whose transitions are not found yet");
+  m.Sample(static_cast<double>(st.transitions_pending));
+  m.Family("transitions_stored_total", "counter", "transitions stored since start");
+  m.Sample(static_cast<double>(st.transitions_stored));
+  m.Family("disk_free_mib", "gauge", "free MiB on the bank's (or recordings') file system");
+  m.Sample(static_cast<double>(st.disk_free_mib));
+  m.Family("storage_stopped", "gauge", "what the disk guard stopped, by what");
+  m.Sample(st.storage_state != "ok" ? 1 : 0, "what=\"recording\"");
+  m.Sample(st.storage_state == "sprites_stopped" ? 1 : 0, "what=\"sprites\"");
+  m.Family("frames_recorded_total", "counter", "raw frames written to the session recording");
+  m.Sample(static_cast<double>(st.frames_recorded));
+  m.Family("frames_record_dropped_total", "counter", "raw frames the recorder could not keep up with");
+  m.Sample(static_cast<double>(st.frames_record_dropped));
+  return m.str();
+}
+
+}  // namespace ss

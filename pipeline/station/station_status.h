@@ -1,0 +1,56 @@
+#pragma once
+// What the station reports: `GET /api/status` (JSON) and `GET /metrics`
+// (Prometheus text exposition format), both made from one StationStatus.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json_fwd.hpp>
+
+#include "pipeline/station/camera_runner.h"
+
+namespace ss {
+
+struct SessionStatus {
+  bool active = false;
+  std::string name;
+  int64_t bank_session_id = 0;
+  std::string started;            // ISO 8601 UTC
+  double seconds = 0;             // since it started
+  uint64_t sprites_stored = 0;    // original sprites stored in it so far
+  std::string recording_dir;      // "" when not recording
+};
+
+struct StationStatus {
+  std::string state;              // starting | running | stopping | stopped
+  double uptime_s = 0;
+  SessionStatus session;
+  std::vector<CameraStatus> cameras;
+  // Bank
+  std::string bank_path;
+  int64_t bank_sprites = 0;       // rows in the bank (originals and mirrors)
+  uint64_t sprites_stored = 0;    // originals stored since start
+  double sprites_per_second = 0;  // over the last ~5 s
+  uint64_t batches_stored = 0, batches_failed = 0, batches_refused = 0;  // refused: storage stopped (disk)
+  size_t writer_queue = 0;
+  double latency_p50_ms = 0, latency_p99_ms = 0;  // frame arrival -> sprite committed, last 10,000 sprites
+  std::string bank_error;         // the last failed append
+  // Transitions
+  bool transitions_enabled = false, transitions_ready = false;
+  int64_t transitions_pending = 0, transitions_stored = 0, transition_rounds_failed = 0;
+  double transitions_last_round_ms = 0;
+  // Storage
+  std::string storage_state;      // ok | recording_stopped | sprites_stopped
+  int64_t disk_free_mib = -1;     // the lower of the bank's and the recordings' file systems
+  std::string recording_mode;     // off | all | usable
+  uint64_t frames_recorded = 0, frames_record_dropped = 0;
+  std::string recording_error;
+  // Control
+  std::string control_url;
+};
+
+nlohmann::json StatusToJson(const StationStatus& status);
+std::string StatusToPrometheus(const StationStatus& status);
+nlohmann::json SessionToJson(const SessionStatus& session);
+
+}  // namespace ss

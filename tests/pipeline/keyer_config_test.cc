@@ -1,0 +1,136 @@
+// The station config's keying section reaches the keyers (PipelineOptionsFromConfig ->
+// CameraPipeline): a changed config value changes what the pipeline's keyer makes of the same
+// frame (docs/keying.md, "From the station config").
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <opencv2/core.hpp>
+
+#include "core/config.h"
+#include "pipeline/run/camera_pipeline.h"
+#include "tests/pipeline/key_scene.h"
+
+namespace ss {
+namespace {
+
+using testing::KeyScene;
+using testing::SceneFrame;
+using testing::SceneOptions;
+using testing::SceneSubject;
+
+// A pinhole camera 1.4 m from the floor origin, looking down at it, for the scene's 640x480 frames.
+CameraModel Camera() {
+  const Eigen::Vector3d centre(0.0, -0.9, 1.1), target(0.0, 0.0, 0.0);
+  const Eigen::Vector3d z = (target - centre).normalized();
+  const Eigen::Vector3d x = z.cross(Eigen::Vector3d::UnitZ()).normalized();
+  Rigid3 cam_from_ground;
+  cam_from_ground.rotation.row(0) = x;
+  cam_from_ground.rotation.row(1) = z.cross(x);
+  cam_from_ground.rotation.row(2) = z;
+  cam_from_ground.translation = -(cam_from_ground.rotation * centre);
+  return CameraModel("LENSMODEL_PINHOLE", {560, 560, 319.5, 239.5}, 640, 480, cam_from_ground);
+}
+
+struct Keyed {
+  Matte matte;
+  const CameraPipeline* pipeline = nullptr;
+  double alpha_sum = 0;   // of 255
+  double shadow_sum = 0;  // of 255
+  double rim_green = 0;   // mean G of the colour layer on the subject's spilled rim
+};
+
+class KeyerConfig : public ::testing::Test {
+ protected:
+  // Trains a pipeline made from `config` on the scene's empty frames and keys one frame.
+  Keyed Key(const StationConfig& config, bool green = true) {
+    SceneOptions so;
+    so.green = green;
+    const KeyScene scene(so);
+    SceneSubject s;
+    s.centre = {320.5, 250.5};
+    std::vector<cv::Mat> empty;
+    for (int i = 0; i < 4; ++i) empty.push_back(scene.Empty(100 + i));
+    const SceneFrame f = scene.Render({s}, 7);
+    GroundPolygon floor({{-0.6, -0.4}, {0.6, -0.4}, {0.6, 0.4}, {-0.6, 0.4}});
+    pipelines_.emplace_back(std::make_unique<CameraPipeline>("cam0", 1, Camera(), floor,
+                                                             PipelineOptionsFromConfig(config)));
+    CameraPipeline& p = *pipelines_.back();
+    p.Train(empty);
+    Keyed k;
+    k.pipeline = &p;
+    p.keyer().Key(f.bgr, k.matte);
+    k.alpha_sum = cv::sum(k.matte.alpha)[0];
+    k.shadow_sum = cv::sum(k.matte.shadow)[0];
+    std::vector<cv::Mat> channels;
+    cv::split(k.matte.colour, channels);
+    const cv::Mat rim = f.rim & (k.matte.alpha == 255);
+    if (cv::countNonZero(rim) > 0) k.rim_green = cv::mean(channels[1], rim)[0];
+    return k;
+  }
+  std::vector<std::unique_ptr<CameraPipeline>> pipelines_;
+};
+
+TEST_F(KeyerConfig, DespillFollowsTheConfig) {
+  StationConfig config;
+  const Keyed on = Key(config);
+  ASSERT_GT(on.alpha_sum, 0);
+  config.keying.despill_strength = 0.5;
+  const Keyed half = Key(config);
+  config.keying.despill = false;
+  const Keyed off = Key(config);
+  // The rim's green spill above the despill limit (~16 levels on average): all of it removed,
+  // half of it, none.
+  EXPECT_GT(half.rim_green, on.rim_green + 5);
+  EXPECT_GT(off.rim_green, half.rim_green + 5);
+  EXPECT_EQ(on.alpha_sum, off.alpha_sum);  // despill changes colour only
+}
+
+TEST_F(KeyerConfig, ShadowFollowsTheConfig) {
+  StationConfig config;
+  const Keyed on = Key(config);
+  ASSERT_GT(on.shadow_sum, 255 * 200.0) << "the scene's subject casts a contact shadow";
+  config.keying.shadow_min_darkening = 0.3;
+  const Keyed faint_dropped = Key(config);
+  EXPECT_LT(faint_dropped.shadow_sum, 0.9 * on.shadow_sum);
+  config.keying = {};
+  config.keying.shadow = false;
+  const Keyed off = Key(config);
+  EXPECT_EQ(off.shadow_sum, 0);
+  EXPECT_GT(off.alpha_sum, 0);
+  // The reach in metres becomes grid cells at the camera's scale (~300 px per metre at the floor).
+  config.keying = {};
+  config.keying.shadow_reach_m = 0.05;
+  const int near = Key(config).pipeline->keyer().grid().shadow_reach_cells;
+  config.keying.shadow_reach_m = 0.5;
+  const int far = Key(config).pipeline->keyer().grid().shadow_reach_cells;
+  EXPECT_GE(near, 1);
+  EXPECT_GT(far, 5 * near);
+}
+
+TEST_F(KeyerConfig, ChromaThresholdsFollowTheConfig) {
+  StationConfig config;
+  const Keyed defaults = Key(config);
+  ASSERT_GT(defaults.alpha_sum, 0);
+  // A key threshold far below the green's own (~105 levels): the soft, greenish edge falls to
+  // background (about 2.5% of the subject's alpha).
+  config.keying.chroma_low = 0;
+  config.keying.chroma_high = 15;
+  const Keyed tight = Key(config);
+  EXPECT_LT(tight.alpha_sum, 0.99 * defaults.alpha_sum);
+  EXPECT_GT(tight.alpha_sum, 0.9 * defaults.alpha_sum);
+}
+
+TEST_F(KeyerConfig, CleanPlateThresholdsFollowTheConfig) {
+  StationConfig config;
+  config.keying.method = "clean_plate";
+  const Keyed defaults = Key(config, /*green=*/false);
+  ASSERT_GT(defaults.alpha_sum, 0);
+  // A wider tolerance and ramp (in noise sigmas) key less of the frame as subject.
+  config.keying.plate_low_sigma = 12;
+  config.keying.plate_high_sigma = 40;
+  const Keyed loose = Key(config, false);
+  EXPECT_LT(loose.alpha_sum, 0.97 * defaults.alpha_sum);
+}
+
+}  // namespace
+}  // namespace ss

@@ -1,0 +1,371 @@
+// End to end: `spritestation daemon` on emulated GigE Vision cameras (and
+// replayed sessions), driven over its HTTP control API, checked against what
+// `spritestation ingest` stores from the same session. Every test process runs
+// in its own network namespace (station_fixture.h).
+#include <signal.h>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <thread>
+
+#include <gtest/gtest.h>
+#include <httplib.h>
+#include <opencv2/imgcodecs.hpp>
+
+#include "tests/station/station_fixture.h"
+#include "tests/support/test_support.h"
+
+namespace ss::testing {
+namespace {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+class DaemonTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    ASSERT_EQ(PrivateNetworkError(), "");
+    session_ = &SharedStationSession();
+    ASSERT_TRUE(fs::exists(session_->ingest_bank));
+  }
+
+  // A fakecam serving one camera of the shared session at `address` (finite: one pass).
+  std::unique_ptr<BackgroundCommand> Fakecam(const std::string& camera, const std::string& address, int loops = 1,
+                                             const std::string& extra = "") {
+    auto cam = std::make_unique<BackgroundCommand>("fakecam " + session_->dir + " --camera " + camera + " --address " +
+                                                       address + " --serial " + camera + " --loop " +
+                                                       std::to_string(loops) + " " + extra,
+                                                   dir_ / ("fakecam-" + camera + ".log"));
+    EXPECT_TRUE(cam->WaitForOutput("fakecam: serving", 20)) << cam->output();
+    return cam;
+  }
+
+  // A station config; `cameras` is the YAML list, `extra` more top-level sections.
+  std::string Config(const std::string& cameras, const std::string& extra = "", const std::string& storage = "") {
+    // `extra` goes under control: when it starts with two spaces, else it is a top-level section.
+    const std::string path = dir_ / "station.yaml";
+    std::ofstream out(path);
+    out << "version: 1\ncameras:\n" << cameras << "enclosure:\n  floor: " << session_->floor_yaml << "\n"
+        << "storage:\n  bank: " << bank() << "\n  recording_dir: " << (dir_ / "recordings") << "\n" << storage
+        << "control:\n  port: 0\n" << extra;
+    return path;
+  }
+  std::string GigECameras() const {
+    return "  - name: cam0\n    source: aravis\n    address: 127.0.0.1\n    model: " + session_->dir +
+           "/cam0.cameramodel\n"
+           "  - name: cam1\n    source: aravis\n    address: 127.0.0.2\n    model: " + session_->dir +
+           "/cam1.cameramodel\n";
+  }
+  std::string ReplayCamera(bool loop = false) const {
+    return "  - name: cam0\n    source: replay\n    session: " + session_->dir + "\n    loop: " +
+           (loop ? "true" : "false") + "\n";
+  }
+  std::string bank() const { return dir_ / "station.bank"; }
+
+  // Starts the daemon and connects a client to its control API.
+  std::unique_ptr<BackgroundCommand> Daemon(const std::string& config, const std::string& args = "") {
+    auto daemon = std::make_unique<BackgroundCommand>("daemon --config " + config + " " + args,
+                                                      dir_ / ("daemon-" + std::to_string(++daemons_) + ".log"));
+    EXPECT_TRUE(daemon->WaitForOutput("daemon: control API on", 30)) << daemon->output();
+    const std::string out = daemon->output();
+    const size_t at = out.find("(port ");
+    port_ = at == std::string::npos ? 0 : std::stoi(out.substr(at + 6));
+    client_ = std::make_unique<httplib::Client>("127.0.0.1", port_);
+    client_->set_read_timeout(30, 0);
+    return daemon;
+  }
+
+  nlohmann::json Status() {
+    const auto res = client_->Get("/api/status");
+    if (!res || res->status != 200) return {};
+    return nlohmann::json::parse(res->body, nullptr, false);
+  }
+
+  // Polls the status until `pred` holds; false after `timeout_s`.
+  template <typename Pred>
+  bool WaitStatus(Pred pred, double timeout_s) {
+    const auto deadline = Clock::now() + std::chrono::duration<double>(timeout_s);
+    while (Clock::now() < deadline) {
+      const nlohmann::json s = Status();
+      if (!s.is_null() && pred(s)) return true;
+      std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    }
+    return false;
+  }
+
+  static const nlohmann::json& Camera(const nlohmann::json& status, const std::string& name) {
+    for (const auto& c : status["cameras"]) {
+      if (c["name"] == name) return c;
+    }
+    static const nlohmann::json none;
+    return none;
+  }
+
+  ScratchDir dir_;
+  const StationSession* session_ = nullptr;
+  int port_ = 0;
+  int daemons_ = 0;  // daemons started (each logs to its own file)
+  std::unique_ptr<httplib::Client> client_;
+};
+
+TEST_F(DaemonTest, TwoEmulatedGigECamerasStoreWhatIngestFinds) {
+  auto cam0 = Fakecam("cam0", "127.0.0.1");
+  auto cam1 = Fakecam("cam1", "127.0.0.2");
+  auto daemon = Daemon(Config(GigECameras()), "--session take-1");
+
+  // Both cameras stream and learn the empty enclosure, then the session runs.
+  ASSERT_TRUE(WaitStatus([](const nlohmann::json& s) {
+    return s["cameras"][0]["state"] == "live" && s["cameras"][1]["state"] == "live";
+  }, 20)) << Status().dump(2) << daemon->output();
+  const auto renamed = client_->Post("/api/session/rename", R"({"name": "take 1 walk"})", "application/json");
+  ASSERT_TRUE(renamed);
+  EXPECT_EQ(renamed->status, 200) << renamed->body;
+
+  // Previews: the latest frame, raw and keyed, as JPEG of the camera's size.
+  for (const char* view : {"raw", "keyed"}) {
+    const auto jpeg = client_->Get(std::string("/api/cameras/cam1/preview.jpg?view=") + view);
+    ASSERT_TRUE(jpeg);
+    ASSERT_EQ(jpeg->status, 200) << jpeg->body;
+    const cv::Mat image = cv::imdecode(std::vector<uint8_t>(jpeg->body.begin(), jpeg->body.end()), cv::IMREAD_COLOR);
+    EXPECT_EQ(image.cols, 640);
+    EXPECT_EQ(image.rows, 480);
+  }
+
+  // The fake cameras end after one pass; then the session stops with every clip stored.
+  EXPECT_EQ(cam0->Wait(30), 0) << cam0->output();
+  EXPECT_EQ(cam1->Wait(30), 0) << cam1->output();
+  const auto stopped = client_->Post("/api/session/stop", "", "application/json");
+  ASSERT_TRUE(stopped);
+  ASSERT_EQ(stopped->status, 200) << stopped->body;
+  const nlohmann::json session = nlohmann::json::parse(stopped->body);
+  EXPECT_EQ(session["name"], "take 1 walk");
+  EXPECT_FALSE(session["active"].get<bool>());
+
+  const nlohmann::json status = Status();
+  const auto metrics = client_->Get("/metrics");
+  ASSERT_TRUE(metrics);
+  EXPECT_NE(metrics->body.find("spritestation_frames_dropped_total{camera=\"cam0\",cause=\"queue_full\"}"),
+            std::string::npos);
+  EXPECT_NE(metrics->body.find("spritestation_sprites_stored_total " +
+                               std::to_string(status["bank"]["sprites_stored"].get<int64_t>())),
+            std::string::npos)
+      << metrics->body;
+
+  // SIGTERM: a clean stop within 5 s.
+  const auto term = Clock::now();
+  daemon->Signal(SIGTERM);
+  EXPECT_EQ(daemon->Wait(10), 0) << daemon->output();
+  EXPECT_LT(std::chrono::duration<double>(Clock::now() - term).count(), 5.0);
+  EXPECT_EQ(RunSpritestation("bank verify " + bank()).exit_code, 0);
+
+  // The same sprites as ingest, but for frames the drop counters account for.
+  const auto ingest = SpritesByCamera(session_->ingest_bank);
+  const auto live = SpritesByCamera(bank());
+  for (const std::string name : {"cam0", "cam1"}) {
+    const nlohmann::json& cam = Camera(status, name);
+    const int64_t dropped = cam["dropped"]["total"].get<int64_t>() + cam["sequence_gaps"].get<int64_t>();
+    ASSERT_TRUE(ingest.count(name)) << name;
+    ASSERT_TRUE(live.count(name)) << name << " stored nothing: " << status.dump(2);
+    const auto& expected = ingest.at(name);
+    const auto& got = live.at(name);
+    size_t missing = 0;
+    for (const auto& [t, s] : expected) missing += got.count(t) ? 0 : 1;
+    for (const auto& [t, s] : got) {
+      ASSERT_TRUE(expected.count(t)) << name << ": a sprite at " << t << " that ingest did not store";
+      EXPECT_NEAR(s.ground_x, expected.at(t).ground_x, 1e-4) << name << " at " << t;
+      EXPECT_NEAR(s.ground_y, expected.at(t).ground_y, 1e-4) << name << " at " << t;
+    }
+    // (Within 0.1 mm: the keyer may learn the enclosure from other frames when frames are lost.)
+    // A lost frame ends the clip there; the pieces shorter than min_clip_frames (5) and the
+    // velocity windows around the gap are what may be missing.
+    EXPECT_LE(missing, static_cast<size_t>(dropped) * 6) << name << ": " << missing << " of " << expected.size()
+                                                         << " sprites missing with " << dropped << " frames dropped";
+    EXPECT_GT(expected.size(), 20u) << name;
+  }
+}
+
+TEST_F(DaemonTest, LostPacketsAreCountedAndTheStationGoesOn) {
+  auto cam0 = Fakecam("cam0", "127.0.0.1", 1, "--lost-packets 0.0005");
+  auto daemon = Daemon(Config("  - name: cam0\n    source: aravis\n    address: 127.0.0.1\n    packet_resend: false\n"
+                              "    model: " + session_->dir + "/cam0.cameramodel\n"),
+                       "--session lossy");
+  EXPECT_EQ(cam0->Wait(30), 0) << cam0->output();
+  const nlohmann::json status = Status();
+  const nlohmann::json& cam = Camera(status, "cam0");
+  // 0.05% of the ~660 packets of each frame lost without resend: about 3 frames in 10 are incomplete.
+  EXPECT_GT(cam["dropped"]["at_source"].get<int64_t>(), 5) << status.dump(2);
+  EXPECT_GT(cam["frames_captured"].get<int64_t>(), 20) << status.dump(2);
+  // Every frame of the pass is accounted for (a finished fake camera repeats its last frame until it exits).
+  EXPECT_GE(cam["frames_captured"].get<int64_t>() + cam["dropped"]["at_source"].get<int64_t>(), 150)
+      << status.dump(2);
+  EXPECT_LE(cam["frames_captured"].get<int64_t>() + cam["dropped"]["at_source"].get<int64_t>(), 160)
+      << status.dump(2);
+  daemon->Signal(SIGTERM);
+  EXPECT_EQ(daemon->Wait(10), 0) << daemon->output();
+  EXPECT_EQ(RunSpritestation("bank verify " + bank()).exit_code, 0);
+}
+
+TEST_F(DaemonTest, ACameraThatVanishesIsReopenedWhenItComesBack) {
+  auto cam0 = Fakecam("cam0", "127.0.0.1", 0);
+  auto daemon = Daemon(Config("  - name: cam0\n    source: aravis\n    address: 127.0.0.1\n    model: " +
+                              session_->dir + "/cam0.cameramodel\n"),
+                       "--offline-after 1");
+  ASSERT_TRUE(WaitStatus([](const nlohmann::json& s) { return s["cameras"][0]["frames_captured"] > 30; }, 20))
+      << Status().dump(2);
+  cam0->Signal(SIGKILL);
+  cam0->Wait(5);
+  ASSERT_TRUE(WaitStatus([](const nlohmann::json& s) { return s["cameras"][0]["state"] == "offline"; }, 15))
+      << Status().dump(2);
+  const int64_t before = Status()["cameras"][0]["frames_captured"].get<int64_t>();
+  cam0 = Fakecam("cam0", "127.0.0.1", 0);
+  ASSERT_TRUE(WaitStatus([&](const nlohmann::json& s) {
+    return s["cameras"][0]["reopens"] >= 1 && s["cameras"][0]["frames_captured"] > before + 10;
+  }, 30)) << Status().dump(2) << daemon->output();
+  daemon->Signal(SIGTERM);
+  EXPECT_EQ(daemon->Wait(10), 0) << daemon->output();
+}
+
+TEST_F(DaemonTest, SigkillDuringASessionLeavesAVerifiableBank) {
+  auto daemon = Daemon(Config(ReplayCamera(true)), "--session killed");
+  // The first pass of the looping replay ends one clip (complete); the next one is open.
+  ASSERT_TRUE(WaitStatus([](const nlohmann::json& s) { return s["cameras"][0]["clips"] >= 1; }, 40))
+      << Status().dump(2) << daemon->output();
+  const int64_t complete = Status()["bank"]["sprites_stored"].get<int64_t>();
+  ASSERT_TRUE(WaitStatus([&](const nlohmann::json& s) { return s["bank"]["sprites_stored"] > complete + 10; }, 40))
+      << Status().dump(2);
+  daemon->Signal(SIGKILL);
+  daemon->Wait(5);
+  const CommandResult verify = RunSpritestation("bank verify " + bank() + " --json");
+  EXPECT_EQ(verify.exit_code, 0) << verify.output;
+  const CommandResult info = RunSpritestation("bank info " + bank() + " --json");
+  // The complete clip is there (originals and mirrors); the open one is not shown to readers.
+  EXPECT_GE(JsonInOutput(info.output)["sprites_visible"].get<int64_t>(), 2 * (complete - 5)) << info.output;
+}
+
+TEST_F(DaemonTest, ADiskNearlyFullStopsRecordingFirstThenSprites) {
+  // Recording limit above the free space: sprites are stored, nothing is recorded.
+  {
+    auto daemon = Daemon(Config(ReplayCamera(), "", "  recording: all\n  stop_recording_below_mib: 1000000000\n"
+                                                    "  stop_sprites_below_mib: 0\n"),
+                         "--session no-recording");
+    ASSERT_TRUE(WaitStatus([](const nlohmann::json& s) { return s["cameras"][0]["state"] == "finished"; }, 30))
+        << Status().dump(2);
+    const nlohmann::json status = Status();
+    EXPECT_EQ(status["storage"]["state"], "recording_stopped");
+    EXPECT_EQ(status["storage"]["frames_recorded"], 0);
+    daemon->Signal(SIGTERM);
+    EXPECT_EQ(daemon->Wait(10), 0);
+    EXPECT_GT(SpritesByCamera(bank())["cam0"].size(), 20u);
+  }
+  // Sprite limit above the free space: nothing more is stored, the bank stays whole.
+  const size_t stored = SpritesByCamera(bank())["cam0"].size();
+  auto daemon = Daemon(Config(ReplayCamera(), "", "  stop_sprites_below_mib: 1000000000\n"), "--session full");
+  ASSERT_TRUE(WaitStatus([](const nlohmann::json& s) { return s["cameras"][0]["state"] == "finished"; }, 30))
+      << Status().dump(2);
+  const auto stopped = client_->Post("/api/session/stop", "", "application/json");
+  ASSERT_TRUE(stopped);
+  const nlohmann::json status = Status();
+  EXPECT_EQ(status["storage"]["state"], "sprites_stopped");
+  EXPECT_GT(status["bank"]["batches_refused"].get<int64_t>(), 0);
+  daemon->Signal(SIGTERM);
+  EXPECT_EQ(daemon->Wait(10), 0);
+  EXPECT_EQ(SpritesByCamera(bank())["cam0"].size(), stored);
+  EXPECT_EQ(RunSpritestation("bank verify " + bank()).exit_code, 0);
+}
+
+TEST_F(DaemonTest, RecordsTheSessionItStores) {
+  auto daemon = Daemon(Config(ReplayCamera(), "", "  recording: all\n  stop_recording_below_mib: 0\n"
+                                                  "  stop_sprites_below_mib: 0\n"),
+                       "--session recorded");
+  ASSERT_TRUE(WaitStatus([](const nlohmann::json& s) { return s["cameras"][0]["state"] == "finished"; }, 30))
+      << Status().dump(2);
+  const auto stopped = client_->Post("/api/session/stop", "", "application/json");
+  ASSERT_TRUE(stopped);
+  const nlohmann::json session = nlohmann::json::parse(stopped->body);
+  const nlohmann::json status = Status();
+  daemon->Signal(SIGTERM);
+  EXPECT_EQ(daemon->Wait(10), 0);
+  // The recording replays: every frame the recorder wrote.
+  const CommandResult replay = RunSpritestation("replay " + session["recording_dir"].get<std::string>() + " --json");
+  ASSERT_EQ(replay.exit_code, 0) << replay.output;
+  const nlohmann::json r = JsonInOutput(replay.output);
+  EXPECT_EQ(r["frames"].get<int64_t>(), status["storage"]["frames_recorded"].get<int64_t>()) << replay.output;
+  EXPECT_GT(r["frames"].get<int64_t>(), 100) << replay.output;
+}
+
+TEST_F(DaemonTest, TheControlApiRefusesBadRequestsByName) {
+  auto daemon = Daemon(Config(ReplayCamera(true)));
+  const auto post = [&](const std::string& path, const std::string& body) {
+    return client_->Post(path.c_str(), body, "application/json");
+  };
+  auto r = post("/api/session/start", "{\"name\": ");
+  ASSERT_TRUE(r);
+  EXPECT_EQ(r->status, 400);
+  EXPECT_NE(r->body.find("body: not valid JSON"), std::string::npos) << r->body;
+  r = post("/api/session/start", R"({"nmae": "x"})");
+  EXPECT_EQ(r->status, 400);
+  EXPECT_NE(r->body.find("nmae: unknown field"), std::string::npos) << r->body;
+  r = post("/api/session/start", R"({"name": "../etc"})");
+  EXPECT_EQ(r->status, 400);
+  EXPECT_NE(r->body.find("name:"), std::string::npos) << r->body;
+  r = post("/api/session/stop", "");
+  EXPECT_EQ(r->status, 409) << r->body;
+  r = post("/api/session/start", R"({"name": "a"})");
+  EXPECT_EQ(r->status, 200) << r->body;
+  r = post("/api/session/start", R"({"name": "b"})");
+  EXPECT_EQ(r->status, 409) << r->body;
+  EXPECT_NE(r->body.find(R"(\"a\" is running)"), std::string::npos) << r->body;
+  auto g = client_->Get("/api/cameras/nope/preview.jpg");
+  EXPECT_EQ(g->status, 404) << g->body;
+  g = client_->Get("/api/cameras/cam0/preview.jpg?view=inverted");
+  EXPECT_EQ(g->status, 400) << g->body;
+  g = client_->Get("/api/nothing");
+  EXPECT_EQ(g->status, 404) << g->body;
+  daemon->Signal(SIGTERM);
+  EXPECT_EQ(daemon->Wait(10), 0);
+}
+
+TEST_F(DaemonTest, WithATokenEveryRequestMustCarryIt) {
+  auto daemon = Daemon(Config(ReplayCamera(true), "  token: 0123456789abcdef0123\n"));
+  auto r = client_->Get("/api/status");
+  ASSERT_TRUE(r);
+  EXPECT_EQ(r->status, 401);
+  client_->set_bearer_token_auth("0123456789abcdef0123");
+  r = client_->Get("/api/status");
+  EXPECT_EQ(r->status, 200);
+  daemon->Signal(SIGTERM);
+  EXPECT_EQ(daemon->Wait(10), 0);
+}
+
+TEST_F(DaemonTest, SighupReloadsWhatIsSafeAndKeepsTheConfigWhenTheFileIsBad) {
+  const std::string config = Config(ReplayCamera(true));
+  auto daemon = Daemon(config);
+  // A changed keying section needs a restart; the storage limits apply at once.
+  Config(ReplayCamera(true), "keying:\n  chroma:\n    low: 25\n", "  stop_sprites_below_mib: 1000000000\n");
+  daemon->Signal(SIGHUP);
+  ASSERT_TRUE(daemon->WaitForOutput("keying: changed; restart the daemon to apply", 10)) << daemon->output();
+  EXPECT_TRUE(WaitStatus([](const nlohmann::json& s) { return s["storage"]["state"] == "sprites_stopped"; }, 10))
+      << Status().dump(2);
+  // A broken file is refused by name and the running config kept.
+  {
+    std::ofstream out(config);
+    out << "version: 1\ncameras:\n  - name: cam0\n    source: replay\n    fps: fast\n";
+  }
+  daemon->Signal(SIGHUP);
+  ASSERT_TRUE(daemon->WaitForOutput("the config was not reloaded", 10)) << daemon->output();
+  EXPECT_NE(daemon->output().find("cameras[0]"), std::string::npos) << daemon->output();
+  EXPECT_EQ(Status()["state"], "running");
+  daemon->Signal(SIGTERM);
+  EXPECT_EQ(daemon->Wait(10), 0) << daemon->output();
+}
+
+TEST_F(DaemonTest, ABadConfigFieldIsRefusedByName) {
+  const std::string config = Config(ReplayCamera() + "    fsp: 30\n");
+  const CommandResult r = RunSpritestation("daemon --config " + config);
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("cameras[0].fsp: unknown key"), std::string::npos) << r.output;
+}
+
+}  // namespace
+}  // namespace ss::testing
