@@ -260,7 +260,7 @@ void Track(const TrackArgs& a) {
 }
 
 struct ImportArgs {
-  std::string format, file, mapping, out, individual;
+  std::string format, file, mapping, out, individual, camera;
   float min_confidence = -1;
   int person = 0;
   bool json = false;
@@ -274,6 +274,8 @@ void Import(const ImportArgs& a) {
     mapping = Body25ToHuman14();
   } else if (a.format == "coco") {
     mapping = Coco17ToHuman14();
+  } else if (a.format == "synth") {
+    mapping = IdentityMapping(HumanSkeleton());  // the figures' joints are human14's
   } else {
     throw InputError("--mapping", "DeepLabCut body parts are named by the project: give a joint mapping file "
                                   "(docs/skeletons.md)");
@@ -287,6 +289,8 @@ void Import(const ImportArgs& a) {
     s = ImportDeepLabCutCsv(a.file, mapping, options);
   } else if (a.format == "openpose") {
     s = ImportOpenPoseJson(a.file, mapping, options);
+  } else if (a.format == "synth") {
+    s = ImportSynthTruth(a.file, a.camera, mapping, options);
   } else {
     s = ImportCocoKeypoints(a.file, mapping, options);
   }
@@ -333,18 +337,21 @@ void AddSkeletonCommand(CLI::App& app) {
   t->callback([track] { Track(*track); });
 
   auto import = std::make_shared<ImportArgs>();
-  CLI::App* i = cmd->add_subcommand("import", "Read DeepLabCut, OpenPose or COCO keypoints");
-  i->add_option("--format", import->format, "deeplabcut | openpose | coco")
+  CLI::App* i = cmd->add_subcommand("import", "Read DeepLabCut, OpenPose or COCO keypoints, or synth joint truth");
+  i->add_option("--format", import->format, "deeplabcut | openpose | coco | synth")
       ->required()
-      ->check(CLI::IsMember({"deeplabcut", "openpose", "coco"}));
-  i->add_option("file", import->file, "CSV (DeepLabCut), a folder of or one *_keypoints.json (OpenPose), COCO JSON")
+      ->check(CLI::IsMember({"deeplabcut", "openpose", "coco", "synth"}));
+  i->add_option("file", import->file,
+                "CSV (DeepLabCut), a folder of or one *_keypoints.json (OpenPose), COCO JSON, "
+                "a synthetic session (synth: its truth/<camera>/joints.csv)")
       ->required();
+  i->add_option("--camera", import->camera, "synth: the camera whose projected joints are read (default: the first)");
   i->add_option("--mapping", import->mapping,
                 "Joint mapping file (required for DeepLabCut; OpenPose BODY_25 and COCO-17 have built-in ones)");
   i->add_option("--out", import->out, "SKEL.json: the skeleton sequence written")->required();
   i->add_option("--min-confidence", import->min_confidence, "Keypoints below this become missing joints");
   i->add_option("--individual", import->individual, "DeepLabCut multi-animal: which individual");
-  i->add_option("--person", import->person, "OpenPose: index into people[]");
+  i->add_option("--person,--subject", import->person, "OpenPose: index into people[]; synth: the subject");
   i->add_flag("--json", import->json, "Print the report as JSON");
   i->callback([import] { Import(*import); });
 }

@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include <benchmark/benchmark.h>
 #include <nlohmann/json.hpp>
 
 #include "animate/skeleton/cost_rows.h"
@@ -41,6 +42,7 @@ struct Args {
   int small_targets = 200, small_sources = 2000;
   bool quality = true;
   bool json = false;
+  bool gbench = false;  // --gbench: the Google Benchmark cases on targets x sources instead
 };
 
 // Values as --name=value (the bench command hands numbers given apart to the suite out of
@@ -71,6 +73,7 @@ Args Parse(const std::vector<std::string>& given) {
     else if (s == "--small-sources") a.small_sources = value();
     else if (s == "--skip-quality") a.quality = false;
     else if (s == "--json") a.json = true;
+    else if (s == "--gbench") a.gbench = true;
     else throw InputError("bench skeleton", "unknown argument '" + s + "' (see bench/skeleton_bench.cc)");
   }
   if (a.targets < 10 || a.sources < 100 || a.clip_frames < 50 || a.naive_rows < 1 || a.small_targets < 2 ||
@@ -197,9 +200,63 @@ nlohmann::json StatsJson(const MatchStats& s, double accuracy) {
           {"stutters", s.stutters},       {"jumps", s.jumps},       {"skips", s.skips}};
 }
 
+// Google Benchmark cases on one T x S problem (built once, outside the timing), one thread:
+//   BM_SkeletonMatchLinear:         descriptors + cost rows + the linear-per-row DP, whole problem;
+//   BM_SkeletonMatchQuadraticRows:  the baseline, the plain quadratic DP on the first rows of
+//                                   the same problem (costs included), extrapolated to all T rows.
+int RunGbench(const Args& a) {
+  static Problem* problem = nullptr;
+  const auto t_make = Clock::now();
+  problem = new Problem(MakeProblem(a.targets, a.sources, a.clip_frames));
+  std::printf("problem %d x %d in %zu clips built in %.1f s (not timed)\n", problem->target.sequence.size(),
+              static_cast<int>(problem->source_labels.size()), problem->clips.size(), Since(t_make));
+  const std::string size = std::to_string(a.targets) + "x" + std::to_string(a.sources);
+  benchmark::RegisterBenchmark(("BM_SkeletonMatchLinear/" + size).c_str(), [](benchmark::State& state) {
+    const Problem& p = *problem;
+    MatchResult r;
+    double describe_s = 0, solve_s = 0;
+    for (auto _ : state) {
+      auto t0 = Clock::now();
+      const PoseDescriptors td = ComputeDescriptors(p.target.sequence, {});
+      const PoseDescriptors sd = ComputeDescriptors(p.sequences, {});
+      const DescriptorCostRows costs(td, sd);
+      describe_s = Since(t0);
+      t0 = Clock::now();
+      r = SolveMatch(costs, p.clip_starts, MatchOptions{});
+      solve_s = Since(t0);
+      benchmark::DoNotOptimize(r.total_cost);
+    }
+    state.counters["describe_s"] = describe_s;
+    state.counters["solve_s"] = solve_s;
+    state.counters["cost_rows_s"] = r.cost_seconds;
+    state.counters["forward_s"] = r.forward_seconds;
+    state.counters["backward_s"] = r.backward_seconds;
+    state.counters["memory_mib"] = static_cast<double>(r.memory_bytes) / (1 << 20);
+    state.counters["gesture_accuracy"] = Accuracy(r.source_frames, p);
+  })->Unit(benchmark::kSecond)->Iterations(1)->UseRealTime();
+  const int rows = a.naive_rows + 1;
+  benchmark::RegisterBenchmark(("BM_SkeletonMatchQuadraticRows/" + size).c_str(), [rows](benchmark::State& state) {
+    const Problem& p = *problem;
+    const PoseDescriptors td = ComputeDescriptors(p.target.sequence, {});
+    const PoseDescriptors sd = ComputeDescriptors(p.sequences, {});
+    const DescriptorCostRows costs(td, sd);
+    double seconds = 0;
+    for (auto _ : state) {
+      const auto t0 = Clock::now();
+      benchmark::DoNotOptimize(QuadraticDp(costs, p.clip_starts, MatchOptions{}, rows));
+      seconds = Since(t0);
+    }
+    state.counters["rows"] = rows;
+    state.counters["s_per_row"] = seconds / rows;
+    state.counters["extrapolated_total_s"] = seconds / rows * costs.targets();
+  })->Unit(benchmark::kSecond)->Iterations(1)->UseRealTime();
+  return RunGoogleBenchmarks("BM_SkeletonMatch", {});
+}
+
 int Run(const std::vector<std::string>& argv) {
   const Args a = Parse(argv);
   SetLogLevel("warn");
+  if (a.gbench) return RunGbench(a);
   nlohmann::json result;
   MatchOptions options;
 

@@ -3,7 +3,9 @@
 // bank writer, TransitionWorker), as a Google Benchmark case run once for S
 // seconds of wall time. Cameras replay a synthetic animal session (made once,
 // cached under the temp dir) in real time, looping.
-//   station/live_NxWxH@F            counters: frames/s delivered, frames dropped (queue
+//   station/live_ffv1_replay_...    cameras replaying the FFV1 session in real time (decoding included)
+//   station/live_from_memory_...    cameras delivering pre-decoded frames in real time, as a
+//                                   camera does: the station's own capacity. Counters: frames/s delivered, frames dropped (queue
 //                                   full / at source), capture-to-bank latency p50/p99,
 //                                   transitions pending (max), sprites/s stored
 //   station/baseline/decode_NxWxH   the same session replayed unpaced by ReplaySource:
@@ -18,6 +20,9 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <condition_variable>
+#include <map>
+#include <mutex>
 #include <thread>
 
 #include "bench/bench_registry.h"
@@ -65,6 +70,75 @@ std::string Session() {
   return dir.string();
 }
 
+// One camera of the session decoded into memory once, then delivered in real time
+// (paced by the recorded timestamps) and looping: a camera, without a decoder's cost.
+class MemorySource : public FrameSource {
+ public:
+  MemorySource(std::shared_ptr<const std::vector<Frame>> frames, SourceCamera camera, int index)
+      : frames_(std::move(frames)), cameras_{std::move(camera)}, index_(index) {}
+  const std::vector<SourceCamera>& cameras() const override { return cameras_; }
+  std::optional<Frame> Next() override {
+    const std::vector<Frame>& all = *frames_;
+    if (all.empty()) return std::nullopt;
+    const size_t n = all.size();
+    const int64_t span = all.back().timestamp_ns - all.front().timestamp_ns + (all.size() > 1 ? all[1].timestamp_ns - all[0].timestamp_ns : 0);
+    Frame f = all[next_ % n];
+    const uint64_t pass = next_ / n;
+    f.camera = index_;
+    f.sequence = next_;
+    f.timestamp_ns += static_cast<int64_t>(pass) * span;
+    ++next_;
+    std::unique_lock lock(mutex_);
+    if (next_ == 1) start_ = std::chrono::steady_clock::now();
+    const auto due = start_ + std::chrono::nanoseconds(f.timestamp_ns - all.front().timestamp_ns);
+    wake_.wait_until(lock, due, [&] { return stopped_; });
+    if (stopped_) return std::nullopt;
+    ++delivered_;
+    return f;
+  }
+  void Stop() override {
+    std::lock_guard lock(mutex_);
+    stopped_ = true;
+    wake_.notify_all();
+  }
+  SourceStats stats() const override {
+    std::lock_guard lock(mutex_);
+    SourceStats s;
+    s.frames_delivered = delivered_;
+    return s;
+  }
+
+ private:
+  std::shared_ptr<const std::vector<Frame>> frames_;
+  std::vector<SourceCamera> cameras_;
+  int index_;
+  uint64_t next_ = 0, delivered_ = 0;
+  mutable std::mutex mutex_;
+  std::condition_variable wake_;
+  bool stopped_ = false;
+  std::chrono::steady_clock::time_point start_;
+};
+
+// Every frame of one session camera, decoded (once per run).
+std::shared_ptr<const std::vector<Frame>> Decoded(const std::string& session, const std::string& camera) {
+  static std::map<std::string, std::shared_ptr<const std::vector<Frame>>> cache;
+  auto& entry = cache[camera];
+  if (!entry) {
+    ReplayOptions o;
+    o.camera = camera;
+    ReplaySource source(session, o);
+    auto frames = std::make_shared<std::vector<Frame>>();
+    while (auto f = source.Next()) {
+      // Own the pixels: the replay reuses its buffers.
+      Frame copy = Frame::Owned(f->format, f->width, f->height, std::vector<uint8_t>(f->data, f->data + f->size));
+      copy.timestamp_ns = f->timestamp_ns;
+      frames->push_back(std::move(copy));
+    }
+    entry = frames;
+  }
+  return entry;
+}
+
 void Decode(benchmark::State& state) {
   const std::string session = Session();
   uint64_t frames = 0;
@@ -78,8 +152,11 @@ void Decode(benchmark::State& state) {
   state.counters["frames_per_s"] = benchmark::Counter(static_cast<double>(frames), benchmark::Counter::kIsRate);
 }
 
-void Live(benchmark::State& state) {
+void Live(benchmark::State& state, bool from_memory) {
   const std::string session = Session();
+  if (from_memory) {
+    for (int c = 0; c < g_args.cameras; ++c) Decoded(session, "cam" + std::to_string(c));
+  }
   const fs::path work = fs::temp_directory_path() / ("spritestation-station-bench-run-" + std::to_string(getpid()));
   fs::remove_all(work);
   fs::create_directories(work);
@@ -101,6 +178,18 @@ void Live(benchmark::State& state) {
     config.storage.stop_recording_below_mib = 0;
     config.storage.stop_sprites_below_mib = 0;
     config.logging.level = "warn";
+    if (from_memory) {
+      options.open_source = [&session](const CameraConfig& camera, int index) -> std::unique_ptr<FrameSource> {
+        auto frames = Decoded(session, camera.name);
+        SourceCamera sc;
+        sc.name = camera.name;
+        sc.width = frames->empty() ? 0 : frames->front().width;
+        sc.height = frames->empty() ? 0 : frames->front().height;
+        sc.format = frames->empty() ? PixelFormat::kRGB8 : frames->front().format;
+        sc.fps = g_args.fps;
+        return std::make_unique<MemorySource>(frames, sc, index);
+      };
+    }
     Station station(options);
     station.Start();
     station.StartSession("bench");
@@ -152,7 +241,11 @@ int Run(const std::vector<std::string>& args) {
       ->Iterations(1)
       ->Unit(benchmark::kSecond)
       ->UseRealTime();
-  benchmark::RegisterBenchmark(("station/live_" + Tag()).c_str(), Live)
+  benchmark::RegisterBenchmark(("station/live_ffv1_replay_" + Tag()).c_str(), Live, false)
+      ->Iterations(1)
+      ->Unit(benchmark::kSecond)
+      ->UseRealTime();
+  benchmark::RegisterBenchmark(("station/live_from_memory_" + Tag()).c_str(), Live, true)
       ->Iterations(1)
       ->Unit(benchmark::kSecond)
       ->UseRealTime();

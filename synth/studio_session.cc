@@ -372,7 +372,8 @@ SynthSummary RenderStudioSession(const SynthOptions& o) {
         }
         w.views->Row("%d,%d,%.4f,%.4f,%d,%d,%d,%d,%.4f,%.4f,%.6f,%.6f,%.6f,%.6f,%.6f,%.4f,%.4f,"
                      "%.4f,%.4f,%.6f,%.6f",
-                     frame, k, w.image.visible_px[static_cast<size_t>(k)], w.image.unoccluded_px[static_cast<size_t>(k)],
+                     frame, k, w.image.visible_px[static_cast<size_t>(k)],
+                     w.image.unoccluded_px[static_cast<size_t>(k)],
                      layer.box.x, layer.box.y, layer.box.width, layer.box.height, low.px.x(), low.px.y(),
                      low.point_in_ground.x(), low.point_in_ground.y(), low.point_in_ground.z(), ray_ground.x(),
                      ray_ground.y(), root_px.x(), root_px.y(), contact_px.x(), contact_px.y(), contact_ground.x(),

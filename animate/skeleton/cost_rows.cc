@@ -20,6 +20,12 @@ DenseCostRows::DenseCostRows(int targets, int sources, std::vector<float> values
   }
 }
 
+float CostRows::At(int t, int s) const {
+  std::vector<float> row(sources());
+  Compute(t, 1, row.data());
+  return row[s];
+}
+
 void DenseCostRows::Compute(int t0, int n, float* out) const {
   std::memcpy(out, values_.data() + static_cast<size_t>(t0) * sources_, sizeof(float) * n * sources_);
 }
@@ -41,6 +47,7 @@ inline v8f Load(const float* p) {
 inline void Store(float* p, v8f v) { std::memcpy(p, &v, sizeof(v)); }
 inline v8f ClampPositive(v8f v) { return v > 0 ? v : v8f{}; }
 
+// (The t loops are unrolled explicitly: at -O2 GCC otherwise keeps acc0/acc1 in memory.)
 // out[t][s] = na[t] + nb[s] + sum_k a[t][k] * b[k][s] for TB targets and one chunk of
 // kChunk sources starting at s (`b`, `nb` already offset by s).
 template <int TB>
@@ -48,18 +55,21 @@ __attribute__((always_inline)) inline void DenseChunk(const float* b, size_t str
                                                       const float* a, const float* na, float* const* out) {
   v8f acc0[TB], acc1[TB];
   const v8f nb0 = Load(nb), nb1 = Load(nb + kLanes);
+#pragma GCC unroll 8
   for (int t = 0; t < TB; ++t) {
     acc0[t] = nb0 + na[t];
     acc1[t] = nb1 + na[t];
   }
   for (int k = 0; k < dim; ++k) {
     const v8f b0 = Load(b + k * stride), b1 = Load(b + k * stride + kLanes);
+#pragma GCC unroll 8
     for (int t = 0; t < TB; ++t) {
       const float at = a[t * dim + k];
       acc0[t] += b0 * at;
       acc1[t] += b1 * at;
     }
   }
+#pragma GCC unroll 8
   for (int t = 0; t < TB; ++t) {
     Store(out[t], ClampPositive(acc0[t]));
     Store(out[t] + kLanes, ClampPositive(acc1[t]));
@@ -180,28 +190,45 @@ void DescriptorCostRows::Compute(int t0, int n, float* out) const {
     for (int s : incomplete_) row[s] = PoseCost(tg, t, src, s);
     for (int s : excluded_) row[s] = kInf;
   }
-  std::vector<float> a(static_cast<size_t>(kTile) * dim), na(kTile);
-  float* rows[kTile];
-  for (size_t first = 0; first < dense.size(); first += kTile) {
-    const int tb = static_cast<int>(std::min<size_t>(kTile, dense.size() - first));
-    for (int i = 0; i < tb; ++i) {
-      const int t = dense[first + i];
-      double norm = 0;
-      for (int k = 0; k < dim; ++k) {
-        const double v = tg.feature(k, t);
-        norm += layout.feature_weight[k] * v * v;
-        a[i * dim + k] = static_cast<float>(-2.0 * layout.feature_weight[k] * v / layout.total_weight);
-      }
-      na[i] = static_cast<float>(norm / layout.total_weight);
-      rows[i] = out + static_cast<size_t>(t - t0) * count;
+  // Every dense target's weighted features first; then source blocks outer and target tiles
+  // inner, so a block of source features (kSourceBlock x dim floats) is read from memory
+  // once per call and stays in cache for all the tiles, instead of once per tile.
+  const size_t nd = dense.size();
+  std::vector<float> a(nd * dim), na(nd);
+  std::vector<float*> all_rows(nd);
+  for (size_t i = 0; i < nd; ++i) {
+    const int t = dense[i];
+    double norm = 0;
+    for (int k = 0; k < dim; ++k) {
+      const double v = tg.feature(k, t);
+      norm += layout.feature_weight[k] * v * v;
+      a[i * dim + k] = static_cast<float>(-2.0 * layout.feature_weight[k] * v / layout.total_weight);
     }
-    DenseKernel(source_features_.data(), padded_, dim, source_norm_.data(), a.data(), na.data(), tb, rows, count);
-    for (int i = 0; i < tb; ++i) {
-      const int t = dense[first + i];
-      for (int s : incomplete_) rows[i][s] = PoseCost(tg, t, src, s);
-      for (int s : excluded_) rows[i][s] = kInf;
+    na[i] = static_cast<float>(norm / layout.total_weight);
+    all_rows[i] = out + static_cast<size_t>(t - t0) * count;
+  }
+  constexpr int kSourceBlock = 64 * kChunk;  // 1,024 sources: ~200 KiB of features for human14
+  float* rows[kTile];
+  for (int s0 = 0; s0 < count; s0 += kSourceBlock) {
+    const int block = std::min(kSourceBlock, count - s0);
+    for (size_t first = 0; first < nd; first += kTile) {
+      const int tb = static_cast<int>(std::min<size_t>(kTile, nd - first));
+      for (int i = 0; i < tb; ++i) rows[i] = all_rows[first + i] + s0;
+      DenseKernel(source_features_.data() + s0, padded_, dim, source_norm_.data() + s0, a.data() + first * dim,
+                  na.data() + first, tb, rows, block);
     }
   }
+  for (size_t i = 0; i < nd; ++i) {
+    const int t = dense[i];
+    for (int s : incomplete_) all_rows[i][s] = PoseCost(tg, t, src, s);
+    for (int s : excluded_) all_rows[i][s] = kInf;
+  }
+}
+
+float DescriptorCostRows::At(int t, int s) const {
+  if (std::binary_search(excluded_.begin(), excluded_.end(), s)) return kInf;
+  if (targets_->present_weight[t] <= 0) return 0.0f;
+  return PoseCost(*targets_, t, *sources_, s);
 }
 
 }  // namespace ss

@@ -15,6 +15,8 @@ class CostRows {
   // Rows t0 .. t0+n-1 into out[(t - t0) * sources() + s]. +inf marks a source frame that
   // may never be chosen.
   virtual void Compute(int t0, int n, float* out) const = 0;
+  // One value c_t(s) (path costs); by default computes the whole row.
+  virtual float At(int t, int s) const;
 };
 
 // An explicit matrix (tests, small problems): values[t * sources + s].
@@ -24,6 +26,7 @@ class DenseCostRows final : public CostRows {
   int targets() const override { return targets_; }
   int sources() const override { return sources_; }
   void Compute(int t0, int n, float* out) const override;
+  float At(int t, int s) const override { return at(t, s); }
   float at(int t, int s) const { return values_[static_cast<size_t>(t) * sources_ + s]; }
 
  private:
@@ -43,6 +46,7 @@ class DescriptorCostRows final : public CostRows {
   int targets() const override { return targets_->count; }
   int sources() const override { return sources_->count; }
   void Compute(int t0, int n, float* out) const override;
+  float At(int t, int s) const override;  // PoseCost directly (+inf when excluded)
   // Number of source frames that can be chosen.
   int usable_sources() const { return sources_->count - static_cast<int>(excluded_.size()); }
 

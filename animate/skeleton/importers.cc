@@ -336,3 +336,100 @@ SkeletonSequence ImportCocoKeypoints(const std::string& path, const JointMapping
 }
 
 }  // namespace ss
+
+namespace ss {
+
+JointMapping IdentityMapping(const SkeletonDef& def) {
+  JointMapping m;
+  m.context = "identity mapping onto " + def.name;
+  m.skeleton = def;
+  for (const auto& name : def.joints) m.sources.push_back({SourceKeypoint{name, -1}});
+  return m;
+}
+
+SkeletonSequence ImportSynthTruth(const std::string& path, const std::string& camera, const JointMapping& mapping,
+                                  const ImportOptions& options) {
+  // Find the truth folder and the CSV.
+  fs::path truth_dir, csv;
+  if (fs::is_regular_file(path)) {
+    csv = path;
+    truth_dir = fs::path(path).parent_path().parent_path();
+  } else if (fs::exists(fs::path(path) / "truth" / "truth.json")) {
+    truth_dir = fs::path(path) / "truth";
+  } else if (fs::exists(fs::path(path) / "truth.json")) {
+    truth_dir = path;
+  } else {
+    throw InputError(path, "not a synthetic session, its truth folder or a <camera>/joints.csv (no truth.json)");
+  }
+  nlohmann::json truth;
+  if (fs::exists(truth_dir / "truth.json")) truth = ReadJsonFile((truth_dir / "truth.json").string());
+  std::string cam = camera;
+  if (csv.empty()) {
+    if (cam.empty()) {
+      if (!truth.contains("cameras") || !truth["cameras"].is_array() || truth["cameras"].empty()) {
+        throw InputError((truth_dir / "truth.json").string(), "lists no cameras");
+      }
+      cam = truth["cameras"][0].value("name", std::string());
+    }
+    csv = truth_dir / cam / "joints.csv";
+  } else if (cam.empty()) {
+    cam = csv.parent_path().filename().string();
+  }
+  std::ifstream in(csv);
+  if (!in) throw InputError(csv.string(), "cannot open (a figure session's projected joint truth)");
+  std::string line;
+  if (!std::getline(in, line)) throw InputError(csv.string(), "empty file");
+  const auto header = SplitCsvLine(line);
+  auto column = [&](const std::string& name) {
+    const auto it = std::find(header.begin(), header.end(), name);
+    if (it == header.end()) throw InputError(csv.string(), "no '" + name + "' column in the header");
+    return static_cast<size_t>(it - header.begin());
+  };
+  const size_t c_frame = column("frame"), c_subject = column("subject"), c_name = column("name"),
+               c_x = column("x"), c_y = column("y");
+  const size_t need = std::max({c_frame, c_subject, c_name, c_x, c_y}) + 1;
+
+  // Rows of the chosen subject, grouped by frame, keypoints by name in first-seen order.
+  std::vector<std::string> names;
+  std::map<std::string, int> index_of;
+  std::map<int64_t, std::map<int, Keypoint>> frames;
+  int line_number = 1;
+  while (std::getline(in, line)) {
+    ++line_number;
+    if (line.empty() || line == "\r") continue;
+    const auto cells = SplitCsvLine(line);
+    const std::string where = csv.string() + ":" + std::to_string(line_number);
+    if (cells.size() < need) throw InputError(where, "too few cells");
+    const auto frame = ParseInteger(cells[c_frame]);
+    const auto subject = ParseInteger(cells[c_subject]);
+    if (!frame || !subject) throw InputError(where, "frame and subject must be integers");
+    if (*subject != options.person) continue;
+    auto [it, added] = index_of.emplace(cells[c_name], static_cast<int>(names.size()));
+    if (added) names.push_back(cells[c_name]);
+    const auto x = ParseCell(cells[c_x], where), y = ParseCell(cells[c_y], where);
+    Keypoint k;
+    if (x && y) k = {*x, *y, 1.0f, true};
+    frames[*frame][it->second] = k;
+  }
+  if (frames.empty()) {
+    throw InputError(csv.string(), "no rows for subject " + std::to_string(options.person));
+  }
+  ResolvedMapping resolved = ResolveMapping(mapping, names, csv.string(), options.min_confidence.value_or(0.0f));
+  if (options.min_confidence) resolved.min_confidence = *options.min_confidence;
+
+  SkeletonSequence sequence;
+  sequence.skeleton = mapping.skeleton;
+  std::string session = truth_dir.parent_path().filename().string();
+  const fs::path session_json = truth_dir.parent_path() / "session.json";
+  if (fs::exists(session_json)) session = ReadJsonFile(session_json.string()).value("name", session);
+  sequence.clip = session + "/" + cam;
+  sequence.fps = truth.is_object() ? truth.value("fps", 0.0) : 0.0;
+  for (const auto& [frame, by_index] : frames) {
+    std::vector<Keypoint> keypoints(names.size());
+    for (const auto& [k, v] : by_index) keypoints[k] = v;
+    sequence.frames.push_back(MapKeypoints(resolved, keypoints, frame));
+  }
+  return sequence;
+}
+
+}  // namespace ss

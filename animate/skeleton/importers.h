@@ -17,7 +17,7 @@ struct ImportOptions {
   // COCO 0.5, which keeps v=1 "labelled, hidden" as confidence 0.5 and v=2 as 1).
   std::optional<float> min_confidence;
   std::string individual;  // DeepLabCut multi-animal: which individual (empty: the first)
-  int person = 0;          // OpenPose: index into people[]
+  int person = 0;          // OpenPose: index into people[]; synth truth: the subject
   int category_id = -1;    // COCO: the category whose annotations are read (-1: the first with keypoints)
 };
 
@@ -38,5 +38,17 @@ SkeletonSequence ImportOpenPoseJson(const std::string& path, const JointMapping&
 // from categories[].keypoints (Coco17KeypointNames() if absent).
 SkeletonSequence ImportCocoKeypoints(const std::string& path, const JointMapping& mapping,
                                      const ImportOptions& options = {});
+
+// The synthetic studio's joint truth (docs/synth.md): `<session>/truth/<camera>/joints.csv`
+// (frame, subject, joint, name, x, y; extra columns ignored) for subject `options.person`.
+// `path` is the session folder, its truth folder or the CSV itself; `camera` empty = the
+// first camera in truth.json. Keypoints are the truth's joint names; every projected joint
+// is present with confidence 1 (also when hidden behind the body: it is the truth). The
+// clip is SESSION/CAMERA, as `skeleton track` names it, and fps comes from truth.json.
+SkeletonSequence ImportSynthTruth(const std::string& path, const std::string& camera, const JointMapping& mapping,
+                                  const ImportOptions& options = {});
+
+// A mapping taking each joint of `def` from the keypoint of the same name.
+JointMapping IdentityMapping(const SkeletonDef& def);
 
 }  // namespace ss

@@ -63,6 +63,7 @@ constexpr int kCostTile = 16;  // target rows of costs computed at once
 
 typedef float v8f __attribute__((vector_size(32)));
 typedef int v8i __attribute__((vector_size(32)));
+typedef uint8_t v8u8 __attribute__((vector_size(8)));
 
 inline v8f Load(const float* p) {
   v8f v;
@@ -177,7 +178,10 @@ struct StepArgs {
   float offset;           // subtracted from every value (the previous row's minimum)
 };
 
-__attribute__((target_clones("arch=x86-64-v3", "default"))) void StepKernel(const StepArgs& a) {
+__attribute__((target_clones("arch=x86-64-v3", "default"))) void StepKernel(const StepArgs& args) {
+  // A local copy: the stores through float pointers below could alias the caller's struct
+  // (it holds floats), which made the compiler reload every field in the loop.
+  const StepArgs a = args;
   const int levels = a.levels;
   const v8f inf = v8f{} + kInf;
   for (int s = 0; s < a.count; s += kLanes) {
@@ -216,7 +220,8 @@ __attribute__((target_clones("arch=x86-64-v3", "default"))) void StepKernel(cons
     Store(a.mcur + s, mm);
     if (a.record) {
       const v8i code = arg | (from_below & 8);
-      for (int l = 0; l < kLanes; ++l) a.record[s + l] = static_cast<uint8_t>(code[l]);
+      const v8u8 bytes = __builtin_convertvector(code, v8u8);  // one 8-byte store, not eight
+      std::memcpy(a.record + s, &bytes, sizeof(bytes));
     }
   }
 }
@@ -563,7 +568,10 @@ MatchResult Engine::Solve() {
   // Backward: recompute each block from its checkpoint, keeping M rows and record bytes,
   // then walk the path back through it.
   const auto back_start = std::chrono::steady_clock::now();
-  std::vector<float> block_m(static_cast<size_t>(block + 1) * S_);
+  // M rows of the block, each padded like Row::m_storage: the steps write into them directly.
+  const size_t m_stride = stride_ + 2 * static_cast<size_t>(pad_);
+  std::vector<float> block_m(static_cast<size_t>(block + 1) * m_stride, kInf);
+  const auto m_row = [&](size_t i) { return block_m.data() + i * m_stride + pad_; };
   std::vector<uint8_t> block_rec(static_cast<size_t>(block + 1) * S_);
   std::vector<std::vector<TopEntry>> block_top(block + 1);
   result.source_frames.assign(T_, 0);
@@ -575,9 +583,9 @@ MatchResult Engine::Solve() {
     // Local row i holds target row b0 - 1 + i.
     cur = 0;
     if (b > 0) {
+      rows[cur].m = m_row(0);
       StateFromCheckpoint(checkpoints[b - 1], &rows[cur], block_rec.data());
       Finish(&rows[cur], b0 - 1);
-      std::copy(rows[cur].m, rows[cur].m + S_, block_m.begin());
       block_top[0] = rows[cur].top;
       checkpoints[b - 1] = {};
       cur = 1;
@@ -588,18 +596,18 @@ MatchResult Engine::Solve() {
       }
       const size_t i = t - b0 + 1;
       uint8_t* record = block_rec.data() + i * S_;
+      rows[cur].m = m_row(i);
       if (t == 0) {
         Init(CostRow(t), &rows[cur], record);
       } else {
         Step(t, CostRow(t), rows[1 - cur], &rows[cur], record);
       }
-      std::copy(rows[cur].m, rows[cur].m + S_, block_m.begin() + i * S_);
       block_top[i] = rows[cur].top;
       cur = 1 - cur;
     }
     if (s < 0) {  // the last row: its best state
       const size_t i = b1 - b0;
-      const float* m = block_m.data() + i * S_;
+      const float* m = m_row(i);
       s = static_cast<int>(std::min_element(m, m + S_) - m);
       r = block_rec[i * S_ + s] & 7;
     }
@@ -607,7 +615,7 @@ MatchResult Engine::Solve() {
       result.source_frames[t] = s;
       if (t == 0) break;
       const size_t i = t - b0 + 1;
-      std::tie(s, r) = Predecessor(t, s, r, block_m.data() + (i - 1) * S_, block_rec.data() + (i - 1) * S_,
+      std::tie(s, r) = Predecessor(t, s, r, m_row(i - 1), block_rec.data() + (i - 1) * S_,
                                    block_rec.data() + i * S_, block_top[i - 1]);
     }
   }
@@ -671,13 +679,11 @@ double PathCost(const CostRows& costs, const std::vector<int>& clip_starts, cons
     if (T > 0) inside[0] = 0;
   }
   double match = 0, total = 0;
-  std::vector<float> row(S);
   int run = 0;
   for (int t = 0; t < T; ++t) {
     const int s = path[t];
     if (s < 0 || s >= S) throw InputError("path", "source frame " + std::to_string(s) + " out of range");
-    costs.Compute(t, 1, row.data());
-    match += row[s];
+    match += costs.At(t, s);
     if (t == 0) continue;
     const int from = path[t - 1];
     if (s == from) {

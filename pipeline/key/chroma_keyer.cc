@@ -12,6 +12,8 @@ namespace {
 
 // Below this luma (of 255) the key of a training pixel is all noise.
 constexpr double kMinTrainingLuma = 8.0;
+// A cell is green (modelled and keyed) when at least this share of its training samples is.
+constexpr double kMinGreenShare = 0.25;
 // key_hi of a cell that is not green: no pixel there is ever keyed as subject
 // (small enough, large enough to keep the kernel's float->int conversions in range).
 constexpr float kNeverKey = -100.f;
@@ -19,7 +21,7 @@ constexpr float kNeverKey = -100.f;
 constexpr float kNoShadow = -1000.f;
 // A pixel whose mean alpha over the empty enclosure exceeds this is not green
 // (the room behind a wall, a cable): it is never keyed.
-constexpr int kUnkeyableAlpha = 64;
+constexpr int kUnkeyableAlpha = 16;
 
 struct PixelKey {
   int alpha;   // 0..255
@@ -65,8 +67,11 @@ void ChromaKeyer::Train(const std::vector<cv::Mat>& empty_bgr) {
   const int s = grid_.step, cols = cols_, rows = rows_;
   const size_t cells = static_cast<size_t>(cols) * rows;
 
-  // Per cell: mean luma, mean key and the key's spread over all pixels of all frames.
-  std::vector<double> sum_y(cells, 0), sum_k(cells, 0), sum_kk(cells, 0), count(cells, 0);
+  // Per cell: mean luma, mean key and the key's spread over the green samples of all frames. A
+  // cell that is part green, part something else (a wall's outside at the floor's edge) models
+  // its green part: over all its pixels the spread would be so wide that nothing is ever keyed
+  // there, not even on the green. Its other pixels are then found not keyable (below).
+  std::vector<double> sum_y(cells, 0), sum_k(cells, 0), sum_kk(cells, 0), count(cells, 0), all(cells, 0);
   std::vector<float> pixel_key(static_cast<size_t>(size_.width) * size_.height, 0.f);
   for (const cv::Mat& frame : empty_bgr) {
     for (int y = 0; y < size_.height; ++y) {
@@ -78,6 +83,8 @@ void ChromaKeyer::Train(const std::vector<cv::Mat>& empty_bgr) {
         const double key = (p[1] - std::max(p[0], p[2])) / std::max(luma, kMinTrainingLuma);
         pk[x] += static_cast<float>(key);
         const size_t c = row + x / s;
+        all[c] += 1;
+        if (key < options_.min_key || luma < kMinTrainingLuma) continue;
         sum_y[c] += luma;
         sum_k[c] += key;
         sum_kk[c] += key * key;
@@ -90,10 +97,11 @@ void ChromaKeyer::Train(const std::vector<cv::Mat>& empty_bgr) {
   size_t n_green = 0;
   double luma_sum = 0, key_sum = 0, spread_sum = 0;
   for (size_t c = 0; c < cells; ++c) {
-    luma[c] = sum_y[c] / count[c];
-    key[c] = sum_k[c] / count[c];
-    spread[c] = std::sqrt(std::max(0.0, sum_kk[c] / count[c] - key[c] * key[c]));
-    green[c] = key[c] >= options_.min_key && luma[c] >= kMinTrainingLuma;
+    const double n = std::max(count[c], 1.0);
+    luma[c] = sum_y[c] / n;
+    key[c] = sum_k[c] / n;
+    spread[c] = std::sqrt(std::max(0.0, sum_kk[c] / n - key[c] * key[c]));
+    green[c] = count[c] >= kMinGreenShare * all[c] && count[c] > 0;
     if (green[c]) {
       ++n_green;
       luma_sum += luma[c];

@@ -79,9 +79,13 @@ std::optional<Billboard> Rectifier::Rectify(const CameraModel& camera, const Spr
   const Eigen::Vector3d right3(right.x(), right.y(), 0.0);
   const Eigen::Vector3d up(0, 0, 1);
 
-  // The billboard's extent: the crop's corners and edge midpoints on the plane.
-  const double x0 = view.offset.x, y0 = view.offset.y;
-  const double x1 = x0 + view.bgr->cols, y1 = y0 + view.bgr->rows;
+  // The billboard's extent: the corners and edge midpoints of the sprite's own box (alpha > 0) on
+  // the plane. Not the crop's: the crop also holds the contact shadow, which goes to the ground
+  // patch, and a long shadow would make the billboard needlessly wide (or too big to keep).
+  const cv::Rect solid = cv::boundingRect(*view.alpha);
+  if (solid.empty()) return std::nullopt;
+  const double x0 = view.offset.x + solid.x, y0 = view.offset.y + solid.y;
+  const double x1 = x0 + solid.width, y1 = y0 + solid.height;
   double min_r = 0, max_r = 0, max_h = 0;
   bool any = false;
   for (const Eigen::Vector2d& px : {Eigen::Vector2d(x0, y0), Eigen::Vector2d(x1, y0), Eigen::Vector2d(x0, y1),

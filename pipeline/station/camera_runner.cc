@@ -149,7 +149,8 @@ struct CameraRunner::Impl {
       }
       if (!src) {
         try {
-          std::shared_ptr<FrameSource> opened = OpenCameraSource(options.camera, index);
+          std::shared_ptr<FrameSource> opened = options.open_source ? options.open_source(options.camera, index)
+                                                                    : OpenCameraSource(options.camera, index);
           {
             std::lock_guard lock(status_mutex);
             if (opened_once) ++status.reopens;

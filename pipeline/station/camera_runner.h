@@ -67,6 +67,8 @@ struct CameraRunnerOptions {
   double backoff_min_s = 0.5;    // first reopen delay, doubled up to backoff_max_s
   double backoff_max_s = 8.0;
   double preview_interval_s = 0.2;
+  // Opens the camera; unset: OpenCameraSource (benchmarks put frames from memory here).
+  std::function<std::unique_ptr<FrameSource>(const CameraConfig&, int camera_index)> open_source;
 };
 
 // Sources are closed on threads of their own (a dead device takes seconds to close):

@@ -311,6 +311,7 @@ void Station::Start() {
     o.training_frames = std::max(1, config.keying.training_frames);
     o.queue_frames = config.pipeline.queue_frames;
     o.offline_after_s = s.options.offline_after_s;
+    o.open_source = s.options.open_source;
     s.runners.push_back(std::make_unique<CameraRunner>(
         static_cast<int>(i), std::move(o), [&s](StationBatch b) { s.Store(std::move(b)); },
         [&s](int camera, const Frame& f, uint64_t drops, bool usable) { s.Tap(camera, f, drops, usable); }));

@@ -7,11 +7,13 @@
 // raw frames. A monitor thread watches the disk: below
 // storage.stop_recording_below_mib raw recording stops, below
 // storage.stop_sprites_below_mib sprite storage stops too (the bank stays whole).
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "capture/frame_source.h"
 #include "core/config.h"
 #include "pipeline/station/station_status.h"
 #include "pipeline/transitions/weights.h"
@@ -23,6 +25,8 @@ struct StationOptions {
   std::optional<TransitionWeights> weights;    // unset: the shipped defaults
   bool transitions = true;                     // keep the bank's transitions current
   double offline_after_s = 3.0;                // a camera silent this long is reopened
+  // Opens each camera; unset: its configured backend (benchmarks replay from memory).
+  std::function<std::unique_ptr<FrameSource>(const CameraConfig&, int camera_index)> open_source;
 };
 
 class Station {

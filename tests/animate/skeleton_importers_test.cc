@@ -1,6 +1,7 @@
 // The importers on small files written by hand in each tool's published layout
 // (tests/data/skeleton/): DeepLabCut analysis and labelled-data CSVs (single and
-// multi-animal), OpenPose BODY_25 per-frame JSON, COCO person keypoints; and the joint
+// multi-animal), OpenPose BODY_25 per-frame JSON, COCO person keypoints, the synthetic
+// studio's joint truth; and the joint
 // mapping's errors.
 #include <gtest/gtest.h>
 
@@ -187,6 +188,46 @@ TEST(SkeletonImporters, ErrorsNameTheFileAndTheReason) {
   EXPECT_NE(ErrorOf([&] { ImportOpenPoseJson(Data("coco_person_keypoints.json"), Body25ToHuman14()); })
                 .find("no 'people' array"),
             std::string::npos);
+}
+
+// The synthetic studio's joint truth (docs/synth.md layout), written by hand: two subjects,
+// two frames, an extra column the importer must ignore, rows out of joint order.
+TEST(SkeletonImporters, SynthJointTruth) {
+  ss::testing::ScratchDir dir;
+  const std::filesystem::path session = dir.path() / "sess";
+  std::filesystem::create_directories(session / "truth" / "cam1");
+  std::ofstream(session / "session.json") << R"({"name": "figure-7", "format_version": 1})";
+  std::ofstream(session / "truth" / "truth.json") << R"({"fps": 12.5, "cameras": [{"name": "cam1"}]})";
+  {
+    std::ofstream csv(session / "truth" / "cam1" / "joints.csv");
+    csv << "frame,subject,joint,name,x,y,hidden\n";
+    const auto& names = HumanSkeleton().joints;
+    for (int f = 0; f < 2; ++f) {
+      for (int subject = 1; subject >= 0; --subject) {
+        for (int j = static_cast<int>(names.size()) - 1; j >= 0; --j) {
+          csv << f << "," << subject << "," << j << "," << names[j] << "," << 100 * subject + 10 * j + f << ","
+              << 200 + j << ",0\n";
+        }
+      }
+    }
+  }
+  ImportOptions options;
+  options.person = 1;
+  const SkeletonSequence s = ImportSynthTruth(session.string(), "", IdentityMapping(HumanSkeleton()), options);
+  ASSERT_EQ(s.size(), 2);
+  EXPECT_EQ(s.clip, "figure-7/cam1");
+  EXPECT_DOUBLE_EQ(s.fps, 12.5);
+  EXPECT_EQ(s.skeleton.name, "human14");
+  ExpectJoint(s, 0, "head", 100, 200);
+  ExpectJoint(s, 1, "wrist_l", 141, 204);
+  ExpectJoint(s, 1, "ankle_r", 241, 214);
+  // The CSV itself works too, subject 0 by default; a subject that is not there is an error.
+  const SkeletonSequence s0 = ImportSynthTruth((session / "truth" / "cam1" / "joints.csv").string(), "",
+                                               IdentityMapping(HumanSkeleton()));
+  ExpectJoint(s0, 1, "neck", 11, 201);
+  options.person = 5;
+  EXPECT_THROW(ImportSynthTruth(session.string(), "", IdentityMapping(HumanSkeleton()), options), InputError);
+  EXPECT_THROW(ImportSynthTruth(dir.path().string(), "", IdentityMapping(HumanSkeleton())), InputError);
 }
 
 }  // namespace

@@ -102,6 +102,7 @@ TEST(KeySynth, MedianAlphaIoUOnAStudioSessionRgb) {
     single += f.candidates == 1;
   }
   ASSERT_GE(seen, 12) << "the animal should be in view in most frames";
+  RecordProperty("median_iou", std::to_string(MedianIoU(frames, 200)));
   EXPECT_GE(MedianIoU(frames, 200), 0.95);
   // One candidate for the one animal: no stray regions from the walls or the room.
   EXPECT_GE(single, seen - 1);

@@ -162,6 +162,7 @@ TEST_F(DaemonTest, TwoEmulatedGigECamerasStoreWhatIngestFinds) {
   // The same sprites as ingest, but for frames the drop counters account for.
   const auto ingest = SpritesByCamera(session_->ingest_bank);
   const auto live = SpritesByCamera(bank());
+  size_t compared = 0;
   for (const std::string name : {"cam0", "cam1"}) {
     const nlohmann::json& cam = Camera(status, name);
     const int64_t dropped = cam["dropped"]["total"].get<int64_t>() + cam["sequence_gaps"].get<int64_t>();
@@ -181,8 +182,10 @@ TEST_F(DaemonTest, TwoEmulatedGigECamerasStoreWhatIngestFinds) {
     // velocity windows around the gap are what may be missing.
     EXPECT_LE(missing, static_cast<size_t>(dropped) * 6) << name << ": " << missing << " of " << expected.size()
                                                          << " sprites missing with " << dropped << " frames dropped";
-    EXPECT_GT(expected.size(), 20u) << name;
+    EXPECT_GT(expected.size(), 5u) << name;
+    compared += expected.size();
   }
+  EXPECT_GT(compared, 60u) << "too few sprites in the session to compare";
 }
 
 TEST_F(DaemonTest, LostPacketsAreCountedAndTheStationGoesOn) {
