@@ -131,7 +131,11 @@ void CameraPipeline::Process(const Frame& frame, std::vector<ClipBatch>* out) {
   last_sequence_ = frame.sequence;
 
   const auto key_start = Clock::now();
-  ToBgr(frame, bgr_);
+  try {
+    ToBgr(frame, bgr_);
+  } catch (const InputError& e) {  // a corrupt frame: say which camera's
+    throw InputError(name_ + " frame " + std::to_string(frame.sequence), e.what());
+  }
   keyer_->Key(bgr_, matte_);
   const std::vector<Candidate>& candidates = extractor_.Extract(matte_);
   stats_.seconds_key += SecondsSince(key_start);

@@ -82,6 +82,7 @@ struct CameraRunner::Impl {
   SteadyTime last_frame_time = Clock::now();
   uint64_t source_dropped_base = 0, source_errors_base = 0;  // of the sources closed before
   std::optional<SourceCamera> source_camera;
+  SteadyTime last_reject_log{};
 
   // Bank camera switching: wanted by the station, applied by the pipeline thread.
   std::mutex target_mutex;
@@ -317,8 +318,14 @@ struct CameraRunner::Impl {
           // Learning the empty enclosure takes a while: it runs beside this loop, which
           // meanwhile keeps the queue empty (those frames only feed the preview).
           if (training.valid() && training.wait_for(std::chrono::seconds(0)) == std::future_status::ready) {
-            training.get();  // rethrows what Train threw
-            SetState(CameraState::kLive, "");
+            try {
+              training.get();  // rethrows what Train threw
+              SetState(CameraState::kLive, "");
+            } catch (const std::exception& e) {
+              // Without a keyer no sprite can be made: the camera streams for preview and recording.
+              SetState(CameraState::kError, std::string("learning the empty enclosure failed: ") + e.what());
+              pipeline_failed = true;
+            }
           }
           ToBgr(frame, bgr);
           UpdatePreview(bgr, nullptr, item->received);
@@ -341,17 +348,16 @@ struct CameraRunner::Impl {
           UpdatePreview(pipeline->last_bgr(), &pipeline->last_matte(), item->received);
           Sink(out, arrivals);
         }
-      } catch (const InputError& e) {
-        // A frame the pipeline cannot take (size changed, malformed): the camera keeps
-        // streaming for preview and recording, and says why it stores no sprites.
-        SetState(CameraState::kError, e.what());
-        if (pipeline && !pipeline_failed) {
-          pipeline->Finish(&out);
-          Sink(out, arrivals);
-        }
-        pipeline_failed = true;
       } catch (const std::exception& e) {
-        SetState(CameraState::kError, e.what());
+        // A frame the pipeline cannot take (corrupt, another size): counted and skipped (its
+        // gap ends the open clips); the message names the camera and the frame.
+        std::lock_guard lock(status_mutex);
+        ++status.frames_rejected;
+        status.message = e.what();
+        if (Seconds(Clock::now() - last_reject_log) > 5.0) {
+          last_reject_log = Clock::now();
+          log->warn("{} (rejected frames so far: {})", e.what(), status.frames_rejected);
+        }
       }
       {
         std::lock_guard lock(status_mutex);

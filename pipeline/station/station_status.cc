@@ -70,6 +70,7 @@ nlohmann::json StatusToJson(const StationStatus& st) {
                                     {"at_source", c.dropped_at_source},
                                     {"total", c.dropped_queue_full + c.dropped_at_source}}},
                        {"source_errors", c.source_errors},
+                       {"frames_rejected", c.frames_rejected},
                        {"queue_depth", c.queue_depth},
                        {"queue_capacity", c.queue_capacity},
                        {"reopens", c.reopens},
@@ -138,6 +139,8 @@ std::string StatusToPrometheus(const StationStatus& st) {
   }
   per_camera("source_errors_total", "counter", "recoverable source problems (timeouts, corrupt frames)",
              [](const CameraStatus& c) { return c.source_errors; });
+  per_camera("frames_rejected_total", "counter", "frames the pipeline refused (corrupt, another size)",
+             [](const CameraStatus& c) { return c.frames_rejected; });
   per_camera("queue_depth", "gauge", "frames waiting for the pipeline", [](const CameraStatus& c) { return c.queue_depth; });
   per_camera("camera_reopens_total", "counter", "times the camera was reopened after going offline",
              [](const CameraStatus& c) { return c.reopens; });
