@@ -329,7 +329,10 @@ struct CameraRunner::Impl {
           }
           ToBgr(frame, bgr);
           UpdatePreview(bgr, nullptr, item->received);
-          if (!training.valid() && !pipeline->trained()) {
+          if (training.valid()) {
+            std::lock_guard lock(status_mutex);
+            ++status.frames_while_learning;
+          } else if (!pipeline->trained()) {
             empty.push_back(bgr.clone());
             if (static_cast<int>(empty.size()) >= options.training_frames) {
               training = std::async(std::launch::async, [p = pipeline.get(), frames = std::move(empty)] {

@@ -49,6 +49,7 @@ struct CameraStatus {
   uint64_t dropped_queue_full = 0;   // the pipeline queue was full
   uint64_t dropped_at_source = 0;    // lost before delivery: incomplete frames, sequence gaps, unreadable
   uint64_t source_errors = 0;        // recoverable source problems (timeouts, corrupt frames)
+  uint64_t frames_while_learning = 0;  // arrived while the keyer learnt the empty enclosure (preview only)
   uint64_t frames_rejected = 0;      // frames the pipeline refused (corrupt, another size); see message
   uint64_t batches_unstored = 0;     // batches made with no capture session (not stored)
   size_t queue_depth = 0, queue_capacity = 0;

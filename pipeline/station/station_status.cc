@@ -71,6 +71,7 @@ nlohmann::json StatusToJson(const StationStatus& st) {
                                     {"total", c.dropped_queue_full + c.dropped_at_source}}},
                        {"source_errors", c.source_errors},
                        {"frames_rejected", c.frames_rejected},
+                       {"frames_while_learning", c.frames_while_learning},
                        {"queue_depth", c.queue_depth},
                        {"queue_capacity", c.queue_capacity},
                        {"reopens", c.reopens},
