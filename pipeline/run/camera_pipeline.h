@@ -85,6 +85,8 @@ class CameraPipeline {
   const std::string& name() const { return name_; }
   const CameraModel& model() const { return model_; }
   const CameraPipelineStats& stats() const { return stats_; }
+  // Sprites that passed every filter so far, short clips included (grows by the frame's usable ones).
+  uint64_t usable_sprites() const { return usable_total_; }
   const FloorMask& floor_mask() const { return floor_mask_; }
   const Keyer& keyer() const { return *keyer_; }  // as configured (PipelineOptionsFromConfig)
 

@@ -256,14 +256,10 @@ struct CameraRunner::Impl {
       sb.camera = index;
       sb.received.reserve(b.sprites.size());
       for (const SpriteRecord& s : b.sprites) {
-        SteadyTime t = Clock::now();
-        for (auto it = arrivals.rbegin(); it != arrivals.rend(); ++it) {
-          if (it->first == s.frame) {
-            t = it->second;
-            break;
-          }
-        }
-        sb.received.push_back(t);
+        // Arrivals are in sequence order; a sprite's frame is its sequence number.
+        const auto it = std::lower_bound(arrivals.begin(), arrivals.end(), s.frame,
+                                         [](const auto& a, int64_t frame) { return a.first < frame; });
+        sb.received.push_back(it != arrivals.end() && it->first == s.frame ? it->second : Clock::now());
       }
       sb.batch = std::move(b);
       sink(std::move(sb));
@@ -271,21 +267,34 @@ struct CameraRunner::Impl {
     out.clear();
   }
 
+  // True every preview_interval_s: only then is a frame kept for the preview.
+  bool PreviewDue(SteadyTime now) const {
+    std::lock_guard lock(preview_mutex);
+    return preview_time == SteadyTime{} || Seconds(now - preview_time) >= options.preview_interval_s;
+  }
+
   void UpdatePreview(const cv::Mat& bgr, const Matte* matte, SteadyTime now) {
     std::lock_guard lock(preview_mutex);
-    if (preview_time != SteadyTime{} && Seconds(now - preview_time) < options.preview_interval_s) return;
     preview_time = now;
     bgr.copyTo(preview_bgr);
-    if (matte != nullptr && !matte->alpha.empty()) {
+    preview_alpha.release();
+    preview_shadow.release();
+    if (matte != nullptr) {
       matte->alpha.copyTo(preview_alpha);
-      if (!matte->shadow.empty()) {
-        matte->shadow.copyTo(preview_shadow);
-      } else {
-        preview_shadow.release();
-      }
-    } else {
-      preview_alpha.release();
-      preview_shadow.release();
+      matte->shadow.copyTo(preview_shadow);
+    }
+  }
+
+  // Once the keyer has learnt the enclosure (on its own thread): live, or in error if it failed.
+  void PollTraining(std::future<void>& training, bool& pipeline_failed) {
+    if (!training.valid() || training.wait_for(std::chrono::seconds(0)) != std::future_status::ready) return;
+    try {
+      training.get();  // rethrows what Train threw
+      SetState(CameraState::kLive, "");
+    } catch (const std::exception& e) {
+      // Without a keyer no sprite can be made: the camera streams for preview and recording.
+      SetState(CameraState::kError, std::string("learning the empty enclosure failed: ") + e.what());
+      pipeline_failed = true;
     }
   }
 
@@ -309,30 +318,17 @@ struct CameraRunner::Impl {
         continue;
       }
       const Frame& frame = item->frame;
+      const bool preview = PreviewDue(item->received);
       bool usable = false;
+      PollTraining(training, pipeline_failed);
       try {
-        if (pipeline_failed) {
-          ToBgr(frame, bgr);
-          UpdatePreview(bgr, nullptr, item->received);
-        } else if (training.valid() || !pipeline->trained()) {
-          // Learning the empty enclosure takes a while: it runs beside this loop, which
-          // meanwhile keeps the queue empty (those frames only feed the preview).
-          if (training.valid() && training.wait_for(std::chrono::seconds(0)) == std::future_status::ready) {
-            try {
-              training.get();  // rethrows what Train threw
-              SetState(CameraState::kLive, "");
-            } catch (const std::exception& e) {
-              // Without a keyer no sprite can be made: the camera streams for preview and recording.
-              SetState(CameraState::kError, std::string("learning the empty enclosure failed: ") + e.what());
-              pipeline_failed = true;
-            }
-          }
-          ToBgr(frame, bgr);
-          UpdatePreview(bgr, nullptr, item->received);
-          if (training.valid()) {
-            std::lock_guard lock(status_mutex);
-            ++status.frames_while_learning;
-          } else if (!pipeline->trained()) {
+        if (pipeline_failed || training.valid() || !pipeline->trained()) {
+          // No keyer yet (or none possible): frames feed the preview and the training set only.
+          // Learning runs beside this loop, which meanwhile keeps the queue empty.
+          const bool collect = !pipeline_failed && !training.valid();
+          if (preview || collect) ToBgr(frame, bgr);
+          if (preview) UpdatePreview(bgr, nullptr, item->received);
+          if (collect) {
             empty.push_back(bgr.clone());
             if (static_cast<int>(empty.size()) >= options.training_frames) {
               training = std::async(std::launch::async, [p = pipeline.get(), frames = std::move(empty)] {
@@ -340,15 +336,17 @@ struct CameraRunner::Impl {
               });
               empty.clear();
             }
+          } else if (!pipeline_failed) {
+            std::lock_guard lock(status_mutex);
+            ++status.frames_while_learning;
           }
         } else {
           arrivals.emplace_back(static_cast<int64_t>(frame.sequence), item->received);
           while (arrivals.size() > 1024) arrivals.pop_front();
-          const uint64_t usable_before = pipeline->stats().discards[static_cast<size_t>(Discard::kNone)] + pipeline->stats().discards[static_cast<size_t>(Discard::kShortClip)];
+          const uint64_t usable_before = pipeline->usable_sprites();
           pipeline->Process(frame, &out);
-          const CameraPipelineStats& s = pipeline->stats();
-          usable = s.discards[static_cast<size_t>(Discard::kNone)] + s.discards[static_cast<size_t>(Discard::kShortClip)] > usable_before;
-          UpdatePreview(pipeline->last_bgr(), &pipeline->last_matte(), item->received);
+          usable = pipeline->usable_sprites() > usable_before;
+          if (preview) UpdatePreview(pipeline->last_bgr(), &pipeline->last_matte(), item->received);
           Sink(out, arrivals);
         }
       } catch (const std::exception& e) {

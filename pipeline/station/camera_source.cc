@@ -25,6 +25,19 @@ namespace fs = std::filesystem;
   return format;
 }
 
+// What every live backend's options share, from the camera's config.
+template <typename Options>
+[[maybe_unused]] void SetLiveOptions(const CameraConfig& camera, int camera_index, Options& options) {
+  options.name = camera.name;
+  options.camera_index = camera_index;
+  options.pixel_format = PixelFormatOf(camera);
+  options.width = camera.width;
+  options.height = camera.height;
+  options.fps = camera.fps;
+  if (camera.exposure_us) options.exposure_us = *camera.exposure_us;
+  options.frame_timeout_ms = 1000;  // the station decides when a silent camera is offline
+}
+
 std::string SessionCameraName(const CameraConfig& camera) {
   return camera.session_camera.empty() ? camera.name : camera.session_camera;
 }
@@ -43,17 +56,10 @@ std::unique_ptr<FrameSource> OpenCameraSource(const CameraConfig& camera, int ca
 #ifdef SPRITESTATION_HAVE_ARAVIS
     AravisOptions options;
     options.camera = camera.camera_id.empty() ? camera.address : camera.camera_id;
-    options.name = camera.name;
-    options.camera_index = camera_index;
-    options.pixel_format = PixelFormatOf(camera);
-    options.width = camera.width;
-    options.height = camera.height;
-    options.fps = camera.fps;
-    if (camera.exposure_us) options.exposure_us = *camera.exposure_us;
+    SetLiveOptions(camera, camera_index, options);
     if (camera.gain_db) options.gain = *camera.gain_db;
     options.packet_resend = camera.packet_resend;
     options.packet_size = camera.packet_size;
-    options.frame_timeout_ms = 1000;
     options.buffers = 32;  // frames queued for the pipeline hold their buffers
     return std::make_unique<AravisSource>(options);
 #else
@@ -64,15 +70,8 @@ std::unique_ptr<FrameSource> OpenCameraSource(const CameraConfig& camera, int ca
 #ifdef SPRITESTATION_HAVE_V4L2
     V4l2Options options;
     options.device = camera.device;
-    options.name = camera.name;
-    options.camera_index = camera_index;
-    options.pixel_format = PixelFormatOf(camera);
-    options.width = camera.width;
-    options.height = camera.height;
-    options.fps = camera.fps;
-    if (camera.exposure_us) options.exposure_us = *camera.exposure_us;
+    SetLiveOptions(camera, camera_index, options);
     if (camera.gain_db) options.gain = static_cast<int>(std::lround(*camera.gain_db));
-    options.frame_timeout_ms = 1000;
     return std::make_unique<V4l2Source>(options);
 #else
     throw InputError("cameras." + camera.name + ".source", "this build has no V4L2 backend");

@@ -490,10 +490,13 @@ StationStatus Station::Status() const {
       }
     }
     if (!s.latencies_ms.empty()) {
-      std::vector<double> sorted(s.latencies_ms.begin(), s.latencies_ms.end());
-      std::sort(sorted.begin(), sorted.end());
-      out.latency_p50_ms = sorted[sorted.size() / 2];
-      out.latency_p99_ms = sorted[std::min(sorted.size() - 1, sorted.size() * 99 / 100)];
+      std::vector<double> v(s.latencies_ms.begin(), s.latencies_ms.end());
+      const auto at = [&v](size_t k) {
+        std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k), v.end());
+        return v[k];
+      };
+      out.latency_p50_ms = at(v.size() / 2);
+      out.latency_p99_ms = at(std::min(v.size() - 1, v.size() * 99 / 100));
     }
   }
   out.writer_queue = s.batches.size();
