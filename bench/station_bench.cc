@@ -201,12 +201,23 @@ void Live(benchmark::State& state, bool from_memory) {
     }
     const StationStatus status = station.Status();
     station.Stop();
-    uint64_t captured = 0, queue_full = 0, at_source = 0;
+    uint64_t captured = 0, queue_full = 0, at_source = 0, learning = 0, processed = 0;
+    double seconds_key = 0, seconds_rest = 0;
     for (const CameraStatus& c : status.cameras) {
       captured += c.frames_captured;
       queue_full += c.dropped_queue_full;
       at_source += c.dropped_at_source;
+      learning += c.frames_while_learning;
+      processed += c.pipeline.frames;
+      seconds_key += c.pipeline.seconds_key;
+      seconds_rest += c.pipeline.seconds_rest;
     }
+    // Wall time a keyed frame spent in the pipeline (keying + extracting, the rest).
+    if (processed > 0) {
+      state.counters["key_ms_per_frame"] = 1e3 * seconds_key / static_cast<double>(processed);
+      state.counters["rest_ms_per_frame"] = 1e3 * seconds_rest / static_cast<double>(processed);
+    }
+    state.counters["frames_while_learning"] = static_cast<double>(learning);
     state.counters["frames_per_s"] = captured / g_args.seconds;
     state.counters["dropped_queue_full"] = static_cast<double>(queue_full);
     state.counters["dropped_at_source"] = static_cast<double>(at_source);

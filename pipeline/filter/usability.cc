@@ -21,15 +21,58 @@ const char* DiscardName(Discard reason) {
   return "unknown";
 }
 
+namespace {
+
+// Ground-frame ray directions through every pixel, unprojected exactly on a grid every `step`
+// pixels and bilinearly interpolated between: the lens maps smoothly, and an exact iterative
+// unprojection of each of a 1080p image's two million pixels took ~3 s a camera.
+class PixelRays {
+ public:
+  PixelRays(const CameraModel& camera, int step) : camera_(camera), step_(step) {
+    cols_ = (camera.width() - 1 + step - 1) / step + 1;
+    rows_ = (camera.height() - 1 + step - 1) / step + 1;
+    std::vector<Eigen::Vector2d> nodes;
+    nodes.reserve(static_cast<size_t>(cols_) * rows_);
+    for (int j = 0; j < rows_; ++j) {
+      for (int i = 0; i < cols_; ++i) nodes.emplace_back(i * step, j * step);
+    }
+    rays_.resize(nodes.size());
+    camera.UnprojectMany(nodes.data(), nodes.size(), rays_.data());
+    const Eigen::Matrix3d ground_from_cam = camera.cam_from_ground().rotation.transpose();
+    for (Eigen::Vector3d& r : rays_) r = ground_from_cam * r.normalized();
+  }
+
+  // The direction through pixel (x, y), in the ground frame.
+  Eigen::Vector3d Direction(int x, int y) const {
+    const int i = x / step_, j = y / step_;
+    const double u = static_cast<double>(x - i * step_) / step_;
+    const double v = static_cast<double>(y - j * step_) / step_;
+    const int i1 = std::min(i + 1, cols_ - 1), j1 = std::min(j + 1, rows_ - 1);
+    const Eigen::Vector3d d = (1 - v) * ((1 - u) * Node(i, j) + u * Node(i1, j)) +
+                              v * ((1 - u) * Node(i, j1) + u * Node(i1, j1));
+    if (d.allFinite()) return d;
+    return camera_.RayInGround(Eigen::Vector2d(x, y)).direction;  // a node outside the lens's valid region
+  }
+
+ private:
+  const Eigen::Vector3d& Node(int i, int j) const { return rays_[static_cast<size_t>(j) * cols_ + i]; }
+
+  const CameraModel& camera_;
+  int step_, cols_ = 0, rows_ = 0;
+  std::vector<Eigen::Vector3d> rays_;
+};
+
+}  // namespace
+
 FloorMask::FloorMask(const CameraModel& camera, const GroundPolygon& floor, const UsabilityOptions& options)
     : floor_(floor), options_(options) {
   mask_ = cv::Mat::zeros(camera.height(), camera.width(), CV_8U);
   const Eigen::Vector3d centre = camera.CentreInGround();
+  const PixelRays rays(camera, kRayGridStepPx);
   for (int y = 0; y < camera.height(); ++y) {
     auto* row = mask_.ptr<uint8_t>(y);
     for (int x = 0; x < camera.width(); ++x) {
-      const Ray ray = camera.RayInGround(Eigen::Vector2d(x, y));
-      const auto g = IntersectGround(ray);
+      const auto g = IntersectGround(Ray{centre, rays.Direction(x, y)});
       if (!g || !floor_.Contains(g->head<2>())) continue;
       // Seen over the walls: where the ray passes wall height it must be inside too.
       if (options_.wall_height_m > 0 && centre.z() > options_.wall_height_m) {

@@ -42,6 +42,9 @@ struct UsabilityOptions {
 // Per camera: the image of the floor, computed once.
 class FloorMask {
  public:
+  // Rays are unprojected exactly every this many pixels and interpolated between.
+  static constexpr int kRayGridStepPx = 8;
+
   FloorMask(const CameraModel& camera, const GroundPolygon& floor, const UsabilityOptions& options);
   // Usability of one sprite from its alpha crop at `offset` and its contact point.
   Discard Check(const cv::Mat& alpha_crop, cv::Point offset, const Eigen::Vector2d& point_in_ground) const;

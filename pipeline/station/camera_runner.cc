@@ -35,6 +35,13 @@ std::atomic<int>& PendingCloses() {
   return pending;
 }
 
+// `n` BGR images of width x height whose pages are already mapped (written once).
+std::vector<cv::Mat> PrefaultedImages(int n, int width, int height) {
+  std::vector<cv::Mat> images(static_cast<size_t>(std::max(1, n)));
+  for (cv::Mat& m : images) m = cv::Mat(height, width, CV_8UC3, cv::Scalar::all(0));
+  return images;
+}
+
 }  // namespace
 
 bool WaitForCameraCloses(double timeout_s) {
@@ -300,10 +307,14 @@ struct CameraRunner::Impl {
 
   // Made before the camera opens (the floor mask takes a while), so the first frames find it ready.
   std::unique_ptr<CameraPipeline> pipeline;
+  // The frames the keyer learns the empty enclosure from, allocated and touched before the camera
+  // opens: first-touch page faults on ~6 MB a 1080p frame cost tens of ms on a VM, which at
+  // 60 frames/s overflowed the queue while the set was collected.
+  std::vector<cv::Mat> training_set;
+  size_t training_collected = 0;
 
   void PipelineLoop() {
     bool pipeline_failed = pipeline == nullptr;
-    std::vector<cv::Mat> empty;
     std::future<void> training;
     std::vector<ClipBatch> out;
     std::deque<std::pair<int64_t, SteadyTime>> arrivals;  // recent frames' sequence and arrival time
@@ -326,17 +337,25 @@ struct CameraRunner::Impl {
           // No keyer yet (or none possible): frames feed the preview and the training set only.
           // Learning runs beside this loop, which meanwhile keeps the queue empty.
           const bool collect = !pipeline_failed && !training.valid();
-          if (preview || collect) ToBgr(frame, bgr);
-          if (preview) UpdatePreview(bgr, nullptr, item->received);
           if (collect) {
-            empty.push_back(bgr.clone());
-            if (static_cast<int>(empty.size()) >= options.training_frames) {
-              training = std::async(std::launch::async, [p = pipeline.get(), frames = std::move(empty)] {
+            // Straight into the next pre-faulted slot of the training set: no allocation here.
+            if (training_set.empty()) training_set = PrefaultedImages(options.training_frames, frame.width, frame.height);
+            cv::Mat& slot = training_set[training_collected];
+            ToBgr(frame, slot);
+            ++training_collected;
+            if (preview) UpdatePreview(slot, nullptr, item->received);
+            if (training_collected >= training_set.size()) {
+              training = std::async(std::launch::async, [p = pipeline.get(), frames = std::move(training_set)] {
                 p->Train(frames);
               });
-              empty.clear();
+              training_set.clear();
+              training_collected = 0;
             }
-          } else if (!pipeline_failed) {
+          } else if (preview) {
+            ToBgr(frame, bgr);
+            UpdatePreview(bgr, nullptr, item->received);
+          }
+          if (!collect && !pipeline_failed) {
             std::lock_guard lock(status_mutex);
             ++status.frames_while_learning;
           }
@@ -400,6 +419,7 @@ CameraRunner::CameraRunner(int index, CameraRunnerOptions options, BatchSink sin
     try {
       s.pipeline = std::make_unique<CameraPipeline>(s.options.camera.name, 0, *s.options.model, s.options.floor,
                                                     s.options.pipeline);
+      s.training_set = PrefaultedImages(s.options.training_frames, s.options.model->width(), s.options.model->height());
     } catch (const std::exception& e) {
       s.SetState(CameraState::kError, e.what());
     }

@@ -1,5 +1,7 @@
 #include "pipeline/filter/usability.h"
 
+#include <cmath>
+
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
 
@@ -28,6 +30,49 @@ TEST(FloorMask, MarksExactlyThePixelsThatSeeTheFloor) {
   EXPECT_NEAR(box.height, 200, 2);
   EXPECT_NEAR(box.x, 170, 2);
   EXPECT_NEAR(box.y, 140, 2);
+}
+
+// A wide-angle, strongly distorted camera 1.6 m up, tilted 35 degrees down, looking at a
+// floor with 0.5 m walls: the interpolated rays must mark the same pixels as exact unprojection.
+TEST(FloorMask, InterpolatedRaysMatchExactUnprojection) {
+  const double tilt = 35.0 * M_PI / 180.0;
+  Rigid3 cam_from_ground;
+  // Camera looking along ground +y, tilted down: x right, y down, z forward.
+  cam_from_ground.rotation << 1, 0, 0,  //
+      0, -std::sin(tilt), -std::cos(tilt),  //
+      0, std::cos(tilt), -std::sin(tilt);
+  const Eigen::Vector3d centre(0.1, -1.2, 1.6);
+  cam_from_ground.translation = -cam_from_ground.rotation * centre;
+  const CameraModel cam("LENSMODEL_OPENCV8", {420, 425, 322, 236, -0.28, 0.09, 0.001, -0.002, -0.012, 0, 0, 0}, 640, 480,
+                        cam_from_ground);
+  const GroundPolygon floor({{-2.0, -0.2}, {2.1, -0.3}, {2.2, 3.9}, {-1.9, 4.0}});
+  UsabilityOptions options;
+  options.wall_height_m = 0.5;
+  const FloorMask mask(cam, floor, options);
+
+  // Ground truth: every pixel's own ray.
+  cv::Mat exact = cv::Mat::zeros(cam.height(), cam.width(), CV_8U);
+  for (int y = 0; y < cam.height(); ++y) {
+    for (int x = 0; x < cam.width(); ++x) {
+      const Ray ray = cam.RayInGround(Eigen::Vector2d(x, y));
+      const auto g = IntersectGround(ray);
+      if (!g || !floor.Contains(g->head<2>())) continue;
+      const double s = (centre.z() - options.wall_height_m) / centre.z();
+      if (!floor.Contains((centre + s * (*g - centre)).head<2>())) continue;
+      exact.at<uint8_t>(y, x) = 255;
+    }
+  }
+  const int floor_pixels = cv::countNonZero(exact);
+  ASSERT_GT(floor_pixels, 640 * 480 / 4);  // the floor fills a good part of the image
+  cv::Mat differ;
+  cv::compare(mask.mask(), exact, differ, cv::CMP_NE);
+  // Any pixel that differs lies on the exact mask's edge (within one pixel of the other class).
+  cv::Mat grown, shrunk, edge;
+  cv::dilate(exact, grown, cv::Mat());
+  cv::erode(exact, shrunk, cv::Mat());
+  cv::compare(grown, shrunk, edge, cv::CMP_NE);
+  EXPECT_EQ(cv::countNonZero(differ & ~edge), 0);
+  EXPECT_LE(cv::countNonZero(differ), floor_pixels / 1000) << "of " << floor_pixels << " floor pixels";
 }
 
 TEST(FloorMask, ChecksBorderFloorAndWalls) {
