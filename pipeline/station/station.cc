@@ -25,6 +25,9 @@ namespace {
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 
+// SIGTERM must finish within 5 s: from the start of Stop, the transition worker may drain this long.
+constexpr double kTransitionDrainS = 3.0;
+
 double Seconds(Clock::duration d) { return std::chrono::duration<double>(d).count(); }
 
 std::string UtcNow(const char* format = "%Y-%m-%dT%H:%M:%SZ") {
@@ -330,6 +333,7 @@ void Station::Stop() {
     return;
   }
   s.state = 2;
+  const auto stop_start = Clock::now();
   bool active = false;
   {
     std::lock_guard lock(s.session_mutex);
@@ -353,7 +357,16 @@ void Station::Stop() {
   }
   if (s.monitor_thread.joinable()) s.monitor_thread.join();
   s.StopRecording("the station stopped");
-  if (s.transitions) s.transitions->Stop();
+  if (s.transitions) {
+    // The transitions of the last sprites get what is left of the stop's few seconds; what
+    // remains is not lost: the worker brings complete clips up to date when it next starts.
+    const double left_s = kTransitionDrainS - std::chrono::duration<double>(Clock::now() - stop_start).count();
+    s.transitions->WaitIdleFor(left_s);
+    if (const int64_t deferred = s.transitions->Stop(); deferred > 0) {
+      s.log->warn("{} new sprites' transitions left for the next start (it brings complete clips up to date)",
+                  deferred);
+    }
+  }
   s.transitions.reset();
   {
     std::lock_guard lock(s.bank_mutex);

@@ -1,5 +1,6 @@
 #include "pipeline/transitions/worker.h"
 
+#include <algorithm>
 #include <chrono>
 #include <optional>
 #include <unordered_set>
@@ -48,15 +49,26 @@ void TransitionWorker::WaitIdle() {
   idle_.wait(lock, [&] { return stop_ || (!busy_ && queue_.empty()); });
 }
 
-void TransitionWorker::Stop() {
+bool TransitionWorker::WaitIdleFor(double seconds) {
+  std::unique_lock<std::mutex> lock(mutex_);
+  return idle_.wait_for(lock, std::chrono::duration<double>(std::max(0.0, seconds)),
+                        [&] { return stop_ || (!busy_ && queue_.empty()); }) &&
+         !stop_;
+}
+
+int64_t TransitionWorker::Stop() {
+  int64_t dropped = 0;
   {
     std::lock_guard<std::mutex> lock(mutex_);
     stop_ = true;
+    dropped = static_cast<int64_t>(queue_.size());
     queue_.clear();
+    stats_.queued = 0;
   }
   wake_.notify_all();
   idle_.notify_all();
   if (thread_.joinable()) thread_.join();
+  return dropped;
 }
 
 TransitionWorkerStats TransitionWorker::stats() const {

@@ -49,8 +49,11 @@ class TransitionWorker {
   void Submit(std::span<const int64_t> sprite_ids);
   // Blocks until everything submitted before the call is processed (tests, shutdown).
   void WaitIdle();
-  // Finishes the round in progress and joins the thread; queued ids are dropped.
-  void Stop();
+  // The same for at most `seconds`; true when idle.
+  bool WaitIdleFor(double seconds);
+  // Finishes the round in progress and joins the thread; queued ids are dropped (their
+  // complete clips are brought up to date at the next start). Returns how many were dropped.
+  int64_t Stop();
   TransitionWorkerStats stats() const;
 
  private:
