@@ -308,12 +308,16 @@ void ReadWhiteBalance(Reader& r, const YAML::Node& node, const std::string& path
     return;
   }
   const MapView view = r.Map(node, path);
-  r.Known(view, {"mode", "red_gain", "blue_gain"});
+  r.Known(view, {"mode", "red_gain", "blue_gain", "temperature_k"});
   r.String(view, "mode", wb.mode);
   const bool red = r.Number(view, "red_gain", wb.red_gain, "a positive number");
   const bool blue = r.Number(view, "blue_gain", wb.blue_gain, "a positive number");
-  if ((red || blue) && wb.mode != "manual") {
-    r.msg().Error(Child(path, red ? "red_gain" : "blue_gain"), "only applies with mode: manual");
+  const bool kelvin = r.Number(view, "temperature_k", wb.temperature_k, "a colour temperature in kelvin");
+  if ((red || blue || kelvin) && wb.mode != "manual") {
+    r.msg().Error(Child(path, red ? "red_gain" : blue ? "blue_gain" : "temperature_k"), "only applies with mode: manual");
+  }
+  if (kelvin && (red || blue)) {
+    r.msg().Error(Child(path, "temperature_k"), "give either the red/blue gains or a colour temperature, not both");
   }
 }
 
@@ -594,6 +598,19 @@ class Validator {
     Enum(c.white_balance.mode, kWhiteBalanceModes, Child(path, "white_balance.mode"));
     Positive(c.white_balance.red_gain, Child(path, "white_balance.red_gain"));
     Positive(c.white_balance.blue_gain, Child(path, "white_balance.blue_gain"));
+    Check(c.white_balance.temperature_k == 0 ||
+              (c.white_balance.temperature_k >= 1500 && c.white_balance.temperature_k <= 15000),
+          Child(path, "white_balance.temperature_k"),
+          "expected a colour temperature of 1500-15000 K, got " + Num(c.white_balance.temperature_k));
+    // How each backend fixes white balance: V4L2 as a colour temperature, GenICam as ratios.
+    if (c.white_balance.mode == "manual" && c.source == "v4l2") {
+      Check(c.white_balance.temperature_k > 0, Child(path, "white_balance.temperature_k"),
+            "V4L2 devices fix white balance as a colour temperature: give temperature_k");
+    }
+    if (c.source == "aravis") {
+      Check(c.white_balance.temperature_k == 0, Child(path, "white_balance.temperature_k"),
+            "GigE Vision cameras fix white balance as red/blue ratios: give red_gain and blue_gain");
+    }
     Exists(c.model, Child(path, "model"), "camera model");
   }
 

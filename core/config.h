@@ -21,6 +21,7 @@ struct WhiteBalanceConfig {
   std::string mode = "device";  // "device" (leave as is) | "once" (auto once, then lock) | "manual"
   double red_gain = 1.0;        // manual: red/green and blue/green balance ratios
   double blue_gain = 1.0;
+  double temperature_k = 0;     // manual: colour temperature instead of ratios (V4L2); 0 = unset
   bool operator==(const WhiteBalanceConfig&) const = default;
 };
 

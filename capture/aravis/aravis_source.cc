@@ -70,6 +70,38 @@ struct AravisSource::Impl {
     throw InputError(field, label + " refuses " + what + ": " + error.message());
   }
 
+  // White balance through the SFNC features (BalanceWhiteAuto, BalanceRatioSelector,
+  // BalanceRatio): run once then locked, or fixed ratios. A camera without them (a mono or
+  // raw Bayer camera, Aravis's fake camera) is refused: the keyer needs the colours fixed.
+  void SetWhiteBalance(ArvCamera* cam, const AravisOptions& o) {
+    const std::string field = "white_balance";
+    const auto has = [&](const char* feature) { return arv_camera_is_feature_available(cam, feature, nullptr); };
+    GErrorHolder error;
+    if (o.white_balance == "once") {
+      if (!has("BalanceWhiteAuto")) {
+        throw InputError(field, label + " has no BalanceWhiteAuto feature, so it cannot balance once (use mode device)");
+      }
+      arv_camera_set_string(cam, "BalanceWhiteAuto", "Once", error.out());
+      Check(error, field, "BalanceWhiteAuto = Once");
+      return;
+    }
+    if (o.white_balance != "manual") throw InputError(field, "unknown mode \"" + o.white_balance + "\"");
+    if (!has("BalanceRatio") || !has("BalanceRatioSelector")) {
+      throw InputError(field, label + " has no BalanceRatio feature: set its white balance on the camera and use mode device");
+    }
+    if (has("BalanceWhiteAuto")) {
+      arv_camera_set_string(cam, "BalanceWhiteAuto", "Off", error.out());
+      Check(error, field, "BalanceWhiteAuto = Off");
+    }
+    for (const auto& [channel, ratio] : {std::pair<const char*, double>{"Red", o.red_ratio}, {"Blue", o.blue_ratio}}) {
+      arv_camera_set_string(cam, "BalanceRatioSelector", channel, error.out());
+      Check(error, field, std::string("BalanceRatioSelector = ") + channel);
+      arv_camera_set_float(cam, "BalanceRatio", ratio, error.out());
+      Check(error, field + "." + (channel[0] == 'R' ? "red_gain" : "blue_gain"),
+            std::string(channel) + " BalanceRatio " + std::to_string(ratio));
+    }
+  }
+
   // Widens the block id past the 16-bit wrap of GigE Vision 1.x (which skips 0)
   // and counts the ids jumped over. Call with the mutex held.
   uint64_t Sequence(uint64_t id) {
@@ -167,6 +199,7 @@ AravisSource::AravisSource(AravisOptions options) : impl_(std::make_unique<Impl>
     arv_camera_set_gain(cam, options.gain, error.out());
     s.Check(error, "gain", std::to_string(options.gain));
   }
+  if (options.white_balance != "device") s.SetWhiteBalance(cam, options);
   if (options.fps > 0) {
     arv_camera_set_frame_rate(cam, options.fps, error.out());
     s.Check(error, "fps", std::to_string(options.fps) + " frames/s");

@@ -212,6 +212,15 @@ struct V4l2Source::Impl {
     }
   }
 
+  // Presses a button control (an action such as a one-time white balance).
+  void Trigger(uint32_t id, const std::string& field, const std::string& what) {
+    if (!Query(id)) throw InputError(field, path() + " cannot do " + what + " (it has no such control)");
+    v4l2_control c{};
+    c.id = id;
+    c.value = 1;
+    if (Xioctl(device->fd, VIDIOC_S_CTRL, &c) < 0) throw InputError(field, path() + " refuses " + what + ": " + Errno());
+  }
+
   // Turns an automatic mode off when the device has it.
   void ManualIfPresent(uint32_t id, int32_t manual_value, const std::string& field, const std::string& what) {
     if (Query(id)) SetControl(id, manual_value, field, what);
@@ -333,6 +342,9 @@ V4l2Source::V4l2Source(V4l2Options options) : impl_(std::make_unique<Impl>()) {
     s.ManualIfPresent(V4L2_CID_AUTO_WHITE_BALANCE, 0, "white_balance_k", "auto white balance");
     s.SetControl(V4L2_CID_WHITE_BALANCE_TEMPERATURE, options.white_balance_k, "white_balance_k",
                  "white balance temperature");
+  } else if (options.white_balance_once) {
+    s.ManualIfPresent(V4L2_CID_AUTO_WHITE_BALANCE, 0, "white_balance", "auto white balance");
+    s.Trigger(V4L2_CID_DO_WHITE_BALANCE, "white_balance", "a one-time white balance");
   }
 
   // Buffers.

@@ -27,6 +27,7 @@ struct V4l2Options {
   double exposure_us = 0.0;                 // > 0: manual exposure (V4L2_CID_EXPOSURE_ABSOLUTE, 100 us units)
   int gain = -1;                            // >= 0: auto gain off, V4L2_CID_GAIN
   int white_balance_k = 0;                  // > 0: auto white balance off, colour temperature in kelvin
+  bool white_balance_once = false;          // balance once (V4L2_CID_DO_WHITE_BALANCE), then hold it
   int buffers = 4;                          // mmap buffers requested
   int frame_timeout_ms = 2000;              // no frame for this long counts as one error
 };

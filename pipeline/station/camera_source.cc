@@ -58,6 +58,9 @@ std::unique_ptr<FrameSource> OpenCameraSource(const CameraConfig& camera, int ca
     options.camera = camera.camera_id.empty() ? camera.address : camera.camera_id;
     SetLiveOptions(camera, camera_index, options);
     if (camera.gain_db) options.gain = *camera.gain_db;
+    options.white_balance = camera.white_balance.mode;
+    options.red_ratio = camera.white_balance.red_gain;
+    options.blue_ratio = camera.white_balance.blue_gain;
     options.packet_resend = camera.packet_resend;
     options.packet_size = camera.packet_size;
     options.buffers = 32;  // frames queued for the pipeline hold their buffers
@@ -72,6 +75,9 @@ std::unique_ptr<FrameSource> OpenCameraSource(const CameraConfig& camera, int ca
     options.device = camera.device;
     SetLiveOptions(camera, camera_index, options);
     if (camera.gain_db) options.gain = static_cast<int>(std::lround(*camera.gain_db));
+    const WhiteBalanceConfig& wb = camera.white_balance;
+    if (wb.mode == "once") options.white_balance_once = true;
+    if (wb.mode == "manual") options.white_balance_k = static_cast<int>(std::lround(wb.temperature_k));
     return std::make_unique<V4l2Source>(options);
 #else
     throw InputError("cameras." + camera.name + ".source", "this build has no V4L2 backend");

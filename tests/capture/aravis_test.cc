@@ -207,6 +207,19 @@ TEST(AravisFakecam, PixelFormatTheCameraLacksIsNamed) {
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("BGR8"), std::string::npos) << e.what();
   }
+  // Fixed white balance ratios on a camera without BalanceRatio (the fake camera): refused by name.
+  ao.pixel_format = PixelFormat::kMono8;
+  ao.white_balance = "manual";
+  ao.red_ratio = 1.4;
+  try {
+    AravisSource source(ao);
+    FAIL() << "white balance ratios accepted by a camera without BalanceRatio";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("white_balance"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("BalanceRatio"), std::string::npos) << e.what();
+  }
+  ao.white_balance = "device";  // left as the camera has it: opens
+  EXPECT_NO_THROW(AravisSource{ao});
 }
 
 TEST(AravisFakecam, MissingCameraIsAWorkErrorNamingIt) {

@@ -223,6 +223,15 @@ TEST(StationConfig, ValueErrorsNameFieldAndLine) {
        "station.yaml:5: cameras[0].exposure_us: expected a positive number, got 0"},
       {kOneCamera + "    white_balance: {mode: once, red_gain: 1.2}\n",
        "station.yaml:5: cameras[0].white_balance.red_gain: only applies with mode: manual"},
+      {kOneCamera + "    white_balance: {mode: manual, red_gain: 1.2, temperature_k: 5600}\n",
+       "station.yaml:5: cameras[0].white_balance.temperature_k: give either the red/blue gains or a colour "
+       "temperature, not both"},
+      {kOneCamera + "    white_balance: {mode: manual, red_gain: 1.2}\n",
+       "station.yaml:5: cameras[0].white_balance.temperature_k: V4L2 devices fix white balance as a colour "
+       "temperature: give temperature_k"},
+      {kOneCamera + "    white_balance: {mode: manual, temperature_k: 560}\n",
+       "station.yaml:5: cameras[0].white_balance.temperature_k: expected a colour temperature of 1500-15000 K, "
+       "got 560"},
       {kOneCamera + kOneCamera.substr(9),
        "station.yaml:5: cameras[1].name: \"cam0\" is already the name of cameras[0]"},
       {"keying:\n  chroma: {low: 80, high: 40}\n",
