@@ -79,7 +79,7 @@ struct PipelineConfig {
   double max_still_s = 2.0;           // still periods longer than this are discarded
   int min_clip_frames = 5;            // shorter clips are discarded
   double px_per_m = 800;              // billboard scale, the same for the whole bank
-  int workers = 0;                    // pipeline threads; 0 = one per core
+  int workers = 0;                    // OpenCV threads inside a frame's work; 0 = OpenCV's default
   int queue_frames = 8;               // per-camera queue between capture and pipeline
   bool operator==(const PipelineConfig&) const = default;
 };

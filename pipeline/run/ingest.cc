@@ -10,6 +10,7 @@
 #include <thread>
 
 #include <nlohmann/json.hpp>
+#include <opencv2/core/utility.hpp>
 
 #include "capture/replay/replay_source.h"
 #include "core/bank.h"
@@ -81,6 +82,7 @@ GroundPolygon FloorForSession(const std::string& session_dir, const StationConfi
 IngestSummary IngestSession(const IngestOptions& options) {
   const auto start = Clock::now();
   const StationConfig& config = options.config;
+  if (config.pipeline.workers > 0) cv::setNumThreads(config.pipeline.workers);  // process-wide
   ReplayOptions replay_options;
   replay_options.realtime = false;
   replay_options.frames_ahead = 6;

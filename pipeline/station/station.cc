@@ -10,6 +10,8 @@
 #include <mutex>
 #include <thread>
 
+#include <opencv2/core/utility.hpp>
+
 #include "core/bank.h"
 #include "core/error.h"
 #include "core/log.h"
@@ -298,6 +300,7 @@ void Station::Start() {
   }
   s.writer_thread = std::thread([&s] { s.WriterLoop(); });
 
+  if (config.pipeline.workers > 0) cv::setNumThreads(config.pipeline.workers);  // process-wide
   CameraPipelineOptions pipeline = PipelineOptionsFromConfig(config);
   for (size_t i = 0; i < config.cameras.size(); ++i) {
     const CameraConfig& c = config.cameras[i];
