@@ -1,6 +1,6 @@
 // spritestation cameras [--json]: lists the cameras this machine can open —
-// V4L2 capture devices and what Aravis discovers (GigE Vision, USB3 Vision) —
-// with the id to put in the station config.
+// V4L2 capture devices, what Aravis discovers (GigE Vision, USB3 Vision) and
+// libcamera's cameras — with the id to put in the station config.
 #include <cstdio>
 #include <memory>
 #include <string>
@@ -13,6 +13,10 @@
 #endif
 #ifdef SPRITESTATION_HAVE_V4L2
 #include "capture/v4l2/v4l2_source.h"
+#endif
+#ifdef SPRITESTATION_HAVE_LIBCAMERA
+#include "capture/libcamera/libcamera_source.h"
+#include "core/log.h"
 #endif
 
 namespace ss::apps {
@@ -32,6 +36,16 @@ void RunCameras(bool json) {
                    {"driver", d.protocol}, {"address", d.address}, {"serial", d.serial}});
   }
 #endif
+#ifdef SPRITESTATION_HAVE_LIBCAMERA
+  try {
+    for (const auto& d : ListLibcameraCameras()) {
+      out.push_back({{"backend", "libcamera"}, {"id", d.id}, {"model", d.model}, {"driver", "libcamera"},
+                     {"address", d.location}, {"serial", ""}});
+    }
+  } catch (const std::exception& e) {  // a broken libcamera must not hide the other backends
+    Log("apps.cameras")->warn("{}", e.what());
+  }
+#endif
   if (json) {
     std::printf("%s\n", out.dump(2).c_str());
     return;
@@ -40,9 +54,9 @@ void RunCameras(bool json) {
     std::printf("no cameras found\n");
     return;
   }
-  std::printf("%-8s %-28s %-24s %-12s %s\n", "backend", "id", "model", "driver", "address");
+  std::printf("%-9s %-28s %-24s %-12s %s\n", "backend", "id", "model", "driver", "address");
   for (const auto& c : out) {
-    std::printf("%-8s %-28s %-24s %-12s %s\n", c["backend"].get<std::string>().c_str(),
+    std::printf("%-9s %-28s %-24s %-12s %s\n", c["backend"].get<std::string>().c_str(),
                 c["id"].get<std::string>().c_str(), c["model"].get<std::string>().c_str(),
                 c["driver"].get<std::string>().c_str(), c["address"].get<std::string>().c_str());
   }
@@ -51,7 +65,7 @@ void RunCameras(bool json) {
 }  // namespace
 
 void AddCamerasCommand(CLI::App& app) {
-  auto* cmd = app.add_subcommand("cameras", "List the cameras V4L2 and Aravis can open");
+  auto* cmd = app.add_subcommand("cameras", "List the cameras V4L2, Aravis and libcamera can open");
   auto json = std::make_shared<bool>(false);
   cmd->add_flag("--json", *json, "Print the list as JSON");
   cmd->callback([json] { RunCameras(*json); });

@@ -12,6 +12,9 @@
 #ifdef SPRITESTATION_HAVE_V4L2
 #include "capture/v4l2/v4l2_source.h"
 #endif
+#ifdef SPRITESTATION_HAVE_LIBCAMERA
+#include "capture/libcamera/libcamera_config.h"
+#endif
 
 namespace ss {
 namespace {
@@ -81,6 +84,13 @@ std::unique_ptr<FrameSource> OpenCameraSource(const CameraConfig& camera, int ca
     return std::make_unique<V4l2Source>(options);
 #else
     throw InputError("cameras." + camera.name + ".source", "this build has no V4L2 backend");
+#endif
+  }
+  if (camera.source == "libcamera") {
+#ifdef SPRITESTATION_HAVE_LIBCAMERA
+    return std::make_unique<LibcameraSource>(LibcameraOptionsFromConfig(camera, camera_index));
+#else
+    throw InputError("cameras." + camera.name + ".source", "this build has no libcamera backend (libcamera not found)");
 #endif
   }
   throw InputError("cameras." + camera.name + ".source",

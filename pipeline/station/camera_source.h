@@ -1,6 +1,6 @@
 #pragma once
 // Opens what a station camera's config names: its FrameSource (replay, v4l2,
-// aravis; libcamera is not built) and its camera model.
+// aravis, libcamera when built) and its camera model.
 #include <memory>
 #include <optional>
 
