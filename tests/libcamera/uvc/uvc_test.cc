@@ -31,145 +31,20 @@
 #include <string>
 #include <vector>
 
+#include "tests/support/qemu_guest.h"
 #include "tests/support/test_support.h"
 
 namespace {
 
 namespace fs = std::filesystem;
 
-std::string ReadFile(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-// Writes a cpio archive in the kernel's "newc" format.
-class CpioWriter {
- public:
-  explicit CpioWriter(const fs::path& path) : out_(path, std::ios::binary) {}
-  void Dir(const std::string& name) { Entry(name, 040755, ""); }
-  void File(const std::string& name, const std::string& data, bool executable) {
-    Entry(name, executable ? 0100755 : 0100644, data);
-  }
-  void Symlink(const std::string& name, const std::string& target) { Entry(name, 0120777, target); }
-  void Finish() {
-    Entry("TRAILER!!!", 0, "");
-    out_.close();
-  }
-  bool ok() const { return out_.good(); }
-
- private:
-  void Entry(const std::string& name, unsigned mode, const std::string& data) {
-    char header[111];
-    std::snprintf(header, sizeof header,
-                  "070701%08X%08X%08X%08X%08X%08X%08X%08X%08X%08X%08X%08X%08X", ino_++, mode, 0u,
-                  0u, 1u, 0u, static_cast<unsigned>(data.size()), 0u, 0u, 0u, 0u,
-                  static_cast<unsigned>(name.size() + 1), 0u);
-    out_.write(header, 110);
-    out_.write(name.c_str(), static_cast<std::streamsize>(name.size() + 1));
-    Pad(110 + name.size() + 1);
-    out_.write(data.data(), static_cast<std::streamsize>(data.size()));
-    Pad(data.size());
-  }
-  void Pad(size_t n) {
-    static const char zeros[4] = {0, 0, 0, 0};
-    out_.write(zeros, static_cast<std::streamsize>((4 - n % 4) % 4));
-  }
-  std::ofstream out_;
-  unsigned ino_ = 1;
-};
+using ss::testing::CpioWriter;
+using ss::testing::FindProgram;
+using ss::testing::ModuleBytes;
+const auto& ReadFile = ss::testing::ReadFileBytes;
+const auto& Interpreter = ss::testing::ElfInterpreter;
 
 const std::vector<std::string> kModules = {"dummy_hcd", "gadgetfs", "uvcvideo"};
-
-// The newest kernel under /boot whose modules ship every module the test loads.
-bool FindKernel(fs::path* kernel, fs::path* modules) {
-  std::error_code ec;
-  std::vector<fs::path> kernels;
-  for (const auto& e : fs::directory_iterator("/boot", ec)) {
-    if (e.path().filename().string().rfind("vmlinuz-", 0) == 0) kernels.push_back(e.path());
-  }
-  std::sort(kernels.rbegin(), kernels.rend());
-  for (const auto& k : kernels) {
-    const fs::path mods = fs::path("/lib/modules") / k.filename().string().substr(8);
-    const std::string dep = fs::exists(mods / "modules.dep") ? ReadFile(mods / "modules.dep") : "";
-    bool all = !dep.empty();
-    for (const auto& m : kModules) all = all && dep.find("/" + m + ".ko") != std::string::npos;
-    if (all) {
-      *kernel = k;
-      *modules = mods;
-      return true;
-    }
-  }
-  return false;
-}
-
-// Module paths (relative to the modules folder) in load order: every module after its dependencies.
-std::vector<std::string> LoadOrder(const fs::path& modules,
-                                   const std::vector<std::string>& targets) {
-  std::map<std::string, std::vector<std::string>> deps;
-  std::map<std::string, std::string> path_of;
-  std::istringstream in(ReadFile(modules / "modules.dep"));
-  for (std::string line; std::getline(in, line);) {
-    const auto colon = line.find(':');
-    if (colon == std::string::npos) continue;
-    const std::string module = line.substr(0, colon);
-    std::istringstream rest(line.substr(colon + 1));
-    std::vector<std::string> list;
-    for (std::string d; rest >> d;) list.push_back(d);
-    deps[module] = list;
-    const std::string file = fs::path(module).filename().string();
-    path_of[file.substr(0, file.find(".ko"))] = module;
-  }
-  std::vector<std::string> order;
-  std::set<std::string> done;
-  std::function<void(const std::string&)> visit = [&](const std::string& m) {
-    if (!done.insert(m).second) return;
-    for (const auto& d : deps[m]) visit(d);
-    order.push_back(m);
-  };
-  for (const auto& t : targets) {
-    if (path_of.count(t)) visit(path_of[t]);
-  }
-  return order;
-}
-
-// A module's bytes, decompressed when the distribution ships it as .ko.xz / .ko.zst.
-bool ModuleBytes(const fs::path& path, std::string* bytes) {
-  const std::string p = path.string();
-  std::string tool;
-  if (p.size() > 3 && p.substr(p.size() - 3) == ".xz") tool = "xz -dc ";
-  if (p.size() > 4 && p.substr(p.size() - 4) == ".zst") tool = "zstd -dc ";
-  if (tool.empty()) {
-    *bytes = ReadFile(path);
-    return !bytes->empty();
-  }
-  FILE* pipe = popen((tool + "'" + p + "'").c_str(), "r");
-  if (pipe == nullptr) return false;
-  bytes->clear();
-  char buf[65536];
-  for (size_t n; (n = fread(buf, 1, sizeof buf, pipe)) > 0;) bytes->append(buf, n);
-  return pclose(pipe) == 0 && !bytes->empty();
-}
-
-// The ELF file's program interpreter ("" for a statically linked executable).
-std::string Interpreter(const std::string& path) {
-  const std::string bytes = ReadFile(path);
-  if (bytes.size() < sizeof(Elf64_Ehdr) || bytes.compare(0, 4, ELFMAG) != 0) return "";
-  Elf64_Ehdr eh;
-  std::memcpy(&eh, bytes.data(), sizeof eh);
-  for (int i = 0; i < eh.e_phnum; ++i) {
-    const size_t at = eh.e_phoff + static_cast<size_t>(i) * eh.e_phentsize;
-    if (at + sizeof(Elf64_Phdr) > bytes.size()) return "";
-    Elf64_Phdr ph;
-    std::memcpy(&ph, bytes.data() + at, sizeof ph);
-    if (ph.p_type == PT_INTERP && ph.p_offset + ph.p_filesz <= bytes.size()) {
-      return std::string(bytes.data() + ph.p_offset,
-                         strnlen(bytes.data() + ph.p_offset, ph.p_filesz));
-    }
-  }
-  return "";
-}
 
 // The shared libraries `ldd` resolves for `binary` (absolute paths).
 std::vector<std::string> SharedLibraries(const std::string& binary) {
@@ -187,12 +62,6 @@ std::vector<std::string> SharedLibraries(const std::string& binary) {
   return out;
 }
 
-std::string FindProgram(const std::vector<std::string>& candidates) {
-  for (const auto& c : candidates) {
-    if (access(c.c_str(), X_OK) == 0) return c;
-  }
-  return "";
-}
 
 // The guest's /init: modules, gadgetfs, the camera in its main layout and the
 // probe, then the camera in its NV12 layout and the probe again.
@@ -249,7 +118,7 @@ TEST(Uvc, LibcameraBackendStreamsFromAUsbCameraUnderQemu) {
   if (qemu.empty())
     GTEST_SKIP() << "qemu-system-x86_64 not installed (Debian package qemu-system-x86)";
   fs::path kernel, modules;
-  if (!FindKernel(&kernel, &modules)) {
+  if (!ss::testing::FindKernelWithModules(kModules, &kernel, &modules)) {
     GTEST_SKIP() << "no kernel under /boot with dummy_hcd, gadgetfs and uvcvideo modules (Debian "
                     "linux-image-amd64)";
   }
@@ -290,7 +159,7 @@ TEST(Uvc, LibcameraBackendStreamsFromAUsbCameraUnderQemu) {
   ASSERT_TRUE(cv::imencode(".jpg", image, jpeg));
   cpio.File("frame.jpg", std::string(jpeg.begin(), jpeg.end()), false);
 
-  const auto order = LoadOrder(modules, kModules);
+  const auto order = ss::testing::ModuleLoadOrder(modules, kModules);
   ASSERT_GE(order.size(), kModules.size()) << modules / "modules.dep";
   std::vector<std::string> module_files;
   for (size_t i = 0; i < order.size(); ++i) {
