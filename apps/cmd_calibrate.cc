@@ -2,6 +2,8 @@
 // (docs/calibration.md). The work lives in calib/workflow.h; this file parses
 // options and prints. Exit 1 when a camera's calibration is not trusted (the
 // report says why), 2 for bad input (no board of that spec anywhere, bad files).
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -17,9 +19,14 @@
 #include "calib/board.h"
 #include "calib/enclosure.h"
 #include "calib/inputs.h"
+#include "calib/wizard.h"
 #include "calib/workflow.h"
+#include "core/config.h"
 #include "core/camera_model.h"
 #include "core/error.h"
+#include "core/frame.h"
+#include "core/session.h"
+#include "pipeline/station/camera_source.h"
 
 namespace ss::apps {
 namespace {
@@ -83,19 +90,25 @@ void AddIntrinsics(CLI::App& parent) {
   auto force = std::make_shared<bool>(false);
   auto min_views = std::make_shared<int>(10);
   auto max_rms = std::make_shared<double>(0.5);
+  auto keep_outliers = std::make_shared<bool>(false);
+  auto min_coverage = std::make_shared<double>(calib::VerdictOptions{}.min_coverage);
   AddInputOptions(cmd, in.get(), 40);
   cmd->add_option("--out", *out, "Output folder: CAMERA.cameramodel, plots, intrinsics.json")->required();
   cmd->add_option("--lensmodel", *lensmodel, "mrcal lens model, e.g. LENSMODEL_OPENCV8, LENSMODEL_SPLINED_STEREOGRAPHIC_order=3_Nx=16_Ny=12_fov_x_deg=100");
   cmd->add_option("--min-views", *min_views, "Accepted views needed for a trusted model");
   cmd->add_option("--max-rms", *max_rms, "Largest trusted RMS reprojection error, px");
+  cmd->add_option("--min-coverage", *min_coverage, "Fraction of the image's coverage cells that need corners");
   cmd->add_flag("--write-rejected", *force, "Write models even when the verdict is 'rejected'");
+  cmd->add_flag("--no-outlier-rejection", *keep_outliers, "Keep every corner (mrcal's outlier rejection off)");
   cmd->add_flag("--json", *json, "Print the report as JSON");
   cmd->callback([=] {
     calib::IntrinsicsJob job;
     job.board = calib::ParseBoardSpec(in->board);
     job.solve.lensmodel = *lensmodel;
+    job.solve.reject_outliers = !*keep_outliers;
     job.verdict.min_views = *min_views;
     job.verdict.max_rms_px = *max_rms;
+    job.verdict.min_coverage = *min_coverage;
     job.out_dir = *out;
     job.write_rejected = *force;
     const auto views = LoadViews(*in, job.board);
@@ -225,6 +238,124 @@ void AddEnclosure(CLI::App& parent) {
   });
 }
 
+
+void AddWizard(CLI::App& parent) {
+  auto* cmd = parent.add_subcommand("wizard", "Guided calibration of one camera: intrinsics, ground, enclosure");
+  struct Options {
+    std::string session, config, camera, board, out, intrinsics, floor_points;
+    std::vector<double> pose{0, 0, 0};
+    double thickness = 0, still_px = 0.5, still_s = 0.2, floor_still_s = 1.0, min_coverage = 0.5, max_rms = 0.5;
+    int min_views = 10, max_views = 30, count = 0;
+    bool json = false;
+  };
+  auto o = std::make_shared<Options>();
+  cmd->add_option("--session", o->session, "A recorded calibration session (replayed, as fast as it decodes)");
+  cmd->add_option("--config", o->config, "Station config: calibrate its camera --camera (live or replay)");
+  cmd->add_option("--camera", o->camera, "Camera name (session: default the first; config: required)");
+  cmd->add_option("--board", o->board, "Board: chessboard:COLSxROWS:SQUARE_M or charuco:COLSxROWS:SQUARE_M:MARKER_M[:DICT]")
+      ->required();
+  cmd->add_option("--out", o->out, "Output folder: CAMERA.cameramodel, plots, enclosure.yaml, wizard.json")->required();
+  cmd->add_option("--intrinsics", o->intrinsics, "Known intrinsics (.cameramodel): start at the ground step");
+  cmd->add_option("--board-pose", o->pose, "Floor board's top-left checkered corner on the floor: X Y YAW_DEG")->expected(3);
+  cmd->add_option("--board-thickness", o->thickness, "Height of the printed surface above the floor, m");
+  cmd->add_option("--floor-points", o->floor_points, "Enclosure floor \"x,y x,y ...\" in ground metres (default: the green floor)");
+  cmd->add_option("--min-views", o->min_views, "Intrinsics: views needed");
+  cmd->add_option("--max-views", o->max_views, "Intrinsics: solve what there is at this many views");
+  cmd->add_option("--min-coverage", o->min_coverage, "Intrinsics: fraction of the image's coverage cells needed");
+  cmd->add_option("--max-rms", o->max_rms, "Intrinsics: largest trusted RMS reprojection error, px");
+  cmd->add_option("--still-px", o->still_px, "Largest corner motion between frames of a still board, px");
+  cmd->add_option("--still-seconds", o->still_s, "Intrinsics: the board is still this long before a capture");
+  cmd->add_option("--floor-still-seconds", o->floor_still_s, "Ground: still this long = lying on the floor");
+  cmd->add_option("--count", o->count, "Stop after this many frames (0: the whole session / until done)");
+  cmd->add_flag("--json", o->json, "Print the result and the step log as JSON");
+  cmd->callback([o] {
+    if (o->session.empty() == o->config.empty()) throw InputError("calibrate wizard", "give exactly one of --session, --config");
+    CameraConfig camera;
+    if (!o->session.empty()) {
+      // A recorded session through the same source a configured replay camera opens.
+      const SessionInfo info = ReadSessionInfo(o->session);
+      if (info.cameras.empty()) throw InputError(o->session, "the session has no camera");
+      camera.name = o->camera.empty() ? info.cameras.front().name : o->camera;
+      const bool known = std::any_of(info.cameras.begin(), info.cameras.end(), [&](const auto& c) { return c.name == camera.name; });
+      if (!known) throw InputError("--camera", "no camera named \"" + camera.name + "\" in " + o->session);
+      camera.source = "replay";
+      camera.session = fs::absolute(o->session).string();
+      camera.realtime = false;
+    } else {
+      if (o->camera.empty()) throw InputError("--camera", "needed with --config");
+      const StationConfig config = LoadStationConfig(o->config);
+      bool found = false;
+      for (const auto& c : config.cameras) {
+        if (c.name == o->camera) camera = c, found = true;
+      }
+      if (!found) throw InputError("--camera", "no camera named \"" + o->camera + "\" in " + o->config);
+    }
+    calib::WizardOptions w;
+    w.board = calib::ParseBoardSpec(o->board);
+    w.verdict.min_views = o->min_views;
+    w.verdict.min_coverage = o->min_coverage;
+    w.verdict.max_rms_px = o->max_rms;
+    w.max_views = std::max(o->max_views, o->min_views);
+    w.still_px = o->still_px;
+    w.detect.exhaustive = false;  // a live camera's frames without a board must stay cheap
+    w.ground_from_board = calib::FloorBoardPose(o->pose[0], o->pose[1], o->pose[2], o->thickness);
+    if (!o->floor_points.empty()) w.floor_points = calib::ParsePointList(o->floor_points, "--floor-points");
+    if (!o->intrinsics.empty()) w.intrinsics = CameraModel::Read(o->intrinsics);
+    auto source = OpenCameraSource(camera, 0);
+    const SourceCamera& sc = source->cameras().at(0);
+    const double fps = sc.fps > 0 ? sc.fps : 30.0;
+    w.still_frames = std::max(2, static_cast<int>(std::lround(o->still_s * fps)));
+    w.floor_still_frames = std::max(3, static_cast<int>(std::lround(o->floor_still_s * fps)));
+    calib::CalibrationWizard wizard(camera.name, sc.width, sc.height, w);
+    size_t printed = 0;
+    auto print_log = [&] {
+      for (; printed < wizard.log().size(); ++printed) {
+        const auto& e = wizard.log()[printed];
+        const std::string kind = e["event"];
+        std::string line = "[" + std::string(e["step"]) + "] frame " + std::to_string(e["frame"].get<int>()) + ": ";
+        if (kind == "guidance") {
+          std::string say;
+          for (const auto& s : e["say"]) say += (say.empty() ? "" : "; ") + s.get<std::string>();
+          line += say;
+        } else {
+          line += kind;
+          for (const auto& [k, v] : e.items()) {
+            if (k != "event" && k != "frame" && k != "step") line += " " + k + "=" + v.dump();
+          }
+        }
+        if (!o->json) std::printf("%s\n", line.c_str());
+      }
+      std::fflush(stdout);
+    };
+    cv::Mat bgr;
+    int frames = 0;
+    while (!wizard.done() && (o->count <= 0 || frames < o->count)) {
+      auto frame = source->Next();
+      if (!frame) break;
+      ToBgr(*frame, bgr);
+      wizard.Feed(bgr, static_cast<int>(frame->sequence));
+      ++frames;
+      print_log();
+    }
+    source->Stop();
+    wizard.Finish();
+    print_log();
+    const nlohmann::json result = calib::WriteWizardOutputs(wizard, o->out, w.verdict);
+    if (o->json) {
+      std::printf("%s\n", result.dump(2).c_str());
+    } else {
+      std::printf("%s: %s after %d frames, %d views captured%s\n", camera.name.c_str(),
+                  result["verdict"].get<std::string>().c_str(), frames, wizard.views(),
+                  result["model"].get<std::string>().empty() ? ", no model written" : "");
+      for (const auto& v : wizard.verdicts()) std::printf("  - %s\n", v.c_str());
+      if (wizard.report()) std::printf("%s", calib::ToText(*wizard.report()).c_str());
+    }
+    std::fflush(stdout);
+    if (!wizard.board_seen()) throw InputError(o->board, "no board " + w.board.ToString() + " found in any frame (wrong --board?)");
+    if (!wizard.verdicts().empty()) throw WorkError(o->out, "calibration not complete (see the verdicts above)");
+  });
+}
+
 }  // namespace
 
 void AddCalibrateCommand(CLI::App& app) {
@@ -233,6 +364,7 @@ void AddCalibrateCommand(CLI::App& app) {
   AddIntrinsics(*cmd);
   AddGround(*cmd);
   AddEnclosure(*cmd);
+  AddWizard(*cmd);
 }
 
 }  // namespace ss::apps

@@ -126,11 +126,12 @@ void NormalizeChessboardOrder(const BoardSpec& board, const cv::Mat& grey, std::
   }
 }
 
-void DetectChessboard(const BoardSpec& board, const cv::Mat& grey, BoardView& view) {
+void DetectChessboard(const BoardSpec& board, const cv::Mat& grey, const DetectOptions& options, BoardView& view) {
   std::vector<cv::Point2f> corners;
+  const bool exhaustive = options.exhaustive;
   const bool found = cv::findChessboardCornersSB(
       grey, cv::Size(board.corners_x(), board.corners_y()), corners,
-      cv::CALIB_CB_NORMALIZE_IMAGE | cv::CALIB_CB_EXHAUSTIVE | cv::CALIB_CB_ACCURACY);
+      cv::CALIB_CB_NORMALIZE_IMAGE | (exhaustive ? cv::CALIB_CB_EXHAUSTIVE : 0) | cv::CALIB_CB_ACCURACY);
   if (!found || static_cast<int>(corners.size()) != board.corner_count()) {
     view.rejection = "no chessboard with " + std::to_string(board.corners_x()) + "x" +
                      std::to_string(board.corners_y()) + " inner corners found";
@@ -259,7 +260,7 @@ BoardView DetectBoard(const BoardSpec& board, const cv::Mat& image, const Detect
   view.width = grey.cols;
   view.height = grey.rows;
   if (board.kind == BoardKind::kChessboard) {
-    DetectChessboard(board, grey, view);
+    DetectChessboard(board, grey, options, view);
   } else {
     DetectCharuco(board, grey, view);
   }

@@ -21,6 +21,7 @@ struct DetectOptions {
   int min_corners = 12;            // partial (ChArUco) views with fewer corners are rejected
   double min_area_fraction = 0.01;  // corners' convex hull must cover this much of the image
   bool check_sharpness = true;
+  bool exhaustive = true;  // chessboard: CALIB_CB_EXHAUSTIVE (harder views; a frame without a board costs ~2x)
 };
 
 // One image's detection.

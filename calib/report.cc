@@ -44,7 +44,17 @@ cv::Mat CellCounts(const SolveSummary& s, int camera, const VerdictOptions& o) {
   return counts;
 }
 
-// Image regions (thirds) without a single observed corner, named for a person.
+void WritePng(const std::string& path, const cv::Mat& image) {
+  bool ok = false;
+  try {
+    ok = cv::imwrite(path, image);
+  } catch (const cv::Exception&) {
+  }
+  if (!ok) throw WorkError(path, "cannot write the PNG");
+}
+
+}  // namespace
+
 std::vector<std::string> EmptyRegions(const cv::Mat& counts) {
   static const char* kNames[3][3] = {{"top-left corner", "top edge", "top-right corner"},
                                      {"left edge", "centre", "right edge"},
@@ -59,17 +69,6 @@ std::vector<std::string> EmptyRegions(const cv::Mat& counts) {
   }
   return out;
 }
-
-void WritePng(const std::string& path, const cv::Mat& image) {
-  bool ok = false;
-  try {
-    ok = cv::imwrite(path, image);
-  } catch (const cv::Exception&) {
-  }
-  if (!ok) throw WorkError(path, "cannot write the PNG");
-}
-
-}  // namespace
 
 CameraReport MakeCameraReport(const BoardSpec& board, const SolveSummary& solution, int camera,
                               const std::vector<BoardView>& views, const VerdictOptions& options) {

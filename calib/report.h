@@ -9,6 +9,7 @@
 #include <vector>
 
 #include <nlohmann/json.hpp>
+#include <opencv2/core.hpp>
 
 #include "calib/detect.h"
 #include "calib/solve.h"
@@ -56,6 +57,10 @@ CameraReport FailedCameraReport(const std::string& camera, const std::vector<Boa
 // corners per cell as a heat map. WorkError naming the file when it cannot be written.
 void WriteResidualPlot(const std::string& path, const SolveSummary& solution, int camera);
 void WriteCoverageMap(const std::string& path, const SolveSummary& solution, int camera, const VerdictOptions& options);
+
+// Image regions (thirds: "left edge", "top-right corner", "centre"...) whose
+// cells of a coverage grid (corner counts, grid_y x grid_x, CV_32F) are all empty.
+std::vector<std::string> EmptyRegions(const cv::Mat& counts);
 
 nlohmann::json ToJson(const CameraReport& report);
 std::string ToText(const CameraReport& report);  // a few human lines

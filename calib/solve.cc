@@ -262,10 +262,16 @@ SolveSummary SolveBoards(const BoardSpec& board, const std::vector<SolveCamera>&
   std::vector<bool> present(p.pool.size());
   for (size_t k2 = 0; k2 < p.pool.size(); ++k2) present[k2] = p.pool[k2].z >= 0;
 
-  // Stage 1: core and poses, no distortion. Stage 2: everything, with outlier rejection.
+  // Stage 1: core and poses, no distortion. Then everything, with outlier rejection.
   std::vector<double> x;
   mrcal_stats_t stats = p.Optimize(p.Selections(false, false, false), &x);
   log->debug("stage 1 (core only): RMS {:.3f} px", stats.rms_reproj_error__pixels);
+  // As mrcal-calibrate-cameras: everything but the board warp first (outliers
+  // found here stay out), then the warp too. Same corners, same outlier set.
+  if (p.warp_on) {
+    stats = p.Optimize(p.Selections(true, options.reject_outliers, false), &x);
+    log->debug("stage 2 (no board warp): RMS {:.3f} px, {} outliers", stats.rms_reproj_error__pixels, stats.Noutliers);
+  }
   const auto final_sel = p.Selections(true, options.reject_outliers, p.warp_on);
   stats = p.Optimize(final_sel, &x);
   if (!std::isfinite(stats.rms_reproj_error__pixels) || stats.rms_reproj_error__pixels < 0) {

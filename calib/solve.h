@@ -3,9 +3,9 @@
 // several stationary cameras observing a moving board. Camera 0 is the
 // reference; board poses are shared between cameras that saw the board at the
 // same instant (`frame`), which ties every camera's pose into one frame.
-// Seeded with OpenCV (initCameraMatrix2D, solvePnP), solved in two stages as
-// mrcal-calibrate-cameras does (core only, then everything with outlier
-// rejection). The covariance of the solution comes from mrcal's own residual
+// Seeded with OpenCV (initCameraMatrix2D, solvePnP), solved in stages as
+// mrcal-calibrate-cameras does (core only; everything but the board warp with
+// outlier rejection; then the warp too), so both reach the same optimum. The covariance of the solution comes from mrcal's own residual
 // function (mrcal_optimizer_callback) differentiated numerically.
 #include <string>
 #include <vector>

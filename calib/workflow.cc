@@ -8,6 +8,7 @@
 #include <optional>
 #include <sstream>
 
+#include "calib/mrcal_corners.h"
 #include "core/error.h"
 #include "core/log.h"
 
@@ -123,6 +124,21 @@ JobOutcome RunIntrinsics(const std::vector<CameraViews>& cameras, const Intrinsi
     }
   }
   if (!solve_error.empty()) j["error"] = solve_error;
+  // The accepted corners as mrcal-calibrate-cameras reads them, and the command that solves them.
+  if (out.any_board) {
+    const std::string vnl = (fs::path(job.out_dir) / "corners.vnl").string();
+    {
+      std::ofstream f(vnl);
+      f << MrcalCornersVnl(job.board, cameras);
+      if (!f) throw WorkError(vnl, "cannot write the corners");
+    }
+    double focal = cameras.empty() ? 0 : 0.8 * cameras.front().width;
+    if (solution) focal = solution->models.front().intrinsics()[0];
+    j["mrcal_cross_check"] = {{"corners", vnl},
+                              {"command", MrcalCalibrateCommand(job.board, cameras, vnl,
+                                                                (fs::path(job.out_dir) / "mrcal").string(),
+                                                                job.solve.lensmodel, std::round(focal))}};
+  }
   j["cameras"] = nlohmann::json::array();
   std::ostringstream text;
   for (const auto& r : reports) {

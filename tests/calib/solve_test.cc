@@ -97,6 +97,38 @@ TEST(SolveBoards, TooFewViewsGiveAVerdictNotATrustedModel) {
   EXPECT_NE(r.reasons[0].find("too few views"), std::string::npos) << r.reasons[0];
 }
 
+TEST(SolveBoards, FrontalViewsOnlyGiveAVerdictNotATrustedModel) {
+  // Degenerate for intrinsics: the board always square to the camera.
+  Rig rig(1);
+  const synth::CameraRenderer renderer(rig.cams[0], rig.studio);
+  const BoardSpec board = ToCalibBoard(rig.spec);
+  std::vector<BoardView> views;
+  std::vector<BoardObservation> obs;
+  const double places[][2] = {{-0.5, -0.4}, {0.5, -0.4}, {-0.5, 0.4}, {0.5, 0.4}, {0, 0}, {0, -0.5}, {0, 0.5}, {-0.6, 0}};
+  int i = 0;
+  for (const auto& p : places) {
+    const Rigid3 cam_from_board = ss::testing::CamFromBoardInView(rig.cams[0], rig.spec, p[0], p[1], 0.5, 0, 0, 0.05 * i);
+    const cv::Mat image = RenderBoards(renderer, {{&rig.texture, rig.cams[0].cam_from_ground.Inverse() * cam_from_board}}, 1.0, i);
+    BoardView v = DetectBoard(board, image, {}, "frontal" + std::to_string(i));
+    if (v.accepted) obs.push_back({0, i, v.source, v.ids, v.pixels});
+    views.push_back(std::move(v));
+    ++i;
+  }
+  ASSERT_GE(obs.size(), 6u);
+  SolveOptions fast;
+  fast.compute_covariance = false;
+  const SolveSummary s = SolveBoards(board, {{"cam0", 640, 480}}, obs, fast);
+  VerdictOptions verdict;
+  verdict.min_views = 6;
+  verdict.min_coverage = 0.2;
+  const CameraReport r = MakeCameraReport(board, s, 0, views, verdict);
+  EXPECT_FALSE(r.good);
+  EXPECT_LT(r.max_tilt_deg, 10.0);
+  bool named = false;
+  for (const auto& reason : r.reasons) named = named || reason.find("tilt the board more") != std::string::npos;
+  EXPECT_TRUE(named) << ::testing::PrintToString(r.reasons);
+}
+
 TEST(SolveBoards, BadInputIsNamed) {
   const BoardSpec board = ParseBoardSpec("chessboard:10x7:0.03");
   EXPECT_THROW(SolveBoards(board, {{"cam0", 640, 480}}, {}), InputError);

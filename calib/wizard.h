@@ -1,0 +1,143 @@
+#pragma once
+// The calibration wizard: intrinsics -> ground -> enclosure for one camera,
+// fed one frame at a time (a live camera, a replayed session, later the
+// browser). It captures a view only when the board is still and the view adds
+// something (place, angle, size or image coverage), keeps a coverage grid,
+// says what is missing ("cover the left edge", "tilt the board more", "lay
+// the board flat on the floor"), and ends each step when its criteria are met.
+// Every decision goes into a step log (JSON).
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <nlohmann/json.hpp>
+#include <opencv2/core.hpp>
+
+#include "calib/board.h"
+#include "calib/detect.h"
+#include "calib/ground.h"
+#include "calib/report.h"
+#include "calib/solve.h"
+#include "core/camera_model.h"
+#include "core/geometry.h"
+
+namespace ss::calib {
+
+enum class WizardStep { kIntrinsics, kGround, kEnclosure, kDone };
+const char* WizardStepName(WizardStep step);  // "intrinsics", "ground", "enclosure", "done"
+
+struct WizardOptions {
+  BoardSpec board;
+  DetectOptions detect;
+  VerdictOptions verdict;          // min_views, min_coverage, min_tilt_deg, max_rms_px: when to stop, what to trust
+  SolveOptions solve;
+  double still_px = 0.5;           // largest corner motion between two frames of a still board
+  int still_frames = 2;            // intrinsics: frames in a row the board must be still for a capture
+  double min_shift = 0.08;         // a new view differs from every captured one: its centre moved this
+                                   // fraction of the image diagonal, ...
+  double min_tilt_change_deg = 10; // ... or its tilt changed this much, ...
+  double min_scale_change = 0.25;  // ... or its size in the image this fraction, ...
+  int min_new_cells = 3;           // ... or it puts corners in this many empty coverage cells
+  int max_views = 30;              // intrinsics: solve what there is at this many views
+  int floor_still_frames = 5;      // ground: still this long = lying on the floor (a held board is not)
+  Rigid3 ground_from_board = FloorBoardPose();
+  std::vector<Eigen::Vector2d> floor_points;  // enclosure in ground metres; empty: the largest green floor region
+  std::optional<CameraModel> intrinsics;      // known intrinsics: start at the ground step
+};
+
+// What one frame did.
+struct WizardFrame {
+  WizardStep step = WizardStep::kIntrinsics;
+  bool detected = false, still = false, captured = false;
+  std::vector<std::string> guidance;  // what to do now, most urgent first
+};
+
+class CalibrationWizard {
+ public:
+  CalibrationWizard(std::string camera, int width, int height, WizardOptions options);
+
+  // One frame (8-bit BGR or grey, the camera's size); `frame` is its index.
+  WizardFrame Feed(const cv::Mat& image, int frame);
+  // The input ended: solves a step that has enough to solve, gives every
+  // unfinished step its verdict with the reason.
+  void Finish();
+
+  WizardStep step() const { return step_; }
+  bool done() const { return step_ == WizardStep::kDone; }
+  bool intrinsics_good() const { return intrinsics_good_; }
+  bool ground_good() const { return ground_.has_value(); }
+  bool enclosure_good() const { return floor_.has_value(); }
+  bool board_seen() const { return board_seen_; }
+
+  const cv::Mat& coverage() const { return coverage_; }  // corners per cell of the captured views
+  double coverage_fraction() const;
+  double max_tilt_deg() const { return max_tilt_deg_; }
+  int views() const { return static_cast<int>(views_.size()); }
+  const std::vector<BoardView>& captured() const { return views_; }
+  // What is missing for the intrinsics step, from the coverage grid and the tilts.
+  std::vector<std::string> MissingForIntrinsics() const;
+
+  const std::string& camera() const { return camera_; }
+  const std::optional<SolveSummary>& solution() const { return solution_; }
+  const std::optional<CameraReport>& report() const { return report_; }
+  const std::optional<CameraModel>& intrinsics_model() const { return intrinsics_model_; }
+  const std::optional<GroundResult>& ground() const { return ground_; }
+  std::optional<CameraModel> posed_model() const;
+  const std::optional<GroundPolygon>& floor() const { return floor_; }
+  std::vector<std::string> verdicts() const { return verdicts_; }  // one line per step that failed
+  const nlohmann::json& log() const { return log_; }
+
+ private:
+  struct Captured {
+    Eigen::Vector2d centre;  // pixels
+    double area = 0;         // corners' bounding box, px^2
+    Eigen::Vector3d normal;  // board z in the camera (rough focal)
+  };
+  void Event(int frame, const std::string& kind, nlohmann::json detail = nlohmann::json::object());
+  Captured Describe(const BoardView& view) const;
+  bool Novel(const BoardView& view, const Captured& d, std::string* why) const;
+  void Capture(const BoardView& view, const Captured& d, int frame, const std::string& why);
+  bool CriteriaMet() const;
+  void SolveIntrinsics(int frame);
+  void EnterGround(int frame);
+  void EnterEnclosure(int frame, const cv::Mat& image);
+  void TryGreenFloor(const cv::Mat& image, int frame, const std::string& from);
+  double Focal() const;
+
+  std::string camera_;
+  int width_, height_;
+  WizardOptions o_;
+  WizardStep step_ = WizardStep::kIntrinsics;
+  std::vector<BoardView> run_;       // consecutive still detections ending at the last frame
+  bool run_used_ = false;            // the current still run was captured already
+  int empty_frames_ = 0;             // enclosure: frames in a row without a board
+  int fed_ = 0;                      // frames fed
+  bool last_detected_ = false;       // the board was found in the last frame
+  std::vector<BoardView> views_;     // captured intrinsics views
+  std::vector<Captured> described_;
+  cv::Mat coverage_;
+  double max_tilt_deg_ = 0;
+  int next_solve_at_ = 0;            // views needed before solving again after a failed verdict
+  bool board_seen_ = false, intrinsics_good_ = false;
+  std::optional<SolveSummary> solution_;
+  std::optional<CameraReport> report_;
+  std::optional<CameraModel> intrinsics_model_;
+  std::optional<GroundResult> ground_;
+  BoardView floor_view_;
+  cv::Mat floor_image_;              // a frame with the board on the floor (green floor fallback)
+  std::optional<GroundPolygon> floor_;
+  std::vector<std::string> verdicts_;
+  std::vector<std::string> last_guidance_;
+  nlohmann::json log_ = nlohmann::json::array();
+};
+
+// Writes what the wizard reached into `out_dir`: CAMERA.cameramodel (posed
+// after the ground step, else the intrinsics; none when the intrinsics were not
+// trusted), the residual and coverage plots, enclosure.yaml, and wizard.json
+// (verdicts, the intrinsics report, ground, enclosure, the step log), which is
+// also returned.
+nlohmann::json WriteWizardOutputs(const CalibrationWizard& wizard, const std::string& out_dir,
+                                  const VerdictOptions& verdict = {});
+
+}  // namespace ss::calib

@@ -1,0 +1,87 @@
+#include "calib/wizard.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+
+#include "core/error.h"
+#include "tests/calib/calib_fixtures.h"
+
+namespace ss::calib {
+namespace {
+
+using ss::testing::CamFromBoardInView;
+using ss::testing::RenderBoards;
+using ss::testing::ToCalibBoard;
+
+bool Has(const std::vector<std::string>& lines, const std::string& text) {
+  return std::any_of(lines.begin(), lines.end(), [&](const std::string& l) { return l.find(text) != std::string::npos; });
+}
+
+WizardOptions Options(const BoardSpec& board) {
+  WizardOptions o;
+  o.board = board;
+  o.detect.exhaustive = false;
+  return o;
+}
+
+TEST(CalibrationWizard, NamesWhatIsMissingAndRefusesToSolveWithoutViews) {
+  CalibrationWizard w("cam0", 320, 240, Options(ParseBoardSpec("chessboard:10x7:0.03")));
+  const auto missing = w.MissingForIntrinsics();
+  EXPECT_TRUE(Has(missing, "cover the left edge"));
+  EXPECT_TRUE(Has(missing, "cover the top-right corner"));
+  EXPECT_TRUE(Has(missing, "tilt the board more"));
+  EXPECT_TRUE(Has(missing, "capture more views (0 of 10)"));
+  // A grey frame: no board, and the wizard says so.
+  const cv::Mat grey(240, 320, CV_8UC3, cv::Scalar(128, 128, 128));
+  const WizardFrame f = w.Feed(grey, 0);
+  EXPECT_FALSE(f.detected);
+  EXPECT_FALSE(f.captured);
+  EXPECT_TRUE(Has(f.guidance, "show the board to the camera"));
+  EXPECT_THROW(w.Feed(cv::Mat(100, 100, CV_8UC3, cv::Scalar(0)), 1), InputError);
+  w.Finish();
+  EXPECT_TRUE(w.done());
+  EXPECT_FALSE(w.intrinsics_good());
+  EXPECT_FALSE(w.intrinsics_model());
+  ASSERT_FALSE(w.verdicts().empty());
+  EXPECT_NE(w.verdicts()[0].find("no board"), std::string::npos) << w.verdicts()[0];
+}
+
+TEST(CalibrationWizard, CapturesAStillBoardOnceAndOnlyANewViewAgain) {
+  const synth::Studio studio = synth::MakeStudio(synth::StudioKind::kEnclosure, 7);
+  const synth::SynthCamera cam = synth::MakeCameras(studio, 1, 320, 240, 7)[0];
+  const synth::CameraRenderer renderer(cam, studio);
+  const synth::BoardSpec spec = synth::ChessboardFor(false);
+  const synth::BoardTexture texture(spec);
+  CalibrationWizard w("cam0", 320, 240, Options(ToCalibBoard(spec)));
+  auto frame_of = [&](const Rigid3& cam_from_board, int n) {
+    return RenderBoards(renderer, {{&texture, cam.cam_from_ground.Inverse() * cam_from_board}}, 1.0, n);
+  };
+  const Rigid3 a = CamFromBoardInView(cam, spec, -0.4, -0.3, 0.5, 0.4, 0.1, 0.05);
+  const Rigid3 b = CamFromBoardInView(cam, spec, 0.4, 0.3, 0.55, -0.3, 0.3, -0.1);
+  int n = 0, captured = 0;
+  // Pose a held for 4 frames: one capture; again: nothing new; pose b: a second capture.
+  for (const Rigid3* pose : {&a, &a, &b}) {
+    for (int i = 0; i < 4; ++i) {
+      const WizardFrame f = w.Feed(frame_of(*pose, n), n);
+      ++n;
+      EXPECT_TRUE(f.detected) << n;
+      captured += f.captured;
+      if (pose == &a && i == 0 && n == 1) {
+        EXPECT_TRUE(Has(f.guidance, "hold the board still"));
+      }
+    }
+  }
+  EXPECT_EQ(captured, 2);
+  EXPECT_EQ(w.views(), 2);
+  EXPECT_GT(w.coverage_fraction(), 0.1);
+  EXPECT_GT(w.max_tilt_deg(), 15.0);
+  // Two views: too few; the verdict says so and there is no model.
+  w.Finish();
+  EXPECT_FALSE(w.intrinsics_model());
+  ASSERT_FALSE(w.verdicts().empty());
+  EXPECT_NE(w.verdicts()[0].find("too few views"), std::string::npos) << w.verdicts()[0];
+}
+
+}  // namespace
+}  // namespace ss::calib
