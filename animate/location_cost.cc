@@ -40,7 +40,11 @@ Eigen::Vector2d LocationTerm::TargetAt(Tracks tracks, int t) const {
 }
 
 std::pair<int, int> LocationTerm::Steps(Tracks tracks, const EvalRequest& /*request*/) const {
-  return window_.Resolve(tracks[sprites()[0]]->size());
+  int n = tracks[sprites()[0]]->size();
+  // A formation lasts while either sprite is on: a follower that stops short holds its last
+  // position and pays for every step the leader goes on (else ending early is cheapest).
+  if (target_.follow_sprite >= 0) n = std::max(n, tracks[target_.follow_sprite]->size());
+  return window_.Resolve(n);
 }
 
 double LocationTerm::StepCost(Tracks tracks, int t) const {

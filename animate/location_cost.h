@@ -4,7 +4,9 @@
 // The target q_t is a fixed point, or follows another sprite for formations:
 //   q_t = p_leader(t) + R(heading_leader(t)) o     (o = (along, left) in the leader's frame)
 // or q_t = p_leader(t) + o in ground axes. The leader's heading is the direction of its mean
-// velocity over the last few steps (only past steps, so the cost stays causal).
+// velocity over the last few steps (only past steps, so the cost stays causal). A window
+// counted from the end, for a follower, counts from the end of the longer of the two
+// sequences: the formation lasts while either sprite is on (a finished sprite holds).
 #include <Eigen/Core>
 
 #include "animate/cost_term.h"

@@ -42,6 +42,9 @@ class Replacer {
         rng_(options.seed),
         stamp_(problem.graph().num_frames(), 0),
         local_(problem.graph().num_frames(), 0) {
+    for (int sprite = 0; sprite < problem_.num_sprites(); ++sprite) {
+      terms_of_.push_back(problem_.TermsOf(sprite));
+    }
     Reset();
     neighbours_.resize(problem_.num_sprites());
     for (int k = 0; k < problem_.num_terms(); ++k) {
@@ -55,6 +58,7 @@ class Replacer {
 
   std::vector<Track> Run() {
     const double optimize_start = MonotonicSeconds();
+    if (options_.start == StartMethod::kSequential) SequentialStart();
     AddTracePoint();
     const int num_sprites = problem_.num_sprites();
     std::vector<int>& failures = failures_;
@@ -101,6 +105,7 @@ class Replacer {
         ++summary_->restarts;
         tracks_ = RandomTracks(problem_, options_.seed + 7919ULL * restart_);
         Reset();
+        if (options_.start == StartMethod::kSequential) SequentialStart();
         failures.assign(num_sprites, 0);
         AddTracePoint();
         continue;
@@ -124,6 +129,48 @@ class Replacer {
   }
 
  private:
+  // The one-by-one phase of StartMethod::kSequential: sprite s is hill-climbed against the
+  // terms whose sprites are all <= s (later sprites are not there yet), until it converges
+  // or its share of the phase's time is used. Its moves are not trace points: the phase
+  // is part of making the start, and the total it sees is not C.
+  void SequentialStart() {
+    const int num_sprites = problem_.num_sprites();
+    if (num_sprites < 2) return;
+    const double start = MonotonicSeconds();
+    const double until = std::min(deadline_, start + options_.sequential_fraction * (deadline_ - start));
+    std::vector<std::vector<int>> all = terms_of_;
+    for (int s = 0; s < num_sprites; ++s) {
+      terms_of_[s].clear();
+      for (int k : all[s]) {
+        const std::vector<int>& read = problem_.term(k).sprites();
+        if (std::all_of(read.begin(), read.end(), [s](int r) { return r <= s; })) {
+          terms_of_[s].push_back(k);
+        }
+      }
+    }
+    warming_up_ = true;
+    for (int s = 0; s < num_sprites; ++s) {
+      // Terms joining s to earlier sprites were not refreshed when those moved.
+      for (int k : terms_of_[s]) {
+        problem_.term(k).BuildCache(view_, &caches_[k]);
+        term_cost_[k] = problem_.term(k).Evaluate(view_);
+      }
+      const double now = MonotonicSeconds();
+      const double share_end = now + std::max(0.0, until - now) / (num_sprites - s);
+      for (int failures = 0; failures < options_.max_tries && MonotonicSeconds() < share_end;) {
+        ++summary_->picks;
+        failures = Pick(s) ? 0 : failures + 1;
+      }
+      if (options_.optimize_free_starts && problem_.sprite(s).anchor == Anchor::kFree) {
+        RefineFreeStart(s);
+      }
+    }
+    warming_up_ = false;
+    terms_of_ = std::move(all);
+    Reset();
+    summary_->start_seconds += MonotonicSeconds() - start;
+  }
+
   // One (k, l) pick of sprite s; true when a candidate lowered the cost.
   bool Pick(int s) {
     const Track& current = tracks_[s];
@@ -143,7 +190,12 @@ class Replacer {
     } else if (kind == MoveKind::kBegin) {
       l = UniformInt(0, n - 1);
     }
-    const int variant = sets_.VariantFor(problem_, view_, s, k, l);
+    int variant = sets_.VariantFor(problem_, view_, s, k, l);
+    if (variant == 0 && kind == MoveKind::kEnd &&
+        std::uniform_real_distribution<double>(0.0, 1.0)(rng_) < 0.5) {
+      // Half of the end moves count a window past the last step (the new end may fill it).
+      variant = sets_.VariantFor(problem_, view_, s, k, l, /*open_end=*/true);
+    }
     const ReachSets& forward = sets_.forward(variant);
     const ReachSets& backward = sets_.backward(variant);
     const int sk = current.frames[k];
@@ -264,7 +316,7 @@ class Replacer {
   // Sum of the terms reading sprite s when its track is `track`; stops once over `budget`.
   double EvaluateInvolved(int s, const Track& track, int first_changed, double budget,
                           std::vector<double>* values) {
-    const std::vector<int>& terms = problem_.TermsOf(s);
+    const std::vector<int>& terms = terms_of_[s];
     values->assign(terms.size(), 0.0);
     view_[s] = &track;
     double sum = 0.0;
@@ -283,19 +335,20 @@ class Replacer {
 
   double InvolvedCost(int s) const {
     double sum = 0.0;
-    for (int k : problem_.TermsOf(s)) sum += term_cost_[k];
+    for (int k : terms_of_[s]) sum += term_cost_[k];
     return sum;
   }
 
   void Accept(int s, Track* chosen) {
     std::swap(tracks_[s], *chosen);
     view_[s] = &tracks_[s];
-    const std::vector<int>& terms = problem_.TermsOf(s);
+    const std::vector<int>& terms = terms_of_[s];
     for (size_t i = 0; i < terms.size(); ++i) {
       term_cost_[terms[i]] = values_[i];
       problem_.term(terms[i]).BuildCache(view_, &caches_[terms[i]]);
     }
     RecomputeTotal();
+    if (warming_up_) return;  // the other terms are stale until the phase's Reset()
     ++summary_->moves_kept;
     for (int r : neighbours_[s]) failures_[r] = 0;
     AddTracePoint();
@@ -307,7 +360,7 @@ class Replacer {
     view_[s] = &track;
     double weight = 0.0;
     Eigen::Vector2d weighted = Eigen::Vector2d::Zero();
-    for (int k : problem_.TermsOf(s)) {
+    for (int k : terms_of_[s]) {
       problem_.term(k).AddStartNormalEquations(view_, s, &weight, &weighted);
     }
     view_[s] = &tracks_[s];
@@ -399,6 +452,8 @@ class Replacer {
   std::vector<double> term_cost_;
   double total_ = 0.0;
   std::vector<std::vector<int>> neighbours_;
+  std::vector<std::vector<int>> terms_of_;  // the terms a move of sprite s is judged by
+  bool warming_up_ = false;
   std::vector<int> failures_;
   std::vector<Track> best_tracks_;
   double best_total_ = 0.0;
@@ -440,7 +495,9 @@ std::vector<Track> InitialTracks(const Problem& problem, const ReplacementOption
     tracks = BeamSearch(problem, beam, &beam_summary);
     summary->start = "beam";
   } else {
-    summary->start = options.start == StartMethod::kGiven ? "given" : "random";
+    summary->start = options.start == StartMethod::kGiven        ? "given"
+                     : options.start == StartMethod::kSequential ? "sequential"
+                                                                 : "random";
     tracks = RandomTracks(problem, options.seed);
     for (int s = 0; s < problem.num_sprites() && options.start == StartMethod::kGiven; ++s) {
       const SpriteSpec& spec = problem.sprite(s);
@@ -491,6 +548,9 @@ bool ReplacementOptions::IsValid(std::string* why) const {
     return fail("time_budget_seconds must be > 0");
   }
   if (max_tries < 1) return fail("max_tries must be >= 1");
+  if (!(sequential_fraction >= 0 && sequential_fraction <= 1)) {
+    return fail("sequential_fraction must be in [0, 1]");
+  }
   if (changes_per_turn < 1) return fail("changes_per_turn must be >= 1");
   if (max_turns < 0) return fail("max_turns must be >= 0");
   if (!(middle_fraction >= 0) || !(begin_fraction >= 0) || middle_fraction + begin_fraction > 1) {
@@ -544,11 +604,12 @@ ReplacementSets ReplacementSets::Build(const Problem& problem, const Replacement
 }
 
 int ReplacementSets::VariantFor(const Problem& problem, Tracks tracks, int sprite, int first,
-                                int last) const {
+                                int last, bool open_end) const {
   for (const auto& [k, variant] : frame_terms_) {
     const auto& term = static_cast<const FrameTerm&>(problem.term(k));
     if (term.sprites()[0] != sprite) continue;
     const auto [begin, end] = term.Window(tracks);
+    if (open_end) last = std::max(last, end - 1);
     const int overlap = std::min(end, last + 1) - std::max(begin, first);
     if (2 * overlap > last - first + 1) return variant;
   }
@@ -609,7 +670,9 @@ std::vector<Track> ImproveSequences(const Problem& problem, const ReplacementOpt
   const double run_start = MonotonicSeconds();
   *summary = Summary{};
   summary->start = "given";
-  return Improve(problem, options, sets, std::move(initial), summary, run_start,
+  ReplacementOptions given = options;  // improve these sequences, not one-by-one new ones
+  if (given.start == StartMethod::kSequential) given.start = StartMethod::kGiven;
+  return Improve(problem, given, sets, std::move(initial), summary, run_start,
                  run_start + options.time_budget_seconds);
 }
 

@@ -1,7 +1,7 @@
 #pragma once
 // Optimization by repeated subsequence replacement (seed 000 §4.2): start from random
-// sequences (or beam search), then repeatedly pick steps k <= l of one sprite's sequence
-// and try to replace
+// sequences (by default optimized one sprite after the other first, or from beam search),
+// then repeatedly pick steps k <= l of one sprite's sequence and try to replace
 //   the middle    s_k..s_l  by S*(s_k->t) S*(t->s_l),  t ∈ F(s_k) ∩ B(s_l),
 //   the beginning s_0..s_l  by S*(t->s_l),              t ∈ B(s_l),
 //   the end       s_k..s_n  by S*(s_k->t),              t ∈ F(s_k),
@@ -21,7 +21,11 @@
 
 namespace ss {
 
-enum class StartMethod { kRandom, kBeam, kGiven };
+// kSequential: random sequences, then the sprites one after the other, each optimized only
+// against the terms that read no later sprite (as beam search plans them), then all together.
+// Without it, coupled sprites pin each other: a leader cannot walk off while its follower
+// stands, nor the follower move while the leader stands (a joint local minimum).
+enum class StartMethod { kRandom, kBeam, kGiven, kSequential };
 
 struct ReplacementOptions {
   ReachOptions reach;              // N = reach.set_size, threads, step cost of Ĉ
@@ -37,7 +41,9 @@ struct ReplacementOptions {
   int max_tries = 2000;         // a sprite has converged after this many picks without a gain
   int changes_per_turn = 100;   // picks per sprite turn
   int max_turns = 0;            // 0: no limit
-  StartMethod start = StartMethod::kRandom;  // kGiven uses SpriteSpec::initial_sequence
+  StartMethod start = StartMethod::kSequential;  // kGiven uses SpriteSpec::initial_sequence
+  // kSequential: share of the remaining time the one-by-one phase may take (each restart too).
+  double sequential_fraction = 0.3;
   // Once every sprite has converged, start again from new random sequences while time
   // remains and return the best result. False: stop at convergence (seed 000 §4.2).
   bool restart_when_converged = true;
@@ -63,8 +69,13 @@ class ReplacementSets {
   const ReachSets& forward(int variant) const { return forward_[variant]; }
   const ReachSets& backward(int variant) const { return backward_[variant]; }
   // The variant for replacing steps [first, last] of `sprite`: a frame constraint's when its
-  // window covers most of those steps, else 0 (plain Ĉ).
-  int VariantFor(const Problem& problem, Tracks tracks, int sprite, int first, int last) const;
+  // window covers most of those steps, else 0 (plain Ĉ). With `open_end` (the end of the
+  // sequence is replaced) a window reaching past the last step counts up to its end: the
+  // new end may fill it (a sequence shorter than its window otherwise never gets there).
+  // Pick() asks so for half of its end moves: a window past the end also stands for a path
+  // not yet passed, where the plain Ĉ is the one that helps.
+  int VariantFor(const Problem& problem, Tracks tracks, int sprite, int first, int last,
+                 bool open_end = false) const;
   double build_seconds() const { return build_seconds_; }
   size_t MemoryBytes() const;
 

@@ -116,6 +116,9 @@ ReplacementOptions Scene::MakeReplacementOptions() const {
   options.seed = o.seed;
   options.changes_per_turn = o.changes_per_turn;
   options.beam.width = o.beam_width;
+  options.start = o.start == "random" ? StartMethod::kRandom
+                  : o.start == "beam" ? StartMethod::kBeam
+                                      : StartMethod::kSequential;
   // Ĉ favours fast frames when the spec does (seed 000 §6.2, the fly).
   std::optional<FastFrameSpec> fast = spec_.fast;
   for (const SpriteSpecEntry& s : spec_.sprites) {

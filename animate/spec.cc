@@ -339,8 +339,14 @@ CollisionSpec ReadCollision(const Reader& r, const AnimationSpec& spec, const YA
 
 void ReadOptimizer(const Reader& r, const YAML::Node& node, OptimizerSpec& o) {
   const std::string f = "optimizer";
-  r.Map(node, f, {"method", "time_budget_s", "seed", "set_size", "threads", "changes_per_turn",
-                  "beam_width", "snapshot_every_s"});
+  r.Map(node, f, {"method", "start", "time_budget_s", "seed", "set_size", "threads",
+                  "changes_per_turn", "beam_width", "snapshot_every_s"});
+  if (node["start"]) {
+    o.start = r.Text(node["start"], f + ".start");
+    if (o.start != "sequential" && o.start != "random" && o.start != "beam") {
+      r.Fail(node["start"], f + ".start", "expected sequential, random or beam");
+    }
+  }
   if (node["method"]) {
     o.method = r.Text(node["method"], f + ".method");
     if (o.method != "replace" && o.method != "beam") {

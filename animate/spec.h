@@ -82,6 +82,7 @@ struct CollisionSpec {  // eq. 9, between every pair of the listed sprites
 
 struct OptimizerSpec {
   std::string method = "replace";  // "replace" | "beam"
+  std::string start = "sequential";  // replacement's start: "sequential" | "random" | "beam"
   double time_budget_s = 30.0;
   uint64_t seed = 1;
   int set_size = 200;          // N of the F/B sets

@@ -1,5 +1,5 @@
 // spritestation render SEQ.json --out OUT: play optimized sequences back through the
-// virtual camera (seed 000 §6) into a Matroska video or a folder of PNG frames with alpha.
+// virtual camera (seed 000 §6) into a video (.mkv, .mp4) or a folder of PNG frames with alpha.
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -13,8 +13,8 @@
 #include "animate/playback.h"
 #include "animate/sequence_io.h"
 #include "animate/spec.h"
+#include "animate/video_file.h"
 #include "apps/commands.h"
-#include "capture/recording/video_writer.h"
 #include "core/error.h"
 #include "core/log.h"
 
@@ -33,16 +33,16 @@ struct RenderArgs {
   bool json = false;
 };
 
-// Frames go to a video (.mkv) or to numbered PNGs in a folder.
+// Frames go to a video (.mkv, .mp4: animate/video_file.h) or to numbered PNGs with alpha in
+// a folder.
 class FrameSink {
  public:
-  FrameSink(const std::string& out, int width, int height, double fps, const std::string& codec)
-      : fps_(fps) {
-    if (fs::path(out).extension() == ".mkv") {
-      video_ = std::make_unique<VideoWriter>(out, PixelFormat::kBGR8, width, height, fps, codec);
+  FrameSink(const std::string& out, int width, int height, double fps, const std::string& codec) {
+    if (IsVideoPath(out)) {
+      video_ = std::make_unique<VideoFileWriter>(out, width, height, fps, codec);
     } else {
       if (fs::path(out).has_extension()) {
-        throw InputError(out, "expected a .mkv file or a folder for PNG frames");
+        throw InputError(out, "expected a .mkv or .mp4 file, or a folder for PNG frames");
       }
       fs::create_directories(out);
       folder_ = out;
@@ -50,10 +50,7 @@ class FrameSink {
   }
   void Write(const cv::Mat& bgra) {
     if (video_) {
-      cv::Mat bgr;
-      cv::cvtColor(bgra, bgr, cv::COLOR_BGRA2BGR);  // transparent parts become black
-      video_->Write(bgr.data, bgr.total() * bgr.elemSize(),
-                    static_cast<int64_t>(std::llround(frames_ * 1000.0 / fps_)));
+      video_->Write(bgra);  // transparent parts become black
     } else {
       char name[32];
       std::snprintf(name, sizeof name, "frame_%06d.png", frames_);
@@ -66,10 +63,10 @@ class FrameSink {
     if (video_) video_->Close();
   }
   int frames() const { return frames_; }
+  std::string encoder() const { return video_ ? video_->encoder_name() : "png"; }
 
  private:
-  double fps_;
-  std::unique_ptr<VideoWriter> video_;
+  std::unique_ptr<VideoFileWriter> video_;
   std::string folder_;
   int frames_ = 0;
 };
@@ -121,6 +118,7 @@ void Run(const RenderArgs& args) {
   if (args.json) {
     const nlohmann::json j = {{"out", args.out},
                               {"frames", sink.frames()},
+                              {"encoder", sink.encoder()},
                               {"width", camera.width()},
                               {"height", camera.height()},
                               {"frame_rate", file.frame_rate},
@@ -140,9 +138,9 @@ void AddRenderCommand(CLI::App& app) {
   auto args = std::make_shared<RenderArgs>();
   auto* cmd = app.add_subcommand("render", "Render optimized sprite sequences into video or PNG frames");
   cmd->add_option("sequences", args->sequences, "Sequences file from `animate` (JSON)")->required();
-  cmd->add_option("--out", args->out, "OUT.mkv (video) or a folder (PNG frames with alpha)")->required();
+  cmd->add_option("--out", args->out, "OUT.mkv or OUT.mp4 (video) or a folder (PNG frames with alpha)")->required();
   cmd->add_option("--spec", args->spec, "Take the camera and background from this spec instead");
-  cmd->add_option("--codec", args->codec, "Video codec: h264 (default), ffv1, mjpeg")
+  cmd->add_option("--codec", args->codec, "Video codec: h264 (default; libx264, in .mp4 mpeg4 without it), ffv1, mjpeg (.mkv only)")
       ->check(CLI::IsMember({"h264", "ffv1", "mjpeg"}));
   cmd->add_flag("--stages", args->stages, "Play the run's intermediate stages before the result");
   cmd->add_flag("--no-shadows", args->no_shadows, "Leave the contact shadows out");

@@ -7,6 +7,7 @@
 #include <numbers>
 #include <random>
 
+#include "animate/animate_run.h"
 #include "animate/basic_costs.h"
 #include "animate/collision_cost.h"
 #include "animate/location_cost.h"
@@ -84,6 +85,12 @@ TEST_F(CostTermsTest, LocationFollowingALeaderForFormations) {
   EXPECT_TRUE(ground.TargetAt(TrackPointers(tracks_), 1).isApprox(Vector2d(-1, 1.5)));
   EXPECT_THROW(LocationTerm(1, StepWindow::All(), LocationTarget::Follow(1, {0, 0}), 1.0),
                InputError);
+  // A follower that stops short holds its place while the formation goes on: leader at
+  // (0,0) (1,0) (2,0), follower one frame at (-1, 0.5), targets (-1,0.5) (0,0.5) (1,0.5):
+  // 2 * (0 + 1 + 4).
+  tracks_[0] = MakeTrack(graph_, {0, 1, 2}, Anchor::kStart, Vector2d(0, 0));
+  tracks_[1] = MakeTrack(graph_, {0}, Anchor::kStart, Vector2d(-1, 0.5));
+  EXPECT_DOUBLE_EQ(Eval(behind), 10.0);
 }
 
 TEST_F(CostTermsTest, LocationGivesTheLeastSquaresStart) {
@@ -181,6 +188,34 @@ TEST_F(CostTermsTest, ProblemSumsAndBreaksDownByKind) {
 
 // Evaluation from a cache with the unchanged steps before `first_changed` must equal the
 // full evaluation, for every term, on random sequences of a random graph.
+// The figures the scenes report (bench animate, `animate --json`), worked out by hand.
+TEST_F(CostTermsTest, ConstraintFigures) {
+  // Sprite 0: (0,0) (1,0) (2,0) (2,1) (2,2); sprite 1: (2,-1) (2,0) (2,1), then held.
+  tracks_.push_back(MakeTrack(graph_, {3, 4, 5}, Anchor::kStart, Vector2d(2, -1)));
+  Problem problem(graph_);
+  for (int s = 0; s < 2; ++s) problem.AddSprite(SpriteSpec{});
+  // 0.5 m beside sprite 0 until it turns, then on it; its end (2,3) is never reached.
+  problem.AddTerm(std::make_unique<PathTerm>(0, Polyline({{0, 0.5}, {2, 0.5}, {2, 3}}), PathStrengths{}));
+  // Sprite 1 passes (2, 0.5) at step 2, on the line.
+  problem.AddTerm(std::make_unique<PathTerm>(1, Polyline({{2, -1}, {2, 0.5}}), PathStrengths{}));
+  // Distances sqrt(5), 1, 1, 0, 1: one step closer than 0.5 m.
+  problem.AddTerm(std::make_unique<CollisionTerm>(0, 1, 0.5, 1.0));
+  // Steps 2..4 show frames 2, 3, 4: one off the set {3, 4}.
+  auto g = std::make_shared<std::vector<bool>>(std::vector<bool>{false, false, false, true, true, false});
+  problem.AddTerm(std::make_unique<FrameTerm>(0, g, StepWindow::Range(2, 4), 1.0));
+  problem.AddTerm(std::make_unique<LengthTerm>(0, 5, 1.0));
+  problem.AddTerm(std::make_unique<LengthTerm>(1, 4, 1.0));  // 3 frames: short
+  const ConstraintFigures f = MeasureConstraints(problem, tracks_);
+  EXPECT_DOUBLE_EQ(f.max_path_deviation_m, 0.5);
+  EXPECT_EQ(f.paths_unfinished, 1);
+  EXPECT_EQ(f.collision_steps, 1);
+  EXPECT_EQ(f.colliding_pairs, 1);
+  EXPECT_DOUBLE_EQ(f.min_distance_m, 0.0);
+  EXPECT_EQ(f.frame_steps, 3);
+  EXPECT_EQ(f.frame_steps_off, 1);
+  EXPECT_EQ(f.sprites_short, 1);
+}
+
 TEST(CostTermCache, IncrementalEqualsFullEvaluation) {
   const TransitionGraph graph = testing::RandomGraph(60, 400, 5);
   auto g = std::make_shared<std::vector<bool>>(graph.FramesWithTag("special"));

@@ -60,6 +60,7 @@ TEST(Replacement, EveryKeptMoveIsValidAndTheCostNeverIncreases) {
   problem.AddTerm(std::make_unique<LengthTerm>(2, 60, 0.5));
 
   ReplacementOptions options = FastOptions(2.0);
+  options.start = StartMethod::kRandom;  // every move a trace point (none in a sequential start)
   int checked = 0;
   int last_restart = 0;
   double last_cost = std::numeric_limits<double>::infinity();
@@ -143,6 +144,74 @@ TEST(Replacement, AnticipatesALaterLocationBetterThanBeamSearchAtTheSameBudget) 
   EXPECT_LT(replaced_miss, 0.35);  // ~0.02 m when it has time for a few restarts
   EXPECT_GT(beamed_miss, replaced_miss);
   EXPECT_LT(replacement_summary.final_cost.total, 0.5 * beam_summary.final_cost.total);
+}
+
+// The stall of the formation scene (seed 000 §6.1, Figure 7e): a follower in formation that
+// must copy its leader's stand-up. Three things kept the pair idle: the follower's location
+// term counted only its own steps, so the cheapest follower was one frame long (held, it
+// paid nothing while the leader walked away); a sequence ending before its frame window
+// never got the Ĉ that includes the frame constraint; and from random sequences the two pin
+// each other (the leader stands at the origin because walking off leaves the follower out
+// of formation, and the follower cannot move alone) — with start: random and no restarts
+// this test ends with the leader idle and its path and stand-up missed. Now the formation
+// lasts while either sprite is on, half the end moves count the window past the end, and
+// the sequential start plans the leader before its follower.
+TEST(Replacement, AFollowerCopiesItsLeadersStandUp) {
+  const TransitionGraph graph = WalkingGraph::Make();
+  Problem problem(graph);
+  SpriteSpec leader;
+  leader.initial_frames = 30;
+  leader.max_frames = 120;
+  problem.AddSprite(leader);
+  SpriteSpec follower = leader;
+  follower.anchor_m = Vector2d(-0.3, 0.0);  // 0.2 m off its place: copying the leader is not free
+  problem.AddSprite(follower);
+  const Polyline path({{0, 0}, {1.0, 0}});
+  problem.AddTerm(std::make_unique<PathTerm>(0, path, PathStrengths{0.5, 20.0, 20.0}));
+  auto standing = std::make_shared<std::vector<bool>>(graph.FramesWithTag("standing"));
+  auto frame_term = [&](int s) {
+    return std::make_unique<FrameTerm>(s, standing, StepWindow::All(), 2.0, PathTrigger{0, path, 15});
+  };
+  problem.AddTerm(frame_term(0));
+  auto follower_frames = frame_term(1);
+  const FrameTerm* follower_term = follower_frames.get();
+  problem.AddTerm(std::move(follower_frames));
+  problem.AddTerm(std::make_unique<LocationTerm>(1, StepWindow::All(),
+                                                 LocationTarget::Follow(0, {-0.3, 0.2}), 5.0));
+
+  // A follower one frame long, its leader walking 1.6 m on along +x: held, it is out of
+  // formation by ~1 m at step 20 and more later.
+  std::vector<int> straight;
+  for (int m = 0; m < 32; ++m) straight.push_back(WalkingGraph::Straight(0, m % WalkingGraph::kStraight));
+  const std::vector<Track> short_follower{problem.MakeSpriteTrack(0, straight),
+                                          problem.MakeSpriteTrack(1, {WalkingGraph::Straight(0, 0)})};
+  const auto location = [&](const std::vector<Track>& tracks) {
+    return problem.Evaluate(tracks).by_kind.at("location");
+  };
+  EXPECT_GT(location(short_follower), 5.0 * 12 * 1.0) << "held steps count for the formation";
+
+  // One hill climb, as in the paper (no restarts): it used to end in the one-frame follower.
+  // The budget is a ceiling: the run stops at convergence (< 1 s), and a loaded machine
+  // does not cut the sequential phase short.
+  ReplacementOptions options = FastOptions(20.0);
+  options.restart_when_converged = false;
+  options.reach.set_size = 200;  // the way into the standing clip can be 16 walking frames
+  Summary summary;
+  const std::vector<Track> tracks = OptimizeSequences(problem, options, &summary);
+  ASSERT_TRUE(problem.IsValid(tracks));
+  std::cout << summary.FullReport();
+  const auto view = TrackPointers(tracks);
+  const auto [begin, end] = follower_term->Window(view);
+  EXPECT_EQ(end - begin, 15);
+  EXPECT_GE(tracks[1].size(), end) << "the follower stops before the stand-up";
+  EXPECT_LE(follower_term->CountViolations(view), 2) << "the follower does not stand up";
+  // The leader walks its path and stands too. From random sequences alone (start: random)
+  // the pair pins itself idle: the leader stands at the origin because walking off would
+  // leave the follower out of formation, and the follower cannot move without it.
+  const CostBreakdown cost = problem.Evaluate(tracks);
+  EXPECT_EQ(cost.violations.at("path"), 0) << "the leader never reaches the end of its path";
+  EXPECT_LE(cost.violations.at("frame"), 3) << "the leader does not stand up";
+  EXPECT_LT(location(tracks), 5.0);  // it starts 0.2 m off its place: ~5 × 0.04 per step until there
 }
 
 TEST(Replacement, FollowsAPathToItsEnd) {

@@ -10,6 +10,7 @@
 
 #include "animate/animate_run.h"
 #include "animate/sequence_io.h"
+#include "animate/video_file.h"
 #include "animate_test_bank.h"
 #include "tests/support/test_support.h"
 
@@ -118,6 +119,10 @@ collisions:
   const auto video = testing::RunSpritestation("render " + seq + " --out " + (dir_ / "anim.mkv") + " --codec ffv1");
   ASSERT_EQ(video.exit_code, 0) << video.output;
   EXPECT_GT(fs::file_size(dir_ / "anim.mkv"), 1000u);
+  EXPECT_EQ(ReadVideoFrames(dir_ / "anim.mkv").size(), 40u);
+  const auto mp4 = testing::RunSpritestation("render " + seq + " --out " + (dir_ / "anim.mp4") + " --json");
+  ASSERT_EQ(mp4.exit_code, 0) << mp4.output;
+  EXPECT_EQ(ReadVideoFrames(dir_ / "anim.mp4").size(), 40u);
 
   const std::string bad = WriteSpec("frame_rate: 30\nlength: 40\nsprites:\n  - name: a\n    start: [0, zero]\n");
   const auto refused = testing::RunSpritestation("animate " + bad + " --out " + seq);

@@ -42,7 +42,7 @@ length: {min_frames: 100, max_frames: 300, strength: 2}
 camera: virtual.cameramodel
 banks: [walker.ssbank]
 fast_frames: {reference_speed_m_s: 1.0, strength: 0.5}
-optimizer: {method: replace, time_budget_s: 5, seed: 7, set_size: 50}
+optimizer: {method: replace, start: random, time_budget_s: 5, seed: 7, set_size: 50}
 sprites:
   - name: lead
     start: [0, 0]
@@ -71,6 +71,7 @@ TEST_F(SpecTest, ReadsEveryField) {
   EXPECT_EQ(spec.camera_path, dir_ / "virtual.cameramodel");
   ASSERT_EQ(spec.bank_paths.size(), 1u);
   EXPECT_EQ(spec.optimizer.seed, 7u);
+  EXPECT_EQ(spec.optimizer.start, "random");
   EXPECT_EQ(spec.optimizer.set_size, 50);
   ASSERT_EQ(spec.sprites.size(), 2u);
   const SpriteSpecEntry& lead = spec.sprites[0];
@@ -169,6 +170,8 @@ TEST_F(SpecTest, BadSpecsNameTheLineAndTheField) {
             o + ":22: collisions[0].min_distance_m: must be > 0");
   EXPECT_EQ(ErrorOf(Edit("name: follower", "name: lead")),
             o + ":15: sprites[1].name: another sprite is named lead");
+  EXPECT_EQ(ErrorOf(Edit("start: random", "start: later")),
+            o + ":7: optimizer.start: expected sequential, random or beam");
   EXPECT_NE(ErrorOf("sprites: [\n").find(o + ":"), std::string::npos);  // YAML syntax: a line too
 }
 
