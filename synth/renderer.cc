@@ -325,12 +325,19 @@ void CameraRenderer::DrawBoards(const FrameScene& scene, CameraImage* out) const
           sum = colour(v0);
           coverage = 1.0;
         } else {
-          for (int s = 0; s < kSubsamples; ++s) {
-            const float ox = ((s % 4) + 0.5f) / 4.0f, oy = ((s / 4) + 0.5f) / 4.0f;
+          // 16 samples on distinct rows and columns (n-rooks: x = s, y = 7 s
+          // mod 16, in 16ths). On a 4 x 4 grid an edge nearly along a pixel
+          // axis crosses a whole row of samples at once, coverage moves in
+          // quarter steps and each board corner lands up to ~0.1 px off, a
+          // fixed pattern that tilted the floor board's pose by ~0.1 deg.
+          constexpr int kBoardSamples = kSubsamples;
+          static_assert(kBoardSamples == 16, "the n-rooks pattern below is for 16 samples");
+          for (int s = 0; s < kBoardSamples; ++s) {
+            const float ox = (s + 0.5f) / kBoardSamples, oy = ((s * 7) % kBoardSamples + 0.5f) / kBoardSamples;
             const int v = sample(x, y, RayAt(x - 0.5f + ox, y - 0.5f + oy));
             if (v < 0) continue;
-            sum += colour(v) / kSubsamples;
-            coverage += 1.0 / kSubsamples;
+            sum += colour(v) / kBoardSamples;
+            coverage += 1.0 / kBoardSamples;
           }
         }
         const float vig = vignette_[static_cast<size_t>(y) * w + x];

@@ -65,12 +65,14 @@ TEST(SolveGroundPose, RecoversEachCameraAndAgreesAcrossCameras) {
     unposed.set_cam_from_ground({});
     const GroundResult g = SolveGroundPose(unposed, board, view, s.ground_from_board, s.cams[c].name);
     const Eigen::Vector3d truth = s.cams[c].CentreInGround();
-    // Issue 6 asks for 2 mm and 0.1 deg. One 0.7 m board seen from ~1.5 m leaves a
-    // rotation/translation trade-off: with corners within 0.3 px of the truth we
-    // reach 2-5 mm and 0.12-0.17 deg (measured), so this holds 6 mm / 0.2 deg.
-    EXPECT_LT((g.centre_in_ground - truth).norm(), 0.006) << s.cams[c].name;
-    EXPECT_NEAR(g.height_m, truth.z(), 0.003);
-    EXPECT_LT(AngleDeg(g.cam_from_ground.rotation, s.cams[c].cam_from_ground.rotation), 0.2);
+    RecordProperty("centre_mm_" + s.cams[c].name, std::to_string((g.centre_in_ground - truth).norm() * 1000));
+    RecordProperty("angle_deg_" + s.cams[c].name,
+                   std::to_string(AngleDeg(g.cam_from_ground.rotation, s.cams[c].cam_from_ground.rotation)));
+    // Issue 6 asks for 2 mm and 0.1 deg: measured 1.3 / 0.35 mm and 0.048 / 0.015 deg
+    // (2-5 mm and 0.12-0.17 deg before the corners were refined with cornerSubPix).
+    EXPECT_LT((g.centre_in_ground - truth).norm(), 0.002) << s.cams[c].name;
+    EXPECT_NEAR(g.height_m, truth.z(), 0.002);
+    EXPECT_LT(AngleDeg(g.cam_from_ground.rotation, s.cams[c].cam_from_ground.rotation), 0.1);
     EXPECT_LT(g.rms_px, 0.3);
     CameraModel posed = unposed;
     posed.set_cam_from_ground(g.cam_from_ground);
@@ -80,6 +82,50 @@ TEST(SolveGroundPose, RecoversEachCameraAndAgreesAcrossCameras) {
   const CrossCheck x = CrossReprojection(models[0], views[0], models[1], views[1], s.ground_from_board);
   EXPECT_GT(x.points, 20);
   EXPECT_LT(x.worst_px, 1.0);
+}
+
+// The enclosure's small chessboard (0.3 m, squares ~9 px at ~1.5 m) lying on
+// the floor, as in a synthetic calibration session. Its corners once carried
+// a fixed per-corner bias that averaging still views cannot remove: corners
+// from findChessboardCornersSB alone (~0.1 px, rows spread apart) and a 4 x 4
+// supersampled board edge (coverage in quarter steps) put the pose 10 mm /
+// 0.39 deg (then 2.7 mm / 0.12 deg) from the truth. Issue 6: 2 mm / 0.1 deg.
+TEST(SolveGroundPose, SmallFloorBoardMeetsTheIssueNumbers) {
+  const synth::Studio studio = synth::MakeStudio(synth::StudioKind::kEnclosure, 5);
+  const std::vector<synth::SynthCamera> cams = synth::MakeCameras(studio, 1, 640, 480, 5);
+  const synth::BoardSpec spec = synth::ChessboardFor(false);
+  const synth::BoardTexture texture{spec};
+  const Rigid3 ground_from_board = FloorBoardPose(-0.5 * spec.width_m(), 0.5 * spec.height_m(), 0.0, 0.001);
+  const BoardSpec board = ToCalibBoard(spec);
+  const synth::CameraRenderer renderer(cams[0], studio);
+  std::vector<BoardView> still;
+  for (int f = 0; f < 3; ++f) {
+    const cv::Mat image = RenderBoards(renderer, {{&texture, ground_from_board}}, 1.0, 200 + f);
+    still.push_back(DetectBoard(board, image, {}, cams[0].name));
+    ASSERT_TRUE(still.back().accepted) << still.back().rejection;
+  }
+  const BoardView view = AverageStillViews(still);
+  ASSERT_EQ(static_cast<int>(view.ids.size()), board.corner_count());
+  Eigen::Vector2d mean_err = Eigen::Vector2d::Zero();
+  double sum2 = 0;
+  for (size_t i = 0; i < view.ids.size(); ++i) {
+    const Eigen::Vector2d e = view.pixels[i] - cams[0].ProjectGround(ground_from_board * board.Corner(view.ids[i]));
+    mean_err += e / static_cast<double>(view.ids.size());
+    sum2 += e.squaredNorm();
+  }
+  const double rms = std::sqrt(sum2 / static_cast<double>(view.ids.size()));
+  EXPECT_LT(mean_err.norm(), 0.03) << mean_err.transpose();  // was 0.07 px with SB corners alone
+  EXPECT_LT(rms, 0.12);                                       // was 0.16 px
+  CameraModel unposed = TrueModel(cams[0]);
+  unposed.set_cam_from_ground({});
+  const GroundResult g = SolveGroundPose(unposed, board, view, ground_from_board, cams[0].name);
+  const double centre_mm = (g.centre_in_ground - cams[0].CentreInGround()).norm() * 1000;
+  const double angle_deg = AngleDeg(g.cam_from_ground.rotation, cams[0].cam_from_ground.rotation);
+  RecordProperty("corner_rms_px", std::to_string(rms));
+  RecordProperty("centre_mm", std::to_string(centre_mm));
+  RecordProperty("angle_deg", std::to_string(angle_deg));
+  EXPECT_LT(centre_mm, 2.0) << "corner rms " << rms << " px, mean " << mean_err.transpose();
+  EXPECT_LT(angle_deg, 0.1);
 }
 
 TEST(AverageStillViews, RefusesAMovingBoard) {

@@ -116,11 +116,11 @@ TEST_F(WizardEndToEnd, GroundAndEnclosureWithKnownIntrinsics) {
   EXPECT_EQ(j["verdict"], "good");
   const CameraModel posed = CameraModel::Read(out + "/cam0.cameramodel");
   EXPECT_EQ(posed.intrinsics(), truth.intrinsics());
-  // The enclosure's 0.3 m board at ~1.5 m (calibrate ground gives the same; docs/calibration.md "Known limits").
-  EXPECT_LT((posed.CentreInGround() - truth.CentreInGround()).norm(), 0.015);
+  // The enclosure's 0.3 m board at ~1.5 m: issue 6's 2 mm / 0.1 deg (measured 1.33 mm, 0.051 deg).
+  EXPECT_LT((posed.CentreInGround() - truth.CentreInGround()).norm(), 0.002);
   const double angle = Eigen::AngleAxisd(posed.cam_from_ground().rotation *
                                          truth.cam_from_ground().rotation.transpose()).angle() * 180 / M_PI;
-  EXPECT_LT(angle, 0.6);
+  EXPECT_LT(angle, 0.1);
   // The green floor (1.2 m x 0.8 m) seen past the boards lying on it; the near wall hides a strip.
   ASSERT_TRUE(j.contains("enclosure")) << r.output;
   const double area = j["enclosure"]["area_m2"].get<double>();
