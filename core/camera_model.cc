@@ -195,9 +195,11 @@ CameraModel CameraModel::Parse(const std::string& text, const std::string& origi
   const int n = mrcal_lensmodel_num_params(&m->lensmodel);
   std::vector<double> intrinsics(m->intrinsics, m->intrinsics + n);
   try {
-    return CameraModel(LensName(m->lensmodel), std::move(intrinsics),
-                       static_cast<int>(m->imagersize[0]), static_cast<int>(m->imagersize[1]),
-                       Rigid3::FromRt(m->rt_cam_ref));
+    CameraModel model(LensName(m->lensmodel), std::move(intrinsics), static_cast<int>(m->imagersize[0]),
+                      static_cast<int>(m->imagersize[1]), Rigid3::FromRt(m->rt_cam_ref));
+    model.rt_as_read_.emplace();
+    std::copy(m->rt_cam_ref, m->rt_cam_ref + 6, model.rt_as_read_->begin());
+    return model;
   } catch (const InputError& e) {
     // Re-name the error after the file: "camera model: X" -> "ORIGIN: X".
     std::string reason = e.what();
@@ -223,6 +225,7 @@ std::string CameraModel::ToText() const {
   if (!valid()) throw std::logic_error("CameraModel::ToText on an empty model");
   double rt[6];
   cam_from_ground_.ToRt(rt);
+  if (rt_as_read_) std::copy(rt_as_read_->begin(), rt_as_read_->end(), rt);
   std::string out;
   out += "# SpriteStation camera model (mrcal .cameramodel). The reference frame is the\n";
   out += "# ground: z up, z = 0 the floor, metres. extrinsics = rt_cam_ref = cam_from_ground.\n";

@@ -7,8 +7,10 @@
 // Every lens model libmrcal 2.2 projects works here: PINHOLE, STEREOGRAPHIC,
 // LONLAT, LATLON, OPENCV4/5/8/12, CAHVOR, SPLINED_STEREOGRAPHIC_... (CAHVORE
 // projects but cannot be unprojected: Unproject gives NaN).
+#include <array>
 #include <cstddef>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -74,6 +76,9 @@ class CameraModel {
   int height_ = 0;
   Rigid3 cam_from_ground_;
   std::shared_ptr<const MrcalLens> lens_;
+  // The extrinsics as the file had them: rt -> R -> rt moves r by ~1 ulp, so a model read
+  // from a file writes these back (a pose read is a pose written, bit for bit).
+  std::optional<std::array<double, 6>> rt_as_read_;
 };
 
 }  // namespace ss

@@ -290,6 +290,13 @@ TEST(CameraModel, ReadsWhatLibmrcalWrites) {
   double back[6];
   cam.cam_from_ground().ToRt(back);
   for (int i = 0; i < 6; ++i) EXPECT_NEAR(back[i], rt[i], 1e-15);
+  // Written again, the file holds mrcal's extrinsics to the bit (not r -> R -> r).
+  const std::string again = dir / "again.cameramodel";
+  cam.Write(again);
+  mrcal_cameramodel_t* back_model = mrcal_read_cameramodel_file(again.c_str());
+  ASSERT_NE(back_model, nullptr);
+  for (int i = 0; i < 6; ++i) EXPECT_EQ(back_model->rt_cam_ref[i], rt[i]) << i;
+  mrcal_free_cameramodel(&back_model);
 }
 
 TEST(CameraModel, ReadsACalibrationToolFile) {
