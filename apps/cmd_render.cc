@@ -13,7 +13,7 @@
 #include "animate/playback.h"
 #include "animate/sequence_io.h"
 #include "animate/spec.h"
-#include "animate/video_file.h"
+#include "capture/recording/video_file.h"
 #include "apps/commands.h"
 #include "core/error.h"
 #include "core/log.h"

@@ -10,7 +10,7 @@
 
 #include "animate/animate_run.h"
 #include "animate/sequence_io.h"
-#include "animate/video_file.h"
+#include "capture/recording/video_file.h"
 #include "animate_test_bank.h"
 #include "tests/support/test_support.h"
 

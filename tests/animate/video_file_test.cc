@@ -1,6 +1,6 @@
 // Rendered animations written as video files and decoded again: frame count, and the sprite
 // where the camera projects it (animate/video_file.h).
-#include "animate/video_file.h"
+#include "capture/recording/video_file.h"
 
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-#include "animate/video_file.h"
+#include "capture/recording/video_file.h"
 
 #include <algorithm>
 #include <cmath>
@@ -16,19 +16,14 @@ extern "C" {
 
 #include <opencv2/imgproc.hpp>
 
+#include "capture/recording/ffmpeg_util.h"
 #include "core/error.h"
 
 namespace ss {
 namespace {
 
-std::string AvError(int ret) {
-  char text[AV_ERROR_MAX_STRING_SIZE] = {0};
-  av_strerror(ret, text, sizeof text);
-  return text;
-}
-
 void Check(int ret, const std::string& path, const std::string& what) {
-  if (ret < 0) throw WorkError(path, what + ": " + AvError(ret));
+  if (ret < 0) throw WorkError(path, what + ": " + av::ErrorText(ret));
 }
 
 std::string Extension(const std::string& path) {
@@ -36,22 +31,6 @@ std::string Extension(const std::string& path) {
   std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
   return ext;
 }
-
-struct CodecContextFree {
-  void operator()(AVCodecContext* c) const { avcodec_free_context(&c); }
-};
-struct FrameFree {
-  void operator()(AVFrame* f) const { av_frame_free(&f); }
-};
-struct PacketFree {
-  void operator()(AVPacket* p) const { av_packet_free(&p); }
-};
-struct SwsFree {
-  void operator()(SwsContext* s) const { sws_freeContext(s); }
-};
-struct InputClose {
-  void operator()(AVFormatContext* f) const { avformat_close_input(&f); }
-};
 
 }  // namespace
 
@@ -67,10 +46,10 @@ struct VideoFileWriter::State {
   std::string encoder_name;
   AVFormatContext* output = nullptr;  // freed in Close (with its pb)
   AVStream* stream = nullptr;
-  std::unique_ptr<AVCodecContext, CodecContextFree> encoder;
-  std::unique_ptr<AVFrame, FrameFree> frame;
-  std::unique_ptr<AVPacket, PacketFree> packet;
-  std::unique_ptr<SwsContext, SwsFree> sws;
+  std::unique_ptr<AVCodecContext, av::CodecContextDeleter> encoder;
+  std::unique_ptr<AVFrame, av::FrameDeleter> frame;
+  std::unique_ptr<AVPacket, av::PacketDeleter> packet;
+  std::unique_ptr<SwsContext, av::SwsDeleter> sws;
   int frames = 0;
   bool header_written = false;
   bool closed = false;
@@ -250,27 +229,27 @@ const std::string& VideoFileWriter::encoder_name() const { return state_->encode
 std::vector<cv::Mat> ReadVideoFrames(const std::string& path) {
   AVFormatContext* raw = nullptr;
   int ret = avformat_open_input(&raw, path.c_str(), nullptr, nullptr);
-  if (ret < 0) throw InputError(path, "not a readable video (" + AvError(ret) + ")");
-  std::unique_ptr<AVFormatContext, InputClose> input(raw);
+  if (ret < 0) throw InputError(path, "not a readable video (" + av::ErrorText(ret) + ")");
+  std::unique_ptr<AVFormatContext, av::InputDeleter> input(raw);
   ret = avformat_find_stream_info(input.get(), nullptr);
-  if (ret < 0) throw InputError(path, "no stream information (" + AvError(ret) + ")");
+  if (ret < 0) throw InputError(path, "no stream information (" + av::ErrorText(ret) + ")");
   const AVCodec* decoder = nullptr;
   const int index = av_find_best_stream(input.get(), AVMEDIA_TYPE_VIDEO, -1, -1, &decoder, 0);
   if (index < 0 || decoder == nullptr) throw InputError(path, "no decodable video stream");
-  std::unique_ptr<AVCodecContext, CodecContextFree> context(avcodec_alloc_context3(decoder));
+  std::unique_ptr<AVCodecContext, av::CodecContextDeleter> context(avcodec_alloc_context3(decoder));
   if (!context) throw WorkError(path, "out of memory");
   Check(avcodec_parameters_to_context(context.get(), input->streams[index]->codecpar), path,
         "bad stream parameters");
   Check(avcodec_open2(context.get(), decoder, nullptr), path, "cannot open the decoder");
-  std::unique_ptr<AVPacket, PacketFree> packet(av_packet_alloc());
-  std::unique_ptr<AVFrame, FrameFree> frame(av_frame_alloc());
-  std::unique_ptr<SwsContext, SwsFree> sws;
+  std::unique_ptr<AVPacket, av::PacketDeleter> packet(av_packet_alloc());
+  std::unique_ptr<AVFrame, av::FrameDeleter> frame(av_frame_alloc());
+  std::unique_ptr<SwsContext, av::SwsDeleter> sws;
   std::vector<cv::Mat> frames;
   auto drain = [&] {
     for (;;) {
       const int r = avcodec_receive_frame(context.get(), frame.get());
       if (r == AVERROR(EAGAIN) || r == AVERROR_EOF) return;
-      if (r < 0) throw InputError(path, "damaged video data (" + AvError(r) + ")");
+      if (r < 0) throw InputError(path, "damaged video data (" + av::ErrorText(r) + ")");
       sws.reset(sws_getCachedContext(sws.release(), frame->width, frame->height,
                                      static_cast<AVPixelFormat>(frame->format), frame->width,
                                      frame->height, AV_PIX_FMT_BGR24, SWS_BICUBIC, nullptr, nullptr,
@@ -288,7 +267,7 @@ std::vector<cv::Mat> ReadVideoFrames(const std::string& path) {
     if (packet->stream_index == index) {
       ret = avcodec_send_packet(context.get(), packet.get());
       av_packet_unref(packet.get());
-      if (ret < 0 && ret != AVERROR(EAGAIN)) throw InputError(path, "damaged video data (" + AvError(ret) + ")");
+      if (ret < 0 && ret != AVERROR(EAGAIN)) throw InputError(path, "damaged video data (" + av::ErrorText(ret) + ")");
       drain();
     } else {
       av_packet_unref(packet.get());
