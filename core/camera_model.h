@@ -50,7 +50,11 @@ class CameraModel {
   int width() const { return width_; }
   int height() const { return height_; }
   const Rigid3& cam_from_ground() const { return cam_from_ground_; }
-  void set_cam_from_ground(const Rigid3& pose) { cam_from_ground_ = pose; }
+  // A new pose is written as itself: the extrinsics as read no longer apply.
+  void set_cam_from_ground(const Rigid3& pose) {
+    cam_from_ground_ = pose;
+    rt_as_read_.reset();
+  }
   // Camera centre in ground coordinates.
   Eigen::Vector3d CentreInGround() const;
 

@@ -299,6 +299,22 @@ TEST(CameraModel, ReadsWhatLibmrcalWrites) {
   mrcal_free_cameramodel(&back_model);
 }
 
+TEST(CameraModel, APoseSetAfterReadingIsThePoseWritten) {
+  // `calibrate ground` reads an intrinsics-only model (identity extrinsics) and poses it:
+  // the file must hold the new pose, not the extrinsics as read.
+  ScratchDir dir;
+  const CameraModel unposed("LENSMODEL_OPENCV8", kOpencv8, 1920, 1080, Rigid3{});
+  unposed.Write(dir / "intrinsics.cameramodel");
+  CameraModel posed = CameraModel::Read(dir / "intrinsics.cameramodel");
+  const double rt[6] = {2.57, -0.03, -0.02, -0.03, -0.02, 1.48};
+  posed.set_cam_from_ground(Rigid3::FromRt(rt));
+  posed.Write(dir / "posed.cameramodel");
+  const CameraModel back = CameraModel::Read(dir / "posed.cameramodel");
+  double got[6];
+  back.cam_from_ground().ToRt(got);
+  for (int i = 0; i < 6; ++i) EXPECT_NEAR(got[i], rt[i], 1e-12) << i;
+}
+
 TEST(CameraModel, ReadsACalibrationToolFile) {
   // The shape mrcal-calibrate-cameras writes: comments, extra keys, a bytes blob.
   ScratchDir dir;
