@@ -2,7 +2,8 @@
 // hamster bank (seed 000 §3), against brute force measured in the same run.
 //   full build of N sprites on T threads; stage-2 evaluations vs all N(N-1)/2 pairs;
 //   recall of the pairs brute force accepts (exact on sampled rows); quality against
-//   the synthetic truth; incremental add of one sprite to a 60,000-sprite set.
+//   the synthetic truth; the candidate cascade with and without the level-2 silhouette
+//   signature (one core, same candidates); incremental add of one sprite to a 60,000-sprite set.
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
@@ -13,6 +14,7 @@
 #include <ctime>
 #include <numeric>
 #include <random>
+#include <stdexcept>
 #include <string>
 #include <thread>
 #include <unordered_set>
@@ -57,9 +59,10 @@ struct Args {
   int threads = 2;
   int labels = 3000;
   double stage1_recall = 0.999;
+  double stage2_bias_shift = 0;  // added to the stage-2 bias (> 0 lowers the threshold T2)
   double near_miss = TruthLabelOptions{}.near_miss_fraction;
   std::string weights_path, train_out;
-  bool incremental = true, micro = false, json = false;
+  bool incremental = true, micro = false, json = false, sweep = false;
 };
 
 Args Parse(const std::vector<std::string>& argv) {
@@ -91,11 +94,13 @@ Args Parse(const std::vector<std::string>& argv) {
     else if (s == "--labels") a.labels = std::stoi(value());
     else if (s == "--near-miss") a.near_miss = std::stod(value());
     else if (s == "--stage1-recall") a.stage1_recall = std::stod(value());
+    else if (s == "--stage2-bias-shift") a.stage2_bias_shift = std::stod(value());
     else if (s == "--weights") a.weights_path = value();
     else if (s == "--train-out") a.train_out = value();
     else if (s == "--skip-incremental") a.incremental = false;
     else if (s == "--micro") a.micro = true;
     else if (s == "--json") a.json = true;
+    else if (s == "--sweep-stage2") a.sweep = true;
     else throw InputError("bench transitions", "unknown argument '" + s + "' (see bench/transitions_bench.cc)");
   }
   if (a.sprites < 100 || a.rows < 1 || a.threads < 1) throw InputError("bench transitions", "bad sizes");
@@ -196,12 +201,107 @@ TransitionWeights Train(const Args& a, nlohmann::json* out) {
   return w;
 }
 
+
+// The candidates of every 10th sprite (j > i), from the built index.
+std::vector<std::pair<int32_t, int32_t>> SampledCandidates(const TransitionBuilder& builder) {
+  std::vector<std::pair<int32_t, int32_t>> out;
+  std::vector<int32_t> hits;
+  for (int32_t i = 0; i < builder.store().size(); i += 10) {
+    hits.clear();
+    builder.index().Query(builder.store().cheap(i), &hits);
+    for (int32_t j : hits) {
+      if (j > i) out.push_back({i, j});
+    }
+  }
+  return out;
+}
+
+// One thread's CPU time per candidate for deciding the sampled candidates two ways:
+// "coarse only" = the cheap terms, the 4 x 4 bound, then the pixels (the cascade before the
+// level-2 signature); "signature" = SignatureRejects (both levels), then the pixels.
+// Both make the same decisions; the accept counts are compared to be sure.
+void CompareCascades(const TransitionBuilder& builder, nlohmann::json* out) {
+  const SpriteStore& store = builder.store();
+  const TransitionClassifier& c = builder.classifier();
+  const auto pairs = SampledCandidates(builder);
+  const auto& u2 = c.stage2_unit_weights();
+  auto coarse_rejects = [&](int32_t i, int32_t j) {
+    const CheapDifference cheap = CheapDiff(store.cheap(i), store.cheap(j));
+    double d = 0;
+    for (int k = 0; k < kCheapFeatureCount; ++k) d += u2[k] * cheap[k];
+    if (d > c.stage2_threshold()) return true;
+    PixelSums bound;
+    bound.alpha_abs_diff = store.CoarseAlphaBound(i, j);
+    bound.weight = 1;
+    return d + u2[4] * PixelDifferenceFromSums(bound, store.box(i), store.box(j)).alpha > c.stage2_threshold();
+  };
+  double ns[2] = {0, 0};
+  int64_t accepts[2] = {0, 0}, pixel_reads[2] = {0, 0};
+  for (int rep = 0; rep < 2; ++rep) {  // twice, alternating, to even out the machine's load
+    for (int way = 0; way < 2; ++way) {
+      const double c0 = ThreadCpuSeconds();
+      int64_t acc = 0, reads = 0;
+      for (size_t k = 0; k < pairs.size(); ++k) {
+        if (k + 8 < pairs.size()) store.PrefetchCoarse(pairs[k + 8].second);
+        const auto [i, j] = pairs[k];
+        if (way == 0 ? coarse_rejects(i, j) : c.SignatureRejects(store, i, j)) continue;
+        ++reads;
+        double d;
+        acc += c.Stage2(store, i, j, &d);
+      }
+      ns[way] += (ThreadCpuSeconds() - c0) * 1e9 / std::max<size_t>(1, pairs.size()) / 2;
+      accepts[way] = acc;
+      pixel_reads[way] = reads;
+    }
+  }
+  if (accepts[0] != accepts[1]) throw std::logic_error("the two cascades decided differently");
+  std::printf("  deciding %zu sampled stage-1 candidates on one core (CPU): 4x4 bound then pixels %.1f ns a candidate "
+              "(%.1f%% read pixels); with the level-2 signature %.1f ns (%.1f%% read pixels)\n",
+              pairs.size(), ns[0], 100.0 * pixel_reads[0] / pairs.size(), ns[1], 100.0 * pixel_reads[1] / pairs.size());
+  (*out)["cascade_ab"] = {{"sampled_candidates", pairs.size()},
+                          {"coarse_only_ns_per_candidate", ns[0]},
+                          {"coarse_only_pixel_reads", pixel_reads[0]},
+                          {"signature_ns_per_candidate", ns[1]},
+                          {"signature_pixel_reads", pixel_reads[1]}};
+}
+
+// --sweep-stage2: per stage-2 bias shift, on the sampled candidates of the shipped stage 1,
+// the stage-2 evaluations (signature survivors) and accepts per sprite.
+void SweepStage2(const TransitionBuilder& builder, const TransitionWeights& weights) {
+  const auto pairs = SampledCandidates(builder);
+  const int32_t n = builder.store().size();
+  const double rows = (n + 9) / 10;
+  for (double shift : {0.0, 0.5, 1.0, 1.25, 1.5, 1.75, 2.0, 2.5, 3.0}) {
+    TransitionWeights w = weights;
+    w.stage2_bias += shift;
+    const TransitionClassifier c(w);
+    int64_t survive = 0, accept = 0;
+    for (const auto& [i, j] : pairs) {
+      if (c.SignatureRejects(builder.store(), i, j)) continue;
+      ++survive;
+      double d;
+      accept += c.Stage2(builder.store(), i, j, &d);
+    }
+    // Each sampled row's candidates j > i: about half of its partners; per sprite = x 2.
+    std::printf("  stage-2 bias %+.2f (T2 %.3f): per sprite %.1f stage-2 evaluations, %.1f accepts -> ~%.0fx fewer "
+                "evaluations than brute force\n",
+                shift, c.stage2_threshold(), 2 * survive / rows, 2 * accept / rows, (n - 1) / (2 * survive / rows));
+  }
+}
+
 int Run(const std::vector<std::string>& argv) {
   const Args a = Parse(argv);
   SetLogLevel("warn");
   nlohmann::json result;
   TransitionWeights weights = a.weights_path.empty() ? DefaultWeights() : LoadWeights(a.weights_path);
   if (!a.train_out.empty()) weights = Train(a, &result);
+  if (a.stage2_bias_shift != 0) {
+    weights.stage2_bias += a.stage2_bias_shift;
+    std::printf("stage-2 bias shifted by %+g (threshold T2 %.4f -> %.4f): NOT the shipped operating point\n",
+                a.stage2_bias_shift, TransitionClassifier(weights).stage2_threshold() + a.stage2_bias_shift,
+                TransitionClassifier(weights).stage2_threshold());
+    result["stage2_bias_shift"] = a.stage2_bias_shift;
+  }
   const double px_per_m = SyntheticSpriteOptions{}.px_per_m;
 
   // ---- full build ----
@@ -279,7 +379,8 @@ int Run(const std::vector<std::string>& argv) {
   benchmark::DoNotOptimize(sink);
   const double seconds_per_eval_core = (ThreadCpuSeconds() - plain_cpu0) / (static_cast<double>(plain_rows) * (n - 1));
   const double brute_seconds_core = all_pairs * seconds_per_eval_core;
-  const double ratio = all_pairs / std::max<int64_t>(1, stats.stage1_candidates);
+  const double ratio = all_pairs / std::max<int64_t>(1, stats.stage2_evaluations);
+  const double ratio_stage1 = all_pairs / std::max<int64_t>(1, stats.stage1_candidates);
   const double recall_vs_brute = brute_accepted > 0 ? static_cast<double>(brute_kept) / brute_accepted : 1.0;
   const double precision_truth = kept_total > 0 ? static_cast<double>(kept_true) / kept_total : 0.0;
   const double recall_truth = truth_pos > 0 ? static_cast<double>(kept_true) / truth_pos : 0.0;
@@ -317,8 +418,15 @@ int Run(const std::vector<std::string>& argv) {
               seconds_build <= 60 ? "met" : "MISSED");
   std::printf("  CPU time of the build %.2f s over %d threads (machine load average %.1f before it)\n", cpu_build,
               a.threads, load_before);
+  std::printf("  stage 1 (k-d tree): %lld candidates of %.0f pairs (%.0fx fewer); silhouette signature rejects %lld "
+              "of them without reading a pixel\n",
+              static_cast<long long>(stats.stage1_candidates), all_pairs, ratio_stage1,
+              static_cast<long long>(stats.signature_rejected));
   std::printf("  stage-2 evaluations: %lld of %.0f pairs -> %.0fx fewer than brute force   goal >= 1000x: %s\n",
-              static_cast<long long>(stats.stage1_candidates), all_pairs, ratio, ratio >= 1000 ? "met" : "MISSED");
+              static_cast<long long>(stats.stage2_evaluations), all_pairs, ratio, ratio >= 1000 ? "met" : "MISSED");
+  std::printf("  accepts per sprite (kept pairs x 2 / sprites): %.1f; at most all_pairs / 1000 = %.0f evaluations for "
+              "1000x\n",
+              2.0 * stats.kept_pairs / n, all_pairs / 1000);
   std::printf("  brute force (extrapolated: stage 2 alone timed on %zu rows x %d pairs, %.0f ns each, CPU time of one "
               "core): %.0f s on one core, %.0f s on %d; the two-stage build (%.2f s CPU) needs %.0fx less CPU\n",
               plain_rows, n - 1, seconds_per_eval_core * 1e9, brute_seconds_core, brute_seconds_core / a.threads,
@@ -334,6 +442,8 @@ int Run(const std::vector<std::string>& argv) {
               truth_options.max_keypoint_displacement_m * 1e3,
               static_cast<double>(truth_pos) / rows.size(), precision_truth, recall_truth, t_found ? static_cast<double>(t_true) / t_found : 0.0,
               t_truth_total ? static_cast<double>(t_true) / t_truth_total : 0.0);
+  CompareCascades(builder, &result);
+  if (a.sweep) SweepStage2(builder, weights);
   result["full_build"] = {{"sprites", n},
                           {"clips", stats.clips},
                           {"threads", a.threads},
@@ -341,7 +451,10 @@ int Run(const std::vector<std::string>& argv) {
                           {"cpu_seconds", cpu_build},
                           {"load_average_before", load_before},
                           {"seconds_generate_synthetic", seconds_generate},
-                          {"stage2_evaluations", stats.stage1_candidates},
+                          {"stage1_candidates", stats.stage1_candidates},
+                          {"signature_rejected", stats.signature_rejected},
+                          {"stage2_evaluations", stats.stage2_evaluations},
+                          {"fewer_stage1_candidates_ratio", ratio_stage1},
                           {"all_pairs", all_pairs},
                           {"fewer_evaluations_ratio", ratio},
                           {"kept_pairs", stats.kept_pairs},
@@ -370,6 +483,7 @@ int Run(const std::vector<std::string>& argv) {
     std::vector<double> ms, cpu_ms;
     int64_t new_transitions = 0, appended = 0;
     const int64_t candidates_before = inc.stats().stage1_candidates;
+    const int64_t evaluations_before = inc.stats().stage2_evaluations;
     for (int k = 0; k < a.adds; ++k) {
       const SpriteInput& s = live_inputs[a.incremental_base + k];
       const auto t0 = Clock::now();
@@ -392,12 +506,15 @@ int Run(const std::vector<std::string>& argv) {
                 seconds_base, a.adds, static_cast<long long>(appended), median, p90, worst,
                 median <= 2 ? "met" : "MISSED");
     std::printf("  median CPU time of one add (this thread): %.3f ms\n", median_cpu);
-    std::printf("  per add: %.1f stage-2 evaluations, %.2f new transitions\n",
+    std::printf("  per add: %.1f stage-1 candidates, %.1f stage-2 evaluations, %.2f new transitions\n",
                 static_cast<double>(inc.stats().stage1_candidates - candidates_before) / a.adds,
+                static_cast<double>(inc.stats().stage2_evaluations - evaluations_before) / a.adds,
                 static_cast<double>(new_transitions) / a.adds);
     result["incremental"] = {{"base_sprites", a.incremental_base}, {"adds", a.adds},         {"median_ms", median}, {"median_cpu_ms", median_cpu},
                              {"p90_ms", p90},                      {"max_ms", worst},        {"base_build_seconds", seconds_base},
-                             {"appended_to_clip", appended}};
+                             {"appended_to_clip", appended},
+                             {"stage1_candidates_per_add", static_cast<double>(inc.stats().stage1_candidates - candidates_before) / a.adds},
+                             {"stage2_evaluations_per_add", static_cast<double>(inc.stats().stage2_evaluations - evaluations_before) / a.adds}};
   }
   if (a.json) std::printf("%s\n", result.dump(2).c_str());
   if (a.micro) return RunGoogleBenchmarks("BM_Transitions", {"--benchmark_min_time=0.2"});
@@ -434,7 +551,7 @@ BENCHMARK(BM_TransitionsPixelKernelScalar);
 const bool registered = RegisterSuite(
     {"transitions",
      "two-stage transition search on a synthetic 30k-sprite bank vs brute force; incremental add at 60k "
-     "[--sprites N --threads T --rows R --weights F --train-out F --skip-incremental --micro --json]",
+     "[--sprites N --threads T --rows R --weights F --train-out F --stage2-bias-shift X --sweep-stage2 --skip-incremental --micro --json]",
      &Run});
 
 }  // namespace

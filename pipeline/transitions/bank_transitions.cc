@@ -149,7 +149,8 @@ std::string BankUpdateSummary::ToJson() const {
   nlohmann::json j{{"bank", bank},
                    {"sprites", sprites},
                    {"clips", clips},
-                   {"stage2_evaluations", build.stage1_candidates},
+                   {"stage1_candidates", build.stage1_candidates},
+                   {"stage2_evaluations", build.stage2_evaluations},
                    {"kept_pairs", build.kept_pairs},
                    {"transitions", transitions},
                    {"added", store.added},
@@ -171,8 +172,10 @@ std::string BankUpdateSummary::ToText() const {
                 static_cast<long long>(clips));
   out += line;
   const double all_pairs = 0.5 * static_cast<double>(sprites) * (static_cast<double>(sprites) - 1);
-  std::snprintf(line, sizeof(line), "  stage-2 evaluations %lld of %.0f pairs, kept pairs %lld\n",
-                static_cast<long long>(build.stage1_candidates), all_pairs, static_cast<long long>(build.kept_pairs));
+  std::snprintf(line, sizeof(line),
+                "  stage-1 candidates %lld, stage-2 evaluations %lld of %.0f pairs, kept pairs %lld\n",
+                static_cast<long long>(build.stage1_candidates), static_cast<long long>(build.stage2_evaluations),
+                all_pairs, static_cast<long long>(build.kept_pairs));
   out += line;
   std::snprintf(line, sizeof(line), "  transitions %lld: %lld added, %lld changed, %lld unchanged, %lld removed%s\n",
                 static_cast<long long>(transitions), static_cast<long long>(store.added),

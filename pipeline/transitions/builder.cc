@@ -64,7 +64,7 @@ void TransitionBuilder::BuildFromScratch(std::span<const SpriteInput> sprites, c
     double distance;
   };
   std::atomic<int32_t> cursor{0};
-  std::atomic<int64_t> candidates{0};
+  std::atomic<int64_t> candidates{0}, evaluations{0};
   std::mutex merge_mutex;
   std::vector<Found> found;
   size_t done = 0;
@@ -72,17 +72,19 @@ void TransitionBuilder::BuildFromScratch(std::span<const SpriteInput> sprites, c
     constexpr int32_t kBlock = 256;
     std::vector<int32_t> hits;
     std::vector<Found> local;
-    int64_t local_candidates = 0;
+    int64_t local_candidates = 0, local_evaluations = 0;
     for (int32_t begin; (begin = cursor.fetch_add(kBlock)) < n;) {
       const int32_t end = std::min(n, begin + kBlock);
       for (int32_t i = begin; i < end; ++i) {
         hits.clear();
         index_.Query(store_.cheap(i), &hits);
         for (size_t h = 0; h < hits.size(); ++h) {
-          if (h + 8 < hits.size()) store_.PrefetchAlphaBlocks(hits[h + 8]);
+          if (h + 8 < hits.size()) store_.PrefetchCoarse(hits[h + 8]);
           const int32_t j = hits[h];
           if (j <= i) continue;
           ++local_candidates;
+          if (classifier_.SignatureRejects(store_, i, j)) continue;
+          ++local_evaluations;
           double d;
           if (classifier_.Stage2(store_, i, j, &d)) local.push_back({i, j, d});
         }
@@ -94,6 +96,7 @@ void TransitionBuilder::BuildFromScratch(std::span<const SpriteInput> sprites, c
       if (options.progress) options.progress(done, n);
     }
     candidates += local_candidates;
+    evaluations += local_evaluations;
   };
   std::vector<std::thread> pool;
   for (int t = 1; t < threads; ++t) pool.emplace_back(work);
@@ -118,13 +121,15 @@ void TransitionBuilder::BuildFromScratch(std::span<const SpriteInput> sprites, c
   stats_.sprites = n;
   stats_.clips = static_cast<int64_t>(store_.clip_count());
   stats_.stage1_candidates = candidates.load();
+  stats_.stage2_evaluations = evaluations.load();
+  stats_.signature_rejected = stats_.stage1_candidates - stats_.stage2_evaluations;
   stats_.kept_pairs = static_cast<int64_t>(found.size());
   if (stats_.clips == 1) {
     stats_.notes.push_back("one clip: every transition stays inside it");
     log->warn("the sprite set has one clip: every transition stays inside it");
   }
-  log->info("{} sprites in {} clips: {} stage-1 candidates, {} kept pairs ({:.2f} s)", n, stats_.clips,
-            stats_.stage1_candidates, stats_.kept_pairs,
+  log->info("{} sprites in {} clips: {} stage-1 candidates, {} stage-2 evaluations, {} kept pairs ({:.2f} s)", n,
+            stats_.clips, stats_.stage1_candidates, stats_.stage2_evaluations, stats_.kept_pairs,
             stats_.seconds_images + stats_.seconds_index + stats_.seconds_pairs);
 }
 
@@ -141,8 +146,13 @@ TransitionDelta TransitionBuilder::Add(std::span<const SpriteInput> sprites) {
     stats_.stage1_candidates += static_cast<int64_t>(hits.size());
     auto& mine = neighbours_[s];
     for (size_t h = 0; h < hits.size(); ++h) {
-      if (h + 8 < hits.size()) store_.PrefetchAlphaBlocks(hits[h + 8]);
+      if (h + 8 < hits.size()) store_.PrefetchCoarse(hits[h + 8]);
       const int32_t j = hits[h];
+      if (classifier_.SignatureRejects(store_, s, j)) {
+        ++stats_.signature_rejected;
+        continue;
+      }
+      ++stats_.stage2_evaluations;
       double d;
       if (!classifier_.Stage2(store_, s, j, &d)) continue;
       mine.push_back({j, d});

@@ -48,7 +48,9 @@ struct BuildOptions {
 struct BuildStats {
   int64_t sprites = 0;
   int64_t clips = 0;
-  int64_t stage1_candidates = 0;   // unordered pairs stage 1 accepted (= stage-2 evaluations)
+  int64_t stage1_candidates = 0;   // unordered pairs stage 1 accepted (the k-d tree's answer)
+  int64_t signature_rejected = 0;  // of those, rejected by SignatureRejects (no pixel read)
+  int64_t stage2_evaluations = 0;  // the rest: stage 2 on the comparison images
   int64_t kept_pairs = 0;
   double seconds_images = 0;       // comparison images
   double seconds_index = 0;        // k-d tree build

@@ -19,23 +19,41 @@ TransitionClassifier::TransitionClassifier(const TransitionWeights& weights) : w
   }
 }
 
+namespace {
+
+// The alpha feature from a numerator (an exact sum or a lower bound of it) and the boxes.
+double AlphaFeature(uint64_t alpha_abs_diff, const CellBox& a, const CellBox& b) {
+  PixelSums sums;
+  sums.alpha_abs_diff = alpha_abs_diff;
+  sums.weight = 1;  // colour not used here
+  return PixelDifferenceFromSums(sums, a, b).alpha;
+}
+
+}  // namespace
+
+bool TransitionClassifier::SignatureRejects(const SpriteStore& store, int32_t i, int32_t j) const {
+  const CheapDifference cheap = CheapDiff(store.cheap(i), store.cheap(j));
+  // Same operations in the same order as Distance(): d is its prefix, and the alpha
+  // feature is monotone in its numerator, so d + u4 * bound <= the full sum.
+  double d = 0;
+  for (int k = 0; k < kCheapFeatureCount; ++k) d += u2_[k] * cheap[k];
+  if (d > t2_) return true;
+  const CellBox& box_i = store.box(i);
+  const CellBox& box_j = store.box(j);
+  if (d + u2_[4] * AlphaFeature(store.CoarseAlphaBound(i, j), box_i, box_j) > t2_) return true;
+  return d + u2_[4] * AlphaFeature(store.SignatureAlphaBound(i, j), box_i, box_j) > t2_;
+}
+
 bool TransitionClassifier::Stage2(const SpriteStore& store, int32_t i, int32_t j, double* distance) const {
   const CheapDifference cheap = CheapDiff(store.cheap(i), store.cheap(j));
   // Same operations in the same order as Distance(): the partial sums are its prefixes.
   double d = 0;
   for (int k = 0; k < kCheapFeatureCount; ++k) d += u2_[k] * cheap[k];
   if (d > t2_) return false;
-  PixelSums bound;  // the alpha term from the block sums: a lower bound of it, exact to compare
-  bound.alpha_abs_diff = store.AlphaLowerBound(i, j);
-  bound.weight = 1;  // colour not used here
-  if (d + u2_[4] * PixelDifferenceFromSums(bound, store.box(i), store.box(j)).alpha > t2_) return false;
   const uint8_t* a = store.image(i);
   const uint8_t* b = store.image(j);
   const int stride = store.window().PlaneStride();
-  PixelSums alpha_only;
-  alpha_only.alpha_abs_diff = SumAlphaDifference(a, b, stride);
-  alpha_only.weight = 1;  // colour not used here
-  const double alpha = PixelDifferenceFromSums(alpha_only, store.box(i), store.box(j)).alpha;
+  const double alpha = AlphaFeature(SumAlphaDifference(a, b, stride), store.box(i), store.box(j));
   if (d + u2_[4] * alpha > t2_) return false;
   const PairFeatures x = MakePairFeatures(cheap, PixelDifferenceFromSums(SumPixelDifferences(a, b, stride),
                                                                          store.box(i), store.box(j)));

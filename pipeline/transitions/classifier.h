@@ -34,11 +34,19 @@ class TransitionClassifier {
     return d;
   }
   bool Stage2Accepts(double distance) const { return distance <= t2_; }
+  // Proves without reading a pixel that stage 2 rejects the pair: the four cheap terms of
+  // D (in Distance()'s order) plus the alpha term bounded from below by the sprites'
+  // silhouette signatures (SpriteStore::CoarseAlphaBound, then SignatureAlphaBound) exceed
+  // the threshold. Every term of D is >= 0 and the bounds are below the alpha term, so a
+  // pair this returns true for is one Stage2Accepts(Distance(...)) rejects; false decides
+  // nothing (run Stage2).
+  bool SignatureRejects(const SpriteStore& store, int32_t i, int32_t j) const;
   // Stage 2 on store indices (i, j) with early exits: the sum of Distance() is built in
-  // its own order (the cheap terms, then alpha, then colour) and every term is >= 0, so
-  // once a partial sum exceeds the threshold the pair is rejected without reading the
-  // rest of the images. Decides exactly as Stage2Accepts(Distance(store.Features(i, j)))
-  // and, when accepted, sets *distance to that same value.
+  // its own order (the cheap terms, then alpha from the alpha plane, then colour) and every
+  // term is >= 0, so once a partial sum exceeds the threshold the pair is rejected without
+  // reading the colour planes. Decides exactly as Stage2Accepts(Distance(store.Features(i, j)))
+  // and, when accepted, sets *distance to that same value. Does not use the signatures:
+  // the builder calls SignatureRejects first and counts only the pairs that reach this.
   bool Stage2(const SpriteStore& store, int32_t i, int32_t j, double* distance) const;
 
   const CheapDifference& stage1_unit_weights() const { return u1_; }

@@ -1,5 +1,7 @@
 #include "pipeline/transitions/sprite_store.h"
 
+#include <emmintrin.h>
+
 #include <algorithm>
 #include <atomic>
 #include <exception>
@@ -25,7 +27,8 @@ void SpriteStore::Clear() {
   next_.clear();
   cheap_.clear();
   boxes_.clear();
-  alpha_blocks_.clear();
+  coarse_.clear();
+  signature_.clear();
   chunks_.clear();
   index_of_.clear();
   clip_last_.clear();
@@ -35,6 +38,66 @@ std::optional<int32_t> SpriteStore::IndexOf(int64_t id) const {
   auto it = index_of_.find(id);
   if (it == index_of_.end()) return std::nullopt;
   return it->second;
+}
+
+void SpriteStore::ComputeSignature(int32_t i) {
+  // Cell (u, v) lies in block (u * G / cells_x, v * G / cells_y) of a G x G grid, in row
+  // band v * 32 / cells_y and column band u * 32 / cells_x (empty parts when a window has
+  // fewer cells than parts: they add 0 to both sides of the bound).
+  const uint8_t* alpha = image(i);
+  std::array<uint32_t, kCoarseBlocks> coarse{};
+  std::array<uint32_t, kSignatureValues> sig{};
+  constexpr int kBlocks = kSignatureGrid * kSignatureGrid;
+  const int cx = window_.cells_x, cy = window_.cells_y;
+  for (int v = 0; v < cy; ++v) {
+    const int block_row = v * kSignatureGrid / cy, coarse_row = v * 4 / cy, band = v * kSignatureBands / cy;
+    for (int u = 0; u < cx; ++u) {
+      const uint32_t a = alpha[v * cx + u];
+      coarse[coarse_row * 4 + u * 4 / cx] += a;
+      sig[block_row * kSignatureGrid + u * kSignatureGrid / cx] += a;
+      sig[kBlocks + band] += a;
+      sig[kBlocks + kSignatureBands + u * kSignatureBands / cx] += a;
+    }
+  }
+  for (int k = 0; k < kCoarseBlocks; ++k) coarse_[i][k] = static_cast<uint16_t>(std::min(coarse[k], kSignatureMax));
+  for (int k = 0; k < kSignatureValues; ++k) signature_[i][k] = static_cast<uint16_t>(std::min(sig[k], kSignatureMax));
+}
+
+namespace {
+
+// sum |a_k - b_k| over `vectors` x 8 values in [0, 32767] (SSE2: the x86-64 baseline).
+inline __m128i AbsDifferenceSums(const uint16_t* a, const uint16_t* b, int vectors) {
+  const __m128i ones = _mm_set1_epi16(1);
+  __m128i sum = _mm_setzero_si128();
+  for (int k = 0; k < vectors; ++k) {
+    const __m128i x = _mm_load_si128(reinterpret_cast<const __m128i*>(a) + k);
+    const __m128i y = _mm_load_si128(reinterpret_cast<const __m128i*>(b) + k);
+    const __m128i d = _mm_or_si128(_mm_subs_epu16(x, y), _mm_subs_epu16(y, x));  // <= 32767: a valid int16
+    sum = _mm_add_epi32(sum, _mm_madd_epi16(d, ones));
+  }
+  return sum;
+}
+inline uint64_t HorizontalSum(__m128i v) {
+  alignas(16) int32_t lanes[4];
+  _mm_store_si128(reinterpret_cast<__m128i*>(lanes), v);
+  return static_cast<uint64_t>(lanes[0]) + lanes[1] + lanes[2] + lanes[3];
+}
+
+}  // namespace
+
+uint64_t SpriteStore::CoarseAlphaBound(int32_t i, int32_t j) const {
+  return HorizontalSum(AbsDifferenceSums(coarse_[i].data(), coarse_[j].data(), kCoarseBlocks / 8));
+}
+
+uint64_t SpriteStore::SignatureAlphaBound(int32_t i, int32_t j) const {
+  constexpr int kBlocks = kSignatureGrid * kSignatureGrid;
+  const uint16_t* a = signature_[i].data();
+  const uint16_t* b = signature_[j].data();
+  const uint64_t blocks = HorizontalSum(AbsDifferenceSums(a, b, kBlocks / 8));
+  const uint64_t rows = HorizontalSum(AbsDifferenceSums(a + kBlocks, b + kBlocks, kSignatureBands / 8));
+  const uint64_t cols = HorizontalSum(
+      AbsDifferenceSums(a + kBlocks + kSignatureBands, b + kBlocks + kSignatureBands, kSignatureBands / 8));
+  return std::max({blocks, rows, cols});
 }
 
 int32_t SpriteStore::Append(std::span<const SpriteInput> sprites, int threads) {
@@ -56,13 +119,17 @@ int32_t SpriteStore::Append(std::span<const SpriteInput> sprites, int threads) {
   }
   const size_t n = static_cast<size_t>(first) + sprites.size();
   if (n > static_cast<size_t>(INT32_MAX)) throw InputError("sprites", "more than 2^31 sprites");
-  ids_.reserve(n);
-  clips_.reserve(n);
-  prev_.reserve(n);
-  next_.reserve(n);
-  cheap_.reserve(n);
+  // Grow geometrically: reserve(n) alone would reallocate (and copy) every vector on each
+  // one-sprite Add.
+  const size_t capacity = n <= ids_.capacity() ? ids_.capacity() : std::max(n, 2 * ids_.capacity());
+  ids_.reserve(capacity);
+  clips_.reserve(capacity);
+  prev_.reserve(capacity);
+  next_.reserve(capacity);
+  cheap_.reserve(capacity);
   boxes_.resize(n);
-  alpha_blocks_.resize(n);
+  coarse_.resize(n);
+  signature_.resize(n);
   while (chunks_.size() * kChunkSize < n) {
     chunks_.emplace_back(new uint8_t[static_cast<size_t>(kChunkSize) * image_bytes_]);
   }
@@ -94,14 +161,7 @@ int32_t SpriteStore::Append(std::span<const SpriteInput> sprites, int threads) {
         const int32_t i = first + static_cast<int32_t>(k);
         try {
           boxes_[i] = MakeComparisonImage(*sprites[k].billboard, px_per_m_, window_, mutable_image(i));
-          const uint8_t* alpha = image(i);
-          auto& blocks = alpha_blocks_[i];
-          blocks.fill(0);
-          for (int v = 0; v < window_.cells_y; ++v) {
-            for (int u = 0; u < window_.cells_x; ++u) {
-              blocks[(v * 4 / window_.cells_y) * 4 + u * 4 / window_.cells_x] += alpha[v * window_.cells_x + u];
-            }
-          }
+          ComputeSignature(i);
         } catch (...) {
           std::lock_guard<std::mutex> lock(error_mutex);
           if (!error) error = std::current_exception();

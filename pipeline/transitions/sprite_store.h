@@ -45,18 +45,23 @@ class SpriteStore {
     return chunks_[i >> kChunkShift].get() + static_cast<size_t>(i & (kChunkSize - 1)) * image_bytes_;
   }
   const CellBox& box(int32_t i) const { return boxes_[i]; }
-  // The alpha plane summed over a 4 x 4 grid of cell blocks (64 bytes a sprite, contiguous):
-  // sum_b |S_i,b - S_j,b| <= sum_cells |A_i - A_j|, an exact lower bound of the alpha
-  // feature's numerator that stage 2 checks before reading a plane.
-  static constexpr int kAlphaBlocks = 16;
-  uint64_t AlphaLowerBound(int32_t i, int32_t j) const {
-    const uint32_t* a = alpha_blocks_[i].data();
-    const uint32_t* b = alpha_blocks_[j].data();
-    uint64_t sum = 0;
-    for (int k = 0; k < kAlphaBlocks; ++k) sum += a[k] > b[k] ? a[k] - b[k] : b[k] - a[k];
-    return sum;
-  }
-  void PrefetchAlphaBlocks(int32_t i) const { __builtin_prefetch(alpha_blocks_[i].data()); }
+  // The silhouette signature (docs/transitions.md "Silhouette signature"): the alpha plane
+  // of the comparison image summed over fixed partitions of its cells, each sum clamped to
+  // kSignatureMax (x -> min(x, M) moves no two values further apart, so clamping keeps the
+  // bound). For any partition P, sum_{p in P} |S_i,p - S_j,p| <= sum_cells |A_i - A_j|
+  // (triangle inequality), so each bound below is an exact lower bound of the alpha
+  // feature's numerator, computed without reading a pixel. Level 1: a 4 x 4 grid of cell
+  // blocks (32 bytes a sprite). Level 2: an 8 x 8 grid, 32 row bands and 32 column bands
+  // (256 bytes); its bound is the largest of the three partitions' (the 8 x 8 grid refines
+  // the 4 x 4 one, so level 2 >= level 1).
+  static constexpr int kCoarseBlocks = 16;
+  static constexpr int kSignatureGrid = 8;    // 8 x 8 blocks
+  static constexpr int kSignatureBands = 32;  // row bands, and column bands
+  static constexpr int kSignatureValues = kSignatureGrid * kSignatureGrid + 2 * kSignatureBands;
+  static constexpr uint32_t kSignatureMax = 32767;  // 16-bit lanes, differences summed as int16
+  uint64_t CoarseAlphaBound(int32_t i, int32_t j) const;
+  uint64_t SignatureAlphaBound(int32_t i, int32_t j) const;
+  void PrefetchCoarse(int32_t i) const { __builtin_prefetch(coarse_[i].data()); }
   std::optional<int32_t> IndexOf(int64_t id) const;
   size_t clip_count() const { return clip_last_.size(); }
   const ComparisonWindow& window() const { return window_; }
@@ -72,6 +77,8 @@ class SpriteStore {
  private:
   static constexpr int kChunkShift = 12;
   static constexpr int32_t kChunkSize = 1 << kChunkShift;
+  // Fills coarse_[i] and signature_[i] from the alpha plane of image(i).
+  void ComputeSignature(int32_t i);
   uint8_t* mutable_image(int32_t i) {
     return chunks_[i >> kChunkShift].get() + static_cast<size_t>(i & (kChunkSize - 1)) * image_bytes_;
   }
@@ -83,7 +90,10 @@ class SpriteStore {
   std::vector<int32_t> prev_, next_;
   std::vector<CheapFeatures> cheap_;
   std::vector<CellBox> boxes_;
-  std::vector<std::array<uint32_t, kAlphaBlocks>> alpha_blocks_;
+  struct alignas(32) Coarse : std::array<uint16_t, kCoarseBlocks> {};
+  struct alignas(64) Signature : std::array<uint16_t, kSignatureValues> {};
+  std::vector<Coarse> coarse_;
+  std::vector<Signature> signature_;
   std::vector<std::unique_ptr<uint8_t[]>> chunks_;
   std::unordered_map<int64_t, int32_t> index_of_;
   std::unordered_map<int64_t, int32_t> clip_last_;

@@ -188,6 +188,7 @@ TEST(TransitionBuilder, ThreadCountDoesNotChangeTheResult) {
   EXPECT_EQ(one.KeptPairs(), two.KeptPairs());
   EXPECT_EQ(one.Transitions(), two.Transitions());
   EXPECT_EQ(one.stats().stage1_candidates, two.stats().stage1_candidates);
+  EXPECT_EQ(one.stats().stage2_evaluations, two.stats().stage2_evaluations);
 }
 
 }  // namespace

@@ -46,7 +46,7 @@ TEST(TransitionCalibration, EarlyExitStageTwoDecidesAsTheFullEvaluation) {
       for (int32_t j = 0; j < store.size(); ++j) {
         if (i == j) continue;
         const double full = c.Distance(store.Features(i, j));
-        ASSERT_LE(store.AlphaLowerBound(i, j),
+        ASSERT_LE(store.SignatureAlphaBound(i, j),
                   SumAlphaDifference(store.image(i), store.image(j), store.window().PlaneStride()));
         double d = -1;
         const bool early = c.Stage2(store, i, j, &d);
