@@ -3,6 +3,8 @@
 // options and prints. Exit 1 when a camera's calibration is not trusted (the
 // report says why), 2 for bad input (no board of that spec anywhere, bad files).
 #include <algorithm>
+#include <atomic>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -10,6 +12,7 @@
 #include <memory>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -245,6 +248,7 @@ void AddWizard(CLI::App& parent) {
     std::string session, config, camera, board, out, intrinsics, floor_points;
     std::vector<double> pose{0, 0, 0};
     double thickness = 0, still_px = 0.5, still_s = 0.2, floor_still_s = 1.0, min_coverage = 0.5, max_rms = 0.5;
+    double silent_s = 5;
     int min_views = 10, max_views = 30, count = 0;
     bool json = false;
   };
@@ -267,6 +271,8 @@ void AddWizard(CLI::App& parent) {
   cmd->add_option("--still-seconds", o->still_s, "Intrinsics: the board is still this long before a capture");
   cmd->add_option("--floor-still-seconds", o->floor_still_s, "Ground: still this long = lying on the floor");
   cmd->add_option("--count", o->count, "Stop after this many frames (0: the whole session / until done)");
+  cmd->add_option("--silent-seconds", o->silent_s, "A live camera without a frame this long ends the wizard")
+      ->check(CLI::PositiveNumber);
   cmd->add_flag("--json", o->json, "Print the result and the step log as JSON");
   cmd->callback([o] {
     if (o->session.empty() == o->config.empty()) throw InputError("calibrate wizard", "give exactly one of --session, --config");
@@ -329,15 +335,44 @@ void AddWizard(CLI::App& parent) {
     };
     cv::Mat bgr;
     int frames = 0;
-    while (!wizard.done() && (o->count <= 0 || frames < o->count)) {
-      auto frame = source->Next();
-      if (!frame) break;
-      ToBgr(*frame, bgr);
-      wizard.Feed(bgr, static_cast<int>(frame->sequence));
-      ++frames;
-      print_log();
+    // A live camera that stops delivering (unplugged, its stream ended) ends the wizard
+    // with what it has; Next() itself waits for frames as long as the source lives.
+    using Clock = std::chrono::steady_clock;
+    std::atomic<int64_t> last_frame_ns{Clock::now().time_since_epoch().count()};
+    std::atomic<bool> reading{true}, silent{false};
+    std::thread watchdog([&] {
+      const auto limit = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(o->silent_s));
+      while (reading.load()) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(100));
+        if (Clock::now().time_since_epoch().count() - last_frame_ns.load() > limit.count()) {
+          silent.store(true);
+          source->Stop();
+          return;
+        }
+      }
+    });
+    try {
+      while (!wizard.done() && (o->count <= 0 || frames < o->count)) {
+        auto frame = source->Next();
+        if (!frame) break;
+        last_frame_ns.store(Clock::now().time_since_epoch().count());
+        ToBgr(*frame, bgr);
+        wizard.Feed(bgr, static_cast<int>(frame->sequence));
+        ++frames;
+        print_log();
+      }
+    } catch (...) {
+      reading.store(false);
+      watchdog.join();
+      throw;
     }
+    reading.store(false);
+    watchdog.join();
     source->Stop();
+    if (silent.load()) {
+      std::fprintf(stderr, "calibrate wizard: %s delivered no frame for %.1f s; ending with what was seen\n",
+                   camera.name.c_str(), o->silent_s);
+    }
     wizard.Finish();
     print_log();
     const nlohmann::json result = calib::WriteWizardOutputs(wizard, o->out, w.verdict);

@@ -240,6 +240,15 @@ void CalibrationWizard::EnterEnclosure(int frame, const cv::Mat& image) {
     return;
   }
   floor_image_ = image.clone();
+  if (const std::optional<CameraModel> posed = posed_model()) {
+    cv::Mat bgr = image;
+    if (image.channels() == 1) cv::cvtColor(image, bgr, cv::COLOR_GRAY2BGR);
+    try {
+      floor_with_board_m2_ = FindGreenFloor(*posed, bgr).Area();
+    } catch (const std::runtime_error&) {
+      floor_with_board_m2_ = 0;
+    }
+  }
 }
 
 void CalibrationWizard::TryGreenFloor(const cv::Mat& image, int frame, const std::string& from) {
@@ -248,7 +257,16 @@ void CalibrationWizard::TryGreenFloor(const cv::Mat& image, int frame, const std
   cv::Mat bgr = image;
   if (image.channels() == 1) cv::cvtColor(image, bgr, cv::COLOR_GRAY2BGR);
   try {
-    floor_ = FindGreenFloor(*posed, bgr);
+    GroundPolygon found = FindGreenFloor(*posed, bgr);
+    // No board in view is not yet an empty floor: a person or a board held up hides part of
+    // it. Taking the board off the floor can only uncover green, so an empty floor shows at
+    // least what the frame with the board lying on it showed.
+    if (frame >= 0 && found.Area() < 0.95 * floor_with_board_m2_) {
+      Event(frame, "enclosure_rejected", {{"from", from}, {"area_m2", found.Area()},
+                                          {"with_board_m2", floor_with_board_m2_}});
+      return;
+    }
+    floor_ = std::move(found);
     step_ = WizardStep::kDone;
     Event(frame, "enclosure", {{"from", from}, {"area_m2", floor_->Area()}, {"vertices", floor_->vertices().size()}});
   } catch (const std::runtime_error& e) {
@@ -357,7 +375,9 @@ WizardFrame CalibrationWizard::Feed(const cv::Mat& image, int frame) {
       TryGreenFloor(image, frame, "the empty floor");
       if (!floor_) empty_frames_ = 0;
     }
-    if (step_ == WizardStep::kEnclosure) now.push_back("take the board off the floor: the empty green floor gives the enclosure");
+    if (step_ == WizardStep::kEnclosure) {
+      now.push_back("take the board off the floor and clear the floor: the empty green floor gives the enclosure");
+    }
   }
   out.step = step_;
   out.guidance = now;

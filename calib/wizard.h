@@ -126,6 +126,7 @@ class CalibrationWizard {
   std::optional<GroundResult> ground_;
   BoardView floor_view_;
   cv::Mat floor_image_;              // a frame with the board on the floor (green floor fallback)
+  double floor_with_board_m2_ = 0;   // the green floor seen in it: an empty floor shows at least this
   std::optional<GroundPolygon> floor_;
   std::vector<std::string> verdicts_;
   std::vector<std::string> last_guidance_;

@@ -10,6 +10,7 @@
 #include <opencv2/core.hpp>
 
 #include "calib/board.h"
+#include "core/camera_model.h"
 #include "core/geometry.h"
 #include "synth/board.h"
 #include "synth/renderer.h"
@@ -26,6 +27,11 @@ inline calib::BoardSpec ToCalibBoard(const synth::BoardSpec& s) {
   b.marker_m = s.marker_m;
   if (!s.dictionary.empty()) b.dictionary = s.dictionary;
   return b;
+}
+
+// The synthetic camera's true model, posed on the ground.
+inline CameraModel TrueModel(const synth::SynthCamera& cam) {
+  return CameraModel(cam.lensmodel, cam.intrinsics, cam.width, cam.height, cam.cam_from_ground);
 }
 
 // Renders the camera's view of the boards, with sensor noise (`noise` 1 = typical).

@@ -6,13 +6,12 @@
 #include "core/error.h"
 #include "synth/renderer.h"
 #include "synth/scene.h"
+#include "tests/calib/calib_fixtures.h"
 
 namespace ss::calib {
 namespace {
 
-CameraModel TrueModel(const synth::SynthCamera& cam) {
-  return CameraModel(cam.lensmodel, cam.intrinsics, cam.width, cam.height, cam.cam_from_ground);
-}
+using ss::testing::TrueModel;
 
 TEST(FloorPolygon, FromGroundPointsIsCheckedAndNamed) {
   const GroundPolygon p = FloorPolygonFromPoints(ParsePointList("-0.6,-0.4 0.6,-0.4 0.6,0.4;-0.6,0.4", "--points"));

@@ -10,16 +10,14 @@
 namespace ss::calib {
 namespace {
 
+using ss::testing::TrueModel;
+
 using ss::testing::RenderBoards;
 using ss::testing::Rot;
 using ss::testing::ToCalibBoard;
 
 double AngleDeg(const Eigen::Matrix3d& a, const Eigen::Matrix3d& b) {
   return Eigen::AngleAxisd(a * b.transpose()).angle() * 180 / M_PI;
-}
-
-CameraModel TrueModel(const synth::SynthCamera& cam) {
-  return CameraModel(cam.lensmodel, cam.intrinsics, cam.width, cam.height, cam.cam_from_ground);
 }
 
 struct FloorScene {

@@ -4,6 +4,8 @@
 
 #include <algorithm>
 
+#include <opencv2/imgproc.hpp>
+
 #include "core/error.h"
 #include "tests/calib/calib_fixtures.h"
 
@@ -13,6 +15,7 @@ namespace {
 using ss::testing::CamFromBoardInView;
 using ss::testing::RenderBoards;
 using ss::testing::ToCalibBoard;
+using ss::testing::TrueModel;
 
 bool Has(const std::vector<std::string>& lines, const std::string& text) {
   return std::any_of(lines.begin(), lines.end(), [&](const std::string& l) { return l.find(text) != std::string::npos; });
@@ -81,6 +84,44 @@ TEST(CalibrationWizard, CapturesAStillBoardOnceAndOnlyANewViewAgain) {
   EXPECT_FALSE(w.intrinsics_model());
   ASSERT_FALSE(w.verdicts().empty());
   EXPECT_NE(w.verdicts()[0].find("too few views"), std::string::npos) << w.verdicts()[0];
+}
+
+// The enclosure step waits for the empty floor. A frame without the board is not enough: a
+// person (here a dark block across the floor) hides part of it, and the floor found then is
+// smaller than with the board lying on it, so the wizard keeps waiting.
+TEST(CalibrationWizard, TheEnclosureWaitsForAFloorNothingHides) {
+  const synth::Studio studio = synth::MakeStudio(synth::StudioKind::kEnclosure, 5);
+  const synth::SynthCamera cam = synth::MakeCameras(studio, 1, 640, 480, 5)[0];
+  const synth::CameraRenderer renderer(cam, studio);
+  const synth::BoardSpec spec = synth::ChessboardFor(false);
+  const synth::BoardTexture texture(spec);
+  WizardOptions o = Options(ToCalibBoard(spec));
+  o.ground_from_board = FloorBoardPose(-0.5 * spec.width_m(), 0.5 * spec.height_m(), 0.0, 0.001);
+  CameraModel unposed = TrueModel(cam);
+  unposed.set_cam_from_ground({});
+  o.intrinsics = unposed;
+  o.floor_still_frames = 3;
+  CalibrationWizard w("cam0", 640, 480, o);
+  int n = 0;
+  for (int i = 0; i < 4; ++i, ++n) w.Feed(RenderBoards(renderer, {{&texture, o.ground_from_board}}, 1.0, n), n);
+  ASSERT_TRUE(w.ground_good());
+  ASSERT_EQ(w.step(), WizardStep::kEnclosure);
+  for (int i = 0; i < 4; ++i, ++n) {
+    cv::Mat hidden = RenderBoards(renderer, {}, 1.0, n);
+    cv::rectangle(hidden, cv::Rect(160, 200, 320, 280), cv::Scalar(40, 40, 60), cv::FILLED);
+    const WizardFrame f = w.Feed(hidden, n);
+    EXPECT_FALSE(f.detected);
+  }
+  EXPECT_EQ(w.step(), WizardStep::kEnclosure);
+  EXPECT_FALSE(w.enclosure_good());
+  const auto& log = w.log();
+  const bool rejected = std::any_of(log.begin(), log.end(), [](const auto& e) { return e["event"] == "enclosure_rejected"; });
+  EXPECT_TRUE(rejected) << log.dump();
+  for (int i = 0; i < 4 && !w.done(); ++i, ++n) w.Feed(RenderBoards(renderer, {}, 1.0, n), n);
+  ASSERT_TRUE(w.enclosure_good()) << log.dump();
+  // The true green floor is 1.2 m x 0.8 m; the near wall hides a strip of it from this camera.
+  EXPECT_GT(w.floor()->Area(), 0.6);
+  EXPECT_LT(w.floor()->Area(), 0.97);
 }
 
 }  // namespace
