@@ -266,6 +266,21 @@ void AddMatchCommand(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--window", a->options.refine.averaging_window, "Refinement: averaging window, frames")
       ->capture_default_str();
+  cmd->add_option("--motion-weight", a->options.descriptor.motion_weight,
+                  "Per limb pair: weight of the motion term (how fast the pair moves); 0 = poses only")
+      ->capture_default_str();
+  cmd->add_option("--motion-window", a->options.descriptor.motion_window_s,
+                  "Motion term: seconds before and after a frame the pose change is measured over")
+      ->capture_default_str();
+  cmd->add_option("--motion-scale", a->options.descriptor.motion_scale,
+                  "Motion term: the pose change per second that counts as half moving")
+      ->capture_default_str();
+  cmd->add_option("--root-motion-weight", a->options.descriptor.root_motion_weight,
+                  "Weight of the root limb's image speed (in root lengths per second); 0 = none")
+      ->capture_default_str();
+  cmd->add_option("--root-motion-scale", a->options.descriptor.root_motion_scale,
+                  "Root motion: the speed (root lengths per second) that counts as half moving")
+      ->capture_default_str();
   cmd->add_flag("--normalize-ratios", a->options.descriptor.normalize_ratios,
                 "Subtract each sequence's median limb length ratios (different body proportions)");
   cmd->add_flag("--no-refine", a->no_refine, "Skip the refinement by atomic movements");

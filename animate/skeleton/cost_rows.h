@@ -37,8 +37,8 @@ class DenseCostRows final : public CostRows {
 // PoseCost between target and source descriptors, vectorized: complete frames use
 // |a|^2 + |b|^2 - 2 a.b over the features (a dense, GEMM-like kernel); a target with a
 // missing term uses the direct sum over its terms; an incomplete source frame is
-// computed exactly like PoseCost. Source frames whose coverage (share of the term weight
-// they have) is below `min_source_coverage` are excluded (+inf).
+// computed exactly like PoseCost. Source frames whose coverage (share of the pose terms'
+// weight they have) is below `min_source_coverage` are excluded (+inf).
 class DescriptorCostRows final : public CostRows {
  public:
   DescriptorCostRows(const PoseDescriptors& targets, const PoseDescriptors& sources,

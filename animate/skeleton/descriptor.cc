@@ -18,6 +18,18 @@ bool DescriptorOptions::IsValid(std::string* why) const {
   if (angle_weight + ratio_weight <= 0) return fail("angle_weight + ratio_weight must be > 0");
   if (!(min_limb_px >= 0)) return fail("min_limb_px must be >= 0");
   if (!(no_overlap_cost >= 0) || !std::isfinite(no_overlap_cost)) return fail("no_overlap_cost must be finite, >= 0");
+  if (!(motion_weight >= 0) || !std::isfinite(motion_weight)) return fail("motion_weight must be finite, >= 0");
+  if (motion_weight > 0 && !(motion_window_s > 0 && std::isfinite(motion_window_s))) {
+    return fail("motion_window_s must be > 0 seconds");
+  }
+  if (motion_weight > 0 && !(motion_scale > 0 && std::isfinite(motion_scale))) return fail("motion_scale must be > 0");
+  if (!(root_motion_weight >= 0) || !std::isfinite(root_motion_weight)) {
+    return fail("root_motion_weight must be finite, >= 0");
+  }
+  if (root_motion_weight > 0 && !(root_motion_scale > 0 && std::isfinite(root_motion_scale))) {
+    return fail("root_motion_scale must be > 0");
+  }
+  if (!(default_fps > 0) || !std::isfinite(default_fps)) return fail("default_fps must be > 0");
   return true;
 }
 
@@ -38,6 +50,25 @@ DescriptorLayout MakeDescriptorLayout(const SkeletonDef& def, const DescriptorOp
                                  {options.orientation_weight / 2, options.orientation_weight / 2});
     layout.feature_group.insert(layout.feature_group.end(), {layout.pairs, layout.pairs});
     layout.group_weight.push_back(options.orientation_weight);
+  }
+  layout.first_motion_group = layout.groups;
+  layout.first_motion_feature = layout.dim;
+  for (float w : layout.group_weight) layout.pose_total_weight += w;
+  if (options.motion_weight > 0) {
+    for (int p = 0; p < layout.pairs; ++p) {
+      layout.feature_weight.push_back(options.motion_weight);
+      layout.feature_group.push_back(layout.groups);
+      layout.group_weight.push_back(options.motion_weight);
+      ++layout.groups;
+      ++layout.dim;
+    }
+    if (options.root_motion_weight > 0) {
+      layout.feature_weight.push_back(options.root_motion_weight);
+      layout.feature_group.push_back(layout.groups);
+      layout.group_weight.push_back(options.root_motion_weight);
+      ++layout.groups;
+      ++layout.dim;
+    }
   }
   for (float w : layout.group_weight) layout.total_weight += w;
   layout.no_overlap_cost = options.no_overlap_cost;
@@ -96,6 +127,7 @@ void Describe(const SkeletonDef& def, const SkeletonFrame& frame, const Descript
     }
   }
   out->present_weight[i] = weight;
+  out->pose_weight[i] = weight;
 }
 
 // Subtracts, per pair, the median log ratio over frames [begin, end) that have it.
@@ -116,6 +148,62 @@ void NormalizeRatios(PoseDescriptors* d, int begin, int end) {
     for (int i = begin; i < end; ++i) {
       if (d->present[p * n + i]) ratio[i] -= median;
     }
+  }
+}
+
+// The motion features of the clip at [begin, begin + clip.size()) from its pose features:
+// per frame, the frames a (the last at or before t - h) and b (the first at or after
+// t + h), clipped to the clip; Δt = t_b - t_a must lie in [h, 4h] (shorter: a clip too
+// short to measure; longer: a gap in the frame numbers).
+void DescribeMotion(const SkeletonSequence& clip, double fps, const DescriptorOptions& options, PoseDescriptors* d,
+                    int begin) {
+  const DescriptorLayout& layout = d->layout;
+  if (layout.first_motion_group == layout.groups) return;
+  const size_t count = d->count;
+  const int n = clip.size();
+  const double h = options.motion_window_s;
+  auto time = [&](int i) { return static_cast<double>(clip.frames[i].frame) / fps; };
+  const double eps = 1e-3 / fps;  // a thousandth of a frame: 0.2f is not 0.2 nor 5 frames at 25 fps exactly
+  int a = 0, b = 0;
+  for (int i = 0; i < n; ++i) {
+    const double t = time(i);
+    while (a + 1 <= i && time(a + 1) <= t - h + eps) ++a;
+    b = std::max(b, i);
+    while (b + 1 < n && time(b) < t + h - eps) ++b;
+    const double dt = time(b) - time(a);
+    if (!(dt >= h - eps) || dt > 4 * h) continue;
+    const int ia = begin + a, ib = begin + b, ii = begin + i;
+    for (int p = 0; p < layout.pairs; ++p) {
+      if (!d->has(p, ia) || !d->has(p, ib)) continue;
+      double sum = 0;
+      for (int k = 3 * p; k < 3 * p + 3; ++k) {
+        const double diff = static_cast<double>(d->features[k * count + ib]) - d->features[k * count + ia];
+        sum += diff * diff;
+      }
+      const double rate = std::sqrt(sum) / dt;
+      const int g = layout.first_motion_group + p;
+      d->features[(layout.first_motion_feature + p) * count + ii] = static_cast<float>(rate / (rate + options.motion_scale));
+      d->present[g * count + ii] = 1;
+      d->present_weight[ii] += layout.group_weight[g];
+    }
+    // The root limb's midpoint.
+    const int g = layout.first_motion_group + layout.pairs;
+    if (g >= layout.groups) continue;
+    const Limb& root = clip.skeleton.limbs[clip.skeleton.root_limb];
+    const auto& ja = clip.frames[a].joints;
+    const auto& jb = clip.frames[b].joints;
+    if (!ja[root.from].present || !ja[root.to].present || !jb[root.from].present || !jb[root.to].present) continue;
+    const double length = (std::hypot(ja[root.to].x_px - ja[root.from].x_px, ja[root.to].y_px - ja[root.from].y_px) +
+                           std::hypot(jb[root.to].x_px - jb[root.from].x_px, jb[root.to].y_px - jb[root.from].y_px)) /
+                          2;
+    if (!(length >= std::max(options.min_limb_px, 1e-6f))) continue;
+    const double dx = (jb[root.from].x_px + jb[root.to].x_px - ja[root.from].x_px - ja[root.to].x_px) / 2.0;
+    const double dy = (jb[root.from].y_px + jb[root.to].y_px - ja[root.from].y_px - ja[root.to].y_px) / 2.0;
+    const double speed = std::hypot(dx, dy) / length / dt;
+    d->features[(layout.first_motion_feature + layout.pairs) * count + ii] =
+        static_cast<float>(speed / (speed + options.root_motion_scale));
+    d->present[g * count + ii] = 1;
+    d->present_weight[ii] += layout.group_weight[g];
   }
 }
 
@@ -145,6 +233,7 @@ PoseDescriptors ComputeDescriptors(const std::vector<const SkeletonSequence*>& c
   d.features.assign(static_cast<size_t>(d.layout.dim) * d.count, 0.0f);
   d.present.assign(static_cast<size_t>(d.layout.groups) * d.count, 0);
   d.present_weight.assign(d.count, 0.0f);
+  d.pose_weight.assign(d.count, 0.0f);
   int i = 0;
   for (const auto* clip : clips) {
     const int begin = i;
@@ -157,6 +246,10 @@ PoseDescriptors ComputeDescriptors(const std::vector<const SkeletonSequence*>& c
       Describe(def, frame, options, &d, i++);
     }
     if (options.normalize_ratios) NormalizeRatios(&d, begin, i);
+    const double fps = clip->fps > 0 ? clip->fps : options.default_fps;
+    d.clip_starts.push_back(begin);
+    d.clip_fps.push_back(fps);
+    DescribeMotion(*clip, fps, options, &d, begin);
   }
   return d;
 }
@@ -165,16 +258,18 @@ PoseDescriptors ComputeDescriptors(const SkeletonSequence& sequence, const Descr
   return ComputeDescriptors(std::vector<const SkeletonSequence*>{&sequence}, options);
 }
 
-float PoseCost(const PoseDescriptors& a, int i, const PoseDescriptors& b, int j) {
+float PoseCost(const PoseDescriptors& a, int i, const PoseDescriptors& b, int j, bool motion) {
   const DescriptorLayout& layout = a.layout;
   if (a.present_weight[i] <= 0) return 0.0f;
+  const int groups = motion ? layout.groups : layout.first_motion_group;
+  const int dim = motion ? layout.dim : layout.first_motion_feature;
   double numerator = 0, denominator = 0;
-  for (int g = 0; g < layout.groups; ++g) {
+  for (int g = 0; g < groups; ++g) {
     if (!a.has(g, i) || !b.has(g, j)) continue;
     denominator += layout.group_weight[g];
   }
   if (denominator <= 0) return layout.no_overlap_cost;
-  for (int k = 0; k < layout.dim; ++k) {
+  for (int k = 0; k < dim; ++k) {
     const int g = layout.feature_group[k];
     if (!a.has(g, i) || !b.has(g, j)) continue;
     const double diff = static_cast<double>(a.feature(k, i)) - b.feature(k, j);
@@ -185,8 +280,14 @@ float PoseCost(const PoseDescriptors& a, int i, const PoseDescriptors& b, int j)
 
 std::vector<float> SequentialCost(const PoseDescriptors& sequence) {
   std::vector<float> cost;
-  for (int t = 0; t + 1 < sequence.count; ++t) cost.push_back(PoseCost(sequence, t, sequence, t + 1));
+  for (int t = 0; t + 1 < sequence.count; ++t) cost.push_back(PoseCost(sequence, t, sequence, t + 1, false));
   return cost;
+}
+
+double FrameRateAt(const PoseDescriptors& d, int i) {
+  const auto it = std::upper_bound(d.clip_starts.begin(), d.clip_starts.end(), i);
+  if (it == d.clip_starts.begin()) return 30.0;
+  return d.clip_fps[it - d.clip_starts.begin() - 1];
 }
 
 }  // namespace ss

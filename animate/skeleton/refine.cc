@@ -7,12 +7,20 @@
 
 namespace ss {
 
-std::vector<int> FindMovements(const std::vector<float>& sequential_cost, const MovementOptions& options) {
+MovementFrames MovementWindows(const MovementOptions& options, double fps) {
+  if (!(fps > 0)) throw InputError("refine", "the frame rate must be > 0");
+  auto frames = [&](double seconds) { return std::max(1, static_cast<int>(std::lround(seconds * fps))); };
+  return {frames(options.lag_s), frames(options.smoothing_s), frames(options.min_length_s)};
+}
+
+std::vector<int> FindMovements(const std::vector<float>& sequential_cost, const MovementOptions& options,
+                               double fps) {
+  const MovementFrames windows = MovementWindows(options, fps);
   const int n = static_cast<int>(sequential_cost.size());  // frames - 1
   std::vector<int> starts = {0};
   if (n < 3) return starts;
   // Smooth.
-  const int half = std::max(0, options.smoothing_window / 2);
+  const int half = std::max(0, windows.smoothing_window / 2);
   std::vector<double> q(n);
   for (int t = 0; t < n; ++t) {
     double sum = 0;
@@ -46,9 +54,9 @@ std::vector<int> FindMovements(const std::vector<float>& sequential_cost, const 
   std::vector<int> kept;
   for (const auto& p : peaks) {
     const int boundary = p.t + 1;
-    if (boundary < options.min_length || frames - boundary < options.min_length) continue;
+    if (boundary < windows.min_length || frames - boundary < windows.min_length) continue;
     bool clear = true;
-    for (int k : kept) clear = clear && std::abs(k - boundary) >= options.min_length;
+    for (int k : kept) clear = clear && std::abs(k - boundary) >= windows.min_length;
     if (clear) kept.push_back(boundary);
   }
   starts.insert(starts.end(), kept.begin(), kept.end());
@@ -60,7 +68,7 @@ std::vector<float> MovementCost(const PoseDescriptors& frames, int begin, int en
   const int l = std::max(1, lag);
   std::vector<float> q;
   for (int t = begin; t + 1 < end; ++t) {
-    q.push_back(PoseCost(frames, std::max(begin, t + 1 - l), frames, std::min(end - 1, t + l)));
+    q.push_back(PoseCost(frames, std::max(begin, t + 1 - l), frames, std::min(end - 1, t + l), false));
   }
   return q;
 }
@@ -71,7 +79,9 @@ std::vector<int> FindMovements(const PoseDescriptors& frames, const std::vector<
   for (size_t c = 0; c < clip_starts.size(); ++c) {
     const int begin = clip_starts[c];
     const int end = c + 1 < clip_starts.size() ? clip_starts[c + 1] : frames.count;
-    for (int s : FindMovements(MovementCost(frames, begin, end, options.lag), options)) starts.push_back(begin + s);
+    const double fps = FrameRateAt(frames, begin);
+    const int lag = MovementWindows(options, fps).lag;
+    for (int s : FindMovements(MovementCost(frames, begin, end, lag), options, fps)) starts.push_back(begin + s);
   }
   return starts;
 }

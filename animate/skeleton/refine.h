@@ -12,13 +12,17 @@
 
 namespace ss {
 
+// The detector's windows are durations in seconds, turned into frames with each clip's
+// frame rate: at 30 fps they are the frames they were tuned as (lag 4, smoothing 5,
+// minimum length 8); at 10 fps a third of those (lag 1, smoothing 2 -> 3, 3 frames).
 struct MovementOptions {
-  // Frames each side of the gap between t and t+1 that the pose change is measured over:
-  // cost(x_{t+1-lag}, x_{t+lag}); 1 is the plain sequential cost. A wider lag lifts a
-  // movement's change above tracking noise, which is the same at every lag.
-  int lag = 4;
-  int smoothing_window = 5;      // centred moving average of the sequential cost first
-  int min_length = 8;            // frames; of two boundaries closer than this the weaker goes
+  // Seconds each side of the gap between t and t+1 that the pose change is measured over:
+  // cost(x_{t+1-lag}, x_{t+lag}) with lag = lag_s * fps frames (at least 1; 1 is the plain
+  // sequential cost). A wider lag lifts a movement's change above tracking noise, which
+  // is the same at every lag.
+  double lag_s = 4.0 / 30;
+  double smoothing_s = 5.0 / 30;  // centred moving average of the sequential cost first
+  double min_length_s = 8.0 / 30; // of two boundaries closer than this the weaker goes
   // A peak's height over the higher of its two bases must reach
   // max(min_prominence, noise_factor * median cost): the median is the noise floor of
   // tracked or imported joints, whose jitter alone makes peaks.
@@ -26,13 +30,21 @@ struct MovementOptions {
   float noise_factor = 2.5f;
 };
 
-// First frame of each movement (0 first) of one sequence, from its sequential cost
-// (`lag` is not used here: the costs are given).
-std::vector<int> FindMovements(const std::vector<float>& sequential_cost, const MovementOptions& options);
+// The windows above in frames at `fps` (rounded, at least 1).
+struct MovementFrames {
+  int lag = 4, smoothing_window = 5, min_length = 8;
+};
+MovementFrames MovementWindows(const MovementOptions& options, double fps);
+
+// First frame of each movement (0 first) of one sequence at `fps`, from its sequential
+// cost (the lag is not used here: the costs are given).
+std::vector<int> FindMovements(const std::vector<float>& sequential_cost, const MovementOptions& options,
+                               double fps = 30);
 // The pose change across each gap t | t+1 of frames [begin, end): cost(x_{t+1-lag}, x_{t+lag}),
 // clipped to the range (end - begin - 1 values).
 std::vector<float> MovementCost(const PoseDescriptors& frames, int begin, int end, int lag);
-// Of several clips laid end to end: every clip start, plus the movements inside each clip.
+// Of several clips laid end to end: every clip start, plus the movements inside each clip,
+// each at its frame rate (FrameRateAt).
 std::vector<int> FindMovements(const PoseDescriptors& frames, const std::vector<int>& clip_starts,
                                const MovementOptions& options);
 

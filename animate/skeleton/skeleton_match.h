@@ -19,7 +19,7 @@ struct SkeletonMatchOptions {
   RefineOptions refine;
   bool refine_enabled = true;
   bool compare_without_penalties = true;  // also solve without the penalties (Figure 2a)
-  float min_source_coverage = 0.5f;       // source frames with less of the term weight are never chosen
+  float min_source_coverage = 0.5f;       // source frames with less of the pose terms' weight are never chosen
 };
 
 // A source frame as the caller knows it.

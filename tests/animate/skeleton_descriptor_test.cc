@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <random>
 
@@ -84,8 +85,11 @@ TEST(SkeletonDescriptor, RotationOnlyChangesTheOrientationTerm) {
   const PoseDescriptors b = ComputeDescriptors(turned, with_orientation);
   const PoseDescriptors a0 = ComputeDescriptors(poses.sequence, without_orientation);
   const PoseDescriptors b0 = ComputeDescriptors(turned, without_orientation);
-  // 1 - cos(0.5) of weight 0.25 among 17 pairs of weight 1.5 and the orientation's 0.25.
-  const float expected = 0.25f * (1 - std::cos(0.5f)) / (17 * 1.5f + 0.25f);
+  // 1 - cos(0.5) of weight 0.25 among 17 pairs of weight 1.5, the orientation's 0.25, 17
+  // pair motion terms and the root's motion (both unchanged by the rotation).
+  ASSERT_EQ(a.layout.groups, 17 + 1 + 17 + 1);
+  const float expected = 0.25f * (1 - std::cos(0.5f)) /
+                         (17 * 1.5f + 0.25f + 17 * with_orientation.motion_weight + with_orientation.root_motion_weight);
   for (int i = 0; i < a.count; i += 11) {
     EXPECT_NEAR(PoseCost(a, i, b, i), expected, 1e-5);
     EXPECT_LT(PoseCost(a0, i, b0, i), 1e-6);
@@ -136,8 +140,20 @@ TEST(SkeletonDescriptor, RobustToAMissingJoint) {
   }
   const PoseDescriptors d = ComputeDescriptors(damaged, {});
   // One pair (elbow angle) uses the wrist; the knee's pair and the knee-hip pair use the knee.
-  EXPECT_NEAR(d.coverage(1), 1 - 1.5f / (17 * 1.5f + 0.25f), 1e-5);
-  EXPECT_NEAR(d.coverage(0), 1 - 2 * 1.5f / (17 * 1.5f + 0.25f), 1e-5);
+  DescriptorOptions poses_only;
+  poses_only.motion_weight = 0;
+  const PoseDescriptors d0 = ComputeDescriptors(damaged, poses_only);
+  EXPECT_NEAR(d0.coverage(1), 1 - 1.5f / (17 * 1.5f + 0.25f), 1e-5);
+  EXPECT_NEAR(d0.coverage(0), 1 - 2 * 1.5f / (17 * 1.5f + 0.25f), 1e-5);
+  // The motion terms of a pair need it in both frames of the window (5 frames each side at
+  // 25 fps: there the other joint is missing). Frame 20 (knee): its two pairs and, from
+  // frames 15 and 25 (wrist), the elbow's motion are gone.
+  // (The coverage counts the pose terms only.)
+  const float w = d.layout.total_weight, wm = DescriptorOptions{}.motion_weight;
+  EXPECT_NEAR(d.present_weight[20], w - (2 * 1.5f + wm), 1e-4);
+  EXPECT_NEAR(d.present_weight[21], w - (1.5f + 2 * wm), 1e-4);
+  EXPECT_NEAR(d.coverage(20), d0.coverage(0), 1e-6);
+  EXPECT_NEAR(d.coverage(21), d0.coverage(1), 1e-6);
   int same = 0;
   for (int i = 0; i < d.count; ++i) {
     EXPECT_LT(PoseCost(d, i, library, i), 1e-6);  // the terms it has agree exactly
@@ -146,6 +162,71 @@ TEST(SkeletonDescriptor, RobustToAMissingJoint) {
   EXPECT_EQ(same, d.count);
   // A missing joint on the source side is handled alike.
   for (int i = 0; i < d.count; i += 5) EXPECT_LT(PoseCost(library, i, d, i), 1e-6);
+}
+
+// Every joint's track, sampled every `step`-th frame, at fps / step.
+SkeletonSequence Subsampled(const SkeletonSequence& in, int step) {
+  SkeletonSequence out = in;
+  out.frames.clear();
+  for (int i = 0; i < in.size(); i += step) {
+    out.frames.push_back(in.frames[i]);
+    out.frames.back().frame = i / step;
+  }
+  out.fps = in.fps / step;
+  return out;
+}
+
+TEST(SkeletonDescriptor, MotionTermIsMeasuredInSecondsAndTellsMovingFromHolding) {
+  // idle 30, Y 30 (with a blend into it), walk 56 at 25 fps.
+  const LabelledSkeletons poses =
+      MakeGestureSequence({{Gesture::kIdle, 30}, {Gesture::kY, 30}, {Gesture::kWalk, 56}}, BodyProportions{});
+  ASSERT_EQ(poses.sequence.fps, 25);
+  DescriptorOptions o;
+  o.motion_window_s = 0.24f;  // 6 frames at 25 fps, 2 at 25 / 3
+  const PoseDescriptors d = ComputeDescriptors(poses.sequence, o);
+  const PoseDescriptors third = ComputeDescriptors(Subsampled(poses.sequence, 3), o);
+  const int m0 = d.layout.first_motion_feature;
+  ASSERT_EQ(d.layout.dim, m0 + d.layout.pairs + 1);  // and the root's
+  auto motion = [&](const PoseDescriptors& x, int i) {  // the mean pair motion feature
+    float sum = 0;
+    for (int p = 0; p < x.layout.pairs; ++p) sum += x.feature(m0 + p, i);
+    return sum / x.layout.pairs;
+  };
+  // The same movement at a third of the frame rate: the same motion features (the window
+  // ends fall on the same instants), though a frame then spans three times the change.
+  for (int i = 2; i + 2 < third.count; ++i) {
+    for (int p = 0; p <= d.layout.pairs; ++p) {  // and the root's
+      ASSERT_NEAR(third.feature(m0 + p, i), d.feature(m0 + p, 3 * i), 1e-5) << "pair " << p << " frame " << 3 * i;
+    }
+  }
+  // The idle and the held Y only sway (3 degrees; the idle's sway, at 0.2 rad of phase a
+  // frame, is fast); the walk swings the legs and arms. Measured: 0.104, 0.041, 0.210.
+  float idle = 0, held = 0, walk = 0;
+  for (int i = 0; i < 24; ++i) idle += motion(d, i) / 24;  // (the window ends before the blend)
+  for (int i = 44; i < 62; ++i) held += motion(d, i) / 18;
+  for (int i = 80; i < d.count; ++i) walk += motion(d, i) / (d.count - 80);
+  std::printf("mean pair motion feature: idle %.3f, Y held %.3f, walk %.3f\n", idle, held, walk);
+  EXPECT_LT(idle, 0.15f);
+  EXPECT_LT(held, 0.08f);
+  EXPECT_GT(walk, 0.18f);
+  EXPECT_GT(walk, 1.8f * idle);
+  EXPECT_GT(motion(d, 33), 0.18f);  // in the blend into Y
+  // Across clips: each clip's motion comes from its own frames and frame rate.
+  const SkeletonSequence slow = Subsampled(poses.sequence, 3);
+  const PoseDescriptors both = ComputeDescriptors(std::vector<const SkeletonSequence*>{&poses.sequence, &slow}, o);
+  ASSERT_EQ(both.clip_starts, (std::vector<int>{0, d.count}));
+  EXPECT_EQ(FrameRateAt(both, d.count + 1), 25.0 / 3);
+  for (int i = 0; i < third.count; ++i) {
+    for (int k = 0; k < d.layout.dim; ++k) ASSERT_EQ(both.feature(k, d.count + i), third.feature(k, i));
+  }
+  // A clip shorter than the window and a gap in the frame numbers leave the motion out.
+  SkeletonSequence gap = poses.sequence;
+  for (int i = 60; i < gap.size(); ++i) gap.frames[i].frame += 100;  // 4 s missing
+  const PoseDescriptors g = ComputeDescriptors(gap, o);
+  EXPECT_FALSE(g.has(g.layout.first_motion_group, 60));
+  EXPECT_TRUE(g.has(g.layout.first_motion_group, 80));
+  EXPECT_TRUE(g.complete(80));
+  EXPECT_FALSE(g.complete(60));
 }
 
 TEST(SkeletonDescriptor, CostRowsAgreeWithPoseCost) {

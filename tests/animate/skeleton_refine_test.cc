@@ -33,8 +33,8 @@ TEST(SkeletonRefine, MovementsStartAfterLocalMaxima) {
 
 TEST(SkeletonRefine, WeakAndCrowdedPeaksAreDropped) {
   MovementOptions o;
-  o.min_length = 8;
-  o.smoothing_window = 3;
+  o.min_length_s = 8.0 / 30;  // frames at the default 30 fps
+  o.smoothing_s = 3.0 / 30;
   o.noise_factor = 0;  // the fixed threshold alone
   o.min_prominence = 0.05f;
   // 85: too weak; 48: 3 frames after the stronger 45; 3: too close to the start.
@@ -47,6 +47,30 @@ TEST(SkeletonRefine, WeakAndCrowdedPeaksAreDropped) {
   // Relative to the noise floor: on a floor of 0.01 the 0.03 bump is noise for a factor of 4.
   o.noise_factor = 4;
   EXPECT_EQ(FindMovements(q, o), (std::vector<int>{0, 21, 47, 71}));
+}
+
+TEST(SkeletonRefine, MovementWindowsAreSecondsAtTheClipsFrameRate) {
+  // 30 fps keeps the frames the detector was tuned with; 10 fps a third of them.
+  const MovementFrames at30 = MovementWindows(MovementOptions{}, 30);
+  EXPECT_EQ(at30.lag, 4);
+  EXPECT_EQ(at30.smoothing_window, 5);
+  EXPECT_EQ(at30.min_length, 8);
+  const MovementFrames at10 = MovementWindows(MovementOptions{}, 10);
+  EXPECT_EQ(at10.lag, 1);
+  EXPECT_EQ(at10.smoothing_window, 2);
+  EXPECT_EQ(at10.min_length, 3);
+  EXPECT_EQ(MovementWindows(MovementOptions{}, 60).min_length, 16);
+  // Two movements 1 s apart: at 30 fps and, sampled every third frame, at 10 fps, the
+  // boundaries fall at the same instants. With the 30 fps frame counts at 10 fps the
+  // minimum length (8 frames = 0.8 s there) would merge the 0.5 s movement in between.
+  const auto q30 = Bumps(120, {{30, 0.5f}, {45, 0.5f}, {90, 0.5f}});
+  std::vector<float> q10;
+  for (int t = 0; t < 120; t += 3) q10.push_back(q30[t]);
+  EXPECT_EQ(FindMovements(q30, MovementOptions{}, 30), (std::vector<int>{0, 31, 46, 91}));
+  EXPECT_EQ(FindMovements(q10, MovementOptions{}, 10), (std::vector<int>{0, 11, 16, 31}));
+  MovementOptions frames_at_30;
+  frames_at_30.min_length_s = 8.0 / 10;
+  EXPECT_EQ(FindMovements(q10, frames_at_30, 10).size(), 3u);
 }
 
 // The gesture script's transitions: [first frame, last frame] of each blend.

@@ -97,9 +97,10 @@ TEST_F(SkeletonEndToEnd, ImportedTruthMatchesGesturesWithoutLongFreezes) {
   const auto target_joints = Joints(ReadJson(*dir_ / "target.skel.json"));
 
   struct Score {
-    int frames = 0, same = 0, arm_frames = 0, arm_same = 0;
+    int frames = 0, same = 0, arm_frames = 0, arm_same = 0, moving_frames = 0, moving_same = 0;
     double all() const { return static_cast<double>(same) / frames; }
     double arms() const { return static_cast<double>(arm_same) / arm_frames; }
+    double moving() const { return static_cast<double>(moving_same) / moving_frames; }
   };
   auto score = [&](const nlohmann::json& frames) {
     Score s;
@@ -112,6 +113,10 @@ TEST_F(SkeletonEndToEnd, ImportedTruthMatchesGesturesWithoutLongFreezes) {
         ++s.arm_frames;
         s.arm_same += same;
       }
+      if (want == "turn" || want == "walk") {
+        ++s.moving_frames;
+        s.moving_same += same;
+      }
     }
     return s;
   };
@@ -119,19 +124,26 @@ TEST_F(SkeletonEndToEnd, ImportedTruthMatchesGesturesWithoutLongFreezes) {
   const Score without = score(m["passes"]["without_penalties"]["frames"]);
   const Score refined = score(m["frames"]);
   std::printf("gesture accuracy without / with penalties / refined: %.3f / %.3f / %.3f (arm gestures Y M C A: "
-              "%.3f / %.3f / %.3f)\n",
-              without.all(), with.all(), refined.all(), without.arms(), with.arms(), refined.arms());
+              "%.3f / %.3f / %.3f; turn and walk: %.3f / %.3f / %.3f)\n",
+              without.all(), with.all(), refined.all(), without.arms(), with.arms(), refined.arms(),
+              without.moving(), with.moving(), refined.moving());
   ASSERT_EQ(with.frames, static_cast<int>(target_labels.size()));
   ASSERT_GT(with.arm_frames, 40);
-  // The arm gestures are matched (measured: 1.0 in every pass).
+  ASSERT_GT(with.moving_frames, 20);  // turn 17, walk 8 (frames 20-35 and 111-119)
+  // The arm gestures are matched (measured: 1.0 / 0.98 / 1.0).
   EXPECT_GE(with.arms(), 0.95);
   EXPECT_GE(refined.arms(), 0.95);
-  // Over every frame the 0.95 is NOT reached (measured 0.883 with penalties, 0.833
-  // refined): the target's short turn and slow walk away from the camera (0.15 m/s, frames
-  // 20-35) are nearly the idle pose in 2D (ankles 1-2 px apart across) and go to idle
-  // source frames; the descriptor has no motion term (docs/skeletons.md, "Known limits").
-  EXPECT_GE(with.all(), 0.85);
-  EXPECT_GE(refined.all(), 0.80);
+  // Over every frame, measured 0.892 without penalties, 0.958 with them, 0.917 refined
+  // (before the motion term: 0.850 / 0.883 / 0.833). The target's turn and slow walk away
+  // from the camera are nearly the idle pose in 2D; the motion term (limb-pair rates and
+  // the root's image speed) sends them to moving source frames: turn and walk measured
+  // 0.48 / 0.84 / 0.68 (before: 0.28 / 0.48 / 0.32). The refinement still puts the walk
+  // into the source turn's or idle's movement (docs/skeletons.md, "Known limits").
+  EXPECT_GE(without.all(), 0.875);
+  EXPECT_GE(with.all(), 0.95);
+  EXPECT_GE(refined.all(), 0.90);
+  EXPECT_GE(with.moving(), 0.80);
+  EXPECT_GE(refined.moving(), 0.60);
 
   // With penalties: no freeze longer than 5 frames while the target moves (a joint moves
   // more than 1 px from the previous target frame).
