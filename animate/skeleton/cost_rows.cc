@@ -49,10 +49,10 @@ inline v8f ClampPositive(v8f v) { return v > 0 ? v : v8f{}; }
 
 // (The t loops are unrolled explicitly: at -O2 GCC otherwise keeps acc0/acc1 in memory.)
 // out[t][s] = na[t] + nb[s] + sum_k a[t][k] * b[k][s] for TB targets and one chunk of
-// kChunk sources starting at s (`b`, `nb` already offset by s).
+// kChunk sources starting at s (`b` the chunk's packed features [k][kChunk], `nb` offset by s).
 template <int TB>
-__attribute__((always_inline)) inline void DenseChunk(const float* b, size_t stride, int dim, const float* nb,
-                                                      const float* a, const float* na, float* const* out) {
+__attribute__((always_inline)) inline void DenseChunk(const float* b, int dim, const float* nb, const float* a,
+                                                      const float* na, float* const* out) {
   v8f acc0[TB], acc1[TB];
   const v8f nb0 = Load(nb), nb1 = Load(nb + kLanes);
 #pragma GCC unroll 8
@@ -61,7 +61,7 @@ __attribute__((always_inline)) inline void DenseChunk(const float* b, size_t str
     acc1[t] = nb1 + na[t];
   }
   for (int k = 0; k < dim; ++k) {
-    const v8f b0 = Load(b + k * stride), b1 = Load(b + k * stride + kLanes);
+    const v8f b0 = Load(b + k * kChunk), b1 = Load(b + k * kChunk + kLanes);
 #pragma GCC unroll 8
     for (int t = 0; t < TB; ++t) {
       const float at = a[t * dim + k];
@@ -77,46 +77,48 @@ __attribute__((always_inline)) inline void DenseChunk(const float* b, size_t str
 }
 
 template <int TB>
-__attribute__((always_inline)) inline void DenseRows(const float* b, int padded, int dim, const float* nb,
-                                                     const float* a, const float* na, float* const* rows,
-                                                     int count) {
+__attribute__((always_inline)) inline void DenseRows(const float* b, int dim, const float* nb, const float* a,
+                                                     const float* na, float* const* rows, int count) {
   float* out[TB];
   alignas(32) float tail[TB][kChunk];
   for (int s = 0; s < count; s += kChunk) {
     const bool full = s + kChunk <= count;
     for (int t = 0; t < TB; ++t) out[t] = full ? rows[t] + s : tail[t];
-    DenseChunk<TB>(b + s, padded, dim, nb + s, a, na, out);
+    DenseChunk<TB>(b + static_cast<size_t>(s) * dim, dim, nb + s, a, na, out);
     if (!full) {
       for (int t = 0; t < TB; ++t) std::memcpy(rows[t] + s, tail[t], sizeof(float) * (count - s));
     }
   }
 }
 
-// Complete targets against every source: see DenseChunk. 1 <= tb <= kTile.
+// Complete targets against every source: see DenseChunk. `b` is the packed block of the
+// first source (a multiple of kChunk). 1 <= tb <= kTile.
 __attribute__((target_clones("arch=x86-64-v3", "default"))) void DenseKernel(
-    const float* b, int padded, int dim, const float* nb, const float* a, const float* na, int tb,
-    float* const* rows, int count) {
+    const float* b, int dim, const float* nb, const float* a, const float* na, int tb, float* const* rows,
+    int count) {
   switch (tb) {
-    case 1: DenseRows<1>(b, padded, dim, nb, a, na, rows, count); break;
-    case 2: DenseRows<2>(b, padded, dim, nb, a, na, rows, count); break;
-    case 3: DenseRows<3>(b, padded, dim, nb, a, na, rows, count); break;
-    case 4: DenseRows<4>(b, padded, dim, nb, a, na, rows, count); break;
-    case 5: DenseRows<5>(b, padded, dim, nb, a, na, rows, count); break;
-    default: DenseRows<kTile>(b, padded, dim, nb, a, na, rows, count); break;
+    case 1: DenseRows<1>(b, dim, nb, a, na, rows, count); break;
+    case 2: DenseRows<2>(b, dim, nb, a, na, rows, count); break;
+    case 3: DenseRows<3>(b, dim, nb, a, na, rows, count); break;
+    case 4: DenseRows<4>(b, dim, nb, a, na, rows, count); break;
+    case 5: DenseRows<5>(b, dim, nb, a, na, rows, count); break;
+    default: DenseRows<kTile>(b, dim, nb, a, na, rows, count); break;
   }
 }
 
-// One target with missing terms: out[s] = sum over its features k of w[k] (a[k] - b[k][s])^2.
+// One target with missing terms: out[s] = sum over its features k of w[k] (a[k] - b[k][s])^2
+// (`b` packed as for DenseKernel, `dim` features a source).
 __attribute__((target_clones("arch=x86-64-v3", "default"))) void SparseKernel(
-    const float* b, int padded, const int* features, int nfeatures, const float* w, const float* a,
-    float* row, int count) {
+    const float* b, int dim, const int* features, int nfeatures, const float* w, const float* a, float* row,
+    int count) {
   alignas(32) float tail[kLanes];
   // Up to `count` only: the last lanes of the padding may lie wholly past it (a negative
   // tail length here once overwrote the row).
   for (int s = 0; s < count; s += kLanes) {
     v8f acc{};
+    const float* chunk = b + static_cast<size_t>(s / kChunk) * dim * kChunk + s % kChunk;
     for (int f = 0; f < nfeatures; ++f) {
-      const v8f d = Load(b + static_cast<size_t>(features[f]) * padded + s) - a[f];
+      const v8f d = Load(chunk + features[f] * kChunk) - a[f];
       acc += d * d * w[f];
     }
     if (s + kLanes <= count) {
@@ -141,8 +143,9 @@ DescriptorCostRows::DescriptorCostRows(const PoseDescriptors& targets, const Pos
   padded_ = (count + kChunk - 1) / kChunk * kChunk;
   source_features_.assign(static_cast<size_t>(layout.dim) * padded_, 0.0f);
   for (int k = 0; k < layout.dim; ++k) {
-    std::copy_n(sources.features.begin() + static_cast<size_t>(k) * count, count,
-                source_features_.begin() + static_cast<size_t>(k) * padded_);
+    for (int s = 0; s < count; ++s) {
+      source_features_[(static_cast<size_t>(s / kChunk) * layout.dim + k) * kChunk + s % kChunk] = sources.feature(k, s);
+    }
   }
   source_norm_.assign(padded_, 0.0f);
   for (int s = 0; s < count; ++s) {
@@ -184,7 +187,7 @@ void DescriptorCostRows::Compute(int t0, int n, float* out) const {
         w.push_back(layout.feature_weight[k] / tg.present_weight[t]);
         a.push_back(tg.feature(k, t));
       }
-      SparseKernel(source_features_.data(), padded_, features.data(), static_cast<int>(features.size()), w.data(),
+      SparseKernel(source_features_.data(), dim, features.data(), static_cast<int>(features.size()), w.data(),
                    a.data(), row, count);
     }
     for (int s : incomplete_) row[s] = PoseCost(tg, t, src, s);
@@ -207,15 +210,15 @@ void DescriptorCostRows::Compute(int t0, int n, float* out) const {
     na[i] = static_cast<float>(norm / layout.total_weight);
     all_rows[i] = out + static_cast<size_t>(t - t0) * count;
   }
-  constexpr int kSourceBlock = 64 * kChunk;  // 1,024 sources: ~200 KiB of features for human14
+  constexpr int kSourceBlock = 64 * kChunk;  // 1,024 sources: ~290 KiB of features for human14 (71)
   float* rows[kTile];
   for (int s0 = 0; s0 < count; s0 += kSourceBlock) {
     const int block = std::min(kSourceBlock, count - s0);
     for (size_t first = 0; first < nd; first += kTile) {
       const int tb = static_cast<int>(std::min<size_t>(kTile, nd - first));
       for (int i = 0; i < tb; ++i) rows[i] = all_rows[first + i] + s0;
-      DenseKernel(source_features_.data() + s0, padded_, dim, source_norm_.data() + s0, a.data() + first * dim,
-                  na.data() + first, tb, rows, block);
+      DenseKernel(source_features_.data() + static_cast<size_t>(s0) * dim, dim, source_norm_.data() + s0,
+                  a.data() + first * dim, na.data() + first, tb, rows, block);
     }
   }
   for (size_t i = 0; i < nd; ++i) {
