@@ -104,6 +104,7 @@ struct RowRules {
   std::vector<float> back_limit;        // per s: backward steps allowed, min(W, segment end - s)
   std::vector<SourceTransition> listed;  // applicable transitions, sorted by `to`
   std::vector<int> listed_begin;        // listed transitions into s: [listed_begin[s], listed_begin[s+1])
+  std::vector<int> edges;               // s where a limit is below Kf or W (near a segment's ends)
   bool local_jumps = false;             // jumps stay inside the segment and cost λ per frame more
 };
 
@@ -121,6 +122,7 @@ RowRules MakeRules(const std::vector<int>& starts, int count, const MatchOptions
     for (int s = begin; s <= end; ++s) {
       rules.fwd_limit[s] = static_cast<float>(std::min(o.max_forward_step, s - begin));
       rules.back_limit[s] = static_cast<float>(std::min(o.stutter_window, end - s));
+      if (s - begin < o.max_forward_step || end - s < o.stutter_window) rules.edges.push_back(s);
     }
   }
   for (const auto& tr : o.transitions) {
@@ -176,9 +178,13 @@ struct StepArgs {
   size_t stride;
   int count;              // s in [0, count), count a multiple of kLanes
   float offset;           // subtracted from every value (the previous row's minimum)
+  bool masked;            // apply fwd_limit / back_limit; false: the caller redoes the edges
 };
 
-__attribute__((target_clones("arch=x86-64-v3", "default"))) void StepKernel(const StepArgs& args) {
+// The row step; kMasked = false ignores the segment limits (every window full), for rules
+// whose few edge cells the caller recomputes with Cell().
+template <bool kMasked>
+__attribute__((always_inline)) inline void StepBody(const StepArgs& args) {
   // A local copy: the stores through float pointers below could alias the caller's struct
   // (it holds floats), which made the compiler reload every field in the loop.
   const StepArgs a = args;
@@ -186,16 +192,21 @@ __attribute__((target_clones("arch=x86-64-v3", "default"))) void StepKernel(cons
   const v8f inf = v8f{} + kInf;
   for (int s = 0; s < a.count; s += kLanes) {
     v8f fwd = inf;
-    const v8f fl = Load(a.fwd_limit + s);
-    for (int k = 1; k <= a.kf; ++k) {
-      const v8f cand = Load(a.m + s - k) + a.skip[k];
-      fwd = (v8f{} + static_cast<float>(k)) <= fl ? Min(fwd, cand) : fwd;
-    }
     v8f stu = inf;
-    const v8f bl = Load(a.back_limit + s);
-    for (int k = 1; k <= a.w; ++k) {
-      const v8f cand = Load(a.m + s + k) + a.stutter[k];
-      stu = (v8f{} + static_cast<float>(k)) <= bl ? Min(stu, cand) : stu;
+    if constexpr (kMasked) {
+      const v8f fl = Load(a.fwd_limit + s);
+      for (int k = 1; k <= a.kf; ++k) {
+        const v8f cand = Load(a.m + s - k) + a.skip[k];
+        fwd = (v8f{} + static_cast<float>(k)) <= fl ? Min(fwd, cand) : fwd;
+      }
+      const v8f bl = Load(a.back_limit + s);
+      for (int k = 1; k <= a.w; ++k) {
+        const v8f cand = Load(a.m + s + k) + a.stutter[k];
+        stu = (v8f{} + static_cast<float>(k)) <= bl ? Min(stu, cand) : stu;
+      }
+    } else {
+      for (int k = 1; k <= a.kf; ++k) fwd = Min(fwd, Load(a.m + s - k) + a.skip[k]);
+      for (int k = 1; k <= a.w; ++k) stu = Min(stu, Load(a.m + s + k) + a.stutter[k]);
     }
     const v8f jmp = a.jump ? Load(a.jump + s) : v8f{} + a.jump_const;
     const v8f best = Min(fwd, Min(stu, jmp));
@@ -223,6 +234,14 @@ __attribute__((target_clones("arch=x86-64-v3", "default"))) void StepKernel(cons
       const v8u8 bytes = __builtin_convertvector(code, v8u8);  // one 8-byte store, not eight
       std::memcpy(a.record + s, &bytes, sizeof(bytes));
     }
+  }
+}
+
+__attribute__((target_clones("arch=x86-64-v3", "default"))) void StepKernel(const StepArgs& args) {
+  if (args.masked) {
+    StepBody<true>(args);
+  } else {
+    StepBody<false>(args);
   }
 }
 
@@ -449,9 +468,18 @@ void Engine::Step(int t, const float* c, const Row& prev, Row* cur, uint8_t* rec
   a.stride = stride_;
   a.count = S_ / kLanes * kLanes;
   a.offset = prev.min;
+  // Free rows have few edges (a clip's first Kf and last W frames): the kernel runs
+  // unmasked and those cells are redone exactly. Movement rows (the refinement) have many.
+  a.masked = local;
   StepKernel(a);
   for (int s = a.count; s < S_; ++s) {
     Cell(s, c, prev, rules, local ? jump_[s] : GlobalJump(prev.top, s, rules), cur, record);
+  }
+  if (!local) {
+    for (int s : rules.edges) {
+      if (s >= a.count) break;
+      Cell(s, c, prev, rules, GlobalJump(prev.top, s, rules), cur, record);
+    }
   }
   if (!local) {  // where the row minimum lies inside [s, s+W] the jump must come from elsewhere
     const int best = prev.top.front().index;
