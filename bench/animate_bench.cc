@@ -39,6 +39,7 @@ struct Args {
   bool json = false;
   bool detail = false;  // per-sprite figures in the JSON
   std::string start;    // replacement's start: random, sequential, beam; "": per scene
+  double fly_collision_strength = 100;  // scenes 6 and 7: each pair's anti-collision strength
 };
 
 Args Parse(const std::vector<std::string>& argv) {
@@ -67,6 +68,7 @@ Args Parse(const std::vector<std::string>& argv) {
     else if (s == "--json") a.json = true;
     else if (s == "--detail") a.detail = true;
     else if (s == "--start") a.start = value();
+    else if (s == "--fly-collision-strength") a.fly_collision_strength = std::stod(value());
     else if (s == "--scenes") {
       a.scenes.clear();
       std::string list = value();
@@ -78,7 +80,7 @@ Args Parse(const std::vector<std::string>& argv) {
     } else {
       throw InputError("bench animate", "unknown argument " + s +
                                             " (--frames=N --budget=S --budget6=S --threads=N "
-                                            "--scenes=1,2,.. --start=random|sequential|beam --no-beam --json --detail)");
+                                            "--scenes=1,2,.. --start=random|sequential|beam --fly-collision-strength=X --no-beam --json --detail)");
     }
   }
   return a;
@@ -153,7 +155,7 @@ std::vector<Eigen::Vector2d> Arc(const Eigen::Vector2d& c, double r, double a0, 
   return p;
 }
 
-std::unique_ptr<Problem> MakeScene(int scene, const TransitionGraph& g) {
+std::unique_ptr<Problem> MakeScene(int scene, const TransitionGraph& g, double fly_collision_strength) {
   auto p = std::make_unique<Problem>(g);
   const double pi = std::numbers::pi;
   auto standing = std::make_shared<std::vector<bool>>(g.FramesWithTag("standing"));
@@ -217,7 +219,7 @@ std::unique_ptr<Problem> MakeScene(int scene, const TransitionGraph& g) {
         }
       }
       for (int a = 0; a < 64; ++a) {
-        for (int b = a + 1; b < 64; ++b) p->AddTerm(std::make_unique<CollisionTerm>(a, b, 0.08, 100));
+        for (int b = a + 1; b < 64; ++b) p->AddTerm(std::make_unique<CollisionTerm>(a, b, 0.08, fly_collision_strength));
       }
       break;
     }
@@ -298,7 +300,7 @@ int Run(const std::vector<std::string>& argv) {
                 "path_dev", "unfin", "collide", "tag_off", "short");
   }
   for (int scene : args.scenes) {
-    const auto problem = MakeScene(scene, graph);
+    const auto problem = MakeScene(scene, graph, args.fly_collision_strength);
     const double budget = scene >= 6 ? args.budget6_s : args.budget_s;
     nlohmann::json row = {{"scene", scene}, {"budget_s", budget}, {"load_at_start", LoadAverage()}};
     ReplacementOptions replace;
