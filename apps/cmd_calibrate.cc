@@ -336,22 +336,27 @@ void AddWizard(CLI::App& parent) {
     cv::Mat bgr;
     int frames = 0;
     // A live camera that stops delivering (unplugged, its stream ended) ends the wizard
-    // with what it has; Next() itself waits for frames as long as the source lives.
+    // with what it has; Next() itself waits for frames as long as the source lives. (The
+    // station's CameraRunner does the same, then reopens the camera.)
     using Clock = std::chrono::steady_clock;
     std::atomic<int64_t> last_frame_ns{Clock::now().time_since_epoch().count()};
     std::atomic<bool> reading{true}, silent{false};
-    std::thread watchdog([&] {
-      const auto limit = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(o->silent_s));
-      while (reading.load()) {
-        std::this_thread::sleep_for(std::chrono::milliseconds(100));
-        if (Clock::now().time_since_epoch().count() - last_frame_ns.load() > limit.count()) {
-          silent.store(true);
-          source->Stop();
-          return;
+    {
+      std::jthread watchdog([&] {
+        const auto limit = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(o->silent_s));
+        while (reading.load()) {
+          std::this_thread::sleep_for(std::chrono::milliseconds(100));
+          if (Clock::now().time_since_epoch().count() - last_frame_ns.load() > limit.count()) {
+            silent.store(true);
+            source->Stop();
+            return;
+          }
         }
-      }
-    });
-    try {
+      });
+      struct StopWatching {
+        std::atomic<bool>& reading;
+        ~StopWatching() { reading.store(false); }  // before the jthread joins, also on a throw
+      } stop_watching{reading};
       while (!wizard.done() && (o->count <= 0 || frames < o->count)) {
         auto frame = source->Next();
         if (!frame) break;
@@ -361,13 +366,7 @@ void AddWizard(CLI::App& parent) {
         ++frames;
         print_log();
       }
-    } catch (...) {
-      reading.store(false);
-      watchdog.join();
-      throw;
     }
-    reading.store(false);
-    watchdog.join();
     source->Stop();
     if (silent.load()) {
       std::fprintf(stderr, "calibrate wizard: %s delivered no frame for %.1f s; ending with what was seen\n",

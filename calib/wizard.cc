@@ -239,31 +239,31 @@ void CalibrationWizard::EnterEnclosure(int frame, const cv::Mat& image) {
     }
     return;
   }
-  floor_image_ = image.clone();
-  if (const std::optional<CameraModel> posed = posed_model()) {
-    cv::Mat bgr = image;
-    if (image.channels() == 1) cv::cvtColor(image, bgr, cv::COLOR_GRAY2BGR);
-    try {
-      floor_with_board_m2_ = FindGreenFloor(*posed, bgr).Area();
-    } catch (const std::runtime_error&) {
-      floor_with_board_m2_ = 0;
-    }
+  try {
+    floor_with_board_ = GreenFloorIn(image);
+  } catch (const std::runtime_error& e) {
+    floor_with_board_error_ = e.what();
   }
 }
 
-void CalibrationWizard::TryGreenFloor(const cv::Mat& image, int frame, const std::string& from) {
+GroundPolygon CalibrationWizard::GreenFloorIn(const cv::Mat& image) const {
   const std::optional<CameraModel> posed = posed_model();
-  if (!posed || image.empty()) return;
+  if (!posed) throw WorkError(camera_, "no ground pose to find the floor with");
   cv::Mat bgr = image;
   if (image.channels() == 1) cv::cvtColor(image, bgr, cv::COLOR_GRAY2BGR);
+  return FindGreenFloor(*posed, bgr);
+}
+
+void CalibrationWizard::TryEmptyFloor(const cv::Mat& image, int frame) {
+  const std::string from = "the empty floor";
   try {
-    GroundPolygon found = FindGreenFloor(*posed, bgr);
+    GroundPolygon found = GreenFloorIn(image);
     // No board in view is not yet an empty floor: a person or a board held up hides part of
     // it. Taking the board off the floor can only uncover green, so an empty floor shows at
     // least what the frame with the board lying on it showed.
-    if (frame >= 0 && found.Area() < 0.95 * floor_with_board_m2_) {
-      Event(frame, "enclosure_rejected", {{"from", from}, {"area_m2", found.Area()},
-                                          {"with_board_m2", floor_with_board_m2_}});
+    const double with_board_m2 = floor_with_board_ ? floor_with_board_->Area() : 0.0;
+    if (found.Area() < 0.95 * with_board_m2) {
+      Event(frame, "enclosure_rejected", {{"from", from}, {"area_m2", found.Area()}, {"with_board_m2", with_board_m2}});
       return;
     }
     floor_ = std::move(found);
@@ -372,7 +372,7 @@ WizardFrame CalibrationWizard::Feed(const cv::Mat& image, int frame) {
   if (step_ == WizardStep::kEnclosure) {
     empty_frames_ = view.accepted ? 0 : empty_frames_ + 1;
     if (empty_frames_ >= o_.floor_still_frames) {
-      TryGreenFloor(image, frame, "the empty floor");
+      TryEmptyFloor(image, frame);
       if (!floor_) empty_frames_ = 0;
     }
     if (step_ == WizardStep::kEnclosure) {
@@ -424,8 +424,12 @@ void CalibrationWizard::Finish() {
   }
   if (step_ == WizardStep::kEnclosure) {
     // No empty floor was seen: the frame with the board on the floor (the board is inside the floor's outline).
-    TryGreenFloor(floor_image_, -1, "the frame with the board on the floor");
-    if (!floor_) {
+    const std::string from = "the frame with the board on the floor";
+    if (floor_with_board_) {
+      floor_ = floor_with_board_;
+      Event(-1, "enclosure", {{"from", from}, {"area_m2", floor_->Area()}, {"vertices", floor_->vertices().size()}});
+    } else {
+      Event(-1, "enclosure_failed", {{"from", from}, {"reason", floor_with_board_error_}});
       verdicts_.push_back("enclosure: no green floor found; show the empty floor or give --floor-points");
       Event(-1, "verdict", {{"reason", verdicts_.back()}});
     }

@@ -102,7 +102,10 @@ class CalibrationWizard {
   void SolveIntrinsics(int frame);
   void EnterGround(int frame);
   void EnterEnclosure(int frame, const cv::Mat& image);
-  void TryGreenFloor(const cv::Mat& image, int frame, const std::string& from);
+  // The largest green floor region of a frame through the posed model; throws when none.
+  GroundPolygon GreenFloorIn(const cv::Mat& image) const;
+  // A frame without the board: its green floor becomes the enclosure if nothing hides it.
+  void TryEmptyFloor(const cv::Mat& image, int frame);
   double Focal() const;
 
   std::string camera_;
@@ -125,8 +128,10 @@ class CalibrationWizard {
   std::optional<CameraModel> intrinsics_model_;
   std::optional<GroundResult> ground_;
   BoardView floor_view_;
-  cv::Mat floor_image_;              // a frame with the board on the floor (green floor fallback)
-  double floor_with_board_m2_ = 0;   // the green floor seen in it: an empty floor shows at least this
+  // The green floor of the frame with the board lying on it: the fallback enclosure, and
+  // the least an empty floor shows (or why none was found).
+  std::optional<GroundPolygon> floor_with_board_;
+  std::string floor_with_board_error_;
   std::optional<GroundPolygon> floor_;
   std::vector<std::string> verdicts_;
   std::vector<std::string> last_guidance_;

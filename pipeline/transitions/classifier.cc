@@ -33,10 +33,9 @@ double AlphaFeature(uint64_t alpha_abs_diff, const CellBox& a, const CellBox& b)
 
 bool TransitionClassifier::SignatureRejects(const SpriteStore& store, int32_t i, int32_t j) const {
   const CheapDifference cheap = CheapDiff(store.cheap(i), store.cheap(j));
-  // Same operations in the same order as Distance(): d is its prefix, and the alpha
-  // feature is monotone in its numerator, so d + u4 * bound <= the full sum.
-  double d = 0;
-  for (int k = 0; k < kCheapFeatureCount; ++k) d += u2_[k] * cheap[k];
+  // d is Distance()'s prefix, and the alpha feature is monotone in its numerator, so
+  // d + u4 * bound <= the full sum.
+  const double d = CheapPart(cheap);
   if (d > t2_) return true;
   const CellBox& box_i = store.box(i);
   const CellBox& box_j = store.box(j);
@@ -46,9 +45,8 @@ bool TransitionClassifier::SignatureRejects(const SpriteStore& store, int32_t i,
 
 bool TransitionClassifier::Stage2(const SpriteStore& store, int32_t i, int32_t j, double* distance) const {
   const CheapDifference cheap = CheapDiff(store.cheap(i), store.cheap(j));
-  // Same operations in the same order as Distance(): the partial sums are its prefixes.
-  double d = 0;
-  for (int k = 0; k < kCheapFeatureCount; ++k) d += u2_[k] * cheap[k];
+  // The partial sums are Distance()'s prefixes.
+  const double d = CheapPart(cheap);
   if (d > t2_) return false;
   const uint8_t* a = store.image(i);
   const uint8_t* b = store.image(j);

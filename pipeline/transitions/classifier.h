@@ -56,6 +56,12 @@ class TransitionClassifier {
   const TransitionWeights& weights() const { return weights_; }
 
  private:
+  // D's four cheap terms summed in Distance()'s order: the prefix both early exits start from.
+  double CheapPart(const CheapDifference& cheap) const {
+    double d = 0;
+    for (int k = 0; k < kCheapFeatureCount; ++k) d += u2_[k] * cheap[k];
+    return d;
+  }
   TransitionWeights weights_;
   CheapDifference u1_{};
   double t1_ = 0;

@@ -28,6 +28,21 @@ WizardOptions Options(const BoardSpec& board) {
   return o;
 }
 
+// One enclosure-studio camera (seed, size) and the chessboard rendered through it.
+struct BoardStudio {
+  BoardStudio(uint64_t seed, int width, int height)
+      : studio(synth::MakeStudio(synth::StudioKind::kEnclosure, seed)),
+        cam(synth::MakeCameras(studio, 1, width, height, seed)[0]),
+        renderer(cam, studio),
+        spec(synth::ChessboardFor(false)),
+        texture(spec) {}
+  synth::Studio studio;
+  synth::SynthCamera cam;
+  synth::CameraRenderer renderer;
+  synth::BoardSpec spec;
+  synth::BoardTexture texture;
+};
+
 TEST(CalibrationWizard, NamesWhatIsMissingAndRefusesToSolveWithoutViews) {
   CalibrationWizard w("cam0", 320, 240, Options(ParseBoardSpec("chessboard:10x7:0.03")));
   const auto missing = w.MissingForIntrinsics();
@@ -51,11 +66,8 @@ TEST(CalibrationWizard, NamesWhatIsMissingAndRefusesToSolveWithoutViews) {
 }
 
 TEST(CalibrationWizard, CapturesAStillBoardOnceAndOnlyANewViewAgain) {
-  const synth::Studio studio = synth::MakeStudio(synth::StudioKind::kEnclosure, 7);
-  const synth::SynthCamera cam = synth::MakeCameras(studio, 1, 320, 240, 7)[0];
-  const synth::CameraRenderer renderer(cam, studio);
-  const synth::BoardSpec spec = synth::ChessboardFor(false);
-  const synth::BoardTexture texture(spec);
+  const BoardStudio board_studio(7, 320, 240);
+  const auto& [studio, cam, renderer, spec, texture] = board_studio;
   CalibrationWizard w("cam0", 320, 240, Options(ToCalibBoard(spec)));
   auto frame_of = [&](const Rigid3& cam_from_board, int n) {
     return RenderBoards(renderer, {{&texture, cam.cam_from_ground.Inverse() * cam_from_board}}, 1.0, n);
@@ -90,11 +102,8 @@ TEST(CalibrationWizard, CapturesAStillBoardOnceAndOnlyANewViewAgain) {
 // person (here a dark block across the floor) hides part of it, and the floor found then is
 // smaller than with the board lying on it, so the wizard keeps waiting.
 TEST(CalibrationWizard, TheEnclosureWaitsForAFloorNothingHides) {
-  const synth::Studio studio = synth::MakeStudio(synth::StudioKind::kEnclosure, 5);
-  const synth::SynthCamera cam = synth::MakeCameras(studio, 1, 640, 480, 5)[0];
-  const synth::CameraRenderer renderer(cam, studio);
-  const synth::BoardSpec spec = synth::ChessboardFor(false);
-  const synth::BoardTexture texture(spec);
+  const BoardStudio board_studio(5, 640, 480);
+  const auto& [studio, cam, renderer, spec, texture] = board_studio;
   WizardOptions o = Options(ToCalibBoard(spec));
   o.ground_from_board = FloorBoardPose(-0.5 * spec.width_m(), 0.5 * spec.height_m(), 0.0, 0.001);
   CameraModel unposed = TrueModel(cam);
