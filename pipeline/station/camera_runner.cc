@@ -312,6 +312,7 @@ struct CameraRunner::Impl {
   // 60 frames/s overflowed the queue while the set was collected.
   std::vector<cv::Mat> training_set;
   size_t training_collected = 0;
+  std::pair<uint64_t, int64_t> training_first;  // the set's first frame: sequence, timestamp
 
   void PipelineLoop() {
     bool pipeline_failed = pipeline == nullptr;
@@ -342,9 +343,16 @@ struct CameraRunner::Impl {
             if (training_set.empty()) training_set = PrefaultedImages(options.training_frames, frame.width, frame.height);
             cv::Mat& slot = training_set[training_collected];
             ToBgr(frame, slot);
+            if (training_collected == 0) training_first = {frame.sequence, frame.timestamp_ns};
             ++training_collected;
             if (preview) UpdatePreview(slot, nullptr, item->received);
             if (training_collected >= training_set.size()) {
+              {
+                std::lock_guard lock(status_mutex);
+                status.learnt_from = {training_collected, static_cast<int64_t>(training_first.first),
+                                      static_cast<int64_t>(frame.sequence), training_first.second,
+                                      frame.timestamp_ns};
+              }
               training = std::async(std::launch::async, [p = pipeline.get(), frames = std::move(training_set)] {
                 p->Train(frames);
               });

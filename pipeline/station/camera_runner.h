@@ -50,6 +50,13 @@ struct CameraStatus {
   uint64_t dropped_at_source = 0;    // lost before delivery: incomplete frames, sequence gaps, unreadable
   uint64_t source_errors = 0;        // recoverable source problems (timeouts, corrupt frames)
   uint64_t frames_while_learning = 0;  // arrived while the keyer learnt the empty enclosure (preview only)
+  // The frames the keyer learnt the empty enclosure from (the last set collected): how many,
+  // and the first and last one's sequence number and timestamp (-1: none collected yet).
+  struct LearntFrom {
+    uint64_t frames = 0;
+    int64_t first_sequence = -1, last_sequence = -1;
+    int64_t first_timestamp_ns = -1, last_timestamp_ns = -1;
+  } learnt_from;
   uint64_t frames_rejected = 0;      // frames the pipeline refused (corrupt, another size); see message
   uint64_t batches_unstored = 0;     // batches made with no capture session (not stored)
   size_t queue_depth = 0, queue_capacity = 0;

@@ -100,6 +100,18 @@ class DaemonTest : public ::testing::Test {
     return false;
   }
 
+  // The timestamp of a camera's recorded frame `index` in the shared session (its frames.csv).
+  int64_t RecordedTimestamp(const std::string& camera, int index) const {
+    std::ifstream csv(session_->dir + "/" + camera + ".frames.csv");
+    std::string line;
+    std::getline(csv, line);  // index,timestamp_ns,sequence,drops_before
+    while (std::getline(csv, line)) {
+      if (std::stoi(line) == index) return std::stoll(line.substr(line.find(',') + 1));
+    }
+    ADD_FAILURE() << camera << ".frames.csv has no frame " << index;
+    return -1;
+  }
+
   static const nlohmann::json& Camera(const nlohmann::json& status, const std::string& name) {
     for (const auto& c : status["cameras"]) {
       if (c["name"] == name) return c;
@@ -165,7 +177,12 @@ TEST_F(DaemonTest, TwoEmulatedGigECamerasStoreWhatIngestFinds) {
   EXPECT_LT(std::chrono::duration<double>(Clock::now() - term).count(), 5.0);
   EXPECT_EQ(RunSpritestation("bank verify " + bank()).exit_code, 0);
 
-  // The same sprites as ingest, but for frames the drop counters account for.
+  // The same sprites as ingest, but for frames the drop counters account for, as long as the
+  // keyer learnt the empty enclosure from ingest's frames: the recording's first 30, in a row.
+  // Keying is then the same, and drops can only remove sprites (a lost frame ends a clip).
+  // When frames were lost while it learnt, its noise model differs slightly and a sprite on a
+  // filter's edge (here: a shadow that reaches the wall in some frames of cam1) may go either
+  // way: then sprites ingest did not store are allowed, a bounded number, and missing ones too.
   const auto ingest = SpritesByCamera(session_->ingest_bank);
   const auto live = SpritesByCamera(bank());
   size_t compared = 0, stored = 0;
@@ -178,23 +195,37 @@ TEST_F(DaemonTest, TwoEmulatedGigECamerasStoreWhatIngestFinds) {
     const int64_t unreceived = std::max<int64_t>(0, 150 - captured - cam["dropped"]["at_source"].get<int64_t>());
     const int64_t dropped = cam["dropped"]["total"].get<int64_t>() + cam["sequence_gaps"].get<int64_t>() +
                             cam["frames_while_learning"].get<int64_t>() + unreceived;
+    const nlohmann::json& learnt = cam["learnt_from"];
+    ASSERT_EQ(learnt["frames"], 30) << status.dump(2);
+    // (By the last frame's timestamp: frame 0's is 0, which GigE Vision delivers as the host's time.)
+    const bool ingests_keyer =
+        learnt["last_timestamp_ns"] == RecordedTimestamp(name, 29) &&
+        learnt["last_sequence"].get<int64_t>() - learnt["first_sequence"].get<int64_t>() == 29;
     ASSERT_TRUE(ingest.count(name)) << name;
     static const std::map<int64_t, BankSprite> kNone;
     const auto& expected = ingest.at(name);
     const auto& got = live.count(name) ? live.at(name) : kNone;
     stored += got.size();
-    size_t missing = 0;
+    size_t missing = 0, extra = 0;
     for (const auto& [t, s] : expected) missing += got.count(t) ? 0 : 1;
     for (const auto& [t, s] : got) {
-      ASSERT_TRUE(expected.count(t)) << name << ": a sprite at " << t << " that ingest did not store";
+      if (!expected.count(t)) {
+        EXPECT_FALSE(ingests_keyer) << name << ": a sprite at " << t << " that ingest did not store, with ingest's keyer\n"
+                                    << cam.dump(2);
+        ++extra;
+        continue;
+      }
+      // (Within 0.1 mm: a keyer that learnt from other frames keys a few pixels differently.)
       EXPECT_NEAR(s.ground_x, expected.at(t).ground_x, 1e-4) << name << " at " << t;
       EXPECT_NEAR(s.ground_y, expected.at(t).ground_y, 1e-4) << name << " at " << t;
     }
-    // (Within 0.1 mm: the keyer may learn the enclosure from other frames when frames are lost.)
     // A lost frame ends the clip there; the pieces shorter than min_clip_frames (5) and the
     // velocity windows around the gap are what may be missing.
-    EXPECT_LE(missing, static_cast<size_t>(dropped) * 6) << name << ": " << missing << " of " << expected.size()
-                                                         << " sprites missing with " << dropped << " frames dropped";
+    const size_t keying_noise = ingests_keyer ? 0 : std::max<size_t>(10, expected.size() / 3);
+    EXPECT_LE(missing, static_cast<size_t>(dropped) * 6 + keying_noise)
+        << name << ": " << missing << " of " << expected.size() << " sprites missing with " << dropped
+        << " frames dropped\n" << cam.dump(2);
+    EXPECT_LE(extra, keying_noise) << name << ": " << extra << " sprites ingest did not store\n" << cam.dump(2);
     EXPECT_GT(expected.size(), 5u) << name;
     compared += expected.size();
   }
