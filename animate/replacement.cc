@@ -44,6 +44,8 @@ class Replacer {
         local_(problem.graph().num_frames(), 0) {
     for (int sprite = 0; sprite < problem_.num_sprites(); ++sprite) {
       terms_of_.push_back(problem_.TermsOf(sprite));
+      collides_.push_back(std::any_of(terms_of_.back().begin(), terms_of_.back().end(),
+                                      [&](int k) { return problem_.term(k).kind() == "collision"; }));
     }
     Reset();
     neighbours_.resize(problem_.num_sprites());
@@ -189,6 +191,25 @@ class Replacer {
       l = k + LogUniformInt(max_span);
     } else if (kind == MoveKind::kBegin) {
       l = UniformInt(0, n - 1);
+    }
+    if (options_.collision_pick_fraction > 0 && n > 1 && collides_[s] &&
+        std::uniform_real_distribution<double>(0.0, 1.0)(rng_) < options_.collision_pick_fraction) {
+      // Around a colliding step v (past the end: the held last state, changed from the end):
+      // a piece of log-uniform width that covers v, replaced as the pick's kind says.
+      const int v = CollidingStep(s);
+      if (v >= 0) {
+        ++summary_->collision_picks;
+        const int last = std::min(v, n - 1);
+        int width = LogUniformInt(options_.max_span > 0 ? std::min(options_.max_span, n - 1) : n - 1);
+        if (kind == MoveKind::kMiddle) {
+          k = std::max(0, last - UniformInt(0, width));
+          l = std::min(n - 1, std::max(last, k + width));
+        } else if (kind == MoveKind::kBegin) {
+          l = std::min(n - 1, last + width);
+        } else {
+          k = std::max(0, last - width);
+        }
+      }
     }
     int variant = sets_.VariantFor(problem_, view_, s, k, l);
     if (variant == 0 && kind == MoveKind::kEnd &&
@@ -429,6 +450,21 @@ class Replacer {
                                summary_->moves_tried, summary_->moves_kept});
   }
 
+  // A step where sprite s collides (one of its collision terms costs something there), drawn
+  // uniformly over all of them; -1 when it collides nowhere.
+  int CollidingStep(int s) {
+    colliding_steps_.clear();
+    for (int k : terms_of_[s]) {
+      if (term_cost_[k] <= 0 || problem_.term(k).kind() != "collision") continue;
+      const std::vector<double>& prefix = caches_[k].prefix;
+      for (size_t t = 0; t + 1 < prefix.size(); ++t) {
+        if (prefix[t + 1] > prefix[t]) colliding_steps_.push_back(static_cast<int>(t));
+      }
+    }
+    if (colliding_steps_.empty()) return -1;
+    return colliding_steps_[UniformInt(0, static_cast<int>(colliding_steps_.size()) - 1)];
+  }
+
   int UniformInt(int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(rng_); }
   // 0..max, log-uniformly: short spans are as likely as long ones per octave.
   int LogUniformInt(int max) {
@@ -464,6 +500,8 @@ class Replacer {
   std::vector<uint32_t> stamp_;
   std::vector<int> local_;
   std::vector<std::pair<int, int>> candidates_;
+  std::vector<int> colliding_steps_;  // CollidingStep's scratch
+  std::vector<char> collides_;        // per sprite: it has collision terms
   std::vector<int> piece_;
   std::vector<int> tail_;
   Track candidate_;
@@ -557,6 +595,9 @@ bool ReplacementOptions::IsValid(std::string* why) const {
     return fail("middle_fraction and begin_fraction must be >= 0 with a sum <= 1");
   }
   if (max_span < 0 || max_candidates < 0) return fail("max_span and max_candidates must be >= 0");
+  if (!(collision_pick_fraction >= 0 && collision_pick_fraction <= 1)) {
+    return fail("collision_pick_fraction must be in [0, 1]");
+  }
   if (!(progress_seconds >= 0)) return fail("progress_seconds must be >= 0");
   if (start == StartMethod::kBeam) {
     std::string beam_why;

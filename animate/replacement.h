@@ -52,6 +52,10 @@ struct ReplacementOptions {
   double middle_fraction = 0.6;  // share of picks replacing a middle piece
   double begin_fraction = 0.2;   // ... the beginning; the rest replace the end
   int max_span = 0;              // longest l - k picked; 0: the whole sequence
+  // Share of a sprite's picks aimed at one of its collisions (a step where it is closer than
+  // d_min to another sprite): k and l are drawn around that step instead of anywhere. Uniform
+  // picks rarely land on the few steps of a shallow collision, which then outlive the budget.
+  double collision_pick_fraction = 0.25;
   int max_candidates = 0;        // t tried per pick; 0: all of them
   bool optimize_free_starts = true;  // least-squares and pattern search on free p_0
   double progress_seconds = 0.0;     // log progress this often; 0: never

@@ -36,6 +36,7 @@ struct Summary {
   int turns = 0;            // sprite turns (replacement) or beam widths tried (beam)
   int restarts = 0;         // random restarts after convergence
   int64_t picks = 0;        // (k, l) pairs picked
+  int64_t collision_picks = 0;  // of them, drawn around a step where the sprite collides
   int64_t moves_tried = 0;  // candidate sequences evaluated
   int64_t moves_kept = 0;   // improvements accepted
 

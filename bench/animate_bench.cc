@@ -40,6 +40,7 @@ struct Args {
   bool detail = false;  // per-sprite figures in the JSON
   std::string start;    // replacement's start: random, sequential, beam; "": per scene
   double fly_collision_strength = 100;  // scenes 6 and 7: each pair's anti-collision strength
+  double collision_pick_fraction = -1;  // replacement's picks aimed at a collision; < 0: its default
 };
 
 Args Parse(const std::vector<std::string>& argv) {
@@ -69,6 +70,7 @@ Args Parse(const std::vector<std::string>& argv) {
     else if (s == "--detail") a.detail = true;
     else if (s == "--start") a.start = value();
     else if (s == "--fly-collision-strength") a.fly_collision_strength = std::stod(value());
+    else if (s == "--collision-pick-fraction") a.collision_pick_fraction = std::stod(value());
     else if (s == "--scenes") {
       a.scenes.clear();
       std::string list = value();
@@ -80,7 +82,7 @@ Args Parse(const std::vector<std::string>& argv) {
     } else {
       throw InputError("bench animate", "unknown argument " + s +
                                             " (--frames=N --budget=S --budget6=S --threads=N "
-                                            "--scenes=1,2,.. --start=random|sequential|beam --fly-collision-strength=X --no-beam --json --detail)");
+                                            "--scenes=1,2,.. --start=random|sequential|beam --fly-collision-strength=X --collision-pick-fraction=F --no-beam --json --detail)");
     }
   }
   return a;
@@ -306,6 +308,8 @@ int Run(const std::vector<std::string>& argv) {
     ReplacementOptions replace;
     replace.time_budget_seconds = budget;
     replace.reach.num_threads = args.threads;
+    if (args.collision_pick_fraction >= 0) replace.collision_pick_fraction = args.collision_pick_fraction;
+    row["collision_pick_fraction"] = replace.collision_pick_fraction;
     if (scene >= 6) {
       replace.reference_speed_m = 0.02;
       replace.slow_frame_cost = 20;

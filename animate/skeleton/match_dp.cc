@@ -5,7 +5,10 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <memory>
+#include <new>
 #include <sstream>
+#include <utility>
 
 #include "core/error.h"
 #include "core/log.h"
@@ -51,7 +54,8 @@ std::string MatchResult::Summary() const {
     << stats.freezes << " freezes in " << stats.freeze_runs << " runs (longest " << stats.longest_freeze << "), "
     << stats.stutters << " stutters, " << stats.skips << " skips, " << stats.jumps << " jumps, " << stats.listed
     << " listed; " << cost_seconds << " s costs, " << forward_seconds << " s forward, " << backward_seconds
-    << " s backward, " << memory_bytes / (1 << 20) << " MiB";
+    << " s backward, " << memory_bytes / (1 << 20) << " MiB ("
+    << (walked_decisions ? "decisions" : "checkpoints") << ")";
   return s.str();
 }
 
@@ -64,6 +68,15 @@ constexpr int kCostTile = 16;  // target rows of costs computed at once
 typedef float v8f __attribute__((vector_size(32)));
 typedef int v8i __attribute__((vector_size(32)));
 typedef uint8_t v8u8 __attribute__((vector_size(8)));
+typedef uint16_t v8u16 __attribute__((vector_size(16)));
+
+// What a step records per cell. The low byte always holds argmin_r V(s, r) (bits 0-2) and
+// whether V(s, R) came from r = R-1 (bit 3). kPacked adds the move into (s, 0) in bits
+// 4-7; kWide stores 2 bytes a cell, the move in the second. Move codes: 0 none (V(s,0) is
+// +inf), k = 1..Kf advance by k, Kf + k (k = 1..W) stutter back by k, Kf + W + 1 a jump
+// (global: the first entry of the previous row's top list outside [s, s+W]; local: the
+// row's stored jump source). A listed transition that wins is kept aside per row.
+enum RecordMode { kArgOnly = 1, kPacked = 2, kWide = 3 };
 
 inline v8f Load(const float* p) {
   v8f v;
@@ -166,7 +179,8 @@ struct StepArgs {
   const float* vprev;     // V_{t-1}(s, r), [r * stride + s]
   float* vcur;
   float* mcur;
-  uint8_t* record;        // nullptr, or per s: argmin r (bits 0-2), V(s,R) came from r = R-1 (bit 3)
+  uint8_t* record;        // nullptr, or per s what `mode` says (RecordMode)
+  int mode;               // RecordMode when record is set
   const float* fwd_limit;
   const float* back_limit;
   const float* jump;      // per s (local jumps) or nullptr
@@ -183,33 +197,57 @@ struct StepArgs {
 
 // The row step; kMasked = false ignores the segment limits (every window full), for rules
 // whose few edge cells the caller recomputes with Cell().
-template <bool kMasked>
+// kMode: 0 (no record) or a RecordMode. The move codes take the first candidate that
+// reaches the minimum in the order advance k = 1..Kf, stutter k = 1..W, jump (as the
+// backtrack by comparison did); the values are computed exactly as without them.
+template <bool kMasked, int kMode>
 __attribute__((always_inline)) inline void StepBody(const StepArgs& args) {
   // A local copy: the stores through float pointers below could alias the caller's struct
   // (it holds floats), which made the compiler reload every field in the loop.
   const StepArgs a = args;
   const int levels = a.levels;
   const v8f inf = v8f{} + kInf;
+  constexpr bool kMoves = kMode == kPacked || kMode == kWide;
+  const v8i jump_code = v8i{} + (a.kf + a.w + 1);
   for (int s = 0; s < a.count; s += kLanes) {
     v8f fwd = inf;
     v8f stu = inf;
+    v8i fcode{}, scode{};
     if constexpr (kMasked) {
       const v8f fl = Load(a.fwd_limit + s);
       for (int k = 1; k <= a.kf; ++k) {
         const v8f cand = Load(a.m + s - k) + a.skip[k];
-        fwd = (v8f{} + static_cast<float>(k)) <= fl ? Min(fwd, cand) : fwd;
+        const v8i ok = (v8f{} + static_cast<float>(k)) <= fl;
+        if constexpr (kMoves) fcode = (ok & (cand < fwd)) ? v8i{} + k : fcode;
+        fwd = ok ? Min(fwd, cand) : fwd;
       }
       const v8f bl = Load(a.back_limit + s);
       for (int k = 1; k <= a.w; ++k) {
         const v8f cand = Load(a.m + s + k) + a.stutter[k];
-        stu = (v8f{} + static_cast<float>(k)) <= bl ? Min(stu, cand) : stu;
+        const v8i ok = (v8f{} + static_cast<float>(k)) <= bl;
+        if constexpr (kMoves) scode = (ok & (cand < stu)) ? v8i{} + (a.kf + k) : scode;
+        stu = ok ? Min(stu, cand) : stu;
       }
     } else {
-      for (int k = 1; k <= a.kf; ++k) fwd = Min(fwd, Load(a.m + s - k) + a.skip[k]);
-      for (int k = 1; k <= a.w; ++k) stu = Min(stu, Load(a.m + s + k) + a.stutter[k]);
+      for (int k = 1; k <= a.kf; ++k) {
+        const v8f cand = Load(a.m + s - k) + a.skip[k];
+        if constexpr (kMoves) fcode = cand < fwd ? v8i{} + k : fcode;
+        fwd = Min(fwd, cand);
+      }
+      for (int k = 1; k <= a.w; ++k) {
+        const v8f cand = Load(a.m + s + k) + a.stutter[k];
+        if constexpr (kMoves) scode = cand < stu ? v8i{} + (a.kf + k) : scode;
+        stu = Min(stu, cand);
+      }
     }
     const v8f jmp = a.jump ? Load(a.jump + s) : v8f{} + a.jump_const;
     const v8f best = Min(fwd, Min(stu, jmp));
+    v8i move{};
+    if constexpr (kMoves) {
+      const v8i stu_first = stu < fwd;
+      move = stu_first ? scode : fcode;
+      move = jmp < (stu_first ? stu : fwd) ? jump_code : move;
+    }
     const v8f c = Load(a.cost + s) - a.offset;
     const v8f v0 = c + best;
     Store(a.vcur + s, v0);
@@ -229,19 +267,32 @@ __attribute__((always_inline)) inline void StepBody(const StepArgs& args) {
     arg = vtop < mm ? v8i{} + levels : arg;
     mm = Min(mm, vtop);
     Store(a.mcur + s, mm);
-    if (a.record) {
-      const v8i code = arg | (from_below & 8);
+    if constexpr (kMode == kArgOnly || kMode == kPacked) {
+      const v8i code = kMode == kPacked ? (arg | (from_below & 8) | (move << 4)) : (arg | (from_below & 8));
       const v8u8 bytes = __builtin_convertvector(code, v8u8);  // one 8-byte store, not eight
       std::memcpy(a.record + s, &bytes, sizeof(bytes));
+    } else if constexpr (kMode == kWide) {
+      const v8u16 words = __builtin_convertvector(arg | (from_below & 8) | (move << 8), v8u16);
+      std::memcpy(a.record + 2 * static_cast<size_t>(s), &words, sizeof(words));  // little endian: low byte first
     }
+  }
+}
+
+template <bool kMasked>
+__attribute__((always_inline)) inline void StepModes(const StepArgs& args) {
+  if (!args.record) return StepBody<kMasked, 0>(args);
+  switch (args.mode) {
+    case kArgOnly: return StepBody<kMasked, kArgOnly>(args);
+    case kPacked: return StepBody<kMasked, kPacked>(args);
+    default: return StepBody<kMasked, kWide>(args);
   }
 }
 
 __attribute__((target_clones("arch=x86-64-v3", "default"))) void StepKernel(const StepArgs& args) {
   if (args.masked) {
-    StepBody<true>(args);
+    StepModes<true>(args);
   } else {
-    StepBody<false>(args);
+    StepModes<false>(args);
   }
 }
 
@@ -261,11 +312,15 @@ class Engine {
   void ComputeCosts(int t0, int n, double* seconds);
   const float* CostRow(int t) const { return tile_.data() + static_cast<size_t>(t - tile_first_) * S_; }
   void Init(const float* c, Row* row, uint8_t* record);
-  void Step(int t, const float* c, const Row& prev, Row* cur, uint8_t* record);
+  // One row; `record` (nullptr: none) receives what mode_ says. With moves recorded, a
+  // listed transition that wins the cell goes to listed_choice_, and a local row's jump
+  // sources to `jump_source`.
+  void Step(int t, const float* c, const Row& prev, Row* cur, uint8_t* record, int32_t* jump_source = nullptr);
   // The scalar cell update (tail and fix-ups); `jump` = J + the best allowed jump source.
   void Cell(int s, const float* c, const Row& prev, const RowRules& rules, float jump, Row* cur,
             uint8_t* record) const;
-  void LocalJumps(const RowRules& rules, const float* m, float* out);
+  // Into `out` J plus the best local jump into each s; its source into `source` if given.
+  void LocalJumps(const RowRules& rules, const float* m, float* out, int32_t* source);
   void Finish(Row* row, int t) const;
   // Best jump value into s from a row's top list (global jumps); +inf if none.
   float GlobalJump(const std::vector<TopEntry>& top, int s, const RowRules& rules) const;
@@ -273,6 +328,12 @@ class Engine {
   std::pair<int, int> Predecessor(int t, int s, int r, const float* m_prev, const uint8_t* rec_prev,
                                   const uint8_t* rec_cur, const std::vector<TopEntry>& top_prev) const;
   void StateFromCheckpoint(const std::vector<float>& v, Row* row, uint8_t* record) const;
+  bool MovesRecorded() const { return mode_ == kPacked || mode_ == kWide; }
+  int RecordBytes() const { return mode_ == kWide ? 2 : 1; }
+  // Backtrack through decisions stored by the forward pass; false when they would not fit
+  // the budget (nothing done then).
+  bool SolveWithDecisions(MatchResult* result);
+  void SolveWithCheckpoints(MatchResult* result);
 
   const CostRows& costs_;
   const MatchOptions& o_;
@@ -286,7 +347,10 @@ class Engine {
   std::vector<float> tile_;
   int tile_first_ = -1, tile_count_ = 0;
   std::vector<float> jump_, suffix_;
+  std::vector<int32_t> suffix_at_;  // where suffix_[x] is reached (LocalJumps with sources)
   double cost_seconds_ = 0;
+  int mode_ = kArgOnly;  // what Step and Cell record (RecordMode)
+  std::vector<std::pair<int, int>> listed_choice_;  // (s, from) of cells a listed transition wins
 };
 
 Engine::Engine(const CostRows& costs, const std::vector<int>& clip_starts, const MatchOptions& options,
@@ -336,6 +400,7 @@ Engine::Engine(const CostRows& costs, const std::vector<int>& clip_starts, const
     }
     jump_.assign(stride_, kInf);
     suffix_.assign(S_ + 1, kInf);
+    suffix_at_.assign(S_ + 1, -1);
   }
 }
 
@@ -352,7 +417,7 @@ void Engine::Init(const float* c, Row* row, uint8_t* record) {
   std::fill(row->v.begin(), row->v.end(), kInf);
   std::copy(c, c + S_, row->v.begin());
   std::copy(c, c + S_, row->m);
-  if (record) std::fill(record, record + S_, 0);
+  if (record) std::fill(record, record + static_cast<size_t>(S_) * RecordBytes(), 0);
   Finish(row, 0);
 }
 
@@ -392,21 +457,34 @@ float Engine::GlobalJump(const std::vector<TopEntry>& top, int s, const RowRules
   return kInf;
 }
 
-void Engine::LocalJumps(const RowRules& rules, const float* m, float* out) {
+void Engine::LocalJumps(const RowRules& rules, const float* m, float* out, int32_t* source) {
   const float lambda = movements_->jump_cost_per_frame;
   const float jump = o_.jump_cost;
   const int w = o_.stutter_window;
   for (size_t g = 0; g < rules.seg_begin.size(); ++g) {
     const int a = rules.seg_begin[g], b = rules.seg_end[g];
     float run = kInf;  // min over s' < s of M(s') - λ (s' - a)
+    int run_at = -1;   // its first s'
     for (int s = a; s <= b; ++s) {
       out[s] = (run + lambda * static_cast<float>(s - a)) + jump;
-      run = Min(run, m[s] - lambda * static_cast<float>(s - a));
+      const float v = m[s] - lambda * static_cast<float>(s - a);
+      if (source) {
+        source[s] = run_at;
+        if (v < run) run_at = s;
+      }
+      run = Min(run, v);
     }
     suffix_[b + 1] = kInf;  // min over s' >= x of M(s') + λ (s' - a)
-    for (int x = b; x >= a; --x) suffix_[x] = Min(suffix_[x + 1], m[x] + lambda * static_cast<float>(x - a));
+    suffix_at_[b + 1] = -1;  // its first s' (kept only with sources)
+    for (int x = b; x >= a; --x) {
+      const float v = m[x] + lambda * static_cast<float>(x - a);
+      if (source) suffix_at_[x] = v <= suffix_[x + 1] ? x : suffix_at_[x + 1];
+      suffix_[x] = Min(suffix_[x + 1], v);
+    }
     for (int s = a; s + w + 1 <= b; ++s) {
-      out[s] = Min(out[s], (suffix_[s + w + 1] - lambda * static_cast<float>(s - a)) + jump);
+      const float after = (suffix_[s + w + 1] - lambda * static_cast<float>(s - a)) + jump;
+      if (source && after < out[s]) source[s] = suffix_at_[s + w + 1];  // a tie keeps the earlier source
+      out[s] = Min(out[s], after);
     }
   }
 }
@@ -415,14 +493,26 @@ void Engine::Cell(int s, const float* c, const Row& prev, const RowRules& rules,
                   uint8_t* record) const {
   const float* m = prev.m;
   const float* stutter = rules.local_jumps ? local_stutter_.data() : stutter_.data();
+  const int kf = o_.max_forward_step;
   float fwd = kInf, stu = kInf;
-  for (int k = 1; k <= o_.max_forward_step; ++k) {
-    if (static_cast<float>(k) <= rules.fwd_limit[s]) fwd = Min(fwd, m[s - k] + skip_[k]);
+  int fcode = 0, scode = 0;  // move codes as in StepBody
+  for (int k = 1; k <= kf; ++k) {
+    if (static_cast<float>(k) <= rules.fwd_limit[s]) {
+      const float cand = m[s - k] + skip_[k];
+      if (cand < fwd) fcode = k;
+      fwd = Min(fwd, cand);
+    }
   }
   for (int k = 1; k <= o_.stutter_window; ++k) {
-    if (static_cast<float>(k) <= rules.back_limit[s]) stu = Min(stu, m[s + k] + stutter[k]);
+    if (static_cast<float>(k) <= rules.back_limit[s]) {
+      const float cand = m[s + k] + stutter[k];
+      if (cand < stu) scode = kf + k;
+      stu = Min(stu, cand);
+    }
   }
   const float best = Min(fwd, Min(stu, jump));
+  int move = stu < fwd ? scode : fcode;
+  if (jump < (stu < fwd ? stu : fwd)) move = kf + o_.stutter_window + 1;
   const float cc = c[s] - prev.min;
   const float v0 = cc + best;
   cur->v[s] = v0;
@@ -440,13 +530,22 @@ void Engine::Cell(int s, const float* c, const Row& prev, const RowRules& rules,
   if (vtop < mm) arg = R_;
   mm = Min(mm, vtop);
   cur->m[s] = mm;
-  if (record) record[s] = static_cast<uint8_t>(arg | (below <= at ? 8 : 0));
+  if (record) {
+    const int low = arg | (below <= at ? 8 : 0);
+    if (mode_ == kWide) {
+      record[2 * static_cast<size_t>(s)] = static_cast<uint8_t>(low);
+      record[2 * static_cast<size_t>(s) + 1] = static_cast<uint8_t>(move);
+    } else {
+      record[s] = static_cast<uint8_t>(mode_ == kPacked ? low | move << 4 : low);
+    }
+  }
 }
 
-void Engine::Step(int t, const float* c, const Row& prev, Row* cur, uint8_t* record) {
+void Engine::Step(int t, const float* c, const Row& prev, Row* cur, uint8_t* record, int32_t* jump_source) {
   const RowRules& rules = Rules(t);
   const bool local = rules.local_jumps;
-  if (local) LocalJumps(rules, prev.m, jump_.data());
+  const bool moves = record && MovesRecorded();
+  if (local) LocalJumps(rules, prev.m, jump_.data(), moves ? jump_source : nullptr);
   const float jump_const = local ? kInf : o_.jump_cost + prev.top.front().value;  // J + the row minimum
   StepArgs a;
   a.cost = c;
@@ -455,6 +554,7 @@ void Engine::Step(int t, const float* c, const Row& prev, Row* cur, uint8_t* rec
   a.vcur = cur->v.data();
   a.mcur = cur->m;
   a.record = record;
+  a.mode = mode_;
   a.fwd_limit = rules.fwd_limit.data();
   a.back_limit = rules.back_limit.data();
   a.jump = local ? jump_.data() : nullptr;
@@ -489,7 +589,9 @@ void Engine::Step(int t, const float* c, const Row& prev, Row* cur, uint8_t* rec
       }
     }
   }
+  const float* stutter = local ? local_stutter_.data() : stutter_.data();
   for (int s = 0; s < S_; ++s) {
+    if (rules.listed_begin[s] == rules.listed_begin[s + 1]) continue;
     for (int l = rules.listed_begin[s]; l < rules.listed_begin[s + 1]; ++l) {
       const SourceTransition& tr = rules.listed[l];
       const float v0 = (c[s] - prev.min) + (prev.m[tr.from] + tr.cost);
@@ -497,9 +599,24 @@ void Engine::Step(int t, const float* c, const Row& prev, Row* cur, uint8_t* rec
       cur->v[s] = v0;
       if (v0 < cur->m[s]) {
         cur->m[s] = v0;
-        if (record) record[s] = static_cast<uint8_t>(record[s] & 8);
+        if (record) record[mode_ == kWide ? 2 * static_cast<size_t>(s) : s] &= static_cast<uint8_t>(~7);
       }
     }
+    if (!moves) continue;
+    // The move into (s, 0) as Predecessor() decides it: a listed transition wins when it is
+    // below every rule move and the listed ones before it.
+    float best = local ? jump_[s] : GlobalJump(prev.top, s, rules);
+    for (int k = 1; k <= static_cast<int>(rules.fwd_limit[s]); ++k) best = Min(best, prev.m[s - k] + skip_[k]);
+    for (int k = 1; k <= static_cast<int>(rules.back_limit[s]); ++k) best = Min(best, prev.m[s + k] + stutter[k]);
+    int from = -1;
+    for (int l = rules.listed_begin[s]; l < rules.listed_begin[s + 1]; ++l) {
+      const float cand = prev.m[rules.listed[l].from] + rules.listed[l].cost;
+      if (cand < best) {
+        best = cand;
+        from = rules.listed[l].from;
+      }
+    }
+    if (from >= 0) listed_choice_.emplace_back(s, from);
   }
   Finish(cur, t);
 }
@@ -566,6 +683,133 @@ void Engine::StateFromCheckpoint(const std::vector<float>& v, Row* row, uint8_t*
 MatchResult Engine::Solve() {
   MatchResult result;
   if (T_ == 0) return result;
+  if (!SolveWithDecisions(&result)) SolveWithCheckpoints(&result);
+  return result;
+}
+
+bool Engine::SolveWithDecisions(MatchResult* out) {
+  mode_ = o_.max_forward_step + o_.stutter_window + 1 <= 15 ? kPacked : kWide;
+  const size_t row_bytes = static_cast<size_t>(S_) * RecordBytes();
+  const size_t top_size = static_cast<size_t>(o_.stutter_window) + 2;
+  // Rows inside a target movement keep each cell's local jump source.
+  std::vector<int> local_row(T_, -1);
+  int local_rows = 0;
+  for (int t = 1; t < T_; ++t) {
+    if (Rules(t).local_jumps) local_row[t] = local_rows++;
+  }
+  const size_t need = static_cast<size_t>(T_) * row_bytes + static_cast<size_t>(local_rows) * S_ * sizeof(int32_t) +
+                      static_cast<size_t>(T_) * top_size * sizeof(int32_t);
+  if (need > o_.max_decision_bytes) {
+    mode_ = kArgOnly;
+    return false;
+  }
+  // Uninitialized: every byte is written by its row's step.
+  std::unique_ptr<uint8_t[]> decisions(new (std::nothrow) uint8_t[static_cast<size_t>(T_) * row_bytes]);
+  std::unique_ptr<int32_t[]> jump_sources(
+      local_rows > 0 ? new (std::nothrow) int32_t[static_cast<size_t>(local_rows) * S_] : nullptr);
+  if (!decisions || (local_rows > 0 && !jump_sources)) {
+    mode_ = kArgOnly;
+    return false;
+  }
+  std::vector<int32_t> tops(static_cast<size_t>(T_) * top_size, -1);  // each row's top list, its indices
+  std::vector<size_t> listed_begin(T_ + 1, 0);                        // row t's listed choices
+  listed_choice_.clear();
+  MatchResult& result = *out;
+  const auto start = std::chrono::steady_clock::now();
+  Row rows[2];
+  for (auto& r : rows) r.Allocate(R_, stride_, pad_);
+  double offset = 0;  // sum of the row minima subtracted on the way
+  int cur = 0;
+  for (int t = 0; t < T_; ++t) {
+    if (t >= tile_first_ + tile_count_ || t < tile_first_) {
+      ComputeCosts(t, std::min(kCostTile, T_ - t), &cost_seconds_);
+    }
+    uint8_t* record = decisions.get() + static_cast<size_t>(t) * row_bytes;
+    listed_begin[t] = listed_choice_.size();
+    if (t == 0) {
+      Init(CostRow(t), &rows[cur], record);
+    } else {
+      offset += rows[1 - cur].min;
+      Step(t, CostRow(t), rows[1 - cur], &rows[cur], record,
+           local_row[t] >= 0 ? jump_sources.get() + static_cast<size_t>(local_row[t]) * S_ : nullptr);
+    }
+    const auto& top = rows[cur].top;
+    for (size_t i = 0; i < top.size() && i < top_size; ++i) tops[t * top_size + i] = top[i].index;
+    cur = 1 - cur;
+  }
+  listed_begin[T_] = listed_choice_.size();
+  result.total_cost = offset + rows[1 - cur].min;
+  result.forward_seconds = Seconds(start) - cost_seconds_;
+
+  // Backward: a walk over the stored decisions.
+  const auto back_start = std::chrono::steady_clock::now();
+  const int kf = o_.max_forward_step, w = o_.stutter_window;
+  const auto low = [&](int t, int s) { return decisions[static_cast<size_t>(t) * row_bytes + s * RecordBytes()]; };
+  const auto move = [&](int t, int s) {
+    const uint8_t* rec = decisions.get() + static_cast<size_t>(t) * row_bytes;
+    return mode_ == kWide ? static_cast<int>(rec[2 * static_cast<size_t>(s) + 1]) : rec[s] >> 4;
+  };
+  result.source_frames.assign(T_, 0);
+  const float* m_last = rows[1 - cur].m;
+  int s = static_cast<int>(std::min_element(m_last, m_last + S_) - m_last);
+  int r = low(T_ - 1, s) & 7;
+  for (int t = T_ - 1;; --t) {
+    result.source_frames[t] = s;
+    if (t == 0) break;
+    if (r > 0 && r < R_) {
+      --r;
+      continue;
+    }
+    if (r == R_) {
+      r = (low(t, s) & 8) ? R_ - 1 : R_;
+      continue;
+    }
+    int from = -1;
+    const auto first = listed_choice_.begin() + static_cast<std::ptrdiff_t>(listed_begin[t]);
+    const auto last = listed_choice_.begin() + static_cast<std::ptrdiff_t>(listed_begin[t + 1]);
+    const auto listed = std::lower_bound(first, last, std::make_pair(s, std::numeric_limits<int>::min()));
+    if (listed != last && listed->first == s) {
+      from = listed->second;
+    } else {
+      const int code = move(t, s);
+      const RowRules& rules = Rules(t);
+      if (code >= 1 && code <= kf) {
+        from = s - code;
+      } else if (code > kf && code <= kf + w) {
+        from = s + (code - kf);
+      } else if (code == kf + w + 1 && rules.local_jumps) {
+        from = jump_sources[static_cast<size_t>(local_row[t]) * S_ + s];
+      } else if (code == kf + w + 1) {
+        const int window_end = s + static_cast<int>(rules.back_limit[s]);
+        for (size_t i = 0; i < top_size; ++i) {
+          const int e = tops[(t - 1) * top_size + i];
+          if (e < 0) break;
+          if (e < s || e > window_end) {
+            from = e;
+            break;
+          }
+        }
+      }
+    }
+    if (from < 0 || from >= S_) {
+      throw WorkError("match", "backtracking lost the path at target frame " + std::to_string(t));
+    }
+    s = from;
+    r = low(t - 1, s) & 7;
+  }
+  result.cost_seconds = cost_seconds_;
+  result.backward_seconds = Seconds(back_start);
+  result.memory_bytes = static_cast<size_t>(T_) * row_bytes + static_cast<size_t>(local_rows) * S_ * sizeof(int32_t) +
+                        tops.size() * sizeof(int32_t) + listed_begin.size() * sizeof(size_t) +
+                        listed_choice_.capacity() * sizeof(listed_choice_[0]);
+  result.walked_decisions = true;
+  mode_ = kArgOnly;
+  return true;
+}
+
+void Engine::SolveWithCheckpoints(MatchResult* out) {
+  MatchResult& result = *out;
+  mode_ = kArgOnly;
   const auto start = std::chrono::steady_clock::now();
   // Block length K balances the checkpoints ((T/K) rows of (R+1) floats per source) and one
   // block of M rows and record bytes (K rows of 5 bytes per source).
@@ -651,7 +895,6 @@ MatchResult Engine::Solve() {
   result.backward_seconds = Seconds(back_start) - (cost_seconds_ - forward_cost_seconds);
   result.memory_bytes = static_cast<size_t>(blocks - 1) * (R_ + 1) * stride_ * sizeof(float) +
                         block_m.size() * sizeof(float) + block_rec.size();
-  return result;
 }
 
 }  // namespace

@@ -12,8 +12,11 @@
 // Exact in O(S) per target frame: the state is (s, r), r = min(repeats so far, R); moves
 // into r = 0 are advance/skip (Kf terms), stutter (W terms), listed transitions, and a jump
 // from the best source outside [s, s+W] (the W+2 smallest of the previous row); a stay
-// moves r to min(r+1, R). Memory O(S sqrt(T)): rows are checkpointed and recomputed block
-// by block for the backtrack. docs/skeletons.md has the details.
+// moves r to min(r+1, R). The forward pass stores each cell's decision (1 byte, 2 when
+// Kf + W > 14) and the backtrack walks them; when they would not fit
+// MatchOptions::max_decision_bytes, memory is O(S sqrt(T)) instead: rows are checkpointed
+// and recomputed block by block for the backtrack. docs/skeletons.md has the details.
+#include <cstddef>
 #include <string>
 #include <vector>
 
@@ -37,6 +40,10 @@ struct MatchOptions {
   int stutter_window = 8;      // W
   float stutter_cost = 0.3f;   // added to J for a backward move of 1..W frames
   std::vector<SourceTransition> transitions;
+  // The forward pass keeps every cell's decision (T x S bytes, twice that when Kf + W > 14,
+  // plus 4 bytes a cell on rows inside a target movement) when that fits here; otherwise
+  // the backtrack recomputes blocks of rows from checkpoints (same path, slower). 0 forces it.
+  size_t max_decision_bytes = size_t{3} << 30;
 
   // Valid when the costs are finite and >= 0, Kf >= 1, W >= 0, 1 <= R <= 7 and a forward
   // skip never costs more than a jump (skip_cost * (Kf - 1) <= J).
@@ -72,8 +79,9 @@ struct MatchResult {
   MatchStats stats;
   double cost_seconds = 0;      // computing cost rows (both passes)
   double forward_seconds = 0;   // the DP rows of the forward pass
-  double backward_seconds = 0;  // recomputing blocks and backtracking
-  size_t memory_bytes = 0;      // checkpoints and one block
+  double backward_seconds = 0;  // backtracking (and, without decisions, recomputing blocks)
+  size_t memory_bytes = 0;      // what the backtrack keeps: decisions and top lists, or checkpoints and one block
+  bool walked_decisions = false;  // the backtrack walked stored decisions (else recomputed from checkpoints)
   std::string Summary() const;  // one line
 };
 

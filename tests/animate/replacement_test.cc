@@ -234,6 +234,68 @@ TEST(Replacement, FollowsAPathToItsEnd) {
   EXPECT_LT(path_term->MaxDeviation(tracks[0]), 0.2);
 }
 
+// Picks aimed at a collision (collision_pick_fraction): two walkers on lanes 8 cm apart pass
+// each other (d_min 10 cm); while they collide, picks are aimed (and counted). A problem
+// without collision terms draws no aimed pick and the same random numbers: its result is the
+// same with and without them.
+TEST(Replacement, PicksAimedAtACollisionAreDrawnOnlyWhereOneIs) {
+  const TransitionGraph graph = WalkingGraph::Make();
+  auto passing = [&](bool collide) {
+    auto problem = std::make_unique<Problem>(graph);
+    // Without collisions, east starts with a bend off its lane (the end of the turning ring),
+    // which moves improve.
+    std::vector<int> east, west;
+    if (!collide) east = {44, 45, 46, 47, 0};
+    for (int m = 0; m < 120; ++m) {
+      if (static_cast<int>(east.size()) < 120) east.push_back(WalkingGraph::Straight(0, m % WalkingGraph::kStraight));
+      west.push_back(WalkingGraph::Straight(4, m % WalkingGraph::kStraight));
+    }
+    const double length = WalkingGraph::kSpeed * 119;
+    SpriteSpec a;
+    a.initial_sequence = east;
+    a.max_frames = 120;
+    problem->AddSprite(a);
+    SpriteSpec b = a;
+    b.initial_sequence = west;
+    b.anchor_m = Vector2d(length, 0.08);
+    problem->AddSprite(b);
+    problem->AddTerm(std::make_unique<PathTerm>(0, Polyline({{0, 0}, {length, 0}}), PathStrengths{0.2, 20.0, 1.0}));
+    problem->AddTerm(std::make_unique<PathTerm>(1, Polyline({{length, 0.08}, {0, 0.08}}), PathStrengths{0.2, 20.0, 1.0}));
+    if (collide) problem->AddTerm(std::make_unique<CollisionTerm>(0, 1, 0.10, 50.0));
+    return problem;
+  };
+  auto optimize = [&](const Problem& problem, double fraction, Summary* summary) {
+    ReplacementOptions options = FastOptions(30.0);
+    options.start = StartMethod::kGiven;
+    options.restart_when_converged = false;
+    options.changes_per_turn = 20;
+    options.max_turns = 6;
+    options.collision_pick_fraction = fraction;
+    return OptimizeSequences(problem, options, summary);
+  };
+
+  const auto colliding = passing(true);
+  const std::vector<Track> given{colliding->MakeSpriteTrack(0, colliding->sprite(0).initial_sequence),
+                                 colliding->MakeSpriteTrack(1, colliding->sprite(1).initial_sequence)};
+  const int before = colliding->Evaluate(given).violations.at("collision");
+  EXPECT_EQ(before, 2);  // steps 59 and 60: 5 cm apart along x, 8 cm across
+  Summary aimed;
+  const auto result = optimize(*colliding, 1.0, &aimed);
+  EXPECT_TRUE(colliding->IsValid(result));
+  EXPECT_LE(colliding->Evaluate(result).violations.at("collision"), before) << aimed.FullReport();
+  EXPECT_LE(aimed.final_cost.total, aimed.initial_cost.total);
+  EXPECT_GT(aimed.collision_picks, 0);
+
+  const auto apart = passing(false);
+  Summary with, without;
+  const auto a = optimize(*apart, 1.0, &with);
+  const auto b = optimize(*apart, 0.0, &without);
+  EXPECT_EQ(with.collision_picks, 0);
+  ASSERT_EQ(a.size(), b.size());
+  for (size_t s = 0; s < a.size(); ++s) EXPECT_EQ(a[s].frames, b[s].frames) << "sprite " << s;
+  EXPECT_GT(with.moves_kept, 0);
+}
+
 TEST(Replacement, FreeStartsAndEndAnchorsMeetTheirLocations) {
   const TransitionGraph graph = WalkingGraph::Make();
   Problem problem(graph);

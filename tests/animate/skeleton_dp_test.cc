@@ -160,8 +160,65 @@ TEST(SkeletonDp, LongSequenceUsesCheckpointsAndStaysOptimal) {
   std::mt19937 rng(5);
   const DenseCostRows costs = RandomCosts(300, 37, rng);
   MatchOptions o;
+  o.max_decision_bytes = 0;  // no stored decisions: the checkpoint backtrack
   const MatchResult r = SolveMatch(costs, {0, 20}, o);
+  EXPECT_FALSE(r.walked_decisions);
   EXPECT_NEAR(PathCost(costs, {0, 20}, o, nullptr, r.source_frames), r.total_cost, 1e-3);
+}
+
+TEST(SkeletonDp, StoredDecisionsGiveTheCheckpointPath) {
+  // The backtrack over decisions stored by the forward pass against the checkpoint
+  // fallback (forced by a zero budget), which recomputes rows and re-derives every move:
+  // the same frames and cost, free and constrained, packed (Kf + W <= 14) and wide codes,
+  // with listed transitions, excluded frames and 0/1 costs (many exact ties).
+  std::mt19937 rng(19);
+  for (int trial = 0; trial < 20; ++trial) {
+    const int T = trial % 4 == 0 ? 160 : 30 + 3 * trial, S = 45 + 5 * trial;
+    DenseCostRows costs = RandomCosts(T, S, rng, trial % 3 == 0 ? 0.05f : 0.0f);
+    if (trial % 5 == 2) {
+      std::vector<float> grid(static_cast<size_t>(T) * S);
+      for (int t = 0; t < T; ++t) {
+        for (int s = 0; s < S; ++s) grid[static_cast<size_t>(t) * S + s] = costs.at(t, s) < 0.7f ? 0.0f : 1.0f;
+      }
+      costs = DenseCostRows(T, S, std::move(grid));
+    }
+    const std::vector<int> clips = {0, 17, 30};
+    MatchOptions o = RandomOptions(rng, S);
+    if (trial % 5 == 2) {  // free skips and round penalties: equal candidates everywhere
+      o.max_forward_step = trial % 2 ? 1 : 3;  // constrained: few moves, so local jumps
+      o.stutter_window = trial % 2 ? 0 : 2;
+      o.skip_cost = 0;
+      o.jump_cost = 0.25f;
+      o.freeze_cost = 0.25f;
+      o.stutter_cost = 0.25f;
+    }
+    if (trial % 4 == 3) {  // move codes above 15: two bytes a cell
+      o.max_forward_step = 5;
+      o.stutter_window = 12;
+      o.skip_cost = o.jump_cost / 8;
+    }
+    if (trial % 3 == 1) {
+      for (int i = 0; i < 25; ++i) {
+        o.transitions.push_back({static_cast<int>(rng() % S), static_cast<int>(rng() % S), 0.05f * (i % 4)});
+      }
+    }
+    MovementConstraint m;
+    m.target_starts = {0, T / 3, T / 2};
+    m.source_starts = {0, 8, 17, 23, 30, 40};
+    m.jump_cost_per_frame = trial % 5 == 2 ? 0.0f : 0.01f * static_cast<float>(trial % 3);
+    const MovementConstraint* constraint = trial % 2 ? &m : nullptr;
+    MatchOptions checkpoints = o;
+    checkpoints.max_decision_bytes = 0;
+    SCOPED_TRACE("trial " + std::to_string(trial));
+    const MatchResult stored = SolveMatch(costs, clips, o, constraint);
+    const MatchResult recomputed = SolveMatch(costs, clips, checkpoints, constraint);
+    EXPECT_TRUE(stored.walked_decisions);
+    EXPECT_FALSE(recomputed.walked_decisions);
+    EXPECT_EQ(stored.source_frames, recomputed.source_frames);
+    EXPECT_EQ(stored.total_cost, recomputed.total_cost);
+    EXPECT_NEAR(PathCost(costs, clips, o, constraint, stored.source_frames), stored.total_cost, 1e-3);
+    EXPECT_GE(stored.memory_bytes, static_cast<size_t>(T) * S);  // at least a byte a cell
+  }
 }
 
 // Cost matrix with `value` everywhere and chosen cells overridden.
