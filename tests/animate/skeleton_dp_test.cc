@@ -172,27 +172,30 @@ TEST(SkeletonDp, StoredDecisionsGiveTheCheckpointPath) {
   // the same frames and cost, free and constrained, packed (Kf + W <= 14) and wide codes,
   // with listed transitions, excluded frames and 0/1 costs (many exact ties).
   std::mt19937 rng(19);
-  for (int trial = 0; trial < 20; ++trial) {
+  for (int trial = 0; trial < 24; ++trial) {
+    const bool constrained = trial % 2 == 1;
+    const bool grid = trial % 5 == 2;  // 0/1 costs, free skips and stutters: equal candidates everywhere
+    const bool wide = trial % 3 == 0;  // move codes above 15: two bytes a cell
     const int T = trial % 4 == 0 ? 160 : 30 + 3 * trial, S = 45 + 5 * trial;
-    DenseCostRows costs = RandomCosts(T, S, rng, trial % 3 == 0 ? 0.05f : 0.0f);
-    if (trial % 5 == 2) {
-      std::vector<float> grid(static_cast<size_t>(T) * S);
+    DenseCostRows costs = RandomCosts(T, S, rng, trial % 4 == 1 ? 0.05f : 0.0f);
+    if (grid) {
+      std::vector<float> values(static_cast<size_t>(T) * S);
       for (int t = 0; t < T; ++t) {
-        for (int s = 0; s < S; ++s) grid[static_cast<size_t>(t) * S + s] = costs.at(t, s) < 0.7f ? 0.0f : 1.0f;
+        for (int s = 0; s < S; ++s) values[static_cast<size_t>(t) * S + s] = costs.at(t, s) < 0.7f ? 0.0f : 1.0f;
       }
-      costs = DenseCostRows(T, S, std::move(grid));
+      costs = DenseCostRows(T, S, std::move(values));
     }
     const std::vector<int> clips = {0, 17, 30};
     MatchOptions o = RandomOptions(rng, S);
-    if (trial % 5 == 2) {  // free skips and round penalties: equal candidates everywhere
-      o.max_forward_step = trial % 2 ? 1 : 3;  // constrained: few moves, so local jumps
-      o.stutter_window = trial % 2 ? 0 : 2;
+    if (grid) {
+      o.max_forward_step = constrained ? 1 : 3;  // constrained: few moves, so local jumps
+      o.stutter_window = constrained && trial % 3 == 2 ? 0 : 2;
       o.skip_cost = 0;
       o.jump_cost = 0.25f;
       o.freeze_cost = 0.25f;
-      o.stutter_cost = 0.25f;
+      o.stutter_cost = 0;
     }
-    if (trial % 4 == 3) {  // move codes above 15: two bytes a cell
+    if (wide) {
       o.max_forward_step = 5;
       o.stutter_window = 12;
       o.skip_cost = o.jump_cost / 8;
@@ -205,8 +208,8 @@ TEST(SkeletonDp, StoredDecisionsGiveTheCheckpointPath) {
     MovementConstraint m;
     m.target_starts = {0, T / 3, T / 2};
     m.source_starts = {0, 8, 17, 23, 30, 40};
-    m.jump_cost_per_frame = trial % 5 == 2 ? 0.0f : 0.01f * static_cast<float>(trial % 3);
-    const MovementConstraint* constraint = trial % 2 ? &m : nullptr;
+    m.jump_cost_per_frame = grid ? 0.0f : 0.01f * static_cast<float>(trial % 3);
+    const MovementConstraint* constraint = constrained ? &m : nullptr;
     MatchOptions checkpoints = o;
     checkpoints.max_decision_bytes = 0;
     SCOPED_TRACE("trial " + std::to_string(trial));
@@ -218,6 +221,32 @@ TEST(SkeletonDp, StoredDecisionsGiveTheCheckpointPath) {
     EXPECT_EQ(stored.total_cost, recomputed.total_cost);
     EXPECT_NEAR(PathCost(costs, clips, o, constraint, stored.source_frames), stored.total_cost, 1e-3);
     EXPECT_GE(stored.memory_bytes, static_cast<size_t>(T) * S);  // at least a byte a cell
+  }
+}
+
+TEST(SkeletonDp, StoredDecisionsBreakTiesLikeTheCheckpointPath) {
+  // Two equal stutters back into frame 10 (from 12 or 13): both backtracks take the
+  // shorter step, free (a row's minimum in the window: scalar cells) and inside a target
+  // movement (the vector kernel).
+  const int S = 40;
+  std::vector<float> values(2 * S, 1.0f);
+  values[12] = values[13] = 0;  // row 0
+  values[S + 10] = 0;           // row 1
+  const DenseCostRows costs(2, S, values);
+  MatchOptions o;
+  o.max_forward_step = 1;
+  o.stutter_window = 3;
+  MovementConstraint inside;
+  inside.target_starts = {0};
+  inside.source_starts = {0};
+  for (const MovementConstraint* m : std::vector<const MovementConstraint*>{nullptr, &inside}) {
+    MatchOptions checkpoints = o;
+    checkpoints.max_decision_bytes = 0;
+    const MatchResult stored = SolveMatch(costs, {0}, o, m);
+    const MatchResult recomputed = SolveMatch(costs, {0}, checkpoints, m);
+    EXPECT_TRUE(stored.walked_decisions);
+    EXPECT_EQ(stored.source_frames, (std::vector<int>{12, 10}));
+    EXPECT_EQ(recomputed.source_frames, (std::vector<int>{12, 10}));
   }
 }
 
