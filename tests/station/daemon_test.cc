@@ -249,6 +249,12 @@ TEST_F(DaemonTest, LostPacketsAreCountedAndTheStationGoesOn) {
       << status.dump(2);
   EXPECT_LE(cam["frames_captured"].get<int64_t>() + cam["dropped"]["at_source"].get<int64_t>(), 160)
       << status.dump(2);
+  // The keyer learnt from 30 complete frames; the incomplete ones among them widened the span
+  // of sequence numbers it took (status learnt_from: how the live keyer may differ from ingest's).
+  const nlohmann::json& learnt = cam["learnt_from"];
+  EXPECT_EQ(learnt["frames"], 30) << status.dump(2);
+  EXPECT_GT(learnt["last_sequence"].get<int64_t>() - learnt["first_sequence"].get<int64_t>(), 29) << status.dump(2);
+  EXPECT_GT(learnt["last_timestamp_ns"].get<int64_t>(), 0) << status.dump(2);
   daemon->Signal(SIGTERM);
   EXPECT_EQ(daemon->Wait(10), 0) << daemon->output();
   EXPECT_EQ(RunSpritestation("bank verify " + bank()).exit_code, 0);
