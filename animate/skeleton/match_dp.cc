@@ -71,7 +71,6 @@ typedef float v8f __attribute__((vector_size(32)));
 typedef int v8i __attribute__((vector_size(32)));
 typedef uint8_t v8u8 __attribute__((vector_size(8)));
 typedef uint16_t v8u16 __attribute__((vector_size(16)));
-typedef long long v4i64 __attribute__((vector_size(32)));
 
 // What a step records per cell. The low byte always holds argmin_r V(s, r) (bits 0-2) and
 // whether V(s, R) came from r = R-1 (bit 3). kPacked adds the move into (s, 0) in bits
@@ -247,9 +246,10 @@ __attribute__((always_inline)) inline void StepBody(const StepArgs& args) {
       // A stutter seldom wins (on free rows only where the row minimum lies in the window,
       // cells Step redoes anyway), so its k is looked for only when one does.
       const v8i stutters = stu_first & ~jump_first;
-      v4i64 any;
-      std::memcpy(&any, &stutters, sizeof(any));
-      if ((any[0] | any[1] | any[2] | any[3]) != 0) {
+      const v8u8 lanes = __builtin_convertvector(stutters, v8u8);
+      uint64_t any;
+      std::memcpy(&any, &lanes, sizeof(any));
+      if (any != 0) {
         v8f first = inf;
         v8i scode{};
         for (int k = 1; k <= a.w; ++k) {
@@ -471,10 +471,13 @@ float Engine::GlobalJump(const std::vector<TopEntry>& top, int s, const RowRules
   return kInf;
 }
 
-void Engine::LocalJumps(const RowRules& rules, const float* m, float* out, int32_t* source) {
-  const float lambda = movements_->jump_cost_per_frame;
-  const float jump = o_.jump_cost;
-  const int w = o_.stutter_window;
+namespace {
+
+// Engine::LocalJumps; kSources also keeps where each best jump comes from (the first
+// source frame reaching it, prefix before suffix, as Predecessor() would pick).
+template <bool kSources>
+void LocalJumpsOf(const RowRules& rules, const float* m, float lambda, float jump, int w, float* out,
+                  int32_t* source, float* suffix, int32_t* suffix_at) {
   for (size_t g = 0; g < rules.seg_begin.size(); ++g) {
     const int a = rules.seg_begin[g], b = rules.seg_end[g];
     float run = kInf;  // min over s' < s of M(s') - λ (s' - a)
@@ -482,24 +485,44 @@ void Engine::LocalJumps(const RowRules& rules, const float* m, float* out, int32
     for (int s = a; s <= b; ++s) {
       out[s] = (run + lambda * static_cast<float>(s - a)) + jump;
       const float v = m[s] - lambda * static_cast<float>(s - a);
-      if (source) {
+      if constexpr (kSources) {
         source[s] = run_at;
         if (v < run) run_at = s;
       }
       run = Min(run, v);
     }
-    suffix_[b + 1] = kInf;  // min over s' >= x of M(s') + λ (s' - a)
-    suffix_at_[b + 1] = -1;  // its first s' (kept only with sources)
+    float after = kInf;  // suffix[x] = min over s' >= x of M(s') + λ (s' - a)
+    int after_at = -1;   // its first s'
+    suffix[b + 1] = kInf;
+    if constexpr (kSources) suffix_at[b + 1] = -1;
     for (int x = b; x >= a; --x) {
       const float v = m[x] + lambda * static_cast<float>(x - a);
-      if (source) suffix_at_[x] = v <= suffix_[x + 1] ? x : suffix_at_[x + 1];
-      suffix_[x] = Min(suffix_[x + 1], v);
+      if constexpr (kSources) {
+        if (v <= after) after_at = x;
+        suffix_at[x] = after_at;
+      }
+      after = Min(after, v);
+      suffix[x] = after;
     }
     for (int s = a; s + w + 1 <= b; ++s) {
-      const float after = (suffix_[s + w + 1] - lambda * static_cast<float>(s - a)) + jump;
-      if (source && after < out[s]) source[s] = suffix_at_[s + w + 1];  // a tie keeps the earlier source
-      out[s] = Min(out[s], after);
+      const float later = (suffix[s + w + 1] - lambda * static_cast<float>(s - a)) + jump;
+      if constexpr (kSources) {
+        if (later < out[s]) source[s] = suffix_at[s + w + 1];  // a tie keeps the earlier source
+      }
+      out[s] = Min(out[s], later);
     }
+  }
+}
+
+}  // namespace
+
+void Engine::LocalJumps(const RowRules& rules, const float* m, float* out, int32_t* source) {
+  const float lambda = movements_->jump_cost_per_frame;
+  if (source) {
+    LocalJumpsOf<true>(rules, m, lambda, o_.jump_cost, o_.stutter_window, out, source, suffix_.data(),
+                       suffix_at_.data());
+  } else {
+    LocalJumpsOf<false>(rules, m, lambda, o_.jump_cost, o_.stutter_window, out, nullptr, suffix_.data(), nullptr);
   }
 }
 
@@ -604,7 +627,7 @@ void Engine::Step(int t, const float* c, const Row& prev, Row* cur, uint8_t* rec
     }
   }
   const float* stutter = local ? local_stutter_.data() : stutter_.data();
-  for (int s = 0; s < S_; ++s) {
+  for (int s = 0; s < (rules.listed.empty() ? 0 : S_); ++s) {
     if (rules.listed_begin[s] == rules.listed_begin[s + 1]) continue;
     for (int l = rules.listed_begin[s]; l < rules.listed_begin[s + 1]; ++l) {
       const SourceTransition& tr = rules.listed[l];
@@ -718,20 +741,19 @@ bool Engine::SolveWithDecisions(MatchResult* out) {
     return false;
   }
   const auto start = std::chrono::steady_clock::now();  // the forward pass includes the store's pages
-  // Mapped with its pages at once (MAP_POPULATE): a page fault at a time made the forward
-  // pass visibly slower (+39 % instead of +7 % over no store at 2,000 x 100,000). Every
-  // byte is written by its row's step.
-  const size_t decision_bytes = static_cast<size_t>(T_) * row_bytes;
-  void* map = mmap(nullptr, decision_bytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS | MAP_POPULATE, -1, 0);
-  const auto unmap = [decision_bytes](uint8_t* p) { munmap(p, decision_bytes); };
-  std::unique_ptr<uint8_t[], decltype(unmap)> decisions(map == MAP_FAILED ? nullptr : static_cast<uint8_t*>(map),
-                                                         unmap);
-  std::unique_ptr<int32_t[]> jump_sources(
-      local_rows > 0 ? new (std::nothrow) int32_t[static_cast<size_t>(local_rows) * S_] : nullptr);
-  if (!decisions || (local_rows > 0 && !jump_sources)) {
+  // The decisions, then the jump sources, mapped with their pages at once (MAP_POPULATE):
+  // a page fault at a time made the forward pass visibly slower (+39 % instead of +7 %
+  // over no store at 2,000 x 100,000). Every byte is written by its row's step.
+  const size_t decision_bytes = (static_cast<size_t>(T_) * row_bytes + 63) / 64 * 64;
+  const size_t map_bytes = decision_bytes + static_cast<size_t>(local_rows) * S_ * sizeof(int32_t);
+  void* map = mmap(nullptr, map_bytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS | MAP_POPULATE, -1, 0);
+  if (map == MAP_FAILED) {
     mode_ = kArgOnly;
     return false;
   }
+  const auto unmap = [map_bytes](uint8_t* p) { munmap(p, map_bytes); };
+  const std::unique_ptr<uint8_t[], decltype(unmap)> decisions(static_cast<uint8_t*>(map), unmap);
+  int32_t* const jump_sources = reinterpret_cast<int32_t*>(decisions.get() + decision_bytes);
   std::vector<int32_t> tops(static_cast<size_t>(T_) * top_size, -1);  // each row's top list, its indices
   std::vector<size_t> listed_begin(T_ + 1, 0);                        // row t's listed choices
   listed_choice_.clear();
@@ -751,7 +773,7 @@ bool Engine::SolveWithDecisions(MatchResult* out) {
     } else {
       offset += rows[1 - cur].min;
       Step(t, CostRow(t), rows[1 - cur], &rows[cur], record,
-           local_row[t] >= 0 ? jump_sources.get() + static_cast<size_t>(local_row[t]) * S_ : nullptr);
+           local_row[t] >= 0 ? jump_sources + static_cast<size_t>(local_row[t]) * S_ : nullptr);
     }
     const auto& top = rows[cur].top;
     for (size_t i = 0; i < top.size() && i < top_size; ++i) tops[t * top_size + i] = top[i].index;
@@ -819,8 +841,7 @@ bool Engine::SolveWithDecisions(MatchResult* out) {
   }
   result.cost_seconds = cost_seconds_;
   result.backward_seconds = Seconds(back_start);
-  result.memory_bytes = static_cast<size_t>(T_) * row_bytes + static_cast<size_t>(local_rows) * S_ * sizeof(int32_t) +
-                        tops.size() * sizeof(int32_t) + listed_begin.size() * sizeof(size_t) +
+  result.memory_bytes = map_bytes + tops.size() * sizeof(int32_t) + listed_begin.size() * sizeof(size_t) +
                         listed_choice_.capacity() * sizeof(listed_choice_[0]);
   result.walked_decisions = true;
   mode_ = kArgOnly;
