@@ -69,6 +69,7 @@ AnimateResult RunAnimation(const Scene& scene, const AnimateRunOptions& options)
     replace.time_budget_seconds = options.time_budget_s;
     replace.seed = options.seed;
     replace.progress_seconds = options.progress_every_s;
+    if (options.max_turns > 0) replace.max_turns = options.max_turns;
     if (options.threads > 0) replace.reach.num_threads = options.threads;
     double next_snapshot = options.snapshot_every_s;
     if (options.snapshot_every_s > 0) {

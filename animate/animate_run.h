@@ -21,6 +21,9 @@ struct AnimateRunOptions {
   double progress_every_s = 0.0;   // log the progress this often; 0: never
   double snapshot_every_s = 0.0;   // keep the current sequences this often; 0: never
   int threads = 0;                 // F/B set threads; 0: the spec's
+  // Replacement: stop after this many sprite turns (0: the time budget alone). With a budget
+  // that is never reached, the same work on any machine, loaded or not (tests).
+  int max_turns = 0;
 };
 
 // How well the result meets its constraints (the scenes' figures).

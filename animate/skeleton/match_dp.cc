@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
+#include <fstream>
 #include <limits>
 #include <memory>
 #include <new>
@@ -724,6 +725,18 @@ MatchResult Engine::Solve() {
   return result;
 }
 
+// MemAvailable of /proc/meminfo, in bytes; the largest size_t when it cannot be read.
+size_t AvailableMemoryBytes() {
+  std::ifstream meminfo("/proc/meminfo");
+  std::string key;
+  size_t kib = 0;
+  std::string unit;
+  while (meminfo >> key >> kib >> unit) {
+    if (key == "MemAvailable:") return kib * 1024;
+  }
+  return std::numeric_limits<size_t>::max();
+}
+
 bool Engine::SolveWithDecisions(MatchResult* out) {
   mode_ = o_.max_forward_step + o_.stutter_window + 1 <= 15 ? kPacked : kWide;
   const size_t row_bytes = static_cast<size_t>(S_) * RecordBytes();
@@ -736,7 +749,10 @@ bool Engine::SolveWithDecisions(MatchResult* out) {
   }
   const size_t need = static_cast<size_t>(T_) * row_bytes + static_cast<size_t>(local_rows) * S_ * sizeof(int32_t) +
                       static_cast<size_t>(T_) * top_size * sizeof(int32_t);
-  if (need > o_.max_decision_bytes) {
+  // Within the budget and within half the memory the system has available now: the pages
+  // are populated at once, and under overcommit an mmap past what is there would not fail
+  // but get the process killed instead of falling back.
+  if (need > std::min(o_.max_decision_bytes, AvailableMemoryBytes() / 2)) {
     mode_ = kArgOnly;
     return false;
   }

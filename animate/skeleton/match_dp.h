@@ -42,7 +42,9 @@ struct MatchOptions {
   std::vector<SourceTransition> transitions;
   // The forward pass keeps every cell's decision (T x S bytes, twice that when Kf + W > 14,
   // plus 4 bytes a cell on rows inside a target movement) when that fits here; otherwise
-  // the backtrack recomputes blocks of rows from checkpoints (same path, slower). 0 forces it.
+  // the backtrack recomputes blocks of rows from checkpoints (slower; an equally optimal path,
+  // the same one unless float rounding ties two jump sources). 0 forces it. Also capped at half
+  // the memory available (/proc/meminfo MemAvailable) when the match starts.
   size_t max_decision_bytes = size_t{3} << 30;
 
   // Valid when the costs are finite and >= 0, Kf >= 1, W >= 0, 1 <= R <= 7 and a forward

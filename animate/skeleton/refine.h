@@ -64,10 +64,20 @@ struct RefineResult {
 };
 
 // Runs the constrained second pass and the averaging. `targets` and `sources` are the
-// descriptors `costs` was built from (for the sequential costs).
+// descriptors `costs` was built from (for the sequential costs). With `first_pass` (the
+// unconstrained choice, one source frame per target frame), a target movement is also cut
+// where that choice moves to another source movement for at least the minimum length
+// (SplitByFirstPass): locomotion has no peak of pose change inside it, so idle, turn and
+// walk can form one target movement that the source holds as several.
 RefineResult RefineMatch(const CostRows& costs, const PoseDescriptors& targets, const PoseDescriptors& sources,
                          const std::vector<int>& clip_starts, const MatchOptions& options,
-                         const RefineOptions& refine = {});
+                         const RefineOptions& refine = {}, const std::vector<int>* first_pass = nullptr);
+
+// `target_starts` plus, inside each target movement, the start of every run of at least
+// `min_length` frames whose `first_pass` frames lie in one source movement, when that
+// source movement differs from the previous such run's (shorter runs join the run after).
+std::vector<int> SplitByFirstPass(const std::vector<int>& target_starts, const std::vector<int>& source_starts,
+                                  const std::vector<int>& first_pass, int min_length);
 
 // Centred moving average of `frames` inside each segment [starts[i], starts[i+1]),
 // rounded to the nearest frame.

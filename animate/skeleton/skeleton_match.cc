@@ -33,7 +33,8 @@ SkeletonMatchResult MatchSkeletons(const SkeletonSequence& target, const std::ve
   }
   result.source_frames = result.with_penalties.source_frames;
   if (options.refine_enabled) {
-    result.refined = RefineMatch(costs, targets, sources, result.clip_starts, options.match, options.refine);
+    result.refined = RefineMatch(costs, targets, sources, result.clip_starts, options.match, options.refine,
+                                 &result.with_penalties.source_frames);
     result.source_frames = result.refined->source_frames;
   }
   for (int s : result.source_frames) {

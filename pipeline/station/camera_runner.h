@@ -50,8 +50,9 @@ struct CameraStatus {
   uint64_t dropped_at_source = 0;    // lost before delivery: incomplete frames, sequence gaps, unreadable
   uint64_t source_errors = 0;        // recoverable source problems (timeouts, corrupt frames)
   uint64_t frames_while_learning = 0;  // arrived while the keyer learnt the empty enclosure (preview only)
-  // The frames the keyer learnt the empty enclosure from (the last set collected): how many,
-  // and the first and last one's sequence number and timestamp (-1: none collected yet).
+  // The frames collected for the keyer to learn the empty enclosure from (set when the set is
+  // complete and learning starts): how many, and the first and last one's sequence number and
+  // timestamp (-1: none collected yet).
   struct LearntFrom {
     uint64_t frames = 0;
     int64_t first_sequence = -1, last_sequence = -1;

@@ -47,7 +47,8 @@ sprites:
       - path: {points: [[0, 0], [1, 0], [1, 1]], direction_strength: 0.2, distance_strength: 20, unreached_strength: 5}
 )")));
   AnimateRunOptions options;
-  options.time_budget_s = 4;
+  options.time_budget_s = 60;
+  options.max_turns = 300;  // the same work on any machine (a budget never reached)
   const AnimateResult result = RunAnimation(*scene, options);
   ASSERT_EQ(result.tracks.size(), 1u);
   const Track& track = result.tracks[0];
@@ -72,8 +73,11 @@ sprites:
       - path: {points: [[0, 0], [0.8, 0]], distance_strength: 20, unreached_strength: 5}
       - frames: {tag: standing, after_path: walker, duration: 0.5, strength: 2}
 )")));
+  // The same work on any machine: 300 sprite turns (~2.3 s idle), a budget never reached.
+  // (With a 4 s budget a loaded CI machine stopped it short: 3 steps off the tag.)
   AnimateRunOptions options;
-  options.time_budget_s = 4;
+  options.time_budget_s = 60;
+  options.max_turns = 300;
   const AnimateResult result = RunAnimation(*scene, options);
   EXPECT_EQ(result.figures.paths_unfinished, 0);
   EXPECT_EQ(result.figures.frame_steps, 15);

@@ -153,6 +153,22 @@ TEST(SkeletonRefine, AveragingWindowStaysInsideEachMovement) {
   EXPECT_EQ(AverageWithinSegments(stutter, {0}, 3), (std::vector<int>{11, 11, 12, 12, 13, 13, 14, 14}));
 }
 
+TEST(SkeletonRefine, TargetMovementsAreCutWhereTheFirstPassChangesSourceMovement) {
+  // Source movements [0, 10), [10, 30), [30, ...). Target movements [0, 20), [20, 26).
+  const std::vector<int> source_starts{0, 10, 30};
+  std::vector<int> first_pass;
+  for (int t = 0; t < 10; ++t) first_pass.push_back(12 + t);  // movement 1
+  first_pass.push_back(5);                                     // movement 0 for 2 frames: too short
+  first_pass.push_back(6);
+  for (int t = 12; t < 20; ++t) first_pass.push_back(31 + t);  // movement 2 for 8 frames: a cut at 12
+  for (int t = 20; t < 26; ++t) first_pass.push_back(40 + t);  // still movement 2, its own target movement
+  EXPECT_EQ(SplitByFirstPass({0, 20}, source_starts, first_pass, 3), (std::vector<int>{0, 12, 20}));
+  // With a minimum of 9 frames the 8-frame run is not a movement of its own either.
+  EXPECT_EQ(SplitByFirstPass({0, 20}, source_starts, first_pass, 9), (std::vector<int>{0, 20}));
+  // A first pass inside one source movement cuts nothing.
+  EXPECT_EQ(SplitByFirstPass({0, 20}, source_starts, std::vector<int>(26, 15), 3), (std::vector<int>{0, 20}));
+}
+
 TEST(SkeletonRefine, OneSourceMovementPerTargetMovement) {
   // Target: the YMCA by one body. Source: the gestures by another body, in another order
   // and at another speed, with walking between them.
