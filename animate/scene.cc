@@ -115,6 +115,7 @@ ReplacementOptions Scene::MakeReplacementOptions() const {
   options.time_budget_seconds = o.time_budget_s;
   options.seed = o.seed;
   options.changes_per_turn = o.changes_per_turn;
+  options.collision_pick_fraction = o.collision_pick_fraction;
   options.beam.width = o.beam_width;
   options.start = o.start == "random" ? StartMethod::kRandom
                   : o.start == "beam" ? StartMethod::kBeam

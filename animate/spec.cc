@@ -340,7 +340,7 @@ CollisionSpec ReadCollision(const Reader& r, const AnimationSpec& spec, const YA
 void ReadOptimizer(const Reader& r, const YAML::Node& node, OptimizerSpec& o) {
   const std::string f = "optimizer";
   r.Map(node, f, {"method", "start", "time_budget_s", "seed", "set_size", "threads",
-                  "changes_per_turn", "beam_width", "snapshot_every_s"});
+                  "changes_per_turn", "beam_width", "snapshot_every_s", "collision_pick_fraction"});
   if (node["start"]) {
     o.start = r.Text(node["start"], f + ".start");
     if (o.start != "sequential" && o.start != "random" && o.start != "beam") {
@@ -361,6 +361,12 @@ void ReadOptimizer(const Reader& r, const YAML::Node& node, OptimizerSpec& o) {
     o.changes_per_turn = r.Integer(node["changes_per_turn"], f + ".changes_per_turn", 1);
   }
   if (node["beam_width"]) o.beam_width = r.Integer(node["beam_width"], f + ".beam_width", 1);
+  if (node["collision_pick_fraction"]) {
+    o.collision_pick_fraction = r.AtLeast(node["collision_pick_fraction"], f + ".collision_pick_fraction", 0.0);
+    if (o.collision_pick_fraction > 1) {
+      r.Fail(node["collision_pick_fraction"], f + ".collision_pick_fraction", "expected 0 to 1");
+    }
+  }
   if (node["snapshot_every_s"]) {
     o.snapshot_every_s = r.Positive(node["snapshot_every_s"], f + ".snapshot_every_s");
   }

@@ -89,6 +89,7 @@ struct OptimizerSpec {
   int threads = 2;
   int changes_per_turn = 100;  // picks per sprite turn
   int beam_width = 32;
+  double collision_pick_fraction = 0.25;  // replacement's picks aimed at a collision
   double snapshot_every_s = 0.0;  // > 0: keep the sequences every so many seconds (stages video)
 };
 

@@ -73,6 +73,7 @@ TEST_F(SpecTest, ReadsEveryField) {
   EXPECT_EQ(spec.optimizer.seed, 7u);
   EXPECT_EQ(spec.optimizer.start, "random");
   EXPECT_EQ(spec.optimizer.set_size, 50);
+  EXPECT_EQ(spec.optimizer.collision_pick_fraction, 0.25);  // the default
   ASSERT_EQ(spec.sprites.size(), 2u);
   const SpriteSpecEntry& lead = spec.sprites[0];
   EXPECT_EQ(lead.anchor, Anchor::kStart);
@@ -172,6 +173,8 @@ TEST_F(SpecTest, BadSpecsNameTheLineAndTheField) {
             o + ":15: sprites[1].name: another sprite is named lead");
   EXPECT_EQ(ErrorOf(Edit("start: random", "start: later")),
             o + ":7: optimizer.start: expected sequential, random or beam");
+  EXPECT_EQ(ErrorOf(Edit("start: random,", "start: random, collision_pick_fraction: 1.5,")),
+            o + ":7: optimizer.collision_pick_fraction: expected 0 to 1");
   EXPECT_NE(ErrorOf("sprites: [\n").find(o + ":"), std::string::npos);  // YAML syntax: a line too
 }
 
