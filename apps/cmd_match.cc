@@ -30,6 +30,7 @@ struct MatchArgs {
   std::vector<std::string> sources;
   SkeletonMatchOptions options;
   bool no_refine = false;
+  double decision_mib = 3072;  // MatchOptions::max_decision_bytes, in MiB
   float transition_scale = 0.5f;
   bool json = false;
 };
@@ -125,6 +126,8 @@ void Match(MatchArgs a) {
     total += loaded[c].size();
   }
   a.options.refine_enabled = !a.no_refine;
+  if (!(a.decision_mib >= 0)) throw InputError("--decision-mib", "must be >= 0");
+  a.options.match.max_decision_bytes = static_cast<size_t>(a.decision_mib * 1024 * 1024);
   a.options.compare_without_penalties = true;
   std::optional<BankSprites> bank;
   if (!a.bank.empty()) {
@@ -283,6 +286,10 @@ void AddMatchCommand(CLI::App& app) {
       ->capture_default_str();
   cmd->add_flag("--normalize-ratios", a->options.descriptor.normalize_ratios,
                 "Subtract each sequence's median limb length ratios (different body proportions)");
+  cmd->add_option("--decision-mib", a->decision_mib,
+                  "Memory the DP may keep its per-cell decisions in (also at most half the available); "
+                  "past it the backtrack recomputes from checkpoints, slower; 0 = always")
+      ->capture_default_str();
   cmd->add_flag("--no-refine", a->no_refine, "Skip the refinement by atomic movements");
   cmd->add_flag("--json", a->json, "Print the report as JSON");
   cmd->callback([a] { Match(*a); });

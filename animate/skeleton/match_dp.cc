@@ -752,7 +752,8 @@ bool Engine::SolveWithDecisions(MatchResult* out) {
   // Within the budget and within half the memory the system has available now: the pages
   // are populated at once, and under overcommit an mmap past what is there would not fail
   // but get the process killed instead of falling back.
-  if (need > std::min(o_.max_decision_bytes, AvailableMemoryBytes() / 2)) {
+  const size_t limit = std::min(o_.max_decision_bytes, AvailableMemoryBytes() / 2);
+  if (need > limit) {
     mode_ = kArgOnly;
     return false;
   }
@@ -790,6 +791,18 @@ bool Engine::SolveWithDecisions(MatchResult* out) {
       offset += rows[1 - cur].min;
       Step(t, CostRow(t), rows[1 - cur], &rows[cur], record,
            local_row[t] >= 0 ? jump_sources + static_cast<size_t>(local_row[t]) * S_ : nullptr);
+    }
+    // The cells listed transitions win are kept aside (8 bytes each); should they push the
+    // store past the limit (a bank whose transitions win most cells), start over without.
+    if (need + listed_choice_.capacity() * sizeof(listed_choice_[0]) > limit) {
+      Log("animate.match")->warn("{} x {}: the listed transitions' choices pass the decision budget at row {}; "
+                                 "solving again with checkpoints", T_, S_, t);
+      std::vector<std::pair<int, int>>().swap(listed_choice_);
+      tile_first_ = -1;
+      tile_count_ = 0;
+      cost_seconds_ = 0;
+      mode_ = kArgOnly;
+      return false;
     }
     const auto& top = rows[cur].top;
     for (size_t i = 0; i < top.size() && i < top_size; ++i) tops[t * top_size + i] = top[i].index;

@@ -224,6 +224,33 @@ TEST(SkeletonDp, StoredDecisionsGiveTheCheckpointPath) {
   }
 }
 
+TEST(SkeletonDp, ListedChoicesPastTheBudgetFallBackToCheckpoints) {
+  // Free listed transitions into every frame from frame 0, whose row minimum they beat: they
+  // win many cells, and their choices (8 bytes each) do not fit a budget that holds the
+  // decisions alone. The solve starts over with checkpoints and gives the same path.
+  std::mt19937 rng(23);
+  const int T = 60, S = 80;
+  const DenseCostRows costs = RandomCosts(T, S, rng, 0.0f);
+  MatchOptions o;
+  for (int s = 0; s < S; ++s) {
+    for (int from = 0; from < S; from += 7) o.transitions.push_back({from, s, 0.0f});
+  }
+  const std::vector<int> clips = {0};
+  MatchOptions roomy = o, tight = o, checkpoints = o;
+  checkpoints.max_decision_bytes = 0;
+  const MatchResult reference = SolveMatch(costs, clips, checkpoints);
+  const MatchResult stored = SolveMatch(costs, clips, roomy);
+  ASSERT_TRUE(stored.walked_decisions);
+  // What the decisions need without the listed choices: a byte a cell and the top lists.
+  tight.max_decision_bytes = static_cast<size_t>(T) * S + static_cast<size_t>(T) * (o.stutter_window + 2) * 4 + 64;
+  const MatchResult fallen = SolveMatch(costs, clips, tight);
+  EXPECT_FALSE(fallen.walked_decisions);
+  EXPECT_EQ(stored.source_frames, reference.source_frames);
+  EXPECT_EQ(fallen.source_frames, reference.source_frames);
+  EXPECT_EQ(fallen.total_cost, reference.total_cost);
+  EXPECT_GT(stored.stats.listed, 0);
+}
+
 TEST(SkeletonDp, StoredDecisionsBreakTiesLikeTheCheckpointPath) {
   // Two equal stutters back into frame 10 (from 12 or 13): both backtracks take the
   // shorter step, free (a row's minimum in the window: scalar cells) and inside a target
