@@ -325,7 +325,12 @@ class Engine {
   bool Inside(int t) const { return inside_row_.empty() ? false : inside_row_[t] != 0; }
   const RowRules& Rules(int t) const { return Inside(t) ? inside_ : free_; }
   void ComputeCosts(int t0, int n, double* seconds);
-  const float* CostRow(int t) const { return tile_.data() + static_cast<size_t>(t - tile_first_) * S_; }
+  // Row t's costs, computing the tile of up to kCostTile rows from t (not past `end`) first
+  // when t is not in the current one.
+  const float* CostRow(int t, int end) {
+    if (t >= tile_first_ + tile_count_ || t < tile_first_) ComputeCosts(t, std::min(kCostTile, end - t), &cost_seconds_);
+    return tile_.data() + static_cast<size_t>(t - tile_first_) * S_;
+  }
   void Init(const float* c, Row* row, uint8_t* record);
   // One row; `record` (nullptr: none) receives what mode_ says. With moves recorded, a
   // listed transition that wins the cell goes to listed_choice_, and a local row's jump
@@ -780,16 +785,14 @@ bool Engine::SolveWithDecisions(MatchResult* out) {
   double offset = 0;  // sum of the row minima subtracted on the way
   int cur = 0;
   for (int t = 0; t < T_; ++t) {
-    if (t >= tile_first_ + tile_count_ || t < tile_first_) {
-      ComputeCosts(t, std::min(kCostTile, T_ - t), &cost_seconds_);
-    }
+    const float* c = CostRow(t, T_);
     uint8_t* record = decisions.get() + static_cast<size_t>(t) * row_bytes;
     listed_begin[t] = listed_choice_.size();
     if (t == 0) {
-      Init(CostRow(t), &rows[cur], record);
+      Init(c, &rows[cur], record);
     } else {
       offset += rows[1 - cur].min;
-      Step(t, CostRow(t), rows[1 - cur], &rows[cur], record,
+      Step(t, c, rows[1 - cur], &rows[cur], record,
            local_row[t] >= 0 ? jump_sources + static_cast<size_t>(local_row[t]) * S_ : nullptr);
     }
     // The cells listed transitions win are kept aside (8 bytes each); should they push the
@@ -798,9 +801,7 @@ bool Engine::SolveWithDecisions(MatchResult* out) {
       Log("animate.match")->warn("{} x {}: the listed transitions' choices pass the decision budget at row {}; "
                                  "solving again with checkpoints", T_, S_, t);
       std::vector<std::pair<int, int>>().swap(listed_choice_);
-      tile_first_ = -1;
-      tile_count_ = 0;
-      cost_seconds_ = 0;
+      cost_seconds_ = 0;  // the checkpoint pass times its own costs
       mode_ = kArgOnly;
       return false;
     }
@@ -891,14 +892,12 @@ void Engine::SolveWithCheckpoints(MatchResult* out) {
   double offset = 0;  // sum of the row minima subtracted on the way
   int cur = 0;
   for (int t = 0; t < T_; ++t) {
-    if (t >= tile_first_ + tile_count_ || t < tile_first_) {
-      ComputeCosts(t, std::min(kCostTile, T_ - t), &cost_seconds_);
-    }
+    const float* c = CostRow(t, T_);
     if (t == 0) {
-      Init(CostRow(t), &rows[cur], nullptr);
+      Init(c, &rows[cur], nullptr);
     } else {
       offset += rows[1 - cur].min;
-      Step(t, CostRow(t), rows[1 - cur], &rows[cur], nullptr);
+      Step(t, c, rows[1 - cur], &rows[cur], nullptr);
     }
     if ((t + 1) % block == 0 && (t + 1) / block < blocks) checkpoints[(t + 1) / block - 1] = rows[cur].v;
     cur = 1 - cur;
@@ -933,16 +932,14 @@ void Engine::SolveWithCheckpoints(MatchResult* out) {
       cur = 1;
     }
     for (int t = b0; t < b1; ++t) {
-      if (t >= tile_first_ + tile_count_ || t < tile_first_) {
-        ComputeCosts(t, std::min(kCostTile, b1 - t), &cost_seconds_);
-      }
+      const float* c = CostRow(t, b1);
       const size_t i = t - b0 + 1;
       uint8_t* record = block_rec.data() + i * S_;
       rows[cur].m = m_row(i);
       if (t == 0) {
-        Init(CostRow(t), &rows[cur], record);
+        Init(c, &rows[cur], record);
       } else {
-        Step(t, CostRow(t), rows[1 - cur], &rows[cur], record);
+        Step(t, c, rows[1 - cur], &rows[cur], record);
       }
       block_top[i] = rows[cur].top;
       cur = 1 - cur;

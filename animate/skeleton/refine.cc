@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
 
 #include "core/error.h"
 
@@ -110,18 +111,19 @@ std::vector<int> AverageWithinSegments(const std::vector<int>& frames, const std
 std::vector<int> SplitByFirstPass(const std::vector<int>& target_starts, const std::vector<int>& source_starts,
                                   const std::vector<int>& first_pass, int min_length) {
   const int n = static_cast<int>(first_pass.size());
-  auto movement_of = [&](int s) {
-    return std::upper_bound(source_starts.begin(), source_starts.end(), s) - source_starts.begin();
-  };
+  std::vector<long> movement(n);  // the source movement of each first-pass frame
+  for (int t = 0; t < n; ++t) {
+    movement[t] = std::upper_bound(source_starts.begin(), source_starts.end(), first_pass[t]) - source_starts.begin();
+  }
   std::vector<int> out = target_starts;
   for (size_t g = 0; g < target_starts.size(); ++g) {
     const int begin = target_starts[g];
     const int end = g + 1 < target_starts.size() ? std::min(n, target_starts[g + 1]) : n;
     long anchor = -1;  // the source movement of the last run long enough
     for (int t = begin; t < end;) {
-      const long id = movement_of(first_pass[t]);
+      const long id = movement[t];
       int u = t;
-      while (u < end && movement_of(first_pass[u]) == id) ++u;
+      while (u < end && movement[u] == id) ++u;
       if (u - t >= std::max(1, min_length)) {
         if (anchor >= 0 && id != anchor) out.push_back(t);
         anchor = id;
@@ -144,7 +146,11 @@ RefineResult RefineMatch(const CostRows& costs, const PoseDescriptors& targets, 
   RefineResult result;
   result.target_movements = FindMovements(targets, {0}, refine.movements);
   result.source_movements = FindMovements(sources, clip_starts, refine.movements);
-  if (first_pass != nullptr && static_cast<int>(first_pass->size()) == targets.count && targets.count > 0) {
+  if (first_pass != nullptr && static_cast<int>(first_pass->size()) != targets.count) {
+    throw InputError("refine", "the first pass has " + std::to_string(first_pass->size()) + " frames for " +
+                                   std::to_string(targets.count) + " target frames");
+  }
+  if (first_pass != nullptr && targets.count > 0) {
     const int min_length = MovementWindows(refine.movements, FrameRateAt(targets, 0)).min_length;
     result.target_movements =
         SplitByFirstPass(result.target_movements, result.source_movements, *first_pass, min_length);

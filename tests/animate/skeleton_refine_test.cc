@@ -12,6 +12,7 @@
 #include "animate/skeleton/match_dp.h"
 #include "animate/skeleton/refine.h"
 #include "animate/skeleton/synthetic_poses.h"
+#include "core/error.h"
 
 namespace ss {
 namespace {
@@ -209,6 +210,9 @@ TEST(SkeletonRefine, OneSourceMovementPerTargetMovement) {
   for (int t = 0; t < td.count; ++t) same += target.labels[t] == source.labels[r.source_frames[t]];
   EXPECT_GE(same, td.count * 95 / 100);
   EXPECT_LE(r.stats.longest_freeze, 5);
+  // A first pass of another length than the target is refused, not ignored.
+  const std::vector<int> short_pass(td.count - 1, 0);
+  EXPECT_THROW(RefineMatch(costs, td, sd, {0}, MatchOptions{}, refine, &short_pass), InputError);
 }
 
 }  // namespace
