@@ -346,10 +346,25 @@ export function el(tag, attrs = {}, ...children) {
     else if (k === 'text') e.textContent = v;
     else if (k.startsWith('on')) e.addEventListener(k.slice(2), v);
     else if (k === 'testid') e.dataset.testid = v;
+    else if (k === 'style') Object.assign(e.style, v); // CSSOM: the daemon's CSP refuses style attributes
     else e.setAttribute(k, v === true ? '' : v);
   }
   for (const c of children.flat()) if (c !== null && c !== undefined) e.append(c);
   return e;
+}
+
+// A data: URL's bytes as a Blob (fetch() of a data: URL is outside the
+// daemon's connect-src 'self').
+export function dataUrlBlob(url) {
+  const comma = url.indexOf(',');
+  const head = url.slice(5, comma);
+  const body = url.slice(comma + 1);
+  const type = head.split(';')[0] || 'application/octet-stream';
+  if (!/;base64$/.test(head)) return new Blob([decodeURIComponent(body)], { type });
+  const bin = atob(body);
+  const bytes = new Uint8Array(bin.length);
+  for (let i = 0; i < bin.length; i++) bytes[i] = bin.charCodeAt(i);
+  return new Blob([bytes], { type });
 }
 
 export const sleep = (ms) => new Promise((r) => setTimeout(r, ms));

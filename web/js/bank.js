@@ -305,10 +305,11 @@ async function showSprite(id, navigate = true) {
     return;
   }
   if (current !== id) return;
+  const sid = s.session_id ?? (typeof s.session === 'number' ? s.session : sessionId);
   if (navigate) {
-    history.replaceState(null, '', `#session=${s.session ?? sessionId}&sprite=${id}`);
-    if (s.session !== undefined && s.session !== sessionId) {
-      await openSession(s.session, id);
+    history.replaceState(null, '', `#session=${sid}&sprite=${id}`);
+    if (sid !== sessionId) {
+      await openSession(sid, id);
     } else {
       const entry = clips.get(s.clip_id);
       if (entry) {
@@ -346,6 +347,7 @@ async function showSprite(id, navigate = true) {
     el('h2', {}, `Sprite #${s.id ?? id}`, s.mirror_of ? el('span', { class: 'badge', text: `mirror of #${s.mirror_of}` }) : null),
     el('div', { class: 'bb' }, bbImg),
     dl([
+      ['session', typeof s.session === 'string' ? s.session : (sid ?? '–'), 'detail-session'],
       ['camera', s.camera ?? '–', 'detail-camera'],
       ['clip', s.clip_id ?? '–', 'detail-clip'],
       ['frame', s.frame ?? '–', 'detail-frame'],
@@ -360,7 +362,7 @@ async function showSprite(id, navigate = true) {
       { testid: 'detail-features' },
       el('dt', { text: 'velocity (m/s)' }), el('dd', { text: vec(f.velocity_m_s) }),
       el('dt', { text: 'mean colour' }),
-      el('dd', {}, colour ? el('i', { class: 'swatch', style: `background: rgb(${colour.map((c) => Math.round(c)).join(',')})` }) : null, colour ? vec(colour, 0) : '–'),
+      el('dd', {}, colour ? el('i', { class: 'swatch', style: { background: `rgb(${colour.map((c) => Math.round(c)).join(',')})` } }) : null, colour ? vec(colour, 0) : '–'),
       el('dt', { text: 'area (m²)' }), el('dd', { text: num(f.area_m2, 4) }),
       el('dt', { text: 'eccentricity' }), el('dd', { text: num(f.eccentricity, 3) }),
       el('dt', { text: 'billboard' }),

@@ -1,5 +1,5 @@
 // The station page: every camera as a live tile, the session panel, the charts.
-import { Events, Limiter, chrome, el, fmt, duration, getJson, getBlob, postJson, sleep } from './api.js';
+import { Events, Limiter, chrome, el, fmt, duration, getJson, getBlob, postJson, dataUrlBlob } from './api.js';
 import { VERDICT_COLOURS, VERDICT_LABELS, verdictColour, histogram, lineChart } from './draw.js';
 import { showMessage } from './message.js';
 
@@ -99,6 +99,7 @@ class Tile {
     sessionStorage.setItem(`view.${this.name}`, view);
     this.root.dataset.view = view;
     this.root.dataset.candidates = '0';
+    this.root.dataset.verdicts = '';
     this.els.cands.hidden = view !== 'sprites';
     this.#markView();
     this.wake?.();
@@ -210,8 +211,7 @@ class Tile {
   async #sprites() {
     const data = await getJson(`/api/cameras/${encodeURIComponent(this.name)}/sprites.json?width=${this.#width()}`);
     if (this.view !== 'sprites') return;
-    const img = await (await fetch(data.image)).blob();
-    const bitmap = await createImageBitmap(img);
+    const bitmap = await createImageBitmap(dataUrlBlob(data.image));
     if (this.view !== 'sprites') return bitmap.close?.();
     this.#draw(bitmap);
     const s = data.scale || 1;
@@ -254,6 +254,7 @@ class Tile {
       }
     }
     this.root.dataset.candidates = String(cands.length);
+    this.root.dataset.verdicts = [...new Set(cands.map((c) => c.verdict))].join(',');
     this.els.cands.textContent = data.training ? 'training' : `${cands.length} candidate${cands.length === 1 ? '' : 's'}`;
     this.#showFrame(data.sequence);
     this.#say(data.training ? 'keyer learning the empty enclosure' : '');
@@ -322,7 +323,6 @@ function syncTiles(cameras) {
     tile.update(cam);
   });
   tilesEl.dataset.count = String(cameras.length);
-  tilesEl.classList.toggle('few', cameras.length <= 2);
 }
 
 // ---- session panel ---------------------------------------------------------
@@ -473,7 +473,7 @@ function queueCharts() {
 
 $('legend').querySelector('ul').append(
   ...Object.entries(VERDICT_COLOURS).map(([v, c]) =>
-    el('li', { 'data-verdict': v }, el('i', { style: `background:${c}` }), el('span', { text: VERDICT_LABELS[v] || v })),
+    el('li', { 'data-verdict': v }, el('i', { style: { background: c } }), el('span', { text: VERDICT_LABELS[v] || v })),
   ),
   el('li', {}, el('i', { class: 'dot' }), el('span', { text: 'contact point, #track id' })),
 );
