@@ -231,6 +231,60 @@ std::vector<TransitionRecord> Bank::LoadTransitionsFrom(int64_t from_sprite) con
   return out;
 }
 
+std::vector<TransitionRecord> Bank::LoadTransitionsTo(int64_t to_sprite) const {
+  std::vector<TransitionRecord> out;
+  auto s = db_->Prepare("SELECT from_sprite, to_sprite, d, cost FROM transitions WHERE to_sprite = ? "
+                        "ORDER BY from_sprite");
+  s.Bind(1, to_sprite);
+  while (s.Step()) out.push_back({s.Int(0), s.Int(1), s.Real(2), s.Real(3)});
+  return out;
+}
+
+std::vector<SpriteRecord> Bank::LoadClipSprites(int64_t clip_id) const {
+  std::vector<SpriteRecord> out;
+  std::map<int64_t, size_t> at;
+  auto s = db_->Prepare(std::string("SELECT ") + kSpriteColumns +
+                        " FROM sprites WHERE clip_id = ? AND mirrored = 0 ORDER BY frame");
+  s.Bind(1, clip_id);
+  while (s.Step()) {
+    out.push_back(ReadSprite(s));
+    at[out.back().id] = out.size() - 1;
+  }
+  auto tags = db_->Prepare("SELECT t.sprite_id, t.tag FROM sprite_tags t JOIN sprites s ON s.id = t.sprite_id "
+                           "WHERE s.clip_id = ? AND s.mirrored = 0 ORDER BY t.tag");
+  tags.Bind(1, clip_id);
+  while (tags.Step()) {
+    const auto it = at.find(tags.Int(0));
+    if (it != at.end()) out[it->second].tags.push_back(tags.Text(1));
+  }
+  return out;
+}
+
+std::vector<int64_t> Bank::ClipSpriteIds(int64_t clip_id, int64_t first_frame, int64_t last_frame) const {
+  std::vector<int64_t> out;
+  auto s = db_->Prepare("SELECT id FROM sprites WHERE clip_id = ? AND frame BETWEEN ? AND ? ORDER BY frame, mirrored");
+  s.Bind(1, clip_id);
+  s.Bind(2, first_frame);
+  s.Bind(3, last_frame);
+  while (s.Step()) out.push_back(s.Int(0));
+  return out;
+}
+
+std::map<int64_t, int64_t> Bank::CountClipSprites() const {
+  std::map<int64_t, int64_t> out;
+  auto s = db_->Prepare("SELECT clip_id, count(*) FROM sprites WHERE mirrored = 0 GROUP BY clip_id");
+  while (s.Step()) out[s.Int(0)] = s.Int(1);
+  return out;
+}
+
+std::map<int64_t, std::map<std::string, int64_t>> Bank::CountClipTags() const {
+  std::map<int64_t, std::map<std::string, int64_t>> out;
+  auto s = db_->Prepare("SELECT s.clip_id, t.tag, count(*) FROM sprite_tags t JOIN sprites s ON s.id = t.sprite_id "
+                        "WHERE s.mirrored = 0 GROUP BY s.clip_id, t.tag");
+  while (s.Step()) out[s.Int(0)][s.Text(1)] = s.Int(2);
+  return out;
+}
+
 std::vector<int64_t> Bank::SpritesTagged(const std::string& tag) const {
   std::vector<int64_t> out;
   auto s = db_->Prepare("SELECT sprite_id FROM sprite_tags WHERE tag = ? ORDER BY sprite_id");

@@ -5,6 +5,7 @@
 // see only complete clips. A Bank object is one connection: use it from one
 // thread at a time.
 #include <cstdint>
+#include <map>
 #include <memory>
 #include <optional>
 #include <string>
@@ -58,6 +59,15 @@ class Bank {
   std::vector<TransitionRecord> LoadTransitions() const;
   // Transitions leaving `from_sprite`.
   std::vector<TransitionRecord> LoadTransitionsFrom(int64_t from_sprite) const;
+  // Transitions arriving at `to_sprite`.
+  std::vector<TransitionRecord> LoadTransitionsTo(int64_t to_sprite) const;
+  // A clip's original sprites (no mirrors, no pixels) with their tags, by frame.
+  std::vector<SpriteRecord> LoadClipSprites(int64_t clip_id) const;
+  // The ids of a clip's sprites at frames first..last (inclusive), with their mirrored copies.
+  std::vector<int64_t> ClipSpriteIds(int64_t clip_id, int64_t first_frame, int64_t last_frame) const;
+  // Original sprites per clip id, and per clip the number of its originals with each tag.
+  std::map<int64_t, int64_t> CountClipSprites() const;
+  std::map<int64_t, std::map<std::string, int64_t>> CountClipTags() const;
   std::vector<int64_t> SpritesTagged(const std::string& tag) const;
   std::optional<std::string> GetMeta(const std::string& key) const;
   BankCounts Counts() const;

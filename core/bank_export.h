@@ -16,6 +16,11 @@ struct BankExportOptions {
 // sprites table plus tags) and DIR/sprite_<id>.png (BGRA billboard) and
 // DIR/sprite_<id>_shadow.png. Returns the number of sprites written.
 // WorkError naming the file when one cannot be written.
+// The CSV's header line and one sprite's row (each ending in a newline); the png columns name
+// the files ExportBank writes beside it.
+std::string SpriteCsvHeader();
+std::string SpriteCsvRow(const SpriteRecord& s);
+
 int64_t ExportBank(const Bank& bank, const std::string& dir, const BankExportOptions& options);
 
 }  // namespace ss
