@@ -13,6 +13,8 @@
 #include <cstdlib>
 #include <memory>
 #include <string>
+#include <filesystem>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -23,8 +25,10 @@
 #include "pipeline/station/camera_runner.h"
 #include "pipeline/station/control_server.h"
 #include "pipeline/station/station.h"
+#include "pipeline/station/station_host.h"
 #include "pipeline/station/station_status.h"
 #include "pipeline/transitions/weights.h"
+#include "web/web_files.h"
 #ifdef SPRITESTATION_HAVE_SYSTEMD
 #include <systemd/sd-daemon.h>
 #endif
@@ -40,6 +44,8 @@ struct DaemonArgs {
   bool no_transitions = false;
   double offline_after_s = 3.0;
   bool json = false;
+  std::string web_dir;
+  std::vector<std::string> replay_dirs;
 };
 
 void Notify([[maybe_unused]] const std::string& state) {
@@ -74,11 +80,40 @@ void RunDaemon(const DaemonArgs& a) {
   sigaddset(&signals, SIGHUP);
   pthread_sigmask(SIG_BLOCK, &signals, nullptr);
 
-  Station station(options);
-  station.Start();
-  ControlServer control(station, options.config.control);
+  // The console's replay page lists the sessions under these folders.
+  std::vector<std::string> replay_roots;
+  if (!options.config.storage.recording_dir.empty()) replay_roots.push_back(options.config.storage.recording_dir);
+  if (a.replay_dirs.empty()) {
+    std::error_code ec;
+    if (std::filesystem::is_directory("recordings", ec)) {
+      replay_roots.push_back(std::filesystem::absolute("recordings", ec).string());
+    }
+  }
+  for (const std::string& dir : a.replay_dirs) {
+    std::error_code ec;
+    if (!std::filesystem::is_directory(dir, ec)) throw InputError("--replay-dir", dir + ": no such folder");
+    replay_roots.push_back(std::filesystem::absolute(dir, ec).lexically_normal().string());
+  }
+  ControlServerOptions control_options;
+  control_options.config = options.config.control;
+  if (!a.web_dir.empty()) {
+    std::error_code ec;
+    if (!std::filesystem::exists(std::filesystem::path(a.web_dir) / "index.html", ec)) {
+      throw InputError("--web-dir", a.web_dir + ": has no index.html (expected the source tree's web/ folder)");
+    }
+    control_options.web_dir = a.web_dir;
+  }
+  control_options.embedded = [](std::string_view path) -> std::optional<WebFile> {
+    const std::optional<EmbeddedWebFile> f = FindEmbeddedWebFile(path);
+    if (!f) return std::nullopt;
+    return WebFile{f->bytes, f->content_type};
+  };
+
+  StationHost host(options, replay_roots);
+  host.Start();
+  ControlServer control(host, control_options);
   const int port = control.Start();
-  if (!a.session.empty()) station.StartSession(a.session);
+  if (!a.session.empty()) host.current()->StartSession(a.session);
   // The ready line: scripts and tests read the port from it.
   std::printf("daemon: control API on %s (port %d)\n", control.url().c_str(), port);
   std::fflush(stdout);
@@ -99,7 +134,7 @@ void RunDaemon(const DaemonArgs& a) {
       Notify("RELOADING=1");
       try {
         const StationConfig next = LoadStationConfig(a.config);
-        station.Reload(next);
+        host.current()->Reload(next);
       } catch (const std::exception& e) {
         log->error("SIGHUP: the config was not reloaded (the running one is kept): {}", e.what());
       }
@@ -112,8 +147,8 @@ void RunDaemon(const DaemonArgs& a) {
   }
   Notify("STOPPING=1");
   control.Stop();
-  station.Stop();
-  const StationStatus status = station.Status();
+  host.Stop();
+  const StationStatus status = host.current()->Status();
   // Cameras that stopped answering are still being closed on threads of their own.
   const bool cameras_closed = WaitForCameraCloses(2.0);
   if (a.json) {
@@ -150,6 +185,10 @@ void AddDaemonCommand(CLI::App& app) {
   cmd->add_flag("--no-transitions", a->no_transitions, "Do not keep the bank's transitions current");
   cmd->add_option("--offline-after", a->offline_after_s, "A camera silent this many seconds is marked offline and reopened");
   cmd->add_flag("--json", a->json, "Print the final status as JSON when stopped");
+  cmd->add_option("--web-dir", a->web_dir, "Serve the console's pages from this folder (a source tree's web/) "
+                                          "instead of the copy built in");
+  cmd->add_option("--replay-dir", a->replay_dirs, "A folder of recorded sessions for the console's replay page "
+                                                  "(repeatable; default: recordings/ here, and storage.recording_dir)");
   cmd->callback([a] { RunDaemon(*a); });
 }
 

@@ -20,6 +20,9 @@ PACKAGES=(
   libgtest-dev libgmock-dev libbenchmark-dev
   # the daemon tests give each test a private loopback with a second address (ip)
   iproute2
+  # the console's browser tests (web/tests): Debian's Chromium driven by playwright-core
+  # under node's test runner (npm installs playwright-core below; it downloads no browser)
+  chromium nodejs
 )
 # Optional: the `vivid` CTest test boots Debian's kernel under qemu to run the
 # V4L2 backend against the vivid driver (it skips without these). Set
@@ -33,15 +36,28 @@ for p in "${PACKAGES[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
 done
 
-if [ ${#missing[@]} -eq 0 ]; then
-  echo "install-deps: all ${#PACKAGES[@]} packages present"
-  exit 0
-fi
-
 SUDO=""
 if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
-echo "install-deps: installing ${#missing[@]} packages: ${missing[*]}"
 export DEBIAN_FRONTEND=noninteractive
-$SUDO apt-get update -qq
-$SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "install-deps: all ${#PACKAGES[@]} packages present"
+else
+  echo "install-deps: installing ${#missing[@]} packages: ${missing[*]}"
+  $SUDO apt-get update -qq
+  $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
+fi
+# Debian's nodejs comes without npm (NodeSource's includes it).
+if ! command -v npm >/dev/null; then
+  $SUDO apt-get update -qq
+  $SUDO apt-get install -y -qq --no-install-recommends npm
+fi
+
+# The browser tests' one npm package, pinned by web/tests/package-lock.json.
+top="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+tests="$top/web/tests"
+if [ -f "$tests/package-lock.json" ] && { [ ! -d "$tests/node_modules/playwright-core" ] ||
+   [ "$tests/package-lock.json" -nt "$tests/node_modules/.package-lock.json" ]; }; then
+  (cd "$tests" && npm ci --no-audit --no-fund --loglevel=error) || {
+    echo "install-deps: npm ci in web/tests failed" >&2; exit 1; }
+fi
 echo "install-deps: done"

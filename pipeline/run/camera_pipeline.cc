@@ -147,10 +147,12 @@ void CameraPipeline::Process(const Frame& frame, std::vector<ClipBatch>* out) {
   std::vector<const Candidate*> grounded;
   std::vector<Eigen::Vector2d> points;
   std::vector<TrackInput> inputs;
+  verdicts_.clear();
   for (const Candidate& c : candidates) {
     const auto hit = IntersectGround(model_.RayInGround(Eigen::Vector2d(c.contact_point.x, c.contact_point.y)));
     if (!hit) {
       ++stats_.discards[static_cast<size_t>(Discard::kNoGroundHit)];
+      verdicts_.push_back({&c, -1, std::nullopt, Discard::kNoGroundHit});
       continue;
     }
     grounded.push_back(&c);
@@ -174,6 +176,7 @@ void CameraPipeline::Process(const Frame& frame, std::vector<ClipBatch>* out) {
       if (!billboards[k]) reason = Discard::kNoGroundHit;
     }
     usable[k] = reason == Discard::kNone;
+    verdicts_.push_back({&c, subjects[k], points[k], reason});
     if (usable[k]) {
       ++usable_total_;
     } else {

@@ -57,6 +57,14 @@ struct CameraPipelineStats {
   double seconds_key = 0, seconds_rest = 0;  // thread time in keying+extracting, in the rest
 };
 
+// What became of one candidate of the last processed frame (the console's sprites view).
+struct CandidateVerdict {
+  const Candidate* candidate = nullptr;  // the extractor's; valid until the next Process
+  int track = -1;                        // the tracker's subject id; -1 when its ray missed the floor
+  std::optional<Eigen::Vector2d> ground;  // contact point on the floor, metres
+  Discard reason = Discard::kNone;       // kNone: usable (it joins a clip)
+};
+
 class CameraPipeline {
  public:
   // `camera_id` is the bank's id of the camera. Throws InputError when the model
@@ -81,6 +89,8 @@ class CameraPipeline {
   // The last processed frame in BGR and its matte (previews; valid until the next Process).
   const cv::Mat& last_bgr() const { return bgr_; }
   const Matte& last_matte() const { return matte_; }
+  // Every candidate of the last processed frame with its verdict (valid until the next Process).
+  const std::vector<CandidateVerdict>& last_verdicts() const { return verdicts_; }
 
   const std::string& name() const { return name_; }
   const CameraModel& model() const { return model_; }
@@ -105,6 +115,7 @@ class CameraPipeline {
   ClipBatcher batcher_;
   cv::Mat bgr_;
   Matte matte_;
+  std::vector<CandidateVerdict> verdicts_;
   void UpdateClipStats();
 
   std::optional<uint64_t> last_sequence_;

@@ -97,10 +97,18 @@ struct CameraRunner::Impl {
   int64_t wanted_camera_id = 0;
   int64_t applied_camera_id = 0;
 
-  // Preview: the latest frame (BGR) and its matte, refreshed every preview_interval_s.
+  // Preview: a snapshot of the latest frame, its matte and candidates, taken every
+  // preview_interval_s. Readers share it; the pipeline thread fills a spare one (reused
+  // when no reader holds it, so no frame-sized allocation in the steady state) and swaps.
   mutable std::mutex preview_mutex;
-  cv::Mat preview_bgr, preview_alpha, preview_shadow;
+  std::shared_ptr<const PreviewFrame> preview;
+  std::shared_ptr<PreviewFrame> preview_spare;
   SteadyTime preview_time{};
+  std::atomic<double> preview_interval_s{0.2};
+  // The exposure figures of the latest preview, measured at most once a second (on a reader's thread).
+  mutable std::mutex exposure_mutex;
+  mutable ExposureFigures exposure;
+  mutable SteadyTime exposure_time{};
 
   void SetState(CameraState state, const std::string& message) {
     std::lock_guard lock(status_mutex);
@@ -277,19 +285,36 @@ struct CameraRunner::Impl {
   // True every preview_interval_s: only then is a frame kept for the preview.
   bool PreviewDue(SteadyTime now) const {
     std::lock_guard lock(preview_mutex);
-    return preview_time == SteadyTime{} || Seconds(now - preview_time) >= options.preview_interval_s;
+    return preview_time == SteadyTime{} || Seconds(now - preview_time) >= preview_interval_s.load();
   }
 
-  void UpdatePreview(const cv::Mat& bgr, const Matte* matte, SteadyTime now) {
-    std::lock_guard lock(preview_mutex);
-    preview_time = now;
-    bgr.copyTo(preview_bgr);
-    preview_alpha.release();
-    preview_shadow.release();
-    if (matte != nullptr) {
-      matte->alpha.copyTo(preview_alpha);
-      matte->shadow.copyTo(preview_shadow);
+  // `pipeline`: the frame went through it (its matte and candidates are shown); else only `bgr`.
+  void UpdatePreview(const cv::Mat& bgr, const CameraPipeline* pipeline, const Frame& frame, SteadyTime now) {
+    std::shared_ptr<PreviewFrame> next;
+    {
+      std::lock_guard lock(preview_mutex);
+      preview_time = now;
+      if (preview_spare && preview_spare.use_count() == 1) next = std::move(preview_spare);
+      preview_spare.reset();
     }
+    if (!next) next = std::make_shared<PreviewFrame>();
+    next->sequence = frame.sequence;
+    next->timestamp_ns = frame.timestamp_ns;
+    next->taken = now;
+    bgr.copyTo(next->bgr);
+    next->training = pipeline == nullptr;
+    if (pipeline != nullptr) {
+      pipeline->last_matte().alpha.copyTo(next->alpha);
+      pipeline->last_matte().shadow.copyTo(next->shadow);
+      next->candidates = PreviewCandidates(pipeline->last_verdicts());
+    } else {
+      next->alpha.release();
+      next->shadow.release();
+      next->candidates.clear();
+    }
+    std::lock_guard lock(preview_mutex);
+    preview_spare = std::const_pointer_cast<PreviewFrame>(std::move(preview));
+    preview = std::move(next);
   }
 
   // Once the keyer has learnt the enclosure (on its own thread): live, or in error if it failed.
@@ -345,7 +370,7 @@ struct CameraRunner::Impl {
             ToBgr(frame, slot);
             if (training_collected == 0) training_first = {frame.sequence, frame.timestamp_ns};
             ++training_collected;
-            if (preview) UpdatePreview(slot, nullptr, item->received);
+            if (preview) UpdatePreview(slot, nullptr, frame, item->received);
             if (training_collected >= training_set.size()) {
               {
                 std::lock_guard lock(status_mutex);
@@ -361,7 +386,7 @@ struct CameraRunner::Impl {
             }
           } else if (preview) {
             ToBgr(frame, bgr);
-            UpdatePreview(bgr, nullptr, item->received);
+            UpdatePreview(bgr, nullptr, frame, item->received);
           }
           if (!collect && !pipeline_failed) {
             std::lock_guard lock(status_mutex);
@@ -373,7 +398,7 @@ struct CameraRunner::Impl {
           const uint64_t usable_before = pipeline->usable_sprites();
           pipeline->Process(frame, &out);
           usable = pipeline->usable_sprites() > usable_before;
-          if (preview) UpdatePreview(pipeline->last_bgr(), &pipeline->last_matte(), item->received);
+          if (preview) UpdatePreview(pipeline->last_bgr(), pipeline.get(), frame, item->received);
           Sink(out, arrivals);
         }
       } catch (const std::exception& e) {
@@ -480,6 +505,21 @@ void CameraRunner::SetBankCamera(int64_t camera_id) {
 
 CameraStatus CameraRunner::status() const {
   const Impl& s = *impl_;
+  CameraStatus out = StatusWithoutExposure();
+  // Measured outside status_mutex, which the pipeline thread takes every frame.
+  std::lock_guard exposure_lock(s.exposure_mutex);
+  if (s.exposure_time == SteadyTime{} || Seconds(Clock::now() - s.exposure_time) >= 1.0) {
+    if (const auto frame = preview()) {
+      s.exposure = MeasureExposure(*frame);
+      s.exposure_time = Clock::now();
+    }
+  }
+  out.exposure = s.exposure;
+  return out;
+}
+
+CameraStatus CameraRunner::StatusWithoutExposure() const {
+  const Impl& s = *impl_;
   std::lock_guard lock(s.status_mutex);
   CameraStatus out = s.status;
   const double span = s.recent_frames.size() >= 2 ? Seconds(s.recent_frames.back() - s.recent_frames.front()) : 0;
@@ -500,36 +540,12 @@ CameraStatus CameraRunner::status() const {
   return out;
 }
 
-std::optional<std::vector<uint8_t>> CameraRunner::PreviewJpeg(bool keyed) const {
-  const Impl& s = *impl_;
-  cv::Mat image;
-  {
-    std::lock_guard lock(s.preview_mutex);
-    if (s.preview_bgr.empty()) return std::nullopt;
-    if (!keyed || s.preview_alpha.empty() || s.preview_alpha.size() != s.preview_bgr.size()) {
-      image = s.preview_bgr.clone();
-      if (keyed) {  // not keyed yet (learning the enclosure): say so by showing it dimmed
-        image *= 0.35;
-      }
-    } else {
-      // The subject over mid grey; the contact shadow darkens the grey.
-      image.create(s.preview_bgr.size(), CV_8UC3);
-      for (int y = 0; y < image.rows; ++y) {
-        const cv::Vec3b* src = s.preview_bgr.ptr<cv::Vec3b>(y);
-        const uint8_t* a = s.preview_alpha.ptr<uint8_t>(y);
-        const uint8_t* sh = s.preview_shadow.empty() ? nullptr : s.preview_shadow.ptr<uint8_t>(y);
-        cv::Vec3b* dst = image.ptr<cv::Vec3b>(y);
-        for (int x = 0; x < image.cols; ++x) {
-          const int grey = 128 * (255 - (sh ? sh[x] : 0)) / 255;
-          for (int c = 0; c < 3; ++c) dst[x][c] = static_cast<uint8_t>((src[x][c] * a[x] + grey * (255 - a[x])) / 255);
-        }
-      }
-    }
-  }
-  std::vector<uint8_t> jpeg;
-  cv::imencode(".jpg", image, jpeg, {cv::IMWRITE_JPEG_QUALITY, 80});
-  return jpeg;
+std::shared_ptr<const PreviewFrame> CameraRunner::preview() const {
+  std::lock_guard lock(impl_->preview_mutex);
+  return impl_->preview;
 }
+
+void CameraRunner::set_preview_interval(double seconds) { impl_->preview_interval_s = seconds; }
 
 const std::string& CameraRunner::name() const { return impl_->options.camera.name; }
 const std::optional<CameraModel>& CameraRunner::model() const { return impl_->options.model; }

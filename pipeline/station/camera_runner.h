@@ -21,6 +21,7 @@
 #include "core/frame.h"
 #include "core/geometry.h"
 #include "pipeline/run/camera_pipeline.h"
+#include "pipeline/station/preview.h"
 
 namespace ss {
 
@@ -64,6 +65,7 @@ struct CameraStatus {
   uint64_t reopens = 0;          // times the camera was opened again after going offline
   bool has_model = false;        // without one no sprite is stored (preview and recording only)
   CameraPipelineStats pipeline;
+  ExposureFigures exposure;      // how the green screen is lit (latest preview, measured once a second)
 };
 
 struct CameraRunnerOptions {
@@ -108,15 +110,17 @@ class CameraRunner {
   void SetBankCamera(int64_t camera_id);
 
   CameraStatus status() const;
-  // The latest frame as JPEG: raw, or keyed (the subject over grey, shadow darkened).
-  // nullopt before the first frame.
-  std::optional<std::vector<uint8_t>> PreviewJpeg(bool keyed) const;
+  // The latest preview snapshot (preview.h); nullptr before the first frame.
+  std::shared_ptr<const PreviewFrame> preview() const;
+  // Snapshots are taken every `seconds` (the station takes fewer while a session stores).
+  void set_preview_interval(double seconds);
   const std::string& name() const;
   const std::optional<CameraModel>& model() const;
   // The source's description once opened (size, format), for the recorder.
   std::optional<SourceCamera> source_camera() const;
 
  private:
+  CameraStatus StatusWithoutExposure() const;
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };

@@ -1,33 +1,73 @@
 #include "pipeline/station/control_server.h"
 
+#include <sys/resource.h>
+#include <sys/syscall.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
 #include <thread>
+#include <vector>
 
 #include <httplib.h>
 #include <nlohmann/json.hpp>
 
 #include "core/error.h"
+#include "core/error_kinds.h"
 #include "core/log.h"
+#include "pipeline/station/console_bank.h"
+#include "pipeline/station/console_events.h"
 #include "pipeline/station/station.h"
+#include "pipeline/station/station_host.h"
 #include "pipeline/station/station_status.h"
 
 namespace ss {
 namespace {
 
-void Reply(httplib::Response& res, int status, const nlohmann::json& body) {
+namespace fs = std::filesystem;
+using httplib::Request;
+using httplib::Response;
+
+constexpr size_t kMaxBodyBytes = 1 << 20;  // every JSON body the API takes is far smaller
+constexpr int kHttpThreads = 32;           // event streams hold one each (at most max_event_streams)
+constexpr int kHttpNice = 10;              // HTTP threads yield the cores to capture and the pipeline
+
+void Reply(Response& res, int status, const nlohmann::json& body) {
   res.status = status;
   res.set_content(body.dump(2) + "\n", "application/json");
 }
 
-void ReplyError(httplib::Response& res, int status, const std::string& message) {
+void ReplyError(Response& res, int status, const std::string& message) {
   Reply(res, status, {{"error", message}});
 }
 
-// The "name" of a JSON body; InputError naming the field when it is missing or not text.
-std::string NameFromBody(const httplib::Request& req, bool required) {
-  if (req.body.empty()) {
-    if (required) throw InputError("body", "expected JSON {\"name\": \"...\"}");
-    return "";
+// HTTP worker threads run at a lower priority than every other thread of the daemon:
+// a preview encode or a bank page never takes a core from capture.
+class NiceThreadPool : public httplib::TaskQueue {
+ public:
+  explicit NiceThreadPool(size_t n) : pool_(n) {}
+  void enqueue(std::function<void()> fn) override {
+    pool_.enqueue([fn = std::move(fn)] {
+      thread_local const bool niced = [] {
+        setpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid)), kHttpNice);
+        return true;
+      }();
+      (void)niced;
+      fn();
+    });
   }
+  void shutdown() override { pool_.shutdown(); }
+
+ private:
+  httplib::ThreadPool pool_;
+};
+
+// The JSON object of a request body; InputError naming the field for anything else or a field
+// not in `fields`. An empty body is an empty object.
+nlohmann::json ObjectBody(const Request& req, std::initializer_list<const char*> fields) {
+  if (req.body.empty()) return nlohmann::json::object();
   nlohmann::json body;
   try {
     body = nlohmann::json::parse(req.body);
@@ -36,108 +76,354 @@ std::string NameFromBody(const httplib::Request& req, bool required) {
   }
   if (!body.is_object()) throw InputError("body", "expected a JSON object");
   for (const auto& [key, value] : body.items()) {
-    if (key != "name") throw InputError(key, "unknown field (the request takes \"name\")");
+    if (std::none_of(fields.begin(), fields.end(), [&](const char* f) { return key == f; })) {
+      std::string list;
+      for (const char* f : fields) list += std::string(list.empty() ? "" : ", ") + "\"" + f + "\"";
+      throw InputError(key, "unknown field (the request takes " + (list.empty() ? std::string("none") : list) + ")");
+    }
   }
+  return body;
+}
+
+// A session name from {"name": S}; "" when absent and not required.
+std::string NameFromBody(const Request& req, bool required) {
+  const nlohmann::json body = ObjectBody(req, {"name"});
   if (!body.contains("name")) {
-    if (required) throw InputError("name", "missing");
+    if (required) throw InputError(req.body.empty() ? "body" : "name", "missing (expected {\"name\": \"...\"})");
     return "";
   }
   if (!body["name"].is_string()) throw InputError("name", "expected text, got " + body["name"].dump());
   return body["name"].get<std::string>();
 }
 
+// An integer query parameter within [lo, hi], or `fallback` when absent.
+int64_t IntParam(const Request& req, const char* name, int64_t fallback, int64_t lo, int64_t hi) {
+  if (!req.has_param(name)) return fallback;
+  const std::string text = req.get_param_value(name);
+  size_t used = 0;
+  int64_t v = 0;
+  try {
+    v = std::stoll(text, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used == 0 || used != text.size() || v < lo || v > hi) {
+    throw InputError(name, "expected an integer from " + std::to_string(lo) + " to " + std::to_string(hi) + ", got \"" +
+                               text + "\"");
+  }
+  return v;
+}
+
+int64_t PathId(const Request& req, const char* what) {
+  try {
+    return std::stoll(req.matches[1]);
+  } catch (const std::exception&) {
+    throw InputError(what, "expected an integer id");
+  }
+}
+
+// "host" of "host:port" / "[v6]:port", lower-cased.
+std::string HostName(std::string host) {
+  std::transform(host.begin(), host.end(), host.begin(), [](unsigned char c) { return std::tolower(c); });
+  if (!host.empty() && host[0] == '[') return host.substr(1, host.find(']') - 1);
+  const size_t colon = host.rfind(':');
+  return colon == std::string::npos ? host : host.substr(0, colon);
+}
+
+const char* ContentTypeOf(const fs::path& path) {
+  const std::string ext = path.extension().string();
+  if (ext == ".html") return "text/html; charset=utf-8";
+  if (ext == ".css") return "text/css; charset=utf-8";
+  if (ext == ".js" || ext == ".mjs") return "text/javascript; charset=utf-8";
+  if (ext == ".svg") return "image/svg+xml";
+  if (ext == ".png") return "image/png";
+  if (ext == ".ico") return "image/x-icon";
+  if (ext == ".json") return "application/json";
+  return "application/octet-stream";
+}
+
+struct Route {
+  const char* method;   // GET | POST
+  const char* pattern;  // httplib regex
+  const char* listed;   // as GET /api lists it
+  std::function<void(const Request&, Response&)> handler;
+};
+
 }  // namespace
 
 struct ControlServer::Impl {
-  Station* station = nullptr;
-  ControlConfig config;
+  StationHost* host = nullptr;
+  ControlServerOptions options;
   httplib::Server server;
   std::thread thread;
   int port = 0;
+  std::unique_ptr<ConsoleEvents> events;
+  std::vector<Route> routes;
 
-  // Runs a handler; InputError becomes 400 (or `input_status`), anything else 500.
+  std::shared_ptr<Station> station() const {
+    std::shared_ptr<Station> s = host->current();
+    if (!s) throw WorkError("station", "not running");
+    return s;
+  }
+
+  nlohmann::json StatusJson() const {
+    const std::shared_ptr<Station> s = station();
+    StationStatus status = s->Status();
+    status.control_url = Url();
+    nlohmann::json j = StatusToJson(status);
+    j.update(host->ModeJson());
+    return j;
+  }
+
+  // Runs a handler: the error's kind picks the status (core/error_kinds.h).
   template <typename F>
-  void Guard(httplib::Response& res, int input_status, F&& f) {
+  static void Guard(Response& res, F&& f) {
     try {
       f();
+    } catch (const NotFoundError& e) {
+      ReplyError(res, 404, e.what());
+    } catch (const ConflictError& e) {
+      ReplyError(res, 409, e.what());
     } catch (const InputError& e) {
-      ReplyError(res, input_status, e.what());
+      ReplyError(res, 400, e.what());
     } catch (const std::exception& e) {
       Log("station.control")->error("{}", e.what());
       ReplyError(res, 500, e.what());
     }
   }
 
-  void Routes() {
-    server.set_pre_routing_handler([this](const httplib::Request& req, httplib::Response& res) {
-      if (config.token.empty()) return httplib::Server::HandlerResponse::Unhandled;
-      const std::string expected = "Bearer " + config.token;
-      if (req.get_header_value("Authorization") != expected) {
-        res.set_header("WWW-Authenticate", "Bearer");
-        ReplyError(res, 401, "Authorization: this station needs \"Authorization: Bearer TOKEN\" (control.token)");
+  // What every /api request must pass before its handler: the host it was sent to (a loopback
+  // station without a token answers only to loopback names: no DNS rebinding), the page that sent
+  // it (another site's page may not act) and the token. (The body is read after this: a POST's
+  // JSON type is checked by its handler's wrapper.)
+  httplib::Server::HandlerResponse Admit(const Request& req, Response& res) {
+    const bool api = req.path == "/metrics" || req.path == "/api" || req.path.rfind("/api/", 0) == 0;
+    if (!api) return httplib::Server::HandlerResponse::Unhandled;
+    const ControlConfig& config = options.config;
+    const std::string host = HostName(req.get_header_value("Host"));
+    if (config.token.empty() && !host.empty() && !IsLoopbackAddress(host)) {
+      ReplyError(res, 403, "Host: \"" + host + "\" is not a loopback name; this station (no control.token) answers only "
+                           "to localhost and 127.0.0.1");
+      return httplib::Server::HandlerResponse::Handled;
+    }
+    const std::string origin = req.get_header_value("Origin");
+    if (!origin.empty()) {
+      const size_t scheme = origin.find("://");
+      const std::string origin_host = scheme == std::string::npos ? origin : origin.substr(scheme + 3);
+      std::string lower_origin = origin_host, lower_host = req.get_header_value("Host");
+      std::transform(lower_origin.begin(), lower_origin.end(), lower_origin.begin(), ::tolower);
+      std::transform(lower_host.begin(), lower_host.end(), lower_host.begin(), ::tolower);
+      if (lower_origin != lower_host) {
+        ReplyError(res, 403, "Origin: a page of " + origin + " may not use this station's API");
         return httplib::Server::HandlerResponse::Handled;
       }
-      return httplib::Server::HandlerResponse::Unhandled;
-    });
-    server.Get("/", [](const httplib::Request&, httplib::Response& res) {
-      Reply(res, 200, {{"service", "spritestation"},
-                       {"endpoints", {"GET /api/status", "GET /metrics", "GET /api/cameras/NAME/preview.jpg?view=raw|keyed",
-                                      "POST /api/session/start {\"name\": S}", "POST /api/session/stop",
-                                      "POST /api/session/rename {\"name\": S}"}}});
-    });
-    server.Get("/api/status", [this](const httplib::Request&, httplib::Response& res) {
-      Guard(res, 400, [&] {
-        StationStatus status = station->Status();
-        status.control_url = Url();
-        Reply(res, 200, StatusToJson(status));
-      });
-    });
-    server.Get("/metrics", [this](const httplib::Request&, httplib::Response& res) {
-      Guard(res, 400, [&] { res.set_content(StatusToPrometheus(station->Status()), "text/plain; version=0.0.4"); });
-    });
-    server.Get(R"(/api/cameras/([^/]+)/preview\.jpg)", [this](const httplib::Request& req, httplib::Response& res) {
-      const std::string view = req.has_param("view") ? req.get_param_value("view") : "raw";
-      if (view != "raw" && view != "keyed") {
-        ReplyError(res, 400, "view: expected raw or keyed, got \"" + view + "\"");
-        return;
+    }
+    if (!config.token.empty() && req.get_header_value("Authorization") != "Bearer " + config.token) {
+      res.set_header("WWW-Authenticate", "Bearer");
+      ReplyError(res, 401, "Authorization: this station needs \"Authorization: Bearer TOKEN\" (control.token)");
+      return httplib::Server::HandlerResponse::Handled;
+    }
+    return httplib::Server::HandlerResponse::Unhandled;
+  }
+
+  // The console's static files: `path` below the web folder, or the embedded copy.
+  bool ServeWebFile(const std::string& request_path, Response& res) {
+    std::string path = request_path == "/" ? "/index.html" : request_path;
+    if (path.find("..") != std::string::npos || path.find('\0') != std::string::npos) return false;
+    path = path.substr(1);
+    if (!options.web_dir.empty()) {
+      const fs::path file = fs::path(options.web_dir) / path;
+      std::ifstream in(file, std::ios::binary);
+      if (!in) return false;
+      std::ostringstream bytes;
+      bytes << in.rdbuf();
+      res.set_content(bytes.str(), ContentTypeOf(file));
+    } else {
+      if (!options.embedded) return false;
+      const std::optional<WebFile> f = options.embedded(path);
+      if (!f) return false;
+      res.set_content(std::string(f->bytes), std::string(f->content_type));
+    }
+    res.set_header("Cache-Control", "no-cache");
+    res.set_header("X-Content-Type-Options", "nosniff");
+    res.set_header("Content-Security-Policy",
+                   "default-src 'self'; img-src 'self' data: blob:; style-src 'self'; script-src 'self'; "
+                   "connect-src 'self'; frame-ancestors 'none'");
+    res.status = 200;
+    return true;
+  }
+
+  void Events(const Request&, Response& res) {
+    if (events->connections() >= static_cast<uint64_t>(options.max_event_streams)) {
+      ReplyError(res, 503, "events: " + std::to_string(options.max_event_streams) +
+                               " event streams are open already (close a console tab)");
+      return;
+    }
+    auto stream = std::make_shared<ConsoleEvents::Stream>(*events);
+    res.set_header("Cache-Control", "no-store");
+    res.set_header("X-Accel-Buffering", "no");
+    res.set_chunked_content_provider("text/event-stream", [stream](size_t, httplib::DataSink& sink) {
+      const std::string text = stream->Next();
+      if (text.empty()) {
+        sink.done();
+        return true;
       }
-      Guard(res, 404, [&] {
-        const auto jpeg = station->PreviewJpeg(req.matches[1], view == "keyed");
-        if (!jpeg) {
-          ReplyError(res, 503, "camera \"" + std::string(req.matches[1]) + "\" has delivered no frame yet");
-          return;
+      return sink.write(text.data(), text.size());
+    });
+  }
+
+  void Preview(const Request& req, Response& res) {
+    const std::string view = req.has_param("view") ? req.get_param_value("view") : "raw";
+    if (view != "raw" && view != "keyed") throw InputError("view", "expected raw or keyed, got \"" + view + "\"");
+    const int width = static_cast<int>(IntParam(req, "width", 640, 16, 4096));
+    const auto image = station()->Preview(req.matches[1], view == "keyed" ? PreviewView::kKeyed : PreviewView::kRaw, width);
+    if (!image) {
+      ReplyError(res, 503, "camera \"" + std::string(req.matches[1]) + "\" has delivered no frame yet");
+      return;
+    }
+    res.set_header("Cache-Control", "no-store");
+    res.set_header("X-Frame-Sequence", std::to_string(image->sequence));
+    res.set_header("X-Frame-Timestamp-Ns", std::to_string(image->timestamp_ns));
+    res.set_header("X-Image-Width", std::to_string(image->width));
+    res.set_header("X-Image-Height", std::to_string(image->height));
+    res.set_content(reinterpret_cast<const char*>(image->jpeg.data()), image->jpeg.size(), "image/jpeg");
+  }
+
+  void Sprites(const Request& req, Response& res) {
+    const int width = static_cast<int>(IntParam(req, "width", 640, 16, 4096));
+    const auto json = station()->SpritesView(req.matches[1], width);
+    if (!json) {
+      ReplyError(res, 503, "camera \"" + std::string(req.matches[1]) + "\" has delivered no frame yet");
+      return;
+    }
+    res.set_header("Cache-Control", "no-store");
+    res.set_content(*json, "application/json");
+  }
+
+  void ReplayStart(const Request& req, Response& res) {
+    const nlohmann::json body = ObjectBody(req, {"path", "paced", "loop"});
+    if (!body.contains("path") || !body["path"].is_string()) throw InputError("path", "expected the session's path (text)");
+    for (const char* flag : {"paced", "loop"}) {
+      if (body.contains(flag) && !body[flag].is_boolean()) throw InputError(flag, "expected true or false");
+    }
+    host->StartReplay(body["path"].get<std::string>(), body.value("paced", true), body.value("loop", false));
+    Reply(res, 200, host->ModeJson());
+  }
+
+  ConsoleBank Bank() const { return ConsoleBank(station()->Status().bank_path); }
+
+  void MakeRoutes() {
+    const auto json = [](auto f) {
+      return [f](const Request& req, Response& res) { Reply(res, 200, f(req)); };
+    };
+    routes = {
+        {"GET", "/api", "GET /api: this list", [this](const Request&, Response& res) {
+           nlohmann::json list = nlohmann::json::array();
+           for (const Route& r : routes) list.push_back(r.listed);
+           Reply(res, 200, {{"service", "spritestation"}, {"console", "/"}, {"endpoints", list}});
+         }},
+        {"GET", "/api/status", "GET /api/status", json([this](const Request&) { return StatusJson(); })},
+        {"GET", "/metrics", "GET /metrics (Prometheus)", [this](const Request&, Response& res) {
+           res.set_content(StatusToPrometheus(station()->Status()), "text/plain; version=0.0.4");
+         }},
+        {"GET", "/api/events", "GET /api/events (Server-Sent Events)",
+         [this](const Request& req, Response& res) { Events(req, res); }},
+        {"GET", R"(/api/cameras/([^/]+)/preview\.jpg)", "GET /api/cameras/NAME/preview.jpg?view=raw|keyed&width=W",
+         [this](const Request& req, Response& res) { Preview(req, res); }},
+        {"GET", R"(/api/cameras/([^/]+)/sprites\.json)", "GET /api/cameras/NAME/sprites.json?width=W",
+         [this](const Request& req, Response& res) { Sprites(req, res); }},
+        {"POST", "/api/session/start", "POST /api/session/start {\"name\": S}", json([this](const Request& req) {
+           std::string name = NameFromBody(req, false);
+           return SessionToJson(station()->StartSession(name.empty() ? "session" : name));
+         })},
+        {"POST", "/api/session/stop", "POST /api/session/stop", json([this](const Request& req) {
+           ObjectBody(req, {});
+           return SessionToJson(station()->StopSession());
+         })},
+        {"POST", "/api/session/rename", "POST /api/session/rename {\"name\": S}", json([this](const Request& req) {
+           return SessionToJson(station()->RenameSession(NameFromBody(req, true)));
+         })},
+        {"GET", "/api/replay/sessions", "GET /api/replay/sessions", json([this](const Request&) {
+           return RecordedSessionsToJson(host->replay_roots(), FindRecordedSessions(host->replay_roots()));
+         })},
+        {"POST", "/api/replay/start", "POST /api/replay/start {\"path\": P, \"paced\": true, \"loop\": false}",
+         [this](const Request& req, Response& res) { ReplayStart(req, res); }},
+        {"POST", "/api/replay/stop", "POST /api/replay/stop", json([this](const Request& req) {
+           ObjectBody(req, {});
+           host->StopReplay();
+           return host->ModeJson();
+         })},
+        {"GET", "/api/bank/sessions", "GET /api/bank/sessions", json([this](const Request&) { return Bank().Sessions(); })},
+        {"GET", R"(/api/bank/sessions/([^/]+)/clips)", "GET /api/bank/sessions/ID/clips",
+         json([this](const Request& req) { return Bank().Clips(PathId(req, "session")); })},
+        {"GET", R"(/api/bank/clips/([^/]+)/sprites)", "GET /api/bank/clips/ID/sprites",
+         json([this](const Request& req) { return Bank().ClipSprites(PathId(req, "clip")); })},
+        {"GET", R"(/api/bank/sprites/([^/]+)/billboard\.png)", "GET /api/bank/sprites/ID/billboard.png?height=H",
+         [this](const Request& req, Response& res) {
+           const auto png = Bank().BillboardPng(PathId(req, "sprite"), static_cast<int>(IntParam(req, "height", 0, 0, 4096)));
+           res.set_header("Cache-Control", "private, max-age=3600");  // a stored billboard never changes
+           res.set_content(reinterpret_cast<const char*>(png.data()), png.size(), "image/png");
+         }},
+        {"GET", R"(/api/bank/sprites/([^/]+))", "GET /api/bank/sprites/ID",
+         json([this](const Request& req) { return Bank().Sprite(PathId(req, "sprite")); })},
+        {"POST", "/api/bank/tag", "POST /api/bank/tag {\"tag\", \"sprites\" | \"clip\", \"first_frame\", \"last_frame\"}",
+         json([this](const Request& req) {
+           return nlohmann::json{{"tagged", Bank().Tag(ObjectBody(req, {"tag", "sprites", "clip", "first_frame", "last_frame"}), false)}};
+         })},
+        {"POST", "/api/bank/untag", "POST /api/bank/untag (as tag)", json([this](const Request& req) {
+           return nlohmann::json{{"untagged", Bank().Tag(ObjectBody(req, {"tag", "sprites", "clip", "first_frame", "last_frame"}), true)}};
+         })},
+        {"GET", "/api/bank/export.csv", "GET /api/bank/export.csv?clip=ID|tag=T", [this](const Request& req, Response& res) {
+           std::optional<int64_t> clip;
+           if (req.has_param("clip")) clip = IntParam(req, "clip", 0, 1, INT64_MAX);
+           const std::string tag = req.has_param("tag") ? req.get_param_value("tag") : "";
+           if (!clip && tag.empty()) throw InputError("clip", "give ?clip=ID or ?tag=T");
+           res.set_header("Content-Disposition", "attachment; filename=\"" +
+                                                     (clip ? "clip-" + std::to_string(*clip) : "tag-" + tag) + ".csv\"");
+           res.set_content(Bank().ExportCsv(clip, tag), "text/csv; charset=utf-8");
+         }},
+    };
+  }
+
+  void Routes() {
+    MakeRoutes();
+    server.new_task_queue = [] { return new NiceThreadPool(kHttpThreads); };
+    server.set_payload_max_length(kMaxBodyBytes);
+    server.set_keep_alive_max_count(1000);
+    server.set_read_timeout(10, 0);
+    server.set_write_timeout(5, 0);  // a stalled event stream is dropped after 5 s of blocked writes
+    server.set_pre_routing_handler([this](const Request& req, Response& res) { return Admit(req, res); });
+    for (const Route& r : routes) {
+      auto handler = [h = r.handler](const Request& req, Response& res) {
+        // A body must be JSON: a form or text/plain post from another site's page is refused
+        // before anything acts (such a post needs no CORS preflight; a JSON one does).
+        if (req.method == "POST" && !req.body.empty()) {
+          const std::string type = req.get_header_value("Content-Type");
+          if (type.rfind("application/json", 0) != 0) {
+            ReplyError(res, 415, "Content-Type: a request body must be JSON (application/json), got \"" + type + "\"");
+            return;
+          }
         }
-        res.set_content(reinterpret_cast<const char*>(jpeg->data()), jpeg->size(), "image/jpeg");
-      });
+        Guard(res, [&] { h(req, res); });
+      };
+      if (std::string(r.method) == "GET") {
+        server.Get(r.pattern, handler);
+      } else {
+        server.Post(r.pattern, handler);
+      }
+    }
+    // The console's pages: everything else that GET asks for.
+    server.Get(R"(/(|[A-Za-z0-9_\-./]+))", [this](const Request& req, Response& res) {
+      if (req.path.rfind("/api/", 0) == 0 || !ServeWebFile(req.path, res)) {
+        ReplyError(res, 404, "no such endpoint or page: GET " + req.path + " (GET /api lists the endpoints)");
+      }
     });
-    server.Post("/api/session/start", [this](const httplib::Request& req, httplib::Response& res) {
-      Guard(res, 400, [&] {
-        std::string name = NameFromBody(req, false);
-        if (name.empty()) name = "session";
-        try {
-          Reply(res, 200, SessionToJson(station->StartSession(name)));
-        } catch (const InputError& e) {
-          ReplyError(res, std::string(e.what()).rfind("name", 0) == 0 ? 400 : 409, e.what());
-        }
-      });
-    });
-    server.Post("/api/session/stop", [this](const httplib::Request&, httplib::Response& res) {
-      Guard(res, 409, [&] { Reply(res, 200, SessionToJson(station->StopSession())); });
-    });
-    server.Post("/api/session/rename", [this](const httplib::Request& req, httplib::Response& res) {
-      Guard(res, 400, [&] {
-        const std::string name = NameFromBody(req, true);
-        try {
-          Reply(res, 200, SessionToJson(station->RenameSession(name)));
-        } catch (const InputError& e) {
-          ReplyError(res, std::string(e.what()).rfind("name", 0) == 0 ? 400 : 409, e.what());
-        }
-      });
-    });
-    server.set_error_handler([](const httplib::Request& req, httplib::Response& res) {
+    server.set_error_handler([](const Request& req, Response& res) {
       if (!res.body.empty()) return;
       if (res.status == 404) {
-        ReplyError(res, 404, "no such endpoint: " + req.method + " " + req.path + " (GET / lists them)");
+        ReplyError(res, 404, "no such endpoint: " + req.method + " " + req.path + " (GET /api lists them)");
+      } else if (res.status == 413) {
+        ReplyError(res, 413, "body: larger than " + std::to_string(kMaxBodyBytes) + " bytes");
       } else if (res.status == 405 || res.status == 400) {
         ReplyError(res, res.status, "malformed request: " + req.method + " " + req.path);
       }
@@ -145,14 +431,15 @@ struct ControlServer::Impl {
   }
 
   std::string Url() const {
-    const bool v6 = config.address.find(':') != std::string::npos;
-    return "http://" + (v6 ? "[" + config.address + "]" : config.address) + ":" + std::to_string(port);
+    const bool v6 = options.config.address.find(':') != std::string::npos;
+    return "http://" + (v6 ? "[" + options.config.address + "]" : options.config.address) + ":" + std::to_string(port);
   }
 };
 
-ControlServer::ControlServer(Station& station, ControlConfig config) : impl_(std::make_unique<Impl>()) {
-  impl_->station = &station;
-  impl_->config = std::move(config);
+ControlServer::ControlServer(StationHost& host, ControlServerOptions options) : impl_(std::make_unique<Impl>()) {
+  impl_->host = &host;
+  impl_->options = std::move(options);
+  impl_->events = std::make_unique<ConsoleEvents>([s = impl_.get()] { return s->StatusJson(); });
   impl_->Routes();
 }
 
@@ -160,23 +447,25 @@ ControlServer::~ControlServer() { Stop(); }
 
 int ControlServer::Start() {
   Impl& s = *impl_;
-  const std::string host = s.config.address == "localhost" ? "127.0.0.1" : s.config.address;
-  if (s.config.port == 0) {
+  const std::string host = s.options.config.address == "localhost" ? "127.0.0.1" : s.options.config.address;
+  if (s.options.config.port == 0) {
     s.port = s.server.bind_to_any_port(host);
   } else {
-    s.port = s.server.bind_to_port(host, s.config.port) ? s.config.port : -1;
+    s.port = s.server.bind_to_port(host, s.options.config.port) ? s.options.config.port : -1;
   }
   if (s.port <= 0) {
-    throw WorkError("control " + s.config.address + ":" + std::to_string(s.config.port),
+    throw WorkError("control " + s.options.config.address + ":" + std::to_string(s.options.config.port),
                     "cannot listen there (address not on this machine, or the port is taken)");
   }
+  s.events->Start();
   s.thread = std::thread([&s] { s.server.listen_after_bind(); });
-  Log("station.control")->info("control API on {}", s.Url());
+  Log("station.control")->info("control API and console on {}", s.Url());
   return s.port;
 }
 
 void ControlServer::Stop() {
   Impl& s = *impl_;
+  s.events->Stop();  // event streams end, so the server's threads can
   if (s.thread.joinable()) {
     s.server.stop();
     s.thread.join();

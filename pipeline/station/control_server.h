@@ -1,26 +1,42 @@
 #pragma once
-// The station's HTTP control API (cpp-httplib), on 127.0.0.1 by default:
-//   GET  /api/status                       status as JSON (StatusToJson)
-//   GET  /metrics                          Prometheus text format
-//   GET  /api/cameras/NAME/preview.jpg     latest frame; ?view=keyed for the matte
-//   POST /api/session/start   {"name": S}  starts a capture session
-//   POST /api/session/stop                 stops it (its sprites are in the bank on return)
-//   POST /api/session/rename  {"name": S}
-// Errors are JSON {"error": "..."} naming the field: 400 bad request, 401 token,
-// 404 unknown camera or path, 409 session state. With a token configured every
-// request needs `Authorization: Bearer TOKEN`.
+// The station's HTTP server (cpp-httplib), on 127.0.0.1:8360 by default: the
+// control API (docs/daemon.md), the console's API (docs/console.md: live
+// events, previews, replay, the bank) and the console's pages. Every endpoint
+// is one row of one table (control_server.cc), which `GET /api` lists.
+// Errors are JSON {"error": "FIELD: reason"}: 400 bad input, 401 token, 403
+// another site's page, 404 unknown camera / sprite / path, 409 wrong state,
+// 415 a body that is not JSON, 503 not ready. With a token every /api request
+// needs `Authorization: Bearer TOKEN`; the pages themselves need none.
+#include <functional>
 #include <memory>
+#include <optional>
 #include <string>
+#include <string_view>
 
 #include "core/config.h"
 
 namespace ss {
 
-class Station;
+class StationHost;
+
+// A static file of the console: its bytes and content type.
+struct WebFile {
+  std::string_view bytes;
+  std::string_view content_type;
+};
+
+struct ControlServerOptions {
+  ControlConfig config;
+  // The console's pages: served from `web_dir` when set (a source tree's web/, edited live),
+  // else by `embedded` (the copy built into the executable); neither: no pages.
+  std::string web_dir;
+  std::function<std::optional<WebFile>(std::string_view path)> embedded;
+  int max_event_streams = 16;  // open /api/events connections; more get 503
+};
 
 class ControlServer {
  public:
-  ControlServer(Station& station, ControlConfig config);
+  ControlServer(StationHost& host, ControlServerOptions options);
   ~ControlServer();  // Stop()
   ControlServer(const ControlServer&) = delete;
   ControlServer& operator=(const ControlServer&) = delete;

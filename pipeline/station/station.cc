@@ -7,13 +7,16 @@
 #include <ctime>
 #include <deque>
 #include <filesystem>
+#include <map>
 #include <mutex>
 #include <thread>
 
+#include <nlohmann/json.hpp>
 #include <opencv2/core/utility.hpp>
 
 #include "core/bank.h"
 #include "core/error.h"
+#include "core/error_kinds.h"
 #include "core/log.h"
 #include "pipeline/run/bounded_queue.h"
 #include "pipeline/run/ingest.h"
@@ -29,6 +32,10 @@ using Clock = std::chrono::steady_clock;
 
 // SIGTERM must finish within 5 s: from the start of Stop, the transition worker may drain this long.
 constexpr double kTransitionDrainS = 3.0;
+
+// Previews: a snapshot every kPreviewIntervalS; an encoded image is shared for kPreviewHoldS.
+// While a session runs both become kPreviewHoldSessionS (at most 2 images a second a camera).
+constexpr double kPreviewIntervalS = 0.2, kPreviewHoldS = 0.1, kPreviewHoldSessionS = 0.5;
 
 double Seconds(Clock::duration d) { return std::chrono::duration<double>(d).count(); }
 
@@ -70,6 +77,20 @@ void ApplyLogging(const LoggingConfig& logging) {
 
 }  // namespace
 
+// One camera's encoded previews, by (view, width): view 0 raw, 1 keyed, 2 the sprites view.
+struct PreviewCache {
+  struct Entry {
+    // The snapshot it was made from, by identity (holding it would keep the runner from reusing it).
+    bool made_any = false;
+    SteadyTime frame_taken{};
+    SteadyTime made{};
+    Station::PreviewImage image;
+    std::string sprites_json;
+  };
+  std::mutex mutex;  // also makes concurrent callers wait for one encode instead of each doing it
+  std::map<std::pair<int, int>, Entry> entries;
+};
+
 struct Station::Impl {
   StationOptions options;
   std::shared_ptr<spdlog::logger> log = Log("station");
@@ -102,6 +123,8 @@ struct Station::Impl {
   // The capture session, under session_mutex (held across start/stop).
   mutable std::mutex session_mutex;
   SessionStatus session;
+  std::atomic<bool> session_active{false};  // session.active, read without the lock (previews)
+  std::vector<std::unique_ptr<PreviewCache>> preview_caches;  // one per runner
   SteadyTime session_started{};
   std::unique_ptr<StationRecorder> recorder;
   mutable std::mutex recorder_mutex;  // guards `recorder` against the pipeline threads' taps
@@ -111,6 +134,29 @@ struct Station::Impl {
   std::mutex monitor_mutex;
   std::condition_variable monitor_wake;
   bool monitor_stop = false;
+
+  // The cache entry of a camera's view, locked in `lock`; `frame` is set when it must be
+  // (re)made from that snapshot. nullptr before the first frame; InputError for no such camera.
+  PreviewCache::Entry* CachedPreview(const std::string& camera, int view, int max_width,
+                                     std::unique_lock<std::mutex>* lock,
+                                     std::shared_ptr<const PreviewFrame>* frame) const {
+    const Impl& s = *this;
+    for (size_t k = 0; k < s.runners.size(); ++k) {
+      if (s.runners[k]->name() != camera) continue;
+      PreviewCache& cache = *s.preview_caches[k];
+      *lock = std::unique_lock(cache.mutex);
+      *frame = s.runners[k]->preview();
+      if (!*frame) return nullptr;
+      PreviewCache::Entry& entry = cache.entries[{view, std::clamp(max_width, 16, 4096)}];
+      const double hold = s.session_active.load() ? kPreviewHoldSessionS : kPreviewHoldS;
+      if (entry.made_any &&
+          (entry.frame_taken == (*frame)->taken || Seconds(Clock::now() - entry.made) < hold)) {
+        *frame = nullptr;  // still fresh: no new encode
+      }
+      return &entry;
+    }
+    throw NotFoundError("camera", "no camera named \"" + camera + "\"");
+  }
 
   void Store(StationBatch sb) {
     {
@@ -321,6 +367,7 @@ void Station::Start() {
     s.runners.push_back(std::make_unique<CameraRunner>(
         static_cast<int>(i), std::move(o), [&s](StationBatch b) { s.Store(std::move(b)); },
         [&s](int camera, const Frame& f, uint64_t drops, bool usable) { s.Tap(camera, f, drops, usable); }));
+    s.preview_caches.push_back(std::make_unique<PreviewCache>());
   }
   s.CheckDisk();  // before any session: a full disk refuses from the first frame
   for (auto& r : s.runners) r->Start();
@@ -385,7 +432,7 @@ SessionStatus Station::StartSession(const std::string& requested_name) {
   std::lock_guard control(s.control_mutex);
   std::unique_lock lock(s.session_mutex);
   if (s.state != 1) throw InputError("session", "the station is not running");
-  if (s.session.active) throw InputError("session", "session \"" + s.session.name + "\" is running; stop it first");
+  if (s.session.active) throw ConflictError("session", "session \"" + s.session.name + "\" is running; stop it first");
   const std::string created = UtcNow();
   SessionRecord record;
   record.uid = name + "@" + created;
@@ -409,6 +456,7 @@ SessionStatus Station::StartSession(const std::string& requested_name) {
     }
   }
   s.session.active = true;
+  s.session_active = true;
   s.session.name = name;
   s.session.started = created;
   s.session_started = Clock::now();
@@ -437,6 +485,8 @@ SessionStatus Station::StartSession(const std::string& requested_name) {
   const SessionStatus out = s.session;
   lock.unlock();  // the writer updates the session's counts meanwhile
   for (size_t i = 0; i < s.runners.size(); ++i) s.runners[i]->SetBankCamera(camera_ids[i]);
+  // Previews back off while a session stores: fewer snapshots for the pipeline threads to copy.
+  for (auto& r : s.runners) r->set_preview_interval(kPreviewHoldSessionS);
   s.log->info("session \"{}\" started (bank session {})", name, out.bank_session_id);
   return out;
 }
@@ -446,7 +496,7 @@ SessionStatus Station::StopSession() {
   std::lock_guard control(s.control_mutex);
   {
     std::lock_guard lock(s.session_mutex);
-    if (!s.session.active) throw InputError("session", "no session is running");
+    if (!s.session.active) throw ConflictError("session", "no session is running");
   }
   // Every open clip closes into the writer queue under the session's cameras; then
   // the writer stores them all before the session is reported stopped.
@@ -455,6 +505,8 @@ SessionStatus Station::StopSession() {
   s.StopRecording("the session stopped");
   std::lock_guard lock(s.session_mutex);
   s.session.active = false;
+  s.session_active = false;
+  for (auto& r : s.runners) r->set_preview_interval(kPreviewIntervalS);
   s.session.seconds = Seconds(Clock::now() - s.session_started);
   s.log->info("session \"{}\" stopped: {} sprites stored", s.session.name, s.session.sprites_stored);
   return s.session;
@@ -465,7 +517,7 @@ SessionStatus Station::RenameSession(const std::string& requested_name) {
   const std::string name = CheckSessionName(requested_name);
   std::lock_guard control(s.control_mutex);
   std::lock_guard lock(s.session_mutex);
-  if (!s.session.active) throw InputError("session", "no session is running");
+  if (!s.session.active) throw ConflictError("session", "no session is running");
   {
     std::lock_guard bank_lock(s.bank_mutex);
     s.bank->RenameSession(s.session.bank_session_id, name);
@@ -527,6 +579,8 @@ StationStatus Station::Status() const {
   }
   const StorageConfig storage = s.StorageSettings();
   out.recording_mode = storage.recording;
+  out.stop_recording_below_mib = storage.stop_recording_below_mib;
+  out.stop_sprites_below_mib = storage.stop_sprites_below_mib;
   {
     std::lock_guard lock(s.recorder_mutex);
     const RecorderStats r = s.recorder ? s.recorder->stats() : s.last_recording;
@@ -537,12 +591,47 @@ StationStatus Station::Status() const {
   return out;
 }
 
-std::optional<std::vector<uint8_t>> Station::PreviewJpeg(const std::string& camera, bool keyed) const {
-  for (const auto& r : impl_->runners) {
-    if (r->name() == camera) return r->PreviewJpeg(keyed);
+std::optional<Station::PreviewImage> Station::Preview(const std::string& camera, PreviewView view,
+                                                      int max_width) const {
+  std::unique_lock<std::mutex> lock;
+  std::shared_ptr<const PreviewFrame> frame;
+  PreviewCache::Entry* entry = impl_->CachedPreview(camera, view == PreviewView::kKeyed ? 1 : 0, max_width, &lock, &frame);
+  if (entry == nullptr) return std::nullopt;
+  if (frame) {
+    entry->image.jpeg = EncodeJpeg(RenderPreview(*frame, view, std::clamp(max_width, 16, 4096)));
+    entry->image.sequence = frame->sequence;
+    entry->image.timestamp_ns = frame->timestamp_ns;
+    entry->image.width = frame->bgr.cols;
+    entry->image.height = frame->bgr.rows;
+    entry->made_any = true;
+    entry->frame_taken = frame->taken;
+    entry->made = Clock::now();
   }
-  throw InputError("camera", "no camera named \"" + camera + "\"");
+  return entry->image;
 }
+
+std::optional<std::string> Station::SpritesView(const std::string& camera, int max_width) const {
+  std::unique_lock<std::mutex> lock;
+  std::shared_ptr<const PreviewFrame> frame;
+  PreviewCache::Entry* entry = impl_->CachedPreview(camera, 2, max_width, &lock, &frame);
+  if (entry == nullptr) return std::nullopt;
+  if (frame) {
+    const cv::Mat image = RenderPreview(*frame, PreviewView::kRaw, std::clamp(max_width, 16, 4096));
+    const double scale = frame->bgr.cols > 0 ? double(image.cols) / frame->bgr.cols : 1.0;
+    bool storing = false;
+    for (const auto& r : impl_->runners) {
+      if (r->name() == camera) storing = SessionActive() && r->model().has_value();
+    }
+    entry->sprites_json =
+        SpritesViewJson(*frame, storing, "data:image/jpeg;base64," + Base64(EncodeJpeg(image)), scale).dump();
+    entry->made_any = true;
+    entry->frame_taken = frame->taken;
+    entry->made = Clock::now();
+  }
+  return entry->sprites_json;
+}
+
+bool Station::SessionActive() const { return impl_->session_active.load(); }
 
 std::vector<std::string> Station::Reload(const StationConfig& config) {
   Impl& s = *impl_;

@@ -15,6 +15,7 @@
 
 #include "capture/frame_source.h"
 #include "core/config.h"
+#include "pipeline/station/preview.h"
 #include "pipeline/station/station_status.h"
 #include "pipeline/transitions/weights.h"
 
@@ -52,8 +53,19 @@ class Station {
   SessionStatus RenameSession(const std::string& name);
 
   StationStatus Status() const;
-  // JPEG of a camera's latest frame; InputError for an unknown camera, nullopt before its first frame.
-  std::optional<std::vector<uint8_t>> PreviewJpeg(const std::string& camera, bool keyed) const;
+  // A camera's latest preview as JPEG, at most `max_width` wide; InputError for an unknown
+  // camera, nullopt before its first frame. One image per camera, view and width is shared by
+  // every caller for 0.1 s (0.5 s while a session runs); encoding runs on the caller's thread.
+  struct PreviewImage {
+    std::vector<uint8_t> jpeg;
+    uint64_t sequence = 0;
+    int64_t timestamp_ns = 0;
+    int width = 0, height = 0;  // the camera's full size
+  };
+  std::optional<PreviewImage> Preview(const std::string& camera, PreviewView view, int max_width) const;
+  // The sprites view (preview.h SpritesViewJson) as JSON text, shared and throttled the same way.
+  std::optional<std::string> SpritesView(const std::string& camera, int max_width) const;
+  bool SessionActive() const;
   // SIGHUP: applies what is safe to change live (logging, storage limits and recording
   // mode, from the next session on); returns one line per section that needs a restart.
   std::vector<std::string> Reload(const StationConfig& config);

@@ -86,7 +86,8 @@ nlohmann::json StatusToJson(const StationStatus& st) {
                        {"clips", c.pipeline.clips},
                        {"sequence_gaps", c.pipeline.sequence_gaps},
                        {"batches_unstored", c.batches_unstored},
-                       {"discards", discards}});
+                       {"discards", discards},
+                       {"exposure", ExposureToJson(c.exposure)}});
   }
   return {{"state", st.state},
           {"uptime_s", st.uptime_s},
@@ -110,6 +111,8 @@ nlohmann::json StatusToJson(const StationStatus& st) {
                            {"last_round_ms", st.transitions_last_round_ms}}},
           {"storage", {{"state", st.storage_state},
                        {"disk_free_mib", st.disk_free_mib},
+                       {"stop_recording_below_mib", st.stop_recording_below_mib},
+                       {"stop_sprites_below_mib", st.stop_sprites_below_mib},
                        {"recording", st.recording_mode},
                        {"frames_recorded", st.frames_recorded},
                        {"frames_record_dropped", st.frames_record_dropped},

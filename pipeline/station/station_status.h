@@ -42,6 +42,7 @@ struct StationStatus {
   // Storage
   std::string storage_state;      // ok | recording_stopped | sprites_stopped
   int64_t disk_free_mib = -1;     // the lower of the bank's and the recordings' file systems
+  int64_t stop_recording_below_mib = 0, stop_sprites_below_mib = 0;  // the disk guard's thresholds
   std::string recording_mode;     // off | all | usable
   uint64_t frames_recorded = 0, frames_record_dropped = 0;
   std::string recording_error;

@@ -1,0 +1,72 @@
+#pragma once
+// The daemon's one running station, and test mode's replay of a recorded
+// session in its place (the console's replay page): StartReplay stops the
+// station of the config's cameras (its session stopped and stored) and starts
+// one whose cameras replay a recorded session, with the same bank, keying,
+// pipeline and storage; StopReplay goes back. Callers take the running
+// station with current(); a replaced station is stopped before its successor
+// starts, and stays valid for whoever still holds it.
+#include <memory>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json_fwd.hpp>
+
+#include "core/session.h"
+#include "pipeline/station/station.h"
+
+namespace ss {
+
+// A recorded session found under a replay root.
+struct RecordedSessionEntry {
+  std::string path;  // absolute
+  std::string root;
+  SessionInfo info;
+  double seconds = 0;  // the longest camera's frames / fps
+  std::string error;   // why it cannot be read ("" when it can)
+};
+// Sessions (folders with a session.json) in each root, the root itself or up to two levels
+// down, sorted by root then path. A root that does not exist is skipped.
+std::vector<RecordedSessionEntry> FindRecordedSessions(const std::vector<std::string>& roots);
+nlohmann::json RecordedSessionsToJson(const std::vector<std::string>& roots,
+                                      const std::vector<RecordedSessionEntry>& sessions);
+
+// The config of a station replaying session `dir` in place of `live`'s cameras.
+StationConfig ReplayStationConfig(const StationConfig& live, const SessionInfo& session, const std::string& dir,
+                                  bool paced, bool loop);
+
+class StationHost {
+ public:
+  StationHost(StationOptions live, std::vector<std::string> replay_roots);
+  ~StationHost();  // Stop()
+
+  void Start();  // the live station
+  void Stop();   // idempotent
+  std::shared_ptr<Station> current() const;
+
+  // InputError (field "path") for a path that is not a listed session, or whose
+  // station cannot start (then the live station runs again).
+  void StartReplay(const std::string& path, bool paced, bool loop);
+  // InputError (field "replay") when no replay runs.
+  void StopReplay();
+
+  // {"mode": "live" | "replay", "replay": {"path", "paced", "loop"} or null}
+  nlohmann::json ModeJson() const;
+  const std::vector<std::string>& replay_roots() const { return replay_roots_; }
+
+ private:
+  // Stops the running station and starts one from `options`. Under switch_mutex_.
+  void Replace(StationOptions options);
+
+  StationOptions live_;
+  std::vector<std::string> replay_roots_;
+  std::mutex switch_mutex_;  // one switch at a time
+  mutable std::mutex mutex_;  // guards station_ and the mode below
+  std::shared_ptr<Station> station_;
+  bool replaying_ = false;
+  std::string replay_path_;
+  bool replay_paced_ = true, replay_loop_ = false;
+};
+
+}  // namespace ss
