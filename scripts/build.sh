@@ -11,8 +11,10 @@ case "$sanitize" in
   tsan) build="${SPRITESTATION_BUILD_DIR:-$top/build-tsan}"; extra+=(-DSPRITESTATION_TSAN=ON -DCMAKE_BUILD_TYPE=Debug) ;;
   *) echo "build.sh: SPRITESTATION_SANITIZE must be asan or tsan, got '$sanitize'" >&2; exit 2 ;;
 esac
-# ccache: paths under the tree hash as relative ones, so a clone in another
-# folder (CI's) reuses what a build of this tree already compiled.
+# ccache: one cache for every build of this machine, CI's (.ci/run) and a
+# developer's alike; paths under the tree hash as relative ones, so a clone in
+# another folder (CI's) reuses what a build of this tree already compiled.
+export CCACHE_DIR="${CCACHE_DIR:-$HOME/.ccache}"
 export CCACHE_BASEDIR="${CCACHE_BASEDIR:-$top}" CCACHE_NOHASHDIR="${CCACHE_NOHASHDIR:-true}"
 generator=()
 command -v ninja >/dev/null && generator=(-G Ninja)
