@@ -269,8 +269,9 @@ async function refreshTags(entry) {
 
 async function exportCsv(query, name) {
   try {
-    const { blob } = await getBlob(`/api/bank/export.csv?${query}`);
-    saveBlob(blob, name);
+    const { blob, headers } = await getBlob(`/api/bank/export.csv?${query}`);
+    const named = /filename="?([^";]+)"?/.exec(headers.get('Content-Disposition') || '');
+    saveBlob(blob, named ? named[1] : name);
   } catch (err) {
     showMessage(`export: ${err.message}`, 'error');
   }
@@ -287,7 +288,10 @@ async function revealSprite(id) {
     if (!loaded) continue;
     const cell = entry.cells.find((c) => Number(c.dataset.sprite) === id);
     if (cell) {
-      cell.scrollIntoView({ block: 'nearest', inline: 'center' });
+      // again once the billboards around it have loaded and widened their cells
+      for (const delay of [0, 400, 1200]) {
+        setTimeout(() => current === id && cell.scrollIntoView({ block: 'nearest', inline: 'center' }), delay);
+      }
       return;
     }
   }
