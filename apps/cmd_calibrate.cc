@@ -29,7 +29,7 @@
 #include "core/error.h"
 #include "core/frame.h"
 #include "core/session.h"
-#include "pipeline/station/camera_source.h"
+#include "capture/camera_source.h"
 
 namespace ss::apps {
 namespace {

@@ -27,7 +27,7 @@
 
 #include "bench/bench_registry.h"
 #include "capture/replay/replay_source.h"
-#include "pipeline/station/station.h"
+#include "station/station.h"
 #include "synth/studio_session.h"
 
 namespace ss::bench {

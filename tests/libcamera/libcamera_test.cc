@@ -13,7 +13,7 @@
 #include "capture/libcamera/libcamera_source.h"
 #include "core/config.h"
 #include "core/error.h"
-#include "pipeline/station/camera_source.h"
+#include "capture/camera_source.h"
 #include "tests/support/test_support.h"
 
 namespace ss {

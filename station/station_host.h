@@ -14,7 +14,7 @@
 #include <nlohmann/json_fwd.hpp>
 
 #include "core/session.h"
-#include "pipeline/station/station.h"
+#include "station/station.h"
 
 namespace ss {
 

@@ -1,4 +1,4 @@
-#include "pipeline/station/console_events.h"
+#include "station/console_events.h"
 
 #include <chrono>
 

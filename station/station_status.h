@@ -7,7 +7,7 @@
 
 #include <nlohmann/json_fwd.hpp>
 
-#include "pipeline/station/camera_runner.h"
+#include "station/camera_runner.h"
 
 namespace ss {
 

@@ -1,4 +1,4 @@
-#include "tests/station/station_fixture.h"
+#include "tests/e2e/daemon/station_fixture.h"
 
 #include <fcntl.h>
 #include <sched.h>

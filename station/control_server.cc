@@ -1,4 +1,4 @@
-#include "pipeline/station/control_server.h"
+#include "station/control_server.h"
 
 #include <sys/resource.h>
 #include <sys/syscall.h>
@@ -17,11 +17,11 @@
 #include "core/error.h"
 #include "core/error_kinds.h"
 #include "core/log.h"
-#include "pipeline/station/console_bank.h"
-#include "pipeline/station/console_events.h"
-#include "pipeline/station/station.h"
-#include "pipeline/station/station_host.h"
-#include "pipeline/station/station_status.h"
+#include "station/console_bank.h"
+#include "station/console_events.h"
+#include "station/station.h"
+#include "station/station_host.h"
+#include "station/station_status.h"
 
 namespace ss {
 namespace {

@@ -1,4 +1,4 @@
-#include "pipeline/station/recorder.h"
+#include "station/recorder.h"
 
 #include <atomic>
 #include <mutex>

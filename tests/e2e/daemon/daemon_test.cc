@@ -19,7 +19,7 @@
 
 #include "core/camera_model.h"
 
-#include "tests/station/station_fixture.h"
+#include "tests/e2e/daemon/station_fixture.h"
 #include "tests/support/test_support.h"
 
 namespace ss::testing {

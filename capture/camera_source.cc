@@ -1,4 +1,4 @@
-#include "pipeline/station/camera_source.h"
+#include "capture/camera_source.h"
 
 #include <cmath>
 #include <filesystem>

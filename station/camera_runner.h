@@ -21,7 +21,7 @@
 #include "core/frame.h"
 #include "core/geometry.h"
 #include "pipeline/run/camera_pipeline.h"
-#include "pipeline/station/preview.h"
+#include "station/preview.h"
 
 namespace ss {
 

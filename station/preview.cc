@@ -1,4 +1,4 @@
-#include "pipeline/station/preview.h"
+#include "station/preview.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "pipeline/station/station.h"
+#include "station/station.h"
 
 #include <algorithm>
 #include <atomic>
@@ -20,8 +20,8 @@
 #include "core/log.h"
 #include "pipeline/run/bounded_queue.h"
 #include "pipeline/run/ingest.h"
-#include "pipeline/station/camera_source.h"
-#include "pipeline/station/recorder.h"
+#include "capture/camera_source.h"
+#include "station/recorder.h"
 #include "pipeline/transitions/worker.h"
 
 namespace ss {

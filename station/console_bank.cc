@@ -1,4 +1,4 @@
-#include "pipeline/station/console_bank.h"
+#include "station/console_bank.h"
 
 #include <algorithm>
 #include <map>

@@ -1,4 +1,4 @@
-#include "pipeline/station/station_host.h"
+#include "station/station_host.h"
 
 #include <algorithm>
 #include <filesystem>

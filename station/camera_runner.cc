@@ -1,4 +1,4 @@
-#include "pipeline/station/camera_runner.h"
+#include "station/camera_runner.h"
 
 #include <algorithm>
 #include <atomic>
@@ -15,7 +15,7 @@
 #include "core/error.h"
 #include "core/log.h"
 #include "pipeline/run/bounded_queue.h"
-#include "pipeline/station/camera_source.h"
+#include "capture/camera_source.h"
 
 namespace ss {
 namespace {

@@ -15,8 +15,8 @@
 
 #include "capture/frame_source.h"
 #include "core/config.h"
-#include "pipeline/station/preview.h"
-#include "pipeline/station/station_status.h"
+#include "station/preview.h"
+#include "station/station_status.h"
 #include "pipeline/transitions/weights.h"
 
 namespace ss {

@@ -16,10 +16,10 @@
 #include "core/bank.h"
 #include "core/error_kinds.h"
 #include "core/session.h"
-#include "pipeline/station/console_bank.h"
-#include "pipeline/station/console_events.h"
-#include "pipeline/station/preview.h"
-#include "pipeline/station/station_host.h"
+#include "station/console_bank.h"
+#include "station/console_events.h"
+#include "station/preview.h"
+#include "station/station_host.h"
 #include "tests/support/test_support.h"
 
 namespace ss {

@@ -1,4 +1,4 @@
-#include "pipeline/station/station_status.h"
+#include "station/station_status.h"
 
 #include <sstream>
 
