@@ -1,4 +1,4 @@
-// spritestation bench station [--cameras=N] [--size=WxH] [--fps=F] [--seconds=S]:
+// spritestation bench station [--cameras=N] [--size=WxH] [--fps=F] [--seconds=S] [--preview-streams=N]:
 // the live station on paced replay (the daemon's code: CameraRunner threads,
 // bank writer, TransitionWorker), as a Google Benchmark case run once for S
 // seconds of wall time. Cameras replay a synthetic animal session (made once,
@@ -8,6 +8,10 @@
 //                                   camera does: the station's own capacity. Counters: frames/s delivered, frames dropped (queue
 //                                   full / at source), capture-to-bank latency p50/p99,
 //                                   transitions pending (max), sprites/s stored
+//   station/live_from_memory_..._with_N_previews (--preview-streams=N): the same with the
+//                                   daemon's HTTP server and N console tiles open (each fetching
+//                                   raw / keyed / sprites views at 10 a second, and an event stream):
+//                                   an open console must cost no captured frame
 //   station/baseline/decode_NxWxH   the same session replayed unpaced by ReplaySource:
 //                                   the machine's decode capacity for these cameras
 // The ratio printed: frames/s the cameras need / frames/s decoding alone gives.
@@ -20,6 +24,7 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <atomic>
 #include <condition_variable>
 #include <map>
 #include <mutex>
@@ -27,8 +32,12 @@
 
 #include "bench/bench_registry.h"
 #include "capture/replay/replay_source.h"
+#include "station/control_server.h"
 #include "station/station.h"
+#include "station/station_host.h"
 #include "synth/studio_session.h"
+// Last: <resolv.h>, which it includes, defines _res, a name Eigen's headers use.
+#include <httplib.h>
 
 namespace ss::bench {
 namespace {
@@ -40,6 +49,7 @@ struct StationBenchArgs {
   int width = 1280, height = 720;
   double fps = 30;
   double seconds = 20;
+  int preview_streams = 0;  // > 0: also the from-memory run with this many open console previews
 };
 StationBenchArgs g_args;
 
@@ -152,7 +162,44 @@ void Decode(benchmark::State& state) {
   state.counters["frames_per_s"] = benchmark::Counter(static_cast<double>(frames), benchmark::Counter::kIsRate);
 }
 
-void Live(benchmark::State& state, bool from_memory) {
+// What an open console costs: `n` browser tabs' worth of preview loops (each a tile fetching
+// its camera's raw, keyed or sprites view at 10 a second, as the page does) and one event stream
+// per loop, against the daemon's own HTTP server. Counts the images served.
+class ConsoleLoad {
+ public:
+  ConsoleLoad(int port, int n, int cameras) {
+    for (int k = 0; k < n; ++k) {
+      threads_.emplace_back([this, port, k, cameras] {
+        httplib::Client client("127.0.0.1", port);
+        client.set_read_timeout(10, 0);
+        static const char* kViews[] = {"preview.jpg?view=raw", "preview.jpg?view=keyed", "sprites.json?x=1"};
+        const std::string path = "/api/cameras/cam" + std::to_string(k % cameras) + "/" + kViews[k % 3] + "&width=640";
+        while (!stop_) {
+          const auto start = std::chrono::steady_clock::now();
+          if (auto res = client.Get(path.c_str()); res && res->status == 200) ++images_;
+          std::this_thread::sleep_until(start + std::chrono::milliseconds(100));
+        }
+      });
+      threads_.emplace_back([this, port] {
+        httplib::Client client("127.0.0.1", port);
+        client.set_read_timeout(10, 0);
+        client.Get("/api/events", [this](const char*, size_t) { return !stop_.load(); });
+      });
+    }
+  }
+  ~ConsoleLoad() {
+    stop_ = true;
+    for (auto& t : threads_) t.join();
+  }
+  uint64_t images() const { return images_; }
+
+ private:
+  std::atomic<bool> stop_{false};
+  std::atomic<uint64_t> images_{0};
+  std::vector<std::thread> threads_;
+};
+
+void Live(benchmark::State& state, bool from_memory, int preview_streams) {
   const std::string session = Session();
   if (from_memory) {
     for (int c = 0; c < g_args.cameras; ++c) Decoded(session, "cam" + std::to_string(c));
@@ -190,8 +237,16 @@ void Live(benchmark::State& state, bool from_memory) {
         return std::make_unique<MemorySource>(frames, sc, index);
       };
     }
-    Station station(options);
-    station.Start();
+    config.control.port = 0;
+    StationHost host(options, {});
+    host.Start();
+    Station& station = *host.current();
+    std::unique_ptr<ControlServer> control;
+    std::unique_ptr<ConsoleLoad> console;
+    if (preview_streams > 0) {
+      control = std::make_unique<ControlServer>(host, ControlServerOptions{config.control});
+      console = std::make_unique<ConsoleLoad>(control->Start(), preview_streams, g_args.cameras);
+    }
     station.StartSession("bench");
     int64_t pending_max = 0;
     const auto start = std::chrono::steady_clock::now();
@@ -200,7 +255,10 @@ void Live(benchmark::State& state, bool from_memory) {
       pending_max = std::max(pending_max, station.Status().transitions_pending);
     }
     const StationStatus status = station.Status();
-    station.Stop();
+    if (console) state.counters["preview_images_per_s"] = console->images() / g_args.seconds;
+    console.reset();
+    if (control) control->Stop();
+    host.Stop();
     uint64_t captured = 0, queue_full = 0, at_source = 0, learning = 0, processed = 0;
     double seconds_key = 0, seconds_rest = 0;
     for (const CameraStatus& c : status.cameras) {
@@ -244,6 +302,8 @@ int Run(const std::vector<std::string>& args) {
       g_args.fps = std::stod(value);
     } else if (key == "--seconds") {
       g_args.seconds = std::stod(value);
+    } else if (key == "--preview-streams") {
+      g_args.preview_streams = std::stoi(value);
     } else {
       pass.push_back(a);
     }
@@ -252,21 +312,29 @@ int Run(const std::vector<std::string>& args) {
       ->Iterations(1)
       ->Unit(benchmark::kSecond)
       ->UseRealTime();
-  benchmark::RegisterBenchmark(("station/live_ffv1_replay_" + Tag()).c_str(), Live, false)
+  benchmark::RegisterBenchmark(("station/live_ffv1_replay_" + Tag()).c_str(), Live, false, 0)
       ->Iterations(1)
       ->Unit(benchmark::kSecond)
       ->UseRealTime();
-  benchmark::RegisterBenchmark(("station/live_from_memory_" + Tag()).c_str(), Live, true)
+  benchmark::RegisterBenchmark(("station/live_from_memory_" + Tag()).c_str(), Live, true, 0)
       ->Iterations(1)
       ->Unit(benchmark::kSecond)
       ->UseRealTime();
+  if (g_args.preview_streams > 0) {
+    benchmark::RegisterBenchmark(
+        ("station/live_from_memory_" + Tag() + "_with_" + std::to_string(g_args.preview_streams) + "_previews").c_str(),
+        Live, true, g_args.preview_streams)
+        ->Iterations(1)
+        ->Unit(benchmark::kSecond)
+        ->UseRealTime();
+  }
   const int rc = RunGoogleBenchmarks("station/", pass);
   std::printf("cameras need %.0f frames/s (%d x %.0f)\n", g_args.cameras * g_args.fps, g_args.cameras, g_args.fps);
   return rc;
 }
 
 const bool kRegistered =
-    RegisterSuite({"station", "the live station on paced replay: drops, latency, transitions lag (--cameras= --size= --fps= --seconds=)", &Run});
+    RegisterSuite({"station", "the live station on paced replay: drops, latency, transitions lag (--cameras= --size= --fps= --seconds= --preview-streams=)", &Run});
 
 }  // namespace
 }  // namespace ss::bench
