@@ -1,0 +1,60 @@
+#pragma once
+// Camera backends by name: what a station camera's `source` names opens one of
+// its devices, and `spritestation cameras` asks each what this machine has.
+// Each backend lives in its own folder with one file that defines
+// `void RegisterNAMECameraBackend()` (calling RegisterCameraBackend), and one
+// line in capture/CMakeLists.txt (spritestation_camera_backend) builds it in and
+// calls it; nothing else in the project names a backend.
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "capture/frame_source.h"
+#include "core/config.h"
+
+namespace ss {
+
+// A device a backend found, with the id a station config names it by.
+struct FoundCamera {
+  std::string backend;  // the backend's name, the config's `source`
+  std::string id;       // `device:` (v4l2) or `camera_id:` (aravis, libcamera)
+  std::string model, driver, address, serial;
+};
+
+struct CameraBackend {
+  std::string name;  // the config's `source`: "v4l2", "aravis", ...
+  std::string description;
+  // Opens and starts the camera; its frames carry Frame::camera = `camera_index`. WorkError
+  // naming the camera when the device cannot be opened (the station retries later);
+  // InputError naming the config field for a setting the backend refuses.
+  std::function<std::unique_ptr<FrameSource>(const CameraConfig& camera, int camera_index)> open;
+  // The devices present now; unset for a backend that has none to list (replay).
+  std::function<std::vector<FoundCamera>()> list;
+};
+
+// Called by each backend's registration function; a second backend of the same name is an error.
+void RegisterCameraBackend(CameraBackend backend);
+// nullptr when no backend of that name is built in.
+const CameraBackend* FindCameraBackend(const std::string& name);
+// Every backend built in, by name.
+std::vector<const CameraBackend*> CameraBackends();
+
+// The config's pixel format; nullopt when unset. InputError naming cameras.NAME.pixel_format when unknown.
+std::optional<PixelFormat> PixelFormatOf(const CameraConfig& camera);
+
+// What every live backend's options share, from the camera's config.
+template <typename Options>
+void SetLiveOptions(const CameraConfig& camera, int camera_index, Options& options) {
+  options.name = camera.name;
+  options.camera_index = camera_index;
+  options.pixel_format = PixelFormatOf(camera);
+  options.width = camera.width;
+  options.height = camera.height;
+  options.fps = camera.fps;
+  if (camera.exposure_us) options.exposure_us = *camera.exposure_us;
+  options.frame_timeout_ms = 1000;  // the station decides when a silent camera is offline
+}
+
+}  // namespace ss
