@@ -5,6 +5,7 @@
 #include <signal.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <map>
 #include <filesystem>
@@ -350,6 +351,73 @@ TEST_F(DaemonTest, RecordsTheSessionItStores) {
   const nlohmann::json r = JsonInOutput(replay.output);
   EXPECT_EQ(r["frames"].get<int64_t>(), status["storage"]["frames_recorded"].get<int64_t>()) << replay.output;
   EXPECT_GT(r["frames"].get<int64_t>(), 100) << replay.output;
+}
+
+// The console's event stream: a snapshot, then patches with growing ids; streams that never
+// read are capped and neither queue state nor keep the API from answering; a write from
+// another site's page, or a form post, is refused before it acts.
+TEST_F(DaemonTest, EventStreamsStreamPatchesAndStalledOnesStarveNothing) {
+  auto daemon = Daemon(Config(ReplayCamera(true)));
+  // A reader: the snapshot first, then patches (the replay's fps and counters change).
+  std::string text;
+  httplib::Client reader("127.0.0.1", port_);
+  reader.set_read_timeout(10, 0);
+  reader.Get("/api/events", [&](const char* data, size_t n) {
+    text.append(data, n);
+    return text.find("event: patch") == std::string::npos;
+  });
+  ASSERT_EQ(text.rfind("id: 1\nevent: snapshot\ndata: ", 0), 0u) << text.substr(0, 300);
+  const size_t patch = text.find("event: patch");
+  ASSERT_NE(patch, std::string::npos) << text.substr(0, 300);
+  const size_t data = text.find("data: ", text.find("event: snapshot"));
+  const nlohmann::json snapshot = nlohmann::json::parse(text.substr(data + 6, text.find('\n', data) - data - 6));
+  EXPECT_EQ(snapshot["status"]["cameras"][0]["name"], "cam0");
+  EXPECT_EQ(snapshot["status"]["mode"], "live");
+
+  // 16 streams that are opened and never read, then one more: refused with 503.
+  std::vector<std::unique_ptr<httplib::Client>> stalled;
+  std::vector<std::thread> threads;
+  std::atomic<int> opened{0};
+  for (int k = 0; k < 16; ++k) {
+    stalled.push_back(std::make_unique<httplib::Client>("127.0.0.1", port_));
+    stalled.back()->set_read_timeout(20, 0);
+    threads.emplace_back([&, c = stalled.back().get()] {
+      c->Get("/api/events", [&](const char*, size_t) {
+        ++opened;
+        std::this_thread::sleep_for(std::chrono::seconds(8));  // a tab that stopped reading
+        return false;
+      });
+    });
+  }
+  const auto deadline = Clock::now() + std::chrono::seconds(10);
+  while (opened < 16 && Clock::now() < deadline) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  EXPECT_EQ(opened.load(), 16);
+  httplib::Client extra("127.0.0.1", port_);
+  extra.set_read_timeout(5, 0);
+  std::string refused;
+  const auto over = extra.Get("/api/events", [&](const char* d, size_t n) {
+    refused.append(d, n);
+    return true;
+  });
+  ASSERT_TRUE(over);
+  EXPECT_EQ(over->status, 503) << refused;
+  // The API answers meanwhile, at once, and the camera keeps streaming.
+  const auto asked = Clock::now();
+  const nlohmann::json status = Status();
+  EXPECT_LT(std::chrono::duration<double>(Clock::now() - asked).count(), 1.0);
+  ASSERT_FALSE(status.is_null());
+  const auto frames = Camera(status, "cam0")["frames_captured"].get<int64_t>();
+  EXPECT_TRUE(WaitStatus([&](const nlohmann::json& s) { return Camera(s, "cam0")["frames_captured"] > frames + 30; }, 10));
+  // Writes: a form post, and a JSON post from another site's page, are refused before acting.
+  auto r = client_->Post("/api/session/start", "name=x", "application/x-www-form-urlencoded");
+  EXPECT_EQ(r->status, 415) << r->body;
+  httplib::Headers foreign = {{"Origin", "http://evil.example"}};
+  r = client_->Post("/api/session/start", foreign, R"({"name": "x"})", "application/json");
+  EXPECT_EQ(r->status, 403) << r->body;
+  EXPECT_FALSE(Status()["session"]["active"].get<bool>());
+  for (auto& t : threads) t.join();
+  daemon->Signal(SIGTERM);
+  EXPECT_EQ(daemon->Wait(10), 0) << daemon->output();
 }
 
 TEST_F(DaemonTest, TheControlApiRefusesBadRequestsByName) {
