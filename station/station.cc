@@ -97,7 +97,7 @@ struct Station::Impl {
   GroundPolygon floor;
   std::vector<std::optional<CameraModel>> models;
   SteadyTime started_at = Clock::now();
-  std::atomic<int> state{0};  // 0 starting, 1 running, 2 stopping, 3 stopped
+  std::atomic<StationState> state{StationState::kStarting};
 
   std::mutex bank_mutex;  // BankWriter is one connection: one thread at a time
   std::unique_ptr<BankWriter> bank;
@@ -117,7 +117,7 @@ struct Station::Impl {
   std::deque<double> latencies_ms;                         // last 10,000
   std::deque<std::pair<SteadyTime, uint64_t>> stored_log;  // (time, sprites_stored) samples for sprites/s
   std::string bank_error;
-  std::string storage_state = "ok";
+  StorageState storage_state = StorageState::kOk;
   int64_t disk_free_mib = -1;
 
   // The capture session, under session_mutex (held across start/stop).
@@ -181,7 +181,7 @@ struct Station::Impl {
   void WriteBatch(StationBatch& sb) {
     {
       std::lock_guard lock(stats_mutex);
-      if (storage_state == "sprites_stopped") {
+      if (storage_state == StorageState::kSpritesStopped) {
         ++batches_refused;
         return;
       }
@@ -267,20 +267,20 @@ struct Station::Impl {
       const int64_t rec = FreeMib(storage.recording_dir);
       if (rec >= 0 && (free_mib < 0 || rec < free_mib)) free_mib = rec;
     }
-    std::string next = "ok";
+    StorageState next = StorageState::kOk;
     if (free_mib >= 0 && free_mib < storage.stop_sprites_below_mib) {
-      next = "sprites_stopped";
+      next = StorageState::kSpritesStopped;
     } else if (free_mib >= 0 && free_mib < storage.stop_recording_below_mib) {
-      next = "recording_stopped";
+      next = StorageState::kRecordingStopped;
     }
-    std::string previous;
+    StorageState previous;
     {
       std::lock_guard lock(stats_mutex);
       previous = storage_state;
       storage_state = next;
       disk_free_mib = free_mib;
     }
-    if (next != "ok") {
+    if (next != StorageState::kOk) {
       bool recording = false;
       {
         std::lock_guard lock(recorder_mutex);
@@ -289,11 +289,11 @@ struct Station::Impl {
       if (recording) StopRecording("free disk space " + std::to_string(free_mib) + " MiB is below storage.stop_recording_below_mib");
     }
     if (next != previous) {
-      if (next == "ok") {
+      if (next == StorageState::kOk) {
         log->info("disk: {} MiB free, storage back to normal", free_mib);
       } else {
         log->warn("disk: {} MiB free: {}", free_mib,
-                  next == "sprites_stopped" ? "sprite storage stopped (storage.stop_sprites_below_mib)"
+                  next == StorageState::kSpritesStopped ? "sprite storage stopped (storage.stop_sprites_below_mib)"
                                             : "raw recording stopped (storage.stop_recording_below_mib)");
       }
     }
@@ -372,17 +372,17 @@ void Station::Start() {
   s.CheckDisk();  // before any session: a full disk refuses from the first frame
   for (auto& r : s.runners) r->Start();
   s.monitor_thread = std::thread([&s] { s.MonitorLoop(); });
-  s.state = 1;
+  s.state = StationState::kRunning;
   s.log->info("station running: {} camera(s), bank {}", s.runners.size(), config.storage.bank);
 }
 
 void Station::Stop() {
   Impl& s = *impl_;
-  if (s.state == 3 || (!s.writer_thread.joinable() && s.runners.empty())) {
-    s.state = 3;
+  if (s.state == StationState::kStopped || (!s.writer_thread.joinable() && s.runners.empty())) {
+    s.state = StationState::kStopped;
     return;
   }
-  s.state = 2;
+  s.state = StationState::kStopping;
   const auto stop_start = Clock::now();
   bool active = false;
   {
@@ -422,7 +422,7 @@ void Station::Stop() {
     std::lock_guard lock(s.bank_mutex);
     s.bank.reset();  // the last connection closes: the bank is whole on disk
   }
-  s.state = 3;
+  s.state = StationState::kStopped;
   s.log->info("station stopped: {} sprites stored", s.sprites_stored);
 }
 
@@ -431,7 +431,7 @@ SessionStatus Station::StartSession(const std::string& requested_name) {
   const std::string name = CheckSessionName(requested_name);
   std::lock_guard control(s.control_mutex);
   std::unique_lock lock(s.session_mutex);
-  if (s.state != 1) throw InputError("session", "the station is not running");
+  if (s.state != StationState::kRunning) throw ConflictError("session", "the station is not running");
   if (s.session.active) throw ConflictError("session", "session \"" + s.session.name + "\" is running; stop it first");
   const std::string created = UtcNow();
   SessionRecord record;
@@ -461,12 +461,12 @@ SessionStatus Station::StartSession(const std::string& requested_name) {
   s.session.started = created;
   s.session_started = Clock::now();
   const StorageConfig storage = s.StorageSettings();
-  std::string storage_state;
+  StorageState storage_state;
   {
     std::lock_guard stats_lock(s.stats_mutex);
     storage_state = s.storage_state;
   }
-  if (storage.recording != "off" && storage_state == "ok") {
+  if (storage.recording != "off" && storage_state == StorageState::kOk) {
     const fs::path dir = fs::path(storage.recording_dir) / (name + "-" + UtcNow("%Y%m%dT%H%M%SZ"));
     RecordingOptions recording;
     recording.codec = storage.recording_codec;
@@ -530,8 +530,7 @@ SessionStatus Station::RenameSession(const std::string& requested_name) {
 StationStatus Station::Status() const {
   const Impl& s = *impl_;
   StationStatus out;
-  static const char* kStates[] = {"starting", "running", "stopping", "stopped"};
-  out.state = kStates[std::clamp(s.state.load(), 0, 3)];
+  out.state = s.state.load();
   out.uptime_s = Seconds(Clock::now() - s.started_at);
   {
     std::lock_guard lock(s.session_mutex);

@@ -49,6 +49,25 @@ nlohmann::json SessionToJson(const SessionStatus& s) {
           {"recording_dir", s.recording_dir}};
 }
 
+const char* StationStateName(StationState state) {
+  switch (state) {
+    case StationState::kStarting: return "starting";
+    case StationState::kRunning: return "running";
+    case StationState::kStopping: return "stopping";
+    case StationState::kStopped: return "stopped";
+  }
+  return "unknown";
+}
+
+const char* StorageStateName(StorageState state) {
+  switch (state) {
+    case StorageState::kOk: return "ok";
+    case StorageState::kRecordingStopped: return "recording_stopped";
+    case StorageState::kSpritesStopped: return "sprites_stopped";
+  }
+  return "unknown";
+}
+
 nlohmann::json StatusToJson(const StationStatus& st) {
   nlohmann::json cameras = nlohmann::json::array();
   for (const CameraStatus& c : st.cameras) {
@@ -89,7 +108,7 @@ nlohmann::json StatusToJson(const StationStatus& st) {
                        {"discards", discards},
                        {"exposure", ExposureToJson(c.exposure)}});
   }
-  return {{"state", st.state},
+  return {{"state", StationStateName(st.state)},
           {"uptime_s", st.uptime_s},
           {"session", SessionToJson(st.session)},
           {"cameras", cameras},
@@ -109,7 +128,7 @@ nlohmann::json StatusToJson(const StationStatus& st) {
                            {"stored", st.transitions_stored},
                            {"failed_rounds", st.transition_rounds_failed},
                            {"last_round_ms", st.transitions_last_round_ms}}},
-          {"storage", {{"state", st.storage_state},
+          {"storage", {{"state", StorageStateName(st.storage_state)},
                        {"disk_free_mib", st.disk_free_mib},
                        {"stop_recording_below_mib", st.stop_recording_below_mib},
                        {"stop_sprites_below_mib", st.stop_sprites_below_mib},
@@ -123,7 +142,7 @@ nlohmann::json StatusToJson(const StationStatus& st) {
 std::string StatusToPrometheus(const StationStatus& st) {
   Metrics m;
   m.Family("up", "gauge", "1 while the station runs");
-  m.Sample(st.state == "running" ? 1 : 0);
+  m.Sample(st.state == StationState::kRunning ? 1 : 0);
   m.Family("uptime_seconds", "gauge", "seconds since the daemon started");
   m.Sample(st.uptime_s);
   m.Family("session_active", "gauge", "1 while a capture session runs");
@@ -180,8 +199,8 @@ std::string StatusToPrometheus(const StationStatus& st) {
   m.Family("disk_free_mib", "gauge", "free MiB on the bank's (or recordings') file system");
   m.Sample(static_cast<double>(st.disk_free_mib));
   m.Family("storage_stopped", "gauge", "what the disk guard stopped, by what");
-  m.Sample(st.storage_state != "ok" ? 1 : 0, "what=\"recording\"");
-  m.Sample(st.storage_state == "sprites_stopped" ? 1 : 0, "what=\"sprites\"");
+  m.Sample(st.storage_state != StorageState::kOk ? 1 : 0, "what=\"recording\"");
+  m.Sample(st.storage_state == StorageState::kSpritesStopped ? 1 : 0, "what=\"sprites\"");
   m.Family("frames_recorded_total", "counter", "raw frames written to the session recording");
   m.Sample(static_cast<double>(st.frames_recorded));
   m.Family("frames_record_dropped_total", "counter", "raw frames the recorder could not keep up with");

@@ -21,8 +21,16 @@ struct SessionStatus {
   std::string recording_dir;      // "" when not recording
 };
 
+enum class StationState { kStarting, kRunning, kStopping, kStopped };
+const char* StationStateName(StationState state);  // "starting", "running", ...
+
+// The disk guard's verdict: below storage.stop_recording_below_mib raw recording stops,
+// below storage.stop_sprites_below_mib sprite storage stops too.
+enum class StorageState { kOk, kRecordingStopped, kSpritesStopped };
+const char* StorageStateName(StorageState state);  // "ok", "recording_stopped", "sprites_stopped"
+
 struct StationStatus {
-  std::string state;              // starting | running | stopping | stopped
+  StationState state = StationState::kStarting;
   double uptime_s = 0;
   SessionStatus session;
   std::vector<CameraStatus> cameras;
@@ -40,7 +48,7 @@ struct StationStatus {
   int64_t transitions_pending = 0, transitions_stored = 0, transition_rounds_failed = 0;
   double transitions_last_round_ms = 0;
   // Storage
-  std::string storage_state;      // ok | recording_stopped | sprites_stopped
+  StorageState storage_state = StorageState::kOk;
   int64_t disk_free_mib = -1;     // the lower of the bank's and the recordings' file systems
   int64_t stop_recording_below_mib = 0, stop_sprites_below_mib = 0;  // the disk guard's thresholds
   std::string recording_mode;     // off | all | usable
