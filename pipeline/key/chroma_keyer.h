@@ -49,6 +49,7 @@ class ChromaKeyer : public Keyer {
   // CV_8U, the trained size: 255 where the empty enclosure is green and keyed, 0 where it is
   // not (the room, a wall's outside, a cable): no subject is ever seen against those pixels.
   cv::Mat GreenMask() const;
+  cv::Mat KeyableMask() const override { return GreenMask(); }
  protected:
   // Key and shadow are symmetric in R and B: only the colour layer minds the order.
   void SampleRow(const uint8_t* row, ChannelOrder order, int cell_row, uint8_t* foreground,

@@ -35,6 +35,10 @@ class Keyer {
   // Throws InputError naming the frame and the reason.
   virtual void Train(const std::vector<cv::Mat>& empty_bgr) = 0;
   bool trained() const { return size_.width > 0; }
+  // CV_8U, the trained size: 255 where the empty enclosure is background this keyer keys
+  // (a chroma key's green), 0 where no subject can ever be seen against it (the room, a wall's
+  // outside, a cable). Empty when the keyer keys every pixel (a clean plate).
+  virtual cv::Mat KeyableMask() const { return {}; }
   cv::Size size() const { return size_; }  // the trained frame size
   const GridOptions& grid() const { return grid_; }
 

@@ -107,7 +107,7 @@ void CameraPipeline::Train(const std::vector<cv::Mat>& empty_bgr) {
   keyer_->Train(empty_bgr);
   // What is not green in the empty enclosure is not floor either: a wall's outside hiding the
   // floor behind it, the room (whatever wall height the config says).
-  if (const auto* chroma = dynamic_cast<const ChromaKeyer*>(keyer_.get())) floor_mask_.Restrict(chroma->GreenMask());
+  if (const cv::Mat keyable = keyer_->KeyableMask(); !keyable.empty()) floor_mask_.Restrict(keyable);
   stats_.training_frames += empty_bgr.size();
   stats_.frames += empty_bgr.size();
 }
