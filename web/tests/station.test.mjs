@@ -169,9 +169,12 @@ test('a killed camera goes offline within 5 s, and streams again when restarted'
   assert.ok(others.cam1.state === 'offline');
   assert.equal(previews.length, 0, 'no preview fetched for the offline camera');
 
+  const lastFrame = others.cam1.frame;
   cams.cam1 = await h.fakecam(s, 'cam1', '127.0.0.2');
-  // reopened with backoff (0.5 s doubling): its tile leaves offline and its frames advance
+  // reopened with backoff (0.5 s doubling): its tile leaves offline and shows
+  // new frames (the restarted camera numbers them from its own start again)
   await h.waitFor('cam1 reopened', async () => (await h.tiles(p)).cam1.state !== 'offline', { timeout: 30000, interval: 200 });
+  await h.waitFor('a new frame of cam1', async () => (await h.tiles(p)).cam1.frame !== lastFrame, { timeout: 5000 });
   await framesAdvance(['cam1']);
 });
 
