@@ -30,7 +30,7 @@ nlohmann::json Transitions(std::vector<TransitionRecord> list, bool outgoing) {
 int64_t IdField(const nlohmann::json& body, const char* field) {
   if (!body.contains(field)) throw InputError(field, "missing");
   const nlohmann::json& v = body[field];
-  if (!v.is_number_integer()) throw InputError(field, "expected an integer, got " + v.dump());
+  if (!v.is_number_integer()) throw InputError(field, "expected an integer, got " + v.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace));
   return v.get<int64_t>();
 }
 
@@ -200,7 +200,7 @@ int64_t ConsoleBank::Tag(const nlohmann::json& body, bool remove) const {
       if (!list.is_array() || list.empty()) throw InputError("sprites", "expected a non-empty list of sprite ids");
       if (list.size() > kMaxTagSprites) throw InputError("sprites", "at most 100000 sprites a request");
       for (const auto& v : list) {
-        if (!v.is_number_integer()) throw InputError("sprites", "expected integer ids, got " + v.dump());
+        if (!v.is_number_integer()) throw InputError("sprites", "expected integer ids, got " + v.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace));
         ids.push_back(v.get<int64_t>());
       }
     } else {

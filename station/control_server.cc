@@ -34,9 +34,15 @@ constexpr size_t kMaxBodyBytes = 1 << 20;  // every JSON body the API takes is f
 constexpr int kHttpThreads = 32;           // event streams hold one each (at most max_event_streams)
 constexpr int kHttpNice = 10;              // HTTP threads yield the cores to capture and the pipeline
 
+// Text a request sent may be anything, and an error may quote it: bytes that are not UTF-8
+// are replaced (U+FFFD) rather than failing the answer.
+std::string Dump(const nlohmann::json& j, int indent = -1) {
+  return j.dump(indent, ' ', false, nlohmann::json::error_handler_t::replace);
+}
+
 void Reply(Response& res, int status, const nlohmann::json& body) {
   res.status = status;
-  res.set_content(body.dump(2) + "\n", "application/json");
+  res.set_content(Dump(body, 2) + "\n", "application/json");
 }
 
 void ReplyError(Response& res, int status, const std::string& message) {
@@ -92,7 +98,7 @@ std::string NameFromBody(const Request& req, bool required) {
     if (required) throw InputError(req.body.empty() ? "body" : "name", "missing (expected {\"name\": \"...\"})");
     return "";
   }
-  if (!body["name"].is_string()) throw InputError("name", "expected text, got " + body["name"].dump());
+  if (!body["name"].is_string()) throw InputError("name", "expected text, got " + Dump(body["name"]));
   return body["name"].get<std::string>();
 }
 

@@ -435,6 +435,16 @@ TEST_F(DaemonTest, TheControlApiRefusesBadRequestsByName) {
   r = post("/api/session/start", R"({"name": "../etc"})");
   EXPECT_EQ(r->status, 400);
   EXPECT_NE(r->body.find("name:"), std::string::npos) << r->body;
+  // Bytes that are not UTF-8, in the JSON and in a path the error quotes: 400 with a JSON answer.
+  r = post("/api/session/start", "{\"name\": \"\xff\xfe\"}");
+  EXPECT_EQ(r->status, 400) << r->body;
+  EXPECT_FALSE(nlohmann::json::parse(r->body, nullptr, false).is_discarded()) << r->body;
+  r = post("/api/replay/start", std::string("{\"path\": \"/tmp/\\u00ff\"}"));
+  EXPECT_EQ(r->status, 400) << r->body;
+  auto bad = client_->Get("/api/bank/sprites/%ff%fe");
+  ASSERT_TRUE(bad);
+  EXPECT_EQ(bad->status, 400) << bad->body;
+  EXPECT_FALSE(nlohmann::json::parse(bad->body, nullptr, false).is_discarded()) << bad->body;
   r = post("/api/session/stop", "");
   EXPECT_EQ(r->status, 409) << r->body;
   r = post("/api/session/start", R"({"name": "a"})");
