@@ -3,6 +3,7 @@
 // (the browser's six connections per host must not freeze any).
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
+import path from 'node:path';
 import * as h from './harness.mjs';
 
 const N = 8;
@@ -56,6 +57,7 @@ test('after signing in all eight tiles are visible and live', async () => {
   assert.equal(boxes.length, N);
   for (const r of boxes) assert.ok(r.top >= 0 && r.bottom <= 1000 && r.left >= 0 && r.right <= 1600, `tile at ${JSON.stringify(r)} is in view`);
   assert.equal(await p.getAttribute('[data-testid="connection"]', 'data-state'), 'connected');
+  await p.screenshot({ path: path.join(h.WORK, 'station-8.png') }); // kept with SS_WEB_KEEP=1
 });
 
 test('writes carry the token: a session starts and stops from the page', async () => {
