@@ -24,9 +24,6 @@ namespace {
 namespace fs = std::filesystem;
 
 const std::vector<std::string> kSources = {"replay", "v4l2", "aravis", "libcamera"};
-const std::vector<std::string> kWhiteBalanceModes = {"device", "once", "manual"};
-const std::vector<std::string> kKeyingMethods = {"chroma", "clean_plate"};
-const std::vector<std::string> kRecordingModes = {"off", "all", "usable"};
 const std::vector<std::string> kCodecs = {"ffv1", "mjpeg", "h264"};
 const std::vector<std::string> kLogLevels = {"trace", "debug",    "info", "warn",
                                              "error", "critical", "off"};
@@ -274,6 +271,27 @@ class Reader {
     out = node->Scalar();
     return true;
   }
+  // One of a closed set's texts (core/config.h), into its enum value; an error naming the
+  // field and every allowed text otherwise.
+  template <typename E, size_t N>
+  bool Enum(const MapView& view, const std::string& key, E& out, const EnumText<E> (&texts)[N]) {
+    std::string text;
+    if (!String(view, key, text)) return false;
+    return ToEnum(text, texts, Child(view.path(), key), out);
+  }
+  template <typename E, size_t N>
+  bool ToEnum(const std::string& text, const EnumText<E> (&texts)[N], const std::string& path, E& out) {
+    std::vector<std::string> names;
+    for (const EnumText<E>& t : texts) {
+      if (text == t.text) {
+        out = t.value;
+        return true;
+      }
+      names.push_back(t.text);
+    }
+    msg_.Error(path, "expected one of " + Join(names) + ", got " + Quoted(text));
+    return false;
+  }
   // A path, resolved against the config file's folder.
   bool Path(const MapView& view, const std::string& key, std::string& out) {
     std::string raw;
@@ -304,16 +322,17 @@ class Reader {
 void ReadWhiteBalance(Reader& r, const YAML::Node& node, const std::string& path,
                       WhiteBalanceConfig& wb) {
   if (node.IsScalar()) {  // shorthand: `white_balance: once`
-    wb.mode = node.Scalar();
+    r.Mark(Child(path, "mode"), node);
+    r.ToEnum(node.Scalar(), kWhiteBalanceModeTexts, Child(path, "mode"), wb.mode);
     return;
   }
   const MapView view = r.Map(node, path);
   r.Known(view, {"mode", "red_gain", "blue_gain", "temperature_k"});
-  r.String(view, "mode", wb.mode);
+  r.Enum(view, "mode", wb.mode, kWhiteBalanceModeTexts);
   const bool red = r.Number(view, "red_gain", wb.red_gain, "a positive number");
   const bool blue = r.Number(view, "blue_gain", wb.blue_gain, "a positive number");
   const bool kelvin = r.Number(view, "temperature_k", wb.temperature_k, "a colour temperature in kelvin");
-  if ((red || blue || kelvin) && wb.mode != "manual") {
+  if ((red || blue || kelvin) && wb.mode != WhiteBalanceMode::kManual) {
     r.msg().Error(Child(path, red ? "red_gain" : blue ? "blue_gain" : "temperature_k"), "only applies with mode: manual");
   }
   if (kelvin && (red || blue)) {
@@ -364,7 +383,7 @@ void ReadCamera(Reader& r, const YAML::Node& node, const std::string& path, Came
 void ReadKeying(Reader& r, const YAML::Node& node, KeyingConfig& k) {
   const MapView view = r.Map(node, "keying");
   r.Known(view, {"method", "training_frames", "chroma", "clean_plate", "despill", "shadow"});
-  r.String(view, "method", k.method);
+  r.Enum(view, "method", k.method, kKeyingMethodTexts);
   r.Int(view, "training_frames", k.training_frames, "a number of frames");
   if (const YAML::Node* n = r.Value(view, "chroma")) {
     const MapView c = r.Map(*n, "keying.chroma");
@@ -446,7 +465,7 @@ void ReadStorage(Reader& r, const YAML::Node& node, StorageConfig& s) {
                  "stop_recording_below_mib", "stop_sprites_below_mib"});
   r.Path(view, "bank", s.bank);
   r.Path(view, "recording_dir", s.recording_dir);
-  r.String(view, "recording", s.recording);
+  r.Enum(view, "recording", s.recording, kRecordingModeTexts);
   r.String(view, "recording_codec", s.recording_codec);
   r.Int64(view, "stop_recording_below_mib", s.stop_recording_below_mib, "a size in MiB");
   r.Int64(view, "stop_sprites_below_mib", s.stop_sprites_below_mib, "a size in MiB");
@@ -595,7 +614,6 @@ class Validator {
           "expected a positive number, got " + Num(c.fps));
     if (c.exposure_us) Positive(*c.exposure_us, Child(path, "exposure_us"));
     if (c.gain_db) NonNegative(*c.gain_db, Child(path, "gain_db"));
-    Enum(c.white_balance.mode, kWhiteBalanceModes, Child(path, "white_balance.mode"));
     Positive(c.white_balance.red_gain, Child(path, "white_balance.red_gain"));
     Positive(c.white_balance.blue_gain, Child(path, "white_balance.blue_gain"));
     Check(c.white_balance.temperature_k == 0 ||
@@ -603,7 +621,7 @@ class Validator {
           Child(path, "white_balance.temperature_k"),
           "expected a colour temperature of 1500-15000 K, got " + Num(c.white_balance.temperature_k));
     // How each backend fixes white balance: V4L2 as a colour temperature, GenICam as ratios.
-    if (c.white_balance.mode == "manual" && c.source == "v4l2") {
+    if (c.white_balance.mode == WhiteBalanceMode::kManual && c.source == "v4l2") {
       Check(c.white_balance.temperature_k > 0, Child(path, "white_balance.temperature_k"),
             "V4L2 devices fix white balance as a colour temperature: give temperature_k");
     }
@@ -634,7 +652,6 @@ class Validator {
     }
 
     KeyingConfig& k = cfg.keying;
-    Enum(k.method, kKeyingMethods, "keying.method");
     Check(k.training_frames >= 1, "keying.training_frames",
           "expected at least 1 frame, got " + std::to_string(k.training_frames));
     Range(k.chroma_low, 0, 255, "keying.chroma.low");
@@ -707,7 +724,6 @@ class Validator {
     StorageConfig& s = cfg.storage;
     Check(!s.bank.empty(), "storage.bank", "expected a path");
     Check(!s.recording_dir.empty(), "storage.recording_dir", "expected a path");
-    Enum(s.recording, kRecordingModes, "storage.recording");
     Enum(s.recording_codec, kCodecs, "storage.recording_codec");
     Check(s.stop_recording_below_mib >= 0, "storage.stop_recording_below_mib",
           "expected a size >= 0, got " + std::to_string(s.stop_recording_below_mib));
@@ -857,5 +873,21 @@ StationConfig LoadStationConfig(const std::string& path, ConfigReport* report,
   const fs::path base = fs::absolute(fs::path(path), ec).parent_path();
   return ParseStationConfig(text.str(), path, base.string(), report, options);
 }
+
+namespace {
+
+template <typename E, size_t N>
+const char* TextOf(E value, const EnumText<E> (&texts)[N]) {
+  for (const EnumText<E>& t : texts) {
+    if (t.value == value) return t.text;
+  }
+  return "unknown";
+}
+
+}  // namespace
+
+const char* ToText(WhiteBalanceMode mode) { return TextOf(mode, kWhiteBalanceModeTexts); }
+const char* ToText(KeyingMethod method) { return TextOf(method, kKeyingMethodTexts); }
+const char* ToText(RecordingMode mode) { return TextOf(mode, kRecordingModeTexts); }
 
 }  // namespace ss

@@ -17,8 +17,29 @@ namespace ss {
 
 inline constexpr int kConfigVersion = 1;
 
+// Closed sets are enums in the program and text only in the config file and the API.
+enum class WhiteBalanceMode { kDevice, kOnce, kManual };  // device: leave as is; once: auto, then lock
+enum class KeyingMethod { kChroma, kCleanPlate };
+enum class RecordingMode { kOff, kAll, kUsable };  // all frames, or those that gave a usable sprite
+
+template <typename E>
+struct EnumText {
+  E value;
+  const char* text;
+};
+inline constexpr EnumText<WhiteBalanceMode> kWhiteBalanceModeTexts[] = {
+    {WhiteBalanceMode::kDevice, "device"}, {WhiteBalanceMode::kOnce, "once"}, {WhiteBalanceMode::kManual, "manual"}};
+inline constexpr EnumText<KeyingMethod> kKeyingMethodTexts[] = {{KeyingMethod::kChroma, "chroma"},
+                                                               {KeyingMethod::kCleanPlate, "clean_plate"}};
+inline constexpr EnumText<RecordingMode> kRecordingModeTexts[] = {
+    {RecordingMode::kOff, "off"}, {RecordingMode::kAll, "all"}, {RecordingMode::kUsable, "usable"}};
+
+const char* ToText(WhiteBalanceMode mode);
+const char* ToText(KeyingMethod method);
+const char* ToText(RecordingMode mode);
+
 struct WhiteBalanceConfig {
-  std::string mode = "device";  // "device" (leave as is) | "once" (auto once, then lock) | "manual"
+  WhiteBalanceMode mode = WhiteBalanceMode::kDevice;
   double red_gain = 1.0;        // manual: red/green and blue/green balance ratios
   double blue_gain = 1.0;
   double temperature_k = 0;     // manual: colour temperature instead of ratios (V4L2); 0 = unset
@@ -48,7 +69,7 @@ struct CameraConfig {
 };
 
 struct KeyingConfig {
-  std::string method = "chroma";  // "chroma" | "clean_plate"
+  KeyingMethod method = KeyingMethod::kChroma;
   int training_frames = 30;       // empty-enclosure frames to learn from
   double chroma_low = 20;      // chroma: key difference (8-bit levels) where alpha starts to fall
   double chroma_high = 60;     // chroma: ... and where it reaches 0 (fully background)
@@ -87,7 +108,7 @@ struct PipelineConfig {
 struct StorageConfig {
   std::string bank;                          // the sprite bank (absolute)
   std::string recording_dir;                 // where recorded sessions go (absolute)
-  std::string recording = "off";             // "off" | "all" | "usable"
+  RecordingMode recording = RecordingMode::kOff;
   std::string recording_codec = "ffv1";      // "ffv1" | "mjpeg" | "h264"
   int64_t stop_recording_below_mib = 20480;  // free disk under which raw recording stops
   int64_t stop_sprites_below_mib = 2048;     // ... and under which sprite storage stops

@@ -263,7 +263,7 @@ struct Station::Impl {
   void CheckDisk() {
     const StorageConfig storage = StorageSettings();
     int64_t free_mib = FreeMib(fs::path(storage.bank).parent_path());
-    if (storage.recording != "off") {
+    if (storage.recording != RecordingMode::kOff) {
       const int64_t rec = FreeMib(storage.recording_dir);
       if (rec >= 0 && (free_mib < 0 || rec < free_mib)) free_mib = rec;
     }
@@ -466,12 +466,12 @@ SessionStatus Station::StartSession(const std::string& requested_name) {
     std::lock_guard stats_lock(s.stats_mutex);
     storage_state = s.storage_state;
   }
-  if (storage.recording != "off" && storage_state == StorageState::kOk) {
+  if (storage.recording != RecordingMode::kOff && storage_state == StorageState::kOk) {
     const fs::path dir = fs::path(storage.recording_dir) / (name + "-" + UtcNow("%Y%m%dT%H%M%SZ"));
     RecordingOptions recording;
     recording.codec = storage.recording_codec;
     try {
-      auto recorder = std::make_unique<StationRecorder>(dir.string(), name, recording, storage.recording == "usable",
+      auto recorder = std::make_unique<StationRecorder>(dir.string(), name, recording, storage.recording == RecordingMode::kUsable,
                                                         static_cast<int>(s.runners.size()));
       std::lock_guard rec_lock(s.recorder_mutex);
       s.recorder = std::move(recorder);
@@ -577,7 +577,7 @@ StationStatus Station::Status() const {
     out.transitions_last_round_ms = t.last_round_ms;
   }
   const StorageConfig storage = s.StorageSettings();
-  out.recording_mode = storage.recording;
+  out.recording_mode = ToText(storage.recording);
   out.stop_recording_below_mib = storage.stop_recording_below_mib;
   out.stop_sprites_below_mib = storage.stop_sprites_below_mib;
   {

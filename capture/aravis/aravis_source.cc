@@ -77,7 +77,7 @@ struct AravisSource::Impl {
     const std::string field = "white_balance";
     const auto has = [&](const char* feature) { return arv_camera_is_feature_available(cam, feature, nullptr); };
     GErrorHolder error;
-    if (o.white_balance == "once") {
+    if (o.white_balance == WhiteBalanceMode::kOnce) {
       if (!has("BalanceWhiteAuto")) {
         throw InputError(field, label + " has no BalanceWhiteAuto feature, so it cannot balance once (use mode device)");
       }
@@ -85,7 +85,6 @@ struct AravisSource::Impl {
       Check(error, field, "BalanceWhiteAuto = Once");
       return;
     }
-    if (o.white_balance != "manual") throw InputError(field, "unknown mode \"" + o.white_balance + "\"");
     if (!has("BalanceRatio") || !has("BalanceRatioSelector")) {
       throw InputError(field, label + " has no BalanceRatio feature: set its white balance on the camera and use mode device");
     }
@@ -199,7 +198,7 @@ AravisSource::AravisSource(AravisOptions options) : impl_(std::make_unique<Impl>
     arv_camera_set_gain(cam, options.gain, error.out());
     s.Check(error, "gain", std::to_string(options.gain));
   }
-  if (options.white_balance != "device") s.SetWhiteBalance(cam, options);
+  if (options.white_balance != WhiteBalanceMode::kDevice) s.SetWhiteBalance(cam, options);
   if (options.fps > 0) {
     arv_camera_set_frame_rate(cam, options.fps, error.out());
     s.Check(error, "fps", std::to_string(options.fps) + " frames/s");

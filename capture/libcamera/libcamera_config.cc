@@ -23,21 +23,22 @@ LibcameraOptions LibcameraOptionsFromConfig(const CameraConfig& camera, int came
   if (camera.exposure_us) o.exposure_us = *camera.exposure_us;
   if (camera.gain_db) o.analogue_gain = std::pow(10.0, *camera.gain_db / 20.0);
   const WhiteBalanceConfig& wb = camera.white_balance;
-  if (wb.mode == "device") {
-    o.white_balance = LibcameraWhiteBalance::kDevice;
-  } else if (wb.mode == "once") {
-    o.white_balance = LibcameraWhiteBalance::kOnce;
-  } else if (wb.mode == "manual") {
-    if (wb.temperature_k > 0) {
-      throw InputError(
-          field + "white_balance.temperature_k",
-          "libcamera fixes white balance as red/blue ColourGains: give red_gain and blue_gain");
-    }
-    o.white_balance = LibcameraWhiteBalance::kManual;
-    o.red_gain = wb.red_gain;
-    o.blue_gain = wb.blue_gain;
-  } else {
-    throw InputError(field + "white_balance.mode", "unknown '" + wb.mode + "'");
+  switch (wb.mode) {
+    case WhiteBalanceMode::kDevice:
+      o.white_balance = LibcameraWhiteBalance::kDevice;
+      break;
+    case WhiteBalanceMode::kOnce:
+      o.white_balance = LibcameraWhiteBalance::kOnce;
+      break;
+    case WhiteBalanceMode::kManual:
+      if (wb.temperature_k > 0) {
+        throw InputError(field + "white_balance.temperature_k",
+                         "libcamera fixes white balance as red/blue ColourGains: give red_gain and blue_gain");
+      }
+      o.white_balance = LibcameraWhiteBalance::kManual;
+      o.red_gain = wb.red_gain;
+      o.blue_gain = wb.blue_gain;
+      break;
   }
   o.buffers = 8;              // frames queued for the pipeline hold their buffers
   o.frame_timeout_ms = 1000;  // the station decides when a silent camera is offline

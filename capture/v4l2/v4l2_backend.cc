@@ -14,8 +14,8 @@ void RegisterV4l2CameraBackend() {
                            SetLiveOptions(camera, camera_index, options);
                            if (camera.gain_db) options.gain = static_cast<int>(std::lround(*camera.gain_db));
                            const WhiteBalanceConfig& wb = camera.white_balance;
-                           if (wb.mode == "once") options.white_balance_once = true;
-                           if (wb.mode == "manual") options.white_balance_k = static_cast<int>(std::lround(wb.temperature_k));
+                           if (wb.mode == WhiteBalanceMode::kOnce) options.white_balance_once = true;
+                           if (wb.mode == WhiteBalanceMode::kManual) options.white_balance_k = static_cast<int>(std::lround(wb.temperature_k));
                            return std::make_unique<V4l2Source>(options);
                          },
                          [] {

@@ -42,9 +42,11 @@ std::unique_ptr<Keyer> MakeKeyer(const CameraPipelineOptions& o, const CameraMod
     chroma.grid.shadow_reach_cells = std::clamp(cells, 1, 64);
     plate.grid.shadow_reach_cells = std::clamp(cells, 1, 64);
   }
-  if (o.keying_method == "chroma") return std::make_unique<ChromaKeyer>(chroma);
-  if (o.keying_method == "clean_plate") return std::make_unique<CleanPlateKeyer>(plate);
-  throw InputError("keying.method", "expected chroma or clean_plate, got \"" + o.keying_method + "\"");
+  switch (o.keying_method) {
+    case KeyingMethod::kChroma: return std::make_unique<ChromaKeyer>(chroma);
+    case KeyingMethod::kCleanPlate: return std::make_unique<CleanPlateKeyer>(plate);
+  }
+  throw InputError("keying.method", "unknown keying method");
 }
 
 }  // namespace

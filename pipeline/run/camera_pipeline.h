@@ -31,7 +31,7 @@ namespace ss {
 
 // Everything a camera pipeline is tuned by, from the station config.
 struct CameraPipelineOptions {
-  std::string keying_method = "chroma";  // "chroma" | "clean_plate"
+  KeyingMethod keying_method = KeyingMethod::kChroma;
   ChromaKeyerOptions chroma;             // the keyer's options (config: keying.*)
   CleanPlateKeyerOptions clean_plate;
   double shadow_reach_m = 0;  // > 0: shaded cells join a subject this far (at the floor's centre), in

@@ -209,7 +209,7 @@ TEST(AravisFakecam, PixelFormatTheCameraLacksIsNamed) {
   }
   // Fixed white balance ratios on a camera without BalanceRatio (the fake camera): refused by name.
   ao.pixel_format = PixelFormat::kMono8;
-  ao.white_balance = "manual";
+  ao.white_balance = WhiteBalanceMode::kManual;
   ao.red_ratio = 1.4;
   try {
     AravisSource source(ao);
@@ -218,7 +218,7 @@ TEST(AravisFakecam, PixelFormatTheCameraLacksIsNamed) {
     EXPECT_NE(std::string(e.what()).find("white_balance"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("BalanceRatio"), std::string::npos) << e.what();
   }
-  ao.white_balance = "device";  // left as the camera has it: opens
+  ao.white_balance = WhiteBalanceMode::kDevice;  // left as the camera has it: opens
   EXPECT_NO_THROW(AravisSource{ao});
 }
 

@@ -69,7 +69,7 @@ TEST(StationConfig, ExampleParsesIntoEveryField) {
   EXPECT_EQ(v4l2.fps, 30);
   EXPECT_EQ(v4l2.exposure_us, 8000);
   EXPECT_EQ(v4l2.gain_db, 0);
-  EXPECT_EQ(v4l2.white_balance.mode, "once");
+  EXPECT_EQ(v4l2.white_balance.mode, WhiteBalanceMode::kOnce);
   EXPECT_EQ(v4l2.model, dir + "/models/side.cameramodel");
 
   const CameraConfig& gige = cfg.cameras[2];
@@ -81,11 +81,11 @@ TEST(StationConfig, ExampleParsesIntoEveryField) {
   EXPECT_EQ(gige.fps, 60);
   EXPECT_EQ(gige.exposure_us, 4000);
   EXPECT_EQ(gige.gain_db, 2.5);
-  EXPECT_EQ(gige.white_balance.mode, "manual");
+  EXPECT_EQ(gige.white_balance.mode, WhiteBalanceMode::kManual);
   EXPECT_EQ(gige.white_balance.red_gain, 1.42);
   EXPECT_EQ(gige.white_balance.blue_gain, 1.87);
 
-  EXPECT_EQ(cfg.keying.method, "chroma");
+  EXPECT_EQ(cfg.keying.method, KeyingMethod::kChroma);
   EXPECT_EQ(cfg.keying.training_frames, 30);
   EXPECT_EQ(cfg.keying.chroma_low, 20);
   EXPECT_EQ(cfg.keying.chroma_high, 60);
@@ -116,7 +116,7 @@ TEST(StationConfig, ExampleParsesIntoEveryField) {
 
   EXPECT_EQ(cfg.storage.bank, dir + "/station.bank");
   EXPECT_EQ(cfg.storage.recording_dir, dir + "/recordings");
-  EXPECT_EQ(cfg.storage.recording, "usable");
+  EXPECT_EQ(cfg.storage.recording, RecordingMode::kUsable);
   EXPECT_EQ(cfg.storage.recording_codec, "ffv1");
   EXPECT_EQ(cfg.storage.stop_recording_below_mib, 20480);
   EXPECT_EQ(cfg.storage.stop_sprites_below_mib, 2048);
@@ -143,7 +143,7 @@ TEST(StationConfig, DefaultsAreFilled) {
   EXPECT_EQ(cfg, expected);
   EXPECT_FALSE(cfg.cameras[0].exposure_us.has_value());  // unset: the device's value, locked
   EXPECT_EQ(cfg.control.address, "127.0.0.1");
-  EXPECT_EQ(cfg.keying.method, "chroma");
+  EXPECT_EQ(cfg.keying.method, KeyingMethod::kChroma);
   EXPECT_TRUE(cfg.enclosure.floor.empty());
 }
 

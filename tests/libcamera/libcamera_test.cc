@@ -214,9 +214,9 @@ TEST(Libcamera, StationConfigMapsToTheOptions) {
   EXPECT_EQ(plan.awb_enable, false);
 
   CameraConfig once = cfg.cameras[0];
-  once.white_balance.mode = "once";
+  once.white_balance.mode = WhiteBalanceMode::kOnce;
   EXPECT_EQ(LibcameraOptionsFromConfig(once, 0).white_balance, LibcameraWhiteBalance::kOnce);
-  once.white_balance.mode = "device";
+  once.white_balance.mode = WhiteBalanceMode::kDevice;
   once.gain_db.reset();
   const LibcameraOptions device = LibcameraOptionsFromConfig(once, 0);
   EXPECT_EQ(device.white_balance, LibcameraWhiteBalance::kDevice);

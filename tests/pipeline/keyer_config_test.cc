@@ -122,7 +122,7 @@ TEST_F(KeyerConfig, ChromaThresholdsFollowTheConfig) {
 
 TEST_F(KeyerConfig, CleanPlateThresholdsFollowTheConfig) {
   StationConfig config;
-  config.keying.method = "clean_plate";
+  config.keying.method = KeyingMethod::kCleanPlate;
   const Keyed defaults = Key(config, /*green=*/false);
   ASSERT_GT(defaults.alpha_sum, 0);
   // A wider tolerance and ramp (in noise sigmas) key less of the frame as subject.
