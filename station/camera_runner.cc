@@ -110,6 +110,45 @@ struct CameraRunner::Impl {
   mutable ExposureFigures exposure;
   mutable SteadyTime exposure_time{};
 
+  // What the keyer can do, which decides the state a camera (re)opens in: still learning the
+  // empty enclosure (training), ready (live), none possible (live for preview and recording
+  // without a model; error when making or training it failed). Under status_mutex.
+  enum class KeyerPhase { kLearning, kReady, kNoModel, kFailed };
+  KeyerPhase keyer_phase = KeyerPhase::kLearning;
+  std::string keyer_message;
+
+  // Applied at once to a camera that is open and learning (or, for a failure, not opened yet);
+  // an offline camera takes it when it reopens.
+  void SetKeyerPhase(KeyerPhase phase, const std::string& message) {
+    bool apply = false;
+    {
+      std::lock_guard lock(status_mutex);
+      keyer_phase = phase;
+      keyer_message = message;
+      apply = status.state == CameraState::kTraining ||
+              (phase == KeyerPhase::kFailed && status.state == CameraState::kStarting);
+    }
+    if (apply) SetStateAfterOpen();
+  }
+
+  // The state of an open camera: from the keyer's phase (a reopened camera whose keyer has
+  // learnt already is live at once, not training again).
+  void SetStateAfterOpen() {
+    KeyerPhase phase;
+    std::string message;
+    {
+      std::lock_guard lock(status_mutex);
+      phase = keyer_phase;
+      message = keyer_message;
+    }
+    switch (phase) {
+      case KeyerPhase::kLearning: SetState(CameraState::kTraining, ""); break;
+      case KeyerPhase::kReady: SetState(CameraState::kLive, ""); break;
+      case KeyerPhase::kNoModel: SetState(CameraState::kLive, message); break;
+      case KeyerPhase::kFailed: SetState(CameraState::kError, message); break;
+    }
+  }
+
   void SetState(CameraState state, const std::string& message) {
     std::lock_guard lock(status_mutex);
     if (status.state != state || status.message != message) {
@@ -184,7 +223,7 @@ struct CameraRunner::Impl {
           opened_once = true;
           stalled = false;
           backoff = options.backoff_min_s;
-          SetState(CameraState::kTraining, "");
+          SetStateAfterOpen();
           continue;
         } catch (const std::exception& e) {
           SetState(CameraState::kOffline, e.what());
@@ -322,10 +361,10 @@ struct CameraRunner::Impl {
     if (!training.valid() || training.wait_for(std::chrono::seconds(0)) != std::future_status::ready) return;
     try {
       training.get();  // rethrows what Train threw
-      SetState(CameraState::kLive, "");
+      SetKeyerPhase(KeyerPhase::kReady, "");
     } catch (const std::exception& e) {
       // Without a keyer no sprite can be made: the camera streams for preview and recording.
-      SetState(CameraState::kError, std::string("learning the empty enclosure failed: ") + e.what());
+      SetKeyerPhase(KeyerPhase::kFailed, std::string("learning the empty enclosure failed: ") + e.what());
       pipeline_failed = true;
     }
   }
@@ -454,8 +493,10 @@ CameraRunner::CameraRunner(int index, CameraRunnerOptions options, BatchSink sin
                                                     s.options.pipeline);
       s.training_set = PrefaultedImages(s.options.training_frames, s.options.model->width(), s.options.model->height());
     } catch (const std::exception& e) {
-      s.SetState(CameraState::kError, e.what());
+      s.SetKeyerPhase(Impl::KeyerPhase::kFailed, e.what());
     }
+  } else {
+    s.SetKeyerPhase(Impl::KeyerPhase::kNoModel, "no camera model: streams for preview and recording, stores no sprites");
   }
 }
 

@@ -178,10 +178,8 @@ test('a killed camera goes offline within 5 s, and streams again when restarted'
   await framesAdvance(['cam1']);
 });
 
-// The daemon marks a reopened camera "training" and, its keyer being learnt
-// already, never "live" again (station/camera_runner.cc, reported): a known
-// failure until that is fixed; remove `todo` then.
-test('the restarted camera is live again', { todo: 'the daemon leaves a reopened camera in "training"' }, async () => {
+// Its keyer learnt the enclosure before the kill: reopened, it is live at once.
+test('the restarted camera is live again', async () => {
   await waitLive(['cam1'], 20000);
 });
 

@@ -270,7 +270,7 @@ TEST_F(DaemonTest, ACameraThatVanishesIsReopenedWhenItComesBack) {
   auto daemon = Daemon(Config("  - name: cam0\n    source: aravis\n    address: 127.0.0.1\n    model: " +
                               session_->dir + "/cam0.cameramodel\n"),
                        "--offline-after 1");
-  ASSERT_TRUE(WaitStatus([](const nlohmann::json& s) { return s["cameras"][0]["frames_captured"] > 30; }, 20))
+  ASSERT_TRUE(WaitStatus([](const nlohmann::json& s) { return s["cameras"][0]["state"] == "live"; }, 30))
       << Status().dump(2);
   cam0->Signal(SIGKILL);
   cam0->Wait(5);
@@ -281,6 +281,8 @@ TEST_F(DaemonTest, ACameraThatVanishesIsReopenedWhenItComesBack) {
   ASSERT_TRUE(WaitStatus([&](const nlohmann::json& s) {
     return s["cameras"][0]["reopens"] >= 1 && s["cameras"][0]["frames_captured"] > before + 10;
   }, 30)) << Status().dump(2) << daemon->output();
+  // Its keyer learnt the enclosure before it vanished: reopened, it is live, not training again.
+  EXPECT_EQ(Status()["cameras"][0]["state"], "live") << Status().dump(2);
   daemon->Signal(SIGTERM);
   EXPECT_EQ(daemon->Wait(10), 0) << daemon->output();
 }
