@@ -194,6 +194,14 @@ CameraModel CameraModel::Parse(const std::string& text, const std::string& origi
   }
   const int n = mrcal_lensmodel_num_params(&m->lensmodel);
   std::vector<double> intrinsics(m->intrinsics, m->intrinsics + n);
+  // Every mrcal lens model starts with the pinhole core fx, fy, cx, cy. A file whose focal
+  // length is 0 (or less) projects every point to the centre: nothing it sees could be keyed
+  // or grounded. (A solver may still make such a model, to report it untrusted.)
+  if (n >= 2 && !(intrinsics[0] > 0 && intrinsics[1] > 0)) {
+    throw InputError(origin, "focal lengths fx = " + std::to_string(intrinsics[0]) + ", fy = " +
+                                 std::to_string(intrinsics[1]) +
+                                 " (intrinsics[0], [1]) must be positive numbers of pixels");
+  }
   try {
     CameraModel model(LensName(m->lensmodel), std::move(intrinsics), static_cast<int>(m->imagersize[0]),
                       static_cast<int>(m->imagersize[1]), Rigid3::FromRt(m->rt_cam_ref));

@@ -438,6 +438,12 @@ TEST(CameraModel, BadFilesNameTheFileAndTheReason) {
        "{ 'lensmodel': 'LENSMODEL_PINHOLE', 'intrinsics': [1,2,3,4], 'extrinsics': [0,0,0,0,0,0], "
        "'imagersize': [0,480] }",
        "imager size 0x480 is not positive"},
+      {"zerofocal.cameramodel",
+       "{ 'lensmodel': 'LENSMODEL_PINHOLE', 'intrinsics': [0,500,320,240], " + good_tail,
+       "focal lengths fx = 0.000000, fy = 500.000000 (intrinsics[0], [1]) must be positive"},
+      {"negativefocal.cameramodel",
+       "{ 'lensmodel': 'LENSMODEL_OPENCV4', 'intrinsics': [500,-500,320,240,0,0,0,0], " + good_tail,
+       "must be positive"},
   };
   for (const Case& c : cases) {
     const std::string path = dir / c.file;
