@@ -7,6 +7,7 @@
 
 #include <cstdio>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -51,6 +52,24 @@ void RunIngest(const std::string& session, const std::string& bank, const std::s
   if (bar) options.progress = PrintProgress;
   const IngestSummary s = IngestSession(options);
   if (bar) std::fprintf(stderr, "\n");
+  // The parts of the work that failed while the rest went on: the summary says them, and the
+  // command then exits 1 (WorkError) instead of reporting success.
+  std::vector<std::string> failed;
+  for (const IngestCamera& c : s.cameras) {
+    if (c.stats.frames == 0) {
+      failed.push_back("camera " + c.name + ": no frame of it could be read" +
+                       (s.source.last_error.empty() ? "" : " (" + s.source.last_error + ")"));
+    }
+  }
+  if (s.transitions && !s.transitions_error.empty()) {
+    failed.push_back("transitions: " + s.transitions_error + " (run 'spritestation transitions " + bank + "')");
+  }
+  const auto finish = [&] {
+    if (failed.empty()) return;
+    std::string what;
+    for (const std::string& f : failed) what += (what.empty() ? "" : "; ") + f;
+    throw WorkError(session, "ingest stored what it could, but " + what);
+  };
 
   if (json) {
     nlohmann::json out;
@@ -86,7 +105,10 @@ void RunIngest(const std::string& session, const std::string& bank, const std::s
                                 {"seconds_key", c.stats.seconds_key},
                                 {"seconds_rest", c.stats.seconds_rest}});
     }
+    out["failed"] = failed;
     std::printf("%s\n", out.dump(2).c_str());
+    std::fflush(stdout);
+    finish();
     return;
   }
   std::printf("ingested %s into %s\n", session.c_str(), bank.c_str());
@@ -125,6 +147,8 @@ void RunIngest(const std::string& session, const std::string& bank, const std::s
     std::printf("  %llu frames could not be read: %s\n", static_cast<unsigned long long>(s.source.frames_dropped),
                 s.source.last_error.c_str());
   }
+  std::fflush(stdout);
+  finish();
 }
 
 }  // namespace

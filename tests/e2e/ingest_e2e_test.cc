@@ -1,6 +1,9 @@
 // End to end: a synthetic session through `spritestation ingest` into a bank.
 #include <gtest/gtest.h>
 
+#include <filesystem>
+#include <fstream>
+
 #include <nlohmann/json.hpp>
 
 #include "tests/support/test_support.h"
@@ -67,6 +70,32 @@ TEST_F(IngestEndToEnd, BadInputNamesTheFile) {
   EXPECT_NE(missing.output.find("nowhere"), std::string::npos) << missing.output;
   const auto no_bank = RunSpritestation("ingest " + *dir_ / "session");
   EXPECT_EQ(no_bank.exit_code, 2) << no_bank.output;
+}
+
+// A camera whose video cannot be read at all: ingest stores the other camera's sprites, then
+// says which camera failed and exits 1 (it used to report success).
+TEST_F(IngestEndToEnd, ACameraThatCannotBeReadIsAFailureNamedAfterTheRest) {
+  namespace fs = std::filesystem;
+  const fs::path damaged = fs::path(*dir_ / "damaged");
+  fs::copy(*dir_ / "session", damaged, fs::copy_options::recursive);
+  {
+    std::ofstream video(damaged / "cam1.mkv", std::ios::trunc | std::ios::binary);
+    video << "this is not a Matroska file";
+  }
+  const std::string bank = *dir_ / "damaged.bank";
+  const auto r = RunSpritestation("--log-level warn ingest " + damaged.string() + " --bank " + bank + " --json");
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.output.find("camera cam1: no frame of it could be read"), std::string::npos) << r.output;
+  const auto j = JsonInOutput(r.output);
+  ASSERT_TRUE(j.contains("cameras")) << r.output;
+  int64_t kept_cam0 = -1;
+  for (const auto& c : j["cameras"]) {
+    if (c["name"] == "cam0") kept_cam0 = c["sprites_kept"].get<int64_t>();
+  }
+  EXPECT_GT(kept_cam0, 0) << "the readable camera's sprites are stored: " << r.output;
+  EXPECT_EQ(j["failed"].size(), 1u) << r.output;
+  const auto verify = RunSpritestation("bank verify " + bank);
+  EXPECT_EQ(verify.exit_code, 0) << verify.output;
 }
 
 }  // namespace
