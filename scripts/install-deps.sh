@@ -18,8 +18,9 @@ PACKAGES=(
   libspdlog-dev libfmt-dev libcpp-httplib-dev libsystemd-dev libpng-dev libzstd-dev
   # tests and benchmarks
   libgtest-dev libgmock-dev libbenchmark-dev
-  # the daemon tests give each test a private loopback with a second address (ip)
-  iproute2
+  # the daemon tests give each test a private loopback with a second address (ip), and
+  # check /metrics with Prometheus's own promtool
+  iproute2 prometheus
   # the console's browser tests (web/tests): Debian's Chromium driven by playwright-core
   # under node's test runner (npm installs playwright-core below; it downloads no browser)
   chromium nodejs

@@ -115,6 +115,8 @@ struct Station::Impl {
   int64_t bank_sprites = 0;
   uint64_t sprites_stored = 0, batches_stored = 0, batches_failed = 0, batches_refused = 0;
   std::deque<double> latencies_ms;                         // last 10,000
+  uint64_t latency_count = 0;                              // every sprite's, since start
+  double latency_sum_ms = 0;
   std::deque<std::pair<SteadyTime, uint64_t>> stored_log;  // (time, sprites_stored) samples for sprites/s
   std::string bank_error;
   StorageState storage_state = StorageState::kOk;
@@ -206,6 +208,8 @@ struct Station::Impl {
         if (sb.batch.sprites[i].mirrored) continue;
         ++originals;
         latencies_ms.push_back(Seconds(now - sb.received[i]) * 1e3);
+        ++latency_count;
+        latency_sum_ms += latencies_ms.back();
         if (latencies_ms.size() > 10000) latencies_ms.pop_front();
       }
       sprites_stored += originals;
@@ -556,6 +560,8 @@ StationStatus Station::Status() const {
         out.sprites_per_second = (s.stored_log.back().second - s.stored_log.front().second) / span;
       }
     }
+    out.latency_count = s.latency_count;
+    out.latency_sum_s = s.latency_sum_ms / 1e3;
     if (!s.latencies_ms.empty()) {
       std::vector<double> v(s.latencies_ms.begin(), s.latencies_ms.end());
       const auto at = [&v](size_t k) {

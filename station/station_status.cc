@@ -33,10 +33,20 @@ class Metrics {
   void Sample(double value, const std::string& labels = "") {
     out_ << "spritestation_" << name_ << (labels.empty() ? "" : "{" + labels + "}") << " " << value << "\n";
   }
+  // A sample of the family's `name_SUFFIX` series (a summary's _sum and _count).
+  void SampleSuffix(const std::string& suffix, double value) {
+    out_ << "spritestation_" << name_ << suffix << " " << value << "\n";
+  }
   std::string str() const { return out_.str(); }
 
  private:
-  std::ostringstream out_;
+  // 12 significant digits: counters stay exact integers to 10^12 (the default 6 wrote
+  // 1234567 frames as 1.23457e+06).
+  std::ostringstream out_ = [] {
+    std::ostringstream o;
+    o.precision(12);
+    return o;
+  }();
   std::string name_;
 };
 
@@ -189,9 +199,12 @@ std::string StatusToPrometheus(const StationStatus& st) {
   m.Sample(static_cast<double>(st.batches_failed));
   m.Family("bank_batches_refused_total", "counter", "clip batches not stored because the disk is nearly full");
   m.Sample(static_cast<double>(st.batches_refused));
-  m.Family("sprite_latency_seconds", "gauge", "frame arrival to sprite committed, over the last 10,000 sprites");
+  // A summary: quantiles over the last 10,000 sprites, _sum and _count over every sprite since start.
+  m.Family("sprite_latency_seconds", "summary", "frame arrival to sprite committed (quantiles over the last 10,000 sprites)");
   m.Sample(st.latency_p50_ms / 1e3, "quantile=\"0.5\"");
   m.Sample(st.latency_p99_ms / 1e3, "quantile=\"0.99\"");
+  m.SampleSuffix("_sum", st.latency_sum_s);
+  m.SampleSuffix("_count", static_cast<double>(st.latency_count));
   m.Family("transitions_pending", "gauge", "stored sprites whose transitions are not found yet");
   m.Sample(static_cast<double>(st.transitions_pending));
   m.Family("transitions_stored_total", "counter", "transitions stored since start");

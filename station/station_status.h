@@ -42,6 +42,8 @@ struct StationStatus {
   uint64_t batches_stored = 0, batches_failed = 0, batches_refused = 0;  // refused: storage stopped (disk)
   size_t writer_queue = 0;
   double latency_p50_ms = 0, latency_p99_ms = 0;  // frame arrival -> sprite committed, last 10,000 sprites
+  uint64_t latency_count = 0;                       // sprites committed since start, and their latencies'
+  double latency_sum_s = 0;                         // sum (the Prometheus summary's _count and _sum)
   std::string bank_error;         // the last failed append
   // Transitions
   bool transitions_enabled = false, transitions_ready = false;

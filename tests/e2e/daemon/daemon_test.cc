@@ -170,6 +170,18 @@ TEST_F(DaemonTest, TwoEmulatedGigECamerasStoreWhatIngestFinds) {
                                std::to_string(status["bank"]["sprites_stored"].get<int64_t>())),
             std::string::npos)
       << metrics->body;
+  // What Prometheus's own checker makes of it (promtool, from Debian's prometheus package).
+  {
+    const std::string file = dir_ / "metrics.txt";
+    std::ofstream(file) << metrics->body;
+    const std::string promtool = "promtool check metrics < " + file + " 2>&1";
+    std::string out;
+    FILE* pipe = popen(promtool.c_str(), "r");
+    ASSERT_NE(pipe, nullptr);
+    char buffer[512];
+    while (fgets(buffer, sizeof buffer, pipe) != nullptr) out += buffer;
+    EXPECT_EQ(pclose(pipe), 0) << "promtool check metrics: " << out << "\n" << metrics->body;
+  }
 
   // SIGTERM: a clean stop within 5 s.
   const auto term = Clock::now();
