@@ -377,6 +377,7 @@ struct CameraRunner::Impl {
   std::vector<cv::Mat> training_set;
   size_t training_collected = 0;
   std::pair<uint64_t, int64_t> training_first;  // the set's first frame: sequence, timestamp
+  std::pair<uint64_t, int64_t> training_last;   // ... and the last one collected so far
 
   void PipelineLoop() {
     bool pipeline_failed = pipeline == nullptr;
@@ -405,6 +406,13 @@ struct CameraRunner::Impl {
           if (collect) {
             // Straight into the next pre-faulted slot of the training set: no allocation here.
             if (training_set.empty()) training_set = PrefaultedImages(options.training_frames, frame.width, frame.height);
+            // A camera that reopened mid-collection numbers and times its frames from its own
+            // start again: the frames before belong to another stream, so the set starts over
+            // (else learnt_from's first frame came after its last).
+            if (training_collected > 0 && (frame.sequence <= training_last.first || frame.timestamp_ns <= training_last.second)) {
+              training_collected = 0;
+            }
+            training_last = {frame.sequence, frame.timestamp_ns};
             cv::Mat& slot = training_set[training_collected];
             ToBgr(frame, slot);
             if (training_collected == 0) training_first = {frame.sequence, frame.timestamp_ns};
