@@ -8,6 +8,8 @@
 #include <deque>
 #include <filesystem>
 #include <map>
+#include <set>
+#include <tuple>
 #include <mutex>
 #include <thread>
 
@@ -119,6 +121,7 @@ struct Station::Impl {
   double latency_sum_ms = 0;
   std::deque<std::pair<SteadyTime, uint64_t>> stored_log;  // (time, sprites_stored) samples for sprites/s
   std::string bank_error;
+  bool last_append_failed = false;  // until an append succeeds again
   StorageState storage_state = StorageState::kOk;
   int64_t disk_free_mib = -1;
 
@@ -180,6 +183,11 @@ struct Station::Impl {
     }
   }
 
+  // Clips one of whose batches failed (camera, track, first frame): their later batches are
+  // not stored, so the bank never holds a complete clip with a hole (the clip's part stored
+  // before the failure stays an incomplete clip, which readers do not see). Writer thread only.
+  std::set<std::tuple<int64_t, int64_t, int64_t>> broken_clips;
+
   void WriteBatch(StationBatch& sb) {
     {
       std::lock_guard lock(stats_mutex);
@@ -188,16 +196,27 @@ struct Station::Impl {
         return;
       }
     }
+    const ClipRecord& clip = sb.batch.clip;
+    const auto key = std::make_tuple(clip.camera_id, clip.track_id, clip.first_frame);
+    if (broken_clips.count(key) > 0) {
+      if (clip.complete) broken_clips.erase(key);
+      std::lock_guard lock(stats_mutex);
+      ++batches_failed;
+      return;
+    }
     AppendResult result;
     try {
       std::lock_guard lock(bank_mutex);
       result = bank->AppendClipBatch(sb.batch.clip, sb.batch.sprites);
     } catch (const std::exception& e) {
       // A failed append is one rolled-back transaction: what was stored stays stored.
-      log->error("bank: {}", e.what());
+      log->error("bank: {} (the rest of clip {}/{} from frame {} is not stored)", e.what(), clip.camera_id,
+                 clip.track_id, clip.first_frame);
+      if (!clip.complete) broken_clips.insert(key);
       std::lock_guard lock(stats_mutex);
       ++batches_failed;
       bank_error = e.what();
+      last_append_failed = true;
       return;
     }
     const SteadyTime now = Clock::now();
@@ -215,6 +234,7 @@ struct Station::Impl {
       sprites_stored += originals;
       bank_sprites += result.inserted;
       ++batches_stored;
+      last_append_failed = false;
       stored_log.emplace_back(now, sprites_stored);
       while (stored_log.size() > 2 && Seconds(now - stored_log.front().first) > 5.0) stored_log.pop_front();
     }
@@ -552,6 +572,7 @@ StationStatus Station::Status() const {
     out.batches_refused = s.batches_refused;
     out.bank_error = s.bank_error;
     out.storage_state = s.storage_state;
+    if (out.storage_state == StorageState::kOk && s.last_append_failed) out.storage_state = StorageState::kWritesFailing;
     out.disk_free_mib = s.disk_free_mib;
     if (s.stored_log.size() >= 2) {
       const double span = Seconds(s.stored_log.back().first - s.stored_log.front().first);

@@ -74,6 +74,7 @@ const char* StorageStateName(StorageState state) {
     case StorageState::kOk: return "ok";
     case StorageState::kRecordingStopped: return "recording_stopped";
     case StorageState::kSpritesStopped: return "sprites_stopped";
+    case StorageState::kWritesFailing: return "writes_failing";
   }
   return "unknown";
 }
@@ -212,8 +213,11 @@ std::string StatusToPrometheus(const StationStatus& st) {
   m.Family("disk_free_mib", "gauge", "free MiB on the bank's (or recordings') file system");
   m.Sample(static_cast<double>(st.disk_free_mib));
   m.Family("storage_stopped", "gauge", "what the disk guard stopped, by what");
-  m.Sample(st.storage_state != StorageState::kOk ? 1 : 0, "what=\"recording\"");
+  m.Sample(st.storage_state == StorageState::kRecordingStopped || st.storage_state == StorageState::kSpritesStopped ? 1 : 0,
+           "what=\"recording\"");
   m.Sample(st.storage_state == StorageState::kSpritesStopped ? 1 : 0, "what=\"sprites\"");
+  m.Family("bank_writes_failing", "gauge", "1 while the bank's last append failed (with disk space above both thresholds)");
+  m.Sample(st.storage_state == StorageState::kWritesFailing ? 1 : 0);
   m.Family("frames_recorded_total", "counter", "raw frames written to the session recording");
   m.Sample(static_cast<double>(st.frames_recorded));
   m.Family("frames_record_dropped_total", "counter", "raw frames the recorder could not keep up with");

@@ -24,10 +24,11 @@ struct SessionStatus {
 enum class StationState { kStarting, kRunning, kStopping, kStopped };
 const char* StationStateName(StationState state);  // "starting", "running", ...
 
-// The disk guard's verdict: below storage.stop_recording_below_mib raw recording stops,
-// below storage.stop_sprites_below_mib sprite storage stops too.
-enum class StorageState { kOk, kRecordingStopped, kSpritesStopped };
-const char* StorageStateName(StorageState state);  // "ok", "recording_stopped", "sprites_stopped"
+// The storage's state: the disk guard's verdict (below storage.stop_recording_below_mib raw
+// recording stops, below storage.stop_sprites_below_mib sprite storage stops too), or, with
+// space above both, the bank's last append failed (a disk full or failing before the guard saw it).
+enum class StorageState { kOk, kRecordingStopped, kSpritesStopped, kWritesFailing };
+const char* StorageStateName(StorageState state);  // "ok", "recording_stopped", "sprites_stopped", "writes_failing"
 
 struct StationStatus {
   StationState state = StationState::kStarting;

@@ -1,0 +1,110 @@
+// The station in-process when the bank's disk fills up under it: appends
+// fail (the process may not grow a file: RLIMIT_FSIZE, a full disk for this
+// process alone), the storage state says so, nothing stored before is lost,
+// and storage resumes when space comes back.
+#include <signal.h>
+#include <sys/resource.h>
+
+#include <chrono>
+#include <filesystem>
+#include <thread>
+
+#include <gtest/gtest.h>
+
+#include "core/bank.h"
+#include "core/bank_verify.h"
+#include "station/station.h"
+#include "station/station_status.h"
+#include <nlohmann/json.hpp>
+#include "synth/studio_session.h"
+#include "tests/support/test_support.h"
+
+namespace ss {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+namespace fs = std::filesystem;
+
+template <typename Pred>
+bool WaitFor(const Station& station, Pred pred, double seconds) {
+  const auto deadline = Clock::now() + std::chrono::duration<double>(seconds);
+  while (Clock::now() < deadline) {
+    if (pred(station.Status())) return true;
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  return false;
+}
+
+// Restores the file-size limit however the test ends.
+struct FileSizeLimit {
+  rlimit saved{};
+  FileSizeLimit() { getrlimit(RLIMIT_FSIZE, &saved); }
+  ~FileSizeLimit() { setrlimit(RLIMIT_FSIZE, &saved); }
+  void Set(rlim_t bytes) {
+    rlimit l = saved;
+    l.rlim_cur = bytes;
+    ASSERT_EQ(setrlimit(RLIMIT_FSIZE, &l), 0);
+  }
+  void Lift() { setrlimit(RLIMIT_FSIZE, &saved); }
+};
+
+TEST(StationFaults, AFullDiskSaysWritesFailLosesNothingAndResumes) {
+  signal(SIGXFSZ, SIG_IGN);  // a write past the limit fails with EFBIG instead of killing the process
+  testing::ScratchDir dir;
+  synth::SynthOptions so;
+  so.out_dir = dir / "session";
+  so.seconds = 4;
+  so.fps = 30;
+  so.width = 640;
+  so.height = 480;
+  so.cameras = 1;
+  so.seed = 11;
+  so.empty_lead_in_s = 1.5;
+  so.write_mattes = false;
+  synth::RenderStudioSession(so);
+
+  StationOptions options;
+  CameraConfig cam;
+  cam.name = "cam0";
+  cam.source = "replay";
+  cam.session = so.out_dir;
+  cam.loop = true;
+  cam.realtime = true;
+  options.config.cameras = {cam};
+  options.config.storage.bank = dir / "station.bank";
+  options.config.storage.recording_dir = dir / "recordings";
+  options.config.storage.stop_recording_below_mib = 0;
+  options.config.storage.stop_sprites_below_mib = 0;
+  options.config.logging.level = "warn";
+  options.transitions = false;
+  Station station(options);
+  station.Start();
+  station.StartSession("full disk");
+  ASSERT_TRUE(WaitFor(station, [](const StationStatus& s) { return s.batches_stored >= 3; }, 30))
+      << "no batch stored before the disk filled: " << StatusToJson(station.Status()).dump(2);
+  EXPECT_EQ(station.Status().storage_state, StorageState::kOk);
+
+  FileSizeLimit limit;
+  limit.Set(4096);  // every file of this process is "full" past 4 KiB
+  ASSERT_TRUE(WaitFor(station, [](const StationStatus& s) { return s.batches_failed >= 2; }, 30))
+      << "no append failed on a full disk";
+  const StationStatus failing = station.Status();
+  EXPECT_EQ(failing.storage_state, StorageState::kWritesFailing);
+  EXPECT_FALSE(failing.bank_error.empty());
+  const uint64_t stored_before = failing.batches_stored;
+
+  limit.Lift();  // space comes back
+  ASSERT_TRUE(WaitFor(station, [&](const StationStatus& s) { return s.batches_stored > stored_before + 2; }, 30))
+      << "storage did not resume: " << station.Status().bank_error;
+  EXPECT_EQ(station.Status().storage_state, StorageState::kOk);
+  station.StopSession();
+  station.Stop();
+  const BankVerifyReport verify = VerifyBank(options.config.storage.bank);
+  std::string problems;
+  for (const std::string& p : verify.problems) problems += p + "\n";
+  EXPECT_TRUE(verify.ok()) << problems;
+  EXPECT_GT(Bank(options.config.storage.bank).Counts().sprites_visible, 0);
+}
+
+}  // namespace
+}  // namespace ss
