@@ -16,6 +16,7 @@ const char* DiscardName(Discard reason) {
     case Discard::kTouchesWall: return "touches_wall";
     case Discard::kStill: return "still";
     case Discard::kShortClip: return "short_clip";
+    case Discard::kTooLarge: return "too_large";
     case Discard::kCount: break;
   }
   return "unknown";

@@ -25,6 +25,7 @@ enum class Discard {
   kTouchesWall,    // the silhouette overlaps something that is not floor (a wall)
   kStill,          // part of an extended period without motion
   kShortClip,      // its clip was too short to give transitions
+  kTooLarge,       // its billboard at the bank's scale (pipeline.px_per_m) exceeds the size limit
   kCount,
 };
 const char* DiscardName(Discard reason);  // "too_small", "touches_border", ...

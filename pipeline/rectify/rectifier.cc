@@ -61,7 +61,8 @@ std::optional<Eigen::Vector3d> IntersectVerticalPlane(const CameraModel& camera,
 
 }  // namespace
 
-std::optional<Billboard> Rectifier::Rectify(const CameraModel& camera, const SpriteView& view) const {
+std::optional<Billboard> Rectifier::Rectify(const CameraModel& camera, const SpriteView& view, Refusal* why) const {
+  if (why != nullptr) *why = {};
   if (view.bgr == nullptr || view.alpha == nullptr || view.bgr->empty() ||
       view.bgr->size() != view.alpha->size()) {
     return std::nullopt;
@@ -106,6 +107,9 @@ std::optional<Billboard> Rectifier::Rectify(const CameraModel& camera, const Spr
   const int width = 2 * static_cast<int>(std::ceil(half_w * s)) + 1;
   const int height = static_cast<int>(std::ceil((max_h + options_.margin_m) * s)) + 1;
   if (width > options_.max_side_px || height > options_.max_side_px || width < 3 || height < 3) {
+    if (why != nullptr && (width > options_.max_side_px || height > options_.max_side_px)) {
+      *why = {true, width, height};
+    }
     Log("pipeline.rectify")->trace("billboard {}x{} px refused (max {}): crop {}x{}+{}+{}, contact ({:.1f}, {:.1f})",
                                    width, height, options_.max_side_px, view.bgr->cols, view.bgr->rows, view.offset.x,
                                    view.offset.y, view.contact_px.x(), view.contact_px.y());

@@ -174,8 +174,18 @@ void CameraPipeline::Process(const Frame& frame, std::vector<ClipBatch>* out) {
     if (reason == Discard::kNone) {
       const SpriteView view{&c.colour, &c.alpha, &c.shadow, c.bbox.tl(),
                             Eigen::Vector2d(c.contact_point.x, c.contact_point.y)};
-      billboards[k] = rectifier_.Rectify(model_, view);
-      if (!billboards[k]) reason = Discard::kNoGroundHit;
+      Rectifier::Refusal why;
+      billboards[k] = rectifier_.Rectify(model_, view, &why);
+      if (!billboards[k]) {
+        reason = why.too_large ? Discard::kTooLarge : Discard::kNoGroundHit;
+        if (why.too_large && (!last_too_large_log_ || Clock::now() - *last_too_large_log_ > std::chrono::seconds(10))) {
+          last_too_large_log_ = Clock::now();
+          log_->warn("{} frame {}: a sprite's billboard would be {}x{} px at pipeline.px_per_m {}, over the {} px "
+                     "limit: refused as too_large (a subject this big needs a smaller px_per_m)",
+                     name_, frame.sequence, why.width_px, why.height_px, rectifier_.options().px_per_m,
+                     rectifier_.options().max_side_px);
+        }
+      }
     }
     usable[k] = reason == Discard::kNone;
     verdicts_.push_back({&c, subjects[k], points[k], reason});

@@ -4,6 +4,7 @@
 // and what comes out are the batches the bank stores. One CameraPipeline
 // belongs to one thread; several cameras run side by side, each its own.
 #include <array>
+#include <chrono>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -120,6 +121,7 @@ class CameraPipeline {
 
   std::optional<uint64_t> last_sequence_;
   std::shared_ptr<spdlog::logger> log_;  // "pipeline.run": per-sprite decisions at trace level
+  std::optional<std::chrono::steady_clock::time_point> last_too_large_log_;  // one warning per 10 s
   uint64_t usable_total_ = 0;  // sprites that passed the filters, short clips included
   CameraPipelineStats stats_;
 };

@@ -139,7 +139,25 @@ TEST(Rectifier, RayAboveTheHorizonGivesNothing) {
   const CameraModel cam = LookAtOrigin(1.0, 0.8);
   cv::Mat bgr(10, 10, CV_8UC3, cv::Scalar::all(0)), alpha(10, 10, CV_8U, cv::Scalar(255));
   const SpriteView view{&bgr, &alpha, nullptr, cv::Point(300, 0), Eigen::Vector2d(305, -2000)};
-  EXPECT_FALSE(Rectifier().Rectify(cam, view).has_value());
+  Rectifier::Refusal why;
+  EXPECT_FALSE(Rectifier().Rectify(cam, view, &why).has_value());
+  EXPECT_FALSE(why.too_large) << "a ray that misses the floor is not a size problem";
+}
+
+// A subject too big for the bank's scale is refused as too large, with the size it would have.
+TEST(Rectifier, ABillboardOverTheSizeLimitIsTooLargeNotAMissedFloor) {
+  const CameraModel cam = LookAtOrigin(1.0, 0.8);
+  const Render r = RenderCard(cam, 0.06, 0.04);
+  const Crop crop = CropOf(r);
+  RectifierOptions o;
+  o.px_per_m = 20000;  // 6 cm at 20,000 px/m: 1,200 px wide, over the 512 px limit
+  Rectifier::Refusal why;
+  EXPECT_FALSE(Rectifier(o).Rectify(cam, crop.View(r.contact_px), &why).has_value());
+  EXPECT_TRUE(why.too_large);
+  EXPECT_GT(why.width_px, o.max_side_px);
+  // The same card at the default scale is made, and says nothing.
+  EXPECT_TRUE(Rectifier().Rectify(cam, crop.View(r.contact_px), &why).has_value());
+  EXPECT_FALSE(why.too_large);
 }
 
 }  // namespace

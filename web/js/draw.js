@@ -9,6 +9,7 @@ export const VERDICT_COLOURS = {
   leaves_floor: '#f472b6',
   touches_wall: '#ef4444',
   still: '#94a3b8',
+  too_large: '#fb923c',
 };
 export const VERDICT_LABELS = {
   stored: 'stored (session runs)',
@@ -18,6 +19,7 @@ export const VERDICT_LABELS = {
   leaves_floor: 'leaves the floor',
   touches_wall: 'touches a wall',
   still: 'still',
+  too_large: 'billboard too large (px_per_m)',
 };
 export function verdictColour(v) {
   return VERDICT_COLOURS[v] || '#eab308';
