@@ -3,7 +3,6 @@
 // options and prints. Exit 1 when a camera's calibration is not trusted (the
 // report says why), 2 for bad input (no board of that spec anywhere, bad files).
 #include <algorithm>
-#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -12,7 +11,6 @@
 #include <memory>
 #include <sstream>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -23,6 +21,7 @@
 #include "calib/enclosure.h"
 #include "calib/inputs.h"
 #include "calib/wizard.h"
+#include "calib/wizard_run.h"
 #include "calib/workflow.h"
 #include "core/config.h"
 #include "core/camera_model.h"
@@ -333,42 +332,12 @@ void AddWizard(CLI::App& parent) {
       }
       std::fflush(stdout);
     };
-    cv::Mat bgr;
-    int frames = 0;
-    // A live camera that stops delivering (unplugged, its stream ended) ends the wizard
-    // with what it has; Next() itself waits for frames as long as the source lives. (The
-    // station's CameraRunner does the same, then reopens the camera.)
-    using Clock = std::chrono::steady_clock;
-    std::atomic<int64_t> last_frame_ns{Clock::now().time_since_epoch().count()};
-    std::atomic<bool> reading{true}, silent{false};
-    {
-      std::jthread watchdog([&] {
-        const auto limit = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(o->silent_s));
-        while (reading.load()) {
-          std::this_thread::sleep_for(std::chrono::milliseconds(100));
-          if (Clock::now().time_since_epoch().count() - last_frame_ns.load() > limit.count()) {
-            silent.store(true);
-            source->Stop();
-            return;
-          }
-        }
-      });
-      struct StopWatching {
-        std::atomic<bool>& reading;
-        ~StopWatching() { reading.store(false); }  // before the jthread joins, also on a throw
-      } stop_watching{reading};
-      while (!wizard.done() && (o->count <= 0 || frames < o->count)) {
-        auto frame = source->Next();
-        if (!frame) break;
-        last_frame_ns.store(Clock::now().time_since_epoch().count());
-        ToBgr(*frame, bgr);
-        wizard.Feed(bgr, static_cast<int>(frame->sequence));
-        ++frames;
-        print_log();
-      }
-    }
-    source->Stop();
-    if (silent.load()) {
+    calib::WizardRunOptions run;
+    run.max_frames = o->count;
+    run.silent_s = o->silent_s;
+    const calib::WizardRunResult ran = calib::RunWizardOnSource(*source, wizard, run, print_log);
+    const int frames = ran.frames;
+    if (ran.silent) {
       std::fprintf(stderr, "calibrate wizard: %s delivered no frame for %.1f s; ending with what was seen\n",
                    camera.name.c_str(), o->silent_s);
     }

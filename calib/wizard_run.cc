@@ -1,0 +1,54 @@
+#include "calib/wizard_run.h"
+
+#include <atomic>
+#include <chrono>
+#include <thread>
+
+#include <opencv2/core.hpp>
+
+#include "core/frame.h"
+
+namespace ss::calib {
+
+WizardRunResult RunWizardOnSource(FrameSource& source, CalibrationWizard& wizard, const WizardRunOptions& options,
+                                  const std::function<void()>& after_frame) {
+  // A live camera that stops delivering (unplugged, its stream ended) ends the run with what
+  // it has; Next() itself waits for frames as long as the source lives. (The station's
+  // CameraRunner does the same, then reopens the camera.)
+  using Clock = std::chrono::steady_clock;
+  WizardRunResult result;
+  std::atomic<int64_t> last_frame_ns{Clock::now().time_since_epoch().count()};
+  std::atomic<bool> reading{true}, silent{false};
+  cv::Mat bgr;
+  {
+    std::jthread watchdog([&] {
+      const auto limit = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(options.silent_s));
+      while (reading.load()) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(100));
+        if (Clock::now().time_since_epoch().count() - last_frame_ns.load() > limit.count()) {
+          silent.store(true);
+          source.Stop();
+          return;
+        }
+      }
+    });
+    struct StopWatching {
+      std::atomic<bool>& reading;
+      ~StopWatching() { reading.store(false); }  // before the jthread joins, also on a throw
+    } stop_watching{reading};
+    while (!wizard.done() && (options.max_frames <= 0 || result.frames < options.max_frames)) {
+      auto frame = source.Next();
+      if (!frame) break;
+      last_frame_ns.store(Clock::now().time_since_epoch().count());
+      ToBgr(*frame, bgr);
+      wizard.Feed(bgr, static_cast<int>(frame->sequence));
+      ++result.frames;
+      if (after_frame) after_frame();
+    }
+  }
+  source.Stop();
+  result.silent = silent.load();
+  return result;
+}
+
+}  // namespace ss::calib
