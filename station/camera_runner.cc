@@ -104,7 +104,7 @@ struct CameraRunner::Impl {
   std::shared_ptr<const PreviewFrame> preview;
   std::shared_ptr<PreviewFrame> preview_spare;
   SteadyTime preview_time{};
-  std::atomic<double> preview_interval_s{0.2};
+  std::atomic<double> preview_interval_s{0};  // options.preview_interval_s, then as the station sets it
   // The exposure figures of the latest preview, measured at most once a second (on a reader's thread).
   mutable std::mutex exposure_mutex;
   mutable ExposureFigures exposure;
@@ -488,6 +488,7 @@ CameraRunner::CameraRunner(int index, CameraRunnerOptions options, BatchSink sin
   Impl& s = *impl_;
   s.index = index;
   s.options = std::move(options);
+  s.preview_interval_s = s.options.preview_interval_s;
   s.sink = std::move(sink);
   s.tap = std::move(tap);
   s.queue = std::make_unique<BoundedQueue<Captured>>(static_cast<size_t>(std::max(1, s.options.queue_frames)));

@@ -78,7 +78,7 @@ struct CameraRunnerOptions {
   double offline_after_s = 3.0;  // no frame for this long: offline, closed and reopened
   double backoff_min_s = 0.5;    // first reopen delay, doubled up to backoff_max_s
   double backoff_max_s = 8.0;
-  double preview_interval_s = 0.2;
+  double preview_interval_s = 0.2;  // a preview snapshot this often (set_preview_interval changes it)
   // Opens the camera; unset: OpenCameraSource (benchmarks put frames from memory here).
   std::function<std::unique_ptr<FrameSource>(const CameraConfig&, int camera_index)> open_source;
 };

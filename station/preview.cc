@@ -55,15 +55,16 @@ cv::Mat RenderPreview(const PreviewFrame& frame, PreviewView view, int max_width
       }
     }
   }
+  // Not keyed yet (learning the enclosure): say so by showing it dimmed.
+  const bool dim = view == PreviewView::kKeyed && !keyed;
   cv::Mat out;
   if (max_width > 0 && image.cols > max_width) {
     const int height = std::max(1, static_cast<int>(std::lround(double(image.rows) * max_width / image.cols)));
     cv::resize(image, out, cv::Size(max_width, height), 0, 0, cv::INTER_AREA);
   } else {
-    out = image.clone();
+    out = dim ? image.clone() : image;  // a raw view at full size is the snapshot itself
   }
-  // Not keyed yet (learning the enclosure): say so by showing it dimmed.
-  if (view == PreviewView::kKeyed && !keyed) out *= 0.35;
+  if (dim) out *= 0.35;
   return out;
 }
 

@@ -45,6 +45,7 @@ std::vector<PreviewCandidate> PreviewCandidates(const std::vector<CandidateVerdi
 enum class PreviewView { kRaw, kKeyed };
 // The view as a BGR image at most `max_width` wide (aspect kept). kKeyed: the subject over
 // mid grey, the contact shadow darkening the grey; before the keyer learnt, the frame dimmed.
+// A raw view that needs no scaling shares `frame.bgr`'s pixels: read it while `frame` lives.
 cv::Mat RenderPreview(const PreviewFrame& frame, PreviewView view, int max_width);
 std::vector<uint8_t> EncodeJpeg(const cv::Mat& bgr, int quality = 80);
 

@@ -35,9 +35,9 @@ using Clock = std::chrono::steady_clock;
 // SIGTERM must finish within 5 s: from the start of Stop, the transition worker may drain this long.
 constexpr double kTransitionDrainS = 3.0;
 
-// Previews: a snapshot every kPreviewIntervalS; an encoded image is shared for kPreviewHoldS.
-// While a session runs both become kPreviewHoldSessionS (at most 2 images a second a camera).
-constexpr double kPreviewIntervalS = 0.2, kPreviewHoldS = 0.1, kPreviewHoldSessionS = 0.5;
+// Preview snapshots a camera takes, idle and while a session stores; each view of a snapshot is
+// encoded once, for every viewer, so these are also the most images a second a view costs.
+constexpr double kPreviewIntervalS = 0.2, kPreviewIntervalSessionS = 0.5;
 
 double Seconds(Clock::duration d) { return std::chrono::duration<double>(d).count(); }
 
@@ -82,10 +82,9 @@ void ApplyLogging(const LoggingConfig& logging) {
 // One camera's encoded previews, by (view, width): view 0 raw, 1 keyed, 2 the sprites view.
 struct PreviewCache {
   struct Entry {
-    // The snapshot it was made from, by identity (holding it would keep the runner from reusing it).
-    bool made_any = false;
-    SteadyTime frame_taken{};
-    SteadyTime made{};
+    // The snapshot it was made from, by when it was taken (holding the snapshot itself would
+    // keep the runner from reusing its buffer).
+    std::optional<SteadyTime> frame_taken;
     Station::PreviewImage image;
     std::string sprites_json;
   };
@@ -140,23 +139,23 @@ struct Station::Impl {
   std::condition_variable monitor_wake;
   bool monitor_stop = false;
 
-  // The cache entry of a camera's view, locked in `lock`; `frame` is set when it must be
-  // (re)made from that snapshot. nullptr before the first frame; InputError for no such camera.
-  PreviewCache::Entry* CachedPreview(const std::string& camera, int view, int max_width,
-                                     std::unique_lock<std::mutex>* lock,
-                                     std::shared_ptr<const PreviewFrame>* frame) const {
-    const Impl& s = *this;
-    for (size_t k = 0; k < s.runners.size(); ++k) {
-      if (s.runners[k]->name() != camera) continue;
-      PreviewCache& cache = *s.preview_caches[k];
+  // The cache entry of a camera's view, locked in `lock`; `frame` is set when the entry must be
+  // made (again) from that snapshot, and `runner` to the camera's. nullptr before the camera's
+  // first frame; NotFoundError for no such camera.
+  PreviewCache::Entry* CachedPreview(const std::string& camera, int view, int width, std::unique_lock<std::mutex>* lock,
+                                     std::shared_ptr<const PreviewFrame>* frame, const CameraRunner** runner) const {
+    for (size_t k = 0; k < runners.size(); ++k) {
+      if (runners[k]->name() != camera) continue;
+      PreviewCache& cache = *preview_caches[k];
       *lock = std::unique_lock(cache.mutex);
-      *frame = s.runners[k]->preview();
+      *runner = runners[k].get();
+      *frame = runners[k]->preview();
       if (!*frame) return nullptr;
-      PreviewCache::Entry& entry = cache.entries[{view, std::clamp(max_width, 16, 4096)}];
-      const double hold = s.session_active.load() ? kPreviewHoldSessionS : kPreviewHoldS;
-      if (entry.made_any &&
-          (entry.frame_taken == (*frame)->taken || Seconds(Clock::now() - entry.made) < hold)) {
-        *frame = nullptr;  // still fresh: no new encode
+      PreviewCache::Entry& entry = cache.entries[{view, width}];
+      if (entry.frame_taken == (*frame)->taken) {
+        *frame = nullptr;  // made from this snapshot already
+      } else {
+        entry.frame_taken = (*frame)->taken;
       }
       return &entry;
     }
@@ -387,6 +386,7 @@ void Station::Start() {
     o.training_frames = std::max(1, config.keying.training_frames);
     o.queue_frames = config.pipeline.queue_frames;
     o.offline_after_s = s.options.offline_after_s;
+    o.preview_interval_s = kPreviewIntervalS;
     o.open_source = s.options.open_source;
     s.runners.push_back(std::make_unique<CameraRunner>(
         static_cast<int>(i), std::move(o), [&s](StationBatch b) { s.Store(std::move(b)); },
@@ -510,7 +510,7 @@ SessionStatus Station::StartSession(const std::string& requested_name) {
   lock.unlock();  // the writer updates the session's counts meanwhile
   for (size_t i = 0; i < s.runners.size(); ++i) s.runners[i]->SetBankCamera(camera_ids[i]);
   // Previews back off while a session stores: fewer snapshots for the pipeline threads to copy.
-  for (auto& r : s.runners) r->set_preview_interval(kPreviewHoldSessionS);
+  for (auto& r : s.runners) r->set_preview_interval(kPreviewIntervalSessionS);
   s.log->info("session \"{}\" started (bank session {})", name, out.bank_session_id);
   return out;
 }
@@ -619,40 +619,33 @@ StationStatus Station::Status() const {
 
 std::optional<Station::PreviewImage> Station::Preview(const std::string& camera, PreviewView view,
                                                       int max_width) const {
+  const int width = std::clamp(max_width, 16, 4096);
   std::unique_lock<std::mutex> lock;
   std::shared_ptr<const PreviewFrame> frame;
-  PreviewCache::Entry* entry = impl_->CachedPreview(camera, view == PreviewView::kKeyed ? 1 : 0, max_width, &lock, &frame);
+  const CameraRunner* runner = nullptr;
+  PreviewCache::Entry* entry =
+      impl_->CachedPreview(camera, view == PreviewView::kKeyed ? 1 : 0, width, &lock, &frame, &runner);
   if (entry == nullptr) return std::nullopt;
   if (frame) {
-    entry->image.jpeg = EncodeJpeg(RenderPreview(*frame, view, std::clamp(max_width, 16, 4096)));
-    entry->image.sequence = frame->sequence;
-    entry->image.timestamp_ns = frame->timestamp_ns;
-    entry->image.width = frame->bgr.cols;
-    entry->image.height = frame->bgr.rows;
-    entry->made_any = true;
-    entry->frame_taken = frame->taken;
-    entry->made = Clock::now();
+    entry->image = {EncodeJpeg(RenderPreview(*frame, view, width)), frame->sequence, frame->timestamp_ns,
+                    frame->bgr.cols, frame->bgr.rows};
   }
   return entry->image;
 }
 
 std::optional<std::string> Station::SpritesView(const std::string& camera, int max_width) const {
+  const int width = std::clamp(max_width, 16, 4096);
   std::unique_lock<std::mutex> lock;
   std::shared_ptr<const PreviewFrame> frame;
-  PreviewCache::Entry* entry = impl_->CachedPreview(camera, 2, max_width, &lock, &frame);
+  const CameraRunner* runner = nullptr;
+  PreviewCache::Entry* entry = impl_->CachedPreview(camera, 2, width, &lock, &frame, &runner);
   if (entry == nullptr) return std::nullopt;
   if (frame) {
-    const cv::Mat image = RenderPreview(*frame, PreviewView::kRaw, std::clamp(max_width, 16, 4096));
+    const cv::Mat image = RenderPreview(*frame, PreviewView::kRaw, width);
     const double scale = frame->bgr.cols > 0 ? double(image.cols) / frame->bgr.cols : 1.0;
-    bool storing = false;
-    for (const auto& r : impl_->runners) {
-      if (r->name() == camera) storing = SessionActive() && r->model().has_value();
-    }
+    const bool storing = SessionActive() && runner->model().has_value();
     entry->sprites_json =
         SpritesViewJson(*frame, storing, "data:image/jpeg;base64," + Base64(EncodeJpeg(image)), scale).dump();
-    entry->made_any = true;
-    entry->frame_taken = frame->taken;
-    entry->made = Clock::now();
   }
   return entry->sprites_json;
 }

@@ -53,9 +53,9 @@ class Station {
   SessionStatus RenameSession(const std::string& name);
 
   StationStatus Status() const;
-  // A camera's latest preview as JPEG, at most `max_width` wide; InputError for an unknown
-  // camera, nullopt before its first frame. One image per camera, view and width is shared by
-  // every caller for 0.1 s (0.5 s while a session runs); encoding runs on the caller's thread.
+  // A camera's latest preview as JPEG, at most `max_width` wide; NotFoundError for an unknown
+  // camera, nullopt before its first frame. Each snapshot (5 a second, 2 while a session runs)
+  // is encoded once per view and width, for every caller, on the first caller's thread.
   struct PreviewImage {
     std::vector<uint8_t> jpeg;
     uint64_t sequence = 0;
@@ -63,7 +63,7 @@ class Station {
     int width = 0, height = 0;  // the camera's full size
   };
   std::optional<PreviewImage> Preview(const std::string& camera, PreviewView view, int max_width) const;
-  // The sprites view (preview.h SpritesViewJson) as JSON text, shared and throttled the same way.
+  // The sprites view (preview.h SpritesViewJson) as JSON text, made once per snapshot the same way.
   std::optional<std::string> SpritesView(const std::string& camera, int max_width) const;
   bool SessionActive() const;
   // SIGHUP: applies what is safe to change live (logging, storage limits and recording
