@@ -103,11 +103,7 @@ void RunDaemon(const DaemonArgs& a) {
     }
     control_options.web_dir = a.web_dir;
   }
-  control_options.embedded = [](std::string_view path) -> std::optional<WebFile> {
-    const std::optional<EmbeddedWebFile> f = FindEmbeddedWebFile(path);
-    if (!f) return std::nullopt;
-    return WebFile{f->bytes, f->content_type};
-  };
+  control_options.embedded = FindEmbeddedWebFile;
 
   StationHost host(options, replay_roots);
   host.Start();

@@ -102,10 +102,8 @@ std::string NameFromBody(const Request& req, bool required) {
   return body["name"].get<std::string>();
 }
 
-// An integer query parameter within [lo, hi], or `fallback` when absent.
-int64_t IntParam(const Request& req, const char* name, int64_t fallback, int64_t lo, int64_t hi) {
-  if (!req.has_param(name)) return fallback;
-  const std::string text = req.get_param_value(name);
+// `text` as a whole integer within [lo, hi]; InputError naming `name` otherwise.
+int64_t ParseInt(const std::string& text, const char* name, int64_t lo, int64_t hi) {
   size_t used = 0;
   int64_t v = 0;
   try {
@@ -120,17 +118,22 @@ int64_t IntParam(const Request& req, const char* name, int64_t fallback, int64_t
   return v;
 }
 
-int64_t PathId(const Request& req, const char* what) {
-  try {
-    return std::stoll(req.matches[1]);
-  } catch (const std::exception&) {
-    throw InputError(what, "expected an integer id");
-  }
+// An integer query parameter within [lo, hi], or `fallback` when absent.
+int64_t IntParam(const Request& req, const char* name, int64_t fallback, int64_t lo, int64_t hi) {
+  return req.has_param(name) ? ParseInt(req.get_param_value(name), name, lo, hi) : fallback;
+}
+
+// The id in the path (the pattern's first group).
+int64_t PathId(const Request& req, const char* what) { return ParseInt(req.matches[1], what, 1, INT64_MAX); }
+
+std::string Lower(std::string text) {
+  std::transform(text.begin(), text.end(), text.begin(), [](unsigned char c) { return std::tolower(c); });
+  return text;
 }
 
 // "host" of "host:port" / "[v6]:port", lower-cased.
-std::string HostName(std::string host) {
-  std::transform(host.begin(), host.end(), host.begin(), [](unsigned char c) { return std::tolower(c); });
+std::string HostName(const std::string& host_port) {
+  const std::string host = Lower(host_port);
   if (!host.empty() && host[0] == '[') return host.substr(1, host.find(']') - 1);
   const size_t colon = host.rfind(':');
   return colon == std::string::npos ? host : host.substr(0, colon);
@@ -216,10 +219,7 @@ struct ControlServer::Impl {
     if (!origin.empty()) {
       const size_t scheme = origin.find("://");
       const std::string origin_host = scheme == std::string::npos ? origin : origin.substr(scheme + 3);
-      std::string lower_origin = origin_host, lower_host = req.get_header_value("Host");
-      std::transform(lower_origin.begin(), lower_origin.end(), lower_origin.begin(), ::tolower);
-      std::transform(lower_host.begin(), lower_host.end(), lower_host.begin(), ::tolower);
-      if (lower_origin != lower_host) {
+      if (Lower(origin_host) != Lower(req.get_header_value("Host"))) {
         ReplyError(res, 403, "Origin: a page of " + origin + " may not use this station's API");
         return httplib::Server::HandlerResponse::Handled;
       }
@@ -246,9 +246,9 @@ struct ControlServer::Impl {
       res.set_content(bytes.str(), ContentTypeOf(file));
     } else {
       if (!options.embedded) return false;
-      const std::optional<WebFile> f = options.embedded(path);
-      if (!f) return false;
-      res.set_content(std::string(f->bytes), std::string(f->content_type));
+      const std::optional<std::string_view> bytes = options.embedded(path);
+      if (!bytes) return false;
+      res.set_content(std::string(*bytes), ContentTypeOf(path));
     }
     res.set_header("Cache-Control", "no-cache");
     res.set_header("X-Content-Type-Options", "nosniff");
@@ -316,7 +316,13 @@ struct ControlServer::Impl {
     Reply(res, 200, host->ModeJson());
   }
 
-  ConsoleBank Bank() const { return ConsoleBank(station()->Status().bank_path); }
+  ConsoleBank Bank() const { return ConsoleBank(station()->bank_path()); }
+
+  // Tag or untag: the same body either way.
+  nlohmann::json Tag(const Request& req, bool remove) const {
+    const int64_t n = Bank().Tag(ObjectBody(req, {"tag", "sprites", "clip", "first_frame", "last_frame"}), remove);
+    return {{remove ? "untagged" : "tagged", n}};
+  }
 
   void MakeRoutes() {
     const auto json = [](auto f) {
@@ -373,12 +379,9 @@ struct ControlServer::Impl {
         {"GET", R"(/api/bank/sprites/([^/]+))", "GET /api/bank/sprites/ID",
          json([this](const Request& req) { return Bank().Sprite(PathId(req, "sprite")); })},
         {"POST", "/api/bank/tag", "POST /api/bank/tag {\"tag\", \"sprites\" | \"clip\", \"first_frame\", \"last_frame\"}",
-         json([this](const Request& req) {
-           return nlohmann::json{{"tagged", Bank().Tag(ObjectBody(req, {"tag", "sprites", "clip", "first_frame", "last_frame"}), false)}};
-         })},
-        {"POST", "/api/bank/untag", "POST /api/bank/untag (as tag)", json([this](const Request& req) {
-           return nlohmann::json{{"untagged", Bank().Tag(ObjectBody(req, {"tag", "sprites", "clip", "first_frame", "last_frame"}), true)}};
-         })},
+         json([this](const Request& req) { return Tag(req, false); })},
+        {"POST", "/api/bank/untag", "POST /api/bank/untag (as tag)",
+         json([this](const Request& req) { return Tag(req, true); })},
         {"GET", "/api/bank/export.csv", "GET /api/bank/export.csv?clip=ID|tag=T", [this](const Request& req, Response& res) {
            std::optional<int64_t> clip;
            if (req.has_param("clip")) clip = IntParam(req, "clip", 0, 1, INT64_MAX);

@@ -19,18 +19,13 @@ namespace ss {
 
 class StationHost;
 
-// A static file of the console: its bytes and content type.
-struct WebFile {
-  std::string_view bytes;
-  std::string_view content_type;
-};
-
 struct ControlServerOptions {
   ControlConfig config;
   // The console's pages: served from `web_dir` when set (a source tree's web/, edited live),
-  // else by `embedded` (the copy built into the executable); neither: no pages.
+  // else by `embedded` (a file's bytes in the copy built into the executable, by its path
+  // below web/); neither: no pages. The content type follows the file's extension.
   std::string web_dir;
-  std::function<std::optional<WebFile>(std::string_view path)> embedded;
+  std::function<std::optional<std::string_view>(std::string_view path)> embedded;
   int max_event_streams = 16;  // open /api/events connections; more get 503
 };
 

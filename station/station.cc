@@ -650,6 +650,8 @@ std::optional<std::string> Station::SpritesView(const std::string& camera, int m
   return entry->sprites_json;
 }
 
+const std::string& Station::bank_path() const { return impl_->options.config.storage.bank; }
+
 bool Station::SessionActive() const { return impl_->session_active.load(); }
 
 std::vector<std::string> Station::Reload(const StationConfig& config) {

@@ -53,6 +53,7 @@ class Station {
   SessionStatus RenameSession(const std::string& name);
 
   StationStatus Status() const;
+  const std::string& bank_path() const;  // storage.bank (fixed for the station's life)
   // A camera's latest preview as JPEG, at most `max_width` wide; NotFoundError for an unknown
   // camera, nullopt before its first frame. Each snapshot (5 a second, 2 while a session runs)
   // is encoded once per view and width, for every caller, on the first caller's thread.
