@@ -222,22 +222,26 @@ std::vector<TransitionRecord> Bank::LoadTransitions() const {
   return out;
 }
 
-std::vector<TransitionRecord> Bank::LoadTransitionsFrom(int64_t from_sprite) const {
+namespace {
+
+// The transitions whose `end` column ("from_sprite" or "to_sprite") is `sprite`.
+std::vector<TransitionRecord> TransitionsAt(sql::Db& db, const char* end, int64_t sprite) {
   std::vector<TransitionRecord> out;
-  auto s = db_->Prepare("SELECT from_sprite, to_sprite, d, cost FROM transitions WHERE from_sprite = ? "
-                        "ORDER BY to_sprite");
-  s.Bind(1, from_sprite);
+  auto s = db.Prepare(std::string("SELECT from_sprite, to_sprite, d, cost FROM transitions WHERE ") + end +
+                      " = ? ORDER BY from_sprite, to_sprite");
+  s.Bind(1, sprite);
   while (s.Step()) out.push_back({s.Int(0), s.Int(1), s.Real(2), s.Real(3)});
   return out;
 }
 
+}  // namespace
+
+std::vector<TransitionRecord> Bank::LoadTransitionsFrom(int64_t from_sprite) const {
+  return TransitionsAt(*db_, "from_sprite", from_sprite);
+}
+
 std::vector<TransitionRecord> Bank::LoadTransitionsTo(int64_t to_sprite) const {
-  std::vector<TransitionRecord> out;
-  auto s = db_->Prepare("SELECT from_sprite, to_sprite, d, cost FROM transitions WHERE to_sprite = ? "
-                        "ORDER BY from_sprite");
-  s.Bind(1, to_sprite);
-  while (s.Step()) out.push_back({s.Int(0), s.Int(1), s.Real(2), s.Real(3)});
-  return out;
+  return TransitionsAt(*db_, "to_sprite", to_sprite);
 }
 
 std::vector<SpriteRecord> Bank::LoadClipSprites(int64_t clip_id) const {
