@@ -8,6 +8,7 @@
 #include "core/error.h"
 #include "core/error_kinds.h"
 #include "core/log.h"
+#include "pipeline/run/ingest.h"
 
 namespace ss {
 
@@ -78,10 +79,13 @@ StationConfig ReplayStationConfig(const StationConfig& live, const SessionInfo& 
     cam.realtime = paced;
     c.cameras.push_back(std::move(cam));
   }
-  // The session's own floor when it has one (as ingest takes it), else the config's.
-  std::error_code ec;
-  if (fs::exists(fs::path(dir) / "enclosure.json", ec) || fs::exists(fs::path(dir) / "truth" / "floor.json", ec)) {
-    c.enclosure.floor = GroundPolygon();
+  // The session's own floor when it has one (read as ingest reads it), else the config's.
+  StationConfig without_floor = c;
+  without_floor.enclosure.floor = GroundPolygon();
+  try {
+    c.enclosure.floor = FloorForSession(dir, without_floor);
+  } catch (const InputError&) {
+    // none in the session: the config's floor stays
   }
   return c;
 }
