@@ -95,6 +95,7 @@ void RunDaemon(const DaemonArgs& a) {
     replay_roots.push_back(std::filesystem::absolute(dir, ec).lexically_normal().string());
   }
   ControlServerOptions control_options;
+  control_options.config_path = std::filesystem::absolute(a.config).string();
   control_options.config = options.config.control;
   if (!a.web_dir.empty()) {
     std::error_code ec;

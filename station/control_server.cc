@@ -18,6 +18,7 @@
 #include "core/error_kinds.h"
 #include "core/log.h"
 #include "station/console_bank.h"
+#include "station/api_part.h"
 #include "station/console_events.h"
 #include "station/station.h"
 #include "station/station_host.h"
@@ -29,25 +30,17 @@ namespace {
 namespace fs = std::filesystem;
 using httplib::Request;
 using httplib::Response;
+using api::Dump;
+using api::IntParam;
+using api::ObjectBody;
+using api::PathId;
+using api::Reply;
+using api::ReplyError;
+using api::Route;
 
 constexpr size_t kMaxBodyBytes = 1 << 20;  // every JSON body the API takes is far smaller
 constexpr int kHttpThreads = 32;           // event streams hold one each (at most max_event_streams)
 constexpr int kHttpNice = 10;              // HTTP threads yield the cores to capture and the pipeline
-
-// Text a request sent may be anything, and an error may quote it: bytes that are not UTF-8
-// are replaced (U+FFFD) rather than failing the answer.
-std::string Dump(const nlohmann::json& j, int indent = -1) {
-  return j.dump(indent, ' ', false, nlohmann::json::error_handler_t::replace);
-}
-
-void Reply(Response& res, int status, const nlohmann::json& body) {
-  res.status = status;
-  res.set_content(Dump(body, 2) + "\n", "application/json");
-}
-
-void ReplyError(Response& res, int status, const std::string& message) {
-  Reply(res, status, {{"error", message}});
-}
 
 // HTTP worker threads run at a lower priority than every other thread of the daemon:
 // a preview encode or a bank page never takes a core from capture.
@@ -70,27 +63,6 @@ class NiceThreadPool : public httplib::TaskQueue {
   httplib::ThreadPool pool_;
 };
 
-// The JSON object of a request body; InputError naming the field for anything else or a field
-// not in `fields`. An empty body is an empty object.
-nlohmann::json ObjectBody(const Request& req, std::initializer_list<const char*> fields) {
-  if (req.body.empty()) return nlohmann::json::object();
-  nlohmann::json body;
-  try {
-    body = nlohmann::json::parse(req.body);
-  } catch (const nlohmann::json::exception& e) {
-    throw InputError("body", std::string("not valid JSON: ") + e.what());
-  }
-  if (!body.is_object()) throw InputError("body", "expected a JSON object");
-  for (const auto& [key, value] : body.items()) {
-    if (std::none_of(fields.begin(), fields.end(), [&](const char* f) { return key == f; })) {
-      std::string list;
-      for (const char* f : fields) list += std::string(list.empty() ? "" : ", ") + "\"" + f + "\"";
-      throw InputError(key, "unknown field (the request takes " + (list.empty() ? std::string("none") : list) + ")");
-    }
-  }
-  return body;
-}
-
 // A session name from {"name": S}; "" when absent and not required.
 std::string NameFromBody(const Request& req, bool required) {
   const nlohmann::json body = ObjectBody(req, {"name"});
@@ -101,30 +73,6 @@ std::string NameFromBody(const Request& req, bool required) {
   if (!body["name"].is_string()) throw InputError("name", "expected text, got " + Dump(body["name"]));
   return body["name"].get<std::string>();
 }
-
-// `text` as a whole integer within [lo, hi]; InputError naming `name` otherwise.
-int64_t ParseInt(const std::string& text, const char* name, int64_t lo, int64_t hi) {
-  size_t used = 0;
-  int64_t v = 0;
-  try {
-    v = std::stoll(text, &used);
-  } catch (const std::exception&) {
-    used = 0;
-  }
-  if (used == 0 || used != text.size() || v < lo || v > hi) {
-    throw InputError(name, "expected an integer from " + std::to_string(lo) + " to " + std::to_string(hi) + ", got \"" +
-                               text + "\"");
-  }
-  return v;
-}
-
-// An integer query parameter within [lo, hi], or `fallback` when absent.
-int64_t IntParam(const Request& req, const char* name, int64_t fallback, int64_t lo, int64_t hi) {
-  return req.has_param(name) ? ParseInt(req.get_param_value(name), name, lo, hi) : fallback;
-}
-
-// The id in the path (the pattern's first group).
-int64_t PathId(const Request& req, const char* what) { return ParseInt(req.matches[1], what, 1, INT64_MAX); }
 
 std::string Lower(std::string text) {
   std::transform(text.begin(), text.end(), text.begin(), [](unsigned char c) { return std::tolower(c); });
@@ -151,13 +99,6 @@ const char* ContentTypeOf(const fs::path& path) {
   return "application/octet-stream";
 }
 
-struct Route {
-  const char* method;   // GET | POST
-  const char* pattern;  // httplib regex
-  const char* listed;   // as GET /api lists it
-  std::function<void(const Request&, Response&)> handler;
-};
-
 }  // namespace
 
 struct ControlServer::Impl {
@@ -168,6 +109,16 @@ struct ControlServer::Impl {
   int port = 0;
   std::unique_ptr<ConsoleEvents> events;
   std::vector<Route> routes;
+  std::vector<std::unique_ptr<api::Part>> parts;  // the API's parts in files of their own
+
+  // Every part of the API that lives in a file of its own: one line each.
+  void MakeParts() {
+    api::Context context;
+    context.host = host;
+    context.station = [this] { return station(); };
+    context.config_path = options.config_path;
+    (void)context;
+  }
 
   std::shared_ptr<Station> station() const {
     std::shared_ptr<Station> s = host->current();
@@ -181,6 +132,7 @@ struct ControlServer::Impl {
     status.control_url = Url();
     nlohmann::json j = StatusToJson(status);
     j.update(host->ModeJson());
+    for (const auto& part : parts) part->AddStatus(j);
     return j;
   }
 
@@ -395,7 +347,11 @@ struct ControlServer::Impl {
   }
 
   void Routes() {
+    MakeParts();
     MakeRoutes();
+    for (const auto& part : parts) {
+      for (Route& r : part->Routes()) routes.push_back(std::move(r));
+    }
     server.new_task_queue = [] { return new NiceThreadPool(kHttpThreads); };
     server.set_payload_max_length(kMaxBodyBytes);
     server.set_keep_alive_max_count(1000);
@@ -474,6 +430,7 @@ int ControlServer::Start() {
 
 void ControlServer::Stop() {
   Impl& s = *impl_;
+  for (const auto& part : s.parts) part->Stop();
   s.events->Stop();  // event streams end, so the server's threads can
   if (s.thread.joinable()) {
     s.server.stop();
