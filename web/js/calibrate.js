@@ -40,7 +40,7 @@ async function act(button, fn) {
   }
   try {
     const r = await fn();
-    if (r && typeof r === 'object' && 'cameras' in r && 'step' in r) apply(r);
+    if (r && typeof r === 'object' && 'cameras' in r && 'step' in r) apply(r, true);
     return r;
   } catch (err) {
     showMessage(err.message, 'error');
@@ -208,6 +208,11 @@ function renderRun() {
   eb.hidden = !err;
   eb.textContent = err;
   if (err && err !== lastError) showMessage(err, 'error');
+  if (!err && lastError) {
+    // the state's error went (a camera came back, a new action): so does its message
+    const box = $('message');
+    if (!box.hidden && $('message-text', box)?.textContent === lastError) box.hidden = true;
+  }
   lastError = err || null;
 
   const posed = (c?.cameras || []).some((k) => k.solve?.verdict === 'good' || k.ground || k.step !== 'intrinsics');
@@ -420,10 +425,11 @@ class Card {
     online.dataset.state = cam.online === false ? 'offline' : 'live';
     e['cam-frames'].textContent = `${fmt(cam.frames)} frames`;
     const msg = cam.message || '';
-    e['cam-message'].hidden = !msg;
-    e['cam-message'].textContent = cam.online === false ? `offline: ${msg || 'no frames'}` : msg;
-    e['cam-message'].dataset.kind = cam.online === false ? 'offline' : 'problem';
-    if (cam.online === false) this.#say(`offline${msg ? ': ' + msg : ''}`);
+    const offline = cam.online === false ? (/^offline\b/.test(msg) ? msg : `offline: ${msg || 'no frames'}`) : '';
+    e['cam-message'].hidden = !msg && !offline;
+    e['cam-message'].textContent = offline || msg;
+    e['cam-message'].dataset.kind = offline ? 'offline' : 'problem';
+    if (offline) this.#say(offline);
     else if (wasOffline) {
       this.#say('');
       this.wake?.();
@@ -1013,7 +1019,19 @@ function render() {
   }
 }
 
-function apply(c) {
+// `answer`: an action's answer or GET /api/calibration, which know nothing of
+// whether a camera delivers (the event stream's status adds "online"): that
+// is kept from the last status until the stream says otherwise.
+function apply(c, answer = false) {
+  if (answer && c?.cameras && calib?.cameras) {
+    for (const k of c.cameras) {
+      const old = calib.cameras.find((o) => o.name === k.name);
+      if (k.online === undefined && old?.online !== undefined) {
+        k.online = old.online;
+        if (!k.message && old.message) k.message = old.message;
+      }
+    }
+  }
   calib = c;
   fillForm(c);
 }
@@ -1029,7 +1047,7 @@ events.addEventListener('status', (e) => {
 getJson('/api/calibration')
   .then((c) => {
     if (calib === null) {
-      apply(c);
+      apply(c, true);
       render();
     }
   })
