@@ -19,6 +19,7 @@
 #include "core/log.h"
 #include "station/console_bank.h"
 #include "station/api_part.h"
+#include "station/console_calibration.h"
 #include "station/console_events.h"
 #include "station/station.h"
 #include "station/station_host.h"
@@ -117,7 +118,7 @@ struct ControlServer::Impl {
     context.host = host;
     context.station = [this] { return station(); };
     context.config_path = options.config_path;
-    (void)context;
+    parts.push_back(std::make_unique<ConsoleCalibration>(context));
   }
 
   std::shared_ptr<Station> station() const {

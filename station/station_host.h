@@ -51,6 +51,14 @@ class StationHost {
   // InputError (field "replay") when no replay runs.
   void StopReplay();
 
+  // The live station's config (the daemon's, with what ApplyLiveConfig changed).
+  StationConfig live_config() const;
+  // A new config for the live station (the calibration wizard's models and floor): the live
+  // station restarts with it at once (true), or, while a replay runs, when the replay stops
+  // (false). When the new station cannot start, the previous config runs again and the
+  // error is thrown.
+  bool ApplyLiveConfig(const StationConfig& config);
+
   // {"mode": "live" | "replay", "replay": {"path", "paced", "loop"} or null}
   nlohmann::json ModeJson() const;
   const std::vector<std::string>& replay_roots() const { return replay_roots_; }
