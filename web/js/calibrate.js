@@ -91,7 +91,8 @@ function num(name, fallback) {
 
 function criteriaSummary() {
   $('calib-criteria-summary').textContent =
-    `views ≥ ${form.elements.min_views.value || 10}, coverage ≥ ${form.elements.min_coverage.value || 50} %, RMS < ${form.elements.max_rms.value || 0.5} px`;
+    `views ≥ ${form.elements.min_views.value || 10}, coverage ≥ ${form.elements.min_coverage.value || 50} %, ` +
+    `RMS < ${form.elements.max_rms.value || 0.5} px, floor still ${form.elements.floor_still.value || 1} s`;
 }
 form.addEventListener('input', criteriaSummary);
 criteriaSummary();
@@ -111,11 +112,13 @@ form.addEventListener('submit', (ev) => {
       min_views: Math.round(num('min_views', 10)),
       min_coverage: num('min_coverage', 50) / 100,
       max_rms_px: num('max_rms', 0.5),
+      floor_still_s: num('floor_still', 1),
       use_current_intrinsics: form.elements.use_current.checked,
     };
     clearPicks();
     lastError = null;
     const r = await postJson('/api/calibration/start', body);
+    $('calib-start-box').open = false; // the run's cards take the room
     try {
       sessionStorage.setItem('calibrate.start', JSON.stringify(body));
     } catch {
@@ -148,6 +151,7 @@ function fillForm(c) {
   if (o.min_views) form.elements.min_views.value = o.min_views;
   if (o.min_coverage !== undefined) form.elements.min_coverage.value = Math.round(o.min_coverage * 100);
   if (o.max_rms_px) form.elements.max_rms.value = o.max_rms_px;
+  if (o.floor_still_s) form.elements.floor_still.value = o.floor_still_s;
   if (Array.isArray(o.board_pose)) ['bx', 'by', 'yaw'].forEach((k, i) => (form.elements[k].value = o.board_pose[i]));
   if (o.board_thickness_m !== undefined) form.elements.thick.value = o.board_thickness_m * 1000;
   criteriaSummary();
@@ -230,7 +234,7 @@ function renderSaved(saved) {
   const list = (items, testid) => el('ul', { class: 'paths' }, ...(items || []).map((p) => el('li', { testid, title: p, 'data-path': p }, el('bdi', { text: p }))));
   box.replaceChildren(
     el('h3', { text: `Saved ${saved.at ? new Date(saved.at).toLocaleString() : ''}` }),
-    list(saved.files, 'saved-file'),
+    list((saved.files || []).filter((f) => f !== saved.config), 'saved-file'),
     ...(saved.previous?.length ? [el('h3', { text: 'Previous files kept' }), list(saved.previous, 'saved-previous')] : []),
     ...(saved.config ? [el('h3', { text: 'Config' }), list([saved.config], 'saved-config')] : []),
     el('p', { testid: 'saved-station', class: saved.station_restarted ? 'ok' : 'warn',
@@ -868,6 +872,8 @@ function drawPlan() {
   ctx.clearRect(0, 0, w, h);
   ctx.fillStyle = '#0a0e14';
   ctx.fillRect(0, 0, w, h);
+  ctx.textAlign = 'left';
+  ctx.textBaseline = 'alphabetic';
   const cams = calib?.cameras || [];
   // the enclosure all cameras share: the one set last
   for (const c of cams) {
@@ -973,10 +979,15 @@ function drawPlan() {
     ctx.fill();
     ctx.strokeStyle = '#fff';
     ctx.stroke();
-    ctx.fillStyle = '#d7dee9';
+    // its name and height beside it, on a dark patch
     const label = `${c.name} ${fmt(pz, 2)} m`;
-    const tx = Math.min(w - ctx.measureText(label).width - 4, Math.max(4, X(px) + 8));
-    ctx.fillText(label, tx, Math.max(12, Math.min(h - 18, Y(py) - 6)));
+    const tw = ctx.measureText(label).width;
+    const tx = Math.min(w - tw - 4, Math.max(4, X(px) + 9));
+    const ty = Math.max(12, Math.min(h - 20, Y(py) + 4));
+    ctx.fillStyle = 'rgba(10,14,20,0.8)';
+    ctx.fillRect(tx - 2, ty - 10, tw + 4, 13);
+    ctx.fillStyle = '#d7dee9';
+    ctx.fillText(label, tx, ty);
   }
   // the metre scale: a nice length about a quarter of the width
   const want = (w * 0.28) / k;
