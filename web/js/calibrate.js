@@ -135,7 +135,7 @@ $('calib-cancel').addEventListener('click', (e) => {
 $('calib-save').addEventListener('click', (e) => {
   act(e.currentTarget, async () => {
     const r = await postJson('/api/calibration/save');
-    const n = r?.saved?.files?.length || 0;
+    const n = (r?.saved?.files || []).filter((f) => f !== r.saved.config).length;
     showMessage(`Saved ${n} camera model${n === 1 ? '' : 's'}${r?.saved?.station_restarted ? '; the station now uses them' : ''}.`, 'info');
     return r;
   });
@@ -239,7 +239,7 @@ function renderSaved(saved) {
     ...(saved.config ? [el('h3', { text: 'Config' }), list([saved.config], 'saved-config')] : []),
     el('p', { testid: 'saved-station', class: saved.station_restarted ? 'ok' : 'warn',
       text: saved.station_restarted ? 'The station was restarted with these models and now uses them.'
-        : 'The station still runs with its previous models.' }),
+        : saved.note || 'The station has not restarted with them yet.' }),
   );
 }
 

@@ -8,6 +8,7 @@
 // The tests run in order on one daemon; each goes on from the last one's state.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
+import { spawn } from 'node:child_process';
 import fs from 'node:fs';
 import path from 'node:path';
 import * as h from './harness.mjs';
@@ -18,7 +19,22 @@ const CARD = '[data-testid="calib-camera"][data-camera="cam0"]';
 const started = Date.now();
 const measured = {}; // what the page and the command line reached, reported at the end
 
-let dir, truth, floor, cfg, station, cam, b, p;
+let dir, truth, floor, cfg, station, cam, b, p, cli, cliProc;
+
+// `calibrate wizard` on the same session, in the background: {code, stdout, stderr, seconds}.
+function runCli(out) {
+  const args = ['--log-level', 'warn', 'calibrate', 'wizard', '--session', dir, '--board', BOARD,
+    '--board-pose', ...POSE, '--board-thickness', '0.001', '--floor-still-seconds', '0.5', '--min-coverage', '0.4',
+    '--out', out, '--json'];
+  const t0 = Date.now();
+  const proc = spawn(h.BIN, args, { stdio: ['ignore', 'pipe', 'pipe'] });
+  cliProc = proc;
+  let stdout = '';
+  let stderr = '';
+  proc.stdout.on('data', (d) => (stdout += d));
+  proc.stderr.on('data', (d) => (stderr += d));
+  return new Promise((resolve) => proc.on('exit', (code) => resolve({ code, stdout, stderr, seconds: (Date.now() - t0) / 1000 })));
+}
 
 // ---- the .cameramodel text (a Python-literal dict) -----------------------------
 
@@ -146,7 +162,7 @@ async function startWizard(board) {
   await p.fill('[data-testid="calib-thickness"]', '1');
   if (!(await p.$eval('details.criteria', (d) => d.open))) await p.click('details.criteria summary');
   await p.fill('[data-testid="calib-min-coverage"]', '40');
-  await p.fill('[data-testid="calib-floor-still"]', '1'); // 4 frames averaged, as the command line's 0.5 s at 8 fps
+  await p.fill('[data-testid="calib-floor-still"]', String(4 / FPS)); // 4 frames averaged, as the command line's 0.5 s at 8 fps
   const run = (await api('/api/calibration')).run || 0;
   await p.click('[data-testid="calib-start"]');
   await h.waitFor(`wizard run ${run + 1} with ${board}`, async () => {
@@ -171,21 +187,28 @@ function errorShown(re) {
   }, { timeout: 20000 });
 }
 
-// The session's 8 frames a second served at 4 (the same frames, twice as far apart): the
+// The session's 8 frames a second served at 2 (the same frames, 4 times as far apart): the
 // board holds each pose for 2 or 3 frames, and the wizard sees it still only when it
-// processes 2 of them in a row; on two shared cores it keeps up with 4 a second, not 8.
-const FPS = process.env.SS_CALIB_FPS || '4';
+// processes 2 of them in a row; on two cores shared with other work it processes 2 to 5
+// frames a second, not 8.
+const FPS = Number(process.env.SS_CALIB_FPS || 2);
 async function fakecam() {
   const c = new h.Child('fakecam-calib', ['fakecam', dir, '--address', '127.0.0.2', '--serial', 'calib',
-    '--loop', '0', '--pixel-format', 'rgb8', '--fps', FPS]);
+    '--loop', '0', '--pixel-format', 'rgb8', '--fps', String(FPS)]);
   await c.waitForOutput(/fakecam: serving/, 30000);
   return c;
 }
 
-// Until the station's camera delivers again (a restarted fakecam is reopened with backoff).
-function stationLive() {
-  return h.waitFor('cam0 live in the station', async () =>
-    (await api('/api/status')).cameras.find((c) => c.name === 'cam0')?.state === 'live', { timeout: 30000, interval: 100 });
+// Until the station's camera delivers again (a restarted fakecam is reopened with backoff)
+// at its rate: the wizard turns its still times into frame counts with the rate the station
+// measures when it starts, which is off for a moment after a reopen.
+async function stationLive() {
+  let steady = 0;
+  await h.waitFor(`cam0 live in the station at ${FPS} fps`, async () => {
+    const c = (await api('/api/status')).cameras.find((k) => k.name === 'cam0');
+    steady = c?.state === 'live' && Math.abs(c.fps - FPS) < 0.2 * FPS ? steady + 1 : 0;
+    return steady >= 3 && c;
+  }, { timeout: 30000, interval: 250 });
 }
 
 // ---- the station -----------------------------------------------------------------
@@ -209,6 +232,7 @@ before(async () => {
 });
 
 after(async () => {
+  if (cliProc && cliProc.exitCode === null) cliProc.kill('SIGKILL');
   await b?.close();
   await station?.stop();
   await cam?.kill();
@@ -231,7 +255,7 @@ test('the start form lists the cameras; a board that does not match is named on 
   }, { timeout: 20000 });
   const seen = await h.waitFor('"no board" on the page', async () => {
     const c = await card();
-    return c.frame > first.frame + 16 && c.boardState === 'none' && /no board/i.test(c.board) &&
+    return c.frame > first.frame + 8 && c.boardState === 'none' && /no board/i.test(c.board) &&
       c.guidance.some((g) => /board/.test(g)) && c;
   }, { timeout: 20000 });
   assert.equal(seen.views, 0, 'no view captured with the wrong board');
@@ -331,6 +355,9 @@ test('intrinsics: views captured while the board stands still; a vanished camera
   assert.ok(err.fx_percent < 0.2 && err.fy_percent < 0.2, `fx, fy within 0.2 % of the truth: ${JSON.stringify(err)}`);
   await h.sleep(300);
   await h.screenshot(p, 'console-calibrate-solve.png');
+  // The command-line wizard's run, while this one waits for the boards to lie on the floor
+  // (the ChArUco segment: 36 s at 2 fps, little for the station to do).
+  cli = runCli(path.join(h.WORK, 'calib-cli'));
 });
 
 test('ground: the board lying on the floor poses the camera; height, tilt, grid; the green floor detected', async () => {
@@ -408,7 +435,8 @@ test('save: the model is written, the station uses it, and its pose meets the tr
   savedFile = path.join(cfg.dir, 'calibration', 'cam0.cameramodel');
   assert.deepEqual(files, [savedFile]);
   assert.ok(fs.existsSync(savedFile));
-  assert.match(await h.text(p, 'saved-station'), /now uses them/);
+  await h.waitFor('the page saying the station uses them', async () => /now uses them/.test(await h.text(p, 'saved-station')),
+    { timeout: 30000 });
   // the config names it (the previous config kept); the station's camera has a model
   const yaml = fs.readFileSync(cfg.file, 'utf8');
   assert.ok(yaml.includes(savedFile), `the config names ${savedFile}:\n${yaml}`);
@@ -451,20 +479,14 @@ test('saving over a read-only folder names the folder, and the saved model is ke
 });
 
 test('the command-line wizard on the same footage meets the same numbers', async () => {
-  // alone on the machine: the station, its camera and the browser are done
-  await b.close();
-  b = null;
-  await station.stop();
-  station = null;
-  await cam.kill();
-  const out = path.join(h.WORK, 'calib-cli');
-  const r = h.run(['--log-level', 'warn', 'calibrate', 'wizard', '--session', dir, '--board', BOARD,
-    '--board-pose', ...POSE, '--board-thickness', '0.001', '--floor-still-seconds', '0.5', '--min-coverage', '0.4',
-    '--out', out, '--json']);
-  const j = JSON.parse(r.slice(r.indexOf('{')));
+  assert.ok(cli, 'the command line ran');
+  const r = await cli;
+  assert.equal(r.code, 0, r.stderr);
+  const j = JSON.parse(r.stdout);
   assert.equal(j.verdict, 'good');
-  const err = against(readModel(path.join(out, 'cam0.cameramodel')));
+  const err = against(readModel(path.join(h.WORK, 'calib-cli', 'cam0.cameramodel')));
   measured.cli = round(err);
+  measured.cli_seconds = Math.round(r.seconds);
   for (const m of [measured.cli, measured.page]) {
     assert.ok(m.fx_percent < 0.2 && m.fy_percent < 0.2 && m.centre_mm < 2 && m.rotation_deg < 0.1, JSON.stringify(m));
   }
