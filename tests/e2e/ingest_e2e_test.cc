@@ -98,5 +98,36 @@ TEST_F(IngestEndToEnd, ACameraThatCannotBeReadIsAFailureNamedAfterTheRest) {
   EXPECT_EQ(verify.exit_code, 0) << verify.output;
 }
 
+// A 1080p session recorded in the fast codec (ffvhuff) and in FFV1 is the same footage: both
+// decode to the same bytes, so ingest stores the same bank from either.
+TEST(IngestCodecs, FfvhuffAndFfv1GiveTheSameBank) {
+  ScratchDir dir;
+  const std::string common = " --kind animal --seconds 5 --fps 10 --size 1920x1080 --cameras 1 --subjects 1 --seed 4"
+                             " --empty-lead-in 3 --no-mattes --noise 1";
+  std::string digest[2];
+  int index = 0;
+  for (const std::string codec : {"ffv1", "ffvhuff"}) {
+    const std::string session = dir / codec;
+    auto r = RunSpritestation("--log-level warn synth --out " + session + common + " --codec " + codec);
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    const std::string bank = dir / (codec + ".bank");
+    r = RunSpritestation("--log-level warn ingest " + session + " --bank " + bank + " --no-transitions --json");
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    const nlohmann::json j = JsonInOutput(r.output);
+    ASSERT_TRUE(j.is_object()) << r.output;
+    EXPECT_GT(j["sprites_kept"].get<int>(), 5) << codec << ": " << r.output;
+    // Every stored number and every billboard's bytes, in order.
+    r = testing::RunCommand("sqlite3 -readonly " + bank +
+                            " \"SELECT s.frame, s.track_id, s.mirrored, s.ground_x_m, s.ground_y_m, s.mean_r, s.mean_g,"
+                            " s.mean_b, s.area_px, s.bbox_x, s.bbox_y, s.bbox_w, s.bbox_h, hex(p.data)"
+                            " FROM sprites s JOIN sprite_pixels p ON p.sprite_id = s.id ORDER BY s.id\"");
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    digest[index++] = r.output;
+  }
+  EXPECT_FALSE(digest[0].empty());
+  EXPECT_TRUE(digest[0] == digest[1]) << "the banks differ (" << digest[0].size() << " vs " << digest[1].size()
+                                      << " bytes of rows)";
+}
+
 }  // namespace
 }  // namespace ss
