@@ -20,6 +20,7 @@
 #include "station/console_bank.h"
 #include "station/api_part.h"
 #include "station/console_events.h"
+#include "station/console_labels.h"
 #include "station/station.h"
 #include "station/station_host.h"
 #include "station/station_status.h"
@@ -118,6 +119,7 @@ struct ControlServer::Impl {
     context.station = [this] { return station(); };
     context.config_path = options.config_path;
     (void)context;
+    parts.push_back(std::make_unique<ConsoleLabels>(context));
   }
 
   std::shared_ptr<Station> station() const {
