@@ -183,15 +183,18 @@ struct ConsoleLabels::Pool {
 };
 
 ConsoleLabels::ConsoleLabels(api::Context context, ConsoleLabelsOptions options)
-    : context_(std::move(context)), options_(std::move(options)) {
-  retrain_ = {{"state", "idle"}, {"progress", 0}, {"stage", ""}};
+    : context_(std::move(context)), options_(std::move(options)), shared_(std::make_shared<Shared>()) {
+  shared_->retrain = {{"state", "idle"}, {"progress", 0}, {"stage", ""}};
 }
 
 ConsoleLabels::~ConsoleLabels() { Stop(); }
 
 void ConsoleLabels::Stop() {
-  stop_ = true;
-  if (thread_.joinable()) thread_.join();
+  std::unique_lock lock(shared_->mutex);
+  shared_->stop = true;
+  // A thread restarting the station or following its rebuild stops within ~0.1 s after that;
+  // one still training is left to finish alone (it touches only `shared_` and files).
+  shared_->changed.wait(lock, [&] { return !shared_->using_host; });
 }
 
 std::string ConsoleLabels::BankPath() const {
@@ -204,8 +207,8 @@ std::pair<TransitionWeights, std::string> ConsoleLabels::WeightsInUse() const {
     StationHost::Weights w = context_.host->weights();
     return {std::move(w.weights), std::move(w.path)};
   }
-  std::lock_guard lock(mutex_);
-  if (own_weights_) return *own_weights_;
+  std::lock_guard lock(shared_->mutex);
+  if (shared_->own_weights) return *shared_->own_weights;
   return {DefaultWeights(), ""};
 }
 
@@ -343,8 +346,8 @@ nlohmann::json ConsoleLabels::Store(const nlohmann::json& body) {
   TransitionLabelRecord record{from, to, label, UtcText(true), "console"};
   BankWriter(bank).SetTransitionLabel(record);
   {
-    std::lock_guard lock(mutex_);
-    dirty_ = true;
+    std::lock_guard lock(shared_->mutex);
+    shared_->dirty = true;
   }
   return {{"stored", {{"from", from}, {"to", to}, {"label", label}, {"labelled_at", record.labelled_at}}},
           {"labels", Counts()}};
@@ -358,8 +361,8 @@ nlohmann::json ConsoleLabels::Undo(const nlohmann::json& body) {
     throw NotFoundError("label", "no label for the pair " + std::to_string(from) + " -> " + std::to_string(to));
   }
   {
-    std::lock_guard lock(mutex_);
-    dirty_ = true;
+    std::lock_guard lock(shared_->mutex);
+    shared_->dirty = true;
   }
   return {{"removed", {{"from", from}, {"to", to}}}, {"labels", Counts()}};
 }
@@ -370,22 +373,16 @@ std::string ConsoleLabels::ExportCsv() const {
 }
 
 nlohmann::json ConsoleLabels::RetrainState() const {
-  std::lock_guard lock(mutex_);
-  return retrain_;
-}
-
-void ConsoleLabels::SetRetrain(const std::function<void(nlohmann::json&)>& change) {
-  std::lock_guard lock(mutex_);
-  change(retrain_);
+  std::lock_guard lock(shared_->mutex);
+  return shared_->retrain;
 }
 
 nlohmann::json ConsoleLabels::StartRetrain() {
   const std::string bank = BankPath();
   {
-    std::lock_guard lock(mutex_);
-    const std::string state = retrain_.value("state", "idle");
-    if (state == "training" || state == "rebuilding") {
-      throw ConflictError("retrain", "a retrain is running (" + retrain_.value("stage", std::string()) + ")");
+    std::lock_guard lock(shared_->mutex);
+    if (shared_->running) {
+      throw ConflictError("retrain", "a retrain is running (" + shared_->retrain.value("stage", std::string()) + ")");
     }
   }
   if (context_.host) {
@@ -402,11 +399,12 @@ nlohmann::json ConsoleLabels::StartRetrain() {
                                    " no: retraining needs at least " + std::to_string(options_.min_labels) +
                                    " labels, some of each (skips do not count)");
   }
-  if (thread_.joinable()) thread_.join();  // the previous retrain, finished
   auto [weights, path] = WeightsInUse();
   {
-    std::lock_guard lock(mutex_);
-    retrain_ = {{"state", "training"},
+    std::lock_guard lock(shared_->mutex);
+    if (shared_->running || shared_->stop) throw ConflictError("retrain", "a retrain is running, or the server stops");
+    shared_->running = true;
+    shared_->retrain = {{"state", "training"},
                 {"progress", 0.02},
                 {"stage", "exporting the labels"},
                 {"labels", yes + no},
@@ -414,17 +412,33 @@ nlohmann::json ConsoleLabels::StartRetrain() {
                 {"started", UtcText(true)},
                 {"previous_weights", path.empty() ? "shipped defaults" : path}};
   }
-  stop_ = false;
-  thread_ = std::thread([this, bank, w = std::move(weights)] { RunRetrain(bank, w); });
+  std::thread(RunRetrain, shared_, context_, options_, bank, std::move(weights)).detach();
   return RetrainState();
 }
 
 void ConsoleLabels::WaitRetrain() {
-  if (thread_.joinable()) thread_.join();
+  std::unique_lock lock(shared_->mutex);
+  shared_->changed.wait(lock, [&] { return !shared_->running; });
 }
 
-void ConsoleLabels::RunRetrain(std::string bank, TransitionWeights current) {
+void ConsoleLabels::RunRetrain(std::shared_ptr<Shared> shared, api::Context context, ConsoleLabelsOptions options,
+                               std::string bank, TransitionWeights current) {
   auto log = Log("station.labels");
+  auto SetRetrain = [&](const std::function<void(nlohmann::json&)>& change) {
+    std::lock_guard lock(shared->mutex);
+    change(shared->retrain);
+  };
+  // Enters the part of the work that uses the station host: false when the server stops.
+  auto enter_host = [&] {
+    std::lock_guard lock(shared->mutex);
+    if (shared->stop) return false;
+    shared->using_host = true;
+    return true;
+  };
+  auto stopping = [&] {
+    std::lock_guard lock(shared->mutex);
+    return shared->stop;
+  };
   const auto t0 = std::chrono::steady_clock::now();
   auto seconds = [](auto since) { return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count(); };
   try {
@@ -449,10 +463,9 @@ void ConsoleLabels::RunRetrain(std::string bank, TransitionWeights current) {
     BankTrainOptions train;
     train.train.folds = kFolds;
     train.window = current.window;
-    train.threads = options_.threads;
+    train.threads = options.threads;
     const BankTrainResult result = TrainOnBank(labels_path.string(), bank, train);
     const double train_s = seconds(t0);
-    if (stop_) return;
 
     // 3. The weights file, written whole under a name no other file has.
     const fs::path weights_path = FreshName(dir, "weights-", stamp, ".json");
@@ -492,16 +505,27 @@ void ConsoleLabels::RunRetrain(std::string bank, TransitionWeights current) {
       });
     };
     bool rebuilt_by_station = false;
-    if (context_.host) {
-      const std::shared_ptr<Station> before = context_.host->current();
+    if (context.host) {
+      if (!enter_host()) throw WorkError("retrain", "the server stopped before the station used the new weights");
+      struct Leave {
+        Shared& s;
+        ~Leave() {
+          {
+            std::lock_guard lock(s.mutex);
+            s.using_host = false;
+          }
+          s.changed.notify_all();
+        }
+      } leave{*shared};
+      const std::shared_ptr<Station> before = context.host->current();
       const bool worker = before && before->Status().transitions_enabled;
-      context_.host->UseWeights(result.weights, weights_path.string());
+      context.host->UseWeights(result.weights, weights_path.string());
       if (worker) {
         rebuilt_by_station = true;
         // The new station's transition worker rebuilds the table at its start.
         for (;;) {
-          if (stop_) return;
-          const std::shared_ptr<Station> station = context_.host->current();
+          if (stopping()) throw WorkError("retrain", "the server stopped while the transitions were rebuilt");
+          const std::shared_ptr<Station> station = context.host->current();
           const StationStatus st = station->Status();
           if (st.transitions_ready) {
             if (!st.transitions_error.empty()) throw WorkError("transitions", st.transitions_error);
@@ -514,13 +538,13 @@ void ConsoleLabels::RunRetrain(std::string bank, TransitionWeights current) {
         }
       }
     } else {
-      std::lock_guard lock(mutex_);
-      own_weights_ = std::make_pair(result.weights, weights_path.string());
+      std::lock_guard lock(shared->mutex);
+      shared->own_weights = std::make_pair(result.weights, weights_path.string());
     }
     if (!rebuilt_by_station) {
       BankUpdateOptions update;
       update.weights = result.weights;
-      update.threads = options_.threads;
+      update.threads = options.threads;
       update.progress = [&](const std::string& stage, size_t done, size_t total) {
         stage_progress(stage, static_cast<int64_t>(done), static_cast<int64_t>(total));
       };
@@ -551,15 +575,20 @@ void ConsoleLabels::RunRetrain(std::string bank, TransitionWeights current) {
       r["finished"] = UtcText(true);
     });
   }
-  std::lock_guard lock(mutex_);
-  dirty_ = true;
+  {
+    std::lock_guard lock(shared->mutex);
+    shared->dirty = true;
+    shared->running = false;
+  }
+  shared->changed.notify_all();
 }
 
 void ConsoleLabels::RefreshStatus() const {
   {
-    std::lock_guard lock(mutex_);
-    if (!dirty_ && Now() - refreshed_at_ < 2.0) return;
-    dirty_ = false;
+    std::lock_guard lock(shared_->mutex);
+    std::lock_guard status_lock(status_mutex_);
+    if (!shared_->dirty && Now() - refreshed_at_ < 2.0) return;
+    shared_->dirty = false;
     refreshed_at_ = Now();
   }
   nlohmann::json labels, weights;
@@ -581,7 +610,7 @@ void ConsoleLabels::RefreshStatus() const {
   std::string fingerprint;
   nlohmann::json training;
   {
-    std::lock_guard lock(mutex_);
+    std::lock_guard lock(status_mutex_);
     if (weights_status_path_ == path && weights_status_.contains("fingerprint")) {
       fingerprint = weights_status_["fingerprint"];
     }
@@ -598,7 +627,7 @@ void ConsoleLabels::RefreshStatus() const {
              {"table", table},
              {"cross_validated", CrossValidated(training, "stage2")},
              {"positive_rate", CalibratedPositiveRate(w) > 0 ? nlohmann::json(CalibratedPositiveRate(w)) : nullptr}};
-  std::lock_guard lock(mutex_);
+  std::lock_guard lock(status_mutex_);
   labels_status_ = std::move(labels);
   weights_status_ = std::move(weights);
   weights_status_path_ = path;
@@ -610,12 +639,13 @@ void ConsoleLabels::AddStatus(nlohmann::json& status) const {
   } catch (const std::exception& e) {
     Log("station.labels")->warn("labels status: {}", e.what());
   }
-  std::lock_guard lock(mutex_);
+  nlohmann::json retrain = RetrainState();
+  std::lock_guard lock(status_mutex_);
   status["labels"] = labels_status_;
   nlohmann::json& t = status["transitions"];
   if (!t.is_object()) t = nlohmann::json::object();
   t["weights"] = weights_status_;
-  t["retrain"] = retrain_;
+  t["retrain"] = std::move(retrain);
 }
 
 std::vector<Route> ConsoleLabels::Routes() {

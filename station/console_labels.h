@@ -9,14 +9,13 @@
 //
 // A pair (i, j) is the classifier's pair: the page plays it as the transition i -> j
 // would look (i-1, i, then j, j+1) and the label says whether that jump looks smooth.
-#include <atomic>
+#include <condition_variable>
 #include <cstdint>
 #include <map>
 #include <memory>
 #include <mutex>
 #include <optional>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -78,29 +77,37 @@ class ConsoleLabels : public api::Part {
 
  private:
   struct Pool;
-  struct Retrain;
+  // What the retrain thread shares with the part. The thread is detached: a daemon told to
+  // stop while a long training runs does not wait for it (Stop waits only while the thread
+  // uses the station host, i.e. restarts the station or follows its rebuild).
+  struct Shared {
+    std::mutex mutex;  // guards every member
+    std::condition_variable changed;
+    nlohmann::json retrain;  // the status' "retrain" member
+    std::optional<std::pair<TransitionWeights, std::string>> own_weights;  // without a host
+    bool running = false;   // a retrain thread exists
+    bool using_host = false;
+    bool stop = false;
+    bool dirty = true;      // the labels or weights changed: refresh the status
+  };
   std::string BankPath() const;
   // The weights in use: the host's (its stations run them), else this part's own.
   std::pair<TransitionWeights, std::string> WeightsInUse() const;
-  void RunRetrain(std::string bank, TransitionWeights current);
-  void SetRetrain(const std::function<void(nlohmann::json&)>& change);
+  static void RunRetrain(std::shared_ptr<Shared> shared, api::Context context, ConsoleLabelsOptions options,
+                         std::string bank, TransitionWeights current);
   void RefreshStatus() const;  // labels and weights from the bank (at most every 2 s)
 
   api::Context context_;
   ConsoleLabelsOptions options_;
+  std::shared_ptr<Shared> shared_;
 
   std::mutex pool_mutex_;  // one pair search at a time
   std::unique_ptr<Pool> pool_;
 
-  mutable std::mutex mutex_;  // guards what follows
-  std::optional<std::pair<TransitionWeights, std::string>> own_weights_;  // without a host
-  nlohmann::json retrain_;     // the status' "retrain" member
+  mutable std::mutex status_mutex_;  // guards what follows
   mutable nlohmann::json labels_status_, weights_status_;
   mutable std::string weights_status_path_;
   mutable double refreshed_at_ = -1e9;
-  mutable bool dirty_ = true;
-  std::thread thread_;
-  std::atomic<bool> stop_{false};
 };
 
 }  // namespace ss
