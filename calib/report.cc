@@ -152,6 +152,17 @@ CameraReport MakeCameraReport(const BoardSpec& board, const SolveSummary& soluti
                   r.max_tilt_deg, options.min_tilt_deg);
     r.reasons.push_back(buf);
   }
+  if (options.max_stdev_percent > 0) {
+    for (size_t i = 0; i < 4 && i < r.intrinsics.size() && i < r.intrinsics_stdev.size(); ++i) {
+      const double percent = 1.96 * r.intrinsics_stdev[i] / std::abs(r.intrinsics[i]) * 100;
+      if (!(percent <= options.max_stdev_percent)) {
+        std::snprintf(buf, sizeof buf, "%s known to %.2f%% only (1.96 sigma; need %.2f%%); capture more views, "
+                      "tilted and nearer the edges", i < r.parameter_names.size() ? r.parameter_names[i].c_str() : "?",
+                      percent, options.max_stdev_percent);
+        r.reasons.push_back(buf);
+      }
+    }
+  }
   r.good = r.reasons.empty();
   return r;
 }
@@ -250,6 +261,60 @@ void WriteCoverageMap(const std::string& path, const SolveSummary& solution, int
   std::snprintf(text, sizeof text, "coverage %.0f%% of %dx%d cells, up to %.0f corners per cell",
                 100.0 * cv::countNonZero(counts) / counts.total(), options.grid_x, options.grid_y, peak);
   cv::putText(canvas, text, {8, 18}, cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
+  WritePng(path, canvas);
+}
+
+void WriteUncertaintyMap(const std::string& path, const SolveSummary& solution, const BoardSpec& board, int camera,
+                         double distance_m) {
+  const CameraModel& m = solution.models.at(camera);
+  const double scale = std::min(1.0, 960.0 / m.width());
+  const int w = static_cast<int>(m.width() * scale), h = static_cast<int>(m.height() * scale);
+  // Sampled on a coarse grid (each sample is a small covariance product), then interpolated.
+  constexpr int kX = 24, kY = 18;
+  cv::Mat samples(kY, kX, CV_32F);
+  double worst = 0;
+  for (int gy = 0; gy < kY; ++gy) {
+    for (int gx = 0; gx < kX; ++gx) {
+      const Eigen::Vector2d q((m.width() - 1) * gx / (kX - 1.0), (m.height() - 1) * gy / (kY - 1.0));
+      const double s = ProjectionStdev(solution, board, camera, q, distance_m);
+      samples.at<float>(gy, gx) = std::isfinite(s) ? static_cast<float>(s) : 0.f;
+      if (std::isfinite(s)) worst = std::max(worst, s);
+    }
+  }
+  const double centre = ProjectionStdev(solution, board, camera, {(m.width() - 1) / 2.0, (m.height() - 1) / 2.0}, distance_m);
+  cv::Mat smooth, levels, canvas;
+  cv::resize(samples, smooth, cv::Size(w, h), 0, 0, cv::INTER_CUBIC);
+  // Colour scale 0 .. max(1 px, worst): a good calibration stays dark everywhere.
+  const double top = std::max(1.0, worst);
+  smooth.convertTo(levels, CV_8U, 255.0 / top);
+  cv::applyColorMap(levels, canvas, cv::COLORMAP_VIRIDIS);
+  // Contours at 0.1, 0.25, 0.5, 1, 2 px.
+  for (const double c : {0.1, 0.25, 0.5, 1.0, 2.0}) {
+    if (c > top) break;
+    cv::Mat above = smooth > c;
+    std::vector<std::vector<cv::Point>> contours;
+    cv::findContours(above, contours, cv::RETR_LIST, cv::CHAIN_APPROX_SIMPLE);
+    cv::drawContours(canvas, contours, -1, cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
+    if (!contours.empty() && !contours.front().empty()) {
+      char label[32];
+      std::snprintf(label, sizeof label, "%.2g", c);
+      cv::putText(canvas, label, contours.front()[contours.front().size() / 2], cv::FONT_HERSHEY_SIMPLEX, 0.4,
+                  cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
+    }
+  }
+  char text[200];
+  std::snprintf(text, sizeof text, "projection uncertainty at %.2f m: centre %.3f px, worst %.3f px (1 sigma)",
+                distance_m, centre, worst);
+  cv::putText(canvas, text, {8, 18}, cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
+  // The scale bar.
+  const int bar_w = std::min(200, w / 3), bar_x = w - bar_w - 10, bar_y = h - 24;
+  for (int x = 0; x < bar_w; ++x) {
+    cv::Mat one(1, 1, CV_8U, cv::Scalar(255 * x / std::max(1, bar_w - 1))), colour;
+    cv::applyColorMap(one, colour, cv::COLORMAP_VIRIDIS);
+    cv::line(canvas, {bar_x + x, bar_y}, {bar_x + x, bar_y + 10}, cv::Scalar(colour.at<cv::Vec3b>(0, 0)));
+  }
+  std::snprintf(text, sizeof text, "0 .. %.2f px", top);
+  cv::putText(canvas, text, {bar_x, bar_y - 4}, cv::FONT_HERSHEY_SIMPLEX, 0.4, cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
   WritePng(path, canvas);
 }
 

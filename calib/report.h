@@ -23,6 +23,8 @@ struct VerdictOptions {
   double min_coverage = 0.5;       // fraction of the image grid cells with observed corners
   double min_tilt_deg = 20.0;      // the most tilted view must be tilted at least this much
   int grid_x = 12, grid_y = 9;     // coverage cells
+  // fx, fy, cx, cy each known to this percent of its value (1.96 sigma); 0: not checked.
+  double max_stdev_percent = 0;
 };
 
 struct CameraReport {
@@ -57,6 +59,10 @@ CameraReport FailedCameraReport(const std::string& camera, const std::vector<Boa
 // corners per cell as a heat map. WorkError naming the file when it cannot be written.
 void WriteResidualPlot(const std::string& path, const SolveSummary& solution, int camera);
 void WriteCoverageMap(const std::string& path, const SolveSummary& solution, int camera, const VerdictOptions& options);
+// mrcal's projection uncertainty (ProjectionStdev) across the image at `distance_m`, as a heat
+// map with contours and a scale, the worst and the centre value written on it.
+void WriteUncertaintyMap(const std::string& path, const SolveSummary& solution, const BoardSpec& board, int camera,
+                         double distance_m);
 
 // Image regions (thirds: "left edge", "top-right corner", "centre"...) whose
 // cells of a coverage grid (corner counts, grid_y x grid_x, CV_32F) are all empty.

@@ -263,16 +263,22 @@ SolveSummary SolveBoards(const BoardSpec& board, const std::vector<SolveCamera>&
   for (size_t k2 = 0; k2 < p.pool.size(); ++k2) present[k2] = p.pool[k2].z >= 0;
 
   // Stage 1: core and poses, no distortion. Then everything, with outlier rejection.
+  const auto progress = [&](const char* stage, double fraction) {
+    if (options.progress) options.progress(stage, fraction);
+  };
+  progress("stage 1 of 3: the lens core and the board poses", 0.1);
   std::vector<double> x;
   mrcal_stats_t stats = p.Optimize(p.Selections(false, false, false), &x);
   log->debug("stage 1 (core only): RMS {:.3f} px", stats.rms_reproj_error__pixels);
   // As mrcal-calibrate-cameras: everything but the board warp first (outliers
   // found here stay out), then the warp too. Same corners, same outlier set.
   if (p.warp_on) {
+    progress("stage 2 of 3: distortion, outliers rejected", 0.3);
     stats = p.Optimize(p.Selections(true, options.reject_outliers, false), &x);
     log->debug("stage 2 (no board warp): RMS {:.3f} px, {} outliers", stats.rms_reproj_error__pixels, stats.Noutliers);
   }
   const auto final_sel = p.Selections(true, options.reject_outliers, p.warp_on);
+  progress("stage 3 of 3: everything, the board's flex too", 0.55);
   stats = p.Optimize(final_sel, &x);
   if (!std::isfinite(stats.rms_reproj_error__pixels) || stats.rms_reproj_error__pixels < 0) {
     throw WorkError("mrcal_optimize", "the solve failed (no finite RMS)");
@@ -335,6 +341,7 @@ SolveSummary SolveBoards(const BoardSpec& board, const std::vector<SolveCamera>&
   // Covariance: sigma^2 (J^T J)^-1 with J = d(mrcal residuals)/d(state), central differences.
   out.intrinsics_stdev.assign(p.ncam, std::vector<double>(p.nparams, NAN));
   if (options.compute_covariance) {
+    progress("the covariance: how well each parameter is known", 0.8);
     const std::vector<double> steps = Steps(p);
     const std::vector<double> s0 = out.state;
     const int nstate = static_cast<int>(s0.size());

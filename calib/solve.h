@@ -7,6 +7,7 @@
 // mrcal-calibrate-cameras does (core only; everything but the board warp with
 // outlier rejection; then the warp too), so both reach the same optimum. The covariance of the solution comes from mrcal's own residual
 // function (mrcal_optimizer_callback) differentiated numerically.
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -37,6 +38,9 @@ struct SolveOptions {
   bool optimize_board_warp = true;    // mrcal's board flex (calobject_warp)
   bool reject_outliers = true;        // mrcal's outlier rejection in the final stage
   bool compute_covariance = true;     // needed for parameter and projection uncertainty
+  // Called between the solve's stages ("stage 2 of 3: ...", fraction of the work done): the
+  // console shows it while a solve runs.
+  std::function<void(const std::string& stage, double fraction)> progress;
 };
 
 // The residual of one observed corner after the solve.

@@ -230,6 +230,7 @@ void CalibrationWizard::EnterEnclosure(int frame, const cv::Mat& image) {
   if (!o_.floor_points.empty()) {
     try {
       floor_ = FloorPolygonFromPoints(o_.floor_points, "--floor-points");
+      floor_from_ = "given points";
       step_ = WizardStep::kDone;
       Event(frame, "enclosure", {{"from", "given points"}, {"area_m2", floor_->Area()}});
     } catch (const InputError& e) {
@@ -267,6 +268,7 @@ void CalibrationWizard::TryEmptyFloor(const cv::Mat& image, int frame) {
       return;
     }
     floor_ = std::move(found);
+    floor_from_ = "green floor";
     step_ = WizardStep::kDone;
     Event(frame, "enclosure", {{"from", from}, {"area_m2", floor_->Area()}, {"vertices", floor_->vertices().size()}});
   } catch (const std::runtime_error& e) {
@@ -298,6 +300,7 @@ WizardFrame CalibrationWizard::Feed(const cv::Mat& image, int frame) {
   if (last_detected_ || fed_ % 4 == 0) view = DetectBoard(o_.board, image, o_.detect, view.source);
   ++fed_;
   last_detected_ = view.accepted;
+  last_view_ = view;
   out.detected = view.accepted;
   board_seen_ = board_seen_ || view.accepted;
   if (!view.accepted) {
@@ -317,6 +320,8 @@ WizardFrame CalibrationWizard::Feed(const cv::Mat& image, int frame) {
       now.push_back("show the board to the camera (" + view.rejection + ")");
     } else if (static_cast<int>(run_.size()) < o_.still_frames) {
       now.push_back("hold the board still");
+    } else if (!o_.auto_solve && views() >= o_.max_views) {
+      now.push_back("enough views (" + std::to_string(views()) + "): solve, or drop the worst");
     } else if (!run_used_) {
       BoardView still;
       try {
@@ -330,7 +335,9 @@ WizardFrame CalibrationWizard::Feed(const cv::Mat& image, int frame) {
       if (Novel(still, d, &why)) {
         Capture(still, d, frame, why);
         out.captured = true;
-        if (CriteriaMet() && views() >= next_solve_at_) {
+        if (!o_.auto_solve) {
+          // The console solves when its operator asks.
+        } else if (CriteriaMet() && views() >= next_solve_at_) {
           SolveIntrinsics(frame);
         } else if (views() >= o_.max_views) {
           SolveIntrinsics(frame);
@@ -347,7 +354,9 @@ WizardFrame CalibrationWizard::Feed(const cv::Mat& image, int frame) {
       now.push_back("move the board to a new place or angle");
     }
     if (step_ == WizardStep::kIntrinsics) {
-      for (auto& m : MissingForIntrinsics()) now.push_back(std::move(m));
+      const std::vector<std::string> missing = MissingForIntrinsics();
+      if (!o_.auto_solve && missing.empty()) now.insert(now.begin(), "the views meet the criteria: solve");
+      for (auto& m : missing) now.push_back(std::move(m));
     }
   }
   if (step_ == WizardStep::kGround) {
@@ -386,6 +395,172 @@ WizardFrame CalibrationWizard::Feed(const cv::Mat& image, int frame) {
     last_guidance_ = now;
   }
   return out;
+}
+
+void CalibrationWizard::Solve(int frame) {
+  if (step_ != WizardStep::kIntrinsics) {
+    throw InputError("solve", std::string("the intrinsics step is over (now: ") + WizardStepName(step_) + ")");
+  }
+  constexpr int kMinToSolve = 3;
+  if (views() < kMinToSolve) {
+    throw InputError("solve", std::to_string(views()) + " views captured; at least " + std::to_string(kMinToSolve) +
+                                  " are needed to solve (" + std::to_string(o_.verdict.min_views) + " to trust it)");
+  }
+  SolveIntrinsics(frame);
+}
+
+void CalibrationWizard::DropView(size_t index, const std::string& why) {
+  Event(-1, "drop", {{"view", static_cast<int>(index) + 1}, {"why", why}, {"source", views_[index].source}});
+  views_.erase(views_.begin() + static_cast<std::ptrdiff_t>(index));
+  described_.erase(described_.begin() + static_cast<std::ptrdiff_t>(index));
+  // The coverage and the tilt are of the views that are left.
+  coverage_.setTo(0);
+  max_tilt_deg_ = 0;
+  for (size_t i = 0; i < views_.size(); ++i) {
+    for (const auto& p : views_[i].pixels) {
+      const int gx = std::clamp(static_cast<int>(p.x() / width_ * coverage_.cols), 0, coverage_.cols - 1);
+      const int gy = std::clamp(static_cast<int>(p.y() / height_ * coverage_.rows), 0, coverage_.rows - 1);
+      coverage_.at<float>(gy, gx) += 1;
+    }
+    const double tilt = std::acos(std::clamp(std::abs(described_[i].normal.z()), 0.0, 1.0)) * 180 / M_PI;
+    max_tilt_deg_ = std::max(max_tilt_deg_, tilt);
+  }
+  // The solve described views that changed.
+  solution_.reset();
+  report_.reset();
+  next_solve_at_ = o_.verdict.min_views;
+  run_used_ = true;  // the board still in view is not captured again at once
+}
+
+void CalibrationWizard::DropLast() {
+  if (step_ != WizardStep::kIntrinsics) throw InputError("drop", "the intrinsics step is over");
+  if (views_.empty()) throw InputError("drop", "no view captured yet");
+  DropView(views_.size() - 1, "dropped by the operator (last)");
+}
+
+void CalibrationWizard::DropWorst() {
+  if (step_ != WizardStep::kIntrinsics) throw InputError("drop", "the intrinsics step is over");
+  if (views_.empty()) throw InputError("drop", "no view captured yet");
+  size_t worst = 0;
+  std::string why;
+  if (solution_ && solution_->observation_frame.size() == views_.size()) {
+    std::vector<double> sum2(views_.size(), 0.0);
+    std::vector<int> n(views_.size(), 0);
+    for (const auto& c : solution_->corners) {
+      if (c.observation < 0 || static_cast<size_t>(c.observation) >= views_.size()) continue;
+      sum2[static_cast<size_t>(c.observation)] += c.residual.squaredNorm();
+      ++n[static_cast<size_t>(c.observation)];
+    }
+    double worst_rms = -1;
+    for (size_t i = 0; i < views_.size(); ++i) {
+      const double rms = n[i] ? std::sqrt(sum2[i] / n[i]) : 0.0;
+      if (rms > worst_rms) worst_rms = rms, worst = i;
+    }
+    why = Fmt("dropped by the operator (worst: RMS %.3f px in the last solve)", worst_rms);
+  } else {
+    double blurriest = -1;
+    for (size_t i = 0; i < views_.size(); ++i) {
+      const double e = std::isfinite(views_[i].edge_width_px) ? views_[i].edge_width_px : 0.0;
+      if (e > blurriest) blurriest = e, worst = i;
+    }
+    why = Fmt("dropped by the operator (worst: the blurriest, edges %.2f px wide)", blurriest);
+  }
+  DropView(worst, why);
+}
+
+void CalibrationWizard::Redo(WizardStep step) {
+  switch (step) {
+    case WizardStep::kIntrinsics:
+      if (o_.intrinsics) throw InputError("step", "the intrinsics were given: redo the ground step instead");
+      views_.clear();
+      described_.clear();
+      coverage_.setTo(0);
+      max_tilt_deg_ = 0;
+      solution_.reset();
+      report_.reset();
+      intrinsics_model_.reset();
+      intrinsics_good_ = false;
+      next_solve_at_ = o_.verdict.min_views;
+      ground_.reset();
+      floor_.reset();
+      floor_with_board_.reset();
+      step_ = WizardStep::kIntrinsics;
+      break;
+    case WizardStep::kGround:
+      if (!intrinsics_model_ || !intrinsics_good_) throw InputError("step", "no trusted intrinsics yet: solve them first");
+      ground_.reset();
+      floor_.reset();
+      floor_with_board_.reset();
+      step_ = WizardStep::kGround;
+      break;
+    case WizardStep::kEnclosure:
+      if (!ground_) throw InputError("step", "the camera is not posed yet: finish the ground step first");
+      floor_.reset();
+      step_ = WizardStep::kEnclosure;
+      break;
+    case WizardStep::kDone:
+      throw InputError("step", "expected intrinsics, ground or enclosure");
+  }
+  verdicts_.clear();
+  run_.clear();
+  run_used_ = false;
+  empty_frames_ = 0;
+  floor_from_.clear();
+  Event(-1, "redo");
+}
+
+void CalibrationWizard::SetFloorFromPixels(const std::vector<Eigen::Vector2d>& pixels) {
+  const std::optional<CameraModel> posed = posed_model();
+  if (!posed) throw InputError("pixels", "the camera is not posed yet: finish the ground step first");
+  floor_ = FloorPolygonFromPixels(*posed, pixels, "pixels");
+  floor_from_ = "clicked corners";
+  step_ = WizardStep::kDone;
+  Event(-1, "enclosure", {{"from", floor_from_}, {"area_m2", floor_->Area()}, {"vertices", floor_->vertices().size()}});
+}
+
+void CalibrationWizard::DetectFloor(const cv::Mat& image) {
+  if (!posed_model()) throw InputError("detect", "the camera is not posed yet: finish the ground step first");
+  try {
+    floor_ = GreenFloorIn(image);
+  } catch (const WorkError& e) {
+    throw InputError("detect", e.what());
+  }
+  floor_from_ = "green floor";
+  step_ = WizardStep::kDone;
+  Event(-1, "enclosure", {{"from", floor_from_}, {"area_m2", floor_->Area()}, {"vertices", floor_->vertices().size()}});
+}
+
+ViewDiversity CalibrationWizard::diversity() const {
+  // As ROS camera_calibration: per view the board's mean corner position (x, y in 0..1), its
+  // size (sqrt of the corners' bounding area over the image's) and skew (how far the angle
+  // at the board's first corner is from 90 degrees); progress = spread / a good set's spread.
+  ViewDiversity d;
+  if (views_.empty()) return d;
+  double lo[4] = {1e9, 1e9, 1e9, 1e9}, hi[4] = {-1e9, -1e9, -1e9, -1e9};
+  const int cx = o_.board.corners_x();
+  for (const auto& v : views_) {
+    Eigen::Vector2d sum = Eigen::Vector2d::Zero(), a = v.pixels.front(), b = a;
+    for (const auto& p : v.pixels) sum += p, a = a.cwiseMin(p), b = b.cwiseMax(p);
+    const Eigen::Vector2d mean = sum / static_cast<double>(v.pixels.size());
+    double skew = 0;
+    // The angle at the first corner between its row and its column (ids id+1 and id+cx).
+    for (size_t i = 0; i < v.ids.size() && skew == 0; ++i) {
+      const auto right = std::find(v.ids.begin(), v.ids.end(), v.ids[i] + 1);
+      const auto down = std::find(v.ids.begin(), v.ids.end(), v.ids[i] + cx);
+      if (right == v.ids.end() || down == v.ids.end() || (v.ids[i] + 1) % cx == 0) continue;
+      const Eigen::Vector2d u = v.pixels[static_cast<size_t>(right - v.ids.begin())] - v.pixels[i];
+      const Eigen::Vector2d w = v.pixels[static_cast<size_t>(down - v.ids.begin())] - v.pixels[i];
+      const double angle = std::acos(std::clamp(u.normalized().dot(w.normalized()), -1.0, 1.0));
+      skew = std::min(1.0, 2.0 * std::abs(M_PI / 2 - angle));
+    }
+    const double value[4] = {mean.x() / width_, mean.y() / height_,
+                             std::sqrt((b - a).prod() / (static_cast<double>(width_) * height_)), skew};
+    for (int k = 0; k < 4; ++k) lo[k] = std::min(lo[k], value[k]), hi[k] = std::max(hi[k], value[k]);
+  }
+  const double range[4] = {0.7, 0.7, 0.4, 0.5};  // ROS's param_ranges
+  double* out[4] = {&d.x, &d.y, &d.size, &d.skew};
+  for (int k = 0; k < 4; ++k) *out[k] = std::min(1.0, (hi[k] - lo[k]) / range[k]);
+  return d;
 }
 
 void CalibrationWizard::Finish() {
@@ -427,6 +602,7 @@ void CalibrationWizard::Finish() {
     const std::string from = "the frame with the board on the floor";
     if (floor_with_board_) {
       floor_ = floor_with_board_;
+      floor_from_ = "green floor";
       Event(-1, "enclosure", {{"from", from}, {"area_m2", floor_->Area()}, {"vertices", floor_->vertices().size()}});
     } else {
       Event(-1, "enclosure_failed", {{"from", from}, {"reason", floor_with_board_error_}});

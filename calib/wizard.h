@@ -44,6 +44,15 @@ struct WizardOptions {
   Rigid3 ground_from_board = FloorBoardPose();
   std::vector<Eigen::Vector2d> floor_points;  // enclosure in ground metres; empty: the largest green floor region
   std::optional<CameraModel> intrinsics;      // known intrinsics: start at the ground step
+  // false: the intrinsics are solved only when Solve() is called (the console's Solve button);
+  // capturing stops at max_views.
+  bool auto_solve = true;
+};
+
+// How varied the captured views are, as ROS's camera_calibration shows it: each 0..1, the
+// spread of the views' board centre (x, y), size and skew against the spread a good set has.
+struct ViewDiversity {
+  double x = 0, y = 0, size = 0, skew = 0;
 };
 
 // What one frame did.
@@ -77,6 +86,29 @@ class CalibrationWizard {
   const std::vector<BoardView>& captured() const { return views_; }
   // What is missing for the intrinsics step, from the coverage grid and the tilts.
   std::vector<std::string> MissingForIntrinsics() const;
+  ViewDiversity diversity() const;
+  // The detection of the last frame fed (rejected with the reason when no board).
+  const BoardView& last_view() const { return last_view_; }
+  bool last_still() const { return run_.size() >= 2; }
+
+  // The console's controls (the command line's wizard does these by itself).
+  // Solves the intrinsics from the captured views now; a trusted result moves on to the
+  // ground step. InputError with fewer than 3 views or past the intrinsics step.
+  void Solve(int frame = -1);
+  // Drops the last captured view, or the worst (largest RMS in the last solve; before one, the
+  // blurriest); the last solve goes with it. InputError when there is no view to drop or the
+  // intrinsics step is over.
+  void DropLast();
+  void DropWorst();
+  // Back to the start of `step`: intrinsics (every view and result goes), ground (the pose and
+  // the enclosure), enclosure (the enclosure). InputError when the step cannot be reached.
+  void Redo(WizardStep step);
+  // The enclosure from points clicked on the camera's image (carried onto the floor), or the
+  // green floor of `image`. InputError (field "pixels" / "image") when it cannot be made or
+  // the camera is not posed yet; the enclosure step ends.
+  void SetFloorFromPixels(const std::vector<Eigen::Vector2d>& pixels);
+  void DetectFloor(const cv::Mat& image);
+  const std::string& floor_from() const { return floor_from_; }
 
   const std::string& camera() const { return camera_; }
   const std::optional<SolveSummary>& solution() const { return solution_; }
@@ -98,6 +130,7 @@ class CalibrationWizard {
   Captured Describe(const BoardView& view) const;
   bool Novel(const BoardView& view, const Captured& d, std::string* why) const;
   void Capture(const BoardView& view, const Captured& d, int frame, const std::string& why);
+  void DropView(size_t index, const std::string& why);
   bool CriteriaMet() const;
   void SolveIntrinsics(int frame);
   void EnterGround(int frame);
@@ -133,6 +166,8 @@ class CalibrationWizard {
   std::optional<GroundPolygon> floor_with_board_;
   std::string floor_with_board_error_;
   std::optional<GroundPolygon> floor_;
+  std::string floor_from_;
+  BoardView last_view_;
   std::vector<std::string> verdicts_;
   std::vector<std::string> last_guidance_;
   nlohmann::json log_ = nlohmann::json::array();

@@ -19,6 +19,7 @@
 #include "core/log.h"
 #include "station/console_bank.h"
 #include "station/api_part.h"
+#include "station/console_calibration.h"
 #include "station/console_events.h"
 #include "station/console_labels.h"
 #include "station/station.h"
@@ -118,7 +119,7 @@ struct ControlServer::Impl {
     context.host = host;
     context.station = [this] { return station(); };
     context.config_path = options.config_path;
-    (void)context;
+    parts.push_back(std::make_unique<ConsoleCalibration>(context));
     parts.push_back(std::make_unique<ConsoleLabels>(context));
   }
 

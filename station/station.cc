@@ -250,7 +250,14 @@ struct Station::Impl {
     idle_cv.wait(lock, [&] { return batches_done >= batches_in; });
   }
 
+  std::mutex watcher_mutex;
+  Station::FrameWatcher watcher;  // under watcher_mutex
+
   void Tap(int camera, const Frame& frame, uint64_t drops_before, bool usable) {
+    {
+      std::lock_guard lock(watcher_mutex);
+      if (watcher) watcher(camera, frame);
+    }
     std::lock_guard lock(recorder_mutex);
     if (!recorder) return;
     const std::optional<SourceCamera> source = runners[static_cast<size_t>(camera)]->source_camera();
@@ -657,6 +664,11 @@ std::optional<std::string> Station::SpritesView(const std::string& camera, int m
 const std::string& Station::bank_path() const { return impl_->options.config.storage.bank; }
 
 bool Station::SessionActive() const { return impl_->session_active.load(); }
+
+void Station::SetFrameWatcher(FrameWatcher watcher) {
+  std::lock_guard lock(impl_->watcher_mutex);
+  impl_->watcher = std::move(watcher);
+}
 
 std::vector<std::string> Station::Reload(const StationConfig& config) {
   Impl& s = *impl_;

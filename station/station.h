@@ -68,6 +68,11 @@ class Station {
   // The sprites view (preview.h SpritesViewJson) as JSON text, made once per snapshot the same way.
   std::optional<std::string> SpritesView(const std::string& camera, int max_width) const;
   bool SessionActive() const;
+  // Called with every frame of every camera (`camera`: its index in the config), on that
+  // camera's pipeline thread after the pipeline has seen it: the calibration wizard's tap.
+  // Keep it short (copy what is needed and return). An empty function removes it.
+  using FrameWatcher = std::function<void(int camera, const Frame& frame)>;
+  void SetFrameWatcher(FrameWatcher watcher);
   // SIGHUP: applies what is safe to change live (logging, storage limits and recording
   // mode, from the next session on); returns one line per section that needs a restart.
   std::vector<std::string> Reload(const StationConfig& config);

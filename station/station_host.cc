@@ -212,6 +212,35 @@ void StationHost::UseWeights(const TransitionWeights& weights, const std::string
   log->info("the station runs with the transition weights {}", path.empty() ? "shipped with the build" : path);
 }
 
+StationConfig StationHost::live_config() const {
+  std::lock_guard lock(mutex_);
+  return live_.config;
+}
+
+bool StationHost::ApplyLiveConfig(const StationConfig& config) {
+  std::lock_guard sw(switch_mutex_);
+  StationOptions previous = live_;
+  bool replaying = false;
+  {
+    std::lock_guard lock(mutex_);
+    live_.config = config;
+    replaying = replaying_;
+  }
+  if (replaying) return false;
+  try {
+    Replace(live_);
+  } catch (const std::exception& e) {
+    Log("station")->error("the station could not start with the new config: {}; the previous one runs again", e.what());
+    {
+      std::lock_guard lock(mutex_);
+      live_ = previous;
+    }
+    Replace(live_);
+    throw;
+  }
+  return true;
+}
+
 nlohmann::json StationHost::ModeJson() const {
   std::lock_guard lock(mutex_);
   if (!replaying_) return {{"mode", "live"}, {"replay", nullptr}};

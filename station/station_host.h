@@ -65,6 +65,13 @@ class StationHost {
   // stops it first. When the station cannot start with them, the previous weights run again
   // and the error is rethrown.
   void UseWeights(const TransitionWeights& weights, const std::string& path);
+  // The live station's config (the daemon's, with what ApplyLiveConfig changed).
+  StationConfig live_config() const;
+  // A new config for the live station (the calibration wizard's models and floor): the live
+  // station restarts with it at once (true), or, while a replay runs, when the replay stops
+  // (false). When the new station cannot start, the previous config runs again and the
+  // error is thrown.
+  bool ApplyLiveConfig(const StationConfig& config);
 
   // {"mode": "live" | "replay", "replay": {"path", "paced", "loop"} or null}
   nlohmann::json ModeJson() const;
@@ -74,7 +81,7 @@ class StationHost {
   // Stops the running station and starts one from `options`. Under switch_mutex_.
   void Replace(StationOptions options);
 
-  StationOptions live_;     // weights fields guarded by mutex_ too (weights() reads them)
+  StationOptions live_;     // written under switch_mutex_ and mutex_ (weights(), live_config() read it)
   StationOptions running_;  // what the current station was started from; under switch_mutex_
   std::vector<std::string> replay_roots_;
   std::mutex switch_mutex_;  // one switch at a time

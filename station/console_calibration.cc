@@ -1,0 +1,1120 @@
+#include "station/console_calibration.h"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <condition_variable>
+#include <ctime>
+#include <deque>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <future>
+#include <mutex>
+#include <optional>
+#include <sstream>
+#include <thread>
+
+#include <Eigen/Core>
+#include <opencv2/imgproc.hpp>
+
+#include "calib/board.h"
+#include "calib/enclosure.h"
+#include "calib/report.h"
+#include "calib/station_save.h"
+#include "calib/wizard.h"
+#include "capture/camera_source.h"
+#include "core/error.h"
+#include "core/error_kinds.h"
+#include "core/frame.h"
+#include "core/log.h"
+#include "station/preview.h"
+#include "station/station.h"
+#include "station/station_host.h"
+
+#include <httplib.h>  // after Eigen (resolv.h's _res)
+
+namespace ss {
+namespace {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+using calib::WizardStep;
+
+constexpr size_t kQueueFrames = 4;     // frames waiting for a camera's wizard; more: the oldest goes
+constexpr int kGrid = 10;              // the coverage map's cells a side
+constexpr double kPublishS = 0.1;      // a camera's state and live view are refreshed this often
+constexpr double kGridStepM = 0.1;     // the floor grid drawn over a posed camera's view
+constexpr double kPlanReachM = 8.0;    // a view's rays above the horizon end this far away on the plan
+
+std::string UtcStamp(const char* format) {
+  const std::time_t now = std::time(nullptr);
+  std::tm tm{};
+  gmtime_r(&now, &tm);
+  char buf[64];
+  std::strftime(buf, sizeof buf, format, &tm);
+  return buf;
+}
+
+nlohmann::json Num(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
+
+nlohmann::json Points(const std::vector<Eigen::Vector2d>& points) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const auto& p : points) out.push_back({p.x(), p.y()});
+  return out;
+}
+
+int StepRank(WizardStep step) {
+  switch (step) {
+    case WizardStep::kIntrinsics: return 0;
+    case WizardStep::kGround: return 1;
+    case WizardStep::kEnclosure: return 2;
+    case WizardStep::kDone: return 3;
+  }
+  return 0;
+}
+
+WizardStep ParseStep(const nlohmann::json& v) {
+  const std::string s = v.is_string() ? v.get<std::string>() : "";
+  if (s == "intrinsics") return WizardStep::kIntrinsics;
+  if (s == "ground") return WizardStep::kGround;
+  if (s == "enclosure") return WizardStep::kEnclosure;
+  throw InputError("step", "expected \"intrinsics\", \"ground\" or \"enclosure\", got " + api::Dump(v));
+}
+
+// The 10 cm floor grid seen by a posed camera, as polylines in its pixels: lines across the
+// part of the floor it sees (within `reach` of the floor point below the image centre), cut
+// where they leave the image or pass behind the camera.
+std::vector<std::vector<Eigen::Vector2d>> FloorGrid(const CameraModel& posed, const std::vector<Eigen::Vector2d>& fov) {
+  std::vector<std::vector<Eigen::Vector2d>> lines;
+  if (fov.size() < 3) return lines;
+  Eigen::Vector2d lo = fov.front(), hi = lo;
+  for (const auto& p : fov) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+  lo = (lo / kGridStepM).array().floor().matrix() * kGridStepM;
+  hi = (hi / kGridStepM).array().ceil().matrix() * kGridStepM;
+  const double w = posed.width(), h = posed.height();
+  const Rigid3& cam_from_ground = posed.cam_from_ground();
+  auto add_line = [&](const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+    const int steps = std::max(1, static_cast<int>(std::lround((b - a).norm() / (kGridStepM / 2))));
+    std::vector<Eigen::Vector2d> run;
+    for (int i = 0; i <= steps; ++i) {
+      const Eigen::Vector2d g = a + (b - a) * (static_cast<double>(i) / steps);
+      const Eigen::Vector3d in_cam = cam_from_ground * Eigen::Vector3d(g.x(), g.y(), 0.0);
+      bool inside = in_cam.z() > 0.05;
+      Eigen::Vector2d px;
+      if (inside) {
+        px = posed.Project(in_cam);
+        inside = std::isfinite(px.x()) && std::isfinite(px.y()) && px.x() >= -0.1 * w && px.x() <= 1.1 * w &&
+                 px.y() >= -0.1 * h && px.y() <= 1.1 * h;
+      }
+      if (inside) {
+        run.push_back(px);
+      } else {
+        if (run.size() >= 2) lines.push_back(run);
+        run.clear();
+      }
+    }
+    if (run.size() >= 2) lines.push_back(run);
+  };
+  for (double x = lo.x(); x <= hi.x() + 1e-9; x += kGridStepM) add_line({x, lo.y()}, {x, hi.y()});
+  for (double y = lo.y(); y <= hi.y() + 1e-9; y += kGridStepM) add_line({lo.x(), y}, {hi.x(), y});
+  return lines;
+}
+
+// The floor a posed camera sees, in ground metres: the image's border carried onto the
+// floor; a ray above the horizon ends kPlanReachM away, level with the floor.
+std::vector<Eigen::Vector2d> FloorOfView(const CameraModel& posed) {
+  std::vector<Eigen::Vector2d> border;
+  const double w = posed.width() - 1, h = posed.height() - 1;
+  constexpr int kPerEdge = 12;
+  for (int i = 0; i < kPerEdge; ++i) border.emplace_back(w * i / kPerEdge, 0);
+  for (int i = 0; i < kPerEdge; ++i) border.emplace_back(w, h * i / kPerEdge);
+  for (int i = 0; i < kPerEdge; ++i) border.emplace_back(w - w * i / kPerEdge, h);
+  for (int i = 0; i < kPerEdge; ++i) border.emplace_back(0, h - h * i / kPerEdge);
+  const Eigen::Vector3d centre = posed.CentreInGround();
+  std::vector<Eigen::Vector2d> out;
+  for (const auto& px : border) {
+    const Ray ray = posed.RayInGround(px);
+    const auto hit = IntersectGround(ray);
+    Eigen::Vector2d p;
+    if (hit && (hit->head<2>() - centre.head<2>()).norm() <= kPlanReachM) {
+      p = hit->head<2>();
+    } else {
+      Eigen::Vector2d d = ray.direction.head<2>();
+      if (d.norm() < 1e-9) continue;
+      p = centre.head<2>() + d.normalized() * kPlanReachM;
+    }
+    out.push_back(p);
+  }
+  return out;
+}
+
+// What the live view shows of a camera's last processed frame.
+struct LiveView {
+  cv::Mat bgr;  // replaced, never written into: readers keep their copy
+  uint64_t sequence = 0;
+  bool detected = false, still = false;
+  std::vector<Eigen::Vector2d> corners;
+  std::vector<std::vector<Eigen::Vector2d>> grid;
+  std::vector<Eigen::Vector2d> floor;
+};
+
+struct WizardSettings {
+  calib::WizardOptions options;
+  double still_s = 0.2, floor_still_s = 1.0;
+  int run = 0;
+  std::string work_dir;  // the solve's plots
+};
+
+// One camera's wizard, on a thread of its own.
+class CameraWork {
+ public:
+  CameraWork(std::string name, int index, const WizardSettings& settings, double fps_hint,
+             std::atomic<uint64_t>* floor_counter)
+      : name_(std::move(name)), index_(index), settings_(settings), fps_hint_(fps_hint), floor_counter_(floor_counter) {
+    settings_.options.solve.progress = [this](const std::string& stage, double fraction) { SetBusy(stage, fraction); };
+    Publish(true);
+    thread_ = std::thread([this] { Loop(); });
+  }
+  ~CameraWork() {
+    {
+      std::lock_guard lock(queue_mutex_);
+      stop_ = true;
+    }
+    queue_cv_.notify_all();
+    if (thread_.joinable()) thread_.join();
+  }
+  CameraWork(const CameraWork&) = delete;
+  CameraWork& operator=(const CameraWork&) = delete;
+
+  const std::string& name() const { return name_; }
+  int index() const { return index_; }
+
+  // From the station's pipeline thread: a copy of the frame, queued.
+  void Offer(const Frame& frame) {
+    Frame copy = Frame::Owned(frame.format, frame.width, frame.height,
+                              std::vector<uint8_t>(frame.data, frame.data + frame.size));
+    copy.camera = frame.camera;
+    copy.sequence = frame.sequence;
+    copy.timestamp_ns = frame.timestamp_ns;
+    {
+      std::lock_guard lock(queue_mutex_);
+      if (frames_.size() >= kQueueFrames) frames_.pop_front();
+      frames_.push_back(std::move(copy));
+    }
+    queue_cv_.notify_one();
+  }
+
+  // Runs `f(wizard)` on the camera's thread between two frames and returns what it returns;
+  // ConflictError before the camera's first frame or while a solve runs.
+  template <typename F>
+  auto Run(F f) -> decltype(f(std::declval<calib::CalibrationWizard&>())) {
+    using R = decltype(f(std::declval<calib::CalibrationWizard&>()));
+    if (busy_.load()) throw ConflictError(name_, "a solve is running; wait for it to end");
+    auto task = std::make_shared<std::packaged_task<R()>>([this, f]() mutable -> R {
+      if (!wizard_) throw ConflictError(name_, "has delivered no frame to the wizard yet");
+      return f(*wizard_);
+    });
+    std::future<R> done = task->get_future();
+    Post([task] { (*task)(); });
+    return done.get();
+  }
+
+  // Starts the solve on the camera's thread; returns at once.
+  void StartSolve() {
+    Run([](calib::CalibrationWizard& w) {
+      if (w.step() != WizardStep::kIntrinsics) {
+        throw ConflictError("solve", std::string("the intrinsics step is over (now: ") + calib::WizardStepName(w.step()) + ")");
+      }
+      if (w.views() < 3) {
+        throw ConflictError("solve", std::to_string(w.views()) + " views captured; at least 3 are needed to solve (" +
+                                         std::to_string(w.views()) + " of the criteria's views)");
+      }
+      return 0;
+    });
+    busy_.store(true);
+    SetBusy("starting", 0.0);
+    Post([this] { SolveNow(); });
+  }
+
+  nlohmann::json Snapshot() const {
+    std::lock_guard lock(state_mutex_);
+    return state_;
+  }
+  std::optional<nlohmann::json> Busy() const {
+    std::lock_guard lock(state_mutex_);
+    return busy_json_;
+  }
+  LiveView Live() const {
+    std::lock_guard lock(state_mutex_);
+    return live_;
+  }
+  uint64_t floor_order() const { return floor_order_.load(); }
+  std::string PlotPath(const char* kind) const {
+    return (fs::path(settings_.work_dir) / (name_ + "." + kind + ".png")).string();
+  }
+  int solves() const { return solves_.load(); }
+
+ private:
+  void Post(std::function<void()> command) {
+    {
+      std::lock_guard lock(queue_mutex_);
+      commands_.push_back(std::move(command));
+    }
+    queue_cv_.notify_one();
+  }
+
+  void SetBusy(const std::string& stage, double fraction) {
+    std::lock_guard lock(state_mutex_);
+    busy_json_ = nlohmann::json{{"what", "solve"}, {"camera", name_}, {"stage", stage}, {"progress", fraction}};
+  }
+
+  void Loop() {
+    for (;;) {
+      std::function<void()> command;
+      std::optional<Frame> frame;
+      {
+        std::unique_lock lock(queue_mutex_);
+        queue_cv_.wait_for(lock, std::chrono::milliseconds(250),
+                           [&] { return stop_ || !commands_.empty() || !frames_.empty(); });
+        if (stop_) return;
+        if (!commands_.empty()) {
+          command = std::move(commands_.front());
+          commands_.pop_front();
+        } else if (!frames_.empty()) {
+          frame = std::move(frames_.front());
+          frames_.pop_front();
+        }
+      }
+      if (command) {
+        command();
+        Publish(true);
+      } else if (frame) {
+        Process(*frame);
+      }
+    }
+  }
+
+  void Process(const Frame& frame) {
+    try {
+      ToBgr(frame, bgr_);
+      if (!wizard_) {
+        calib::WizardOptions o = settings_.options;
+        const double fps = fps_hint_ > 0 ? fps_hint_ : 30.0;
+        o.still_frames = std::max(2, static_cast<int>(std::lround(settings_.still_s * fps)));
+        o.floor_still_frames = std::max(3, static_cast<int>(std::lround(settings_.floor_still_s * fps)));
+        wizard_ = std::make_unique<calib::CalibrationWizard>(name_, bgr_.cols, bgr_.rows, o);
+      }
+      const calib::WizardFrame out = wizard_->Feed(bgr_, static_cast<int>(frame.sequence));
+      guidance_ = out.guidance;
+      ++frames_fed_;
+      message_.clear();
+    } catch (const std::exception& e) {
+      message_ = e.what();
+      Log("station.calibration")->warn("{}: {}", name_, e.what());
+    }
+    last_sequence_ = frame.sequence;
+    Publish(false);
+  }
+
+  void SolveNow() {
+    try {
+      if (!wizard_) throw ConflictError(name_, "has delivered no frame to the wizard yet");
+      wizard_->Solve(-1);
+      SetBusy("plots", 0.95);
+      if (wizard_->solution()) {
+        std::error_code ec;
+        fs::create_directories(settings_.work_dir, ec);
+        calib::WriteResidualPlot(PlotPath("residuals"), *wizard_->solution(), 0);
+        const double distance = wizard_->report() && wizard_->report()->working_distance_m > 0
+                                    ? wizard_->report()->working_distance_m
+                                    : 1.0;
+        calib::WriteUncertaintyMap(PlotPath("uncertainty"), *wizard_->solution(), settings_.options.board, 0, distance);
+      }
+      ++solves_;
+      message_.clear();
+    } catch (const std::exception& e) {
+      message_ = std::string("solve failed: ") + e.what();
+      Log("station.calibration")->warn("{}: {}", name_, message_);
+    }
+    {
+      std::lock_guard lock(state_mutex_);
+      busy_json_.reset();
+    }
+    busy_.store(false);
+  }
+
+  nlohmann::json Checklist(const calib::CalibrationWizard& w) const {
+    const calib::VerdictOptions& v = settings_.options.verdict;
+    char buf[96];
+    nlohmann::json list = nlohmann::json::array();
+    auto item = [&](const char* id, const std::string& label, nlohmann::json met, nlohmann::json value) {
+      list.push_back({{"id", id}, {"label", label}, {"met", std::move(met)}, {"value", std::move(value)}});
+    };
+    item("views", "views ≥ " + std::to_string(v.min_views), w.views() >= v.min_views, std::to_string(w.views()));
+    std::snprintf(buf, sizeof buf, "coverage ≥ %.0f %%", v.min_coverage * 100);
+    const std::vector<std::string> empty = calib::EmptyRegions(w.coverage());
+    char value[64];
+    std::snprintf(value, sizeof value, "%.0f %%", w.coverage_fraction() * 100);
+    item("coverage", buf, w.coverage_fraction() >= v.min_coverage && empty.empty(),
+         empty.empty() ? std::string(value) : std::string(value) + ", " + empty.front() + " empty");
+    std::snprintf(buf, sizeof buf, "a view tilted ≥ %.0f°", v.min_tilt_deg);
+    std::snprintf(value, sizeof value, "%.0f°", w.max_tilt_deg());
+    item("tilt", buf, w.max_tilt_deg() >= v.min_tilt_deg, value);
+    const auto& report = w.report();
+    const bool solved = report && !report->intrinsics.empty();
+    std::snprintf(buf, sizeof buf, "RMS < %.2g px", v.max_rms_px);
+    if (solved) {
+      std::snprintf(value, sizeof value, "%.3f px", report->rms_px);
+      item("rms", buf, report->rms_px < v.max_rms_px, value);
+    } else {
+      item("rms", buf, nullptr, nullptr);
+    }
+    const char* names[4] = {"fx", "fy", "cx", "cy"};
+    for (size_t i = 0; i < 4; ++i) {
+      std::snprintf(buf, sizeof buf, "%s known to ≤ %.2g %% (1.96 σ)", names[i], v.max_stdev_percent);
+      if (solved && i < report->intrinsics_stdev.size() && std::isfinite(report->intrinsics_stdev[i])) {
+        const double percent = 1.96 * report->intrinsics_stdev[i] / std::abs(report->intrinsics[i]) * 100;
+        std::snprintf(value, sizeof value, "%.3f %%", percent);
+        item(names[i], buf, percent <= v.max_stdev_percent, value);
+      } else {
+        item(names[i], buf, nullptr, nullptr);
+      }
+    }
+    return list;
+  }
+
+  nlohmann::json SolveJson(const calib::CalibrationWizard& w) const {
+    const auto& report = w.report();
+    if (!report) return nullptr;
+    nlohmann::json j = {{"verdict", report->good ? "good" : "rejected"}, {"reasons", report->reasons},
+                        {"rms_px", Num(report->rms_px)}, {"worst_px", Num(report->worst_px)},
+                        {"views", report->views_accepted}};
+    if (report->intrinsics.size() >= 4) {
+      const char* names[4] = {"fx", "fy", "cx", "cy"};
+      nlohmann::json in, pct;
+      for (size_t i = 0; i < 4; ++i) {
+        in[names[i]] = report->intrinsics[i];
+        pct[names[i]] = i < report->intrinsics_stdev.size()
+                            ? Num(1.96 * report->intrinsics_stdev[i] / std::abs(report->intrinsics[i]) * 100)
+                            : nlohmann::json(nullptr);
+      }
+      j["intrinsics"] = in;
+      j["uncertainty_percent"] = pct;
+      j["lensmodel"] = w.intrinsics_model() ? w.intrinsics_model()->lensmodel() : "";
+      j["projection_stdev_px"] = {{"centre", Num(report->projection_stdev_centre_px)},
+                                  {"worst", Num(report->projection_stdev_worst_px)}};
+    }
+    if (w.solution()) {
+      const std::string query = "?run=" + std::to_string(settings_.run) + "&solve=" + std::to_string(solves_.load());
+      j["residuals_png"] = "/api/calibration/cameras/" + name_ + "/residuals.png" + query;
+      j["uncertainty_png"] = "/api/calibration/cameras/" + name_ + "/uncertainty.png" + query;
+    }
+    return j;
+  }
+
+  // The camera's state and live view, at most every kPublishS unless `force`.
+  void Publish(bool force) {
+    const auto now = Clock::now();
+    if (!force && std::chrono::duration<double>(now - last_publish_).count() < kPublishS) return;
+    last_publish_ = now;
+    nlohmann::json j;
+    j["name"] = name_;
+    j["frames"] = frames_fed_;
+    j["message"] = message_;
+    if (!wizard_) {
+      j.update({{"width", nullptr}, {"height", nullptr},
+                {"step", settings_.options.intrinsics ? "ground" : "intrinsics"}, {"detected", false},
+                {"still", false}, {"guidance", {"waiting for the camera's first frame"}}, {"views", 0},
+                {"coverage", {{"grid", nlohmann::json::array()}, {"fraction", 0}}},
+                {"diversity", {{"x", 0}, {"y", 0}, {"size", 0}, {"skew", 0}}}, {"checklist", nlohmann::json::array()},
+                {"solve", nullptr}, {"ground", nullptr}, {"enclosure", nullptr}, {"plan", nullptr}});
+      std::lock_guard lock(state_mutex_);
+      state_ = std::move(j);
+      return;
+    }
+    const calib::CalibrationWizard& w = *wizard_;
+    const calib::BoardView& view = w.last_view();
+    j["width"] = bgr_.cols;
+    j["height"] = bgr_.rows;
+    j["step"] = calib::WizardStepName(w.step());
+    j["detected"] = view.accepted;
+    j["still"] = w.last_still();
+    j["guidance"] = guidance_;
+    j["views"] = w.views();
+    nlohmann::json grid = nlohmann::json::array();
+    for (int y = 0; y < w.coverage().rows; ++y) {
+      nlohmann::json row = nlohmann::json::array();
+      for (int x = 0; x < w.coverage().cols; ++x) row.push_back(static_cast<int>(w.coverage().at<float>(y, x)));
+      grid.push_back(row);
+    }
+    j["coverage"] = {{"grid", grid}, {"fraction", w.coverage_fraction()}};
+    const calib::ViewDiversity d = w.diversity();
+    j["diversity"] = {{"x", d.x}, {"y", d.y}, {"size", d.size}, {"skew", d.skew}};
+    j["checklist"] = Checklist(w);
+    j["solve"] = SolveJson(w);
+    const std::optional<CameraModel> posed = w.posed_model();
+    if (posed && w.ground()) {
+      const calib::GroundResult& g = *w.ground();
+      j["ground"] = {{"height_m", g.height_m},
+                     {"tilt_deg", g.optical_axis_down_deg},
+                     {"centre_m", {g.centre_in_ground.x(), g.centre_in_ground.y(), g.centre_in_ground.z()}},
+                     {"rms_px", Num(g.rms_px)}};
+      if (fov_.empty()) {
+        fov_ = FloorOfView(*posed);
+        grid_ = FloorGrid(*posed, fov_);
+      }
+      j["plan"] = {{"position_m", {g.centre_in_ground.x(), g.centre_in_ground.y(), g.centre_in_ground.z()}},
+                   {"fov_m", Points(fov_)}};
+    } else {
+      fov_.clear();
+      grid_.clear();
+      j["ground"] = nullptr;
+      j["plan"] = nullptr;
+    }
+    std::vector<Eigen::Vector2d> floor_px;
+    if (w.floor()) {
+      j["enclosure"] = {{"polygon_m", Points(w.floor()->vertices())}, {"area_m2", w.floor()->Area()},
+                        {"from", w.floor_from()}};
+      if (!had_floor_ || w.floor()->vertices() != last_floor_) floor_order_.store(++*floor_counter_);
+      last_floor_ = w.floor()->vertices();
+      if (posed) {
+        for (const auto& v : w.floor()->vertices()) {
+          const Eigen::Vector3d in_cam = posed->cam_from_ground() * Eigen::Vector3d(v.x(), v.y(), 0.0);
+          if (in_cam.z() > 0.05) floor_px.push_back(posed->Project(in_cam));
+        }
+      }
+    } else {
+      j["enclosure"] = nullptr;
+    }
+    had_floor_ = w.floor().has_value();
+    LiveView live;
+    live.bgr = bgr_.clone();
+    live.sequence = last_sequence_;
+    live.detected = view.accepted;
+    live.still = w.last_still();
+    if (view.accepted) live.corners = view.pixels;
+    live.grid = grid_;
+    live.floor = std::move(floor_px);
+    std::lock_guard lock(state_mutex_);
+    state_ = std::move(j);
+    live_ = std::move(live);
+  }
+
+  const std::string name_;
+  const int index_;
+  WizardSettings settings_;
+  const double fps_hint_;
+  std::atomic<uint64_t>* floor_counter_;
+
+  std::mutex queue_mutex_;
+  std::condition_variable queue_cv_;
+  std::deque<Frame> frames_;
+  std::deque<std::function<void()>> commands_;
+  bool stop_ = false;
+
+  // The camera thread's own.
+  std::unique_ptr<calib::CalibrationWizard> wizard_;
+  cv::Mat bgr_;
+  uint64_t frames_fed_ = 0, last_sequence_ = 0;
+  std::vector<std::string> guidance_;
+  std::string message_;
+  Clock::time_point last_publish_{};
+  std::vector<Eigen::Vector2d> fov_;
+  std::vector<std::vector<Eigen::Vector2d>> grid_;
+  bool had_floor_ = false;
+  std::vector<Eigen::Vector2d> last_floor_;
+
+  std::atomic<bool> busy_{false};
+  std::atomic<int> solves_{0};
+  std::atomic<uint64_t> floor_order_{0};
+  mutable std::mutex state_mutex_;
+  nlohmann::json state_;
+  std::optional<nlohmann::json> busy_json_;
+  LiveView live_;
+
+  std::thread thread_;  // last: starts once everything above exists
+};
+
+}  // namespace
+
+struct ConsoleCalibration::Impl {
+  api::Context context;
+  std::shared_ptr<spdlog::logger> log = Log("station.calibration");
+
+  mutable std::mutex mutex;  // the run below
+  bool active = false;
+  int run = 0;
+  std::string board;
+  nlohmann::json options = nlohmann::json::object();
+  std::vector<std::string> warnings;
+  std::string error;
+  nlohmann::json saved;
+  bool saving = false;
+  std::string work_dir;
+  std::atomic<uint64_t> floor_counter{0};
+  std::vector<std::shared_ptr<CameraWork>> works;
+
+  // The station whose frames the wizard takes (re-tapped when the host replaces it).
+  std::mutex tap_mutex;
+  std::shared_ptr<Station> tapped;
+  std::thread keeper;
+  std::mutex keeper_mutex;
+  std::condition_variable keeper_cv;
+  bool stopping = false;
+
+  ~Impl() {
+    if (!work_dir.empty()) {
+      std::error_code ec;
+      fs::remove_all(work_dir, ec);
+    }
+  }
+
+  std::shared_ptr<CameraWork> Work(const std::string& name) const {
+    std::lock_guard lock(mutex);
+    for (const auto& w : works) {
+      if (w->name() == name) return w;
+    }
+    throw NotFoundError("camera", "\"" + name + "\" is not in the calibration wizard");
+  }
+
+  std::vector<std::shared_ptr<CameraWork>> Works() const {
+    std::lock_guard lock(mutex);
+    return works;
+  }
+
+  // The camera a request names (body "camera"), or every camera of the wizard when it names none.
+  std::vector<std::shared_ptr<CameraWork>> Chosen(const nlohmann::json& body, bool required) const {
+    if (!body.contains("camera")) {
+      if (required) throw InputError("camera", "missing (the camera's name)");
+      std::vector<std::shared_ptr<CameraWork>> all = Works();
+      if (all.empty()) throw ConflictError("calibration", "no wizard is running: start one");
+      return all;
+    }
+    if (!body["camera"].is_string()) throw InputError("camera", "expected the camera's name, got " + api::Dump(body["camera"]));
+    return {Work(body["camera"].get<std::string>())};
+  }
+
+  void RequireActive() const {
+    std::lock_guard lock(mutex);
+    if (!active) throw ConflictError("calibration", "no wizard is running: start one");
+  }
+
+  // Taps the host's current station when it changed (a replay started or stopped, a save
+  // restarted it); called by the keeper thread and after a start.
+  void Retap() {
+    std::shared_ptr<Station> current = context.host->current();
+    std::vector<std::shared_ptr<CameraWork>> routed;
+    bool on = false;
+    {
+      std::lock_guard lock(mutex);
+      on = active;
+      routed = works;
+    }
+    std::lock_guard lock(tap_mutex);
+    if (!on) {
+      if (tapped) tapped->SetFrameWatcher({});
+      tapped.reset();
+      return;
+    }
+    if (current == tapped && current) return;
+    if (tapped) tapped->SetFrameWatcher({});
+    tapped = current;
+    if (!current) return;
+    // Camera index (the station's config order) -> the wizard's camera of that name.
+    const StationStatus status = current->Status();
+    auto by_index = std::make_shared<std::vector<std::shared_ptr<CameraWork>>>(status.cameras.size());
+    for (size_t i = 0; i < status.cameras.size(); ++i) {
+      for (const auto& w : routed) {
+        if (w->name() == status.cameras[i].name) (*by_index)[i] = w;
+      }
+    }
+    current->SetFrameWatcher([by_index](int camera, const Frame& frame) {
+      if (camera < 0 || static_cast<size_t>(camera) >= by_index->size()) return;
+      if (const auto& w = (*by_index)[static_cast<size_t>(camera)]) w->Offer(frame);
+    });
+  }
+
+  void Untap() {
+    std::lock_guard lock(tap_mutex);
+    if (tapped) tapped->SetFrameWatcher({});
+    tapped.reset();
+  }
+
+  void KeeperLoop() {
+    std::unique_lock lock(keeper_mutex);
+    while (!stopping) {
+      keeper_cv.wait_for(lock, std::chrono::milliseconds(250));
+      if (stopping) break;
+      lock.unlock();
+      try {
+        Retap();
+      } catch (const std::exception& e) {
+        log->warn("calibration: cannot take the station's frames: {}", e.what());
+      }
+      lock.lock();
+    }
+  }
+
+  nlohmann::json Start(const nlohmann::json& body) {
+    const std::shared_ptr<Station> station = context.station();
+    if (station->SessionActive()) {
+      throw ConflictError("session", "a capture session is running: stop it before calibrating (the board would be "
+                                     "stored as sprites)");
+    }
+    if (!body.contains("board") || !body["board"].is_string()) {
+      throw InputError("board", "expected the board's spec, e.g. \"chessboard:10x7:0.03\"");
+    }
+    WizardSettings settings;
+    calib::WizardOptions& o = settings.options;
+    o.board = calib::ParseBoardSpec(body["board"].get<std::string>(), "board");
+    o.auto_solve = false;
+    o.detect.exhaustive = false;  // a frame without a board must stay cheap
+    o.verdict.grid_x = o.verdict.grid_y = kGrid;
+    o.verdict.max_stdev_percent = 0.5;
+    auto number = [&](const char* field, double lo, double hi, double fallback) {
+      if (!body.contains(field)) return fallback;
+      if (!body[field].is_number()) throw InputError(field, "expected a number, got " + api::Dump(body[field]));
+      const double v = body[field].get<double>();
+      if (!(v >= lo && v <= hi)) {
+        std::ostringstream range;
+        range << "expected " << lo << " to " << hi << ", got " << v;
+        throw InputError(field, range.str());
+      }
+      return v;
+    };
+    o.verdict.min_views = static_cast<int>(number("min_views", 3, 200, o.verdict.min_views));
+    o.max_views = std::max(o.verdict.min_views, static_cast<int>(number("max_views", 3, 500, 30)));
+    o.verdict.min_coverage = number("min_coverage", 0, 1, o.verdict.min_coverage);
+    o.verdict.max_rms_px = number("max_rms_px", 0.01, 100, o.verdict.max_rms_px);
+    settings.still_s = number("still_s", 0, 10, 0.2);
+    settings.floor_still_s = number("floor_still_s", 0, 60, 1.0);
+    double pose[3] = {0, 0, 0};
+    if (body.contains("board_pose")) {
+      const nlohmann::json& p = body["board_pose"];
+      if (!p.is_array() || p.size() != 3 || !p[0].is_number() || !p[1].is_number() || !p[2].is_number()) {
+        throw InputError("board_pose", "expected [x_m, y_m, yaw_deg], got " + api::Dump(p));
+      }
+      for (int i = 0; i < 3; ++i) pose[i] = p[static_cast<size_t>(i)].get<double>();
+    }
+    o.ground_from_board = calib::FloorBoardPose(pose[0], pose[1], pose[2], number("board_thickness_m", 0, 0.1, 0));
+    bool use_current = false;
+    if (body.contains("use_current_intrinsics")) {
+      if (!body["use_current_intrinsics"].is_boolean()) throw InputError("use_current_intrinsics", "expected true or false");
+      use_current = body["use_current_intrinsics"].get<bool>();
+    }
+
+    const StationStatus status = station->Status();
+    std::vector<std::string> names;
+    if (body.contains("cameras")) {
+      const nlohmann::json& c = body["cameras"];
+      if (!c.is_array() || c.empty()) throw InputError("cameras", "expected a list of camera names, got " + api::Dump(c));
+      for (const auto& n : c) {
+        if (!n.is_string()) throw InputError("cameras", "expected camera names, got " + api::Dump(n));
+        const bool known = std::any_of(status.cameras.begin(), status.cameras.end(),
+                                       [&](const CameraStatus& s) { return s.name == n.get<std::string>(); });
+        if (!known) throw InputError("cameras", "no camera \"" + n.get<std::string>() + "\" in the station");
+        if (std::find(names.begin(), names.end(), n.get<std::string>()) == names.end()) names.push_back(n);
+      }
+    } else {
+      for (const auto& s : status.cameras) names.push_back(s.name);
+    }
+    std::vector<std::optional<CameraModel>> current(names.size());
+    const StationConfig config = context.host->live_config();
+    if (use_current) {
+      for (size_t i = 0; i < names.size(); ++i) {
+        std::optional<CameraModel> model;
+        for (const auto& c : config.cameras) {
+          if (c.name == names[i]) model = ModelForCamera(c);
+        }
+        if (!model) throw InputError("use_current_intrinsics", names[i] + " has no camera model yet: solve its intrinsics");
+        current[i] = model;
+      }
+    }
+    std::vector<std::string> warnings;
+    if (o.board.kind == calib::BoardKind::kChessboard) {
+      if (o.board.squares_x == o.board.squares_y) {
+        warnings.push_back("the board is square (" + std::to_string(o.board.squares_x) + "x" +
+                           std::to_string(o.board.squares_y) + " squares): its orientation is ambiguous, so views "
+                           "may be matched the wrong way round; use a board with an even and an odd side");
+      } else if (o.board.squares_x % 2 == o.board.squares_y % 2) {
+        warnings.push_back("the board's sides (" + std::to_string(o.board.squares_x) + "x" +
+                           std::to_string(o.board.squares_y) + " squares) are both " +
+                           (o.board.squares_x % 2 ? "odd" : "even") + ": it looks the same turned half round; "
+                           "use a board with an even and an odd side");
+      }
+    }
+
+    Stop();  // the previous run's cameras
+    std::lock_guard lock(mutex);
+    ++run;
+    if (work_dir.empty()) {
+      work_dir = (fs::temp_directory_path() / ("spritestation-calibration-" + std::to_string(::getpid()))).string();
+    }
+    settings.run = run;
+    settings.work_dir = (fs::path(work_dir) / std::to_string(run)).string();
+    for (size_t i = 0; i < names.size(); ++i) {
+      WizardSettings s = settings;
+      s.options.intrinsics = current[i];
+      double fps = 0;
+      int index = 0;
+      for (size_t k = 0; k < status.cameras.size(); ++k) {
+        if (status.cameras[k].name == names[i]) fps = status.cameras[k].fps, index = static_cast<int>(k);
+      }
+      for (const auto& c : config.cameras) {
+        if (c.name == names[i] && fps <= 0 && c.fps > 0) fps = c.fps;
+      }
+      works.push_back(std::make_shared<CameraWork>(names[i], index, s, fps, &floor_counter));
+    }
+    active = true;
+    board = o.board.ToString();
+    this->warnings = warnings;
+    error.clear();
+    saved = nullptr;
+    options = {{"min_views", o.verdict.min_views}, {"max_views", o.max_views}, {"min_coverage", o.verdict.min_coverage},
+               {"max_rms_px", o.verdict.max_rms_px}, {"max_stdev_percent", o.verdict.max_stdev_percent},
+               {"min_tilt_deg", o.verdict.min_tilt_deg}, {"board_pose", {pose[0], pose[1], pose[2]}},
+               {"use_current_intrinsics", use_current}};
+    log->info("calibration wizard started on {} camera(s), board {}", works.size(), board);
+    return nullptr;
+  }
+
+  // Ends the run: the taps go first, then the cameras' threads.
+  void Stop() {
+    std::vector<std::shared_ptr<CameraWork>> done;
+    {
+      std::lock_guard lock(mutex);
+      active = false;
+      done.swap(works);
+    }
+    Untap();
+    done.clear();
+  }
+
+  nlohmann::json Save() {
+    RequireActive();
+    {
+      std::lock_guard lock(mutex);
+      if (saving) throw ConflictError("save", "a save is running");
+      saving = true;
+    }
+    for (const auto& w : Works()) {
+      if (w->Busy()) throw ConflictError("save", w->name() + " is solving; save when it is done");
+    }
+    struct Unbusy {
+      Impl* s;
+      ~Unbusy() {
+        std::lock_guard lock(s->mutex);
+        s->saving = false;
+      }
+    } unbusy{this};
+    calib::StationSaveRequest request;
+    uint64_t floor_order = 0;
+    for (const auto& w : Works()) {
+      std::optional<CameraModel> model;
+      std::optional<GroundPolygon> floor;
+      try {
+        std::tie(model, floor) = w->Run([](calib::CalibrationWizard& wiz) {
+          std::optional<CameraModel> m = wiz.posed_model();
+          if (!m && wiz.intrinsics_good() && wiz.intrinsics_model()) m = wiz.intrinsics_model();
+          return std::make_pair(m, wiz.floor());
+        });
+      } catch (const ConflictError&) {
+        continue;  // no frame yet: nothing of it to save
+      }
+      if (model) request.models.emplace_back(w->name(), *model);
+      if (floor && w->floor_order() >= floor_order) floor_order = w->floor_order(), request.floor = floor;
+    }
+    if (request.models.empty()) {
+      throw ConflictError("save", "no camera has trusted intrinsics yet: solve first");
+    }
+    const StationConfig config = context.host->live_config();
+    fs::path dir = context.config_path.empty() ? fs::path(config.storage.bank).parent_path() : fs::path(context.config_path).parent_path();
+    request.config_path = context.config_path;
+    request.calibration_dir = (dir / "calibration").string();
+    request.stamp = UtcStamp("%Y%m%dT%H%M%SZ");
+    calib::StationSaveResult result;
+    try {
+      result = calib::SaveStationCalibration(config, request);
+    } catch (const std::exception& e) {
+      std::lock_guard lock(mutex);
+      error = std::string("not saved: ") + e.what() + " (nothing already saved was changed)";
+      throw;
+    }
+    nlohmann::json j = {{"at", UtcStamp("%Y-%m-%dT%H:%M:%SZ")}, {"files", result.files}, {"previous", result.previous},
+                        {"config", context.config_path.empty() ? nlohmann::json(nullptr) : nlohmann::json(context.config_path)},
+                        {"cameras", nlohmann::json::array()}, {"station_restarted", false}};
+    for (const auto& [name, model] : request.models) j["cameras"].push_back(name);
+    {
+      std::lock_guard lock(mutex);
+      saved = j;
+      error.clear();
+    }
+    log->info("calibration saved: {}", api::Dump(result.files));
+    // The live station restarts with them (a replay keeps running; the live station uses them when it stops).
+    try {
+      const bool restarted = context.host->ApplyLiveConfig(result.config);
+      j["station_restarted"] = restarted;
+      if (!restarted) j["note"] = "a replay is running: the live station uses them when it stops";
+    } catch (const std::exception& e) {
+      std::lock_guard lock(mutex);
+      error = std::string("saved, but the station could not start with them: ") + e.what();
+      saved = j;
+      throw WorkError("station", error);
+    }
+    Retap();
+    std::lock_guard lock(mutex);
+    saved = j;
+    return j;
+  }
+
+  nlohmann::json State() const {
+    std::lock_guard lock(mutex);
+    nlohmann::json j;
+    j["active"] = active;
+    j["run"] = run;
+    j["board"] = board;
+    j["warnings"] = warnings;
+    j["options"] = options;
+    j["error"] = error.empty() ? nlohmann::json(nullptr) : nlohmann::json(error);
+    j["saved"] = saved;
+    j["busy"] = nullptr;
+    if (saving) j["busy"] = {{"what", "save"}, {"camera", nullptr}, {"stage", "writing the files"}, {"progress", 0.5}};
+    j["cameras"] = nlohmann::json::array();
+    int least = 3;
+    for (const auto& w : works) {
+      nlohmann::json c = w->Snapshot();
+      if (const auto busy = w->Busy()) j["busy"] = *busy;
+      const std::string step = c.value("step", "intrinsics");
+      least = std::min(least, step == "intrinsics" ? 0 : step == "ground" ? 1 : step == "enclosure" ? 2 : 3);
+      j["cameras"].push_back(std::move(c));
+    }
+    if (!active) {
+      j["step"] = saved.is_null() ? "idle" : "saved";
+    } else if (works.empty()) {
+      j["step"] = "idle";
+    } else {
+      static const char* kSteps[] = {"intrinsics", "ground", "enclosure", "save"};
+      j["step"] = kSteps[least];
+      if (least == 3 && !saved.is_null()) j["step"] = "saved";
+    }
+    return j;
+  }
+};
+
+ConsoleCalibration::ConsoleCalibration(api::Context context) : impl_(std::make_unique<Impl>()) {
+  impl_->context = std::move(context);
+  impl_->keeper = std::thread([s = impl_.get()] { s->KeeperLoop(); });
+}
+
+ConsoleCalibration::~ConsoleCalibration() { Stop(); }
+
+void ConsoleCalibration::Stop() {
+  Impl& s = *impl_;
+  {
+    std::lock_guard lock(s.keeper_mutex);
+    s.stopping = true;
+  }
+  s.keeper_cv.notify_all();
+  if (s.keeper.joinable()) s.keeper.join();
+  s.Stop();
+}
+
+nlohmann::json ConsoleCalibration::State() const { return impl_->State(); }
+
+void ConsoleCalibration::AddStatus(nlohmann::json& status) const {
+  nlohmann::json calibration = State();
+  // Whether each camera delivers, as the station sees it.
+  std::string offline;
+  if (status.contains("cameras") && status["cameras"].is_array()) {
+    for (auto& c : calibration["cameras"]) {
+      bool online = false;
+      std::string message;
+      for (const auto& s : status["cameras"]) {
+        if (s.value("name", "") != c.value("name", "")) continue;
+        const std::string state = s.value("state", "");
+        online = state == "live" || state == "training" || state == "starting";
+        if (!online) message = state + (s.value("message", "").empty() ? "" : ": " + s.value("message", ""));
+      }
+      c["online"] = online;
+      if (!online && calibration.value("active", false)) {
+        if (c.value("message", "").empty()) c["message"] = message;
+        if (offline.empty()) {
+          offline = c.value("name", "") + " delivers no frames (" + (message.empty() ? "not in the station" : message) +
+                    "); the views captured so far are kept";
+        }
+      }
+    }
+  }
+  if (calibration["error"].is_null() && !offline.empty()) calibration["error"] = offline;
+  status["calibration"] = std::move(calibration);
+}
+
+std::vector<api::Route> ConsoleCalibration::Routes() {
+  Impl* s = impl_.get();
+  using httplib::Request;
+  using httplib::Response;
+  auto state_after = [s](auto f) {
+    return api::Json([s, f](const Request& req) {
+      f(req);
+      return s->State();
+    });
+  };
+  auto camera_png = [s](const char* kind) {
+    return [s, kind](const Request& req, Response& res) {
+      const std::shared_ptr<CameraWork> w = s->Work(api::PathText(req));
+      std::ifstream in(w->PlotPath(kind), std::ios::binary);
+      if (w->solves() == 0 || !in) throw NotFoundError(std::string(kind), "no solve of " + w->name() + " yet");
+      std::ostringstream bytes;
+      bytes << in.rdbuf();
+      res.set_header("Cache-Control", "no-store");
+      res.set_content(bytes.str(), "image/png");
+    };
+  };
+  return {
+      {"GET", "/api/calibration", "GET /api/calibration", api::Json([s](const Request&) { return s->State(); })},
+      {"POST", "/api/calibration/start",
+       "POST /api/calibration/start {\"board\", \"cameras\", \"board_pose\", \"board_thickness_m\", \"min_views\", "
+       "\"max_views\", \"min_coverage\", \"max_rms_px\", \"still_s\", \"floor_still_s\", \"use_current_intrinsics\"}",
+       state_after([s](const Request& req) {
+         s->Start(api::ObjectBody(req, {"board", "cameras", "board_pose", "board_thickness_m", "min_views", "max_views",
+                                        "min_coverage", "max_rms_px", "still_s", "floor_still_s",
+                                        "use_current_intrinsics"}));
+         s->Retap();
+       })},
+      {"POST", "/api/calibration/cancel", "POST /api/calibration/cancel", state_after([s](const Request& req) {
+         api::ObjectBody(req, {});
+         s->RequireActive();
+         s->Stop();
+         std::lock_guard lock(s->mutex);
+         s->error.clear();
+       })},
+      {"POST", "/api/calibration/drop", "POST /api/calibration/drop {\"camera\", \"which\": \"last\" | \"worst\"}",
+       state_after([s](const Request& req) {
+         const nlohmann::json body = api::ObjectBody(req, {"camera", "which"});
+         const std::string which = body.value("which", nlohmann::json("last")).is_string() ? body.value("which", "last") : "";
+         if (which != "last" && which != "worst") {
+           throw InputError("which", "expected \"last\" or \"worst\", got " + api::Dump(body.value("which", nlohmann::json())));
+         }
+         for (const auto& w : s->Chosen(body, true)) {
+           w->Run([&](calib::CalibrationWizard& wiz) {
+             try {
+               which == "last" ? wiz.DropLast() : wiz.DropWorst();
+             } catch (const InputError& e) {
+               throw ConflictError(w->name(), e.what());
+             }
+             return 0;
+           });
+         }
+       })},
+      {"POST", "/api/calibration/solve", "POST /api/calibration/solve {\"camera\"} (202: runs in the background)",
+       [s](const Request& req, Response& res) {
+         const nlohmann::json body = api::ObjectBody(req, {"camera"});
+         s->RequireActive();
+         std::vector<std::shared_ptr<CameraWork>> chosen = s->Chosen(body, false);
+         if (!body.contains("camera")) {
+           // Every camera still in the intrinsics step.
+           std::vector<std::shared_ptr<CameraWork>> in_step;
+           for (const auto& w : chosen) {
+             if (w->Snapshot().value("step", "") == "intrinsics") in_step.push_back(w);
+           }
+           if (in_step.empty()) throw ConflictError("solve", "no camera is in the intrinsics step");
+           chosen = in_step;
+         }
+         for (const auto& w : chosen) w->StartSolve();
+         api::Reply(res, 202, s->State());
+       }},
+      {"POST", "/api/calibration/redo", "POST /api/calibration/redo {\"camera\", \"step\": \"intrinsics\" | \"ground\" | \"enclosure\"}",
+       state_after([s](const Request& req) {
+         const nlohmann::json body = api::ObjectBody(req, {"camera", "step"});
+         if (!body.contains("step")) throw InputError("step", "missing (intrinsics, ground or enclosure)");
+         const WizardStep step = ParseStep(body["step"]);
+         for (const auto& w : s->Chosen(body, false)) {
+           w->Run([&](calib::CalibrationWizard& wiz) {
+             try {
+               wiz.Redo(step);
+             } catch (const InputError& e) {
+               throw ConflictError(w->name(), e.what());
+             }
+             return 0;
+           });
+         }
+         std::lock_guard lock(s->mutex);
+         s->saved = nullptr;
+       })},
+      {"POST", "/api/calibration/floor",
+       "POST /api/calibration/floor {\"camera\", \"detect\": true} | {\"camera\", \"pixels\": [[x, y], ...]}",
+       state_after([s](const Request& req) {
+         const nlohmann::json body = api::ObjectBody(req, {"camera", "detect", "pixels"});
+         const std::shared_ptr<CameraWork> w = s->Chosen(body, true).front();
+         if (body.contains("pixels")) {
+           const nlohmann::json& p = body["pixels"];
+           if (!p.is_array()) throw InputError("pixels", "expected [[x, y], ...] in the camera's pixels");
+           std::vector<Eigen::Vector2d> pixels;
+           for (const auto& q : p) {
+             if (!q.is_array() || q.size() != 2 || !q[0].is_number() || !q[1].is_number()) {
+               throw InputError("pixels", "expected [x, y] pairs, got " + api::Dump(q));
+             }
+             pixels.emplace_back(q[0].get<double>(), q[1].get<double>());
+           }
+           w->Run([&](calib::CalibrationWizard& wiz) {
+             if (!wiz.posed_model()) throw ConflictError(w->name(), "is not posed yet: finish the ground step first");
+             wiz.SetFloorFromPixels(pixels);
+             return 0;
+           });
+         } else if (body.value("detect", false) == true) {
+           const LiveView live = w->Live();
+           w->Run([&](calib::CalibrationWizard& wiz) {
+             if (!wiz.posed_model()) throw ConflictError(w->name(), "is not posed yet: finish the ground step first");
+             if (live.bgr.empty()) throw ConflictError(w->name(), "has no frame to find the floor in");
+             try {
+               wiz.DetectFloor(live.bgr);
+             } catch (const InputError& e) {
+               throw InputError("detect", std::string("no green floor found: ") + e.what() +
+                                              "; clear the floor, or click its corners on the image");
+             }
+             return 0;
+           });
+         } else {
+           throw InputError("body", "give \"detect\": true or \"pixels\": [[x, y], ...]");
+         }
+         std::lock_guard lock(s->mutex);
+         s->saved = nullptr;
+       })},
+      {"POST", "/api/calibration/save", "POST /api/calibration/save", api::Json([s](const Request& req) {
+         api::ObjectBody(req, {});
+         s->Save();
+         return s->State();
+       })},
+      {"GET", R"(/api/calibration/cameras/([^/]+)/view\.json)", "GET /api/calibration/cameras/NAME/view.json?width=W",
+       [s](const Request& req, Response& res) {
+         const std::shared_ptr<CameraWork> w = s->Work(api::PathText(req));
+         const int width = static_cast<int>(api::IntParam(req, "width", 640, 16, 4096));
+         const LiveView live = w->Live();
+         if (live.bgr.empty()) {
+           api::ReplyError(res, 503, "camera \"" + w->name() + "\" has delivered no frame to the wizard yet");
+           return;
+         }
+         const double scale = std::min(1.0, static_cast<double>(width) / live.bgr.cols);
+         cv::Mat image = live.bgr;
+         if (scale < 1.0) cv::resize(live.bgr, image, cv::Size(), scale, scale, cv::INTER_AREA);
+         nlohmann::json grid = nlohmann::json::array();
+         for (const auto& line : live.grid) grid.push_back(Points(line));
+         const nlohmann::json j = {{"frame", live.sequence}, {"width", live.bgr.cols}, {"height", live.bgr.rows},
+                                   {"scale", scale}, {"image", "data:image/jpeg;base64," + Base64(EncodeJpeg(image))},
+                                   {"detected", live.detected}, {"still", live.still}, {"corners", Points(live.corners)},
+                                   {"grid", grid}, {"floor", Points(live.floor)}};
+         res.set_header("Cache-Control", "no-store");
+         res.set_content(api::Dump(j), "application/json");
+       }},
+      {"GET", R"(/api/calibration/cameras/([^/]+)/residuals\.png)", "GET /api/calibration/cameras/NAME/residuals.png",
+       camera_png("residuals")},
+      {"GET", R"(/api/calibration/cameras/([^/]+)/uncertainty\.png)", "GET /api/calibration/cameras/NAME/uncertainty.png",
+       camera_png("uncertainty")},
+  };
+}
+
+}  // namespace ss
