@@ -11,6 +11,7 @@
 #include <random>
 #include <set>
 #include <sstream>
+#include <tuple>
 #include <unordered_map>
 #include <unordered_set>
 
@@ -115,7 +116,16 @@ std::string TransitionLabelsCsv(const std::vector<TransitionLabelRecord>& labels
     out += text;
   }
   out += "sprite_i,sprite_j,accept\n";
-  for (const TransitionLabelRecord& l : labels) {
+  // In pair order, not labelling order: training's fold split follows the file's order, so
+  // the same labels give the same cross-validated figures however they were asked.
+  std::vector<const TransitionLabelRecord*> sorted;
+  for (const TransitionLabelRecord& l : labels) sorted.push_back(&l);
+  std::stable_sort(sorted.begin(), sorted.end(), [](const auto* x, const auto* y) {
+    return std::make_tuple(std::min(x->from_sprite, x->to_sprite), std::max(x->from_sprite, x->to_sprite), x->from_sprite) <
+           std::make_tuple(std::min(y->from_sprite, y->to_sprite), std::max(y->from_sprite, y->to_sprite), y->from_sprite);
+  });
+  for (const TransitionLabelRecord* p : sorted) {
+    const TransitionLabelRecord& l = *p;
     if (l.label != "yes" && l.label != "no") continue;
     out += std::to_string(l.from_sprite) + "," + std::to_string(l.to_sprite) + "," + (l.label == "yes" ? "1" : "0") +
            "\n";

@@ -35,8 +35,8 @@ struct ConsoleLabelsOptions {
 };
 
 // The labels CSV of `transitions train` (training.h ReadLabelsCsv): the header, then one
-// row per yes / no label (skips are left out); a positive rate > 0 is written as the
-// "# positive_rate=R" line first.
+// row per yes / no label (skips are left out) in pair order (by the smaller, then the larger
+// sprite id); a positive rate > 0 is written as the "# positive_rate=R" line first.
 std::string TransitionLabelsCsv(const std::vector<TransitionLabelRecord>& labels, double positive_rate);
 
 // The positive rate the weights' stage 2 was calibrated for (training.stage2_calibration),
