@@ -190,6 +190,33 @@ struct ConsoleLabels::Pool {
     }
     last_seq = max_seq;
   }
+
+  // A pair of store indices as the page takes it (docs/console.md).
+  nlohmann::json PairJson(int32_t i, int32_t j, double d, const TransitionClassifier& classifier) const {
+    const SpriteStore& s = *store;
+    auto sprite_json = [&](int32_t k) {
+      return nlohmann::json{{"id", s.id(k)}, {"prev", s.id(s.prev(k))}, {"next", s.id(s.next(k))},
+                            {"clip", meta[k].clip}, {"frame", meta[k].frame}};
+    };
+    nlohmann::json billboards = nlohmann::json::object();
+    for (int32_t k : {i, j}) {
+      for (int32_t m : {s.prev(k), k, s.next(k)}) {
+        billboards[std::to_string(s.id(m))] = {
+            {"width", meta[m].width}, {"height", meta[m].height}, {"anchor", {meta[m].anchor_x, meta[m].anchor_y}}};
+      }
+    }
+    const double margin = d - classifier.stage2_threshold();
+    return {{"from", s.id(i)},
+            {"to", s.id(j)},
+            {"d", d},
+            {"margin", margin},
+            {"p_accept", 1.0 / (1.0 + std::exp(std::clamp(margin, -50.0, 50.0)))},
+            {"decision", classifier.Stage2Accepts(d) ? "accept" : "reject"},
+            {"a", sprite_json(i)},
+            {"b", sprite_json(j)},
+            {"frames", {s.id(s.prev(i)), s.id(i), s.id(j), s.id(s.next(j))}},
+            {"billboards", billboards}};
+  }
 };
 
 ConsoleLabels::ConsoleLabels(api::Context context, ConsoleLabelsOptions options)
@@ -298,18 +325,6 @@ nlohmann::json ConsoleLabels::Pairs(int count) {
   // Each sprite (and its neighbours in the clip) in at most one pair of the answer, so the
   // questions are not the same pair shifted by a frame.
   std::unordered_set<int32_t> used;
-  auto sprite_json = [&](int32_t i) {
-    const Pool::Meta& m = pool_->meta[i];
-    return nlohmann::json{{"id", store.id(i)},
-                          {"prev", store.id(store.prev(i))},
-                          {"next", store.id(store.next(i))},
-                          {"clip", m.clip},
-                          {"frame", m.frame}};
-  };
-  auto billboard_json = [&](int32_t i) {
-    const Pool::Meta& m = pool_->meta[i];
-    return nlohmann::json{{"width", m.width}, {"height", m.height}, {"anchor", {m.anchor_x, m.anchor_y}}};
-  };
   for (const Candidate& c : candidates) {
     if (static_cast<int>(out["pairs"].size()) >= count) break;
     if (used.count(c.i) || used.count(c.j)) continue;
@@ -318,23 +333,43 @@ nlohmann::json ConsoleLabels::Pairs(int count) {
       used.insert(store.prev(k));
       used.insert(store.next(k));
     }
-    const double margin = c.d - threshold;
-    nlohmann::json billboards = nlohmann::json::object();
-    for (int32_t k : {c.i, c.j}) {
-      for (int32_t m : {store.prev(k), k, store.next(k)}) billboards[std::to_string(store.id(m))] = billboard_json(m);
-    }
-    out["pairs"].push_back({{"from", store.id(c.i)},
-                            {"to", store.id(c.j)},
-                            {"d", c.d},
-                            {"margin", margin},
-                            {"p_accept", 1.0 / (1.0 + std::exp(std::clamp(margin, -50.0, 50.0)))},
-                            {"decision", classifier.Stage2Accepts(c.d) ? "accept" : "reject"},
-                            {"a", sprite_json(c.i)},
-                            {"b", sprite_json(c.j)},
-                            {"frames", {store.id(store.prev(c.i)), store.id(c.i), store.id(c.j), store.id(store.next(c.j))}},
-                            {"billboards", billboards}});
+    out["pairs"].push_back(pool_->PairJson(c.i, c.j, c.d, classifier));
   }
   return out;
+}
+
+nlohmann::json ConsoleLabels::Pair(int64_t from, int64_t to) {
+  if (from == to) throw InputError("to", "the same sprite as \"from\" (" + std::to_string(from) + ")");
+  const std::string bank = BankPath();
+  {
+    const Bank reader(bank);
+    CheckSprite(reader, from);
+    CheckSprite(reader, to);
+  }
+  const auto [weights, weights_path] = WeightsInUse();
+  std::lock_guard lock(pool_mutex_);
+  if (!pool_ || pool_->bank != bank || !SameWindow(pool_->window, weights.window)) {
+    pool_ = std::make_unique<Pool>();
+    pool_->bank = bank;
+    pool_->window = weights.window;
+  }
+  pool_->Update(options_.threads);
+  auto index = [&](int64_t id, const char* field) {
+    const std::optional<int32_t> i = pool_->store ? pool_->store->IndexOf(id) : std::nullopt;
+    if (!i) {
+      throw InputError(field, "sprite " + std::to_string(id) +
+                                  " is a mirrored copy or in a clip still being written: only originals of complete "
+                                  "clips are labelled");
+    }
+    if (pool_->store->prev(*i) < 0 || pool_->store->next(*i) < 0) {
+      throw InputError(field, "sprite " + std::to_string(id) +
+                                  " is the first or last frame of its clip: the transition cannot be played");
+    }
+    return *i;
+  };
+  const int32_t i = index(from, "from"), j = index(to, "to");
+  const TransitionClassifier classifier(weights);
+  return pool_->PairJson(i, j, classifier.Distance(pool_->store->Features(i, j)), classifier);
 }
 
 nlohmann::json ConsoleLabels::Store(const nlohmann::json& body) {
@@ -663,6 +698,13 @@ std::vector<Route> ConsoleLabels::Routes() {
       {"GET", "/api/labels", "GET /api/labels (counts)", Json([this](const httplib::Request&) { return Counts(); })},
       {"GET", "/api/labels/pairs", "GET /api/labels/pairs?count=N (least sure first)",
        Json([this](const httplib::Request& req) { return Pairs(static_cast<int>(api::IntParam(req, "count", 10, 1, 100))); })},
+      {"GET", "/api/labels/pair", "GET /api/labels/pair?from=ID&to=ID (one pair, as pairs gives it)",
+       Json([this](const httplib::Request& req) {
+         for (const char* field : {"from", "to"}) {
+           if (!req.has_param(field)) throw InputError(field, "missing (?from=ID&to=ID)");
+         }
+         return Pair(api::IntParam(req, "from", 0, 1, INT64_MAX), api::IntParam(req, "to", 0, 1, INT64_MAX));
+       })},
       {"POST", "/api/labels", "POST /api/labels {\"from\": ID, \"to\": ID, \"label\": \"yes\" | \"no\" | \"skip\"}",
        Json([this](const httplib::Request& req) { return Store(ObjectBody(req, {"from", "to", "label"})); })},
       {"POST", "/api/labels/undo", "POST /api/labels/undo {\"from\": ID, \"to\": ID}",

@@ -59,6 +59,10 @@ class ConsoleLabels : public api::Part {
   // among the stage-1 candidates of up to `candidate_rows` sprites. Every sprite of a pair
   // has a predecessor and a successor in its clip, so either side can be played first.
   nlohmann::json Pairs(int count);
+  // GET /api/labels/pair?from=ID&to=ID: one pair as Pairs gives it (a link to a transition).
+  // NotFoundError naming an unknown sprite; InputError naming the field for a mirrored
+  // sprite, one of a clip still being written, or a first or last frame.
+  nlohmann::json Pair(int64_t from, int64_t to);
   // POST /api/labels {"from", "to", "label": "yes" | "no" | "skip"}: stores (or replaces)
   // a label. InputError naming the field; NotFoundError naming an unknown sprite.
   nlohmann::json Store(const nlohmann::json& body);

@@ -226,6 +226,12 @@ TEST(ConsoleLabels, AsksTheLeastSurePairsFirstAndNeverAgain) {
       EXPECT_TRUE(sprites.insert(s.id).second) << "each sprite in one pair of an answer";
     }
   }
+  // One pair asked by its ids (a link) is the pair as the list gives it.
+  EXPECT_EQ(labels.Pair(pairs[1]["from"], pairs[1]["to"]), pairs[1]);
+  std::string e = ErrorOf([&] { labels.Pair(pairs[1]["from"], 999999); });
+  EXPECT_EQ(e, "sprite: no sprite with id 999999 in the bank");
+  e = ErrorOf([&] { labels.Pair(bank.originals[0], pairs[1]["to"]); });  // a clip's first frame
+  EXPECT_EQ(e.rfind("from: sprite " + std::to_string(bank.originals[0]) + " is the first or last frame", 0), 0u) << e;
   // A labelled pair (in either order) is not asked again.
   labels.Store({{"from", pairs[0]["to"]}, {"to", pairs[0]["from"]}, {"label", "skip"}});
   const nlohmann::json again = labels.Pairs(8);

@@ -18,8 +18,13 @@ let batchSize = 0;
 let current = null; // {pair, from, to, frames: [ids], a, b}
 let busy = false;
 let answered = 0;
-let history = []; // [{from, to, item}] labelled on this visit, for undo
+let given = []; // [{from, to, item}] labelled on this visit, for undo
 let lastRetrainState = null;
+// label.html#pair=FROM,TO asks about that pair first (a link to one transition).
+let linked = (() => {
+  const m = /(?:^#|&)pair=(\d+),(\d+)/.exec(location.hash);
+  return m ? { from: Number(m[1]), to: Number(m[2]) } : null;
+})();
 
 // ---- billboards ------------------------------------------------------------
 
@@ -135,7 +140,7 @@ async function fetchBatch() {
 
 function setAnswerButtons(enabled) {
   for (const b of document.querySelectorAll('.answers .answer')) b.disabled = !enabled;
-  $('answer-undo').disabled = busy || history.length === 0;
+  $('answer-undo').disabled = busy || given.length === 0;
 }
 
 function caption(side, name) {
@@ -148,14 +153,27 @@ async function next() {
   const box = $('pair');
   box.dataset.state = 'loading';
   setAnswerButtons(false);
+  let pair = null;
+  let flip = Math.random() < 0.5;
+  if (linked) {
+    const link = linked;
+    linked = null;
+    window.history.replaceState(null, '', location.pathname);
+    try {
+      pair = await getJson(`/api/labels/pair?from=${link.from}&to=${link.to}`);
+      flip = false; // as linked
+    } catch (err) {
+      showMessage(err.message, 'error'); // the API's words: "sprite: no sprite with id … in the bank"
+    }
+  }
   try {
-    if (!queue.length) await fetchBatch();
+    if (!pair && !queue.length) await fetchBatch();
   } catch (err) {
     showMessage(`pairs: ${err.message}`, 'error');
     box.dataset.state = 'error';
     return;
   }
-  if (!queue.length) {
+  if (!pair && !queue.length) {
     box.dataset.state = 'empty';
     $('pair-empty').hidden = false;
     $('pair-empty').textContent = 'No unlabelled pair is left among the classifier\'s candidates of the sprites searched. ' +
@@ -164,15 +182,15 @@ async function next() {
     return;
   }
   $('pair-empty').hidden = true;
-  const pair = queue.shift();
+  const fromLink = pair !== null;
+  if (!pair) pair = queue.shift();
   // Sides at random: B → A is the same classifier pair played the other way.
-  const flip = Math.random() < 0.5;
   const a = flip ? pair.b : pair.a;
   const b = flip ? pair.a : pair.b;
   const shown = { pair, a, b, from: a.id, to: b.id, frames: [a.prev, a.id, b.id, b.next] };
   current = shown;
   const index = batchSize - queue.length;
-  $('batch-progress').textContent = `pair ${index} of ${batchSize} in this batch`;
+  $('batch-progress').textContent = fromLink ? 'the linked pair' : `pair ${index} of ${batchSize} in this batch`;
   Object.assign(box.dataset, {
     from: String(shown.from),
     to: String(shown.to),
@@ -212,7 +230,7 @@ async function answer(label) {
   try {
     const r = await postJson('/api/labels', { from: shown.from, to: shown.to, label });
     answered++;
-    history.push({ from: shown.from, to: shown.to, item: recentItem(shown, label) });
+    given.push({ from: shown.from, to: shown.to, item: recentItem(shown, label) });
     $('session-count').textContent = String(answered);
     showCounts(r.labels);
   } catch (err) {
@@ -228,9 +246,9 @@ async function answer(label) {
 }
 
 async function undo() {
-  if (busy || !history.length) return;
+  if (busy || !given.length) return;
   busy = true;
-  const last = history.pop();
+  const last = given.pop();
   try {
     const r = await postJson('/api/labels/undo', { from: last.from, to: last.to });
     last.item.classList.add('undone');

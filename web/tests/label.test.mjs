@@ -27,7 +27,6 @@ before(async () => {
   station = await h.daemon('label', cfg, ['--replay-dir', s.root]);
   b = await h.browser();
   p = await h.page(b);
-  await p.goto(`${station.url}/label.html`);
 });
 
 after(async () => {
@@ -38,6 +37,16 @@ after(async () => {
 const pairSel = (i) => `[data-testid="pair"][data-state="ready"][data-index="${i}"]`;
 const messageText = () => p.textContent('[data-testid="message-text"]').catch(() => '');
 const metaFingerprint = () => h.sql(cfg.bank, "SELECT value FROM meta WHERE key = 'transitions.weights'");
+
+test('a link to a pair with an unknown sprite ends in a clear message', async () => {
+  await p.goto(`${station.url}/label.html#pair=1,999999`);
+  await h.waitFor('the API\'s words in the message bar', async () =>
+    (await messageText()) === 'sprite: no sprite with id 999999 in the bank');
+  // and the page goes on with the least sure pairs
+  await p.waitForSelector(pairSel(0), { timeout: 20000 });
+  assert.match(await h.text(p, 'batch-progress'), /^pair 1 of \d+ in this batch$/);
+  await p.click('[data-testid="message"] button');
+});
 
 test('a retrain with no labels yet ends in a clear message', async () => {
   await p.waitForSelector(pairSel(0), { timeout: 20000 });
