@@ -21,6 +21,7 @@
 #include "station/api_part.h"
 #include "station/console_calibration.h"
 #include "station/console_events.h"
+#include "station/console_labels.h"
 #include "station/station.h"
 #include "station/station_host.h"
 #include "station/station_status.h"
@@ -119,6 +120,7 @@ struct ControlServer::Impl {
     context.station = [this] { return station(); };
     context.config_path = options.config_path;
     parts.push_back(std::make_unique<ConsoleCalibration>(context));
+    parts.push_back(std::make_unique<ConsoleLabels>(context));
   }
 
   std::shared_ptr<Station> station() const {

@@ -41,7 +41,8 @@ trap cleanup EXIT INT TERM
 
 cd "$repo"
 status=0
-node --test --test-concurrency=1 --test-timeout=240000 "$here"/*.test.mjs || status=$?
+# SS_WEB_TESTS=NAME runs web/tests/NAME.test.mjs alone (default: every *.test.mjs).
+node --test --test-concurrency=1 --test-timeout=240000 "$here"/${SS_WEB_TESTS:-*}.test.mjs || status=$?
 if [ "$status" -ne 0 ]; then
   for f in "$SS_WEB_WORK"/*.log "$SS_WEB_WORK"/*/*.log; do
     [ -f "$f" ] || continue
