@@ -72,6 +72,28 @@ TEST_F(IngestEndToEnd, BadInputNamesTheFile) {
   EXPECT_EQ(no_bank.exit_code, 2) << no_bank.output;
 }
 
+// Issue 20: ingest went on writing into a damaged bank. Now a bank that fails SQLite's quick
+// check is refused by name before anything is written, and the file is left as it was.
+TEST_F(IngestEndToEnd, ADamagedBankIsRefusedAndLeftAsItWas) {
+  namespace fs = std::filesystem;
+  const std::string bank = *dir_ / "damaged.bank";
+  auto r = RunSpritestation("--log-level warn ingest " + *dir_ / "session" + " --bank " + bank + " --no-transitions");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  ASSERT_GT(fs::file_size(bank), 3 * 4096u);
+  {
+    std::fstream f(bank, std::ios::in | std::ios::out | std::ios::binary);
+    f.seekp(2 * 4096);  // page 3: a b-tree page of the schema's first tables
+    const std::string garbage(4096, '\xa5');
+    f.write(garbage.data(), static_cast<std::streamsize>(garbage.size()));
+  }
+  const auto before = testing::RunCommand("md5sum < " + bank);
+  r = RunSpritestation("--log-level warn ingest " + *dir_ / "session" + " --bank " + bank + " --no-transitions");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find(bank + ": the bank does not pass SQLite's quick check"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("bank verify"), std::string::npos) << r.output;
+  EXPECT_EQ(testing::RunCommand("md5sum < " + bank).output, before.output);
+}
+
 // A camera whose video cannot be read at all: ingest stores the other camera's sprites, then
 // says which camera failed and exits 1 (it used to report success).
 TEST_F(IngestEndToEnd, ACameraThatCannotBeReadIsAFailureNamedAfterTheRest) {
