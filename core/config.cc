@@ -424,6 +424,11 @@ void ReadEnclosure(Reader& r, const YAML::Node& node, EnclosureConfig& e) {
                   "expected a list of [x, y] points in metres, got " + ScalarText(*floor));
     return;
   }
+  if (floor->size() > GroundPolygon::kMaxVertices) {
+    r.msg().Error("enclosure.floor", std::to_string(floor->size()) + " points; a floor polygon has at most " +
+                                         std::to_string(GroundPolygon::kMaxVertices));
+    return;
+  }
   std::vector<Eigen::Vector2d> vertices;
   for (size_t i = 0; i < floor->size(); ++i) {
     const YAML::Node p = (*floor)[i];

@@ -45,6 +45,10 @@ std::optional<GroundPolygon> ReadFloorJson(const fs::path& path) {
   }
   if (floor != nullptr && floor->is_object() && floor->contains("vertices")) floor = &(*floor)["vertices"];
   if (floor == nullptr || !floor->is_array()) throw InputError(path.string(), "expected a \"floor\" list of [x, y] points");
+  if (floor->size() > GroundPolygon::kMaxVertices) {
+    throw InputError(path.string(), "floor: " + std::to_string(floor->size()) + " points; a floor polygon has at most " +
+                                        std::to_string(GroundPolygon::kMaxVertices));
+  }
   std::vector<Eigen::Vector2d> vertices;
   for (const auto& p : *floor) {
     if (p.is_array() && p.size() >= 2 && p[0].is_number() && p[1].is_number()) {
