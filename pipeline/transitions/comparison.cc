@@ -250,6 +250,15 @@ uint64_t SumAlphaDifference(const uint8_t* a, const uint8_t* b, int stride) {
   return kernel(a, b, stride);
 }
 
+int MaxAlphaDifference(const uint8_t* a, const uint8_t* b, int stride) {
+  uint8_t worst = 0;  // a plain loop the compiler vectorizes (max of |a - b| on bytes)
+  for (int k = 0; k < stride; ++k) {
+    const uint8_t d = a[k] > b[k] ? static_cast<uint8_t>(a[k] - b[k]) : static_cast<uint8_t>(b[k] - a[k]);
+    worst = std::max(worst, d);
+  }
+  return worst;
+}
+
 PixelSums SumPixelDifferences(const uint8_t* a, const uint8_t* b, int stride) {
   static const Kernel kernel = ChooseKernel();
   return kernel(a, b, stride);

@@ -399,7 +399,7 @@ TEST(TransitionWeightsFile, WrongFilesNameTheFileAndField) {
     edit(j);
     return ErrorOf(j.dump());
   };
-  EXPECT_NE(with([](auto& j) { j["version"] = 2; }).find("field 'version'"), std::string::npos);
+  EXPECT_NE(with([](auto& j) { j["version"] = 3; }).find("field 'version'"), std::string::npos);  // 2 exists now
   EXPECT_NE(with([](auto& j) { j["format"] = "other"; }).find("field 'format'"), std::string::npos);
   EXPECT_NE(with([](auto& j) { j["stage1"]["weights"][2] = -0.5; }).find("field 'stage1.weights'"), std::string::npos);
   EXPECT_NE(with([](auto& j) { j["stage1"]["weights"] = {1, 2}; }).find("field 'stage1.weights'"), std::string::npos);
