@@ -40,6 +40,7 @@ bool TransitionClassifier::SignatureRejects(const SpriteStore& store, int32_t i,
   if (linf()) {
     return cheap[0] > weights_.linf_max_velocity_mps || store.SignatureLinfExceeds(i, j, linf_alpha_limit_);
   }
+  if (colour_blob()) return cheap[0] > weights_.colour_blob_max_velocity_mps;
   // d is Distance()'s prefix, and the alpha feature is monotone in its numerator, so
   // d + u4 * bound <= the full sum.
   const double d = CheapPart(cheap);
@@ -57,6 +58,14 @@ bool TransitionClassifier::Stage2(const SpriteStore& store, int32_t i, int32_t j
     const int worst = MaxAlphaDifference(store.image(i), store.image(j), store.window().PlaneStride());
     if (worst > linf_alpha_limit_) return false;
     *distance = std::max(cheap[0] / weights_.linf_max_velocity_mps, worst / (255.0 * weights_.linf_max_alpha));
+    return true;
+  }
+  if (colour_blob()) {
+    if (cheap[0] > weights_.colour_blob_max_velocity_mps) return false;
+    const int blob = LargestColourBlob(store.image(i), store.image(j), store.window());
+    if (blob > weights_.colour_blob_max_cells) return false;
+    *distance = std::max(cheap[0] / weights_.colour_blob_max_velocity_mps,
+                         static_cast<double>(blob) / std::max(1, weights_.colour_blob_max_cells));
     return true;
   }
   // The partial sums are Distance()'s prefixes.

@@ -42,6 +42,8 @@ class TransitionClassifier {
   // nothing (run Stage2).
   // With the linf variant: true when the velocity difference exceeds its bound or
   // SpriteStore::SignatureLinfExceeds proves the largest cell difference exceeds its bound.
+  // With the colour_blob variant: true when the velocity difference exceeds its bound (the
+  // colour blob has no per-sprite bound: every other pair is evaluated).
   bool SignatureRejects(const SpriteStore& store, int32_t i, int32_t j) const;
   // Stage 2 on store indices (i, j) with early exits: the sum of Distance() is built in
   // its own order (the cheap terms, then alpha from the alpha plane, then colour) and every
@@ -51,10 +53,14 @@ class TransitionClassifier {
   // the builder calls SignatureRejects first and counts only the pairs that reach this.
   // With the linf variant (weights().stage2_variant): kept when velocity <= max_velocity_mps
   // and MaxAlphaDifference <= floor(255 * max_alpha_linf); *distance = the larger of the two
-  // ratios to their bounds (0..1). Distance() and Stage2Accepts() stay the linear D (training
+  // ratios to their bounds (0..1). With the colour_blob variant: kept when velocity <=
+  // max_velocity_mps and LargestColourBlob <= max_blob_cells; *distance = the larger of
+  // velocity / max_velocity_mps and blob / max(1, max_blob_cells) (0..1). Distance() and
+  // Stage2Accepts() stay the linear D (training
   // and the labelling page use them).
   bool Stage2(const SpriteStore& store, int32_t i, int32_t j, double* distance) const;
   bool linf() const { return weights_.stage2_variant == Stage2Variant::kLinf; }
+  bool colour_blob() const { return weights_.stage2_variant == Stage2Variant::kColourBlob; }
   // linf: the largest accepted MaxAlphaDifference (0..255).
   int linf_alpha_limit() const { return linf_alpha_limit_; }
 

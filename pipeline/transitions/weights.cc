@@ -101,6 +101,12 @@ bool TransitionWeights::IsValid(std::string* why) const {
       return fail("stage2.linf.max_alpha_linf", "must be in (0, 1]");
     }
   }
+  if (stage2_variant == Stage2Variant::kColourBlob) {
+    if (!(colour_blob_max_velocity_mps > 0) || !std::isfinite(colour_blob_max_velocity_mps)) {
+      return fail("stage2.colour_blob.max_velocity_mps", "must be a positive number");
+    }
+    if (colour_blob_max_cells < 0) return fail("stage2.colour_blob.max_blob_cells", "must be >= 0");
+  }
   return true;
 }
 
@@ -157,8 +163,12 @@ TransitionWeights ParseWeights(const std::string& text, const std::string& sourc
       w.stage2_variant = Stage2Variant::kLinf;
       w.linf_max_velocity_mps = r.Number("stage2.linf.max_velocity_mps");
       w.linf_max_alpha = r.Number("stage2.linf.max_alpha_linf");
+    } else if (variant == "colour_blob") {
+      w.stage2_variant = Stage2Variant::kColourBlob;
+      w.colour_blob_max_velocity_mps = r.Number("stage2.colour_blob.max_velocity_mps");
+      w.colour_blob_max_cells = r.Integer("stage2.colour_blob.max_blob_cells");
     } else {
-      r.Fail("stage2.variant", "expected \"paper\" or \"linf\", got " + variant.dump());
+      r.Fail("stage2.variant", "expected \"paper\", \"linf\" or \"colour_blob\", got " + variant.dump());
     }
   }
   if (root.contains("training")) {
@@ -183,7 +193,8 @@ std::string WeightsToJson(const TransitionWeights& w) {
   json root;
   root["format"] = kWeightsFileFormat;
   const bool linf = w.stage2_variant == Stage2Variant::kLinf;
-  root["version"] = linf ? 2 : 1;  // the paper variant is written as version 1 was
+  const bool blob = w.stage2_variant == Stage2Variant::kColourBlob;
+  root["version"] = linf || blob ? 2 : 1;  // the paper variant is written as version 1 was
   root["features"] = FeatureNames();
   root["comparison_window"] = {{"width_m", w.window.width_m},
                                {"height_m", w.window.height_m},
@@ -198,6 +209,11 @@ std::string WeightsToJson(const TransitionWeights& w) {
   if (linf) {
     root["stage2"]["variant"] = "linf";
     root["stage2"]["linf"] = {{"max_velocity_mps", w.linf_max_velocity_mps}, {"max_alpha_linf", w.linf_max_alpha}};
+  }
+  if (blob) {
+    root["stage2"]["variant"] = "colour_blob";
+    root["stage2"]["colour_blob"] = {{"max_velocity_mps", w.colour_blob_max_velocity_mps},
+                                     {"max_blob_cells", w.colour_blob_max_cells}};
   }
   json training = json::parse(w.training_json, nullptr, false);
   root["training"] = training.is_object() ? training : json::object();

@@ -1,9 +1,11 @@
-// The linf stage-2 variant: velocity AND the largest cell alpha difference. The feature is
-// symmetric and right on hand-made pairs, its signature bound never rejects a pair the full
-// evaluation accepts, and the weights file carries the variant (version 2) while version-1
-// files load as before.
+// The linf stage-2 variant (velocity AND the largest cell alpha difference) and the
+// colour_blob one (velocity AND the largest blob of colour differences): the features are
+// symmetric and right on hand-made pairs, the filters never reject a pair the full evaluation
+// accepts, and the weights file carries the variant (version 2) while version-1 files load
+// as before.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <functional>
 #include <random>
 #include <vector>
@@ -37,7 +39,7 @@ struct Cell {
   uint8_t alpha;
 };
 
-RgbaBillboard Sprite(const std::vector<Cell>& cells) {
+RgbaBillboard Sprite(const std::vector<Cell>& cells, const std::array<uint8_t, 3>& rgb = {200, 100, 50}) {
   RgbaBillboard b;
   b.width = 32;
   b.height = 32;
@@ -46,9 +48,9 @@ RgbaBillboard Sprite(const std::vector<Cell>& cells) {
   b.rgba.assign(32 * 32 * 4, 0);
   for (const Cell& c : cells) {
     uint8_t* p = b.rgba.data() + (static_cast<size_t>(c.y) * 32 + c.x) * 4;
-    p[0] = 200;
-    p[1] = 100;
-    p[2] = 50;
+    p[0] = rgb[0];
+    p[1] = rgb[1];
+    p[2] = rgb[2];
     p[3] = c.alpha;
   }
   return b;
@@ -214,6 +216,97 @@ TEST(TransitionLinf, FilterIsExactOnSyntheticSprites) {
   }
 }
 
+// Paints `cells` of an existing sprite with another colour (alpha kept).
+RgbaBillboard Recolour(RgbaBillboard b, const std::vector<Cell>& cells, const std::array<uint8_t, 3>& rgb) {
+  for (const Cell& c : cells) {
+    uint8_t* p = b.rgba.data() + (static_cast<size_t>(c.y) * 32 + c.x) * 4;
+    p[0] = rgb[0];
+    p[1] = rgb[1];
+    p[2] = rgb[2];
+  }
+  return b;
+}
+
+TEST(TransitionColourBlob, FeatureOnHandMadePairs) {
+  const RgbaBillboard body = Sprite(Rectangle(8, 10, 20, 32, 255));
+  RgbaBillboard two_patches = Recolour(body, Rectangle(9, 12, 12, 14, 255), {90, 100, 50});  // 3 x 2, dR 110
+  two_patches = Recolour(two_patches, Rectangle(15, 20, 17, 21, 255), {200, 40, 20});          // 2 x 1, 90
+  const RgbaBillboard faint = Recolour(body, Rectangle(9, 12, 12, 14, 255), {150, 80, 40});      // dR+dG+dB 80
+  RgbaBillboard half_transparent = Sprite(Rectangle(8, 10, 20, 32, 255));
+  for (const Cell& c : Rectangle(9, 12, 12, 14, 0)) half_transparent.rgba[(c.y * 32 + c.x) * 4 + 3] = 100;
+  half_transparent = Recolour(half_transparent, Rectangle(9, 12, 12, 14, 255), {90, 100, 50});
+  const RgbaBillboard diagonal = Recolour(body, {{9, 12, 255}, {10, 13, 255}}, {0, 0, 0});  // not 4-connected
+  const std::vector<RgbaBillboard> sprites = {body, two_patches, faint, half_transparent, diagonal};
+  std::vector<SpriteInput> inputs;
+  for (size_t k = 0; k < sprites.size(); ++k) {
+    inputs.push_back({static_cast<int64_t>(k + 1), static_cast<int64_t>(k + 1), {}, &sprites[k]});
+  }
+  SpriteStore s(CellPerPixel(), 100.0);
+  s.Append(inputs);
+  auto blob = [&](int32_t i, int32_t j) { return LargestColourBlob(s.image(i), s.image(j), s.window()); };
+  EXPECT_EQ(blob(0, 1), 6);  // the larger of the two patches
+  EXPECT_EQ(blob(0, 2), 0);  // below the colour step
+  EXPECT_EQ(blob(0, 3), 0);  // the patch is not opaque in both
+  EXPECT_EQ(blob(0, 4), 1);  // two cells touching at a corner are two blobs
+  for (int32_t i = 0; i < s.size(); ++i) {
+    EXPECT_EQ(blob(i, i), 0);
+    for (int32_t j = 0; j < s.size(); ++j) EXPECT_EQ(blob(i, j), blob(j, i));
+  }
+  TransitionWeights w = LinfWeights(CellPerPixel(), 0.05, 0.5);
+  w.stage2_variant = Stage2Variant::kColourBlob;
+  w.colour_blob_max_velocity_mps = 0.05;
+  w.colour_blob_max_cells = 4;
+  const TransitionClassifier c(w);
+  ASSERT_TRUE(c.colour_blob());
+  double d = -1;
+  EXPECT_FALSE(c.Stage2(s, 0, 1, &d));  // blob 6 > 4
+  EXPECT_TRUE(c.Stage2(s, 0, 4, &d));   // blob 1, velocity 0
+  EXPECT_NEAR(d, 0.25, 1e-12);
+  EXPECT_TRUE(c.Stage2(s, 0, 3, &d));
+  EXPECT_EQ(d, 0.0);
+}
+
+// Only the velocity filters a colour_blob pair before it is evaluated: on generated sprites
+// in the 1 px window the builder keeps exactly what a linear scan keeps.
+TEST(TransitionColourBlob, BuilderKeepsWhatALinearScanKeeps) {
+  SyntheticSpriteOptions so;
+  so.frames = 100;
+  so.seed = 9;
+  const auto sprites = MakeSyntheticSprites(so);
+  ComparisonWindow window;
+  window.width_m = 0.24;
+  window.height_m = 0.18;
+  window.cells_x = 60;
+  window.cells_y = 45;
+  window.align = HorizontalAlignment::kContactPoint;
+  SpriteStore store(window, so.px_per_m);
+  store.Append(AsSpriteInputs(sprites), 2);
+  TransitionWeights w = LinfWeights(window, 0.05, 0.5);
+  w.stage2_variant = Stage2Variant::kColourBlob;
+  w.colour_blob_max_velocity_mps = 0.05;
+  w.colour_blob_max_cells = 30;
+  const TransitionClassifier c(w);
+  int64_t kept = 0;
+  for (int32_t i = 0; i < store.size(); ++i) {
+    for (int32_t j = 0; j < store.size(); ++j) {
+      if (i == j) continue;
+      double d = -1, e = -1;
+      const bool full = c.Stage2(store, i, j, &d);
+      ASSERT_EQ(full, c.Stage2(store, j, i, &e));
+      ASSERT_FALSE(full && c.SignatureRejects(store, i, j));
+      if (full) {
+        ASSERT_EQ(d, e);
+        ASSERT_TRUE(c.Stage1Accepts(store.cheap(i), store.cheap(j)));
+      }
+      kept += full;
+    }
+  }
+  EXPECT_GT(kept, 0);
+  TransitionBuilder builder(w, so.px_per_m);
+  builder.BuildFromScratch(AsSpriteInputs(sprites), BuildOptions{.threads = 2});
+  EXPECT_EQ(builder.stats().kept_pairs, kept / 2);
+}
+
 std::string ErrorOf(const std::string& text) {
   try {
     ParseWeights(text, "w.json");
@@ -267,6 +360,32 @@ TEST(TransitionLinf, WeightsFileCarriesTheVariant) {
             std::string::npos);
   EXPECT_NE(with([](auto& j) { j["stage2"]["linf"]["max_velocity_mps"] = "fast"; })
                 .find("field 'stage2.linf.max_velocity_mps'"),
+            std::string::npos);
+  // The colour_blob variant's fields.
+  TransitionWeights b = w;
+  b.stage2_variant = Stage2Variant::kColourBlob;
+  b.colour_blob_max_velocity_mps = 0.05;
+  b.colour_blob_max_cells = 12;
+  const std::string btext = WeightsToJson(b);
+  const TransitionWeights bback = ParseWeights(btext, "w.json");
+  EXPECT_EQ(bback.stage2_variant, Stage2Variant::kColourBlob);
+  EXPECT_EQ(bback.colour_blob_max_cells, 12);
+  EXPECT_EQ(bback.colour_blob_max_velocity_mps, 0.05);
+  EXPECT_EQ(WeightsToJson(bback), btext);
+  const nlohmann::json bgood = nlohmann::json::parse(btext);
+  auto bwith = [&](const std::function<void(nlohmann::json&)>& edit) {
+    nlohmann::json j = bgood;
+    edit(j);
+    return ErrorOf(j.dump());
+  };
+  EXPECT_NE(bwith([](auto& j) { j["stage2"]["colour_blob"]["max_blob_cells"] = -1; })
+                .find("field 'stage2.colour_blob.max_blob_cells'"),
+            std::string::npos);
+  EXPECT_NE(bwith([](auto& j) { j["stage2"]["colour_blob"]["max_blob_cells"] = 2.5; })
+                .find("field 'stage2.colour_blob.max_blob_cells'"),
+            std::string::npos);
+  EXPECT_NE(bwith([](auto& j) { j["stage2"]["colour_blob"].erase("max_velocity_mps"); })
+                .find("field 'stage2.colour_blob.max_velocity_mps': missing"),
             std::string::npos);
   // A version-1 file has no variant: one that names one is refused rather than misread.
   EXPECT_NE(with([](auto& j) { j["version"] = 1; }).find("field 'stage2.variant'"), std::string::npos);
