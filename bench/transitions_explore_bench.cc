@@ -1,5 +1,6 @@
 // spritestation bench transitions-explore: which pair features can agree with the synthetic
-// truth (same pose, every key point within 4 mm = 1 px at 250 px/m)? On a few thousand
+// truth (same pose, every key point visible in either sprite within 4 mm = 1 px at 250
+// px/m)? On a few thousand
 // synthetic sprites (training set seed 1, test set seed 2), for every pair of sampled rows:
 // candidate features at several comparison resolutions and alignments, then the best
 // achievable pair-level and transition-level F1 (precision >= 0.85 and unconstrained) per
@@ -289,14 +290,23 @@ std::array<double, kNumFeat> PairFeats(const Image& i, const Image& j, double ce
   return f;
 }
 
+// Whether point k of a matched with point l of b is compared: visible in at least one.
+bool Seen(const SpriteTruth& a, size_t k, const SpriteTruth& b, size_t l) {
+  const auto& va = a.keypoint_visible;
+  const auto& vb = b.keypoint_visible;
+  return va.empty() || vb.empty() || va[k] || vb[l];
+}
+
 // KeypointDisplacement with the feet (points 4.. of the list) matched as an unordered set.
 double PermDisplacement(const SpriteTruth& a, const SpriteTruth& b) {
   const auto& p = a.keypoints_m;
   const auto& q = b.keypoints_m;
   if (p.size() != q.size() || p.size() < 8) return INFINITY;
   double fixed = 0;
-  for (size_t k = 0; k < 8; k += 2)
-    fixed = std::max(fixed, std::hypot(p[k] - q[k], p[k + 1] - q[k + 1]));
+  for (size_t k = 0; k < 8; k += 2) {
+    if (Seen(a, k / 2, b, k / 2))
+      fixed = std::max(fixed, std::hypot(p[k] - q[k], p[k + 1] - q[k + 1]));
+  }
   const int legs = static_cast<int>(p.size() - 8) / 2;
   std::vector<int> perm(legs);
   std::iota(perm.begin(), perm.end(), 0);
@@ -304,6 +314,7 @@ double PermDisplacement(const SpriteTruth& a, const SpriteTruth& b) {
   do {
     double worst = 0;
     for (int l = 0; l < legs; ++l) {
+      if (!Seen(a, 4 + l, b, 4 + perm[l])) continue;
       worst = std::max(
           worst, std::hypot(p[8 + 2 * l] - q[8 + 2 * perm[l]], p[9 + 2 * l] - q[9 + 2 * perm[l]]));
     }
@@ -723,6 +734,7 @@ int Run(const std::vector<std::string>& argv) {
         size_t arg = 0;
         double w = -1;
         for (size_t k = 0; k < a.size(); k += 2) {
+          if (!Seen(test.sprites[i].truth, k / 2, test.sprites[j].truth, k / 2)) continue;
           const double d = std::hypot(a[k] - b[k], a[k + 1] - b[k + 1]);
           if (d > w) w = d, arg = k / 2;
         }
@@ -760,6 +772,11 @@ int Run(const std::vector<std::string>& argv) {
       }
       print(cands[a].name + " & " + cands[b].name + " x" + std::to_string(best_ratio).substr(0, 4),
             best);
+      // The thresholds of the best transitions F1: x_a <= t * unit_a AND x_b <= t * unit_b * ratio.
+      std::printf("    thresholds (transitions' best): %s <= %.4g, %s <= %.4g; (pairs' best): %.4g, %.4g\n",
+                  cands[a].name.c_str(), best.second.threshold * cands[a].unit, cands[b].name.c_str(),
+                  best.second.threshold * cands[b].unit * best_ratio, best.first.threshold * cands[a].unit,
+                  best.first.threshold * cands[b].unit * best_ratio);
     }
   }
   std::printf(
