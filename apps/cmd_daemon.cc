@@ -67,7 +67,10 @@ void RunDaemon(const DaemonArgs& a) {
   ConfigReport report;
   StationOptions options;
   options.config = LoadStationConfig(a.config, &report);
-  if (!a.weights.empty()) options.weights = LoadWeights(a.weights);
+  if (!a.weights.empty()) {
+    options.weights = LoadWeights(a.weights);
+    options.weights_path = a.weights;
+  }
   options.transitions = !a.no_transitions;
   if (!(a.offline_after_s > 0)) throw InputError("--offline-after", "expected a positive number of seconds");
   options.offline_after_s = a.offline_after_s;

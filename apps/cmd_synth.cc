@@ -110,6 +110,8 @@ void AddSynthCommand(CLI::App& app) {
   cmd->add_option("--empty-lead-in", args->empty_lead_in_s,
                   "Seconds of empty enclosure before the subjects appear (keyer training; default 1 for animal "
                   "sessions, 0 otherwise)");
+  cmd->add_option("--codec", o.codec, "Video codec: ffv1 (lossless, the default), ffvhuff (lossless, faster to decode), "
+                                     "mjpeg or h264");
   cmd->add_flag("--no-mattes", [&o](int64_t) { o.write_mattes = false; }, "Skip the per-frame matte PNGs in truth/");
   cmd->add_flag("--json", args->json, "Print the report as JSON");
   cmd->callback([args] { RunSynth(*args); });

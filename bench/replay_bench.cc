@@ -1,10 +1,12 @@
-// spritestation bench replay: how fast a recorded session replays and records.
-//   replay/ffv1_1080p_bgr8           ReplaySource over a 1920x1080 BGR8 FFV1 session, as fast as possible
-//   replay/decode_only_1080p_bgr8    the same video through a bare VideoReader (no CSV, no queue, no thread)
+// spritestation bench replay: how fast a recorded session replays and records, per codec.
+//   replay/CODEC_1080p_bgr8          ReplaySource over a 1920x1080 BGR8 session, as fast as possible
+//   replay/decode_only/CODEC         the same video through a bare VideoReader (no CSV, no queue, no thread);
+//                                    decode_only/ffv1 is the baseline the others are divided by
 //   replay/baseline/memcpy_1080p     the same frames memcpy'd from memory into a reused buffer
-//   replay/record_ffv1_1080p_bgr8    SessionWriter recording those frames (can a station keep up live?)
+//   replay/record_CODEC_1080p_bgr8   SessionWriter recording those frames (can a station keep up live?)
+// CODEC: ffv1 (the default: Golomb-Rice coder) and ffvhuff (core/recording_codecs.h).
 // Content: a green-screen studio frame (lit backdrop, a moving subject, sensor noise sigma 2).
-// Figures: frames/s, and the replay as a ratio to the memcpy baseline of the same run.
+// Figures: frames/s, bytes a frame on disk, and each decode as a ratio to the baseline of the same run.
 #include <unistd.h>
 
 #include <cstdio>
@@ -21,6 +23,7 @@
 #include "bench/bench_registry.h"
 #include "capture/recording/session_writer.h"
 #include "capture/recording/video_reader.h"
+#include "capture/recording/video_writer.h"
 #include "capture/replay/replay_source.h"
 
 namespace ss::bench {
@@ -84,14 +87,16 @@ Frame AsFrame(const cv::Mat& m, int i) {
   return f;
 }
 
-void Record(const std::string& dir) {
+void Record(const std::string& dir, const std::string& codec) {
   SourceCamera cam;
   cam.name = "cam0";
   cam.width = kWidth;
   cam.height = kHeight;
   cam.format = PixelFormat::kBGR8;
   cam.fps = 30;
-  SessionWriter writer(dir, "bench");
+  RecordingOptions options;
+  options.codec = codec;
+  SessionWriter writer(dir, "bench", options);
   const int index = writer.AddCamera(cam, nullptr);
   for (int i = 0; i < kFrames; ++i) {
     Frame f = AsFrame(Frames()[static_cast<size_t>(i)], i);
@@ -101,17 +106,36 @@ void Record(const std::string& dir) {
   writer.Close();
 }
 
-const std::string& Session() {
-  static const std::string dir = [] {
-    const std::string d = (ScratchFolder() / "session").string();
-    Record(d);
-    return d;
-  }();
-  return dir;
+const std::string& Session(const std::string& codec) {
+  static std::map<std::string, std::string> dirs;
+  auto it = dirs.find(codec);
+  if (it == dirs.end()) {
+    const std::string d = (ScratchFolder() / ("session-" + codec)).string();
+    Record(d, codec);
+    it = dirs.emplace(codec, d).first;
+  }
+  return it->second;
 }
 
-void BM_Replay(benchmark::State& state) {
-  const std::string& dir = Session();
+// The frames as one video of `codec`.
+const std::string& Video(const std::string& codec) {
+  static std::map<std::string, std::string> files;
+  auto it = files.find(codec);
+  if (it == files.end()) {
+    const std::string path = (ScratchFolder() / (codec + ".mkv")).string();
+    VideoWriter writer(path, PixelFormat::kBGR8, kWidth, kHeight, 30, codec);
+    for (int i = 0; i < kFrames; ++i) {
+      const cv::Mat& m = Frames()[static_cast<size_t>(i)];
+      writer.Write(m.data, m.total() * m.elemSize(), i * 33);
+    }
+    writer.Close();
+    it = files.emplace(codec, path).first;
+  }
+  return it->second;
+}
+
+void BM_Replay(benchmark::State& state, const std::string& codec) {
+  const std::string& dir = Session(codec);
   int64_t frames = 0;
   for (auto _ : state) {
     ReplaySource source(dir);
@@ -126,8 +150,8 @@ void BM_Replay(benchmark::State& state) {
       static_cast<double>(fs::file_size(dir + "/cam0.mkv")) / kFrames / 1e6;
 }
 
-void BM_DecodeOnly(benchmark::State& state) {
-  const std::string video = Session() + "/cam0.mkv";
+void BM_DecodeOnly(benchmark::State& state, const std::string& codec) {
+  const std::string& video = Video(codec);
   std::vector<uint8_t> pixels;
   int64_t frames = 0;
   for (auto _ : state) {
@@ -136,6 +160,7 @@ void BM_DecodeOnly(benchmark::State& state) {
     benchmark::DoNotOptimize(pixels.data());
   }
   state.SetItemsProcessed(frames);
+  state.counters["MB_per_frame_on_disk"] = static_cast<double>(fs::file_size(video)) / kFrames / 1e6;
 }
 
 void BM_Memcpy(benchmark::State& state) {
@@ -152,12 +177,12 @@ void BM_Memcpy(benchmark::State& state) {
   state.SetItemsProcessed(frames);
 }
 
-void BM_Record(benchmark::State& state) {
+void BM_Record(benchmark::State& state, const std::string& codec) {
   Frames();
   int run = 0;
   for (auto _ : state) {
     const std::string dir = (ScratchFolder() / ("record" + std::to_string(run++))).string();
-    Record(dir);
+    Record(dir, codec);
     state.PauseTiming();
     fs::remove_all(dir);
     state.ResumeTiming();
@@ -165,10 +190,19 @@ void BM_Record(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations() * kFrames);
 }
 
-BENCHMARK(BM_Replay)->Name("replay/ffv1_1080p_bgr8")->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(2.0);
-BENCHMARK(BM_DecodeOnly)->Name("replay/decode_only_1080p_bgr8")->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_Replay, ffv1, std::string("ffv1"))
+    ->Name("replay/ffv1_1080p_bgr8")->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(2.0);
+BENCHMARK_CAPTURE(BM_Replay, ffvhuff, std::string("ffvhuff"))
+    ->Name("replay/ffvhuff_1080p_bgr8")->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(2.0);
+BENCHMARK_CAPTURE(BM_DecodeOnly, ffv1, std::string("ffv1"))
+    ->Name("replay/decode_only/ffv1")->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(2.0);
+BENCHMARK_CAPTURE(BM_DecodeOnly, ffvhuff, std::string("ffvhuff"))
+    ->Name("replay/decode_only/ffvhuff")->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(2.0);
 BENCHMARK(BM_Memcpy)->Name("replay/baseline/memcpy_1080p")->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK(BM_Record)->Name("replay/record_ffv1_1080p_bgr8")->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_Record, ffv1, std::string("ffv1"))
+    ->Name("replay/record_ffv1_1080p_bgr8")->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_Record, ffvhuff, std::string("ffvhuff"))
+    ->Name("replay/record_ffvhuff_1080p_bgr8")->Unit(benchmark::kMillisecond)->UseRealTime();
 
 // Keeps each case's frames/s so the suite can print ratios after the table.
 class Collector : public benchmark::ConsoleReporter {
@@ -179,10 +213,13 @@ class Collector : public benchmark::ConsoleReporter {
       const auto it = r.counters.find("items_per_second");
       // The case name without its /min_time:.../real_time suffixes.
       if (it != r.counters.end()) frames_per_second[r.run_name.function_name] = it->second.value;
+      const auto mb = r.counters.find("MB_per_frame_on_disk");
+      if (mb != r.counters.end()) mb_per_frame[r.run_name.function_name] = mb->second.value;
     }
     ConsoleReporter::ReportRuns(runs);
   }
   std::map<std::string, double> frames_per_second;
+  std::map<std::string, double> mb_per_frame;
 };
 
 int Run(const std::vector<std::string>& args) {
@@ -200,14 +237,17 @@ int Run(const std::vector<std::string>& args) {
   fs::remove_all(ScratchFolder(), ec);
 
   auto& fps = collector.frames_per_second;
-  const char* baseline = "replay/baseline/memcpy_1080p";
-  std::printf("\nreplay figures (1920x1080 BGR8, %ld cores):\n", sysconf(_SC_NPROCESSORS_ONLN));
-  for (const char* name : {"replay/ffv1_1080p_bgr8", "replay/decode_only_1080p_bgr8", "replay/record_ffv1_1080p_bgr8"}) {
+  auto& mb = collector.mb_per_frame;
+  const char* baseline = "replay/decode_only/ffv1";
+  std::printf("\nreplay figures (1920x1080 BGR8, %ld cores; ratios to %s in this run):\n",
+              sysconf(_SC_NPROCESSORS_ONLN), baseline);
+  for (const char* name : {"replay/decode_only/ffv1", "replay/decode_only/ffvhuff",
+                           "replay/ffv1_1080p_bgr8", "replay/ffvhuff_1080p_bgr8", "replay/record_ffv1_1080p_bgr8",
+                           "replay/record_ffvhuff_1080p_bgr8", "replay/baseline/memcpy_1080p"}) {
     if (!fps.count(name)) continue;
-    std::printf("  %-32s %8.1f frames/s", name, fps[name]);
-    if (fps.count(baseline)) {
-      std::printf("  = %.4f x memcpy of the same frames (%.0f frames/s)", fps[name] / fps[baseline], fps[baseline]);
-    }
+    std::printf("  %-40s %8.1f frames/s", name, fps[name]);
+    if (fps.count(baseline)) std::printf("  %6.2f x", fps[name] / fps[baseline]);
+    if (mb.count(name)) std::printf("  %.2f MB a frame", mb[name]);
     std::printf("\n");
   }
   return 0;

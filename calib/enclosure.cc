@@ -14,6 +14,10 @@ namespace {
 
 GroundPolygon Checked(std::vector<Eigen::Vector2d> points, const std::string& field) {
   if (points.size() < 3) throw InputError(field, "a floor polygon needs at least 3 points");
+  if (points.size() > GroundPolygon::kMaxVertices) {
+    throw InputError(field, std::to_string(points.size()) + " points; a floor polygon has at most " +
+                                std::to_string(GroundPolygon::kMaxVertices));
+  }
   GroundPolygon polygon(std::move(points));
   if (!polygon.IsSimple()) {
     throw InputError(field, "the floor polygon crosses itself, repeats a point or has no area; give its corners in order");

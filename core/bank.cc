@@ -304,6 +304,21 @@ std::optional<std::string> Bank::GetMeta(const std::string& key) const {
   return s.Text(0);
 }
 
+std::vector<TransitionLabelRecord> Bank::LoadTransitionLabels() const {
+  std::vector<TransitionLabelRecord> out;
+  auto s = db_->Prepare("SELECT from_sprite, to_sprite, label, labelled_at, source FROM transition_labels "
+                        "ORDER BY labelled_at, from_sprite, to_sprite");
+  while (s.Step()) out.push_back({s.Int(0), s.Int(1), s.Text(2), s.Text(3), s.Text(4)});
+  return out;
+}
+
+std::map<std::string, int64_t> Bank::CountTransitionLabels() const {
+  std::map<std::string, int64_t> out = {{"yes", 0}, {"no", 0}, {"skip", 0}};
+  auto s = db_->Prepare("SELECT label, count(*) FROM transition_labels GROUP BY label");
+  while (s.Step()) out[s.Text(0)] = s.Int(1);
+  return out;
+}
+
 BankCounts Bank::Counts() const {
   // One read transaction so that the figures agree with each other.
   db_->Exec("BEGIN");
@@ -574,6 +589,35 @@ void BankWriter::SetMeta(const std::string& key, const std::string& value) {
   if (key == "schema_version" || key == "application") throw WorkError(path(), "meta key '" + key + "' is reserved");
   auto q = db().Prepare("INSERT OR REPLACE INTO meta (key, value) VALUES (?, ?)");
   q.Bind(1, key).Bind(2, value).Step();
+}
+
+void BankWriter::SetTransitionLabel(const TransitionLabelRecord& label) {
+  if (label.label != "yes" && label.label != "no" && label.label != "skip") {
+    throw InputError("label", "expected yes, no or skip, got \"" + label.label + "\"");
+  }
+  if (label.from_sprite == label.to_sprite) {
+    throw InputError("label", "sprite " + std::to_string(label.from_sprite) + " paired with itself");
+  }
+  sql::Transaction tx(db());
+  auto exists = db().Prepare("SELECT 1 FROM sprites WHERE id = ?");
+  for (int64_t id : {label.from_sprite, label.to_sprite}) {
+    exists.Reset();
+    if (!exists.Bind(1, id).Step()) throw InputError(path(), "no sprite with id " + std::to_string(id));
+  }
+  exists.Reset();
+  auto q = db().Prepare(
+      "INSERT OR REPLACE INTO transition_labels (from_sprite, to_sprite, label, labelled_at, source) "
+      "VALUES (?, ?, ?, ?, ?)");
+  q.Bind(1, label.from_sprite).Bind(2, label.to_sprite).Bind(3, label.label).Bind(4, label.labelled_at);
+  q.Bind(5, label.source).Step();
+  q.Reset();
+  tx.Commit();
+}
+
+bool BankWriter::RemoveTransitionLabel(int64_t from_sprite, int64_t to_sprite) {
+  auto q = db().Prepare("DELETE FROM transition_labels WHERE from_sprite = ? AND to_sprite = ?");
+  q.Bind(1, from_sprite).Bind(2, to_sprite).Step();
+  return sqlite3_changes(db().get()) > 0;
 }
 
 }  // namespace ss

@@ -71,6 +71,10 @@ class Bank {
   std::vector<int64_t> SpritesTagged(const std::string& tag) const;
   std::optional<std::string> GetMeta(const std::string& key) const;
   BankCounts Counts() const;
+  // The labels of sprite pairs (transition_labels), in the order they were made.
+  std::vector<TransitionLabelRecord> LoadTransitionLabels() const;
+  // Labels per kind: {"yes": n, "no": n, "skip": n} (kinds without labels are 0).
+  std::map<std::string, int64_t> CountTransitionLabels() const;
 
  protected:
   enum class Mode { kReadOnly, kReadWrite };
@@ -121,6 +125,12 @@ class BankWriter : public Bank {
   void Tag(const std::vector<int64_t>& sprite_ids, const std::string& tag);
   void Untag(const std::vector<int64_t>& sprite_ids, const std::string& tag);
   void SetMeta(const std::string& key, const std::string& value);
+  // Stores (or replaces) the label of from_sprite -> to_sprite. InputError naming the bank and
+  // the sprite for an unknown sprite id, InputError("label", ...) for a label other than
+  // yes / no / skip or a sprite paired with itself.
+  void SetTransitionLabel(const TransitionLabelRecord& label);
+  // Removes a label; false when there was none.
+  bool RemoveTransitionLabel(int64_t from_sprite, int64_t to_sprite);
 
  private:
   struct Impl;

@@ -94,4 +94,14 @@ struct TransitionRecord {
   double cost = 0;
 };
 
+// A person's judgement of the transition from_sprite -> to_sprite (the labelling page):
+// "yes" (smooth), "no", or "skip" (not judged; never asked again, never exported).
+struct TransitionLabelRecord {
+  int64_t from_sprite = 0;
+  int64_t to_sprite = 0;
+  std::string label;        // yes | no | skip
+  std::string labelled_at;  // ISO 8601 UTC
+  std::string source;       // who or what labelled it ("console", ...)
+};
+
 }  // namespace ss

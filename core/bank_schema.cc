@@ -109,6 +109,22 @@ CREATE INDEX transitions_by_to ON transitions (to_sprite);
 INSERT INTO meta (key, value) VALUES ('application', 'spritestation sprite bank');
 )sql";
 
+// Version 2: a person's judgements of sprite pairs (the console's labelling page), kept
+// in the bank beside the sprites they name; exported as the labels CSV that
+// `transitions train` reads.
+constexpr const char* kSchemaV2 = R"sql(
+CREATE TABLE transition_labels (
+  from_sprite INTEGER NOT NULL REFERENCES sprites(id) ON DELETE CASCADE,
+  to_sprite   INTEGER NOT NULL REFERENCES sprites(id) ON DELETE CASCADE,
+  label       TEXT NOT NULL CHECK (label IN ('yes', 'no', 'skip')),
+  labelled_at TEXT NOT NULL,
+  source      TEXT NOT NULL DEFAULT '',
+  PRIMARY KEY (from_sprite, to_sprite),
+  CHECK (from_sprite <> to_sprite)
+) WITHOUT ROWID;
+CREATE INDEX transition_labels_by_to ON transition_labels (to_sprite);
+)sql";
+
 std::string Hex(int64_t v) {
   char buffer[32];
   std::snprintf(buffer, sizeof(buffer), "0x%08llx", static_cast<unsigned long long>(v) & 0xffffffffULL);
@@ -155,6 +171,7 @@ std::string Normalize(std::string sql) {
 const std::vector<BankMigration>& BankMigrations() {
   static const std::vector<BankMigration> migrations = {
       {1, "initial schema: sessions, cameras, clips, sprites, tags, pixels, transitions", kSchemaV1},
+      {2, "transition_labels: a person's yes / no / skip on sprite pairs", kSchemaV2},
   };
   return migrations;
 }

@@ -13,7 +13,7 @@ namespace sql {
 class Db;
 }
 
-inline constexpr int kBankSchemaVersion = 1;
+inline constexpr int kBankSchemaVersion = 2;
 // PRAGMA application_id of every bank: "SSBK".
 inline constexpr int32_t kBankApplicationId = 0x5353424B;
 

@@ -1,5 +1,7 @@
 #include "core/bank_verify.h"
 
+#include <algorithm>
+
 #include <sqlite3.h>
 
 #include <cmath>
@@ -185,6 +187,24 @@ BankVerifyReport VerifyBank(const std::string& path) {
   check.Run("pixels", [&] { CheckPixels(db, check, report); });
   sqlite3_exec(db.get(), "COMMIT", nullptr, nullptr, nullptr);
   return report;
+}
+
+std::vector<std::string> QuickCheckBank(const std::string& path) {
+  std::vector<std::string> problems;
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec)) return problems;
+  try {
+    sql::Db db(path, SQLITE_OPEN_READONLY | SQLITE_OPEN_NOMUTEX);
+    auto s = db.Prepare("PRAGMA quick_check(20)");
+    while (s.Step()) {
+      std::string line = s.Text(0);
+      std::replace(line.begin(), line.end(), '\n', ' ');
+      if (line != "ok") problems.push_back(line);
+    }
+  } catch (const std::exception& e) {
+    problems.push_back(e.what());
+  }
+  return problems;
 }
 
 }  // namespace ss

@@ -20,4 +20,9 @@ struct BankVerifyReport {
 // Throws InputError when the file is missing, not a bank, or of another schema version.
 BankVerifyReport VerifyBank(const std::string& path);
 
+// SQLite's quick check of an existing bank file (pages and indexes well formed; seconds for a
+// large bank, much less than VerifyBank): the problems it reports, empty when it passes or the
+// file does not exist. What writes into a bank (ingest) runs it first and refuses a damaged one.
+std::vector<std::string> QuickCheckBank(const std::string& path);
+
 }  // namespace ss

@@ -17,6 +17,7 @@
 #include "core/error.h"
 #include "core/frame.h"
 #include "core/log.h"
+#include "core/recording_codecs.h"
 
 namespace ss {
 namespace {
@@ -24,7 +25,6 @@ namespace {
 namespace fs = std::filesystem;
 
 const std::vector<std::string> kSources = {"replay", "v4l2", "aravis", "libcamera"};
-const std::vector<std::string> kCodecs = {"ffv1", "mjpeg", "h264"};
 const std::vector<std::string> kLogLevels = {"trace", "debug",    "info", "warn",
                                              "error", "critical", "off"};
 
@@ -424,6 +424,11 @@ void ReadEnclosure(Reader& r, const YAML::Node& node, EnclosureConfig& e) {
                   "expected a list of [x, y] points in metres, got " + ScalarText(*floor));
     return;
   }
+  if (floor->size() > GroundPolygon::kMaxVertices) {
+    r.msg().Error("enclosure.floor", std::to_string(floor->size()) + " points; a floor polygon has at most " +
+                                         std::to_string(GroundPolygon::kMaxVertices));
+    return;
+  }
   std::vector<Eigen::Vector2d> vertices;
   for (size_t i = 0; i < floor->size(); ++i) {
     const YAML::Node p = (*floor)[i];
@@ -724,7 +729,11 @@ class Validator {
     StorageConfig& s = cfg.storage;
     Check(!s.bank.empty(), "storage.bank", "expected a path");
     Check(!s.recording_dir.empty(), "storage.recording_dir", "expected a path");
-    Enum(s.recording_codec, kCodecs, "storage.recording_codec");
+    {
+      std::vector<std::string> codecs;
+      for (const RecordingCodec& c : RecordingCodecs()) codecs.push_back(c.name);
+      Enum(s.recording_codec, codecs, "storage.recording_codec");
+    }
     Check(s.stop_recording_below_mib >= 0, "storage.stop_recording_below_mib",
           "expected a size >= 0, got " + std::to_string(s.stop_recording_below_mib));
     Check(s.stop_sprites_below_mib >= 0, "storage.stop_sprites_below_mib",

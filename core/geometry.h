@@ -40,6 +40,10 @@ std::optional<Eigen::Vector3d> IntersectGround(const Ray& ray);
 // A simple polygon on the floor (ground x, y in metres), vertices in order.
 class GroundPolygon {
  public:
+  // The most vertices a floor polygon may have (IsSimple compares every pair of edges: at this
+  // size ~50 M tests, a fraction of a second). Every reader of a floor refuses more, naming it.
+  static constexpr size_t kMaxVertices = 10000;
+
   GroundPolygon() = default;
   explicit GroundPolygon(std::vector<Eigen::Vector2d> vertices);
 

@@ -13,6 +13,7 @@
 
 #include "core/error.h"
 #include "core/log.h"
+#include "core/recording_codecs.h"
 
 namespace ss {
 namespace {
@@ -126,8 +127,8 @@ SessionCamera ParseCamera(const std::string& path, const json& j, size_t i) {
   }
   c.pixel_format = *parsed;
   c.codec = f.String("codec");
-  if (c.codec != "ffv1" && c.codec != "mjpeg" && c.codec != "h264") {
-    f.Fail("codec", "unknown codec '" + c.codec + "' (expected ffv1, mjpeg or h264)");
+  if (FindRecordingCodec(c.codec) == nullptr) {
+    f.Fail("codec", "unknown codec '" + c.codec + "' (expected " + RecordingCodecNames() + ")");
   }
   if (c.pixel_format == PixelFormat::kMJPEG && c.codec != "mjpeg") {
     f.Fail("codec", "an mjpeg camera is stored as codec 'mjpeg', got '" + c.codec + "'");

@@ -21,6 +21,7 @@
 #include "station/api_part.h"
 #include "station/console_calibration.h"
 #include "station/console_events.h"
+#include "station/console_labels.h"
 #include "station/station.h"
 #include "station/station_host.h"
 #include "station/station_status.h"
@@ -40,7 +41,11 @@ using api::ReplyError;
 using api::Route;
 
 constexpr size_t kMaxBodyBytes = 1 << 20;  // every JSON body the API takes is far smaller
-constexpr int kHttpThreads = 32;           // event streams hold one each (at most max_event_streams)
+// Each open connection holds an HTTP thread while it waits for its request (cpp-httplib 0.11
+// reads a request on the thread that serves it, and its read timeout restarts with every byte,
+// so a client that sends a header line every few seconds keeps its thread). Enough threads
+// that 500 slow or idle clients leave the API answering: idle, they cost ~10 MB.
+constexpr int kHttpThreads = 600;
 constexpr int kHttpNice = 10;              // HTTP threads yield the cores to capture and the pipeline
 
 // HTTP worker threads run at a lower priority than every other thread of the daemon:
@@ -119,6 +124,7 @@ struct ControlServer::Impl {
     context.station = [this] { return station(); };
     context.config_path = options.config_path;
     parts.push_back(std::make_unique<ConsoleCalibration>(context));
+    parts.push_back(std::make_unique<ConsoleLabels>(context));
   }
 
   std::shared_ptr<Station> station() const {

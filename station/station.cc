@@ -609,6 +609,10 @@ StationStatus Station::Status() const {
     out.transitions_stored = t.transitions_stored;
     out.transition_rounds_failed = t.failed_rounds;
     out.transitions_last_round_ms = t.last_round_ms;
+    out.transitions_error = t.last_error;
+    out.transitions_startup_stage = t.startup_stage;
+    out.transitions_startup_done = t.startup_done;
+    out.transitions_startup_total = t.startup_total;
   }
   const StorageConfig storage = s.StorageSettings();
   out.recording_mode = ToText(storage.recording);

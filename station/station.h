@@ -24,6 +24,7 @@ namespace ss {
 struct StationOptions {
   StationConfig config;                        // validated
   std::optional<TransitionWeights> weights;    // unset: the shipped defaults
+  std::string weights_path;                    // the file `weights` came from (named in the status)
   bool transitions = true;                     // keep the bank's transitions current
   double offline_after_s = 3.0;                // a camera silent this long is reopened
   // Opens each camera; unset: its configured backend (benchmarks replay from memory).

@@ -99,6 +99,7 @@ void StationHost::Start() {
   std::lock_guard sw(switch_mutex_);
   auto station = std::make_shared<Station>(live_);
   station->Start();
+  running_ = live_;
   std::lock_guard lock(mutex_);
   station_ = std::move(station);
 }
@@ -118,6 +119,7 @@ void StationHost::Replace(StationOptions options) {
   std::shared_ptr<Station> old = current();
   if (old) old->Stop();  // its session stopped and stored, its bank closed
   // The stopped station stays current (its status says "stopped") until the next one runs.
+  running_ = options;
   auto next = std::make_shared<Station>(std::move(options));
   next->Start();
   std::lock_guard lock(mutex_);
@@ -171,6 +173,43 @@ void StationHost::StopReplay() {
   replaying_ = false;
   replay_path_.clear();
   Log("station")->info("replay stopped; the config's cameras run again");
+}
+
+StationHost::Weights StationHost::weights() const {
+  std::lock_guard lock(mutex_);
+  return {live_.weights ? *live_.weights : DefaultWeights(), live_.weights_path};
+}
+
+void StationHost::UseWeights(const TransitionWeights& weights, const std::string& path) {
+  std::lock_guard sw(switch_mutex_);
+  const std::shared_ptr<Station> station = current();
+  if (station && station->SessionActive()) {
+    throw ConflictError("session", "a capture session is running; stop it first (the station restarts to use new "
+                                   "weights, which would end the session)");
+  }
+  const StationOptions before = running_;
+  const std::optional<TransitionWeights> live_before = live_.weights;
+  const std::string live_path_before = live_.weights_path;
+  auto set_live = [&](std::optional<TransitionWeights> w, std::string p) {
+    std::lock_guard lock(mutex_);
+    live_.weights = std::move(w);
+    live_.weights_path = std::move(p);
+  };
+  set_live(weights, path);
+  if (!station) return;  // not started: the next Start uses them
+  StationOptions next = running_;
+  next.weights = weights;
+  next.weights_path = path;
+  auto log = Log("station");
+  try {
+    Replace(next);
+  } catch (const std::exception& e) {
+    log->error("the station could not start with the weights {}: {}; the previous weights run again", path, e.what());
+    set_live(live_before, live_path_before);
+    Replace(before);
+    throw;
+  }
+  log->info("the station runs with the transition weights {}", path.empty() ? "shipped with the build" : path);
 }
 
 StationConfig StationHost::live_config() const {

@@ -51,6 +51,20 @@ class StationHost {
   // InputError (field "replay") when no replay runs.
   void StopReplay();
 
+  // The transition weights every station of this host runs with, and the file they came
+  // from ("" for the shipped defaults).
+  struct Weights {
+    TransitionWeights weights;
+    std::string path;
+  };
+  Weights weights() const;
+  // Restarts the running station (live or replay, as it is) with new transition weights and
+  // keeps them for every later station: its transition worker rebuilds the bank's table with
+  // them at start (UpdateBankTransitions' rules), in the background. ConflictError (field
+  // "session") while a capture session is active: a restart would end it, so the operator
+  // stops it first. When the station cannot start with them, the previous weights run again
+  // and the error is rethrown.
+  void UseWeights(const TransitionWeights& weights, const std::string& path);
   // The live station's config (the daemon's, with what ApplyLiveConfig changed).
   StationConfig live_config() const;
   // A new config for the live station (the calibration wizard's models and floor): the live
@@ -67,7 +81,8 @@ class StationHost {
   // Stops the running station and starts one from `options`. Under switch_mutex_.
   void Replace(StationOptions options);
 
-  StationOptions live_;
+  StationOptions live_;     // written under switch_mutex_ and mutex_ (weights(), live_config() read it)
+  StationOptions running_;  // what the current station was started from; under switch_mutex_
   std::vector<std::string> replay_roots_;
   std::mutex switch_mutex_;  // one switch at a time
   mutable std::mutex mutex_;  // guards station_ and the mode below

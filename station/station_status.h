@@ -50,6 +50,9 @@ struct StationStatus {
   bool transitions_enabled = false, transitions_ready = false;
   int64_t transitions_pending = 0, transitions_stored = 0, transition_rounds_failed = 0;
   double transitions_last_round_ms = 0;
+  std::string transitions_error;           // the worker's last failed round (or start-up)
+  std::string transitions_startup_stage;   // "load" | "pairs" while the start-up build runs
+  int64_t transitions_startup_done = 0, transitions_startup_total = 0;
   // Storage
   StorageState storage_state = StorageState::kOk;
   int64_t disk_free_mib = -1;     // the lower of the bank's and the recordings' file systems

@@ -216,6 +216,7 @@ SynthSummary RenderStudioSession(const SynthOptions& o) {
   // The recorded session.
   RecordingOptions rec;
   rec.synthetic = true;
+  rec.codec = o.codec;
   rec.flush_interval_ms = 1000;
   SessionWriter writer(o.out_dir, "synth-" + SynthKindName(o.kind) + "-seed" + std::to_string(o.seed), rec);
   const fs::path truth = fs::path(o.out_dir) / "truth";

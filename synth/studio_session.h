@@ -39,6 +39,7 @@ struct SynthOptions {
   int figure_variant = 0;      // 0: the reference figure; 1: differently proportioned
   int threads = 1;             // cameras rendered in parallel
   bool write_mattes = true;    // the per-frame PNG mattes in truth/
+  std::string codec = "ffv1";  // the videos' codec (core/recording_codecs.h)
   // Subjects stay out of view for this long at the start (truth pose "absent"),
   // as a studio records the empty enclosure first for the keyer to learn.
   double empty_lead_in_s = 0.0;

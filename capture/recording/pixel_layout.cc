@@ -38,12 +38,30 @@ AVPixelFormat LosslessStorageFormat(PixelFormat format) {
   return AV_PIX_FMT_NONE;
 }
 
+bool IsLosslessStorage(int av_format, PixelFormat format) {
+  const AVPixelFormat storage = LosslessStorageFormat(format);
+  if (av_format == storage) return true;
+  // Colour as planes (ffvhuff), or as B G R A.
+  return storage == AV_PIX_FMT_BGR0 && (av_format == AV_PIX_FMT_GBRP || av_format == AV_PIX_FMT_BGRA);
+}
+
 void RawToStorage(const uint8_t* src, PixelFormat format, int width, int height, AVFrame* dst) {
   auto* s = const_cast<uint8_t*>(src);  // cv::Mat headers only; never written
   switch (format) {
     case PixelFormat::kBGR8:
     case PixelFormat::kRGB8: {
       cv::Mat in(height, width, CV_8UC3, s);
+      if (dst->format == AV_PIX_FMT_GBRP) {
+        // Planes G, B, R.
+        cv::Mat planes[3] = {cv::Mat(height, width, CV_8UC1, dst->data[0], static_cast<size_t>(dst->linesize[0])),
+                             cv::Mat(height, width, CV_8UC1, dst->data[1], static_cast<size_t>(dst->linesize[1])),
+                             cv::Mat(height, width, CV_8UC1, dst->data[2], static_cast<size_t>(dst->linesize[2]))};
+        const bool bgr = format == PixelFormat::kBGR8;
+        const int from_to[] = {1, 0, bgr ? 0 : 2, 1, bgr ? 2 : 0, 2};
+        cv::mixChannels(&in, 1, planes, 3, from_to, 3);
+        return;
+      }
+      // Packed B G R X (FFV1).
       cv::Mat out(height, width, CV_8UC4, dst->data[0], static_cast<size_t>(dst->linesize[0]));
       cv::cvtColor(in, out, format == PixelFormat::kBGR8 ? cv::COLOR_BGR2BGRA : cv::COLOR_RGB2BGRA);
       return;
@@ -92,8 +110,18 @@ void StorageToRaw(const AVFrame* src, PixelFormat format, int width, int height,
   switch (format) {
     case PixelFormat::kBGR8:
     case PixelFormat::kRGB8: {
-      cv::Mat in(height, width, CV_8UC4, src->data[0], static_cast<size_t>(src->linesize[0]));
       cv::Mat out(height, width, CV_8UC3, dst);
+      if (src->format == AV_PIX_FMT_GBRP) {
+        const cv::Mat planes[3] = {
+            cv::Mat(height, width, CV_8UC1, src->data[0], static_cast<size_t>(src->linesize[0])),
+            cv::Mat(height, width, CV_8UC1, src->data[1], static_cast<size_t>(src->linesize[1])),
+            cv::Mat(height, width, CV_8UC1, src->data[2], static_cast<size_t>(src->linesize[2]))};
+        const bool bgr = format == PixelFormat::kBGR8;
+        const int from_to[] = {0, 1, 1, bgr ? 0 : 2, 2, bgr ? 2 : 0};
+        cv::mixChannels(planes, 3, &out, 1, from_to, 3);
+        return;
+      }
+      cv::Mat in(height, width, CV_8UC4, src->data[0], static_cast<size_t>(src->linesize[0]));
       cv::cvtColor(in, out, format == PixelFormat::kBGR8 ? cv::COLOR_BGRA2BGR : cv::COLOR_BGRA2RGB);
       return;
     }

@@ -13,6 +13,7 @@
 #include "capture/recording/video_writer.h"
 #include "core/error.h"
 #include "core/log.h"
+#include "core/recording_codecs.h"
 
 namespace ss {
 namespace {
@@ -116,8 +117,8 @@ struct SessionWriter::Impl {
 
 SessionWriter::SessionWriter(const std::string& dir, const std::string& name, RecordingOptions options)
     : impl_(std::make_unique<Impl>()) {
-  if (options.codec != "ffv1" && options.codec != "mjpeg" && options.codec != "h264") {
-    throw InputError("codec", "unknown codec '" + options.codec + "' (expected ffv1, mjpeg or h264)");
+  if (FindRecordingCodec(options.codec) == nullptr) {
+    throw InputError("codec", "unknown codec '" + options.codec + "' (expected " + RecordingCodecNames() + ")");
   }
   if (options.flush_interval_ms < 0) {
     throw InputError("flush_interval_ms", "expected 0 or more, got " + std::to_string(options.flush_interval_ms));

@@ -209,7 +209,7 @@ VideoReader::Result VideoReader::Convert(const AVFrame* frame, std::vector<uint8
   pixels.resize(FrameBytes(format_, width_, height_));
   Result r;
   r.status = Status::kFrame;
-  if (frame->format == av::LosslessStorageFormat(format_)) {
+  if (av::IsLosslessStorage(frame->format, format_)) {
     av::StorageToRaw(frame, format_, width_, height_, pixels.data());  // exact
     return r;
   }

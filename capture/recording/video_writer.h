@@ -1,7 +1,8 @@
 #pragma once
 // One camera's Matroska video, written through libavformat/libavcodec.
-//   codec "ffv1":  lossless (FFV1 level 3, every frame a keyframe, slice CRCs),
+//   codec "ffv1":  lossless (FFV1 level 3, Golomb-Rice, every frame a keyframe, slice CRCs),
 //                  bit-exact for every raw format (capture/recording/pixel_layout.h)
+//   codec "ffvhuff": lossless, faster to decode, no checksums (core/recording_codecs.h)
 //   codec "mjpeg": JPEG per frame (lossy); an MJPEG camera's JPEGs are stored as they came
 //   codec "h264":  libx264, zero latency, no B-frames (lossy)
 // Packet timestamps are milliseconds since the first frame (VideoPtsMs), so a

@@ -14,6 +14,7 @@
 
 #include "capture/replay/replay_source.h"
 #include "core/bank.h"
+#include "core/bank_verify.h"
 #include "core/error.h"
 #include "core/log.h"
 #include "pipeline/run/bounded_queue.h"
@@ -44,6 +45,10 @@ std::optional<GroundPolygon> ReadFloorJson(const fs::path& path) {
   }
   if (floor != nullptr && floor->is_object() && floor->contains("vertices")) floor = &(*floor)["vertices"];
   if (floor == nullptr || !floor->is_array()) throw InputError(path.string(), "expected a \"floor\" list of [x, y] points");
+  if (floor->size() > GroundPolygon::kMaxVertices) {
+    throw InputError(path.string(), "floor: " + std::to_string(floor->size()) + " points; a floor polygon has at most " +
+                                        std::to_string(GroundPolygon::kMaxVertices));
+  }
   std::vector<Eigen::Vector2d> vertices;
   for (const auto& p : *floor) {
     if (p.is_array() && p.size() >= 2 && p[0].is_number() && p[1].is_number()) {
@@ -109,6 +114,14 @@ IngestSummary IngestSession(const IngestOptions& options) {
   const TransitionWeights transition_weights =
       options.transition_weights.empty() ? DefaultWeights() : LoadWeights(options.transition_weights);
 
+  // A damaged bank is not written into: what it holds is still readable by `bank export` and
+  // `bank verify` says where it is damaged; appending could only spread the damage.
+  if (const std::vector<std::string> damage = QuickCheckBank(options.bank_path); !damage.empty()) {
+    throw InputError(options.bank_path, "the bank does not pass SQLite's quick check (" + damage.front() +
+                                            (damage.size() > 1 ? ", and " + std::to_string(damage.size() - 1) + " more" : "") +
+                                            "); nothing was written. Run `spritestation bank verify " +
+                                            options.bank_path + "` to see the damage");
+  }
   BankWriter bank(options.bank_path);
   IngestSummary summary;
   summary.session_name = info.name;

@@ -1,5 +1,8 @@
 #include "pipeline/transitions/classifier.h"
 
+#include <algorithm>
+#include <cmath>
+
 #include "core/error.h"
 
 namespace ss {
@@ -17,6 +20,7 @@ TransitionClassifier::TransitionClassifier(const TransitionWeights& weights) : w
     u2_[k] = weights.stage2_weights[k] / weights.feature_scale[k];
     t2_ += u2_[k] * weights.feature_mean[k];
   }
+  linf_alpha_limit_ = static_cast<int>(std::floor(255.0 * weights.linf_max_alpha + 1e-9));
 }
 
 namespace {
@@ -33,6 +37,10 @@ double AlphaFeature(uint64_t alpha_abs_diff, const CellBox& a, const CellBox& b)
 
 bool TransitionClassifier::SignatureRejects(const SpriteStore& store, int32_t i, int32_t j) const {
   const CheapDifference cheap = CheapDiff(store.cheap(i), store.cheap(j));
+  if (linf()) {
+    return cheap[0] > weights_.linf_max_velocity_mps || store.SignatureLinfExceeds(i, j, linf_alpha_limit_);
+  }
+  if (colour_blob()) return cheap[0] > weights_.colour_blob_max_velocity_mps;
   // d is Distance()'s prefix, and the alpha feature is monotone in its numerator, so
   // d + u4 * bound <= the full sum.
   const double d = CheapPart(cheap);
@@ -45,6 +53,21 @@ bool TransitionClassifier::SignatureRejects(const SpriteStore& store, int32_t i,
 
 bool TransitionClassifier::Stage2(const SpriteStore& store, int32_t i, int32_t j, double* distance) const {
   const CheapDifference cheap = CheapDiff(store.cheap(i), store.cheap(j));
+  if (linf()) {
+    if (cheap[0] > weights_.linf_max_velocity_mps) return false;
+    const int worst = MaxAlphaDifference(store.image(i), store.image(j), store.window().PlaneStride());
+    if (worst > linf_alpha_limit_) return false;
+    *distance = std::max(cheap[0] / weights_.linf_max_velocity_mps, worst / (255.0 * weights_.linf_max_alpha));
+    return true;
+  }
+  if (colour_blob()) {
+    if (cheap[0] > weights_.colour_blob_max_velocity_mps) return false;
+    const int blob = LargestColourBlob(store.image(i), store.image(j), store.window());
+    if (blob > weights_.colour_blob_max_cells) return false;
+    *distance = std::max(cheap[0] / weights_.colour_blob_max_velocity_mps,
+                         static_cast<double>(blob) / std::max(1, weights_.colour_blob_max_cells));
+    return true;
+  }
   // The partial sums are Distance()'s prefixes.
   const double d = CheapPart(cheap);
   if (d > t2_) return false;

@@ -40,6 +40,10 @@ class TransitionClassifier {
   // the threshold. Every term of D is >= 0 and the bounds are below the alpha term, so a
   // pair this returns true for is one Stage2Accepts(Distance(...)) rejects; false decides
   // nothing (run Stage2).
+  // With the linf variant: true when the velocity difference exceeds its bound or
+  // SpriteStore::SignatureLinfExceeds proves the largest cell difference exceeds its bound.
+  // With the colour_blob variant: true when the velocity difference exceeds its bound (the
+  // colour blob has no per-sprite bound: every other pair is evaluated).
   bool SignatureRejects(const SpriteStore& store, int32_t i, int32_t j) const;
   // Stage 2 on store indices (i, j) with early exits: the sum of Distance() is built in
   // its own order (the cheap terms, then alpha from the alpha plane, then colour) and every
@@ -47,7 +51,18 @@ class TransitionClassifier {
   // reading the colour planes. Decides exactly as Stage2Accepts(Distance(store.Features(i, j)))
   // and, when accepted, sets *distance to that same value. Does not use the signatures:
   // the builder calls SignatureRejects first and counts only the pairs that reach this.
+  // With the linf variant (weights().stage2_variant): kept when velocity <= max_velocity_mps
+  // and MaxAlphaDifference <= floor(255 * max_alpha_linf); *distance = the larger of the two
+  // ratios to their bounds (0..1). With the colour_blob variant: kept when velocity <=
+  // max_velocity_mps and LargestColourBlob <= max_blob_cells; *distance = the larger of
+  // velocity / max_velocity_mps and blob / max(1, max_blob_cells) (0..1). Distance() and
+  // Stage2Accepts() stay the linear D (training
+  // and the labelling page use them).
   bool Stage2(const SpriteStore& store, int32_t i, int32_t j, double* distance) const;
+  bool linf() const { return weights_.stage2_variant == Stage2Variant::kLinf; }
+  bool colour_blob() const { return weights_.stage2_variant == Stage2Variant::kColourBlob; }
+  // linf: the largest accepted MaxAlphaDifference (0..255).
+  int linf_alpha_limit() const { return linf_alpha_limit_; }
 
   const CheapDifference& stage1_unit_weights() const { return u1_; }
   double stage1_threshold() const { return t1_; }
@@ -67,6 +82,7 @@ class TransitionClassifier {
   double t1_ = 0;
   PairFeatures u2_{};
   double t2_ = 0;
+  int linf_alpha_limit_ = 0;
 };
 
 }  // namespace ss

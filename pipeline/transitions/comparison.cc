@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <vector>
 
@@ -248,6 +249,53 @@ AlphaKernel ChooseAlphaKernel() { return __builtin_cpu_supports("avx2") ? &Alpha
 uint64_t SumAlphaDifference(const uint8_t* a, const uint8_t* b, int stride) {
   static const AlphaKernel kernel = ChooseAlphaKernel();
   return kernel(a, b, stride);
+}
+
+int MaxAlphaDifference(const uint8_t* a, const uint8_t* b, int stride) {
+  uint8_t worst = 0;  // a plain loop the compiler vectorizes (max of |a - b| on bytes)
+  for (int k = 0; k < stride; ++k) {
+    const uint8_t d = a[k] > b[k] ? static_cast<uint8_t>(a[k] - b[k]) : static_cast<uint8_t>(b[k] - a[k]);
+    worst = std::max(worst, d);
+  }
+  return worst;
+}
+
+int LargestColourBlob(const uint8_t* a, const uint8_t* b, const ComparisonWindow& window) {
+  const int w = window.cells_x, h = window.cells_y, n = window.Cells(), stride = window.PlaneStride();
+  std::vector<uint8_t> mark(n, 0);
+  int marked = 0;
+  for (int k = 0; k < n; ++k) {
+    if (a[k] < 128 || b[k] < 128) continue;
+    int d = 0;
+    for (int c = 1; c <= 3; ++c) d += std::abs(int{a[c * stride + k]} - int{b[c * stride + k]});
+    mark[k] = d >= 90;
+    marked += mark[k];
+  }
+  int best = 0;
+  std::vector<int> stack;
+  for (int k = 0; k < n && marked > best; ++k) {
+    if (mark[k] != 1) continue;
+    int size = 0;
+    stack.assign(1, k);
+    mark[k] = 2;
+    while (!stack.empty()) {
+      const int cell = stack.back();
+      stack.pop_back();
+      ++size;
+      const int x = cell % w, y = cell / w;
+      const int next[4] = {x > 0 ? cell - 1 : -1, x + 1 < w ? cell + 1 : -1, y > 0 ? cell - w : -1,
+                           y + 1 < h ? cell + w : -1};
+      for (int q : next) {
+        if (q >= 0 && mark[q] == 1) {
+          mark[q] = 2;
+          stack.push_back(q);
+        }
+      }
+    }
+    best = std::max(best, size);
+    marked -= size;
+  }
+  return best;
 }
 
 PixelSums SumPixelDifferences(const uint8_t* a, const uint8_t* b, int stride) {

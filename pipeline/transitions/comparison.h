@@ -70,6 +70,11 @@ PixelSums SumPixelDifferences(const uint8_t* image_a, const uint8_t* image_b, in
 // sum |A_i - A_j| over the alpha plane alone (= PixelSums::alpha_abs_diff), for an early
 // exit of stage 2 before the colour planes are read.
 uint64_t SumAlphaDifference(const uint8_t* image_a, const uint8_t* image_b, int stride);
+// max |A_i - A_j| over the alpha plane (0..255): the linf stage 2's pixel feature times 255.
+int MaxAlphaDifference(const uint8_t* image_a, const uint8_t* image_b, int stride);
+// The colour_blob stage 2's pixel feature: the most cells in one 4-connected blob of cells
+// opaque in both (A >= 128) whose colours differ by |dR| + |dG| + |dB| >= 90. Symmetric.
+int LargestColourBlob(const uint8_t* image_a, const uint8_t* image_b, const ComparisonWindow& window);
 // Plain loop, the reference the SIMD kernels are tested against.
 PixelSums SumPixelDifferencesScalar(const uint8_t* image_a, const uint8_t* image_b, int stride);
 // The features from the sums and the two alpha boxes.

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cstdlib>
 #include <exception>
 #include <mutex>
 #include <string>
@@ -18,6 +19,29 @@ SpriteStore::SpriteStore(const ComparisonWindow& window, double px_per_m)
   std::string why;
   if (!window.IsValid(&why)) throw InputError("comparison_window", why);
   if (!(px_per_m > 0)) throw InputError("px_per_m", "must be positive");
+  // Cells per signature part, with ComputeSignature's partition.
+  constexpr int kBlocks = kSignatureGrid * kSignatureGrid;
+  const int cx = window_.cells_x, cy = window_.cells_y;
+  for (int v = 0; v < cy; ++v) {
+    for (int u = 0; u < cx; ++u) {
+      ++coarse_cells_[(v * 4 / cy) * 4 + u * 4 / cx];
+      ++signature_cells_[(v * kSignatureGrid / cy) * kSignatureGrid + u * kSignatureGrid / cx];
+      ++signature_cells_[kBlocks + v * kSignatureBands / cy];
+      ++signature_cells_[kBlocks + kSignatureBands + u * kSignatureBands / cx];
+    }
+  }
+}
+
+bool SpriteStore::SignatureLinfExceeds(int32_t i, int32_t j, int limit) const {
+  for (int k = 0; k < kCoarseBlocks; ++k) {
+    const int64_t d = std::abs(int64_t{coarse_[i][k]} - int64_t{coarse_[j][k]});
+    if (d > int64_t{limit} * coarse_cells_[k]) return true;
+  }
+  for (int k = 0; k < kSignatureValues; ++k) {
+    const int64_t d = std::abs(int64_t{signature_[i][k]} - int64_t{signature_[j][k]});
+    if (d > int64_t{limit} * signature_cells_[k]) return true;
+  }
+  return false;
 }
 
 void SpriteStore::Clear() {

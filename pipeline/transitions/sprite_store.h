@@ -61,6 +61,11 @@ class SpriteStore {
   static constexpr uint32_t kSignatureMax = 32767;  // 16-bit lanes, differences summed as int16
   uint64_t CoarseAlphaBound(int32_t i, int32_t j) const;
   uint64_t SignatureAlphaBound(int32_t i, int32_t j) const;
+  // Proves without reading a pixel that max_cells |A_i - A_j| > limit (0..255): true when
+  // some part p of the level-1 or level-2 signature has |S_i,p - S_j,p| > limit * cells(p),
+  // since |S_i,p - S_j,p| <= sum_{cells in p} |A_i - A_j| <= cells(p) * max |A_i - A_j|
+  // (clamping keeps it: x -> min(x, M) moves no two values further apart). False decides nothing.
+  bool SignatureLinfExceeds(int32_t i, int32_t j, int limit) const;
   void PrefetchCoarse(int32_t i) const { __builtin_prefetch(coarse_[i].data()); }
   std::optional<int32_t> IndexOf(int64_t id) const;
   size_t clip_count() const { return clip_last_.size(); }
@@ -94,6 +99,8 @@ class SpriteStore {
   struct alignas(64) Signature : std::array<uint16_t, kSignatureValues> {};
   std::vector<Coarse> coarse_;
   std::vector<Signature> signature_;
+  std::array<uint32_t, kCoarseBlocks> coarse_cells_{};       // cells in each level-1 part
+  std::array<uint32_t, kSignatureValues> signature_cells_{};  // cells in each level-2 part
   std::vector<std::unique_ptr<uint8_t[]>> chunks_;
   std::unordered_map<int64_t, int32_t> index_of_;
   std::unordered_map<int64_t, int32_t> clip_last_;

@@ -184,69 +184,150 @@ Geometry Layout(const State& s) {
   return g;
 }
 
-// The visible key points of state `s` (billboard plane, metres, fixed order per pose):
-// head centre, the body's right and left extremes and top, each leg's foot.
-std::vector<double> Keypoints(const State& s) {
+// The shapes each part paints, in the billboard plane (metres), shared by the renderer and
+// the key points' visibility so that both see the same picture.
+struct EllipseShape {
+  double cx, cz, ax, az;
+  bool Contains(double x, double z) const {
+    if (ax <= 0 || az <= 0) return false;
+    const double u = (x - cx) / ax, v = (z - cz) / az;
+    return u * u + v * v <= 1.0;
+  }
+};
+struct RectShape {
+  double x0, z0, x1, z1;
+  bool Contains(double x, double z) const { return x >= x0 && x <= x1 && z >= z0 && z <= z1; }
+};
+enum class HeadPiece { kHead, kEar, kFace, kEye };
+
+RectShape LegShape(const Geometry& g, const Geometry::Leg& l, double k) {
+  const double top = g.body_z - g.body_az + 0.012 * k;
+  return {l.x - 0.006 * k, l.lift, l.x + 0.006 * k, top};
+}
+EllipseShape BodyShape(const Geometry& g) { return {0, g.body_z, g.body_ax, g.body_az}; }
+// The head's pieces in painting order: the head, both ears, the face (when it is toward the
+// camera), the eye.
+std::vector<std::pair<HeadPiece, EllipseShape>> HeadShapes(const Geometry& g, const State& s) {
+  const double c = std::cos(s.heading), sn = std::sin(s.heading), k = s.size;
+  const double head_x = g.head_x, head_z = g.head_z, r = 0.028 * k;
+  const bool facing = sn < 0;  // the face is toward the camera
+  std::vector<std::pair<HeadPiece, EllipseShape>> out;
+  out.push_back({HeadPiece::kHead, {head_x, head_z, r, r * 0.95}});
+  for (int side : {-1, 1}) {
+    const double ex = head_x + side * 0.012 * k * std::abs(sn) - 0.006 * k * c;
+    out.push_back({HeadPiece::kEar, {ex, head_z + 0.85 * r, 0.009 * k, 0.009 * k}});
+  }
+  if (facing) {
+    out.push_back({HeadPiece::kFace,
+                   {head_x + 0.5 * r * c, head_z - 0.25 * r, 0.6 * r * (0.4 + 0.6 * std::abs(sn)), 0.45 * r}});
+  }
+  const double eye_x = head_x + 0.45 * r * c;
+  if (facing || std::abs(c) > 0.3) {
+    out.push_back({HeadPiece::kEye, {eye_x, head_z + 0.2 * r, 0.0045 * k, 0.0045 * k}});
+  }
+  return out;
+}
+
+// The parts in Render's painting order, farthest first: part l < legs is leg l, part legs
+// is the body, part legs + 1 the head.
+std::vector<int> PaintOrder(const Geometry& g) {
+  const int legs = static_cast<int>(g.legs.size());
+  std::vector<std::pair<double, int>> parts;
+  for (int l = 0; l < legs; ++l) parts.push_back({g.legs[l].depth, l});
+  parts.push_back({0.0, legs});
+  parts.push_back({g.head_depth, legs + 1});
+  std::stable_sort(parts.begin(), parts.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
+  std::vector<int> order;
+  for (const auto& p : parts) order.push_back(p.second);
+  return order;
+}
+
+// The key points of state `s` (billboard plane, metres, fixed order per pose): head centre,
+// the body's right and left extremes and top, each leg's foot. `visible` gets, per point,
+// whether the picture shows it: a point is hidden when a part painted after its own part
+// (nearer the camera) covers it — the head centre behind the body, the body top or an
+// extreme behind the head, a foot behind a nearer leg.
+std::vector<double> Keypoints(const State& s, std::vector<uint8_t>* visible) {
   const Geometry g = Layout(s);
   std::vector<double> p = {g.head_x, g.head_z, g.body_ax, g.body_z, -g.body_ax, g.body_z, 0.0, g.body_z + g.body_az};
   for (const Geometry::Leg& l : g.legs) {
     p.push_back(l.x);
     p.push_back(l.lift);
   }
+  const int legs = static_cast<int>(g.legs.size()), body = legs, head = legs + 1;
+  std::vector<int> owner = {head, body, body, body};
+  for (int l = 0; l < legs; ++l) owner.push_back(l);
+  const std::vector<int> order = PaintOrder(g);
+  std::vector<size_t> rank(order.size());
+  for (size_t r = 0; r < order.size(); ++r) rank[order[r]] = r;
+  const auto head_shapes = HeadShapes(g, s);
+  auto covers = [&](int part, double x, double z) {
+    if (part == head) {
+      return std::any_of(head_shapes.begin(), head_shapes.end(),
+                         [&](const auto& piece) { return piece.second.Contains(x, z); });
+    }
+    if (part == body) return BodyShape(g).Contains(x, z);
+    return LegShape(g, g.legs[part], s.size).Contains(x, z);
+  };
+  visible->assign(owner.size(), 1);
+  for (size_t k = 0; k < owner.size(); ++k) {
+    for (size_t r = rank[owner[k]] + 1; r < order.size(); ++r) {
+      if (covers(order[r], p[2 * k], p[2 * k + 1])) {
+        (*visible)[k] = 0;
+        break;
+      }
+    }
+  }
   return p;
+}
+
+// The original's key point that point k of its mirror image is the image of: the head and
+// the body top keep their places, the body's right and left extremes swap, and so do the
+// feet of legs 0 and 1 and of legs 2 and 3 (the mirrored state's gait phase is p + 0.5; a
+// standing pose shows legs 2 and 3 only).
+size_t MirrorKeypoint(size_t k) {
+  if (k == 1 || k == 2) return 3 - k;
+  if (k < 4) return k;
+  return 4 + ((k - 4) ^ 1);
 }
 
 // Renders the animal in state `s`.
 RgbaBillboard Render(const State& s, double px_per_m, std::mt19937_64& rng, int noise) {
   Canvas canvas(px_per_m);
   const Geometry g = Layout(s);
-  const double c = std::cos(s.heading), sn = std::sin(s.heading), k = s.size;
+  const double k = s.size;
   const Rgb fur = Shade({205, 150, 85}, s.brightness), belly = Shade({236, 214, 176}, s.brightness);
   const Rgb stripe = Shade({150, 100, 58}, s.brightness), leg = Shade({170, 120, 80}, s.brightness);
   const Rgb face = Shade({240, 222, 192}, s.brightness), ear = Shade({215, 140, 130}, s.brightness);
   const Rgb eye{25, 20, 20};
 
-  struct Part {
-    double depth;  // larger = farther from the camera, painted first
-    std::function<void()> paint;
-  };
-  std::vector<Part> parts;
-  const double body_z = g.body_z, body_ax = g.body_ax, body_az = g.body_az, head_z = g.head_z;
-  const double top = body_z - body_az + 0.012 * k;
+  std::vector<std::function<void()>> parts;  // by part index (PaintOrder)
+  const double body_z = g.body_z;
   for (const Geometry::Leg& l : g.legs) {
-    const double x = l.x, lift = l.lift;
-    parts.push_back({l.depth, [&canvas, x, lift, top, k, leg] {
-                       canvas.Rect(x - 0.006 * k, lift, x + 0.006 * k, top, leg);
-                     }});
+    const RectShape r = LegShape(g, l, k);
+    parts.push_back([&canvas, r, leg] { canvas.Rect(r.x0, r.z0, r.x1, r.z1, leg); });
   }
-  parts.push_back({0.0, [&canvas, body_z, body_ax, body_az, fur, belly, stripe] {
-                     canvas.Ellipse(0, body_z, body_ax, body_az, [=](double, double z) {
-                       if (z < body_z - 0.45 * body_az) return belly;
-                       if (z > body_z + 0.7 * body_az) return stripe;
-                       return fur;
-                     });
-                   }});
-  const double head_x = g.head_x, head_depth = g.head_depth, r = 0.028 * k;
-  const bool facing = sn < 0;  // the face is toward the camera
-  parts.push_back({head_depth, [=, &canvas] {
-                     canvas.Ellipse(head_x, head_z, r, r * 0.95, [=](double, double) { return fur; });
-                     for (int side : {-1, 1}) {
-                       const double ex = head_x + side * 0.012 * k * std::abs(sn) - 0.006 * k * c;
-                       canvas.Ellipse(ex, head_z + 0.85 * r, 0.009 * k, 0.009 * k,
-                                      [=](double, double) { return ear; });
+  const EllipseShape body_shape = BodyShape(g);
+  parts.push_back([&canvas, body_shape, body_z, fur, belly, stripe] {
+                     const double body_az = body_shape.az;
+                     canvas.Ellipse(body_shape.cx, body_shape.cz, body_shape.ax, body_shape.az,
+                                    [=](double, double z) {
+                                      if (z < body_z - 0.45 * body_az) return belly;
+                                      if (z > body_z + 0.7 * body_az) return stripe;
+                                      return fur;
+                                    });
+                   });
+  const auto head_shapes = HeadShapes(g, s);
+  parts.push_back([=, &canvas] {
+                     for (const auto& [piece, e] : head_shapes) {
+                       const Rgb colour = piece == HeadPiece::kHead  ? fur
+                                          : piece == HeadPiece::kEar ? ear
+                                          : piece == HeadPiece::kFace ? face
+                                                                      : eye;
+                       canvas.Ellipse(e.cx, e.cz, e.ax, e.az, [=](double, double) { return colour; });
                      }
-                     if (facing) {
-                       canvas.Ellipse(head_x + 0.5 * r * c, head_z - 0.25 * r, 0.6 * r * (0.4 + 0.6 * std::abs(sn)),
-                                      0.45 * r, [=](double, double) { return face; });
-                     }
-                     const double eye_x = head_x + 0.45 * r * c;
-                     if (facing || std::abs(c) > 0.3) {
-                       canvas.Ellipse(eye_x, head_z + 0.2 * r, 0.0045 * k, 0.0045 * k,
-                                      [=](double, double) { return eye; });
-                     }
-                   }});
-  std::stable_sort(parts.begin(), parts.end(), [](const Part& a, const Part& b) { return a.depth > b.depth; });
-  for (const Part& p : parts) p.paint();
+                   });
+  for (int part : PaintOrder(g)) parts[part]();
   return canvas.Resolve(rng, noise);
 }
 
@@ -313,7 +394,7 @@ std::vector<SyntheticSprite> MakeSyntheticSprites(const SyntheticSpriteOptions& 
       sprite.truth.pose = s.pose;
       sprite.truth.heading_rad = s.heading;
       sprite.truth.gait_phase = s.phase;
-      sprite.truth.keypoints_m = Keypoints(s);
+      sprite.truth.keypoints_m = Keypoints(s, &sprite.truth.keypoint_visible);
       states.push_back(s);
       out.push_back(std::move(sprite));
     }
@@ -343,7 +424,15 @@ std::vector<SyntheticSprite> MakeSyntheticSprites(const SyntheticSpriteOptions& 
         State mirrored = states[k];
         mirrored.heading = m.truth.heading_rad;
         mirrored.phase = m.truth.gait_phase;
-        m.truth.keypoints_m = Keypoints(mirrored);
+        std::vector<uint8_t> unused;
+        m.truth.keypoints_m = Keypoints(mirrored, &unused);
+        // Visibility is the picture's, i.e. the original's: the mirrored state's own painting
+        // order can differ (its legs' depths are not the mirrored ones). Point k of the mirror
+        // is the image of the original's point MirrorKeypoint(k).
+        m.truth.keypoint_visible.resize(src.truth.keypoint_visible.size());
+        for (size_t q = 0; q < m.truth.keypoint_visible.size(); ++q) {
+          m.truth.keypoint_visible[q] = src.truth.keypoint_visible[MirrorKeypoint(q)];
+        }
         out.push_back(std::move(m));
       }
     }

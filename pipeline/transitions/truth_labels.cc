@@ -24,8 +24,13 @@ double KeypointDisplacement(const SpriteTruth& a, const SpriteTruth& b) {
   if (a.keypoints_m.empty() || a.keypoints_m.size() != b.keypoints_m.size() || a.keypoints_m.size() % 2 != 0) {
     return INFINITY;
   }
+  const size_t points = a.keypoints_m.size() / 2;
+  const auto& va = a.keypoint_visible;
+  const auto& vb = b.keypoint_visible;
+  if ((!va.empty() && va.size() != points) || (!vb.empty() && vb.size() != points)) return INFINITY;
   double worst = 0;
   for (size_t k = 0; k < a.keypoints_m.size(); k += 2) {
+    if (!va.empty() && !vb.empty() && !va[k / 2] && !vb[k / 2]) continue;
     worst = std::max(worst, std::hypot(a.keypoints_m[k] - b.keypoints_m[k], a.keypoints_m[k + 1] - b.keypoints_m[k + 1]));
   }
   return worst;

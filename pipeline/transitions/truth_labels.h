@@ -3,7 +3,8 @@
 // (seed 000 §3 asks a person whether a pair would make a smooth transition). A pair is
 // "accept" when both sprites have the same pose label and look alike:
 //  - when both truths carry key points (the synthetic sets of synthetic.h do): every
-//    visible key point moved at most max_keypoint_displacement_m in the billboard plane;
+//    key point visible in either sprite moved at most max_keypoint_displacement_m in the
+//    billboard plane (a point hidden in both is not seen to move);
 //  - otherwise (e.g. a studio session's subjects.csv): headings and gait phases are close.
 // Key points measure closeness the way an eye does: a phase tolerance alone would call a
 // barely moving sniff "different" and a fast trot "alike" (docs/transitions.md).
@@ -21,9 +22,12 @@ struct SpriteTruth {
   std::string pose;                 // "walk", "trot", "idle", "stand", ...
   double heading_rad = 0;           // facing direction on the ground
   double gait_phase = std::nan("");  // cycles in [0, 1); NaN when the pose has no gait
-  // Optional: visible key points as (x, z) pairs in the billboard plane, metres, x from
-  // the body centre, z up from the floor; the same points in the same order per pose.
+  // Optional: key points as (x, z) pairs in the billboard plane, metres, x from the body
+  // centre, z up from the floor; the same points in the same order per pose.
   std::vector<double> keypoints_m;
+  // Per key point: 1 when the picture shows it, 0 when a nearer part hides it. Empty: all
+  // visible. Only points visible in at least one sprite of a pair are compared.
+  std::vector<uint8_t> keypoint_visible;
 };
 
 struct TruthLabelOptions {
@@ -36,7 +40,8 @@ struct TruthLabelOptions {
   double near_miss_factor = 3.0;
 };
 
-// The largest key-point displacement (metres); infinity when the sets do not correspond.
+// The largest displacement (metres) among the key points visible in a or in b (a point
+// hidden in both is not seen to move); infinity when the sets do not correspond.
 double KeypointDisplacement(const SpriteTruth& a, const SpriteTruth& b);
 
 // Circular differences: headings in radians (0..pi), phases in cycles (0..0.5).

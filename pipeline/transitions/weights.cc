@@ -93,6 +93,20 @@ bool TransitionWeights::IsValid(std::string* why) const {
   }
   if (!std::isfinite(stage1_bias)) return fail("stage1.bias", "not finite");
   if (!std::isfinite(stage2_bias)) return fail("stage2.bias", "not finite");
+  if (stage2_variant == Stage2Variant::kLinf) {
+    if (!(linf_max_velocity_mps > 0) || !std::isfinite(linf_max_velocity_mps)) {
+      return fail("stage2.linf.max_velocity_mps", "must be a positive number");
+    }
+    if (!(linf_max_alpha > 0 && linf_max_alpha <= 1)) {
+      return fail("stage2.linf.max_alpha_linf", "must be in (0, 1]");
+    }
+  }
+  if (stage2_variant == Stage2Variant::kColourBlob) {
+    if (!(colour_blob_max_velocity_mps > 0) || !std::isfinite(colour_blob_max_velocity_mps)) {
+      return fail("stage2.colour_blob.max_velocity_mps", "must be a positive number");
+    }
+    if (colour_blob_max_cells < 0) return fail("stage2.colour_blob.max_blob_cells", "must be >= 0");
+  }
   return true;
 }
 
@@ -110,9 +124,9 @@ TransitionWeights ParseWeights(const std::string& text, const std::string& sourc
     r.Fail("format", std::string("expected \"") + kWeightsFileFormat + "\", got " + format.dump());
   }
   const int version = r.Integer("version");
-  if (version != kWeightsFileVersion) {
-    r.Fail("version", "this build reads version " + std::to_string(kWeightsFileVersion) + ", the file has " +
-                          std::to_string(version));
+  if (version < 1 || version > kWeightsFileVersion) {
+    r.Fail("version", "this build reads versions 1 to " + std::to_string(kWeightsFileVersion) +
+                          ", the file has " + std::to_string(version));
   }
   const json& names = r.Get("features");
   json expected = json::array();
@@ -138,6 +152,25 @@ TransitionWeights ParseWeights(const std::string& text, const std::string& sourc
   w.stage1_bias = r.Number("stage1.bias");
   w.stage2_weights = r.Numbers<kPairFeatureCount>("stage2.weights");
   w.stage2_bias = r.Number("stage2.bias");
+  if (version < 2 && r.Get("stage2").contains("variant")) {
+    r.Fail("stage2.variant", "needs version 2 (version 1 files are the paper's variant)");
+  }
+  if (version >= 2) {
+    const json& variant = r.Get("stage2.variant");
+    if (variant == "paper") {
+      w.stage2_variant = Stage2Variant::kPaper;
+    } else if (variant == "linf") {
+      w.stage2_variant = Stage2Variant::kLinf;
+      w.linf_max_velocity_mps = r.Number("stage2.linf.max_velocity_mps");
+      w.linf_max_alpha = r.Number("stage2.linf.max_alpha_linf");
+    } else if (variant == "colour_blob") {
+      w.stage2_variant = Stage2Variant::kColourBlob;
+      w.colour_blob_max_velocity_mps = r.Number("stage2.colour_blob.max_velocity_mps");
+      w.colour_blob_max_cells = r.Integer("stage2.colour_blob.max_blob_cells");
+    } else {
+      r.Fail("stage2.variant", "expected \"paper\", \"linf\" or \"colour_blob\", got " + variant.dump());
+    }
+  }
   if (root.contains("training")) {
     if (!root["training"].is_object()) r.Fail("training", "expected an object");
     w.training_json = root["training"].dump();
@@ -159,7 +192,9 @@ TransitionWeights LoadWeights(const std::string& path) {
 std::string WeightsToJson(const TransitionWeights& w) {
   json root;
   root["format"] = kWeightsFileFormat;
-  root["version"] = kWeightsFileVersion;
+  const bool linf = w.stage2_variant == Stage2Variant::kLinf;
+  const bool blob = w.stage2_variant == Stage2Variant::kColourBlob;
+  root["version"] = linf || blob ? 2 : 1;  // the paper variant is written as version 1 was
   root["features"] = FeatureNames();
   root["comparison_window"] = {{"width_m", w.window.width_m},
                                {"height_m", w.window.height_m},
@@ -171,6 +206,15 @@ std::string WeightsToJson(const TransitionWeights& w) {
   root["feature_scale"] = w.feature_scale;
   root["stage1"] = {{"weights", w.stage1_weights}, {"bias", w.stage1_bias}};
   root["stage2"] = {{"weights", w.stage2_weights}, {"bias", w.stage2_bias}};
+  if (linf) {
+    root["stage2"]["variant"] = "linf";
+    root["stage2"]["linf"] = {{"max_velocity_mps", w.linf_max_velocity_mps}, {"max_alpha_linf", w.linf_max_alpha}};
+  }
+  if (blob) {
+    root["stage2"]["variant"] = "colour_blob";
+    root["stage2"]["colour_blob"] = {{"max_velocity_mps", w.colour_blob_max_velocity_mps},
+                                     {"max_blob_cells", w.colour_blob_max_cells}};
+  }
   json training = json::parse(w.training_json, nullptr, false);
   root["training"] = training.is_object() ? training : json::object();
   return root.dump(2) + "\n";

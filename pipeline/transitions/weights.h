@@ -12,7 +12,16 @@
 
 namespace ss {
 
-inline constexpr int kWeightsFileVersion = 1;
+// Version 1: the paper's linear stage 2. Version 2 adds `stage2.variant` ("paper" or
+// "linf"); files with the paper variant are still written as version 1, byte for byte.
+inline constexpr int kWeightsFileVersion = 2;
+
+// Which stage 2 the builder runs (docs/transitions.md "Stage-2 variants").
+enum class Stage2Variant {
+  kPaper,  // D = sum_k u2_k x_k <= T2 on the six features
+  kLinf,   // velocity <= max_velocity_mps AND the largest cell alpha difference <= max_alpha_linf
+  kColourBlob,  // velocity <= max_velocity_mps AND the largest colour-difference blob <= max_blob_cells
+};
 inline constexpr const char* kWeightsFileFormat = "spritestation-transition-weights";
 
 struct TransitionWeights {
@@ -23,6 +32,11 @@ struct TransitionWeights {
   double stage1_bias = 0;
   PairFeatures stage2_weights{};
   double stage2_bias = 0;
+  Stage2Variant stage2_variant = Stage2Variant::kPaper;
+  double linf_max_velocity_mps = 0;  // linf: ||v_i - v_j|| bound (m/s), > 0
+  double linf_max_alpha = 0;         // linf: max_cells |A_i - A_j| / 255 bound, in (0, 1]
+  double colour_blob_max_velocity_mps = 0;  // colour_blob: ||v_i - v_j|| bound (m/s), > 0
+  int colour_blob_max_cells = 0;            // colour_blob: LargestColourBlob bound (cells), >= 0
   std::string training_json = "{}";  // provenance and cross-validation figures (free form JSON object)
 
   // False (with the field and the reason) unless every field is usable.

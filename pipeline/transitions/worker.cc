@@ -90,10 +90,19 @@ void TransitionWorker::Run() {
   try {
     s.reader.emplace(bank_path_);  // InputError when there is no bank: never create one here
     s.writer.emplace(bank_path_);
-    const BankSprites sprites = LoadBankSprites(*s.reader, &s.keys);
+    const auto progress = [this](const char* stage) {
+      return [this, stage](size_t done, size_t total) {
+        std::lock_guard<std::mutex> lock(mutex_);
+        stats_.startup_stage = stage;
+        stats_.startup_done = static_cast<int64_t>(done);
+        stats_.startup_total = static_cast<int64_t>(total);
+      };
+    };
+    const BankSprites sprites = LoadBankSprites(*s.reader, &s.keys, progress("load"));
     if (!sprites.inputs.empty()) {
       s.builder = std::make_unique<TransitionBuilder>(s.weights, sprites.px_per_m);
-      s.builder->BuildFromScratch(sprites.inputs, BuildOptions{.threads = s.startup_threads});
+      s.builder->BuildFromScratch(sprites.inputs,
+                                  BuildOptions{.threads = s.startup_threads, .progress = progress("pairs")});
       const auto transitions = s.builder->Transitions();
       const std::unordered_set<int64_t> universe(sprites.ids.begin(), sprites.ids.end());
       const StoreResult r = StoreTransitionTable(*s.writer, transitions, WeightsFingerprint(s.weights), universe);
@@ -111,6 +120,7 @@ void TransitionWorker::Run() {
   {
     std::lock_guard<std::mutex> lock(mutex_);
     stats_.ready = true;
+    stats_.startup_stage.clear();
     stats_.sprites = known;
     stats_.transitions_stored = stored;
     busy_ = false;

@@ -34,6 +34,10 @@ struct TransitionWorkerStats {
   int64_t failed_rounds = 0;
   std::string last_error;       // of the last failed round (or start-up)
   double last_round_ms = 0;     // find + store time of the last round
+  // While the start-up build runs: "load" (sprites read) or "pairs" (sprites searched), with
+  // sprites done of total; "" once it is done.
+  std::string startup_stage;
+  int64_t startup_done = 0, startup_total = 0;
 };
 
 class TransitionWorker {

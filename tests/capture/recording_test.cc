@@ -37,6 +37,7 @@ struct FormatCase {
   PixelFormat format;
   int width;
   int height;
+  std::string codec = "ffv1";  // every lossless codec of core/recording_codecs.h
 };
 
 class LosslessRoundTrip : public ::testing::TestWithParam<FormatCase> {};
@@ -49,7 +50,7 @@ TEST_P(LosslessRoundTrip, ReplaysBitExactWithTimestampsAndSequences) {
   const int64_t t0 = 5'000'000'123;
   // Irregular timestamps and a sequence gap, as a real camera delivers them.
   {
-    SessionWriter writer(session, "lossless");
+    SessionWriter writer(session, "lossless", {.codec = c.codec});
     const int cam = writer.AddCamera(TestCamera("cam0", c.format, c.width, c.height), nullptr);
     for (int i = 0; i < count; ++i) {
       const uint64_t seq = 100 + static_cast<uint64_t>(i) + (i >= 6 ? 2 : 0);
@@ -60,7 +61,7 @@ TEST_P(LosslessRoundTrip, ReplaysBitExactWithTimestampsAndSequences) {
   }
   const SessionInfo info = ReadSessionInfo(session);
   ASSERT_EQ(info.cameras.size(), 1u);
-  EXPECT_EQ(info.cameras[0].codec, "ffv1");
+  EXPECT_EQ(info.cameras[0].codec, c.codec);
   EXPECT_EQ(info.cameras[0].pixel_format, c.format);
 
   ReplaySource source(session);
@@ -95,8 +96,11 @@ INSTANTIATE_TEST_SUITE_P(
     ::testing::Values(FormatCase{PixelFormat::kBGR8, 96, 64}, FormatCase{PixelFormat::kRGB8, 97, 63},
                       FormatCase{PixelFormat::kMono8, 64, 48}, FormatCase{PixelFormat::kBayerRG8, 96, 64},
                       FormatCase{PixelFormat::kBayerGB8, 80, 60}, FormatCase{PixelFormat::kYUYV, 96, 64},
-                      FormatCase{PixelFormat::kNV12, 96, 64}),
-    [](const auto& info) { return PixelFormatName(info.param.format); });
+                      FormatCase{PixelFormat::kNV12, 96, 64}, FormatCase{PixelFormat::kBGR8, 96, 64, "ffvhuff"},
+                      FormatCase{PixelFormat::kRGB8, 97, 63, "ffvhuff"}, FormatCase{PixelFormat::kMono8, 64, 48, "ffvhuff"},
+                      FormatCase{PixelFormat::kBayerGB8, 80, 60, "ffvhuff"}, FormatCase{PixelFormat::kYUYV, 96, 64, "ffvhuff"},
+                      FormatCase{PixelFormat::kNV12, 96, 64, "ffvhuff"}),
+    [](const auto& info) { return PixelFormatName(info.param.format) + "_" + info.param.codec; });
 
 TEST(Recording, MjpegCameraKeepsItsJpegs) {
   ScratchDir dir;

@@ -427,6 +427,41 @@ TEST(Bank, WrongSchemaVersionNamesTheFileAndVersions) {
   EXPECT_THROW(VerifyBank(path), InputError);
 }
 
+TEST(Bank, AVersionOneBankIsUpgradedInPlaceAndKeepsItsSprites) {
+  ScratchDir dir;
+  const std::string path = dir / "v1.db";
+  // A bank as version 1 made it: its migration alone, then one clip.
+  RawExec(path, BankMigrations().at(0).sql);
+  RawExec(path, "PRAGMA application_id = " + std::to_string(kBankApplicationId) +
+                    "; PRAGMA user_version = 1; INSERT INTO meta (key, value) VALUES ('schema_version', '1')");
+  EXPECT_THROW(Bank b(path), InputError) << "a reader asks for the upgrade";
+  int64_t first = 0;
+  {
+    BankWriter w(path);  // upgrades
+    EXPECT_EQ(w.schema_version(), kBankSchemaVersion);
+    const Fixture fx = Register(w);
+    first = w.AppendClipBatch(Clip(fx.camera, 1, 0, true), MakeBatch(0, 3, 1)).sprite_ids.at(0);
+  }
+  EXPECT_TRUE(VerifyBank(path).ok()) << "new and upgraded banks hold the same schema";
+  BankWriter w(path);
+  w.SetTransitionLabel({first, first + 2, "yes", "2026-12-01T10:00:00Z", "test"});
+  w.SetTransitionLabel({first + 2, first, "skip", "2026-12-01T10:00:01Z", "test"});
+  w.SetTransitionLabel({first, first + 2, "no", "2026-12-01T10:00:02Z", "test"});  // replaces
+  EXPECT_THROW(w.SetTransitionLabel({first, 999999, "yes", "t", "test"}), InputError);
+  EXPECT_THROW(w.SetTransitionLabel({first, first + 2, "maybe", "t", "test"}), InputError);
+  EXPECT_THROW(w.SetTransitionLabel({first, first, "yes", "t", "test"}), InputError);
+  const Bank b(path);
+  const auto labels = b.LoadTransitionLabels();
+  ASSERT_EQ(labels.size(), 2u);
+  EXPECT_EQ(labels[0].label, "skip");
+  EXPECT_EQ(labels[1].from_sprite, first);
+  EXPECT_EQ(labels[1].label, "no");
+  EXPECT_EQ(b.CountTransitionLabels(), (std::map<std::string, int64_t>{{"no", 1}, {"skip", 1}, {"yes", 0}}));
+  EXPECT_TRUE(w.RemoveTransitionLabel(first + 2, first));
+  EXPECT_FALSE(w.RemoveTransitionLabel(first + 2, first));
+  EXPECT_EQ(b.LoadTransitionLabels().size(), 1u);
+}
+
 TEST(Bank, FilesThatAreNotBanksAreInputErrors) {
   ScratchDir dir;
   const std::string garbage = dir / "garbage.db";

@@ -119,7 +119,7 @@ TEST(SessionInfo, ErrorsNameTheFileAndTheField) {
   expect([](auto& j) { j["cameras"][1]["codec"] = "ffv1"; },
          "field 'cameras[1].codec': an mjpeg camera is stored as codec 'mjpeg', got 'ffv1'");
   expect([](auto& j) { j["cameras"][0]["codec"] = "vp9"; },
-         "field 'cameras[0].codec': unknown codec 'vp9' (expected ffv1, mjpeg or h264)");
+         "field 'cameras[0].codec': unknown codec 'vp9' (expected ffv1, ffvhuff, mjpeg or h264)");
   const std::string bad_format = ReadEdited(dir, [](auto& j) { j["cameras"][0]["pixel_format"] = "rgb16"; });
   EXPECT_NE(bad_format.find("field 'cameras[0].pixel_format': unknown pixel format 'rgb16'"), std::string::npos)
       << bad_format;

@@ -72,6 +72,28 @@ TEST_F(IngestEndToEnd, BadInputNamesTheFile) {
   EXPECT_EQ(no_bank.exit_code, 2) << no_bank.output;
 }
 
+// Issue 20: ingest went on writing into a damaged bank. Now a bank that fails SQLite's quick
+// check is refused by name before anything is written, and the file is left as it was.
+TEST_F(IngestEndToEnd, ADamagedBankIsRefusedAndLeftAsItWas) {
+  namespace fs = std::filesystem;
+  const std::string bank = *dir_ / "damaged.bank";
+  auto r = RunSpritestation("--log-level warn ingest " + *dir_ / "session" + " --bank " + bank + " --no-transitions");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  ASSERT_GT(fs::file_size(bank), 3 * 4096u);
+  {
+    std::fstream f(bank, std::ios::in | std::ios::out | std::ios::binary);
+    f.seekp(2 * 4096);  // page 3: a b-tree page of the schema's first tables
+    const std::string garbage(4096, '\xa5');
+    f.write(garbage.data(), static_cast<std::streamsize>(garbage.size()));
+  }
+  const auto before = testing::RunCommand("md5sum < " + bank);
+  r = RunSpritestation("--log-level warn ingest " + *dir_ / "session" + " --bank " + bank + " --no-transitions");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find(bank + ": the bank does not pass SQLite's quick check"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("bank verify"), std::string::npos) << r.output;
+  EXPECT_EQ(testing::RunCommand("md5sum < " + bank).output, before.output);
+}
+
 // A camera whose video cannot be read at all: ingest stores the other camera's sprites, then
 // says which camera failed and exits 1 (it used to report success).
 TEST_F(IngestEndToEnd, ACameraThatCannotBeReadIsAFailureNamedAfterTheRest) {
@@ -96,6 +118,37 @@ TEST_F(IngestEndToEnd, ACameraThatCannotBeReadIsAFailureNamedAfterTheRest) {
   EXPECT_EQ(j["failed"].size(), 1u) << r.output;
   const auto verify = RunSpritestation("bank verify " + bank);
   EXPECT_EQ(verify.exit_code, 0) << verify.output;
+}
+
+// A 1080p session recorded in the fast codec (ffvhuff) and in FFV1 is the same footage: both
+// decode to the same bytes, so ingest stores the same bank from either.
+TEST(IngestCodecs, FfvhuffAndFfv1GiveTheSameBank) {
+  ScratchDir dir;
+  const std::string common = " --kind animal --seconds 5 --fps 10 --size 1920x1080 --cameras 1 --subjects 1 --seed 4"
+                             " --empty-lead-in 3 --no-mattes --noise 1";
+  std::string digest[2];
+  int index = 0;
+  for (const std::string codec : {"ffv1", "ffvhuff"}) {
+    const std::string session = dir / codec;
+    auto r = RunSpritestation("--log-level warn synth --out " + session + common + " --codec " + codec);
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    const std::string bank = dir / (codec + ".bank");
+    r = RunSpritestation("--log-level warn ingest " + session + " --bank " + bank + " --no-transitions --json");
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    const nlohmann::json j = JsonInOutput(r.output);
+    ASSERT_TRUE(j.is_object()) << r.output;
+    EXPECT_GT(j["sprites_kept"].get<int>(), 5) << codec << ": " << r.output;
+    // Every stored number and every billboard's bytes, in order.
+    r = testing::RunCommand("sqlite3 -readonly " + bank +
+                            " \"SELECT s.frame, s.track_id, s.mirrored, s.ground_x_m, s.ground_y_m, s.mean_r, s.mean_g,"
+                            " s.mean_b, s.area_px, s.bbox_x, s.bbox_y, s.bbox_w, s.bbox_h, hex(p.data)"
+                            " FROM sprites s JOIN sprite_pixels p ON p.sprite_id = s.id ORDER BY s.id\"");
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    digest[index++] = r.output;
+  }
+  EXPECT_FALSE(digest[0].empty());
+  EXPECT_TRUE(digest[0] == digest[1]) << "the banks differ (" << digest[0].size() << " vs " << digest[1].size()
+                                      << " bytes of rows)";
 }
 
 }  // namespace

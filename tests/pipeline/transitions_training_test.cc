@@ -195,6 +195,22 @@ TEST(TransitionTraining, KeypointTruth) {
   d.keypoints_m.push_back(0);
   EXPECT_EQ(KeypointDisplacement(a, d), INFINITY);
 
+  // Only key points visible in at least one of the two count: a point hidden in both (e.g.
+  // the head behind the body) is not seen to move; one hidden in only one sprite is.
+  SpriteTruth e = a, f = a;
+  e.keypoint_visible = {0, 1};
+  f.keypoint_visible = {0, 1};
+  f.keypoints_m[0] += 0.05;  // point 0 moved 5 cm, hidden in both
+  EXPECT_NEAR(KeypointDisplacement(e, f), 0.0, 1e-12);
+  EXPECT_TRUE(TruthAccepts(e, f, o));
+  f.keypoint_visible = {1, 1};  // now visible in f
+  EXPECT_NEAR(KeypointDisplacement(e, f), 0.05, 1e-12);
+  EXPECT_NEAR(KeypointDisplacement(f, e), 0.05, 1e-12);
+  f.keypoint_visible.clear();  // no flags: every point visible
+  EXPECT_NEAR(KeypointDisplacement(e, f), 0.05, 1e-12);
+  f.keypoint_visible = {1};  // flags that do not match the points
+  EXPECT_EQ(KeypointDisplacement(e, f), INFINITY);
+
   // A synthetic mirror's key points are its original's mirrored (x -> -x), legs permuted.
   SyntheticSpriteOptions so;
   so.frames = 300;
@@ -216,6 +232,23 @@ TEST(TransitionTraining, KeypointTruth) {
       EXPECT_NEAR(got[i].first, want[i].first, 1e-9) << k;
       EXPECT_NEAR(got[i].second, want[i].second, 1e-9) << k;
     }
+    // Visibility is the picture's: each point of the mirror is as visible as the original's
+    // point it is the image of.
+    const auto& pv = sprites[k].truth.keypoint_visible;
+    const auto& mv = sprites[300 + k].truth.keypoint_visible;
+    ASSERT_EQ(pv.size(), p.size() / 2);
+    ASSERT_EQ(mv.size(), p.size() / 2);
+    for (size_t i = 0; i < got.size(); ++i) {
+      size_t match = got.size();
+      for (size_t q = 0; q < want.size(); ++q) {
+        if (std::abs(got[i].first - want[q].first) < 1e-9 && std::abs(got[i].second - want[q].second) < 1e-9 &&
+            (match == got.size() || pv[q] == mv[i])) {
+          match = q;
+        }
+      }
+      ASSERT_LT(match, got.size()) << k << " point " << i;
+      EXPECT_EQ(mv[i], pv[match]) << k << " point " << i << " " << sprites[k].truth.pose;
+    }
     std::sort(want.begin() + 1, want.begin() + 3);
     std::sort(got.begin() + 1, got.begin() + 3);
     std::sort(want.begin() + 4, want.end());
@@ -226,6 +259,34 @@ TEST(TransitionTraining, KeypointTruth) {
       EXPECT_NEAR(got[i].second, want[i].second, 1e-9) << k << " " << sprites[k].truth.pose;
     }
   }
+}
+
+TEST(TransitionTraining, SyntheticKeypointsAreVisibleAsDrawn) {
+  // The head is painted behind the body when the animal faces away (sin(heading) > 0) and in
+  // front of it otherwise; a walking or trotting head's centre lies inside the body's outline,
+  // so it is hidden exactly when facing away. Nothing covers the body's extremes and top when
+  // the head is behind, nor the feet from the body.
+  SyntheticSpriteOptions so;
+  so.frames = 600;
+  so.mirrors = false;
+  so.seed = 5;
+  int hidden_heads = 0, shown_heads = 0;
+  for (const auto& s : MakeSyntheticSprites(so)) {
+    const auto& v = s.truth.keypoint_visible;
+    ASSERT_EQ(v.size(), s.truth.keypoints_m.size() / 2);
+    const double sn = std::sin(s.truth.heading_rad);
+    if (s.truth.pose != "walk" && s.truth.pose != "trot") continue;
+    if (sn > 0.05) {
+      EXPECT_EQ(v[0], 0) << s.id;
+      for (size_t q : {1, 2, 3}) EXPECT_EQ(v[q], 1) << s.id << " point " << q;
+      hidden_heads += 1;
+    } else if (sn < -0.05) {
+      EXPECT_EQ(v[0], 1) << s.id;
+      shown_heads += 1;
+    }
+  }
+  EXPECT_GT(hidden_heads, 50);
+  EXPECT_GT(shown_heads, 50);
 }
 
 TEST(TransitionTraining, TrainsOnSyntheticTruth) {
@@ -338,7 +399,7 @@ TEST(TransitionWeightsFile, WrongFilesNameTheFileAndField) {
     edit(j);
     return ErrorOf(j.dump());
   };
-  EXPECT_NE(with([](auto& j) { j["version"] = 2; }).find("field 'version'"), std::string::npos);
+  EXPECT_NE(with([](auto& j) { j["version"] = 3; }).find("field 'version'"), std::string::npos);  // 2 exists now
   EXPECT_NE(with([](auto& j) { j["format"] = "other"; }).find("field 'format'"), std::string::npos);
   EXPECT_NE(with([](auto& j) { j["stage1"]["weights"][2] = -0.5; }).find("field 'stage1.weights'"), std::string::npos);
   EXPECT_NE(with([](auto& j) { j["stage1"]["weights"] = {1, 2}; }).find("field 'stage1.weights'"), std::string::npos);

@@ -40,7 +40,11 @@ std::string SourcePath(const std::string& relative) {
 
 CommandResult RunSpritestation(const std::string& args) {
   const char* bin = std::getenv("SPRITESTATION_BIN");
-  const std::string command = std::string(bin ? bin : "spritestation") + " " + args + " 2>&1";
+  return RunCommand(std::string(bin ? bin : "spritestation") + " " + args);
+}
+
+CommandResult RunCommand(const std::string& shell_command) {
+  const std::string command = shell_command + " 2>&1";
   CommandResult result;
   FILE* pipe = popen(command.c_str(), "r");
   if (!pipe) return result;

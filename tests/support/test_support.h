@@ -32,6 +32,8 @@ std::string SourcePath(const std::string& relative);
 
 // Runs `spritestation ARGS` (the binary named by $SPRITESTATION_BIN) through the shell.
 CommandResult RunSpritestation(const std::string& args);
+// Runs a shell command (sqlite3, ffprobe ...): its exit code and output (stdout, then stderr).
+CommandResult RunCommand(const std::string& command);
 
 // `spritestation ARGS` running in the background (daemon, fakecam); stdout and
 // stderr go to `log_path`. Killed (SIGKILL) when the object dies.

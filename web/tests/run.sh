@@ -41,7 +41,8 @@ cleanup() {
 trap cleanup EXIT INT TERM
 
 cd "$repo"
-# SS_WEB_TESTS="calibrate station" runs only those files (default: every *.test.mjs).
+# SS_WEB_TESTS=NAME runs web/tests/NAME.test.mjs alone; "calibrate,label" (or
+# "calibrate label") runs those files (default: every *.test.mjs).
 if [ -n "${SS_WEB_TESTS:-}" ]; then
   set --
   for t in $(echo "$SS_WEB_TESTS" | tr ',' ' '); do

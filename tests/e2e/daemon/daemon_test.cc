@@ -14,6 +14,11 @@
 
 // Eigen before httplib: <resolv.h> (through httplib) defines _res, a name Eigen uses.
 #include <Eigen/Geometry>
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
 #include <gtest/gtest.h>
 #include <httplib.h>
 #include <opencv2/imgcodecs.hpp>
@@ -474,6 +479,41 @@ TEST_F(DaemonTest, TheControlApiRefusesBadRequestsByName) {
   EXPECT_EQ(g->status, 404) << g->body;
   daemon->Signal(SIGTERM);
   EXPECT_EQ(daemon->Wait(10), 0);
+}
+
+// Issue 20: 200 connections that sent a header line every 2 s made the API unreachable. Now
+// 500 slow clients (a request line, then a header line now and then, never finished) leave
+// the API answering every request.
+TEST_F(DaemonTest, SlowClientsDoNotStarveTheApi) {
+  auto daemon = Daemon(Config(ReplayCamera(true)));
+  ASSERT_TRUE(WaitStatus([](const nlohmann::json& s) { return s["state"] == "running"; }, 20));
+  std::vector<int> slow;
+  for (int i = 0; i < 500; ++i) {
+    const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+    ASSERT_GE(fd, 0);
+    sockaddr_in addr{};
+    addr.sin_family = AF_INET;
+    addr.sin_port = htons(static_cast<uint16_t>(port_));
+    addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    ASSERT_EQ(::connect(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr), 0) << "connection " << i;
+    const std::string start = "GET /api/status HTTP/1.1\r\nHost: 127.0.0.1\r\n";
+    ASSERT_GT(::send(fd, start.data(), start.size(), MSG_NOSIGNAL), 0);
+    slow.push_back(fd);
+  }
+  httplib::Client probe("127.0.0.1", port_);
+  probe.set_connection_timeout(2, 0);
+  probe.set_read_timeout(2, 0);
+  for (int round = 0; round < 3; ++round) {
+    // Every slow client sends one more header line, as the attack does every 2 s.
+    for (const int fd : slow) ::send(fd, "X-Slow: 1\r\n", 11, MSG_NOSIGNAL);
+    const auto r = probe.Get("/api/status");
+    ASSERT_TRUE(r) << "round " << round << ": the API did not answer within 2 s (" << httplib::to_string(r.error()) << ")";
+    EXPECT_EQ(r->status, 200);
+    std::this_thread::sleep_for(std::chrono::seconds(1));
+  }
+  for (const int fd : slow) ::close(fd);
+  daemon->Signal(SIGTERM);
+  EXPECT_EQ(daemon->Wait(10), 0) << daemon->output();
 }
 
 TEST_F(DaemonTest, WithATokenEveryRequestMustCarryIt) {
