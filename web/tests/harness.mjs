@@ -59,12 +59,16 @@ export function run(args, opts = {}) {
 
 // A background process whose output goes to a log file (and is kept for
 // waiting on a line).
+// `prefix`: a command the executable runs under (e.g. setpriv dropping a
+// capability), its arguments before BIN's.
 export class Child {
-  constructor(name, args) {
+  constructor(name, args, { prefix = [] } = {}) {
     this.name = name;
     this.log = path.join(WORK, `${name}.log`);
     this.out = '';
-    this.proc = spawn(BIN, args, { stdio: ['ignore', 'pipe', 'pipe'] });
+    this.proc = prefix.length
+      ? spawn(prefix[0], [...prefix.slice(1), BIN, ...args], { stdio: ['ignore', 'pipe', 'pipe'] })
+      : spawn(BIN, args, { stdio: ['ignore', 'pipe', 'pipe'] });
     children.add(this.proc);
     const file = fs.createWriteStream(this.log, { flags: 'a' });
     file.write(`$ spritestation ${args.join(' ')}\n`);
@@ -152,8 +156,8 @@ export function config(name, s, cameras, { control = {}, storage = {} } = {}) {
   return { file, dir, bank: st.bank };
 }
 
-export async function daemon(name, cfg, args = []) {
-  const d = new Child(`daemon-${name}`, ['daemon', '--config', cfg.file, '--web-dir', WEB_DIR, ...args]);
+export async function daemon(name, cfg, args = [], opts = {}) {
+  const d = new Child(`daemon-${name}`, ['daemon', '--config', cfg.file, '--web-dir', WEB_DIR, ...args], opts);
   const m = await d.waitForOutput(/daemon: control API on (http:\/\/\S+) \(port (\d+)\)/, 60000);
   d.url = m[1].replace(/\/$/, '');
   d.port = Number(m[2]);

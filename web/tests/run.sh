@@ -3,7 +3,8 @@
 #   web/tests/run.sh /abs/path/to/build/apps/spritestation
 # They run in a private network namespace (as root `unshare -n`, else
 # `unshare -rn`) with 127.0.0.2 on its loopback, so the emulated GigE cameras
-# serve on port 3956 without meeting other tests' cameras.
+# serve on port 3956 without meeting other tests' cameras. SS_WEB_TESTS=NAME[,NAME]
+# runs only web/tests/NAME.test.mjs.
 set -eu
 here=$(cd "$(dirname "$0")" && pwd)
 repo=$(cd "$here/../.." && pwd)
@@ -40,9 +41,19 @@ cleanup() {
 trap cleanup EXIT INT TERM
 
 cd "$repo"
+# SS_WEB_TESTS=NAME runs web/tests/NAME.test.mjs alone; "calibrate,label" (or
+# "calibrate label") runs those files (default: every *.test.mjs).
+if [ -n "${SS_WEB_TESTS:-}" ]; then
+  set --
+  for t in $(echo "$SS_WEB_TESTS" | tr ',' ' '); do
+    [ -f "$here/$t.test.mjs" ] || { echo "run.sh: no $here/$t.test.mjs" >&2; exit 2; }
+    set -- "$@" "$here/$t.test.mjs"
+  done
+else
+  set -- "$here"/*.test.mjs
+fi
 status=0
-# SS_WEB_TESTS=NAME runs web/tests/NAME.test.mjs alone (default: every *.test.mjs).
-node --test --test-concurrency=1 --test-timeout=240000 "$here"/${SS_WEB_TESTS:-*}.test.mjs || status=$?
+node --test --test-concurrency=1 --test-timeout=240000 "$@" || status=$?
 if [ "$status" -ne 0 ]; then
   for f in "$SS_WEB_WORK"/*.log "$SS_WEB_WORK"/*/*.log; do
     [ -f "$f" ] || continue
