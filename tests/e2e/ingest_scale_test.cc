@@ -28,11 +28,14 @@ class IngestScale : public ::testing::Test {
     // 30 fps: its first 30 frames teach the keyer the empty enclosure.
     for (const auto& [name, args] : std::vector<std::pair<std::string, std::string>>{
              {"animal", "--kind animal --seconds 3 --fps 30 --seed 11"},
-             {"figure", "--kind figure --seconds 2 --fps 10 --seed 3 --empty-lead-in 0.5"}}) {
+             {"figure", "--kind figure --seconds 3 --fps 10 --seed 3 --empty-lead-in 0.5"}}) {
       const auto r = RunSpritestation("--log-level warn synth --out " + *dir_ / name +
                                       " --size 480x360 --cameras 1 --subjects 1 --no-mattes --threads 2 " + args);
       ASSERT_EQ(r.exit_code, 0) << r.output;
     }
+    // The figure session's 5 empty frames teach the keyer (keying.training_frames).
+    std::ofstream(*dir_ / "figure.yaml") << "keying:\n  training_frames: 5\n";
+    std::ofstream(*dir_ / "figure800.yaml") << "keying:\n  training_frames: 5\npipeline:\n  px_per_m: 800\n";
     for (const int px_per_m : {300, 500, 800}) {
       std::ofstream(*dir_ / ("px" + std::to_string(px_per_m) + ".yaml"))
           << "pipeline:\n  px_per_m: " << px_per_m << "\n";
@@ -60,7 +63,7 @@ double TallestInTruth(const std::string& session) {
 }
 
 TEST_F(IngestScale, APersonIsStoredAtAScaleItFits) {
-  const nlohmann::json j = Ingest("figure", "figure.bank");
+  const nlohmann::json j = Ingest("figure", "figure.bank", "figure.yaml");
   const double s = j["px_per_m"].get<double>();
   const double height = TallestInTruth(*dir_ / "figure");
   EXPECT_GT(height, 1.7);
@@ -68,6 +71,11 @@ TEST_F(IngestScale, APersonIsStoredAtAScaleItFits) {
   EXPECT_LE(std::ceil((height + 0.01) * s) + 1, 512) << j["px_per_m_why"];
   EXPECT_GT(s, 40) << "no coarser than it must be: " << j["px_per_m_why"];
   EXPECT_EQ(j["discards"]["too_large"].get<int>(), 0) << j.dump(2);
+  EXPECT_GT(j["sprites_kept"].get<int>(), 10) << j.dump(2);
+  // At the old default, 800 px/m, every one was too large.
+  const nlohmann::json old = Ingest("figure", "figure800.bank", "figure800.yaml");
+  EXPECT_EQ(old["sprites_kept"].get<int>(), 0);
+  EXPECT_GE(old["discards"]["too_large"].get<int>(), j["sprites_kept"].get<int>());
 }
 
 TEST_F(IngestScale, TheHamsterStoresAsAtTheOld800) {
@@ -89,7 +97,7 @@ TEST_F(IngestScale, ANumberOverridesAndTheBankKeepsItsScale) {
   EXPECT_EQ(first["px_per_m"].get<double>(), 500);
   EXPECT_GT(first["rows_inserted"].get<int>(), 0);
   // auto into a bank that holds sprites: the bank's scale.
-  const nlohmann::json second = Ingest("figure", "kept.bank");
+  const nlohmann::json second = Ingest("figure", "kept.bank", "figure.yaml");
   EXPECT_EQ(second["px_per_m"].get<double>(), 500);
   EXPECT_NE(second["px_per_m_why"].get<std::string>().find("bank"), std::string::npos) << second["px_per_m_why"];
   EXPECT_EQ(Bank((*dir_ / "kept.bank")).BillboardScales(), std::vector<double>{500});
