@@ -80,6 +80,8 @@ void RunIngest(const std::string& session, const std::string& bank, const std::s
     out["sprites_kept"] = s.sprites_kept;
     out["rows_inserted"] = s.rows_inserted;
     out["batches"] = s.batches;
+    out["px_per_m"] = s.px_per_m;
+    out["px_per_m_why"] = s.px_per_m_why;
     out["discards"] = DiscardsJson(s.discards);
     out["seconds"] = s.seconds;
     out["frames_per_second"] = s.frames_per_second;
@@ -118,6 +120,7 @@ void RunIngest(const std::string& session, const std::string& bank, const std::s
               static_cast<unsigned long long>(s.sprites_kept), static_cast<unsigned long long>(s.rows_inserted),
               static_cast<unsigned long long>(s.batches),
               s.rows_inserted == 0 && s.sprites_kept > 0 ? " (already in the bank)" : "");
+  std::printf("  billboard scale %g px/m: %s\n", s.px_per_m, s.px_per_m_why.c_str());
   std::printf("  discarded:");
   for (size_t r = 1; r < s.discards.size(); ++r) {
     std::printf(" %s %llu", DiscardName(static_cast<Discard>(r)), static_cast<unsigned long long>(s.discards[r]));

@@ -319,6 +319,13 @@ std::map<std::string, int64_t> Bank::CountTransitionLabels() const {
   return out;
 }
 
+std::vector<double> Bank::BillboardScales() const {
+  auto s = db_->Prepare("SELECT DISTINCT px_per_m FROM sprites ORDER BY px_per_m");
+  std::vector<double> out;
+  while (s.Step()) out.push_back(s.Real(0));
+  return out;
+}
+
 BankCounts Bank::Counts() const {
   // One read transaction so that the figures agree with each other.
   db_->Exec("BEGIN");

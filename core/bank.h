@@ -71,6 +71,9 @@ class Bank {
   std::vector<int64_t> SpritesTagged(const std::string& tag) const;
   std::optional<std::string> GetMeta(const std::string& key) const;
   BankCounts Counts() const;
+  // The billboard scales (px_per_m) its sprites are stored at, smallest first: empty for a bank
+  // without sprites, one for a sound bank (one bank keeps one scale).
+  std::vector<double> BillboardScales() const;
   // The labels of sprite pairs (transition_labels), in the order they were made.
   std::vector<TransitionLabelRecord> LoadTransitionLabels() const;
   // Labels per kind: {"yes": n, "no": n, "skip": n} (kinds without labels are 0).

@@ -459,7 +459,16 @@ void ReadPipeline(Reader& r, const YAML::Node& node, PipelineConfig& p) {
   r.Number(view, "still_speed_m_per_s", p.still_speed_m_per_s, "a speed in m/s");
   r.Number(view, "max_still_s", p.max_still_s, "a duration in seconds");
   r.Int(view, "min_clip_frames", p.min_clip_frames, "a number of frames");
-  r.Number(view, "px_per_m", p.px_per_m, "a positive number of pixels per metre");
+  // `auto` (stored as 0) or a positive number of pixels per metre.
+  if (const YAML::Node* n = view.Find("px_per_m"); n && n->IsScalar() && n->Scalar() == "auto") {
+    p.px_per_m = 0;
+  } else {
+    double v = 0;
+    if (r.Number(view, "px_per_m", v, "auto or a positive number of pixels per metre")) {
+      p.px_per_m = v;
+      if (v == 0) r.msg().Error("pipeline.px_per_m", "expected auto or a positive number, got 0");
+    }
+  }
   r.Int(view, "workers", p.workers, "a number of threads");
   r.Int(view, "queue_frames", p.queue_frames, "a number of frames");
 }
@@ -712,7 +721,8 @@ class Validator {
     Positive(p.max_still_s, "pipeline.max_still_s");
     Check(p.min_clip_frames >= 1, "pipeline.min_clip_frames",
           "expected at least 1 frame, got " + std::to_string(p.min_clip_frames));
-    Positive(p.px_per_m, "pipeline.px_per_m");
+    Check(p.px_per_m == 0 || (std::isfinite(p.px_per_m) && p.px_per_m > 0), "pipeline.px_per_m",
+          "expected auto or a positive number, got " + Num(p.px_per_m));
     Check(p.workers >= 0, "pipeline.workers",
           "expected 0 (one per core) or more, got " + std::to_string(p.workers));
     Check(p.queue_frames >= 1, "pipeline.queue_frames",

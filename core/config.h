@@ -99,7 +99,9 @@ struct PipelineConfig {
   double still_speed_m_per_s = 0.05;  // slower than this counts as not moving
   double max_still_s = 2.0;           // still periods longer than this are discarded
   int min_clip_frames = 5;            // shorter clips are discarded
-  double px_per_m = 800;              // billboard scale, the same for the whole bank
+  // Billboard scale in pixels per metre, the same for the whole bank; 0 = `auto` (chosen from
+  // the cameras, or the bank's own scale when it holds sprites: pipeline/run/bank_scale.h).
+  double px_per_m = 0;
   int workers = 0;                    // OpenCV threads inside a frame's work; 0 = OpenCV's default
   int queue_frames = 8;               // per-camera queue between capture and pipeline
   bool operator==(const PipelineConfig&) const = default;

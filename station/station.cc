@@ -17,6 +17,7 @@
 #include <opencv2/core/utility.hpp>
 
 #include "core/bank.h"
+#include "pipeline/run/bank_scale.h"
 #include "core/error.h"
 #include "core/error_kinds.h"
 #include "core/log.h"
@@ -370,6 +371,23 @@ void Station::Start() {
   const StationConfig& config = s.options.config;
   s.bank = std::make_unique<BankWriter>(config.storage.bank);
   s.bank_sprites = s.bank->Counts().sprites;
+  CameraPipelineOptions pipeline = PipelineOptionsFromConfig(config);
+  // The bank's one billboard scale, shared by every camera (pipeline/run/bank_scale.h).
+  BankScaleInputs scale_inputs;
+  scale_inputs.configured = config.pipeline.px_per_m;
+  scale_inputs.bank_scales = s.bank->BillboardScales();
+  scale_inputs.bank_path = config.storage.bank;
+  for (const std::optional<CameraModel>& m : s.models) {
+    if (m) scale_inputs.models.push_back(&*m);
+  }
+  scale_inputs.floor = s.floor;
+  scale_inputs.max_side_px = pipeline.rectify.max_side_px;
+  scale_inputs.margin_m = pipeline.rectify.margin_m;
+  if (!scale_inputs.models.empty()) {
+    const BankScale scale = ChooseBankScale(scale_inputs);
+    pipeline.rectify.px_per_m = scale.px_per_m;
+    s.log->info("billboard scale {} px/m: {}", scale.px_per_m, scale.why);
+  }
   if (s.options.transitions) {
     s.transitions = std::make_unique<TransitionWorker>(config.storage.bank,
                                                       s.options.weights ? *s.options.weights : DefaultWeights());
@@ -377,7 +395,6 @@ void Station::Start() {
   s.writer_thread = std::thread([&s] { s.WriterLoop(); });
 
   if (config.pipeline.workers > 0) cv::setNumThreads(config.pipeline.workers);  // process-wide
-  CameraPipelineOptions pipeline = PipelineOptionsFromConfig(config);
   for (size_t i = 0; i < config.cameras.size(); ++i) {
     const CameraConfig& c = config.cameras[i];
     // Live batches are small (1/30 s of frames): a sprite reaches the bank as soon as its

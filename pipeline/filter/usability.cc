@@ -55,6 +55,9 @@ class PixelRays {
     return camera_.RayInGround(Eigen::Vector2d(x, y)).direction;  // a node outside the lens's valid region
   }
 
+  int cols() const { return cols_; }
+  int rows() const { return rows_; }
+
  private:
   const Eigen::Vector3d& Node(int i, int j) const { return rays_[static_cast<size_t>(j) * cols_ + i]; }
 
@@ -70,6 +73,16 @@ FloorMask::FloorMask(const CameraModel& camera, const GroundPolygon& floor, cons
   mask_ = cv::Mat::zeros(camera.height(), camera.width(), CV_8U);
   const Eigen::Vector3d centre = camera.CentreInGround();
   const PixelRays rays(camera, kRayGridStepPx);
+  centre_ = centre;
+  ray_cols_ = rays.cols();
+  ray_rows_ = rays.rows();
+  rays_.reserve(static_cast<size_t>(ray_cols_) * ray_rows_);
+  for (int j = 0; j < ray_rows_; ++j) {
+    for (int i = 0; i < ray_cols_; ++i) {
+      rays_.push_back(rays.Direction(std::min(i * kRayGridStepPx, camera.width() - 1),
+                                     std::min(j * kRayGridStepPx, camera.height() - 1)).cast<float>());
+    }
+  }
   for (int y = 0; y < camera.height(); ++y) {
     auto* row = mask_.ptr<uint8_t>(y);
     for (int x = 0; x < camera.width(); ++x) {
@@ -86,6 +99,28 @@ FloorMask::FloorMask(const CameraModel& camera, const GroundPolygon& floor, cons
   }
   cv::integral(mask_ == 0, not_floor_integral_, CV_32S);
   not_floor_integral_ /= 255;
+}
+
+bool FloorMask::SeesBehind(int x, int y, const Eigen::Vector2d& point_in_ground) const {
+  if (!(options_.wall_check_height_m > 0) || rays_.empty()) return false;
+  const int i = std::min(x / kRayGridStepPx, ray_cols_ - 1), j = std::min(y / kRayGridStepPx, ray_rows_ - 1);
+  const double u = static_cast<double>(x - i * kRayGridStepPx) / kRayGridStepPx;
+  const double v = static_cast<double>(y - j * kRayGridStepPx) / kRayGridStepPx;
+  const int i1 = std::min(i + 1, ray_cols_ - 1), j1 = std::min(j + 1, ray_rows_ - 1);
+  const auto node = [&](int a, int b) { return rays_[static_cast<size_t>(b) * ray_cols_ + a].cast<double>(); };
+  const Eigen::Vector3d d = (1 - v) * ((1 - u) * node(i, j) + u * node(i1, j)) + v * ((1 - u) * node(i, j1) + u * node(i1, j1));
+  if (!d.allFinite()) return false;
+  // Past the floor: the ray meets the ground outside the polygon, or never.
+  if (d.z() < 0) {
+    const Eigen::Vector3d g = centre_ + (-centre_.z() / d.z()) * d;
+    if (floor_.Contains(g.head<2>())) return false;
+  }
+  // Its height where it passes the contact point's distance from the camera.
+  const double reach = (point_in_ground - centre_.head<2>()).norm();
+  const double along = d.head<2>().norm();
+  if (along < 1e-9) return false;
+  const double z = centre_.z() + d.z() * (reach / along);
+  return z > options_.wall_check_height_m;
 }
 
 void FloorMask::Restrict(const cv::Mat& seen) {
@@ -128,7 +163,9 @@ Discard FloorMask::Check(const cv::Mat& alpha_crop, cv::Point offset, const Eige
     const auto* f = mask_.ptr<uint8_t>(iy);
     for (int x = 0; x < padded.cols; ++x) {
       const int ix = box.x - m + x;
-      if (ix >= 0 && ix < mask_.cols && p[x] && !f[ix]) return Discard::kTouchesWall;
+      if (ix >= 0 && ix < mask_.cols && p[x] && !f[ix] && !SeesBehind(ix, iy, point_in_ground)) {
+        return Discard::kTouchesWall;
+      }
     }
   }
   return Discard::kNone;

@@ -7,6 +7,7 @@
 #include <deque>
 #include <string>
 #include <unordered_map>
+#include <vector>
 
 #include <Eigen/Core>
 #include <opencv2/core.hpp>
@@ -38,6 +39,11 @@ struct UsabilityOptions {
   int floor_margin_px = 3;        // floor pixels required around the silhouette
   double wall_margin_m = 0.005;   // contact point distance to keep from the polygon edge
   double wall_height_m = 0.0;     // walls occlude the floor behind them up to this height
+  // A non-floor pixel under the silhouette is not counted (touches_wall) when it sees past the floor
+  // (its ray meets the ground outside the floor polygon, or never) and passes more than this high
+  // over the subject's contact point: background behind a tall subject's upper part, not something
+  // in front of it (what stands on the floor in front of a subject hides its lowest part first).
+  double wall_check_height_m = 0.3;
 };
 
 // Per camera: the image of the floor, computed once.
@@ -58,6 +64,11 @@ class FloorMask {
  private:
   GroundPolygon floor_;
   UsabilityOptions options_;
+  Eigen::Vector3d centre_;                  // the camera's centre on the ground frame
+  std::vector<Eigen::Vector3f> rays_;       // ground-frame ray directions every kRayGridStepPx
+  int ray_cols_ = 0, ray_rows_ = 0;
+  // The pixel sees past the floor, over the contact point higher than wall_check_height_m.
+  bool SeesBehind(int x, int y, const Eigen::Vector2d& point_in_ground) const;
   cv::Mat mask_;
   cv::Mat geometric_;           // the floor polygon seen over the walls, before Restrict
   cv::Mat not_floor_integral_;  // integral image of (mask_ == 0), for O(1) box tests

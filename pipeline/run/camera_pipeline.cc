@@ -9,6 +9,7 @@
 #include "pipeline/describe/sprite_description.h"
 #include "pipeline/key/chroma_keyer.h"
 #include "pipeline/key/clean_plate_keyer.h"
+#include "pipeline/run/bank_scale.h"
 
 namespace ss {
 namespace {
@@ -17,20 +18,6 @@ using Clock = std::chrono::steady_clock;
 
 double SecondsSince(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
-}
-
-// Image pixels per metre on the floor at the polygon's centre (0 when it cannot be seen).
-double FloorPixelsPerMetre(const CameraModel& model, const GroundPolygon& floor) {
-  if (floor.empty()) return 0;
-  Eigen::Vector2d centre = Eigen::Vector2d::Zero();
-  for (const Eigen::Vector2d& v : floor.vertices()) centre += v;
-  centre /= static_cast<double>(floor.vertices().size());
-  const double step = 0.01;
-  const Eigen::Vector2d p = model.ProjectGround({centre.x(), centre.y(), 0.0});
-  const Eigen::Vector2d px = model.ProjectGround({centre.x() + step, centre.y(), 0.0});
-  const Eigen::Vector2d py = model.ProjectGround({centre.x(), centre.y() + step, 0.0});
-  const double s = ((px - p).norm() + (py - p).norm()) / (2 * step);
-  return std::isfinite(s) ? s : 0.0;
 }
 
 std::unique_ptr<Keyer> MakeKeyer(const CameraPipelineOptions& o, const CameraModel& model,
@@ -93,7 +80,12 @@ CameraPipeline::CameraPipeline(std::string name, int64_t camera_id, CameraModel 
       stillness_(options.still_speed_m_per_s, options.max_still_s),
       rectifier_(options.rectify),
       batcher_(camera_id, options.batch),
-      log_(Log("pipeline.run")) {}
+      log_(Log("pipeline.run")) {
+  if (!(options_.rectify.px_per_m > 0)) {
+    throw InputError("pipeline.px_per_m", "camera " + name_ + ": the bank's billboard scale was not chosen "
+                                          "(ChooseBankScale resolves auto)");
+  }
+}
 
 CameraPipeline::~CameraPipeline() = default;
 CameraPipeline::CameraPipeline(CameraPipeline&&) noexcept = default;

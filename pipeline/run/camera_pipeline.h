@@ -45,6 +45,8 @@ struct CameraPipelineOptions {
   RectifierOptions rectify;
   ClipBatcherOptions batch;
 };
+// rectify.px_per_m is the config's pipeline.px_per_m, 0 for auto: the caller sets the bank's
+// scale (ChooseBankScale, bank_scale.h) before making a CameraPipeline.
 CameraPipelineOptions PipelineOptionsFromConfig(const StationConfig& config);
 
 struct CameraPipelineStats {
@@ -69,7 +71,7 @@ struct CandidateVerdict {
 class CameraPipeline {
  public:
   // `camera_id` is the bank's id of the camera. Throws InputError when the model
-  // is missing or the options are invalid.
+  // is missing or the options are invalid (rectify.px_per_m not chosen: <= 0).
   CameraPipeline(std::string name, int64_t camera_id, CameraModel model, GroundPolygon floor,
                  CameraPipelineOptions options);
   ~CameraPipeline();

@@ -17,6 +17,7 @@
 #include "core/bank_verify.h"
 #include "core/error.h"
 #include "core/log.h"
+#include "pipeline/run/bank_scale.h"
 #include "pipeline/run/bounded_queue.h"
 #include "pipeline/transitions/worker.h"
 
@@ -110,7 +111,7 @@ IngestSummary IngestSession(const IngestOptions& options) {
                            std::to_string(cam.width) + "x" + std::to_string(cam.height));
     }
   }
-  const CameraPipelineOptions pipeline_options = PipelineOptionsFromConfig(config);
+  CameraPipelineOptions pipeline_options = PipelineOptionsFromConfig(config);
   const TransitionWeights transition_weights =
       options.transition_weights.empty() ? DefaultWeights() : LoadWeights(options.transition_weights);
 
@@ -124,6 +125,20 @@ IngestSummary IngestSession(const IngestOptions& options) {
   }
   BankWriter bank(options.bank_path);
   IngestSummary summary;
+  // The bank's one billboard scale: its own when it holds sprites, else the config's or auto.
+  BankScaleInputs scale_inputs;
+  scale_inputs.configured = config.pipeline.px_per_m;
+  scale_inputs.bank_scales = bank.BillboardScales();
+  scale_inputs.bank_path = options.bank_path;
+  for (const CameraModel& m : models) scale_inputs.models.push_back(&m);
+  scale_inputs.floor = floor;
+  scale_inputs.max_side_px = pipeline_options.rectify.max_side_px;
+  scale_inputs.margin_m = pipeline_options.rectify.margin_m;
+  const BankScale scale = ChooseBankScale(scale_inputs);
+  pipeline_options.rectify.px_per_m = scale.px_per_m;
+  summary.px_per_m = scale.px_per_m;
+  summary.px_per_m_why = scale.why;
+  Log("pipeline.ingest")->info("billboard scale {} px/m: {}", scale.px_per_m, scale.why);
   summary.session_name = info.name;
   SessionRecord session_record;
   session_record.uid = info.name + "@" + info.created;

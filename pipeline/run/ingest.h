@@ -49,6 +49,8 @@ struct IngestSummary {
   uint64_t sprites_kept = 0;      // usable originals handed to the bank
   uint64_t rows_inserted = 0;     // new sprite rows (originals + mirrors); 0 on a re-ingest
   uint64_t batches = 0;
+  double px_per_m = 0;            // the bank's billboard scale the sprites were made at
+  std::string px_per_m_why;       // how it was chosen (ChooseBankScale)
   DiscardCounts discards{};       // summed over cameras
   SourceStats source;             // what the replay could not read
   double seconds = 0;

@@ -126,7 +126,7 @@ TEST(StationConfig, ExampleParsesIntoEveryField) {
   EXPECT_EQ(cfg.pipeline.still_speed_m_per_s, 0.05);
   EXPECT_EQ(cfg.pipeline.max_still_s, 2.0);
   EXPECT_EQ(cfg.pipeline.min_clip_frames, 5);
-  EXPECT_EQ(cfg.pipeline.px_per_m, 800);
+  EXPECT_EQ(cfg.pipeline.px_per_m, 0);  // auto
   EXPECT_EQ(cfg.pipeline.workers, 0);
   EXPECT_EQ(cfg.pipeline.queue_frames, 8);
 
@@ -161,6 +161,11 @@ TEST(StationConfig, DefaultsAreFilled) {
   EXPECT_EQ(cfg.control.address, "127.0.0.1");
   EXPECT_EQ(cfg.keying.method, KeyingMethod::kChroma);
   EXPECT_TRUE(cfg.enclosure.floor.empty());
+}
+
+TEST(StationConfig, PxPerMIsAutoOrANumber) {
+  EXPECT_EQ(Parse(kOneCamera + "pipeline:\n  px_per_m: auto\n").pipeline.px_per_m, 0);
+  EXPECT_EQ(Parse(kOneCamera + "pipeline:\n  px_per_m: 500\n").pipeline.px_per_m, 500);
 }
 
 TEST(StationConfig, ReplayCameraDefaultsToItsOwnNameInTheSession) {
@@ -255,7 +260,9 @@ TEST(StationConfig, ValueErrorsNameFieldAndLine) {
       {"keying:\n  method: luma\n",
        "station.yaml:2: keying.method: expected one of chroma, clean_plate, got \"luma\""},
       {"pipeline:\n  px_per_m: 0\n",
-       "station.yaml:2: pipeline.px_per_m: expected a positive number, got 0"},
+       "station.yaml:2: pipeline.px_per_m: expected auto or a positive number, got 0"},
+      {"pipeline:\n  px_per_m: big\n",
+       "station.yaml:2: pipeline.px_per_m: expected auto or a positive number of pixels per metre, got \"big\""},
       {"pipeline:\n  min_area_px: 0\n",
        "station.yaml:2: pipeline.min_area_px: expected at least 1 pixel, got 0"},
       {"storage:\n  recording: some\n",
@@ -298,7 +305,7 @@ TEST(StationConfig, EveryErrorIsReportedAtOnce) {
   EXPECT_EQ(ErrorOf(yaml),
             "station.yaml:5: cameras[0].fps: expected a positive number, got \"fast\"\n"
             "station.yaml:8: pipeline.min_aera_px: unknown key (did you mean \"min_area_px\"?)\n"
-            "station.yaml:7: pipeline.px_per_m: expected a positive number, got -1");
+            "station.yaml:7: pipeline.px_per_m: expected auto or a positive number, got -1");
 }
 
 TEST(StationConfig, SyntaxErrorsAndBadFiles) {
@@ -422,7 +429,7 @@ TEST(StationConfig, ValidatesConfigsBuiltInCode) {
   const ConfigReport report = ValidateStationConfig(cfg, "code", {}, NoFileChecks());
   EXPECT_EQ(report.status, ConfigStatus::kInvalid);
   ASSERT_EQ(report.errors.size(), 2u);
-  EXPECT_EQ(report.errors[0], "code: pipeline.px_per_m: expected a positive number, got -5");
+  EXPECT_EQ(report.errors[0], "code: pipeline.px_per_m: expected auto or a positive number, got -5");
   EXPECT_EQ(report.errors[1].rfind("code: control.token: required", 0), 0u) << report.errors[1];
 }
 

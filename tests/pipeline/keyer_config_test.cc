@@ -52,8 +52,9 @@ class KeyerConfig : public ::testing::Test {
     for (int i = 0; i < 4; ++i) empty.push_back(scene.Empty(100 + i));
     const SceneFrame f = scene.Render({s}, 7);
     GroundPolygon floor({{-0.6, -0.4}, {0.6, -0.4}, {0.6, 0.4}, {-0.6, 0.4}});
-    pipelines_.emplace_back(std::make_unique<CameraPipeline>("cam0", 1, Camera(), floor,
-                                                             PipelineOptionsFromConfig(config)));
+    CameraPipelineOptions options = PipelineOptionsFromConfig(config);
+    options.rectify.px_per_m = 800;  // auto is resolved per bank (ChooseBankScale); any scale does here
+    pipelines_.emplace_back(std::make_unique<CameraPipeline>("cam0", 1, Camera(), floor, options));
     CameraPipeline& p = *pipelines_.back();
     p.Train(empty);
     Keyed k;

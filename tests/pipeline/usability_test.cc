@@ -90,6 +90,37 @@ TEST(FloorMask, ChecksBorderFloorAndWalls) {
   EXPECT_EQ(floor.Check(line, {450, 230}, {0.25, 0.0}), Discard::kNone);
 }
 
+// A person on a 4 m x 4.5 m stage, seen from 4 m in front at 1.6 m: above its lowest 0.3 m it is
+// seen against what lies past the floor (the back wall), which is background, not a wall in front.
+TEST(FloorMask, ATallSubjectSeenAgainstTheBackgroundIsNotTouchingAWall) {
+  const Eigen::Vector3d centre(0, -4, 1.6), target(0, 0, 0.8);
+  const Eigen::Vector3d z = (target - centre).normalized();
+  const Eigen::Vector3d x = z.cross(Eigen::Vector3d::UnitZ()).normalized();
+  Rigid3 cam_from_ground;
+  cam_from_ground.rotation.row(0) = x;
+  cam_from_ground.rotation.row(1) = z.cross(x);
+  cam_from_ground.rotation.row(2) = z;
+  cam_from_ground.translation = -(cam_from_ground.rotation * centre);
+  const CameraModel cam("LENSMODEL_PINHOLE", {700, 700, 319.5, 239.5}, 640, 480, cam_from_ground);
+  const GroundPolygon stage({{-2, -1.5}, {2, -1.5}, {2, 3}, {-2, 3}});
+  // A 1.75 m tall, 40 px wide silhouette standing at `at`.
+  const auto person = [&](const Eigen::Vector2d& at, cv::Point* offset) {
+    const Eigen::Vector2d foot = cam.ProjectGround({at.x(), at.y(), 0.0});
+    const Eigen::Vector2d head = cam.ProjectGround({at.x(), at.y(), 1.75});
+    *offset = cv::Point(static_cast<int>(foot.x()) - 20, static_cast<int>(head.y()));
+    return cv::Mat(static_cast<int>(foot.y() - head.y()), 40, CV_8U, cv::Scalar(255));
+  };
+  cv::Point offset;
+  const cv::Mat middle = person({0.0, 0.5}, &offset);
+  EXPECT_EQ(FloorMask(cam, stage, {}).Check(middle, offset, {0.0, 0.5}), Discard::kNone);
+  UsabilityOptions every_pixel;  // the check before: any non-floor pixel under the silhouette
+  every_pixel.wall_check_height_m = 0;
+  EXPECT_EQ(FloorMask(cam, stage, every_pixel).Check(middle, offset, {0.0, 0.5}), Discard::kTouchesWall);
+  // Against the back wall its legs are seen past the floor too: that is touching the wall.
+  const cv::Mat back = person({0.0, 2.95}, &offset);
+  EXPECT_EQ(FloorMask(cam, stage, {}).Check(back, offset, {0.0, 2.95}), Discard::kTouchesWall);
+}
+
 TEST(StillnessFilter, DropsOnlyTheTooLongStillPart) {
   StillnessFilter still(0.02, 1.0);
   const int64_t frame_ns = 33'333'333;
