@@ -1,6 +1,7 @@
 #include "station/camera_runner.h"
 
 #include <algorithm>
+#include <cstdio>
 #include <atomic>
 #include <condition_variable>
 #include <deque>
@@ -243,7 +244,9 @@ struct CameraRunner::Impl {
       if (!frame) {
         if (stopping) break;
         if (stalled) {
-          SetState(CameraState::kOffline, "no frame for " + std::to_string(options.offline_after_s) + " s");
+          char silent[64];
+          std::snprintf(silent, sizeof silent, "no frame for %.1f s", options.offline_after_s);
+          SetState(CameraState::kOffline, silent);
           CloseSource();
           Backoff(backoff);
           continue;

@@ -34,6 +34,7 @@
 #include "station/preview.h"
 #include "station/station.h"
 #include "station/station_host.h"
+#include "station/station_status.h"
 
 #include <httplib.h>  // after Eigen (resolv.h's _res)
 
@@ -441,8 +442,8 @@ class CameraWork {
     j["width"] = bgr_.cols;
     j["height"] = bgr_.rows;
     j["step"] = calib::WizardStepName(w.step());
-    j["detected"] = view.accepted;
-    j["still"] = w.last_still();
+    j["detected"] = !w.done() && view.accepted;
+    j["still"] = !w.done() && w.last_still();
     j["guidance"] = guidance_;
     j["views"] = w.views();
     nlohmann::json grid = nlohmann::json::array();
@@ -494,9 +495,11 @@ class CameraWork {
     LiveView live;
     live.bgr = bgr_.clone();
     live.sequence = last_sequence_;
-    live.detected = view.accepted;
-    live.still = w.last_still();
-    if (view.accepted) live.corners = view.pixels;
+    // A finished wizard searches no more frames: its last detection is not of this image.
+    const bool searched = !w.done();
+    live.detected = searched && view.accepted;
+    live.still = searched && w.last_still();
+    if (live.detected) live.corners = view.pixels;
     live.grid = grid_;
     live.floor = std::move(floor_px);
     std::lock_guard lock(state_mutex_);
@@ -925,6 +928,17 @@ void ConsoleCalibration::Stop() {
 
 nlohmann::json ConsoleCalibration::State() const { return impl_->State(); }
 
+nlohmann::json ConsoleCalibration::StateWithCameras() const {
+  nlohmann::json status;
+  try {
+    status = StatusToJson(impl_->context.station()->Status());
+  } catch (const std::exception&) {
+    status = nlohmann::json::object();  // no station: no camera is online
+  }
+  AddStatus(status);
+  return status["calibration"];
+}
+
 void ConsoleCalibration::AddStatus(nlohmann::json& status) const {
   nlohmann::json calibration = State();
   // Whether each camera delivers, as the station sees it.
@@ -957,10 +971,10 @@ std::vector<api::Route> ConsoleCalibration::Routes() {
   Impl* s = impl_.get();
   using httplib::Request;
   using httplib::Response;
-  auto state_after = [s](auto f) {
-    return api::Json([s, f](const Request& req) {
+  auto state_after = [this](auto f) {
+    return api::Json([this, f](const Request& req) {
       f(req);
-      return s->State();
+      return StateWithCameras();
     });
   };
   auto camera_png = [s](const char* kind) {
@@ -975,7 +989,7 @@ std::vector<api::Route> ConsoleCalibration::Routes() {
     };
   };
   return {
-      {"GET", "/api/calibration", "GET /api/calibration", api::Json([s](const Request&) { return s->State(); })},
+      {"GET", "/api/calibration", "GET /api/calibration", api::Json([this](const Request&) { return StateWithCameras(); })},
       {"POST", "/api/calibration/start",
        "POST /api/calibration/start {\"board\", \"cameras\", \"board_pose\", \"board_thickness_m\", \"min_views\", "
        "\"max_views\", \"min_coverage\", \"max_rms_px\", \"still_s\", \"floor_still_s\", \"use_current_intrinsics\"}",
@@ -1011,7 +1025,7 @@ std::vector<api::Route> ConsoleCalibration::Routes() {
          }
        })},
       {"POST", "/api/calibration/solve", "POST /api/calibration/solve {\"camera\"} (202: runs in the background)",
-       [s](const Request& req, Response& res) {
+       [this, s](const Request& req, Response& res) {
          const nlohmann::json body = api::ObjectBody(req, {"camera"});
          s->RequireActive();
          std::vector<std::shared_ptr<CameraWork>> chosen = s->Chosen(body, false);
@@ -1025,7 +1039,7 @@ std::vector<api::Route> ConsoleCalibration::Routes() {
            chosen = in_step;
          }
          for (const auto& w : chosen) w->StartSolve();
-         api::Reply(res, 202, s->State());
+         api::Reply(res, 202, StateWithCameras());
        }},
       {"POST", "/api/calibration/redo", "POST /api/calibration/redo {\"camera\", \"step\": \"intrinsics\" | \"ground\" | \"enclosure\"}",
        state_after([s](const Request& req) {
@@ -1084,10 +1098,10 @@ std::vector<api::Route> ConsoleCalibration::Routes() {
          std::lock_guard lock(s->mutex);
          s->saved = nullptr;
        })},
-      {"POST", "/api/calibration/save", "POST /api/calibration/save", api::Json([s](const Request& req) {
+      {"POST", "/api/calibration/save", "POST /api/calibration/save", api::Json([this, s](const Request& req) {
          api::ObjectBody(req, {});
          s->Save();
-         return s->State();
+         return StateWithCameras();
        })},
       {"GET", R"(/api/calibration/cameras/([^/]+)/view\.json)", "GET /api/calibration/cameras/NAME/view.json?width=W",
        [s](const Request& req, Response& res) {

@@ -24,8 +24,10 @@ class ConsoleCalibration : public api::Part {
   void AddStatus(nlohmann::json& status) const override;
   void Stop() override;
 
-  // The wizard's state (`status.calibration`).
+  // The wizard's state (`status.calibration`), without and with each camera's `online` and
+  // `message` from the station's status (what GET /api/calibration and the actions answer).
   nlohmann::json State() const;
+  nlohmann::json StateWithCameras() const;
 
  private:
   struct Impl;
