@@ -296,8 +296,12 @@ WizardFrame CalibrationWizard::Feed(const cv::Mat& image, int frame) {
   // in view, every 4th frame is searched; once one is, every frame.
   BoardView view;
   view.source = camera_ + " frame " + std::to_string(frame);
-  view.rejection = "not searched (no board in the last frames)";
-  if (last_detected_ || fed_ % 4 == 0) view = DetectBoard(o_.board, image, o_.detect, view.source);
+  // A frame skipped between searches says why the last searched one had no board.
+  view.rejection = last_rejection_.empty() ? "no board in the last frames" : last_rejection_;
+  if (last_detected_ || fed_ % 4 == 0) {
+    view = DetectBoard(o_.board, image, o_.detect, view.source);
+    last_rejection_ = view.rejection;
+  }
   ++fed_;
   last_detected_ = view.accepted;
   last_view_ = view;

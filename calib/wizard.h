@@ -150,6 +150,7 @@ class CalibrationWizard {
   int empty_frames_ = 0;             // enclosure: frames in a row without a board
   int fed_ = 0;                      // frames fed
   bool last_detected_ = false;       // the board was found in the last frame
+  std::string last_rejection_;       // why the last searched frame had no board
   std::vector<BoardView> views_;     // captured intrinsics views
   std::vector<Captured> described_;
   cv::Mat coverage_;
