@@ -168,11 +168,13 @@ TEST(AravisFakecam, LostPacketsAreRequestedCountedAndNeverDelivered) {
   FakeGigEOptions fo;
   fo.serial = "SSTLOSS";
   fo.fps = 60;
-  fo.lost_packet_ratio = 0.01;
+  // 3 % of packets: at 1 % a run of ~12 frames (~470 packets) lost none about one run in ten
+  // here (Aravis draws the losses from an unseeded generator), and the test failed.
+  fo.lost_packet_ratio = 0.03;
   auto cam = StartFakecam(session, fo);
   AravisOptions ao;
   ao.camera = "127.0.0.1";
-  ao.packet_size = 8000;  // ~40 packets a frame: about two frames in three arrive whole
+  ao.packet_size = 8000;  // ~40 packets a frame: about one frame in three arrives whole
   const Received r = Receive(ao, kFrames, PixelFormat::kMono8, [](int i) {
     return TestPixels(PixelFormat::kMono8, kW, kH, 0, static_cast<uint64_t>(i));
   });
