@@ -368,3 +368,18 @@ export function dataUrlBlob(url) {
 }
 
 export const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
+
+// Sleeps `ms`, or less when owner.wake() is called (a poller's view changed, its camera came back).
+export function wakeableSleep(owner, ms) {
+  return new Promise((resolve) => {
+    const t = setTimeout(done, ms);
+    function done() {
+      clearTimeout(t);
+      resolve();
+    }
+    owner.wake = () => {
+      owner.wake = null;
+      done();
+    };
+  });
+}

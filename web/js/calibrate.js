@@ -3,7 +3,7 @@
 // solve, pose on the floor, set the enclosure, save. docs/console.md
 // ("Calibration wizard") is the contract; the state is status.calibration from
 // the event stream, each action's answer is shown at once.
-import { Events, Limiter, chrome, el, fmt, getJson, getBlob, postJson } from './api.js';
+import { Events, Limiter, chrome, el, fmt, getJson, getBlob, postJson, wakeableSleep } from './api.js';
 import { fitCanvas } from './draw.js';
 import { showMessage } from './message.js';
 
@@ -783,17 +783,7 @@ class Card {
   }
 
   #nap(ms) {
-    return new Promise((resolve) => {
-      const t = setTimeout(done, ms);
-      function done() {
-        clearTimeout(t);
-        resolve();
-      }
-      this.wake = () => {
-        this.wake = null;
-        done();
-      };
-    });
+    return wakeableSleep(this, ms);
   }
 
   destroy() {

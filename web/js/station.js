@@ -1,5 +1,5 @@
 // The station page: every camera as a live tile, the session panel, the charts.
-import { Events, Limiter, chrome, el, fmt, duration, getJson, getBlob, postJson, dataUrlBlob } from './api.js';
+import { Events, Limiter, chrome, el, fmt, duration, getJson, getBlob, postJson, dataUrlBlob, wakeableSleep } from './api.js';
 import { VERDICT_COLOURS, VERDICT_LABELS, verdictColour, histogram, lineChart } from './draw.js';
 import { showMessage } from './message.js';
 
@@ -283,19 +283,8 @@ class Tile {
     }
   }
 
-  // Sleeps, or less when the view changes or the camera comes back.
   #nap(ms) {
-    return new Promise((resolve) => {
-      const t = setTimeout(done, ms);
-      function done() {
-        clearTimeout(t);
-        resolve();
-      }
-      this.wake = () => {
-        this.wake = null;
-        done();
-      };
-    });
+    return wakeableSleep(this, ms);
   }
 
   destroy() {
