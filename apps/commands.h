@@ -8,6 +8,7 @@ namespace ss::apps {
 void AddSynthCommand(CLI::App& app);
 void AddCalibrateCommand(CLI::App& app);
 void AddReplayCommand(CLI::App& app);
+void AddPlateCommand(CLI::App& app);
 void AddBankCommand(CLI::App& app);
 void AddBenchCommand(CLI::App& app);
 void AddIngestCommand(CLI::App& app);

@@ -20,6 +20,7 @@ int main(int argc, char** argv) {
   ss::apps::AddSynthCommand(app);
   ss::apps::AddCalibrateCommand(app);
   ss::apps::AddReplayCommand(app);
+  ss::apps::AddPlateCommand(app);
   ss::apps::AddBankCommand(app);
   ss::apps::AddIngestCommand(app);
   ss::apps::AddBenchCommand(app);

@@ -243,6 +243,10 @@ SynthSummary RenderStudioSession(const SynthOptions& o) {
     CameraWork& w = work[c];
     w.camera = &cam;
     w.renderer = std::make_unique<CameraRenderer>(cam, studio);
+    // The empty enclosure as the camera sees it without sensor noise (what `plate` estimates).
+    if (!cv::imwrite((truth / (cam.name + "_plate.png")).string(), w.renderer->clean_plate())) {
+      throw WorkError((truth / (cam.name + "_plate.png")).string(), "cannot write the clean plate");
+    }
     w.sensor = std::make_unique<Sensor>(o.seed, static_cast<int>(c), o.noise);
     w.truth_dir = truth / cam.name;
     fs::create_directories(w.truth_dir / "shadow", ec);

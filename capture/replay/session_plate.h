@@ -1,0 +1,32 @@
+#pragma once
+// The clean plate of one camera of a recorded session: the per-pixel median of its
+// empty-enclosure frames. By default the first 30 frames, which are what a keyer learns
+// the empty enclosure from when the session is ingested (keying.training_frames); a
+// range that the subject crosses works too when it moves enough within it.
+#include <cstdint>
+#include <string>
+
+#include <opencv2/core.hpp>
+
+namespace ss {
+
+struct PlateOptions {
+  int64_t first_frame = 0;  // the range of the camera's frames (0-based, as replayed: unreadable ones skipped)
+  int64_t last_frame = 29;  // inclusive
+  int samples = 30;         // frames taken, spread evenly over the range (all of them when fewer)
+};
+
+struct SessionPlate {
+  cv::Mat bgr;                  // CV_8UC3, the camera's size
+  int frames_used = 0;
+  int64_t first_frame = 0, last_frame = 0;  // the frames used, first and last
+  int64_t first_timestamp_ns = 0, last_timestamp_ns = 0;
+};
+
+// InputError naming the session and the field for an unknown camera, a bad range or a
+// camera without one readable frame in the range; a range past the recording's end uses
+// the frames there are. Unreadable frames are skipped (and not counted).
+SessionPlate ReadSessionPlate(const std::string& session_dir, const std::string& camera,
+                              const PlateOptions& options = {});
+
+}  // namespace ss
