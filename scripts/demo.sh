@@ -27,12 +27,16 @@ echo "== ingesting $sample into $out/sample.bank (the live pipeline, as fast as 
 echo "== finding the bank's transitions (seed 000 §3)"
 "$ss" transitions "$out/sample.bank"
 
+echo "== the empty enclosure cam0 saw before the animal came in: the render's background"
+"$ss" plate "$sample" --camera cam0 --out "$out/plate.png"
+
 echo "== animating: one sprite walks a straight path across the floor (seed 000 §4-5)"
 cat > "$out/walk.yaml" <<EOF
 version: 1
 frame_rate: 30
 length: {frames: 90}
 camera: $sample/cam0.cameramodel
+background: $out/plate.png
 banks: [$out/sample.bank]
 optimizer: {method: replace, time_budget_s: 10}
 sprites:
@@ -45,6 +49,6 @@ sprites:
 EOF
 "$ss" animate "$out/walk.yaml" --out "$out/walk.json"
 
-echo "== rendering the animation"
+echo "== rendering the animation into the enclosure, with its contact shadow"
 "$ss" render "$out/walk.json" --out "$out/walk.mkv"
 echo "== done: the animation is $out/walk.mkv (cost plot: $out/walk.cost.png)"
