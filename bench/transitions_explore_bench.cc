@@ -693,6 +693,7 @@ int Run(const std::vector<std::string>& argv) {
                                     {"contact haus_mean", col(cc, kHausMean), 1.0},
                                     {"contact blob", col(cc, kBlob), 2.0},
                                     {"contact colour_blob", col(cc, kColBlob), 2.0},
+                                    {"contact colour_cells", col(cc, kColCount), 4.0},
                                     {"centroid colour_blob", col(cf, kColBlob), 2.0},
                                     {"contact alpha_l1", col(cc, kL1), 0.03}};
   {
