@@ -347,7 +347,8 @@ void ReadCamera(Reader& r, const YAML::Node& node, const std::string& path, Came
   // Keys that belong to another source are named as such; others are unknown.
   std::vector<std::string> all;
   for (const auto& [key, sources] : kCameraKeys) all.push_back(key);
-  for (const auto& [key, entry] : view.entries()) {
+  for (const auto& item : view.entries()) {
+    const std::string& key = item.first;  // (a structured binding cannot be captured before clang 16)
     const auto it = std::find_if(kCameraKeys.begin(), kCameraKeys.end(),
                                  [&](const auto& k) { return k.first == key; });
     if (it == kCameraKeys.end()) {
