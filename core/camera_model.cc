@@ -180,13 +180,54 @@ CameraModel::CameraModel(std::string lensmodel, std::vector<double> intrinsics, 
   }
 }
 
+namespace {
+
+// mrcal's parser (libmrcal 2.x) reads past the end of the text when a quoted string is not
+// closed ("{ 'abc", or a backslash as the last character of a string; found by tests/fuzz):
+// such a text, e.g. a model file cut short, is refused here, naming the line the string starts on.
+void CheckStringsClosed(const std::string& text, const std::string& origin) {
+  int line = 1;
+  for (size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    if (c == '\n') {
+      ++line;
+    } else if (c == '#') {  // a comment, to the end of its line
+      while (i + 1 < text.size() && text[i + 1] != '\n') ++i;
+    } else if (c == '\'' || c == '"') {
+      const int start = line;
+      bool closed = false;
+      for (++i; i < text.size(); ++i) {
+        if (text[i] == '\n') ++line;
+        if (text[i] == '\\') {
+          ++i;  // an escaped character, whatever it is
+          if (i < text.size() && text[i] == '\n') ++line;
+        } else if (text[i] == c) {
+          closed = true;
+          break;
+        }
+      }
+      if (!closed) {
+        throw InputError(origin, "a quoted string at line " + std::to_string(start) +
+                                     " is not closed (is the file cut short?)");
+      }
+    }
+  }
+}
+
+}  // namespace
+
 CameraModel CameraModel::Parse(const std::string& text, const std::string& origin) {
   if (text.find_first_not_of(" \t\r\n") == std::string::npos)
     throw InputError(origin, "empty camera model");
   if (text.size() > static_cast<size_t>(std::numeric_limits<int>::max())) {
     throw InputError(origin, "too large to be a camera model");
   }
-  MrcalModelPtr m(mrcal_read_cameramodel_string(text.data(), static_cast<int>(text.size())));
+  CheckStringsClosed(text, origin);
+  // mrcal's parser (libmrcal 2.x) reads past the end of a text whose last line is a comment
+  // without its newline (found by tests/fuzz: "# " crashes it): end every text with one.
+  std::string terminated = text;
+  if (terminated.back() != '\n') terminated.push_back('\n');
+  MrcalModelPtr m(mrcal_read_cameramodel_string(terminated.data(), static_cast<int>(terminated.size())));
   if (!m) throw InputError(origin, DiagnoseRefusal(text));
   for (double v : m->rt_cam_ref) {
     if (!std::isfinite(v))

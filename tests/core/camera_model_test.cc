@@ -444,6 +444,10 @@ TEST(CameraModel, BadFilesNameTheFileAndTheReason) {
       {"negativefocal.cameramodel",
        "{ 'lensmodel': 'LENSMODEL_OPENCV4', 'intrinsics': [500,-500,320,240,0,0,0,0], " + good_tail,
        "must be positive"},
+      // A file cut short inside a string (libmrcal's parser read past the end of it: tests/fuzz).
+      {"cut.cameramodel", "# SpriteStation camera model\n{\n    'lensmodel': 'LENSMODEL_PIN",
+       "a quoted string at line 3 is not closed (is the file cut short?)"},
+      {"cut2.cameramodel", "{ 'lensmodel': 'LENSMODEL_PINHOLE\\", "a quoted string at line 1 is not closed"},
   };
   for (const Case& c : cases) {
     const std::string path = dir / c.file;
