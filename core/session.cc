@@ -182,7 +182,8 @@ SessionInfo ReadSessionInfo(const std::string& dir) {
   const std::string path = (fs::path(dir) / "session.json").string();
   std::ifstream in(path, std::ios::binary);
   if (!in) {
-    throw InputError(path, fs::exists(dir) ? "cannot open (is this a recorded session?)"
+    std::error_code ec;
+    throw InputError(path, fs::exists(dir, ec) ? "cannot open (is this a recorded session?)"
                                            : "no such session folder");
   }
   std::stringstream text;
@@ -190,7 +191,7 @@ SessionInfo ReadSessionInfo(const std::string& dir) {
   json root;
   try {
     root = json::parse(text.str());
-  } catch (const json::parse_error& e) {
+  } catch (const json::exception& e) {  // parse errors, and numbers out of range (tests/fuzz)
     throw InputError(path, std::string("not valid JSON: ") + e.what());
   }
   if (!root.is_object()) throw InputError(path, "expected a JSON object at the top level");
@@ -254,7 +255,8 @@ void WriteSessionInfo(const std::string& dir, const SessionInfo& info) {
 std::vector<FrameRecord> ReadFrameCsv(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) {
-    throw InputError(path, fs::exists(path) ? "cannot open" : "no such file");
+    std::error_code ec;
+    throw InputError(path, fs::exists(path, ec) ? "cannot open" : "no such file");
   }
   std::stringstream buffer;
   buffer << in.rdbuf();

@@ -114,7 +114,7 @@ TransitionWeights ParseWeights(const std::string& text, const std::string& sourc
   json root;
   try {
     root = json::parse(text);
-  } catch (const json::parse_error& e) {
+  } catch (const json::exception& e) {  // parse errors, and numbers out of range (tests/fuzz)
     throw InputError(source, std::string("not valid JSON: ") + e.what());
   }
   if (!root.is_object()) throw InputError(source, "expected a JSON object at the top level");
