@@ -16,8 +16,8 @@ PACKAGES=(
   # storage, config, CLI, logging, HTTP
   libsqlite3-dev sqlite3 libyaml-cpp-dev nlohmann-json3-dev libcli11-dev
   libspdlog-dev libfmt-dev libcpp-httplib-dev libsystemd-dev libpng-dev libzstd-dev
-  # tests and benchmarks
-  libgtest-dev libgmock-dev libbenchmark-dev
+  # tests and benchmarks; clang and its runtimes for the libFuzzer targets (scripts/fuzz.sh)
+  libgtest-dev libgmock-dev libbenchmark-dev clang libclang-rt-14-dev
   # the daemon tests give each test a private loopback with a second address (ip), and
   # check /metrics with Prometheus's own promtool
   iproute2 prometheus

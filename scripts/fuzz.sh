@@ -1,0 +1,46 @@
+#!/usr/bin/env bash
+# Fuzzes every parser of outside input (tests/fuzz/README.md): builds the libFuzzer targets
+# with clang under ASan and UBSan into build-fuzz/, then runs each for SECONDS (default 20)
+# on a working copy of its committed corpus. A finding (crash, sanitizer report, an exception
+# other than the project's own errors, an input taking > 10 s or > 2 GB) stops the run with
+# exit 1 and its input in build-fuzz/findings/<target>/: add it to tests/fuzz/corpus/<target>/
+# once fixed, where the ordinary build's fuzz_corpus.<target> test replays it for good.
+#   scripts/fuzz.sh [SECONDS] [target...]      e.g. scripts/fuzz.sh 600 config spec
+set -euo pipefail
+top="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+seconds="${1:-20}"
+shift || true
+build="${SPRITESTATION_FUZZ_BUILD_DIR:-$top/build-fuzz}"
+export CCACHE_DIR="${CCACHE_DIR:-$HOME/.ccache}"
+export CCACHE_BASEDIR="${CCACHE_BASEDIR:-$top}" CCACHE_NOHASHDIR="${CCACHE_NOHASHDIR:-true}"
+generator=()
+command -v ninja >/dev/null && generator=(-G Ninja)
+if [ ! -f "$build/CMakeCache.txt" ]; then
+  CC=clang CXX=clang++ cmake -S "$top" -B "$build" "${generator[@]}" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+    -DSPRITESTATION_FUZZ=ON >/dev/null
+fi
+cmake --build "$build" -j "$(nproc)"
+
+targets=("$@")
+if [ ${#targets[@]} -eq 0 ]; then
+  for dir in "$top"/tests/fuzz/corpus/*/; do targets+=("$(basename "$dir")"); done
+fi
+status=0
+for t in "${targets[@]}"; do
+  exe="$build/tests/fuzz/${t}_fuzz"
+  [ -x "$exe" ] || { echo "fuzz.sh: no target '$t' (tests/fuzz/corpus/ names them)" >&2; exit 2; }
+  work="$build/corpus/$t" findings="$build/findings/$t"
+  mkdir -p "$work" "$findings"
+  cp -n "$top/tests/fuzz/corpus/$t/"* "$work/" 2>/dev/null || true
+  log="$build/fuzz-$t.log"
+  if "$exe" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 -malloc_limit_mb=2048 \
+      -artifact_prefix="$findings/" -print_final_stats=1 "$work" >"$log" 2>&1; then
+    runs="$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | grep -o '[0-9]*$' || echo '?')"
+    echo "fuzz $t: ${seconds} s, $runs inputs, no finding"
+  else
+    status=1
+    echo "fuzz $t: FINDING (input in $findings/, log $log):" >&2
+    grep -E 'ERROR|SUMMARY|terminate called|what\(\)' "$log" | head -5 >&2 || tail -20 "$log" >&2
+  fi
+done
+exit $status
