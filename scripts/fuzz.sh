@@ -6,6 +6,9 @@
 # exit 1 and its input in build-fuzz/findings/<target>/: add it to tests/fuzz/corpus/<target>/
 # once fixed, where the ordinary build's fuzz_corpus.<target> test replays it for good.
 #   scripts/fuzz.sh [SECONDS] [target...]      e.g. scripts/fuzz.sh 600 config spec
+# SPRITESTATION_FUZZ_SEED=N fixes libFuzzer's seed (default: a new one each run), and
+# SPRITESTATION_FUZZ_FRESH=1 starts from the committed corpus alone: together they make a run
+# repeat the inputs of an earlier one (scripts/test.sh uses both, so CI replays what ran here).
 set -euo pipefail
 top="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 seconds="${1:-20}"
@@ -30,10 +33,11 @@ for t in "${targets[@]}"; do
   exe="$build/tests/fuzz/${t}_fuzz"
   [ -x "$exe" ] || { echo "fuzz.sh: no target '$t' (tests/fuzz/corpus/ names them)" >&2; exit 2; }
   work="$build/corpus/$t" findings="$build/findings/$t"
+  [ "${SPRITESTATION_FUZZ_FRESH:-0}" = "1" ] && rm -rf "$work"
   mkdir -p "$work" "$findings"
   cp -n "$top/tests/fuzz/corpus/$t/"* "$work/" 2>/dev/null || true
   log="$build/fuzz-$t.log"
-  if "$exe" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 -malloc_limit_mb=2048 \
+  if "$exe" -max_total_time="$seconds" -seed="${SPRITESTATION_FUZZ_SEED:-0}" -timeout=10 -rss_limit_mb=2048 -malloc_limit_mb=2048 \
       -artifact_prefix="$findings/" -print_final_stats=1 "$work" >"$log" 2>&1; then
     runs="$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | grep -o '[0-9]*$' || echo '?')"
     echo "fuzz $t: ${seconds} s, $runs inputs, no finding"
