@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Fuzzes every parser of outside input (tests/fuzz/README.md): builds the libFuzzer targets
-# with clang under ASan and UBSan into build-fuzz/, then runs each for SECONDS (default 20)
-# on a working copy of its committed corpus. A finding (crash, sanitizer report, an exception
+# with clang under ASan and UBSan into build-fuzz/, runs core's unit tests there (the same
+# sanitizers), then fuzzes each target for SECONDS (default 20) on a working copy of its
+# committed corpus. A finding (crash, sanitizer report, an exception
 # other than the project's own errors, an input taking > 10 s or > 2 GB) stops the run with
 # exit 1 and its input in build-fuzz/findings/<target>/: add it to tests/fuzz/corpus/<target>/
 # once fixed, where the ordinary build's fuzz_corpus.<target> test replays it for good.
@@ -26,6 +27,14 @@ cmake --build "$build" -j "$(nproc)"
 
 targets=("$@")
 if [ ${#targets[@]} -eq 0 ]; then
+  # core's unit tests, built here under the same sanitizers (ASan + UBSan, clang)
+  if ! (cd "$build" && tests/core_tests --gtest_brief=1 >"$build/core_tests.log" 2>&1); then
+    echo "fuzz.sh: core_tests failed under ASan+UBSan (log $build/core_tests.log):" >&2
+    grep -E 'ERROR|runtime error|FAILED' "$build/core_tests.log" | head -10 >&2
+    exit 1
+  fi
+  echo "core_tests under ASan+UBSan: $(grep -o '[0-9]* tests\? from [0-9]* test suites\? ran' "$build/core_tests.log"), passed"
+
   for dir in "$top"/tests/fuzz/corpus/*/; do targets+=("$(basename "$dir")"); done
 fi
 status=0
