@@ -2,7 +2,7 @@
 
 #include <algorithm>
 
-#include <opencv2/imgproc.hpp>
+#include <cstdlib>
 
 #include "core/error.h"
 
@@ -20,7 +20,7 @@ void EvenFrameSampler::Offer(const cv::Mat& bgr) {
   }
 }
 
-cv::Mat PerPixelMedian(const std::vector<cv::Mat>& frames) {
+RobustBackground MedianAndSpread(const std::vector<cv::Mat>& frames) {
   if (frames.empty()) throw WorkError("median plate", "no frames to take the median of");
   const cv::Mat& first = frames.front();
   for (const cv::Mat& f : frames) {
@@ -28,35 +28,45 @@ cv::Mat PerPixelMedian(const std::vector<cv::Mat>& frames) {
       throw WorkError("median plate", "frames differ in size or type");
     }
   }
-  cv::Mat median(first.size(), CV_8UC3);
+  RobustBackground b{cv::Mat(first.size(), CV_8UC3), cv::Mat(first.size(), CV_32FC3)};
   const size_t values = first.total() * 3, n = frames.size();
   std::vector<const uint8_t*> planes;
   for (const cv::Mat& f : frames) planes.push_back(f.data);
-  uint8_t* out = median.data;
+  uint8_t* median = b.median.data;
+  float* spread = b.spread.ptr<float>();
   // A histogram per value would be faster for many frames; a few dozen sort quickly enough.
   std::vector<uint8_t> column(n);
   for (size_t v = 0; v < values; ++v) {
     for (size_t i = 0; i < n; ++i) column[i] = planes[i][v];
     std::nth_element(column.begin(), column.begin() + n / 2, column.end());
-    out[v] = column[n / 2];
+    const uint8_t m = column[n / 2];
+    median[v] = m;
+    for (size_t i = 0; i < n; ++i) column[i] = static_cast<uint8_t>(std::abs(int{planes[i][v]} - int{m}));
+    std::nth_element(column.begin(), column.begin() + n / 2, column.end());
+    spread[v] = 1.4826f * column[n / 2];
   }
-  return median;
+  return b;
 }
 
-cv::Mat WithoutForeground(const cv::Mat& frame, const cv::Mat& plate, int threshold_levels, int grow_px,
-                          double* replaced_share) {
-  cv::Mat diff;
-  cv::absdiff(frame, plate, diff);
-  std::vector<cv::Mat> channels;
-  cv::split(diff, channels);
-  cv::Mat most = cv::max(channels[0], cv::max(channels[1], channels[2]));
-  cv::Mat mask = most > threshold_levels;
-  if (grow_px > 0) {
-    cv::dilate(mask, mask, cv::getStructuringElement(cv::MORPH_ELLIPSE, {2 * grow_px + 1, 2 * grow_px + 1}));
+cv::Mat Winsorized(const cv::Mat& frame, const RobustBackground& background, double k, double* kept_share) {
+  if (frame.size() != background.median.size() || frame.type() != CV_8UC3 || !frame.isContinuous()) {
+    throw WorkError("median plate", "frame differs from the plate in size or type");
   }
-  cv::Mat out = frame.clone();
-  plate.copyTo(out, mask);
-  if (replaced_share != nullptr) *replaced_share = static_cast<double>(cv::countNonZero(mask)) / mask.total();
+  cv::Mat out(frame.size(), CV_8UC3);
+  const size_t values = frame.total() * 3;
+  const uint8_t* in = frame.data;
+  const uint8_t* median = background.median.data;
+  const float* spread = background.spread.ptr<float>();
+  uint8_t* o = out.data;
+  size_t kept = 0;
+  for (size_t v = 0; v < values; ++v) {
+    const float limit = std::max(1.0f, static_cast<float>(k) * spread[v]);
+    const float d = static_cast<float>(in[v]) - median[v];
+    const float clamped = std::clamp(d, -limit, limit);
+    kept += clamped == d;
+    o[v] = cv::saturate_cast<uint8_t>(median[v] + clamped);
+  }
+  if (kept_share != nullptr) *kept_share = static_cast<double>(kept) / values;
   return out;
 }
 

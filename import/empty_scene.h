@@ -2,8 +2,9 @@
 // The empty scene the clean-plate keyer learns from, for footage that has no
 // empty stretch: a per-pixel median over frames spread across the video (a
 // walker covers a pixel for a moment, the floor is there the rest of the time),
-// and "empty" frames made from real ones by putting the median where they
-// differ from it, so each keeps the camera's own noise on the background.
+// and "empty" frames made from real ones by pulling each value to within a few
+// robust spreads of the median, so each keeps the camera's own noise and the
+// background's own motion but loses the walkers.
 #include <cstdint>
 #include <vector>
 
@@ -29,15 +30,24 @@ class EvenFrameSampler {
   std::vector<cv::Mat> frames_;
 };
 
-// The per-pixel, per-channel median of equally sized CV_8UC3 frames (the upper
-// of the two middle values for an even count).
-cv::Mat PerPixelMedian(const std::vector<cv::Mat>& frames);
+// The background a set of frames agrees on, per pixel and channel: the median
+// (the upper of the two middle values for an even count) and the spread around
+// it, 1.4826 x the median absolute deviation (the noise std for Gaussian noise;
+// unmoved by a walker who covers the pixel in under half the frames, large
+// where the background itself moves: a flag, leaves, a fluttering tape).
+struct RobustBackground {
+  cv::Mat median;  // CV_8UC3
+  cv::Mat spread;  // CV_32FC3, levels
+};
+// Of equally sized CV_8UC3 frames (at least one).
+RobustBackground MedianAndSpread(const std::vector<cv::Mat>& frames);
 
-// `frame` with every pixel that differs from `plate` by more than
-// `threshold_levels` in a channel, grown by `grow_px`, replaced by the plate's.
-// `replaced_share` (optional) gets the fraction of pixels replaced.
-cv::Mat WithoutForeground(const cv::Mat& frame, const cv::Mat& plate, int threshold_levels, int grow_px,
-                          double* replaced_share = nullptr);
+// `frame` with each value pulled to within `k` spreads (at least 1 level) of the
+// median: a walker's pixels become background, the background's own noise and
+// motion stay, so a keyer learning from such frames learns how much each pixel
+// moves. `kept_share` (optional) gets the share of values left as they were.
+cv::Mat Winsorized(const cv::Mat& frame, const RobustBackground& background, double k,
+                   double* kept_share = nullptr);
 
 // `count` indices spread evenly over 0..n-1 (each used once when n >= count).
 std::vector<int> EvenIndices(int n, int count);

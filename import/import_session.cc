@@ -123,12 +123,12 @@ std::vector<cv::Mat> EmptyScene(const ImportOptions& o, size_t i, const SourceVi
       throw InputError("--range", std::to_string(samples.size()) + " frames of " + o.videos[i] + " lie in " +
                                       RangeText(o.range) + " s; a median plate needs at least 3");
     }
-    const cv::Mat plate = PerPixelMedian(samples);
+    const RobustBackground background = MedianAndSpread(samples);
     double share_sum = 0;
     for (const int k : EvenIndices(static_cast<int>(samples.size()), n)) {
-      double replaced = 0;
-      out.push_back(WithoutForeground(samples[k], plate, o.foreground_levels, o.foreground_grow_px, &replaced));
-      share_sum += 1 - replaced;
+      double kept = 0;
+      out.push_back(Winsorized(samples[k], background, o.winsor_spreads, &kept));
+      share_sum += kept;
     }
     cam->median_background_share = share_sum / n;
     return out;

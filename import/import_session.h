@@ -48,8 +48,7 @@ struct ImportOptions {
   std::vector<std::string> empty_clips;   // kClip: one per video, the same size
   int empty_frames = 30;
   int median_samples = 31;                // kMedian: frames (at least) the median is taken over
-  int foreground_levels = 30;             // kMedian: a pixel this far from the median is not background
-  int foreground_grow_px = 4;             // ... and neither are its neighbours this close
+  double winsor_spreads = 2.5;            // kMedian: values pulled to within this many spreads of the median
 
   // The floor: a JSON file ({"floor": [[x, y], ...]}), or what the (first) camera sees.
   std::string floor_path;
@@ -72,7 +71,7 @@ struct ImportedCamera {
   int64_t corrupt_frames = 0;       // the decoder reported damaged and that were skipped
   std::string last_problem;
   int64_t first_timestamp_ns = 0, last_timestamp_ns = 0;  // of the imported frames
-  double median_background_share = 0;  // kMedian: mean share of a sample frame that matched the median
+  double median_background_share = 0;  // kMedian: share of the sampled values within the spreads kept
   std::string model_source;         // the file, or "rough: ..."
 };
 
