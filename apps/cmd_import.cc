@@ -82,8 +82,10 @@ void RunImport(ImportArgs a) {
                     static_cast<long long>(c.corrupt_frames), c.last_problem.c_str());
       }
     }
-    std::printf("next: spritestation ingest %s --bank BANK --config %s/ingest.yaml\n", s.session_dir.c_str(),
-                s.session_dir.c_str());
+    if (o.empty_frames > 0 && !o.no_model) {
+      std::printf("next: spritestation ingest %s --bank BANK --config %s/ingest.yaml\n", s.session_dir.c_str(),
+                  s.session_dir.c_str());
+    }
   }
   std::fflush(stdout);
 }
@@ -95,13 +97,15 @@ void AddImportCommand(CLI::App& app) {
   auto a = std::make_shared<ImportArgs>();
   ImportOptions& o = a->options;
   cmd->add_option("VIDEO", o.videos,
-                  "Videos, one camera each (MP4, MKV, AVI, ...; an image sequence as a pattern, e.g. img%04d.png)")
+                  "Videos, one camera each (MP4, MKV, AVI, ...; an image sequence as a pattern: img%04d.png, 'left*.jpg')")
       ->required();
   cmd->add_option("--out", o.out_dir, "The session folder to make")->required();
   cmd->add_flag("--force", o.force, "Replace the recorded session already at --out");
   cmd->add_option("--name", o.name, "Session name (default: the first video's file name)");
   cmd->add_option("--range", a->range, "Import only START-END seconds of each video (\"10-40\", \"10-\", \"-40\")");
   cmd->add_option("--model", o.model_paths, "The camera's mrcal .cameramodel, one per video");
+  cmd->add_flag("--no-model", o.no_model,
+                "No camera model: footage of a calibration board, for `spritestation calibrate` (docs/import.md)");
   auto* height = cmd->add_option("--camera-height", a->camera_height_m,
                                  "Rough camera: its height above the floor, metres");
   auto* tilt = cmd->add_option("--tilt", a->tilt_deg, "Rough camera: degrees its view points below the horizontal");
@@ -110,7 +114,7 @@ void AddImportCommand(CLI::App& app) {
                   "The empty scene: START-END seconds of each video (default: a per-pixel median)");
   cmd->add_option("--empty-clip", o.empty_clips, "The empty scene: a separate clip per video");
   cmd->add_option("--empty-frames", o.empty_frames,
-                  "Empty-scene frames written in front (= ingest's keying.training_frames)")
+                  "Empty-scene frames written in front (= ingest's keying.training_frames; 0: none)")
       ->capture_default_str();
   cmd->add_option("--median-samples", o.median_samples, "Median plate: at least this many frames")
       ->capture_default_str();

@@ -94,8 +94,12 @@ void WriteText(const fs::path& path, const std::string& text) {
   if (!out.flush()) throw WorkError(path.string(), "cannot write it");
 }
 
-// Makes the camera's model: its file, or the rough camera.
-CameraModel ModelFor(const ImportOptions& o, size_t i, const SourceVideo& video, std::string* source) {
+// Makes the camera's model: its file, or the rough camera; none with no_model.
+std::optional<CameraModel> ModelFor(const ImportOptions& o, size_t i, const SourceVideo& video, std::string* source) {
+  if (o.no_model) {
+    *source = "none";
+    return std::nullopt;
+  }
   if (o.use_rough) {
     *source = "rough: height " + Seconds(o.rough.height_m) + " m, tilt " + Seconds(o.rough.tilt_deg) +
               " deg, hfov " + Seconds(o.rough.hfov_deg) + " deg";
@@ -114,6 +118,7 @@ CameraModel ModelFor(const ImportOptions& o, size_t i, const SourceVideo& video,
 // The empty scene of camera `i`: exactly o.empty_frames frames of the video's size.
 std::vector<cv::Mat> EmptyScene(const ImportOptions& o, size_t i, const SourceVideo& main, ImportedCamera* cam) {
   const int n = o.empty_frames;
+  if (n == 0) return {};
   std::vector<cv::Mat> samples;
   std::vector<cv::Mat> out;
   if (o.empty_source == EmptySceneSource::kMedian) {
@@ -162,7 +167,7 @@ Frame BgrFrame(const cv::Mat& bgr, uint64_t sequence, int64_t timestamp_ns) {
 }
 
 // Writes camera `i` (its empty scene, then its range) and fills `cam`.
-void ImportCamera(const ImportOptions& o, size_t i, const CameraModel& model, SessionWriter& writer,
+void ImportCamera(const ImportOptions& o, size_t i, const CameraModel* model, SessionWriter& writer,
                   ImportedCamera* cam) {
   SourceVideo video(o.videos[i], o.image_sequence_fps);
   const std::vector<cv::Mat> empty = EmptyScene(o, i, video, cam);
@@ -173,7 +178,7 @@ void ImportCamera(const ImportOptions& o, size_t i, const CameraModel& model, Se
   source.height = video.height();
   source.format = PixelFormat::kBGR8;
   source.fps = video.fps();
-  const int index = writer.AddCamera(source, &model);
+  const int index = writer.AddCamera(source, model);
 
   video.SeekBefore(o.range.start_s);
   SourceFrame f;
@@ -256,6 +261,25 @@ nlohmann::json SummaryJson(const ImportOptions& o, const ImportSummary& s) {
   return j;
 }
 
+// The video's file stem, without an image sequence's pattern characters ("left[01]*.jpg" -> "left01").
+std::string NameFromPath(const std::string& path) {
+  std::string name;
+  for (const char c : fs::path(path).stem().string()) {
+    if (std::string("%*?[]").find(c) == std::string::npos) name += c;
+  }
+  return name.empty() ? "import" : name;
+}
+
+std::string EmptySourceText(const ImportOptions& o) {
+  if (o.empty_frames == 0) return "none";
+  switch (o.empty_source) {
+    case EmptySceneSource::kMedian: return "median";
+    case EmptySceneSource::kTimeRange: return "range " + RangeText(o.empty_range);
+    case EmptySceneSource::kClip: return "clip";
+  }
+  return "";
+}
+
 // Refuses to replace anything but a recorded session (or an empty folder).
 void CheckOut(const ImportOptions& o) {
   std::error_code ec;
@@ -299,8 +323,9 @@ bool ImportOptions::IsValid(std::string* why) const {
   if (FindRecordingCodec(codec) == nullptr) {
     return *why = "--codec: expected " + RecordingCodecNames() + ", got \"" + codec + "\"", false;
   }
-  if (use_rough == !model_paths.empty()) {
-    return *why = "give the camera model: --model FILE (one per video), or --camera-height, --tilt and --hfov", false;
+  if (int{use_rough} + int{!model_paths.empty()} + int{no_model} != 1) {
+    return *why = "give the camera model: --model FILE (one per video), or --camera-height, --tilt and --hfov, or "
+                  "--no-model (footage for `spritestation calibrate`)", false;
   }
   if (!model_paths.empty() && model_paths.size() != videos.size()) {
     return *why = "--model: " + std::to_string(model_paths.size()) + " models for " + std::to_string(videos.size()) +
@@ -318,8 +343,8 @@ bool ImportOptions::IsValid(std::string* why) const {
     return *why = "--empty-clip: " + std::to_string(empty_clips.size()) + " clips for " +
                   std::to_string(videos.size()) + " videos; give one per video", false;
   }
-  if (!(empty_frames >= 1 && empty_frames <= 1000)) {
-    return *why = "--empty-frames: expected 1 to 1000, got " + std::to_string(empty_frames), false;
+  if (!(empty_frames >= 0 && empty_frames <= 1000)) {
+    return *why = "--empty-frames: expected 0 to 1000, got " + std::to_string(empty_frames), false;
   }
   if (!(median_samples >= 3 && median_samples <= 255)) {
     return *why = "--median-samples: expected 3 to 255, got " + std::to_string(median_samples), false;
@@ -339,7 +364,7 @@ ImportSummary ImportVideos(const ImportOptions& o) {
 
   // Everything that can be refused is checked before anything is written.
   ImportSummary summary;
-  std::vector<CameraModel> models;
+  std::vector<std::optional<CameraModel>> models;
   for (size_t i = 0; i < o.videos.size(); ++i) {
     SourceVideo video(o.videos[i], o.image_sequence_fps);
     CheckRangeInVideo(o.range, video, "--range");
@@ -358,20 +383,18 @@ ImportSummary ImportVideos(const ImportOptions& o) {
   if (!o.floor_path.empty()) {
     floor = ReadFloorFile(o.floor_path);
     summary.floor_source = o.floor_path;
-  } else {
-    const double range_m = o.floor_max_range_m > 0 ? o.floor_max_range_m : 5 * models[0].CentreInGround().z();
-    floor = VisibleFloor(models[0], range_m);
+  } else if (models[0]) {
+    const double range_m = o.floor_max_range_m > 0 ? o.floor_max_range_m : 5 * models[0]->CentreInGround().z();
+    floor = VisibleFloor(*models[0], range_m);
     summary.floor_source = "what " + summary.cameras[0].name + " sees within " + Seconds(range_m) + " m";
+  } else {
+    summary.floor_source = "none (no camera model)";
   }
-  switch (o.empty_source) {
-    case EmptySceneSource::kMedian: summary.empty_source = "median"; break;
-    case EmptySceneSource::kTimeRange: summary.empty_source = "range " + RangeText(o.empty_range); break;
-    case EmptySceneSource::kClip: summary.empty_source = "clip"; break;
-  }
+  summary.empty_source = EmptySourceText(o);
 
   const fs::path out = fs::absolute(o.out_dir).lexically_normal();
   const std::string stem = out.filename().string();
-  summary.name = o.name.empty() ? fs::path(o.videos[0]).stem().string() : o.name;
+  summary.name = o.name.empty() ? NameFromPath(o.videos[0]) : o.name;
   summary.session_dir = o.out_dir;
   std::error_code ec;
   fs::create_directories(out.parent_path(), ec);
@@ -385,16 +408,18 @@ ImportSummary ImportVideos(const ImportOptions& o) {
       SessionWriter writer(temp.string(), summary.name, recording);
       for (size_t i = 0; i < o.videos.size(); ++i) {
         if (o.progress) o.progress(summary.cameras[i].name + ": " + o.videos[i] + " (" + summary.empty_source + ")");
-        ImportCamera(o, i, models[i], writer, &summary.cameras[i]);
+        ImportCamera(o, i, models[i] ? &*models[i] : nullptr, writer, &summary.cameras[i]);
       }
       writer.Close();
     }
-    nlohmann::json enclosure;
-    enclosure["floor"] = nlohmann::json::array();
-    for (const Eigen::Vector2d& v : floor.vertices()) enclosure["floor"].push_back({v.x(), v.y()});
-    enclosure["source"] = summary.floor_source;
-    WriteText(temp / "enclosure.json", enclosure.dump(2) + "\n");
-    WriteText(temp / "ingest.yaml", IngestYaml(o.empty_frames));
+    if (!floor.empty()) {
+      nlohmann::json enclosure;
+      enclosure["floor"] = nlohmann::json::array();
+      for (const Eigen::Vector2d& v : floor.vertices()) enclosure["floor"].push_back({v.x(), v.y()});
+      enclosure["source"] = summary.floor_source;
+      WriteText(temp / "enclosure.json", enclosure.dump(2) + "\n");
+    }
+    if (o.empty_frames > 0) WriteText(temp / "ingest.yaml", IngestYaml(o.empty_frames));
     WriteText(temp / "import.json", SummaryJson(o, summary).dump(2) + "\n");
 
     // Into place: an existing session (checked above, --force) only now makes way.

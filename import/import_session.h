@@ -37,12 +37,15 @@ struct ImportOptions {
   double image_sequence_fps = 25;         // frame rate of an image-sequence pattern (`%04d.png`)
   std::string codec = "ffv1";             // the session's video codec (core/recording_codecs.h)
 
-  // Camera models: a .cameramodel per video, or (one video) a rough camera.
+  // Camera models: a .cameramodel per video, or (one video) a rough camera, or
+  // none (footage of a calibration board, for `spritestation calibrate`).
   std::vector<std::string> model_paths;
   bool use_rough = false;
   RoughCamera rough;
+  bool no_model = false;
 
-  // The empty scene: `empty_frames` frames (= the ingest's keying.training_frames).
+  // The empty scene: `empty_frames` frames (= the ingest's keying.training_frames;
+  // 0: none, for footage that is not to be ingested).
   EmptySceneSource empty_source = EmptySceneSource::kMedian;
   TimeRange empty_range;                  // kTimeRange: of each video
   std::vector<std::string> empty_clips;   // kClip: one per video, the same size

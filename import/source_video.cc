@@ -18,7 +18,9 @@ constexpr AVRational kNanos{1, 1000000000};
 // Read errors in a row after which the rest of the file is given up as unreadable.
 constexpr int kMaxConsecutiveReadErrors = 64;
 
-bool IsImageSequence(const std::string& path) { return path.find('%') != std::string::npos; }
+// A printf pattern (img%04d.png) or a glob (left*.jpg): image2 reads the files as frames.
+bool IsImageSequence(const std::string& path) { return path.find_first_of("%*?[") != std::string::npos; }
+bool IsGlob(const std::string& path) { return path.find_first_of("*?[") != std::string::npos; }
 
 }  // namespace
 
@@ -36,6 +38,7 @@ SourceVideo::SourceVideo(const std::string& path, double image_sequence_fps) : p
   if (IsImageSequence(path)) {
     format = av_find_input_format("image2");
     av_dict_set(&options, "framerate", std::to_string(image_sequence_fps).c_str(), 0);
+    if (IsGlob(path)) av_dict_set(&options, "pattern_type", "glob", 0);
   }
   AVFormatContext* raw = nullptr;
   const int opened = avformat_open_input(&raw, path.c_str(), format, &options);

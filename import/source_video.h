@@ -1,6 +1,6 @@
 #pragma once
 // Any video FFmpeg reads (MP4 from a phone, an OBS or camera recording, an AVI,
-// an image sequence such as `shot%04d.png`), decoded frame by frame to 8-bit
+// an image sequence such as `shot%04d.png` or `left*.jpg`), decoded frame by frame to 8-bit
 // BGR with its time from the container: the frame's presentation timestamp
 // since the stream's start, so a variable frame rate stays as it was recorded.
 #include <cstdint>
@@ -20,8 +20,9 @@ struct SourceFrame {
 
 class SourceVideo {
  public:
-  // Opens PATH. `image_sequence_fps` is the frame rate of an image-sequence
-  // pattern (a path holding `%`), which carries no time of its own. InputError
+  // Opens PATH. `image_sequence_fps` is the frame rate of an image sequence (a
+  // path holding `%` as printf has it, or `*`, `?`, `[` as a glob, in sorted order),
+  // which carries no time of its own. InputError
   // naming the file when it is missing, not a video FFmpeg reads, or holds no
   // decodable video stream.
   explicit SourceVideo(const std::string& path, double image_sequence_fps = 25);
