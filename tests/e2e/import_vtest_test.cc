@@ -2,7 +2,8 @@
 // which scripts/install-deps.sh installs; Apache-2.0 / BSD-3-Clause): a fixed camera over a
 // square, people walking, never empty. `import` with a rough camera model and the per-pixel
 // median plate, then `ingest` with the clean-plate keyer, then the stored billboards judged
-// as a person would (docs/import.md, "Real footage": what each clip holds, seen by eye).
+// as a person would (docs/import.md, "Real footage": what each clip holds, seen by eye). And
+// OpenCV's chessboard views (left01..14.jpg, same package) through import and `calibrate`.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -14,6 +15,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "core/camera_model.h"
 #include "core/session.h"
 #include "tests/support/test_support.h"
 
@@ -151,6 +153,30 @@ TEST_F(ImportVtest, PeopleWalkingAreStoredAtTheirScaleWithLittleNoise) {
   // gets worse (the first median plate, which replaced moving background by the median, stored
   // 33 of 120 tape-and-crowd strips).
   EXPECT_LE(noise_share, 0.20) << judged;
+}
+
+// Board calibration from footage: OpenCV's own chessboard views (left01..14.jpg, 9x6 inner
+// corners of 25 mm), imported as an image sequence with no model, then `calibrate intrinsics` on
+// the session as on any recorded one. OpenCV's solution for these images (left_intrinsics.yml,
+// fixed aspect ratio) has fx = fy = 535.9 px.
+TEST_F(ImportVtest, BoardFootageImportsForCalibration) {
+  const std::string session = *dir_ / "board";
+  const auto imported = RunSpritestation(
+      "--log-level warn import '/usr/share/doc/opencv-doc/examples/data/left[01]*.jpg' --out " + session +
+      " --no-model --empty-frames 0 --fps 1 --json");
+  ASSERT_EQ(imported.exit_code, 0) << imported.output;
+  EXPECT_EQ(JsonInOutput(imported.output)["cameras"][0]["frames"], 13);
+  EXPECT_EQ(JsonInOutput(imported.output)["name"], "left01");
+  EXPECT_FALSE(fs::exists(session + "/ingest.yaml"));  // no empty scene: not for ingest
+  const auto solved = RunSpritestation("--log-level warn calibrate intrinsics " + session +
+                                       " --board chessboard:10x7:0.025 --lensmodel LENSMODEL_OPENCV4 --every 1 "
+                                       "--min-views 8 --min-coverage 0 --out " + *dir_ / "intrinsics" + " --json");
+  ASSERT_EQ(solved.exit_code, 0) << solved.output;
+  const CameraModel model = CameraModel::Read(*dir_ / "intrinsics/cam0.cameramodel");
+  EXPECT_NEAR(model.intrinsics()[0], 535.9, 0.01 * 535.9);
+  EXPECT_NEAR(model.intrinsics()[1], 535.9, 0.01 * 535.9);
+  EXPECT_NEAR(model.intrinsics()[2], 342.3, 3);
+  EXPECT_NEAR(model.intrinsics()[3], 235.6, 3);
 }
 
 }  // namespace
