@@ -125,6 +125,45 @@ TEST_F(ImportVideo, ATimeRangeKeepsItsFramesAndTheirTimes) {
   EXPECT_EQ(JsonInOutput(r.output)["empty_scene"], "range 0-4");
 }
 
+TEST_F(ImportVideo, TwoVideosAreTwoCamerasWithTheirModelsAndAnEmptyClip) {
+  // A model of the right size: the one a rough import wrote.
+  const std::string first = *dir_ / "for_model";
+  ASSERT_EQ(RunSpritestation("--log-level warn import " + *dir_ / "walk.mp4" + " --out " + first + kRough +
+                             " --codec ffvhuff --range 0-0.5 --empty-frames 3").exit_code, 0);
+  const std::string model = first + "/cam0.cameramodel";
+  std::ofstream(*dir_ / "floor.json") << "{\"floor\": [[-3, 2], [3, 2], [3, 9], [-3, 9]]}\n";
+  // The empty scene from a separate clip: the background alone, a second of it.
+  ASSERT_EQ(RunCommand("ffmpeg -v error -y -f lavfi -i color=c=0x305070:s=320x240:r=25:d=1 -c:v libx264 "
+                       "-pix_fmt yuv420p " + *dir_ / "empty.mp4").exit_code, 0);
+  const std::string out = *dir_ / "two";
+  const auto r = RunSpritestation("--log-level warn import " + *dir_ / "walk.mp4" + " " + *dir_ / "walk.mp4" +
+                                  " --out " + out + " --model " + model + " --model " + model + " --floor " +
+                                  *dir_ / "floor.json" + " --empty-clip " + *dir_ / "empty.mp4" + " --empty-clip " +
+                                  *dir_ / "empty.mp4" + " --empty-frames 20 --range 0-1 --codec ffvhuff --json");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const SessionInfo info = ReadSessionInfo(out);
+  ASSERT_EQ(info.cameras.size(), 2u);
+  EXPECT_EQ(info.cameras[0].name, "cam0");
+  EXPECT_EQ(info.cameras[1].name, "cam1");
+  for (const SessionCamera& cam : info.cameras) {
+    EXPECT_EQ(cam.frames, 20 + 25) << cam.name;
+    EXPECT_FALSE(cam.model.empty()) << cam.name;
+    VideoReader reader(out + "/" + cam.video, PixelFormat::kBGR8, 320, 240);
+    std::vector<uint8_t> pixels;
+    ASSERT_EQ(reader.Next(pixels).status, VideoReader::Status::kFrame);
+    EXPECT_LE(MaxDifferenceFromBackground(pixels), 6) << cam.name << ": the clip's empty scene";
+  }
+  std::ifstream enclosure(out + "/enclosure.json");
+  const nlohmann::json floor = nlohmann::json::parse(enclosure);
+  EXPECT_EQ(floor["floor"].size(), 4u);
+  EXPECT_EQ(JsonInOutput(r.output)["empty_scene"], "clip");
+  // Several cameras share one floor: without --floor the import refuses.
+  const auto no_floor = RunSpritestation("--log-level warn import " + *dir_ / "walk.mp4" + " " + *dir_ / "walk.mp4" +
+                                         " --out " + *dir_ / "two_b" + " --model " + model + " --model " + model);
+  EXPECT_EQ(no_floor.exit_code, 2);
+  EXPECT_NE(no_floor.output.find("--floor"), std::string::npos) << no_floor.output;
+}
+
 TEST_F(ImportVideo, RefusesWhatItCannotUseNamingTheFileOrFlag) {
   const std::string video = *dir_ / "walk.mp4";
   const auto expect_refusal = [](const std::string& args, const std::string& named) {
