@@ -1,7 +1,6 @@
 #include "import/empty_scene.h"
 
 #include <algorithm>
-
 #include <cstdlib>
 
 #include "core/error.h"
@@ -41,15 +40,18 @@ RobustBackground MedianAndSpread(const std::vector<cv::Mat>& frames) {
     std::nth_element(column.begin(), column.begin() + n / 2, column.end());
     const uint8_t m = column[n / 2];
     median[v] = m;
-    for (size_t i = 0; i < n; ++i) column[i] = static_cast<uint8_t>(std::abs(int{planes[i][v]} - int{m}));
+    for (size_t i = 0; i < n; ++i)
+      column[i] = static_cast<uint8_t>(std::abs(int{planes[i][v]} - int{m}));
     std::nth_element(column.begin(), column.begin() + n / 2, column.end());
     spread[v] = 1.4826f * column[n / 2];
   }
   return b;
 }
 
-cv::Mat Winsorized(const cv::Mat& frame, const RobustBackground& background, double k, double* kept_share) {
-  if (frame.size() != background.median.size() || frame.type() != CV_8UC3 || !frame.isContinuous()) {
+cv::Mat Winsorized(const cv::Mat& frame, const RobustBackground& background, double k,
+                   double* kept_share) {
+  if (frame.size() != background.median.size() || frame.type() != CV_8UC3 ||
+      !frame.isContinuous()) {
     throw WorkError("median plate", "frame differs from the plate in size or type");
   }
   cv::Mat out(frame.size(), CV_8UC3);

@@ -6,9 +6,8 @@
 // robust spreads of the median, so each keeps the camera's own noise and the
 // background's own motion but loses the walkers.
 #include <cstdint>
-#include <vector>
-
 #include <opencv2/core.hpp>
+#include <vector>
 
 namespace ss {
 

@@ -7,9 +7,8 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <optional>
-
 #include <nlohmann/json.hpp>
+#include <optional>
 
 #include "capture/recording/session_writer.h"
 #include "core/error.h"
@@ -38,14 +37,14 @@ void CheckRangeInVideo(const TimeRange& r, const SourceVideo& video, const std::
   const double length = video.duration_s();
   if (length <= 0) return;  // unknown: checked by finding no frame in it
   if (r.start_s >= length) {
-    throw InputError(flag, "starts at " + Seconds(r.start_s) + " s but " + video.path() + " is " + Seconds(length) +
-                               " s long");
+    throw InputError(flag, "starts at " + Seconds(r.start_s) + " s but " + video.path() + " is " +
+                               Seconds(length) + " s long");
   }
   // One frame of slack: containers round their duration.
   const double frame = video.fps() > 0 ? 1.0 / video.fps() : 0.1;
   if (!std::isinf(r.end_s) && r.end_s > length + frame) {
-    throw InputError(flag, "ends at " + Seconds(r.end_s) + " s but " + video.path() + " is " + Seconds(length) +
-                               " s long");
+    throw InputError(flag, "ends at " + Seconds(r.end_s) + " s but " + video.path() + " is " +
+                               Seconds(length) + " s long");
   }
 }
 
@@ -82,9 +81,11 @@ GroundPolygon ReadFloorFile(const std::string& path) {
     }
     vertices.emplace_back(p[0].get<double>(), p[1].get<double>());
   }
-  if (vertices.size() > GroundPolygon::kMaxVertices) throw InputError(path, "floor: too many points");
+  if (vertices.size() > GroundPolygon::kMaxVertices)
+    throw InputError(path, "floor: too many points");
   GroundPolygon polygon(std::move(vertices));
-  if (!polygon.IsSimple()) throw InputError(path, "floor: not a simple polygon of at least 3 points");
+  if (!polygon.IsSimple())
+    throw InputError(path, "floor: not a simple polygon of at least 3 points");
   return polygon;
 }
 
@@ -95,28 +96,31 @@ void WriteText(const fs::path& path, const std::string& text) {
 }
 
 // Makes the camera's model: its file, or the rough camera; none with no_model.
-std::optional<CameraModel> ModelFor(const ImportOptions& o, size_t i, const SourceVideo& video, std::string* source) {
+std::optional<CameraModel> ModelFor(const ImportOptions& o, size_t i, const SourceVideo& video,
+                                    std::string* source) {
   if (o.no_model) {
     *source = "none";
     return std::nullopt;
   }
   if (o.use_rough) {
-    *source = "rough: height " + Seconds(o.rough.height_m) + " m, tilt " + Seconds(o.rough.tilt_deg) +
-              " deg, hfov " + Seconds(o.rough.hfov_deg) + " deg";
+    *source = "rough: height " + Seconds(o.rough.height_m) + " m, tilt " +
+              Seconds(o.rough.tilt_deg) + " deg, hfov " + Seconds(o.rough.hfov_deg) + " deg";
     return RoughCameraModel(o.rough, video.width(), video.height());
   }
   CameraModel m = CameraModel::Read(o.model_paths[i]);
   if (m.width() != video.width() || m.height() != video.height()) {
     throw InputError(o.model_paths[i], "the model is for " + std::to_string(m.width()) + "x" +
-                                           std::to_string(m.height()) + " images but " + video.path() + " is " +
-                                           std::to_string(video.width()) + "x" + std::to_string(video.height()));
+                                           std::to_string(m.height()) + " images but " +
+                                           video.path() + " is " + std::to_string(video.width()) +
+                                           "x" + std::to_string(video.height()));
   }
   *source = o.model_paths[i];
   return m;
 }
 
 // The empty scene of camera `i`: exactly o.empty_frames frames of the video's size.
-std::vector<cv::Mat> EmptyScene(const ImportOptions& o, size_t i, const SourceVideo& main, ImportedCamera* cam) {
+std::vector<cv::Mat> EmptyScene(const ImportOptions& o, size_t i, const SourceVideo& main,
+                                ImportedCamera* cam) {
   const int n = o.empty_frames;
   if (n == 0) return {};
   std::vector<cv::Mat> samples;
@@ -125,8 +129,9 @@ std::vector<cv::Mat> EmptyScene(const ImportOptions& o, size_t i, const SourceVi
     SourceVideo video(o.videos[i], o.image_sequence_fps);
     samples = SampleRange(video, o.range, o.median_samples).frames();
     if (samples.size() < 3) {
-      throw InputError("--range", std::to_string(samples.size()) + " frames of " + o.videos[i] + " lie in " +
-                                      RangeText(o.range) + " s; a median plate needs at least 3");
+      throw InputError("--range", std::to_string(samples.size()) + " frames of " + o.videos[i] +
+                                      " lie in " + RangeText(o.range) +
+                                      " s; a median plate needs at least 3");
     }
     const RobustBackground background = MedianAndSpread(samples);
     double share_sum = 0;
@@ -152,15 +157,17 @@ std::vector<cv::Mat> EmptyScene(const ImportOptions& o, size_t i, const SourceVi
   samples = SampleRange(video, range, n).frames();
   if (static_cast<int>(samples.size()) < n) {
     throw InputError(flag, path + " holds " + std::to_string(samples.size()) + " frames" +
-                               (clip ? "" : " in " + RangeText(range) + " s") + "; the keyer learns from " +
-                               std::to_string(n) + " (--empty-frames)");
+                               (clip ? "" : " in " + RangeText(range) + " s") +
+                               "; the keyer learns from " + std::to_string(n) +
+                               " (--empty-frames)");
   }
   for (const int k : EvenIndices(static_cast<int>(samples.size()), n)) out.push_back(samples[k]);
   return out;
 }
 
 Frame BgrFrame(const cv::Mat& bgr, uint64_t sequence, int64_t timestamp_ns) {
-  Frame f = Frame::Borrowed(PixelFormat::kBGR8, bgr.cols, bgr.rows, bgr.data, bgr.total() * 3, [] {});
+  Frame f =
+      Frame::Borrowed(PixelFormat::kBGR8, bgr.cols, bgr.rows, bgr.data, bgr.total() * 3, [] {});
   f.sequence = sequence;
   f.timestamp_ns = timestamp_ns;
   return f;
@@ -191,9 +198,11 @@ void ImportCamera(const ImportOptions& o, size_t i, const CameraModel* model, Se
     if (first) {
       // The empty scene just before the first frame, a nominal frame apart (its times are made up;
       // import.json says so, and ingest only learns from these frames).
-      const int64_t step = static_cast<int64_t>(std::llround(1e9 / (video.fps() > 0 ? video.fps() : 25.0)));
+      const int64_t step =
+          static_cast<int64_t>(std::llround(1e9 / (video.fps() > 0 ? video.fps() : 25.0)));
       for (size_t k = 0; k < empty.size(); ++k) {
-        Frame e = BgrFrame(empty[k], sequence++, f.timestamp_ns - static_cast<int64_t>(empty.size() - k) * step);
+        Frame e = BgrFrame(empty[k], sequence++,
+                           f.timestamp_ns - static_cast<int64_t>(empty.size() - k) * step);
         e.camera = index;
         writer.Write(e);
       }
@@ -206,18 +215,21 @@ void ImportCamera(const ImportOptions& o, size_t i, const CameraModel* model, Se
     cam->last_timestamp_ns = f.timestamp_ns;
     ++cam->frames;
     if (o.progress && cam->frames % 250 == 0) {
-      o.progress(cam->name + ": " + std::to_string(cam->frames) + " frames, at " + Seconds(t) + " s");
+      o.progress(cam->name + ": " + std::to_string(cam->frames) + " frames, at " + Seconds(t) +
+                 " s");
     }
   }
   cam->corrupt_frames = video.corrupt_frames();
   cam->last_problem = video.last_problem();
   if (cam->frames == 0) {
-    throw InputError("--range", "no frame of " + o.videos[i] + " lies in " + RangeText(o.range) + " s" +
-                                    (video.corrupt_frames() > 0 ? " that decodes (" + video.last_problem() + ")" : ""));
+    throw InputError(
+        "--range",
+        "no frame of " + o.videos[i] + " lies in " + RangeText(o.range) + " s" +
+            (video.corrupt_frames() > 0 ? " that decodes (" + video.last_problem() + ")" : ""));
   }
   if (cam->corrupt_frames > 0) {
-    Log("import")->warn("{}: {} damaged frames skipped, the last: {}", o.videos[i], cam->corrupt_frames,
-                        cam->last_problem);
+    Log("import")->warn("{}: {} damaged frames skipped, the last: {}", o.videos[i],
+                        cam->corrupt_frames, cam->last_problem);
   }
 }
 
@@ -255,13 +267,15 @@ nlohmann::json SummaryJson(const ImportOptions& o, const ImportSummary& s) {
                          {"first_timestamp_ns", c.first_timestamp_ns},
                          {"last_timestamp_ns", c.last_timestamp_ns},
                          {"model", c.model_source}};
-    if (o.empty_source == EmptySceneSource::kMedian) cj["median_background_share"] = c.median_background_share;
+    if (o.empty_source == EmptySceneSource::kMedian)
+      cj["median_background_share"] = c.median_background_share;
     j["cameras"].push_back(cj);
   }
   return j;
 }
 
-// The video's file stem, without an image sequence's pattern characters ("left[01]*.jpg" -> "left01").
+// The video's file stem, without an image sequence's pattern characters ("left[01]*.jpg" ->
+// "left01").
 std::string NameFromPath(const std::string& path) {
   std::string name;
   for (const char c : fs::path(path).stem().string()) {
@@ -273,9 +287,12 @@ std::string NameFromPath(const std::string& path) {
 std::string EmptySourceText(const ImportOptions& o) {
   if (o.empty_frames == 0) return "none";
   switch (o.empty_source) {
-    case EmptySceneSource::kMedian: return "median";
-    case EmptySceneSource::kTimeRange: return "range " + RangeText(o.empty_range);
-    case EmptySceneSource::kClip: return "clip";
+    case EmptySceneSource::kMedian:
+      return "median";
+    case EmptySceneSource::kTimeRange:
+      return "range " + RangeText(o.empty_range);
+    case EmptySceneSource::kClip:
+      return "clip";
   }
   return "";
 }
@@ -284,12 +301,17 @@ std::string EmptySourceText(const ImportOptions& o) {
 void CheckOut(const ImportOptions& o) {
   std::error_code ec;
   if (!fs::exists(o.out_dir, ec)) return;
-  if (!fs::is_directory(o.out_dir, ec)) throw InputError(o.out_dir, "exists and is not a folder (--out)");
+  if (!fs::is_directory(o.out_dir, ec))
+    throw InputError(o.out_dir, "exists and is not a folder (--out)");
   if (fs::is_empty(o.out_dir, ec)) return;
-  if (!o.force) throw InputError(o.out_dir, "already exists (--out); give --force to replace the session in it");
+  if (!o.force)
+    throw InputError(o.out_dir,
+                     "already exists (--out); give --force to replace the session in it");
   if (!fs::exists(fs::path(o.out_dir) / "session.json", ec)) {
-    throw InputError(o.out_dir, "exists and holds no session.json: not a recorded session, so --force does not "
-                                "replace it");
+    throw InputError(
+        o.out_dir,
+        "exists and holds no session.json: not a recorded session, so --force does not "
+        "replace it");
   }
 }
 
@@ -297,8 +319,11 @@ void CheckOut(const ImportOptions& o) {
 
 TimeRange ParseTimeRange(const std::string& text, const std::string& flag) {
   const auto bad = [&] {
-    return InputError(flag, "expected START-END in seconds (\"12.5-30\", \"12.5-\" to the end, \"-30\" from the "
-                            "start), got \"" + text + "\"");
+    return InputError(
+        flag,
+        "expected START-END in seconds (\"12.5-30\", \"12.5-\" to the end, \"-30\" from the "
+        "start), got \"" +
+            text + "\"");
   };
   const size_t dash = text.find('-');
   if (dash == std::string::npos || text.find('-', dash + 1) != std::string::npos) throw bad();
@@ -312,8 +337,9 @@ TimeRange ParseTimeRange(const std::string& text, const std::string& flag) {
   TimeRange r;
   r.start_s = number(text.substr(0, dash), 0);
   r.end_s = number(text.substr(dash + 1), std::numeric_limits<double>::infinity());
-  if (!(r.end_s > r.start_s)) throw InputError(flag, "ends (" + Seconds(r.end_s) + " s) before it starts (" +
-                                                     Seconds(r.start_s) + " s)");
+  if (!(r.end_s > r.start_s))
+    throw InputError(
+        flag, "ends (" + Seconds(r.end_s) + " s) before it starts (" + Seconds(r.start_s) + " s)");
   return r;
 }
 
@@ -324,15 +350,21 @@ bool ImportOptions::IsValid(std::string* why) const {
     return *why = "--codec: expected " + RecordingCodecNames() + ", got \"" + codec + "\"", false;
   }
   if (int{use_rough} + int{!model_paths.empty()} + int{no_model} != 1) {
-    return *why = "give the camera model: --model FILE (one per video), or --camera-height, --tilt and --hfov, or "
-                  "--no-model (footage for `spritestation calibrate`)", false;
+    return *why =
+               "give the camera model: --model FILE (one per video), or --camera-height, --tilt "
+               "and --hfov, or "
+               "--no-model (footage for `spritestation calibrate`)",
+           false;
   }
   if (!model_paths.empty() && model_paths.size() != videos.size()) {
-    return *why = "--model: " + std::to_string(model_paths.size()) + " models for " + std::to_string(videos.size()) +
-                  " videos; give one per video, in the same order", false;
+    return *why = "--model: " + std::to_string(model_paths.size()) + " models for " +
+                  std::to_string(videos.size()) + " videos; give one per video, in the same order",
+           false;
   }
   if (use_rough && videos.size() > 1) {
-    return *why = "--camera-height/--tilt/--hfov describe one camera; with several videos give --model per video",
+    return *why =
+               "--camera-height/--tilt/--hfov describe one camera; with several videos give "
+               "--model per video",
            false;
   }
   if (use_rough && !rough.IsValid(why)) return false;
@@ -341,16 +373,19 @@ bool ImportOptions::IsValid(std::string* why) const {
   }
   if (empty_source == EmptySceneSource::kClip && empty_clips.size() != videos.size()) {
     return *why = "--empty-clip: " + std::to_string(empty_clips.size()) + " clips for " +
-                  std::to_string(videos.size()) + " videos; give one per video", false;
+                  std::to_string(videos.size()) + " videos; give one per video",
+           false;
   }
   if (!(empty_frames >= 0 && empty_frames <= 1000)) {
     return *why = "--empty-frames: expected 0 to 1000, got " + std::to_string(empty_frames), false;
   }
   if (!(median_samples >= 3 && median_samples <= 255)) {
-    return *why = "--median-samples: expected 3 to 255, got " + std::to_string(median_samples), false;
+    return *why = "--median-samples: expected 3 to 255, got " + std::to_string(median_samples),
+           false;
   }
   if (!(image_sequence_fps > 0 && image_sequence_fps <= 1000)) {
-    return *why = "--fps: expected a frame rate > 0, got " + std::to_string(image_sequence_fps), false;
+    return *why = "--fps: expected a frame rate > 0, got " + std::to_string(image_sequence_fps),
+           false;
   }
   if (!(floor_max_range_m >= 0)) return *why = "--floor-max-range: expected metres >= 0", false;
   return true;
@@ -368,7 +403,8 @@ ImportSummary ImportVideos(const ImportOptions& o) {
   for (size_t i = 0; i < o.videos.size(); ++i) {
     SourceVideo video(o.videos[i], o.image_sequence_fps);
     CheckRangeInVideo(o.range, video, "--range");
-    if (o.empty_source == EmptySceneSource::kTimeRange) CheckRangeInVideo(o.empty_range, video, "--empty-range");
+    if (o.empty_source == EmptySceneSource::kTimeRange)
+      CheckRangeInVideo(o.empty_range, video, "--empty-range");
     ImportedCamera cam;
     cam.name = o.videos.size() == 1 ? "cam0" : "cam" + std::to_string(i);
     cam.video = o.videos[i];
@@ -384,9 +420,11 @@ ImportSummary ImportVideos(const ImportOptions& o) {
     floor = ReadFloorFile(o.floor_path);
     summary.floor_source = o.floor_path;
   } else if (models[0]) {
-    const double range_m = o.floor_max_range_m > 0 ? o.floor_max_range_m : 5 * models[0]->CentreInGround().z();
+    const double range_m =
+        o.floor_max_range_m > 0 ? o.floor_max_range_m : 5 * models[0]->CentreInGround().z();
     floor = VisibleFloor(*models[0], range_m);
-    summary.floor_source = "what " + summary.cameras[0].name + " sees within " + Seconds(range_m) + " m";
+    summary.floor_source =
+        "what " + summary.cameras[0].name + " sees within " + Seconds(range_m) + " m";
   } else {
     summary.floor_source = "none (no camera model)";
   }
@@ -407,7 +445,9 @@ ImportSummary ImportVideos(const ImportOptions& o) {
     {
       SessionWriter writer(temp.string(), summary.name, recording);
       for (size_t i = 0; i < o.videos.size(); ++i) {
-        if (o.progress) o.progress(summary.cameras[i].name + ": " + o.videos[i] + " (" + summary.empty_source + ")");
+        if (o.progress)
+          o.progress(summary.cameras[i].name + ": " + o.videos[i] + " (" + summary.empty_source +
+                     ")");
         ImportCamera(o, i, models[i] ? &*models[i] : nullptr, writer, &summary.cameras[i]);
       }
       writer.Close();
@@ -415,7 +455,8 @@ ImportSummary ImportVideos(const ImportOptions& o) {
     if (!floor.empty()) {
       nlohmann::json enclosure;
       enclosure["floor"] = nlohmann::json::array();
-      for (const Eigen::Vector2d& v : floor.vertices()) enclosure["floor"].push_back({v.x(), v.y()});
+      for (const Eigen::Vector2d& v : floor.vertices())
+        enclosure["floor"].push_back({v.x(), v.y()});
       enclosure["source"] = summary.floor_source;
       WriteText(temp / "enclosure.json", enclosure.dump(2) + "\n");
     }
@@ -424,7 +465,8 @@ ImportSummary ImportVideos(const ImportOptions& o) {
 
     // Into place: an existing session (checked above, --force) only now makes way.
     if (fs::exists(out)) {
-      const fs::path old = out.parent_path() / ("." + stem + ".replaced-" + std::to_string(getpid()));
+      const fs::path old =
+          out.parent_path() / ("." + stem + ".replaced-" + std::to_string(getpid()));
       fs::rename(out, old);
       fs::rename(temp, out);
       fs::remove_all(old);

@@ -19,11 +19,13 @@ bool RoughCamera::IsValid(std::string* why) const {
     return false;
   }
   if (!(tilt_deg > -90 && tilt_deg <= 90)) {
-    *why = "--tilt: expected degrees below the horizontal, in (-90, 90], got " + std::to_string(tilt_deg);
+    *why = "--tilt: expected degrees below the horizontal, in (-90, 90], got " +
+           std::to_string(tilt_deg);
     return false;
   }
   if (!(hfov_deg >= 1 && hfov_deg <= 170)) {
-    *why = "--hfov: expected the horizontal field of view in degrees, 1 to 170, got " + std::to_string(hfov_deg);
+    *why = "--hfov: expected the horizontal field of view in degrees, 1 to 170, got " +
+           std::to_string(hfov_deg);
     return false;
   }
   return true;
@@ -37,9 +39,11 @@ CameraModel RoughCameraModel(const RoughCamera& camera, int width, int height) {
   // The bottom row must look below the horizon, or the camera sees no floor.
   const double lowest_ray_deg = camera.tilt_deg + std::atan((height - 1 - cy) / f) / kDegToRad;
   if (!(lowest_ray_deg > 0.5)) {
-    throw InputError("--tilt", "a camera tilted " + std::to_string(camera.tilt_deg) + " degrees down with a " +
-                                   std::to_string(camera.hfov_deg) + " degree field of view sees no floor; its image's " +
-                                   "bottom row looks " + std::to_string(lowest_ray_deg) + " degrees down");
+    throw InputError("--tilt", "a camera tilted " + std::to_string(camera.tilt_deg) +
+                                   " degrees down with a " + std::to_string(camera.hfov_deg) +
+                                   " degree field of view sees no floor; its image's " +
+                                   "bottom row looks " + std::to_string(lowest_ray_deg) +
+                                   " degrees down");
   }
   // Camera axes in the ground frame: x right, y down the image, z forward.
   const double t = camera.tilt_deg * kDegToRad;
@@ -48,7 +52,8 @@ CameraModel RoughCameraModel(const RoughCamera& camera, int width, int height) {
   ground_from_cam.col(1) = Eigen::Vector3d(0, -std::sin(t), -std::cos(t));
   ground_from_cam.col(2) = Eigen::Vector3d(0, std::cos(t), -std::sin(t));
   const Rigid3 ground_from_cam_pose{ground_from_cam, Eigen::Vector3d(0, 0, camera.height_m)};
-  return CameraModel("LENSMODEL_PINHOLE", {f, f, cx, cy}, width, height, ground_from_cam_pose.Inverse());
+  return CameraModel("LENSMODEL_PINHOLE", {f, f, cx, cy}, width, height,
+                     ground_from_cam_pose.Inverse());
 }
 
 GroundPolygon VisibleFloor(const CameraModel& model, double max_range_m) {

@@ -13,9 +13,9 @@
 namespace ss {
 
 struct RoughCamera {
-  double height_m = 0;   // camera centre above the floor
-  double tilt_deg = 0;   // optical axis below the horizontal (90: straight down)
-  double hfov_deg = 0;   // horizontal field of view, edge to edge
+  double height_m = 0;  // camera centre above the floor
+  double tilt_deg = 0;  // optical axis below the horizontal (90: straight down)
+  double hfov_deg = 0;  // horizontal field of view, edge to edge
 
   // False with the flag at fault and what was expected in `why`.
   bool IsValid(std::string* why) const;

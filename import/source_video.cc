@@ -19,7 +19,9 @@ constexpr AVRational kNanos{1, 1000000000};
 constexpr int kMaxConsecutiveReadErrors = 64;
 
 // A printf pattern (img%04d.png) or a glob (left*.jpg): image2 reads the files as frames.
-bool IsImageSequence(const std::string& path) { return path.find_first_of("%*?[") != std::string::npos; }
+bool IsImageSequence(const std::string& path) {
+  return path.find_first_of("%*?[") != std::string::npos;
+}
 bool IsGlob(const std::string& path) { return path.find_first_of("*?[") != std::string::npos; }
 
 }  // namespace
@@ -30,7 +32,8 @@ SourceVideo::SourceVideo(const std::string& path, double image_sequence_fps) : p
     std::error_code ec;
     if (!std::filesystem::exists(path, ec)) throw InputError(path, "no such file");
     if (std::filesystem::is_directory(path, ec)) {
-      throw InputError(path, "is a folder; for an image sequence give a pattern such as " + path + "/%04d.png");
+      throw InputError(
+          path, "is a folder; for an image sequence give a pattern such as " + path + "/%04d.png");
     }
   }
   AVDictionary* options = nullptr;
@@ -43,7 +46,8 @@ SourceVideo::SourceVideo(const std::string& path, double image_sequence_fps) : p
   AVFormatContext* raw = nullptr;
   const int opened = avformat_open_input(&raw, path.c_str(), format, &options);
   av_dict_free(&options);
-  if (opened < 0) throw InputError(path, "FFmpeg cannot open it as a video (" + av::ErrorText(opened) + ")");
+  if (opened < 0)
+    throw InputError(path, "FFmpeg cannot open it as a video (" + av::ErrorText(opened) + ")");
   input_.reset(raw);
   if (const int r = avformat_find_stream_info(input_.get(), nullptr); r < 0) {
     throw InputError(path, "FFmpeg cannot read its streams (" + av::ErrorText(r) + ")");
@@ -51,8 +55,9 @@ SourceVideo::SourceVideo(const std::string& path, double image_sequence_fps) : p
   const AVCodec* codec = nullptr;
   stream_ = av_find_best_stream(input_.get(), AVMEDIA_TYPE_VIDEO, -1, -1, &codec, 0);
   if (stream_ < 0 || codec == nullptr) {
-    throw InputError(path, stream_ == AVERROR_DECODER_NOT_FOUND ? "its video is in a codec this FFmpeg cannot decode"
-                                                                 : "holds no video stream");
+    throw InputError(path, stream_ == AVERROR_DECODER_NOT_FOUND
+                               ? "its video is in a codec this FFmpeg cannot decode"
+                               : "holds no video stream");
   }
   const AVStream* stream = input_->streams[stream_];
   time_base_ = stream->time_base;
@@ -71,7 +76,8 @@ SourceVideo::SourceVideo(const std::string& path, double image_sequence_fps) : p
   width_ = decoder_->width;
   height_ = decoder_->height;
   if (width_ <= 0 || height_ <= 0) throw InputError(path, "its video has no frame size");
-  const AVRational rate = stream->avg_frame_rate.num > 0 ? stream->avg_frame_rate : stream->r_frame_rate;
+  const AVRational rate =
+      stream->avg_frame_rate.num > 0 ? stream->avg_frame_rate : stream->r_frame_rate;
   if (rate.num > 0 && rate.den > 0) fps_ = av_q2d(rate);
   if (stream->duration != AV_NOPTS_VALUE && stream->duration > 0) {
     duration_s_ = stream->duration * av_q2d(time_base_);
@@ -85,10 +91,12 @@ SourceVideo::SourceVideo(const std::string& path, double image_sequence_fps) : p
 void SourceVideo::SeekBefore(double time_s) {
   if (time_s <= 0) return;
   const int64_t base = start_pts_ == AV_NOPTS_VALUE ? 0 : start_pts_;
-  const int64_t target = base + av_rescale_q(static_cast<int64_t>(std::llround(time_s * 1e9)), kNanos, time_base_);
+  const int64_t target =
+      base + av_rescale_q(static_cast<int64_t>(std::llround(time_s * 1e9)), kNanos, time_base_);
   const int r = avformat_seek_file(input_.get(), stream_, INT64_MIN, target, target, 0);
   if (r < 0) {
-    Log("import")->info("{}: the container cannot seek ({}); reading from the start", path_, av::ErrorText(r));
+    Log("import")->info("{}: the container cannot seek ({}); reading from the start", path_,
+                        av::ErrorText(r));
     return;
   }
   avcodec_flush_buffers(decoder_.get());
@@ -122,20 +130,22 @@ bool SourceVideo::Receive(SourceFrame* out) {
   }
   if (frame_->flags & AV_FRAME_FLAG_CORRUPT || frame_->decode_error_flags != 0) {
     ++corrupt_frames_;
-    last_problem_ = "the decoder reports the frame at " + std::to_string(timestamp_ns / 1e9) + " s damaged";
+    last_problem_ =
+        "the decoder reports the frame at " + std::to_string(timestamp_ns / 1e9) + " s damaged";
     av_frame_unref(frame_.get());
     return false;
   }
   if (frame_->width != width_ || frame_->height != height_) {
     ++corrupt_frames_;
-    last_problem_ = "a frame of " + std::to_string(frame_->width) + "x" + std::to_string(frame_->height) +
-                    " in a video of " + std::to_string(width_) + "x" + std::to_string(height_) +
-                    " (a size change mid-stream is not imported)";
+    last_problem_ = "a frame of " + std::to_string(frame_->width) + "x" +
+                    std::to_string(frame_->height) + " in a video of " + std::to_string(width_) +
+                    "x" + std::to_string(height_) + " (a size change mid-stream is not imported)";
     av_frame_unref(frame_.get());
     return false;
   }
-  sws_.reset(sws_getCachedContext(sws_.release(), width_, height_, static_cast<AVPixelFormat>(frame_->format), width_,
-                                  height_, AV_PIX_FMT_BGR24, SWS_BILINEAR, nullptr, nullptr, nullptr));
+  sws_.reset(sws_getCachedContext(sws_.release(), width_, height_,
+                                  static_cast<AVPixelFormat>(frame_->format), width_, height_,
+                                  AV_PIX_FMT_BGR24, SWS_BILINEAR, nullptr, nullptr, nullptr));
   if (!sws_) throw WorkError(path_, "cannot convert its pixel format to BGR");
   out->bgr.create(height_, width_, CV_8UC3);
   uint8_t* dst[4] = {out->bgr.data, nullptr, nullptr, nullptr};
@@ -164,7 +174,8 @@ bool SourceVideo::Next(SourceFrame* out) {
       ++corrupt_frames_;
       last_problem_ = "cannot read the container (" + av::ErrorText(r) + ")";
       if (++read_errors >= kMaxConsecutiveReadErrors) {
-        Log("import")->warn("{}: {} read errors in a row; the rest of the file is unreadable", path_, read_errors);
+        Log("import")->warn("{}: {} read errors in a row; the rest of the file is unreadable",
+                            path_, read_errors);
         draining_ = true;
         avcodec_send_packet(decoder_.get(), nullptr);
       }

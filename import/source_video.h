@@ -4,18 +4,17 @@
 // BGR with its time from the container: the frame's presentation timestamp
 // since the stream's start, so a variable frame rate stays as it was recorded.
 #include <cstdint>
-#include <string>
-
 #include <opencv2/core.hpp>
+#include <string>
 
 #include "capture/recording/ffmpeg_util.h"
 
 namespace ss {
 
 struct SourceFrame {
-  cv::Mat bgr;                // CV_8UC3, the video's size
-  int64_t timestamp_ns = 0;   // presentation time since the stream's start
-  int64_t index = 0;          // frames delivered before it since the open (or the seek)
+  cv::Mat bgr;               // CV_8UC3, the video's size
+  int64_t timestamp_ns = 0;  // presentation time since the stream's start
+  int64_t index = 0;         // frames delivered before it since the open (or the seek)
 };
 
 class SourceVideo {
@@ -32,8 +31,8 @@ class SourceVideo {
   const std::string& path() const { return path_; }
   int width() const { return width_; }
   int height() const { return height_; }
-  double fps() const { return fps_; }                 // nominal (the container's average); 0 when unknown
-  double duration_s() const { return duration_s_; }   // -1 when the container does not say
+  double fps() const { return fps_; }  // nominal (the container's average); 0 when unknown
+  double duration_s() const { return duration_s_; }    // -1 when the container does not say
   const std::string& codec() const { return codec_; }  // FFmpeg's decoder name, e.g. "h264"
 
   // Jumps to the last keyframe at or before `time_s` (the caller drops the

@@ -8,7 +8,6 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
-
 #include <nlohmann/json.hpp>
 
 #include "capture/recording/video_reader.h"
@@ -24,7 +23,7 @@ using testing::RunCommand;
 using testing::RunSpritestation;
 using testing::ScratchDir;
 
-constexpr int kFrames = 100;           // 4 s at 25 fps
+constexpr int kFrames = 100;             // 4 s at 25 fps
 constexpr int64_t kGapNs = 200'000'000;  // added before frame 50: a variable frame rate
 // The background, BGR, of 0x305070; a light-grey 30x60 box crosses it at 60 px/s,
 // so it covers any one pixel for half a second of the four.
@@ -47,7 +46,9 @@ class ImportVideo : public ::testing::Test {
     ASSERT_EQ(r.exit_code, 0) << r.output;
   }
   static void TearDownTestSuite() { delete dir_; }
-  static int64_t TrueTimestampNs(int frame) { return frame * 40'000'000LL + (frame >= 50 ? kGapNs : 0); }
+  static int64_t TrueTimestampNs(int frame) {
+    return frame * 40'000'000LL + (frame >= 50 ? kGapNs : 0);
+  }
   static ScratchDir* dir_;
 };
 ScratchDir* ImportVideo::dir_ = nullptr;
@@ -55,14 +56,15 @@ ScratchDir* ImportVideo::dir_ = nullptr;
 // The largest difference from the background over a frame's pixels, in levels.
 int MaxDifferenceFromBackground(const std::vector<uint8_t>& bgr) {
   int worst = 0;
-  for (size_t i = 0; i < bgr.size(); ++i) worst = std::max(worst, std::abs(int{bgr[i]} - kBackground[i % 3]));
+  for (size_t i = 0; i < bgr.size(); ++i)
+    worst = std::max(worst, std::abs(int{bgr[i]} - kBackground[i % 3]));
   return worst;
 }
 
 TEST_F(ImportVideo, KeepsEveryFrameWithTheContainersTimes) {
   const std::string out = *dir_ / "all";
-  const auto r = RunSpritestation("--log-level warn import " + *dir_ / "walk.mp4" + " --out " + out + kRough +
-                                  " --codec ffvhuff --json");
+  const auto r = RunSpritestation("--log-level warn import " + *dir_ / "walk.mp4" + " --out " +
+                                  out + kRough + " --codec ffvhuff --json");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const nlohmann::json j = JsonInOutput(r.output);
   ASSERT_EQ(j["cameras"].size(), 1u) << r.output;
@@ -95,8 +97,8 @@ TEST_F(ImportVideo, KeepsEveryFrameWithTheContainersTimes) {
 
 TEST_F(ImportVideo, TheMedianPlateHoldsTheBackgroundWithoutTheWalker) {
   const std::string out = *dir_ / "median";
-  const auto r = RunSpritestation("--log-level warn import " + *dir_ / "walk.mp4" + " --out " + out + kRough +
-                                  " --codec ffvhuff --empty-frames 10");
+  const auto r = RunSpritestation("--log-level warn import " + *dir_ / "walk.mp4" + " --out " +
+                                  out + kRough + " --codec ffvhuff --empty-frames 10");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const SessionInfo info = ReadSessionInfo(out);
   VideoReader reader(out + "/" + info.cameras[0].video, PixelFormat::kBGR8, 320, 240);
@@ -115,8 +117,9 @@ TEST_F(ImportVideo, TheMedianPlateHoldsTheBackgroundWithoutTheWalker) {
 
 TEST_F(ImportVideo, ATimeRangeKeepsItsFramesAndTheirTimes) {
   const std::string out = *dir_ / "range";
-  const auto r = RunSpritestation("--log-level warn import " + *dir_ / "walk.mp4" + " --out " + out + kRough +
-                                  " --codec ffvhuff --range 1.9-2.5 --empty-range 0-4 --empty-frames 5 --json");
+  const auto r = RunSpritestation(
+      "--log-level warn import " + *dir_ / "walk.mp4" + " --out " + out + kRough +
+      " --codec ffvhuff --range 1.9-2.5 --empty-range 0-4 --empty-frames 5 --json");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const std::vector<FrameRecord> rows = ReadFrameCsv(out + "/cam0.frames.csv");
   // 1.92, 1.96, then the gap, 2.20 .. 2.48: frames 48..57.
@@ -128,18 +131,25 @@ TEST_F(ImportVideo, ATimeRangeKeepsItsFramesAndTheirTimes) {
 TEST_F(ImportVideo, TwoVideosAreTwoCamerasWithTheirModelsAndAnEmptyClip) {
   // A model of the right size: the one a rough import wrote.
   const std::string first = *dir_ / "for_model";
-  ASSERT_EQ(RunSpritestation("--log-level warn import " + *dir_ / "walk.mp4" + " --out " + first + kRough +
-                             " --codec ffvhuff --range 0-0.5 --empty-frames 3").exit_code, 0);
+  ASSERT_EQ(RunSpritestation("--log-level warn import " + *dir_ / "walk.mp4" + " --out " + first +
+                             kRough + " --codec ffvhuff --range 0-0.5 --empty-frames 3")
+                .exit_code,
+            0);
   const std::string model = first + "/cam0.cameramodel";
   std::ofstream(*dir_ / "floor.json") << "{\"floor\": [[-3, 2], [3, 2], [3, 9], [-3, 9]]}\n";
   // The empty scene from a separate clip: the background alone, a second of it.
-  ASSERT_EQ(RunCommand("ffmpeg -v error -y -f lavfi -i color=c=0x305070:s=320x240:r=25:d=1 -c:v libx264 "
-                       "-pix_fmt yuv420p " + *dir_ / "empty.mp4").exit_code, 0);
+  ASSERT_EQ(
+      RunCommand("ffmpeg -v error -y -f lavfi -i color=c=0x305070:s=320x240:r=25:d=1 -c:v libx264 "
+                 "-pix_fmt yuv420p " +
+                 *dir_ / "empty.mp4")
+          .exit_code,
+      0);
   const std::string out = *dir_ / "two";
-  const auto r = RunSpritestation("--log-level warn import " + *dir_ / "walk.mp4" + " " + *dir_ / "walk.mp4" +
-                                  " --out " + out + " --model " + model + " --model " + model + " --floor " +
-                                  *dir_ / "floor.json" + " --empty-clip " + *dir_ / "empty.mp4" + " --empty-clip " +
-                                  *dir_ / "empty.mp4" + " --empty-frames 20 --range 0-1 --codec ffvhuff --json");
+  const auto r = RunSpritestation(
+      "--log-level warn import " + *dir_ / "walk.mp4" + " " + *dir_ / "walk.mp4" + " --out " + out +
+      " --model " + model + " --model " + model + " --floor " + *dir_ / "floor.json" +
+      " --empty-clip " + *dir_ / "empty.mp4" + " --empty-clip " + *dir_ / "empty.mp4" +
+      " --empty-frames 20 --range 0-1 --codec ffvhuff --json");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const SessionInfo info = ReadSessionInfo(out);
   ASSERT_EQ(info.cameras.size(), 2u);
@@ -158,8 +168,9 @@ TEST_F(ImportVideo, TwoVideosAreTwoCamerasWithTheirModelsAndAnEmptyClip) {
   EXPECT_EQ(floor["floor"].size(), 4u);
   EXPECT_EQ(JsonInOutput(r.output)["empty_scene"], "clip");
   // Several cameras share one floor: without --floor the import refuses.
-  const auto no_floor = RunSpritestation("--log-level warn import " + *dir_ / "walk.mp4" + " " + *dir_ / "walk.mp4" +
-                                         " --out " + *dir_ / "two_b" + " --model " + model + " --model " + model);
+  const auto no_floor =
+      RunSpritestation("--log-level warn import " + *dir_ / "walk.mp4" + " " + *dir_ / "walk.mp4" +
+                       " --out " + *dir_ / "two_b" + " --model " + model + " --model " + model);
   EXPECT_EQ(no_floor.exit_code, 2);
   EXPECT_NE(no_floor.output.find("--floor"), std::string::npos) << no_floor.output;
 }
@@ -171,33 +182,41 @@ TEST_F(ImportVideo, RefusesWhatItCannotUseNamingTheFileOrFlag) {
     EXPECT_EQ(r.exit_code, 2) << args << "\n" << r.output;
     EXPECT_NE(r.output.find(named), std::string::npos) << args << "\n" << r.output;
   };
-  expect_refusal(*dir_ / "missing.mp4" + " --out " + *dir_ / "x" + kRough, "missing.mp4: no such file");
+  expect_refusal(*dir_ / "missing.mp4" + " --out " + *dir_ / "x" + kRough,
+                 "missing.mp4: no such file");
   std::ofstream(*dir_ / "garbage.mp4") << std::string(5000, 'x');
-  expect_refusal(*dir_ / "garbage.mp4" + " --out " + *dir_ / "x" + kRough, "garbage.mp4: FFmpeg cannot");
-  expect_refusal(video + " --out " + *dir_ / "x" + kRough + " --range 10-20", "--range: starts at 10 s");
+  expect_refusal(*dir_ / "garbage.mp4" + " --out " + *dir_ / "x" + kRough,
+                 "garbage.mp4: FFmpeg cannot");
+  expect_refusal(video + " --out " + *dir_ / "x" + kRough + " --range 10-20",
+                 "--range: starts at 10 s");
   expect_refusal(video + " --out " + *dir_ / "x" + kRough + " --range 1-9", "--range: ends at 9 s");
-  expect_refusal(video + " --out " + *dir_ / "x" + kRough + " --range 3-1", "--range: ends");
-  expect_refusal(video + " --out " + *dir_ / "x" + kRough + " --empty-range 0-0.2", "--empty-range");
+  expect_refusal(video + " --out " + *dir_ / "x" + kRough + " --empty-range 0-0.2",
+                 "--empty-range");
   expect_refusal(video + " --out " + *dir_ / "x", "--model");
   expect_refusal(video + " --out " + *dir_ / "x --camera-height 3 --tilt 30", "all three");
-  expect_refusal(video + " --out " + *dir_ / "x --camera-height 3 --tilt -40 --hfov 60", "sees no floor");
+  expect_refusal(video + " --out " + *dir_ / "x --camera-height 3 --tilt -40 --hfov 60",
+                 "sees no floor");
   expect_refusal(video + " --out " + *dir_ / "x" + kRough + " --codec png", "--codec");
   EXPECT_FALSE(fs::exists(*dir_ / "x")) << "a refused import leaves nothing behind";
 
   // An existing session is not replaced without --force; a folder that is not a session never.
   const std::string out = *dir_ / "existing";
   ASSERT_EQ(RunSpritestation("--log-level warn import " + video + " --out " + out + kRough +
-                             " --codec ffvhuff --range 0-0.5 --empty-frames 3").exit_code, 0);
+                             " --codec ffvhuff --range 0-0.5 --empty-frames 3")
+                .exit_code,
+            0);
   const auto before = RunCommand("md5sum " + out + "/cam0.frames.csv");
   expect_refusal(video + " --out " + out + kRough + " --range 0-1", "give --force");
   EXPECT_EQ(RunCommand("md5sum " + out + "/cam0.frames.csv").output, before.output);
-  const auto forced = RunSpritestation("--log-level warn import " + video + " --out " + out + kRough +
-                                       " --codec ffvhuff --range 0-1 --empty-frames 3 --force");
+  const auto forced =
+      RunSpritestation("--log-level warn import " + video + " --out " + out + kRough +
+                       " --codec ffvhuff --range 0-1 --empty-frames 3 --force");
   EXPECT_EQ(forced.exit_code, 0) << forced.output;
   EXPECT_EQ(ReadFrameCsv(out + "/cam0.frames.csv").size(), 3u + 25u);
   fs::create_directories(*dir_ / "notes");
   std::ofstream(*dir_ / "notes/todo.txt") << "keep me\n";
-  expect_refusal(video + " --out " + *dir_ / "notes" + kRough + " --force", "not a recorded session");
+  expect_refusal(video + " --out " + *dir_ / "notes" + kRough + " --force",
+                 "not a recorded session");
   EXPECT_TRUE(fs::exists(*dir_ / "notes/todo.txt"));
   // No temporary folder is left beside the sessions.
   for (const auto& entry : fs::directory_iterator(dir_->path())) {

@@ -9,11 +9,10 @@
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
-
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <sstream>
 
 #include "core/camera_model.h"
 #include "core/session.h"
@@ -50,13 +49,15 @@ Silhouette Measure(const std::string& png, double px_per_m) {
   cv::extractChannel(bgra, alpha, 3);
   cv::Mat mask = alpha > 127;
   const int k = std::max(3, static_cast<int>(0.2 * px_per_m) | 1);
-  cv::morphologyEx(mask, mask, cv::MORPH_CLOSE, cv::getStructuringElement(cv::MORPH_ELLIPSE, {k, k}));
+  cv::morphologyEx(mask, mask, cv::MORPH_CLOSE,
+                   cv::getStructuringElement(cv::MORPH_ELLIPSE, {k, k}));
   cv::Mat labels, stats, centroids;
   const int n = cv::connectedComponentsWithStats(mask, labels, stats, centroids, 8);
   int total = 0, people = 0;
   for (int i = 1; i < n; ++i) {
     const int area = stats.at<int>(i, cv::CC_STAT_AREA);
-    const double h = stats.at<int>(i, cv::CC_STAT_HEIGHT) / px_per_m, w = stats.at<int>(i, cv::CC_STAT_WIDTH) / px_per_m;
+    const double h = stats.at<int>(i, cv::CC_STAT_HEIGHT) / px_per_m,
+                 w = stats.at<int>(i, cv::CC_STAT_WIDTH) / px_per_m;
     total += area;
     if (h >= 1.2 && h <= 2.3 && w <= 1.6) {
       people += area;
@@ -74,8 +75,9 @@ class ImportVtest : public ::testing::Test {
   static void TearDownTestSuite() { delete dir_; }
   void SetUp() override {
     // Not a skip: install-deps installs opencv-doc, so its absence is a broken setup.
-    ASSERT_TRUE(fs::exists(kVtest)) << kVtest << " is missing: install the Debian package opencv-doc "
-                                    << "(scripts/install-deps.sh does)";
+    ASSERT_TRUE(fs::exists(kVtest))
+        << kVtest << " is missing: install the Debian package opencv-doc "
+        << "(scripts/install-deps.sh does)";
   }
   static ScratchDir* dir_;
 };
@@ -83,8 +85,8 @@ ScratchDir* ImportVtest::dir_ = nullptr;
 
 TEST_F(ImportVtest, PeopleWalkingAreStoredAtTheirScaleWithLittleNoise) {
   const std::string session = *dir_ / "vtest";
-  const auto imported = RunSpritestation(std::string("--log-level warn import ") + kVtest + " --out " + session +
-                                         kImportArgs + " --json");
+  const auto imported = RunSpritestation(std::string("--log-level warn import ") + kVtest +
+                                         " --out " + session + kImportArgs + " --json");
   ASSERT_EQ(imported.exit_code, 0) << imported.output;
   const nlohmann::json ij = JsonInOutput(imported.output);
   EXPECT_EQ(ij["cameras"][0]["frames"], 300);
@@ -95,8 +97,9 @@ TEST_F(ImportVtest, PeopleWalkingAreStoredAtTheirScaleWithLittleNoise) {
   EXPECT_EQ(rows.back().timestamp_ns, 29'900'000'000);
 
   const std::string bank = *dir_ / "vtest.bank";
-  const auto ingested = RunSpritestation("--log-level warn ingest " + session + " --bank " + bank + " --config " +
-                                         session + "/ingest.yaml --no-transitions --json");
+  const auto ingested =
+      RunSpritestation("--log-level warn ingest " + session + " --bank " + bank + " --config " +
+                       session + "/ingest.yaml --no-transitions --json");
   ASSERT_EQ(ingested.exit_code, 0) << ingested.output;
   const nlohmann::json j = JsonInOutput(ingested.output);
   EXPECT_EQ(j["cameras"][0]["training_frames"], 30);
@@ -110,7 +113,8 @@ TEST_F(ImportVtest, PeopleWalkingAreStoredAtTheirScaleWithLittleNoise) {
   EXPECT_GE(kept, 90) << ingested.output;  // 128 measured (docs/import.md)
 
   const std::string exported = *dir_ / "export";
-  const auto ex = RunSpritestation("--log-level warn bank export " + bank + " --out " + exported + " --no-mirrors");
+  const auto ex = RunSpritestation("--log-level warn bank export " + bank + " --out " + exported +
+                                   " --no-mirrors");
   ASSERT_EQ(ex.exit_code, 0) << ex.output;
   std::ifstream csv(exported + "/sprites.csv");
   std::string line;
@@ -133,8 +137,11 @@ TEST_F(ImportVtest, PeopleWalkingAreStoredAtTheirScaleWithLittleNoise) {
       heights_m.push_back(s.tallest_m);
     }
     char row[160];
-    std::snprintf(row, sizeof(row), "sprite %s clip %s: %s, %d person-shaped parts, %.2f of the matte, tallest %.2f m\n",
-                  f[0].c_str(), f[1].c_str(), person ? "people" : "NOISE", s.people, s.people_share, s.tallest_m);
+    std::snprintf(
+        row, sizeof(row),
+        "sprite %s clip %s: %s, %d person-shaped parts, %.2f of the matte, tallest %.2f m\n",
+        f[0].c_str(), f[1].c_str(), person ? "people" : "NOISE", s.people, s.people_share,
+        s.tallest_m);
     judged += row;
   }
   EXPECT_EQ(sprites, kept);
@@ -142,8 +149,11 @@ TEST_F(ImportVtest, PeopleWalkingAreStoredAtTheirScaleWithLittleNoise) {
   std::nth_element(heights_m.begin(), heights_m.begin() + heights_m.size() / 2, heights_m.end());
   const double median_height_m = heights_m[heights_m.size() / 2];
   const double noise_share = static_cast<double>(noise) / sprites;
-  std::printf("vtest.avi 0-30 s: %d sprites stored at %.0f px/m, %d judged noise (%.1f %%), median person height "
-              "%.2f m\n", sprites, px_per_m, noise, 100 * noise_share, median_height_m);
+  std::printf(
+      "vtest.avi 0-30 s: %d sprites stored at %.0f px/m, %d judged noise (%.1f %%), median person "
+      "height "
+      "%.2f m\n",
+      sprites, px_per_m, noise, 100 * noise_share, median_height_m);
   // The rough camera was fitted to people of ~1.75 m: the billboards must say so.
   EXPECT_GE(median_height_m, 1.5);
   EXPECT_LE(median_height_m, 2.0);
@@ -162,15 +172,17 @@ TEST_F(ImportVtest, PeopleWalkingAreStoredAtTheirScaleWithLittleNoise) {
 TEST_F(ImportVtest, BoardFootageImportsForCalibration) {
   const std::string session = *dir_ / "board";
   const auto imported = RunSpritestation(
-      "--log-level warn import '/usr/share/doc/opencv-doc/examples/data/left[01]*.jpg' --out " + session +
-      " --no-model --empty-frames 0 --fps 1 --json");
+      "--log-level warn import '/usr/share/doc/opencv-doc/examples/data/left[01]*.jpg' --out " +
+      session + " --no-model --empty-frames 0 --fps 1 --json");
   ASSERT_EQ(imported.exit_code, 0) << imported.output;
   EXPECT_EQ(JsonInOutput(imported.output)["cameras"][0]["frames"], 13);
   EXPECT_EQ(JsonInOutput(imported.output)["name"], "left01");
   EXPECT_FALSE(fs::exists(session + "/ingest.yaml"));  // no empty scene: not for ingest
-  const auto solved = RunSpritestation("--log-level warn calibrate intrinsics " + session +
-                                       " --board chessboard:10x7:0.025 --lensmodel LENSMODEL_OPENCV4 --every 1 "
-                                       "--min-views 8 --min-coverage 0 --out " + *dir_ / "intrinsics" + " --json");
+  const auto solved =
+      RunSpritestation("--log-level warn calibrate intrinsics " + session +
+                       " --board chessboard:10x7:0.025 --lensmodel LENSMODEL_OPENCV4 --every 1 "
+                       "--min-views 8 --min-coverage 0 --out " +
+                       *dir_ / "intrinsics" + " --json");
   ASSERT_EQ(solved.exit_code, 0) << solved.output;
   const CameraModel model = CameraModel::Read(*dir_ / "intrinsics/cam0.cameramodel");
   EXPECT_NEAR(model.intrinsics()[0], 535.9, 0.01 * 535.9);

@@ -5,8 +5,8 @@
 
 #include <opencv2/core.hpp>
 
-#include "import/import_session.h"
 #include "core/error.h"
+#include "import/import_session.h"
 
 namespace ss {
 namespace {
@@ -22,7 +22,8 @@ cv::Mat Frame(cv::RNG& rng, int walker_x, double noise) {
 TEST(MedianAndSpread, SeesThroughAWalkerAndMeasuresTheNoise) {
   cv::RNG rng(7);
   std::vector<cv::Mat> frames;
-  for (int i = 0; i < 31; ++i) frames.push_back(Frame(rng, (i % 3) * 10, 4.0));  // each column covered 1/3 of the time
+  for (int i = 0; i < 31; ++i)
+    frames.push_back(Frame(rng, (i % 3) * 10, 4.0));  // each column covered 1/3 of the time
   const RobustBackground b = MedianAndSpread(frames);
   const cv::Scalar median = cv::mean(b.median), spread = cv::mean(b.spread);
   // The walker covers each pixel a third of the time: the median is the floor, pulled a little up.
@@ -54,7 +55,8 @@ TEST(Winsorized, RemovesTheWalkerAndKeepsTheBackgroundsOwnNoise) {
   cv::Scalar mean, std;
   cv::meanStdDev(w.colRange(0, 10), mean, std);
   EXPECT_GT(std[0], 3);
-  EXPECT_EQ(cv::norm(w.colRange(0, 10), with_walker.colRange(0, 10), cv::NORM_INF) <= 2.5 * 8, true);
+  EXPECT_EQ(cv::norm(w.colRange(0, 10), with_walker.colRange(0, 10), cv::NORM_INF) <= 2.5 * 8,
+            true);
 }
 
 TEST(EvenFrameSampler, KeepsAnEvenSpreadOfUnknownManyFrames) {

@@ -45,9 +45,9 @@ TEST(VisibleFloor, HoldsWhatTheCameraSeesOutToTheRange) {
   ASSERT_TRUE(floor.IsSimple());
   const double ahead = 6.5 / std::tan(22 * M_PI / 180);  // 16.1 m, the image centre
   EXPECT_TRUE(floor.Contains({0, ahead}));
-  EXPECT_FALSE(floor.Contains({0, 31}));           // beyond the range
-  EXPECT_FALSE(floor.Contains({0, 5}));            // below the bottom row (it sees from ~11 m)
-  EXPECT_FALSE(floor.Contains({-20, ahead}));      // outside the field of view
+  EXPECT_FALSE(floor.Contains({0, 31}));       // beyond the range
+  EXPECT_FALSE(floor.Contains({0, 5}));        // below the bottom row (it sees from ~11 m)
+  EXPECT_FALSE(floor.Contains({-20, ahead}));  // outside the field of view
   for (const Eigen::Vector2d& v : floor.vertices()) {
     EXPECT_LE(v.norm(), 30 + 1e-6);
     // Every vertex is seen by a pixel inside the image.
