@@ -260,6 +260,7 @@ nlohmann::json SummaryJson(const ImportOptions& o, const ImportSummary& s) {
                          {"video_codec", c.codec},
                          {"width", c.width},
                          {"height", c.height},
+                         {"rotation_deg", c.rotation_deg},
                          {"fps", c.fps},
                          {"frames", c.frames},
                          {"empty_frames", c.empty_frames},
@@ -412,6 +413,7 @@ ImportSummary ImportVideos(const ImportOptions& o) {
     cam.width = video.width();
     cam.height = video.height();
     cam.fps = video.fps();
+    cam.rotation_deg = video.rotation_deg();
     models.push_back(ModelFor(o, i, video, &cam.model_source));
     summary.cameras.push_back(cam);
   }

@@ -68,6 +68,7 @@ struct ImportedCamera {
   std::string video;  // the source
   std::string codec;  // the source's codec
   int width = 0, height = 0;
+  int rotation_deg = 0;        // the display rotation applied (clockwise): a phone's portrait video
   double fps = 0;              // nominal, as the container says (0: unknown)
   int64_t frames = 0;          // imported from the range (the empty scene not counted)
   int64_t empty_frames = 0;    // written before them

@@ -5,8 +5,10 @@
 
 extern "C" {
 #include <libavutil/dict.h>
-#include <libavutil/imgutils.h>
+#include <libavutil/display.h>
 }
+
+#include <opencv2/core.hpp>
 
 #include "core/error.h"
 #include "core/log.h"
@@ -73,9 +75,27 @@ SourceVideo::SourceVideo(const std::string& path, double image_sequence_fps) : p
   if (const int r = avcodec_open2(decoder_.get(), codec, nullptr); r < 0) {
     throw InputError(path, "cannot open its " + codec_ + " decoder (" + av::ErrorText(r) + ")");
   }
-  width_ = decoder_->width;
-  height_ = decoder_->height;
-  if (width_ <= 0 || height_ <= 0) throw InputError(path, "its video has no frame size");
+  coded_width_ = decoder_->width;
+  coded_height_ = decoder_->height;
+  if (coded_width_ <= 0 || coded_height_ <= 0)
+    throw InputError(path, "its video has no frame size");
+  // A phone stores a portrait video as landscape frames and a display matrix that turns them;
+  // players (and the ffmpeg CLI) show them turned, and so does the import.
+  width_ = coded_width_;
+  height_ = coded_height_;
+  if (const uint8_t* matrix = av_stream_get_side_data(stream, AV_PKT_DATA_DISPLAYMATRIX, nullptr)) {
+    const double ccw = av_display_rotation_get(reinterpret_cast<const int32_t*>(matrix));
+    // Clockwise degrees, as the ffmpeg CLI's autorotation reads them.
+    const int clockwise = ((static_cast<int>(std::lround(-ccw)) % 360) + 360) % 360;
+    if (clockwise == 90) rotation_ = cv::ROTATE_90_CLOCKWISE;
+    if (clockwise == 180) rotation_ = cv::ROTATE_180;
+    if (clockwise == 270) rotation_ = cv::ROTATE_90_COUNTERCLOCKWISE;
+    if (clockwise == 90 || clockwise == 270) std::swap(width_, height_);
+    if (clockwise % 90 != 0 || std::isnan(ccw)) {
+      Log("import")->warn("{}: a display rotation of {} degrees is not applied", path, -ccw);
+    }
+    rotation_deg_ = clockwise % 90 == 0 ? clockwise : 0;
+  }
   const AVRational rate =
       stream->avg_frame_rate.num > 0 ? stream->avg_frame_rate : stream->r_frame_rate;
   if (rate.num > 0 && rate.den > 0) fps_ = av_q2d(rate);
@@ -135,23 +155,26 @@ bool SourceVideo::Receive(SourceFrame* out) {
     av_frame_unref(frame_.get());
     return false;
   }
-  if (frame_->width != width_ || frame_->height != height_) {
+  if (frame_->width != coded_width_ || frame_->height != coded_height_) {
     ++corrupt_frames_;
     last_problem_ = "a frame of " + std::to_string(frame_->width) + "x" +
-                    std::to_string(frame_->height) + " in a video of " + std::to_string(width_) +
-                    "x" + std::to_string(height_) + " (a size change mid-stream is not imported)";
+                    std::to_string(frame_->height) + " in a video of " +
+                    std::to_string(coded_width_) + "x" + std::to_string(coded_height_) +
+                    " (a size change mid-stream is not imported)";
     av_frame_unref(frame_.get());
     return false;
   }
-  sws_.reset(sws_getCachedContext(sws_.release(), width_, height_,
-                                  static_cast<AVPixelFormat>(frame_->format), width_, height_,
-                                  AV_PIX_FMT_BGR24, SWS_BILINEAR, nullptr, nullptr, nullptr));
+  sws_.reset(sws_getCachedContext(
+      sws_.release(), coded_width_, coded_height_, static_cast<AVPixelFormat>(frame_->format),
+      coded_width_, coded_height_, AV_PIX_FMT_BGR24, SWS_BILINEAR, nullptr, nullptr, nullptr));
   if (!sws_) throw WorkError(path_, "cannot convert its pixel format to BGR");
-  out->bgr.create(height_, width_, CV_8UC3);
-  uint8_t* dst[4] = {out->bgr.data, nullptr, nullptr, nullptr};
-  int dst_lines[4] = {static_cast<int>(out->bgr.step), 0, 0, 0};
-  sws_scale(sws_.get(), frame_->data, frame_->linesize, 0, height_, dst, dst_lines);
+  cv::Mat& coded = rotation_ < 0 ? out->bgr : coded_;
+  coded.create(coded_height_, coded_width_, CV_8UC3);
+  uint8_t* dst[4] = {coded.data, nullptr, nullptr, nullptr};
+  int dst_lines[4] = {static_cast<int>(coded.step), 0, 0, 0};
+  sws_scale(sws_.get(), frame_->data, frame_->linesize, 0, coded_height_, dst, dst_lines);
   av_frame_unref(frame_.get());
+  if (rotation_ >= 0) cv::rotate(coded_, out->bgr, rotation_);
   out->timestamp_ns = timestamp_ns;
   out->index = next_index_++;
   last_timestamp_ns_ = timestamp_ns;

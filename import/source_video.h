@@ -29,8 +29,10 @@ class SourceVideo {
   SourceVideo& operator=(const SourceVideo&) = delete;
 
   const std::string& path() const { return path_; }
+  // The size frames come in: as a player shows them, turned by the stream's display rotation.
   int width() const { return width_; }
   int height() const { return height_; }
+  int rotation_deg() const { return rotation_deg_; }  // clockwise turn applied: 0, 90, 180, 270
   double fps() const { return fps_; }  // nominal (the container's average); 0 when unknown
   double duration_s() const { return duration_s_; }    // -1 when the container does not say
   const std::string& codec() const { return codec_; }  // FFmpeg's decoder name, e.g. "h264"
@@ -50,7 +52,11 @@ class SourceVideo {
   bool Receive(SourceFrame* frame);
 
   std::string path_;
-  int width_ = 0, height_ = 0;
+  int width_ = 0, height_ = 0;              // displayed
+  int coded_width_ = 0, coded_height_ = 0;  // decoded
+  int rotation_ = -1;                       // cv::RotateFlags, -1 for none
+  int rotation_deg_ = 0;
+  cv::Mat coded_;  // the decoded frame before turning
   double fps_ = 0;
   double duration_s_ = -1;
   std::string codec_;

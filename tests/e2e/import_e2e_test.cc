@@ -175,6 +175,40 @@ TEST_F(ImportVideo, TwoVideosAreTwoCamerasWithTheirModelsAndAnEmptyClip) {
   EXPECT_NE(no_floor.output.find("--floor"), std::string::npos) << no_floor.output;
 }
 
+// A phone's portrait video: landscape frames and a display matrix that turns them. The import
+// shows them as a player does; the ffmpeg CLI (which turns them too) is the reference.
+TEST_F(ImportVideo, APortraitPhoneVideoComesTurnedAsAPlayerShowsIt) {
+  const std::string mov = *dir_ / "portrait.mov";
+  ASSERT_EQ(RunCommand("ffmpeg -v error -y -i " + *dir_ / "walk.mp4" +
+                       " -c copy -metadata:s:v:0 rotate=90 " + mov)
+                .exit_code,
+            0);
+  const std::string out = *dir_ / "portrait";
+  const auto r =
+      RunSpritestation("--log-level warn import " + mov + " --out " + out +
+                       " --no-model --empty-frames 0 --range 0-0.2 --codec ffvhuff --json");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const SessionInfo info = ReadSessionInfo(out);
+  EXPECT_EQ(info.cameras[0].width, 240);
+  EXPECT_EQ(info.cameras[0].height, 320);
+  const std::string raw = *dir_ / "portrait.bgr";
+  ASSERT_EQ(
+      RunCommand("ffmpeg -v error -y -i " + mov + " -frames:v 1 -f rawvideo -pix_fmt bgr24 " + raw)
+          .exit_code,
+      0);
+  std::ifstream in(raw, std::ios::binary);
+  const std::vector<uint8_t> shown((std::istreambuf_iterator<char>(in)),
+                                   std::istreambuf_iterator<char>());
+  VideoReader reader(out + "/" + info.cameras[0].video, PixelFormat::kBGR8, 240, 320);
+  std::vector<uint8_t> pixels;
+  ASSERT_EQ(reader.Next(pixels).status, VideoReader::Status::kFrame);
+  ASSERT_EQ(pixels.size(), shown.size());
+  int worst = 0;
+  for (size_t i = 0; i < pixels.size(); ++i)
+    worst = std::max(worst, std::abs(pixels[i] - shown[i]));
+  EXPECT_LE(worst, 2);
+}
+
 TEST_F(ImportVideo, RefusesWhatItCannotUseNamingTheFileOrFlag) {
   const std::string video = *dir_ / "walk.mp4";
   const auto expect_refusal = [](const std::string& args, const std::string& named) {
