@@ -1,7 +1,9 @@
 #include "import/import_session.h"
 
+#include <signal.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
@@ -275,6 +277,24 @@ nlohmann::json SummaryJson(const ImportOptions& o, const ImportSummary& s) {
   return j;
 }
 
+// Removes what a killed import of the same --out left beside it: `.STEM.import-PID` folders
+// whose process is gone (a running import's is left alone).
+void RemoveAbandonedImports(const fs::path& parent, const std::string& stem) {
+  const std::string prefix = "." + stem + ".import-";
+  std::error_code ec;
+  for (const auto& entry : fs::directory_iterator(parent, ec)) {
+    const std::string name = entry.path().filename().string();
+    if (name.rfind(prefix, 0) != 0 || !entry.is_directory(ec)) continue;
+    const std::string digits = name.substr(prefix.size());
+    if (digits.empty() || digits.find_first_not_of("0123456789") != std::string::npos) continue;
+    const long pid = std::strtol(digits.c_str(), nullptr, 10);
+    // Alive, or not ours to judge: left alone.
+    if (pid <= 0 || kill(static_cast<pid_t>(pid), 0) == 0 || errno != ESRCH) continue;
+    Log("import")->info("{}: removing what an interrupted import left", entry.path().string());
+    fs::remove_all(entry.path(), ec);
+  }
+}
+
 // The video's file stem, without an image sequence's pattern characters ("left[01]*.jpg" ->
 // "left01").
 std::string NameFromPath(const std::string& path) {
@@ -438,6 +458,7 @@ ImportSummary ImportVideos(const ImportOptions& o) {
   summary.session_dir = o.out_dir;
   std::error_code ec;
   fs::create_directories(out.parent_path(), ec);
+  RemoveAbandonedImports(out.parent_path(), stem);
   const fs::path temp = out.parent_path() / ("." + stem + ".import-" + std::to_string(getpid()));
   fs::remove_all(temp, ec);
   try {

@@ -117,6 +117,10 @@ TEST_F(ImportVideo, TheMedianPlateHoldsTheBackgroundWithoutTheWalker) {
 
 TEST_F(ImportVideo, ATimeRangeKeepsItsFramesAndTheirTimes) {
   const std::string out = *dir_ / "range";
+  // What a killed import of the same --out left (its process, beyond any pid_max, is gone).
+  const std::string abandoned = *dir_ / ".range.import-99999999";
+  fs::create_directories(abandoned);
+  std::ofstream(abandoned + "/cam0.mkv") << "half a video";
   const auto r = RunSpritestation(
       "--log-level warn import " + *dir_ / "walk.mp4" + " --out " + out + kRough +
       " --codec ffvhuff --range 1.9-2.5 --empty-range 0-4 --empty-frames 5 --json");
@@ -126,6 +130,7 @@ TEST_F(ImportVideo, ATimeRangeKeepsItsFramesAndTheirTimes) {
   ASSERT_EQ(rows.size(), 5u + 10u);
   for (int i = 0; i < 10; ++i) EXPECT_EQ(rows[5 + i].timestamp_ns, TrueTimestampNs(48 + i)) << i;
   EXPECT_EQ(JsonInOutput(r.output)["empty_scene"], "range 0-4");
+  EXPECT_FALSE(fs::exists(abandoned)) << "an abandoned import is cleared away";
 }
 
 TEST_F(ImportVideo, TwoVideosAreTwoCamerasWithTheirModelsAndAnEmptyClip) {
