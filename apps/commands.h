@@ -21,5 +21,6 @@ void AddSkeletonCommand(CLI::App& app);
 void AddMatchCommand(CLI::App& app);
 void AddTransitionsCommand(CLI::App& app);
 void AddDaemonCommand(CLI::App& app);
+void AddImportCommand(CLI::App& app);
 
 }  // namespace ss::apps

@@ -33,6 +33,7 @@ int main(int argc, char** argv) {
   ss::apps::AddMatchCommand(app);
   ss::apps::AddTransitionsCommand(app);
   ss::apps::AddDaemonCommand(app);
+  ss::apps::AddImportCommand(app);
 
   try {
     app.parse(argc, argv);

@@ -11,8 +11,11 @@ PACKAGES=(
   libmrcal-dev mrcal
   # cameras
   libaravis-dev aravis-tools libusb-1.0-0-dev libv4l-dev libcamera-dev
-  # recordings (FFmpeg's libraries; the ffmpeg CLI is used by benchmarks only)
+  # recordings (FFmpeg's libraries; the ffmpeg CLI makes test videos and runs benchmarks)
   libavformat-dev libavcodec-dev libavutil-dev libswscale-dev libavfilter-dev ffmpeg
+  # real footage for the import tests (tests/e2e/import_*): OpenCV's sample videos,
+  # vtest.avi (a fixed camera over people walking), Apache-2.0 / BSD-3-Clause
+  opencv-doc
   # storage, config, CLI, logging, HTTP
   libsqlite3-dev sqlite3 libyaml-cpp-dev nlohmann-json3-dev libcli11-dev
   libspdlog-dev libfmt-dev libcpp-httplib-dev libsystemd-dev libpng-dev libzstd-dev
