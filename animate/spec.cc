@@ -88,6 +88,12 @@ class Reader {
     }
     return static_cast<int>(value);
   }
+  // A whole number in [low, high]; `high` is a limit of the optimizer, named in the message.
+  int IntegerIn(const YAML::Node& node, const std::string& field, int low, int high) const {
+    const int value = Integer(node, field, low);
+    if (value > high) Fail(node, field, "expected at most " + std::to_string(high) + ", got " + std::to_string(value));
+    return value;
+  }
   Eigen::Vector2d Point(const YAML::Node& node, const std::string& field) const {
     if (!node.IsSequence() || node.size() != 2) Fail(node, field, "expected [x, y] in metres");
     return {Number(node[0], Index(field, 0)), Number(node[1], Index(field, 1))};
@@ -360,12 +366,14 @@ void ReadOptimizer(const Reader& r, const YAML::Node& node, OptimizerSpec& o) {
   }
   if (node["time_budget_s"]) o.time_budget_s = r.Positive(node["time_budget_s"], f + ".time_budget_s");
   if (node["seed"]) o.seed = static_cast<uint64_t>(r.Integer(node["seed"], f + ".seed", 0));
-  if (node["set_size"]) o.set_size = r.Integer(node["set_size"], f + ".set_size", 2);
-  if (node["threads"]) o.threads = r.Integer(node["threads"], f + ".threads", 1);
+  // The bounds are the optimizer's (ReplacementOptions::IsValid, beam search), checked here so
+  // that the message names the spec's file, line and field rather than the optimizer's own.
+  if (node["set_size"]) o.set_size = r.IntegerIn(node["set_size"], f + ".set_size", 2, 65535);
+  if (node["threads"]) o.threads = r.IntegerIn(node["threads"], f + ".threads", 1, 256);
   if (node["changes_per_turn"]) {
     o.changes_per_turn = r.Integer(node["changes_per_turn"], f + ".changes_per_turn", 1);
   }
-  if (node["beam_width"]) o.beam_width = r.Integer(node["beam_width"], f + ".beam_width", 1);
+  if (node["beam_width"]) o.beam_width = r.IntegerIn(node["beam_width"], f + ".beam_width", 1, 65535);
   if (node["collision_pick_fraction"]) {
     o.collision_pick_fraction = r.AtLeast(node["collision_pick_fraction"], f + ".collision_pick_fraction", 0.0);
     if (o.collision_pick_fraction > 1) {
