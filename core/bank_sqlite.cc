@@ -14,6 +14,9 @@ void Fail(sqlite3* db, int rc, const std::string& path, std::string_view what) {
       throw InputError(path, "not a SQLite database (" + reason + ")");
     case SQLITE_CORRUPT:
       throw CorruptError(path, "the database is damaged (" + reason + ")");
+    case SQLITE_BUSY:
+    case SQLITE_LOCKED:
+      throw BusyError(path, reason);
     default:
       throw WorkError(path, reason);
   }

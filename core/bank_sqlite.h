@@ -1,7 +1,8 @@
 #pragma once
 // Small move-only RAII wrappers over the sqlite3 C API, used by the sprite bank.
 // Every failure throws: SQLITE_NOTADB -> InputError, SQLITE_CORRUPT -> CorruptError
-// (an InputError: the file is damaged), anything else -> WorkError, each naming the
+// (an InputError: the file is damaged), SQLITE_BUSY / SQLITE_LOCKED -> BusyError
+// (core/error_kinds.h: a WorkError worth retrying), anything else -> WorkError, each naming the
 // database file and SQLite's message.
 #include <sqlite3.h>
 
@@ -10,6 +11,7 @@
 #include <string_view>
 
 #include "core/error.h"
+#include "core/error_kinds.h"  // BusyError
 
 namespace ss::sql {
 

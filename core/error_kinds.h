@@ -1,6 +1,6 @@
 #pragma once
-// Kinds of bad input that a caller answers differently (HTTP 404, 409); both
-// stay InputErrors (exit code 2) for every command-line caller.
+// Kinds of error that a caller answers differently: bad input (HTTP 404, 409; both stay
+// InputErrors, exit code 2, for every command-line caller), and failures worth retrying.
 #include "core/error.h"
 
 namespace ss {
@@ -15,6 +15,13 @@ class NotFoundError : public InputError {
 class ConflictError : public InputError {
  public:
   using InputError::InputError;
+};
+
+// A resource was held by someone else for longer than we wait (a database's write lock):
+// nothing is wrong with the work, which may be tried again.
+class BusyError : public WorkError {
+ public:
+  using WorkError::WorkError;
 };
 
 }  // namespace ss

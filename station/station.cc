@@ -116,6 +116,8 @@ struct Station::Impl {
   mutable std::mutex stats_mutex;
   int64_t bank_sprites = 0;
   uint64_t sprites_stored = 0, batches_stored = 0, batches_failed = 0, batches_refused = 0;
+  uint64_t batches_retried = 0;  // appends tried again after the bank stayed locked (BusyError)
+  static constexpr int kBusyAttempts = 6;  // with SQLite's 10 s busy timeout: up to a minute
   std::deque<double> latencies_ms;                         // last 10,000
   uint64_t latency_count = 0;                              // every sprite's, since start
   double latency_sum_ms = 0;
@@ -206,8 +208,22 @@ struct Station::Impl {
     }
     AppendResult result;
     try {
-      std::lock_guard lock(bank_mutex);
-      result = bank->AppendClipBatch(sb.batch.clip, sb.batch.sprites);
+      // Another writer of the bank (the transitions worker, a labelling page, another process)
+      // may hold its write lock past SQLite's busy timeout (10 s) on a loaded machine: the batch
+      // is still in hand, so it is tried again before anything is given up.
+      for (int attempt = 1;; ++attempt) {
+        try {
+          std::lock_guard lock(bank_mutex);
+          result = bank->AppendClipBatch(sb.batch.clip, sb.batch.sprites);
+          break;
+        } catch (const BusyError& e) {
+          if (attempt == kBusyAttempts) throw;
+          log->warn("bank: {} (clip {}/{} from frame {}: try {} of {})", e.what(), clip.camera_id, clip.track_id,
+                    clip.first_frame, attempt + 1, kBusyAttempts);
+          std::lock_guard lock(stats_mutex);
+          ++batches_retried;
+        }
+      }
     } catch (const std::exception& e) {
       // A failed append is one rolled-back transaction: what was stored stays stored.
       log->error("bank: {} (the rest of clip {}/{} from frame {} is not stored)", e.what(), clip.camera_id,
@@ -593,6 +609,7 @@ StationStatus Station::Status() const {
     out.sprites_stored = s.sprites_stored;
     out.batches_stored = s.batches_stored;
     out.batches_failed = s.batches_failed;
+    out.batches_retried = s.batches_retried;
     out.batches_refused = s.batches_refused;
     out.bank_error = s.bank_error;
     out.storage_state = s.storage_state;

@@ -129,6 +129,7 @@ nlohmann::json StatusToJson(const StationStatus& st) {
                     {"sprites_per_second", st.sprites_per_second},
                     {"batches_stored", st.batches_stored},
                     {"batches_failed", st.batches_failed},
+                    {"batches_retried", st.batches_retried},
                     {"batches_refused", st.batches_refused},
                     {"writer_queue", st.writer_queue},
                     {"latency_ms", {{"p50", st.latency_p50_ms}, {"p99", st.latency_p99_ms}}},
@@ -202,6 +203,9 @@ std::string StatusToPrometheus(const StationStatus& st) {
   m.Sample(static_cast<double>(st.bank_sprites));
   m.Family("bank_batches_failed_total", "counter", "clip batches the bank could not store");
   m.Sample(static_cast<double>(st.batches_failed));
+  m.Family("bank_batches_retried_total", "counter",
+           "clip batch appends tried again because another writer held the bank's lock past its busy timeout");
+  m.Sample(static_cast<double>(st.batches_retried));
   m.Family("bank_batches_refused_total", "counter", "clip batches not stored because the disk is nearly full");
   m.Sample(static_cast<double>(st.batches_refused));
   // A summary: quantiles over the last 10,000 sprites, _sum and _count over every sprite since start.

@@ -41,6 +41,7 @@ struct StationStatus {
   uint64_t sprites_stored = 0;    // originals stored since start
   double sprites_per_second = 0;  // over the last ~5 s
   uint64_t batches_stored = 0, batches_failed = 0, batches_refused = 0;  // refused: storage stopped (disk)
+  uint64_t batches_retried = 0;  // appends tried again after the bank stayed locked past its busy timeout
   size_t writer_queue = 0;
   double latency_p50_ms = 0, latency_p99_ms = 0;  // frame arrival -> sprite committed, last 10,000 sprites
   uint64_t latency_count = 0;                       // sprites committed since start, and their latencies'

@@ -1,7 +1,8 @@
 // The station in-process when the bank's disk fills up under it: appends
 // fail (the process may not grow a file: RLIMIT_FSIZE, a full disk for this
 // process alone), the storage state says so, nothing stored before is lost,
-// and storage resumes when space comes back.
+// and storage resumes when space comes back. And when another writer holds the
+// bank's lock past SQLite's busy timeout: no batch is lost.
 #include <signal.h>
 #include <sys/resource.h>
 
@@ -10,6 +11,7 @@
 #include <thread>
 
 #include <gtest/gtest.h>
+#include <sqlite3.h>
 
 #include "core/bank.h"
 #include "core/bank_verify.h"
@@ -104,6 +106,68 @@ TEST(StationFaults, AFullDiskSaysWritesFailLosesNothingAndResumes) {
   for (const std::string& p : verify.problems) problems += p + "\n";
   EXPECT_TRUE(verify.ok()) << problems;
   EXPECT_GT(Bank(options.config.storage.bank).Counts().sprites_visible, 0);
+}
+
+TEST(StationFaults, ABankLockedPastTheBusyTimeoutLosesNoBatch) {
+  // Another writer (here a second connection; in the soak, the transitions worker's long
+  // transactions on a loaded machine) holds the bank's write lock for 12 s, past SQLite's
+  // 10 s busy timeout: the station tries its batches again and stores every one of them.
+  testing::ScratchDir dir;
+  synth::SynthOptions so;
+  so.out_dir = dir / "session";
+  so.seconds = 4;
+  so.fps = 30;
+  so.width = 640;
+  so.height = 480;
+  so.cameras = 1;
+  so.seed = 11;
+  so.empty_lead_in_s = 1.5;
+  so.write_mattes = false;
+  synth::RenderStudioSession(so);
+
+  StationOptions options;
+  CameraConfig cam;
+  cam.name = "cam0";
+  cam.source = "replay";
+  cam.session = so.out_dir;
+  cam.loop = true;
+  cam.realtime = true;
+  options.config.cameras = {cam};
+  options.config.storage.bank = dir / "station.bank";
+  options.config.storage.recording_dir = dir / "recordings";
+  options.config.storage.stop_recording_below_mib = 0;
+  options.config.storage.stop_sprites_below_mib = 0;
+  options.config.logging.level = "error";
+  options.transitions = false;
+  Station station(options);
+  station.Start();
+  station.StartSession("locked");
+  ASSERT_TRUE(WaitFor(station, [](const StationStatus& s) { return s.batches_stored >= 3; }, 30))
+      << "no batch stored: " << StatusToJson(station.Status()).dump(2);
+
+  {
+    sqlite3* other = nullptr;
+    ASSERT_EQ(sqlite3_open(options.config.storage.bank.c_str(), &other), SQLITE_OK);
+    ASSERT_EQ(sqlite3_exec(other, "BEGIN IMMEDIATE", nullptr, nullptr, nullptr), SQLITE_OK);
+    std::this_thread::sleep_for(std::chrono::seconds(12));
+    ASSERT_EQ(sqlite3_exec(other, "COMMIT", nullptr, nullptr, nullptr), SQLITE_OK);
+    sqlite3_close(other);
+  }
+  const uint64_t retried = station.Status().batches_retried;
+  const uint64_t stored_then = station.Status().batches_stored;
+  ASSERT_TRUE(WaitFor(station, [&](const StationStatus& s) { return s.batches_stored > stored_then + 2; }, 30))
+      << "storage did not go on: " << station.Status().bank_error;
+  station.StopSession();
+  station.Stop();
+  const StationStatus end = station.Status();
+  EXPECT_GE(retried, 1u) << "the lock outlived the busy timeout, so an append had to be tried again";
+  EXPECT_EQ(end.batches_failed, 0u) << end.bank_error;
+  EXPECT_EQ(end.storage_state, StorageState::kOk);
+  const BankVerifyReport verify = VerifyBank(options.config.storage.bank);
+  EXPECT_TRUE(verify.ok());
+  // Every sprite the station counted as stored is in the bank.
+  const BankCounts counts = Bank(options.config.storage.bank).Counts();
+  EXPECT_EQ(static_cast<uint64_t>(counts.sprites - counts.mirrors), end.sprites_stored);
 }
 
 }  // namespace
