@@ -13,6 +13,11 @@
 #include "pipeline/transitions/builder.h"
 
 namespace ss {
+namespace {
+
+constexpr size_t kRowsPerTransaction = 2000;  // transitions stored per bank transaction
+
+}  // namespace
 
 // Everything the thread owns (connections are used from the worker thread only).
 struct TransitionWorker::State {
@@ -153,7 +158,17 @@ void TransitionWorker::Run() {
         const BankSprites sprites = LoadBankSpritesById(*s.reader, fresh, &s.keys, scale);
         if (!s.builder) s.builder = std::make_unique<TransitionBuilder>(s.weights, sprites.px_per_m);
         const TransitionDelta delta = s.builder->Add(sprites.inputs);
-        if (!delta.transitions.empty()) s.writer->UpsertTransitions(ToRecords(delta.transitions));
+        if (!delta.transitions.empty()) {
+          // A few thousand rows a transaction: a round of a large bank holds tens of thousands,
+          // and one transaction for all of them held the bank's write lock past the station
+          // writer's busy timeout on a loaded machine (batches failed). Upserts are idempotent,
+          // so rows stored before a failure are simply stored again by a rebuild.
+          const std::vector<TransitionRecord> records = ToRecords(delta.transitions);
+          for (size_t i = 0; i < records.size(); i += kRowsPerTransaction) {
+            const auto end = records.begin() + static_cast<std::ptrdiff_t>(std::min(records.size(), i + kRowsPerTransaction));
+            s.writer->UpsertTransitions(std::vector<TransitionRecord>(records.begin() + static_cast<std::ptrdiff_t>(i), end));
+          }
+        }
         added_sprites = static_cast<int64_t>(fresh.size());
         added_transitions = static_cast<int64_t>(delta.transitions.size());
       }
