@@ -68,16 +68,6 @@ nlohmann::json Points(const std::vector<Eigen::Vector2d>& points) {
   return out;
 }
 
-int StepRank(WizardStep step) {
-  switch (step) {
-    case WizardStep::kIntrinsics: return 0;
-    case WizardStep::kGround: return 1;
-    case WizardStep::kEnclosure: return 2;
-    case WizardStep::kDone: return 3;
-  }
-  return 0;
-}
-
 WizardStep ParseStep(const nlohmann::json& v) {
   const std::string s = v.is_string() ? v.get<std::string>() : "";
   if (s == "intrinsics") return WizardStep::kIntrinsics;
