@@ -1,8 +1,11 @@
 // spritestation ingest SESSION --bank BANK [--config station.yaml] [--no-transitions]
-//                     [--transition-weights W] [--json]:
+//                     [--transition-weights W] [--decode-threads N] [--json]:
 // runs a recorded session through the live pipeline into a sprite bank as fast
 // as the machine allows, keeps the bank's transitions current (unless
 // --no-transitions) and prints what it kept and what it discarded, by reason.
+// A camera none of whose frames could be read, or whose recording is damaged or
+// cut short (frames its CSV lists that cannot be read), makes the command exit 1
+// naming the file and the frame, after everything readable has been stored.
 #include <unistd.h>
 
 #include <cstdio>
@@ -37,8 +40,9 @@ nlohmann::json DiscardsJson(const DiscardCounts& counts) {
 }
 
 void RunIngest(const std::string& session, const std::string& bank, const std::string& config_path, bool json,
-               bool transitions, const std::string& transition_weights) {
+               bool transitions, const std::string& transition_weights, int decode_threads) {
   IngestOptions options;
+  options.decode_threads = decode_threads;
   options.session_dir = session;
   options.bank_path = bank;
   options.transitions = transitions;
@@ -59,6 +63,11 @@ void RunIngest(const std::string& session, const std::string& bank, const std::s
     if (c.stats.frames == 0) {
       failed.push_back("camera " + c.name + ": no frame of it could be read" +
                        (s.source.last_error.empty() ? "" : " (" + s.source.last_error + ")"));
+    } else if (c.replay.frames_unreadable > 0) {
+      // A damaged or cut recording: the frames around the damage are stored, the damage is named.
+      failed.push_back("camera " + c.name + ": " + std::to_string(c.replay.frames_unreadable) + " of " +
+                       std::to_string(c.replay.frames_in_csv) + " frames could not be read" +
+                       (c.replay.problems.empty() ? "" : " (" + c.replay.problems.front() + ")"));
     }
   }
   if (s.transitions && !s.transitions_error.empty()) {
@@ -105,7 +114,9 @@ void RunIngest(const std::string& session, const std::string& bank, const std::s
                                 {"sequence_gaps", c.stats.sequence_gaps},
                                 {"discards", DiscardsJson(c.stats.discards)},
                                 {"seconds_key", c.stats.seconds_key},
-                                {"seconds_rest", c.stats.seconds_rest}});
+                                {"seconds_rest", c.stats.seconds_rest},
+                                {"unreadable_frames", c.replay.frames_unreadable},
+                                {"problems", c.replay.problems}});
     }
     out["failed"] = failed;
     std::printf("%s\n", out.dump(2).c_str());
@@ -164,14 +175,19 @@ void AddIngestCommand(CLI::App& app) {
   auto json = std::make_shared<bool>(false);
   auto transitions = std::make_shared<bool>(true);
   auto weights = std::make_shared<std::string>();
+  auto decode_threads = std::make_shared<int>(0);
   cmd->add_option("SESSION", *session, "Recorded session folder")->required();
   cmd->add_option("--bank", *bank, "Sprite bank (created when missing)")->required();
   cmd->add_option("--config", *config, "Station config (keying, enclosure, pipeline sections)");
   cmd->add_flag("--transitions,!--no-transitions", *transitions,
                 "Keep the bank's transition table current while ingesting (default on)");
   cmd->add_option("--transition-weights", *weights, "Transition classifier weights (default: the shipped weights)");
+  cmd->add_option("--decode-threads", *decode_threads,
+                  "Decoder threads per camera for FFV1/ffvhuff videos (0: one per core; 1: one decoder, "
+                  "frames decoded one after another)")
+      ->check(CLI::NonNegativeNumber);
   cmd->add_flag("--json", *json, "Print the summary as JSON");
-  cmd->callback([=] { RunIngest(*session, *bank, *config, *json, *transitions, *weights); });
+  cmd->callback([=] { RunIngest(*session, *bank, *config, *json, *transitions, *weights, *decode_threads); });
 }
 
 }  // namespace ss::apps

@@ -113,7 +113,7 @@ struct ReplaySource::Impl {
     std::unique_ptr<VideoReader> reader;
     try {
       reader = std::make_unique<VideoReader>(cam.video_path, cam.meta.pixel_format, cam.meta.width,
-                                             cam.meta.height);
+                                             cam.meta.height, options.decode_threads);
     } catch (const std::exception& e) {
       Problem(cam, std::string(e.what()) + " (camera '" + cam.meta.name + "' skipped)");
       std::lock_guard<std::mutex> lock(mutex);

@@ -2,8 +2,9 @@
 // Replays a recorded session (core/session.h) as a FrameSource: every camera's
 // frames merged in device-timestamp order, each with its original timestamp_ns
 // and sequence number from the CSV and in the camera's own pixel format (a
-// Bayer session replays as Bayer). One decoding thread per camera runs a few
-// frames ahead into reused buffers.
+// Bayer session replays as Bayer). One thread per camera reads its video a few
+// frames ahead into reused buffers; FFV1 and ffvhuff frames are decoded in
+// parallel by decoder threads of their own (VideoReader, decode_threads).
 //
 // Damage does not stop a replay: a corrupt frame, a truncated video or a video
 // that cannot be opened is logged as [capture.replay] naming the file and the
@@ -25,6 +26,7 @@ struct ReplayOptions {
   bool realtime = false;     // keep the original inter-frame timing (else as fast as possible)
   int loops = 1;             // passes over the session; 0 = until Stop()
   int frames_ahead = 4;      // decoded frames each camera may hold ready
+  int decode_threads = 0;    // per camera: 0 = one decoder thread per core, 1 = one decoder (VideoReader)
   std::string camera;        // replay only this camera of the session ("" = every camera); it is then Frame::camera 0
   // Later passes shift timestamp_ns by the session's span (plus one frame) and
   // sequence by the camera's sequence span, so time never runs backwards.

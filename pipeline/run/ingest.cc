@@ -92,6 +92,7 @@ IngestSummary IngestSession(const IngestOptions& options) {
   ReplayOptions replay_options;
   replay_options.realtime = false;
   replay_options.frames_ahead = 6;
+  replay_options.decode_threads = options.decode_threads;
   ReplaySource source(options.session_dir, replay_options);
   const SessionInfo& info = source.session();
   const GroundPolygon floor = FloorForSession(options.session_dir, config);
@@ -273,9 +274,11 @@ IngestSummary IngestSession(const IngestOptions& options) {
   }
 
   summary.source = source.stats();
-  for (CameraWork& w : cameras) {
+  const std::vector<ReplayCameraStats> replay_stats = source.camera_stats();
+  for (size_t c = 0; c < cameras.size(); ++c) {
+    CameraWork& w = cameras[c];
     const CameraPipelineStats& s = w.pipeline->stats();
-    summary.cameras.push_back({w.name, w.camera_id, s});
+    summary.cameras.push_back({w.name, w.camera_id, s, c < replay_stats.size() ? replay_stats[c] : ReplayCameraStats{}});
     summary.frames += s.frames;
     summary.sprites_kept += s.stored_sprites;
     for (size_t r = 0; r < summary.discards.size(); ++r) summary.discards[r] += s.discards[r];

@@ -1,9 +1,11 @@
 #pragma once
 // `spritestation ingest`: a recorded session through the live pipeline into a
-// bank, as fast as the machine allows. The replay decodes each camera on its
-// own thread; each camera's pipeline runs on its own thread; one writer thread
-// stores the clip batches, so no stage waits on the disk. Ingesting the same
-// session twice stores nothing new (the bank knows the session and its sprites).
+// bank, as fast as the machine allows. The replay reads each camera on its own
+// thread a few frames ahead of the pipeline, with one decoder thread per core
+// decoding FFV1/ffvhuff frames in parallel; each camera's pipeline runs on its
+// own thread; one writer thread stores the clip batches, so no stage waits on
+// the disk. Ingesting the same session twice stores nothing new (the bank knows
+// the session and its sprites).
 // With `transitions` on, a TransitionWorker (pipeline/transitions/worker.h) is handed
 // each stored batch's sprite ids and keeps the bank's transition table current; the
 // ingest waits for it at the end.
@@ -13,6 +15,7 @@
 #include <vector>
 
 #include "capture/frame_source.h"
+#include "capture/replay/replay_source.h"
 #include "core/config.h"
 #include "core/geometry.h"
 #include "pipeline/run/camera_pipeline.h"
@@ -33,12 +36,16 @@ struct IngestOptions {
   std::function<void(const IngestProgress&)> progress;  // a few times a second, from the calling thread
   bool transitions = true;         // keep the transition table current (TransitionWorker)
   std::string transition_weights;  // weights file; empty: the shipped default weights
+  // Decoder threads per camera (ReplayOptions::decode_threads): 0 = one per core, 1 = frames
+  // decoded one after another on the replay thread. The bank is the same either way.
+  int decode_threads = 0;
 };
 
 struct IngestCamera {
   std::string name;
   int64_t bank_camera_id = 0;
   CameraPipelineStats stats;
+  ReplayCameraStats replay;  // what its recording held: unreadable frames, each problem naming the file and frame
 };
 
 struct IngestSummary {

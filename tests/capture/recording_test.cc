@@ -5,11 +5,13 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <tuple>
 
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 
 #include "capture/recording/session_writer.h"
+#include "capture/recording/video_reader.h"
 #include "capture/replay/replay_source.h"
 #include "core/camera_model.h"
 #include "core/error.h"
@@ -273,6 +275,50 @@ TEST(Replay, HeldFramesDoNotStallTheReplay) {
     const auto expected = TestPixels(PixelFormat::kBGR8, 32, 16, 0, f.sequence);
     EXPECT_EQ(std::memcmp(f.data, expected.data(), expected.size()), 0) << f.sequence;
   }
+}
+
+// Issue 19: FFV1 and ffvhuff frames are decoded by several decoder threads at once. Each
+// camera format, in either codec, must come back as the same bytes in the same order as
+// with one decoder, and as recorded.
+class ParallelDecoding : public ::testing::TestWithParam<std::tuple<std::string, PixelFormat>> {};
+
+TEST_P(ParallelDecoding, GivesTheFramesOneDecoderGivesInFileOrder) {
+  const auto& [codec, format] = GetParam();
+  ScratchDir dir;
+  const std::string session = dir / "s";
+  RecordTestSession(session, format, 96, 64, 41, {.codec = codec});
+  // The reader really decodes with three threads (else this test would compare a path with itself).
+  EXPECT_EQ(VideoReader(session + "/cam0.mkv", format, 96, 64, 3).decode_threads(), 3);
+  EXPECT_EQ(VideoReader(session + "/cam0.mkv", format, 96, 64, 1).decode_threads(), 1);
+  const std::vector<Frame> one = ReplayAll(session, {.decode_threads = 1});
+  const std::vector<Frame> three = ReplayAll(session, {.decode_threads = 3});
+  ASSERT_EQ(one.size(), 41u);
+  ASSERT_EQ(three.size(), 41u);
+  for (size_t i = 0; i < one.size(); ++i) {
+    ASSERT_EQ(three[i].sequence, i);
+    ASSERT_EQ(three[i].timestamp_ns, one[i].timestamp_ns);
+    ASSERT_EQ(three[i].size, one[i].size);
+    EXPECT_EQ(std::memcmp(three[i].data, one[i].data, one[i].size), 0) << "frame " << i;
+    const auto expected = TestPixels(format, 96, 64, 0, i);
+    EXPECT_EQ(std::memcmp(three[i].data, expected.data(), expected.size()), 0) << "frame " << i;
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    LosslessCodecs, ParallelDecoding,
+    ::testing::Combine(::testing::Values("ffv1", "ffvhuff"),
+                       ::testing::Values(PixelFormat::kBGR8, PixelFormat::kRGB8, PixelFormat::kMono8,
+                                         PixelFormat::kYUYV, PixelFormat::kNV12)),
+    [](const auto& info) {
+      return std::get<0>(info.param) + "_" + PixelFormatName(std::get<1>(info.param));
+    });
+
+TEST(ParallelDecoding, LossyCodecsKeepOneDecoder) {
+  ScratchDir dir;
+  const std::string session = dir / "s";
+  RecordTestSession(session, PixelFormat::kBGR8, 96, 64, 5, {.codec = "h264"}, 33'000'000, 1'000'000'000, true);
+  EXPECT_EQ(VideoReader(session + "/cam0.mkv", PixelFormat::kBGR8, 96, 64, 4).decode_threads(), 1);
+  EXPECT_EQ(ReplayAll(session, {.decode_threads = 4}).size(), 5u);
 }
 
 }  // namespace

@@ -152,14 +152,21 @@ TEST(KilledRecorder, FramesWrittenBeforeAPauseAreFlushedInTheBackground) {
   EXPECT_EQ(source.stats().errors, 0u) << AllProblems(source);
 }
 
-TEST(DamagedVideo, TruncatedFileReplaysItsReadablePartAndNamesTheFile) {
+// Damage is read the same with one decoder and with decoder threads decoding frames in
+// parallel (issue 19): each test runs with both.
+class DamagedVideo : public ::testing::TestWithParam<int> {
+ protected:
+  ReplayOptions Options() const { return {.decode_threads = GetParam()}; }
+};
+
+TEST_P(DamagedVideo, TruncatedFileReplaysItsReadablePartAndNamesTheFile) {
   ScratchDir dir;
   const std::string session = dir / "s";
   RecordTestSession(session, PixelFormat::kBGR8, 160, 120, 30);
   const std::string video = session + "/cam0.mkv";
   std::filesystem::resize_file(video, std::filesystem::file_size(video) * 6 / 10);
 
-  ReplaySource source(session);
+  ReplaySource source(session, Options());
   std::vector<Frame> frames;
   while (auto f = source.Next()) frames.push_back(std::move(*f));
   ASSERT_GT(frames.size(), 5u);
@@ -179,7 +186,7 @@ TEST(DamagedVideo, TruncatedFileReplaysItsReadablePartAndNamesTheFile) {
   EXPECT_TRUE(Contains(cli.output, video)) << cli.output;
 }
 
-TEST(DamagedVideo, CutAnywhereTheReadablePrefixReplaysIntact) {
+TEST_P(DamagedVideo, CutAnywhereTheReadablePrefixReplaysIntact) {
   ScratchDir dir;
   const std::string original = dir / "original";
   RecordTestSession(original, PixelFormat::kYUYV, 64, 48, 20);
@@ -189,7 +196,7 @@ TEST(DamagedVideo, CutAnywhereTheReadablePrefixReplaysIntact) {
     const std::string session = dir / ("cut" + std::to_string(cut));
     std::filesystem::copy(original, session);
     std::filesystem::resize_file(session + "/cam0.mkv", size * static_cast<uintmax_t>(cut) / 40);
-    ReplaySource source(session);
+    ReplaySource source(session, Options());
     std::vector<Frame> frames;
     while (auto f = source.Next()) frames.push_back(std::move(*f));
     for (size_t i = 0; i < frames.size(); ++i) ASSERT_EQ(frames[i].sequence, i) << "cut " << cut;
@@ -204,7 +211,7 @@ TEST(DamagedVideo, CutAnywhereTheReadablePrefixReplaysIntact) {
   EXPECT_EQ(previous, 20u);
 }
 
-TEST(DamagedVideo, CorruptFrameIsNamedAndSkipped) {
+TEST_P(DamagedVideo, CorruptFrameIsNamedAndSkipped) {
   ScratchDir dir;
   const std::string session = dir / "s";
   RecordTestSession(session, PixelFormat::kBGR8, 160, 120, 30);
@@ -220,7 +227,7 @@ TEST(DamagedVideo, CorruptFrameIsNamedAndSkipped) {
     file.seekp(size / 2);
     file.write(bytes, sizeof(bytes));
   }
-  ReplaySource source(session);
+  ReplaySource source(session, Options());
   std::vector<Frame> frames;
   while (auto f = source.Next()) frames.push_back(std::move(*f));
   ExpectFramesIntact(frames, PixelFormat::kBGR8, 160, 120);
@@ -232,7 +239,10 @@ TEST(DamagedVideo, CorruptFrameIsNamedAndSkipped) {
   EXPECT_EQ(source.stats().frames_dropped, 30u - frames.size());
 }
 
-TEST(DamagedVideo, UnopenableVideoSkipsItsCameraOnly) {
+INSTANTIATE_TEST_SUITE_P(DecodeThreads, DamagedVideo, ::testing::Values(1, 3),
+                         [](const auto& info) { return std::to_string(info.param) + "_decoders"; });
+
+TEST(UnopenableVideo, SkipsItsCameraOnly) {
   ScratchDir dir;
   const std::string session = dir / "s";
   {

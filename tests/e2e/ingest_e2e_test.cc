@@ -120,24 +120,107 @@ TEST_F(IngestEndToEnd, ACameraThatCannotBeReadIsAFailureNamedAfterTheRest) {
   EXPECT_EQ(verify.exit_code, 0) << verify.output;
 }
 
+// Issue 19: a recording cut short or damaged in the middle. Ingest stores every frame it can
+// read (the sprites before the damage, and the other camera's), then exits 1 naming the file
+// and the frame, instead of reporting success.
+TEST_F(IngestEndToEnd, ATruncatedRecordingIsAFailureNamingTheFileAfterStoringWhatCameBefore) {
+  namespace fs = std::filesystem;
+  const fs::path damaged = fs::path(*dir_ / "truncated");
+  fs::copy(*dir_ / "session", damaged, fs::copy_options::recursive);
+  const fs::path video = damaged / "cam0.mkv";
+  fs::resize_file(video, fs::file_size(video) * 7 / 10);
+  const std::string bank = *dir_ / "truncated.bank";
+  const auto r = RunSpritestation("--log-level warn ingest " + damaged.string() + " --bank " + bank +
+                                  " --no-transitions --json");
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.output.find("camera cam0: "), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find(video.string() + ": video ends after "), std::string::npos) << r.output;
+  const auto j = JsonInOutput(r.output);
+  ASSERT_TRUE(j.contains("cameras")) << r.output;
+  for (const auto& c : j["cameras"]) {
+    if (c["name"] == "cam0") {
+      // The frames before the cut went through the pipeline and their sprites are stored.
+      EXPECT_GT(c["frames"].get<int>(), 60) << r.output;
+      EXPECT_LT(c["frames"].get<int>(), 180) << r.output;
+      EXPECT_GT(c["sprites_kept"].get<int>(), 0) << r.output;
+      EXPECT_EQ(c["unreadable_frames"].get<int>(), 180 - c["frames"].get<int>()) << r.output;
+    } else {
+      EXPECT_EQ(c["frames"].get<int>(), 180) << r.output;
+      EXPECT_EQ(c["unreadable_frames"].get<int>(), 0) << r.output;
+    }
+  }
+  EXPECT_EQ(j["failed"].size(), 1u) << r.output;
+  const auto info = RunSpritestation("--log-level warn bank info " + bank + " --json");
+  ASSERT_EQ(info.exit_code, 0) << info.output;
+  EXPECT_EQ(JsonInOutput(info.output)["sprites"].get<int>(), j["rows_inserted"].get<int>()) << info.output;
+  EXPECT_GT(j["rows_inserted"].get<int>(), 0) << r.output;
+}
+
+TEST_F(IngestEndToEnd, ACorruptFrameIsAFailureNamingTheFileAndTheFrame) {
+  namespace fs = std::filesystem;
+  const fs::path damaged = fs::path(*dir_ / "corrupt");
+  fs::copy(*dir_ / "session", damaged, fs::copy_options::recursive);
+  const fs::path video = damaged / "cam1.mkv";
+  {
+    // Flip a run of bytes in the middle of the file: inside some frame's data.
+    std::fstream file(video, std::ios::in | std::ios::out | std::ios::binary);
+    const auto middle = static_cast<std::streamoff>(fs::file_size(video) / 2);
+    file.seekg(middle);
+    char bytes[16];
+    file.read(bytes, sizeof(bytes));
+    for (char& b : bytes) b = static_cast<char>(~b);
+    file.seekp(middle);
+    file.write(bytes, sizeof(bytes));
+  }
+  const std::string bank = *dir_ / "corrupt.bank";
+  const auto r = RunSpritestation("--log-level warn ingest " + damaged.string() + " --bank " + bank +
+                                  " --no-transitions --json");
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.output.find(" of 180 frames could not be read (" + video.string() + ": frame "), std::string::npos)
+      << r.output;
+  const auto j = JsonInOutput(r.output);
+  ASSERT_TRUE(j.contains("cameras")) << r.output;
+  for (const auto& c : j["cameras"]) {
+    if (c["name"] == "cam1") {
+      // Only the damaged frame (or its cluster) is lost; the frames after it are read again.
+      EXPECT_GE(c["frames"].get<int>(), 170) << r.output;
+      EXPECT_LT(c["frames"].get<int>(), 180) << r.output;
+      EXPECT_EQ(c["unreadable_frames"].get<int>(), 180 - c["frames"].get<int>()) << r.output;
+    } else {
+      EXPECT_EQ(c["frames"].get<int>(), 180) << r.output;
+    }
+  }
+  EXPECT_GT(j["rows_inserted"].get<int>(), 0) << r.output;
+}
+
 // A 1080p session recorded in the fast codec (ffvhuff) and in FFV1 is the same footage: both
-// decode to the same bytes, so ingest stores the same bank from either.
-TEST(IngestCodecs, FfvhuffAndFfv1GiveTheSameBank) {
+// decode to the same bytes, so ingest stores the same bank from either; and the FFV1 session
+// ingested with one decoder (frames decoded one after another, as before issue 19) stores the
+// same bank as with the decoder threads.
+TEST(IngestCodecs, FfvhuffAndFfv1GiveTheSameBankWithAnyNumberOfDecoders) {
   ScratchDir dir;
   const std::string common = " --kind animal --seconds 5 --fps 10 --size 1920x1080 --cameras 1 --subjects 1 --seed 4"
                              " --empty-lead-in 3 --no-mattes --noise 1";
-  std::string digest[2];
-  int index = 0;
   for (const std::string codec : {"ffv1", "ffvhuff"}) {
-    const std::string session = dir / codec;
-    auto r = RunSpritestation("--log-level warn synth --out " + session + common + " --codec " + codec);
+    const auto r = RunSpritestation("--log-level warn synth --out " + dir / codec + common + " --codec " + codec);
     ASSERT_EQ(r.exit_code, 0) << r.output;
-    const std::string bank = dir / (codec + ".bank");
-    r = RunSpritestation("--log-level warn ingest " + session + " --bank " + bank + " --no-transitions --json");
+  }
+  struct Run {
+    std::string codec;
+    std::string decoders;  // --decode-threads
+  };
+  const Run runs[] = {{"ffv1", "0"}, {"ffv1", "1"}, {"ffvhuff", "0"}, {"ffvhuff", "1"}};
+  std::string digest[4];
+  int index = 0;
+  for (const Run& run : runs) {
+    const std::string session = dir / run.codec;
+    const std::string bank = dir / (run.codec + "-" + run.decoders + ".bank");
+    auto r = RunSpritestation("--log-level warn ingest " + session + " --bank " + bank +
+                              " --no-transitions --json --decode-threads " + run.decoders);
     ASSERT_EQ(r.exit_code, 0) << r.output;
     const nlohmann::json j = JsonInOutput(r.output);
     ASSERT_TRUE(j.is_object()) << r.output;
-    EXPECT_GT(j["sprites_kept"].get<int>(), 5) << codec << ": " << r.output;
+    EXPECT_GT(j["sprites_kept"].get<int>(), 5) << run.codec << ": " << r.output;
     // Every stored number and every billboard's bytes, in order.
     r = testing::RunCommand("sqlite3 -readonly " + bank +
                             " \"SELECT s.frame, s.track_id, s.mirrored, s.ground_x_m, s.ground_y_m, s.mean_r, s.mean_g,"
@@ -147,8 +230,11 @@ TEST(IngestCodecs, FfvhuffAndFfv1GiveTheSameBank) {
     digest[index++] = r.output;
   }
   EXPECT_FALSE(digest[0].empty());
-  EXPECT_TRUE(digest[0] == digest[1]) << "the banks differ (" << digest[0].size() << " vs " << digest[1].size()
-                                      << " bytes of rows)";
+  for (int i = 1; i < 4; ++i) {
+    EXPECT_TRUE(digest[0] == digest[i]) << runs[i].codec << " with --decode-threads " << runs[i].decoders
+                                        << ": the banks differ (" << digest[0].size() << " vs " << digest[i].size()
+                                        << " bytes of rows)";
+  }
 }
 
 }  // namespace
