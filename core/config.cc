@@ -452,7 +452,8 @@ void ReadPipeline(Reader& r, const YAML::Node& node, PipelineConfig& p) {
   const MapView view = r.Map(node, "pipeline");
   r.Known(view, {"min_area_px", "border_margin_px", "floor_margin_px", "wall_margin_m",
                  "still_speed_m_per_s", "max_still_s", "min_clip_frames", "px_per_m", "workers",
-                 "queue_frames"});
+                 "queue_frames", "noise_recover_solidity", "noise_thick_px", "noise_min_thick_share", "noise_min_solidity",
+                 "noise_min_largest_share", "noise_min_mean_alpha"});
   r.Int(view, "min_area_px", p.min_area_px, "an area in pixels");
   r.Int(view, "border_margin_px", p.border_margin_px, "a number of pixels");
   r.Int(view, "floor_margin_px", p.floor_margin_px, "a number of pixels");
@@ -460,6 +461,12 @@ void ReadPipeline(Reader& r, const YAML::Node& node, PipelineConfig& p) {
   r.Number(view, "still_speed_m_per_s", p.still_speed_m_per_s, "a speed in m/s");
   r.Number(view, "max_still_s", p.max_still_s, "a duration in seconds");
   r.Int(view, "min_clip_frames", p.min_clip_frames, "a number of frames");
+  r.Number(view, "noise_recover_solidity", p.noise_recover_solidity, "a share from 0 to 1");
+  r.Number(view, "noise_thick_px", p.noise_thick_px, "a distance in pixels");
+  r.Number(view, "noise_min_thick_share", p.noise_min_thick_share, "a share from 0 to 1");
+  r.Number(view, "noise_min_solidity", p.noise_min_solidity, "a share from 0 to 1");
+  r.Number(view, "noise_min_largest_share", p.noise_min_largest_share, "a share from 0 to 1");
+  r.Number(view, "noise_min_mean_alpha", p.noise_min_mean_alpha, "a share from 0 to 1");
   // `auto` (stored as 0) or a positive number of pixels per metre.
   if (const YAML::Node* n = view.Find("px_per_m"); n && n->IsScalar() && n->Scalar() == "auto") {
     p.px_per_m = 0;
@@ -722,6 +729,15 @@ class Validator {
     Positive(p.max_still_s, "pipeline.max_still_s");
     Check(p.min_clip_frames >= 1, "pipeline.min_clip_frames",
           "expected at least 1 frame, got " + std::to_string(p.min_clip_frames));
+    NonNegative(p.noise_thick_px, "pipeline.noise_thick_px");
+    for (const auto& [v, key] : {std::pair{p.noise_recover_solidity, "noise_recover_solidity"},
+                                 std::pair{p.noise_min_thick_share, "noise_min_thick_share"},
+                                 std::pair{p.noise_min_solidity, "noise_min_solidity"},
+                                 std::pair{p.noise_min_largest_share, "noise_min_largest_share"},
+                                 std::pair{p.noise_min_mean_alpha, "noise_min_mean_alpha"}}) {
+      Check(std::isfinite(v) && v >= 0 && v <= 1, std::string("pipeline.") + key,
+            "expected a share from 0 to 1 (0 turns the test off), got " + Num(v));
+    }
     Check(p.px_per_m == 0 || (std::isfinite(p.px_per_m) && p.px_per_m > 0), "pipeline.px_per_m",
           "expected auto or a positive number, got " + Num(p.px_per_m));
     Check(p.workers >= 0, "pipeline.workers",

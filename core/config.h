@@ -99,6 +99,13 @@ struct PipelineConfig {
   double still_speed_m_per_s = 0.05;  // slower than this counts as not moving
   double max_still_s = 2.0;           // still periods longer than this are discarded
   int min_clip_frames = 5;            // shorter clips are discarded
+  // Noise (docs/pipeline.md, `noise`): keyed background, not a subject. 0 turns a test off.
+  double noise_min_solidity = 0.25;      // noise when the matte fills less of its convex hull
+  double noise_recover_solidity = 0.30;  // a subject noise the frame before stays noise below this
+  double noise_thick_px = 2.0;           // interior: more than this from the matte's edge (pixels)
+  double noise_min_thick_share = 0.0;    // ... or when less of the matte is interior
+  double noise_min_largest_share = 0.0;  // ... or its largest part holds less of it
+  double noise_min_mean_alpha = 0.0;     // ... or its mean alpha (of 1) is lower
   // Billboard scale in pixels per metre, the same for the whole bank; 0 = `auto` (chosen from
   // the cameras, or the bank's own scale when it holds sprites: pipeline/run/bank_scale.h).
   double px_per_m = 0;

@@ -17,6 +17,7 @@ const char* DiscardName(Discard reason) {
     case Discard::kStill: return "still";
     case Discard::kShortClip: return "short_clip";
     case Discard::kTooLarge: return "too_large";
+    case Discard::kNoise: return "noise";
     case Discard::kCount: break;
   }
   return "unknown";
@@ -169,6 +170,58 @@ Discard FloorMask::Check(const cv::Mat& alpha_crop, cv::Point offset, const Eige
     }
   }
   return Discard::kNone;
+}
+
+MatteShape MeasureMatteShape(const cv::Mat& alpha_crop, double thick_px) {
+  MatteShape s;
+  if (alpha_crop.empty()) return s;
+  const cv::Mat solid = alpha_crop > 127;
+  const int area = cv::countNonZero(solid);
+  s.area_px = area;
+  const cv::Mat present = alpha_crop >= 16;
+  const int present_px = cv::countNonZero(present);
+  if (present_px > 0) s.mean_alpha = cv::mean(alpha_crop, present)[0] / 255.0;
+  if (area == 0) return s;
+
+  std::vector<cv::Point> points;
+  cv::findNonZero(solid, points);
+  std::vector<cv::Point> hull;
+  cv::convexHull(points, hull);
+  // The hull through pixel centres misses half a pixel all round: count it back so a filled
+  // rectangle is 1, not (w-1)(h-1)/(wh).
+  const double hull_area = cv::contourArea(hull) + 0.5 * cv::arcLength(hull, true) + 1.0;
+  s.solidity = std::min(1.0, area / hull_area);
+
+  cv::Mat labels, stats, centroids;
+  const int n = cv::connectedComponentsWithStats(solid, labels, stats, centroids, 8, CV_32S);
+  int largest = 0;
+  for (int i = 1; i < n; ++i) largest = std::max(largest, stats.at<int>(i, cv::CC_STAT_AREA));
+  s.largest_share = static_cast<double>(largest) / area;
+
+  // Distance to the nearest non-solid pixel, the crop's outside counting as non-solid.
+  cv::Mat padded, dist;
+  cv::copyMakeBorder(solid, padded, 1, 1, 1, 1, cv::BORDER_CONSTANT, cv::Scalar(0));
+  cv::distanceTransform(padded, dist, cv::DIST_L2, cv::DIST_MASK_PRECISE);
+  s.thick_share = static_cast<double>(cv::countNonZero(dist > thick_px)) / area;
+  return s;
+}
+
+bool IsNoise(const MatteShape& shape, const NoiseOptions& o) {
+  return shape.solidity < o.min_solidity || shape.thick_share < o.min_thick_share ||
+         shape.largest_share < o.min_largest_share || shape.mean_alpha < o.min_mean_alpha;
+}
+
+void NoiseFilter::NextFrame() {
+  last_.swap(current_);
+  current_.clear();
+}
+
+bool NoiseFilter::IsNoise(int subject, const MatteShape& shape) {
+  const auto before = last_.find(subject);
+  const bool was_noise = before != last_.end() && before->second;
+  const bool noise = ss::IsNoise(shape, options_) || (was_noise && shape.solidity < options_.recover_solidity);
+  current_[subject] = noise;
+  return noise;
 }
 
 bool StillnessFilter::IsStill(int subject, int64_t timestamp_ns, const Eigen::Vector2d& point) {

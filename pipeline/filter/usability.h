@@ -27,6 +27,7 @@ enum class Discard {
   kStill,          // part of an extended period without motion
   kShortClip,      // its clip was too short to give transitions
   kTooLarge,       // its billboard at the bank's scale (pipeline.px_per_m) exceeds the size limit
+  kNoise,          // keyed background, not a subject: scattered specks, thin lines, a soft haze (NoiseRule)
   kCount,
 };
 const char* DiscardName(Discard reason);  // "too_small", "touches_border", ...
@@ -44,6 +45,50 @@ struct UsabilityOptions {
   // over the subject's contact point: background behind a tall subject's upper part, not something
   // in front of it (what stands on the floor in front of a subject hides its lowest part first).
   double wall_check_height_m = 0.3;
+};
+
+// The shape of a candidate's matte (its alpha crop at full resolution), for telling a subject from
+// keyed background (issue 19). The matte is `alpha > 127` ("solid").
+struct MatteShape {
+  double area_px = 0;        // solid pixels
+  double solidity = 0;       // solid pixels / their convex hull's area (1: convex; specks, rings: low)
+  double thick_share = 0;    // of the solid pixels, those more than `thick_px` from the matte's edge
+  double largest_share = 0;  // of the solid pixels, those in the largest 8-connected part
+  double mean_alpha = 0;     // mean alpha / 255 over the pixels of alpha >= 16 (a soft haze: low)
+};
+// `thick_px`: distance to the matte's edge (L2) from which a pixel is interior.
+MatteShape MeasureMatteShape(const cv::Mat& alpha_crop, double thick_px);
+
+// When a candidate is noise (Discard::kNoise): a matte that fills too little of its convex hull
+// (keyed background: specks, pieces of a sign, a line of tape, alone or joined to a person), or,
+// when set, one with too little interior, too scattered or too soft. A threshold of 0 turns its
+// test off. Defaults: measured on vtest.avi and the synthetic sessions (docs/pipeline.md).
+struct NoiseOptions {
+  double thick_px = 2.0;            // MatteShape::thick_px
+  double min_solidity = 0.25;       // noise when solidity is below this
+  double min_thick_share = 0.0;     // ... or thick_share
+  double min_largest_share = 0.0;   // ... or largest_share
+  double min_mean_alpha = 0.0;      // ... or mean_alpha
+  // A subject whose previous frame was noise stays noise until its solidity reaches this
+  // (keyed background flickers about the threshold; 0: no memory).
+  double recover_solidity = 0.30;
+};
+// The shape tests alone, without a subject's history.
+bool IsNoise(const MatteShape& shape, const NoiseOptions& options);
+
+// Per subject: IsNoise, with the memory of NoiseOptions::recover_solidity.
+class NoiseFilter {
+ public:
+  explicit NoiseFilter(NoiseOptions options) : options_(options) {}
+  // Starts a frame: subjects not checked in the frame before are forgotten.
+  void NextFrame();
+  // True when the tracked subject's matte this frame is noise.
+  bool IsNoise(int subject, const MatteShape& shape);
+  const NoiseOptions& options() const { return options_; }
+
+ private:
+  NoiseOptions options_;
+  std::unordered_map<int, bool> last_, current_;  // subject -> noise, the frame before and this one
 };
 
 // Per camera: the image of the floor, computed once.

@@ -58,6 +58,8 @@ CameraPipelineOptions PipelineOptionsFromConfig(const StationConfig& config) {
   o.usability.floor_margin_px = p.floor_margin_px;
   o.usability.wall_margin_m = p.wall_margin_m;
   o.usability.wall_height_m = config.enclosure.wall_height_m;
+  o.noise = {p.noise_thick_px,          p.noise_min_solidity,   p.noise_min_thick_share,
+             p.noise_min_largest_share, p.noise_min_mean_alpha, p.noise_recover_solidity};
   o.still_speed_m_per_s = p.still_speed_m_per_s;
   o.max_still_s = p.max_still_s;
   o.rectify.px_per_m = p.px_per_m;
@@ -78,6 +80,7 @@ CameraPipeline::CameraPipeline(std::string name, int64_t camera_id, CameraModel 
       extractor_(options.extract),
       tracker_(options.track),
       stillness_(options.still_speed_m_per_s, options.max_still_s),
+      noise_(options.noise),
       rectifier_(options.rectify),
       batcher_(camera_id, options.batch),
       log_(Log("pipeline.run")) {
@@ -156,11 +159,22 @@ void CameraPipeline::Process(const Frame& frame, std::vector<ClipBatch>* out) {
   const std::vector<int> subjects = tracker_.Update(frame.timestamp_ns, inputs);
 
   // Filter and rectify.
+  noise_.NextFrame();
   std::vector<bool> usable(subjects.size(), false);
   std::vector<std::optional<Billboard>> billboards(subjects.size());
   for (size_t k = 0; k < subjects.size(); ++k) {
     const Candidate& c = *grounded[k];
     Discard reason = c.touches_border ? Discard::kTouchesBorder : floor_mask_.Check(c.alpha, c.bbox.tl(), points[k]);
+    if (reason == Discard::kNone) {
+      const MatteShape shape = MeasureMatteShape(c.alpha, options_.noise.thick_px);
+      if (noise_.IsNoise(subjects[k], shape)) reason = Discard::kNoise;
+      if (log_->should_log(spdlog::level::trace)) {
+        log_->trace("{} frame {} subject {} box {}x{}+{}+{} shape area {:.0f} solidity {:.3f} thick {:.3f} "
+                    "largest {:.3f} mean_alpha {:.3f}",
+                    name_, frame.sequence, subjects[k], c.bbox.width, c.bbox.height, c.bbox.x, c.bbox.y,
+                    shape.area_px, shape.solidity, shape.thick_share, shape.largest_share, shape.mean_alpha);
+      }
+    }
     const bool still = stillness_.IsStill(subjects[k], frame.timestamp_ns, points[k]);
     if (reason == Discard::kNone && still) reason = Discard::kStill;
     if (reason == Discard::kNone) {

@@ -40,6 +40,7 @@ struct CameraPipelineOptions {
   ExtractorOptions extract;
   TrackerOptions track;
   UsabilityOptions usability;
+  NoiseOptions noise;
   double still_speed_m_per_s = 0.05;
   double max_still_s = 2.0;
   RectifierOptions rectify;
@@ -113,6 +114,7 @@ class CameraPipeline {
   Extractor extractor_;
   Tracker tracker_;
   StillnessFilter stillness_;
+  NoiseFilter noise_;
   ClipCutter cutter_;
   Rectifier rectifier_;
   ClipBatcher batcher_;

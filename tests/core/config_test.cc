@@ -129,6 +129,9 @@ TEST(StationConfig, ExampleParsesIntoEveryField) {
   EXPECT_EQ(cfg.pipeline.px_per_m, 0);  // auto
   EXPECT_EQ(cfg.pipeline.workers, 0);
   EXPECT_EQ(cfg.pipeline.queue_frames, 8);
+  EXPECT_EQ(cfg.pipeline.noise_min_solidity, 0.25);
+  EXPECT_EQ(cfg.pipeline.noise_recover_solidity, 0.30);
+  EXPECT_EQ(cfg.pipeline.noise_min_thick_share, 0);  // off
 
   EXPECT_EQ(cfg.storage.bank, dir + "/station.bank");
   EXPECT_EQ(cfg.storage.recording_dir, dir + "/recordings");
@@ -306,6 +309,22 @@ TEST(StationConfig, EveryErrorIsReportedAtOnce) {
             "station.yaml:5: cameras[0].fps: expected a positive number, got \"fast\"\n"
             "station.yaml:8: pipeline.min_aera_px: unknown key (did you mean \"min_area_px\"?)\n"
             "station.yaml:7: pipeline.px_per_m: expected auto or a positive number, got -1");
+}
+
+// The noise rule's thresholds (issue 19): shares from 0 to 1, 0 turning a test off.
+TEST(StationConfig, NoiseThresholds) {
+  const StationConfig cfg = Parse(
+      "pipeline:\n  noise_min_solidity: 0\n  noise_recover_solidity: 0.4\n  noise_thick_px: 3\n"
+      "  noise_min_thick_share: 0.2\n  noise_min_largest_share: 0.5\n  noise_min_mean_alpha: 0.6\n");
+  EXPECT_EQ(cfg.pipeline.noise_min_solidity, 0);
+  EXPECT_EQ(cfg.pipeline.noise_recover_solidity, 0.4);
+  EXPECT_EQ(cfg.pipeline.noise_thick_px, 3);
+  EXPECT_EQ(cfg.pipeline.noise_min_thick_share, 0.2);
+  EXPECT_EQ(cfg.pipeline.noise_min_largest_share, 0.5);
+  EXPECT_EQ(cfg.pipeline.noise_min_mean_alpha, 0.6);
+  const std::string share = ErrorOf("pipeline:\n  noise_min_solidity: 1.5\n");
+  EXPECT_NE(share.find("pipeline.noise_min_solidity: expected a share from 0 to 1"), std::string::npos) << share;
+  EXPECT_NE(ErrorOf("pipeline:\n  noise_thick_px: -1\n").find("pipeline.noise_thick_px"), std::string::npos);
 }
 
 TEST(StationConfig, SyntaxErrorsAndBadFiles) {

@@ -110,7 +110,10 @@ TEST_F(ImportVtest, PeopleWalkingAreStoredAtTheirScaleWithLittleNoise) {
   EXPECT_LE(px_per_m, 60) << j["px_per_m_why"];
   EXPECT_EQ(j["discards"]["too_large"], 0);
   const int kept = j["sprites_kept"].get<int>();
-  EXPECT_GE(kept, 90) << ingested.output;  // 128 measured (docs/import.md)
+  // 110 measured (docs/import.md): 128 before the noise rule, which took the 11 that are no person
+  // and 7 of people (5 carrying a streak of tape, 2 in clips the rule cut short).
+  EXPECT_GE(kept, 100) << ingested.output;
+  EXPECT_GE(j["discards"]["noise"].get<int>(), 20) << ingested.output;  // 121 candidates measured
 
   const std::string exported = *dir_ / "export";
   const auto ex = RunSpritestation("--log-level warn bank export " + bank + " --out " + exported +
@@ -156,12 +159,12 @@ TEST_F(ImportVtest, PeopleWalkingAreStoredAtTheirScaleWithLittleNoise) {
   // The rough camera was fitted to people of ~1.75 m: the billboards must say so.
   EXPECT_GE(median_height_m, 1.5);
   EXPECT_LE(median_height_m, 2.0);
-  // Measured: 20 of 128 (15.6 %) judged noise. By eye (docs/import.md) 11 of the 128 are no
-  // person at all, 8 of them among these 20; the other 12 are people whose matte broke (a pair
-  // keyed as two distant parts, a person behind the lamp post). The goal is 2 % (issue 19); this
-  // bound catches a keyer or plate that gets worse (the first median plate, which replaced moving
-  // background by the median, stored 33 of 120 noise by eye, 28 of them tape-and-crowd strips).
-  EXPECT_LE(noise_share, 0.20) << judged;
+  // Measured: 12 of 110 (10.9 %) judged noise; by eye (docs/import.md) none of the 110 is noise:
+  // the 12 are people whose matte broke (a pair keyed as two distant parts, a person behind the
+  // lamp post), the judge's own error. Before the noise rule (issue 19): 20 of 128 judged, 11 of
+  // 128 noise by eye. The bound catches the rule or the keyer getting worse (the first median
+  // plate, which replaced moving background by the median, stored 33 of 120 noise by eye).
+  EXPECT_LE(noise_share, 0.12) << judged;
 }
 
 // Board calibration from footage: OpenCV's own chessboard views (left01..14.jpg, 9x6 inner

@@ -37,8 +37,8 @@ TEST_F(IngestEndToEnd, KeepsUsableSpritesAndCountsEveryDiscard) {
   EXPECT_EQ(j["frames"].get<int>(), 2 * 6 * 30);
   EXPECT_GT(j["sprites_kept"].get<int>(), 30) << r.output;
   EXPECT_EQ(j["rows_inserted"].get<int>(), 2 * j["sprites_kept"].get<int>());  // each with its mirror
-  for (const char* reason : {"too_small", "touches_border", "no_ground_hit", "leaves_floor", "touches_wall", "still",
-                             "short_clip"}) {
+  for (const char* reason : {"too_small", "touches_border", "no_ground_hit", "leaves_floor", "touches_wall", "noise",
+                             "still", "short_clip"}) {
     EXPECT_TRUE(j["discards"].contains(reason)) << reason;
   }
   ASSERT_EQ(j["cameras"].size(), 2u);

@@ -281,6 +281,8 @@ TEST_F(IngestQuality, KeepsNearlyEveryUsableFrame) {
   RecordProperty("recall", std::to_string(m.recall()));
   EXPECT_GE(m.recall(), 0.98) << m.usable_kept << " of " << m.usable_frames << " usable frames kept; "
                               << summary_->dump();
+  // Every candidate here is the hamster: none is keyed background (issue 19's noise rule).
+  EXPECT_EQ((*summary_)["discards"]["noise"], 0) << summary_->dump();
 }
 
 TEST_F(IngestQuality, KeepsNoFrameTouchingAWallOrLeavingTheFloor) {

@@ -137,5 +137,116 @@ TEST(StillnessFilter, DropsOnlyTheTooLongStillPart) {
   }
 }
 
+// Matte shapes (issue 19): hand-made mattes of what a subject and keyed background look like.
+cv::Mat Blank(int w, int h) { return cv::Mat::zeros(h, w, CV_8U); }
+// Every test off but the ones set.
+NoiseOptions Off() {
+  NoiseOptions o;
+  o.min_solidity = 0;
+  o.recover_solidity = 0;
+  return o;
+}
+NoiseOptions Only(double NoiseOptions::*test, double threshold) {
+  NoiseOptions o = Off();
+  o.*test = threshold;
+  return o;
+}
+
+TEST(MatteShape, ASolidFigureIsThickSolidAndWhole) {
+  cv::Mat a = Blank(60, 120);
+  cv::ellipse(a, {30, 60}, {14, 50}, 0, 0, 360, cv::Scalar(255), cv::FILLED);
+  const MatteShape s = MeasureMatteShape(a, 2.0);
+  EXPECT_NEAR(s.area_px, CV_PI * 14.5 * 50.5, 0.03 * CV_PI * 14.5 * 50.5);  // drawn with its outline
+  EXPECT_GT(s.solidity, 0.95);
+  EXPECT_GT(s.thick_share, 0.8);
+  EXPECT_DOUBLE_EQ(s.largest_share, 1.0);
+  EXPECT_DOUBLE_EQ(s.mean_alpha, 1.0);
+  cv::Mat rect = Blank(30, 40);
+  rect(cv::Rect(5, 5, 20, 30)).setTo(255);
+  EXPECT_NEAR(MeasureMatteShape(rect, 2.0).solidity, 1.0, 1e-9);  // the hull counts whole pixels
+  NoiseOptions all;
+  all.min_thick_share = 0.3;
+  all.min_largest_share = 0.6;
+  all.min_mean_alpha = 0.5;
+  EXPECT_FALSE(IsNoise(s, all));
+}
+
+TEST(MatteShape, ScatteredSpecksHaveNoInteriorAndNoLargePart) {
+  cv::Mat a = Blank(80, 80);
+  for (int y = 4; y < 76; y += 9) {
+    for (int x = 4 + (y % 2) * 3; x < 76; x += 8) a(cv::Rect(x, y, 3, 2)).setTo(255);
+  }
+  const MatteShape s = MeasureMatteShape(a, 2.0);
+  EXPECT_EQ(s.thick_share, 0.0);
+  EXPECT_LT(s.largest_share, 0.05);
+  EXPECT_LT(s.solidity, 0.2);
+  EXPECT_TRUE(IsNoise(s, Only(&NoiseOptions::min_thick_share, 0.3)));
+  EXPECT_TRUE(IsNoise(s, Only(&NoiseOptions::min_largest_share, 0.5)));
+  EXPECT_TRUE(IsNoise(s, NoiseOptions{}));  // the defaults: by solidity
+}
+
+TEST(MatteShape, AThinLineHasNoInterior) {
+  cv::Mat a = Blank(100, 60);
+  cv::line(a, {5, 50}, {95, 10}, cv::Scalar(255), 2);
+  const MatteShape s = MeasureMatteShape(a, 2.0);
+  EXPECT_GT(s.area_px, 150);
+  EXPECT_EQ(s.thick_share, 0.0);
+  EXPECT_DOUBLE_EQ(s.largest_share, 1.0);  // whole and fairly convex: only its thinness tells
+  EXPECT_TRUE(IsNoise(s, Only(&NoiseOptions::min_thick_share, 0.3)));
+  // A thick bar of the same length is not noise by thickness.
+  cv::Mat bar = Blank(100, 60);
+  cv::line(bar, {5, 50}, {95, 10}, cv::Scalar(255), 12);
+  EXPECT_GT(MeasureMatteShape(bar, 2.0).thick_share, 0.4);
+}
+
+TEST(MatteShape, ARingIsWholeButNotSolid) {
+  cv::Mat a = Blank(100, 100);
+  cv::circle(a, {50, 50}, 40, cv::Scalar(255), 2);
+  const MatteShape s = MeasureMatteShape(a, 2.0);
+  EXPECT_DOUBLE_EQ(s.largest_share, 1.0);
+  EXPECT_LT(s.solidity, 0.25);
+  EXPECT_LT(s.thick_share, 0.1);
+  EXPECT_TRUE(IsNoise(s, Only(&NoiseOptions::min_solidity, 0.5)));
+  EXPECT_TRUE(IsNoise(s, NoiseOptions{}));
+}
+
+TEST(MatteShape, ASoftHazeIsLowInAlpha) {
+  cv::Mat a = Blank(60, 60);
+  a(cv::Rect(10, 10, 40, 40)).setTo(60);
+  a(cv::Rect(25, 25, 6, 6)).setTo(200);
+  const MatteShape s = MeasureMatteShape(a, 2.0);
+  EXPECT_EQ(s.area_px, 36);
+  EXPECT_LT(s.mean_alpha, 0.3);
+  EXPECT_TRUE(IsNoise(s, Only(&NoiseOptions::min_mean_alpha, 0.5)));
+  EXPECT_FALSE(IsNoise(s, Off()));  // every test off
+  EXPECT_EQ(MeasureMatteShape(Blank(10, 10), 2.0).area_px, 0);
+  EXPECT_STREQ(DiscardName(Discard::kNoise), "noise");
+}
+
+// Keyed background flickers about the threshold: once noise, a subject stays noise until its
+// matte is clearly solid again; a subject that was never noise is judged by the threshold alone.
+TEST(NoiseFilter, ASubjectStaysNoiseUntilItsMatteRecovers) {
+  NoiseFilter f(NoiseOptions{});  // 0.25 to become noise, 0.30 to stop
+  const auto shape = [](double solidity) {
+    MatteShape s;
+    s.solidity = solidity;
+    return s;
+  };
+  f.NextFrame();
+  EXPECT_TRUE(f.IsNoise(1, shape(0.20)));
+  EXPECT_FALSE(f.IsNoise(2, shape(0.27)));
+  f.NextFrame();
+  EXPECT_TRUE(f.IsNoise(1, shape(0.27)));   // was noise: 0.27 is not enough
+  EXPECT_FALSE(f.IsNoise(2, shape(0.27)));  // was not
+  f.NextFrame();
+  EXPECT_FALSE(f.IsNoise(1, shape(0.31)));  // recovered
+  f.NextFrame();
+  EXPECT_FALSE(f.IsNoise(1, shape(0.27)));
+  EXPECT_TRUE(f.IsNoise(3, shape(0.10)));
+  f.NextFrame();
+  f.NextFrame();  // subject 3 unseen for a frame: forgotten
+  EXPECT_FALSE(f.IsNoise(3, shape(0.27)));
+}
+
 }  // namespace
 }  // namespace ss

@@ -8,6 +8,7 @@ export const VERDICT_COLOURS = {
   no_ground_hit: '#a78bfa',
   leaves_floor: '#f472b6',
   touches_wall: '#ef4444',
+  noise: '#e879f9',
   still: '#94a3b8',
   too_large: '#fb923c',
 };
@@ -18,6 +19,7 @@ export const VERDICT_LABELS = {
   no_ground_hit: 'ray misses the floor',
   leaves_floor: 'leaves the floor',
   touches_wall: 'touches a wall',
+  noise: 'noise (keyed background)',
   still: 'still',
   too_large: 'billboard too large (px_per_m)',
 };
