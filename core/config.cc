@@ -451,7 +451,7 @@ void ReadEnclosure(Reader& r, const YAML::Node& node, EnclosureConfig& e) {
 void ReadPipeline(Reader& r, const YAML::Node& node, PipelineConfig& p) {
   const MapView view = r.Map(node, "pipeline");
   r.Known(view, {"min_area_px", "border_margin_px", "floor_margin_px", "wall_margin_m",
-                 "still_speed_m_per_s", "max_still_s", "min_clip_frames", "px_per_m", "workers",
+                 "still_speed_m_per_s", "max_speed_m_per_s", "max_still_s", "min_clip_frames", "px_per_m", "workers",
                  "queue_frames", "noise_recover_solidity", "noise_thick_px", "noise_min_thick_share", "noise_min_solidity",
                  "noise_min_largest_share", "noise_min_mean_alpha"});
   r.Int(view, "min_area_px", p.min_area_px, "an area in pixels");
@@ -459,6 +459,7 @@ void ReadPipeline(Reader& r, const YAML::Node& node, PipelineConfig& p) {
   r.Int(view, "floor_margin_px", p.floor_margin_px, "a number of pixels");
   r.Number(view, "wall_margin_m", p.wall_margin_m, "a distance in metres");
   r.Number(view, "still_speed_m_per_s", p.still_speed_m_per_s, "a speed in m/s");
+  r.Number(view, "max_speed_m_per_s", p.max_speed_m_per_s, "a speed in m/s");
   r.Number(view, "max_still_s", p.max_still_s, "a duration in seconds");
   r.Int(view, "min_clip_frames", p.min_clip_frames, "a number of frames");
   r.Number(view, "noise_recover_solidity", p.noise_recover_solidity, "a share from 0 to 1");
@@ -726,6 +727,7 @@ class Validator {
           "expected a number >= 0, got " + std::to_string(p.floor_margin_px));
     NonNegative(p.wall_margin_m, "pipeline.wall_margin_m");
     Positive(p.still_speed_m_per_s, "pipeline.still_speed_m_per_s");
+    Positive(p.max_speed_m_per_s, "pipeline.max_speed_m_per_s");
     Positive(p.max_still_s, "pipeline.max_still_s");
     Check(p.min_clip_frames >= 1, "pipeline.min_clip_frames",
           "expected at least 1 frame, got " + std::to_string(p.min_clip_frames));

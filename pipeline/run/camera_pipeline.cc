@@ -61,6 +61,7 @@ CameraPipelineOptions PipelineOptionsFromConfig(const StationConfig& config) {
   o.noise = {p.noise_thick_px,          p.noise_min_solidity,   p.noise_min_thick_share,
              p.noise_min_largest_share, p.noise_min_mean_alpha, p.noise_recover_solidity};
   o.still_speed_m_per_s = p.still_speed_m_per_s;
+  o.track.max_speed_m_per_s = p.max_speed_m_per_s;
   o.max_still_s = p.max_still_s;
   o.rectify.px_per_m = p.px_per_m;
   o.batch.min_clip_frames = p.min_clip_frames;

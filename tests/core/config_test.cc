@@ -124,6 +124,7 @@ TEST(StationConfig, ExampleParsesIntoEveryField) {
   EXPECT_EQ(cfg.pipeline.floor_margin_px, 3);
   EXPECT_EQ(cfg.pipeline.wall_margin_m, 0.005);
   EXPECT_EQ(cfg.pipeline.still_speed_m_per_s, 0.05);
+  EXPECT_EQ(cfg.pipeline.max_speed_m_per_s, 1.5);
   EXPECT_EQ(cfg.pipeline.max_still_s, 2.0);
   EXPECT_EQ(cfg.pipeline.min_clip_frames, 5);
   EXPECT_EQ(cfg.pipeline.px_per_m, 0);  // auto
