@@ -4,6 +4,7 @@
 #include <cstdlib>
 
 #include "core/error.h"
+#include "core/image_median.h"
 
 namespace ss {
 
@@ -21,30 +22,17 @@ void EvenFrameSampler::Offer(const cv::Mat& bgr) {
 
 RobustBackground MedianAndSpread(const std::vector<cv::Mat>& frames) {
   if (frames.empty()) throw WorkError("median plate", "no frames to take the median of");
-  const cv::Mat& first = frames.front();
   for (const cv::Mat& f : frames) {
-    if (f.type() != CV_8UC3 || f.size() != first.size() || !f.isContinuous()) {
+    if (f.type() != CV_8UC3 || f.size() != frames.front().size()) {
       throw WorkError("median plate", "frames differ in size or type");
     }
   }
-  RobustBackground b{cv::Mat(first.size(), CV_8UC3), cv::Mat(first.size(), CV_32FC3)};
-  const size_t values = first.total() * 3, n = frames.size();
-  std::vector<const uint8_t*> planes;
-  for (const cv::Mat& f : frames) planes.push_back(f.data);
-  uint8_t* median = b.median.data;
-  float* spread = b.spread.ptr<float>();
-  // A histogram per value would be faster for many frames; a few dozen sort quickly enough.
-  std::vector<uint8_t> column(n);
-  for (size_t v = 0; v < values; ++v) {
-    for (size_t i = 0; i < n; ++i) column[i] = planes[i][v];
-    std::nth_element(column.begin(), column.begin() + n / 2, column.end());
-    const uint8_t m = column[n / 2];
-    median[v] = m;
-    for (size_t i = 0; i < n; ++i)
-      column[i] = static_cast<uint8_t>(std::abs(int{planes[i][v]} - int{m}));
-    std::nth_element(column.begin(), column.begin() + n / 2, column.end());
-    spread[v] = 1.4826f * column[n / 2];
-  }
+  // The median, then the median absolute deviation from it (scaled to a normal sigma).
+  RobustBackground b;
+  b.median = PerPixelMedian(frames, "median plate");
+  std::vector<cv::Mat> deviations(frames.size());
+  for (size_t i = 0; i < frames.size(); ++i) cv::absdiff(frames[i], b.median, deviations[i]);
+  PerPixelMedian(deviations, "median plate").convertTo(b.spread, CV_32FC3, 1.4826);
   return b;
 }
 
