@@ -50,9 +50,9 @@ struct FileSizeLimit {
   void Lift() { setrlimit(RLIMIT_FSIZE, &saved); }
 };
 
-TEST(StationFaults, AFullDiskSaysWritesFailLosesNothingAndResumes) {
-  signal(SIGXFSZ, SIG_IGN);  // a write past the limit fails with EFBIG instead of killing the process
-  testing::ScratchDir dir;
+// A station on one looping, paced replay camera of a fresh 4 s synthetic session in `dir`,
+// storing into dir/station.bank with the disk guard off; no transitions worker.
+StationOptions OneReplayCamera(const testing::ScratchDir& dir) {
   synth::SynthOptions so;
   so.out_dir = dir / "session";
   so.seconds = 4;
@@ -64,7 +64,6 @@ TEST(StationFaults, AFullDiskSaysWritesFailLosesNothingAndResumes) {
   so.empty_lead_in_s = 1.5;
   so.write_mattes = false;
   synth::RenderStudioSession(so);
-
   StationOptions options;
   CameraConfig cam;
   cam.name = "cam0";
@@ -77,8 +76,15 @@ TEST(StationFaults, AFullDiskSaysWritesFailLosesNothingAndResumes) {
   options.config.storage.recording_dir = dir / "recordings";
   options.config.storage.stop_recording_below_mib = 0;
   options.config.storage.stop_sprites_below_mib = 0;
-  options.config.logging.level = "warn";
   options.transitions = false;
+  return options;
+}
+
+TEST(StationFaults, AFullDiskSaysWritesFailLosesNothingAndResumes) {
+  signal(SIGXFSZ, SIG_IGN);  // a write past the limit fails with EFBIG instead of killing the process
+  testing::ScratchDir dir;
+  StationOptions options = OneReplayCamera(dir);
+  options.config.logging.level = "warn";
   Station station(options);
   station.Start();
   station.StartSession("full disk");
@@ -113,32 +119,8 @@ TEST(StationFaults, ABankLockedPastTheBusyTimeoutLosesNoBatch) {
   // transactions on a loaded machine) holds the bank's write lock for 12 s, past SQLite's
   // 10 s busy timeout: the station tries its batches again and stores every one of them.
   testing::ScratchDir dir;
-  synth::SynthOptions so;
-  so.out_dir = dir / "session";
-  so.seconds = 4;
-  so.fps = 30;
-  so.width = 640;
-  so.height = 480;
-  so.cameras = 1;
-  so.seed = 11;
-  so.empty_lead_in_s = 1.5;
-  so.write_mattes = false;
-  synth::RenderStudioSession(so);
-
-  StationOptions options;
-  CameraConfig cam;
-  cam.name = "cam0";
-  cam.source = "replay";
-  cam.session = so.out_dir;
-  cam.loop = true;
-  cam.realtime = true;
-  options.config.cameras = {cam};
-  options.config.storage.bank = dir / "station.bank";
-  options.config.storage.recording_dir = dir / "recordings";
-  options.config.storage.stop_recording_below_mib = 0;
-  options.config.storage.stop_sprites_below_mib = 0;
+  StationOptions options = OneReplayCamera(dir);
   options.config.logging.level = "error";
-  options.transitions = false;
   Station station(options);
   station.Start();
   station.StartSession("locked");
