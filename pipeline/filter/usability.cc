@@ -172,7 +172,9 @@ Discard FloorMask::Check(const cv::Mat& alpha_crop, cv::Point offset, const Eige
   return Discard::kNone;
 }
 
-MatteShape MeasureMatteShape(const cv::Mat& alpha_crop, double thick_px) {
+namespace {
+
+MatteShape Measure(const cv::Mat& alpha_crop, double thick_px, bool parts, bool interior) {
   MatteShape s;
   if (alpha_crop.empty()) return s;
   const cv::Mat solid = alpha_crop > 127;
@@ -192,18 +194,33 @@ MatteShape MeasureMatteShape(const cv::Mat& alpha_crop, double thick_px) {
   const double hull_area = cv::contourArea(hull) + 0.5 * cv::arcLength(hull, true) + 1.0;
   s.solidity = std::min(1.0, area / hull_area);
 
-  cv::Mat labels, stats, centroids;
-  const int n = cv::connectedComponentsWithStats(solid, labels, stats, centroids, 8, CV_32S);
-  int largest = 0;
-  for (int i = 1; i < n; ++i) largest = std::max(largest, stats.at<int>(i, cv::CC_STAT_AREA));
-  s.largest_share = static_cast<double>(largest) / area;
-
-  // Distance to the nearest non-solid pixel, the crop's outside counting as non-solid.
-  cv::Mat padded, dist;
-  cv::copyMakeBorder(solid, padded, 1, 1, 1, 1, cv::BORDER_CONSTANT, cv::Scalar(0));
-  cv::distanceTransform(padded, dist, cv::DIST_L2, cv::DIST_MASK_PRECISE);
-  s.thick_share = static_cast<double>(cv::countNonZero(dist > thick_px)) / area;
+  s.largest_share = 1.0;
+  if (parts) {
+    cv::Mat labels, stats, centroids;
+    const int n = cv::connectedComponentsWithStats(solid, labels, stats, centroids, 8, CV_32S);
+    int largest = 0;
+    for (int i = 1; i < n; ++i) largest = std::max(largest, stats.at<int>(i, cv::CC_STAT_AREA));
+    s.largest_share = static_cast<double>(largest) / area;
+  }
+  s.thick_share = 1.0;
+  if (interior) {
+    // Distance to the nearest non-solid pixel, the crop's outside counting as non-solid.
+    cv::Mat padded, dist;
+    cv::copyMakeBorder(solid, padded, 1, 1, 1, 1, cv::BORDER_CONSTANT, cv::Scalar(0));
+    cv::distanceTransform(padded, dist, cv::DIST_L2, cv::DIST_MASK_PRECISE);
+    s.thick_share = static_cast<double>(cv::countNonZero(dist > thick_px)) / area;
+  }
   return s;
+}
+
+}  // namespace
+
+MatteShape MeasureMatteShape(const cv::Mat& alpha_crop, double thick_px) {
+  return Measure(alpha_crop, thick_px, true, true);
+}
+
+MatteShape MeasureMatteShape(const cv::Mat& alpha_crop, const NoiseOptions& tests) {
+  return Measure(alpha_crop, tests.thick_px, tests.min_largest_share > 0, tests.min_thick_share > 0);
 }
 
 bool IsNoise(const MatteShape& shape, const NoiseOptions& o) {

@@ -73,6 +73,9 @@ struct NoiseOptions {
   // (keyed background flickers about the threshold; 0: no memory).
   double recover_solidity = 0.30;
 };
+// The features those tests need, no more (the per-frame path): thick_share and largest_share,
+// the costly ones, are measured only when their tests are on, and read 1 (pass) otherwise.
+MatteShape MeasureMatteShape(const cv::Mat& alpha_crop, const NoiseOptions& tests);
 // The shape tests alone, without a subject's history.
 bool IsNoise(const MatteShape& shape, const NoiseOptions& options);
 

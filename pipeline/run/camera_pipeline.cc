@@ -167,9 +167,11 @@ void CameraPipeline::Process(const Frame& frame, std::vector<ClipBatch>* out) {
     const Candidate& c = *grounded[k];
     Discard reason = c.touches_border ? Discard::kTouchesBorder : floor_mask_.Check(c.alpha, c.bbox.tl(), points[k]);
     if (reason == Discard::kNone) {
-      const MatteShape shape = MeasureMatteShape(c.alpha, options_.noise.thick_px);
+      const bool trace = log_->should_log(spdlog::level::trace);  // then every feature, for the log
+      const MatteShape shape =
+          trace ? MeasureMatteShape(c.alpha, options_.noise.thick_px) : MeasureMatteShape(c.alpha, options_.noise);
       if (noise_.IsNoise(subjects[k], shape)) reason = Discard::kNoise;
-      if (log_->should_log(spdlog::level::trace)) {
+      if (trace) {
         log_->trace("{} frame {} subject {} box {}x{}+{}+{} shape area {:.0f} solidity {:.3f} thick {:.3f} "
                     "largest {:.3f} mean_alpha {:.3f}",
                     name_, frame.sequence, subjects[k], c.bbox.width, c.bbox.height, c.bbox.x, c.bbox.y,
