@@ -9,7 +9,9 @@
 
 #include "core/bank_pixels.h"
 #include "core/bank_schema.h"
-#include "core/bank_sqlite.h"
+#include "core/sql.h"
+#include "core/sql_postgres.h"
+#include "core/sql_sqlite.h"
 #include "core/error.h"
 
 namespace ss {
@@ -17,11 +19,14 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// The sprite columns in the order ReadSprite reads them.
-constexpr const char* kSpriteColumns =
-    "id, clip_id, camera_id, track_id, frame, timestamp_ns, mirrored, mirror_of, ground_x_m, ground_y_m, "
-    "velocity_x_m_s, velocity_y_m_s, mean_r, mean_g, mean_b, area_px, eccentricity, bbox_x, bbox_y, bbox_w, "
-    "bbox_h, billboard_w_px, billboard_h_px, px_per_m, anchor_x_px, anchor_y_px";
+// The sprite columns in the order ReadSprite reads them; the bank assigns the id.
+#define SS_SPRITE_FIELDS                                                                                      \
+  "clip_id, camera_id, track_id, frame, timestamp_ns, mirrored, mirror_of, ground_x_m, ground_y_m, "          \
+  "velocity_x_m_s, velocity_y_m_s, mean_r, mean_g, mean_b, area_px, eccentricity, bbox_x, bbox_y, bbox_w, " \
+  "bbox_h, billboard_w_px, billboard_h_px, px_per_m, anchor_x_px, anchor_y_px"
+constexpr const char* kSpriteColumns = "id, " SS_SPRITE_FIELDS;
+constexpr const char* kSpriteFields = SS_SPRITE_FIELDS;
+#undef SS_SPRITE_FIELDS
 
 SpriteRecord ReadSprite(const sql::Stmt& s) {
   SpriteRecord r;
@@ -81,17 +86,9 @@ struct Bank::ReadCache {
 
 Bank::Bank(const std::string& path) : Bank(path, Mode::kReadOnly) {}
 
-Bank::Bank(const std::string& path, Mode mode) : path_(path) {
-  std::error_code ec;
-  if (mode == Mode::kReadOnly) {
-    if (!fs::exists(path, ec)) throw InputError(path, "no such sprite bank");
-    if (!fs::is_regular_file(path, ec)) throw InputError(path, "not a sprite bank (not a regular file)");
-  }
-  const int flags = (mode == Mode::kReadOnly ? SQLITE_OPEN_READONLY : SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE) |
-                    SQLITE_OPEN_NOMUTEX;
-  db_ = std::make_unique<sql::Db>(path, flags);
-  PrepareBankSchema(*db_, mode == Mode::kReadWrite);
-}
+Bank::Bank(const std::string& path, Mode mode)
+    : path_(sql::IsPostgresAddress(path) ? sql::RedactAddress(path) : path),
+      db_(std::make_unique<sql::Db>(OpenBankDatabase(path, mode == Mode::kReadWrite))) {}
 
 Bank::~Bank() = default;
 Bank::Bank(Bank&&) noexcept = default;
@@ -107,7 +104,9 @@ Bank::ReadCache& Bank::cache() const {
   return *cache_;
 }
 
-int Bank::schema_version() const { return static_cast<int>(db_->QueryInt("PRAGMA user_version")); }
+int Bank::schema_version() const { return ReadSchemaVersion(*db_); }
+
+bool Bank::is_postgres() const { return db_->dialect() == sql::Dialect::kPostgres; }
 
 std::vector<SessionRecord> Bank::ListSessions() const {
   std::vector<SessionRecord> out;
@@ -328,9 +327,9 @@ std::vector<double> Bank::BillboardScales() const {
 
 BankCounts Bank::Counts() const {
   // One read transaction so that the figures agree with each other.
-  db_->Exec("BEGIN");
   BankCounts c;
-  try {
+  {
+    sql::ReadSnapshot snapshot(*db_);
     c.schema_version = schema_version();
     c.sessions = db_->QueryInt("SELECT count(*) FROM sessions");
     c.cameras = db_->QueryInt("SELECT count(*) FROM cameras");
@@ -345,13 +344,18 @@ BankCounts Bank::Counts() const {
     c.transitions = db_->QueryInt("SELECT count(*) FROM transitions");
     c.tags = db_->QueryInt("SELECT count(DISTINCT tag) FROM sprite_tags");
     c.tagged_sprites = db_->QueryInt("SELECT count(DISTINCT sprite_id) FROM sprite_tags");
-  } catch (...) {
-    sqlite3_exec(db_->get(), "ROLLBACK", nullptr, nullptr, nullptr);
-    throw;
+    if (is_postgres()) {
+      // The bank's tables with their indexes and out-of-line (TOAST) data, on the server.
+      c.file_bytes = db_->QueryInt(
+          "SELECT coalesce(sum(pg_total_relation_size(c.oid)), 0) FROM pg_catalog.pg_class c "
+          "JOIN pg_catalog.pg_namespace n ON n.oid = c.relnamespace "
+          "WHERE n.nspname = current_schema() AND c.relkind = 'r'");
+    }
   }
-  db_->Exec("COMMIT");
-  c.file_bytes = FileBytes(path_);
-  c.wal_bytes = FileBytes(path_ + "-wal");
+  if (!is_postgres()) {
+    c.file_bytes = FileBytes(path_);
+    c.wal_bytes = FileBytes(path_ + "-wal");
+  }
   return c;
 }
 
@@ -361,22 +365,26 @@ struct BankWriter::Impl {
   explicit Impl(sql::Db& db)
       : find_clip(db.Prepare(std::string("SELECT ") + kClipColumns +
                              " FROM clips WHERE camera_id = ? AND track_id = ? AND first_frame = ?")),
-        insert_clip(db.Prepare("INSERT INTO clips (camera_id, track_id, first_frame, last_frame) VALUES (?, ?, ?, ?)")),
+        insert_clip(db.Prepare("INSERT INTO clips (camera_id, track_id, first_frame, last_frame) VALUES (?, ?, ?, ?) "
+                               "RETURNING id")),
         extend_clip(db.Prepare("UPDATE clips SET last_frame = ? WHERE id = ? AND last_frame < ?")),
         complete_clip(db.Prepare("UPDATE clips SET complete = 1, complete_seq = "
                                  "(SELECT coalesce(max(complete_seq), 0) + 1 FROM clips) "
                                  "WHERE id = ? AND complete = 0")),
         insert_sprite(db.Prepare(
-            std::string("INSERT INTO sprites (") + kSpriteColumns +
-            ") VALUES (NULL, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?) "
-            "ON CONFLICT (camera_id, frame, track_id, mirrored) DO NOTHING")),
+            std::string("INSERT INTO sprites (") + kSpriteFields +
+            ") VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?) "
+            "ON CONFLICT (camera_id, frame, track_id, mirrored) DO NOTHING RETURNING id")),
         find_sprite(db.Prepare("SELECT id FROM sprites WHERE camera_id = ? AND frame = ? AND track_id = ? "
                                "AND mirrored = ?")),
-        insert_pixels(db.Prepare("INSERT OR REPLACE INTO sprite_pixels (sprite_id, width_px, height_px, codec, data) "
-                                 "VALUES (?, ?, ?, ?, ?)")),
-        insert_tag(db.Prepare("INSERT OR IGNORE INTO sprite_tags (sprite_id, tag) VALUES (?, ?)")),
-        upsert_transition(db.Prepare("INSERT OR REPLACE INTO transitions (from_sprite, to_sprite, d, cost) "
-                                     "VALUES (?, ?, ?, ?)")) {}
+        insert_pixels(db.Prepare("INSERT INTO sprite_pixels (sprite_id, width_px, height_px, codec, data) "
+                                 "VALUES (?, ?, ?, ?, ?) ON CONFLICT (sprite_id) DO UPDATE SET "
+                                 "width_px = excluded.width_px, height_px = excluded.height_px, "
+                                 "codec = excluded.codec, data = excluded.data")),
+        insert_tag(db.Prepare("INSERT INTO sprite_tags (sprite_id, tag) VALUES (?, ?) ON CONFLICT DO NOTHING")),
+        upsert_transition(db.Prepare("INSERT INTO transitions (from_sprite, to_sprite, d, cost) VALUES (?, ?, ?, ?) "
+                                     "ON CONFLICT (from_sprite, to_sprite) DO UPDATE SET "
+                                     "d = excluded.d, cost = excluded.cost")) {}
 
   sql::Stmt find_clip, insert_clip, extend_clip, complete_clip;
   sql::Stmt insert_sprite, find_sprite, insert_pixels, insert_tag, upsert_transition;
@@ -483,7 +491,8 @@ AppendResult BankWriter::AppendClipBatch(const ClipRecord& clip, const std::vect
     camera.Reset();
     w.insert_clip.Reset();
     w.insert_clip.Bind(1, clip.camera_id).Bind(2, clip.track_id).Bind(3, clip.first_frame).Bind(4, last_frame).Step();
-    result.clip_id = sqlite3_last_insert_rowid(db().get());
+    result.clip_id = w.insert_clip.Int(0);
+    w.insert_clip.Reset();
   }
 
   result.sprite_ids.assign(sprites.size(), 0);
@@ -522,10 +531,10 @@ AppendResult BankWriter::AppendClipBatch(const ClipRecord& clip, const std::vect
       q.Bind(19, int64_t{s.bbox_in_image.width}).Bind(20, int64_t{s.bbox_in_image.height});
       q.Bind(21, int64_t{s.billboard_width_px}).Bind(22, int64_t{s.billboard_height_px}).Bind(23, s.px_per_m);
       q.Bind(24, s.anchor_x_px).Bind(25, s.anchor_y_px);
-      q.Step();
       int64_t id = 0;
-      if (sqlite3_changes(db().get()) == 1) {
-        id = sqlite3_last_insert_rowid(db().get());
+      if (q.Step()) {  // inserted: RETURNING gave its id (a sprite already stored returns no row)
+        id = q.Int(0);
+        q.Reset();
         ++result.inserted;
         if (!s.mirrored) {
           std::vector<uint8_t> const* blob = nullptr;
@@ -549,6 +558,7 @@ AppendResult BankWriter::AppendClipBatch(const ClipRecord& clip, const std::vect
     }
   }
   if (clip.complete) {
+    SerializeClipCompletion(db());
     w.complete_clip.Reset();
     w.complete_clip.Bind(1, result.clip_id).Step();
   }
@@ -594,7 +604,7 @@ void BankWriter::Untag(const std::vector<int64_t>& sprite_ids, const std::string
 
 void BankWriter::SetMeta(const std::string& key, const std::string& value) {
   if (key == "schema_version" || key == "application") throw WorkError(path(), "meta key '" + key + "' is reserved");
-  auto q = db().Prepare("INSERT OR REPLACE INTO meta (key, value) VALUES (?, ?)");
+  auto q = db().Prepare("INSERT INTO meta (key, value) VALUES (?, ?) ON CONFLICT (key) DO UPDATE SET value = excluded.value");
   q.Bind(1, key).Bind(2, value).Step();
 }
 
@@ -613,8 +623,9 @@ void BankWriter::SetTransitionLabel(const TransitionLabelRecord& label) {
   }
   exists.Reset();
   auto q = db().Prepare(
-      "INSERT OR REPLACE INTO transition_labels (from_sprite, to_sprite, label, labelled_at, source) "
-      "VALUES (?, ?, ?, ?, ?)");
+      "INSERT INTO transition_labels (from_sprite, to_sprite, label, labelled_at, source) VALUES (?, ?, ?, ?, ?) "
+      "ON CONFLICT (from_sprite, to_sprite) DO UPDATE SET label = excluded.label, "
+      "labelled_at = excluded.labelled_at, source = excluded.source");
   q.Bind(1, label.from_sprite).Bind(2, label.to_sprite).Bind(3, label.label).Bind(4, label.labelled_at);
   q.Bind(5, label.source).Step();
   q.Reset();
@@ -624,7 +635,7 @@ void BankWriter::SetTransitionLabel(const TransitionLabelRecord& label) {
 bool BankWriter::RemoveTransitionLabel(int64_t from_sprite, int64_t to_sprite) {
   auto q = db().Prepare("DELETE FROM transition_labels WHERE from_sprite = ? AND to_sprite = ?");
   q.Bind(1, from_sprite).Bind(2, to_sprite).Step();
-  return sqlite3_changes(db().get()) > 0;
+  return q.Changes() > 0;
 }
 
 }  // namespace ss

@@ -1,9 +1,10 @@
 #pragma once
-// The sprite bank: one SQLite file in WAL mode (schema in docs/formats.md).
-// One writer (BankWriter) appends clips batch by batch; any number of readers
-// (Bank, each its own connection, in threads or processes) read meanwhile and
-// see only complete clips. A Bank object is one connection: use it from one
-// thread at a time.
+// The sprite bank (schema in docs/formats.md): one SQLite file in WAL mode (a path), or one
+// PostgreSQL database shared by many stations (an address `postgresql://...`, docs/scaling.md);
+// every command that takes a bank takes either. Writers (BankWriter) append clips batch by
+// batch: one at a time for SQLite, any number at once for PostgreSQL; any number of readers
+// (Bank, each its own connection, in threads or processes) read meanwhile and see only
+// complete clips. A Bank object is one connection: use it from one thread at a time.
 #include <cstdint>
 #include <map>
 #include <memory>
@@ -35,14 +36,17 @@ struct BankCounts {
 class Bank {
  public:
   // Opens an existing bank read-only. InputError naming the file when it is missing,
-  // not a SQLite database, not a sprite bank, or of another schema version.
+  // not a SQLite database, not a sprite bank, or of another schema version; BusyError when a
+  // PostgreSQL server cannot be reached.
   explicit Bank(const std::string& path);
   virtual ~Bank();
   Bank(Bank&&) noexcept;
   Bank& operator=(Bank&&) noexcept;
 
+  // The file, or the server's address without its password.
   const std::string& path() const { return path_; }
   int schema_version() const;
+  bool is_postgres() const;
 
   std::vector<SessionRecord> ListSessions() const;
   std::vector<CameraRecord> ListCameras() const;

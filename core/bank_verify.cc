@@ -11,7 +11,9 @@
 
 #include "core/bank_pixels.h"
 #include "core/bank_schema.h"
-#include "core/bank_sqlite.h"
+#include "core/sql.h"
+#include "core/sql_postgres.h"
+#include "core/sql_sqlite.h"
 #include "core/error.h"
 
 namespace ss {
@@ -74,10 +76,49 @@ void CheckSchema(const sql::Db& db, Checker& check) {
   }
 }
 
+// PostgreSQL: every table, column and index that the current schema version defines is there
+// (the same names as SQLite's; their types are PostgreSQL's, set by the migrations).
+void CheckPostgresSchema(const sql::Db& db, Checker& check) {
+  const int version = ReadSchemaVersion(db);
+  if (version != kBankSchemaVersion) {
+    check.Add("schema: meta.schema_version is " + std::to_string(version) + ", expected " +
+              std::to_string(kBankSchemaVersion));
+  }
+  sql::Db reference = sql::OpenSqlite(":memory:", SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE | SQLITE_OPEN_MEMORY);
+  for (const auto& m : BankMigrations(sql::Dialect::kSqlite)) reference.Exec(m.sql);
+  auto columns = db.Prepare("SELECT column_name FROM information_schema.columns "
+                            "WHERE table_schema = current_schema() AND table_name = ? ORDER BY ordinal_position");
+  auto index = db.Prepare("SELECT count(*) FROM pg_catalog.pg_indexes WHERE schemaname = current_schema() "
+                          "AND indexname = ?");
+  for (const auto& want : ExpectedSchema()) {
+    if (want.type == "index") {
+      index.Reset();
+      index.Bind(1, want.name).Step();
+      if (index.Int(0) == 0) check.Add("schema: index '" + want.name + "' is missing");
+      continue;
+    }
+    std::vector<std::string> expected, found;
+    auto info = reference.Prepare("SELECT name FROM pragma_table_info(?) ORDER BY cid");
+    info.Bind(1, want.name);
+    while (info.Step()) expected.push_back(info.Text(0));
+    columns.Reset();
+    columns.Bind(1, want.name);
+    while (columns.Step()) found.push_back(columns.Text(0));
+    if (found.empty()) {
+      check.Add("schema: table '" + want.name + "' is missing");
+    } else if (found != expected) {
+      std::string list;
+      for (const auto& c : found) list += (list.empty() ? "" : ", ") + c;
+      check.Add("schema: table '" + want.name + "' has columns (" + list + "), not those of schema version " +
+                std::to_string(kBankSchemaVersion));
+    }
+  }
+}
+
 void CheckClips(Checker& check) {
   check.Rows("clip", "SELECT 'clip ' || id || ': first_frame ' || first_frame || ' > last_frame ' || last_frame "
                      "FROM clips WHERE first_frame > last_frame");
-  check.Rows("clip", "SELECT 'clip ' || id || ': complete but complete_seq is ' || coalesce(complete_seq, 'NULL') "
+  check.Rows("clip", "SELECT 'clip ' || id || ': complete but complete_seq is ' || coalesce(CAST(complete_seq AS TEXT), 'NULL') "
                      "FROM clips WHERE (complete = 1) != (complete_seq IS NOT NULL)");
   check.Rows("sprite",
              "SELECT 'sprite ' || s.id || ': frame ' || s.frame || ' outside its clip ' || c.id || ' [' || "
@@ -91,8 +132,8 @@ void CheckClips(Checker& check) {
   // A complete clip is a run of consecutive frames: one original per frame from first to last.
   check.Rows("clip",
              "SELECT 'clip ' || c.id || ': complete over frames [' || c.first_frame || ', ' || c.last_frame || "
-             "'] but holds ' || count(s.id) || ' original sprites spanning [' || coalesce(min(s.frame), '-') || "
-             "', ' || coalesce(max(s.frame), '-') || ']' "
+             "'] but holds ' || count(s.id) || ' original sprites spanning [' || coalesce(CAST(min(s.frame) AS TEXT), '-') || "
+             "', ' || coalesce(CAST(max(s.frame) AS TEXT), '-') || ']' "
              "FROM clips c LEFT JOIN sprites s ON s.clip_id = c.id AND s.mirrored = 0 WHERE c.complete = 1 "
              "GROUP BY c.id HAVING count(s.id) != c.last_frame - c.first_frame + 1 "
              "OR min(s.frame) != c.first_frame OR max(s.frame) != c.last_frame");
@@ -100,7 +141,7 @@ void CheckClips(Checker& check) {
 
 void CheckMirrors(Checker& check) {
   check.Rows("mirror", "SELECT 'sprite ' || id || ': mirrored = ' || mirrored || ' but mirror_of is ' || "
-                       "coalesce(mirror_of, 'NULL') FROM sprites WHERE (mirrored = 1) != (mirror_of IS NOT NULL)");
+                       "coalesce(CAST(mirror_of AS TEXT), 'NULL') FROM sprites WHERE (mirrored = 1) != (mirror_of IS NOT NULL)");
   check.Rows("mirror",
              "SELECT 'sprite ' || m.id || ': its original ' || o.id || ' is itself mirrored' "
              "FROM sprites m JOIN sprites o ON o.id = m.mirror_of WHERE o.mirrored != 0");
@@ -150,34 +191,43 @@ void CheckPixels(const sql::Db& db, Checker& check, BankVerifyReport& report) {
 
 BankVerifyReport VerifyBank(const std::string& path) {
   BankVerifyReport report;
-  report.path = path;
+  const bool postgres = sql::IsPostgresAddress(path);
+  report.path = postgres ? sql::RedactAddress(path) : path;
   // Opening checks that the file is a bank of this schema version (InputError if not).
-  if (!std::filesystem::exists(path)) throw InputError(path, "no such sprite bank");
-  sql::Db db(path, SQLITE_OPEN_READONLY | SQLITE_OPEN_NOMUTEX);
+  if (!postgres && !std::filesystem::exists(path)) throw InputError(path, "no such sprite bank");
+  sql::Db db = postgres ? sql::OpenPostgres(path, /*read_only=*/true)
+                        : sql::OpenSqlite(path, SQLITE_OPEN_READONLY | SQLITE_OPEN_NOMUTEX);
   try {
     report.schema_version = PrepareBankSchema(db, /*writable=*/false);
   } catch (const sql::CorruptError& e) {
     // The header reads as a bank but the file is damaged beyond opening it.
     report.problems.push_back(std::string("open: ") + e.what());
     return report;
+  } catch (const BusyError&) {
+    throw;  // the server is not there: nothing was checked
   } catch (const WorkError& e) {
     report.problems.push_back(std::string("open: ") + e.what());
     return report;
   }
   Checker check(db, report);
-  // One read transaction: every check sees the same snapshot while a writer goes on.
-  check.Run("snapshot", [&] { db.Exec("BEGIN"); });
-  check.Run("integrity", [&] {
-    auto s = db.Prepare("PRAGMA integrity_check(100)");
-    while (s.Step()) {
-      if (s.Text(0) != "ok") check.Add("integrity: " + s.Text(0));
-    }
-  });
-  check.Run("foreign keys", [&] {
-    check.Rows("foreign key", "SELECT \"table\" || ' row ' || coalesce(rowid, '?') || ' refers to a missing ' || "
-                              "parent FROM pragma_foreign_key_check");
-  });
-  check.Run("schema", [&] { CheckSchema(db, check); });
+  // One read transaction: every check sees the same snapshot while writers go on.
+  check.Run("snapshot", [&] { db.impl().BeginRead(); });
+  if (postgres) {
+    // The server keeps its pages and foreign keys whole; what is ours to check is the schema.
+    check.Run("schema", [&] { CheckPostgresSchema(db, check); });
+  } else {
+    check.Run("integrity", [&] {
+      auto s = db.Prepare("PRAGMA integrity_check(100)");
+      while (s.Step()) {
+        if (s.Text(0) != "ok") check.Add("integrity: " + s.Text(0));
+      }
+    });
+    check.Run("foreign keys", [&] {
+      check.Rows("foreign key", "SELECT \"table\" || ' row ' || coalesce(rowid, '?') || ' refers to a missing ' || "
+                                "parent FROM pragma_foreign_key_check");
+    });
+    check.Run("schema", [&] { CheckSchema(db, check); });
+  }
   check.Run("clips", [&] {
     CheckClips(check);
     report.clips_checked = db.QueryInt("SELECT count(*) FROM clips");
@@ -185,16 +235,17 @@ BankVerifyReport VerifyBank(const std::string& path) {
   });
   check.Run("mirrors", [&] { CheckMirrors(check); });
   check.Run("pixels", [&] { CheckPixels(db, check, report); });
-  sqlite3_exec(db.get(), "COMMIT", nullptr, nullptr, nullptr);
+  db.impl().Rollback();
   return report;
 }
 
 std::vector<std::string> QuickCheckBank(const std::string& path) {
   std::vector<std::string> problems;
   std::error_code ec;
-  if (!std::filesystem::exists(path, ec)) return problems;
+  // A PostgreSQL server keeps its own pages whole (and refuses a damaged one itself).
+  if (sql::IsPostgresAddress(path) || !std::filesystem::exists(path, ec)) return problems;
   try {
-    sql::Db db(path, SQLITE_OPEN_READONLY | SQLITE_OPEN_NOMUTEX);
+    sql::Db db = sql::OpenSqlite(path, SQLITE_OPEN_READONLY | SQLITE_OPEN_NOMUTEX);
     auto s = db.Prepare("PRAGMA quick_check(20)");
     while (s.Step()) {
       std::string line = s.Text(0);

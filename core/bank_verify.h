@@ -15,7 +15,8 @@ struct BankVerifyReport {
 };
 
 // Opens `path` read-only and checks: SQLite integrity and foreign keys, the schema
-// (version, application id, every table and index as this version defines them),
+// (version, application id, every table and index as this version defines them; for a
+// PostgreSQL bank its tables, columns and indexes: the server keeps pages and keys whole),
 // clip frame ranges, mirror links, every pixel blob decompressing to its stated size.
 // Throws InputError when the file is missing, not a bank, or of another schema version.
 BankVerifyReport VerifyBank(const std::string& path);

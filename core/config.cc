@@ -15,6 +15,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "core/error.h"
+#include "core/sql_postgres.h"
 #include "core/frame.h"
 #include "core/log.h"
 #include "core/recording_codecs.h"
@@ -486,7 +487,12 @@ void ReadStorage(Reader& r, const YAML::Node& node, StorageConfig& s) {
   const MapView view = r.Map(node, "storage");
   r.Known(view, {"bank", "recording_dir", "recording", "recording_codec",
                  "stop_recording_below_mib", "stop_sprites_below_mib"});
-  r.Path(view, "bank", s.bank);
+  // A file (resolved against the config's folder) or a PostgreSQL server's address, kept as written.
+  if (r.Path(view, "bank", s.bank)) {
+    std::string raw;
+    r.String(view, "bank", raw, "a path");
+    if (sql::IsPostgresAddress(raw)) s.bank = raw;
+  }
   r.Path(view, "recording_dir", s.recording_dir);
   r.Enum(view, "recording", s.recording, kRecordingModeTexts);
   r.String(view, "recording_codec", s.recording_codec);

@@ -1,5 +1,6 @@
-#include "core/bank_sqlite.h"
+#include "core/sql_sqlite.h"
 
+#include <memory>
 #include <utility>
 
 #include "core/error.h"
@@ -22,124 +23,116 @@ void Fail(sqlite3* db, int rc, const std::string& path, std::string_view what) {
   }
 }
 
-Stmt::Stmt(sqlite3* db, std::string_view sql, const std::string& path) : db_(db), path_(path) {
-  const int rc = sqlite3_prepare_v2(db, sql.data(), static_cast<int>(sql.size()), &stmt_, nullptr);
-  if (rc != SQLITE_OK) Fail(db, rc, path, "prepare '" + std::string(sql.substr(0, 60)) + "'");
-}
+namespace {
 
-Stmt::~Stmt() { sqlite3_finalize(stmt_); }
-
-Stmt::Stmt(Stmt&& other) noexcept
-    : stmt_(std::exchange(other.stmt_, nullptr)), db_(other.db_), path_(std::move(other.path_)) {}
-
-Stmt& Stmt::operator=(Stmt&& other) noexcept {
-  if (this != &other) {
-    sqlite3_finalize(stmt_);
-    stmt_ = std::exchange(other.stmt_, nullptr);
-    db_ = other.db_;
-    path_ = std::move(other.path_);
+class SqliteStmt final : public StmtImpl {
+ public:
+  SqliteStmt(sqlite3* db, std::string_view sql, const std::string& path) : db_(db), path_(path) {
+    const int rc = sqlite3_prepare_v2(db, sql.data(), static_cast<int>(sql.size()), &stmt_, nullptr);
+    if (rc != SQLITE_OK) Fail(db, rc, path, "prepare '" + std::string(sql.substr(0, 60)) + "'");
   }
-  return *this;
-}
+  ~SqliteStmt() override { sqlite3_finalize(stmt_); }
+  SqliteStmt(const SqliteStmt&) = delete;
+  SqliteStmt& operator=(const SqliteStmt&) = delete;
 
-Stmt& Stmt::Bind(int index, int64_t value) {
-  const int rc = sqlite3_bind_int64(stmt_, index, value);
-  if (rc != SQLITE_OK) Fail(db_, rc, path_, "bind");
-  return *this;
-}
-
-Stmt& Stmt::Bind(int index, double value) {
-  const int rc = sqlite3_bind_double(stmt_, index, value);
-  if (rc != SQLITE_OK) Fail(db_, rc, path_, "bind");
-  return *this;
-}
-
-Stmt& Stmt::Bind(int index, std::string_view text) {
-  const int rc = sqlite3_bind_text(stmt_, index, text.data(), static_cast<int>(text.size()), SQLITE_TRANSIENT);
-  if (rc != SQLITE_OK) Fail(db_, rc, path_, "bind");
-  return *this;
-}
-
-Stmt& Stmt::BindBlob(int index, const void* data, size_t size) {
-  const int rc = sqlite3_bind_blob64(stmt_, index, data, size, SQLITE_TRANSIENT);
-  if (rc != SQLITE_OK) Fail(db_, rc, path_, "bind");
-  return *this;
-}
-
-Stmt& Stmt::BindNull(int index) {
-  const int rc = sqlite3_bind_null(stmt_, index);
-  if (rc != SQLITE_OK) Fail(db_, rc, path_, "bind");
-  return *this;
-}
-
-bool Stmt::Step() {
-  const int rc = sqlite3_step(stmt_);
-  if (rc == SQLITE_ROW) return true;
-  if (rc == SQLITE_DONE) return false;
-  const std::string sql = sqlite3_sql(stmt_) ? sqlite3_sql(stmt_) : "";
-  sqlite3_reset(stmt_);
-  Fail(db_, rc, path_, "'" + sql.substr(0, 60) + "'");
-}
-
-void Stmt::Reset() {
-  sqlite3_reset(stmt_);
-  sqlite3_clear_bindings(stmt_);
-}
-
-std::string Stmt::Text(int col) const {
-  const auto* text = sqlite3_column_text(stmt_, col);
-  if (!text) return {};
-  return std::string(reinterpret_cast<const char*>(text), static_cast<size_t>(sqlite3_column_bytes(stmt_, col)));
-}
-
-Db::Db(const std::string& path, int flags) : path_(path) {
-  const int rc = sqlite3_open_v2(path.c_str(), &db_, flags, nullptr);
-  if (rc != SQLITE_OK) {
-    const std::string message = db_ ? sqlite3_errmsg(db_) : sqlite3_errstr(rc);
-    sqlite3_close_v2(db_);
-    db_ = nullptr;
-    if ((rc & 0xff) == SQLITE_CANTOPEN) throw InputError(path, "cannot open (" + message + ")");
-    throw WorkError(path, "cannot open (" + message + ")");
+  void Bind(int index, int64_t value) override { Check(sqlite3_bind_int64(stmt_, index, value)); }
+  void Bind(int index, double value) override { Check(sqlite3_bind_double(stmt_, index, value)); }
+  void Bind(int index, std::string_view text) override {
+    Check(sqlite3_bind_text(stmt_, index, text.data(), static_cast<int>(text.size()), SQLITE_TRANSIENT));
   }
-  sqlite3_extended_result_codes(db_, 1);
-}
-
-Db::~Db() { sqlite3_close_v2(db_); }
-
-Db::Db(Db&& other) noexcept : db_(std::exchange(other.db_, nullptr)), path_(std::move(other.path_)) {}
-
-Db& Db::operator=(Db&& other) noexcept {
-  if (this != &other) {
-    sqlite3_close_v2(db_);
-    db_ = std::exchange(other.db_, nullptr);
-    path_ = std::move(other.path_);
+  void BindBlob(int index, const void* data, size_t size) override {
+    Check(sqlite3_bind_blob64(stmt_, index, data, size, SQLITE_TRANSIENT));
   }
-  return *this;
-}
+  void BindNull(int index) override { Check(sqlite3_bind_null(stmt_, index)); }
 
-void Db::Exec(const std::string& sql) {
-  char* error = nullptr;
-  const int rc = sqlite3_exec(db_, sql.c_str(), nullptr, nullptr, &error);
-  if (rc != SQLITE_OK) {
-    sqlite3_free(error);
+  bool Step() override {
+    const int rc = sqlite3_step(stmt_);
+    if (rc == SQLITE_ROW) return true;
+    if (rc == SQLITE_DONE) {
+      changes_ = sqlite3_changes64(db_);
+      return false;
+    }
+    const std::string sql = sqlite3_sql(stmt_) ? sqlite3_sql(stmt_) : "";
+    sqlite3_reset(stmt_);
     Fail(db_, rc, path_, "'" + sql.substr(0, 60) + "'");
   }
-}
+  void Reset() override {
+    sqlite3_reset(stmt_);
+    sqlite3_clear_bindings(stmt_);
+  }
 
-int64_t Db::QueryInt(std::string_view sql) const {
-  Stmt stmt = Prepare(sql);
-  return stmt.Step() ? stmt.Int(0) : 0;
-}
+  int64_t Int(int col) const override { return sqlite3_column_int64(stmt_, col); }
+  double Real(int col) const override { return sqlite3_column_double(stmt_, col); }
+  bool IsNull(int col) const override { return sqlite3_column_type(stmt_, col) == SQLITE_NULL; }
+  std::string Text(int col) const override {
+    const auto* text = sqlite3_column_text(stmt_, col);
+    if (!text) return {};
+    return std::string(reinterpret_cast<const char*>(text), static_cast<size_t>(sqlite3_column_bytes(stmt_, col)));
+  }
+  const void* Blob(int col) const override { return sqlite3_column_blob(stmt_, col); }
+  size_t Bytes(int col) const override { return static_cast<size_t>(sqlite3_column_bytes(stmt_, col)); }
+  int64_t Changes() const override { return changes_; }
 
-Transaction::Transaction(Db& db) : db_(db) { db_.Exec("BEGIN IMMEDIATE"); }
+ private:
+  void Check(int rc) {
+    if (rc != SQLITE_OK) Fail(db_, rc, path_, "bind");
+  }
 
-Transaction::~Transaction() {
-  if (!done_) sqlite3_exec(db_.get(), "ROLLBACK", nullptr, nullptr, nullptr);
-}
+  sqlite3_stmt* stmt_ = nullptr;
+  sqlite3* db_ = nullptr;
+  std::string path_;
+  int64_t changes_ = 0;
+};
 
-void Transaction::Commit() {
-  db_.Exec("COMMIT");
-  done_ = true;
+class SqliteDb final : public DbImpl {
+ public:
+  SqliteDb(const std::string& path, int flags) : path_(path) {
+    const int rc = sqlite3_open_v2(path.c_str(), &db_, flags, nullptr);
+    if (rc != SQLITE_OK) {
+      const std::string message = db_ ? sqlite3_errmsg(db_) : sqlite3_errstr(rc);
+      sqlite3_close_v2(db_);
+      db_ = nullptr;
+      if ((rc & 0xff) == SQLITE_CANTOPEN) throw InputError(path, "cannot open (" + message + ")");
+      throw WorkError(path, "cannot open (" + message + ")");
+    }
+    sqlite3_extended_result_codes(db_, 1);
+  }
+  ~SqliteDb() override { sqlite3_close_v2(db_); }
+  SqliteDb(const SqliteDb&) = delete;
+  SqliteDb& operator=(const SqliteDb&) = delete;
+
+  sqlite3* get() const { return db_; }
+  Dialect dialect() const override { return Dialect::kSqlite; }
+  const std::string& path() const override { return path_; }
+  void Exec(const std::string& sql) override {
+    char* error = nullptr;
+    const int rc = sqlite3_exec(db_, sql.c_str(), nullptr, nullptr, &error);
+    if (rc != SQLITE_OK) {
+      sqlite3_free(error);
+      Fail(db_, rc, path_, "'" + sql.substr(0, 60) + "'");
+    }
+  }
+  std::unique_ptr<StmtImpl> Prepare(std::string_view sql) override {
+    return std::make_unique<SqliteStmt>(db_, sql, path_);
+  }
+  void BeginWrite() override { Exec("BEGIN IMMEDIATE"); }
+  void BeginRead() override { Exec("BEGIN"); }
+  void Commit() override { Exec("COMMIT"); }
+  void Rollback() noexcept override { sqlite3_exec(db_, "ROLLBACK", nullptr, nullptr, nullptr); }
+
+ private:
+  sqlite3* db_ = nullptr;
+  std::string path_;
+};
+
+}  // namespace
+
+Db OpenSqlite(const std::string& path, int flags) { return Db(std::make_unique<SqliteDb>(path, flags)); }
+
+sqlite3* SqliteHandle(const Db& db) {
+  auto* sqlite = dynamic_cast<SqliteDb*>(&db.impl());
+  if (!sqlite) throw WorkError(db.path(), "not a SQLite database");
+  return sqlite->get();
 }
 
 }  // namespace ss::sql

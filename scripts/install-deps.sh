@@ -17,10 +17,13 @@ PACKAGES=(
   # vtest.avi (a fixed camera over people walking), Apache-2.0 / BSD-3-Clause
   opencv-doc
   # storage, config, CLI, logging, HTTP
-  libsqlite3-dev sqlite3 libyaml-cpp-dev nlohmann-json3-dev libcli11-dev
+  libsqlite3-dev sqlite3 libpq-dev libyaml-cpp-dev nlohmann-json3-dev libcli11-dev
   libspdlog-dev libfmt-dev libcpp-httplib-dev libsystemd-dev libpng-dev libzstd-dev
   # tests and benchmarks; clang and its runtimes for the libFuzzer targets (scripts/fuzz.sh)
   libgtest-dev libgmock-dev libbenchmark-dev clang libclang-rt-14-dev
+  # the PostgreSQL bank (libpq) and, for its tests, the server: each test starts a private
+  # one (initdb in /tmp, a free port of 127.0.0.1; tests/support/postgres_server.h)
+  postgresql
   # the daemon tests give each test a private loopback with a second address (ip), and
   # check /metrics with Prometheus's own promtool
   iproute2 prometheus

@@ -20,6 +20,7 @@
 #include "pipeline/run/bank_scale.h"
 #include "core/error.h"
 #include "core/error_kinds.h"
+#include "core/sql_postgres.h"
 #include "core/log.h"
 #include "pipeline/run/bounded_queue.h"
 #include "pipeline/run/ingest.h"
@@ -309,7 +310,8 @@ struct Station::Impl {
 
   void CheckDisk() {
     const StorageConfig storage = StorageSettings();
-    int64_t free_mib = FreeMib(fs::path(storage.bank).parent_path());
+    // A PostgreSQL bank's disk is its server's (a full one fails appends: writes_failing).
+    int64_t free_mib = sql::IsPostgresAddress(storage.bank) ? -1 : FreeMib(fs::path(storage.bank).parent_path());
     if (storage.recording != RecordingMode::kOff) {
       const int64_t rec = FreeMib(storage.recording_dir);
       if (rec >= 0 && (free_mib < 0 || rec < free_mib)) free_mib = rec;

@@ -21,6 +21,7 @@
 
 #include "core/bank_export.h"
 #include "core/bank_schema.h"
+#include "core/sql.h"
 #include "core/bank_verify.h"
 #include "core/error.h"
 #include "tests/support/bank_fixtures.h"
@@ -431,7 +432,7 @@ TEST(Bank, AVersionOneBankIsUpgradedInPlaceAndKeepsItsSprites) {
   ScratchDir dir;
   const std::string path = dir / "v1.db";
   // A bank as version 1 made it: its migration alone, then one clip.
-  RawExec(path, BankMigrations().at(0).sql);
+  RawExec(path, BankMigrations(sql::Dialect::kSqlite).at(0).sql);
   RawExec(path, "PRAGMA application_id = " + std::to_string(kBankApplicationId) +
                     "; PRAGMA user_version = 1; INSERT INTO meta (key, value) VALUES ('schema_version', '1')");
   EXPECT_THROW(Bank b(path), InputError) << "a reader asks for the upgrade";
