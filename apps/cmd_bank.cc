@@ -1,4 +1,5 @@
-// spritestation bank info|verify|tag|export|upgrade BANK: inspect and maintain a sprite bank.
+// spritestation bank info|verify|tag|export|upgrade|digest BANK, bank copy FROM TO: inspect, maintain and
+// move a sprite bank (a SQLite file or a postgresql:// address).
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -9,10 +10,12 @@
 
 #include "apps/commands.h"
 #include "core/bank.h"
+#include "core/bank_copy.h"
 #include "core/bank_export.h"
 #include "core/bank_schema.h"
 #include "core/bank_verify.h"
 #include "core/error.h"
+#include "core/sql_postgres.h"
 
 namespace ss::apps {
 namespace {
@@ -27,8 +30,9 @@ std::string Megabytes(int64_t bytes) {
   return buffer;
 }
 
-void Info(const std::string& path, bool json) {
-  const Bank bank(path);
+void Info(const std::string& address, bool json) {
+  const Bank bank(address);
+  const std::string& path = bank.path();  // without a password
   const BankCounts c = bank.Counts();
   if (json) {
     nlohmann::json j = {{"bank", path},
@@ -64,12 +68,17 @@ void Info(const std::string& path, bool json) {
   std::printf("transitions:    %lld\n", static_cast<long long>(c.transitions));
   std::printf("tags:           %lld names on %lld sprites\n", static_cast<long long>(c.tags),
               static_cast<long long>(c.tagged_sprites));
-  std::printf("file:           %s (+ %s write-ahead log)\n", Megabytes(c.file_bytes).c_str(),
-              Megabytes(c.wal_bytes).c_str());
+  if (bank.is_postgres()) {
+    std::printf("on the server:  %s (tables, indexes and their out-of-line data)\n", Megabytes(c.file_bytes).c_str());
+  } else {
+    std::printf("file:           %s (+ %s write-ahead log)\n", Megabytes(c.file_bytes).c_str(),
+                Megabytes(c.wal_bytes).c_str());
+  }
 }
 
-void Verify(const std::string& path, bool json) {
-  const BankVerifyReport r = VerifyBank(path);
+void Verify(const std::string& address, bool json) {
+  const BankVerifyReport r = VerifyBank(address);
+  const std::string& path = r.path;  // without a password
   if (json) {
     nlohmann::json j = {{"bank", path},
                         {"ok", r.ok()},
@@ -106,18 +115,18 @@ void AddBankCommand(CLI::App& app) {
   auto args = std::make_shared<Args>();
 
   auto* info = bank->add_subcommand("info", "Counts: sessions, cameras, clips, sprites, transitions, tags, size");
-  info->add_option("bank", args->path, "Sprite bank file")->required();
+  info->add_option("bank", args->path, "Sprite bank (file or postgresql://...)")->required();
   info->add_flag("--json", args->json, "Print JSON");
   info->callback([args] { Info(args->path, args->json); });
 
   auto* verify = bank->add_subcommand(
       "verify", "Check integrity, schema and invariants; exit 1 when damaged, 2 when not a bank of this version");
-  verify->add_option("bank", args->path, "Sprite bank file")->required();
+  verify->add_option("bank", args->path, "Sprite bank (file or postgresql://...)")->required();
   verify->add_flag("--json", args->json, "Print JSON");
   verify->callback([args] { Verify(args->path, args->json); });
 
   auto* tag = bank->add_subcommand("tag", "Add (or --remove) a tag on sprites");
-  tag->add_option("bank", args->path, "Sprite bank file")->required();
+  tag->add_option("bank", args->path, "Sprite bank (file or postgresql://...)")->required();
   tag->add_option("--sprites", args->sprites, "Sprite ids, comma-separated")->required()->delimiter(',');
   tag->add_option("--tag", args->tag, "Tag name")->required();
   tag->add_flag("--remove", args->remove, "Remove the tag instead");
@@ -147,7 +156,7 @@ void AddBankCommand(CLI::App& app) {
   });
 
   auto* exp = bank->add_subcommand("export", "Write the visible sprites as PNG billboards and sprites.csv");
-  exp->add_option("bank", args->path, "Sprite bank file")->required();
+  exp->add_option("bank", args->path, "Sprite bank (file or postgresql://...)")->required();
   exp->add_option("--out", args->out, "Output folder")->required();
   exp->add_option("--tag", args->tag, "Only sprites with this tag");
   exp->add_flag("--no-mirrors", args->no_mirrors, "Leave out the mirrored copies");
@@ -163,18 +172,58 @@ void AddBankCommand(CLI::App& app) {
   });
 
   auto* upgrade = bank->add_subcommand("upgrade", "Upgrade an older bank's schema in place");
-  upgrade->add_option("bank", args->path, "Sprite bank file")->required();
+  upgrade->add_option("bank", args->path, "Sprite bank (file or postgresql://...)")->required();
   upgrade->add_flag("--json", args->json, "Print JSON");
   upgrade->callback([args] {
-    if (!std::filesystem::exists(args->path)) throw InputError(args->path, "no such sprite bank");
+    if (!sql::IsPostgresAddress(args->path) && !std::filesystem::exists(args->path)) {
+      throw InputError(args->path, "no such sprite bank");
+    }
     const BankWriter writer(args->path);
     if (args->json) {
-      std::printf("%s\n", nlohmann::json({{"bank", args->path}, {"schema_version", writer.schema_version()}})
+      std::printf("%s\n", nlohmann::json({{"bank", writer.path()}, {"schema_version", writer.schema_version()}})
                               .dump(2)
                               .c_str());
     } else {
-      std::printf("%s: schema version %d (current %d)\n", args->path.c_str(), writer.schema_version(),
+      std::printf("%s: schema version %d (current %d)\n", writer.path().c_str(), writer.schema_version(),
                   kBankSchemaVersion);
+    }
+  });
+
+  auto* copy = bank->add_subcommand(
+      "copy", "Copy a bank into an empty one, keeping every id: SQLite to PostgreSQL or back (verified)");
+  copy->add_option("from", args->path, "Sprite bank to copy (file or postgresql://...)")->required();
+  copy->add_option("to", args->out, "Empty or new sprite bank to copy into (file or postgresql://...)")->required();
+  copy->add_flag("--json", args->json, "Print JSON");
+  copy->callback([args] {
+    const BankDigest d = CopyBank(args->path, args->out);
+    const BankVerifyReport r = VerifyBank(args->out);
+    if (!r.ok()) throw WorkError(r.path, "the copy does not verify: " + r.problems.front());
+    int64_t rows = 0;
+    for (const auto& [table, n] : d.rows) rows += n;
+    if (args->json) {
+      std::printf("%s\n", nlohmann::json({{"from", sql::RedactAddress(args->path)},
+                                          {"to", r.path},
+                                          {"digest", d.digest},
+                                          {"rows", d.rows},
+                                          {"verified", true}})
+                              .dump(2)
+                              .c_str());
+    } else {
+      std::printf("copied %lld rows (%lld sprites, %lld transitions) into %s: digest %s on both sides, verified\n",
+                  static_cast<long long>(rows), static_cast<long long>(d.rows.at("sprites")),
+                  static_cast<long long>(d.rows.at("transitions")), r.path.c_str(), d.digest.c_str());
+    }
+  });
+
+  auto* digest = bank->add_subcommand("digest", "A digest of the bank's content, the same in SQLite and PostgreSQL");
+  digest->add_option("bank", args->path, "Sprite bank (file or postgresql://...)")->required();
+  digest->add_flag("--json", args->json, "Print JSON");
+  digest->callback([args] {
+    const BankDigest d = DigestBank(args->path);
+    if (args->json) {
+      std::printf("%s\n", nlohmann::json({{"digest", d.digest}, {"rows", d.rows}}).dump(2).c_str());
+    } else {
+      std::printf("%s\n", d.digest.c_str());
     }
   });
 }

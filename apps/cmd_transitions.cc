@@ -138,7 +138,7 @@ void AddTransitionsCommand(CLI::App& app) {
   auto args = std::make_shared<Args>();
   auto* cmd = app.add_subcommand("transitions",
                                  "Build or bring up to date a bank's transitions; 'label' and 'train' the classifier");
-  cmd->add_option("bank", args->bank, "Sprite bank file (build or update its transitions)");
+  cmd->add_option("bank", args->bank, "Sprite bank, file or postgresql://... (build or update its transitions)");
   cmd->add_option("--weights", args->weights, "Classifier weights file (default: the shipped weights)");
   cmd->add_option("--threads", args->threads, "Worker threads")->check(CLI::Range(1, 64));
   cmd->add_flag("--quiet", args->quiet, "No progress lines");
