@@ -486,7 +486,7 @@ void ReadPipeline(Reader& r, const YAML::Node& node, PipelineConfig& p) {
 void ReadStorage(Reader& r, const YAML::Node& node, StorageConfig& s) {
   const MapView view = r.Map(node, "storage");
   r.Known(view, {"bank", "recording_dir", "recording", "recording_codec",
-                 "stop_recording_below_mib", "stop_sprites_below_mib"});
+                 "stop_recording_below_mib", "stop_sprites_below_mib", "spool_dir", "spool_max_mib"});
   // A file (resolved against the config's folder) or a PostgreSQL server's address, kept as written.
   if (r.Path(view, "bank", s.bank)) {
     std::string raw;
@@ -498,6 +498,8 @@ void ReadStorage(Reader& r, const YAML::Node& node, StorageConfig& s) {
   r.String(view, "recording_codec", s.recording_codec);
   r.Int64(view, "stop_recording_below_mib", s.stop_recording_below_mib, "a size in MiB");
   r.Int64(view, "stop_sprites_below_mib", s.stop_sprites_below_mib, "a size in MiB");
+  r.Path(view, "spool_dir", s.spool_dir);
+  r.Int64(view, "spool_max_mib", s.spool_max_mib, "a size in MiB");
 }
 
 void ReadControl(Reader& r, const YAML::Node& node, ControlConfig& c) {
@@ -771,6 +773,7 @@ class Validator {
     }
     Check(s.stop_recording_below_mib >= 0, "storage.stop_recording_below_mib",
           "expected a size >= 0, got " + std::to_string(s.stop_recording_below_mib));
+    Check(s.spool_max_mib >= 1, "storage.spool_max_mib", "expected a size >= 1, got " + std::to_string(s.spool_max_mib));
     Check(s.stop_sprites_below_mib >= 0, "storage.stop_sprites_below_mib",
           "expected a size >= 0, got " + std::to_string(s.stop_sprites_below_mib));
     // Raw recording must stop first: its low-water mark is never below the sprites' one.
@@ -878,6 +881,7 @@ StationConfig ParseStationConfig(const std::string& yaml, const std::string& ori
   StationConfig cfg;
   cfg.storage.bank = r.Resolve("station.bank");
   cfg.storage.recording_dir = r.Resolve("recordings");
+  cfg.storage.spool_dir = r.Resolve("spool");
   const MapView top = r.Map(root, "");
   r.Known(top, {"version", "cameras", "keying", "enclosure", "pipeline", "storage", "control",
                 "logging"});

@@ -122,6 +122,11 @@ struct StorageConfig {
   std::string recording_codec = "ffv1";      // "ffv1" | "mjpeg" | "h264"
   int64_t stop_recording_below_mib = 20480;  // free disk under which raw recording stops
   int64_t stop_sprites_below_mib = 2048;     // ... and under which sprite storage stops
+  // Where clip batches wait on disk while the bank cannot take them (a PostgreSQL server gone,
+  // a SQLite file locked past every retry), and how much they may fill; drained in order when
+  // the bank answers again, also at the next start (absolute).
+  std::string spool_dir;
+  int64_t spool_max_mib = 4096;
   bool operator==(const StorageConfig&) const = default;
 };
 

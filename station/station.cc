@@ -21,6 +21,7 @@
 #include "core/error.h"
 #include "core/error_kinds.h"
 #include "core/sql_postgres.h"
+#include "station/bank_spool.h"
 #include "core/log.h"
 #include "pipeline/run/bounded_queue.h"
 #include "pipeline/run/ingest.h"
@@ -104,6 +105,7 @@ struct Station::Impl {
 
   std::mutex bank_mutex;  // BankWriter is one connection: one thread at a time
   std::unique_ptr<BankWriter> bank;
+  std::unique_ptr<BankSpool> spool;  // the writer thread's
   std::unique_ptr<TransitionWorker> transitions;
   std::vector<std::unique_ptr<CameraRunner>> runners;
 
@@ -118,6 +120,9 @@ struct Station::Impl {
   int64_t bank_sprites = 0;
   uint64_t sprites_stored = 0, batches_stored = 0, batches_failed = 0, batches_refused = 0;
   uint64_t batches_retried = 0;  // appends tried again after the bank stayed locked (BusyError)
+  uint64_t batches_spooled = 0;  // kept on disk while the bank could not take them
+  uint64_t spool_batches = 0;
+  int64_t spool_bytes = 0;
   static constexpr int kBusyAttempts = 6;  // with SQLite's 10 s busy timeout: up to a minute
   std::deque<double> latencies_ms;                         // last 10,000
   uint64_t latency_count = 0;                              // every sprite's, since start
@@ -178,12 +183,27 @@ struct Station::Impl {
   }
 
   void WriterLoop() {
-    while (std::optional<StationBatch> sb = batches.Pop()) {
+    DrainSpool();  // what an earlier run left
+    while (true) {
+      std::optional<StationBatch> sb;
+      if (spool && !spool->empty()) {
+        // Batches wait on disk: try the bank again every second even if no new batch comes.
+        sb = batches.PopFor(std::chrono::seconds(1));
+        if (!sb) {
+          if (batches.closed()) break;
+          DrainSpool();
+          continue;
+        }
+      } else {
+        sb = batches.Pop();
+        if (!sb) break;
+      }
       WriteBatch(*sb);
       std::lock_guard lock(idle_mutex);
       ++batches_done;
       idle_cv.notify_all();
     }
+    DrainSpool();  // a last try; what is left waits for the next start
   }
 
   // Clips one of whose batches failed (camera, track, first frame): their later batches are
@@ -207,24 +227,43 @@ struct Station::Impl {
       ++batches_failed;
       return;
     }
+    if (spool && !spool->empty()) {
+      // Earlier batches wait in the spool: this one goes behind them, so that the bank takes
+      // every clip's batches in order.
+      Spool(sb.batch);
+      DrainSpool();
+      return;
+    }
     AppendResult result;
     try {
-      // Another writer of the bank (the transitions worker, a labelling page, another process)
-      // may hold its write lock past SQLite's busy timeout (10 s) on a loaded machine: the batch
-      // is still in hand, so it is tried again before anything is given up.
+      // Another writer of a SQLite bank (the transitions worker, a labelling page, another
+      // process) may hold its write lock past the busy timeout (10 s) on a loaded machine: the
+      // batch is still in hand, so it is tried again before it is spooled. A PostgreSQL bank
+      // that is busy has lost its server: the spool takes the batch at once.
+      const int attempts = bank->is_postgres() ? 1 : kBusyAttempts;
       for (int attempt = 1;; ++attempt) {
         try {
           std::lock_guard lock(bank_mutex);
           result = bank->AppendClipBatch(sb.batch.clip, sb.batch.sprites);
           break;
         } catch (const BusyError& e) {
-          if (attempt == kBusyAttempts) throw;
+          if (attempt == attempts) throw;
           log->warn("bank: {} (clip {}/{} from frame {}: try {} of {})", e.what(), clip.camera_id, clip.track_id,
-                    clip.first_frame, attempt + 1, kBusyAttempts);
+                    clip.first_frame, attempt + 1, attempts);
           std::lock_guard lock(stats_mutex);
           ++batches_retried;
         }
       }
+    } catch (const BusyError& e) {
+      log->warn("bank: {} (clip {}/{} from frame {}: kept in the spool until the bank answers)", e.what(),
+                clip.camera_id, clip.track_id, clip.first_frame);
+      {
+        std::lock_guard lock(stats_mutex);
+        bank_error = e.what();
+        last_append_failed = true;
+      }
+      Spool(sb.batch);
+      return;
     } catch (const std::exception& e) {
       // A failed append is one rolled-back transaction: what was stored stays stored.
       log->error("bank: {} (the rest of clip {}/{} from frame {} is not stored)", e.what(), clip.camera_id,
@@ -236,14 +275,80 @@ struct Station::Impl {
       last_append_failed = true;
       return;
     }
+    Stored(sb.batch, result, &sb.received);
+  }
+
+  // Keeps a batch the bank could not take in the spool; if even that fails, the batch is lost
+  // as a failed append is (counted, its clip's later batches not stored).
+  void Spool(const ClipBatch& batch) {
+    std::string why;
+    try {
+      if (spool && spool->Push(batch)) {
+        std::lock_guard lock(stats_mutex);
+        ++batches_spooled;
+        spool_batches = spool->batches();
+        spool_bytes = spool->bytes();
+        return;
+      }
+      why = spool ? "the spool " + spool->dir() + " is full (storage.spool_max_mib)" : "no spool";
+    } catch (const std::exception& e) {
+      why = e.what();
+    }
+    const ClipRecord& clip = batch.clip;
+    log->error("bank: clip {}/{} from frame {} not stored and not spooled: {}", clip.camera_id, clip.track_id,
+               clip.first_frame, why);
+    if (!clip.complete) broken_clips.insert(std::make_tuple(clip.camera_id, clip.track_id, clip.first_frame));
+    std::lock_guard lock(stats_mutex);
+    ++batches_failed;
+    bank_error = why;
+    last_append_failed = true;
+  }
+
+  // Appends the spooled batches, oldest first, until the spool is empty or the bank is still
+  // away. A batch the bank refuses for what it holds is set aside in the spool's damaged/ folder.
+  void DrainSpool() {
+    size_t drained = 0;
+    while (spool && !spool->empty()) {
+      std::optional<ClipBatch> batch = spool->Front();
+      if (!batch) break;
+      AppendResult result;
+      try {
+        std::lock_guard lock(bank_mutex);
+        result = bank->AppendClipBatch(batch->clip, batch->sprites);
+      } catch (const BusyError&) {
+        break;  // still away: the next batch or the next second tries again
+      } catch (const std::exception& e) {
+        log->error("bank: a spooled batch is refused: {}", e.what());
+        spool->SetAsideFront(e.what());
+        std::lock_guard lock(stats_mutex);
+        ++batches_failed;
+        bank_error = e.what();
+        continue;
+      }
+      spool->PopFront();
+      ++drained;
+      Stored(*batch, result, nullptr);
+    }
+    std::lock_guard lock(stats_mutex);
+    if (spool) {
+      spool_batches = spool->batches();
+      spool_bytes = spool->bytes();
+    }
+    if (drained > 0) log->info("bank: {} spooled batches stored, {} still waiting", drained, spool_batches);
+  }
+
+  // Counts a batch the bank took (`received`: when each sprite's frame arrived, for the latency;
+  // none for a batch from the spool) and hands its new sprites to the transitions worker.
+  void Stored(const ClipBatch& batch, const AppendResult& result, const std::vector<SteadyTime>* received) {
     const SteadyTime now = Clock::now();
     uint64_t originals = 0;
     {
       std::lock_guard lock(stats_mutex);
-      for (size_t i = 0; i < sb.batch.sprites.size(); ++i) {
-        if (sb.batch.sprites[i].mirrored) continue;
+      for (size_t i = 0; i < batch.sprites.size(); ++i) {
+        if (batch.sprites[i].mirrored) continue;
         ++originals;
-        latencies_ms.push_back(Seconds(now - sb.received[i]) * 1e3);
+        if (!received) continue;
+        latencies_ms.push_back(Seconds(now - (*received)[i]) * 1e3);
         ++latency_count;
         latency_sum_ms += latencies_ms.back();
         if (latencies_ms.size() > 10000) latencies_ms.pop_front();
@@ -389,6 +494,13 @@ void Station::Start() {
   const StationConfig& config = s.options.config;
   s.bank = std::make_unique<BankWriter>(config.storage.bank);
   s.bank_sprites = s.bank->Counts().sprites;
+  {
+    std::string spool_dir = config.storage.spool_dir;
+    if (spool_dir.empty()) spool_dir = s.bank->is_postgres() ? "spool" : config.storage.bank + ".spool";
+    s.spool = std::make_unique<BankSpool>(spool_dir, config.storage.spool_max_mib * 1024 * 1024);
+    s.spool_batches = s.spool->batches();
+    s.spool_bytes = s.spool->bytes();
+  }
   CameraPipelineOptions pipeline = PipelineOptionsFromConfig(config);
   // The bank's one billboard scale, shared by every camera (pipeline/run/bank_scale.h).
   BankScaleInputs scale_inputs;
@@ -612,6 +724,9 @@ StationStatus Station::Status() const {
     out.batches_stored = s.batches_stored;
     out.batches_failed = s.batches_failed;
     out.batches_retried = s.batches_retried;
+    out.batches_spooled = s.batches_spooled;
+    out.spool_batches = s.spool_batches;
+    out.spool_bytes = s.spool_bytes;
     out.batches_refused = s.batches_refused;
     out.bank_error = s.bank_error;
     out.storage_state = s.storage_state;

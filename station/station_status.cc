@@ -130,6 +130,8 @@ nlohmann::json StatusToJson(const StationStatus& st) {
                     {"batches_stored", st.batches_stored},
                     {"batches_failed", st.batches_failed},
                     {"batches_retried", st.batches_retried},
+                    {"batches_spooled", st.batches_spooled},
+                    {"spool", {{"batches", st.spool_batches}, {"bytes", st.spool_bytes}}},
                     {"batches_refused", st.batches_refused},
                     {"writer_queue", st.writer_queue},
                     {"latency_ms", {{"p50", st.latency_p50_ms}, {"p99", st.latency_p99_ms}}},
@@ -206,6 +208,10 @@ std::string StatusToPrometheus(const StationStatus& st) {
   m.Family("bank_batches_retried_total", "counter",
            "clip batch appends tried again because another writer held the bank's lock past its busy timeout");
   m.Sample(static_cast<double>(st.batches_retried));
+  m.Family("bank_batches_spooled_total", "counter", "clip batches kept on disk because the bank could not take them");
+  m.Sample(static_cast<double>(st.batches_spooled));
+  m.Family("bank_spool_batches", "gauge", "clip batches waiting in the spool for the bank");
+  m.Sample(static_cast<double>(st.spool_batches));
   m.Family("bank_batches_refused_total", "counter", "clip batches not stored because the disk is nearly full");
   m.Sample(static_cast<double>(st.batches_refused));
   // A summary: quantiles over the last 10,000 sprites, _sum and _count over every sprite since start.

@@ -42,6 +42,9 @@ struct StationStatus {
   double sprites_per_second = 0;  // over the last ~5 s
   uint64_t batches_stored = 0, batches_failed = 0, batches_refused = 0;  // refused: storage stopped (disk)
   uint64_t batches_retried = 0;  // appends tried again after the bank stayed locked past its busy timeout
+  uint64_t batches_spooled = 0;  // batches kept on disk because the bank could not take them (since start)
+  uint64_t spool_batches = 0;    // ... of them (and of earlier runs) still waiting in the spool
+  int64_t spool_bytes = 0;
   size_t writer_queue = 0;
   double latency_p50_ms = 0, latency_p99_ms = 0;  // frame arrival -> sprite committed, last 10,000 sprites
   uint64_t latency_count = 0;                       // sprites committed since start, and their latencies'

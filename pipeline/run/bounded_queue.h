@@ -51,6 +51,10 @@ class BoundedQueue {
     return items_.size();
   }
   size_t capacity() const { return capacity_; }
+  bool closed() const {
+    std::lock_guard lock(mutex_);
+    return closed_;
+  }
 
   std::optional<T> Pop() {
     std::unique_lock lock(mutex_);

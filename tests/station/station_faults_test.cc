@@ -19,23 +19,16 @@
 #include "station/station_status.h"
 #include <nlohmann/json.hpp>
 #include "synth/studio_session.h"
+#include "tests/station/replay_station.h"
 #include "tests/support/test_support.h"
 
 namespace ss {
 namespace {
 
 using Clock = std::chrono::steady_clock;
+using testing::OneReplayCamera;
+using testing::WaitFor;
 namespace fs = std::filesystem;
-
-template <typename Pred>
-bool WaitFor(const Station& station, Pred pred, double seconds) {
-  const auto deadline = Clock::now() + std::chrono::duration<double>(seconds);
-  while (Clock::now() < deadline) {
-    if (pred(station.Status())) return true;
-    std::this_thread::sleep_for(std::chrono::milliseconds(50));
-  }
-  return false;
-}
 
 // Restores the file-size limit however the test ends.
 struct FileSizeLimit {
@@ -49,36 +42,6 @@ struct FileSizeLimit {
   }
   void Lift() { setrlimit(RLIMIT_FSIZE, &saved); }
 };
-
-// A station on one looping, paced replay camera of a fresh 4 s synthetic session in `dir`,
-// storing into dir/station.bank with the disk guard off; no transitions worker.
-StationOptions OneReplayCamera(const testing::ScratchDir& dir) {
-  synth::SynthOptions so;
-  so.out_dir = dir / "session";
-  so.seconds = 4;
-  so.fps = 30;
-  so.width = 640;
-  so.height = 480;
-  so.cameras = 1;
-  so.seed = 11;
-  so.empty_lead_in_s = 1.5;
-  so.write_mattes = false;
-  synth::RenderStudioSession(so);
-  StationOptions options;
-  CameraConfig cam;
-  cam.name = "cam0";
-  cam.source = "replay";
-  cam.session = so.out_dir;
-  cam.loop = true;
-  cam.realtime = true;
-  options.config.cameras = {cam};
-  options.config.storage.bank = dir / "station.bank";
-  options.config.storage.recording_dir = dir / "recordings";
-  options.config.storage.stop_recording_below_mib = 0;
-  options.config.storage.stop_sprites_below_mib = 0;
-  options.transitions = false;
-  return options;
-}
 
 TEST(StationFaults, AFullDiskSaysWritesFailLosesNothingAndResumes) {
   signal(SIGXFSZ, SIG_IGN);  // a write past the limit fails with EFBIG instead of killing the process
