@@ -107,15 +107,9 @@ void WriteSequenceFile(const std::string& path, const SequenceFile& file) {
   if (ec) throw WorkError(path, "cannot write the sequences: " + ec.message());
 }
 
-SequenceFile ReadSequenceFile(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw InputError(path, "cannot read the sequences");
-  json j;
-  try {
-    j = json::parse(in);
-  } catch (const json::exception& e) {
-    throw InputError(path, std::string("not valid JSON: ") + e.what());
-  }
+namespace {
+
+SequenceFile ReadSequenceJson(const json& j, const std::string& path) {
   if (!j.is_object() || j.value("format", "") != "spritestation-sequences") {
     throw InputError(path, "format: not a spritestation sequences file");
   }
@@ -149,6 +143,25 @@ SequenceFile ReadSequenceFile(const std::string& path) {
   }
   file.summary = j.value("summary", json::object());
   return file;
+}
+
+}  // namespace
+
+SequenceFile ReadSequenceFile(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw InputError(path, "cannot read the sequences");
+  json j;
+  try {
+    j = json::parse(in);
+  } catch (const json::exception& e) {
+    throw InputError(path, std::string("not valid JSON: ") + e.what());
+  }
+  // Any field of the wrong JSON type (an array where text belongs) is the file's fault.
+  try {
+    return ReadSequenceJson(j, path);
+  } catch (const json::exception& e) {
+    throw InputError(path, std::string("wrong field: ") + e.what());
+  }
 }
 
 }  // namespace ss
