@@ -160,6 +160,7 @@ TEST(StationConfig, DefaultsAreFilled) {
   expected.cameras = {cam};
   expected.storage.bank = "/studio/station.bank";
   expected.storage.recording_dir = "/studio/recordings";
+  expected.storage.spool_dir = "/studio/spool";
   EXPECT_EQ(cfg, expected);
   EXPECT_FALSE(cfg.cameras[0].exposure_us.has_value());  // unset: the device's value, locked
   EXPECT_EQ(cfg.control.address, "127.0.0.1");
