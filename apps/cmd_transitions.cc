@@ -1,11 +1,12 @@
 // spritestation transitions BANK | train LABELS --bank BANK --out WEIGHTS |
-//                label --from-truth SESSION --bank BANK --out LABELS
+//                label --from-truth SESSION --bank BANK --out LABELS | worker --bank postgresql://...
 // The transition table of a sprite bank (seed 000 §3; docs/transitions.md).
 #include <chrono>
 #include <cstdio>
 #include <memory>
 #include <mutex>
 #include <string>
+#include <thread>
 
 #include <nlohmann/json.hpp>
 
@@ -13,12 +14,15 @@
 #include "core/error.h"
 #include "pipeline/transitions/bank_training.h"
 #include "pipeline/transitions/bank_transitions.h"
+#include "pipeline/transitions/unit_worker.h"
 
 namespace ss::apps {
 namespace {
 
 struct Args {
-  std::string bank, weights, labels, out, session;
+  std::string bank, weights, labels, out, session, name;
+  double lease_s = 60;
+  bool exit_when_idle = false;
   int threads = 2, folds = 5, count = 1000;
   uint64_t seed = 1;
   double stage1_recall = 0.999;
@@ -132,6 +136,47 @@ void Label(const Args& a) {
   }
 }
 
+// One of any number of workers sharing a PostgreSQL bank's transition work (docs/scaling.md).
+void Worker(const Args& a) {
+  UnitWorkerOptions options;
+  options.weights = WeightsOf(a);
+  options.name = a.name;
+  options.lease_s = a.lease_s;
+  options.load_threads = a.threads;
+  UnitWorker worker(a.bank, options);
+  const auto t0 = std::chrono::steady_clock::now();
+  while (true) {
+    if (worker.RunOne()) continue;
+    if (a.exit_when_idle) {
+      const WorkCounts c = worker.Counts();
+      if (c.pending == 0 && c.leased == 0) break;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(200));  // polls the bank for new clips
+  }
+  const UnitWorkerStats& s = worker.stats();
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  if (a.json) {
+    std::printf("%s\n", nlohmann::json({{"worker", worker.name()},
+                                        {"units", s.units},
+                                        {"transitions", s.transitions},
+                                        {"sprites_indexed", s.sprites_indexed},
+                                        {"clips_indexed", s.clips_indexed},
+                                        {"stage2_evaluations", s.stage2_evaluations},
+                                        {"kept_pairs", s.kept_pairs},
+                                        {"seconds", seconds},
+                                        {"seconds_index", s.seconds_index},
+                                        {"seconds_pairs", s.seconds_pairs},
+                                        {"seconds_store", s.seconds_store}})
+                            .dump(2)
+                            .c_str());
+  } else {
+    std::printf("%s: %lld units, %lld transitions stored; %lld sprites indexed; %.1f s (index %.1f, pairs %.1f, "
+                "store %.1f)\n",
+                worker.name().c_str(), static_cast<long long>(s.units), static_cast<long long>(s.transitions),
+                static_cast<long long>(s.sprites_indexed), seconds, s.seconds_index, s.seconds_pairs, s.seconds_store);
+  }
+}
+
 }  // namespace
 
 void AddTransitionsCommand(CLI::App& app) {
@@ -173,6 +218,19 @@ void AddTransitionsCommand(CLI::App& app) {
   label->add_option("--seed", args->seed, "Seed of the pair sampling");
   label->add_flag("--json", args->json, "Print JSON");
   label->callback([args] { Label(*args); });
+
+  auto* worker = cmd->add_subcommand(
+      "worker", "Share a PostgreSQL bank's transition work with any number of workers on any hosts");
+  worker->add_option("--bank", args->bank, "The PostgreSQL bank (postgresql://...)")->required();
+  worker->add_option("--weights", args->weights, "Classifier weights file (default: the shipped weights)");
+  worker->add_option("--name", args->name, "This worker's name in the work table (default host:pid)");
+  worker->add_option("--lease", args->lease_s, "Seconds a claimed unit is this worker's; then any worker's")
+      ->check(CLI::Range(1.0, 86400.0));
+  worker->add_option("--threads", args->threads, "Threads for the comparison images of new sprites")
+      ->check(CLI::Range(1, 64));
+  worker->add_flag("--exit-when-idle", args->exit_when_idle, "Exit when no unit is pending or leased");
+  worker->add_flag("--json", args->json, "Print JSON");
+  worker->callback([args] { Worker(*args); });
 }
 
 }  // namespace ss::apps

@@ -174,6 +174,56 @@ TransitionDelta TransitionBuilder::Add(std::span<const SpriteInput> sprites) {
   return delta;
 }
 
+int32_t TransitionBuilder::AppendIndexOnly(std::span<const SpriteInput> sprites, int threads) {
+  if (sprites.empty()) return store_.size();
+  const int32_t first = store_.Append(sprites, threads);
+  neighbours_.resize(store_.size());
+  for (int32_t s = first; s < store_.size(); ++s) index_.Insert(store_.cheap(s));
+  stats_.sprites = store_.size();
+  stats_.clips = static_cast<int64_t>(store_.clip_count());
+  return first;
+}
+
+TransitionDelta TransitionBuilder::AddPairsOf(int32_t first, int32_t end) {
+  TransitionDelta delta;
+  std::vector<int32_t> hits;
+  for (int32_t s = first; s < end; ++s) {
+    hits.clear();
+    index_.Query(store_.cheap(s), &hits);
+    stats_.stage1_candidates += static_cast<int64_t>(hits.size());
+    for (size_t h = 0; h < hits.size(); ++h) {
+      if (h + 8 < hits.size()) store_.PrefetchCoarse(hits[h + 8]);
+      const int32_t j = hits[h];
+      if (j == s || (j >= first && j < end && j > s)) continue;  // within the range: each pair once
+      if (Find(neighbours_[s], j)) continue;                       // found by an earlier unit here
+      if (classifier_.SignatureRejects(store_, s, j)) {
+        ++stats_.signature_rejected;
+        continue;
+      }
+      ++stats_.stage2_evaluations;
+      double d;
+      if (!classifier_.Stage2(store_, s, j, &d)) continue;
+      InsertNeighbour(s, j, d);
+      InsertNeighbour(j, s, d);
+      ++stats_.kept_pairs;
+      const int64_t a = store_.id(s), b = store_.id(j);
+      delta.pairs.push_back({std::min(a, b), std::max(a, b), d});
+    }
+  }
+  for (int32_t i = first; i < end; ++i) {
+    TransitionsFrom(i, &delta.transitions);
+    TransitionsInto(i, &delta.transitions);
+  }
+  std::sort(delta.transitions.begin(), delta.transitions.end(),
+            [](const Transition& a, const Transition& b) { return a.from != b.from ? a.from < b.from : a.to < b.to; });
+  delta.transitions.erase(std::unique(delta.transitions.begin(), delta.transitions.end(),
+                                      [](const Transition& a, const Transition& b) {
+                                        return a.from == b.from && a.to == b.to;
+                                      }),
+                          delta.transitions.end());
+  return delta;
+}
+
 void TransitionBuilder::TransitionsFrom(int32_t i, std::vector<Transition>* out) const {
   const int32_t successor = store_.next(i);
   if (successor < 0) return;  // a clip's last frame: no i+1, no transition out

@@ -69,6 +69,17 @@ class TransitionBuilder {
   // Appends sprites (one thread) and returns what became new.
   TransitionDelta Add(std::span<const SpriteInput> sprites);
 
+  // For transition work shared by many workers (docs/scaling.md), one unit per bank clip:
+  // AppendIndexOnly puts sprites in the store and the stage-1 index without finding any of
+  // their pairs (their clips are other units'); returns the first new store index.
+  int32_t AppendIndexOnly(std::span<const SpriteInput> sprites, int threads = 1);
+  // Finds the kept pairs of the store range [first, end) (one bank clip's sprites) with every
+  // sprite in the store, each pair once (pairs found before are not evaluated again), and
+  // returns every transition with an end in the range. A transition's three pairs join the
+  // same two clips, so the unit of the later of them finds it whole: the union over the units
+  // is the table a single builder makes.
+  TransitionDelta AddPairsOf(int32_t first, int32_t end);
+
   std::vector<KeptPair> KeptPairs() const;       // sorted by (sprite_a, sprite_b)
   std::vector<Transition> Transitions() const;   // sorted by (from, to)
   int64_t TransitionCount() const;

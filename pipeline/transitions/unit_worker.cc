@@ -1,0 +1,114 @@
+#include "pipeline/transitions/unit_worker.h"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdlib>
+#include <thread>
+#include <vector>
+
+#include "core/error.h"
+#include "core/log.h"
+#include "pipeline/transitions/bank_transitions.h"
+
+namespace ss {
+namespace {
+
+constexpr size_t kRowsPerTransaction = 2000;
+
+double SecondsSince(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+std::string DefaultName() {
+  char host[256] = {};
+  ::gethostname(host, sizeof(host) - 1);
+  return std::string(host) + ":" + std::to_string(::getpid());
+}
+
+}  // namespace
+
+UnitWorker::UnitWorker(const std::string& bank, UnitWorkerOptions options)
+    : options_(std::move(options)), reader_(bank), writer_(bank), queue_(bank) {
+  if (options_.name.empty()) options_.name = DefaultName();
+  const TransitionClassifier check(options_.weights);  // InputError for invalid weights
+  const std::string fingerprint = WeightsFingerprint(options_.weights);
+  const std::optional<std::string> made_with = reader_.GetMeta(kTransitionWeightsMetaKey);
+  if (made_with && *made_with != fingerprint && reader_.Counts().transitions > 0) {
+    throw InputError(reader_.path(), "its transitions were made with other weights (" + *made_with +
+                                         "); rebuild them with `spritestation transitions BANK` first");
+  }
+  if (!made_with) writer_.SetMeta(kTransitionWeightsMetaKey, fingerprint);
+}
+
+void UnitWorker::CatchUp() {
+  const auto t0 = std::chrono::steady_clock::now();
+  // The clips' numbers first: every clip numbered up to `upto` is committed, so the features
+  // read next hold all of them (and perhaps later ones, which are taken too and skipped later).
+  int64_t upto = loaded_seq_;
+  for (const ClipRecord& c : reader_.ListClips(loaded_seq_)) upto = std::max(upto, c.complete_seq);
+  if (upto == loaded_seq_) return;
+  std::vector<int64_t> ids;
+  std::vector<int64_t> clips;  // per id
+  for (const SpriteFeatures& f : reader_.LoadFeatures(loaded_seq_)) {
+    if (clip_range_.count(f.clip_id)) continue;
+    ids.push_back(f.id);
+    clips.push_back(f.clip_id);
+  }
+  loaded_seq_ = upto;
+  if (ids.empty()) return;
+  const double scale = builder_ ? builder_->store().px_per_m() : 0.0;
+  const BankSprites sprites = LoadBankSpritesById(reader_, ids, &keys_, scale);
+  if (!builder_) builder_ = std::make_unique<TransitionBuilder>(options_.weights, sprites.px_per_m);
+  const int32_t first = builder_->AppendIndexOnly(sprites.inputs, options_.load_threads);
+  for (size_t k = 0; k < clips.size(); ++k) {
+    const int32_t index = first + static_cast<int32_t>(k);
+    auto [it, fresh] = clip_range_.try_emplace(clips[k], index, index + 1);
+    if (!fresh) it->second.second = index + 1;  // a clip's sprites are one run (LoadFeatures' order)
+    if (fresh) ++stats_.clips_indexed;
+  }
+  stats_.sprites_indexed += static_cast<int64_t>(ids.size());
+  stats_.seconds_index += SecondsSince(t0);
+}
+
+bool UnitWorker::RunOne() {
+  queue_.Register();
+  const std::optional<WorkUnit> unit = queue_.Claim(options_.name, options_.lease_s);
+  if (!unit) return false;
+  if (const char* pause = std::getenv("SPRITESTATION_WORKER_TEST_PAUSE_S")) {
+    // Tests: hold the claimed unit a while, so that the worker can be killed in the middle of it.
+    std::this_thread::sleep_for(std::chrono::duration<double>(std::atof(pause)));
+  }
+  CatchUp();
+  const auto range = clip_range_.find(unit->clip_id);
+  if (range == clip_range_.end()) {
+    // A clip whose sprites were all removed since: nothing to find.
+    queue_.Done(unit->clip_id);
+    ++stats_.units;
+    return true;
+  }
+  auto t0 = std::chrono::steady_clock::now();
+  const int64_t evaluations = builder_->stats().stage2_evaluations, kept = builder_->stats().kept_pairs;
+  const TransitionDelta delta = builder_->AddPairsOf(range->second.first, range->second.second);
+  stats_.seconds_pairs += SecondsSince(t0);
+  stats_.stage2_evaluations += builder_->stats().stage2_evaluations - evaluations;
+  stats_.kept_pairs += builder_->stats().kept_pairs - kept;
+
+  t0 = std::chrono::steady_clock::now();
+  const std::vector<TransitionRecord> records = ToRecords(delta.transitions);
+  for (size_t i = 0; i < records.size(); i += kRowsPerTransaction) {
+    const auto end = records.begin() + static_cast<std::ptrdiff_t>(std::min(records.size(), i + kRowsPerTransaction));
+    writer_.UpsertTransitions(std::vector<TransitionRecord>(records.begin() + static_cast<std::ptrdiff_t>(i), end));
+  }
+  queue_.Done(unit->clip_id);
+  stats_.seconds_store += SecondsSince(t0);
+  stats_.transitions += static_cast<int64_t>(records.size());
+  ++stats_.units;
+  Log("pipeline.transitions")
+      ->debug("{}: unit clip {} (seq {}, try {}): {} transitions", options_.name, unit->clip_id, unit->complete_seq,
+              unit->attempts, records.size());
+  return true;
+}
+
+}  // namespace ss

@@ -1,0 +1,64 @@
+#pragma once
+// One of any number of transition workers sharing a PostgreSQL bank (`spritestation
+// transitions worker`, docs/scaling.md). Each keeps the stage-1 index and comparison images of
+// every sprite of the bank's complete clips in memory, brings them up to date from the bank
+// by complete_seq before each unit, and does units claimed from core/bank_work.h: one clip's
+// pairs with every sprite it knows, and every transition with an end in that clip. The union
+// of the units is the table a single `transitions BANK` builds, exactly (a transition's three
+// pairs join the same two clips: TransitionBuilder::AddPairsOf).
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <string>
+#include <utility>
+
+#include "core/bank.h"
+#include "core/bank_work.h"
+#include "pipeline/transitions/bank_sprites.h"
+#include "pipeline/transitions/builder.h"
+#include "pipeline/transitions/weights.h"
+
+namespace ss {
+
+struct UnitWorkerOptions {
+  TransitionWeights weights = DefaultWeights();
+  std::string name;      // in the work table (host:pid when empty)
+  double lease_s = 60;   // a unit not done by then may be taken by another worker
+  int load_threads = 1;  // comparison images of newly indexed sprites
+};
+
+struct UnitWorkerStats {
+  int64_t units = 0, transitions = 0;
+  int64_t sprites_indexed = 0, clips_indexed = 0;
+  int64_t stage2_evaluations = 0, kept_pairs = 0;
+  double seconds_index = 0, seconds_pairs = 0, seconds_store = 0;
+};
+
+class UnitWorker {
+ public:
+  // InputError for a bank that is not PostgreSQL, or whose transitions were made with other
+  // weights (rebuild them with `transitions BANK` first).
+  UnitWorker(const std::string& bank, UnitWorkerOptions options);
+
+  // Registers new complete clips as units, claims one and does it. False when none was free.
+  bool RunOne();
+  WorkCounts Counts() const { return queue_.Counts(); }
+  const UnitWorkerStats& stats() const { return stats_; }
+  const std::string& name() const { return options_.name; }
+
+ private:
+  // Indexes the sprites of every complete clip not yet known.
+  void CatchUp();
+
+  UnitWorkerOptions options_;
+  Bank reader_;
+  BankWriter writer_;
+  BankWorkQueue queue_;
+  SegmentKeys keys_;
+  std::unique_ptr<TransitionBuilder> builder_;
+  std::map<int64_t, std::pair<int32_t, int32_t>> clip_range_;  // bank clip -> store [first, end)
+  int64_t loaded_seq_ = 0;
+  UnitWorkerStats stats_;
+};
+
+}  // namespace ss

@@ -1,0 +1,107 @@
+// Transition work shared by several `spritestation transitions worker` processes on one
+// PostgreSQL bank (issue 21): the table they make together equals a single-process build of
+// the same bank exactly, also when one worker is killed in the middle of a unit.
+#include <gtest/gtest.h>
+#include <libpq-fe.h>
+#include <signal.h>
+
+#include <chrono>
+#include <cstdlib>
+#include <thread>
+
+#include <nlohmann/json.hpp>
+
+#include "core/bank.h"
+#include "tests/support/postgres_server.h"
+#include "tests/support/test_support.h"
+
+namespace ss {
+namespace {
+
+using testing::BackgroundCommand;
+using testing::JsonInOutput;
+using testing::PostgresServer;
+using testing::RunSpritestation;
+using testing::ScratchDir;
+
+int64_t Query(const std::string& address, const std::string& sql) {
+  PGconn* conn = PQconnectdb(address.c_str());
+  PGresult* r = PQexec(conn, sql.c_str());
+  const bool ok = PQresultStatus(r) == PGRES_TUPLES_OK && PQntuples(r) > 0;
+  if (!ok) ADD_FAILURE() << sql << ": " << PQerrorMessage(conn);
+  const int64_t value = ok ? std::atoll(PQgetvalue(r, 0, 0)) : -1;
+  PQclear(r);
+  PQfinish(conn);
+  return value;
+}
+
+void ExpectSameTransitions(const std::string& got_bank, const std::string& want_bank) {
+  const auto got = Bank(got_bank).LoadTransitions();
+  const auto want = Bank(want_bank).LoadTransitions();
+  ASSERT_GT(want.size(), 0u) << "the session must have transitions for the test to mean anything";
+  ASSERT_EQ(got.size(), want.size());
+  size_t differ = 0;
+  for (size_t k = 0; k < want.size(); ++k) {
+    if (got[k].from_sprite != want[k].from_sprite || got[k].to_sprite != want[k].to_sprite || got[k].d != want[k].d ||
+        got[k].cost != want[k].cost) {
+      ++differ;
+    }
+  }
+  EXPECT_EQ(differ, 0u) << "of " << want.size();
+}
+
+TEST(TransitionWorkers, TwoWorkersAndAKilledOneMakeTheSingleProcessTable) {
+  PostgresServer server;
+  ASSERT_TRUE(server.ok());
+  ScratchDir dir;
+  const auto synth = RunSpritestation("synth --out " + dir / "session" +
+                                      " --kind animal --seconds 8 --fps 30 --size 480x360 --cameras 2 --subjects 2 "
+                                      "--seed 21");
+  ASSERT_EQ(synth.exit_code, 0) << synth.output;
+  const std::string pg = server.CreateDatabase("studio");
+  const auto ingest =
+      RunSpritestation("--log-level warn ingest " + dir / "session" + " --bank " + pg + " --no-transitions --json");
+  ASSERT_EQ(ingest.exit_code, 0) << ingest.output;
+  // The single-process build, on a copy made before any worker ran.
+  const std::string single = dir / "single.db";
+  ASSERT_EQ(RunSpritestation("--log-level warn bank copy " + pg + " " + single).exit_code, 0);
+  const auto build = RunSpritestation("--log-level warn transitions " + single + " --json");
+  ASSERT_EQ(build.exit_code, 0) << build.output;
+  const int64_t clips = Query(pg, "SELECT count(*) FROM clips WHERE complete = 1");
+  ASSERT_GE(clips, 4) << "several units are needed to share";
+
+  // A worker that claims a unit and is killed before it stores anything: its lease (2 s) runs out.
+  setenv("SPRITESTATION_WORKER_TEST_PAUSE_S", "60", 1);
+  BackgroundCommand victim("--log-level warn transitions worker --bank " + pg + " --name victim --lease 2",
+                           dir / "victim.log");
+  unsetenv("SPRITESTATION_WORKER_TEST_PAUSE_S");
+  int64_t claimed = 0;
+  for (int i = 0; i < 300 && claimed == 0; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    // The worker makes its work table when it starts.
+    if (Query(pg, "SELECT count(*) FROM pg_tables WHERE tablename = 'transition_work'") == 0) continue;
+    claimed = Query(pg, "SELECT count(*) FROM transition_work WHERE worker = 'victim'");
+  }
+  ASSERT_EQ(claimed, 1) << victim.output();
+  victim.Signal(SIGKILL);
+  victim.Wait(10);
+
+  // Two workers at once do everything, the killed unit included.
+  BackgroundCommand a("--log-level warn transitions worker --bank " + pg + " --name a --exit-when-idle --json",
+                      dir / "a.log");
+  BackgroundCommand b("--log-level warn transitions worker --bank " + pg + " --name b --exit-when-idle --json",
+                      dir / "b.log");
+  ASSERT_EQ(a.Wait(300), 0) << a.output();
+  ASSERT_EQ(b.Wait(300), 0) << b.output();
+  const nlohmann::json ja = JsonInOutput(a.output()), jb = JsonInOutput(b.output());
+  EXPECT_EQ(ja["units"].get<int64_t>() + jb["units"].get<int64_t>(), clips) << a.output() << b.output();
+  EXPECT_EQ(Query(pg, "SELECT count(*) FROM transition_work WHERE done = 1"), clips);
+  EXPECT_EQ(Query(pg, "SELECT count(*) FROM transition_work WHERE attempts >= 2"), 1);  // the killed one, redone
+
+  const std::string shared = dir / "shared.db";
+  ASSERT_EQ(RunSpritestation("--log-level warn bank copy " + pg + " " + shared).exit_code, 0);
+  ExpectSameTransitions(shared, single);
+}
+
+}  // namespace
+}  // namespace ss
