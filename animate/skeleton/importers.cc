@@ -187,7 +187,8 @@ SkeletonSequence ImportDeepLabCutCsv(const std::string& path, const JointMapping
   return sequence;
 }
 
-SkeletonSequence ImportOpenPoseJson(const std::string& path, const JointMapping& mapping,
+namespace {
+SkeletonSequence ImportOpenPoseJsonUnchecked(const std::string& path, const JointMapping& mapping,
                                     const ImportOptions& options) {
   std::vector<std::string> files;
   std::error_code ec;
@@ -265,8 +266,20 @@ SkeletonSequence ImportOpenPoseJson(const std::string& path, const JointMapping&
   if (layout < 0) Log("animate.skeleton")->warn("{}: no file holds person {}", path, options.person);
   return sequence;
 }
+}  // namespace
 
-SkeletonSequence ImportCocoKeypoints(const std::string& path, const JointMapping& mapping,
+SkeletonSequence ImportOpenPoseJson(const std::string& path, const JointMapping& mapping,
+                                    const ImportOptions& options) {
+  // A field of the wrong JSON type (an array where a name belongs) is the file's fault.
+  try {
+    return ImportOpenPoseJsonUnchecked(path, mapping, options);
+  } catch (const nlohmann::json::exception& e) {
+    throw InputError(path, std::string("wrong field: ") + e.what());
+  }
+}
+
+namespace {
+SkeletonSequence ImportCocoKeypointsUnchecked(const std::string& path, const JointMapping& mapping,
                                      const ImportOptions& options) {
   const nlohmann::json json = ReadJsonFile(path);
   const auto annotations = json.find("annotations");
@@ -334,6 +347,17 @@ SkeletonSequence ImportCocoKeypoints(const std::string& path, const JointMapping
   }
   return sequence;
 }
+}  // namespace
+
+SkeletonSequence ImportCocoKeypoints(const std::string& path, const JointMapping& mapping,
+                                     const ImportOptions& options) {
+  // A field of the wrong JSON type (an array where a name belongs) is the file's fault.
+  try {
+    return ImportCocoKeypointsUnchecked(path, mapping, options);
+  } catch (const nlohmann::json::exception& e) {
+    throw InputError(path, std::string("wrong field: ") + e.what());
+  }
+}
 
 }  // namespace ss
 
@@ -347,7 +371,8 @@ JointMapping IdentityMapping(const SkeletonDef& def) {
   return m;
 }
 
-SkeletonSequence ImportSynthTruth(const std::string& path, const std::string& camera, const JointMapping& mapping,
+namespace {
+SkeletonSequence ImportSynthTruthUnchecked(const std::string& path, const std::string& camera, const JointMapping& mapping,
                                   const ImportOptions& options) {
   // Find the truth folder and the CSV.
   fs::path truth_dir, csv;
@@ -430,6 +455,17 @@ SkeletonSequence ImportSynthTruth(const std::string& path, const std::string& ca
     sequence.frames.push_back(MapKeypoints(resolved, keypoints, frame));
   }
   return sequence;
+}
+}  // namespace
+
+SkeletonSequence ImportSynthTruth(const std::string& path, const std::string& camera, const JointMapping& mapping,
+                                  const ImportOptions& options) {
+  // A field of the wrong JSON type (an array where a name belongs) is the file's fault.
+  try {
+    return ImportSynthTruthUnchecked(path, camera, mapping, options);
+  } catch (const nlohmann::json::exception& e) {
+    throw InputError(path, std::string("wrong field: ") + e.what());
+  }
 }
 
 }  // namespace ss
