@@ -5,12 +5,18 @@
 //   bank/load_features_60k     Bank::LoadFeatures on a bank of 60,000 sprites (30,000 + mirrors)
 //   bank/baseline/scan_60k     a bare sqlite3 scan of the same rows and columns
 //   bank/load_pixels           Bank::LoadPixels of random sprites of that bank
+//   bank/postgres/append_4_writers  four writers at once (threads, a session each) appending batches of
+//                              50 originals + 50 mirrors into one PostgreSQL bank; only when
+//                              SPRITESTATION_BENCH_POSTGRES names one (scripts/bench-postgres.sh starts
+//                              a private server for it): compared with bank/append/with_mirrors, one
+//                              SQLite writer, in the same run
 // Figures: sprites/s and ms, then each case as a ratio to its baseline from the same run.
 #include <sqlite3.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <cstdio>
 #include <filesystem>
 #include <map>
@@ -226,6 +232,37 @@ void BM_LoadPixels(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations());
 }
 
+// Four stations storing into one PostgreSQL bank at once: each thread its own writer, session
+// and camera (so their clips never collide), the same batches as bank/append/with_mirrors.
+void BM_PostgresFourWriters(benchmark::State& state) {
+  const char* address = std::getenv("SPRITESTATION_BENCH_POSTGRES");
+  if (!address || !*address) {
+    state.SkipWithError("SPRITESTATION_BENCH_POSTGRES is not set (scripts/bench-postgres.sh sets it)");
+    return;
+  }
+  BankWriter writer(address);
+  const std::string uid = "bench-" + std::to_string(getpid()) + "-" + std::to_string(state.thread_index()) + "-" +
+                          std::to_string(std::random_device{}());
+  const int64_t session = writer.AddSession({0, uid, "bench", "", ""});
+  const int64_t camera = writer.AddCamera(session, {0, 0, "cam0", "", 1280, 720});
+  int64_t track = 0;
+  for (auto _ : state) {
+    std::vector<SpriteRecord> batch;
+    state.PauseTiming();
+    for (int i = 0; i < kBatch / 2; ++i) {
+      batch.push_back(Sprite(i, Billboards()[static_cast<size_t>(i)]));
+      batch.push_back(Mirror(batch.back()));
+    }
+    ClipRecord clip;
+    clip.camera_id = camera;
+    clip.track_id = track++;
+    clip.complete = true;
+    state.ResumeTiming();
+    writer.AppendClipBatch(clip, batch);
+  }
+  state.SetItemsProcessed(state.iterations() * kBatch);
+}
+
 // Wall-clock rates (UseRealTime): appending includes the file writes.
 BENCHMARK(BM_AppendOriginals)->Name("bank/append/originals")->Unit(benchmark::kMillisecond)->MinTime(1.0)->UseRealTime();
 BENCHMARK(BM_AppendWithMirrors)->Name("bank/append/with_mirrors")->Unit(benchmark::kMillisecond)->MinTime(1.0)->UseRealTime();
@@ -233,6 +270,12 @@ BENCHMARK(BM_Compress)->Name("bank/baseline/compress")->Unit(benchmark::kMillise
 BENCHMARK(BM_LoadFeatures)->Name("bank/load_features_60k")->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_ScanBaseline)->Name("bank/baseline/scan_60k")->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_LoadPixels)->Name("bank/load_pixels")->Unit(benchmark::kMicrosecond)->UseRealTime();
+BENCHMARK(BM_PostgresFourWriters)
+    ->Name("bank/postgres/append_4_writers")
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(2.0)
+    ->Threads(4)
+    ->UseRealTime();
 
 // Keeps what each case measured so the suite can print ratios after the table.
 class Collector : public benchmark::ConsoleReporter {
@@ -288,6 +331,16 @@ int Run(const std::vector<std::string>& args) {
     std::printf("  %-26s %7.1f ms wall, %7.1f ms CPU for 60,000 sprites", f.c_str(), ms[f], ms[f] * collector.cpu_share[f]);
     if (has(b)) {
       std::printf("  = %.2f x a bare sqlite3 scan (%.1f ms CPU)", cpu_rate(b) / cpu_rate(f), ms[b] * collector.cpu_share[b]);
+    }
+    std::printf("\n");
+  }
+  const std::string pg = "bank/postgres/append_4_writers", lite = "bank/append/with_mirrors";
+  if (has(pg)) {
+    // Four threads' items together, per second of wall clock (the server and the writers share the cores).
+    std::printf("  %-26s %7.0f sprites/s wall, four writers together", pg.c_str(), collector.items_per_second[pg]);
+    if (has(lite)) {
+      std::printf("  = %.2f x one SQLite writer (%.0f sprites/s wall)",
+                  collector.items_per_second[pg] / collector.items_per_second[lite], collector.items_per_second[lite]);
     }
     std::printf("\n");
   }

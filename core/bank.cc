@@ -495,6 +495,25 @@ AppendResult BankWriter::AppendClipBatch(const ClipRecord& clip, const std::vect
     w.insert_clip.Reset();
   }
 
+  if (db().dialect() == sql::Dialect::kPostgres) {
+    AppendSpritesManyRows(clip, result.clip_id, sprites, where, &result);
+  } else {
+    AppendSpritesOneByOne(clip, result.clip_id, sprites, where, &result);
+  }
+  if (clip.complete) {
+    SerializeClipCompletion(db());
+    w.complete_clip.Reset();
+    w.complete_clip.Bind(1, result.clip_id).Step();
+  }
+  tx.Commit();
+  return result;
+}
+
+void BankWriter::AppendSpritesOneByOne(const ClipRecord& clip, int64_t clip_id, const std::vector<SpriteRecord>& sprites,
+                                       const std::string& where, AppendResult* out) {
+  Impl& w = *impl_;
+  AppendResult& result = *out;
+  result.clip_id = clip_id;
   result.sprite_ids.assign(sprites.size(), 0);
   auto find = [&](int64_t frame, bool mirrored) -> int64_t {
     w.find_sprite.Reset();
@@ -557,13 +576,131 @@ AppendResult BankWriter::AppendClipBatch(const ClipRecord& clip, const std::vect
       }
     }
   }
-  if (clip.complete) {
-    SerializeClipCompletion(db());
-    w.complete_clip.Reset();
-    w.complete_clip.Bind(1, result.clip_id).Step();
+}
+
+namespace {
+
+// Binds one sprite's columns (kSpriteFields' order) from `first`; returns the next index.
+int BindSprite(sql::Stmt& q, int first, int64_t clip_id, const ClipRecord& clip, const SpriteRecord& s,
+               int64_t mirror_of) {
+  const double reals[] = {s.ground_x_m, s.ground_y_m, s.velocity_x_m_s, s.velocity_y_m_s, s.mean_r,
+                          s.mean_g,     s.mean_b,     s.area_px,        s.eccentricity};
+  const int64_t box[] = {s.bbox_in_image.x, s.bbox_in_image.y, s.bbox_in_image.width, s.bbox_in_image.height,
+                         s.billboard_width_px, s.billboard_height_px};
+  int i = first;
+  for (int64_t v : {clip_id, clip.camera_id, clip.track_id, s.frame, s.timestamp_ns, int64_t{s.mirrored}}) {
+    q.Bind(i++, v);
   }
-  tx.Commit();
-  return result;
+  if (s.mirrored) {
+    q.Bind(i++, mirror_of);
+  } else {
+    q.BindNull(i++);
+  }
+  for (double v : reals) q.Bind(i++, v);
+  for (int64_t v : box) q.Bind(i++, v);
+  for (double v : {s.px_per_m, s.anchor_x_px, s.anchor_y_px}) q.Bind(i++, v);
+  return i;
+}
+
+std::string Rows(int rows, int columns) {
+  std::string row = "(";
+  for (int c = 0; c < columns; ++c) row += c ? ", ?" : "?";
+  row += ")";
+  std::string out;
+  for (int r = 0; r < rows; ++r) out += (r ? ", " : "") + row;
+  return out;
+}
+
+}  // namespace
+
+// A server a network hop away answers each statement in a round trip: the batch's sprites go
+// in a few statements of many rows each (originals, their pixels, mirrors), not one per sprite.
+void BankWriter::AppendSpritesManyRows(const ClipRecord& clip, int64_t clip_id,
+                                       const std::vector<SpriteRecord>& sprites, const std::string& where,
+                                       AppendResult* out) {
+  constexpr int kColumns = 25, kRowsPerStatement = 200;
+  Impl& w = *impl_;
+  AppendResult& result = *out;
+  result.clip_id = clip_id;
+  result.sprite_ids.assign(sprites.size(), 0);
+  // The ids of this clip's sprites already stored (before this batch), by (frame, mirrored).
+  std::map<std::pair<int64_t, bool>, int64_t> ids;
+  if (!sprites.empty()) {
+    int64_t lo = sprites.front().frame, hi = lo;
+    for (const SpriteRecord& s : sprites) lo = std::min(lo, s.frame), hi = std::max(hi, s.frame);
+    auto q = db().Prepare("SELECT id, frame, mirrored FROM sprites WHERE camera_id = ? AND track_id = ? "
+                          "AND frame BETWEEN ? AND ?");
+    q.Bind(1, clip.camera_id).Bind(2, clip.track_id).Bind(3, lo).Bind(4, hi);
+    while (q.Step()) ids[{q.Int(1), q.Int(2) != 0}] = q.Int(0);
+  }
+  for (int pass = 0; pass < 2; ++pass) {
+    const bool mirrors = pass == 1;
+    std::vector<size_t> fresh;  // batch positions of the sprites to insert
+    for (size_t i = 0; i < sprites.size(); ++i) {
+      const SpriteRecord& s = sprites[i];
+      if (s.mirrored != mirrors) continue;
+      if (ids.count({s.frame, s.mirrored})) continue;
+      if (mirrors && !ids.count({s.frame, false})) {
+        throw WorkError(where + ", frame " + std::to_string(s.frame),
+                        "a mirrored sprite needs its original (same camera, track and frame) in the bank or batch");
+      }
+      fresh.push_back(i);
+    }
+    for (size_t at = 0; at < fresh.size(); at += kRowsPerStatement) {
+      const size_t n = std::min<size_t>(kRowsPerStatement, fresh.size() - at);
+      auto q = db().Prepare(std::string("INSERT INTO sprites (") + kSpriteFields + ") VALUES " +
+                            Rows(static_cast<int>(n), kColumns) +
+                            " ON CONFLICT (camera_id, frame, track_id, mirrored) DO NOTHING RETURNING id, frame");
+      int index = 1;
+      for (size_t k = 0; k < n; ++k) {
+        const SpriteRecord& s = sprites[fresh[at + k]];
+        index = BindSprite(q, index, clip_id, clip, s, mirrors ? ids.at({s.frame, false}) : 0);
+      }
+      std::vector<std::pair<int64_t, int64_t>> inserted;  // (frame, id)
+      while (q.Step()) inserted.emplace_back(q.Int(1), q.Int(0));
+      result.inserted += static_cast<int64_t>(inserted.size());
+      for (const auto& [frame, id] : inserted) ids[{frame, mirrors}] = id;
+      if (!mirrors && !inserted.empty()) {
+        auto p = db().Prepare("INSERT INTO sprite_pixels (sprite_id, width_px, height_px, codec, data) VALUES " +
+                              Rows(static_cast<int>(inserted.size()), 5) +
+                              " ON CONFLICT (sprite_id) DO UPDATE SET width_px = excluded.width_px, "
+                              "height_px = excluded.height_px, codec = excluded.codec, data = excluded.data");
+        std::map<int64_t, const SpriteRecord*> by_frame;
+        for (size_t k = 0; k < n; ++k) by_frame[sprites[fresh[at + k]].frame] = &sprites[fresh[at + k]];
+        int pi = 1;
+        for (const auto& [frame, id] : inserted) {
+          const SpriteRecord& s = *by_frame.at(frame);
+          const std::vector<uint8_t>* blob = nullptr;
+          try {
+            blob = &w.codec.Encode(s.pixels);
+          } catch (const WorkError& e) {
+            throw WorkError(where + ", frame " + std::to_string(s.frame), e.what());
+          }
+          p.Bind(pi, id).Bind(pi + 1, int64_t{s.pixels.bgra.cols}).Bind(pi + 2, int64_t{s.pixels.bgra.rows});
+          p.Bind(pi + 3, std::string_view(kPixelCodec)).BindBlob(pi + 4, blob->data(), blob->size());
+          pi += 5;
+        }
+        p.Step();
+      }
+    }
+    if (!fresh.empty() && std::any_of(fresh.begin(), fresh.end(), [&](size_t i) {
+          return !ids.count({sprites[i].frame, mirrors});
+        })) {
+      // Another writer stored some of them meanwhile (ON CONFLICT skipped them): read their ids.
+      auto q = db().Prepare("SELECT id, frame FROM sprites WHERE camera_id = ? AND track_id = ? AND mirrored = ?");
+      q.Bind(1, clip.camera_id).Bind(2, clip.track_id).Bind(3, int64_t{mirrors});
+      while (q.Step()) ids.try_emplace({q.Int(1), mirrors}, q.Int(0));
+    }
+  }
+  for (size_t i = 0; i < sprites.size(); ++i) {
+    const SpriteRecord& s = sprites[i];
+    const int64_t id = ids.at({s.frame, s.mirrored});
+    result.sprite_ids[i] = id;
+    for (const std::string& tag : s.tags) {
+      w.insert_tag.Reset();
+      w.insert_tag.Bind(1, id).Bind(2, tag).Step();
+    }
+  }
 }
 
 void BankWriter::UpsertTransitions(const std::vector<TransitionRecord>& transitions) {

@@ -140,6 +140,13 @@ class BankWriter : public Bank {
   bool RemoveTransitionLabel(int64_t from_sprite, int64_t to_sprite);
 
  private:
+  // AppendClipBatch's sprites: one statement each (SQLite, in-process), or a few statements of
+  // many rows (PostgreSQL, where every statement is a round trip to the server).
+  void AppendSpritesOneByOne(const ClipRecord& clip, int64_t clip_id, const std::vector<SpriteRecord>& sprites,
+                             const std::string& where, AppendResult* out);
+  void AppendSpritesManyRows(const ClipRecord& clip, int64_t clip_id, const std::vector<SpriteRecord>& sprites,
+                             const std::string& where, AppendResult* out);
+
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
