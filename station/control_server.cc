@@ -33,7 +33,6 @@ namespace {
 namespace fs = std::filesystem;
 using httplib::Request;
 using httplib::Response;
-using api::Dump;
 using api::IntParam;
 using api::ObjectBody;
 using api::PathId;
@@ -72,13 +71,7 @@ class NiceThreadPool : public httplib::TaskQueue {
 
 // A session name from {"name": S}; "" when absent and not required.
 std::string NameFromBody(const Request& req, bool required) {
-  const nlohmann::json body = ObjectBody(req, {"name"});
-  if (!body.contains("name")) {
-    if (required) throw InputError(req.body.empty() ? "body" : "name", "missing (expected {\"name\": \"...\"})");
-    return "";
-  }
-  if (!body["name"].is_string()) throw InputError("name", "expected text, got " + Dump(body["name"]));
-  return body["name"].get<std::string>();
+  return api::ParseSessionName(ObjectBody(req, api::kSessionFields), required, req.body.empty());
 }
 
 std::string Lower(std::string text) {
@@ -275,12 +268,8 @@ struct ControlServer::Impl {
   }
 
   void ReplayStart(const Request& req, Response& res) {
-    const nlohmann::json body = ObjectBody(req, {"path", "paced", "loop"});
-    if (!body.contains("path") || !body["path"].is_string()) throw InputError("path", "expected the session's path (text)");
-    for (const char* flag : {"paced", "loop"}) {
-      if (body.contains(flag) && !body[flag].is_boolean()) throw InputError(flag, "expected true or false");
-    }
-    host->StartReplay(body["path"].get<std::string>(), body.value("paced", true), body.value("loop", false));
+    const api::ReplayStartRequest r = api::ParseReplayStart(ObjectBody(req, api::kReplayStartFields));
+    host->StartReplay(r.path, r.paced, r.loop);
     Reply(res, 200, host->ModeJson());
   }
 
@@ -288,7 +277,7 @@ struct ControlServer::Impl {
 
   // Tag or untag: the same body either way.
   nlohmann::json Tag(const Request& req, bool remove) const {
-    const int64_t n = Bank().Tag(ObjectBody(req, {"tag", "sprites", "clip", "first_frame", "last_frame"}), remove);
+    const int64_t n = Bank().Tag(ObjectBody(req, api::kTagFields), remove);
     return {{remove ? "untagged" : "tagged", n}};
   }
 
