@@ -32,8 +32,17 @@ std::string Dump(const nlohmann::json& j, int indent) {
 nlohmann::json ObjectBody(const std::string& text, std::initializer_list<const char*> fields) {
   if (text.empty()) return nlohmann::json::object();
   nlohmann::json body;
+  // Refused while it is parsed: nlohmann::json writes and copies a value by recursion, so a body
+  // of 1 MiB of brackets overflowed the HTTP thread's stack when an error message quoted it.
+  const nlohmann::json::parser_callback_t limit_depth = [](int depth, nlohmann::json::parse_event_t event, nlohmann::json&) {
+    if ((event == nlohmann::json::parse_event_t::object_start || event == nlohmann::json::parse_event_t::array_start) &&
+        depth >= kMaxBodyDepth) {
+      throw InputError("body", "nested deeper than " + std::to_string(kMaxBodyDepth) + " levels");
+    }
+    return true;
+  };
   try {
-    body = nlohmann::json::parse(text);
+    body = nlohmann::json::parse(text, limit_depth);
   } catch (const nlohmann::json::exception& e) {
     throw InputError("body", std::string("not valid JSON: ") + e.what());
   }
@@ -216,7 +225,9 @@ CalibrationFloorRequest ParseCalibrationFloor(const nlohmann::json& body) {
       }
       r.pixels.emplace_back(q[0].get<double>(), q[1].get<double>());
     }
-  } else if (body.value("detect", false) == true) {
+  } else if (body.contains("detect") && !body["detect"].is_boolean()) {
+    throw InputError("detect", "expected true or false, got " + Dump(body["detect"]));
+  } else if (body.value("detect", false)) {
     r.detect = true;
   } else {
     throw InputError("body", "give \"detect\": true or \"pixels\": [[x, y], ...]");

@@ -25,7 +25,8 @@ namespace ss::api {
 std::string Dump(const nlohmann::json& j, int indent = -1);
 
 // The body's text as a JSON object (empty text: {}); InputError naming the field for anything
-// else or a member not in `fields`.
+// else, a member not in `fields`, or arrays and objects nested deeper than kMaxBodyDepth.
+inline constexpr int kMaxBodyDepth = 32;  // every body the API takes needs 3
 nlohmann::json ObjectBody(const std::string& text, std::initializer_list<const char*> fields);
 
 // POST /api/session/start, /api/session/rename {"name": S}: the name, "" when absent and not

@@ -34,6 +34,24 @@ TEST(RequestBodies, ObjectBodyTakesAnObjectWithTheRoutesMembersOnly) {
   EXPECT_EQ(FieldOf([] { Body(R"({"x": 1})", {}); }), "x");
 }
 
+// Issue 20's fuzzing: 1 MiB of brackets (what the server lets in) overflowed the HTTP thread's
+// stack when the error message quoted the value (nlohmann::json writes by recursion), and the
+// daemon died. Bodies nest 32 levels at most; the API needs 3.
+TEST(RequestBodies, ADeeplyNestedBodyIsRefusedWhileItIsParsed) {
+  const auto nested = [](size_t depth) { return R"({"name": )" + std::string(depth, '[') + std::string(depth, ']') + "}"; };
+  const std::string deep = nested(524000);
+  ASSERT_LE(deep.size(), 1u << 20);
+  try {
+    ObjectBody(deep, kSessionFields);
+    ADD_FAILURE() << "parsed";
+  } catch (const InputError& e) {
+    EXPECT_STREQ(e.what(), "body: nested deeper than 32 levels");
+  }
+  EXPECT_EQ(FieldOf([&] { ObjectBody(nested(32), kSessionFields); }), "body");
+  const nlohmann::json deepest = ObjectBody(nested(31), kSessionFields);  // the object is level 1
+  EXPECT_EQ(FieldOf([&] { ParseSessionName(deepest, true, false); }), "name");
+}
+
 TEST(RequestBodies, SessionReplayAndTagRequests) {
   EXPECT_EQ(ParseSessionName(Body(R"({"name": "take 1"})", kSessionFields), true, false), "take 1");
   EXPECT_EQ(ParseSessionName(Body("", kSessionFields), false, true), "");
@@ -114,6 +132,11 @@ TEST(RequestBodies, CalibrationWizardRequests) {
   EXPECT_EQ(floor.pixels[2], Eigen::Vector2d(5, 6.5));
   EXPECT_EQ(FieldOf([] { ParseCalibrationFloor(Body(R"({"pixels": [[1]]})", kCalibrationFloorFields)); }), "pixels");
   EXPECT_EQ(FieldOf([] { ParseCalibrationFloor(Body(R"({"camera": "cam0"})", kCalibrationFloorFields)); }), "body");
+  EXPECT_EQ(FieldOf([] { ParseCalibrationFloor(Body(R"({"camera": "cam0", "detect": false})", kCalibrationFloorFields)); }),
+            "body");
+  // Found by fuzzing: a "detect" that is not a boolean let nlohmann::json's type_error escape (500).
+  EXPECT_EQ(FieldOf([] { ParseCalibrationFloor(Body(R"({"camera": "cam0", "detect": 1})", kCalibrationFloorFields)); }),
+            "detect");
 }
 
 }  // namespace

@@ -541,6 +541,13 @@ TEST_F(DaemonTest, TheControlApiRefusesBadRequestsByName) {
     EXPECT_EQ(answer.rfind("HTTP/1.1 431 ", 0), 0u) << answer.substr(0, 300);
     EXPECT_NE(answer.find("header: larger than 65536 bytes"), std::string::npos) << answer.substr(0, 300);
   }
+  // 1 MiB of nested brackets (issue 20's fuzzing: the daemon died of a stack overflow when the
+  // error quoted the value): refused by its depth, and the daemon answers on.
+  const std::string deep = R"({"name": )" + std::string(524000, '[') + std::string(524000, ']') + "}";
+  r = post("/api/session/start", deep);
+  ASSERT_TRUE(r) << "the daemon did not answer a deeply nested body";
+  EXPECT_EQ(r->status, 400) << r->body;
+  EXPECT_NE(r->body.find("body: nested deeper than 32 levels"), std::string::npos) << r->body;
   r = post("/api/session/stop", "");
   EXPECT_EQ(r->status, 409) << r->body;
   r = post("/api/session/start", R"({"name": "a"})");
