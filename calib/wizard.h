@@ -19,13 +19,11 @@
 #include "calib/ground.h"
 #include "calib/report.h"
 #include "calib/solve.h"
+#include "calib/wizard_step.h"
 #include "core/camera_model.h"
 #include "core/geometry.h"
 
 namespace ss::calib {
-
-enum class WizardStep { kIntrinsics, kGround, kEnclosure, kDone };
-const char* WizardStepName(WizardStep step);  // "intrinsics", "ground", "enclosure", "done"
 
 struct WizardOptions {
   BoardSpec board;

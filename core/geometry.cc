@@ -1,8 +1,11 @@
 #include "core/geometry.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <iterator>
 #include <limits>
+#include <set>
 
 namespace ss {
 
@@ -75,12 +78,92 @@ bool GroundPolygon::ContainsWithMargin(const Eigen::Vector2d& p, double margin) 
 
 namespace {
 
-// Sign of the turn a -> b -> c: +1 left, -1 right, 0 collinear.
-int Orientation(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector2d& c) {
-  const double cross = (b - a).x() * (c - a).y() - (b - a).y() * (c - a).x();
-  return (cross > 0) - (cross < 0);
+// Exact signs of orientation determinants for double coordinates (Shewchuk, "Adaptive
+// Precision Floating-Point Arithmetic and Fast Robust Geometric Predicates", 1997): a
+// floating-point filter settles nearly every case; the rest is summed exactly as an expansion.
+// Exact while no product overflows or underflows (coordinates and their differences between
+// about 1e-140 and 1e150 in magnitude, or 0): any floor in metres.
+constexpr double kEpsilon = 0x1p-53;  // half an ulp of 1.0
+constexpr double kOrientErrorBound = (3.0 + 16.0 * kEpsilon) * kEpsilon;
+
+// a + b == s + e exactly, s the rounded sum.
+void TwoSum(double a, double b, double& s, double& e) {
+  s = a + b;
+  const double b_virtual = s - a;
+  e = (a - (s - b_virtual)) + (b - b_virtual);
 }
 
+// a * b == p + e exactly, p the rounded product.
+void TwoProduct(double a, double b, double& p, double& e) {
+  p = a * b;
+  e = std::fma(a, b, -p);
+}
+
+// Sign of the exact sum of `terms`, kept as a nonoverlapping expansion (Shewchuk's
+// Grow-Expansion with zero elimination): its largest component, the last, carries the sign.
+template <size_t N>
+int ExactSumSign(const std::array<double, N>& terms) {
+  std::array<double, N> e{};
+  size_t m = 0;
+  for (const double term : terms) {
+    double q = term;
+    size_t k = 0;
+    for (size_t i = 0; i < m; ++i) {
+      double sum = 0, error = 0;
+      TwoSum(q, e[i], sum, error);
+      if (error != 0) e[k++] = error;
+      q = sum;
+    }
+    if (q != 0) e[k++] = q;
+    m = k;
+  }
+  return m == 0 ? 0 : (e[m - 1] > 0) - (e[m - 1] < 0);
+}
+
+// Sign of the turn a -> b -> c, exactly: +1 left, -1 right, 0 collinear.
+int Orientation(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector2d& c) {
+  const double left = (b.x() - a.x()) * (c.y() - a.y());
+  const double right = (b.y() - a.y()) * (c.x() - a.x());
+  const double det = left - right;
+  const auto sign = [](double v) { return (v > 0) - (v < 0); };
+  // A difference of doubles is 0 only when they are equal, and rounding keeps signs: when the
+  // two products' signs differ (or one is 0), det's sign is exact.
+  double magnitude = 0;
+  if (left > 0) {
+    if (right <= 0) return sign(det);
+    magnitude = left + right;
+  } else if (left < 0) {
+    if (right >= 0) return sign(det);
+    magnitude = -left - right;
+  } else {
+    return sign(det);
+  }
+  if (std::abs(det) >= kOrientErrorBound * magnitude) return sign(det);
+  // (bx - ax)(cy - ay) - (by - ay)(cx - ax), each difference an exact pair, each product of
+  // pairs four exact pairs: 16 terms.
+  std::array<double, 2> bax, cay, bay, cax;
+  TwoSum(b.x(), -a.x(), bax[0], bax[1]);
+  TwoSum(c.y(), -a.y(), cay[0], cay[1]);
+  TwoSum(b.y(), -a.y(), bay[0], bay[1]);
+  TwoSum(c.x(), -a.x(), cax[0], cax[1]);
+  std::array<double, 16> terms{};
+  size_t t = 0;
+  for (const double u : bax) {
+    for (const double v : cay) {
+      TwoProduct(u, v, terms[t], terms[t + 1]);
+      t += 2;
+    }
+  }
+  for (const double u : bay) {
+    for (const double v : cax) {
+      TwoProduct(-u, v, terms[t], terms[t + 1]);
+      t += 2;
+    }
+  }
+  return ExactSumSign(terms);
+}
+
+// p within the box of a and b (on segment ab when collinear with it).
 bool OnSegment(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector2d& p) {
   return std::min(a.x(), b.x()) <= p.x() && p.x() <= std::max(a.x(), b.x()) &&
          std::min(a.y(), b.y()) <= p.y() && p.y() <= std::max(a.y(), b.y());
@@ -96,6 +179,109 @@ bool SegmentsMeet(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eige
          (o3 == 0 && OnSegment(c, d, a)) || (o4 == 0 && OnSegment(c, d, b));
 }
 
+// Sweep order of points: by x, then y (a sweep line turned by an infinitesimal angle, so that
+// no segment is vertical to it).
+bool SweepsFirst(const Eigen::Vector2d& p, const Eigen::Vector2d& q) {
+  return p.x() < q.x() || (p.x() == q.x() && p.y() < q.y());
+}
+
+// Whether two edges of the polygon that are not neighbours share a point: the Shamos-Hoey sweep
+// (Shamos and Hoey, "Geometric intersection problems", 1976), O(n log n). The sweep line moves
+// over the edges' endpoints; the edges it crosses are kept in their order along it, and an edge
+// is tested against its neighbours in that order whenever it gets new ones. The first pair that
+// meets is always neighbours by the time the sweep reaches their meeting point, so it is found.
+// At a point where edges start and end, the starting ones are added before the ending ones
+// leave: edges that only touch there are then neighbours, and found too.
+class EdgeSweep {
+ public:
+  explicit EdgeSweep(const std::vector<Eigen::Vector2d>& v) : v_(v), n_(v.size()) {}
+
+  bool AnyNonNeighboursMeet() {
+    // The vertices in sweep order (each is where its two edges start or leave), with their
+    // coordinates beside them so that the sort reads memory in order.
+    struct Stop {
+      double x, y;
+      size_t vertex;
+    };
+    std::vector<Stop> stops(n_);
+    for (size_t k = 0; k < n_; ++k) stops[k] = {v_[k].x(), v_[k].y(), k};
+    std::sort(stops.begin(), stops.end(), [](const Stop& a, const Stop& b) {
+      return a.x != b.x ? a.x < b.x : a.y != b.y ? a.y < b.y : a.vertex < b.vertex;
+    });
+    std::set<size_t, Below> crossed(Below{this});
+    std::vector<std::set<size_t, Below>::iterator> where(n_);
+    std::vector<size_t> starting, leaving;
+    for (size_t first = 0; first < n_;) {
+      // Every vertex at this point (more than one: the polygon passes it twice).
+      size_t last = first + 1;
+      while (last < n_ && stops[last].x == stops[first].x && stops[last].y == stops[first].y) ++last;
+      starting.clear();
+      leaving.clear();
+      for (size_t s = first; s < last; ++s) {
+        const size_t k = stops[s].vertex;
+        for (const size_t edge : {k == 0 ? n_ - 1 : k - 1, k}) {
+          (&Left(edge) == &v_[k] ? starting : leaving).push_back(edge);
+        }
+      }
+      first = last;
+      // Edges starting here join before those ending here leave: edges that only touch at
+      // this point are then neighbours for a moment, and found.
+      for (const size_t edge : starting) {
+        const auto it = crossed.insert(edge).first;  // always new: ties are broken by index
+        where[edge] = it;
+        if (it != crossed.begin() && Meet(*std::prev(it), edge)) return true;
+        if (std::next(it) != crossed.end() && Meet(*std::next(it), edge)) return true;
+      }
+      for (const size_t edge : leaving) {
+        const auto it = where[edge];
+        if (it != crossed.begin() && std::next(it) != crossed.end() && Meet(*std::prev(it), *std::next(it))) {
+          return true;
+        }
+        crossed.erase(it);
+      }
+    }
+    return false;
+  }
+
+ private:
+  // Edge i runs from vertex i to vertex i + 1 (the last back to the first).
+  const Eigen::Vector2d& A(size_t i) const { return v_[i]; }
+  const Eigen::Vector2d& B(size_t i) const { return v_[i + 1 == n_ ? 0 : i + 1]; }
+  const Eigen::Vector2d& Left(size_t i) const { return SweepsFirst(B(i), A(i)) ? B(i) : A(i); }
+  const Eigen::Vector2d& Right(size_t i) const { return SweepsFirst(B(i), A(i)) ? A(i) : B(i); }
+
+  // Edges i and j meet, unless they are neighbours (which share a vertex; that they do not fold
+  // back onto each other is checked beforehand).
+  bool Meet(size_t i, size_t j) const {
+    const size_t d = i > j ? i - j : j - i;
+    if (d == 1 || d == n_ - 1) return false;
+    return SegmentsMeet(A(i), B(i), A(j), B(j));
+  }
+
+  // Edge s lies below edge t along the sweep line, judged where the later of the two starts:
+  // that start against the other edge's line, then (when on it) the later edge's other end. The
+  // same test decides (s, t) and (t, s), so the order is antisymmetric; edges on one line from
+  // one point are ordered by index.
+  struct Below {
+    const EdgeSweep* sweep;
+    bool operator()(size_t s, size_t t) const {
+      if (s == t) return false;
+      const EdgeSweep& w = *sweep;
+      if (SweepsFirst(w.Left(t), w.Left(s))) {
+        int o = Orientation(w.Left(t), w.Right(t), w.Left(s));
+        if (o == 0) o = Orientation(w.Left(t), w.Right(t), w.Right(s));
+        return o != 0 ? o < 0 : s < t;
+      }
+      int o = Orientation(w.Left(s), w.Right(s), w.Left(t));
+      if (o == 0) o = Orientation(w.Left(s), w.Right(s), w.Right(t));
+      return o != 0 ? o > 0 : s < t;
+    }
+  };
+
+  const std::vector<Eigen::Vector2d>& v_;
+  const size_t n_;
+};
+
 }  // namespace
 
 bool GroundPolygon::IsSimple() const {
@@ -105,25 +291,14 @@ bool GroundPolygon::IsSimple() const {
     if (!v.allFinite()) return false;
   }
   for (size_t i = 0; i < n; ++i) {
-    const Eigen::Vector2d& a = vertices_[i];
-    const Eigen::Vector2d& b = vertices_[(i + 1) % n];
-    if (a == b) return false;  // a repeated vertex makes a zero-length edge
-    for (size_t j = i + 1; j < n; ++j) {
-      const Eigen::Vector2d& c = vertices_[j];
-      const Eigen::Vector2d& d = vertices_[(j + 1) % n];
-      const bool adjacent = j == i + 1 || (i == 0 && j == n - 1);
-      if (adjacent) {
-        // Neighbours share one vertex; they must not fold back onto each other.
-        const Eigen::Vector2d& shared = j == i + 1 ? b : a;
-        const Eigen::Vector2d& p = j == i + 1 ? a : b;  // far end of edge i
-        const Eigen::Vector2d& q = j == i + 1 ? d : c;  // far end of edge j
-        if (Orientation(p, shared, q) == 0 && (p - shared).dot(q - shared) > 0) return false;
-        continue;
-      }
-      if (SegmentsMeet(a, b, c, d)) return false;
-    }
+    const Eigen::Vector2d& p = vertices_[i == 0 ? n - 1 : i - 1];
+    const Eigen::Vector2d& shared = vertices_[i];
+    const Eigen::Vector2d& q = vertices_[i + 1 == n ? 0 : i + 1];
+    if (shared == q) return false;  // a repeated vertex makes a zero-length edge
+    // Neighbours share one vertex; they must not fold back onto each other.
+    if (Orientation(p, shared, q) == 0 && (p - shared).dot(q - shared) > 0) return false;
   }
-  return Area() > 0;
+  return !EdgeSweep(vertices_).AnyNonNeighboursMeet() && Area() > 0;
 }
 
 double GroundPolygon::Area() const {

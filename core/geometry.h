@@ -40,9 +40,12 @@ std::optional<Eigen::Vector3d> IntersectGround(const Ray& ray);
 // A simple polygon on the floor (ground x, y in metres), vertices in order.
 class GroundPolygon {
  public:
-  // The most vertices a floor polygon may have (IsSimple compares every pair of edges: at this
-  // size ~50 M tests, a fraction of a second). Every reader of a floor refuses more, naming it.
-  static constexpr size_t kMaxVertices = 10000;
+  // The most vertices a floor polygon may have; every reader of a floor refuses more, naming
+  // it. IsSimple no longer bounds it (a million vertices: 0.1-1.1 s, bench/RESULTS.md); the
+  // config reader does: yaml-cpp holds ~1.5 KB a point while it parses (100,000 points: 250 MB
+  // and 1.4 s; a million: 1.7 GB and 10 s). Beware that the pipeline's floor mask tests every
+  // pixel against every edge (FloorMask: ~13 s a 640x480 camera at 10,000 vertices, linear in both).
+  static constexpr size_t kMaxVertices = 100000;
 
   GroundPolygon() = default;
   explicit GroundPolygon(std::vector<Eigen::Vector2d> vertices);
@@ -57,7 +60,8 @@ class GroundPolygon {
   bool ContainsWithMargin(const Eigen::Vector2d& point_in_ground, double margin) const;
   double Area() const;  // square metres, whatever the vertex order
   // At least 3 finite vertices, no two edges crossing or touching except
-  // neighbours at their shared vertex, and a non-zero area.
+  // neighbours at their shared vertex, and a non-zero area. O(n log n) (a sweep), in exact
+  // arithmetic for any floor in metres.
   bool IsSimple() const;
   bool operator==(const GroundPolygon& o) const { return vertices_ == o.vertices_; }
 

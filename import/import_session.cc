@@ -84,7 +84,8 @@ GroundPolygon ReadFloorFile(const std::string& path) {
     vertices.emplace_back(p[0].get<double>(), p[1].get<double>());
   }
   if (vertices.size() > GroundPolygon::kMaxVertices)
-    throw InputError(path, "floor: too many points");
+    throw InputError(path, "floor: " + std::to_string(vertices.size()) + " points; a floor polygon has at most " +
+                               std::to_string(GroundPolygon::kMaxVertices));
   GroundPolygon polygon(std::move(vertices));
   if (!polygon.IsSimple())
     throw InputError(path, "floor: not a simple polygon of at least 3 points");

@@ -8,10 +8,6 @@
 
 namespace ss::api {
 
-std::string Dump(const nlohmann::json& j, int indent) {
-  return j.dump(indent, ' ', false, nlohmann::json::error_handler_t::replace);
-}
-
 void Reply(httplib::Response& res, int status, const nlohmann::json& body) {
   res.status = status;
   res.set_content(Dump(body, 2) + "\n", "application/json");
@@ -26,22 +22,7 @@ Handler Json(std::function<nlohmann::json(const httplib::Request&)> f) {
 }
 
 nlohmann::json ObjectBody(const httplib::Request& req, std::initializer_list<const char*> fields) {
-  if (req.body.empty()) return nlohmann::json::object();
-  nlohmann::json body;
-  try {
-    body = nlohmann::json::parse(req.body);
-  } catch (const nlohmann::json::exception& e) {
-    throw InputError("body", std::string("not valid JSON: ") + e.what());
-  }
-  if (!body.is_object()) throw InputError("body", "expected a JSON object");
-  for (const auto& [key, value] : body.items()) {
-    if (std::none_of(fields.begin(), fields.end(), [&](const char* f) { return key == f; })) {
-      std::string list;
-      for (const char* f : fields) list += std::string(list.empty() ? "" : ", ") + "\"" + f + "\"";
-      throw InputError(key, "unknown field (the request takes " + (list.empty() ? std::string("none") : list) + ")");
-    }
-  }
-  return body;
+  return ObjectBody(req.body, fields);
 }
 
 int64_t ParseInt(const std::string& text, const char* name, int64_t lo, int64_t hi) {

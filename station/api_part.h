@@ -19,6 +19,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "station/request_bodies.h"  // Dump, ObjectBody of a body's text, and each route's request
+
 namespace httplib {
 struct Request;
 struct Response;
@@ -40,15 +42,12 @@ struct Route {
   Handler handler;
 };
 
-// JSON text of `j`; bytes that are not UTF-8 (a request may send anything) are replaced.
-std::string Dump(const nlohmann::json& j, int indent = -1);
 void Reply(httplib::Response& res, int status, const nlohmann::json& body);
 void ReplyError(httplib::Response& res, int status, const std::string& message);
 // A handler that answers 200 with what `f(req)` returns.
 Handler Json(std::function<nlohmann::json(const httplib::Request&)> f);
 
-// The request's body as a JSON object (empty body: {}); InputError naming the field for
-// anything else or a member not in `fields`.
+// The request's body as a JSON object: ObjectBody(req.body, fields) (request_bodies.h).
 nlohmann::json ObjectBody(const httplib::Request& req, std::initializer_list<const char*> fields);
 // `text` as a whole integer within [lo, hi]; InputError naming `name` otherwise.
 int64_t ParseInt(const std::string& text, const char* name, int64_t lo, int64_t hi);

@@ -11,12 +11,12 @@
 #include "core/bank_export.h"
 #include "core/error.h"
 #include "core/error_kinds.h"
+#include "station/request_bodies.h"
 
 namespace ss {
 namespace {
 
 constexpr size_t kMaxTransitionsShown = 50;
-constexpr size_t kMaxTagSprites = 100000;
 
 nlohmann::json Transitions(std::vector<TransitionRecord> list, bool outgoing) {
   std::sort(list.begin(), list.end(), [](const auto& a, const auto& b) { return a.cost < b.cost; });
@@ -25,13 +25,6 @@ nlohmann::json Transitions(std::vector<TransitionRecord> list, bool outgoing) {
     out.push_back({{"sprite", outgoing ? list[k].to_sprite : list[k].from_sprite}, {"cost", list[k].cost}, {"d", list[k].d}});
   }
   return out;
-}
-
-int64_t IdField(const nlohmann::json& body, const char* field) {
-  if (!body.contains(field)) throw InputError(field, "missing");
-  const nlohmann::json& v = body[field];
-  if (!v.is_number_integer()) throw InputError(field, "expected an integer, got " + v.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace));
-  return v.get<int64_t>();
 }
 
 }  // namespace
@@ -177,44 +170,19 @@ std::vector<uint8_t> ConsoleBank::BillboardPng(int64_t sprite_id, int max_height
 }
 
 int64_t ConsoleBank::Tag(const nlohmann::json& body, bool remove) const {
-  if (!body.is_object()) throw InputError("body", "expected a JSON object");
-  for (const auto& [key, value] : body.items()) {
-    if (key != "tag" && key != "sprites" && key != "clip" && key != "first_frame" && key != "last_frame") {
-      throw InputError(key, "unknown field (the request takes tag with sprites, or tag with clip, first_frame, last_frame)");
-    }
-  }
-  if (!body.contains("tag") || !body["tag"].is_string()) throw InputError("tag", "expected text");
-  const std::string tag = body["tag"].get<std::string>();
-  if (tag.empty() || tag.size() > 64) throw InputError("tag", "a tag needs 1 to 64 characters");
-  for (const char c : tag) {
-    if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_' || c == '.')) {
-      throw InputError("tag", "\"" + tag + "\": only letters, digits, '-', '_' and '.' are allowed");
-    }
-  }
-  std::vector<int64_t> ids;
+  const api::TagRequest r = api::ParseTag(body);
+  std::vector<int64_t> ids = r.sprites;
   {
     const Bank bank(path_);
-    if (body.contains("sprites")) {
-      if (body.contains("clip")) throw InputError("clip", "give sprites or a clip's frames, not both");
-      const nlohmann::json& list = body["sprites"];
-      if (!list.is_array() || list.empty()) throw InputError("sprites", "expected a non-empty list of sprite ids");
-      if (list.size() > kMaxTagSprites) throw InputError("sprites", "at most 100000 sprites a request");
-      for (const auto& v : list) {
-        if (!v.is_number_integer()) throw InputError("sprites", "expected integer ids, got " + v.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace));
-        ids.push_back(v.get<int64_t>());
-      }
-    } else {
-      const int64_t clip = IdField(body, "clip");
-      const int64_t first = IdField(body, "first_frame");
-      const int64_t last = IdField(body, "last_frame");
-      if (last < first) throw InputError("last_frame", "comes before first_frame");
-      ids = bank.ClipSpriteIds(clip, first, last);
+    if (ids.empty()) {
+      ids = bank.ClipSpriteIds(r.clip, r.first_frame, r.last_frame);
       if (ids.empty()) {
-        throw InputError("clip", "clip " + std::to_string(clip) + " has no sprites at frames " + std::to_string(first) +
-                                     ".." + std::to_string(last));
+        throw InputError("clip", "clip " + std::to_string(r.clip) + " has no sprites at frames " +
+                                     std::to_string(r.first_frame) + ".." + std::to_string(r.last_frame));
       }
     }
   }
+  const std::string& tag = r.tag;
   BankWriter writer(path_);
   try {
     if (remove) {

@@ -25,8 +25,8 @@ class ConsoleBank {
   // PNG with alpha, scaled down to at most `max_height` pixels high (0: as stored).
   std::vector<uint8_t> BillboardPng(int64_t sprite_id, int max_height) const;
   // `body`: {"tag", "sprites": [ids]} or {"tag", "clip", "first_frame", "last_frame"} (a run of a
-  // clip's frames, with their mirrored copies). InputError naming the field. Returns the
-  // number of sprites (un)tagged.
+  // clip's frames, with their mirrored copies; api::ParseTag). InputError naming the field.
+  // Returns the number of sprites (un)tagged.
   int64_t Tag(const nlohmann::json& body, bool remove) const;
   // The sprites of a clip, or with a tag, as `bank export`'s sprites.csv (originals and mirrors).
   std::string ExportCsv(std::optional<int64_t> clip_id, const std::string& tag) const;

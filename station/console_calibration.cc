@@ -68,14 +68,6 @@ nlohmann::json Points(const std::vector<Eigen::Vector2d>& points) {
   return out;
 }
 
-WizardStep ParseStep(const nlohmann::json& v) {
-  const std::string s = v.is_string() ? v.get<std::string>() : "";
-  if (s == "intrinsics") return WizardStep::kIntrinsics;
-  if (s == "ground") return WizardStep::kGround;
-  if (s == "enclosure") return WizardStep::kEnclosure;
-  throw InputError("step", "expected \"intrinsics\", \"ground\" or \"enclosure\", got " + api::Dump(v));
-}
-
 // The 10 cm floor grid seen by a posed camera, as polylines in its pixels: lines across the
 // part of the floor it sees (within `reach` of the floor point below the image centre), cut
 // where they leave the image or pass behind the camera.
@@ -579,16 +571,14 @@ struct ConsoleCalibration::Impl {
     return works;
   }
 
-  // The camera a request names (body "camera"), or every camera of the wizard when it names none.
-  std::vector<std::shared_ptr<CameraWork>> Chosen(const nlohmann::json& body, bool required) const {
-    if (!body.contains("camera")) {
-      if (required) throw InputError("camera", "missing (the camera's name)");
+  // The camera a request names (api::ParseCameraName), or every camera of the wizard when it names none.
+  std::vector<std::shared_ptr<CameraWork>> Chosen(const std::optional<std::string>& camera) const {
+    if (!camera) {
       std::vector<std::shared_ptr<CameraWork>> all = Works();
       if (all.empty()) throw ConflictError("calibration", "no wizard is running: start one");
       return all;
     }
-    if (!body["camera"].is_string()) throw InputError("camera", "expected the camera's name, got " + api::Dump(body["camera"]));
-    return {Work(body["camera"].get<std::string>())};
+    return {Work(*camera)};
   }
 
   void RequireActive() const {
@@ -658,62 +648,30 @@ struct ConsoleCalibration::Impl {
       throw ConflictError("session", "a capture session is running: stop it before calibrating (the board would be "
                                      "stored as sprites)");
     }
-    if (!body.contains("board") || !body["board"].is_string()) {
-      throw InputError("board", "expected the board's spec, e.g. \"chessboard:10x7:0.03\"");
-    }
+    const StationStatus status = station->Status();
+    const api::CalibrationStartRequest r = api::ParseCalibrationStart(body, [&](const std::string& name) {
+      return std::any_of(status.cameras.begin(), status.cameras.end(),
+                         [&](const CameraStatus& c) { return c.name == name; });
+    });
     WizardSettings settings;
     calib::WizardOptions& o = settings.options;
-    o.board = calib::ParseBoardSpec(body["board"].get<std::string>(), "board");
+    o.board = r.board;
     o.auto_solve = false;
     o.detect.exhaustive = false;  // a frame without a board must stay cheap
     o.verdict.grid_x = o.verdict.grid_y = kGrid;
     o.verdict.max_stdev_percent = 0.5;
-    auto number = [&](const char* field, double lo, double hi, double fallback) {
-      if (!body.contains(field)) return fallback;
-      if (!body[field].is_number()) throw InputError(field, "expected a number, got " + api::Dump(body[field]));
-      const double v = body[field].get<double>();
-      if (!(v >= lo && v <= hi)) {
-        std::ostringstream range;
-        range << "expected " << lo << " to " << hi << ", got " << v;
-        throw InputError(field, range.str());
-      }
-      return v;
-    };
-    o.verdict.min_views = static_cast<int>(number("min_views", 3, 200, o.verdict.min_views));
-    o.max_views = std::max(o.verdict.min_views, static_cast<int>(number("max_views", 3, 500, 30)));
-    o.verdict.min_coverage = number("min_coverage", 0, 1, o.verdict.min_coverage);
-    o.verdict.max_rms_px = number("max_rms_px", 0.01, 100, o.verdict.max_rms_px);
-    settings.still_s = number("still_s", 0, 10, 0.2);
-    settings.floor_still_s = number("floor_still_s", 0, 60, 1.0);
-    double pose[3] = {0, 0, 0};
-    if (body.contains("board_pose")) {
-      const nlohmann::json& p = body["board_pose"];
-      if (!p.is_array() || p.size() != 3 || !p[0].is_number() || !p[1].is_number() || !p[2].is_number()) {
-        throw InputError("board_pose", "expected [x_m, y_m, yaw_deg], got " + api::Dump(p));
-      }
-      for (int i = 0; i < 3; ++i) pose[i] = p[static_cast<size_t>(i)].get<double>();
-    }
-    o.ground_from_board = calib::FloorBoardPose(pose[0], pose[1], pose[2], number("board_thickness_m", 0, 0.1, 0));
-    bool use_current = false;
-    if (body.contains("use_current_intrinsics")) {
-      if (!body["use_current_intrinsics"].is_boolean()) throw InputError("use_current_intrinsics", "expected true or false");
-      use_current = body["use_current_intrinsics"].get<bool>();
-    }
-
-    const StationStatus status = station->Status();
-    std::vector<std::string> names;
-    if (body.contains("cameras")) {
-      const nlohmann::json& c = body["cameras"];
-      if (!c.is_array() || c.empty()) throw InputError("cameras", "expected a list of camera names, got " + api::Dump(c));
-      for (const auto& n : c) {
-        if (!n.is_string()) throw InputError("cameras", "expected camera names, got " + api::Dump(n));
-        const bool known = std::any_of(status.cameras.begin(), status.cameras.end(),
-                                       [&](const CameraStatus& s) { return s.name == n.get<std::string>(); });
-        if (!known) throw InputError("cameras", "no camera \"" + n.get<std::string>() + "\" in the station");
-        if (std::find(names.begin(), names.end(), n.get<std::string>()) == names.end()) names.push_back(n);
-      }
-    } else {
-      for (const auto& s : status.cameras) names.push_back(s.name);
+    o.verdict.min_views = static_cast<int>(r.min_views.value_or(o.verdict.min_views));
+    o.max_views = std::max(o.verdict.min_views, static_cast<int>(r.max_views.value_or(30)));
+    o.verdict.min_coverage = r.min_coverage.value_or(o.verdict.min_coverage);
+    o.verdict.max_rms_px = r.max_rms_px.value_or(o.verdict.max_rms_px);
+    settings.still_s = r.still_s.value_or(0.2);
+    settings.floor_still_s = r.floor_still_s.value_or(1.0);
+    const double* pose = r.board_pose;
+    o.ground_from_board = calib::FloorBoardPose(pose[0], pose[1], pose[2], r.board_thickness_m.value_or(0));
+    const bool use_current = r.use_current_intrinsics;
+    std::vector<std::string> names = r.cameras;
+    if (names.empty()) {
+      for (const auto& c : status.cameras) names.push_back(c.name);
     }
     std::vector<std::optional<CameraModel>> current(names.size());
     const StationConfig config = context.host->live_config();
@@ -984,9 +942,7 @@ std::vector<api::Route> ConsoleCalibration::Routes() {
        "POST /api/calibration/start {\"board\", \"cameras\", \"board_pose\", \"board_thickness_m\", \"min_views\", "
        "\"max_views\", \"min_coverage\", \"max_rms_px\", \"still_s\", \"floor_still_s\", \"use_current_intrinsics\"}",
        state_after([s](const Request& req) {
-         s->Start(api::ObjectBody(req, {"board", "cameras", "board_pose", "board_thickness_m", "min_views", "max_views",
-                                        "min_coverage", "max_rms_px", "still_s", "floor_still_s",
-                                        "use_current_intrinsics"}));
+         s->Start(api::ObjectBody(req, api::kCalibrationStartFields));
          s->Retap();
        })},
       {"POST", "/api/calibration/cancel", "POST /api/calibration/cancel", state_after([s](const Request& req) {
@@ -998,12 +954,9 @@ std::vector<api::Route> ConsoleCalibration::Routes() {
        })},
       {"POST", "/api/calibration/drop", "POST /api/calibration/drop {\"camera\", \"which\": \"last\" | \"worst\"}",
        state_after([s](const Request& req) {
-         const nlohmann::json body = api::ObjectBody(req, {"camera", "which"});
-         const std::string which = body.value("which", nlohmann::json("last")).is_string() ? body.value("which", "last") : "";
-         if (which != "last" && which != "worst") {
-           throw InputError("which", "expected \"last\" or \"worst\", got " + api::Dump(body.value("which", nlohmann::json())));
-         }
-         for (const auto& w : s->Chosen(body, true)) {
+         const api::CalibrationDropRequest r = api::ParseCalibrationDrop(api::ObjectBody(req, api::kCalibrationDropFields));
+         const std::string& which = r.which;
+         for (const auto& w : s->Chosen(r.camera)) {
            w->Run([&](calib::CalibrationWizard& wiz) {
              try {
                which == "last" ? wiz.DropLast() : wiz.DropWorst();
@@ -1016,10 +969,11 @@ std::vector<api::Route> ConsoleCalibration::Routes() {
        })},
       {"POST", "/api/calibration/solve", "POST /api/calibration/solve {\"camera\"} (202: runs in the background)",
        [this, s](const Request& req, Response& res) {
-         const nlohmann::json body = api::ObjectBody(req, {"camera"});
+         const nlohmann::json body = api::ObjectBody(req, api::kCalibrationSolveFields);
          s->RequireActive();
-         std::vector<std::shared_ptr<CameraWork>> chosen = s->Chosen(body, false);
-         if (!body.contains("camera")) {
+         const std::optional<std::string> camera = api::ParseCameraName(body, false);
+         std::vector<std::shared_ptr<CameraWork>> chosen = s->Chosen(camera);
+         if (!camera) {
            // Every camera still in the intrinsics step.
            std::vector<std::shared_ptr<CameraWork>> in_step;
            for (const auto& w : chosen) {
@@ -1033,10 +987,9 @@ std::vector<api::Route> ConsoleCalibration::Routes() {
        }},
       {"POST", "/api/calibration/redo", "POST /api/calibration/redo {\"camera\", \"step\": \"intrinsics\" | \"ground\" | \"enclosure\"}",
        state_after([s](const Request& req) {
-         const nlohmann::json body = api::ObjectBody(req, {"camera", "step"});
-         if (!body.contains("step")) throw InputError("step", "missing (intrinsics, ground or enclosure)");
-         const WizardStep step = ParseStep(body["step"]);
-         for (const auto& w : s->Chosen(body, false)) {
+         const api::CalibrationRedoRequest r = api::ParseCalibrationRedo(api::ObjectBody(req, api::kCalibrationRedoFields));
+         const WizardStep step = r.step;
+         for (const auto& w : s->Chosen(r.camera)) {
            w->Run([&](calib::CalibrationWizard& wiz) {
              try {
                wiz.Redo(step);
@@ -1052,24 +1005,16 @@ std::vector<api::Route> ConsoleCalibration::Routes() {
       {"POST", "/api/calibration/floor",
        "POST /api/calibration/floor {\"camera\", \"detect\": true} | {\"camera\", \"pixels\": [[x, y], ...]}",
        state_after([s](const Request& req) {
-         const nlohmann::json body = api::ObjectBody(req, {"camera", "detect", "pixels"});
-         const std::shared_ptr<CameraWork> w = s->Chosen(body, true).front();
-         if (body.contains("pixels")) {
-           const nlohmann::json& p = body["pixels"];
-           if (!p.is_array()) throw InputError("pixels", "expected [[x, y], ...] in the camera's pixels");
-           std::vector<Eigen::Vector2d> pixels;
-           for (const auto& q : p) {
-             if (!q.is_array() || q.size() != 2 || !q[0].is_number() || !q[1].is_number()) {
-               throw InputError("pixels", "expected [x, y] pairs, got " + api::Dump(q));
-             }
-             pixels.emplace_back(q[0].get<double>(), q[1].get<double>());
-           }
+         const nlohmann::json body = api::ObjectBody(req, api::kCalibrationFloorFields);
+         const std::shared_ptr<CameraWork> w = s->Chosen(api::ParseCameraName(body, true)).front();
+         const api::CalibrationFloorRequest r = api::ParseCalibrationFloor(body);
+         if (!r.detect) {
            w->Run([&](calib::CalibrationWizard& wiz) {
              if (!wiz.posed_model()) throw ConflictError(w->name(), "is not posed yet: finish the ground step first");
-             wiz.SetFloorFromPixels(pixels);
+             wiz.SetFloorFromPixels(r.pixels);
              return 0;
            });
-         } else if (body.value("detect", false) == true) {
+         } else {
            const LiveView live = w->Live();
            w->Run([&](calib::CalibrationWizard& wiz) {
              if (!wiz.posed_model()) throw ConflictError(w->name(), "is not posed yet: finish the ground step first");
@@ -1082,8 +1027,6 @@ std::vector<api::Route> ConsoleCalibration::Routes() {
              }
              return 0;
            });
-         } else {
-           throw InputError("body", "give \"detect\": true or \"pixels\": [[x, y], ...]");
          }
          std::lock_guard lock(s->mutex);
          s->saved = nullptr;

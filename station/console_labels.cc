@@ -58,15 +58,6 @@ std::string UtcText(bool iso) {
   return text;
 }
 
-int64_t IdField(const nlohmann::json& body, const char* field) {
-  if (!body.contains(field)) throw InputError(field, "missing (expected a sprite id)");
-  const nlohmann::json& v = body[field];
-  if (!v.is_number_integer() || v.get<int64_t>() < 1) {
-    throw InputError(field, "expected a sprite id (an integer >= 1), got " + api::Dump(v));
-  }
-  return v.get<int64_t>();
-}
-
 // NotFoundError naming the sprite when the bank has no such sprite.
 void CheckSprite(const Bank& bank, int64_t id) {
   try {
@@ -373,15 +364,9 @@ nlohmann::json ConsoleLabels::Pair(int64_t from, int64_t to) {
 }
 
 nlohmann::json ConsoleLabels::Store(const nlohmann::json& body) {
-  const int64_t from = IdField(body, "from");
-  const int64_t to = IdField(body, "to");
-  if (!body.contains("label")) throw InputError("label", "missing (expected \"yes\", \"no\" or \"skip\")");
-  if (!body["label"].is_string()) throw InputError("label", "expected \"yes\", \"no\" or \"skip\", got " + api::Dump(body["label"]));
-  const std::string label = body["label"].get<std::string>();
-  if (label != "yes" && label != "no" && label != "skip") {
-    throw InputError("label", "expected \"yes\", \"no\" or \"skip\", got \"" + label + "\"");
-  }
-  if (from == to) throw InputError("to", "the same sprite as \"from\" (" + std::to_string(from) + ")");
+  const api::LabelRequest r = api::ParseLabel(body);
+  const int64_t from = r.from, to = r.to;
+  const std::string& label = r.label;
   const std::string bank = BankPath();
   {
     const Bank reader(bank);
@@ -399,8 +384,8 @@ nlohmann::json ConsoleLabels::Store(const nlohmann::json& body) {
 }
 
 nlohmann::json ConsoleLabels::Undo(const nlohmann::json& body) {
-  const int64_t from = IdField(body, "from");
-  const int64_t to = IdField(body, "to");
+  const api::LabelRequest r = api::ParseLabelUndo(body);
+  const int64_t from = r.from, to = r.to;
   const std::string bank = BankPath();
   if (!BankWriter(bank).RemoveTransitionLabel(from, to)) {
     throw NotFoundError("label", "no label for the pair " + std::to_string(from) + " -> " + std::to_string(to));
@@ -706,9 +691,9 @@ std::vector<Route> ConsoleLabels::Routes() {
          return Pair(api::IntParam(req, "from", 0, 1, INT64_MAX), api::IntParam(req, "to", 0, 1, INT64_MAX));
        })},
       {"POST", "/api/labels", "POST /api/labels {\"from\": ID, \"to\": ID, \"label\": \"yes\" | \"no\" | \"skip\"}",
-       Json([this](const httplib::Request& req) { return Store(ObjectBody(req, {"from", "to", "label"})); })},
+       Json([this](const httplib::Request& req) { return Store(ObjectBody(req, api::kLabelFields)); })},
       {"POST", "/api/labels/undo", "POST /api/labels/undo {\"from\": ID, \"to\": ID}",
-       Json([this](const httplib::Request& req) { return Undo(ObjectBody(req, {"from", "to"})); })},
+       Json([this](const httplib::Request& req) { return Undo(ObjectBody(req, api::kLabelUndoFields)); })},
       {"GET", R"(/api/labels/export\.csv)", "GET /api/labels/export.csv (transitions train's labels CSV)",
        [this](const httplib::Request&, httplib::Response& res) {
          res.set_header("Content-Disposition", "attachment; filename=\"labels.csv\"");

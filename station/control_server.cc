@@ -22,6 +22,7 @@
 #include "station/console_calibration.h"
 #include "station/console_events.h"
 #include "station/console_labels.h"
+#include "station/http_server.h"
 #include "station/station.h"
 #include "station/station_host.h"
 #include "station/station_status.h"
@@ -32,7 +33,6 @@ namespace {
 namespace fs = std::filesystem;
 using httplib::Request;
 using httplib::Response;
-using api::Dump;
 using api::IntParam;
 using api::ObjectBody;
 using api::PathId;
@@ -42,9 +42,9 @@ using api::Route;
 
 constexpr size_t kMaxBodyBytes = 1 << 20;  // every JSON body the API takes is far smaller
 // Each open connection holds an HTTP thread while it waits for its request (cpp-httplib 0.11
-// reads a request on the thread that serves it, and its read timeout restarts with every byte,
-// so a client that sends a header line every few seconds keeps its thread). Enough threads
-// that 500 slow or idle clients leave the API answering: idle, they cost ~10 MB.
+// reads a request on the thread that serves it). Enough threads that 500 slow or idle clients
+// leave the API answering: idle, they cost ~10 MB. A slow client keeps its thread for at most
+// the request deadline, and one address holds at most 64 of them (HttpLimits).
 constexpr int kHttpThreads = 600;
 constexpr int kHttpNice = 10;              // HTTP threads yield the cores to capture and the pipeline
 
@@ -71,13 +71,7 @@ class NiceThreadPool : public httplib::TaskQueue {
 
 // A session name from {"name": S}; "" when absent and not required.
 std::string NameFromBody(const Request& req, bool required) {
-  const nlohmann::json body = ObjectBody(req, {"name"});
-  if (!body.contains("name")) {
-    if (required) throw InputError(req.body.empty() ? "body" : "name", "missing (expected {\"name\": \"...\"})");
-    return "";
-  }
-  if (!body["name"].is_string()) throw InputError("name", "expected text, got " + Dump(body["name"]));
-  return body["name"].get<std::string>();
+  return api::ParseSessionName(ObjectBody(req, api::kSessionFields), required, req.body.empty());
 }
 
 std::string Lower(std::string text) {
@@ -110,7 +104,7 @@ const char* ContentTypeOf(const fs::path& path) {
 struct ControlServer::Impl {
   StationHost* host = nullptr;
   ControlServerOptions options;
-  httplib::Server server;
+  HttpServer server;  // cpp-httplib's, with the limits per client and per request (http_server.h)
   std::thread thread;
   int port = 0;
   std::unique_ptr<ConsoleEvents> events;
@@ -133,11 +127,19 @@ struct ControlServer::Impl {
     return s;
   }
 
-  nlohmann::json StatusJson() const {
-    const std::shared_ptr<Station> s = station();
-    StationStatus status = s->Status();
+  // The station's status, with the HTTP server's own figures.
+  StationStatus Status() const {
+    StationStatus status = station()->Status();
     status.control_url = Url();
-    nlohmann::json j = StatusToJson(status);
+    const HttpCounters http = server.counters();
+    status.control_connections_open = http.connections_open;
+    status.control_connections_refused = http.connections_refused;
+    status.control_requests_timed_out = http.requests_timed_out;
+    return status;
+  }
+
+  nlohmann::json StatusJson() const {
+    nlohmann::json j = StatusToJson(Status());
     j.update(host->ModeJson());
     for (const auto& part : parts) part->AddStatus(j);
     return j;
@@ -266,12 +268,8 @@ struct ControlServer::Impl {
   }
 
   void ReplayStart(const Request& req, Response& res) {
-    const nlohmann::json body = ObjectBody(req, {"path", "paced", "loop"});
-    if (!body.contains("path") || !body["path"].is_string()) throw InputError("path", "expected the session's path (text)");
-    for (const char* flag : {"paced", "loop"}) {
-      if (body.contains(flag) && !body[flag].is_boolean()) throw InputError(flag, "expected true or false");
-    }
-    host->StartReplay(body["path"].get<std::string>(), body.value("paced", true), body.value("loop", false));
+    const api::ReplayStartRequest r = api::ParseReplayStart(ObjectBody(req, api::kReplayStartFields));
+    host->StartReplay(r.path, r.paced, r.loop);
     Reply(res, 200, host->ModeJson());
   }
 
@@ -279,7 +277,7 @@ struct ControlServer::Impl {
 
   // Tag or untag: the same body either way.
   nlohmann::json Tag(const Request& req, bool remove) const {
-    const int64_t n = Bank().Tag(ObjectBody(req, {"tag", "sprites", "clip", "first_frame", "last_frame"}), remove);
+    const int64_t n = Bank().Tag(ObjectBody(req, api::kTagFields), remove);
     return {{remove ? "untagged" : "tagged", n}};
   }
 
@@ -295,7 +293,7 @@ struct ControlServer::Impl {
          }},
         {"GET", "/api/status", "GET /api/status", json([this](const Request&) { return StatusJson(); })},
         {"GET", "/metrics", "GET /metrics (Prometheus)", [this](const Request&, Response& res) {
-           res.set_content(StatusToPrometheus(station()->Status()), "text/plain; version=0.0.4");
+           res.set_content(StatusToPrometheus(Status()), "text/plain; version=0.0.4");
          }},
         {"GET", "/api/events", "GET /api/events (Server-Sent Events)",
          [this](const Request& req, Response& res) { Events(req, res); }},
@@ -390,9 +388,18 @@ struct ControlServer::Impl {
         ReplyError(res, 404, "no such endpoint or page: GET " + req.path + " (GET /api lists the endpoints)");
       }
     });
-    server.set_error_handler([](const Request& req, Response& res) {
+    server.set_error_handler([this](const Request& req, Response& res) {
       if (!res.body.empty()) return;
-      if (res.status == 404) {
+      // A request the HTTP server could not read whole (cpp-httplib's bare 400): the limit it broke.
+      const HttpLimits& limits = server.limits();
+      if (HttpServer::CurrentFault() == HttpServer::RequestFault::kTimedOut) {
+        const int64_t ms = limits.request_deadline.count();
+        ReplyError(res, 408, "request: not received whole within " +
+                                 (ms % 1000 == 0 ? std::to_string(ms / 1000) + " s" : std::to_string(ms) + " ms") +
+                                 " of its first byte");
+      } else if (HttpServer::CurrentFault() == HttpServer::RequestFault::kHeaderTooLarge) {
+        ReplyError(res, 431, "header: larger than " + std::to_string(limits.max_header_bytes) + " bytes");
+      } else if (res.status == 404) {
         ReplyError(res, 404, "no such endpoint: " + req.method + " " + req.path + " (GET /api lists them)");
       } else if (res.status == 413) {
         ReplyError(res, 413, "body: larger than " + std::to_string(kMaxBodyBytes) + " bytes");

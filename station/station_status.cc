@@ -154,7 +154,10 @@ nlohmann::json StatusToJson(const StationStatus& st) {
                        {"frames_recorded", st.frames_recorded},
                        {"frames_record_dropped", st.frames_record_dropped},
                        {"recording_error", st.recording_error}}},
-          {"control", {{"url", st.control_url}}}};
+          {"control", {{"url", st.control_url},
+                       {"connections_open", st.control_connections_open},
+                       {"connections_refused", st.control_connections_refused},
+                       {"requests_timed_out", st.control_requests_timed_out}}}};
 }
 
 std::string StatusToPrometheus(const StationStatus& st) {
@@ -236,6 +239,12 @@ std::string StatusToPrometheus(const StationStatus& st) {
   m.Sample(static_cast<double>(st.frames_recorded));
   m.Family("frames_record_dropped_total", "counter", "raw frames the recorder could not keep up with");
   m.Sample(static_cast<double>(st.frames_record_dropped));
+  m.Family("http_connections", "gauge", "connections the control API serves now");
+  m.Sample(static_cast<double>(st.control_connections_open));
+  m.Family("http_connections_refused_total", "counter", "connections refused: too many open from the same address");
+  m.Sample(static_cast<double>(st.control_connections_refused));
+  m.Family("http_requests_timed_out_total", "counter", "requests not received whole by the request deadline");
+  m.Sample(static_cast<double>(st.control_requests_timed_out));
   return m.str();
 }
 

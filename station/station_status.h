@@ -64,8 +64,11 @@ struct StationStatus {
   std::string recording_mode;     // off | all | usable
   uint64_t frames_recorded = 0, frames_record_dropped = 0;
   std::string recording_error;
-  // Control
+  // Control: its HTTP server (station/http_server.h)
   std::string control_url;
+  uint64_t control_connections_open = 0;     // being served now
+  uint64_t control_connections_refused = 0;  // over the per-client limit, since start
+  uint64_t control_requests_timed_out = 0;   // not received whole by the request deadline, since start
 };
 
 nlohmann::json StatusToJson(const StationStatus& status);

@@ -3,14 +3,20 @@
 #include "core/geometry.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <functional>
 #include <random>
+#include <string>
 
 #include <gtest/gtest.h>
 
 extern "C" {
 #include <mrcal/poseutils.h>
 }
+
+#include "tests/core/polygon_fixtures.h"
 
 namespace ss {
 namespace {
@@ -169,6 +175,233 @@ TEST(GroundPolygon, IsSimple) {
   EXPECT_FALSE(
       GroundPolygon({{0, 0}, {2, 0}, {2, 2}, {1, 0}, {0, 2}}).IsSimple());  // vertex on an edge
   EXPECT_FALSE(GroundPolygon({{0, 0}, {1, 0}, {NAN, 1}}).IsSimple());
+}
+
+// --- IsSimple: the sweep against the brute force it replaced (issue 20) ---
+
+using Poly = std::vector<Vector2d>;
+
+using testing::Comb;
+using testing::Star;
+
+// Random vertices on a small grid: collinear points, repeats and touching edges are common.
+Poly GridPolygon(std::mt19937& rng, int grid, size_t n) {
+  std::uniform_int_distribution<int> c(0, grid);
+  Poly v;
+  for (size_t i = 0; i < n; ++i) v.push_back({c(rng), c(rng)});
+  return v;
+}
+
+// The same polygon seen otherwise: verdicts must not change. Scales and shifts are powers of two
+// and integers, so the arithmetic of both checks stays exact.
+std::vector<Poly> Variants(const Poly& p, std::mt19937& rng) {
+  std::vector<Poly> out = {p};
+  Poly r = p;
+  std::reverse(r.begin(), r.end());
+  out.push_back(r);
+  Poly rotated = p;
+  std::rotate(rotated.begin(), rotated.begin() + static_cast<long>(rng() % p.size()), rotated.end());
+  out.push_back(rotated);
+  Poly swapped = p, mirrored = p, scaled = p;
+  for (size_t i = 0; i < p.size(); ++i) {
+    swapped[i] = {p[i].y(), p[i].x()};
+    mirrored[i] = {-p[i].x(), p[i].y()};
+    scaled[i] = p[i] * 0x1p-20 + Vector2d(3, -5);
+  }
+  out.push_back(swapped);
+  out.push_back(mirrored);
+  out.push_back(scaled);
+  return out;
+}
+
+// Counts verdicts and fails on the first that differs from the brute force, naming the case.
+struct Agreement {
+  int simple = 0, not_simple = 0;
+  void Check(const Poly& p, const std::string& what) {
+    const bool sweep = GroundPolygon(p).IsSimple();
+    const bool brute = testing::BruteForceIsSimple(p);
+    if (sweep != brute) {
+      std::string text;
+      for (const Vector2d& v : p) text += "(" + std::to_string(v.x()) + ", " + std::to_string(v.y()) + ") ";
+      ADD_FAILURE() << what << ": sweep says " << sweep << ", the brute force " << brute << " for " << p.size()
+                    << " vertices: " << text.substr(0, 2000);
+    }
+    ++(brute ? simple : not_simple);
+  }
+};
+
+TEST(GroundPolygon, IsSimpleAgreesWithTheBruteForceOnRandomGridPolygons) {
+  std::mt19937 rng(20);
+  Agreement a;
+  for (int i = 0; i < 20000; ++i) {
+    const int grid = 2 + i % 7;
+    const Poly p = GridPolygon(rng, grid, 3 + rng() % 9);
+    for (const Poly& v : Variants(p, rng)) a.Check(v, "grid " + std::to_string(grid) + " case " + std::to_string(i));
+  }
+  std::printf("random grid polygons: %d simple, %d not\n", a.simple, a.not_simple);
+  EXPECT_GT(a.simple, 1000);
+  EXPECT_GT(a.not_simple, 1000);
+}
+
+TEST(GroundPolygon, IsSimpleAgreesWithTheBruteForceOnAdversarialPolygons) {
+  std::mt19937 rng(21);
+  Agreement a;
+  const auto check = [&](const Poly& p, const std::string& what) {
+    for (const Poly& v : Variants(p, rng)) a.Check(v, what);
+  };
+  // Stars: simple ones, and star polygons {n/k} whose edges cross.
+  for (size_t n : {3, 4, 5, 17, 200}) check(Star(n, rng), "star " + std::to_string(n));
+  for (int n = 5; n <= 13; ++n) {
+    for (int k = 1; k < n / 2 + 1; ++k) {
+      Poly p;
+      for (int i = 0; i < n; ++i) {
+        const double angle = 2 * M_PI * k * i / n;
+        p.push_back({std::round(1000 * std::cos(angle)), std::round(1000 * std::sin(angle))});
+      }
+      check(p, "star polygon {" + std::to_string(n) + "/" + std::to_string(k) + "}");
+    }
+  }
+  // Combs, with one tooth leaning onto, against or through its neighbour, or to a gap's bottom.
+  for (size_t teeth : {1, 2, 3, 8, 20}) {
+    const Poly comb = Comb(teeth);
+    check(comb, "comb");
+    for (size_t k = 2; k + 2 < comb.size(); k += 4) {
+      for (double dx : {0.5, 1.0, 1.5, 2.0, 3.0}) {
+        Poly lean = comb;
+        lean[k].x() += dx;  // a tooth's top-right corner pushed right
+        check(lean, "comb, tooth corner " + std::to_string(k) + " moved " + std::to_string(dx));
+      }
+      for (double dy : {-9.0, -10.0, -10.5, -11.0}) {
+        Poly low = comb;
+        low[k].y() += dy;  // down to, onto or through the bar
+        check(low, "comb, tooth corner " + std::to_string(k) + " lowered " + std::to_string(dy));
+      }
+    }
+  }
+  // Collinear: every vertex on one line; straight vertices; an edge running back over another.
+  check({{0, 0}, {1, 1}, {2, 2}, {3, 3}}, "all on a line");
+  check({{0, 0}, {1, 0}, {2, 0}, {2, 1}, {0, 1}}, "a straight vertex");
+  check({{0, 0}, {1, 0}, {2, 0}, {3, 0}, {3, 1}, {2, 1}, {1, 1}, {0, 1}}, "straight vertices both sides");
+  check({{0, 0}, {4, 0}, {4, 2}, {3, 0}, {2, 0}, {1, 2}}, "a notch down onto the bottom edge");
+  check({{0, 0}, {4, 0}, {4, 2}, {2, 2}, {2, 0}, {1, 0}, {1, 2}, {0, 2}}, "edges overlapping on one line");
+  check({{0, 0}, {4, 0}, {4, 4}, {0, 4}, {0, 3}, {2, 3}, {2, 1}, {0, 1}}, "a gap closed on the left edge");
+  // Repeated vertices: in a row, or a figure of eight through one point.
+  check({{0, 0}, {2, 0}, {2, 0}, {2, 2}, {0, 2}}, "a vertex twice in a row");
+  check({{0, 0}, {2, 0}, {1, 1}, {2, 2}, {0, 2}, {1, 1}}, "two loops through one vertex");
+  check({{0, 0}, {2, 0}, {2, 2}, {0, 2}, {0, 0}}, "the first vertex again at the end");
+  // Spikes: out and back along one line (folds), or a thin one through another edge.
+  check({{0, 0}, {4, 0}, {4, 4}, {2, 4}, {2, 6}, {2, 4}, {0, 4}}, "a spike out and straight back");
+  check({{0, 0}, {4, 0}, {4, 4}, {2, 4}, {2, 6}, {2, 5}, {0, 4}}, "a spike folding back half way");
+  check({{0, 0}, {4, 0}, {4, 4}, {2, 4}, {2, -1}, {1.9, 4}, {0, 4}}, "a spike through the bottom edge");
+  check({{0, 0}, {4, 0}, {4, 4}, {2, 4}, {2, 0}, {1.9, 4}, {0, 4}}, "a spike down to the bottom edge");
+  check({{0, 0}, {4, 0}, {4, 4}, {2, 4}, {2, 0.5}, {1.9, 4}, {0, 4}}, "a spike short of the bottom edge");
+  // Tiny crossings: a notch's tip a hair above, on or below the bottom edge (exact in doubles).
+  for (double delta : {0x1p-20, 0x1p-30, 0x1p-40, 0x1p-50, 1e-12, 0.0, -1e-12, -0x1p-50, -0x1p-40, -0x1p-20}) {
+    check({{0, 0}, {4, 0}, {4, 4}, {2, delta}, {0, 4}}, "notch tip at " + std::to_string(delta));
+    check({{0, 0}, {4, 0}, {4, 4}, {2, 4}, {2 + delta, 0}, {1, 4}, {0, 4}}, "leaning spike at " + std::to_string(delta));
+  }
+  // The same tiny crossings turned by an angle: rounded, but the old arithmetic still gets their
+  // signs right at these sizes.
+  for (double angle : {0.1, 0.7, 2.0}) {
+    const Eigen::Rotation2Dd turn(angle);
+    for (double delta : {1e-6, 1e-9, -1e-9, -1e-6}) {
+      Poly p = {{0, 0}, {4, 0}, {4, 4}, {2, delta}, {0, 4}};
+      for (Vector2d& v : p) v = turn * v;
+      check(p, "turned notch tip at " + std::to_string(delta));
+    }
+  }
+  // Random grid polygons made simple by construction (a star on a grid) and then broken.
+  for (int i = 0; i < 2000; ++i) {
+    Poly p = Star(6 + i % 20, rng);
+    for (Vector2d& v : p) v = (v * 16).array().round();
+    check(p, "star on a grid, case " + std::to_string(i));
+    p[rng() % p.size()] = p[rng() % p.size()];
+    check(p, "star on a grid with a vertex copied, case " + std::to_string(i));
+  }
+  std::printf("adversarial polygons: %d simple, %d not\n", a.simple, a.not_simple);
+  EXPECT_GT(a.simple, 1000);
+  EXPECT_GT(a.not_simple, 1000);
+}
+
+// Near-degenerate polygons where the old floating-point products rounded: vertices of a grid
+// polygon (full of collinear points and touching edges) scaled by 2^40 and moved by a few units,
+// so that the verdict hangs on a cross product's last bits. The sweep's orientation test is
+// exact: it agrees with 128-bit integer arithmetic, where the old check sometimes did not.
+TEST(GroundPolygon, IsSimpleIsExactWhereTheOldArithmeticRounded) {
+  const auto exact = [](const Poly& p) {
+    // The brute force with the orientation in exact integers (every coordinate is one, < 2^53).
+    const auto orientation = [](const Vector2d& a, const Vector2d& b, const Vector2d& c) {
+      const __int128 bx = static_cast<int64_t>(b.x()) - static_cast<int64_t>(a.x());
+      const __int128 by = static_cast<int64_t>(b.y()) - static_cast<int64_t>(a.y());
+      const __int128 cx = static_cast<int64_t>(c.x()) - static_cast<int64_t>(a.x());
+      const __int128 cy = static_cast<int64_t>(c.y()) - static_cast<int64_t>(a.y());
+      const __int128 cross = bx * cy - by * cx;
+      return (cross > 0) - (cross < 0);
+    };
+    const size_t n = p.size();
+    const auto meet = [&](const Vector2d& a, const Vector2d& b, const Vector2d& c, const Vector2d& d) {
+      const int o1 = orientation(a, b, c), o2 = orientation(a, b, d), o3 = orientation(c, d, a), o4 = orientation(c, d, b);
+      if (o1 != o2 && o3 != o4) return true;
+      using testing::reference::OnSegment;
+      return (o1 == 0 && OnSegment(a, b, c)) || (o2 == 0 && OnSegment(a, b, d)) || (o3 == 0 && OnSegment(c, d, a)) ||
+             (o4 == 0 && OnSegment(c, d, b));
+    };
+    for (size_t i = 0; i < n; ++i) {
+      const Vector2d &a = p[i], &b = p[(i + 1) % n];
+      if (a == b) return false;
+      for (size_t j = i + 1; j < n; ++j) {
+        const Vector2d &c = p[j], &d = p[(j + 1) % n];
+        if (j == i + 1 || (i == 0 && j == n - 1)) {
+          const Vector2d& shared = j == i + 1 ? b : a;
+          const Vector2d& q1 = j == i + 1 ? a : b;
+          const Vector2d& q2 = j == i + 1 ? d : c;
+          if (orientation(q1, shared, q2) == 0 && (q1 - shared).dot(q2 - shared) > 0) return false;
+          continue;
+        }
+        if (meet(a, b, c, d)) return false;
+      }
+    }
+    return testing::reference::Area(p) > 0;
+  };
+  std::mt19937 rng(22);
+  std::uniform_int_distribution<int> nudge(-2, 2);
+  int simple = 0, not_simple = 0, old_differs = 0;
+  for (int i = 0; i < 20000; ++i) {
+    Poly p = i % 2 ? GridPolygon(rng, 3 + i % 5, 4 + rng() % 6) : Comb(1 + rng() % 3, 1 + rng() % 3);
+    for (Vector2d& v : p) v = v * 0x1p40 + Vector2d(nudge(rng), nudge(rng));
+    const bool truth = exact(p);
+    EXPECT_EQ(GroundPolygon(p).IsSimple(), truth) << "case " << i;
+    old_differs += testing::BruteForceIsSimple(p) != truth;
+    ++(truth ? simple : not_simple);
+  }
+  std::printf("near-degenerate polygons: %d simple, %d not; the old check was wrong on %d\n", simple, not_simple,
+              old_differs);
+  EXPECT_GT(simple, 1000);
+  EXPECT_GT(not_simple, 1000);
+}
+
+// Issue 20: a floor of 100k points took 43 s to check. A million now: a comb (half its edges
+// cross the sweep line at once), simple, and with one tooth bent onto the next, not; and a star
+// of 200,000 (its edges zigzag: thousands cross the sweep line), simple, and with two vertices
+// swapped, not.
+TEST(GroundPolygon, IsSimpleChecksAMillionVertices) {
+  const auto timed = [](const Poly& p) {
+    const auto start = std::chrono::steady_clock::now();
+    const bool simple = GroundPolygon(p).IsSimple();
+    std::printf("%zu vertices: %s in %.2f s\n", p.size(), simple ? "simple" : "not simple",
+                std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+    return simple;
+  };
+  Poly comb = Comb(250'000);
+  ASSERT_EQ(comb.size(), 1'000'000u);
+  EXPECT_TRUE(timed(comb));
+  comb[500'002].x() += 1;  // a tooth's top-right corner onto the next tooth's left side
+  EXPECT_FALSE(timed(comb));
+  std::mt19937 rng(23);
+  Poly star = Star(200'000, rng, 0.9);
+  EXPECT_TRUE(timed(star));
+  std::swap(star[10], star[100'000]);
+  EXPECT_FALSE(timed(star));
 }
 
 }  // namespace

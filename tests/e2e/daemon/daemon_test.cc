@@ -16,6 +16,7 @@
 #include <Eigen/Geometry>
 #include <arpa/inet.h>
 #include <netinet/in.h>
+#include <poll.h>
 #include <sys/socket.h>
 #include <unistd.h>
 
@@ -33,6 +34,69 @@ namespace {
 
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
+
+// A TCP connection to 127.0.0.1:port from the loopback address `from` (any of 127.0.0.0/8
+// reaches the loopback: a client at another address); -1 when it fails.
+int ConnectFrom(const std::string& from, int port) {
+  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+  if (fd < 0) return -1;
+  sockaddr_in local{};
+  local.sin_family = AF_INET;
+  ::inet_pton(AF_INET, from.c_str(), &local.sin_addr);
+  sockaddr_in server{};
+  server.sin_family = AF_INET;
+  server.sin_port = htons(static_cast<uint16_t>(port));
+  server.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  if (::bind(fd, reinterpret_cast<sockaddr*>(&local), sizeof local) != 0 ||
+      ::connect(fd, reinterpret_cast<sockaddr*>(&server), sizeof server) != 0) {
+    ::close(fd);
+    return -1;
+  }
+  return fd;
+}
+
+// What the peer sends on `fd` until it closes the connection, or until `timeout_s`.
+std::string ReadUntilClosed(int fd, double timeout_s, bool* closed = nullptr) {
+  std::string text;
+  const auto deadline = Clock::now() + std::chrono::duration<double>(timeout_s);
+  if (closed) *closed = false;
+  while (Clock::now() < deadline) {
+    pollfd p{fd, POLLIN, 0};
+    if (::poll(&p, 1, 50) <= 0) continue;
+    char buf[4096];
+    const ssize_t n = ::recv(fd, buf, sizeof buf, 0);
+    if (n <= 0) {
+      if (closed) *closed = true;
+      break;
+    }
+    text.append(buf, static_cast<size_t>(n));
+  }
+  return text;
+}
+
+// One HTTP/1.1 GET on an open keep-alive connection: the status code of its answer, whose
+// body (by its Content-Length) is read whole; -1 when the answer is not in within `timeout_s`.
+int KeepAliveGet(int fd, const std::string& path, double timeout_s) {
+  const std::string request = "GET " + path + " HTTP/1.1\r\nHost: 127.0.0.1\r\n\r\n";
+  if (::send(fd, request.data(), request.size(), MSG_NOSIGNAL) != static_cast<ssize_t>(request.size())) return -1;
+  std::string text;
+  const auto deadline = Clock::now() + std::chrono::duration<double>(timeout_s);
+  while (Clock::now() < deadline) {
+    const size_t head = text.find("\r\n\r\n");
+    if (head != std::string::npos) {
+      const size_t at = text.find("Content-Length: ");
+      if (at == std::string::npos || at > head) return -1;
+      if (text.size() >= head + 4 + std::stoul(text.substr(at + 16))) return std::stoi(text.substr(9, 3));
+    }
+    pollfd p{fd, POLLIN, 0};
+    if (::poll(&p, 1, 20) <= 0) continue;
+    char buf[4096];
+    const ssize_t n = ::recv(fd, buf, sizeof buf, 0);
+    if (n <= 0) return -1;
+    text.append(buf, static_cast<size_t>(n));
+  }
+  return -1;
+}
 
 class DaemonTest : public ::testing::Test {
  protected:
@@ -464,6 +528,26 @@ TEST_F(DaemonTest, TheControlApiRefusesBadRequestsByName) {
   ASSERT_TRUE(bad);
   EXPECT_EQ(bad->status, 400) << bad->body;
   EXPECT_FALSE(nlohmann::json::parse(bad->body, nullptr, false).is_discarded()) << bad->body;
+  // A header of more than 64 KiB (each line within cpp-httplib's 8 KiB): 431 naming the limit.
+  {
+    std::string big = "GET /api/status HTTP/1.1\r\nHost: 127.0.0.1\r\n";
+    for (int i = 0; i < 10; ++i) big += "X-Big-" + std::to_string(i) + ": " + std::string(7000, 'a') + "\r\n";
+    big += "\r\n";
+    const int fd = ConnectFrom("127.0.0.1", port_);
+    ASSERT_GE(fd, 0);
+    ASSERT_EQ(::send(fd, big.data(), big.size(), MSG_NOSIGNAL), static_cast<ssize_t>(big.size()));
+    const std::string answer = ReadUntilClosed(fd, 5);
+    ::close(fd);
+    EXPECT_EQ(answer.rfind("HTTP/1.1 431 ", 0), 0u) << answer.substr(0, 300);
+    EXPECT_NE(answer.find("header: larger than 65536 bytes"), std::string::npos) << answer.substr(0, 300);
+  }
+  // 1 MiB of nested brackets (issue 20's fuzzing: the daemon died of a stack overflow when the
+  // error quoted the value): refused by its depth, and the daemon answers on.
+  const std::string deep = R"({"name": )" + std::string(524000, '[') + std::string(524000, ']') + "}";
+  r = post("/api/session/start", deep);
+  ASSERT_TRUE(r) << "the daemon did not answer a deeply nested body";
+  EXPECT_EQ(r->status, 400) << r->body;
+  EXPECT_NE(r->body.find("body: nested deeper than 32 levels"), std::string::npos) << r->body;
   r = post("/api/session/stop", "");
   EXPECT_EQ(r->status, 409) << r->body;
   r = post("/api/session/start", R"({"name": "a"})");
@@ -483,19 +567,15 @@ TEST_F(DaemonTest, TheControlApiRefusesBadRequestsByName) {
 
 // Issue 20: 200 connections that sent a header line every 2 s made the API unreachable. Now
 // 500 slow clients (a request line, then a header line now and then, never finished) leave
-// the API answering every request.
+// the API answering every request. They come from 10 addresses, 50 each: one address may
+// hold 64 connections at most (the next test).
 TEST_F(DaemonTest, SlowClientsDoNotStarveTheApi) {
   auto daemon = Daemon(Config(ReplayCamera(true)));
   ASSERT_TRUE(WaitStatus([](const nlohmann::json& s) { return s["state"] == "running"; }, 20));
   std::vector<int> slow;
   for (int i = 0; i < 500; ++i) {
-    const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
-    ASSERT_GE(fd, 0);
-    sockaddr_in addr{};
-    addr.sin_family = AF_INET;
-    addr.sin_port = htons(static_cast<uint16_t>(port_));
-    addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    ASSERT_EQ(::connect(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr), 0) << "connection " << i;
+    const int fd = ConnectFrom("127.0.0." + std::to_string(1 + i % 10), port_);
+    ASSERT_GE(fd, 0) << "connection " << i;
     const std::string start = "GET /api/status HTTP/1.1\r\nHost: 127.0.0.1\r\n";
     ASSERT_GT(::send(fd, start.data(), start.size(), MSG_NOSIGNAL), 0);
     slow.push_back(fd);
@@ -512,6 +592,131 @@ TEST_F(DaemonTest, SlowClientsDoNotStarveTheApi) {
     std::this_thread::sleep_for(std::chrono::seconds(1));
   }
   for (const int fd : slow) ::close(fd);
+  daemon->Signal(SIGTERM);
+  EXPECT_EQ(daemon->Wait(10), 0) << daemon->output();
+}
+
+// Issue 20: one client could hold every HTTP thread. 64 connections from one address are
+// served; the next from there is answered 503 naming the limit and closed, while a client at
+// another address is served at once; once they close, the address is served again.
+TEST_F(DaemonTest, OneAddressHoldsAtMost64ConnectionsAndOthersAreStillServed) {
+  auto daemon = Daemon(Config(ReplayCamera(true)));
+  ASSERT_TRUE(WaitStatus([](const nlohmann::json& s) { return s["state"] == "running"; }, 20));
+  httplib::Client other("127.0.0.1", port_);
+  other.set_interface("127.0.0.2");  // binds the client's end to this address
+  other.set_connection_timeout(2, 0);
+  other.set_read_timeout(2, 0);
+  const auto control = [&]() -> nlohmann::json {
+    const auto r = other.Get("/api/status");
+    if (!r || r->status != 200) return {};
+    return nlohmann::json::parse(r->body, nullptr, false)["control"];
+  };
+  // 64 requests from 127.0.0.1, begun and never finished (each holds its connection for the
+  // 10 s request deadline; the test is done with them well before).
+  std::vector<int> held;
+  for (int i = 0; i < 64; ++i) {
+    const int fd = ConnectFrom("127.0.0.1", port_);
+    ASSERT_GE(fd, 0) << "connection " << i;
+    const std::string start = "GET /api/status HTTP/1.1\r\nHost: 127.0.0.1\r\n";
+    ASSERT_GT(::send(fd, start.data(), start.size(), MSG_NOSIGNAL), 0);
+    held.push_back(fd);
+  }
+  // A connection counts once a thread serves it: all 64, and the status request itself.
+  const auto until = Clock::now() + std::chrono::seconds(5);
+  nlohmann::json c;
+  while (Clock::now() < until && !((c = control()).is_object() && c["connections_open"].get<int>() >= 65)) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  ASSERT_TRUE(c.is_object());
+  ASSERT_GE(c["connections_open"].get<int>(), 65) << c.dump();
+  EXPECT_EQ(c["connections_refused"], 0) << c.dump();
+
+  const int over = ConnectFrom("127.0.0.1", port_);
+  ASSERT_GE(over, 0);
+  bool closed = false;
+  const std::string refused = ReadUntilClosed(over, 5, &closed);
+  ::close(over);
+  EXPECT_TRUE(closed);
+  EXPECT_EQ(refused.rfind("HTTP/1.1 503 ", 0), 0u) << refused;
+  EXPECT_NE(refused.find("connections: 64 are open from 127.0.0.1 already (the limit per client address)"),
+            std::string::npos) << refused;
+
+  const auto asked = Clock::now();
+  c = control();
+  EXPECT_LT(std::chrono::duration<double>(Clock::now() - asked).count(), 1.0);
+  ASSERT_TRUE(c.is_object()) << "127.0.0.2 was not served";
+  EXPECT_EQ(c["connections_refused"], 1) << c.dump();
+  const auto metrics = other.Get("/metrics");
+  ASSERT_TRUE(metrics);
+  EXPECT_NE(metrics->body.find("spritestation_http_connections_refused_total 1\n"), std::string::npos) << metrics->body;
+
+  for (const int fd : held) ::close(fd);
+  EXPECT_TRUE(WaitStatus([](const nlohmann::json& s) { return s["state"] == "running"; }, 5))
+      << "127.0.0.1 was not served again once its connections closed";
+  daemon->Signal(SIGTERM);
+  EXPECT_EQ(daemon->Wait(10), 0) << daemon->output();
+}
+
+// Issue 20: cpp-httplib restarts its read timeout with every byte, so a client sending its
+// header a byte a second kept its thread for ever. Now the whole request must be in within
+// 10 s of its first byte: the trickler gets a 408 naming the limit and is closed, while the
+// API answers within 1 s throughout, on one keep-alive connection that outlives the deadline
+// (it restarts with each request), and an event stream goes on past it.
+TEST_F(DaemonTest, AClientTricklingItsHeaderIsDroppedAtTheRequestDeadline) {
+  auto daemon = Daemon(Config(ReplayCamera(true)));
+  ASSERT_TRUE(WaitStatus([](const nlohmann::json& s) { return s["state"] == "running"; }, 20));
+  std::atomic<bool> stop_events{false};
+  std::atomic<double> last_event_s{0};
+  const auto t0 = Clock::now();
+  const auto since_t0 = [&] { return std::chrono::duration<double>(Clock::now() - t0).count(); };
+  std::thread events([&] {
+    httplib::Client reader("127.0.0.1", port_);
+    reader.set_interface("127.0.0.3");
+    reader.set_read_timeout(5, 0);
+    reader.Get("/api/events", [&](const char*, size_t) {
+      last_event_s = since_t0();
+      return !stop_events;
+    });
+  });
+
+  const int slow = ConnectFrom("127.0.0.1", port_);
+  ASSERT_GE(slow, 0);
+  const std::string line = "GET /api/status HTTP/1.1\r\nHost: 127.0.0.1\r\nX-Slow: ";
+  const auto first_byte = Clock::now();
+  ASSERT_EQ(::send(slow, line.data(), line.size(), MSG_NOSIGNAL), static_cast<ssize_t>(line.size()));
+  const int keep_alive = ConnectFrom("127.0.0.2", port_);
+  ASSERT_GE(keep_alive, 0);
+
+  std::string answer;
+  double dropped_s = -1;
+  int requests = 0;
+  while (dropped_s < 0 && std::chrono::duration<double>(Clock::now() - first_byte).count() < 15) {
+    ::send(slow, "a", 1, MSG_NOSIGNAL);  // one more header byte a second
+    const auto asked = Clock::now();
+    const int status = KeepAliveGet(keep_alive, "/api/status", 1.0);
+    ASSERT_EQ(status, 200) << "request " << requests << " on the keep-alive connection: no answer within 1 s";
+    ASSERT_LT(std::chrono::duration<double>(Clock::now() - asked).count(), 1.0);
+    ++requests;
+    bool closed = false;
+    answer += ReadUntilClosed(slow, std::max(0.0, 1.0 - std::chrono::duration<double>(Clock::now() - asked).count()),
+                              &closed);
+    if (closed) dropped_s = std::chrono::duration<double>(Clock::now() - first_byte).count();
+  }
+  ::close(slow);
+  ::close(keep_alive);
+  std::printf("trickler dropped after %.2f s; %d requests on one keep-alive connection meanwhile\n", dropped_s, requests);
+  EXPECT_GE(dropped_s, 9.9);
+  EXPECT_LT(dropped_s, 12.0);
+  EXPECT_GE(requests, 10);
+  EXPECT_EQ(answer.rfind("HTTP/1.1 408 ", 0), 0u) << answer;
+  EXPECT_NE(answer.find("request: not received whole within 10 s of its first byte"), std::string::npos) << answer;
+  EXPECT_EQ(Status()["control"]["requests_timed_out"], 1) << Status()["control"].dump();
+  // The event stream, opened before the trickler's first byte, streams on 11 s later.
+  const auto until = Clock::now() + std::chrono::seconds(3);
+  while (last_event_s < 11.0 && Clock::now() < until) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  EXPECT_GE(last_event_s.load(), 11.0);
+  stop_events = true;
+  events.join();
   daemon->Signal(SIGTERM);
   EXPECT_EQ(daemon->Wait(10), 0) << daemon->output();
 }

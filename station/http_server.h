@@ -1,0 +1,70 @@
+#pragma once
+// The station's HTTP server: cpp-httplib's, with two limits its 0.11 (Debian 12's) lacks
+// (docs/daemon.md, "Limits of the HTTP server"):
+//  - connections per client address: a connection beyond `max_connections_per_client` open
+//    from the same address is answered 503 and closed at once, so that one client cannot hold
+//    every HTTP thread;
+//  - a deadline for each request: its request line, header and body must have arrived within
+//    `request_deadline` of its first byte, else the connection is closed (with a 408 when the
+//    request line was in). cpp-httplib restarts its read timeout with every byte, so without
+//    it a client that trickles its header a byte at a time held a thread for ever. Once the
+//    request is in, the deadline no longer applies: an event stream or a download takes as long
+//    as it needs (the write timeout still drops a reader that stalls). Between requests of a
+//    keep-alive connection the keep-alive timeout applies, as before;
+//  - the request line and header together at most `max_header_bytes` (cpp-httplib limits each
+//    line, not their number), else 431 and the connection is closed.
+// It replaces the server's connection loop (Server::process_and_close_socket, the one virtual
+// step between accept and the request; the base's is private, so it cannot be wrapped): its
+// own keep-alive loop over its own Stream, which reads under the deadline, and cpp-httplib's
+// process_request for everything else. Timeouts and keep-alive come from the usual setters.
+//
+// Include after any Eigen header (<resolv.h>, through httplib, defines `_res`).
+#include <atomic>
+#include <chrono>
+#include <cstddef>
+#include <cstdint>
+#include <mutex>
+#include <string>
+#include <unordered_map>
+
+#include <httplib.h>
+
+namespace ss {
+
+struct HttpLimits {
+  int max_connections_per_client = 64;                  // open at once from one address
+  std::chrono::milliseconds request_deadline{10'000};  // first byte of a request -> all of it read
+  size_t max_header_bytes = 64 << 10;                   // request line and header together
+};
+
+struct HttpCounters {
+  uint64_t connections_open = 0;     // served now (a connection waiting for a thread is not)
+  uint64_t connections_refused = 0;  // over the per-client limit, since start
+  uint64_t requests_timed_out = 0;   // not in whole by the deadline, since start
+};
+
+class HttpServer : public httplib::Server {
+ public:
+  explicit HttpServer(HttpLimits limits = {});
+
+  const HttpLimits& limits() const { return limits_; }
+  HttpCounters counters() const;
+
+  // Why the request served on the calling thread could not be read whole, for the error
+  // handler to name the limit (cpp-httplib answers any header cut short with a bare 400).
+  enum class RequestFault { kNone, kTimedOut, kHeaderTooLarge };
+  static RequestFault CurrentFault();
+
+ private:
+  bool process_and_close_socket(socket_t sock) override;
+  // Counts a connection from `address` in; false (and counted as refused) over the limit.
+  bool Admit(const std::string& address);
+  void Release(const std::string& address);
+
+  HttpLimits limits_;
+  std::mutex mutex_;
+  std::unordered_map<std::string, int> open_by_address_;  // guarded by mutex_
+  std::atomic<uint64_t> open_{0}, refused_{0}, timed_out_{0};
+};
+
+}  // namespace ss
