@@ -509,6 +509,33 @@ AppendResult BankWriter::AppendClipBatch(const ClipRecord& clip, const std::vect
   return result;
 }
 
+namespace {
+
+// Binds one sprite's columns (kSpriteFields' order) from `first`; returns the next index.
+int BindSprite(sql::Stmt& q, int first, int64_t clip_id, const ClipRecord& clip, const SpriteRecord& s,
+               int64_t mirror_of) {
+  const double reals[] = {s.ground_x_m, s.ground_y_m, s.velocity_x_m_s, s.velocity_y_m_s, s.mean_r,
+                          s.mean_g,     s.mean_b,     s.area_px,        s.eccentricity};
+  const int64_t box[] = {s.bbox_in_image.x, s.bbox_in_image.y, s.bbox_in_image.width, s.bbox_in_image.height,
+                         s.billboard_width_px, s.billboard_height_px};
+  int i = first;
+  for (int64_t v : {clip_id, clip.camera_id, clip.track_id, s.frame, s.timestamp_ns, int64_t{s.mirrored}}) {
+    q.Bind(i++, v);
+  }
+  if (s.mirrored) {
+    q.Bind(i++, mirror_of);
+  } else {
+    q.BindNull(i++);
+  }
+  for (double v : reals) q.Bind(i++, v);
+  for (int64_t v : box) q.Bind(i++, v);
+  for (double v : {s.px_per_m, s.anchor_x_px, s.anchor_y_px}) q.Bind(i++, v);
+  return i;
+}
+
+
+}  // namespace
+
 void BankWriter::AppendSpritesOneByOne(const ClipRecord& clip, int64_t clip_id, const std::vector<SpriteRecord>& sprites,
                                        const std::string& where, AppendResult* out) {
   Impl& w = *impl_;
@@ -537,19 +564,7 @@ void BankWriter::AppendSpritesOneByOne(const ClipRecord& clip, int64_t clip_id, 
       }
       sql::Stmt& q = w.insert_sprite;
       q.Reset();
-      q.Bind(1, result.clip_id).Bind(2, clip.camera_id).Bind(3, clip.track_id).Bind(4, s.frame);
-      q.Bind(5, s.timestamp_ns).Bind(6, int64_t{s.mirrored});
-      if (s.mirrored) {
-        q.Bind(7, mirror_of);
-      } else {
-        q.BindNull(7);
-      }
-      q.Bind(8, s.ground_x_m).Bind(9, s.ground_y_m).Bind(10, s.velocity_x_m_s).Bind(11, s.velocity_y_m_s);
-      q.Bind(12, s.mean_r).Bind(13, s.mean_g).Bind(14, s.mean_b).Bind(15, s.area_px).Bind(16, s.eccentricity);
-      q.Bind(17, int64_t{s.bbox_in_image.x}).Bind(18, int64_t{s.bbox_in_image.y});
-      q.Bind(19, int64_t{s.bbox_in_image.width}).Bind(20, int64_t{s.bbox_in_image.height});
-      q.Bind(21, int64_t{s.billboard_width_px}).Bind(22, int64_t{s.billboard_height_px}).Bind(23, s.px_per_m);
-      q.Bind(24, s.anchor_x_px).Bind(25, s.anchor_y_px);
+      BindSprite(q, 1, result.clip_id, clip, s, mirror_of);
       int64_t id = 0;
       if (q.Step()) {  // inserted: RETURNING gave its id (a sprite already stored returns no row)
         id = q.Int(0);
@@ -578,40 +593,6 @@ void BankWriter::AppendSpritesOneByOne(const ClipRecord& clip, int64_t clip_id, 
   }
 }
 
-namespace {
-
-// Binds one sprite's columns (kSpriteFields' order) from `first`; returns the next index.
-int BindSprite(sql::Stmt& q, int first, int64_t clip_id, const ClipRecord& clip, const SpriteRecord& s,
-               int64_t mirror_of) {
-  const double reals[] = {s.ground_x_m, s.ground_y_m, s.velocity_x_m_s, s.velocity_y_m_s, s.mean_r,
-                          s.mean_g,     s.mean_b,     s.area_px,        s.eccentricity};
-  const int64_t box[] = {s.bbox_in_image.x, s.bbox_in_image.y, s.bbox_in_image.width, s.bbox_in_image.height,
-                         s.billboard_width_px, s.billboard_height_px};
-  int i = first;
-  for (int64_t v : {clip_id, clip.camera_id, clip.track_id, s.frame, s.timestamp_ns, int64_t{s.mirrored}}) {
-    q.Bind(i++, v);
-  }
-  if (s.mirrored) {
-    q.Bind(i++, mirror_of);
-  } else {
-    q.BindNull(i++);
-  }
-  for (double v : reals) q.Bind(i++, v);
-  for (int64_t v : box) q.Bind(i++, v);
-  for (double v : {s.px_per_m, s.anchor_x_px, s.anchor_y_px}) q.Bind(i++, v);
-  return i;
-}
-
-std::string Rows(int rows, int columns) {
-  std::string row = "(";
-  for (int c = 0; c < columns; ++c) row += c ? ", ?" : "?";
-  row += ")";
-  std::string out;
-  for (int r = 0; r < rows; ++r) out += (r ? ", " : "") + row;
-  return out;
-}
-
-}  // namespace
 
 // A server a network hop away answers each statement in a round trip: the batch's sprites go
 // in a few statements of many rows each (originals, their pixels, mirrors), not one per sprite.
@@ -649,7 +630,7 @@ void BankWriter::AppendSpritesManyRows(const ClipRecord& clip, int64_t clip_id,
     for (size_t at = 0; at < fresh.size(); at += kRowsPerStatement) {
       const size_t n = std::min<size_t>(kRowsPerStatement, fresh.size() - at);
       auto q = db().Prepare(std::string("INSERT INTO sprites (") + kSpriteFields + ") VALUES " +
-                            Rows(static_cast<int>(n), kColumns) +
+                            sql::RowPlaceholders(static_cast<int>(n), kColumns) +
                             " ON CONFLICT (camera_id, frame, track_id, mirrored) DO NOTHING RETURNING id, frame");
       int index = 1;
       for (size_t k = 0; k < n; ++k) {
@@ -662,7 +643,7 @@ void BankWriter::AppendSpritesManyRows(const ClipRecord& clip, int64_t clip_id,
       for (const auto& [frame, id] : inserted) ids[{frame, mirrors}] = id;
       if (!mirrors && !inserted.empty()) {
         auto p = db().Prepare("INSERT INTO sprite_pixels (sprite_id, width_px, height_px, codec, data) VALUES " +
-                              Rows(static_cast<int>(inserted.size()), 5) +
+                              sql::RowPlaceholders(static_cast<int>(inserted.size()), 5) +
                               " ON CONFLICT (sprite_id) DO UPDATE SET width_px = excluded.width_px, "
                               "height_px = excluded.height_px, codec = excluded.codec, data = excluded.data");
         std::map<int64_t, const SpriteRecord*> by_frame;

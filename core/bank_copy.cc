@@ -121,10 +121,6 @@ class BatchInsert {
   BatchInsert(sql::Db& db, const Table& t) : db_(db), table_(t), width_(static_cast<int>(std::strlen(t.kinds))) {
     // SQLite takes at most 32766 parameters a statement, PostgreSQL 65535.
     per_statement_ = std::max(1, std::min(500, 30000 / width_));
-    std::string row = "(";
-    for (int c = 0; c < width_; ++c) row += c ? ", ?" : "?";
-    row += ")";
-    row_ = row;
   }
   void Add(std::vector<Value> row) {
     rows_.push_back(std::move(row));
@@ -132,8 +128,8 @@ class BatchInsert {
   }
   void Flush() {
     if (rows_.empty()) return;
-    std::string sql = std::string("INSERT INTO ") + table_.name + " (" + table_.columns + ") VALUES ";
-    for (size_t r = 0; r < rows_.size(); ++r) sql += (r ? ", " : "") + row_;
+    std::string sql = std::string("INSERT INTO ") + table_.name + " (" + table_.columns + ") VALUES " +
+                      sql::RowPlaceholders(static_cast<int>(rows_.size()), width_);
     if (std::strcmp(table_.name, "meta") == 0) sql += " ON CONFLICT (key) DO UPDATE SET value = excluded.value";
     auto q = db_.Prepare(sql);
     int index = 1;
@@ -163,7 +159,6 @@ class BatchInsert {
   const Table& table_;
   int width_;
   int per_statement_ = 1;
-  std::string row_;
   std::vector<std::vector<Value>> rows_;
 };
 

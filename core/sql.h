@@ -147,4 +147,14 @@ class ReadSnapshot {
   Db& db_;
 };
 
+// "(?, ?, ?), (?, ?, ?)": the VALUES of a statement inserting `rows` rows of `columns` values.
+inline std::string RowPlaceholders(int rows, int columns) {
+  std::string row = "(";
+  for (int c = 0; c < columns; ++c) row += c ? ", ?" : "?";
+  row += ")";
+  std::string out;
+  for (int r = 0; r < rows; ++r) out += (r ? ", " : "") + row;
+  return out;
+}
+
 }  // namespace ss::sql
