@@ -38,6 +38,10 @@ class FrameSource {
   // Makes a blocked or future Next() return std::nullopt; callable from any thread.
   virtual void Stop() = 0;
   virtual SourceStats stats() const = 0;
+  // True for a source that loses nothing by waiting for its reader (a recording read as fast
+  // as it runs): the station then holds it back instead of dropping frames, and learns the
+  // enclosure before reading on, so it stores what `ingest` stores. Cameras never wait.
+  virtual bool WaitsForReader() const { return false; }
 };
 
 }  // namespace ss

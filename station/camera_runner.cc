@@ -223,6 +223,7 @@ struct CameraRunner::Impl {
           }
           opened_once = true;
           stalled = false;
+          source_waits = opened->WaitsForReader();
           backoff = options.backoff_min_s;
           SetStateAfterOpen();
           continue;
@@ -264,7 +265,9 @@ struct CameraRunner::Impl {
         while (!recent_frames.empty() && Seconds(now - recent_frames.front()) > 2.0) recent_frames.pop_front();
       }
       frame->camera = index;
-      if (queue->TryPush(Captured{std::move(*frame), now, pending_drops})) {
+      // A recording read as fast as it runs waits for the pipeline; a camera never does.
+      Captured item{std::move(*frame), now, pending_drops};
+      if (source_waits ? queue->Push(std::move(item)) : queue->TryPush(std::move(item))) {
         pending_drops = 0;
       } else {
         ++pending_drops;
@@ -433,6 +436,12 @@ struct CameraRunner::Impl {
               });
               training_set.clear();
               training_collected = 0;
+              // A source that waits for us (a recording) is held back while the keyer learns, so
+              // no frame goes by unkeyed: the frames after the set are keyed, as ingest keys them.
+              if (source_waits) {
+                training.wait();
+                PollTraining(training, pipeline_failed);
+              }
             }
           } else if (preview) {
             ToBgr(frame, bgr);
@@ -483,6 +492,7 @@ struct CameraRunner::Impl {
   }
 
   std::atomic<bool> capture_done{false};
+  std::atomic<bool> source_waits{false};  // the open source's WaitsForReader()
   bool pipeline_done = false;  // under target_mutex
 };
 

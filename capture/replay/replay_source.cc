@@ -362,6 +362,8 @@ void ReplaySource::Stop() {
   impl_->changed.notify_all();
 }
 
+bool ReplaySource::WaitsForReader() const { return !impl_->options.realtime; }
+
 SourceStats ReplaySource::stats() const {
   std::lock_guard<std::mutex> lock(impl_->mutex);
   SourceStats out = impl_->totals;

@@ -58,6 +58,7 @@ class ReplaySource : public FrameSource {
   std::optional<Frame> Next() override;
   void Stop() override;
   SourceStats stats() const override;
+  bool WaitsForReader() const override;
 
   const SessionInfo& session() const;
   std::vector<ReplayCameraStats> camera_stats() const;
