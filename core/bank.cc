@@ -726,6 +726,16 @@ void BankWriter::SetMeta(const std::string& key, const std::string& value) {
   q.Bind(1, key).Bind(2, value).Step();
 }
 
+std::string BankWriter::KeepMeta(const std::string& key, const std::string& value) {
+  if (key == "schema_version" || key == "application") throw WorkError(path(), "meta key '" + key + "' is reserved");
+  // One statement each: on PostgreSQL two writers inserting at once are ordered by the key's
+  // unique index (the second does nothing), and both then read the first one's value.
+  db().Prepare("INSERT INTO meta (key, value) VALUES (?, ?) ON CONFLICT (key) DO NOTHING").Bind(1, key).Bind(2, value).Step();
+  const std::optional<std::string> kept = GetMeta(key);
+  if (!kept) throw WorkError(path(), "meta key '" + key + "' vanished after it was set");
+  return *kept;
+}
+
 void BankWriter::SetTransitionLabel(const TransitionLabelRecord& label) {
   if (label.label != "yes" && label.label != "no" && label.label != "skip") {
     throw InputError("label", "expected yes, no or skip, got \"" + label.label + "\"");

@@ -132,6 +132,9 @@ class BankWriter : public Bank {
   void Tag(const std::vector<int64_t>& sprite_ids, const std::string& tag);
   void Untag(const std::vector<int64_t>& sprite_ids, const std::string& tag);
   void SetMeta(const std::string& key, const std::string& value);
+  // Sets `key` only if the bank has no value for it, and returns the value the bank keeps:
+  // `value`, or the one an earlier (or concurrent) writer set first.
+  std::string KeepMeta(const std::string& key, const std::string& value);
   // Stores (or replaces) the label of from_sprite -> to_sprite. InputError naming the bank and
   // the sprite for an unknown sprite id, InputError("label", ...) for a label other than
   // yes / no / skip or a sprite paired with itself.

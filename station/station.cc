@@ -505,7 +505,6 @@ void Station::Start() {
   // The bank's one billboard scale, shared by every camera (pipeline/run/bank_scale.h).
   BankScaleInputs scale_inputs;
   scale_inputs.configured = config.pipeline.px_per_m;
-  scale_inputs.bank_scales = s.bank->BillboardScales();
   scale_inputs.bank_path = config.storage.bank;
   for (const std::optional<CameraModel>& m : s.models) {
     if (m) scale_inputs.models.push_back(&*m);
@@ -514,7 +513,7 @@ void Station::Start() {
   scale_inputs.max_side_px = pipeline.rectify.max_side_px;
   scale_inputs.margin_m = pipeline.rectify.margin_m;
   if (!scale_inputs.models.empty()) {
-    const BankScale scale = ChooseBankScale(scale_inputs);
+    const BankScale scale = ChooseAndKeepBankScale(*s.bank, scale_inputs);
     pipeline.rectify.px_per_m = scale.px_per_m;
     s.log->info("billboard scale {} px/m: {}", scale.px_per_m, scale.why);
   }

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
+#include <optional>
 
 #include <spdlog/fmt/fmt.h>
 
@@ -118,6 +120,44 @@ BankScale ChooseBankScale(const BankScaleInputs& in) {
       "floor is {:.2f} m, which fits {} px up to {:.0f} px/m; {} px/m (two digits, rounded down)",
       finest, tallest, in.max_side_px, fit, Num(chosen));
   return {chosen, why};
+}
+
+namespace {
+
+double RecordedScale(const Bank& bank, const std::string& text) {
+  char* end = nullptr;
+  const double v = std::strtod(text.c_str(), &end);
+  if (end == text.c_str() || *end != '\0' || !(v > 0) || !std::isfinite(v)) {
+    throw WorkError(bank.path(), std::string("meta '") + kBankScaleMetaKey + "' is \"" + text +
+                                     "\", not a scale in px/m (the bank is damaged)");
+  }
+  return v;
+}
+
+}  // namespace
+
+BankScale ChooseAndKeepBankScale(BankWriter& bank, BankScaleInputs in) {
+  in.bank_scales = bank.BillboardScales();
+  if (const std::optional<std::string> text = bank.GetMeta(kBankScaleMetaKey)) {
+    const double recorded = RecordedScale(bank, *text);
+    if (in.bank_scales.empty() && in.configured > 0 && recorded != in.configured) {
+      // No sprite is stored yet (a station ran without a session): a configured number decides.
+      bank.SetMeta(kBankScaleMetaKey, fmt::format("{:.17g}", in.configured));
+    } else {
+      in.bank_scales.push_back(recorded);
+      std::sort(in.bank_scales.begin(), in.bank_scales.end());
+      in.bank_scales.erase(std::unique(in.bank_scales.begin(), in.bank_scales.end()), in.bank_scales.end());
+    }
+  }
+  BankScale chosen = ChooseBankScale(in);
+  const double kept = RecordedScale(bank, bank.KeepMeta(kBankScaleMetaKey, fmt::format("{:.17g}", chosen.px_per_m)));
+  if (kept != chosen.px_per_m) {
+    // Another writer chose first, between our read and our write: its scale is the bank's.
+    in.bank_scales = {kept};
+    chosen = ChooseBankScale(in);
+    chosen.why += " (recorded by another writer that started at the same time)";
+  }
+  return chosen;
 }
 
 }  // namespace ss

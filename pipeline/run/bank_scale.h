@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "core/bank.h"
 #include "core/camera_model.h"
 #include "core/geometry.h"
 
@@ -38,5 +39,14 @@ struct BankScaleInputs {
 // InputError naming both scales when a configured number differs from the scale the bank
 // already holds (one bank keeps one scale), and naming the bank when it already mixes scales.
 BankScale ChooseBankScale(const BankScaleInputs& in);
+
+// Where a bank records its scale (`meta`), so that writers starting together on an empty
+// bank (stations and ingests on one PostgreSQL bank) agree before any sprite is stored.
+inline constexpr const char* kBankScaleMetaKey = "billboard.px_per_m";
+
+// ChooseBankScale with the bank's scales read from `bank` (its sprites' and its recorded one;
+// `in.bank_scales` is ignored), then recorded there unless another writer recorded one first,
+// in which case that one is used (or the configured number that differs is refused).
+BankScale ChooseAndKeepBankScale(BankWriter& bank, BankScaleInputs in);
 
 }  // namespace ss

@@ -129,13 +129,12 @@ IngestSummary IngestSession(const IngestOptions& options) {
   // The bank's one billboard scale: its own when it holds sprites, else the config's or auto.
   BankScaleInputs scale_inputs;
   scale_inputs.configured = config.pipeline.px_per_m;
-  scale_inputs.bank_scales = bank.BillboardScales();
   scale_inputs.bank_path = options.bank_path;
   for (const CameraModel& m : models) scale_inputs.models.push_back(&m);
   scale_inputs.floor = floor;
   scale_inputs.max_side_px = pipeline_options.rectify.max_side_px;
   scale_inputs.margin_m = pipeline_options.rectify.margin_m;
-  const BankScale scale = ChooseBankScale(scale_inputs);
+  const BankScale scale = ChooseAndKeepBankScale(bank, scale_inputs);
   pipeline_options.rectify.px_per_m = scale.px_per_m;
   summary.px_per_m = scale.px_per_m;
   summary.px_per_m_why = scale.why;
