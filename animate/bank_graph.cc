@@ -25,6 +25,8 @@ BankGraph LoadBankGraph(const std::vector<std::string>& bank_paths,
   int clip = 0;
   for (size_t b = 0; b < bank_paths.size(); ++b) {
     const Bank bank(bank_paths[b]);
+    // One snapshot for the sprites, tags and transitions of a bank that may still be written.
+    const BankSnapshot snapshot(bank);
     const std::vector<SpriteFeatures> features = bank.LoadFeatures();
     if (features.empty()) throw InputError(bank_paths[b], "the bank holds no sprites in complete clips");
     // The source frame interval: the median timestamp step between clip neighbours.

@@ -325,6 +325,10 @@ std::vector<double> Bank::BillboardScales() const {
   return out;
 }
 
+BankSnapshot::BankSnapshot(const Bank& bank) : snapshot_(std::make_unique<sql::ReadSnapshot>(*bank.db_)) {}
+
+BankSnapshot::~BankSnapshot() = default;
+
 BankCounts Bank::Counts() const {
   // One read transaction so that the figures agree with each other.
   BankCounts c;

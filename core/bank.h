@@ -18,6 +18,7 @@ namespace ss {
 
 namespace sql {
 class Db;
+class ReadSnapshot;
 }
 
 // Figures for `bank info`.
@@ -95,6 +96,21 @@ class Bank {
   std::string path_;
   std::unique_ptr<sql::Db> db_;
   mutable std::unique_ptr<ReadCache> cache_;
+  friend class BankSnapshot;
+};
+
+// While it lives, every read through `bank` sees one committed state of the bank, however much
+// other writers commit meanwhile (a read transaction: SQLite's WAL snapshot, PostgreSQL's
+// REPEATABLE READ). The offline optimizer reads its whole graph inside one.
+class BankSnapshot {
+ public:
+  explicit BankSnapshot(const Bank& bank);
+  ~BankSnapshot();
+  BankSnapshot(const BankSnapshot&) = delete;
+  BankSnapshot& operator=(const BankSnapshot&) = delete;
+
+ private:
+  std::unique_ptr<sql::ReadSnapshot> snapshot_;
 };
 
 // What one appended batch did.

@@ -111,9 +111,12 @@ class Db {
     return stmt.Step() ? stmt.Int(0) : 0;
   }
   DbImpl& impl() const { return *impl_; }
+  // Read snapshots open on this connection (ReadSnapshot nests: the outermost one decides).
+  int& read_depth() { return read_depth_; }
 
  private:
   std::unique_ptr<DbImpl> impl_;
+  int read_depth_ = 0;
 };
 
 // A write transaction from construction; rolled back on destruction unless Commit() was called.
@@ -136,10 +139,17 @@ class Transaction {
 };
 
 // A read transaction (one snapshot of a bank that others go on writing); ended on destruction.
+// One made while another is open on the same connection joins it: every read in between sees
+// the outer snapshot (a caller can hold one across many Bank calls that each take their own).
 class ReadSnapshot {
  public:
-  explicit ReadSnapshot(Db& db) : db_(db) { db_.impl().BeginRead(); }
-  ~ReadSnapshot() { db_.impl().Rollback(); }
+  explicit ReadSnapshot(Db& db) : db_(db) {
+    if (db_.read_depth() == 0) db_.impl().BeginRead();
+    ++db_.read_depth();
+  }
+  ~ReadSnapshot() {
+    if (--db_.read_depth() == 0) db_.impl().Rollback();
+  }
   ReadSnapshot(const ReadSnapshot&) = delete;
   ReadSnapshot& operator=(const ReadSnapshot&) = delete;
 

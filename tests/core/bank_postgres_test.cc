@@ -265,5 +265,45 @@ TEST(BankPostgres, CopyToPostgresAndBackGivesTheSameBank) {
   EXPECT_NE(DigestBank(pg).digest, DigestBank(original).digest);
 }
 
+// The offline optimizer's reads (BankSnapshot) and the bank's one scale (KeepMeta) on both
+// backends while another writer goes on.
+void SnapshotAndKeptMeta(const std::string& path) {
+  BankWriter w(path);
+  const Fixture fx = Register(w);
+  w.AppendClipBatch(Clip(fx.camera, 1, 0, true), MakeBatch(0, 4, 1));
+  w.UpsertTransitions({{w.LoadFeatures()[0].id, w.LoadFeatures()[1].id, 0.5, 0.25}});
+  const Bank reader(path);
+  {
+    const BankSnapshot snapshot(reader);
+    const size_t features = reader.LoadFeatures().size();
+    // Another writer completes a clip and adds a transition: the snapshot does not see them,
+    // also through calls that take a snapshot of their own (Counts).
+    w.AppendClipBatch(Clip(fx.camera, 2, 0, true), MakeBatch(0, 4, 2));
+    const auto f = w.LoadFeatures();
+    w.UpsertTransitions({{f[2].id, f[7].id, 0.75, 0.5}});
+    EXPECT_EQ(reader.LoadFeatures().size(), features);
+    EXPECT_EQ(reader.LoadTransitions().size(), 1u);
+    EXPECT_EQ(reader.Counts().clips_complete, 1);
+    EXPECT_EQ(reader.ListClips().size(), 1u);
+  }
+  EXPECT_EQ(reader.LoadTransitions().size(), 2u);
+  EXPECT_EQ(reader.Counts().clips_complete, 2);
+
+  // The first value kept wins; later writers read it back.
+  EXPECT_EQ(w.KeepMeta("billboard.px_per_m", "150"), "150");
+  BankWriter other(path);
+  EXPECT_EQ(other.KeepMeta("billboard.px_per_m", "800"), "150");
+  EXPECT_EQ(reader.GetMeta("billboard.px_per_m"), "150");
+  EXPECT_THROW(other.KeepMeta("schema_version", "9"), WorkError);
+}
+
+TEST(BankPostgres, ASnapshotSeesOneStateWhileAnotherWriterGoesOn) {
+  PostgresServer server;
+  ASSERT_TRUE(server.ok());
+  SnapshotAndKeptMeta(server.CreateDatabase("snapshot"));
+  ScratchDir dir;
+  SnapshotAndKeptMeta(dir / "snapshot.db");  // and the same on SQLite
+}
+
 }  // namespace
 }  // namespace ss
