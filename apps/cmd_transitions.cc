@@ -2,6 +2,7 @@
 //                label --from-truth SESSION --bank BANK --out LABELS | worker --bank postgresql://...
 // The transition table of a sprite bank (seed 000 §3; docs/transitions.md).
 #include <chrono>
+#include <csignal>
 #include <cstdio>
 #include <memory>
 #include <mutex>
@@ -136,8 +137,13 @@ void Label(const Args& a) {
   }
 }
 
+volatile std::sig_atomic_t g_worker_stop = 0;
+
 // One of any number of workers sharing a PostgreSQL bank's transition work (docs/scaling.md).
+// SIGTERM or SIGINT: the unit in progress is finished and stored, then the summary, exit 0.
 void Worker(const Args& a) {
+  std::signal(SIGTERM, [](int) { g_worker_stop = 1; });
+  std::signal(SIGINT, [](int) { g_worker_stop = 1; });
   UnitWorkerOptions options;
   options.weights = WeightsOf(a);
   options.name = a.name;
@@ -145,7 +151,7 @@ void Worker(const Args& a) {
   options.load_threads = a.threads;
   UnitWorker worker(a.bank, options);
   const auto t0 = std::chrono::steady_clock::now();
-  while (true) {
+  while (!g_worker_stop) {
     if (worker.RunOne()) continue;
     if (a.exit_when_idle) {
       const WorkCounts c = worker.Counts();

@@ -30,7 +30,7 @@ std::string DefaultName() {
 }  // namespace
 
 UnitWorker::UnitWorker(const std::string& bank, UnitWorkerOptions options)
-    : options_(std::move(options)), reader_(bank), writer_(bank), queue_(bank) {
+    : options_(std::move(options)), queue_(bank), writer_(bank), reader_(bank) {
   if (options_.name.empty()) options_.name = DefaultName();
   const TransitionClassifier check(options_.weights);  // InputError for invalid weights
   const std::string fingerprint = WeightsFingerprint(options_.weights);

@@ -51,9 +51,9 @@ class UnitWorker {
   void CatchUp();
 
   UnitWorkerOptions options_;
+  BankWorkQueue queue_;  // first: refuses a bank that is not PostgreSQL before anything opens it
+  BankWriter writer_;    // then: a worker started before any station makes the (empty) bank
   Bank reader_;
-  BankWriter writer_;
-  BankWorkQueue queue_;
   SegmentKeys keys_;
   std::unique_ptr<TransitionBuilder> builder_;
   std::map<int64_t, std::pair<int32_t, int32_t>> clip_range_;  // bank clip -> store [first, end)

@@ -8,9 +8,11 @@
 #include "core/bank.h"
 #include "core/error.h"
 #include "core/log.h"
+#include "core/sql_postgres.h"
 #include "pipeline/transitions/bank_sprites.h"
 #include "pipeline/transitions/bank_transitions.h"
 #include "pipeline/transitions/builder.h"
+#include "pipeline/transitions/unit_worker.h"
 
 namespace ss {
 namespace {
@@ -81,15 +83,18 @@ TransitionWorkerStats TransitionWorker::stats() const {
   return stats_;
 }
 
+void TransitionWorker::Fail(const std::string& what) {
+  Log("pipeline.transitions")->error("transition worker: {}", what);
+  std::lock_guard<std::mutex> lock(mutex_);
+  ++stats_.failed_rounds;
+  stats_.last_error = what;
+}
+
 void TransitionWorker::Run() {
+  if (sql::IsPostgresAddress(bank_path_)) return RunUnits();
   auto log = Log("pipeline.transitions");
   State& s = *state_;
-  auto fail = [&](const std::string& what) {
-    log->error("transition worker: {}", what);
-    std::lock_guard<std::mutex> lock(mutex_);
-    ++stats_.failed_rounds;
-    stats_.last_error = what;
-  };
+  auto fail = [&](const std::string& what) { Fail(what); };
   // Start-up: the connections, then the table of the complete clips.
   int64_t stored = 0, known = 0;
   try {
@@ -186,6 +191,68 @@ void TransitionWorker::Run() {
       busy_ = false;
     }
     idle_.notify_all();
+  }
+}
+
+// A PostgreSQL bank may have other writers (stations, ingests) and other workers at once: an
+// incremental table kept by each would race (a start-up rebuild replaces rows another writer's
+// sprites need). So this process does its share as units, claimed from the bank's work table
+// like `spritestation transitions worker` does (unit_worker.h): together they make exactly the
+// table a single build makes. Submit only wakes the loop; idle means no unit was free.
+void TransitionWorker::RunUnits() {
+  std::unique_ptr<UnitWorker> units;
+  try {
+    units = std::make_unique<UnitWorker>(
+        bank_path_, UnitWorkerOptions{.weights = state_->weights, .load_threads = state_->startup_threads});
+  } catch (const std::exception& e) {
+    Fail(std::string("start-up: ") + e.what());
+  }
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    stats_.ready = true;
+    busy_ = units != nullptr;
+  }
+  idle_.notify_all();
+  if (!units) {
+    // Nothing can be done: drop what is submitted, as the incremental worker does.
+    std::unique_lock<std::mutex> lock(mutex_);
+    while (!stop_) {
+      queue_.clear();
+      stats_.queued = 0;
+      idle_.notify_all();
+      wake_.wait(lock, [&] { return stop_ || !queue_.empty(); });
+    }
+    return;
+  }
+  while (true) {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (stop_) break;
+      queue_.clear();  // their clips are units once complete (RunOne registers them)
+      stats_.queued = 0;
+      busy_ = true;
+    }
+    const auto t0 = std::chrono::steady_clock::now();
+    bool did = false;
+    try {
+      did = units->RunOne();
+    } catch (const std::exception& e) {
+      Fail(e.what());
+    }
+    const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    std::unique_lock<std::mutex> lock(mutex_);
+    const UnitWorkerStats& u = units->stats();
+    stats_.rounds = u.units;
+    stats_.sprites = u.sprites_indexed;
+    stats_.transitions_stored = u.transitions;
+    if (did) {
+      stats_.last_round_ms = ms;
+      continue;
+    }
+    busy_ = !queue_.empty();
+    if (!busy_) idle_.notify_all();
+    // New clips of other writers are found by polling, as `transitions worker` does.
+    wake_.wait_for(lock, std::chrono::milliseconds(200), [&] { return stop_ || !queue_.empty(); });
   }
 }
 

@@ -11,6 +11,8 @@
 // to date (UpdateBankTransitions' rules). Sprites of clips that were incomplete at start
 // and are never submitted are not seen (run `spritestation transitions BANK` later).
 // Errors never stop the thread: a round that fails is counted, logged and skipped.
+// On a PostgreSQL bank (other writers, other workers) the thread does units of the bank's
+// shared work table instead (unit_worker.h, docs/scaling.md): the same table, exactly.
 #include <condition_variable>
 #include <cstdint>
 #include <deque>
@@ -63,6 +65,8 @@ class TransitionWorker {
  private:
   struct State;
   void Run();
+  void RunUnits();  // on a PostgreSQL bank
+  void Fail(const std::string& what);
 
   std::string bank_path_;
   std::unique_ptr<State> state_;
