@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <map>
 #include <system_error>
 #include <utility>
 
@@ -690,6 +691,34 @@ void BankWriter::AppendSpritesManyRows(const ClipRecord& clip, int64_t clip_id,
 
 void BankWriter::UpsertTransitions(const std::vector<TransitionRecord>& transitions) {
   sql::Transaction tx(db());
+  if (is_postgres()) {
+    // A round trip a row cost ~0.15 ms on a server (a worker's whole unit stored 5x slower than
+    // it was found): rows go 1,000 a statement. One statement may not touch a row twice, so a
+    // pair given twice keeps its last values, as one statement a row would.
+    constexpr size_t kRows = 1000;
+    std::vector<TransitionRecord> chunk;
+    std::map<std::pair<int64_t, int64_t>, size_t> at;
+    for (size_t first = 0; first < transitions.size(); first += kRows) {
+      chunk.clear();
+      at.clear();
+      for (size_t k = first; k < std::min(transitions.size(), first + kRows); ++k) {
+        const TransitionRecord& t = transitions[k];
+        const auto [it, fresh] = at.try_emplace({t.from_sprite, t.to_sprite}, chunk.size());
+        if (fresh) chunk.push_back(t);
+        else chunk[it->second] = t;
+      }
+      sql::Stmt q = db().Prepare("INSERT INTO transitions (from_sprite, to_sprite, d, cost) VALUES " +
+                                 sql::RowPlaceholders(static_cast<int>(chunk.size()), 4) +
+                                 " ON CONFLICT (from_sprite, to_sprite) DO UPDATE SET d = excluded.d, cost = excluded.cost");
+      for (size_t r = 0; r < chunk.size(); ++r) {
+        const int i = static_cast<int>(4 * r);
+        q.Bind(i + 1, chunk[r].from_sprite).Bind(i + 2, chunk[r].to_sprite).Bind(i + 3, chunk[r].d).Bind(i + 4, chunk[r].cost);
+      }
+      q.Step();
+    }
+    tx.Commit();
+    return;
+  }
   sql::Stmt& q = impl_->upsert_transition;
   for (const TransitionRecord& t : transitions) {
     q.Reset();

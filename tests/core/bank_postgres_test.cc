@@ -295,6 +295,15 @@ void SnapshotAndKeptMeta(const std::string& path) {
   EXPECT_EQ(other.KeepMeta("billboard.px_per_m", "800"), "150");
   EXPECT_EQ(reader.GetMeta("billboard.px_per_m"), "150");
   EXPECT_THROW(other.KeepMeta("schema_version", "9"), WorkError);
+
+  // A pair given twice in one call keeps its last values (PostgreSQL stores many rows a
+  // statement, and one statement may not touch a row twice).
+  const auto f = w.LoadFeatures();
+  w.UpsertTransitions({{f[3].id, f[8].id, 0.125, 0.5}, {f[4].id, f[8].id, 1, 1}, {f[3].id, f[8].id, 0.25, 0.75}});
+  const auto from = reader.LoadTransitionsFrom(f[3].id);
+  ASSERT_EQ(from.size(), 1u);
+  EXPECT_EQ(from[0].d, 0.25);
+  EXPECT_EQ(from[0].cost, 0.75);
 }
 
 TEST(BankPostgres, ASnapshotSeesOneStateWhileAnotherWriterGoesOn) {
