@@ -18,7 +18,9 @@
 #include "core/sql_postgres.h"
 #include "core/frame.h"
 #include "core/log.h"
+#include "core/options_binder.h"
 #include "core/recording_codecs.h"
+#include "core/yaml_reader.h"
 
 namespace ss {
 namespace {
@@ -52,273 +54,24 @@ const std::vector<std::pair<std::string, std::vector<std::string>>> kCameraKeys 
     {"white_balance", {"v4l2", "aravis", "libcamera"}},
 };
 
-std::string Join(const std::vector<std::string>& items, const std::string& sep = ", ") {
-  std::string out;
-  for (size_t i = 0; i < items.size(); ++i) out += (i ? sep : "") + items[i];
-  return out;
+using namespace yaml_text;
+using Messages = YamlMessages;
+using MapView = YamlMap;
+using Reader = YamlReader;
+
+// ---------------------------------------------------------------- the sections' keys
+// Each section binds its keys to its fields (core/options_binder.h); the defaults are the
+// fields' initial values in core/config.h and the docs are docs/config.md's, shortened.
+
+OptionsBinder WhiteBalanceKeys(WhiteBalanceConfig& wb) {
+  OptionsBinder b;
+  b.AddEnum("mode", &wb.mode, kWhiteBalanceModeTexts, "device: leave as is; once: auto, then lock; manual")
+      .Add("red_gain", &wb.red_gain, "a positive number", "manual: red/green balance ratio")
+      .Add("blue_gain", &wb.blue_gain, "a positive number", "manual: blue/green balance ratio")
+      .Add("temperature_k", &wb.temperature_k, "a colour temperature in kelvin",
+           "manual: colour temperature instead of ratios (V4L2)");
+  return b;
 }
-
-bool OneOf(const std::string& value, const std::vector<std::string>& options) {
-  return std::find(options.begin(), options.end(), value) != options.end();
-}
-
-std::string Quoted(const std::string& s) { return "\"" + s + "\""; }
-
-// Short form of a number for messages ("25", "0.5").
-std::string Num(double v) {
-  std::ostringstream s;
-  s << v;
-  return s.str();
-}
-
-size_t EditDistance(const std::string& a, const std::string& b) {
-  std::vector<size_t> row(b.size() + 1);
-  for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
-  for (size_t i = 1; i <= a.size(); ++i) {
-    size_t diag = row[0];
-    row[0] = i;
-    for (size_t j = 1; j <= b.size(); ++j) {
-      const size_t up = row[j];
-      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diag + (a[i - 1] == b[j - 1] ? 0 : 1)});
-      diag = up;
-    }
-  }
-  return row[b.size()];
-}
-
-// " (did you mean "fps"?)" for a near miss, else "".
-std::string Suggest(const std::string& key, const std::vector<std::string>& known) {
-  std::string best;
-  size_t best_d = std::max<size_t>(2, key.size() / 3) + 1;
-  for (const auto& k : known) {
-    const size_t d = EditDistance(key, k);
-    if (d < best_d) {
-      best_d = d;
-      best = k;
-    }
-  }
-  return best.empty() ? "" : " (did you mean " + Quoted(best) + "?)";
-}
-
-std::string Child(const std::string& path, const std::string& key) {
-  return path.empty() ? key : path + "." + key;
-}
-std::string Index(const std::string& path, size_t i) {
-  return path + "[" + std::to_string(i) + "]";
-}
-
-// Errors and adjustments, each tied to a field path and its YAML line.
-class Messages {
- public:
-  Messages(std::string origin, const std::map<std::string, int>& lines)
-      : origin_(std::move(origin)), lines_(lines) {}
-  // `line_of` names the field whose line to show, when it is not `path` itself.
-  void Error(const std::string& path, const std::string& reason, const std::string& line_of = "") {
-    errors.push_back(Where(line_of.empty() ? path : line_of) + path + ": " + reason);
-    failed.insert(path);
-  }
-  void Adjust(const std::string& path, const std::string& what) {
-    adjustments.push_back(Where(path) + path + ": " + what);
-  }
-  bool Failed(const std::string& path) const { return failed.count(path) > 0; }
-
-  std::vector<std::string> errors, adjustments;
-  std::set<std::string> failed;  // paths that already have an error
-
- private:
-  // "ORIGIN:LINE: " with the line of the field or, if it is absent, of its nearest parent.
-  std::string Where(std::string path) const {
-    while (!path.empty()) {
-      const auto it = lines_.find(path);
-      if (it != lines_.end()) return origin_ + ":" + std::to_string(it->second) + ": ";
-      const size_t cut = path.find_last_of(".[");
-      path = cut == std::string::npos ? "" : path.substr(0, cut);
-    }
-    return origin_ + ": ";
-  }
-  std::string origin_;
-  const std::map<std::string, int>& lines_;
-};
-
-// ---------------------------------------------------------------- reading YAML
-
-int LineOf(const YAML::Node& node) {
-  const YAML::Mark mark = node.Mark();
-  return mark.is_null() ? 0 : mark.line + 1;
-}
-
-std::string ScalarText(const YAML::Node& node) {
-  if (node.IsScalar()) return Quoted(node.Scalar());
-  if (node.IsSequence()) return "a list";
-  if (node.IsMap()) return "a mapping";
-  return "nothing";
-}
-
-// One YAML mapping: its entries by key, with unknown and duplicate keys reported.
-class MapView {
- public:
-  struct Entry {
-    YAML::Node key, value;
-  };
-  MapView() = default;
-  MapView(const YAML::Node& node, std::string path, Messages& msg,
-          std::map<std::string, int>& lines)
-      : path_(std::move(path)) {
-    if (!node.IsMap()) {
-      if (!node.IsNull()) {
-        const std::string name = path_.empty() ? "(top level)" : path_;
-        lines.emplace(name, LineOf(node));
-        msg.Error(name, "expected a mapping of keys, got " + ScalarText(node));
-      }
-      return;
-    }
-    for (auto it = node.begin(); it != node.end(); ++it) {
-      const std::string key = it->first.IsScalar() ? it->first.Scalar() : "";
-      const std::string field = Child(path_, key);
-      if (key.empty()) {
-        const std::string name = path_.empty() ? "(top level)" : path_;
-        lines.emplace(name, LineOf(it->first));
-        msg.Error(name,
-                  "a key at line " + std::to_string(LineOf(it->first)) + " is not a plain name");
-        continue;
-      }
-      if (entries_.count(key)) {
-        lines[field] = LineOf(it->first);
-        msg.Error(field, "given twice (lines " + std::to_string(LineOf(entries_[key].key)) +
-                             " and " + std::to_string(LineOf(it->first)) + ")");
-        continue;
-      }
-      entries_[key] = {it->first, it->second};
-      lines[field] = LineOf(it->first);
-    }
-  }
-  const std::string& path() const { return path_; }
-  const std::map<std::string, Entry>& entries() const { return entries_; }
-  const YAML::Node* Find(const std::string& key) const {
-    const auto it = entries_.find(key);
-    return it == entries_.end() ? nullptr : &it->second.value;
-  }
-
- private:
-  std::string path_;
-  std::map<std::string, Entry> entries_;
-};
-
-class Reader {
- public:
-  Reader(Messages& msg, std::map<std::string, int>& lines, std::string base_dir)
-      : msg_(msg), lines_(lines), base_dir_(std::move(base_dir)) {}
-
-  MapView Map(const YAML::Node& node, const std::string& path) {
-    return MapView(node, path, msg_, lines_);
-  }
-
-  // Reports every key of `view` not in `known`.
-  void Known(const MapView& view, const std::vector<std::string>& known) {
-    for (const auto& [key, entry] : view.entries()) {
-      if (!OneOf(key, known))
-        msg_.Error(Child(view.path(), key), "unknown key" + Suggest(key, known));
-    }
-  }
-
-  // The value node of `key`, or nullptr when absent. An explicit null is an error.
-  const YAML::Node* Value(const MapView& view, const std::string& key) {
-    const YAML::Node* node = view.Find(key);
-    if (node && node->IsNull()) {
-      msg_.Error(Child(view.path(), key), "has no value (remove the key to use the default)");
-      return nullptr;
-    }
-    return node;
-  }
-
-  template <typename T>
-  bool Scalar(const MapView& view, const std::string& key, T& out, const std::string& expected) {
-    const YAML::Node* node = Value(view, key);
-    if (!node) return false;
-    T value{};
-    if (!node->IsScalar() || !YAML::convert<T>::decode(*node, value)) {
-      msg_.Error(Child(view.path(), key), "expected " + expected + ", got " + ScalarText(*node));
-      return false;
-    }
-    out = value;
-    return true;
-  }
-  bool Number(const MapView& view, const std::string& key, double& out,
-              const std::string& expected = "a number") {
-    return Scalar(view, key, out, expected);
-  }
-  bool Int(const MapView& view, const std::string& key, int& out,
-           const std::string& expected = "an integer") {
-    return Scalar(view, key, out, expected);
-  }
-  bool Int64(const MapView& view, const std::string& key, int64_t& out,
-             const std::string& expected) {
-    long long v = 0;
-    if (!Scalar(view, key, v, expected)) return false;
-    out = v;
-    return true;
-  }
-  bool Bool(const MapView& view, const std::string& key, bool& out) {
-    return Scalar(view, key, out, "true or false");
-  }
-  bool String(const MapView& view, const std::string& key, std::string& out,
-              const std::string& expected = "a string") {
-    const YAML::Node* node = Value(view, key);
-    if (!node) return false;
-    if (!node->IsScalar()) {
-      msg_.Error(Child(view.path(), key), "expected " + expected + ", got " + ScalarText(*node));
-      return false;
-    }
-    out = node->Scalar();
-    return true;
-  }
-  // One of a closed set's texts (core/config.h), into its enum value; an error naming the
-  // field and every allowed text otherwise.
-  template <typename E, size_t N>
-  bool Enum(const MapView& view, const std::string& key, E& out, const EnumText<E> (&texts)[N]) {
-    std::string text;
-    if (!String(view, key, text)) return false;
-    return ToEnum(text, texts, Child(view.path(), key), out);
-  }
-  template <typename E, size_t N>
-  bool ToEnum(const std::string& text, const EnumText<E> (&texts)[N], const std::string& path, E& out) {
-    std::vector<std::string> names;
-    for (const EnumText<E>& t : texts) {
-      if (text == t.text) {
-        out = t.value;
-        return true;
-      }
-      names.push_back(t.text);
-    }
-    msg_.Error(path, "expected one of " + Join(names) + ", got " + Quoted(text));
-    return false;
-  }
-  // A path, resolved against the config file's folder.
-  bool Path(const MapView& view, const std::string& key, std::string& out) {
-    std::string raw;
-    if (!String(view, key, raw, "a path")) return false;
-    if (raw.empty()) {
-      msg_.Error(Child(view.path(), key), "expected a path, got \"\"");
-      return false;
-    }
-    out = Resolve(raw);
-    return true;
-  }
-  std::string Resolve(const std::string& raw) const {
-    fs::path p(raw);
-    if (p.is_relative()) p = fs::path(base_dir_) / p;
-    return p.lexically_normal().string();
-  }
-
-  Messages& msg() { return msg_; }
-  // Records where a list item sits, for messages about it.
-  void Mark(const std::string& path, const YAML::Node& node) { lines_[path] = LineOf(node); }
-
- private:
-  Messages& msg_;
-  std::map<std::string, int>& lines_;
-  std::string base_dir_;
-};
 
 void ReadWhiteBalance(Reader& r, const YAML::Node& node, const std::string& path,
                       WhiteBalanceConfig& wb) {
@@ -327,12 +80,12 @@ void ReadWhiteBalance(Reader& r, const YAML::Node& node, const std::string& path
     r.ToEnum(node.Scalar(), kWhiteBalanceModeTexts, Child(path, "mode"), wb.mode);
     return;
   }
+  const OptionsBinder keys = WhiteBalanceKeys(wb);
   const MapView view = r.Map(node, path);
-  r.Known(view, {"mode", "red_gain", "blue_gain", "temperature_k"});
-  r.Enum(view, "mode", wb.mode, kWhiteBalanceModeTexts);
-  const bool red = r.Number(view, "red_gain", wb.red_gain, "a positive number");
-  const bool blue = r.Number(view, "blue_gain", wb.blue_gain, "a positive number");
-  const bool kelvin = r.Number(view, "temperature_k", wb.temperature_k, "a colour temperature in kelvin");
+  r.Known(view, keys.Keys());
+  keys.ReadKeys(r, view);
+  const auto given = [&](const char* key) { return view.Find(key) && !r.msg().Failed(Child(path, key)); };
+  const bool red = given("red_gain"), blue = given("blue_gain"), kelvin = given("temperature_k");
   if ((red || blue || kelvin) && wb.mode != WhiteBalanceMode::kManual) {
     r.msg().Error(Child(path, red ? "red_gain" : blue ? "blue_gain" : "temperature_k"), "only applies with mode: manual");
   }
@@ -341,10 +94,41 @@ void ReadWhiteBalance(Reader& r, const YAML::Node& node, const std::string& path
   }
 }
 
+// A camera's keys after name and source; which sources take each is kCameraKeys.
+OptionsBinder CameraSettingKeys(CameraConfig& cam) {
+  OptionsBinder b;
+  b.AddPath("model", &cam.model, ".cameramodel; unset: the session's, or none")
+      .AddPath("session", &cam.session, "replay: the recorded session's folder")
+      .Add("session_camera", &cam.session_camera, "a string", "replay: the camera within the session")
+      .Add("loop", &cam.loop, "replay: start over at the end")
+      .Add("realtime", &cam.realtime, "replay: paced by the device timestamps")
+      .Add("device", &cam.device, "a string", "v4l2: the device, e.g. /dev/video0")
+      .Add("camera_id", &cam.camera_id, "a string", "aravis / libcamera: the device id")
+      .Add("address", &cam.address, "a string", "aravis: IP address of a GigE Vision camera")
+      .Add("packet_resend", &cam.packet_resend, "aravis")
+      .Add("packet_size", &cam.packet_size, "a packet size in bytes", "aravis: GigE packet size, 0 = negotiate")
+      .Add("pixel_format", &cam.pixel_format, "a string", "yuyv, bayer_rg8...; unset = device default")
+      .Add("width", &cam.width, "a width in pixels", "0 = device default")
+      .Add("height", &cam.height, "a height in pixels", "0 = device default")
+      .Add("fps", &cam.fps, "a positive number", "0 = device default")
+      .Add("exposure_us", &cam.exposure_us, "an exposure time in microseconds",
+           "unset = keep the device's value, locked")
+      .Add("gain_db", &cam.gain_db, "a gain in dB", "unset = keep the device's value, locked")
+      .AddRead("white_balance", "device", "device, once, or {mode: manual, ...}",
+               [&cam](Reader& r, const MapView& view, const std::string& key) {
+                 const YAML::Node* wb = r.Value(view, key);
+                 if (wb) ReadWhiteBalance(r, *wb, Child(view.path(), key), cam.white_balance);
+                 return wb != nullptr;
+               });
+  return b;
+}
+
 void ReadCamera(Reader& r, const YAML::Node& node, const std::string& path, CameraConfig& cam) {
   const MapView view = r.Map(node, path);
-  r.String(view, "name", cam.name);
-  r.String(view, "source", cam.source);
+  OptionsBinder identity;
+  identity.Add("name", &cam.name, "a string", "unique; the stem of its recorded files")
+      .Add("source", &cam.source, "a string", Join(kSources, " | "));
+  identity.ReadKeys(r, view);
   // Keys that belong to another source are named as such; others are unknown.
   std::vector<std::string> all;
   for (const auto& [key, sources] : kCameraKeys) all.push_back(key);
@@ -360,184 +144,208 @@ void ReadCamera(Reader& r, const YAML::Node& node, const std::string& path, Came
                                           " (this camera's source is " + cam.source + ")");
     }
   }
-  r.Path(view, "model", cam.model);
-  r.Path(view, "session", cam.session);
-  r.String(view, "session_camera", cam.session_camera);
-  r.Bool(view, "loop", cam.loop);
-  r.Bool(view, "realtime", cam.realtime);
-  r.String(view, "device", cam.device);
-  r.String(view, "camera_id", cam.camera_id);
-  r.String(view, "address", cam.address);
-  r.Bool(view, "packet_resend", cam.packet_resend);
-  r.Int(view, "packet_size", cam.packet_size, "a packet size in bytes");
-  r.String(view, "pixel_format", cam.pixel_format);
-  r.Int(view, "width", cam.width, "a width in pixels");
-  r.Int(view, "height", cam.height, "a height in pixels");
-  r.Number(view, "fps", cam.fps, "a positive number");
-  double v = 0;
-  if (r.Number(view, "exposure_us", v, "an exposure time in microseconds")) cam.exposure_us = v;
-  if (r.Number(view, "gain_db", v, "a gain in dB")) cam.gain_db = v;
-  if (const YAML::Node* wb = r.Value(view, "white_balance")) {
-    ReadWhiteBalance(r, *wb, Child(path, "white_balance"), cam.white_balance);
-  }
+  CameraSettingKeys(cam).ReadKeys(r, view);
 }
 
-void ReadKeying(Reader& r, const YAML::Node& node, KeyingConfig& k) {
-  const MapView view = r.Map(node, "keying");
-  r.Known(view, {"method", "training_frames", "chroma", "clean_plate", "despill", "shadow"});
-  r.Enum(view, "method", k.method, kKeyingMethodTexts);
-  r.Int(view, "training_frames", k.training_frames, "a number of frames");
-  if (const YAML::Node* n = r.Value(view, "chroma")) {
-    const MapView c = r.Map(*n, "keying.chroma");
-    r.Known(c, {"low", "high"});
-    r.Number(c, "low", k.chroma_low, "a level 0..255");
-    r.Number(c, "high", k.chroma_high, "a level 0..255");
-  }
-  if (const YAML::Node* n = r.Value(view, "clean_plate")) {
-    const MapView c = r.Map(*n, "keying.clean_plate");
-    r.Known(c, {"low_sigma", "high_sigma"});
-    r.Number(c, "low_sigma", k.plate_low_sigma, "a number of noise sigmas");
-    r.Number(c, "high_sigma", k.plate_high_sigma, "a number of noise sigmas");
-  }
-  if (const YAML::Node* n = r.Value(view, "despill")) {
-    const MapView c = r.Map(*n, "keying.despill");
-    r.Known(c, {"enabled", "strength"});
-    r.Bool(c, "enabled", k.despill);
-    r.Number(c, "strength", k.despill_strength, "a number 0..1");
-  }
-  if (const YAML::Node* n = r.Value(view, "shadow")) {
-    const MapView c = r.Map(*n, "keying.shadow");
-    r.Known(c, {"enabled", "min_darkening", "max_darkening", "reach_m"});
-    r.Bool(c, "enabled", k.shadow);
-    r.Number(c, "min_darkening", k.shadow_min_darkening, "a fraction 0..1");
-    r.Number(c, "max_darkening", k.shadow_max_darkening, "a fraction 0..1");
-    r.Number(c, "reach_m", k.shadow_reach_m, "a distance in metres");
-  }
+OptionsBinder KeyingKeys(KeyingConfig& k) {
+  OptionsBinder b;
+  b.AddEnum("method", &k.method, kKeyingMethodTexts, "chroma (a green screen) or clean_plate (any background)")
+      .Add("training_frames", &k.training_frames, "a number of frames", "empty-enclosure frames to learn from")
+      .Add("chroma.low", &k.chroma_low, "a level 0..255", "key difference where alpha starts to fall")
+      .Add("chroma.high", &k.chroma_high, "a level 0..255", "... and where it reaches 0")
+      .Add("clean_plate.low_sigma", &k.plate_low_sigma, "a number of noise sigmas",
+           "difference where alpha starts to rise")
+      .Add("clean_plate.high_sigma", &k.plate_high_sigma, "a number of noise sigmas", "... and where it reaches 1")
+      .Add("despill.enabled", &k.despill, "remove the green cast from the subject's edges")
+      .Add("despill.strength", &k.despill_strength, "a number 0..1", "share of the cast removed")
+      .Add("shadow.enabled", &k.shadow, "keep the contact-shadow layer")
+      .Add("shadow.min_darkening", &k.shadow_min_darkening, "a fraction 0..1",
+           "darkening below which there is no shadow")
+      .Add("shadow.max_darkening", &k.shadow_max_darkening, "a fraction 0..1", "darkening that counts as full shadow")
+      .Add("shadow.reach_m", &k.shadow_reach_m, "a distance in metres", "shadow kept this far around the foot");
+  return b;
 }
 
-void ReadEnclosure(Reader& r, const YAML::Node& node, EnclosureConfig& e) {
-  const MapView view = r.Map(node, "enclosure");
-  r.Known(view, {"floor", "wall_height_m"});
-  r.Number(view, "wall_height_m", e.wall_height_m, "a height in metres");
-  const YAML::Node* floor = r.Value(view, "floor");
-  if (!floor) return;
-  if (!floor->IsSequence()) {
-    r.msg().Error("enclosure.floor",
-                  "expected a list of [x, y] points in metres, got " + ScalarText(*floor));
-    return;
-  }
-  if (floor->size() > GroundPolygon::kMaxVertices) {
-    r.msg().Error("enclosure.floor", std::to_string(floor->size()) + " points; a floor polygon has at most " +
-                                         std::to_string(GroundPolygon::kMaxVertices));
-    return;
-  }
-  std::vector<Eigen::Vector2d> vertices;
-  for (size_t i = 0; i < floor->size(); ++i) {
-    const YAML::Node p = (*floor)[i];
-    const std::string path = Index("enclosure.floor", i);
-    r.Mark(path, p);
-    double x = 0, y = 0;
-    if (!p.IsSequence() || p.size() != 2 || !YAML::convert<double>::decode(p[0], x) ||
-        !YAML::convert<double>::decode(p[1], y)) {
-      r.msg().Error(path,
-                    "expected a point [x, y] in metres, got " +
-                        (p.IsSequence() ? "a list of " + std::to_string(p.size()) : ScalarText(p)));
-      continue;
-    }
-    vertices.emplace_back(x, y);
-  }
-  e.floor = GroundPolygon(std::move(vertices));
+OptionsBinder EnclosureKeys(EnclosureConfig& e) {
+  OptionsBinder b;
+  b.Add("wall_height_m", &e.wall_height_m, "a height in metres", "walls occlude the floor behind them up to this")
+      .AddRead("floor", "[]", "the floor polygon, [x, y] ground metres in order",
+               [&e](Reader& r, const MapView& view, const std::string& key) {
+                 const YAML::Node* floor = r.Value(view, key);
+                 if (!floor) return false;
+                 if (!floor->IsSequence()) {
+                   r.msg().Error("enclosure.floor",
+                                 "expected a list of [x, y] points in metres, got " + ShapeOf(*floor));
+                   return false;
+                 }
+                 if (floor->size() > GroundPolygon::kMaxVertices) {
+                   r.msg().Error("enclosure.floor", std::to_string(floor->size()) +
+                                                        " points; a floor polygon has at most " +
+                                                        std::to_string(GroundPolygon::kMaxVertices));
+                   return false;
+                 }
+                 std::vector<Eigen::Vector2d> vertices;
+                 for (size_t i = 0; i < floor->size(); ++i) {
+                   const YAML::Node p = (*floor)[i];
+                   const std::string path = Index("enclosure.floor", i);
+                   r.Mark(path, p);
+                   double x = 0, y = 0;
+                   if (!p.IsSequence() || p.size() != 2 || !YAML::convert<double>::decode(p[0], x) ||
+                       !YAML::convert<double>::decode(p[1], y)) {
+                     r.msg().Error(path, "expected a point [x, y] in metres, got " +
+                                             (p.IsSequence() ? "a list of " + std::to_string(p.size())
+                                                             : ShapeOf(p)));
+                     continue;
+                   }
+                   vertices.emplace_back(x, y);
+                 }
+                 e.floor = GroundPolygon(std::move(vertices));
+                 return true;
+               });
+  return b;
 }
 
-void ReadPipeline(Reader& r, const YAML::Node& node, PipelineConfig& p) {
-  const MapView view = r.Map(node, "pipeline");
-  r.Known(view, {"min_area_px", "border_margin_px", "floor_margin_px", "wall_margin_m",
-                 "still_speed_m_per_s", "max_speed_m_per_s", "max_still_s", "min_clip_frames", "px_per_m", "workers",
-                 "queue_frames", "noise_recover_solidity", "noise_thick_px", "noise_min_thick_share", "noise_min_solidity",
-                 "noise_min_largest_share", "noise_min_mean_alpha"});
-  r.Int(view, "min_area_px", p.min_area_px, "an area in pixels");
-  r.Int(view, "border_margin_px", p.border_margin_px, "a number of pixels");
-  r.Int(view, "floor_margin_px", p.floor_margin_px, "a number of pixels");
-  r.Number(view, "wall_margin_m", p.wall_margin_m, "a distance in metres");
-  r.Number(view, "still_speed_m_per_s", p.still_speed_m_per_s, "a speed in m/s");
-  r.Number(view, "max_speed_m_per_s", p.max_speed_m_per_s, "a speed in m/s");
-  r.Number(view, "max_still_s", p.max_still_s, "a duration in seconds");
-  r.Int(view, "min_clip_frames", p.min_clip_frames, "a number of frames");
-  r.Number(view, "noise_recover_solidity", p.noise_recover_solidity, "a share from 0 to 1");
-  r.Number(view, "noise_thick_px", p.noise_thick_px, "a distance in pixels");
-  r.Number(view, "noise_min_thick_share", p.noise_min_thick_share, "a share from 0 to 1");
-  r.Number(view, "noise_min_solidity", p.noise_min_solidity, "a share from 0 to 1");
-  r.Number(view, "noise_min_largest_share", p.noise_min_largest_share, "a share from 0 to 1");
-  r.Number(view, "noise_min_mean_alpha", p.noise_min_mean_alpha, "a share from 0 to 1");
-  // `auto` (stored as 0) or a positive number of pixels per metre.
-  if (const YAML::Node* n = view.Find("px_per_m"); n && n->IsScalar() && n->Scalar() == "auto") {
-    p.px_per_m = 0;
-  } else {
-    double v = 0;
-    if (r.Number(view, "px_per_m", v, "auto or a positive number of pixels per metre")) {
-      p.px_per_m = v;
-      if (v == 0) r.msg().Error("pipeline.px_per_m", "expected auto or a positive number, got 0");
-    }
-  }
-  r.Int(view, "workers", p.workers, "a number of threads");
-  r.Int(view, "queue_frames", p.queue_frames, "a number of frames");
+OptionsBinder PipelineKeys(PipelineConfig& p) {
+  OptionsBinder b;
+  b.Add("min_area_px", &p.min_area_px, "an area in pixels", "smaller blobs are noise")
+      .Add("border_margin_px", &p.border_margin_px, "a number of pixels", "distance to keep from the image border")
+      .Add("floor_margin_px", &p.floor_margin_px, "a number of pixels", "floor pixels required around the silhouette")
+      .Add("wall_margin_m", &p.wall_margin_m, "a distance in metres", "contact point distance to keep from the walls")
+      .Add("still_speed_m_per_s", &p.still_speed_m_per_s, "a speed in m/s", "slower counts as not moving")
+      .Add("max_speed_m_per_s", &p.max_speed_m_per_s, "a speed in m/s", "faster starts a new clip")
+      .Add("max_still_s", &p.max_still_s, "a duration in seconds", "longer still periods are discarded")
+      .Add("min_clip_frames", &p.min_clip_frames, "a number of frames", "shorter clips are discarded")
+      .Add("noise_recover_solidity", &p.noise_recover_solidity, "a share from 0 to 1",
+           "a subject noise the frame before stays noise below this")
+      .Add("noise_thick_px", &p.noise_thick_px, "a distance in pixels", "interior: this far from the matte's edge")
+      .Add("noise_min_thick_share", &p.noise_min_thick_share, "a share from 0 to 1", "noise below this interior share")
+      .Add("noise_min_solidity", &p.noise_min_solidity, "a share from 0 to 1", "noise below this solidity")
+      .Add("noise_min_largest_share", &p.noise_min_largest_share, "a share from 0 to 1",
+           "noise when its largest part holds less")
+      .Add("noise_min_mean_alpha", &p.noise_min_mean_alpha, "a share from 0 to 1", "noise below this mean alpha")
+      .AddRead("px_per_m", "auto", "billboard scale in pixels per metre, or auto",
+               [&p](Reader& r, const MapView& view, const std::string& key) {
+                 // `auto` (stored as 0) or a positive number of pixels per metre.
+                 if (const YAML::Node* n = view.Find(key); n && n->IsScalar() && n->Scalar() == "auto") {
+                   p.px_per_m = 0;
+                   return true;
+                 }
+                 double v = 0;
+                 if (!r.Number(view, key, v, "auto or a positive number of pixels per metre")) return false;
+                 p.px_per_m = v;
+                 if (v == 0) r.msg().Error("pipeline.px_per_m", "expected auto or a positive number, got 0");
+                 return true;
+               })
+      .Add("workers", &p.workers, "a number of threads", "OpenCV threads inside a frame's work; 0 = default")
+      .Add("queue_frames", &p.queue_frames, "a number of frames", "per-camera queue between capture and pipeline");
+  return b;
 }
 
-void ReadStorage(Reader& r, const YAML::Node& node, StorageConfig& s) {
-  const MapView view = r.Map(node, "storage");
-  r.Known(view, {"bank", "recording_dir", "recording", "recording_codec",
-                 "stop_recording_below_mib", "stop_sprites_below_mib", "spool_dir", "spool_max_mib"});
-  // A file (resolved against the config's folder) or a PostgreSQL server's address, kept as written.
-  if (r.Path(view, "bank", s.bank)) {
-    std::string raw;
-    r.String(view, "bank", raw, "a path");
-    if (sql::IsPostgresAddress(raw)) s.bank = raw;
-  }
-  r.Path(view, "recording_dir", s.recording_dir);
-  r.Enum(view, "recording", s.recording, kRecordingModeTexts);
-  r.String(view, "recording_codec", s.recording_codec);
-  r.Int64(view, "stop_recording_below_mib", s.stop_recording_below_mib, "a size in MiB");
-  r.Int64(view, "stop_sprites_below_mib", s.stop_sprites_below_mib, "a size in MiB");
-  r.Path(view, "spool_dir", s.spool_dir);
-  r.Int64(view, "spool_max_mib", s.spool_max_mib, "a size in MiB");
+OptionsBinder StorageKeys(StorageConfig& s) {
+  OptionsBinder b;
+  b.AddRead("bank", Quoted(s.bank), "the sprite bank: a file, or a PostgreSQL server's address",
+            [&s](Reader& r, const MapView& view, const std::string& key) {
+              // A file (resolved against the config's folder) or a PostgreSQL address, kept as written.
+              if (!r.Path(view, key, s.bank)) return false;
+              std::string raw;
+              r.String(view, key, raw, "a path");
+              if (sql::IsPostgresAddress(raw)) s.bank = raw;
+              return true;
+            })
+      .AddPath("recording_dir", &s.recording_dir, "where recorded sessions go")
+      .AddEnum("recording", &s.recording, kRecordingModeTexts, "off, all frames, or those that gave a usable sprite")
+      .Add("recording_codec", &s.recording_codec, "a string", "ffv1, mjpeg or h264")
+      .Add("stop_recording_below_mib", &s.stop_recording_below_mib, "a size in MiB",
+           "free disk under which raw recording stops")
+      .Add("stop_sprites_below_mib", &s.stop_sprites_below_mib, "a size in MiB",
+           "free disk under which sprite storage stops")
+      .AddPath("spool_dir", &s.spool_dir, "where clip batches wait while the bank cannot take them")
+      .Add("spool_max_mib", &s.spool_max_mib, "a size in MiB", "how much the spool may fill");
+  return b;
 }
 
-void ReadControl(Reader& r, const YAML::Node& node, ControlConfig& c) {
-  const MapView view = r.Map(node, "control");
-  r.Known(view, {"address", "port", "token", "token_file"});
-  r.String(view, "address", c.address, "an IP address");
-  r.Int(view, "port", c.port, "a port number 0..65535");
-  r.String(view, "token", c.token);
-  std::string token_file;
-  if (r.Path(view, "token_file", token_file)) {
-    if (view.Find("token")) {
-      r.msg().Error("control.token_file", "give token or token_file, not both");
-      return;
-    }
-    std::ifstream in(token_file);
-    if (!in) {
-      r.msg().Error("control.token_file",
-                    token_file + ": cannot read the token: " + std::strerror(errno));
-      return;
-    }
-    std::getline(in, c.token);
-    while (!c.token.empty() && std::isspace(static_cast<unsigned char>(c.token.back())))
-      c.token.pop_back();
-    if (c.token.empty()) r.msg().Error("control.token_file", token_file + ": the file is empty");
-  }
+OptionsBinder ControlKeys(ControlConfig& c) {
+  OptionsBinder b;
+  b.Add("address", &c.address, "an IP address", "where the control server listens")
+      .Add("port", &c.port, "a port number 0..65535", "0 = any free port")
+      .Add("token", &c.token, "a string", "required when address is not loopback (>= 16 chars)")
+      .AddRead("token_file", "\"\"", "a file holding the token",
+               [&c](Reader& r, const MapView& view, const std::string& key) {
+                 std::string token_file;
+                 if (!r.Path(view, key, token_file)) return false;
+                 if (view.Find("token")) {
+                   r.msg().Error("control.token_file", "give token or token_file, not both");
+                   return false;
+                 }
+                 std::ifstream in(token_file);
+                 if (!in) {
+                   r.msg().Error("control.token_file",
+                                 token_file + ": cannot read the token: " + std::strerror(errno));
+                   return false;
+                 }
+                 std::getline(in, c.token);
+                 while (!c.token.empty() && std::isspace(static_cast<unsigned char>(c.token.back())))
+                   c.token.pop_back();
+                 if (c.token.empty()) r.msg().Error("control.token_file", token_file + ": the file is empty");
+                 return true;
+               });
+  return b;
 }
 
-void ReadLogging(Reader& r, const YAML::Node& node, LoggingConfig& l) {
-  const MapView view = r.Map(node, "logging");
-  r.Known(view, {"level", "components"});
-  r.String(view, "level", l.level, "a log level");
-  if (const YAML::Node* n = r.Value(view, "components")) {
-    const MapView c = r.Map(*n, "logging.components");
-    for (const auto& [key, entry] : c.entries()) {
-      std::string level;
-      if (r.String(c, key, level, "a log level")) l.components[key] = level;
-    }
-  }
+OptionsBinder LoggingKeys(LoggingConfig& l) {
+  OptionsBinder b;
+  b.Add("level", &l.level, "a log level", Join(kLogLevels, " "))
+      .AddRead("components", "{}", "a level per component, e.g. capture.aravis: debug",
+               [&l](Reader& r, const MapView& view, const std::string& key) {
+                 const YAML::Node* n = r.Value(view, key);
+                 if (!n) return false;
+                 const MapView c = r.Map(*n, Child(view.path(), key));
+                 for (const auto& [component, entry] : c.entries()) {
+                   std::string level;
+                   if (r.String(c, component, level, "a log level")) l.components[component] = level;
+                 }
+                 return true;
+               });
+  return b;
+}
+
+// A section read by its binder, when present.
+template <typename Config>
+OptionsBinder::ReadFn Section(OptionsBinder (*keys)(Config&), Config& config) {
+  return [keys, &config](Reader& r, const MapView& view, const std::string& key) {
+    const YAML::Node* n = r.Value(view, key);
+    if (n) keys(config).Read(r, *n, Child(view.path(), key));
+    return n != nullptr;
+  };
+}
+
+// The whole file.
+OptionsBinder StationKeys(StationConfig& cfg) {
+  OptionsBinder b;
+  b.Add("version", &cfg.version, "a config version number", "the config format's version")
+      .AddRead("cameras", "[]", "the cameras, each a mapping",
+               [&cfg](Reader& r, const MapView& view, const std::string& key) {
+                 const YAML::Node* cams = r.Value(view, key);
+                 if (!cams) return false;
+                 if (!cams->IsSequence()) {
+                   r.msg().Error("cameras", "expected a list of cameras, got " + ShapeOf(*cams));
+                   return false;
+                 }
+                 for (size_t i = 0; i < cams->size(); ++i) {
+                   const std::string path = Index("cameras", i);
+                   r.Mark(path, (*cams)[i]);
+                   cfg.cameras.emplace_back();
+                   ReadCamera(r, (*cams)[i], path, cfg.cameras.back());
+                 }
+                 return true;
+               })
+      .AddRead("keying", "", "keying.*", Section(KeyingKeys, cfg.keying))
+      .AddRead("enclosure", "", "enclosure.*", Section(EnclosureKeys, cfg.enclosure))
+      .AddRead("pipeline", "", "pipeline.*", Section(PipelineKeys, cfg.pipeline))
+      .AddRead("storage", "", "storage.*", Section(StorageKeys, cfg.storage))
+      .AddRead("control", "", "control.*", Section(ControlKeys, cfg.control))
+      .AddRead("logging", "", "logging.*", Section(LoggingKeys, cfg.logging));
+  return b;
 }
 
 // ---------------------------------------------------------------- validation
@@ -882,28 +690,7 @@ StationConfig ParseStationConfig(const std::string& yaml, const std::string& ori
   cfg.storage.bank = r.Resolve("station.bank");
   cfg.storage.recording_dir = r.Resolve("recordings");
   cfg.storage.spool_dir = r.Resolve("spool");
-  const MapView top = r.Map(root, "");
-  r.Known(top, {"version", "cameras", "keying", "enclosure", "pipeline", "storage", "control",
-                "logging"});
-  r.Int(top, "version", cfg.version, "a config version number");
-  if (const YAML::Node* cams = r.Value(top, "cameras")) {
-    if (!cams->IsSequence()) {
-      msg.Error("cameras", "expected a list of cameras, got " + ScalarText(*cams));
-    } else {
-      for (size_t i = 0; i < cams->size(); ++i) {
-        const std::string path = Index("cameras", i);
-        r.Mark(path, (*cams)[i]);
-        cfg.cameras.emplace_back();
-        ReadCamera(r, (*cams)[i], path, cfg.cameras.back());
-      }
-    }
-  }
-  if (const YAML::Node* n = r.Value(top, "keying")) ReadKeying(r, *n, cfg.keying);
-  if (const YAML::Node* n = r.Value(top, "enclosure")) ReadEnclosure(r, *n, cfg.enclosure);
-  if (const YAML::Node* n = r.Value(top, "pipeline")) ReadPipeline(r, *n, cfg.pipeline);
-  if (const YAML::Node* n = r.Value(top, "storage")) ReadStorage(r, *n, cfg.storage);
-  if (const YAML::Node* n = r.Value(top, "control")) ReadControl(r, *n, cfg.control);
-  if (const YAML::Node* n = r.Value(top, "logging")) ReadLogging(r, *n, cfg.logging);
+  StationKeys(cfg).Read(r, root, "");
 
   Validator(msg, options).Run(cfg);
   Conclude(MakeReport(msg), report);
@@ -921,18 +708,6 @@ StationConfig LoadStationConfig(const std::string& path, ConfigReport* report,
   const fs::path base = fs::absolute(fs::path(path), ec).parent_path();
   return ParseStationConfig(text.str(), path, base.string(), report, options);
 }
-
-namespace {
-
-template <typename E, size_t N>
-const char* TextOf(E value, const EnumText<E> (&texts)[N]) {
-  for (const EnumText<E>& t : texts) {
-    if (t.value == value) return t.text;
-  }
-  return "unknown";
-}
-
-}  // namespace
 
 const char* ToText(WhiteBalanceMode mode) { return TextOf(mode, kWhiteBalanceModeTexts); }
 const char* ToText(KeyingMethod method) { return TextOf(method, kKeyingMethodTexts); }
