@@ -4,8 +4,10 @@
 #include <cmath>
 #include <string>
 
+#include "core/config.h"
 #include "core/error.h"
 #include "core/log.h"
+#include "pipeline/key/keyer_registry.h"
 
 namespace ss {
 namespace {
@@ -318,5 +320,18 @@ void ChromaKeyer::FineRow(const uint8_t* row, ChannelOrder order, int y, int x0,
                  despill256, strength256, keyable, alpha, shadow, colour);
   }
 }
+
+ChromaKeyerOptions ChromaKeyerOptionsFrom(const KeyingConfig& k) {
+  ChromaKeyerOptions o;
+  o.key_low_levels = k.chroma_low;
+  o.key_high_levels = k.chroma_high;
+  o.despill_strength = k.despill ? k.despill_strength : 0.0;
+  o.shadow = k.shadow;
+  o.shadow_min = k.shadow_min_darkening;
+  o.dark_floor = 1.0 - k.shadow_max_darkening;
+  return o;
+}
+
+void RegisterChromaKeyer() { RegisterKeyerType<ChromaKeyer>(KeyingMethod::kChroma, ChromaKeyerOptionsFrom); }
 
 }  // namespace ss

@@ -17,6 +17,8 @@
 
 namespace ss {
 
+struct KeyingConfig;
+
 struct ChromaKeyerOptions {
   GridOptions grid;
   double noise_z = 5.0;         // background tolerance in noise std of the learned key...
@@ -38,6 +40,10 @@ struct ChromaKeyerOptions {
   double key_high_levels = -1;
   bool global_model = false;    // one reference for the whole frame: the naive keyer, for comparison
 };
+
+// The options the station config's keying section sets (docs/keying.md, "From the station
+// config"): keying.chroma.*, keying.despill.*, keying.shadow.*; the others keep their defaults.
+ChromaKeyerOptions ChromaKeyerOptionsFrom(const KeyingConfig& keying);
 
 class ChromaKeyer : public Keyer {
  public:

@@ -6,8 +6,10 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "core/config.h"
 #include "core/error.h"
 #include "core/log.h"
+#include "pipeline/key/keyer_registry.h"
 
 namespace ss {
 namespace {
@@ -168,6 +170,20 @@ void CleanPlateKeyer::FineRow(const uint8_t* row, ChannelOrder order, int y, int
     PlateRowBgr(row, plate_.ptr<uint8_t>(y), tolerance_.ptr<float>(y), x0, x1, gain, dark_floor, shadow_min, alpha,
                 shadow, colour);
   }
+}
+
+CleanPlateKeyerOptions CleanPlateKeyerOptionsFrom(const KeyingConfig& k) {
+  CleanPlateKeyerOptions o;
+  o.noise_z = k.plate_low_sigma;
+  o.ramp_sigma = k.plate_high_sigma - k.plate_low_sigma;
+  o.shadow = k.shadow;
+  o.shadow_min = k.shadow_min_darkening;
+  o.dark_floor = 1.0 - k.shadow_max_darkening;
+  return o;
+}
+
+void RegisterCleanPlateKeyer() {
+  RegisterKeyerType<CleanPlateKeyer>(KeyingMethod::kCleanPlate, CleanPlateKeyerOptionsFrom);
 }
 
 }  // namespace ss

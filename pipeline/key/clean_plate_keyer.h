@@ -13,6 +13,8 @@
 
 namespace ss {
 
+struct KeyingConfig;
+
 struct CleanPlateKeyerOptions {
   GridOptions grid;
   double noise_z = 4.0;         // background tolerance, noise std (the false-positive rate of a 1-D z test)
@@ -25,6 +27,10 @@ struct CleanPlateKeyerOptions {
   double ramp_sigma = 0;        // > 0: the ramp is this many of the plate's mean noise std instead of `ramp`
   bool shadow = true;           // false: no contact-shadow layer (and no shaded cells)
 };
+
+// The options the station config's keying section sets (docs/keying.md, "From the station
+// config"): keying.clean_plate.*, keying.shadow.*; the others keep their defaults.
+CleanPlateKeyerOptions CleanPlateKeyerOptionsFrom(const KeyingConfig& keying);
 
 class CleanPlateKeyer : public Keyer {
  public:
