@@ -39,6 +39,8 @@ struct ChromaKeyerOptions {
   double key_low_levels = -1;
   double key_high_levels = -1;
   bool global_model = false;    // one reference for the whole frame: the naive keyer, for comparison
+  // False with "FIELD: reason" in `why` when a value is out of its range.
+  bool IsValid(std::string* why) const;
 };
 
 // The options the station config's keying section sets (docs/keying.md, "From the station

@@ -74,10 +74,14 @@ SS_PLATE_ROW(PlateRowRgb, true)
 
 }  // namespace
 
-CleanPlateKeyer::CleanPlateKeyer(CleanPlateKeyerOptions options) : Keyer(options.grid), options_(options) {
-  const auto& o = options_;
-  auto check = [](bool ok, const char* field, const char* reason) {
-    if (!ok) throw InputError(std::string("keying.clean_plate.") + field, reason);
+bool CleanPlateKeyerOptions::IsValid(std::string* why) const {
+  const CleanPlateKeyerOptions& o = *this;
+  bool ok = true;
+  auto check = [&](bool good, const char* field, const char* reason) {
+    if (ok && !good) {
+      ok = false;
+      if (why) *why = std::string(field) + ": " + reason;
+    }
   };
   check(o.noise_z >= 0, "noise_z", "must not be negative");
   check(o.min_sigma > 0, "min_sigma", "must be positive");
@@ -87,6 +91,11 @@ CleanPlateKeyer::CleanPlateKeyer(CleanPlateKeyerOptions options) : Keyer(options
   check(o.coarse_alpha > 0 && o.coarse_alpha < 1, "coarse_alpha", "must be within (0, 1)");
   check(o.coarse_shadow > 0 && o.coarse_shadow < 1, "coarse_shadow", "must be within (0, 1)");
   check(o.ramp_sigma >= 0, "ramp_sigma", "must not be negative");
+  return ok;
+}
+
+CleanPlateKeyer::CleanPlateKeyer(CleanPlateKeyerOptions options) : Keyer(options.grid), options_(options) {
+  if (std::string why; !options_.IsValid(&why)) throw InputError("keying.clean_plate." + why);
 }
 
 int CleanPlateKeyer::ShadowMin() const {
