@@ -47,13 +47,7 @@ inline PixelKey KeyPixel(int b, int g, int r, float key_hi, float gain, int32_t 
 
 bool ChromaKeyerOptions::IsValid(std::string* why) const {
   const ChromaKeyerOptions& o = *this;
-  bool ok = true;
-  auto check = [&](bool good, const char* field, const char* reason) {
-    if (ok && !good) {
-      ok = false;
-      if (why) *why = std::string(field) + ": " + reason;
-    }
-  };
+  OptionChecks check(why);
   check(o.noise_z >= 0, "noise_z", "must not be negative");
   check(o.min_margin >= 0 && o.min_margin < 1, "min_margin", "must be within [0, 1)");
   check(o.ramp > 0 && o.ramp <= 2, "ramp", "must be within (0, 2]");
@@ -66,7 +60,7 @@ bool ChromaKeyerOptions::IsValid(std::string* why) const {
   check(o.despill_bias >= 0 && o.despill_bias <= 1, "despill_bias", "must be within [0, 1]");
   check(o.despill_strength >= 0 && o.despill_strength <= 1, "despill_strength", "must be within [0, 1]");
   check(o.key_low_levels < 0 || o.key_high_levels > o.key_low_levels, "high", "must be above keying.chroma.low");
-  return ok;
+  return check.ok();
 }
 
 ChromaKeyer::ChromaKeyer(ChromaKeyerOptions options) : Keyer(options.grid), options_(options) {

@@ -76,13 +76,7 @@ SS_PLATE_ROW(PlateRowRgb, true)
 
 bool CleanPlateKeyerOptions::IsValid(std::string* why) const {
   const CleanPlateKeyerOptions& o = *this;
-  bool ok = true;
-  auto check = [&](bool good, const char* field, const char* reason) {
-    if (ok && !good) {
-      ok = false;
-      if (why) *why = std::string(field) + ": " + reason;
-    }
-  };
+  OptionChecks check(why);
   check(o.noise_z >= 0, "noise_z", "must not be negative");
   check(o.min_sigma > 0, "min_sigma", "must be positive");
   check(o.ramp > 0, "ramp", "must be positive");
@@ -91,7 +85,7 @@ bool CleanPlateKeyerOptions::IsValid(std::string* why) const {
   check(o.coarse_alpha > 0 && o.coarse_alpha < 1, "coarse_alpha", "must be within (0, 1)");
   check(o.coarse_shadow > 0 && o.coarse_shadow < 1, "coarse_shadow", "must be within (0, 1)");
   check(o.ramp_sigma >= 0, "ramp_sigma", "must not be negative");
-  return ok;
+  return check.ok();
 }
 
 CleanPlateKeyer::CleanPlateKeyer(CleanPlateKeyerOptions options) : Keyer(options.grid), options_(options) {
