@@ -6,6 +6,8 @@
 #include <fstream>
 #include <initializer_list>
 #include <map>
+#include <optional>
+#include <utility>
 #include <sstream>
 
 #include <yaml-cpp/yaml.h>
@@ -410,36 +412,43 @@ void ReadOptimizer(const Reader& r, const YAML::Node& node, OptimizerSpec& o) {
 }
 
 void ReadLengthTop(const Reader& r, const YAML::Node& node, AnimationSpec& spec) {
+  int fixed = 0, min_frames = 0, max_frames = 0, initial_frames = 0;
+  std::optional<double> strength;
   if (node.IsScalar()) {
-    spec.fixed_frames = r.Integer(node, "length", 1);
+    fixed = r.Integer(node, "length", 1);
   } else {
-    r.Map(node, "length", {"frames", "min_frames", "max_frames", "initial_frames", "strength"});
-    if (node["frames"]) {
-      if (node["min_frames"] || node["max_frames"]) {
-        r.Fail(node["frames"], "length.frames", "give either frames (fixed) or min/max_frames");
-      }
-      spec.fixed_frames = r.Integer(node["frames"], "length.frames", 1);
+    OptionsBinder keys;
+    keys.Add("frames", &fixed, "a whole number >= 1", "every sequence is this long")
+        .Add("min_frames", &min_frames, "a whole number >= 1", "sequences shorter are penalized")
+        .Add("max_frames", &max_frames, "a whole number >= 1", "the longest sequence")
+        .Add("initial_frames", &initial_frames, "a whole number >= 1", "length of random initial sequences")
+        .Add("strength", &strength, "a number", "weight of the length term");
+    ReadBound(r, keys, node, "length");
+    for (const auto& [key, value] : {std::pair{"frames", fixed}, std::pair{"min_frames", min_frames},
+                                     std::pair{"max_frames", max_frames}, std::pair{"initial_frames", initial_frames}}) {
+      if (node[key] && value < 1) r.Fail(node[key], std::string("length.") + key, "expected a whole number >= 1");
     }
-    if (node["max_frames"]) spec.max_frames = r.Integer(node["max_frames"], "length.max_frames", 1);
-    if (node["initial_frames"]) {
-      spec.initial_frames = r.Integer(node["initial_frames"], "length.initial_frames", 1);
+    if (strength && (!std::isfinite(*strength) || *strength < 0)) {
+      r.Fail(node["strength"], "length.strength", std::isfinite(*strength) ? "must be >= 0" : "expected a finite number");
     }
-    if (node["min_frames"]) {
-      spec.length = LengthSpec{r.Integer(node["min_frames"], "length.min_frames", 1),
-                               ReadStrength(r, node, "length", 1.0)};
-      if (spec.max_frames > 0 && spec.max_frames < spec.length->min_frames) {
+    if (node["frames"] && (node["min_frames"] || node["max_frames"])) {
+      r.Fail(node["frames"], "length.frames", "give either frames (fixed) or min/max_frames");
+    }
+    spec.max_frames = max_frames;
+    if (initial_frames > 0) spec.initial_frames = initial_frames;
+    if (min_frames > 0) {
+      spec.length = LengthSpec{min_frames, strength.value_or(1.0)};
+      if (spec.max_frames > 0 && spec.max_frames < min_frames) {
         r.Fail(node["max_frames"], "length.max_frames", "is below length.min_frames");
       }
     }
   }
-  if (spec.fixed_frames > 0) {
+  if (fixed > 0) {
     // A fixed length: sequences are cut at N and strongly held to N.
-    const double strength = node.IsMap() && node["strength"]
-                                ? r.AtLeast(node["strength"], "length.strength", 0)
-                                : 100.0;
-    spec.max_frames = spec.fixed_frames;
-    spec.initial_frames = spec.fixed_frames;
-    spec.length = LengthSpec{spec.fixed_frames, strength};
+    spec.fixed_frames = fixed;
+    spec.max_frames = fixed;
+    spec.initial_frames = fixed;
+    spec.length = LengthSpec{fixed, strength.value_or(100.0)};
   }
 }
 
