@@ -354,7 +354,8 @@ CollisionSpec ReadCollision(const Reader& r, const AnimationSpec& spec, const YA
 
 // Reads `node` as the block `field` with `keys` (the station config's reader,
 // core/options_binder.h: types, unknown keys) and throws its first mistake: a spec stops there.
-void ReadBound(const Reader& r, const OptionsBinder& keys, const YAML::Node& node, const std::string& field) {
+void ReadBound(const Reader& r, const OptionsBinder& keys, const YAML::Node& node,
+               const std::string& field) {
   std::map<std::string, int> lines;
   YamlMessages msg(r.origin(), lines);
   YamlReader reader(msg, lines, fs::path(r.origin()).parent_path().string());
@@ -375,17 +376,21 @@ void ReadOptimizer(const Reader& r, const YAML::Node& node, OptimizerSpec& o) {
       .Add("threads", &o.threads, "a whole number >= 1", "worker threads")
       .Add("changes_per_turn", &o.changes_per_turn, "a whole number >= 1", "picks per sprite turn")
       .Add("beam_width", &o.beam_width, "a whole number >= 1", "the beam search's width")
-      .Add("snapshot_every_s", &o.snapshot_every_s, "a number", "> 0: keep the sequences every so many seconds")
+      .Add("snapshot_every_s", &o.snapshot_every_s, "a number",
+           "> 0: keep the sequences every so many seconds")
       .Add("collision_pick_fraction", &o.collision_pick_fraction, "a number",
            "replacement's picks aimed at a collision, 0 to 1");
   ReadBound(r, keys, node, f);
   // The bounds; those of the optimizer (ReplacementOptions::IsValid, beam search) are checked
   // here so that the message names the spec's file, line and field rather than the optimizer's.
-  const auto fail = [&](const char* key, const std::string& why) { r.Fail(node[key], f + "." + key, why); };
+  const auto fail = [&](const char* key, const std::string& why) {
+    r.Fail(node[key], f + "." + key, why);
+  };
   const auto whole = [&](const char* key, int value, int low, int high) {
     if (!node[key]) return;
     if (value < low) fail(key, "expected a whole number >= " + std::to_string(low));
-    if (value > high) fail(key, "expected at most " + std::to_string(high) + ", got " + std::to_string(value));
+    if (value > high)
+      fail(key, "expected at most " + std::to_string(high) + ", got " + std::to_string(value));
   };
   const auto positive = [&](const char* key, double value) {
     if (!node[key]) return;
@@ -395,7 +400,8 @@ void ReadOptimizer(const Reader& r, const YAML::Node& node, OptimizerSpec& o) {
   if (node["start"] && o.start != "sequential" && o.start != "random" && o.start != "beam") {
     fail("start", "expected sequential, random or beam");
   }
-  if (node["method"] && o.method != "replace" && o.method != "beam") fail("method", "expected replace or beam");
+  if (node["method"] && o.method != "replace" && o.method != "beam")
+    fail("method", "expected replace or beam");
   positive("time_budget_s", o.time_budget_s);
   if (node["seed"] && (seed < 0 || seed > 1000000000)) fail("seed", "expected a whole number >= 0");
   o.seed = static_cast<uint64_t>(seed);
@@ -404,7 +410,8 @@ void ReadOptimizer(const Reader& r, const YAML::Node& node, OptimizerSpec& o) {
   whole("changes_per_turn", o.changes_per_turn, 1, 1000000000);
   whole("beam_width", o.beam_width, 1, 65535);
   if (node["collision_pick_fraction"]) {
-    if (!std::isfinite(o.collision_pick_fraction)) fail("collision_pick_fraction", "expected a finite number");
+    if (!std::isfinite(o.collision_pick_fraction))
+      fail("collision_pick_fraction", "expected a finite number");
     if (o.collision_pick_fraction < 0) fail("collision_pick_fraction", "must be >= 0");
     if (o.collision_pick_fraction > 1) fail("collision_pick_fraction", "expected 0 to 1");
   }
@@ -421,15 +428,19 @@ void ReadLengthTop(const Reader& r, const YAML::Node& node, AnimationSpec& spec)
     keys.Add("frames", &fixed, "a whole number >= 1", "every sequence is this long")
         .Add("min_frames", &min_frames, "a whole number >= 1", "sequences shorter are penalized")
         .Add("max_frames", &max_frames, "a whole number >= 1", "the longest sequence")
-        .Add("initial_frames", &initial_frames, "a whole number >= 1", "length of random initial sequences")
+        .Add("initial_frames", &initial_frames, "a whole number >= 1",
+             "length of random initial sequences")
         .Add("strength", &strength, "a number", "weight of the length term");
     ReadBound(r, keys, node, "length");
-    for (const auto& [key, value] : {std::pair{"frames", fixed}, std::pair{"min_frames", min_frames},
-                                     std::pair{"max_frames", max_frames}, std::pair{"initial_frames", initial_frames}}) {
-      if (node[key] && value < 1) r.Fail(node[key], std::string("length.") + key, "expected a whole number >= 1");
+    for (const auto& [key, value] :
+         {std::pair{"frames", fixed}, std::pair{"min_frames", min_frames},
+          std::pair{"max_frames", max_frames}, std::pair{"initial_frames", initial_frames}}) {
+      if (node[key] && value < 1)
+        r.Fail(node[key], std::string("length.") + key, "expected a whole number >= 1");
     }
     if (strength && (!std::isfinite(*strength) || *strength < 0)) {
-      r.Fail(node["strength"], "length.strength", std::isfinite(*strength) ? "must be >= 0" : "expected a finite number");
+      r.Fail(node["strength"], "length.strength",
+             std::isfinite(*strength) ? "must be >= 0" : "expected a finite number");
     }
     if (node["frames"] && (node["min_frames"] || node["max_frames"])) {
       r.Fail(node["frames"], "length.frames", "give either frames (fixed) or min/max_frames");

@@ -124,18 +124,20 @@ class Validator {
     if (c.gain_db) NonNegative(*c.gain_db, Child(path, "gain_db"));
     Positive(c.white_balance.red_gain, Child(path, "white_balance.red_gain"));
     Positive(c.white_balance.blue_gain, Child(path, "white_balance.blue_gain"));
-    Check(c.white_balance.temperature_k == 0 ||
-              (c.white_balance.temperature_k >= 1500 && c.white_balance.temperature_k <= 15000),
-          Child(path, "white_balance.temperature_k"),
-          "expected a colour temperature of 1500-15000 K, got " + Num(c.white_balance.temperature_k));
+    Check(
+        c.white_balance.temperature_k == 0 ||
+            (c.white_balance.temperature_k >= 1500 && c.white_balance.temperature_k <= 15000),
+        Child(path, "white_balance.temperature_k"),
+        "expected a colour temperature of 1500-15000 K, got " + Num(c.white_balance.temperature_k));
     // How each backend fixes white balance: V4L2 as a colour temperature, GenICam as ratios.
     if (c.white_balance.mode == WhiteBalanceMode::kManual && c.source == "v4l2") {
       Check(c.white_balance.temperature_k > 0, Child(path, "white_balance.temperature_k"),
             "V4L2 devices fix white balance as a colour temperature: give temperature_k");
     }
     if (c.source == "aravis") {
-      Check(c.white_balance.temperature_k == 0, Child(path, "white_balance.temperature_k"),
-            "GigE Vision cameras fix white balance as red/blue ratios: give red_gain and blue_gain");
+      Check(
+          c.white_balance.temperature_k == 0, Child(path, "white_balance.temperature_k"),
+          "GigE Vision cameras fix white balance as red/blue ratios: give red_gain and blue_gain");
     }
     Exists(c.model, Child(path, "model"), "camera model");
   }
@@ -250,7 +252,8 @@ class Validator {
     }
     Check(s.stop_recording_below_mib >= 0, "storage.stop_recording_below_mib",
           "expected a size >= 0, got " + std::to_string(s.stop_recording_below_mib));
-    Check(s.spool_max_mib >= 1, "storage.spool_max_mib", "expected a size >= 1, got " + std::to_string(s.spool_max_mib));
+    Check(s.spool_max_mib >= 1, "storage.spool_max_mib",
+          "expected a size >= 1, got " + std::to_string(s.spool_max_mib));
     Check(s.stop_sprites_below_mib >= 0, "storage.stop_sprites_below_mib",
           "expected a size >= 0, got " + std::to_string(s.stop_sprites_below_mib));
     // Raw recording must stop first: its low-water mark is never below the sprites' one.

@@ -22,29 +22,32 @@ OptionsBinder& OptionsBinder::AddRead(std::string key, std::string default_text,
   return *this;
 }
 
-OptionsBinder& OptionsBinder::Add(std::string key, int* field, std::string expected, std::string doc) {
+OptionsBinder& OptionsBinder::Add(std::string key, int* field, std::string expected,
+                                  std::string doc) {
   return AddRead(std::move(key), std::to_string(*field), std::move(doc),
                  [field, expected](YamlReader& r, const YamlMap& view, const std::string& k) {
                    return r.Int(view, k, *field, expected);
                  });
 }
 
-OptionsBinder& OptionsBinder::Add(std::string key, int64_t* field, std::string expected, std::string doc) {
+OptionsBinder& OptionsBinder::Add(std::string key, int64_t* field, std::string expected,
+                                  std::string doc) {
   return AddRead(std::move(key), std::to_string(*field), std::move(doc),
                  [field, expected](YamlReader& r, const YamlMap& view, const std::string& k) {
                    return r.Int64(view, k, *field, expected);
                  });
 }
 
-OptionsBinder& OptionsBinder::Add(std::string key, double* field, std::string expected, std::string doc) {
+OptionsBinder& OptionsBinder::Add(std::string key, double* field, std::string expected,
+                                  std::string doc) {
   return AddRead(std::move(key), Num(*field), std::move(doc),
                  [field, expected](YamlReader& r, const YamlMap& view, const std::string& k) {
                    return r.Number(view, k, *field, expected);
                  });
 }
 
-OptionsBinder& OptionsBinder::Add(std::string key, std::optional<double>* field, std::string expected,
-                                  std::string doc) {
+OptionsBinder& OptionsBinder::Add(std::string key, std::optional<double>* field,
+                                  std::string expected, std::string doc) {
   return AddRead(std::move(key), *field ? Num(**field) : "unset", std::move(doc),
                  [field, expected](YamlReader& r, const YamlMap& view, const std::string& k) {
                    double v = 0;
@@ -118,7 +121,8 @@ std::vector<std::string> OptionsBinder::Keys() const {
 std::string OptionsBinder::Describe(const std::string& prefix) const {
   std::string out;
   for (const Binding& b : bindings_) {
-    out += Child(prefix, b.key) + ": " + b.default_text + (b.doc.empty() ? "" : "  # " + b.doc) + "\n";
+    out +=
+        Child(prefix, b.key) + ": " + b.default_text + (b.doc.empty() ? "" : "  # " + b.doc) + "\n";
   }
   return out;
 }

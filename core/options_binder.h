@@ -24,14 +24,16 @@ class OptionsBinder {
   OptionsBinder& Add(std::string key, int* field, std::string expected, std::string doc);
   OptionsBinder& Add(std::string key, int64_t* field, std::string expected, std::string doc);
   OptionsBinder& Add(std::string key, double* field, std::string expected, std::string doc);
-  OptionsBinder& Add(std::string key, std::optional<double>* field, std::string expected, std::string doc);
+  OptionsBinder& Add(std::string key, std::optional<double>* field, std::string expected,
+                     std::string doc);
   OptionsBinder& Add(std::string key, bool* field, std::string doc);
   OptionsBinder& Add(std::string key, std::string* field, std::string expected, std::string doc);
   // A file or folder, resolved against the file's folder.
   OptionsBinder& AddPath(std::string key, std::string* field, std::string doc);
   // One of a closed set's texts (core/enum_text.h).
   template <typename E, size_t N>
-  OptionsBinder& AddEnum(std::string key, E* field, const EnumText<E> (&texts)[N], std::string doc) {
+  OptionsBinder& AddEnum(std::string key, E* field, const EnumText<E> (&texts)[N],
+                         std::string doc) {
     return AddRead(std::move(key), TextOf(*field, texts), std::move(doc),
                    [field, &texts](YamlReader& r, const YamlMap& view, const std::string& k) {
                      return r.Enum(view, k, *field, texts);

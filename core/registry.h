@@ -23,7 +23,8 @@ class PartRegistry {
 
   // A second part of the same name is a bug: WorkError.
   void Add(const std::string& name, Part part) {
-    if (!parts_.emplace(name, std::move(part)).second) throw WorkError(kind_ + " " + name, "registered twice");
+    if (!parts_.emplace(name, std::move(part)).second)
+      throw WorkError(kind_ + " " + name, "registered twice");
   }
   // nullptr when no part of that name is built in.
   const Part* Find(const std::string& name) {

@@ -61,7 +61,9 @@ std::string Child(const std::string& path, const std::string& key) {
   return path.empty() ? key : path + "." + key;
 }
 
-std::string Index(const std::string& path, size_t i) { return path + "[" + std::to_string(i) + "]"; }
+std::string Index(const std::string& path, size_t i) {
+  return path + "[" + std::to_string(i) + "]";
+}
 
 int LineOf(const YAML::Node& node) {
   const YAML::Mark mark = node.Mark();
@@ -79,7 +81,8 @@ std::string ShapeOf(const YAML::Node& node) {
 
 using namespace yaml_text;
 
-void YamlMessages::Error(const std::string& path, const std::string& reason, const std::string& line_of) {
+void YamlMessages::Error(const std::string& path, const std::string& reason,
+                         const std::string& line_of) {
   errors.push_back(Where(line_of.empty() ? path : line_of) + path + ": " + reason);
   failed.insert(path);
 }
@@ -115,7 +118,8 @@ YamlMap::YamlMap(const YAML::Node& node, std::string path, YamlMessages& msg,
     if (key.empty()) {
       const std::string name = path_.empty() ? "(top level)" : path_;
       lines.emplace(name, LineOf(it->first));
-      msg.Error(name, "a key at line " + std::to_string(LineOf(it->first)) + " is not a plain name");
+      msg.Error(name,
+                "a key at line " + std::to_string(LineOf(it->first)) + " is not a plain name");
       continue;
     }
     if (entries_.count(key)) {
@@ -136,7 +140,8 @@ const YAML::Node* YamlMap::Find(const std::string& key) const {
 
 void YamlReader::Known(const YamlMap& view, const std::vector<std::string>& known) {
   for (const auto& [key, entry] : view.entries()) {
-    if (!OneOf(key, known)) msg_.Error(Child(view.path(), key), "unknown key" + Suggest(key, known));
+    if (!OneOf(key, known))
+      msg_.Error(Child(view.path(), key), "unknown key" + Suggest(key, known));
   }
 }
 

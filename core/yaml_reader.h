@@ -24,7 +24,7 @@ std::string Num(double v);  // short form of a number for messages ("25", "0.5")
 // " (did you mean "fps"?)" for a near miss among `known`, else "".
 std::string Suggest(const std::string& key, const std::vector<std::string>& known);
 std::string Child(const std::string& path, const std::string& key);  // "a.b"
-std::string Index(const std::string& path, size_t i);               // "a[3]"
+std::string Index(const std::string& path, size_t i);                // "a[3]"
 int LineOf(const YAML::Node& node);                                  // 1-based; 0 when unknown
 std::string ShapeOf(const YAML::Node& node);  // "\"text\"", "a list", "a mapping", "nothing"
 }  // namespace yaml_text
@@ -103,7 +103,8 @@ class YamlReader {
            const std::string& expected = "an integer") {
     return Scalar(view, key, out, expected);
   }
-  bool Int64(const YamlMap& view, const std::string& key, int64_t& out, const std::string& expected);
+  bool Int64(const YamlMap& view, const std::string& key, int64_t& out,
+             const std::string& expected);
   bool Bool(const YamlMap& view, const std::string& key, bool& out) {
     return Scalar(view, key, out, "true or false");
   }
@@ -118,7 +119,8 @@ class YamlReader {
     return ToEnum(text, texts, yaml_text::Child(view.path(), key), out);
   }
   template <typename E, size_t N>
-  bool ToEnum(const std::string& text, const EnumText<E> (&texts)[N], const std::string& path, E& out) {
+  bool ToEnum(const std::string& text, const EnumText<E> (&texts)[N], const std::string& path,
+              E& out) {
     std::vector<std::string> names;
     for (const EnumText<E>& t : texts) {
       if (text == t.text) {
@@ -127,7 +129,8 @@ class YamlReader {
       }
       names.push_back(t.text);
     }
-    msg_.Error(path, "expected one of " + yaml_text::Join(names) + ", got " + yaml_text::Quoted(text));
+    msg_.Error(path,
+               "expected one of " + yaml_text::Join(names) + ", got " + yaml_text::Quoted(text));
     return false;
   }
   // A path, resolved against the file's folder.
@@ -136,7 +139,9 @@ class YamlReader {
 
   YamlMessages& msg() { return msg_; }
   // Records where a list item sits, for messages about it.
-  void Mark(const std::string& path, const YAML::Node& node) { lines_[path] = yaml_text::LineOf(node); }
+  void Mark(const std::string& path, const YAML::Node& node) {
+    lines_[path] = yaml_text::LineOf(node);
+  }
 
  private:
   YamlMessages& msg_;

@@ -335,6 +335,8 @@ ChromaKeyerOptions ChromaKeyerOptionsFrom(const KeyingConfig& k) {
   return o;
 }
 
-void RegisterChromaKeyer() { RegisterKeyerType<ChromaKeyer>(KeyingMethod::kChroma, ChromaKeyerOptionsFrom); }
+void RegisterChromaKeyer() {
+  RegisterKeyerType<ChromaKeyer>(KeyingMethod::kChroma, ChromaKeyerOptionsFrom);
+}
 
 }  // namespace ss

@@ -88,7 +88,8 @@ bool CleanPlateKeyerOptions::IsValid(std::string* why) const {
   return check.ok();
 }
 
-CleanPlateKeyer::CleanPlateKeyer(CleanPlateKeyerOptions options) : Keyer(options.grid), options_(options) {
+CleanPlateKeyer::CleanPlateKeyer(CleanPlateKeyerOptions options)
+    : Keyer(options.grid), options_(options) {
   if (std::string why; !options_.IsValid(&why)) throw InputError("keying.clean_plate." + why);
 }
 

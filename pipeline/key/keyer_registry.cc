@@ -25,7 +25,9 @@ void RegisterKeyer(KeyerKind kind) {
 
 std::unique_ptr<Keyer> MakeKeyer(const KeyingConfig& keying, int shadow_reach_cells) {
   const KeyerKind* kind = Keyers().Find(ToText(keying.method));
-  if (!kind) throw InputError("keying.method", std::string("no keyer for ") + ToText(keying.method) + " is built in");
+  if (!kind)
+    throw InputError("keying.method",
+                     std::string("no keyer for ") + ToText(keying.method) + " is built in");
   return kind->make(keying, shadow_reach_cells);
 }
 

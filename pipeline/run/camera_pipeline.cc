@@ -25,8 +25,10 @@ std::unique_ptr<Keyer> KeyerFor(const CameraPipelineOptions& o, const CameraMode
                                 const GroundPolygon& floor) {
   if (!o.keying) return std::make_unique<ChromaKeyer>();
   int shadow_reach_cells = 0;
-  if (const double px_per_m = FloorPixelsPerMetre(model, floor); o.keying->shadow_reach_m > 0 && px_per_m > 0) {
-    const int cells = static_cast<int>(std::ceil(o.keying->shadow_reach_m * px_per_m / GridOptions{}.step));
+  if (const double px_per_m = FloorPixelsPerMetre(model, floor);
+      o.keying->shadow_reach_m > 0 && px_per_m > 0) {
+    const int cells =
+        static_cast<int>(std::ceil(o.keying->shadow_reach_m * px_per_m / GridOptions{}.step));
     shadow_reach_cells = std::clamp(cells, 1, 64);
   }
   return MakeKeyer(*o.keying, shadow_reach_cells);
@@ -37,7 +39,8 @@ std::unique_ptr<Keyer> KeyerFor(const CameraPipelineOptions& o, const CameraMode
 CameraPipelineOptions PipelineOptionsFromConfig(const StationConfig& config) {
   const PipelineConfig& p = config.pipeline;
   CameraPipelineOptions o;
-  o.keying = config.keying;  // each keyer reads its own block (docs/keying.md, "From the station config")
+  // Each keyer reads its own block (docs/keying.md, "From the station config").
+  o.keying = config.keying;
   o.extract.min_area = p.min_area_px;
   o.usability.border_margin_px = p.border_margin_px;
   o.usability.floor_margin_px = p.floor_margin_px;
@@ -53,13 +56,14 @@ CameraPipelineOptions PipelineOptionsFromConfig(const StationConfig& config) {
   return o;
 }
 
-CameraPipeline::CameraPipeline(std::string name, int64_t camera_id, CameraModel model, GroundPolygon floor,
-                               CameraPipelineOptions options)
+CameraPipeline::CameraPipeline(std::string name, int64_t camera_id, CameraModel model,
+                               GroundPolygon floor, CameraPipelineOptions options)
     : name_(std::move(name)),
       camera_id_(camera_id),
       model_(model.valid() ? std::move(model)
-                           : throw InputError(name_, "the camera has no model: calibrate it first "
-                                                     "(spritestation calibrate)")),
+                           : throw InputError(name_,
+                                              "the camera has no model: calibrate it first "
+                                              "(spritestation calibrate)")),
       options_(options),
       keyer_(KeyerFor(options, model_, floor)),
       floor_mask_(model_, floor, options.usability),

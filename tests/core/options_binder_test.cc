@@ -28,7 +28,8 @@ OptionsBinder Keys(Options& o) {
 }
 
 // Reads `yaml` as the block `path`; the messages, one per line.
-std::vector<std::string> Read(const std::string& yaml, Options& o, const std::string& path = "keying") {
+std::vector<std::string> Read(const std::string& yaml, Options& o,
+                              const std::string& path = "keying") {
   std::map<std::string, int> lines;
   YamlMessages msg("station.yaml", lines);
   YamlReader r(msg, lines, "/studio");
@@ -55,13 +56,17 @@ TEST(OptionsBinder, KeysNotGivenKeepTheirDefaults) {
 TEST(OptionsBinder, ErrorsNameTheFileLineAndFullKey) {
   Options o;
   EXPECT_EQ(Read("frames: 5\nblock:\n  lw: 12\n", o),
-            std::vector<std::string>{"station.yaml:3: keying.block.lw: unknown key (did you mean \"low\"?)"});
+            std::vector<std::string>{
+                "station.yaml:3: keying.block.lw: unknown key (did you mean \"low\"?)"});
   EXPECT_EQ(Read("frames: many\n", o),
-            std::vector<std::string>{"station.yaml:1: keying.frames: expected a number of frames, got \"many\""});
+            std::vector<std::string>{
+                "station.yaml:1: keying.frames: expected a number of frames, got \"many\""});
   EXPECT_EQ(Read("colour: blue\n", o),
-            std::vector<std::string>{"station.yaml:1: keying.colour: expected one of red, green, got \"blue\""});
+            std::vector<std::string>{
+                "station.yaml:1: keying.colour: expected one of red, green, got \"blue\""});
   EXPECT_EQ(Read("block: 3\n", o),
-            std::vector<std::string>{"station.yaml:1: keying.block: expected a mapping of keys, got \"3\""});
+            std::vector<std::string>{
+                "station.yaml:1: keying.block: expected a mapping of keys, got \"3\""});
 }
 
 TEST(OptionsBinder, DescribesEveryKeyWithItsDefault) {
