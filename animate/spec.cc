@@ -5,11 +5,15 @@
 #include <filesystem>
 #include <fstream>
 #include <initializer_list>
+#include <map>
+#include <optional>
+#include <utility>
 #include <sstream>
 
 #include <yaml-cpp/yaml.h>
 
 #include "core/error.h"
+#include "core/options_binder.h"
 
 namespace ss {
 namespace {
@@ -348,74 +352,114 @@ CollisionSpec ReadCollision(const Reader& r, const AnimationSpec& spec, const YA
   return out;
 }
 
+// Reads `node` as the block `field` with `keys` (the station config's reader,
+// core/options_binder.h: types, unknown keys) and throws its first mistake: a spec stops there.
+void ReadBound(const Reader& r, const OptionsBinder& keys, const YAML::Node& node,
+               const std::string& field) {
+  std::map<std::string, int> lines;
+  YamlMessages msg(r.origin(), lines);
+  YamlReader reader(msg, lines, fs::path(r.origin()).parent_path().string());
+  if (!node.IsMap()) r.Fail(node, field, "expected a map");
+  keys.Read(reader, node, field);
+  if (!msg.errors.empty()) throw InputError(msg.errors.front());
+}
+
 void ReadOptimizer(const Reader& r, const YAML::Node& node, OptimizerSpec& o) {
   const std::string f = "optimizer";
-  r.Map(node, f, {"method", "start", "time_budget_s", "seed", "set_size", "threads",
-                  "changes_per_turn", "beam_width", "snapshot_every_s", "collision_pick_fraction"});
-  if (node["start"]) {
-    o.start = r.Text(node["start"], f + ".start");
-    if (o.start != "sequential" && o.start != "random" && o.start != "beam") {
-      r.Fail(node["start"], f + ".start", "expected sequential, random or beam");
-    }
+  int64_t seed = static_cast<int64_t>(o.seed);
+  OptionsBinder keys;
+  keys.Add("method", &o.method, "a string", "replace or beam")
+      .Add("start", &o.start, "a string", "replacement's start: sequential, random or beam")
+      .Add("time_budget_s", &o.time_budget_s, "a number", "seconds the optimizer may run")
+      .Add("seed", &seed, "a whole number >= 0", "the random generator's seed")
+      .Add("set_size", &o.set_size, "a whole number >= 2", "N of the F/B sets")
+      .Add("threads", &o.threads, "a whole number >= 1", "worker threads")
+      .Add("changes_per_turn", &o.changes_per_turn, "a whole number >= 1", "picks per sprite turn")
+      .Add("beam_width", &o.beam_width, "a whole number >= 1", "the beam search's width")
+      .Add("snapshot_every_s", &o.snapshot_every_s, "a number",
+           "> 0: keep the sequences every so many seconds")
+      .Add("collision_pick_fraction", &o.collision_pick_fraction, "a number",
+           "replacement's picks aimed at a collision, 0 to 1");
+  ReadBound(r, keys, node, f);
+  // The bounds; those of the optimizer (ReplacementOptions::IsValid, beam search) are checked
+  // here so that the message names the spec's file, line and field rather than the optimizer's.
+  const auto fail = [&](const char* key, const std::string& why) {
+    r.Fail(node[key], f + "." + key, why);
+  };
+  const auto whole = [&](const char* key, int value, int low, int high) {
+    if (!node[key]) return;
+    if (value < low) fail(key, "expected a whole number >= " + std::to_string(low));
+    if (value > high)
+      fail(key, "expected at most " + std::to_string(high) + ", got " + std::to_string(value));
+  };
+  const auto positive = [&](const char* key, double value) {
+    if (!node[key]) return;
+    if (!std::isfinite(value)) fail(key, "expected a finite number");
+    if (value <= 0) fail(key, "must be > 0");
+  };
+  if (node["start"] && o.start != "sequential" && o.start != "random" && o.start != "beam") {
+    fail("start", "expected sequential, random or beam");
   }
-  if (node["method"]) {
-    o.method = r.Text(node["method"], f + ".method");
-    if (o.method != "replace" && o.method != "beam") {
-      r.Fail(node["method"], f + ".method", "expected replace or beam");
-    }
-  }
-  if (node["time_budget_s"]) o.time_budget_s = r.Positive(node["time_budget_s"], f + ".time_budget_s");
-  if (node["seed"]) o.seed = static_cast<uint64_t>(r.Integer(node["seed"], f + ".seed", 0));
-  // The bounds are the optimizer's (ReplacementOptions::IsValid, beam search), checked here so
-  // that the message names the spec's file, line and field rather than the optimizer's own.
-  if (node["set_size"]) o.set_size = r.IntegerIn(node["set_size"], f + ".set_size", 2, 65535);
-  if (node["threads"]) o.threads = r.IntegerIn(node["threads"], f + ".threads", 1, 256);
-  if (node["changes_per_turn"]) {
-    o.changes_per_turn = r.Integer(node["changes_per_turn"], f + ".changes_per_turn", 1);
-  }
-  if (node["beam_width"]) o.beam_width = r.IntegerIn(node["beam_width"], f + ".beam_width", 1, 65535);
+  if (node["method"] && o.method != "replace" && o.method != "beam")
+    fail("method", "expected replace or beam");
+  positive("time_budget_s", o.time_budget_s);
+  if (node["seed"] && (seed < 0 || seed > 1000000000)) fail("seed", "expected a whole number >= 0");
+  o.seed = static_cast<uint64_t>(seed);
+  whole("set_size", o.set_size, 2, 65535);
+  whole("threads", o.threads, 1, 256);
+  whole("changes_per_turn", o.changes_per_turn, 1, 1000000000);
+  whole("beam_width", o.beam_width, 1, 65535);
   if (node["collision_pick_fraction"]) {
-    o.collision_pick_fraction = r.AtLeast(node["collision_pick_fraction"], f + ".collision_pick_fraction", 0.0);
-    if (o.collision_pick_fraction > 1) {
-      r.Fail(node["collision_pick_fraction"], f + ".collision_pick_fraction", "expected 0 to 1");
-    }
+    if (!std::isfinite(o.collision_pick_fraction))
+      fail("collision_pick_fraction", "expected a finite number");
+    if (o.collision_pick_fraction < 0) fail("collision_pick_fraction", "must be >= 0");
+    if (o.collision_pick_fraction > 1) fail("collision_pick_fraction", "expected 0 to 1");
   }
-  if (node["snapshot_every_s"]) {
-    o.snapshot_every_s = r.Positive(node["snapshot_every_s"], f + ".snapshot_every_s");
-  }
+  positive("snapshot_every_s", o.snapshot_every_s);
 }
 
 void ReadLengthTop(const Reader& r, const YAML::Node& node, AnimationSpec& spec) {
+  int fixed = 0, min_frames = 0, max_frames = 0, initial_frames = 0;
+  std::optional<double> strength;
   if (node.IsScalar()) {
-    spec.fixed_frames = r.Integer(node, "length", 1);
+    fixed = r.Integer(node, "length", 1);
   } else {
-    r.Map(node, "length", {"frames", "min_frames", "max_frames", "initial_frames", "strength"});
-    if (node["frames"]) {
-      if (node["min_frames"] || node["max_frames"]) {
-        r.Fail(node["frames"], "length.frames", "give either frames (fixed) or min/max_frames");
-      }
-      spec.fixed_frames = r.Integer(node["frames"], "length.frames", 1);
+    OptionsBinder keys;
+    keys.Add("frames", &fixed, "a whole number >= 1", "every sequence is this long")
+        .Add("min_frames", &min_frames, "a whole number >= 1", "sequences shorter are penalized")
+        .Add("max_frames", &max_frames, "a whole number >= 1", "the longest sequence")
+        .Add("initial_frames", &initial_frames, "a whole number >= 1",
+             "length of random initial sequences")
+        .Add("strength", &strength, "a number", "weight of the length term");
+    ReadBound(r, keys, node, "length");
+    for (const auto& [key, value] :
+         {std::pair{"frames", fixed}, std::pair{"min_frames", min_frames},
+          std::pair{"max_frames", max_frames}, std::pair{"initial_frames", initial_frames}}) {
+      if (node[key] && value < 1)
+        r.Fail(node[key], std::string("length.") + key, "expected a whole number >= 1");
     }
-    if (node["max_frames"]) spec.max_frames = r.Integer(node["max_frames"], "length.max_frames", 1);
-    if (node["initial_frames"]) {
-      spec.initial_frames = r.Integer(node["initial_frames"], "length.initial_frames", 1);
+    if (strength && (!std::isfinite(*strength) || *strength < 0)) {
+      r.Fail(node["strength"], "length.strength",
+             std::isfinite(*strength) ? "must be >= 0" : "expected a finite number");
     }
-    if (node["min_frames"]) {
-      spec.length = LengthSpec{r.Integer(node["min_frames"], "length.min_frames", 1),
-                               ReadStrength(r, node, "length", 1.0)};
-      if (spec.max_frames > 0 && spec.max_frames < spec.length->min_frames) {
+    if (node["frames"] && (node["min_frames"] || node["max_frames"])) {
+      r.Fail(node["frames"], "length.frames", "give either frames (fixed) or min/max_frames");
+    }
+    spec.max_frames = max_frames;
+    if (initial_frames > 0) spec.initial_frames = initial_frames;
+    if (min_frames > 0) {
+      spec.length = LengthSpec{min_frames, strength.value_or(1.0)};
+      if (spec.max_frames > 0 && spec.max_frames < min_frames) {
         r.Fail(node["max_frames"], "length.max_frames", "is below length.min_frames");
       }
     }
   }
-  if (spec.fixed_frames > 0) {
+  if (fixed > 0) {
     // A fixed length: sequences are cut at N and strongly held to N.
-    const double strength = node.IsMap() && node["strength"]
-                                ? r.AtLeast(node["strength"], "length.strength", 0)
-                                : 100.0;
-    spec.max_frames = spec.fixed_frames;
-    spec.initial_frames = spec.fixed_frames;
-    spec.length = LengthSpec{spec.fixed_frames, strength};
+    spec.fixed_frames = fixed;
+    spec.max_frames = fixed;
+    spec.initial_frames = fixed;
+    spec.length = LengthSpec{fixed, strength.value_or(100.0)};
   }
 }
 

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "core/enum_text.h"
 #include "core/geometry.h"
 
 namespace ss {
@@ -22,11 +23,6 @@ enum class WhiteBalanceMode { kDevice, kOnce, kManual };  // device: leave as is
 enum class KeyingMethod { kChroma, kCleanPlate };
 enum class RecordingMode { kOff, kAll, kUsable };  // all frames, or those that gave a usable sprite
 
-template <typename E>
-struct EnumText {
-  E value;
-  const char* text;
-};
 inline constexpr EnumText<WhiteBalanceMode> kWhiteBalanceModeTexts[] = {
     {WhiteBalanceMode::kDevice, "device"}, {WhiteBalanceMode::kOnce, "once"}, {WhiteBalanceMode::kManual, "manual"}};
 inline constexpr EnumText<KeyingMethod> kKeyingMethodTexts[] = {{KeyingMethod::kChroma, "chroma"},

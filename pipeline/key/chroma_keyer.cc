@@ -4,8 +4,10 @@
 #include <cmath>
 #include <string>
 
+#include "core/config.h"
 #include "core/error.h"
 #include "core/log.h"
+#include "pipeline/key/keyer_registry.h"
 
 namespace ss {
 namespace {
@@ -43,11 +45,9 @@ inline PixelKey KeyPixel(int b, int g, int r, float key_hi, float gain, int32_t 
 
 }  // namespace
 
-ChromaKeyer::ChromaKeyer(ChromaKeyerOptions options) : Keyer(options.grid), options_(options) {
-  const auto& o = options_;
-  auto check = [](bool ok, const char* field, const char* reason) {
-    if (!ok) throw InputError(std::string("keying.chroma.") + field, reason);
-  };
+bool ChromaKeyerOptions::IsValid(std::string* why) const {
+  const ChromaKeyerOptions& o = *this;
+  OptionChecks check(why);
   check(o.noise_z >= 0, "noise_z", "must not be negative");
   check(o.min_margin >= 0 && o.min_margin < 1, "min_margin", "must be within [0, 1)");
   check(o.ramp > 0 && o.ramp <= 2, "ramp", "must be within (0, 2]");
@@ -60,6 +60,11 @@ ChromaKeyer::ChromaKeyer(ChromaKeyerOptions options) : Keyer(options.grid), opti
   check(o.despill_bias >= 0 && o.despill_bias <= 1, "despill_bias", "must be within [0, 1]");
   check(o.despill_strength >= 0 && o.despill_strength <= 1, "despill_strength", "must be within [0, 1]");
   check(o.key_low_levels < 0 || o.key_high_levels > o.key_low_levels, "high", "must be above keying.chroma.low");
+  return check.ok();
+}
+
+ChromaKeyer::ChromaKeyer(ChromaKeyerOptions options) : Keyer(options.grid), options_(options) {
+  if (std::string why; !options_.IsValid(&why)) throw InputError("keying.chroma." + why);
 }
 
 void ChromaKeyer::Train(const std::vector<cv::Mat>& empty_bgr) {
@@ -317,6 +322,21 @@ void ChromaKeyer::FineRow(const uint8_t* row, ChannelOrder order, int y, int x0,
     ChromaRowBgr(row, x0, x1, p.f[kKeyHi], p.f[kGain], p.luma_floor, p.f[kInvLuma], p.f[kShadowBase], shadow_min,
                  despill256, strength256, keyable, alpha, shadow, colour);
   }
+}
+
+ChromaKeyerOptions ChromaKeyerOptionsFrom(const KeyingConfig& k) {
+  ChromaKeyerOptions o;
+  o.key_low_levels = k.chroma_low;
+  o.key_high_levels = k.chroma_high;
+  o.despill_strength = k.despill ? k.despill_strength : 0.0;
+  o.shadow = k.shadow;
+  o.shadow_min = k.shadow_min_darkening;
+  o.dark_floor = 1.0 - k.shadow_max_darkening;
+  return o;
+}
+
+void RegisterChromaKeyer() {
+  RegisterKeyerType<ChromaKeyer>(KeyingMethod::kChroma, ChromaKeyerOptionsFrom);
 }
 
 }  // namespace ss

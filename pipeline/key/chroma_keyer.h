@@ -17,6 +17,8 @@
 
 namespace ss {
 
+struct KeyingConfig;
+
 struct ChromaKeyerOptions {
   GridOptions grid;
   double noise_z = 5.0;         // background tolerance in noise std of the learned key...
@@ -37,7 +39,13 @@ struct ChromaKeyerOptions {
   double key_low_levels = -1;
   double key_high_levels = -1;
   bool global_model = false;    // one reference for the whole frame: the naive keyer, for comparison
+  // False with "FIELD: reason" in `why` when a value is out of its range.
+  bool IsValid(std::string* why) const;
 };
+
+// The options the station config's keying section sets (docs/keying.md, "From the station
+// config"): keying.chroma.*, keying.despill.*, keying.shadow.*; the others keep their defaults.
+ChromaKeyerOptions ChromaKeyerOptionsFrom(const KeyingConfig& keying);
 
 class ChromaKeyer : public Keyer {
  public:

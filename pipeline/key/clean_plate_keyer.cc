@@ -6,8 +6,10 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "core/config.h"
 #include "core/error.h"
 #include "core/log.h"
+#include "pipeline/key/keyer_registry.h"
 
 namespace ss {
 namespace {
@@ -72,11 +74,9 @@ SS_PLATE_ROW(PlateRowRgb, true)
 
 }  // namespace
 
-CleanPlateKeyer::CleanPlateKeyer(CleanPlateKeyerOptions options) : Keyer(options.grid), options_(options) {
-  const auto& o = options_;
-  auto check = [](bool ok, const char* field, const char* reason) {
-    if (!ok) throw InputError(std::string("keying.clean_plate.") + field, reason);
-  };
+bool CleanPlateKeyerOptions::IsValid(std::string* why) const {
+  const CleanPlateKeyerOptions& o = *this;
+  OptionChecks check(why);
   check(o.noise_z >= 0, "noise_z", "must not be negative");
   check(o.min_sigma > 0, "min_sigma", "must be positive");
   check(o.ramp > 0, "ramp", "must be positive");
@@ -85,6 +85,12 @@ CleanPlateKeyer::CleanPlateKeyer(CleanPlateKeyerOptions options) : Keyer(options
   check(o.coarse_alpha > 0 && o.coarse_alpha < 1, "coarse_alpha", "must be within (0, 1)");
   check(o.coarse_shadow > 0 && o.coarse_shadow < 1, "coarse_shadow", "must be within (0, 1)");
   check(o.ramp_sigma >= 0, "ramp_sigma", "must not be negative");
+  return check.ok();
+}
+
+CleanPlateKeyer::CleanPlateKeyer(CleanPlateKeyerOptions options)
+    : Keyer(options.grid), options_(options) {
+  if (std::string why; !options_.IsValid(&why)) throw InputError("keying.clean_plate." + why);
 }
 
 int CleanPlateKeyer::ShadowMin() const {
@@ -168,6 +174,20 @@ void CleanPlateKeyer::FineRow(const uint8_t* row, ChannelOrder order, int y, int
     PlateRowBgr(row, plate_.ptr<uint8_t>(y), tolerance_.ptr<float>(y), x0, x1, gain, dark_floor, shadow_min, alpha,
                 shadow, colour);
   }
+}
+
+CleanPlateKeyerOptions CleanPlateKeyerOptionsFrom(const KeyingConfig& k) {
+  CleanPlateKeyerOptions o;
+  o.noise_z = k.plate_low_sigma;
+  o.ramp_sigma = k.plate_high_sigma - k.plate_low_sigma;
+  o.shadow = k.shadow;
+  o.shadow_min = k.shadow_min_darkening;
+  o.dark_floor = 1.0 - k.shadow_max_darkening;
+  return o;
+}
+
+void RegisterCleanPlateKeyer() {
+  RegisterKeyerType<CleanPlateKeyer>(KeyingMethod::kCleanPlate, CleanPlateKeyerOptionsFrom);
 }
 
 }  // namespace ss

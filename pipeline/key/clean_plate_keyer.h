@@ -13,6 +13,8 @@
 
 namespace ss {
 
+struct KeyingConfig;
+
 struct CleanPlateKeyerOptions {
   GridOptions grid;
   double noise_z = 4.0;         // background tolerance, noise std (the false-positive rate of a 1-D z test)
@@ -24,7 +26,13 @@ struct CleanPlateKeyerOptions {
   double coarse_shadow = 0.12;  // a sample darkened more marks its cell as shaded
   double ramp_sigma = 0;        // > 0: the ramp is this many of the plate's mean noise std instead of `ramp`
   bool shadow = true;           // false: no contact-shadow layer (and no shaded cells)
+  // False with "FIELD: reason" in `why` when a value is out of its range.
+  bool IsValid(std::string* why) const;
 };
+
+// The options the station config's keying section sets (docs/keying.md, "From the station
+// config"): keying.clean_plate.*, keying.shadow.*; the others keep their defaults.
+CleanPlateKeyerOptions CleanPlateKeyerOptionsFrom(const KeyingConfig& keying);
 
 class CleanPlateKeyer : public Keyer {
  public:

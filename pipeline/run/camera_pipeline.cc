@@ -8,7 +8,7 @@
 #include "core/log.h"
 #include "pipeline/describe/sprite_description.h"
 #include "pipeline/key/chroma_keyer.h"
-#include "pipeline/key/clean_plate_keyer.h"
+#include "pipeline/key/keyer_registry.h"
 #include "pipeline/run/bank_scale.h"
 
 namespace ss {
@@ -20,20 +20,18 @@ double SecondsSince(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
-std::unique_ptr<Keyer> MakeKeyer(const CameraPipelineOptions& o, const CameraModel& model,
-                                 const GroundPolygon& floor) {
-  ChromaKeyerOptions chroma = o.chroma;
-  CleanPlateKeyerOptions plate = o.clean_plate;
-  if (const double px_per_m = FloorPixelsPerMetre(model, floor); o.shadow_reach_m > 0 && px_per_m > 0) {
-    const int cells = static_cast<int>(std::ceil(o.shadow_reach_m * px_per_m / chroma.grid.step));
-    chroma.grid.shadow_reach_cells = std::clamp(cells, 1, 64);
-    plate.grid.shadow_reach_cells = std::clamp(cells, 1, 64);
+// The keyer the options pick, its shadow reach made grid cells at the floor's scale.
+std::unique_ptr<Keyer> KeyerFor(const CameraPipelineOptions& o, const CameraModel& model,
+                                const GroundPolygon& floor) {
+  if (!o.keying) return std::make_unique<ChromaKeyer>();
+  int shadow_reach_cells = 0;
+  if (const double px_per_m = FloorPixelsPerMetre(model, floor);
+      o.keying->shadow_reach_m > 0 && px_per_m > 0) {
+    const int cells =
+        static_cast<int>(std::ceil(o.keying->shadow_reach_m * px_per_m / GridOptions{}.step));
+    shadow_reach_cells = std::clamp(cells, 1, 64);
   }
-  switch (o.keying_method) {
-    case KeyingMethod::kChroma: return std::make_unique<ChromaKeyer>(chroma);
-    case KeyingMethod::kCleanPlate: return std::make_unique<CleanPlateKeyer>(plate);
-  }
-  throw InputError("keying.method", "unknown keying method");
+  return MakeKeyer(*o.keying, shadow_reach_cells);
 }
 
 }  // namespace
@@ -41,18 +39,8 @@ std::unique_ptr<Keyer> MakeKeyer(const CameraPipelineOptions& o, const CameraMod
 CameraPipelineOptions PipelineOptionsFromConfig(const StationConfig& config) {
   const PipelineConfig& p = config.pipeline;
   CameraPipelineOptions o;
-  o.keying_method = config.keying.method;
-  // Keying (docs/keying.md, "From the station config").
-  const KeyingConfig& k = config.keying;
-  o.chroma.key_low_levels = k.chroma_low;
-  o.chroma.key_high_levels = k.chroma_high;
-  o.chroma.despill_strength = k.despill ? k.despill_strength : 0.0;
-  o.clean_plate.noise_z = k.plate_low_sigma;
-  o.clean_plate.ramp_sigma = k.plate_high_sigma - k.plate_low_sigma;
-  o.chroma.shadow = o.clean_plate.shadow = k.shadow;
-  o.chroma.shadow_min = o.clean_plate.shadow_min = k.shadow_min_darkening;
-  o.chroma.dark_floor = o.clean_plate.dark_floor = 1.0 - k.shadow_max_darkening;
-  o.shadow_reach_m = k.shadow_reach_m;
+  // Each keyer reads its own block (docs/keying.md, "From the station config").
+  o.keying = config.keying;
   o.extract.min_area = p.min_area_px;
   o.usability.border_margin_px = p.border_margin_px;
   o.usability.floor_margin_px = p.floor_margin_px;
@@ -68,15 +56,16 @@ CameraPipelineOptions PipelineOptionsFromConfig(const StationConfig& config) {
   return o;
 }
 
-CameraPipeline::CameraPipeline(std::string name, int64_t camera_id, CameraModel model, GroundPolygon floor,
-                               CameraPipelineOptions options)
+CameraPipeline::CameraPipeline(std::string name, int64_t camera_id, CameraModel model,
+                               GroundPolygon floor, CameraPipelineOptions options)
     : name_(std::move(name)),
       camera_id_(camera_id),
       model_(model.valid() ? std::move(model)
-                           : throw InputError(name_, "the camera has no model: calibrate it first "
-                                                     "(spritestation calibrate)")),
+                           : throw InputError(name_,
+                                              "the camera has no model: calibrate it first "
+                                              "(spritestation calibrate)")),
       options_(options),
-      keyer_(MakeKeyer(options, model_, floor)),
+      keyer_(KeyerFor(options, model_, floor)),
       floor_mask_(model_, floor, options.usability),
       extractor_(options.extract),
       tracker_(options.track),

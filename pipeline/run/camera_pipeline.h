@@ -20,8 +20,6 @@
 #include "core/geometry.h"
 #include "pipeline/extract/extractor.h"
 #include "pipeline/filter/usability.h"
-#include "pipeline/key/chroma_keyer.h"
-#include "pipeline/key/clean_plate_keyer.h"
 #include "pipeline/key/keyer.h"
 #include "pipeline/key/matte.h"
 #include "pipeline/rectify/rectifier.h"
@@ -32,11 +30,10 @@ namespace ss {
 
 // Everything a camera pipeline is tuned by, from the station config.
 struct CameraPipelineOptions {
-  KeyingMethod keying_method = KeyingMethod::kChroma;
-  ChromaKeyerOptions chroma;             // the keyer's options (config: keying.*)
-  CleanPlateKeyerOptions clean_plate;
-  double shadow_reach_m = 0;  // > 0: shaded cells join a subject this far (at the floor's centre), in
-                              // place of the keyers' grid.shadow_reach_cells
+  // The config's keying section: keying.method picks the keyer, which reads its own block
+  // (pipeline/key/keyer_registry.h); keying.shadow.reach_m (> 0) becomes its grid's
+  // shadow_reach_cells at the floor's centre. Unset: a chroma keyer with its own defaults.
+  std::optional<KeyingConfig> keying;
   ExtractorOptions extract;
   TrackerOptions track;
   UsabilityOptions usability;

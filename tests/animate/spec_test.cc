@@ -181,7 +181,19 @@ TEST_F(SpecTest, BadSpecsNameTheLineAndTheField) {
   EXPECT_EQ(ErrorOf(Edit("set_size: 50", "set_size: 50, threads: 100000")),
             o + ":7: optimizer.threads: expected at most 256, got 100000");
   // A mapping as a key (found by tests/fuzz: yaml-cpp's exception escaped and aborted).
-  EXPECT_EQ(ErrorOf(Edit("set_size: 50", "set_size: 50, {a: 1}: 2")), o + ":7: optimizer: a key that is not a plain name");
+  EXPECT_EQ(ErrorOf(Edit("set_size: 50", "set_size: 50, {a: 1}: 2")),
+            o + ":7: optimizer: a key at line 7 is not a plain name");
+  // The optimizer's and length's keys are read as the station config's are (core/options_binder.h).
+  EXPECT_EQ(ErrorOf(Edit("max_frames: 300", "max_frame: 300")),
+            o + ":3: length.max_frame: unknown key (did you mean \"max_frames\"?)");
+  EXPECT_EQ(ErrorOf(Edit("max_frames: 300", "max_frames: 50")),
+            o + ":3: length.max_frames: is below length.min_frames");
+  EXPECT_EQ(ErrorOf(Edit("min_frames: 100", "min_frames: 0")),
+            o + ":3: length.min_frames: expected a whole number >= 1");
+  EXPECT_EQ(ErrorOf(Edit("set_size: 50", "set_sise: 50")),
+            o + ":7: optimizer.set_sise: unknown key (did you mean \"set_size\"?)");
+  EXPECT_EQ(ErrorOf(Edit("set_size: 50", "set_size: 2.5")),
+            o + ":7: optimizer.set_size: expected a whole number >= 2, got \"2.5\"");
   EXPECT_NE(ErrorOf("sprites: [\n").find(o + ":"), std::string::npos);  // YAML syntax: a line too
 }
 

@@ -113,10 +113,10 @@ TEST(KeySynth, MedianAlphaIoUOnAStudioSessionBayer) {
   EXPECT_GE(MedianIoU(frames, 200), 0.9);
 }
 
-// The keyer as the station's default config sets it up (PipelineOptionsFromConfig: chroma
+// The keyer as the station's default config sets it up (ChromaKeyerOptionsFrom: chroma
 // low/high in levels, shadow thresholds, despill) keys the studio as well as the keyer's defaults.
 TEST(KeySynth, MedianAlphaIoUWithTheStationConfigDefaults) {
-  const ChromaKeyerOptions options = PipelineOptionsFromConfig(StationConfig{}).chroma;
+  const ChromaKeyerOptions options = ChromaKeyerOptionsFrom(KeyingConfig{});
   const std::vector<KeyedFrame> frames = KeySynthSession(3, PixelFormat::kRGB8, 16, 7, options);
   const double iou = MedianIoU(frames, 200);
   RecordProperty("median_iou", std::to_string(iou));

@@ -1,0 +1,25 @@
+#pragma once
+// Inside the station config's reader (core/config.cc), for its own files only:
+// config_keys.cc binds every key to its field, config_validate.cc checks values.
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "core/config.h"
+#include "core/options_binder.h"
+#include "core/yaml_reader.h"
+
+namespace ss::config_detail {
+
+extern const std::vector<std::string> kSources;    // a camera's `source`
+extern const std::vector<std::string> kLogLevels;  // logging.level and per component
+// Camera keys and the sources they apply to (empty: every source).
+extern const std::vector<std::pair<std::string, std::vector<std::string>>> kCameraKeys;
+
+// The whole file's keys, bound to `cfg`'s fields.
+OptionsBinder StationKeys(StationConfig& cfg);
+// Checks values and cross-field rules, adjusting what can be fixed; reports to `msg`.
+void Validate(StationConfig& cfg, YamlMessages& msg, const ConfigOptions& options);
+ConfigReport MakeReport(const YamlMessages& msg);
+
+}  // namespace ss::config_detail

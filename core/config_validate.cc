@@ -1,0 +1,335 @@
+// The station config's values and cross-field rules: Valid / Adjusted / Invalid with the reason
+// (core/config.h, ValidateStationConfig).
+#include <arpa/inet.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <filesystem>
+
+#include "core/config_detail.h"
+#include "core/frame.h"
+#include "core/recording_codecs.h"
+
+namespace ss {
+namespace config_detail {
+namespace {
+
+namespace fs = std::filesystem;
+using namespace yaml_text;
+using Messages = YamlMessages;
+
+bool IsIpAddress(const std::string& a) {
+  unsigned char buf[16];
+  return inet_pton(AF_INET, a.c_str(), buf) == 1 || inet_pton(AF_INET6, a.c_str(), buf) == 1;
+}
+
+bool ValidName(const std::string& name) {
+  return !name.empty() && std::all_of(name.begin(), name.end(), [](char c) {
+    return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' || c == '.';
+  }) && name[0] != '.';
+}
+
+class Validator {
+ public:
+  Validator(Messages& msg, const ConfigOptions& options) : msg_(msg), options_(options) {}
+
+  // Each check reports only when the field has no error from reading already.
+  void Check(bool ok, const std::string& path, const std::string& reason) {
+    if (!ok && !msg_.Failed(path)) msg_.Error(path, reason);
+  }
+  void Finite(double v, const std::string& path) {
+    Check(std::isfinite(v), path, "expected a finite number, got " + Num(v));
+  }
+  void Positive(double v, const std::string& path) {
+    Check(std::isfinite(v) && v > 0, path, "expected a positive number, got " + Num(v));
+  }
+  void NonNegative(double v, const std::string& path) {
+    Check(std::isfinite(v) && v >= 0, path, "expected a number >= 0, got " + Num(v));
+  }
+  void Range(double v, double lo, double hi, const std::string& path) {
+    Check(std::isfinite(v) && v >= lo && v <= hi, path,
+          "expected a number from " + Num(lo) + " to " + Num(hi) + ", got " + Num(v));
+  }
+  void Enum(const std::string& v, const std::vector<std::string>& options,
+            const std::string& path) {
+    Check(OneOf(v, options), path, "expected one of " + Join(options) + ", got " + Quoted(v));
+  }
+  void Exists(const std::string& file, const std::string& path, const std::string& what) {
+    if (!options_.check_files || file.empty()) return;
+    std::error_code ec;
+    Check(fs::exists(file, ec), path, file + ": no such " + what);
+  }
+
+  void Camera(CameraConfig& c, const std::string& path) {
+    Check(ValidName(c.name), Child(path, "name"),
+          c.name.empty() ? "every camera needs a name"
+                         : "expected letters, digits, '_', '-' or '.', got " + Quoted(c.name));
+    if (c.source.empty()) {
+      Check(false, Child(path, "source"),
+            "every camera needs a source (one of " + Join(kSources) + ")");
+      return;
+    }
+    Enum(c.source, kSources, Child(path, "source"));
+    if (c.source == "replay") {
+      Check(!c.session.empty(), Child(path, "session"),
+            "a replay camera needs the session folder it replays");
+      Exists(c.session.empty() ? "" : (fs::path(c.session) / "session.json").string(),
+             Child(path, "session"), "recorded session (session.json)");
+      if (c.session_camera.empty()) c.session_camera = c.name;
+    } else if (c.source == "v4l2") {
+      Check(!c.device.empty(), Child(path, "device"),
+            "a v4l2 camera needs its device, e.g. /dev/video0");
+    } else if (c.source == "aravis") {
+      Check(!c.camera_id.empty() || !c.address.empty(), Child(path, "camera_id"),
+            "an aravis camera needs camera_id or address");
+      Check(c.camera_id.empty() || c.address.empty(), Child(path, "address"),
+            "give camera_id or address, not both");
+      if (!c.address.empty()) {
+        Check(IsIpAddress(c.address), Child(path, "address"),
+              "expected an IP address, got " + Quoted(c.address));
+      }
+      Check(c.packet_size == 0 || (c.packet_size >= 576 && c.packet_size <= 16384),
+            Child(path, "packet_size"),
+            "expected 0 (negotiate) or 576..16384 bytes, got " + std::to_string(c.packet_size));
+    }
+    if (!c.pixel_format.empty()) {
+      Check(ParsePixelFormat(c.pixel_format).has_value(), Child(path, "pixel_format"),
+            "expected one of mono8, bayer_rg8, bayer_gr8, bayer_gb8, bayer_bg8, rgb8, bgr8, yuyv, "
+            "nv12, mjpeg, got " +
+                Quoted(c.pixel_format));
+    }
+    Check(c.width >= 0, Child(path, "width"),
+          "expected a width in pixels, got " + std::to_string(c.width));
+    Check(c.height >= 0, Child(path, "height"),
+          "expected a height in pixels, got " + std::to_string(c.height));
+    Check((c.width > 0) == (c.height > 0), Child(path, c.width > 0 ? "height" : "width"),
+          "give width and height together");
+    // Chroma-subsampled formats carry whole 2-pixel groups: round odd sizes down.
+    if ((c.pixel_format == "yuyv" || c.pixel_format == "nv12") && c.width % 2 == 1) {
+      msg_.Adjust(Child(path, "width"), std::to_string(c.width) + " is odd, which " +
+                                            c.pixel_format + " cannot carry; lowered to " +
+                                            std::to_string(c.width - 1));
+      --c.width;
+    }
+    if (c.pixel_format == "nv12" && c.height % 2 == 1) {
+      msg_.Adjust(Child(path, "height"), std::to_string(c.height) +
+                                             " is odd, which nv12 cannot carry; lowered to " +
+                                             std::to_string(c.height - 1));
+      --c.height;
+    }
+    Check(std::isfinite(c.fps) && c.fps >= 0, Child(path, "fps"),
+          "expected a positive number, got " + Num(c.fps));
+    if (c.exposure_us) Positive(*c.exposure_us, Child(path, "exposure_us"));
+    if (c.gain_db) NonNegative(*c.gain_db, Child(path, "gain_db"));
+    Positive(c.white_balance.red_gain, Child(path, "white_balance.red_gain"));
+    Positive(c.white_balance.blue_gain, Child(path, "white_balance.blue_gain"));
+    Check(
+        c.white_balance.temperature_k == 0 ||
+            (c.white_balance.temperature_k >= 1500 && c.white_balance.temperature_k <= 15000),
+        Child(path, "white_balance.temperature_k"),
+        "expected a colour temperature of 1500-15000 K, got " + Num(c.white_balance.temperature_k));
+    // How each backend fixes white balance: V4L2 as a colour temperature, GenICam as ratios.
+    if (c.white_balance.mode == WhiteBalanceMode::kManual && c.source == "v4l2") {
+      Check(c.white_balance.temperature_k > 0, Child(path, "white_balance.temperature_k"),
+            "V4L2 devices fix white balance as a colour temperature: give temperature_k");
+    }
+    if (c.source == "aravis") {
+      Check(
+          c.white_balance.temperature_k == 0, Child(path, "white_balance.temperature_k"),
+          "GigE Vision cameras fix white balance as red/blue ratios: give red_gain and blue_gain");
+    }
+    Exists(c.model, Child(path, "model"), "camera model");
+  }
+
+  void Run(StationConfig& cfg) {
+    Check(cfg.version == kConfigVersion, "version",
+          cfg.version > kConfigVersion
+              ? "written for a newer SpriteStation (config version " + std::to_string(cfg.version) +
+                    "); this one reads version " + std::to_string(kConfigVersion)
+              : "expected " + std::to_string(kConfigVersion) + ", got " +
+                    std::to_string(cfg.version));
+    std::map<std::string, size_t> names;
+    for (size_t i = 0; i < cfg.cameras.size(); ++i) {
+      const std::string path = Index("cameras", i);
+      Camera(cfg.cameras[i], path);
+      const auto [it, fresh] = names.emplace(cfg.cameras[i].name, i);
+      if (!fresh && !cfg.cameras[i].name.empty()) {
+        Check(false, Child(path, "name"),
+              Quoted(cfg.cameras[i].name) + " is already the name of " +
+                  Index("cameras", it->second));
+      }
+    }
+
+    KeyingConfig& k = cfg.keying;
+    Check(k.training_frames >= 1, "keying.training_frames",
+          "expected at least 1 frame, got " + std::to_string(k.training_frames));
+    Range(k.chroma_low, 0, 255, "keying.chroma.low");
+    Range(k.chroma_high, 0, 255, "keying.chroma.high");
+    Check(!(k.chroma_low >= k.chroma_high), "keying.chroma.high",
+          "must be above keying.chroma.low (" + Num(k.chroma_low) + "), got " + Num(k.chroma_high));
+    NonNegative(k.plate_low_sigma, "keying.clean_plate.low_sigma");
+    NonNegative(k.plate_high_sigma, "keying.clean_plate.high_sigma");
+    Check(!(k.plate_low_sigma >= k.plate_high_sigma), "keying.clean_plate.high_sigma",
+          "must be above keying.clean_plate.low_sigma (" + Num(k.plate_low_sigma) + "), got " +
+              Num(k.plate_high_sigma));
+    Finite(k.despill_strength, "keying.despill.strength");
+    if (std::isfinite(k.despill_strength) && (k.despill_strength < 0 || k.despill_strength > 1)) {
+      const double clamped = std::clamp(k.despill_strength, 0.0, 1.0);
+      msg_.Adjust("keying.despill.strength",
+                  Num(k.despill_strength) + " is outside 0..1; clamped to " + Num(clamped));
+      k.despill_strength = clamped;
+    }
+    Range(k.shadow_min_darkening, 0, 1, "keying.shadow.min_darkening");
+    Range(k.shadow_max_darkening, 0, 1, "keying.shadow.max_darkening");
+    Check(!(k.shadow_min_darkening >= k.shadow_max_darkening), "keying.shadow.max_darkening",
+          "must be above keying.shadow.min_darkening (" + Num(k.shadow_min_darkening) + "), got " +
+              Num(k.shadow_max_darkening));
+    Positive(k.shadow_reach_m, "keying.shadow.reach_m");
+
+    const auto& floor = cfg.enclosure.floor.vertices();
+    if (!floor.empty() && !msg_.Failed("enclosure.floor")) {
+      bool points_ok = true;
+      for (size_t i = 0; i < floor.size(); ++i)
+        points_ok = points_ok && !msg_.Failed(Index("enclosure.floor", i));
+      if (points_ok) {
+        Check(floor.size() >= 3, "enclosure.floor",
+              "a floor polygon needs at least 3 points, got " + std::to_string(floor.size()));
+        if (floor.size() >= 3) {
+          Check(
+              cfg.enclosure.floor.IsSimple(), "enclosure.floor",
+              "the polygon crosses itself, repeats a point, has a non-finite point or has no area "
+              "(list the corners in order around the floor)");
+        }
+      }
+    }
+    NonNegative(cfg.enclosure.wall_height_m, "enclosure.wall_height_m");
+
+    PipelineConfig& p = cfg.pipeline;
+    Check(p.min_area_px >= 1, "pipeline.min_area_px",
+          "expected at least 1 pixel, got " + std::to_string(p.min_area_px));
+    Check(p.border_margin_px >= 0, "pipeline.border_margin_px",
+          "expected a number >= 0, got " + std::to_string(p.border_margin_px));
+    Check(p.floor_margin_px >= 0, "pipeline.floor_margin_px",
+          "expected a number >= 0, got " + std::to_string(p.floor_margin_px));
+    NonNegative(p.wall_margin_m, "pipeline.wall_margin_m");
+    Positive(p.still_speed_m_per_s, "pipeline.still_speed_m_per_s");
+    Positive(p.max_speed_m_per_s, "pipeline.max_speed_m_per_s");
+    Positive(p.max_still_s, "pipeline.max_still_s");
+    Check(p.min_clip_frames >= 1, "pipeline.min_clip_frames",
+          "expected at least 1 frame, got " + std::to_string(p.min_clip_frames));
+    NonNegative(p.noise_thick_px, "pipeline.noise_thick_px");
+    for (const auto& [v, key] : {std::pair{p.noise_recover_solidity, "noise_recover_solidity"},
+                                 std::pair{p.noise_min_thick_share, "noise_min_thick_share"},
+                                 std::pair{p.noise_min_solidity, "noise_min_solidity"},
+                                 std::pair{p.noise_min_largest_share, "noise_min_largest_share"},
+                                 std::pair{p.noise_min_mean_alpha, "noise_min_mean_alpha"}}) {
+      Check(std::isfinite(v) && v >= 0 && v <= 1, std::string("pipeline.") + key,
+            "expected a share from 0 to 1 (0 turns the test off), got " + Num(v));
+    }
+    Check(p.px_per_m == 0 || (std::isfinite(p.px_per_m) && p.px_per_m > 0), "pipeline.px_per_m",
+          "expected auto or a positive number, got " + Num(p.px_per_m));
+    Check(p.workers >= 0, "pipeline.workers",
+          "expected 0 (one per core) or more, got " + std::to_string(p.workers));
+    Check(p.queue_frames >= 1, "pipeline.queue_frames",
+          "expected at least 1 frame, got " + std::to_string(p.queue_frames));
+    constexpr int kMaxQueue = 1024;
+    if (p.queue_frames > kMaxQueue) {
+      msg_.Adjust("pipeline.queue_frames", std::to_string(p.queue_frames) +
+                                               " would hold too many frames in memory; "
+                                               "lowered to " +
+                                               std::to_string(kMaxQueue));
+      p.queue_frames = kMaxQueue;
+    }
+
+    StorageConfig& s = cfg.storage;
+    Check(!s.bank.empty(), "storage.bank", "expected a path");
+    Check(!s.recording_dir.empty(), "storage.recording_dir", "expected a path");
+    {
+      std::vector<std::string> codecs;
+      for (const RecordingCodec& c : RecordingCodecs()) codecs.push_back(c.name);
+      Enum(s.recording_codec, codecs, "storage.recording_codec");
+    }
+    Check(s.stop_recording_below_mib >= 0, "storage.stop_recording_below_mib",
+          "expected a size >= 0, got " + std::to_string(s.stop_recording_below_mib));
+    Check(s.spool_max_mib >= 1, "storage.spool_max_mib",
+          "expected a size >= 1, got " + std::to_string(s.spool_max_mib));
+    Check(s.stop_sprites_below_mib >= 0, "storage.stop_sprites_below_mib",
+          "expected a size >= 0, got " + std::to_string(s.stop_sprites_below_mib));
+    // Raw recording must stop first: its low-water mark is never below the sprites' one.
+    if (s.stop_recording_below_mib < s.stop_sprites_below_mib && s.stop_recording_below_mib >= 0 &&
+        !msg_.Failed("storage.stop_recording_below_mib") &&
+        !msg_.Failed("storage.stop_sprites_below_mib")) {
+      msg_.Adjust("storage.stop_recording_below_mib",
+                  std::to_string(s.stop_recording_below_mib) +
+                      " is below stop_sprites_below_mib; raised to " +
+                      std::to_string(s.stop_sprites_below_mib) +
+                      " so that raw recording stops before sprite storage");
+      s.stop_recording_below_mib = s.stop_sprites_below_mib;
+    }
+
+    ControlConfig& c = cfg.control;
+    Check(c.address == "localhost" || IsIpAddress(c.address), "control.address",
+          "expected an IP address (or localhost), got " + Quoted(c.address));
+    Check(c.port >= 0 && c.port <= 65535, "control.port",
+          "expected a port number 0..65535, got " + std::to_string(c.port));
+    if (!c.token.empty()) {
+      Check(c.token.size() >= 16, "control.token",
+            "too short: use at least 16 characters (got " + std::to_string(c.token.size()) + ")");
+    } else if (!IsLoopbackAddress(c.address) && !msg_.Failed("control.address")) {
+      msg_.Error("control.token",
+                 "required when control.address (" + c.address +
+                     ") is not loopback; set token or token_file",
+                 "control.address");
+    }
+
+    LoggingConfig& l = cfg.logging;
+    Enum(l.level, kLogLevels, "logging.level");
+    for (const auto& [component, level] : l.components)
+      Enum(level, kLogLevels, "logging.components." + component);
+  }
+
+ private:
+  Messages& msg_;
+  const ConfigOptions& options_;
+};
+
+}  // namespace
+
+void Validate(StationConfig& cfg, YamlMessages& msg, const ConfigOptions& options) {
+  Validator(msg, options).Run(cfg);
+}
+
+ConfigReport MakeReport(const Messages& msg) {
+  ConfigReport report;
+  report.errors = msg.errors;
+  report.adjustments = msg.adjustments;
+  report.status = !msg.errors.empty()        ? ConfigStatus::kInvalid
+                  : !msg.adjustments.empty() ? ConfigStatus::kAdjusted
+                                             : ConfigStatus::kValid;
+  return report;
+}
+
+}  // namespace config_detail
+
+bool IsLoopbackAddress(const std::string& address) {
+  if (address == "localhost" || address == "::1") return true;
+  unsigned char buf[16];
+  if (inet_pton(AF_INET, address.c_str(), buf) == 1) return buf[0] == 127;
+  if (inet_pton(AF_INET6, address.c_str(), buf) == 1) {
+    // ::ffff:127.x.y.z (IPv4-mapped loopback)
+    static const unsigned char prefix[12] = {0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0xff, 0xff};
+    return std::equal(prefix, prefix + 12, buf) && buf[12] == 127;
+  }
+  return false;
+}
+
+ConfigReport ValidateStationConfig(StationConfig& config, const std::string& origin,
+                                   const std::map<std::string, int>& lines,
+                                   const ConfigOptions& options) {
+  YamlMessages msg(origin, lines);
+  config_detail::Validate(config, msg, options);
+  return config_detail::MakeReport(msg);
+}
+
+}  // namespace ss

@@ -1,0 +1,130 @@
+#include "core/options_binder.h"
+
+#include <utility>
+
+namespace ss {
+namespace {
+
+using namespace yaml_text;
+
+// "chroma" and "low" of "chroma.low"; "method" and "" of "method".
+std::pair<std::string, std::string> SplitFirst(const std::string& key) {
+  const size_t dot = key.find('.');
+  if (dot == std::string::npos) return {key, ""};
+  return {key.substr(0, dot), key.substr(dot + 1)};
+}
+
+}  // namespace
+
+OptionsBinder& OptionsBinder::AddRead(std::string key, std::string default_text, std::string doc,
+                                      ReadFn read) {
+  bindings_.push_back({std::move(key), std::move(default_text), std::move(doc), std::move(read)});
+  return *this;
+}
+
+OptionsBinder& OptionsBinder::Add(std::string key, int* field, std::string expected,
+                                  std::string doc) {
+  return AddRead(std::move(key), std::to_string(*field), std::move(doc),
+                 [field, expected](YamlReader& r, const YamlMap& view, const std::string& k) {
+                   return r.Int(view, k, *field, expected);
+                 });
+}
+
+OptionsBinder& OptionsBinder::Add(std::string key, int64_t* field, std::string expected,
+                                  std::string doc) {
+  return AddRead(std::move(key), std::to_string(*field), std::move(doc),
+                 [field, expected](YamlReader& r, const YamlMap& view, const std::string& k) {
+                   return r.Int64(view, k, *field, expected);
+                 });
+}
+
+OptionsBinder& OptionsBinder::Add(std::string key, double* field, std::string expected,
+                                  std::string doc) {
+  return AddRead(std::move(key), Num(*field), std::move(doc),
+                 [field, expected](YamlReader& r, const YamlMap& view, const std::string& k) {
+                   return r.Number(view, k, *field, expected);
+                 });
+}
+
+OptionsBinder& OptionsBinder::Add(std::string key, std::optional<double>* field,
+                                  std::string expected, std::string doc) {
+  return AddRead(std::move(key), *field ? Num(**field) : "unset", std::move(doc),
+                 [field, expected](YamlReader& r, const YamlMap& view, const std::string& k) {
+                   double v = 0;
+                   if (!r.Number(view, k, v, expected)) return false;
+                   *field = v;
+                   return true;
+                 });
+}
+
+OptionsBinder& OptionsBinder::Add(std::string key, bool* field, std::string doc) {
+  return AddRead(std::move(key), *field ? "true" : "false", std::move(doc),
+                 [field](YamlReader& r, const YamlMap& view, const std::string& k) {
+                   return r.Bool(view, k, *field);
+                 });
+}
+
+OptionsBinder& OptionsBinder::Add(std::string key, std::string* field, std::string expected,
+                                  std::string doc) {
+  return AddRead(std::move(key), Quoted(*field), std::move(doc),
+                 [field, expected](YamlReader& r, const YamlMap& view, const std::string& k) {
+                   return r.String(view, k, *field, expected);
+                 });
+}
+
+OptionsBinder& OptionsBinder::AddPath(std::string key, std::string* field, std::string doc) {
+  return AddRead(std::move(key), Quoted(*field), std::move(doc),
+                 [field](YamlReader& r, const YamlMap& view, const std::string& k) {
+                   return r.Path(view, k, *field);
+                 });
+}
+
+void OptionsBinder::Read(YamlReader& r, const YAML::Node& node, const std::string& path) const {
+  const YamlMap view = r.Map(node, path);
+  std::vector<std::string> known;
+  for (const Binding& b : bindings_) {
+    const std::string first = SplitFirst(b.key).first;
+    if (!OneOf(first, known)) known.push_back(first);
+  }
+  r.Known(view, known);
+  ReadKeys(r, view);
+}
+
+void OptionsBinder::ReadKeys(YamlReader& r, const YamlMap& view) const {
+  std::vector<std::string> done;  // nested blocks already read
+  for (const Binding& b : bindings_) {
+    const auto [first, rest] = SplitFirst(b.key);
+    if (rest.empty()) {
+      b.read(r, view, first);
+      continue;
+    }
+    if (OneOf(first, done)) continue;
+    done.push_back(first);
+    // The nested block: every binding under `first.`, read from its own mapping.
+    OptionsBinder block;
+    for (const Binding& inner : bindings_) {
+      const auto [inner_first, inner_rest] = SplitFirst(inner.key);
+      if (inner_first == first && !inner_rest.empty()) {
+        block.bindings_.push_back({inner_rest, inner.default_text, inner.doc, inner.read});
+      }
+    }
+    if (const YAML::Node* n = r.Value(view, first)) block.Read(r, *n, Child(view.path(), first));
+  }
+}
+
+std::vector<std::string> OptionsBinder::Keys() const {
+  std::vector<std::string> keys;
+  for (const Binding& b : bindings_) keys.push_back(b.key);
+  return keys;
+}
+
+std::string OptionsBinder::Describe(const std::string& prefix) const {
+  std::string out;
+  for (const Binding& b : bindings_) {
+    out +=
+        Child(prefix, b.key) + ": " + b.default_text + (b.doc.empty() ? "" : "  # " + b.doc) + "\n";
+  }
+  return out;
+}
+
+}  // namespace ss

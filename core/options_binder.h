@@ -1,0 +1,67 @@
+#pragma once
+// Config keys bound straight to option fields (COLMAP's option_manager binds
+// "ImageReader.mask_path" to &image_reader->mask_path): one list per block says each key's
+// field, type, expected value and doc, and its default is the field's value when bound. Read()
+// sets every key given, refuses unknown keys by name (with a near miss suggested) and names
+// ORIGIN:LINE: the.full.key in every error (core/yaml_reader.h). Keys with dots are nested
+// blocks: "chroma.low" is `low:` inside `chroma:`.
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/yaml_reader.h"
+
+namespace ss {
+
+class OptionsBinder {
+ public:
+  // Reads one key of `view` (whose path is the block's) into its field; true when it set it.
+  using ReadFn = std::function<bool(YamlReader& r, const YamlMap& view, const std::string& key)>;
+
+  // `expected` completes "expected ..., got ..." when the value has the wrong type.
+  OptionsBinder& Add(std::string key, int* field, std::string expected, std::string doc);
+  OptionsBinder& Add(std::string key, int64_t* field, std::string expected, std::string doc);
+  OptionsBinder& Add(std::string key, double* field, std::string expected, std::string doc);
+  OptionsBinder& Add(std::string key, std::optional<double>* field, std::string expected,
+                     std::string doc);
+  OptionsBinder& Add(std::string key, bool* field, std::string doc);
+  OptionsBinder& Add(std::string key, std::string* field, std::string expected, std::string doc);
+  // A file or folder, resolved against the file's folder.
+  OptionsBinder& AddPath(std::string key, std::string* field, std::string doc);
+  // One of a closed set's texts (core/enum_text.h).
+  template <typename E, size_t N>
+  OptionsBinder& AddEnum(std::string key, E* field, const EnumText<E> (&texts)[N],
+                         std::string doc) {
+    return AddRead(std::move(key), TextOf(*field, texts), std::move(doc),
+                   [field, &texts](YamlReader& r, const YamlMap& view, const std::string& k) {
+                     return r.Enum(view, k, *field, texts);
+                   });
+  }
+  // A key whose value has a shape of its own (`auto` or a number, a list of points...).
+  OptionsBinder& AddRead(std::string key, std::string default_text, std::string doc, ReadFn read);
+
+  // Reads the mapping `node` at `path` ("" for the top level): unknown keys first, then each
+  // bound key in the order it was bound. Reports to r.msg(); never throws.
+  void Read(YamlReader& r, const YAML::Node& node, const std::string& path) const;
+  // The same on a mapping already opened, without the unknown-key check (a block whose keys
+  // depend on another key's value checks them itself).
+  void ReadKeys(YamlReader& r, const YamlMap& view) const;
+
+  // Every key bound, with dots, in the order bound.
+  std::vector<std::string> Keys() const;
+  // "key: default  # doc", one line per key (`spritestation config keys`, docs/config.md).
+  std::string Describe(const std::string& prefix = "") const;
+
+ private:
+  struct Binding {
+    std::string key;  // relative to the block, dotted
+    std::string default_text;
+    std::string doc;
+    ReadFn read;
+  };
+  std::vector<Binding> bindings_;
+};
+
+}  // namespace ss

@@ -1,0 +1,39 @@
+#pragma once
+// Keyers by the config's keying.method (docs/keying.md). Each keyer's pair of files,
+// pipeline/key/NAME_keyer.{h,cc}, defines `void Register<Name>Keyer()`, which calls
+// RegisterKeyer with how it makes itself from its block of the config's keying section; one
+// line in pipeline/CMakeLists.txt (spritestation_registrations) builds the call in. Nothing
+// else in the project picks a keyer by its method.
+#include <functional>
+#include <memory>
+#include <string>
+
+#include "core/config.h"
+#include "pipeline/key/keyer.h"
+
+namespace ss {
+
+struct KeyerKind {
+  KeyingMethod method = KeyingMethod::kChroma;  // the config's keying.method
+  // Makes the keyer from the config's keying section (its own block and the shared shadow
+  // one); `shadow_reach_cells` > 0 replaces its grid's (keying.shadow.reach_m at the camera's
+  // scale). InputError naming the config field for a value the keyer refuses.
+  std::function<std::unique_ptr<Keyer>(const KeyingConfig& keying, int shadow_reach_cells)> make;
+};
+
+// Called by each keyer's registration function; a second keyer for one method is an error.
+void RegisterKeyer(KeyerKind kind);
+// Registers keyer type `K` for `method`, made from `options_from(keying)` (its block of the
+// config's keying section) with the shadow reach applied to its grid.
+template <typename K, typename Options>
+void RegisterKeyerType(KeyingMethod method, Options (*options_from)(const KeyingConfig&)) {
+  RegisterKeyer({method, [options_from](const KeyingConfig& keying, int shadow_reach_cells) {
+                   Options options = options_from(keying);
+                   if (shadow_reach_cells > 0) options.grid.shadow_reach_cells = shadow_reach_cells;
+                   return std::unique_ptr<Keyer>(std::make_unique<K>(options));
+                 }});
+}
+// The keyer of `keying.method`; InputError naming keying.method when it is not built in.
+std::unique_ptr<Keyer> MakeKeyer(const KeyingConfig& keying, int shadow_reach_cells = 0);
+
+}  // namespace ss
