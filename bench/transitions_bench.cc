@@ -548,11 +548,23 @@ void BM_TransitionsPixelKernelScalar(benchmark::State& state) {
 BENCHMARK(BM_TransitionsPixelKernelSimd);
 BENCHMARK(BM_TransitionsPixelKernelScalar);
 
+}  // namespace
+
+int RunTransitionWorkers(const std::vector<std::string>& args);  // transition_workers_bench.cc
+
+namespace {
+
+int RunOrWorkers(const std::vector<std::string>& args) {
+  if (!args.empty() && args.front() == "--workers") return RunTransitionWorkers({args.begin() + 1, args.end()});
+  return Run(args);
+}
+
 const bool registered = RegisterSuite(
     {"transitions",
      "two-stage transition search on a synthetic 30k-sprite bank vs brute force; incremental add at 60k "
-     "[--sprites N --threads T --rows R --weights F --train-out F --stage2-bias-shift X --sweep-stage2 --skip-incremental --micro --json]",
-     &Run});
+     "[--sprites N --threads T --rows R --weights F --train-out F --stage2-bias-shift X --sweep-stage2 --skip-incremental --micro --json]; --workers: PostgreSQL transition workers "
+     "(scripts/bench-postgres.sh BUILD transitions)",
+     &RunOrWorkers});
 
 }  // namespace
 }  // namespace ss::bench
