@@ -15,6 +15,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "core/error.h"
+#include "core/input_file.h"
 #include "core/sql_postgres.h"
 #include "core/frame.h"
 #include "core/log.h"
@@ -916,10 +917,9 @@ StationConfig LoadStationConfig(const std::string& path, ConfigReport* report,
   if (fs::is_directory(path, ec)) throw InputError(path, "is a directory, not a config file");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path, std::string("cannot open the config: ") + std::strerror(errno));
-  std::ostringstream text;
-  text << in.rdbuf();
+  const std::string text = ReadWithinLimit(in, path, "a config file");
   const fs::path base = fs::absolute(fs::path(path), ec).parent_path();
-  return ParseStationConfig(text.str(), path, base.string(), report, options);
+  return ParseStationConfig(text, path, base.string(), report, options);
 }
 
 namespace {
