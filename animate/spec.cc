@@ -13,6 +13,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "core/error.h"
+#include "core/input_file.h"
 #include "core/options_binder.h"
 
 namespace ss {
@@ -578,9 +579,7 @@ AnimationSpec ParseAnimationSpec(const std::string& yaml, const std::string& ori
 AnimationSpec LoadAnimationSpec(const std::string& path) {
   std::ifstream in(path);
   if (!in) throw InputError(path, "cannot read the animation spec");
-  std::stringstream text;
-  text << in.rdbuf();
-  return ParseAnimationSpec(text.str(), path);
+  return ParseAnimationSpec(ReadWithinLimit(in, path, "an animation spec"), path);
 }
 
 }  // namespace ss

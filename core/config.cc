@@ -10,6 +10,7 @@
 
 #include "core/config_detail.h"
 #include "core/error.h"
+#include "core/input_file.h"
 #include "core/log.h"
 #include "core/yaml_reader.h"
 
@@ -73,10 +74,9 @@ StationConfig LoadStationConfig(const std::string& path, ConfigReport* report,
   if (fs::is_directory(path, ec)) throw InputError(path, "is a directory, not a config file");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path, std::string("cannot open the config: ") + std::strerror(errno));
-  std::ostringstream text;
-  text << in.rdbuf();
+  const std::string text = ReadWithinLimit(in, path, "a config file");
   const fs::path base = fs::absolute(fs::path(path), ec).parent_path();
-  return ParseStationConfig(text.str(), path, base.string(), report, options);
+  return ParseStationConfig(text, path, base.string(), report, options);
 }
 
 const char* ToText(WhiteBalanceMode mode) { return TextOf(mode, kWhiteBalanceModeTexts); }

@@ -78,6 +78,93 @@ bool GroundPolygon::ContainsWithMargin(const Eigen::Vector2d& p, double margin) 
 
 namespace {
 
+// How far rounding can carry an edge's computed points (DistanceToSegment's nearest point, the
+// even-odd test's crossing) beyond its extent along one axis, with coordinates a and b: a few
+// ulps, here a thousand-fold margin, plus the distance whose square underflows to 0.
+double RoundingReach(double a, double b) { return 1e-12 * (std::abs(a) + std::abs(b)) + 1e-150; }
+// Vertices beyond this are not indexed (differences and products could overflow).
+constexpr double kIndexedCoordinateLimit = 1e150;
+
+}  // namespace
+
+GroundPolygonIndex::GroundPolygonIndex(const GroundPolygon& polygon) : polygon_(polygon) {
+  const std::vector<Eigen::Vector2d>& v = polygon_.vertices();
+  const size_t n = v.size();
+  if (polygon_.empty() || n >= std::numeric_limits<uint32_t>::max() / 16) return;
+  for (const Eigen::Vector2d& p : v) {
+    if (!(std::abs(p.x()) < kIndexedCoordinateLimit && std::abs(p.y()) < kIndexedCoordinateLimit)) return;
+  }
+  // Edge k runs from vertex k - 1 to vertex k, as the loops of SignedDistance take them.
+  std::vector<Eigen::Vector2d> y_range(n);
+  x_range_.resize(n);
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo, spans = 0;
+  for (size_t k = 0; k < n; ++k) {
+    const Eigen::Vector2d& a = v[k];
+    const Eigen::Vector2d& b = v[k ? k - 1 : n - 1];
+    const double ry = RoundingReach(a.y(), b.y()), rx = RoundingReach(a.x(), b.x());
+    y_range[k] = {std::min(a.y(), b.y()) - ry, std::max(a.y(), b.y()) + ry};
+    x_range_[k] = {std::min(a.x(), b.x()) - rx, std::max(a.x(), b.x()) + rx};
+    lo = std::min(lo, y_range[k][0]);
+    hi = std::max(hi, y_range[k][1]);
+    spans += y_range[k][1] - y_range[k][0];
+  }
+  // An edge is filed in every band its y extent meets: as many bands as keep that near 8 entries
+  // an edge (n + bands * spans / height), at most 2 per edge. Edges spanning much of the height
+  // (a comb's teeth) thus make few wide bands, and the memory stays linear in n.
+  const double height = hi - lo;
+  double bands = 2.0 * static_cast<double>(n);
+  if (spans > 0 && height > 0) bands = std::min(bands, 7.0 * static_cast<double>(n) * height / spans);
+  bands_ = height > 0 ? static_cast<int>(std::clamp(bands, 1.0, 4194304.0)) : 1;
+  y0_ = lo;
+  scale_ = height > 0 ? bands_ / height : 0.0;
+  band_start_.assign(static_cast<size_t>(bands_) + 1, 0);
+  for (size_t k = 0; k < n; ++k) {
+    for (int b = Band(y_range[k][0]), last = Band(y_range[k][1]); b <= last; ++b) ++band_start_[b + 1];
+  }
+  for (int b = 0; b < bands_; ++b) band_start_[b + 1] += band_start_[b];
+  band_edges_.resize(band_start_.back());
+  std::vector<uint32_t> next(band_start_.begin(), band_start_.end() - 1);
+  for (size_t k = 0; k < n; ++k) {
+    for (int b = Band(y_range[k][0]), last = Band(y_range[k][1]); b <= last; ++b) {
+      band_edges_[next[b]++] = static_cast<uint32_t>(k);
+    }
+  }
+  indexed_ = true;
+}
+
+int GroundPolygonIndex::Band(double y) const {
+  if (!(y > y0_)) return 0;
+  const double t = (y - y0_) * scale_;  // monotone in y: so is the band
+  if (!(t < bands_)) return bands_ - 1;
+  return static_cast<int>(t);
+}
+
+bool GroundPolygonIndex::Contains(const Eigen::Vector2d& p) const {
+  if (!indexed_ || !p.allFinite()) return polygon_.Contains(p);
+  // GroundPolygon::Contains is "on an edge (distance exactly 0) or inside by the even-odd rule".
+  // An edge outside p's band is neither: the even-odd test needs p.y within its y extent, a zero
+  // distance needs p within rounding of it, and the band holds every edge within that reach.
+  const std::vector<Eigen::Vector2d>& v = polygon_.vertices();
+  const size_t n = v.size();
+  const int band = Band(p.y());
+  bool inside = false, on_edge = false;
+  for (uint32_t e = band_start_[band]; e < band_start_[band + 1]; ++e) {
+    const size_t k = band_edges_[e];
+    const Eigen::Vector2d& a = v[k];
+    const Eigen::Vector2d& b = v[k ? k - 1 : n - 1];
+    if ((a.y() > p.y()) != (b.y() > p.y())) {  // as in SignedDistance
+      const double x = a.x() + (p.y() - a.y()) * (b.x() - a.x()) / (b.y() - a.y());
+      if (p.x() < x) inside = !inside;
+    }
+    if (!on_edge && x_range_[k][0] <= p.x() && p.x() <= x_range_[k][1] && DistanceToSegment(p, b, a) == 0.0) {
+      on_edge = true;
+    }
+  }
+  return on_edge || inside;
+}
+
+namespace {
+
 // Exact signs of orientation determinants for double coordinates (Shewchuk, "Adaptive
 // Precision Floating-Point Arithmetic and Fast Robust Geometric Predicates", 1997): a
 // floating-point filter settles nearly every case; the rest is summed exactly as an expansion.

@@ -2,6 +2,7 @@
 // Ground geometry. One convention everywhere: `b_from_a` maps a point in frame a
 // to frame b (x_b = R x_a + t). The ground frame is the world: z up, z = 0 is
 // the floor, metres.
+#include <cstdint>
 #include <optional>
 #include <vector>
 
@@ -43,8 +44,8 @@ class GroundPolygon {
   // The most vertices a floor polygon may have; every reader of a floor refuses more, naming
   // it. IsSimple no longer bounds it (a million vertices: 0.1-1.1 s, bench/RESULTS.md); the
   // config reader does: yaml-cpp holds ~1.5 KB a point while it parses (100,000 points: 250 MB
-  // and 1.4 s; a million: 1.7 GB and 10 s). Beware that the pipeline's floor mask tests every
-  // pixel against every edge (FloorMask: ~13 s a 640x480 camera at 10,000 vertices, linear in both).
+  // and 1.4 s; a million: 1.7 GB and 10 s). Points in bulk (the pipeline's floor mask): use a
+  // GroundPolygonIndex, which tests only the edges near each point.
   static constexpr size_t kMaxVertices = 100000;
 
   GroundPolygon() = default;
@@ -67,6 +68,27 @@ class GroundPolygon {
 
  private:
   std::vector<Eigen::Vector2d> vertices_;
+};
+
+// GroundPolygon::Contains for many points, bit for bit the same answer (the same even-odd rule,
+// the boundary inside), from the edges near each point only: the edges are filed in bands of
+// ground y, and a point tests only its band's (those the horizontal line through it crosses,
+// and those within rounding of it). A point then costs the edges near its y, not all n
+// (bench/RESULTS.md, geometry). Borrows nothing: it copies the vertices.
+class GroundPolygonIndex {
+ public:
+  explicit GroundPolygonIndex(const GroundPolygon& polygon);
+  bool Contains(const Eigen::Vector2d& point_in_ground) const;
+
+ private:
+  int Band(double y) const;  // monotone in y, clamped to [0, bands)
+  GroundPolygon polygon_;    // the fallback for points or vertices beyond the bands' reach
+  bool indexed_ = false;
+  double y0_ = 0, scale_ = 0;
+  int bands_ = 1;
+  std::vector<uint32_t> band_start_;  // band b's edges: band_edges_[band_start_[b] .. band_start_[b + 1])
+  std::vector<uint32_t> band_edges_;  // edge k runs from vertex k - 1 (n - 1 for k = 0) to vertex k
+  std::vector<Eigen::Vector2d> x_range_;  // edge k's x extent, widened by its rounding reach
 };
 
 }  // namespace ss

@@ -1,12 +1,16 @@
 #!/usr/bin/env bash
-# Fuzzes every parser of outside input (tests/fuzz/README.md): builds the libFuzzer targets
-# with clang under ASan and UBSan into build-fuzz/, runs core's unit tests there (the same
-# sanitizers), then fuzzes each target for SECONDS (default 20) on a working copy of its
-# committed corpus. A finding (crash, sanitizer report, an exception
+# The sanitizer build (tests/fuzz/README.md): builds unit suites and the libFuzzer targets with
+# clang under ASan and UBSan into build-fuzz/ (-O1, line tables only: no app, web or
+# benchmarks), runs those suites there (SPRITESTATION_SANITIZE_SUITES, below), then
+# fuzzes each parser of outside input for SECONDS (default 20) on a working copy of its committed
+# corpus. A sanitizer report or a failed test stops the run with exit 1 (logs in build-fuzz/). A
+# fuzz finding (crash, sanitizer report, an exception
 # other than the project's own errors, an input taking > 10 s or > 2 GB) stops the run with
 # exit 1 and its input in build-fuzz/findings/<target>/: add it to tests/fuzz/corpus/<target>/
 # once fixed, where the ordinary build's fuzz_corpus.<target> test replays it for good.
 #   scripts/fuzz.sh [SECONDS] [target...]      e.g. scripts/fuzz.sh 600 config spec
+# Naming targets fuzzes only them (no unit suites). The suites that run `spritestation` use the
+# ordinary build's (SPRITESTATION_BIN, default build/apps/spritestation, built when missing).
 # SPRITESTATION_FUZZ_SEED=N fixes libFuzzer's seed (default: a new one each run), and
 # SPRITESTATION_FUZZ_FRESH=1 starts from the committed corpus alone: together they make a run
 # repeat the inputs of an earlier one (scripts/test.sh uses both, so CI replays what ran here).
@@ -19,21 +23,34 @@ export CCACHE_DIR="${CCACHE_DIR:-$HOME/.ccache}"
 export CCACHE_BASEDIR="${CCACHE_BASEDIR:-$top}" CCACHE_NOHASHDIR="${CCACHE_NOHASHDIR:-true}"
 generator=()
 command -v ninja >/dev/null && generator=(-G Ninja)
-if [ ! -f "$build/CMakeCache.txt" ]; then
-  CC=clang CXX=clang++ cmake -S "$top" -B "$build" "${generator[@]}" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-    -DSPRITESTATION_FUZZ=ON >/dev/null
-fi
+# -O1 (AddressSanitizer's advice: reports stay exact) and line tables only (file:line in every
+# report, without full debug info to write and link). Always configured: an older build-fuzz/
+# takes these flags too.
+flags="-O1 -gline-tables-only"
+# The unit suites built and run here (SPRITESTATION_SANITIZE_SUITES, CMake's names, or `all`).
+# The default is what fits CI's hour from a cold ccache; calib, pipeline, station and libcamera
+# need ss_calib, ss_pipeline and ss_station, ~9 more minutes to build (tests/fuzz/README.md, Cost).
+all="core_tests capture_tests synth_tests calib_tests pipeline_tests station_tests animate_tests import_tests libcamera_tests"
+suites="${SPRITESTATION_SANITIZE_SUITES:-core_tests capture_tests synth_tests animate_tests import_tests}"
+[ "$suites" = all ] && suites="$all"
+CC=clang CXX=clang++ cmake -S "$top" -B "$build" "${generator[@]}" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+  "-DCMAKE_C_FLAGS_RELWITHDEBINFO=$flags" "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=$flags" -DSPRITESTATION_FUZZ=ON \
+  "-DSPRITESTATION_SANITIZE_SUITES=${suites// /;}" >/dev/null
 cmake --build "$build" -j "$(nproc)"
 
 targets=("$@")
 if [ ${#targets[@]} -eq 0 ]; then
-  # core's unit tests, built here under the same sanitizers (ASan + UBSan, clang)
-  if ! (cd "$build" && tests/core_tests --gtest_brief=1 >"$build/core_tests.log" 2>&1); then
-    echo "fuzz.sh: core_tests failed under ASan+UBSan (log $build/core_tests.log):" >&2
-    grep -E 'ERROR|runtime error|FAILED' "$build/core_tests.log" | head -10 >&2
+  # The unit suites, built here under ASan + UBSan (clang).
+  export SPRITESTATION_BIN="${SPRITESTATION_BIN:-$top/build/apps/spritestation}"
+  [ -x "$SPRITESTATION_BIN" ] || "$top/scripts/build.sh" >/dev/null
+  log="$build/unit-tests.log"
+  start=$SECONDS
+  if ! (cd "$build" && ctest -L unit --timeout 900 -j "$(nproc)" --output-on-failure >"$log" 2>&1); then
+    echo "fuzz.sh: unit suites failed under ASan+UBSan (log $log):" >&2
+    grep -E 'ERROR: |runtime error|SUMMARY|\*\*\*Failed|\*\*\*Exception|Timeout|tests failed' "$log" | head -20 >&2
     exit 1
   fi
-  echo "core_tests under ASan+UBSan: $(grep -o '[0-9]* tests\? from [0-9]* test suites\? ran' "$build/core_tests.log"), passed"
+  echo "unit suites under ASan+UBSan ($suites): $(grep -o '[0-9]* tests failed out of [0-9]*' "$log"), $((SECONDS - start)) s"
 
   for dir in "$top"/tests/fuzz/corpus/*/; do targets+=("$(basename "$dir")"); done
 fi

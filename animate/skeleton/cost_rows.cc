@@ -108,9 +108,11 @@ __attribute__((target_clones("arch=x86-64-v3", "default"))) void DenseKernel(
 
 // One target with missing terms: out[s] = sum over its features k of w[k] (a[k] - b[k][s])^2
 // (`b` packed as for DenseKernel, `dim` features a source).
-__attribute__((target_clones("arch=x86-64-v3", "default"))) void SparseKernel(
-    const float* b, int dim, const int* features, int nfeatures, const float* w, const float* a, float* row,
-    int count) {
+// The body of SparseKernel, inlined into each of its clones. (Its own function, as DenseRows is
+// DenseKernel's: a clone built for AVX may not call Load or Store, built without, with a vector
+// argument or result; clang refuses it as an ABI change, GCC let it pass.)
+__attribute__((always_inline)) inline void SparseRow(const float* b, int dim, const int* features, int nfeatures,
+                                                     const float* w, const float* a, float* row, int count) {
   alignas(32) float tail[kLanes];
   // Up to `count` only: the last lanes of the padding may lie wholly past it (a negative
   // tail length here once overwrote the row).
@@ -128,6 +130,12 @@ __attribute__((target_clones("arch=x86-64-v3", "default"))) void SparseKernel(
       std::memcpy(row + s, tail, sizeof(float) * (count - s));
     }
   }
+}
+
+__attribute__((target_clones("arch=x86-64-v3", "default"))) void SparseKernel(
+    const float* b, int dim, const int* features, int nfeatures, const float* w, const float* a, float* row,
+    int count) {
+  SparseRow(b, dim, features, nfeatures, w, a, row, count);
 }
 
 }  // namespace

@@ -67,14 +67,38 @@ class PixelRays {
   std::vector<Eigen::Vector3d> rays_;
 };
 
+cv::Mat FloorPixels(const CameraModel& camera, const PixelRays& rays, double wall_height_m,
+                    const std::function<bool(const Eigen::Vector2d&)>& contains) {
+  cv::Mat mask = cv::Mat::zeros(camera.height(), camera.width(), CV_8U);
+  const Eigen::Vector3d centre = camera.CentreInGround();
+  for (int y = 0; y < camera.height(); ++y) {
+    auto* row = mask.ptr<uint8_t>(y);
+    for (int x = 0; x < camera.width(); ++x) {
+      const auto g = IntersectGround(Ray{centre, rays.Direction(x, y)});
+      if (!g || !contains(g->head<2>())) continue;
+      // Seen over the walls: where the ray passes wall height it must be inside too.
+      if (wall_height_m > 0 && centre.z() > wall_height_m) {
+        const double s = (centre.z() - wall_height_m) / centre.z();
+        const Eigen::Vector3d top = centre + s * (*g - centre);
+        if (!contains(top.head<2>())) continue;
+      }
+      row[x] = 255;
+    }
+  }
+  return mask;
+}
+
 }  // namespace
 
+cv::Mat FloorPixels(const CameraModel& camera, double wall_height_m,
+                    const std::function<bool(const Eigen::Vector2d&)>& contains) {
+  return FloorPixels(camera, PixelRays(camera, FloorMask::kRayGridStepPx), wall_height_m, contains);
+}
+
 FloorMask::FloorMask(const CameraModel& camera, const GroundPolygon& floor, const UsabilityOptions& options)
-    : floor_(floor), options_(options) {
-  mask_ = cv::Mat::zeros(camera.height(), camera.width(), CV_8U);
-  const Eigen::Vector3d centre = camera.CentreInGround();
+    : floor_(floor), floor_index_(floor), options_(options) {
   const PixelRays rays(camera, kRayGridStepPx);
-  centre_ = centre;
+  centre_ = camera.CentreInGround();
   ray_cols_ = rays.cols();
   ray_rows_ = rays.rows();
   rays_.reserve(static_cast<size_t>(ray_cols_) * ray_rows_);
@@ -84,20 +108,8 @@ FloorMask::FloorMask(const CameraModel& camera, const GroundPolygon& floor, cons
                                      std::min(j * kRayGridStepPx, camera.height() - 1)).cast<float>());
     }
   }
-  for (int y = 0; y < camera.height(); ++y) {
-    auto* row = mask_.ptr<uint8_t>(y);
-    for (int x = 0; x < camera.width(); ++x) {
-      const auto g = IntersectGround(Ray{centre, rays.Direction(x, y)});
-      if (!g || !floor_.Contains(g->head<2>())) continue;
-      // Seen over the walls: where the ray passes wall height it must be inside too.
-      if (options_.wall_height_m > 0 && centre.z() > options_.wall_height_m) {
-        const double s = (centre.z() - options_.wall_height_m) / centre.z();
-        const Eigen::Vector3d top = centre + s * (*g - centre);
-        if (!floor_.Contains(top.head<2>())) continue;
-      }
-      row[x] = 255;
-    }
-  }
+  mask_ = FloorPixels(camera, rays, options_.wall_height_m,
+                      [this](const Eigen::Vector2d& p) { return floor_index_.Contains(p); });
   cv::integral(mask_ == 0, not_floor_integral_, CV_32S);
   not_floor_integral_ /= 255;
 }
@@ -114,7 +126,7 @@ bool FloorMask::SeesBehind(int x, int y, const Eigen::Vector2d& point_in_ground)
   // Past the floor: the ray meets the ground outside the polygon, or never.
   if (d.z() < 0) {
     const Eigen::Vector3d g = centre_ + (-centre_.z() / d.z()) * d;
-    if (floor_.Contains(g.head<2>())) return false;
+    if (floor_index_.Contains(g.head<2>())) return false;
   }
   // Its height where it passes the contact point's distance from the camera.
   const double reach = (point_in_ground - centre_.head<2>()).norm();

@@ -5,6 +5,7 @@
 #include <array>
 #include <cstdint>
 #include <deque>
+#include <functional>
 #include <string>
 #include <unordered_map>
 #include <vector>
@@ -94,6 +95,13 @@ class NoiseFilter {
   std::unordered_map<int, bool> last_, current_;  // subject -> noise, the frame before and this one
 };
 
+// The pixels (255, CV_8U, the image size) whose ray meets the ground inside the floor and, with
+// wall_height_m > 0, passes that height inside it too: FloorMask's mask before Restrict.
+// `contains` decides a ground point: FloorMask gives it a GroundPolygonIndex (the edges near the
+// point only); GroundPolygon::Contains (every edge, the way before issue 20) gives the same mask.
+cv::Mat FloorPixels(const CameraModel& camera, double wall_height_m,
+                    const std::function<bool(const Eigen::Vector2d&)>& contains);
+
 // Per camera: the image of the floor, computed once.
 class FloorMask {
  public:
@@ -111,6 +119,7 @@ class FloorMask {
 
  private:
   GroundPolygon floor_;
+  GroundPolygonIndex floor_index_;  // floor_'s Contains for every pixel
   UsabilityOptions options_;
   Eigen::Vector3d centre_;                  // the camera's centre on the ground frame
   std::vector<Eigen::Vector3f> rays_;       // ground-frame ray directions every kRayGridStepPx

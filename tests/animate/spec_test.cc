@@ -216,6 +216,20 @@ TEST_F(SpecTest, LoadsAFileAndRefusesAMissingOne) {
   EXPECT_THROW(LoadAnimationSpec(dir_ / "missing.yaml"), InputError);
 }
 
+// Issue 20: yaml-cpp parses a whole file first. A sparse 250 MB spec is refused from its size,
+// naming the file, its size and the limit, before a byte of it is read.
+TEST_F(SpecTest, AFileOverTheLimitIsRefusedBeforeItIsRead) {
+  std::ofstream(Origin()) << kGood;
+  std::filesystem::resize_file(Origin(), 250'000'000);
+  try {
+    LoadAnimationSpec(Origin());
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()),
+              Origin() + ": 238.4 MiB (250000000 bytes): larger than the 16 MiB an animation spec may be");
+  }
+}
+
 // Every example in docs/examples parses (with stand-ins for its bank, camera and image).
 TEST_F(SpecTest, TheDocumentedExamplesAreValid) {
   namespace fs = std::filesystem;

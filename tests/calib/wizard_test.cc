@@ -69,8 +69,10 @@ TEST(CalibrationWizard, CapturesAStillBoardOnceAndOnlyANewViewAgain) {
   const BoardStudio board_studio(7, 320, 240);
   const auto& [studio, cam, renderer, spec, texture] = board_studio;
   CalibrationWizard w("cam0", 320, 240, Options(ToCalibBoard(spec)));
-  auto frame_of = [&](const Rigid3& cam_from_board, int n) {
-    return RenderBoards(renderer, {{&texture, cam.cam_from_ground.Inverse() * cam_from_board}}, 1.0, n);
+  // (clang 14, the sanitizer build's, cannot capture structured bindings: a lambda takes members.)
+  auto frame_of = [&board_studio](const Rigid3& cam_from_board, int n) {
+    return RenderBoards(board_studio.renderer,
+                        {{&board_studio.texture, board_studio.cam.cam_from_ground.Inverse() * cam_from_board}}, 1.0, n);
   };
   const Rigid3 a = CamFromBoardInView(cam, spec, -0.4, -0.3, 0.5, 0.4, 0.1, 0.05);
   const Rigid3 b = CamFromBoardInView(cam, spec, 0.4, 0.3, 0.55, -0.3, 0.3, -0.1);

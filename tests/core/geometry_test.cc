@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <functional>
+#include <limits>
 #include <random>
 #include <string>
 
@@ -378,6 +379,93 @@ TEST(GroundPolygon, IsSimpleIsExactWhereTheOldArithmeticRounded) {
               old_differs);
   EXPECT_GT(simple, 1000);
   EXPECT_GT(not_simple, 1000);
+}
+
+// GroundPolygonIndex::Contains must answer as GroundPolygon::Contains (every edge) does, bit for
+// bit. Probed where they could differ: on vertices, on edges (points rounded onto them), at a
+// vertex's y (the even-odd rule's half-open test), a few ulps off each, and anywhere around.
+std::vector<Vector2d> ProbePoints(const Poly& p, std::mt19937& rng, size_t random) {
+  std::vector<Vector2d> points;
+  Vector2d lo = p[0], hi = p[0];
+  for (const Vector2d& v : p) {
+    lo = lo.cwiseMin(v);
+    hi = hi.cwiseMax(v);
+  }
+  const Vector2d pad = 0.1 * (hi - lo) + Vector2d::Constant(1e-300);
+  std::uniform_real_distribution<double> ux(lo.x() - pad.x(), hi.x() + pad.x()), uy(lo.y() - pad.y(), hi.y() + pad.y());
+  const size_t stride = std::max<size_t>(1, p.size() / 500);  // at most ~500 vertices probed closely
+  for (size_t i = 0; i < p.size(); i += stride) {
+    const Vector2d& a = p[i];
+    const Vector2d& b = p[(i + 1) % p.size()];
+    points.push_back(a);
+    for (int k = 1; k < 8; ++k) points.push_back(a + (k / 8.0) * (b - a));
+    for (const double d : {-1.0, 1.0}) {
+      points.push_back({std::nextafter(a.x(), a.x() + d), a.y()});
+      points.push_back({a.x(), std::nextafter(a.y(), a.y() + d)});
+      const Vector2d m = 0.5 * (a + b);
+      points.push_back({std::nextafter(m.x(), m.x() + d), m.y()});
+    }
+    points.push_back({ux(rng), a.y()});  // a horizontal line through a vertex
+  }
+  for (size_t i = 0; i < random; ++i) points.push_back({ux(rng), uy(rng)});
+  const double inf = std::numeric_limits<double>::infinity();
+  for (const Vector2d& far : {Vector2d(1e300, 0), Vector2d(0, -1e300), Vector2d(-inf, lo.y()), Vector2d(lo.x(), inf),
+                              Vector2d(std::nan(""), 0), Vector2d(-inf, 0.5 * (lo.y() + hi.y()))}) {
+    points.push_back(far);
+  }
+  return points;
+}
+
+struct IndexAgreement {
+  int inside = 0, outside = 0, on_boundary = 0, failures = 0;
+  void Check(const Poly& p, std::mt19937& rng, const std::string& what, size_t random = 200) {
+    const GroundPolygon polygon(p);
+    const GroundPolygonIndex index(polygon);
+    for (const Vector2d& q : ProbePoints(p, rng, random)) {
+      const double distance = polygon.SignedDistance(q);  // Contains is distance >= 0
+      const bool all_edges = distance >= 0.0;
+      if (index.Contains(q) != all_edges && ++failures <= 10) {
+        ADD_FAILURE() << what << " (" << p.size() << " vertices): the index says " << !all_edges << " at ("
+                      << q.x() << ", " << q.y() << "), every edge " << all_edges;
+      }
+      ++(all_edges ? inside : outside);
+      if (distance == 0.0) ++on_boundary;
+    }
+  }
+};
+
+TEST(GroundPolygonIndex, AnswersAsEveryEdgeDoesOnRandomAndAdversarialPolygons) {
+  std::mt19937 rng(24);
+  IndexAgreement a;
+  // Random grid polygons, simple or not (collinear points, repeats, touching edges), seen otherwise.
+  for (int i = 0; i < 1000; ++i) {
+    const Poly p = GridPolygon(rng, 2 + i % 7, 3 + rng() % 9);
+    for (const Poly& v : Variants(p, rng)) a.Check(v, rng, "grid case " + std::to_string(i), 20);
+  }
+  // Stars (zigzag edges: many cross a horizontal line) and combs (teeth spanning the height: few,
+  // wide bands), up to 2,000 vertices (each probe tests every edge the old way).
+  for (size_t n : {3, 17, 300, 2000}) a.Check(Star(n, rng, 0.9), rng, "star " + std::to_string(n), 1000);
+  for (size_t teeth : {1, 10, 500}) a.Check(Comb(teeth), rng, "comb " + std::to_string(teeth), 1000);
+  // Scales: a floor in metres far from the origin, tiny coordinates (squares underflow: a point
+  // near an edge is "on" it), huge ones (beyond the index's reach: the polygon answers).
+  Poly offset = Star(300, rng, 0.5), tiny = offset, huge = offset;
+  for (size_t i = 0; i < offset.size(); ++i) {
+    offset[i] = 1e-3 * offset[i] + Vector2d(1e5, -3e4);
+    tiny[i] *= 1e-160;
+    huge[i] *= 1e200;
+  }
+  a.Check(offset, rng, "offset star");
+  a.Check(tiny, rng, "tiny star");
+  a.Check(huge, rng, "huge star");
+  // Degenerate: flat (every y alike), a spike, fewer than 3 vertices.
+  a.Check({{0, 1}, {2, 1}, {5, 1}}, rng, "flat");
+  a.Check({{0, 0}, {4, 0}, {4, 4}, {4, 8}, {4, 4}, {0, 4}}, rng, "spike");
+  a.Check({{0, 0}, {1, 1}}, rng, "two vertices");
+  std::printf("index agreement: %d inside (%d on the boundary), %d outside\n", a.inside, a.on_boundary, a.outside);
+  EXPECT_EQ(a.failures, 0);
+  EXPECT_GT(a.inside, 5000);
+  EXPECT_GT(a.on_boundary, 2000);
+  EXPECT_GT(a.outside, 5000);
 }
 
 // Issue 20: a floor of 100k points took 43 s to check. A million now: a comb (half its edges

@@ -42,5 +42,25 @@ TEST(StationConfig, CheckCommand) {
   EXPECT_NE(r.output.find(dir / "missing.yaml"), std::string::npos) << r.output;
 }
 
+// Issue 20: a config or a spec over 16 MiB is bad input (exit 2), refused before it is parsed.
+TEST(StationConfig, OversizedFilesAreRefusedWithExitCode2) {
+  if (std::getenv("SPRITESTATION_BIN") == nullptr)
+    GTEST_SKIP() << "SPRITESTATION_BIN not set (run through ctest)";
+  ScratchDir dir;
+  const std::string config = dir / "big.yaml", spec = dir / "big-spec.yaml";
+  for (const std::string& path : {config, spec}) {
+    std::ofstream(path) << kOneCamera;
+    fs::resize_file(path, 250'000'000);  // sparse
+  }
+  auto r = ss::testing::RunSpritestation("config check " + config);
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find(config + ": 238.4 MiB (250000000 bytes): larger than the 16 MiB a config file may be"),
+            std::string::npos) << r.output;
+  r = ss::testing::RunSpritestation("animate " + spec + " --out " + (dir / "out.json"));
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find(spec + ": 238.4 MiB (250000000 bytes): larger than the 16 MiB an animation spec may be"),
+            std::string::npos) << r.output;
+}
+
 }  // namespace
 }  // namespace ss

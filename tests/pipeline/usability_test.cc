@@ -1,6 +1,10 @@
 #include "pipeline/filter/usability.h"
 
 #include <cmath>
+#include <random>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
@@ -73,6 +77,69 @@ TEST(FloorMask, InterpolatedRaysMatchExactUnprojection) {
   cv::compare(grown, shrunk, edge, cv::CMP_NE);
   EXPECT_EQ(cv::countNonZero(differ & ~edge), 0);
   EXPECT_LE(cv::countNonZero(differ), floor_pixels / 1000) << "of " << floor_pixels << " floor pixels";
+}
+
+// Issue 20: the mask tested every pixel against every edge (~13 s a 640x480 camera at 10,000
+// vertices); it now tests the edges near each pixel's ground point (GroundPolygonIndex). The mask
+// must be the one the old way gives, pixel for pixel: on a strongly distorted tilted camera and a
+// straight-down one, over a star (zigzag edges), a comb (teeth spanning the floor) and a polygon
+// on the pixels' ground grid, with and without walls.
+TEST(FloorMask, TheIndexedMaskIsTheMaskOfEveryEdge) {
+  const double tilt = 35.0 * M_PI / 180.0;
+  Rigid3 cam_from_ground;
+  cam_from_ground.rotation << 1, 0, 0,  //
+      0, -std::sin(tilt), -std::cos(tilt),  //
+      0, std::cos(tilt), -std::sin(tilt);
+  const Eigen::Vector3d centre(0.1, -1.2, 1.6);
+  cam_from_ground.translation = -cam_from_ground.rotation * centre;
+  const CameraModel tilted("LENSMODEL_OPENCV8", {420, 425, 322, 236, -0.28, 0.09, 0.001, -0.002, -0.012, 0, 0, 0},
+                           640, 480, cam_from_ground);
+  const CameraModel down = DownCamera();
+
+  std::mt19937 rng(20);
+  std::vector<std::pair<std::string, GroundPolygon>> floors;
+  std::vector<Eigen::Vector2d> star;
+  for (int i = 0; i < 120; ++i) {  // radii 1.5-2.2 m around (0, 1.8): zigzag edges
+    const double angle = 2 * M_PI * (i + std::uniform_real_distribution<double>(0, 0.9)(rng)) / 120;
+    const double r = std::uniform_real_distribution<double>(1.5, 2.2)(rng);
+    star.push_back({r * std::cos(angle), 1.8 + r * std::sin(angle)});
+  }
+  floors.emplace_back("star", GroundPolygon(star));
+  std::vector<Eigen::Vector2d> comb = {{-2.0, -0.2}, {2.0, -0.2}};
+  for (int k = 29; k >= 0; --k) {  // 30 teeth 4 cm wide, 4 m long, gaps of 4 cm
+    const double x0 = -2.0 + 0.08 * k;
+    comb.push_back({x0 + 0.04, 3.9});
+    comb.push_back({x0, 3.9});
+    if (k > 0) {
+      comb.push_back({x0, 0.0});
+      comb.push_back({x0 - 0.04, 0.0});
+    }
+  }
+  floors.emplace_back("comb", GroundPolygon(comb));
+  // Straight down at 1 m, f = 500: pixel x sees ground x = (x - 320) / 500, multiples of 1/500 m:
+  // a polygon on that grid puts ground points on (or within rounding of) its vertices and edges.
+  floors.emplace_back("grid-aligned", GroundPolygon({{-0.3, -0.2}, {0.3, -0.2}, {0.3, 0.2}, {0.0, 0.0}, {-0.3, 0.2}}));
+
+  for (const auto& named : floors) {
+    const std::string& name = named.first;
+    const GroundPolygon& floor = named.second;  // (not a structured binding: a lambda takes it)
+    for (const double wall_height_m : {0.0, 0.5}) {
+      for (const CameraModel* cam : {&tilted, &down}) {
+        // (The old way is slow: each floor on one camera, the grid on the straight-down one.)
+        if ((cam == &down) != (name == "grid-aligned")) continue;
+        UsabilityOptions options;
+        options.wall_height_m = wall_height_m;
+        const FloorMask mask(*cam, floor, options);
+        const cv::Mat every_edge =
+            FloorPixels(*cam, wall_height_m, [&](const Eigen::Vector2d& p) { return floor.Contains(p); });
+        cv::Mat differ;
+        cv::compare(mask.mask(), every_edge, differ, cv::CMP_NE);
+        EXPECT_EQ(cv::countNonZero(differ), 0) << name << ", walls " << wall_height_m << ", camera "
+                                               << (cam == &down ? "down" : "tilted");
+        EXPECT_GT(cv::countNonZero(every_edge), 1000) << name;  // the floor is in view
+      }
+    }
+  }
 }
 
 TEST(FloorMask, ChecksBorderFloorAndWalls) {
