@@ -296,16 +296,8 @@ class Collector : public benchmark::ConsoleReporter {
 };
 
 int Run(const std::vector<std::string>& args) {
-  std::vector<std::string> storage = {"spritestation-bench", "--benchmark_filter=^bank/"};
-  storage.insert(storage.end(), args.begin(), args.end());
-  std::vector<char*> argv;
-  for (auto& s : storage) argv.push_back(s.data());
-  int argc = static_cast<int>(argv.size());
-  benchmark::Initialize(&argc, argv.data());
-  if (benchmark::ReportUnrecognizedArguments(argc, argv.data())) return 2;
   Collector collector;
-  benchmark::RunSpecifiedBenchmarks(&collector);
-  benchmark::Shutdown();
+  if (const int status = RunGoogleBenchmarks("bank/", args, &collector)) return status;
   std::error_code ec;
   fs::remove_all(ScratchFolder(), ec);
 

@@ -16,7 +16,8 @@ bool RegisterSuite(Suite suite) {
 
 const std::vector<Suite>& Suites() { return Registry(); }
 
-int RunGoogleBenchmarks(const std::string& prefix, const std::vector<std::string>& args) {
+int RunGoogleBenchmarks(const std::string& prefix, const std::vector<std::string>& args,
+                        benchmark::BenchmarkReporter* reporter) {
   std::vector<std::string> storage = {"spritestation-bench", "--benchmark_filter=^" + prefix};
   storage.insert(storage.end(), args.begin(), args.end());
   std::vector<char*> argv;
@@ -24,9 +25,18 @@ int RunGoogleBenchmarks(const std::string& prefix, const std::vector<std::string
   int argc = static_cast<int>(argv.size());
   benchmark::Initialize(&argc, argv.data());
   if (benchmark::ReportUnrecognizedArguments(argc, argv.data())) return 2;
-  benchmark::RunSpecifiedBenchmarks();
+  benchmark::RunSpecifiedBenchmarks(reporter);
   benchmark::Shutdown();
   return 0;
+}
+
+void RealTimes::ReportRuns(const std::vector<Run>& runs) {
+  for (const Run& r : runs) {
+    if (r.error_occurred || r.run_type != Run::RT_Iteration) continue;
+    const std::string& args = r.run_name.args;
+    time[r.run_name.function_name + (args.empty() ? "" : "/" + args)] = r.GetAdjustedRealTime();
+  }
+  ConsoleReporter::ReportRuns(runs);
 }
 
 }  // namespace ss::bench

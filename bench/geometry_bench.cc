@@ -114,39 +114,19 @@ BENCHMARK_CAPTURE(BM_FloorMaskEveryEdge, star, std::string("star"))
     ->Name("geometry/floor_mask/every_edge/star")->RangeMultiplier(10)->Range(1000, 10000)
     ->Unit(benchmark::kMillisecond);
 
-// Keeps each case's time so the suite can print the ratios after the table.
-class Collector : public benchmark::ConsoleReporter {
- public:
-  void ReportRuns(const std::vector<Run>& runs) override {
-    for (const Run& r : runs) {
-      if (!r.error_occurred && r.run_type == Run::RT_Iteration) ms[r.run_name.str()] = r.GetAdjustedRealTime();
-    }
-    ConsoleReporter::ReportRuns(runs);
-  }
-  std::map<std::string, double> ms;  // by "geometry/is_simple/sweep/comb/1000" (the unit is ms)
-};
-
 int Run(const std::vector<std::string>& args) {
-  std::vector<std::string> storage = {"spritestation-bench", "--benchmark_filter=^geometry/"};
-  storage.insert(storage.end(), args.begin(), args.end());
-  std::vector<char*> argv;
-  for (auto& s : storage) argv.push_back(s.data());
-  int argc = static_cast<int>(argv.size());
-  benchmark::Initialize(&argc, argv.data());
-  if (benchmark::ReportUnrecognizedArguments(argc, argv.data())) return 2;
-  Collector collector;
-  benchmark::RunSpecifiedBenchmarks(&collector);
-  benchmark::Shutdown();
+  RealTimes collector;  // by "geometry/is_simple/sweep/comb/1000", in ms
+  if (const int status = RunGoogleBenchmarks("geometry/", args, &collector)) return status;
 
   std::printf("\ngeometry figures (IsSimple, one thread; the brute force as a multiple of the sweep, this run):\n");
   for (const char* shape : {"comb", "star"}) {
     for (const int n : {1000, 10000, 100000, 1000000}) {
       const std::string sweep = std::string("geometry/is_simple/sweep/") + shape + "/" + std::to_string(n);
       const std::string brute = std::string("geometry/is_simple/brute_force/") + shape + "/" + std::to_string(n);
-      if (!collector.ms.count(sweep)) continue;
-      std::printf("  %-5s %8d vertices: sweep %9.3f ms", shape, n, collector.ms[sweep]);
-      if (collector.ms.count(brute)) {
-        std::printf(", brute force %9.1f ms = %6.0f x", collector.ms[brute], collector.ms[brute] / collector.ms[sweep]);
+      if (!collector.time.count(sweep)) continue;
+      std::printf("  %-5s %8d vertices: sweep %9.3f ms", shape, n, collector.time[sweep]);
+      if (collector.time.count(brute)) {
+        std::printf(", brute force %9.1f ms = %6.0f x", collector.time[brute], collector.time[brute] / collector.time[sweep]);
       }
       std::printf("\n");
     }
@@ -156,10 +136,10 @@ int Run(const std::vector<std::string>& args) {
     for (const int n : {1000, 10000, 100000}) {
       const std::string index = std::string("geometry/floor_mask/index/") + shape + "/" + std::to_string(n);
       const std::string every = std::string("geometry/floor_mask/every_edge/") + shape + "/" + std::to_string(n);
-      if (!collector.ms.count(index)) continue;
-      std::printf("  %-5s %8d vertices: index %9.2f ms", shape, n, collector.ms[index]);
-      if (collector.ms.count(every)) {
-        std::printf(", every edge %9.1f ms = %6.0f x", collector.ms[every], collector.ms[every] / collector.ms[index]);
+      if (!collector.time.count(index)) continue;
+      std::printf("  %-5s %8d vertices: index %9.2f ms", shape, n, collector.time[index]);
+      if (collector.time.count(every)) {
+        std::printf(", every edge %9.1f ms = %6.0f x", collector.time[every], collector.time[every] / collector.time[index]);
       }
       std::printf("\n");
     }

@@ -12,7 +12,6 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
-#include <map>
 #include <string>
 #include <thread>
 #include <vector>
@@ -130,35 +129,15 @@ void BM_Workers(benchmark::State& state) {
 BENCHMARK(BM_SingleProcess)->Name("transitions/workers/single_process")->Unit(benchmark::kSecond)->Iterations(1)->UseRealTime();
 BENCHMARK(BM_Workers)->Name("transitions/workers")->Arg(1)->Arg(2)->Unit(benchmark::kSecond)->Iterations(1)->UseRealTime();
 
-// Each case's wall seconds, for the ratios printed after the table.
-class Seconds : public benchmark::ConsoleReporter {
- public:
-  void ReportRuns(const std::vector<Run>& runs) override {
-    for (const Run& r : runs) {
-      if (!r.error_occurred && r.run_type == Run::RT_Iteration) wall[r.benchmark_name()] = r.GetAdjustedRealTime();
-    }
-    ConsoleReporter::ReportRuns(runs);
-  }
-  std::map<std::string, double> wall;
-};
-
 }  // namespace
 
 // Called by `bench transitions --workers [benchmark flags]`.
 int RunTransitionWorkers(const std::vector<std::string>& args) {
-  std::vector<std::string> storage = {"spritestation-bench", "--benchmark_filter=^transitions/workers"};
-  storage.insert(storage.end(), args.begin(), args.end());
-  std::vector<char*> argv;
-  for (auto& s : storage) argv.push_back(s.data());
-  int argc = static_cast<int>(argv.size());
-  benchmark::Initialize(&argc, argv.data());
-  if (benchmark::ReportUnrecognizedArguments(argc, argv.data())) return 2;
-  Seconds seconds;
-  benchmark::RunSpecifiedBenchmarks(&seconds);
-  benchmark::Shutdown();
-  const auto base = seconds.wall.find("transitions/workers/single_process/iterations:1/real_time");
-  if (base == seconds.wall.end()) return 1;
-  for (const auto& [name, s] : seconds.wall) {
+  RealTimes seconds;
+  if (const int status = RunGoogleBenchmarks("transitions/workers", args, &seconds)) return status;
+  const auto base = seconds.time.find("transitions/workers/single_process");
+  if (base == seconds.time.end()) return 1;
+  for (const auto& [name, s] : seconds.time) {
     if (name != base->first) std::printf("%s: %.2f s = %.2f x the single-process build (%.2f s)\n", name.c_str(), s, s / base->second, base->second);
   }
   return 0;
