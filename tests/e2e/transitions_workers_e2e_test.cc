@@ -2,7 +2,6 @@
 // PostgreSQL bank (issue 21): the table they make together equals a single-process build of
 // the same bank exactly, also when one worker is killed in the middle of a unit.
 #include <gtest/gtest.h>
-#include <libpq-fe.h>
 #include <signal.h>
 
 #include <chrono>
@@ -21,19 +20,10 @@ namespace {
 using testing::BackgroundCommand;
 using testing::JsonInOutput;
 using testing::PostgresServer;
+using testing::QueryInt;
 using testing::RunSpritestation;
 using testing::ScratchDir;
 
-int64_t Query(const std::string& address, const std::string& sql) {
-  PGconn* conn = PQconnectdb(address.c_str());
-  PGresult* r = PQexec(conn, sql.c_str());
-  const bool ok = PQresultStatus(r) == PGRES_TUPLES_OK && PQntuples(r) > 0;
-  if (!ok) ADD_FAILURE() << sql << ": " << PQerrorMessage(conn);
-  const int64_t value = ok ? std::atoll(PQgetvalue(r, 0, 0)) : -1;
-  PQclear(r);
-  PQfinish(conn);
-  return value;
-}
 
 void ExpectSameTransitions(const std::string& got_bank, const std::string& want_bank) {
   const auto got = Bank(got_bank).LoadTransitions();
@@ -67,7 +57,7 @@ TEST(TransitionWorkers, TwoWorkersAndAKilledOneMakeTheSingleProcessTable) {
   ASSERT_EQ(RunSpritestation("--log-level warn bank copy " + pg + " " + single).exit_code, 0);
   const auto build = RunSpritestation("--log-level warn transitions " + single + " --json");
   ASSERT_EQ(build.exit_code, 0) << build.output;
-  const int64_t clips = Query(pg, "SELECT count(*) FROM clips WHERE complete = 1");
+  const int64_t clips = QueryInt(pg, "SELECT count(*) FROM clips WHERE complete = 1");
   ASSERT_GE(clips, 4) << "several units are needed to share";
 
   // A worker that claims a unit and is killed before it stores anything: its lease (2 s) runs out.
@@ -79,8 +69,8 @@ TEST(TransitionWorkers, TwoWorkersAndAKilledOneMakeTheSingleProcessTable) {
   for (int i = 0; i < 300 && claimed == 0; ++i) {
     std::this_thread::sleep_for(std::chrono::milliseconds(100));
     // The worker makes its work table when it starts.
-    if (Query(pg, "SELECT count(*) FROM pg_tables WHERE tablename = 'transition_work'") == 0) continue;
-    claimed = Query(pg, "SELECT count(*) FROM transition_work WHERE worker = 'victim'");
+    if (QueryInt(pg, "SELECT count(*) FROM pg_tables WHERE tablename = 'transition_work'") == 0) continue;
+    claimed = QueryInt(pg, "SELECT count(*) FROM transition_work WHERE worker = 'victim'");
   }
   ASSERT_EQ(claimed, 1) << victim.output();
   victim.Signal(SIGKILL);
@@ -95,8 +85,8 @@ TEST(TransitionWorkers, TwoWorkersAndAKilledOneMakeTheSingleProcessTable) {
   ASSERT_EQ(b.Wait(300), 0) << b.output();
   const nlohmann::json ja = JsonInOutput(a.output()), jb = JsonInOutput(b.output());
   EXPECT_EQ(ja["units"].get<int64_t>() + jb["units"].get<int64_t>(), clips) << a.output() << b.output();
-  EXPECT_EQ(Query(pg, "SELECT count(*) FROM transition_work WHERE done = 1"), clips);
-  EXPECT_EQ(Query(pg, "SELECT count(*) FROM transition_work WHERE attempts >= 2"), 1);  // the killed one, redone
+  EXPECT_EQ(QueryInt(pg, "SELECT count(*) FROM transition_work WHERE done = 1"), clips);
+  EXPECT_EQ(QueryInt(pg, "SELECT count(*) FROM transition_work WHERE attempts >= 2"), 1);  // the killed one, redone
 
   const std::string shared = dir / "shared.db";
   ASSERT_EQ(RunSpritestation("--log-level warn bank copy " + pg + " " + shared).exit_code, 0);

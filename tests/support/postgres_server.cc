@@ -166,4 +166,15 @@ std::string PostgresServer::log() const {
   return s.str();
 }
 
+int64_t QueryInt(const std::string& address, const std::string& sql) {
+  PGconn* conn = PQconnectdb(address.c_str());
+  PGresult* r = PQexec(conn, sql.c_str());
+  const bool ok = PQresultStatus(r) == PGRES_TUPLES_OK && PQntuples(r) > 0;
+  if (!ok) ADD_FAILURE() << sql << ": " << PQerrorMessage(conn);
+  const int64_t value = ok ? std::atoll(PQgetvalue(r, 0, 0)) : -1;
+  PQclear(r);
+  PQfinish(conn);
+  return value;
+}
+
 }  // namespace ss::testing

@@ -5,6 +5,7 @@
 // trust authentication for its superuser `spritestation`. Stopped, and its folder removed, when
 // the object dies. Start failures are test failures (ADD_FAILURE with the server's log): the
 // README's test command installs the server, so a missing one is a broken set-up, not a skip.
+#include <cstdint>
 #include <string>
 
 namespace ss::testing {
@@ -35,5 +36,9 @@ class PostgresServer {
   int port_ = 0;
   int pid_ = -1;
 };
+
+// The single integer `sql` returns from database `address` (a test failure and -1 when the
+// query fails or returns no row): straight libpq, bypassing the bank's code.
+int64_t QueryInt(const std::string& address, const std::string& sql);
 
 }  // namespace ss::testing

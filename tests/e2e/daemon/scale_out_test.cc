@@ -16,7 +16,6 @@
 #include <Eigen/Core>
 #include <gtest/gtest.h>
 #include <httplib.h>
-#include <libpq-fe.h>
 #include <spdlog/fmt/fmt.h>
 
 #include <nlohmann/json.hpp>
@@ -32,6 +31,7 @@ namespace {
 using testing::BackgroundCommand;
 using testing::JsonInOutput;
 using testing::PostgresServer;
+using testing::QueryInt;
 using testing::PrivateNetworkError;
 using testing::RunSpritestation;
 using testing::ScratchDir;
@@ -39,16 +39,6 @@ using Clock = std::chrono::steady_clock;
 
 constexpr int kStations = 3;
 
-int64_t Query(const std::string& address, const std::string& sql) {
-  PGconn* conn = PQconnectdb(address.c_str());
-  PGresult* r = PQexec(conn, sql.c_str());
-  const bool ok = PQresultStatus(r) == PGRES_TUPLES_OK && PQntuples(r) > 0;
-  if (!ok) ADD_FAILURE() << sql << ": " << PQerrorMessage(conn);
-  const int64_t value = ok ? std::atoll(PQgetvalue(r, 0, 0)) : -1;
-  PQclear(r);
-  PQfinish(conn);
-  return value;
-}
 
 uint64_t Fnv1a(const cv::Mat& m, uint64_t h) {
   if (m.empty()) return h;
@@ -176,13 +166,13 @@ TEST(ScaleOut, ThreeDaemonsAndTwoWorkersStoreWhatIngestStores) {
     EXPECT_GT(final_status["bank"]["sprites_stored"].get<int64_t>(), 0) << final_status.dump(2);
   }
   // The workers (and the stations' own share, done before they stopped) finish every unit.
-  const int64_t clips = Query(pg, "SELECT count(*) FROM clips WHERE complete = 1");
+  const int64_t clips = QueryInt(pg, "SELECT count(*) FROM clips WHERE complete = 1");
   ASSERT_GE(clips, 2 * kStations);
   const auto deadline = Clock::now() + std::chrono::seconds(240);
-  while (Clock::now() < deadline && Query(pg, "SELECT count(*) FROM transition_work WHERE done = 1") < clips) {
+  while (Clock::now() < deadline && QueryInt(pg, "SELECT count(*) FROM transition_work WHERE done = 1") < clips) {
     std::this_thread::sleep_for(std::chrono::milliseconds(250));
   }
-  EXPECT_EQ(Query(pg, "SELECT count(*) FROM transition_work WHERE done = 1"), clips);
+  EXPECT_EQ(QueryInt(pg, "SELECT count(*) FROM transition_work WHERE done = 1"), clips);
   int64_t worker_units = 0;
   for (auto& w : workers) {
     w->Signal(SIGTERM);  // finishes its unit, prints its summary
