@@ -18,9 +18,9 @@ struct AnimateRunOptions {
   std::string method = "replace";  // "replace" | "beam"
   double time_budget_s = 30.0;
   uint64_t seed = 1;
-  double progress_every_s = 0.0;   // log the progress this often; 0: never
-  double snapshot_every_s = 0.0;   // keep the current sequences this often; 0: never
-  int threads = 0;                 // F/B set threads; 0: the spec's
+  double progress_every_s = 0.0;  // log the progress this often; 0: never
+  double snapshot_every_s = 0.0;  // keep the current sequences this often; 0: never
+  int threads = 0;                // F/B set threads; 0: the spec's
   // Replacement: stop after this many sprite turns (0: the time budget alone). With a budget
   // that is never reached, the same work on any machine, loaded or not (tests).
   int max_turns = 0;
@@ -28,14 +28,14 @@ struct AnimateRunOptions {
 
 // How well the result meets its constraints (the scenes' figures).
 struct ConstraintFigures {
-  double max_path_deviation_m = 0.0;   // over the sprites with a path
-  int paths_unfinished = 0;            // sprites that never reach their path's end
-  int collision_steps = 0;             // steps closer than d_min, summed over pairs
-  int colliding_pairs = 0;             // pairs that come closer than d_min at least once
-  double min_distance_m = -1.0;        // smallest pair distance (-1: no collision terms)
-  int frame_steps_off = 0;             // steps of frame constraints outside their set
-  int frame_steps = 0;                 // steps under frame constraints
-  int sprites_short = 0;               // sprites under their length constraint
+  double max_path_deviation_m = 0.0;  // over the sprites with a path
+  int paths_unfinished = 0;           // sprites that never reach their path's end
+  int collision_steps = 0;            // steps closer than d_min, summed over pairs
+  int colliding_pairs = 0;            // pairs that come closer than d_min at least once
+  double min_distance_m = -1.0;       // smallest pair distance (-1: no collision terms)
+  int frame_steps_off = 0;            // steps of frame constraints outside their set
+  int frame_steps = 0;                // steps under frame constraints
+  int sprites_short = 0;              // sprites under their length constraint
 };
 
 struct AnimateResult {

@@ -28,14 +28,16 @@ BankGraph LoadBankGraph(const std::vector<std::string>& bank_paths,
     // One snapshot for the sprites, tags and transitions of a bank that may still be written.
     const BankSnapshot snapshot(bank);
     const std::vector<SpriteFeatures> features = bank.LoadFeatures();
-    if (features.empty()) throw InputError(bank_paths[b], "the bank holds no sprites in complete clips");
+    if (features.empty())
+      throw InputError(bank_paths[b], "the bank holds no sprites in complete clips");
     // The source frame interval: the median timestamp step between clip neighbours.
     std::vector<int64_t> steps;
     for (const SpriteFeatures& f : features) {
       if (f.next >= 0) {
         const SpriteFeatures& n = features[f.next];
         const int64_t frames = std::max<int64_t>(1, n.frame - f.frame);
-        if (n.timestamp_ns > f.timestamp_ns) steps.push_back((n.timestamp_ns - f.timestamp_ns) / frames);
+        if (n.timestamp_ns > f.timestamp_ns)
+          steps.push_back((n.timestamp_ns - f.timestamp_ns) / frames);
       }
     }
     double interval_s = 1.0 / 30.0;
@@ -74,8 +76,9 @@ BankGraph LoadBankGraph(const std::vector<std::string>& bank_paths,
       edges.push_back({from->second, to->second, std::max(0.0, t.cost)});
       ++kept;
     }
-    Log("animate.bank")->info("{}: {} frames, {} transitions, source interval {:.4f} s",
-                              bank_paths[b], features.size(), kept, interval_s);
+    Log("animate.bank")
+        ->info("{}: {} frames, {} transitions, source interval {:.4f} s", bank_paths[b],
+               features.size(), kept, interval_s);
   }
   out.graph = TransitionGraph(std::move(infos), edges);
   return out;

@@ -35,7 +35,8 @@ std::pair<int, int> FastFrameTerm::Steps(Tracks tracks, const EvalRequest& /*req
 }
 
 double FastFrameTerm::StepCost(Tracks tracks, int t) const {
-  return strength() * std::max(0.0, reference_speed_m_ - tracks[sprites()[0]]->VelocityAt(t).norm());
+  return strength() *
+         std::max(0.0, reference_speed_m_ - tracks[sprites()[0]]->VelocityAt(t).norm());
 }
 
 LengthTerm::LengthTerm(int sprite, int min_frames, double strength)

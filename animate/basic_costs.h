@@ -60,7 +60,7 @@ class LengthTerm : public StepSumTerm {
 // Starts the frame window when a sprite passes the end of a path: "once the hamster reaches
 // the bottom of the path" (seed 000 §6.1). A path never passed starts it at that sprite's end.
 struct PathTrigger {
-  int sprite = 0;        // whose path (a follower may share its leader's trigger)
+  int sprite = 0;  // whose path (a follower may share its leader's trigger)
   Polyline path;
   int duration_steps = 1;
 };

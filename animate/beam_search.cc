@@ -19,9 +19,11 @@ struct Child {
 
 class BeamPlanner {
  public:
-  BeamPlanner(const Problem& problem, const BeamOptions& options, double deadline,
-              Summary* summary)
-      : problem_(problem), graph_(problem.graph()), options_(options), deadline_(deadline),
+  BeamPlanner(const Problem& problem, const BeamOptions& options, double deadline, Summary* summary)
+      : problem_(problem),
+        graph_(problem.graph()),
+        options_(options),
+        deadline_(deadline),
         summary_(summary) {}
 
   // Plans every sprite in turn; past the deadline the rest is planned with width 1.
@@ -48,7 +50,7 @@ class BeamPlanner {
         active_.push_back(k);
       }
     }
-    int length = options_.length > 0 ? options_.length
+    int length = options_.length > 0   ? options_.length
                  : spec.max_frames > 0 ? spec.max_frames
                                        : spec.initial_frames;
     if (spec.max_frames > 0) length = std::min(length, spec.max_frames);
@@ -57,8 +59,8 @@ class BeamPlanner {
 
     // Step 1: every start frame (or an even spread of them).
     const int num_frames = graph_.num_frames();
-    const int starts = options_.start_frames > 0 ? std::min(options_.start_frames, num_frames)
-                                                 : num_frames;
+    const int starts =
+        options_.start_frames > 0 ? std::min(options_.start_frames, num_frames) : num_frames;
     std::vector<Child> children;
     std::vector<Track> beam;
     Track scratch;
@@ -68,7 +70,8 @@ class BeamPlanner {
       children.push_back({Cost(s, scratch, 0, nullptr, 1), -1, f});
     }
     KeepBest(width, &children);
-    for (const Child& c : children) beam.push_back(MakeTrack(graph_, {c.frame}, anchor, spec.anchor_m));
+    for (const Child& c : children)
+      beam.push_back(MakeTrack(graph_, {c.frame}, anchor, spec.anchor_m));
 
     Track best;
     double best_cost = kInf;

@@ -14,9 +14,9 @@
 namespace ss {
 
 struct BeamOptions {
-  int width = 32;           // partial sequences kept per step
-  int length = 0;           // steps to extend to; 0: the sprite's max_frames, else initial_frames
-  int start_frames = 0;     // first frames tried (evenly spread); 0: every frame
+  int width = 32;        // partial sequences kept per step
+  int length = 0;        // steps to extend to; 0: the sprite's max_frames, else initial_frames
+  int start_frames = 0;  // first frames tried (evenly spread); 0: every frame
   // > 0: after a pass, rerun with twice the width while time remains and keep the best
   // result; a pass cut by the budget returns the best sequences found so far.
   double time_budget_seconds = 0.0;
@@ -24,7 +24,6 @@ struct BeamOptions {
 };
 
 // Throws InputError when the options are not valid.
-std::vector<Track> BeamSearch(const Problem& problem, const BeamOptions& options,
-                              Summary* summary);
+std::vector<Track> BeamSearch(const Problem& problem, const BeamOptions& options, Summary* summary);
 
 }  // namespace ss

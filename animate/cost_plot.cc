@@ -50,13 +50,14 @@ cv::Mat PlotCostTraces(const std::vector<PlotSeries>& series, const std::string&
     const int px = area.x + static_cast<int>(area.width * k / 5.0);
     cv::line(image, {px, area.y}, {px, area.y + area.height}, grey, 1);
     std::snprintf(label, sizeof label, "%.3g", t_max * k / 5.0);
-    cv::putText(image, label, {px - 15, area.y + area.height + 20}, font, 0.45, black, 1, cv::LINE_AA);
+    cv::putText(image, label, {px - 15, area.y + area.height + 20}, font, 0.45, black, 1,
+                cv::LINE_AA);
   }
   cv::rectangle(image, area, black, 1);
   cv::putText(image, "seconds", {area.x + area.width / 2 - 30, height_px - 8}, font, 0.5, black, 1,
               cv::LINE_AA);
-  cv::putText(image, title + (log_axis ? "  (cost, log scale)" : "  (cost)"), {left, 25}, font, 0.55,
-              black, 1, cv::LINE_AA);
+  cv::putText(image, title + (log_axis ? "  (cost, log scale)" : "  (cost)"), {left, 25}, font,
+              0.55, black, 1, cv::LINE_AA);
   int legend_y = area.y + 20;
   for (const PlotSeries& s : series) {
     if (s.trace.empty()) continue;
@@ -68,10 +69,11 @@ cv::Mat PlotCostTraces(const std::vector<PlotSeries>& series, const std::string&
       points.push_back(to_px(p.seconds, p.best_cost));
     }
     cv::polylines(image, points, false, s.colour, 2, cv::LINE_AA);
-    cv::line(image, {area.x + area.width - 170, legend_y - 5}, {area.x + area.width - 140, legend_y - 5},
-             s.colour, 2);
+    cv::line(image, {area.x + area.width - 170, legend_y - 5},
+             {area.x + area.width - 140, legend_y - 5}, s.colour, 2);
     std::snprintf(label, sizeof label, "%s %.4g", s.label.c_str(), s.trace.back().best_cost);
-    cv::putText(image, label, {area.x + area.width - 135, legend_y}, font, 0.45, black, 1, cv::LINE_AA);
+    cv::putText(image, label, {area.x + area.width - 135, legend_y}, font, 0.45, black, 1,
+                cv::LINE_AA);
     legend_y += 20;
   }
   return image;

@@ -16,8 +16,8 @@ std::pair<int, int> StepWindow::Resolve(int n) const {
 CostTerm::CostTerm(std::string kind, std::vector<int> sprites, double strength)
     : kind_(std::move(kind)), sprites_(std::move(sprites)), strength_(strength) {
   if (!std::isfinite(strength) || strength < 0) {
-    throw InputError(kind_ + ".strength", "must be finite and >= 0, got " +
-                                              std::to_string(strength));
+    throw InputError(kind_ + ".strength",
+                     "must be finite and >= 0, got " + std::to_string(strength));
   }
 }
 

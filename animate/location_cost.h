@@ -15,12 +15,13 @@ namespace ss {
 
 struct LocationTarget {
   Eigen::Vector2d point_m = Eigen::Vector2d::Zero();  // the target, or the offset o from a leader
-  int follow_sprite = -1;          // >= 0: formation behind/beside this sprite
-  bool offset_in_heading = true;   // o is (along, left) of the leader's heading; else ground axes
-  int heading_steps = 5;           // the leader's heading averages this many past velocities
+  int follow_sprite = -1;                             // >= 0: formation behind/beside this sprite
+  bool offset_in_heading = true;  // o is (along, left) of the leader's heading; else ground axes
+  int heading_steps = 5;          // the leader's heading averages this many past velocities
 
   static LocationTarget Fixed(const Eigen::Vector2d& point_m) { return {point_m}; }
-  static LocationTarget Follow(int leader, const Eigen::Vector2d& offset_m, bool in_heading = true) {
+  static LocationTarget Follow(int leader, const Eigen::Vector2d& offset_m,
+                               bool in_heading = true) {
     return {offset_m, leader, in_heading};
   }
 };

@@ -123,8 +123,8 @@ void PathTerm::BuildCache(Tracks tracks, TermCache* cache) const {
   FillPathStates(path_, track, cache);
   cache->prefix.assign(track.size() + 1, 0.0);
   for (int t = 0; t < track.size(); ++t) {
-    cache->prefix[t + 1] = cache->prefix[t] + StepCost(track.positions_m[t],
-                                                       track.velocities_m[t], cache->state[t + 1]);
+    cache->prefix[t + 1] = cache->prefix[t] + StepCost(track.positions_m[t], track.velocities_m[t],
+                                                       cache->state[t + 1]);
   }
 }
 

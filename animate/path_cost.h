@@ -43,9 +43,9 @@ int PathCompletionStep(const Polyline& path, const Track& track, const TermCache
 void FillPathStates(const Polyline& path, const Track& track, TermCache* cache);
 
 struct PathStrengths {
-  double direction = 1.0;   // δ, per radian per step
-  double distance = 1.0;    // φ, per m^2 per step
-  double unreached = 1.0;   // η, per metre of path not reached at the end
+  double direction = 1.0;  // δ, per radian per step
+  double distance = 1.0;   // φ, per m^2 per step
+  double unreached = 1.0;  // η, per metre of path not reached at the end
 };
 
 class PathTerm : public CostTerm {

@@ -17,7 +17,8 @@ namespace ss {
 class SequencePlayer {
  public:
   // Opens the banks; `renderer` draws the frames.
-  SequencePlayer(const std::vector<std::string>& bank_paths, std::unique_ptr<SpriteRenderer> renderer);
+  SequencePlayer(const std::vector<std::string>& bank_paths,
+                 std::unique_ptr<SpriteRenderer> renderer);
 
   // The frame of step t (sprites past their end hold their last state).
   cv::Mat RenderStep(const std::vector<SpriteSequence>& sprites, int t);

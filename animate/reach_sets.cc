@@ -37,9 +37,8 @@ class DijkstraWorkspace {
       settled_[u] = round_;
       const int32_t entry = count++;
       entries[entry] = {u, parent_[u], static_cast<float>(d)};
-      depths[entry] = parent_[u] < 0 ? 0
-                                     : static_cast<uint16_t>(std::min<int>(
-                                           depths[parent_[u]] + 1, 65535));
+      depths[entry] =
+          parent_[u] < 0 ? 0 : static_cast<uint16_t>(std::min<int>(depths[parent_[u]] + 1, 65535));
       const bool forward = direction == ReachDirection::kForward;
       const std::span<const int> next = forward ? graph.successors(u) : graph.predecessors(u);
       const std::span<const double> cost =
@@ -79,8 +78,8 @@ class DijkstraWorkspace {
 ReachSets ReachSets::Build(const TransitionGraph& graph, ReachDirection direction,
                            const ReachOptions& options, std::span<const double> entry_cost) {
   if (options.set_size < 1 || options.set_size > 65535) {
-    throw InputError("reach.set_size", "must be in 1..65535, got " +
-                                           std::to_string(options.set_size));
+    throw InputError("reach.set_size",
+                     "must be in 1..65535, got " + std::to_string(options.set_size));
   }
   if (!(options.step_cost >= 0) || !std::isfinite(options.step_cost)) {
     throw InputError("reach.step_cost", "must be finite and >= 0");

@@ -52,7 +52,7 @@ class ReachSets {
 
  private:
   ReachDirection direction_ = ReachDirection::kForward;
-  int stride_ = 0;                // = set_size; set r occupies entries [r*stride, r*stride+count)
+  int stride_ = 0;  // = set_size; set r occupies entries [r*stride, r*stride+count)
   std::vector<Entry> entries_;
   std::vector<int32_t> counts_;
   std::vector<uint16_t> depths_;  // path length - 1 per entry (saturates at 65535)

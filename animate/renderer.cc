@@ -90,7 +90,8 @@ void SpriteRenderer::DrawPlane(const cv::Mat& full_layer, const Eigen::Vector3d&
     if (fx < 0.75 || fy < 0.75) {
       const int w = std::max(1, static_cast<int>(std::lround(layer.cols * fx)));
       const int h = std::max(1, static_cast<int>(std::lround(layer.rows * fy)));
-      const double rx = static_cast<double>(layer.cols) / w, ry = static_cast<double>(layer.rows) / h;
+      const double rx = static_cast<double>(layer.cols) / w,
+                   ry = static_cast<double>(layer.rows) / h;
       cv::resize(full_layer, layer, cv::Size(w, h), 0, 0, cv::INTER_AREA);
       // Pixel u' of the small layer is centred on u = (u' + 0.5) rx - 0.5 of the full one.
       origin = full_origin + full_du * (0.5 * rx - 0.5) + full_dv * (0.5 * ry - 0.5);
@@ -130,7 +131,8 @@ void SpriteRenderer::DrawPlane(const cv::Mat& full_layer, const Eigen::Vector3d&
   const int gw = (bw + g - 1) / g + 1, gh = (bh + g - 1) / g + 1;
   std::vector<Eigen::Vector2d> pixels(static_cast<size_t>(gw) * gh);
   for (int gy = 0; gy < gh; ++gy) {
-    for (int gx = 0; gx < gw; ++gx) pixels[gy * gw + gx] = Eigen::Vector2d(bx0 + gx * g, by0 + gy * g);
+    for (int gx = 0; gx < gw; ++gx)
+      pixels[gy * gw + gx] = Eigen::Vector2d(bx0 + gx * g, by0 + gy * g);
   }
   std::vector<Eigen::Vector3d> rays(pixels.size());
   camera_.UnprojectMany(pixels.data(), pixels.size(), rays.data());
@@ -148,7 +150,8 @@ void SpriteRenderer::DrawPlane(const cv::Mat& full_layer, const Eigen::Vector3d&
     const double s = (origin - centre_in_ground_).dot(normal) / denom;
     if (s <= 0) continue;
     const Eigen::Vector3d rel = centre_in_ground_ + s * d - origin;
-    grid[i] = Eigen::Vector2f(static_cast<float>(rel.dot(du) / du2), static_cast<float>(rel.dot(dv) / dv2));
+    grid[i] = Eigen::Vector2f(static_cast<float>(rel.dot(du) / du2),
+                              static_cast<float>(rel.dot(dv) / dv2));
   }
   cv::Mat map(bh, bw, CV_32FC2);
   for (int y = 0; y < bh; ++y) {
@@ -196,7 +199,8 @@ cv::Mat SpriteRenderer::Render(const std::vector<PlacedSprite>& sprites) const {
     const Eigen::Vector3d p(sprites[i].ground_m.x(), sprites[i].ground_m.y(), 0.0);
     return (p - centre_in_ground_).norm();
   };
-  std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return distance(a) > distance(b); });
+  std::stable_sort(order.begin(), order.end(),
+                   [&](size_t a, size_t b) { return distance(a) > distance(b); });
   const Eigen::Vector3d up(0, 0, 1);
   if (options_.shadows) {
     for (size_t i : order) {
@@ -209,8 +213,8 @@ cv::Mat SpriteRenderer::Render(const std::vector<PlacedSprite>& sprites) const {
       const Eigen::Vector3d p(s.ground_m.x(), s.ground_m.y(), 0.0);
       const double cu = (s.pixels->shadow.cols - 1) / 2.0, cv_ = (s.pixels->shadow.rows - 1) / 2.0;
       const Eigen::Vector3d origin = p - right * (cu / s.px_per_m) - away * (cv_ / s.px_per_m);
-      DrawPlane(ShadowLayer(s.pixels->shadow, options_.shadow_opacity), origin,
-                right / s.px_per_m, away / s.px_per_m, &canvas);
+      DrawPlane(ShadowLayer(s.pixels->shadow, options_.shadow_opacity), origin, right / s.px_per_m,
+                away / s.px_per_m, &canvas);
     }
   }
   for (size_t i : order) {
@@ -235,7 +239,8 @@ cv::Mat SpriteRenderer::Render(const std::vector<PlacedSprite>& sprites) const {
         continue;
       }
       const float k = 255.0f / a;
-      o[x] = cv::Vec4b(cv::saturate_cast<uint8_t>(in[x][0] * k), cv::saturate_cast<uint8_t>(in[x][1] * k),
+      o[x] = cv::Vec4b(cv::saturate_cast<uint8_t>(in[x][0] * k),
+                       cv::saturate_cast<uint8_t>(in[x][1] * k),
                        cv::saturate_cast<uint8_t>(in[x][2] * k), cv::saturate_cast<uint8_t>(a));
     }
   }

@@ -44,8 +44,9 @@ class Replacer {
         local_(problem.graph().num_frames(), 0) {
     for (int sprite = 0; sprite < problem_.num_sprites(); ++sprite) {
       terms_of_.push_back(problem_.TermsOf(sprite));
-      collides_.push_back(std::any_of(terms_of_.back().begin(), terms_of_.back().end(),
-                                      [&](int k) { return problem_.term(k).kind() == "collision"; }));
+      collides_.push_back(std::any_of(terms_of_.back().begin(), terms_of_.back().end(), [&](int k) {
+        return problem_.term(k).kind() == "collision";
+      }));
     }
     Reset();
     neighbours_.resize(problem_.num_sprites());
@@ -85,7 +86,8 @@ class Replacer {
             break;
           }
         }
-        if (running && options_.optimize_free_starts && problem_.sprite(s).anchor == Anchor::kFree) {
+        if (running && options_.optimize_free_starts &&
+            problem_.sprite(s).anchor == Anchor::kFree) {
           RefineFreeStart(s);
         }
         ++summary_->turns;
@@ -99,8 +101,8 @@ class Replacer {
       if (!running) break;
       if (std::all_of(failures.begin(), failures.end(),
                       [&](int f) { return f >= options_.max_tries; })) {
-        message = "no improvement in " + std::to_string(options_.max_tries) +
-                  " picks for every sprite";
+        message =
+            "no improvement in " + std::to_string(options_.max_tries) + " picks for every sprite";
         if (!options_.restart_when_converged || MonotonicSeconds() > deadline_) break;
         KeepBest();
         ++restart_;
@@ -139,7 +141,8 @@ class Replacer {
     const int num_sprites = problem_.num_sprites();
     if (num_sprites < 2) return;
     const double start = MonotonicSeconds();
-    const double until = std::min(deadline_, start + options_.sequential_fraction * (deadline_ - start));
+    const double until =
+        std::min(deadline_, start + options_.sequential_fraction * (deadline_ - start));
     std::vector<std::vector<int>> all = terms_of_;
     for (int s = 0; s < num_sprites; ++s) {
       terms_of_[s].clear();
@@ -203,7 +206,8 @@ class Replacer {
       if (v >= 0) {
         ++summary_->collision_picks;
         const int last = std::min(v, n - 1);
-        const int width = LogUniformInt(options_.max_span > 0 ? std::min(options_.max_span, n - 1) : n - 1);
+        const int width =
+            LogUniformInt(options_.max_span > 0 ? std::min(options_.max_span, n - 1) : n - 1);
         if (kind == MoveKind::kMiddle) {
           k = std::max(0, last - UniformInt(0, width));
           l = std::min(n - 1, std::max(last, k + width));
@@ -247,7 +251,8 @@ class Replacer {
       }
     }
     std::shuffle(candidates_.begin(), candidates_.end(), rng_);
-    if (options_.max_candidates > 0 && static_cast<int>(candidates_.size()) > options_.max_candidates) {
+    if (options_.max_candidates > 0 &&
+        static_cast<int>(candidates_.size()) > options_.max_candidates) {
       candidates_.resize(options_.max_candidates);
     }
 
@@ -319,8 +324,8 @@ class Replacer {
         shifted_ = candidate;
         ShiftTrack(start - candidate.positions_m.front(), &shifted_);
         ++summary_->moves_tried;
-        const double value = EvaluateInvolved(s, shifted_, 0, std::min(best, current_sum),
-                                              &values_shifted_);
+        const double value =
+            EvaluateInvolved(s, shifted_, 0, std::min(best, current_sum), &values_shifted_);
         if (value < best) {
           best = value;
           chosen = &shifted_;
@@ -396,11 +401,12 @@ class Replacer {
   // Pattern search on a free start: steps of ±h along x and y, halving h on failure.
   void RefineFreeStart(int s) {
     Eigen::Vector2d least_squares;
-    if (LeastSquaresStart(s, tracks_[s], &least_squares)) TryShift(s, least_squares - tracks_[s].positions_m.front());
+    if (LeastSquaresStart(s, tracks_[s], &least_squares))
+      TryShift(s, least_squares - tracks_[s].positions_m.front());
     for (double h = 0.25; h > 1e-3 && MonotonicSeconds() < deadline_;) {
       bool improved = false;
       for (const Eigen::Vector2d& step : {Eigen::Vector2d(h, 0), Eigen::Vector2d(-h, 0),
-                                         Eigen::Vector2d(0, h), Eigen::Vector2d(0, -h)}) {
+                                          Eigen::Vector2d(0, h), Eigen::Vector2d(0, -h)}) {
         if (TryShift(s, step)) {
           improved = true;
           break;
@@ -576,9 +582,11 @@ bool ReplacementOptions::IsValid(std::string* why) const {
     if (why) *why = reason;
     return false;
   };
-  if (reach.set_size < 1 || reach.set_size > 65535) return fail("reach.set_size must be in 1..65535");
+  if (reach.set_size < 1 || reach.set_size > 65535)
+    return fail("reach.set_size must be in 1..65535");
   if (reach.num_threads < 1) return fail("reach.num_threads must be >= 1");
-  if (!(reach.step_cost >= 0) || !std::isfinite(reach.step_cost)) return fail("reach.step_cost must be >= 0");
+  if (!(reach.step_cost >= 0) || !std::isfinite(reach.step_cost))
+    return fail("reach.step_cost must be >= 0");
   if (!(step_cost_fraction >= 0) || !std::isfinite(step_cost_fraction)) {
     return fail("step_cost_fraction must be >= 0");
   }

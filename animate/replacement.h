@@ -28,7 +28,7 @@ namespace ss {
 enum class StartMethod { kRandom, kBeam, kGiven, kSequential };
 
 struct ReplacementOptions {
-  ReachOptions reach;              // N = reach.set_size, threads, step cost of Ĉ
+  ReachOptions reach;  // N = reach.set_size, threads, step cost of Ĉ
   // Ĉ also adds this fraction of the median positive transition cost per step, so long
   // zero-cost runs of a clip do not crowd the transitions out of the F/B sets.
   double step_cost_fraction = 0.05;
@@ -38,9 +38,9 @@ struct ReplacementOptions {
 
   double time_budget_seconds = 10.0;  // the whole run: F/B sets, start and optimization
   uint64_t seed = 1;
-  int max_tries = 2000;         // a sprite has converged after this many picks without a gain
-  int changes_per_turn = 100;   // picks per sprite turn
-  int max_turns = 0;            // 0: no limit
+  int max_tries = 2000;        // a sprite has converged after this many picks without a gain
+  int changes_per_turn = 100;  // picks per sprite turn
+  int max_turns = 0;           // 0: no limit
   StartMethod start = StartMethod::kSequential;  // kGiven uses SpriteSpec::initial_sequence
   // kSequential: share of the remaining time the one-by-one phase may take (each restart too).
   double sequential_fraction = 0.3;
@@ -56,7 +56,7 @@ struct ReplacementOptions {
   // d_min to another sprite): k and l are drawn around that step instead of anywhere. Uniform
   // picks rarely land on the few steps of a shallow collision, which then outlive the budget.
   double collision_pick_fraction = 0.25;
-  int max_candidates = 0;        // t tried per pick; 0: all of them
+  int max_candidates = 0;            // t tried per pick; 0: all of them
   bool optimize_free_starts = true;  // least-squares and pattern search on free p_0
   double progress_seconds = 0.0;     // log progress this often; 0: never
   // Called after every accepted move with the current tracks (tests, live plots).

@@ -10,8 +10,7 @@
 
 namespace ss {
 
-Scene::Scene(AnimationSpec spec, BankGraph bank)
-    : spec_(std::move(spec)), bank_(std::move(bank)) {
+Scene::Scene(AnimationSpec spec, BankGraph bank) : spec_(std::move(spec)), bank_(std::move(bank)) {
   problem_ = std::make_unique<Problem>(bank_.graph);
   AddTerms();
 }
@@ -43,10 +42,10 @@ void Scene::AddTerms() {
   for (int id = 0; id < static_cast<int>(spec_.sprites.size()); ++id) {
     const SpriteSpecEntry& entry = spec_.sprites[id];
     for (const LocationSpec& l : entry.locations) {
-      const LocationTarget target =
-          l.follow.empty()
-              ? LocationTarget::Fixed(l.target_m)
-              : LocationTarget::Follow(spec_.SpriteIndex(l.follow), l.target_m, l.offset_in_heading);
+      const LocationTarget target = l.follow.empty()
+                                        ? LocationTarget::Fixed(l.target_m)
+                                        : LocationTarget::Follow(spec_.SpriteIndex(l.follow),
+                                                                 l.target_m, l.offset_in_heading);
       problem_->AddTerm(std::make_unique<LocationTerm>(id, l.window, target, l.strength));
     }
     if (entry.path) {

@@ -33,7 +33,9 @@ class Scene {
 
  private:
   void AddTerms();
-  double IntervalS() const { return bank_.frame_interval_s.empty() ? 1.0 / 30 : bank_.frame_interval_s[0]; }
+  double IntervalS() const {
+    return bank_.frame_interval_s.empty() ? 1.0 / 30 : bank_.frame_interval_s[0];
+  }
 
   AnimationSpec spec_;
   BankGraph bank_;

@@ -15,8 +15,8 @@ json SpritesToJson(const std::vector<SpriteSequence>& sprites) {
   for (const SpriteSequence& s : sprites) {
     json steps = json::array();
     for (size_t t = 0; t < s.frames.size(); ++t) {
-      steps.push_back({s.frames[t].bank, s.frames[t].sprite_id, s.positions_m[t].x(),
-                       s.positions_m[t].y()});
+      steps.push_back(
+          {s.frames[t].bank, s.frames[t].sprite_id, s.positions_m[t].x(), s.positions_m[t].y()});
     }
     out.push_back({{"name", s.name}, {"steps", std::move(steps)}});
   }
@@ -39,13 +39,13 @@ std::vector<SpriteSequence> SpritesFromJson(const json& j, const std::string& pa
       const json& step = s["steps"][t];
       if (!step.is_array() || step.size() != 4 || !step[0].is_number_integer() ||
           !step[1].is_number_integer() || !step[2].is_number() || !step[3].is_number()) {
-        throw InputError(path, f + ".steps[" + std::to_string(t) +
-                                   "]: expected [bank, sprite, x_m, y_m]");
+        throw InputError(
+            path, f + ".steps[" + std::to_string(t) + "]: expected [bank, sprite, x_m, y_m]");
       }
       const int bank = step[0].get<int>();
       if (bank < 0 || bank >= num_banks) {
-        throw InputError(path, f + ".steps[" + std::to_string(t) + "][0]: no bank " +
-                                   std::to_string(bank));
+        throw InputError(
+            path, f + ".steps[" + std::to_string(t) + "][0]: no bank " + std::to_string(bank));
       }
       seq.frames.push_back({bank, step[1].get<int64_t>()});
       seq.positions_m.emplace_back(step[2].get<double>(), step[3].get<double>());
@@ -91,8 +91,9 @@ void WriteSequenceFile(const std::string& path, const SequenceFile& file) {
             {"sprites", SpritesToJson(file.sprites)}};
   json stages = json::array();
   for (const SequenceStage& stage : file.stages) {
-    stages.push_back(
-        {{"seconds", stage.seconds}, {"cost", stage.cost}, {"sprites", SpritesToJson(stage.sprites)}});
+    stages.push_back({{"seconds", stage.seconds},
+                      {"cost", stage.cost},
+                      {"sprites", SpritesToJson(stage.sprites)}});
   }
   j["stages"] = std::move(stages);
   j["summary"] = file.summary.is_null() ? json::object() : file.summary;
@@ -114,8 +115,8 @@ SequenceFile ReadSequenceJson(const json& j, const std::string& path) {
     throw InputError(path, "format: not a spritestation sequences file");
   }
   if (j.value("version", 0) != kSequenceFormatVersion) {
-    throw InputError(path, "version: this build reads version " +
-                               std::to_string(kSequenceFormatVersion));
+    throw InputError(path,
+                     "version: this build reads version " + std::to_string(kSequenceFormatVersion));
   }
   SequenceFile file;
   try {

@@ -7,8 +7,8 @@
 #include <initializer_list>
 #include <map>
 #include <optional>
-#include <utility>
 #include <sstream>
+#include <utility>
 
 #include <yaml-cpp/yaml.h>
 
@@ -96,7 +96,9 @@ class Reader {
   // A whole number in [low, high]; `high` is a limit of the optimizer, named in the message.
   int IntegerIn(const YAML::Node& node, const std::string& field, int low, int high) const {
     const int value = Integer(node, field, low);
-    if (value > high) Fail(node, field, "expected at most " + std::to_string(high) + ", got " + std::to_string(value));
+    if (value > high)
+      Fail(node, field,
+           "expected at most " + std::to_string(high) + ", got " + std::to_string(value));
     return value;
   }
   Eigen::Vector2d Point(const YAML::Node& node, const std::string& field) const {
@@ -186,8 +188,8 @@ LocationSpec ReadLocation(const Reader& r, const AnimationSpec& spec, const YAML
   if (node["follow"]) {
     if (node["target"]) r.Fail(node["target"], field + ".target", "give either target or follow");
     out.follow = r.Text(node["follow"], field + ".follow");
-    out.target_m = node["offset"] ? r.Point(node["offset"], field + ".offset")
-                                  : Eigen::Vector2d::Zero();
+    out.target_m =
+        node["offset"] ? r.Point(node["offset"], field + ".offset") : Eigen::Vector2d::Zero();
     if (node["offset_axes"]) {
       const std::string axes = r.Text(node["offset_axes"], field + ".offset_axes");
       if (axes != "heading" && axes != "ground") {
@@ -223,7 +225,8 @@ PathSpec ReadPath(const Reader& r, const YAML::Node& node, const std::string& fi
     r.Fail(points, field + ".points", "needs two distinct points");
   }
   if (node["direction_strength"]) {
-    out.strengths.direction = r.AtLeast(node["direction_strength"], field + ".direction_strength", 0);
+    out.strengths.direction =
+        r.AtLeast(node["direction_strength"], field + ".direction_strength", 0);
   }
   if (node["distance_strength"]) {
     out.strengths.distance = r.AtLeast(node["distance_strength"], field + ".distance_strength", 0);
@@ -309,7 +312,8 @@ SpriteSpecEntry ReadSprite(const Reader& r, const AnimationSpec& spec, const YAM
       if (!item.IsMap() || item.size() != 1) {
         r.Fail(item, cfield, "expected one of location:, path:, frames:");
       }
-      if (!item.begin()->first.IsScalar()) r.Fail(item, cfield, "expected one of location:, path:, frames:");
+      if (!item.begin()->first.IsScalar())
+        r.Fail(item, cfield, "expected one of location:, path:, frames:");
       const std::string kind = item.begin()->first.as<std::string>();
       const YAML::Node body = item.begin()->second;
       if (kind == "location") {
@@ -487,8 +491,9 @@ AnimationSpec ParseSpecRoot(const YAML::Node& root, const std::string& origin) {
   const Reader r(origin);
   AnimationSpec spec;
   spec.path = origin;
-  r.Map(root, "", {"version", "frame_rate", "length", "camera", "background", "banks", "sprites",
-                   "collisions", "fast_frames", "optimizer"});
+  r.Map(root, "",
+        {"version", "frame_rate", "length", "camera", "background", "banks", "sprites",
+         "collisions", "fast_frames", "optimizer"});
   if (root["version"]) {
     spec.version = r.Integer(root["version"], "version", 1);
     if (spec.version != kAnimationSpecVersion) {
@@ -507,7 +512,8 @@ AnimationSpec ParseSpecRoot(const YAML::Node& root, const std::string& origin) {
   if (banks.IsScalar()) {
     spec.bank_paths.push_back(r.Path(banks, "banks", true));
   } else {
-    if (!banks.IsSequence() || banks.size() == 0) r.Fail(banks, "banks", "expected a list of banks");
+    if (!banks.IsSequence() || banks.size() == 0)
+      r.Fail(banks, "banks", "expected a list of banks");
     for (size_t i = 0; i < banks.size(); ++i) {
       spec.bank_paths.push_back(r.Path(banks[i], Reader::Index("banks", i), true));
     }
@@ -533,16 +539,19 @@ AnimationSpec ParseSpecRoot(const YAML::Node& root, const std::string& origin) {
       if (l.follow.empty()) continue;
       const int leader = spec.SpriteIndex(l.follow);
       if (leader < 0 || leader == static_cast<int>(i)) {
-        throw InputError(spec.Where(l.place) + ".follow",
-                         leader < 0 ? "no sprite named " + l.follow : "a sprite cannot follow itself");
+        throw InputError(spec.Where(l.place) + ".follow", leader < 0
+                                                              ? "no sprite named " + l.follow
+                                                              : "a sprite cannot follow itself");
       }
     }
     for (const FrameSpec& f : s.frames) {
       if (f.after_path_of.empty()) continue;
       const int owner = spec.SpriteIndex(f.after_path_of);
-      if (owner < 0) throw InputError(spec.Where(f.place) + ".after_path", "no sprite named " + f.after_path_of);
+      if (owner < 0)
+        throw InputError(spec.Where(f.place) + ".after_path", "no sprite named " + f.after_path_of);
       if (!spec.sprites[owner].path) {
-        throw InputError(spec.Where(f.place) + ".after_path", f.after_path_of + " has no path constraint");
+        throw InputError(spec.Where(f.place) + ".after_path",
+                         f.after_path_of + " has no path constraint");
       }
     }
   }
@@ -572,7 +581,8 @@ AnimationSpec ParseAnimationSpec(const std::string& yaml, const std::string& ori
     return ParseSpecRoot(root, origin);
   } catch (const YAML::Exception& e) {
     // A shape the reader did not check for (found by tests/fuzz): still an error naming the line.
-    throw InputError(origin + ":" + std::to_string(e.mark.line + 1), "cannot read this (" + e.msg + ")");
+    throw InputError(origin + ":" + std::to_string(e.mark.line + 1),
+                     "cannot read this (" + e.msg + ")");
   }
 }
 

@@ -69,8 +69,8 @@ struct SpriteSpecEntry {
   std::vector<LocationSpec> locations;
   std::optional<PathSpec> path;
   std::vector<FrameSpec> frames;
-  std::optional<LengthSpec> length;     // overrides the spec's
-  std::optional<FastFrameSpec> fast;    // overrides the spec's
+  std::optional<LengthSpec> length;   // overrides the spec's
+  std::optional<FastFrameSpec> fast;  // overrides the spec's
 };
 
 struct CollisionSpec {  // eq. 9, between every pair of the listed sprites
@@ -81,11 +81,11 @@ struct CollisionSpec {  // eq. 9, between every pair of the listed sprites
 };
 
 struct OptimizerSpec {
-  std::string method = "replace";  // "replace" | "beam"
+  std::string method = "replace";    // "replace" | "beam"
   std::string start = "sequential";  // replacement's start: "sequential" | "random" | "beam"
   double time_budget_s = 30.0;
   uint64_t seed = 1;
-  int set_size = 200;          // N of the F/B sets
+  int set_size = 200;  // N of the F/B sets
   int threads = 2;
   int changes_per_turn = 100;  // picks per sprite turn
   int beam_width = 32;
@@ -97,20 +97,20 @@ struct AnimationSpec {
   std::string path;  // the spec file
   int version = kAnimationSpecVersion;
   double frame_rate = 30.0;
-  int fixed_frames = 0;  // > 0: every sequence has exactly this length
-  int max_frames = 0;    // free length: longest sequence; 0 = no limit
-  int initial_frames = 0;  // length of random initial sequences (default: derived)
+  int fixed_frames = 0;              // > 0: every sequence has exactly this length
+  int max_frames = 0;                // free length: longest sequence; 0 = no limit
+  int initial_frames = 0;            // length of random initial sequences (default: derived)
   std::optional<LengthSpec> length;  // free length: penalize sequences under N frames
   std::optional<FastFrameSpec> fast;
-  std::string camera_path;      // .cameramodel (absolute)
-  std::string background_path;  // image (absolute) or ""
+  std::string camera_path;              // .cameramodel (absolute)
+  std::string background_path;          // image (absolute) or ""
   std::vector<std::string> bank_paths;  // absolute
   std::vector<SpriteSpecEntry> sprites;
   std::vector<CollisionSpec> collisions;
   OptimizerSpec optimizer;
 
-  int Steps(double seconds) const;  // seconds -> steps at the frame rate
-  int SpriteIndex(const std::string& name) const;  // -1 if unknown
+  int Steps(double seconds) const;                  // seconds -> steps at the frame rate
+  int SpriteIndex(const std::string& name) const;   // -1 if unknown
   std::string Where(const SpecPlace& place) const;  // "FILE:LINE: FIELD"
 };
 

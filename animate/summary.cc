@@ -7,10 +7,14 @@ namespace ss {
 
 const char* TerminationTypeName(TerminationType type) {
   switch (type) {
-    case TerminationType::kConverged: return "CONVERGED";
-    case TerminationType::kTimeBudget: return "TIME_BUDGET";
-    case TerminationType::kMaxTurns: return "MAX_TURNS";
-    case TerminationType::kBeamComplete: return "BEAM_COMPLETE";
+    case TerminationType::kConverged:
+      return "CONVERGED";
+    case TerminationType::kTimeBudget:
+      return "TIME_BUDGET";
+    case TerminationType::kMaxTurns:
+      return "MAX_TURNS";
+    case TerminationType::kBeamComplete:
+      return "BEAM_COMPLETE";
   }
   return "UNKNOWN";
 }
@@ -22,8 +26,7 @@ std::string Summary::BriefReport() const {
                 "%.2f s, %s",
                 method.c_str(), start.c_str(), initial_cost.total, final_cost.total,
                 static_cast<long long>(moves_kept), static_cast<long long>(moves_tried), turns,
-                restarts,
-                total_seconds, TerminationTypeName(termination));
+                restarts, total_seconds, TerminationTypeName(termination));
   return line;
 }
 

@@ -18,7 +18,7 @@ const char* TerminationTypeName(TerminationType type);
 
 // One point of the cost-versus-time curve.
 struct TracePoint {
-  double seconds = 0.0;  // since the start of the run, precomputation included
+  double seconds = 0.0;    // since the start of the run, precomputation included
   double cost = 0.0;       // of the current sequences
   double best_cost = 0.0;  // lowest so far over restarts (the curve to plot)
   int restart = 0;         // costs never rise within one restart
@@ -33,12 +33,12 @@ struct Summary {
   std::string message;  // why it stopped, in words
 
   int num_sprites = 0;
-  int turns = 0;            // sprite turns (replacement) or beam widths tried (beam)
-  int restarts = 0;         // random restarts after convergence
-  int64_t picks = 0;        // (k, l) pairs picked
+  int turns = 0;                // sprite turns (replacement) or beam widths tried (beam)
+  int restarts = 0;             // random restarts after convergence
+  int64_t picks = 0;            // (k, l) pairs picked
   int64_t collision_picks = 0;  // of them, drawn around a step where the sprite collides
-  int64_t moves_tried = 0;  // candidate sequences evaluated
-  int64_t moves_kept = 0;   // improvements accepted
+  int64_t moves_tried = 0;      // candidate sequences evaluated
+  int64_t moves_kept = 0;       // improvements accepted
 
   double precompute_seconds = 0.0;  // F/B sets
   double start_seconds = 0.0;       // initial sequences (beam search when chosen)

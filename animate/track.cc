@@ -35,8 +35,8 @@ void IntegrateTrack(const TransitionGraph& graph, Anchor anchor, const Eigen::Ve
 void UpdateChunkBoxes(Track* track, int from_step) {
   const int n = track->size();
   const int chunks = (n + Track::kChunkSteps - 1) / Track::kChunkSteps;
-  const int first = std::clamp(from_step / Track::kChunkSteps, 0,
-                               static_cast<int>(track->chunk_boxes_m.size()));
+  const int first =
+      std::clamp(from_step / Track::kChunkSteps, 0, static_cast<int>(track->chunk_boxes_m.size()));
   track->chunk_boxes_m.resize(chunks);
   for (int c = first; c < chunks; ++c) {
     Eigen::AlignedBox2d box;  // empty

@@ -25,9 +25,9 @@ enum class Anchor {
 struct Track {
   static constexpr int kChunkSteps = 16;
 
-  std::vector<int> frames;                     // s_t
-  std::vector<Eigen::Vector2d> positions_m;    // p_t, ground metres
-  std::vector<Eigen::Vector2d> velocities_m;   // v_t = v(s_t), metres per step
+  std::vector<int> frames;                    // s_t
+  std::vector<Eigen::Vector2d> positions_m;   // p_t, ground metres
+  std::vector<Eigen::Vector2d> velocities_m;  // v_t = v(s_t), metres per step
   // Bounding box of the positions of steps [16c, 16c + 16) per chunk c (kept by
   // IntegrateTrack and ShiftTrack; lets pairwise terms skip chunks far apart).
   std::vector<Eigen::AlignedBox2d> chunk_boxes_m;

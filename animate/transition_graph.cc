@@ -89,8 +89,8 @@ bool TransitionGraph::IsValidSequence(std::span<const int> frames, std::string* 
     }
     if (t > 0 && !HasEdge(frames[t - 1], frames[t])) {
       if (why) {
-        *why = "step " + std::to_string(t) + ": no edge " + std::to_string(frames[t - 1]) +
-               " -> " + std::to_string(frames[t]);
+        *why = "step " + std::to_string(t) + ": no edge " + std::to_string(frames[t - 1]) + " -> " +
+               std::to_string(frames[t]);
       }
       return false;
     }

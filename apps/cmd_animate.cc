@@ -34,7 +34,8 @@ void Run(const AnimateArgs& args) {
   AnimationSpec spec = LoadAnimationSpec(args.spec);
   AnimateRunOptions options;
   options.method = args.method.empty() ? spec.optimizer.method : args.method;
-  options.time_budget_s = args.time_budget_s > 0 ? args.time_budget_s : spec.optimizer.time_budget_s;
+  options.time_budget_s =
+      args.time_budget_s > 0 ? args.time_budget_s : spec.optimizer.time_budget_s;
   options.seed = args.seed >= 0 ? static_cast<uint64_t>(args.seed) : spec.optimizer.seed;
   options.threads = args.threads;
   options.snapshot_every_s =
@@ -84,9 +85,11 @@ void AddAnimateCommand(CLI::App& app) {
   cmd->add_option("--out", args->out, "Sequences file to write (JSON)")->required();
   cmd->add_option("--method", args->method, "replace (default) or beam")
       ->check(CLI::IsMember({"replace", "beam"}));
-  cmd->add_option("--time-budget", args->time_budget_s, "Seconds for the whole run (default: the spec's)")
+  cmd->add_option("--time-budget", args->time_budget_s,
+                  "Seconds for the whole run (default: the spec's)")
       ->check(CLI::PositiveNumber);
-  cmd->add_option("--seed", args->seed, "Random seed (default: the spec's)")->check(CLI::NonNegativeNumber);
+  cmd->add_option("--seed", args->seed, "Random seed (default: the spec's)")
+      ->check(CLI::NonNegativeNumber);
   cmd->add_option("--threads", args->threads, "Threads for the F/B sets (default: the spec's)")
       ->check(CLI::PositiveNumber);
   cmd->add_option("--snapshot-every", args->snapshot_every_s,

@@ -1,5 +1,5 @@
-// spritestation bank info|verify|tag|export|upgrade|digest BANK, bank copy FROM TO: inspect, maintain and
-// move a sprite bank (a SQLite file or a postgresql:// address).
+// spritestation bank info|verify|tag|export|upgrade|digest BANK, bank copy FROM TO: inspect,
+// maintain and move a sprite bank (a SQLite file or a postgresql:// address).
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -69,7 +69,8 @@ void Info(const std::string& address, bool json) {
   std::printf("tags:           %lld names on %lld sprites\n", static_cast<long long>(c.tags),
               static_cast<long long>(c.tagged_sprites));
   if (bank.is_postgres()) {
-    std::printf("on the server:  %s (tables, indexes and their out-of-line data)\n", Megabytes(c.file_bytes).c_str());
+    std::printf("on the server:  %s (tables, indexes and their out-of-line data)\n",
+                Megabytes(c.file_bytes).c_str());
   } else {
     std::printf("file:           %s (+ %s write-ahead log)\n", Megabytes(c.file_bytes).c_str(),
                 Megabytes(c.wal_bytes).c_str());
@@ -89,15 +90,16 @@ void Verify(const std::string& address, bool json) {
                         {"problems", r.problems}};
     std::printf("%s\n", j.dump(2).c_str());
   } else if (r.ok()) {
-    std::printf("%s: ok (schema version %d; %lld clips, %lld sprites, %lld billboards checked)\n", path.c_str(),
-                r.schema_version, static_cast<long long>(r.clips_checked), static_cast<long long>(r.sprites_checked),
+    std::printf("%s: ok (schema version %d; %lld clips, %lld sprites, %lld billboards checked)\n",
+                path.c_str(), r.schema_version, static_cast<long long>(r.clips_checked),
+                static_cast<long long>(r.sprites_checked),
                 static_cast<long long>(r.pixel_blobs_checked));
   } else {
     for (const auto& p : r.problems) std::printf("%s: %s\n", path.c_str(), p.c_str());
   }
   if (!r.ok()) {
-    throw WorkError(path, "the bank is damaged (" + std::to_string(r.problems.size()) + " problems; first: " +
-                              r.problems.front() + ")");
+    throw WorkError(path, "the bank is damaged (" + std::to_string(r.problems.size()) +
+                              " problems; first: " + r.problems.front() + ")");
   }
 }
 
@@ -114,20 +116,24 @@ void AddBankCommand(CLI::App& app) {
   };
   auto args = std::make_shared<Args>();
 
-  auto* info = bank->add_subcommand("info", "Counts: sessions, cameras, clips, sprites, transitions, tags, size");
+  auto* info = bank->add_subcommand(
+      "info", "Counts: sessions, cameras, clips, sprites, transitions, tags, size");
   info->add_option("bank", args->path, "Sprite bank (file or postgresql://...)")->required();
   info->add_flag("--json", args->json, "Print JSON");
   info->callback([args] { Info(args->path, args->json); });
 
-  auto* verify = bank->add_subcommand(
-      "verify", "Check integrity, schema and invariants; exit 1 when damaged, 2 when not a bank of this version");
+  auto* verify = bank->add_subcommand("verify",
+                                      "Check integrity, schema and invariants; exit 1 when "
+                                      "damaged, 2 when not a bank of this version");
   verify->add_option("bank", args->path, "Sprite bank (file or postgresql://...)")->required();
   verify->add_flag("--json", args->json, "Print JSON");
   verify->callback([args] { Verify(args->path, args->json); });
 
   auto* tag = bank->add_subcommand("tag", "Add (or --remove) a tag on sprites");
   tag->add_option("bank", args->path, "Sprite bank (file or postgresql://...)")->required();
-  tag->add_option("--sprites", args->sprites, "Sprite ids, comma-separated")->required()->delimiter(',');
+  tag->add_option("--sprites", args->sprites, "Sprite ids, comma-separated")
+      ->required()
+      ->delimiter(',');
   tag->add_option("--tag", args->tag, "Tag name")->required();
   tag->add_flag("--remove", args->remove, "Remove the tag instead");
   tag->add_flag("--json", args->json, "Print JSON");
@@ -150,12 +156,14 @@ void AddBankCommand(CLI::App& app) {
                               .dump(2)
                               .c_str());
     } else {
-      std::printf("%s '%s' on %zu sprites; %zu sprites now carry it\n", args->remove ? "removed" : "tagged",
-                  args->tag.c_str(), args->sprites.size(), total);
+      std::printf("%s '%s' on %zu sprites; %zu sprites now carry it\n",
+                  args->remove ? "removed" : "tagged", args->tag.c_str(), args->sprites.size(),
+                  total);
     }
   });
 
-  auto* exp = bank->add_subcommand("export", "Write the visible sprites as PNG billboards and sprites.csv");
+  auto* exp =
+      bank->add_subcommand("export", "Write the visible sprites as PNG billboards and sprites.csv");
   exp->add_option("bank", args->path, "Sprite bank (file or postgresql://...)")->required();
   exp->add_option("--out", args->out, "Output folder")->required();
   exp->add_option("--tag", args->tag, "Only sprites with this tag");
@@ -180,19 +188,24 @@ void AddBankCommand(CLI::App& app) {
     }
     const BankWriter writer(args->path);
     if (args->json) {
-      std::printf("%s\n", nlohmann::json({{"bank", writer.path()}, {"schema_version", writer.schema_version()}})
+      std::printf("%s\n", nlohmann::json({{"bank", writer.path()},
+                                          {"schema_version", writer.schema_version()}})
                               .dump(2)
                               .c_str());
     } else {
-      std::printf("%s: schema version %d (current %d)\n", writer.path().c_str(), writer.schema_version(),
-                  kBankSchemaVersion);
+      std::printf("%s: schema version %d (current %d)\n", writer.path().c_str(),
+                  writer.schema_version(), kBankSchemaVersion);
     }
   });
 
   auto* copy = bank->add_subcommand(
-      "copy", "Copy a bank into an empty one, keeping every id: SQLite to PostgreSQL or back (verified)");
-  copy->add_option("from", args->path, "Sprite bank to copy (file or postgresql://...)")->required();
-  copy->add_option("to", args->out, "Empty or new sprite bank to copy into (file or postgresql://...)")->required();
+      "copy",
+      "Copy a bank into an empty one, keeping every id: SQLite to PostgreSQL or back (verified)");
+  copy->add_option("from", args->path, "Sprite bank to copy (file or postgresql://...)")
+      ->required();
+  copy->add_option("to", args->out,
+                   "Empty or new sprite bank to copy into (file or postgresql://...)")
+      ->required();
   copy->add_flag("--json", args->json, "Print JSON");
   copy->callback([args] {
     const BankDigest d = CopyBank(args->path, args->out);
@@ -209,13 +222,16 @@ void AddBankCommand(CLI::App& app) {
                               .dump(2)
                               .c_str());
     } else {
-      std::printf("copied %lld rows (%lld sprites, %lld transitions) into %s: digest %s on both sides, verified\n",
-                  static_cast<long long>(rows), static_cast<long long>(d.rows.at("sprites")),
-                  static_cast<long long>(d.rows.at("transitions")), r.path.c_str(), d.digest.c_str());
+      std::printf(
+          "copied %lld rows (%lld sprites, %lld transitions) into %s: digest %s on both sides, "
+          "verified\n",
+          static_cast<long long>(rows), static_cast<long long>(d.rows.at("sprites")),
+          static_cast<long long>(d.rows.at("transitions")), r.path.c_str(), d.digest.c_str());
     }
   });
 
-  auto* digest = bank->add_subcommand("digest", "A digest of the bank's content, the same in SQLite and PostgreSQL");
+  auto* digest = bank->add_subcommand(
+      "digest", "A digest of the bank's content, the same in SQLite and PostgreSQL");
   digest->add_option("bank", args->path, "Sprite bank (file or postgresql://...)")->required();
   digest->add_flag("--json", args->json, "Print JSON");
   digest->callback([args] {

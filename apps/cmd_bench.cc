@@ -27,7 +27,8 @@ void AddBenchCommand(CLI::App& app) {
     std::vector<std::string> all = *args;
     for (const auto& extra : cmd->remaining()) all.push_back(extra);
     if (*list || name->empty()) {
-      for (const auto& s : bench::Suites()) std::printf("%-14s %s\n", s.name.c_str(), s.summary.c_str());
+      for (const auto& s : bench::Suites())
+        std::printf("%-14s %s\n", s.name.c_str(), s.summary.c_str());
       return;
     }
     for (const auto& s : bench::Suites()) {
@@ -40,7 +41,8 @@ void AddBenchCommand(CLI::App& app) {
     throw InputError("bench", "no suite named '" + *name + "' (see spritestation bench --list)");
 #else
     (void)cmd;
-    throw InputError("bench", "this build has no benchmarks (configure with -DSPRITESTATION_BENCHMARKS=ON)");
+    throw InputError("bench",
+                     "this build has no benchmarks (configure with -DSPRITESTATION_BENCHMARKS=ON)");
 #endif
   });
 }

@@ -23,12 +23,12 @@
 #include "calib/wizard.h"
 #include "calib/wizard_run.h"
 #include "calib/workflow.h"
-#include "core/config.h"
+#include "capture/camera_source.h"
 #include "core/camera_model.h"
+#include "core/config.h"
 #include "core/error.h"
 #include "core/frame.h"
 #include "core/session.h"
-#include "capture/camera_source.h"
 
 namespace ss::apps {
 namespace {
@@ -46,15 +46,21 @@ struct InputOptions {
 
 void AddInputOptions(CLI::App* cmd, InputOptions* o, int default_max_views) {
   o->max_views = default_max_views;
-  cmd->add_option("input", o->inputs, "A recorded session folder, or image files / a folder of images")->required();
-  cmd->add_option("--board", o->board, "Board: chessboard:COLSxROWS:SQUARE_M or charuco:COLSxROWS:SQUARE_M:MARKER_M[:DICT]")
+  cmd->add_option("input", o->inputs,
+                  "A recorded session folder, or image files / a folder of images")
+      ->required();
+  cmd->add_option(
+         "--board", o->board,
+         "Board: chessboard:COLSxROWS:SQUARE_M or charuco:COLSxROWS:SQUARE_M:MARKER_M[:DICT]")
       ->required();
   cmd->add_option("--camera", o->cameras, "Session: only this camera (repeat for several)");
-  cmd->add_option("--every", o->every, "Session: use every N-th frame (default: spread --max-views over the session)");
+  cmd->add_option("--every", o->every,
+                  "Session: use every N-th frame (default: spread --max-views over the session)");
   cmd->add_option("--max-views", o->max_views, "Session: views per camera");
   cmd->add_option("--first", o->first, "Session: first frame to use");
   cmd->add_option("--count", o->count, "Session: frames to use from --first (0: to the end)");
-  cmd->add_option("--max-edge-width", o->max_edge_width_px, "Reject views whose square edges rise over more pixels");
+  cmd->add_option("--max-edge-width", o->max_edge_width_px,
+                  "Reject views whose square edges rise over more pixels");
   cmd->add_option("--min-corners", o->min_corners, "Reject views with fewer corners");
 }
 
@@ -71,7 +77,8 @@ std::vector<calib::CameraViews> LoadViews(const InputOptions& o, const calib::Bo
     sample.cameras = o.cameras;
     return calib::DetectInSession(o.inputs[0], board, detect, sample);
   }
-  return {calib::DetectInImages(o.inputs, board, detect, o.cameras.empty() ? "camera0" : o.cameras.front())};
+  return {calib::DetectInImages(o.inputs, board, detect,
+                                o.cameras.empty() ? "camera0" : o.cameras.front())};
 }
 
 void Print(const calib::JobOutcome& outcome, bool json) {
@@ -84,7 +91,8 @@ void Print(const calib::JobOutcome& outcome, bool json) {
 }
 
 void AddIntrinsics(CLI::App& parent) {
-  auto* cmd = parent.add_subcommand("intrinsics", "Solve lens intrinsics (mrcal) from board views; several cameras jointly");
+  auto* cmd = parent.add_subcommand(
+      "intrinsics", "Solve lens intrinsics (mrcal) from board views; several cameras jointly");
   auto in = std::make_shared<InputOptions>();
   auto out = std::make_shared<std::string>();
   auto lensmodel = std::make_shared<std::string>("LENSMODEL_OPENCV8");
@@ -95,13 +103,18 @@ void AddIntrinsics(CLI::App& parent) {
   auto keep_outliers = std::make_shared<bool>(false);
   auto min_coverage = std::make_shared<double>(calib::VerdictOptions{}.min_coverage);
   AddInputOptions(cmd, in.get(), 40);
-  cmd->add_option("--out", *out, "Output folder: CAMERA.cameramodel, plots, intrinsics.json")->required();
-  cmd->add_option("--lensmodel", *lensmodel, "mrcal lens model, e.g. LENSMODEL_OPENCV8, LENSMODEL_SPLINED_STEREOGRAPHIC_order=3_Nx=16_Ny=12_fov_x_deg=100");
+  cmd->add_option("--out", *out, "Output folder: CAMERA.cameramodel, plots, intrinsics.json")
+      ->required();
+  cmd->add_option("--lensmodel", *lensmodel,
+                  "mrcal lens model, e.g. LENSMODEL_OPENCV8, "
+                  "LENSMODEL_SPLINED_STEREOGRAPHIC_order=3_Nx=16_Ny=12_fov_x_deg=100");
   cmd->add_option("--min-views", *min_views, "Accepted views needed for a trusted model");
   cmd->add_option("--max-rms", *max_rms, "Largest trusted RMS reprojection error, px");
-  cmd->add_option("--min-coverage", *min_coverage, "Fraction of the image's coverage cells that need corners");
+  cmd->add_option("--min-coverage", *min_coverage,
+                  "Fraction of the image's coverage cells that need corners");
   cmd->add_flag("--write-rejected", *force, "Write models even when the verdict is 'rejected'");
-  cmd->add_flag("--no-outlier-rejection", *keep_outliers, "Keep every corner (mrcal's outlier rejection off)");
+  cmd->add_flag("--no-outlier-rejection", *keep_outliers,
+                "Keep every corner (mrcal's outlier rejection off)");
   cmd->add_flag("--json", *json, "Print the report as JSON");
   cmd->callback([=] {
     calib::IntrinsicsJob job;
@@ -117,14 +130,16 @@ void AddIntrinsics(CLI::App& parent) {
     const calib::JobOutcome outcome = calib::RunIntrinsics(views, job);
     Print(outcome, *json);
     if (!outcome.any_board) {
-      throw InputError(in->inputs.front(), "no board " + job.board.ToString() + " found in any view (wrong --board?)");
+      throw InputError(in->inputs.front(),
+                       "no board " + job.board.ToString() + " found in any view (wrong --board?)");
     }
     if (!outcome.all_good) throw WorkError(*out, "calibration not trusted (see the reasons above)");
   });
 }
 
 void AddGround(CLI::App& parent) {
-  auto* cmd = parent.add_subcommand("ground", "Pose every camera against the floor from a board lying flat on it");
+  auto* cmd = parent.add_subcommand(
+      "ground", "Pose every camera against the floor from a board lying flat on it");
   auto in = std::make_shared<InputOptions>();
   auto out = std::make_shared<std::string>();
   auto models = std::make_shared<std::vector<std::string>>();
@@ -134,13 +149,20 @@ void AddGround(CLI::App& parent) {
   auto rigid = std::make_shared<bool>(false);
   auto json = std::make_shared<bool>(false);
   AddInputOptions(cmd, in.get(), 10);
-  cmd->add_option("--out", *out, "Output folder: CAMERA.cameramodel with cam_from_ground, ground.json")->required();
+  cmd->add_option("--out", *out,
+                  "Output folder: CAMERA.cameramodel with cam_from_ground, ground.json")
+      ->required();
   cmd->add_option("--models", *models,
-                  "Intrinsics: a folder with CAMERA.cameramodel, or one file per camera (default: the session's)");
-  cmd->add_option("--board-pose", *pose, "Board's top-left checkered corner on the floor: X Y YAW_DEG")->expected(3);
-  cmd->add_option("--board-thickness", *thickness, "Height of the printed surface above the floor, m");
+                  "Intrinsics: a folder with CAMERA.cameramodel, or one file per camera (default: "
+                  "the session's)");
+  cmd->add_option("--board-pose", *pose,
+                  "Board's top-left checkered corner on the floor: X Y YAW_DEG")
+      ->expected(3);
+  cmd->add_option("--board-thickness", *thickness,
+                  "Height of the printed surface above the floor, m");
   cmd->add_option("--still-views", *still, "Accepted views of the still board averaged per camera");
-  cmd->add_flag("--rigid", *rigid, "Models share one reference (joint solve): cameras without a floor view follow");
+  cmd->add_flag("--rigid", *rigid,
+                "Models share one reference (joint solve): cameras without a floor view follow");
   cmd->add_flag("--json", *json, "Print the report as JSON");
   cmd->callback([=] {
     calib::GroundJob job;
@@ -160,14 +182,17 @@ void AddGround(CLI::App& parent) {
       } else if (models->empty()) {
         path = views[c].model_path;
       } else {
-        throw InputError("--models", "give a folder, or one model per camera (" + std::to_string(views.size()) + ")");
+        throw InputError("--models", "give a folder, or one model per camera (" +
+                                         std::to_string(views.size()) + ")");
       }
       if (path.empty()) throw InputError("--models", "no model for camera " + views[c].name);
       cams.push_back(CameraModel::Read(path));
     }
     const calib::JobOutcome outcome = calib::RunGround(views, cams, job);
     Print(outcome, *json);
-    if (!outcome.any_board) throw InputError(in->inputs.front(), "no board " + job.board.ToString() + " found on the floor");
+    if (!outcome.any_board)
+      throw InputError(in->inputs.front(),
+                       "no board " + job.board.ToString() + " found on the floor");
     if (!outcome.all_good) throw WorkError(*out, "not every camera could be posed (see above)");
   });
 }
@@ -183,8 +208,10 @@ void AddEnclosure(CLI::App& parent) {
   auto wall = std::make_shared<double>(0.0);
   auto json = std::make_shared<bool>(false);
   cmd->add_option("--points", *points, "Ground points \"x,y x,y ...\" in metres, in order");
-  cmd->add_option("--pixels", *pixels, "Image points \"u,v u,v ...\" of the floor's corners (needs --model)");
-  cmd->add_option("--green", *green, "Image of the empty enclosure: the largest green floor region (needs --model)");
+  cmd->add_option("--pixels", *pixels,
+                  "Image points \"u,v u,v ...\" of the floor's corners (needs --model)");
+  cmd->add_option("--green", *green,
+                  "Image of the empty enclosure: the largest green floor region (needs --model)");
   cmd->add_option("--model", *model, "Posed .cameramodel (after calibrate ground)");
   cmd->add_option("--wall-height", *wall, "enclosure.wall_height_m written with the polygon");
   cmd->add_option("--out", *out, "Write the enclosure section (YAML) here");
@@ -192,7 +219,8 @@ void AddEnclosure(CLI::App& parent) {
   cmd->add_flag("--json", *json, "Print the polygon as JSON");
   cmd->callback([=] {
     const int sources = !points->empty() + !pixels->empty() + !green->empty();
-    if (sources != 1) throw InputError("calibrate enclosure", "give exactly one of --points, --pixels, --green");
+    if (sources != 1)
+      throw InputError("calibrate enclosure", "give exactly one of --points, --pixels, --green");
     GroundPolygon floor;
     if (!points->empty()) {
       floor = calib::FloorPolygonFromPoints(calib::ParsePointList(*points, "--points"), "--points");
@@ -200,7 +228,8 @@ void AddEnclosure(CLI::App& parent) {
       if (model->empty()) throw InputError("--model", "needed with --pixels and --green");
       const CameraModel m = CameraModel::Read(*model);
       if (!pixels->empty()) {
-        floor = calib::FloorPolygonFromPixels(m, calib::ParsePointList(*pixels, "--pixels"), "--pixels");
+        floor = calib::FloorPolygonFromPixels(m, calib::ParsePointList(*pixels, "--pixels"),
+                                              "--pixels");
       } else {
         const cv::Mat image = cv::imread(*green, cv::IMREAD_COLOR);
         if (image.empty()) throw InputError(*green, "unreadable image");
@@ -235,54 +264,79 @@ void AddEnclosure(CLI::App& parent) {
       j["wall_height_m"] = *wall;
       std::printf("%s\n", j.dump(2).c_str());
     } else {
-      std::printf("%s# %zu vertices, %.4f m^2\n", yaml.c_str(), floor.vertices().size(), floor.Area());
+      std::printf("%s# %zu vertices, %.4f m^2\n", yaml.c_str(), floor.vertices().size(),
+                  floor.Area());
     }
   });
 }
 
-
 void AddWizard(CLI::App& parent) {
-  auto* cmd = parent.add_subcommand("wizard", "Guided calibration of one camera: intrinsics, ground, enclosure");
+  auto* cmd = parent.add_subcommand(
+      "wizard", "Guided calibration of one camera: intrinsics, ground, enclosure");
   struct Options {
     std::string session, config, camera, board, out, intrinsics, floor_points;
     std::vector<double> pose{0, 0, 0};
-    double thickness = 0, still_px = 0.5, still_s = 0.2, floor_still_s = 1.0, min_coverage = 0.5, max_rms = 0.5;
+    double thickness = 0, still_px = 0.5, still_s = 0.2, floor_still_s = 1.0, min_coverage = 0.5,
+           max_rms = 0.5;
     double silent_s = 5;
     int min_views = 10, max_views = 30, count = 0;
     bool json = false;
   };
   auto o = std::make_shared<Options>();
-  cmd->add_option("--session", o->session, "A recorded calibration session (replayed, as fast as it decodes)");
-  cmd->add_option("--config", o->config, "Station config: calibrate its camera --camera (live or replay)");
-  cmd->add_option("--camera", o->camera, "Camera name (session: default the first; config: required)");
-  cmd->add_option("--board", o->board, "Board: chessboard:COLSxROWS:SQUARE_M or charuco:COLSxROWS:SQUARE_M:MARKER_M[:DICT]")
+  cmd->add_option("--session", o->session,
+                  "A recorded calibration session (replayed, as fast as it decodes)");
+  cmd->add_option("--config", o->config,
+                  "Station config: calibrate its camera --camera (live or replay)");
+  cmd->add_option("--camera", o->camera,
+                  "Camera name (session: default the first; config: required)");
+  cmd->add_option(
+         "--board", o->board,
+         "Board: chessboard:COLSxROWS:SQUARE_M or charuco:COLSxROWS:SQUARE_M:MARKER_M[:DICT]")
       ->required();
-  cmd->add_option("--out", o->out, "Output folder: CAMERA.cameramodel, plots, enclosure.yaml, wizard.json")->required();
-  cmd->add_option("--intrinsics", o->intrinsics, "Known intrinsics (.cameramodel): start at the ground step");
-  cmd->add_option("--board-pose", o->pose, "Floor board's top-left checkered corner on the floor: X Y YAW_DEG")->expected(3);
-  cmd->add_option("--board-thickness", o->thickness, "Height of the printed surface above the floor, m");
-  cmd->add_option("--floor-points", o->floor_points, "Enclosure floor \"x,y x,y ...\" in ground metres (default: the green floor)");
+  cmd->add_option("--out", o->out,
+                  "Output folder: CAMERA.cameramodel, plots, enclosure.yaml, wizard.json")
+      ->required();
+  cmd->add_option("--intrinsics", o->intrinsics,
+                  "Known intrinsics (.cameramodel): start at the ground step");
+  cmd->add_option("--board-pose", o->pose,
+                  "Floor board's top-left checkered corner on the floor: X Y YAW_DEG")
+      ->expected(3);
+  cmd->add_option("--board-thickness", o->thickness,
+                  "Height of the printed surface above the floor, m");
+  cmd->add_option("--floor-points", o->floor_points,
+                  "Enclosure floor \"x,y x,y ...\" in ground metres (default: the green floor)");
   cmd->add_option("--min-views", o->min_views, "Intrinsics: views needed");
-  cmd->add_option("--max-views", o->max_views, "Intrinsics: solve what there is at this many views");
-  cmd->add_option("--min-coverage", o->min_coverage, "Intrinsics: fraction of the image's coverage cells needed");
-  cmd->add_option("--max-rms", o->max_rms, "Intrinsics: largest trusted RMS reprojection error, px");
-  cmd->add_option("--still-px", o->still_px, "Largest corner motion between frames of a still board, px");
-  cmd->add_option("--still-seconds", o->still_s, "Intrinsics: the board is still this long before a capture");
-  cmd->add_option("--floor-still-seconds", o->floor_still_s, "Ground: still this long = lying on the floor");
-  cmd->add_option("--count", o->count, "Stop after this many frames (0: the whole session / until done)");
-  cmd->add_option("--silent-seconds", o->silent_s, "A live camera without a frame this long ends the wizard")
+  cmd->add_option("--max-views", o->max_views,
+                  "Intrinsics: solve what there is at this many views");
+  cmd->add_option("--min-coverage", o->min_coverage,
+                  "Intrinsics: fraction of the image's coverage cells needed");
+  cmd->add_option("--max-rms", o->max_rms,
+                  "Intrinsics: largest trusted RMS reprojection error, px");
+  cmd->add_option("--still-px", o->still_px,
+                  "Largest corner motion between frames of a still board, px");
+  cmd->add_option("--still-seconds", o->still_s,
+                  "Intrinsics: the board is still this long before a capture");
+  cmd->add_option("--floor-still-seconds", o->floor_still_s,
+                  "Ground: still this long = lying on the floor");
+  cmd->add_option("--count", o->count,
+                  "Stop after this many frames (0: the whole session / until done)");
+  cmd->add_option("--silent-seconds", o->silent_s,
+                  "A live camera without a frame this long ends the wizard")
       ->check(CLI::PositiveNumber);
   cmd->add_flag("--json", o->json, "Print the result and the step log as JSON");
   cmd->callback([o] {
-    if (o->session.empty() == o->config.empty()) throw InputError("calibrate wizard", "give exactly one of --session, --config");
+    if (o->session.empty() == o->config.empty())
+      throw InputError("calibrate wizard", "give exactly one of --session, --config");
     CameraConfig camera;
     if (!o->session.empty()) {
       // A recorded session through the same source a configured replay camera opens.
       const SessionInfo info = ReadSessionInfo(o->session);
       if (info.cameras.empty()) throw InputError(o->session, "the session has no camera");
       camera.name = o->camera.empty() ? info.cameras.front().name : o->camera;
-      const bool known = std::any_of(info.cameras.begin(), info.cameras.end(), [&](const auto& c) { return c.name == camera.name; });
-      if (!known) throw InputError("--camera", "no camera named \"" + camera.name + "\" in " + o->session);
+      const bool known = std::any_of(info.cameras.begin(), info.cameras.end(),
+                                     [&](const auto& c) { return c.name == camera.name; });
+      if (!known)
+        throw InputError("--camera", "no camera named \"" + camera.name + "\" in " + o->session);
       camera.source = "replay";
       camera.session = fs::absolute(o->session).string();
       camera.realtime = false;
@@ -293,7 +347,8 @@ void AddWizard(CLI::App& parent) {
       for (const auto& c : config.cameras) {
         if (c.name == o->camera) camera = c, found = true;
       }
-      if (!found) throw InputError("--camera", "no camera named \"" + o->camera + "\" in " + o->config);
+      if (!found)
+        throw InputError("--camera", "no camera named \"" + o->camera + "\" in " + o->config);
     }
     calib::WizardOptions w;
     w.board = calib::ParseBoardSpec(o->board);
@@ -304,7 +359,8 @@ void AddWizard(CLI::App& parent) {
     w.still_px = o->still_px;
     w.detect.exhaustive = false;  // a live camera's frames without a board must stay cheap
     w.ground_from_board = calib::FloorBoardPose(o->pose[0], o->pose[1], o->pose[2], o->thickness);
-    if (!o->floor_points.empty()) w.floor_points = calib::ParsePointList(o->floor_points, "--floor-points");
+    if (!o->floor_points.empty())
+      w.floor_points = calib::ParsePointList(o->floor_points, "--floor-points");
     if (!o->intrinsics.empty()) w.intrinsics = CameraModel::Read(o->intrinsics);
     auto source = OpenCameraSource(camera, 0);
     const SourceCamera& sc = source->cameras().at(0);
@@ -317,7 +373,8 @@ void AddWizard(CLI::App& parent) {
       for (; printed < wizard.log().size(); ++printed) {
         const auto& e = wizard.log()[printed];
         const std::string kind = e["event"];
-        std::string line = "[" + std::string(e["step"]) + "] frame " + std::to_string(e["frame"].get<int>()) + ": ";
+        std::string line = "[" + std::string(e["step"]) + "] frame " +
+                           std::to_string(e["frame"].get<int>()) + ": ";
         if (kind == "guidance") {
           std::string say;
           for (const auto& s : e["say"]) say += (say.empty() ? "" : "; ") + s.get<std::string>();
@@ -338,8 +395,9 @@ void AddWizard(CLI::App& parent) {
     const calib::WizardRunResult ran = calib::RunWizardOnSource(*source, wizard, run, print_log);
     const int frames = ran.frames;
     if (ran.silent) {
-      std::fprintf(stderr, "calibrate wizard: %s delivered no frame for %.1f s; ending with what was seen\n",
-                   camera.name.c_str(), o->silent_s);
+      std::fprintf(
+          stderr, "calibrate wizard: %s delivered no frame for %.1f s; ending with what was seen\n",
+          camera.name.c_str(), o->silent_s);
     }
     wizard.Finish();
     print_log();
@@ -354,15 +412,19 @@ void AddWizard(CLI::App& parent) {
       if (wizard.report()) std::printf("%s", calib::ToText(*wizard.report()).c_str());
     }
     std::fflush(stdout);
-    if (!wizard.board_seen()) throw InputError(o->board, "no board " + w.board.ToString() + " found in any frame (wrong --board?)");
-    if (!wizard.verdicts().empty()) throw WorkError(o->out, "calibration not complete (see the verdicts above)");
+    if (!wizard.board_seen())
+      throw InputError(o->board,
+                       "no board " + w.board.ToString() + " found in any frame (wrong --board?)");
+    if (!wizard.verdicts().empty())
+      throw WorkError(o->out, "calibration not complete (see the verdicts above)");
   });
 }
 
 }  // namespace
 
 void AddCalibrateCommand(CLI::App& app) {
-  auto* cmd = app.add_subcommand("calibrate", "Camera calibration: intrinsics, ground plane, enclosure");
+  auto* cmd =
+      app.add_subcommand("calibrate", "Camera calibration: intrinsics, ground plane, enclosure");
   cmd->require_subcommand(1);
   AddIntrinsics(*cmd);
   AddGround(*cmd);

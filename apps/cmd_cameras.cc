@@ -21,8 +21,12 @@ void RunCameras(bool json) {
     if (!backend->list) continue;
     try {
       for (const FoundCamera& d : backend->list()) {
-        out.push_back({{"backend", d.backend}, {"id", d.id}, {"model", d.model}, {"driver", d.driver},
-                       {"address", d.address}, {"serial", d.serial}});
+        out.push_back({{"backend", d.backend},
+                       {"id", d.id},
+                       {"model", d.model},
+                       {"driver", d.driver},
+                       {"address", d.address},
+                       {"serial", d.serial}});
       }
     } catch (const std::exception& e) {  // a broken backend must not hide the others
       Log("apps.cameras")->warn("{}: {}", backend->name, e.what());
@@ -47,7 +51,8 @@ void RunCameras(bool json) {
 }  // namespace
 
 void AddCamerasCommand(CLI::App& app) {
-  auto* cmd = app.add_subcommand("cameras", "List the cameras the built-in backends (V4L2, Aravis, libcamera) can open");
+  auto* cmd = app.add_subcommand(
+      "cameras", "List the cameras the built-in backends (V4L2, Aravis, libcamera) can open");
   auto json = std::make_shared<bool>(false);
   cmd->add_flag("--json", *json, "Print the list as JSON");
   cmd->callback([json] { RunCameras(*json); });

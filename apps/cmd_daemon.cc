@@ -11,9 +11,9 @@
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <memory>
 #include <string>
-#include <filesystem>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -22,12 +22,12 @@
 #include "core/config.h"
 #include "core/error.h"
 #include "core/log.h"
+#include "pipeline/transitions/weights.h"
 #include "station/camera_runner.h"
 #include "station/control_server.h"
 #include "station/station.h"
 #include "station/station_host.h"
 #include "station/station_status.h"
-#include "pipeline/transitions/weights.h"
 #include "web/web_files.h"
 #ifdef SPRITESTATION_HAVE_SYSTEMD
 #include <systemd/sd-daemon.h>
@@ -72,10 +72,12 @@ void RunDaemon(const DaemonArgs& a) {
     options.weights_path = a.weights;
   }
   options.transitions = !a.no_transitions;
-  if (!(a.offline_after_s > 0)) throw InputError("--offline-after", "expected a positive number of seconds");
+  if (!(a.offline_after_s > 0))
+    throw InputError("--offline-after", "expected a positive number of seconds");
   options.offline_after_s = a.offline_after_s;
 
-  // Signals are taken by this thread alone (sigtimedwait below): block them before any thread starts.
+  // Signals are taken by this thread alone (sigtimedwait below): block them before any thread
+  // starts.
   sigset_t signals;
   sigemptyset(&signals);
   sigaddset(&signals, SIGINT);
@@ -85,7 +87,8 @@ void RunDaemon(const DaemonArgs& a) {
 
   // The console's replay page lists the sessions under these folders.
   std::vector<std::string> replay_roots;
-  if (!options.config.storage.recording_dir.empty()) replay_roots.push_back(options.config.storage.recording_dir);
+  if (!options.config.storage.recording_dir.empty())
+    replay_roots.push_back(options.config.storage.recording_dir);
   if (a.replay_dirs.empty()) {
     std::error_code ec;
     if (std::filesystem::is_directory("recordings", ec)) {
@@ -94,7 +97,8 @@ void RunDaemon(const DaemonArgs& a) {
   }
   for (const std::string& dir : a.replay_dirs) {
     std::error_code ec;
-    if (!std::filesystem::is_directory(dir, ec)) throw InputError("--replay-dir", dir + ": no such folder");
+    if (!std::filesystem::is_directory(dir, ec))
+      throw InputError("--replay-dir", dir + ": no such folder");
     replay_roots.push_back(std::filesystem::absolute(dir, ec).lexically_normal().string());
   }
   ControlServerOptions control_options;
@@ -103,7 +107,8 @@ void RunDaemon(const DaemonArgs& a) {
   if (!a.web_dir.empty()) {
     std::error_code ec;
     if (!std::filesystem::exists(std::filesystem::path(a.web_dir) / "index.html", ec)) {
-      throw InputError("--web-dir", a.web_dir + ": has no index.html (expected the source tree's web/ folder)");
+      throw InputError("--web-dir",
+                       a.web_dir + ": has no index.html (expected the source tree's web/ folder)");
     }
     control_options.web_dir = a.web_dir;
   }
@@ -141,7 +146,8 @@ void RunDaemon(const DaemonArgs& a) {
       Notify("READY=1");
     }
     if (a.duration_s > 0 &&
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() >= a.duration_s) {
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() >=
+            a.duration_s) {
       break;
     }
   }
@@ -157,11 +163,14 @@ void RunDaemon(const DaemonArgs& a) {
     std::printf("daemon: stopped; %llu sprites stored this run, bank %s\n",
                 static_cast<unsigned long long>(status.sprites_stored), status.bank_path.c_str());
     for (const CameraStatus& c : status.cameras) {
-      std::printf("  %s: %llu frames, %llu processed, dropped %llu (queue full) + %llu (at the source), %llu reopens\n",
-                  c.name.c_str(), static_cast<unsigned long long>(c.frames_captured),
-                  static_cast<unsigned long long>(c.frames_processed),
-                  static_cast<unsigned long long>(c.dropped_queue_full),
-                  static_cast<unsigned long long>(c.dropped_at_source), static_cast<unsigned long long>(c.reopens));
+      std::printf(
+          "  %s: %llu frames, %llu processed, dropped %llu (queue full) + %llu (at the source), "
+          "%llu reopens\n",
+          c.name.c_str(), static_cast<unsigned long long>(c.frames_captured),
+          static_cast<unsigned long long>(c.frames_processed),
+          static_cast<unsigned long long>(c.dropped_queue_full),
+          static_cast<unsigned long long>(c.dropped_at_source),
+          static_cast<unsigned long long>(c.reopens));
     }
   }
   if (!cameras_closed) {
@@ -176,19 +185,26 @@ void RunDaemon(const DaemonArgs& a) {
 }  // namespace
 
 void AddDaemonCommand(CLI::App& app) {
-  auto* cmd = app.add_subcommand("daemon", "Run the live station from a config file (cameras, pipeline, bank, HTTP control)");
+  auto* cmd = app.add_subcommand(
+      "daemon", "Run the live station from a config file (cameras, pipeline, bank, HTTP control)");
   auto a = std::make_shared<DaemonArgs>();
   cmd->add_option("--config", a->config, "Station config (docs/config.md)")->required();
   cmd->add_option("--session", a->session, "Start a capture session with this name at once");
-  cmd->add_option("--duration", a->duration_s, "Stop after this many seconds (0: until SIGTERM/SIGINT)");
-  cmd->add_option("--weights", a->weights, "Transition classifier weights (default: the shipped ones)");
-  cmd->add_flag("--no-transitions", a->no_transitions, "Do not keep the bank's transitions current");
-  cmd->add_option("--offline-after", a->offline_after_s, "A camera silent this many seconds is marked offline and reopened");
+  cmd->add_option("--duration", a->duration_s,
+                  "Stop after this many seconds (0: until SIGTERM/SIGINT)");
+  cmd->add_option("--weights", a->weights,
+                  "Transition classifier weights (default: the shipped ones)");
+  cmd->add_flag("--no-transitions", a->no_transitions,
+                "Do not keep the bank's transitions current");
+  cmd->add_option("--offline-after", a->offline_after_s,
+                  "A camera silent this many seconds is marked offline and reopened");
   cmd->add_flag("--json", a->json, "Print the final status as JSON when stopped");
-  cmd->add_option("--web-dir", a->web_dir, "Serve the console's pages from this folder (a source tree's web/) "
-                                          "instead of the copy built in");
-  cmd->add_option("--replay-dir", a->replay_dirs, "A folder of recorded sessions for the console's replay page "
-                                                  "(repeatable; default: recordings/ here, and storage.recording_dir)");
+  cmd->add_option("--web-dir", a->web_dir,
+                  "Serve the console's pages from this folder (a source tree's web/) "
+                  "instead of the copy built in");
+  cmd->add_option("--replay-dir", a->replay_dirs,
+                  "A folder of recorded sessions for the console's replay page "
+                  "(repeatable; default: recordings/ here, and storage.recording_dir)");
   cmd->callback([a] { RunDaemon(*a); });
 }
 

@@ -24,12 +24,15 @@ namespace ss::apps {
 namespace {
 
 void PrintProgress(const IngestProgress& p) {
-  const double fraction = p.frames_total ? static_cast<double>(p.frames_done) / p.frames_total : 0.0;
+  const double fraction =
+      p.frames_total ? static_cast<double>(p.frames_done) / p.frames_total : 0.0;
   const int width = 30, filled = static_cast<int>(fraction * width + 0.5);
   std::fprintf(stderr, "\r[%s%s] %5.1f%%  %llu/%llu frames  %llu sprites  %.0f frames/s ",
-               std::string(filled, '#').c_str(), std::string(width - filled, '.').c_str(), 100 * fraction,
-               static_cast<unsigned long long>(p.frames_done), static_cast<unsigned long long>(p.frames_total),
-               static_cast<unsigned long long>(p.sprites_stored), p.seconds > 0 ? p.frames_done / p.seconds : 0.0);
+               std::string(filled, '#').c_str(), std::string(width - filled, '.').c_str(),
+               100 * fraction, static_cast<unsigned long long>(p.frames_done),
+               static_cast<unsigned long long>(p.frames_total),
+               static_cast<unsigned long long>(p.sprites_stored),
+               p.seconds > 0 ? p.frames_done / p.seconds : 0.0);
   std::fflush(stderr);
 }
 
@@ -39,8 +42,9 @@ nlohmann::json DiscardsJson(const DiscardCounts& counts) {
   return j;
 }
 
-void RunIngest(const std::string& session, const std::string& bank, const std::string& config_path, bool json,
-               bool transitions, const std::string& transition_weights, int decode_threads) {
+void RunIngest(const std::string& session, const std::string& bank, const std::string& config_path,
+               bool json, bool transitions, const std::string& transition_weights,
+               int decode_threads) {
   IngestOptions options;
   options.decode_threads = decode_threads;
   options.session_dir = session;
@@ -65,13 +69,15 @@ void RunIngest(const std::string& session, const std::string& bank, const std::s
                        (s.source.last_error.empty() ? "" : " (" + s.source.last_error + ")"));
     } else if (c.replay.frames_unreadable > 0) {
       // A damaged or cut recording: the frames around the damage are stored, the damage is named.
-      failed.push_back("camera " + c.name + ": " + std::to_string(c.replay.frames_unreadable) + " of " +
-                       std::to_string(c.replay.frames_in_csv) + " frames could not be read" +
+      failed.push_back("camera " + c.name + ": " + std::to_string(c.replay.frames_unreadable) +
+                       " of " + std::to_string(c.replay.frames_in_csv) +
+                       " frames could not be read" +
                        (c.replay.problems.empty() ? "" : " (" + c.replay.problems.front() + ")"));
     }
   }
   if (s.transitions && !s.transitions_error.empty()) {
-    failed.push_back("transitions: " + s.transitions_error + " (run 'spritestation transitions " + bank + "')");
+    failed.push_back("transitions: " + s.transitions_error + " (run 'spritestation transitions " +
+                     bank + "')");
   }
   const auto finish = [&] {
     if (failed.empty()) return;
@@ -125,40 +131,47 @@ void RunIngest(const std::string& session, const std::string& bank, const std::s
     return;
   }
   std::printf("ingested %s into %s\n", session.c_str(), bank.c_str());
-  std::printf("  %llu frames in %.2f s (%.0f frames/s)\n", static_cast<unsigned long long>(s.frames), s.seconds,
-              s.frames_per_second);
-  std::printf("  %llu usable sprites kept (+ as many mirrored copies), %llu new rows in %llu batches%s\n",
-              static_cast<unsigned long long>(s.sprites_kept), static_cast<unsigned long long>(s.rows_inserted),
-              static_cast<unsigned long long>(s.batches),
-              s.rows_inserted == 0 && s.sprites_kept > 0 ? " (already in the bank)" : "");
+  std::printf("  %llu frames in %.2f s (%.0f frames/s)\n",
+              static_cast<unsigned long long>(s.frames), s.seconds, s.frames_per_second);
+  std::printf(
+      "  %llu usable sprites kept (+ as many mirrored copies), %llu new rows in %llu batches%s\n",
+      static_cast<unsigned long long>(s.sprites_kept),
+      static_cast<unsigned long long>(s.rows_inserted), static_cast<unsigned long long>(s.batches),
+      s.rows_inserted == 0 && s.sprites_kept > 0 ? " (already in the bank)" : "");
   std::printf("  billboard scale %g px/m: %s\n", s.px_per_m, s.px_per_m_why.c_str());
   std::printf("  discarded:");
   for (size_t r = 1; r < s.discards.size(); ++r) {
-    std::printf(" %s %llu", DiscardName(static_cast<Discard>(r)), static_cast<unsigned long long>(s.discards[r]));
+    std::printf(" %s %llu", DiscardName(static_cast<Discard>(r)),
+                static_cast<unsigned long long>(s.discards[r]));
   }
   std::printf("\n");
   for (const IngestCamera& c : s.cameras) {
-    std::printf("  %s: %llu frames (%llu learnt as the empty enclosure), %llu candidates, %llu kept in %llu clips, "
-                "key %.2f s, rest %.2f s\n",
-                c.name.c_str(), static_cast<unsigned long long>(c.stats.frames),
-                static_cast<unsigned long long>(c.stats.training_frames),
-                static_cast<unsigned long long>(c.stats.candidates),
-                static_cast<unsigned long long>(c.stats.stored_sprites), static_cast<unsigned long long>(c.stats.clips),
-                c.stats.seconds_key, c.stats.seconds_rest);
+    std::printf(
+        "  %s: %llu frames (%llu learnt as the empty enclosure), %llu candidates, %llu kept in "
+        "%llu clips, "
+        "key %.2f s, rest %.2f s\n",
+        c.name.c_str(), static_cast<unsigned long long>(c.stats.frames),
+        static_cast<unsigned long long>(c.stats.training_frames),
+        static_cast<unsigned long long>(c.stats.candidates),
+        static_cast<unsigned long long>(c.stats.stored_sprites),
+        static_cast<unsigned long long>(c.stats.clips), c.stats.seconds_key, c.stats.seconds_rest);
   }
   if (s.transitions) {
-    std::printf("  transitions: %lld stored (table of %lld sprites kept current; waited %.2f s at the end)\n",
-                static_cast<long long>(s.transitions_stored), static_cast<long long>(s.transition_sprites),
-                s.seconds_transitions_wait);
+    std::printf(
+        "  transitions: %lld stored (table of %lld sprites kept current; waited %.2f s at the "
+        "end)\n",
+        static_cast<long long>(s.transitions_stored), static_cast<long long>(s.transition_sprites),
+        s.seconds_transitions_wait);
     if (!s.transitions_error.empty()) {
-      std::printf("  transitions FAILED: %s (run 'spritestation transitions %s')\n", s.transitions_error.c_str(),
-                  bank.c_str());
+      std::printf("  transitions FAILED: %s (run 'spritestation transitions %s')\n",
+                  s.transitions_error.c_str(), bank.c_str());
     }
   } else {
     std::printf("  transitions: not kept current (--no-transitions)\n");
   }
   if (s.source.frames_dropped > 0) {
-    std::printf("  %llu frames could not be read: %s\n", static_cast<unsigned long long>(s.source.frames_dropped),
+    std::printf("  %llu frames could not be read: %s\n",
+                static_cast<unsigned long long>(s.source.frames_dropped),
                 s.source.last_error.c_str());
   }
   std::fflush(stdout);
@@ -168,7 +181,8 @@ void RunIngest(const std::string& session, const std::string& bank, const std::s
 }  // namespace
 
 void AddIngestCommand(CLI::App& app) {
-  auto* cmd = app.add_subcommand("ingest", "Run a recorded session through the live pipeline into a sprite bank");
+  auto* cmd = app.add_subcommand(
+      "ingest", "Run a recorded session through the live pipeline into a sprite bank");
   auto session = std::make_shared<std::string>();
   auto bank = std::make_shared<std::string>();
   auto config = std::make_shared<std::string>();
@@ -181,13 +195,16 @@ void AddIngestCommand(CLI::App& app) {
   cmd->add_option("--config", *config, "Station config (keying, enclosure, pipeline sections)");
   cmd->add_flag("--transitions,!--no-transitions", *transitions,
                 "Keep the bank's transition table current while ingesting (default on)");
-  cmd->add_option("--transition-weights", *weights, "Transition classifier weights (default: the shipped weights)");
-  cmd->add_option("--decode-threads", *decode_threads,
-                  "Decoder threads per camera for FFV1/ffvhuff videos (0: one per core; 1: one decoder, "
-                  "frames decoded one after another)")
+  cmd->add_option("--transition-weights", *weights,
+                  "Transition classifier weights (default: the shipped weights)");
+  cmd->add_option(
+         "--decode-threads", *decode_threads,
+         "Decoder threads per camera for FFV1/ffvhuff videos (0: one per core; 1: one decoder, "
+         "frames decoded one after another)")
       ->check(CLI::NonNegativeNumber);
   cmd->add_flag("--json", *json, "Print the summary as JSON");
-  cmd->callback([=] { RunIngest(*session, *bank, *config, *json, *transitions, *weights, *decode_threads); });
+  cmd->callback(
+      [=] { RunIngest(*session, *bank, *config, *json, *transitions, *weights, *decode_threads); });
 }
 
 }  // namespace ss::apps

@@ -36,8 +36,12 @@ struct MatchArgs {
 };
 
 nlohmann::json StatsJson(const MatchStats& s) {
-  return {{"freezes", s.freezes}, {"freeze_runs", s.freeze_runs}, {"longest_freeze", s.longest_freeze},
-          {"stutters", s.stutters}, {"skips", s.skips},           {"jumps", s.jumps},
+  return {{"freezes", s.freezes},
+          {"freeze_runs", s.freeze_runs},
+          {"longest_freeze", s.longest_freeze},
+          {"stutters", s.stutters},
+          {"skips", s.skips},
+          {"jumps", s.jumps},
           {"listed", s.listed}};
 }
 
@@ -50,7 +54,8 @@ struct BankSprites {
 };
 
 BankSprites ResolveBank(const std::string& path, const std::vector<const SkeletonSequence*>& clips,
-                        const std::vector<int>& clip_starts, int total, float transition_scale, float jump_cost) {
+                        const std::vector<int>& clip_starts, int total, float transition_scale,
+                        float jump_cost) {
   const Bank bank(path);
   std::map<int64_t, std::string> session_names;
   for (const auto& s : bank.ListSessions()) session_names[s.id] = s.name;
@@ -88,13 +93,15 @@ BankSprites ResolveBank(const std::string& path, const std::vector<const Skeleto
       flat_of_sprite[features[it->second].id] = flat;
       ++found;
     }
-    if (found == 0) throw InputError(path, "the bank holds no sprite of any frame of source clip '" + name + "'");
+    if (found == 0)
+      throw InputError(path, "the bank holds no sprite of any frame of source clip '" + name + "'");
   }
   // Bank transitions between source frames, scaled so the median one costs transition_scale * J.
   const auto transitions = bank.LoadTransitions();
   std::vector<double> costs;
   for (const auto& t : transitions) {
-    if (flat_of_sprite.count(t.from_sprite) && flat_of_sprite.count(t.to_sprite)) costs.push_back(t.cost);
+    if (flat_of_sprite.count(t.from_sprite) && flat_of_sprite.count(t.to_sprite))
+      costs.push_back(t.cost);
   }
   if (!costs.empty()) {
     std::nth_element(costs.begin(), costs.begin() + costs.size() / 2, costs.end());
@@ -131,7 +138,8 @@ void Match(MatchArgs a) {
   a.options.compare_without_penalties = true;
   std::optional<BankSprites> bank;
   if (!a.bank.empty()) {
-    bank = ResolveBank(a.bank, clips, clip_starts, total, a.transition_scale, a.options.match.jump_cost);
+    bank = ResolveBank(a.bank, clips, clip_starts, total, a.transition_scale,
+                       a.options.match.jump_cost);
     // Frames the bank has no sprite for can never be chosen: leave their joints out.
     for (size_t c = 0; c < loaded.size(); ++c) {
       for (int i = 0; i < loaded[c].size(); ++i) {
@@ -147,10 +155,13 @@ void Match(MatchArgs a) {
   auto frames_json = [&](const std::vector<int>& flat) {
     nlohmann::json list = nlohmann::json::array();
     for (size_t t = 0; t < flat.size(); ++t) {
-      const int c = static_cast<int>(std::upper_bound(clip_starts.begin(), clip_starts.end(), flat[t]) -
-                                     clip_starts.begin()) - 1;
+      const int c =
+          static_cast<int>(std::upper_bound(clip_starts.begin(), clip_starts.end(), flat[t]) -
+                           clip_starts.begin()) -
+          1;
       const int64_t frame = loaded[c].frames[flat[t] - clip_starts[c]].frame;
-      nlohmann::json item = {{"target_frame", target.frames[t].frame}, {"clip", c}, {"frame", frame}};
+      nlohmann::json item = {
+          {"target_frame", target.frames[t].frame}, {"clip", c}, {"frame", frame}};
       if (bank) item["sprite"] = bank->sprite[flat[t]];
       list.push_back(item);
     }
@@ -158,12 +169,14 @@ void Match(MatchArgs a) {
   };
   nlohmann::json sources = nlohmann::json::array();
   for (size_t c = 0; c < loaded.size(); ++c) {
-    sources.push_back({{"path", a.sources[c]}, {"clip", loaded[c].clip}, {"frames", loaded[c].size()}});
+    sources.push_back(
+        {{"path", a.sources[c]}, {"clip", loaded[c].clip}, {"frames", loaded[c].size()}});
   }
-  nlohmann::json passes = {{"with_penalties", {{"stats", StatsJson(r.with_penalties.stats)},
-                                               {"total_cost", r.with_penalties.total_cost},
-                                               {"matching_cost", r.with_penalties.matching_cost},
-                                               {"frames", frames_json(r.with_penalties.source_frames)}}}};
+  nlohmann::json passes = {{"with_penalties",
+                            {{"stats", StatsJson(r.with_penalties.stats)},
+                             {"total_cost", r.with_penalties.total_cost},
+                             {"matching_cost", r.with_penalties.matching_cost},
+                             {"frames", frames_json(r.with_penalties.source_frames)}}}};
   if (r.without_penalties) {
     passes["without_penalties"] = {{"stats", StatsJson(r.without_penalties->stats)},
                                    {"total_cost", r.without_penalties->total_cost},
@@ -177,8 +190,10 @@ void Match(MatchArgs a) {
                           {"frames", frames_json(r.source_frames)},
                           {"passes", passes}};
   if (r.refined) {
-    match["movements"] = {{"target", r.refined->target_movements}, {"source", r.refined->source_movements}};
-    match["passes"]["refined"] = {{"stats", StatsJson(r.refined->stats)}, {"total_cost", r.refined->total_cost}};
+    match["movements"] = {{"target", r.refined->target_movements},
+                          {"source", r.refined->source_movements}};
+    match["passes"]["refined"] = {{"stats", StatsJson(r.refined->stats)},
+                                  {"total_cost", r.refined->total_cost}};
   }
   const double fps = target.fps > 0 ? target.fps : (loaded[0].fps > 0 ? loaded[0].fps : 30.0);
   if (bank) {
@@ -209,7 +224,8 @@ void Match(MatchArgs a) {
   }
   if (!a.plot.empty()) {
     std::vector<PlotPanel> panels;
-    if (r.without_penalties) panels.push_back({"(a) without penalties", r.without_penalties->source_frames});
+    if (r.without_penalties)
+      panels.push_back({"(a) without penalties", r.without_penalties->source_frames});
     panels.push_back({"(b) with penalties", r.with_penalties.source_frames});
     PlotOptions po;
     po.clip_starts = clip_starts;
@@ -221,26 +237,32 @@ void Match(MatchArgs a) {
     WriteMatchPlot(a.plot, panels, total, po);
   }
   if (a.json) {
-    nlohmann::json report = {{"out", a.out}, {"target_frames", target.size()}, {"source_frames", total},
-                             {"with_penalties", StatsJson(r.with_penalties.stats)},
-                             {"seconds", r.with_penalties.cost_seconds + r.with_penalties.forward_seconds +
-                                             r.with_penalties.backward_seconds}};
+    nlohmann::json report = {
+        {"out", a.out},
+        {"target_frames", target.size()},
+        {"source_frames", total},
+        {"with_penalties", StatsJson(r.with_penalties.stats)},
+        {"seconds", r.with_penalties.cost_seconds + r.with_penalties.forward_seconds +
+                        r.with_penalties.backward_seconds}};
     if (r.without_penalties) report["without_penalties"] = StatsJson(r.without_penalties->stats);
     if (r.refined) report["refined"] = StatsJson(r.refined->stats);
     if (!a.plot.empty()) report["plot"] = a.plot;
     std::printf("%s\n", report.dump(2).c_str());
     return;
   }
-  std::printf("matched %d target frames to %d source frames in %zu clips -> %s\n", target.size(), total,
-              loaded.size(), a.out.c_str());
-  if (r.without_penalties) std::printf("without penalties: %s\n", r.without_penalties->Summary().c_str());
+  std::printf("matched %d target frames to %d source frames in %zu clips -> %s\n", target.size(),
+              total, loaded.size(), a.out.c_str());
+  if (r.without_penalties)
+    std::printf("without penalties: %s\n", r.without_penalties->Summary().c_str());
   std::printf("with penalties:    %s\n", r.with_penalties.Summary().c_str());
   if (r.refined) {
     const MatchStats& s = r.refined->stats;
-    std::printf("refined:           %zu target movements, %zu source movements; %d freezes (longest %d), %d stutters, "
-                "%d jumps\n",
-                r.refined->target_movements.size(), r.refined->source_movements.size(), s.freezes, s.longest_freeze,
-                s.stutters, s.jumps);
+    std::printf(
+        "refined:           %zu target movements, %zu source movements; %d freezes (longest %d), "
+        "%d stutters, "
+        "%d jumps\n",
+        r.refined->target_movements.size(), r.refined->source_movements.size(), s.freezes,
+        s.longest_freeze, s.stutters, s.jumps);
   }
 }
 
@@ -248,18 +270,26 @@ void Match(MatchArgs a) {
 
 void AddMatchCommand(CLI::App& app) {
   auto a = std::make_shared<MatchArgs>();
-  CLI::App* cmd = app.add_subcommand("match", "Match target skeletons to source clips (articulated sprites)");
+  CLI::App* cmd =
+      app.add_subcommand("match", "Match target skeletons to source clips (articulated sprites)");
   cmd->add_option("target", a->target, "TARGET.json: the target skeleton sequence")->required();
-  cmd->add_option("--source", a->sources, "SKEL.json of a source clip (repeat for several clips)")->required();
-  cmd->add_option("--bank", a->bank, "The sprite bank holding the source clips: write renderable sequences");
-  cmd->add_option("--out", a->out, "SEQ.json: sequences (with --bank) or the chosen clip frames")->required();
-  cmd->add_option("--plot", a->plot, "PNG: source frame against target frame, without and with penalties");
-  cmd->add_option("--camera", a->camera, "With --bank: the virtual camera written into the sequences");
+  cmd->add_option("--source", a->sources, "SKEL.json of a source clip (repeat for several clips)")
+      ->required();
+  cmd->add_option("--bank", a->bank,
+                  "The sprite bank holding the source clips: write renderable sequences");
+  cmd->add_option("--out", a->out, "SEQ.json: sequences (with --bank) or the chosen clip frames")
+      ->required();
+  cmd->add_option("--plot", a->plot,
+                  "PNG: source frame against target frame, without and with penalties");
+  cmd->add_option("--camera", a->camera,
+                  "With --bank: the virtual camera written into the sequences");
   cmd->add_option("--jump-cost", a->options.match.jump_cost, "J: any move that is not a short step")
       ->capture_default_str();
-  cmd->add_option("--freeze-cost", a->options.match.freeze_cost, "Per repeat of the same frame, growing with the run")
+  cmd->add_option("--freeze-cost", a->options.match.freeze_cost,
+                  "Per repeat of the same frame, growing with the run")
       ->capture_default_str();
-  cmd->add_option("--stutter-cost", a->options.match.stutter_cost, "Added to J for a short backward move")
+  cmd->add_option("--stutter-cost", a->options.match.stutter_cost,
+                  "Added to J for a short backward move")
       ->capture_default_str();
   cmd->add_option("--transition-scale", a->transition_scale,
                   "With --bank: the median bank transition costs this share of J")
@@ -267,10 +297,12 @@ void AddMatchCommand(CLI::App& app) {
   cmd->add_option("--jump-per-frame", a->options.refine.jump_cost_per_frame,
                   "Refinement: extra cost per frame jumped inside a movement")
       ->capture_default_str();
-  cmd->add_option("--window", a->options.refine.averaging_window, "Refinement: averaging window, frames")
+  cmd->add_option("--window", a->options.refine.averaging_window,
+                  "Refinement: averaging window, frames")
       ->capture_default_str();
-  cmd->add_option("--motion-weight", a->options.descriptor.motion_weight,
-                  "Per limb pair: weight of the motion term (how fast the pair moves); 0 = poses only")
+  cmd->add_option(
+         "--motion-weight", a->options.descriptor.motion_weight,
+         "Per limb pair: weight of the motion term (how fast the pair moves); 0 = poses only")
       ->capture_default_str();
   cmd->add_option("--motion-window", a->options.descriptor.motion_window_s,
                   "Motion term: seconds before and after a frame the pose change is measured over")
@@ -286,9 +318,10 @@ void AddMatchCommand(CLI::App& app) {
       ->capture_default_str();
   cmd->add_flag("--normalize-ratios", a->options.descriptor.normalize_ratios,
                 "Subtract each sequence's median limb length ratios (different body proportions)");
-  cmd->add_option("--decision-mib", a->decision_mib,
-                  "Memory the DP may keep its per-cell decisions in (also at most half the available); "
-                  "past it the backtrack recomputes from checkpoints, slower; 0 = always")
+  cmd->add_option(
+         "--decision-mib", a->decision_mib,
+         "Memory the DP may keep its per-cell decisions in (also at most half the available); "
+         "past it the backtrack recomputes from checkpoints, slower; 0 = always")
       ->capture_default_str();
   cmd->add_flag("--no-refine", a->no_refine, "Skip the refinement by atomic movements");
   cmd->add_flag("--json", a->json, "Print the report as JSON");

@@ -33,7 +33,8 @@ PlateOptions ParseRange(const std::string& text, int samples) {
     o.last_frame = std::stoll(last, &used);
     if (used != last.size()) throw std::invalid_argument("last");
   } catch (const std::exception&) {
-    throw InputError("--frames", "expected FIRST:LAST frame numbers, e.g. 0:29, got \"" + text + "\"");
+    throw InputError("--frames",
+                     "expected FIRST:LAST frame numbers, e.g. 0:29, got \"" + text + "\"");
   }
   return o;
 }
@@ -43,10 +44,11 @@ void Run(const PlateArgs& args) {
   // Before decoding anything: an image that could not be written.
   const std::filesystem::path out(args.out);
   if (!cv::haveImageWriter(args.out)) {
-    throw InputError("--out", args.out + ": no image format for the extension \"" + out.extension().string() +
-                                  "\" (use .png)");
+    throw InputError("--out", args.out + ": no image format for the extension \"" +
+                                  out.extension().string() + "\" (use .png)");
   }
-  if (const std::filesystem::path folder = out.parent_path(); !folder.empty() && !std::filesystem::is_directory(folder)) {
+  if (const std::filesystem::path folder = out.parent_path();
+      !folder.empty() && !std::filesystem::is_directory(folder)) {
     throw InputError("--out", args.out + ": the folder " + folder.string() + " does not exist");
   }
   const SessionPlate plate = ReadSessionPlate(args.session, args.camera, options);
@@ -57,24 +59,30 @@ void Run(const PlateArgs& args) {
     throw InputError("--out", args.out + ": cannot write the image (" + e.err + ")");
   }
   if (!written) throw WorkError(args.out, "cannot write the image");
-  std::printf("%s camera %s: plate of %d frames (%lld..%lld, %.3f..%.3f s) -> %s (%dx%d)\n", args.session.c_str(),
-              args.camera.c_str(), plate.frames_used, static_cast<long long>(plate.first_frame),
-              static_cast<long long>(plate.last_frame), static_cast<double>(plate.first_timestamp_ns) / 1e9,
-              static_cast<double>(plate.last_timestamp_ns) / 1e9, args.out.c_str(), plate.bgr.cols, plate.bgr.rows);
+  std::printf("%s camera %s: plate of %d frames (%lld..%lld, %.3f..%.3f s) -> %s (%dx%d)\n",
+              args.session.c_str(), args.camera.c_str(), plate.frames_used,
+              static_cast<long long>(plate.first_frame), static_cast<long long>(plate.last_frame),
+              static_cast<double>(plate.first_timestamp_ns) / 1e9,
+              static_cast<double>(plate.last_timestamp_ns) / 1e9, args.out.c_str(), plate.bgr.cols,
+              plate.bgr.rows);
 }
 
 }  // namespace
 
 void AddPlateCommand(CLI::App& app) {
-  auto* cmd = app.add_subcommand("plate", "Write a camera's clean plate (the empty enclosure) from a recorded session");
+  auto* cmd = app.add_subcommand(
+      "plate", "Write a camera's clean plate (the empty enclosure) from a recorded session");
   auto args = std::make_shared<PlateArgs>();
   cmd->add_option("session", args->session, "Session folder (holds session.json)")->required();
   cmd->add_option("--camera", args->camera, "The session's camera")->required();
-  cmd->add_option("--out", args->out, "Image to write (.png, .jpg, ...: by its extension)")->required();
-  cmd->add_option("--frames", args->frames,
-                  "FIRST:LAST frames the plate is taken from (default 0:29, the frames a keyer learns the "
-                  "empty enclosure from)");
-  cmd->add_option("--samples", args->samples, "Frames taken, spread evenly over the range (default 30)")
+  cmd->add_option("--out", args->out, "Image to write (.png, .jpg, ...: by its extension)")
+      ->required();
+  cmd->add_option(
+      "--frames", args->frames,
+      "FIRST:LAST frames the plate is taken from (default 0:29, the frames a keyer learns the "
+      "empty enclosure from)");
+  cmd->add_option("--samples", args->samples,
+                  "Frames taken, spread evenly over the range (default 30)")
       ->check(CLI::Range(1, 1000));
   cmd->callback([args] { Run(*args); });
 }

@@ -13,8 +13,8 @@
 #include "animate/playback.h"
 #include "animate/sequence_io.h"
 #include "animate/spec.h"
-#include "capture/recording/video_file.h"
 #include "apps/commands.h"
+#include "capture/recording/video_file.h"
 #include "core/error.h"
 #include "core/log.h"
 
@@ -116,12 +116,9 @@ void Run(const RenderArgs& args) {
   sink.Close();
 
   if (args.json) {
-    const nlohmann::json j = {{"out", args.out},
-                              {"frames", sink.frames()},
-                              {"encoder", sink.encoder()},
-                              {"width", camera.width()},
-                              {"height", camera.height()},
-                              {"frame_rate", file.frame_rate},
+    const nlohmann::json j = {{"out", args.out},           {"frames", sink.frames()},
+                              {"encoder", sink.encoder()}, {"width", camera.width()},
+                              {"height", camera.height()}, {"frame_rate", file.frame_rate},
                               {"stages", stages.size()}};
     std::printf("%s\n", j.dump(2).c_str());
   } else {
@@ -136,11 +133,16 @@ void Run(const RenderArgs& args) {
 
 void AddRenderCommand(CLI::App& app) {
   auto args = std::make_shared<RenderArgs>();
-  auto* cmd = app.add_subcommand("render", "Render optimized sprite sequences into video or PNG frames");
+  auto* cmd =
+      app.add_subcommand("render", "Render optimized sprite sequences into video or PNG frames");
   cmd->add_option("sequences", args->sequences, "Sequences file from `animate` (JSON)")->required();
-  cmd->add_option("--out", args->out, "OUT.mkv or OUT.mp4 (video) or a folder (PNG frames with alpha)")->required();
+  cmd->add_option("--out", args->out,
+                  "OUT.mkv or OUT.mp4 (video) or a folder (PNG frames with alpha)")
+      ->required();
   cmd->add_option("--spec", args->spec, "Take the camera and background from this spec instead");
-  cmd->add_option("--codec", args->codec, "Video codec: h264 (default; libx264, in .mp4 mpeg4 without it), ffv1, mjpeg (.mkv only)")
+  cmd->add_option(
+         "--codec", args->codec,
+         "Video codec: h264 (default; libx264, in .mp4 mpeg4 without it), ffv1, mjpeg (.mkv only)")
       ->check(CLI::IsMember({"h264", "ffv1", "mjpeg"}));
   cmd->add_flag("--stages", args->stages, "Play the run's intermediate stages before the result");
   cmd->add_flag("--no-shadows", args->no_shadows, "Leave the contact shadows out");

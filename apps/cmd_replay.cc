@@ -46,15 +46,18 @@ void RunReplay(const std::string& dir, bool realtime, int loops, bool json) {
     ++r.frames;
     ++total;
   }
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const double fps = seconds > 0 ? static_cast<double>(total) / seconds : 0.0;
   const auto stats = source.camera_stats();
   const SourceStats totals = source.stats();
 
   // The recorded span and frame rate of what each camera delivered.
   auto span_s = [&](size_t i) {
-    return report[i].frames > 1 ? static_cast<double>(report[i].last_timestamp_ns - report[i].first_timestamp_ns) / 1e9
-                                : 0.0;
+    return report[i].frames > 1
+               ? static_cast<double>(report[i].last_timestamp_ns - report[i].first_timestamp_ns) /
+                     1e9
+               : 0.0;
   };
   auto recorded_fps = [&](size_t i) {
     const double span = span_s(i);
@@ -95,31 +98,37 @@ void RunReplay(const std::string& dir, bool realtime, int loops, bool json) {
     out["errors"] = totals.errors;
     std::printf("%s\n", out.dump(2).c_str());
   } else {
-    std::printf("session %s ('%s'), %zu camera(s)%s\n", dir.c_str(), source.session().name.c_str(), cameras.size(),
-                realtime ? ", real time" : "");
-    std::printf("%-14s %-9s %-10s %-5s %7s %20s %9s %7s %5s %5s %6s\n", "camera", "format", "size", "codec",
-                "frames", "first_timestamp_ns", "span_s", "fps", "gaps", "drops", "errors");
+    std::printf("session %s ('%s'), %zu camera(s)%s\n", dir.c_str(), source.session().name.c_str(),
+                cameras.size(), realtime ? ", real time" : "");
+    std::printf("%-14s %-9s %-10s %-5s %7s %20s %9s %7s %5s %5s %6s\n", "camera", "format", "size",
+                "codec", "frames", "first_timestamp_ns", "span_s", "fps", "gaps", "drops",
+                "errors");
     for (size_t i = 0; i < cameras.size(); ++i) {
       const auto& c = cameras[i];
       const auto& r = report[i];
       const std::string size = std::to_string(c.width) + "x" + std::to_string(c.height);
-      std::printf("%-14s %-9s %-10s %-5s %7llu %20lld %9.3f %7.2f %5llu %5llu %6llu\n", c.name.c_str(),
-                  PixelFormatName(c.format).c_str(), size.c_str(), source.session().cameras[i].codec.c_str(),
-                  static_cast<unsigned long long>(r.frames), static_cast<long long>(r.first_timestamp_ns), span_s(i),
-                  recorded_fps(i), static_cast<unsigned long long>(r.sequence_gaps),
+      std::printf("%-14s %-9s %-10s %-5s %7llu %20lld %9.3f %7.2f %5llu %5llu %6llu\n",
+                  c.name.c_str(), PixelFormatName(c.format).c_str(), size.c_str(),
+                  source.session().cameras[i].codec.c_str(),
+                  static_cast<unsigned long long>(r.frames),
+                  static_cast<long long>(r.first_timestamp_ns), span_s(i), recorded_fps(i),
+                  static_cast<unsigned long long>(r.sequence_gaps),
                   static_cast<unsigned long long>(stats[i].recorded_drops),
                   static_cast<unsigned long long>(stats[i].errors));
       for (const auto& p : stats[i].problems) std::printf("  ! %s\n", p.c_str());
     }
-    std::printf("(gaps: frames missing between delivered sequence numbers, lost at the device or unreadable; "
-                "drops: the recorder's drops_before)\n");
-    std::printf("total: %llu frames replayed in %.3f s = %.1f frames/s\n", static_cast<unsigned long long>(total),
-                seconds, fps);
+    std::printf(
+        "(gaps: frames missing between delivered sequence numbers, lost at the device or "
+        "unreadable; "
+        "drops: the recorder's drops_before)\n");
+    std::printf("total: %llu frames replayed in %.3f s = %.1f frames/s\n",
+                static_cast<unsigned long long>(total), seconds, fps);
   }
   std::fflush(stdout);
   if (totals.errors > 0) {
     std::string message = totals.last_error;
-    if (totals.errors > 1) message += " (and " + std::to_string(totals.errors - 1) + " more problem(s), listed above)";
+    if (totals.errors > 1)
+      message += " (and " + std::to_string(totals.errors - 1) + " more problem(s), listed above)";
     throw InputError(message);
   }
 }

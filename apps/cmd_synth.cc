@@ -35,7 +35,8 @@ void RunSynth(SynthArgs args) {
   } else {
     throw InputError("--kind", "expected animal, figure or calibration, got '" + args.kind + "'");
   }
-  o.empty_lead_in_s = args.empty_lead_in_s >= 0 ? args.empty_lead_in_s : (args.kind == "animal" ? 1.0 : 0.0);
+  o.empty_lead_in_s =
+      args.empty_lead_in_s >= 0 ? args.empty_lead_in_s : (args.kind == "animal" ? 1.0 : 0.0);
   int w = 0, h = 0;
   char tail = 0;
   if (std::sscanf(args.size.c_str(), "%dx%d%c", &w, &h, &tail) != 2) {
@@ -44,7 +45,8 @@ void RunSynth(SynthArgs args) {
   o.width = w;
   o.height = h;
   const auto format = ParsePixelFormat(args.pixel_format);
-  if (!format) throw InputError("--pixel-format", "unknown pixel format '" + args.pixel_format + "'");
+  if (!format)
+    throw InputError("--pixel-format", "unknown pixel format '" + args.pixel_format + "'");
   o.pixel_format = *format;
 
   const synth::SynthSummary s = synth::RenderStudioSession(o);
@@ -70,12 +72,14 @@ void RunSynth(SynthArgs args) {
     out["wall_touch_frames"] = s.wall_touch_frames;
     std::printf("%s\n", out.dump(2).c_str());
   } else {
-    std::printf("synth: %s session in %s: %d frames x %d camera(s), %d subject(s), seed %llu\n", args.kind.c_str(),
-                s.out_dir.c_str(), s.frames, s.cameras, s.subjects, static_cast<unsigned long long>(o.seed));
-    std::printf("  %.2f s wall (%.2fx real time), %.2f s CPU (%.2f camera-seconds per CPU-second)\n", s.wall_s,
-                s.RealTimeFactor(), s.cpu_s, s.CpuRealTimeFactor());
-    std::printf("  CPU s: simulate %.2f, render %.2f, sensor %.2f, encode %.2f, truth %.2f\n", s.simulate_s,
-                s.render_s, s.sensor_s, s.encode_s, s.truth_s);
+    std::printf("synth: %s session in %s: %d frames x %d camera(s), %d subject(s), seed %llu\n",
+                args.kind.c_str(), s.out_dir.c_str(), s.frames, s.cameras, s.subjects,
+                static_cast<unsigned long long>(o.seed));
+    std::printf(
+        "  %.2f s wall (%.2fx real time), %.2f s CPU (%.2f camera-seconds per CPU-second)\n",
+        s.wall_s, s.RealTimeFactor(), s.cpu_s, s.CpuRealTimeFactor());
+    std::printf("  CPU s: simulate %.2f, render %.2f, sensor %.2f, encode %.2f, truth %.2f\n",
+                s.simulate_s, s.render_s, s.sensor_s, s.encode_s, s.truth_s);
     if (!s.pose_frames.empty()) {
       std::printf("  subject-frames per pose:");
       for (const auto& [pose, n] : s.pose_frames) std::printf(" %s %d", pose.c_str(), n);
@@ -88,13 +92,16 @@ void RunSynth(SynthArgs args) {
 }  // namespace
 
 void AddSynthCommand(CLI::App& app) {
-  auto* cmd = app.add_subcommand("synth", "Render a synthetic studio session with ground truth (truth/)");
+  auto* cmd =
+      app.add_subcommand("synth", "Render a synthetic studio session with ground truth (truth/)");
   auto args = std::make_shared<SynthArgs>();
   synth::SynthOptions& o = args->options;
-  cmd->add_option("--out", o.out_dir, "Session folder to create (must not exist or be empty)")->required();
+  cmd->add_option("--out", o.out_dir, "Session folder to create (must not exist or be empty)")
+      ->required();
   cmd->add_option("--kind", args->kind, "animal, figure or calibration")
       ->check(CLI::IsMember({"animal", "figure", "calibration"}));
-  cmd->add_option("--studio", o.studio, "enclosure or stage (default: stage for figures, else enclosure)")
+  cmd->add_option("--studio", o.studio,
+                  "enclosure or stage (default: stage for figures, else enclosure)")
       ->check(CLI::IsMember({"enclosure", "stage"}));
   cmd->add_option("--seconds", o.seconds, "Length of the session");
   cmd->add_option("--fps", o.fps, "Frames per second");
@@ -104,15 +111,22 @@ void AddSynthCommand(CLI::App& app) {
   cmd->add_option("--seed", o.seed, "Seed: the same seed gives the same session");
   cmd->add_option("--pixel-format", args->pixel_format, "rgb8, bgr8, bayer_rg8 or mono8");
   cmd->add_option("--noise", o.noise, "Sensor noise scale (0: none, 1: typical)");
-  cmd->add_flag("--motion-blur", o.motion_blur, "Blur moving subjects over half the frame interval");
-  cmd->add_option("--figure-variant", o.figure_variant, "Figure proportions: 0 reference, 1 the other figure");
+  cmd->add_flag("--motion-blur", o.motion_blur,
+                "Blur moving subjects over half the frame interval");
+  cmd->add_option("--figure-variant", o.figure_variant,
+                  "Figure proportions: 0 reference, 1 the other figure");
   cmd->add_option("--threads", o.threads, "Cameras rendered in parallel");
-  cmd->add_option("--empty-lead-in", args->empty_lead_in_s,
-                  "Seconds of empty enclosure before the subjects appear (keyer training; default 1 for animal "
-                  "sessions, 0 otherwise)");
-  cmd->add_option("--codec", o.codec, "Video codec: ffv1 (lossless, the default), ffvhuff (lossless, faster to decode), "
-                                     "mjpeg or h264");
-  cmd->add_flag("--no-mattes", [&o](int64_t) { o.write_mattes = false; }, "Skip the per-frame matte PNGs in truth/");
+  cmd->add_option(
+      "--empty-lead-in", args->empty_lead_in_s,
+      "Seconds of empty enclosure before the subjects appear (keyer training; default 1 for animal "
+      "sessions, 0 otherwise)");
+  cmd->add_option(
+      "--codec", o.codec,
+      "Video codec: ffv1 (lossless, the default), ffvhuff (lossless, faster to decode), "
+      "mjpeg or h264");
+  cmd->add_flag(
+      "--no-mattes", [&o](int64_t) { o.write_mattes = false; },
+      "Skip the per-frame matte PNGs in truth/");
   cmd->add_flag("--json", args->json, "Print the report as JSON");
   cmd->callback([args] { RunSynth(*args); });
 }

@@ -1,5 +1,6 @@
 // spritestation transitions BANK | train LABELS --bank BANK --out WEIGHTS |
-//                label --from-truth SESSION --bank BANK --out LABELS | worker --bank postgresql://...
+//                label --from-truth SESSION --bank BANK --out LABELS | worker --bank
+//                postgresql://...
 // The transition table of a sprite bank (seed 000 §3; docs/transitions.md).
 #include <chrono>
 #include <csignal>
@@ -31,7 +32,9 @@ struct Args {
   bool json = false, quiet = false;
 };
 
-TransitionWeights WeightsOf(const Args& a) { return a.weights.empty() ? DefaultWeights() : LoadWeights(a.weights); }
+TransitionWeights WeightsOf(const Args& a) {
+  return a.weights.empty() ? DefaultWeights() : LoadWeights(a.weights);
+}
 
 // Progress on stderr, at most a few lines a second, always the last one of a stage.
 class Progress {
@@ -57,7 +60,8 @@ class Progress {
 };
 
 void Build(const Args& a) {
-  if (a.bank.empty()) throw InputError("transitions", "a sprite bank is needed: spritestation transitions BANK");
+  if (a.bank.empty())
+    throw InputError("transitions", "a sprite bank is needed: spritestation transitions BANK");
   BankUpdateOptions options;
   options.weights = WeightsOf(a);
   options.threads = a.threads;
@@ -88,33 +92,42 @@ void Train(const Args& a) {
   const TrainReport& t = r.report;
   std::printf("trained on %lld labelled pairs (%lld accepts), %d-fold cross-validated:\n",
               static_cast<long long>(t.samples), static_cast<long long>(t.accepts), t.folds);
-  std::printf("  stage 1 (4 cheap features): precision %.3f, recall %.3f\n", t.stage1.precision(), t.stage1.recall());
-  std::printf("  stage 2 (all 6 features):   precision %.3f, recall %.3f\n", t.stage2.precision(), t.stage2.recall());
+  std::printf("  stage 1 (4 cheap features): precision %.3f, recall %.3f\n", t.stage1.precision(),
+              t.stage1.recall());
+  std::printf("  stage 2 (all 6 features):   precision %.3f, recall %.3f\n", t.stage2.precision(),
+              t.stage2.recall());
   if (r.stage2_calibrated) {
-    std::printf("  stage 2 then set for the positive rate %.3g on the bank: %.1f accepts per sprite, estimated "
-                "precision %.3f, recall %.3f (threshold D <= %.4f)\n",
-                r.stage2.positive_rate, r.stage2.accepts_per_sprite, r.stage2.precision, r.stage2.recall,
-                r.stage2.threshold);
+    std::printf(
+        "  stage 2 then set for the positive rate %.3g on the bank: %.1f accepts per sprite, "
+        "estimated "
+        "precision %.3f, recall %.3f (threshold D <= %.4f)\n",
+        r.stage2.positive_rate, r.stage2.accepts_per_sprite, r.stage2.precision, r.stage2.recall,
+        r.stage2.threshold);
   } else {
-    std::printf("  stage 2 keeps the labels' 50/50 operating point (no positive rate: give --positive-rate or make "
-                "labels with 'label --from-truth')\n");
+    std::printf(
+        "  stage 2 keeps the labels' 50/50 operating point (no positive rate: give --positive-rate "
+        "or make "
+        "labels with 'label --from-truth')\n");
   }
   if (a.stage1_recall > 0 && r.stage2_calibrated) {
-    std::printf("  stage 1 refitted as its filter to pass %.3f of %lld stage-2 accepts on the bank: %.1f candidates "
-                "per sprite (%.0fx fewer than all pairs)\n",
-                a.stage1_recall, static_cast<long long>(r.calibration_accepts), r.stage1.candidates_per_sprite,
-                r.stage1.fewer_than_all);
+    std::printf(
+        "  stage 1 refitted as its filter to pass %.3f of %lld stage-2 accepts on the bank: %.1f "
+        "candidates "
+        "per sprite (%.0fx fewer than all pairs)\n",
+        a.stage1_recall, static_cast<long long>(r.calibration_accepts),
+        r.stage1.candidates_per_sprite, r.stage1.fewer_than_all);
   } else if (a.stage1_recall > 0) {
-    std::printf("  stage 1 then set to pass %.3f of %lld stage-2 accepts on the bank (bias %.4f -> %.4f)\n",
-                a.stage1_recall, static_cast<long long>(r.calibration_accepts), r.stage1_bias_from_labels,
-                r.weights.stage1_bias);
+    std::printf(
+        "  stage 1 then set to pass %.3f of %lld stage-2 accepts on the bank (bias %.4f -> %.4f)\n",
+        a.stage1_recall, static_cast<long long>(r.calibration_accepts), r.stage1_bias_from_labels,
+        r.weights.stage1_bias);
   }
   std::printf("weights written to %s\n", a.out.c_str());
 }
 
 void Label(const Args& a) {
-  const TruthLabelSummary s =
-      LabelBankFromTruth(a.session, a.bank, static_cast<size_t>(a.count), TruthLabelOptions{}, a.seed);
+  const TruthLabelSummary s = LabelBankFromTruth(a.session, a.bank, static_cast<size_t>(a.count),
+                                                 TruthLabelOptions{}, a.seed);
   WriteLabelsCsv(s.labels, a.out, s.positive_rate > 0 ? s.positive_rate : -1);
   size_t accepts = 0;
   for (const auto& l : s.labels) accepts += l.accept ? 1 : 0;
@@ -129,11 +142,13 @@ void Label(const Args& a) {
                             .dump(2)
                             .c_str());
   } else {
-    std::printf("%zu labels (%zu accepts) from the truth of %lld sprites (%lld unmatched, %lld mirrors left out; "
-                "%.3g of their pairs are true transitions) written to %s\n",
-                s.labels.size(), accepts, static_cast<long long>(s.sprites_matched),
-                static_cast<long long>(s.sprites_unmatched), static_cast<long long>(s.mirrored_skipped),
-                s.positive_rate, a.out.c_str());
+    std::printf(
+        "%zu labels (%zu accepts) from the truth of %lld sprites (%lld unmatched, %lld mirrors "
+        "left out; "
+        "%.3g of their pairs are true transitions) written to %s\n",
+        s.labels.size(), accepts, static_cast<long long>(s.sprites_matched),
+        static_cast<long long>(s.sprites_unmatched), static_cast<long long>(s.mirrored_skipped),
+        s.positive_rate, a.out.c_str());
   }
 }
 
@@ -160,7 +175,8 @@ void Worker(const Args& a) {
     std::this_thread::sleep_for(std::chrono::milliseconds(200));  // polls the bank for new clips
   }
   const UnitWorkerStats& s = worker.stats();
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   if (a.json) {
     std::printf("%s\n", nlohmann::json({{"worker", worker.name()},
                                         {"units", s.units},
@@ -176,10 +192,13 @@ void Worker(const Args& a) {
                             .dump(2)
                             .c_str());
   } else {
-    std::printf("%s: %lld units, %lld transitions stored; %lld sprites indexed; %.1f s (index %.1f, pairs %.1f, "
-                "store %.1f)\n",
-                worker.name().c_str(), static_cast<long long>(s.units), static_cast<long long>(s.transitions),
-                static_cast<long long>(s.sprites_indexed), seconds, s.seconds_index, s.seconds_pairs, s.seconds_store);
+    std::printf(
+        "%s: %lld units, %lld transitions stored; %lld sprites indexed; %.1f s (index %.1f, pairs "
+        "%.1f, "
+        "store %.1f)\n",
+        worker.name().c_str(), static_cast<long long>(s.units),
+        static_cast<long long>(s.transitions), static_cast<long long>(s.sprites_indexed), seconds,
+        s.seconds_index, s.seconds_pairs, s.seconds_store);
   }
 }
 
@@ -187,10 +206,13 @@ void Worker(const Args& a) {
 
 void AddTransitionsCommand(CLI::App& app) {
   auto args = std::make_shared<Args>();
-  auto* cmd = app.add_subcommand("transitions",
-                                 "Build or bring up to date a bank's transitions; 'label' and 'train' the classifier");
-  cmd->add_option("bank", args->bank, "Sprite bank, file or postgresql://... (build or update its transitions)");
-  cmd->add_option("--weights", args->weights, "Classifier weights file (default: the shipped weights)");
+  auto* cmd = app.add_subcommand(
+      "transitions",
+      "Build or bring up to date a bank's transitions; 'label' and 'train' the classifier");
+  cmd->add_option("bank", args->bank,
+                  "Sprite bank, file or postgresql://... (build or update its transitions)");
+  cmd->add_option("--weights", args->weights,
+                  "Classifier weights file (default: the shipped weights)");
   cmd->add_option("--threads", args->threads, "Worker threads")->check(CLI::Range(1, 64));
   cmd->add_flag("--quiet", args->quiet, "No progress lines");
   cmd->add_flag("--json", args->json, "Print JSON");
@@ -198,43 +220,56 @@ void AddTransitionsCommand(CLI::App& app) {
     if (cmd->get_subcommands().empty()) Build(*args);
   });
 
-  auto* train = cmd->add_subcommand("train", "Train both classifiers on labelled pairs; prints cross-validated "
-                                             "precision/recall");
+  auto* train =
+      cmd->add_subcommand("train",
+                          "Train both classifiers on labelled pairs; prints cross-validated "
+                          "precision/recall");
   train->add_option("labels", args->labels, "Labels CSV: sprite_i,sprite_j,accept")->required();
   train->add_option("--bank", args->bank, "The bank the sprite ids belong to")->required();
   train->add_option("--out", args->out, "Weights file to write")->required();
   train->add_option("--folds", args->folds, "Cross-validation folds")->check(CLI::Range(2, 50));
   train->add_option("--seed", args->seed, "Seed of the fold split and the calibration sample");
-  train->add_option("--stage1-recall", args->stage1_recall,
-                    "Share of stage-2 accepts stage 1 must pass on the bank (0: keep the label fit)")
+  train
+      ->add_option("--stage1-recall", args->stage1_recall,
+                   "Share of stage-2 accepts stage 1 must pass on the bank (0: keep the label fit)")
       ->check(CLI::Range(0.0, 1.0));
-  train->add_option("--positive-rate", args->positive_rate,
-                    "Share of all sprite pairs that are true transitions, to set stage 2's threshold for "
-                    "(default: the labels file's '# positive_rate=' line)")
+  train
+      ->add_option(
+          "--positive-rate", args->positive_rate,
+          "Share of all sprite pairs that are true transitions, to set stage 2's threshold for "
+          "(default: the labels file's '# positive_rate=' line)")
       ->check(CLI::Range(0.0, 1.0));
   train->add_option("--threads", args->threads, "Worker threads")->check(CLI::Range(1, 64));
   train->add_flag("--json", args->json, "Print JSON");
   train->callback([args] { Train(*args); });
 
   auto* label = cmd->add_subcommand("label", "Make labels from a synthetic session's truth");
-  label->add_option("--from-truth", args->session, "Synthetic session directory (with truth/)")->required();
+  label->add_option("--from-truth", args->session, "Synthetic session directory (with truth/)")
+      ->required();
   label->add_option("--bank", args->bank, "The bank the session was ingested into")->required();
   label->add_option("--out", args->out, "Labels CSV to write")->required();
-  label->add_option("--count", args->count, "About this many labels, half accepts")->check(CLI::Range(10, 1000000));
+  label->add_option("--count", args->count, "About this many labels, half accepts")
+      ->check(CLI::Range(10, 1000000));
   label->add_option("--seed", args->seed, "Seed of the pair sampling");
   label->add_flag("--json", args->json, "Print JSON");
   label->callback([args] { Label(*args); });
 
   auto* worker = cmd->add_subcommand(
-      "worker", "Share a PostgreSQL bank's transition work with any number of workers on any hosts");
+      "worker",
+      "Share a PostgreSQL bank's transition work with any number of workers on any hosts");
   worker->add_option("--bank", args->bank, "The PostgreSQL bank (postgresql://...)")->required();
-  worker->add_option("--weights", args->weights, "Classifier weights file (default: the shipped weights)");
-  worker->add_option("--name", args->name, "This worker's name in the work table (default host:pid)");
-  worker->add_option("--lease", args->lease_s, "Seconds a claimed unit is this worker's; then any worker's")
+  worker->add_option("--weights", args->weights,
+                     "Classifier weights file (default: the shipped weights)");
+  worker->add_option("--name", args->name,
+                     "This worker's name in the work table (default host:pid)");
+  worker
+      ->add_option("--lease", args->lease_s,
+                   "Seconds a claimed unit is this worker's; then any worker's")
       ->check(CLI::Range(1.0, 86400.0));
   worker->add_option("--threads", args->threads, "Threads for the comparison images of new sprites")
       ->check(CLI::Range(1, 64));
-  worker->add_flag("--exit-when-idle", args->exit_when_idle, "Exit when no unit is pending or leased");
+  worker->add_flag("--exit-when-idle", args->exit_when_idle,
+                   "Exit when no unit is pending or leased");
   worker->add_flag("--json", args->json, "Print JSON");
   worker->callback([args] { Worker(*args); });
 }

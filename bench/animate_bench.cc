@@ -40,7 +40,8 @@ struct Args {
   bool detail = false;  // per-sprite figures in the JSON
   std::string start;    // replacement's start: random, sequential, beam; "": per scene
   double fly_collision_strength = 100;  // scenes 6 and 7: each pair's anti-collision strength
-  double collision_pick_fraction = -1;  // replacement's picks aimed at a collision; < 0: its default
+  double collision_pick_fraction =
+      -1;  // replacement's picks aimed at a collision; < 0: its default
 };
 
 Args Parse(const std::vector<std::string>& argv) {
@@ -61,16 +62,26 @@ Args Parse(const std::vector<std::string>& argv) {
       if (k + 1 >= argv.size()) throw InputError("bench animate", s + " needs a value");
       return argv[++k];
     };
-    if (s == "--frames") a.frames = std::stoi(value());
-    else if (s == "--budget") a.budget_s = std::stod(value());
-    else if (s == "--budget6") a.budget6_s = std::stod(value());
-    else if (s == "--threads") a.threads = std::stoi(value());
-    else if (s == "--no-beam") a.beam = false;
-    else if (s == "--json") a.json = true;
-    else if (s == "--detail") a.detail = true;
-    else if (s == "--start") a.start = value();
-    else if (s == "--fly-collision-strength") a.fly_collision_strength = std::stod(value());
-    else if (s == "--collision-pick-fraction") a.collision_pick_fraction = std::stod(value());
+    if (s == "--frames")
+      a.frames = std::stoi(value());
+    else if (s == "--budget")
+      a.budget_s = std::stod(value());
+    else if (s == "--budget6")
+      a.budget6_s = std::stod(value());
+    else if (s == "--threads")
+      a.threads = std::stoi(value());
+    else if (s == "--no-beam")
+      a.beam = false;
+    else if (s == "--json")
+      a.json = true;
+    else if (s == "--detail")
+      a.detail = true;
+    else if (s == "--start")
+      a.start = value();
+    else if (s == "--fly-collision-strength")
+      a.fly_collision_strength = std::stod(value());
+    else if (s == "--collision-pick-fraction")
+      a.collision_pick_fraction = std::stod(value());
     else if (s == "--scenes") {
       a.scenes.clear();
       std::string list = value();
@@ -80,9 +91,12 @@ Args Parse(const std::vector<std::string>& argv) {
         p = q == std::string::npos ? list.size() : q + 1;
       }
     } else {
-      throw InputError("bench animate", "unknown argument " + s +
-                                            " (--frames=N --budget=S --budget6=S --threads=N "
-                                            "--scenes=1,2,.. --start=random|sequential|beam --fly-collision-strength=X --collision-pick-fraction=F --no-beam --json --detail)");
+      throw InputError(
+          "bench animate",
+          "unknown argument " + s +
+              " (--frames=N --budget=S --budget6=S --threads=N "
+              "--scenes=1,2,.. --start=random|sequential|beam --fly-collision-strength=X "
+              "--collision-pick-fraction=F --no-beam --json --detail)");
     }
   }
   return a;
@@ -101,7 +115,8 @@ TransitionGraph CritterGraph(int num_frames, uint64_t seed) {
   while (static_cast<int>(frames.size()) < num_frames) {
     ++clip;
     const bool standing = unit(rng) < 0.03;
-    const int n = std::min(num_frames - static_cast<int>(frames.size()), 20 + static_cast<int>(rng() % 41));
+    const int n =
+        std::min(num_frames - static_cast<int>(frames.size()), 20 + static_cast<int>(rng() % 41));
     double a = two_pi * unit(rng);
     const double turn = (unit(rng) - 0.5) * 0.08;
     const double v = standing ? 0.0 : 0.005 + 0.025 * unit(rng);
@@ -119,7 +134,8 @@ TransitionGraph CritterGraph(int num_frames, uint64_t seed) {
   // Buckets of heading (24) x speed (4); each frame gets transitions into its bucket.
   auto bucket = [&](int i) {
     const int h = static_cast<int>((heading[i] + std::numbers::pi) / two_pi * 24) % 24;
-    const int s = speed[i] == 0 ? 0 : 1 + std::min(2, static_cast<int>((speed[i] - 0.005) / 0.0084));
+    const int s =
+        speed[i] == 0 ? 0 : 1 + std::min(2, static_cast<int>((speed[i] - 0.005) / 0.0084));
     return h * 4 + s;
   };
   std::vector<std::vector<int>> buckets(24 * 4);
@@ -138,8 +154,10 @@ TransitionGraph CritterGraph(int num_frames, uint64_t seed) {
   // Standing up happens from slow walking only, and back.
   std::vector<int> standing, slow;
   for (int i = 0; i < num_frames; ++i) {
-    if (speed[i] == 0) standing.push_back(i);
-    else if (speed[i] < 0.012) slow.push_back(i);
+    if (speed[i] == 0)
+      standing.push_back(i);
+    else if (speed[i] < 0.012)
+      slow.push_back(i);
   }
   for (size_t k = 0; k < standing.size() / 4 && !slow.empty(); ++k) {
     edges.push_back({slow[rng() % slow.size()], standing[rng() % standing.size()], 0.5});
@@ -157,7 +175,8 @@ std::vector<Eigen::Vector2d> Arc(const Eigen::Vector2d& c, double r, double a0, 
   return p;
 }
 
-std::unique_ptr<Problem> MakeScene(int scene, const TransitionGraph& g, double fly_collision_strength) {
+std::unique_ptr<Problem> MakeScene(int scene, const TransitionGraph& g,
+                                   double fly_collision_strength) {
   auto p = std::make_unique<Problem>(g);
   const double pi = std::numbers::pi;
   auto standing = std::make_shared<std::vector<bool>>(g.FramesWithTag("standing"));
@@ -174,21 +193,26 @@ std::unique_ptr<Problem> MakeScene(int scene, const TransitionGraph& g, double f
   switch (scene) {
     case 1: {
       const int s = sprite("hamster", Anchor::kStart, {0.5, 0}, 150, 600);
-      p->AddTerm(std::make_unique<PathTerm>(s, Polyline(Arc({0, 0}, 0.5, 0, 2 * pi, 16)), PathStrengths{0.5, 50, 100}));
+      p->AddTerm(std::make_unique<PathTerm>(s, Polyline(Arc({0, 0}, 0.5, 0, 2 * pi, 16)),
+                                            PathStrengths{0.5, 50, 100}));
       break;
     }
     case 2: {
       const int s = sprite("hamster", Anchor::kStart, {0, 0}, 180, 180);
-      p->AddTerm(std::make_unique<LocationTerm>(s, StepWindow::Range(0, 117), LocationTarget::Fixed({0, 0}), 0.5));
-      p->AddTerm(std::make_unique<LocationTerm>(s, StepWindow{120, false, 0, true}, LocationTarget::Fixed({0.8, 0.6}), 50));
+      p->AddTerm(std::make_unique<LocationTerm>(s, StepWindow::Range(0, 117),
+                                                LocationTarget::Fixed({0, 0}), 0.5));
+      p->AddTerm(std::make_unique<LocationTerm>(s, StepWindow{120, false, 0, true},
+                                                LocationTarget::Fixed({0.8, 0.6}), 50));
       p->AddTerm(std::make_unique<LengthTerm>(s, 180, 100));
       break;
     }
     case 3: {
       const int a = sprite("right_goer", Anchor::kStart, {-0.8, 0}, 150, 150);
       const int b = sprite("left_goer", Anchor::kStart, {0.8, 0.05}, 150, 150);
-      p->AddTerm(std::make_unique<LocationTerm>(a, StepWindow::LastStep(), LocationTarget::Fixed({0.8, 0}), 20));
-      p->AddTerm(std::make_unique<LocationTerm>(b, StepWindow::LastStep(), LocationTarget::Fixed({-0.8, 0.05}), 20));
+      p->AddTerm(std::make_unique<LocationTerm>(a, StepWindow::LastStep(),
+                                                LocationTarget::Fixed({0.8, 0}), 20));
+      p->AddTerm(std::make_unique<LocationTerm>(b, StepWindow::LastStep(),
+                                                LocationTarget::Fixed({-0.8, 0.05}), 20));
       p->AddTerm(std::make_unique<LengthTerm>(a, 150, 100));
       p->AddTerm(std::make_unique<LengthTerm>(b, 150, 100));
       p->AddTerm(std::make_unique<CollisionTerm>(a, b, 0.15, 200));
@@ -198,11 +222,15 @@ std::unique_ptr<Problem> MakeScene(int scene, const TransitionGraph& g, double f
     case 5: {
       const int s = sprite("leader", Anchor::kStart, curve.points().front(), 150, 600);
       p->AddTerm(std::make_unique<PathTerm>(s, curve, PathStrengths{0.5, 50, 100}));
-      p->AddTerm(std::make_unique<FrameTerm>(s, standing, StepWindow::All(), 5, PathTrigger{s, curve, 60}));
+      p->AddTerm(std::make_unique<FrameTerm>(s, standing, StepWindow::All(), 5,
+                                             PathTrigger{s, curve, 60}));
       if (scene == 5) {
-        const int f = sprite("follower", Anchor::kStart, curve.points().front() + Eigen::Vector2d(-0.15, 0), 150, 600);
-        p->AddTerm(std::make_unique<LocationTerm>(f, StepWindow::All(), LocationTarget::Follow(s, {-0.15, 0.12}), 20));
-        p->AddTerm(std::make_unique<FrameTerm>(f, standing, StepWindow::All(), 5, PathTrigger{s, curve, 60}));
+        const int f = sprite("follower", Anchor::kStart,
+                             curve.points().front() + Eigen::Vector2d(-0.15, 0), 150, 600);
+        p->AddTerm(std::make_unique<LocationTerm>(f, StepWindow::All(),
+                                                  LocationTarget::Follow(s, {-0.15, 0.12}), 20));
+        p->AddTerm(std::make_unique<FrameTerm>(f, standing, StepWindow::All(), 5,
+                                               PathTrigger{s, curve, 60}));
         p->AddTerm(std::make_unique<CollisionTerm>(s, f, 0.08, 100));
       }
       break;
@@ -216,12 +244,14 @@ std::unique_ptr<Problem> MakeScene(int scene, const TransitionGraph& g, double f
         p->AddTerm(std::make_unique<FastFrameTerm>(s, 0.02, 20));
         if (scene == 7) {  // arriving from a ring 1.5 m out, in shuffled order: the paths cross
           const double a = 2 * pi * ((k * 27) % 64) / 64.0;
-          p->AddTerm(std::make_unique<LocationTerm>(s, StepWindow::At(0),
-                                                    LocationTarget::Fixed(1.5 * Eigen::Vector2d(std::cos(a), std::sin(a))), 20));
+          p->AddTerm(std::make_unique<LocationTerm>(
+              s, StepWindow::At(0),
+              LocationTarget::Fixed(1.5 * Eigen::Vector2d(std::cos(a), std::sin(a))), 20));
         }
       }
       for (int a = 0; a < 64; ++a) {
-        for (int b = a + 1; b < 64; ++b) p->AddTerm(std::make_unique<CollisionTerm>(a, b, 0.08, fly_collision_strength));
+        for (int b = a + 1; b < 64; ++b)
+          p->AddTerm(std::make_unique<CollisionTerm>(a, b, 0.08, fly_collision_strength));
       }
       break;
     }
@@ -231,7 +261,8 @@ std::unique_ptr<Problem> MakeScene(int scene, const TransitionGraph& g, double f
   return p;
 }
 
-nlohmann::json Figures(const std::string& method, const Summary& summary, const ConstraintFigures& f) {
+nlohmann::json Figures(const std::string& method, const Summary& summary,
+                       const ConstraintFigures& f) {
   return {{"method", method},
           {"cost", summary.final_cost.total},
           {"by_kind", summary.final_cost.by_kind},
@@ -308,7 +339,8 @@ int Run(const std::vector<std::string>& argv) {
     ReplacementOptions replace;
     replace.time_budget_seconds = budget;
     replace.reach.num_threads = args.threads;
-    if (args.collision_pick_fraction >= 0) replace.collision_pick_fraction = args.collision_pick_fraction;
+    if (args.collision_pick_fraction >= 0)
+      replace.collision_pick_fraction = args.collision_pick_fraction;
     row["collision_pick_fraction"] = replace.collision_pick_fraction;
     if (scene >= 6) {
       replace.reference_speed_m = 0.02;
@@ -317,10 +349,14 @@ int Run(const std::vector<std::string>& argv) {
     // Replacement starts one sprite after the other (the default); 64 flies start from
     // beam search (a quarter of the budget), as the paper allows (§4.2).
     const std::string start = !args.start.empty() ? args.start : scene >= 6 ? "beam" : "sequential";
-    if (start == "random") replace.start = StartMethod::kRandom;
-    else if (start == "beam") replace.start = StartMethod::kBeam;
-    else if (start == "sequential") replace.start = StartMethod::kSequential;
-    else throw InputError("--start", "expected random, sequential or beam, got " + start);
+    if (start == "random")
+      replace.start = StartMethod::kRandom;
+    else if (start == "beam")
+      replace.start = StartMethod::kBeam;
+    else if (start == "sequential")
+      replace.start = StartMethod::kSequential;
+    else
+      throw InputError("--start", "expected random, sequential or beam, got " + start);
     row["start"] = start;
     // The F/B sets are per bank (and frame constraint), built before the run as the paper
     // did; the budget is the optimization's, the same for both methods.
@@ -332,7 +368,8 @@ int Run(const std::vector<std::string>& argv) {
     const ConstraintFigures rf = MeasureConstraints(*problem, rt);
     row["replace"] = Figures("replace", rs, rf);
     if (args.detail) row["replace"]["sprites"] = SpriteDetail(*problem, rt);
-    std::vector<std::pair<std::string, std::pair<Summary, ConstraintFigures>>> results{{"replace", {rs, rf}}};
+    std::vector<std::pair<std::string, std::pair<Summary, ConstraintFigures>>> results{
+        {"replace", {rs, rf}}};
     if (args.beam) {
       BeamOptions beam;
       beam.time_budget_seconds = budget;
@@ -349,11 +386,13 @@ int Run(const std::vector<std::string>& argv) {
     if (!args.json) {
       for (const auto& [name, r] : results) {
         const auto& [s, f] = r;
-        std::printf("%-6d %-8s %12.5g %8.1f %9.3f %8d %9d %9d %8d\n", scene, name.c_str(), s.final_cost.total,
-                    s.total_seconds, f.max_path_deviation_m, f.paths_unfinished, f.colliding_pairs,
-                    f.frame_steps_off, f.sprites_short);
+        std::printf("%-6d %-8s %12.5g %8.1f %9.3f %8d %9d %9d %8d\n", scene, name.c_str(),
+                    s.final_cost.total, s.total_seconds, f.max_path_deviation_m, f.paths_unfinished,
+                    f.colliding_pairs, f.frame_steps_off, f.sprites_short);
       }
-      if (args.beam) std::printf("       beam/replace cost ratio: %.2f\n", row["beam_over_replace"].get<double>());
+      if (args.beam)
+        std::printf("       beam/replace cost ratio: %.2f\n",
+                    row["beam_over_replace"].get<double>());
       std::fflush(stdout);
     }
   }

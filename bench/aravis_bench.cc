@@ -65,8 +65,10 @@ void RecordSession(const std::string& dir, PixelFormat format) {
         const bool subject = x > 100 + 10 * i && x < 220 + 10 * i && y > 120 && y < 440;
         for (size_t c = 0; c < bpp; ++c) {
           seed = seed * 1664525u + 1013904223u;
-          const int base = subject ? 120 + 30 * static_cast<int>(c) : (c == 1 || bpp == 1 ? 170 : 50);
-          px[(static_cast<size_t>(y) * kW + x) * bpp + c] = static_cast<uint8_t>(base + ((seed >> 28) & 3));
+          const int base =
+              subject ? 120 + 30 * static_cast<int>(c) : (c == 1 || bpp == 1 ? 170 : 50);
+          px[(static_cast<size_t>(y) * kW + x) * bpp + c] =
+              static_cast<uint8_t>(base + ((seed >> 28) & 3));
         }
       }
     }
@@ -90,8 +92,9 @@ struct Result {
 
 Result Measure(const std::string& session, PixelFormat format, int packet_size, double seconds) {
   const std::string self = fs::read_symlink("/proc/self/exe").string();
-  std::vector<std::string> args = {self, "--log-level", "warn", "fakecam", session, "--address", "127.0.0.1",
-                                   "--serial", "SSBENCH", "--fps", "1000"};
+  std::vector<std::string> args = {self,      "--log-level", "warn",      "fakecam",
+                                   session,   "--address",   "127.0.0.1", "--serial",
+                                   "SSBENCH", "--fps",       "1000"};
   std::vector<char*> argv;
   for (auto& a : args) argv.push_back(a.data());
   argv.push_back(nullptr);
@@ -161,7 +164,8 @@ int Run(const std::vector<std::string>& args) {
   for (size_t i = 0; i + 1 < args.size(); ++i) {
     if (args[i] == "--seconds") seconds = std::stod(args[i + 1]);
   }
-  const fs::path dir = fs::temp_directory_path() / ("spritestation-aravis-bench-" + std::to_string(getpid()));
+  const fs::path dir =
+      fs::temp_directory_path() / ("spritestation-aravis-bench-" + std::to_string(getpid()));
   fs::create_directories(dir);
   struct Case {
     const char* name;
@@ -172,15 +176,16 @@ int Run(const std::vector<std::string>& args) {
                         {"rgb8_640x480_packet8000", PixelFormat::kRGB8, 8000},
                         {"mono8_640x480_packet1500", PixelFormat::kMono8, 1500},
                         {"rgb8_640x480_packet1500", PixelFormat::kRGB8, 1500}};
-  std::printf("%-28s %9s %9s %14s %14s %8s %8s\n", "aravis/case", "frames/s", "MiB/s", "cpu_us/frame",
-              "x_memcpy", "dropped", "resent");
+  std::printf("%-28s %9s %9s %14s %14s %8s %8s\n", "aravis/case", "frames/s", "MiB/s",
+              "cpu_us/frame", "x_memcpy", "dropped", "resent");
   for (const auto& c : cases) {
     const std::string session = (dir / PixelFormatName(c.format)).string();
     if (!fs::exists(session)) RecordSession(session, c.format);
     const Result r = Measure(session, c.format, c.packet_size, seconds);
     const double base = MemcpyUsPerFrame(FrameBytes(c.format, kW, kH));
-    std::printf("%-28s %9.1f %9.1f %14.1f %14.1f %8llu %8llu\n", c.name, r.fps, r.mib_per_s, r.cpu_us_per_frame,
-                base > 0 ? r.cpu_us_per_frame / base : 0.0, static_cast<unsigned long long>(r.dropped),
+    std::printf("%-28s %9.1f %9.1f %14.1f %14.1f %8llu %8llu\n", c.name, r.fps, r.mib_per_s,
+                r.cpu_us_per_frame, base > 0 ? r.cpu_us_per_frame / base : 0.0,
+                static_cast<unsigned long long>(r.dropped),
                 static_cast<unsigned long long>(r.resent));
     std::fflush(stdout);
   }
@@ -196,7 +201,8 @@ int Run(const std::vector<std::string>&) {
 #endif
 
 const bool registered = RegisterSuite(
-    {"aravis", "frames/s and CPU per frame through the Aravis backend from the emulated GigE camera", &Run});
+    {"aravis",
+     "frames/s and CPU per frame through the Aravis backend from the emulated GigE camera", &Run});
 
 }  // namespace
 }  // namespace ss::bench

@@ -1,23 +1,24 @@
 // spritestation bench bank: sprite bank append rate and feature-load time.
 //   bank/append/originals      batches of 100 original sprites, each a 64x64 BGRA+shadow billboard
-//   bank/append/with_mirrors   batches of 50 originals + their 50 mirrored copies (as the pipeline stores them)
-//   bank/baseline/compress     the same 100 billboards only zstd-compressed (what appending cannot beat)
-//   bank/load_features_60k     Bank::LoadFeatures on a bank of 60,000 sprites (30,000 + mirrors)
-//   bank/baseline/scan_60k     a bare sqlite3 scan of the same rows and columns
-//   bank/load_pixels           Bank::LoadPixels of random sprites of that bank
-//   bank/postgres/append_4_writers  four writers at once (threads, a session each) appending batches of
+//   bank/append/with_mirrors   batches of 50 originals + their 50 mirrored copies (as the pipeline
+//   stores them) bank/baseline/compress     the same 100 billboards only zstd-compressed (what
+//   appending cannot beat) bank/load_features_60k     Bank::LoadFeatures on a bank of 60,000
+//   sprites (30,000 + mirrors) bank/baseline/scan_60k     a bare sqlite3 scan of the same rows and
+//   columns bank/load_pixels           Bank::LoadPixels of random sprites of that bank
+//   bank/postgres/append_4_writers  four writers at once (threads, a session each) appending
+//   batches of
 //                              50 originals + 50 mirrors into one PostgreSQL bank; only when
-//                              SPRITESTATION_BENCH_POSTGRES names one (scripts/bench-postgres.sh starts
-//                              a private server for it): compared with bank/append/with_mirrors, one
-//                              SQLite writer, in the same run
+//                              SPRITESTATION_BENCH_POSTGRES names one (scripts/bench-postgres.sh
+//                              starts a private server for it): compared with
+//                              bank/append/with_mirrors, one SQLite writer, in the same run
 // Figures: sprites/s and ms, then each case as a ratio to its baseline from the same run.
 #include <sqlite3.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
-#include <cstdlib>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <map>
 #include <random>
@@ -41,7 +42,8 @@ constexpr int kFeatureBankSprites = 60'000;
 
 fs::path ScratchFolder() {
   static const fs::path dir = [] {
-    fs::path d = fs::temp_directory_path() / ("spritestation-bank-bench-" + std::to_string(getpid()));
+    fs::path d =
+        fs::temp_directory_path() / ("spritestation-bank-bench-" + std::to_string(getpid()));
     fs::create_directories(d);
     return d;
   }();
@@ -63,13 +65,19 @@ SpritePixels RealisticBillboard(uint32_t seed) {
       const double r = std::sqrt(dx * dx + dy * dy);
       const double alpha = std::clamp((1.05 - r) * 10.0, 0.0, 1.0);
       if (alpha > 0) {
-        auto c = [&](double v) { return static_cast<uint8_t>(std::clamp(v + noise(rng), 0.0, 255.0)); };
+        auto c = [&](double v) {
+          return static_cast<uint8_t>(std::clamp(v + noise(rng), 0.0, 255.0));
+        };
         const double stripe = (y / 6 + seed) % 2 ? 40 : 0;
-        p.bgra.at<cv::Vec4b>(y, x) = {c(60 + stripe), c(90 + 0.5 * y), c(150 - stripe), static_cast<uint8_t>(alpha * 255)};
+        p.bgra.at<cv::Vec4b>(y, x) = {c(60 + stripe), c(90 + 0.5 * y), c(150 - stripe),
+                                      static_cast<uint8_t>(alpha * 255)};
       }
-      const double sx = (x - cx) / (kBillboardPx * 0.3), sy = (y - kBillboardPx * 0.9) / (kBillboardPx * 0.06);
+      const double sx = (x - cx) / (kBillboardPx * 0.3),
+                   sy = (y - kBillboardPx * 0.9) / (kBillboardPx * 0.06);
       const double s = 1.0 - (sx * sx + sy * sy);
-      if (s > 0) p.shadow.at<uint8_t>(y, x) = static_cast<uint8_t>(std::clamp(s * 120 + noise(rng), 0.0, 255.0));
+      if (s > 0)
+        p.shadow.at<uint8_t>(y, x) =
+            static_cast<uint8_t>(std::clamp(s * 120 + noise(rng), 0.0, 255.0));
     }
   }
   return p;
@@ -141,7 +149,8 @@ void AppendCase(benchmark::State& state, bool mirrors) {
   bytes = writer.Counts().pixel_bytes;
   state.SetItemsProcessed(state.iterations() * kBatch);
   state.counters["stored_bytes_per_billboard"] =
-      static_cast<double>(bytes) / static_cast<double>(state.iterations() * (mirrors ? kBatch / 2 : kBatch));
+      static_cast<double>(bytes) /
+      static_cast<double>(state.iterations() * (mirrors ? kBatch / 2 : kBatch));
 }
 
 void BM_AppendOriginals(benchmark::State& state) { AppendCase(state, false); }
@@ -191,7 +200,8 @@ void BM_LoadFeatures(benchmark::State& state) {
     n = features.size();
     benchmark::DoNotOptimize(features.data());
   }
-  if (n != kFeatureBankSprites) state.SkipWithError("the feature bank holds the wrong number of sprites");
+  if (n != kFeatureBankSprites)
+    state.SkipWithError("the feature bank holds the wrong number of sprites");
   state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(n));
 }
 
@@ -199,11 +209,12 @@ void BM_ScanBaseline(benchmark::State& state) {
   sqlite3* db = nullptr;
   sqlite3_open_v2(FeatureBank().c_str(), &db, SQLITE_OPEN_READONLY, nullptr);
   sqlite3_stmt* stmt = nullptr;
-  sqlite3_prepare_v2(db,
-                     "SELECT s.id, s.clip_id, s.frame, s.timestamp_ns, s.mirror_of, s.mirrored, s.ground_x_m, "
-                     "s.ground_y_m, s.velocity_x_m_s, s.velocity_y_m_s, s.mean_r, s.mean_g, s.mean_b, s.area_px, "
-                     "s.eccentricity FROM sprites s",
-                     -1, &stmt, nullptr);
+  sqlite3_prepare_v2(
+      db,
+      "SELECT s.id, s.clip_id, s.frame, s.timestamp_ns, s.mirror_of, s.mirrored, s.ground_x_m, "
+      "s.ground_y_m, s.velocity_x_m_s, s.velocity_y_m_s, s.mean_r, s.mean_g, s.mean_b, s.area_px, "
+      "s.eccentricity FROM sprites s",
+      -1, &stmt, nullptr);
   int64_t rows = 0;
   for (auto _ : state) {
     double sum = 0;
@@ -218,7 +229,6 @@ void BM_ScanBaseline(benchmark::State& state) {
   sqlite3_close(db);
   state.SetItemsProcessed(rows);
 }
-
 
 // Stage-2 transition features read billboards one by one: random sprites of the 60k bank.
 void BM_LoadPixels(benchmark::State& state) {
@@ -237,11 +247,13 @@ void BM_LoadPixels(benchmark::State& state) {
 void BM_PostgresFourWriters(benchmark::State& state) {
   const char* address = std::getenv("SPRITESTATION_BENCH_POSTGRES");
   if (!address || !*address) {
-    state.SkipWithError("SPRITESTATION_BENCH_POSTGRES is not set (scripts/bench-postgres.sh sets it)");
+    state.SkipWithError(
+        "SPRITESTATION_BENCH_POSTGRES is not set (scripts/bench-postgres.sh sets it)");
     return;
   }
   BankWriter writer(address);
-  const std::string uid = "bench-" + std::to_string(getpid()) + "-" + std::to_string(state.thread_index()) + "-" +
+  const std::string uid = "bench-" + std::to_string(getpid()) + "-" +
+                          std::to_string(state.thread_index()) + "-" +
                           std::to_string(std::random_device{}());
   const int64_t session = writer.AddSession({0, uid, "bench", "", ""});
   const int64_t camera = writer.AddCamera(session, {0, 0, "cam0", "", 1280, 720});
@@ -264,11 +276,28 @@ void BM_PostgresFourWriters(benchmark::State& state) {
 }
 
 // Wall-clock rates (UseRealTime): appending includes the file writes.
-BENCHMARK(BM_AppendOriginals)->Name("bank/append/originals")->Unit(benchmark::kMillisecond)->MinTime(1.0)->UseRealTime();
-BENCHMARK(BM_AppendWithMirrors)->Name("bank/append/with_mirrors")->Unit(benchmark::kMillisecond)->MinTime(1.0)->UseRealTime();
-BENCHMARK(BM_Compress)->Name("bank/baseline/compress")->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK(BM_LoadFeatures)->Name("bank/load_features_60k")->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK(BM_ScanBaseline)->Name("bank/baseline/scan_60k")->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_AppendOriginals)
+    ->Name("bank/append/originals")
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(1.0)
+    ->UseRealTime();
+BENCHMARK(BM_AppendWithMirrors)
+    ->Name("bank/append/with_mirrors")
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(1.0)
+    ->UseRealTime();
+BENCHMARK(BM_Compress)
+    ->Name("bank/baseline/compress")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK(BM_LoadFeatures)
+    ->Name("bank/load_features_60k")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK(BM_ScanBaseline)
+    ->Name("bank/baseline/scan_60k")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 BENCHMARK(BM_LoadPixels)->Name("bank/load_pixels")->Unit(benchmark::kMicrosecond)->UseRealTime();
 BENCHMARK(BM_PostgresFourWriters)
     ->Name("bank/postgres/append_4_writers")
@@ -292,7 +321,8 @@ class Collector : public benchmark::ConsoleReporter {
     ConsoleReporter::ReportRuns(runs);
   }
   std::map<std::string, double> items_per_second, ms_per_iteration;
-  std::map<std::string, double> cpu_share;  // CPU time / wall time: below 1 when the machine is busy
+  std::map<std::string, double>
+      cpu_share;  // CPU time / wall time: below 1 when the machine is busy
 };
 
 int Run(const std::vector<std::string>& args) {
@@ -307,43 +337,54 @@ int Run(const std::vector<std::string>& args) {
     return collector.items_per_second[name] / collector.cpu_share[name];
   };
   auto has = [&](const std::string& name) { return collector.items_per_second.count(name) > 0; };
-  std::printf("\nbank figures (one thread; wall clock, and per CPU-second since the machine may be shared):\n");
+  std::printf(
+      "\nbank figures (one thread; wall clock, and per CPU-second since the machine may be "
+      "shared):\n");
   for (const char* name : {"bank/append/originals", "bank/append/with_mirrors"}) {
     if (!has(name)) continue;
-    std::printf("  %-26s %7.0f sprites/s wall, %7.0f per CPU-second", name, collector.items_per_second[name],
-                cpu_rate(name));
+    std::printf("  %-26s %7.0f sprites/s wall, %7.0f per CPU-second", name,
+                collector.items_per_second[name], cpu_rate(name));
     if (has("bank/baseline/compress")) {
       std::printf("  = %.2f x zstd-compressing alone (%.0f billboards per CPU-second)",
-                  cpu_rate(name) / cpu_rate("bank/baseline/compress"), cpu_rate("bank/baseline/compress"));
+                  cpu_rate(name) / cpu_rate("bank/baseline/compress"),
+                  cpu_rate("bank/baseline/compress"));
     }
     std::printf("\n");
   }
   if (has("bank/load_features_60k")) {
     const std::string f = "bank/load_features_60k", b = "bank/baseline/scan_60k";
-    std::printf("  %-26s %7.1f ms wall, %7.1f ms CPU for 60,000 sprites", f.c_str(), ms[f], ms[f] * collector.cpu_share[f]);
+    std::printf("  %-26s %7.1f ms wall, %7.1f ms CPU for 60,000 sprites", f.c_str(), ms[f],
+                ms[f] * collector.cpu_share[f]);
     if (has(b)) {
-      std::printf("  = %.2f x a bare sqlite3 scan (%.1f ms CPU)", cpu_rate(b) / cpu_rate(f), ms[b] * collector.cpu_share[b]);
+      std::printf("  = %.2f x a bare sqlite3 scan (%.1f ms CPU)", cpu_rate(b) / cpu_rate(f),
+                  ms[b] * collector.cpu_share[b]);
     }
     std::printf("\n");
   }
   const std::string pg = "bank/postgres/append_4_writers", lite = "bank/append/with_mirrors";
   if (has(pg)) {
-    // Four threads' items together, per second of wall clock (the server and the writers share the cores).
-    std::printf("  %-26s %7.0f sprites/s wall, four writers together", pg.c_str(), collector.items_per_second[pg]);
+    // Four threads' items together, per second of wall clock (the server and the writers share the
+    // cores).
+    std::printf("  %-26s %7.0f sprites/s wall, four writers together", pg.c_str(),
+                collector.items_per_second[pg]);
     if (has(lite)) {
       std::printf("  = %.2f x one SQLite writer (%.0f sprites/s wall)",
-                  collector.items_per_second[pg] / collector.items_per_second[lite], collector.items_per_second[lite]);
+                  collector.items_per_second[pg] / collector.items_per_second[lite],
+                  collector.items_per_second[lite]);
     }
     std::printf("\n");
   }
   if (has("bank/load_pixels")) {
-    std::printf("  %-26s %7.0f billboards/s wall, %7.0f per CPU-second (decompressed; mirrors flipped)\n",
-                "bank/load_pixels", collector.items_per_second["bank/load_pixels"], cpu_rate("bank/load_pixels"));
+    std::printf(
+        "  %-26s %7.0f billboards/s wall, %7.0f per CPU-second (decompressed; mirrors flipped)\n",
+        "bank/load_pixels", collector.items_per_second["bank/load_pixels"],
+        cpu_rate("bank/load_pixels"));
   }
   return 0;
 }
 
-const bool kRegistered = RegisterSuite({"bank", "sprite bank: append rate (sprites/s) and 60k feature load", &Run});
+const bool kRegistered =
+    RegisterSuite({"bank", "sprite bank: append rate (sprites/s) and 60k feature load", &Run});
 
 }  // namespace
 }  // namespace ss::bench

@@ -11,8 +11,8 @@
 namespace ss::bench {
 
 struct Suite {
-  std::string name;      // "key", "bank", "replay", ...
-  std::string summary;   // one line for `spritestation bench --help`
+  std::string name;                                  // "key", "bank", "replay", ...
+  std::string summary;                               // one line for `spritestation bench --help`
   int (*run)(const std::vector<std::string>& args);  // exit code
 };
 

@@ -49,16 +49,24 @@ void BM_BruteForce(benchmark::State& state, std::string shape) {
 }
 
 BENCHMARK_CAPTURE(BM_Sweep, comb, std::string("comb"))
-    ->Name("geometry/is_simple/sweep/comb")->RangeMultiplier(10)->Range(1000, 1000000)
+    ->Name("geometry/is_simple/sweep/comb")
+    ->RangeMultiplier(10)
+    ->Range(1000, 1000000)
     ->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_Sweep, star, std::string("star"))
-    ->Name("geometry/is_simple/sweep/star")->RangeMultiplier(10)->Range(1000, 1000000)
+    ->Name("geometry/is_simple/sweep/star")
+    ->RangeMultiplier(10)
+    ->Range(1000, 1000000)
     ->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_BruteForce, comb, std::string("comb"))
-    ->Name("geometry/is_simple/brute_force/comb")->RangeMultiplier(10)->Range(1000, 10000)
+    ->Name("geometry/is_simple/brute_force/comb")
+    ->RangeMultiplier(10)
+    ->Range(1000, 10000)
     ->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_BruteForce, star, std::string("star"))
-    ->Name("geometry/is_simple/brute_force/star")->RangeMultiplier(10)->Range(1000, 10000)
+    ->Name("geometry/is_simple/brute_force/star")
+    ->RangeMultiplier(10)
+    ->Range(1000, 10000)
     ->Unit(benchmark::kMillisecond);
 
 // A 640x480 pinhole camera 3 m above the floor looking straight down (3.84 x 2.88 m of floor), and
@@ -87,7 +95,8 @@ void BM_FloorMaskIndex(benchmark::State& state, std::string shape) {
   const GroundPolygon floor = MaskFloor(shape, static_cast<size_t>(state.range(0)));
   for (auto _ : state) {
     const GroundPolygonIndex index(floor);  // part of the cost: FloorMask builds one per camera
-    const cv::Mat mask = FloorPixels(camera, 0.0, [&](const Eigen::Vector2d& p) { return index.Contains(p); });
+    const cv::Mat mask =
+        FloorPixels(camera, 0.0, [&](const Eigen::Vector2d& p) { return index.Contains(p); });
     benchmark::DoNotOptimize(mask.data);
   }
 }
@@ -96,50 +105,69 @@ void BM_FloorMaskEveryEdge(benchmark::State& state, std::string shape) {
   const CameraModel camera = MaskCamera();
   const GroundPolygon floor = MaskFloor(shape, static_cast<size_t>(state.range(0)));
   for (auto _ : state) {
-    const cv::Mat mask = FloorPixels(camera, 0.0, [&](const Eigen::Vector2d& p) { return floor.Contains(p); });
+    const cv::Mat mask =
+        FloorPixels(camera, 0.0, [&](const Eigen::Vector2d& p) { return floor.Contains(p); });
     benchmark::DoNotOptimize(mask.data);
   }
 }
 
 BENCHMARK_CAPTURE(BM_FloorMaskIndex, comb, std::string("comb"))
-    ->Name("geometry/floor_mask/index/comb")->RangeMultiplier(10)->Range(1000, 100000)
+    ->Name("geometry/floor_mask/index/comb")
+    ->RangeMultiplier(10)
+    ->Range(1000, 100000)
     ->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_FloorMaskIndex, star, std::string("star"))
-    ->Name("geometry/floor_mask/index/star")->RangeMultiplier(10)->Range(1000, 100000)
+    ->Name("geometry/floor_mask/index/star")
+    ->RangeMultiplier(10)
+    ->Range(1000, 100000)
     ->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_FloorMaskEveryEdge, comb, std::string("comb"))
-    ->Name("geometry/floor_mask/every_edge/comb")->RangeMultiplier(10)->Range(1000, 10000)
+    ->Name("geometry/floor_mask/every_edge/comb")
+    ->RangeMultiplier(10)
+    ->Range(1000, 10000)
     ->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_FloorMaskEveryEdge, star, std::string("star"))
-    ->Name("geometry/floor_mask/every_edge/star")->RangeMultiplier(10)->Range(1000, 10000)
+    ->Name("geometry/floor_mask/every_edge/star")
+    ->RangeMultiplier(10)
+    ->Range(1000, 10000)
     ->Unit(benchmark::kMillisecond);
 
 int Run(const std::vector<std::string>& args) {
   RealTimes collector;  // by "geometry/is_simple/sweep/comb/1000", in ms
   if (const int status = RunGoogleBenchmarks("geometry/", args, &collector)) return status;
 
-  std::printf("\ngeometry figures (IsSimple, one thread; the brute force as a multiple of the sweep, this run):\n");
+  std::printf(
+      "\ngeometry figures (IsSimple, one thread; the brute force as a multiple of the sweep, this "
+      "run):\n");
   for (const char* shape : {"comb", "star"}) {
     for (const int n : {1000, 10000, 100000, 1000000}) {
-      const std::string sweep = std::string("geometry/is_simple/sweep/") + shape + "/" + std::to_string(n);
-      const std::string brute = std::string("geometry/is_simple/brute_force/") + shape + "/" + std::to_string(n);
+      const std::string sweep =
+          std::string("geometry/is_simple/sweep/") + shape + "/" + std::to_string(n);
+      const std::string brute =
+          std::string("geometry/is_simple/brute_force/") + shape + "/" + std::to_string(n);
       if (!collector.time.count(sweep)) continue;
       std::printf("  %-5s %8d vertices: sweep %9.3f ms", shape, n, collector.time[sweep]);
       if (collector.time.count(brute)) {
-        std::printf(", brute force %9.1f ms = %6.0f x", collector.time[brute], collector.time[brute] / collector.time[sweep]);
+        std::printf(", brute force %9.1f ms = %6.0f x", collector.time[brute],
+                    collector.time[brute] / collector.time[sweep]);
       }
       std::printf("\n");
     }
   }
-  std::printf("\nfloor mask figures (640x480 camera, one thread; every edge as a multiple of the index, this run):\n");
+  std::printf(
+      "\nfloor mask figures (640x480 camera, one thread; every edge as a multiple of the index, "
+      "this run):\n");
   for (const char* shape : {"comb", "star"}) {
     for (const int n : {1000, 10000, 100000}) {
-      const std::string index = std::string("geometry/floor_mask/index/") + shape + "/" + std::to_string(n);
-      const std::string every = std::string("geometry/floor_mask/every_edge/") + shape + "/" + std::to_string(n);
+      const std::string index =
+          std::string("geometry/floor_mask/index/") + shape + "/" + std::to_string(n);
+      const std::string every =
+          std::string("geometry/floor_mask/every_edge/") + shape + "/" + std::to_string(n);
       if (!collector.time.count(index)) continue;
       std::printf("  %-5s %8d vertices: index %9.2f ms", shape, n, collector.time[index]);
       if (collector.time.count(every)) {
-        std::printf(", every edge %9.1f ms = %6.0f x", collector.time[every], collector.time[every] / collector.time[index]);
+        std::printf(", every edge %9.1f ms = %6.0f x", collector.time[every],
+                    collector.time[every] / collector.time[index]);
       }
       std::printf("\n");
     }
@@ -147,7 +175,10 @@ int Run(const std::vector<std::string>& args) {
   return 0;
 }
 
-const bool kRegistered = RegisterSuite({"geometry", "floor polygon: simplicity check (sweep vs brute force), floor mask (index vs every edge)", &Run});
+const bool kRegistered = RegisterSuite(
+    {"geometry",
+     "floor polygon: simplicity check (sweep vs brute force), floor mask (index vs every edge)",
+     &Run});
 
 }  // namespace
 }  // namespace ss::bench

@@ -1,14 +1,18 @@
 // spritestation bench ingest: how fast one 1080p camera's recording is ingested, per codec.
-//   ingest/decode_only/CODEC            the session's video through a bare VideoReader with one decoder
-//                                       (no pipeline, no bank): the plain decode each ingest is divided by
+//   ingest/decode_only/CODEC            the session's video through a bare VideoReader with one
+//   decoder
+//                                       (no pipeline, no bank): the plain decode each ingest is
+//                                       divided by
 //   ingest/decode_threads/CODEC         the same with one decoder thread per core (decoding alone)
-//   ingest/CODEC_1080p                  IngestSession (replay, pipeline, bank; no transitions), one decoder
+//   ingest/CODEC_1080p                  IngestSession (replay, pipeline, bank; no transitions), one
+//   decoder
 //                                       thread per core: what `spritestation ingest` does
-//   ingest/CODEC_1080p/one_decoder      the same with --decode-threads 1: frames decoded one after another
+//   ingest/CODEC_1080p/one_decoder      the same with --decode-threads 1: frames decoded one after
+//   another
 //                                       (FFmpeg's slice threads for FFV1), the path before issue 19
-// CODEC: ffv1 and ffvhuff (core/recording_codecs.h). Session: `synth` animal, 1920x1080 RGB8, 4 s at
-// 30 fps (1 s of empty enclosure for the keyer), seed 4, made once per codec and cached in the temp
-// dir. Each case runs once (an ingest takes seconds); --benchmark_repetitions=N repeats them.
+// CODEC: ffv1 and ffvhuff (core/recording_codecs.h). Session: `synth` animal, 1920x1080 RGB8, 4 s
+// at 30 fps (1 s of empty enclosure for the keyer), seed 4, made once per codec and cached in the
+// temp dir. Each case runs once (an ingest takes seconds); --benchmark_repetitions=N repeats them.
 // Figures: frames/s of wall time, frames per CPU-second of the whole process, MB a frame on disk,
 // ratios to the plain decode of the same file and to the one-decoder FFV1 ingest of this run, and
 // the load average before and after (the machine is shared).
@@ -55,7 +59,8 @@ std::string LoadAverage() {
 
 fs::path ScratchFolder() {
   static const fs::path dir = [] {
-    fs::path d = fs::temp_directory_path() / ("spritestation-ingest-bench-" + std::to_string(getpid()));
+    fs::path d =
+        fs::temp_directory_path() / ("spritestation-ingest-bench-" + std::to_string(getpid()));
     fs::create_directories(d);
     return d;
   }();
@@ -82,8 +87,8 @@ const std::string& Session(const std::string& codec) {
     o.empty_lead_in_s = 1;
     o.write_mattes = false;
     o.codec = codec;
-    std::fprintf(stderr, "bench ingest: rendering the 1080p %s session into %s (once)...\n", codec.c_str(),
-                 o.out_dir.c_str());
+    std::fprintf(stderr, "bench ingest: rendering the 1080p %s session into %s (once)...\n",
+                 codec.c_str(), o.out_dir.c_str());
     synth::RenderStudioSession(o);
   }
   return dirs.emplace(codec, dir.string()).first->second;
@@ -94,9 +99,11 @@ std::string Video(const std::string& codec) { return Session(codec) + "/cam0.mkv
 void SetCounters(benchmark::State& state, int64_t frames, double cpu_s, const std::string& codec) {
   state.SetItemsProcessed(frames);
   state.counters["frames_per_cpu_s"] = cpu_s > 0 ? static_cast<double>(frames) / cpu_s : 0;
-  const double frames_per_pass = static_cast<double>(frames) / static_cast<double>(state.iterations());
+  const double frames_per_pass =
+      static_cast<double>(frames) / static_cast<double>(state.iterations());
   state.counters["MB_per_frame_on_disk"] =
-      frames_per_pass > 0 ? static_cast<double>(fs::file_size(Video(codec))) / frames_per_pass / 1e6 : 0;
+      frames_per_pass > 0 ? static_cast<double>(fs::file_size(Video(codec))) / frames_per_pass / 1e6
+                          : 0;
 }
 
 void BM_Decode(benchmark::State& state, const std::string& codec, int decode_threads) {
@@ -137,9 +144,12 @@ void BM_Ingest(benchmark::State& state, const std::string& codec, int decode_thr
   SetCounters(state, frames, cpu_s, codec);
 }
 
-#define SS_INGEST_CASE(fn, codec, threads, name) \
+#define SS_INGEST_CASE(fn, codec, threads, name)                         \
   BENCHMARK_CAPTURE(fn, codec##_##threads, std::string(#codec), threads) \
-      ->Name(name)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1)
+      ->Name(name)                                                       \
+      ->Unit(benchmark::kMillisecond)                                    \
+      ->UseRealTime()                                                    \
+      ->Iterations(1)
 
 SS_INGEST_CASE(BM_Decode, ffv1, 1, "ingest/decode_only/ffv1");
 SS_INGEST_CASE(BM_Decode, ffv1, 0, "ingest/decode_threads/ffv1");
@@ -185,7 +195,8 @@ int Run(const std::vector<std::string>& args) {
   benchmark::Initialize(&argc, argv.data());
   if (benchmark::ReportUnrecognizedArguments(argc, argv.data())) return 2;
   SetLogLevel("error");  // the keyer's warnings about the synthetic enclosure are not figures
-  for (const char* codec : {"ffv1", "ffvhuff"}) Session(codec);  // rendered before anything is timed
+  for (const char* codec : {"ffv1", "ffvhuff"})
+    Session(codec);  // rendered before anything is timed
   const std::string load_before = LoadAverage();
   Collector collector;
   benchmark::RunSpecifiedBenchmarks(&collector);
@@ -196,15 +207,17 @@ int Run(const std::vector<std::string>& args) {
 
   auto& figures = collector.figures;
   const char* today = "ingest/ffv1_1080p/one_decoder";
-  std::printf("\ningest figures (one 1920x1080 RGB8 camera, %ld cores; load average %s before, %s after):\n",
-              sysconf(_SC_NPROCESSORS_ONLN), load_before.c_str(), load_after.c_str());
-  std::printf("  %-36s %9s %12s %10s %14s %10s\n", "case", "frames/s", "per CPU-s", "x decode", "x ffv1 1 dec",
-              "MB/frame");
+  std::printf(
+      "\ningest figures (one 1920x1080 RGB8 camera, %ld cores; load average %s before, %s "
+      "after):\n",
+      sysconf(_SC_NPROCESSORS_ONLN), load_before.c_str(), load_after.c_str());
+  std::printf("  %-36s %9s %12s %10s %14s %10s\n", "case", "frames/s", "per CPU-s", "x decode",
+              "x ffv1 1 dec", "MB/frame");
   for (const char* codec : {"ffv1", "ffvhuff"}) {
     const std::string plain = std::string("ingest/decode_only/") + codec;
     for (const std::string& name : {plain, std::string("ingest/decode_threads/") + codec,
-                                   std::string("ingest/") + codec + "_1080p/one_decoder",
-                                   std::string("ingest/") + codec + "_1080p"}) {
+                                    std::string("ingest/") + codec + "_1080p/one_decoder",
+                                    std::string("ingest/") + codec + "_1080p"}) {
       if (!figures.count(name)) continue;
       const Collector::Figures& f = figures[name];
       std::printf("  %-36s %9.1f %12.1f", name.c_str(), f.fps, f.fps_cpu);
@@ -221,12 +234,15 @@ int Run(const std::vector<std::string>& args) {
       std::printf(" %10.2f\n", f.mb);
     }
   }
-  std::printf("  (x decode: to the plain one-decoder decode of the same file; x ffv1 1 dec: to %s)\n", today);
+  std::printf(
+      "  (x decode: to the plain one-decoder decode of the same file; x ffv1 1 dec: to %s)\n",
+      today);
   return 0;
 }
 
-const bool kRegistered =
-    RegisterSuite({"ingest", "one 1080p camera's ingest per codec (frames/s) vs a plain decode of the same file", &Run});
+const bool kRegistered = RegisterSuite(
+    {"ingest", "one 1080p camera's ingest per codec (frames/s) vs a plain decode of the same file",
+     &Run});
 
 }  // namespace
 }  // namespace ss::bench

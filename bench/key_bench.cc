@@ -1,7 +1,8 @@
 // spritestation bench key [--json] [google benchmark args]: key + extract on one core.
 //   key/key_extract_1080p_rgb8      ChromaKeyer + Extractor on 1920x1080 RGB8 frames, one subject
-//   key/baseline/read_1080p_rgb8    a plain read of every byte of the same frames (memory bandwidth)
-//   key/ffmpeg_chromakey_1080p      FFmpeg's chromakey filter (libavfilter), one thread, the same frames
+//   key/baseline/read_1080p_rgb8    a plain read of every byte of the same frames (memory
+//   bandwidth) key/ffmpeg_chromakey_1080p      FFmpeg's chromakey filter (libavfilter), one thread,
+//   the same frames
 //                                   pre-converted (untimed) to its own pixel format, yuva444p
 // Content: tests/pipeline/key_scene.h at 1080p: uneven, vignetted, tinted green with sensor
 // noise; one brown textured subject with legs, spill and a contact shadow, moving across.
@@ -45,9 +46,9 @@ constexpr int kHeight = 1080;
 constexpr int kFrames = 12;  // 75 MB of RGB: more than any cache, so every pass reads memory
 
 struct Footage {
-  std::vector<cv::Mat> empty_bgr;       // to train the keyer
+  std::vector<cv::Mat> empty_bgr;         // to train the keyer
   std::vector<std::vector<uint8_t>> rgb;  // the frames as a camera delivers them
-  std::vector<cv::Mat> bgr;             // the same, for FFmpeg's conversion
+  std::vector<cv::Mat> bgr;               // the same, for FFmpeg's conversion
 };
 
 const Footage& Frames() {
@@ -86,7 +87,8 @@ void BM_KeyExtract(benchmark::State& state) {
   cv::Mat scratch;
   std::vector<Frame> frames;
   for (const auto& bytes : f.rgb) {
-    frames.push_back(Frame::Borrowed(PixelFormat::kRGB8, kWidth, kHeight, bytes.data(), bytes.size(), nullptr));
+    frames.push_back(
+        Frame::Borrowed(PixelFormat::kRGB8, kWidth, kHeight, bytes.data(), bytes.size(), nullptr));
   }
   int64_t n = 0, candidates = 0;
   for (auto _ : state) {
@@ -98,7 +100,8 @@ void BM_KeyExtract(benchmark::State& state) {
     }
   }
   state.SetItemsProcessed(n);
-  state.counters["candidates_per_frame"] = static_cast<double>(candidates) / std::max<int64_t>(n, 1);
+  state.counters["candidates_per_frame"] =
+      static_cast<double>(candidates) / std::max<int64_t>(n, 1);
   if (candidates != n) state.SkipWithError("expected exactly one candidate per frame");
 }
 
@@ -148,13 +151,14 @@ AvFrame ToYuva444(const cv::Mat& bgr) {
   out->width = bgr.cols;
   out->height = bgr.rows;
   if (av_frame_get_buffer(out.get(), 0) < 0) return nullptr;
-  SwsContext* sws = sws_getContext(bgr.cols, bgr.rows, AV_PIX_FMT_BGR24, bgr.cols, bgr.rows, AV_PIX_FMT_YUVA444P,
-                                   SWS_POINT, nullptr, nullptr, nullptr);
+  SwsContext* sws = sws_getContext(bgr.cols, bgr.rows, AV_PIX_FMT_BGR24, bgr.cols, bgr.rows,
+                                   AV_PIX_FMT_YUVA444P, SWS_POINT, nullptr, nullptr, nullptr);
   const uint8_t* src[1] = {bgr.data};
   const int stride[1] = {static_cast<int>(bgr.step)};
   sws_scale(sws, src, stride, 0, bgr.rows, out->data, out->linesize);
   sws_freeContext(sws);
-  for (int y = 0; y < bgr.rows; ++y) std::fill_n(out->data[3] + y * out->linesize[3], bgr.cols, 255);
+  for (int y = 0; y < bgr.rows; ++y)
+    std::fill_n(out->data[3] + y * out->linesize[3], bgr.cols, 255);
   return out;
 }
 
@@ -170,15 +174,17 @@ void BM_FfmpegChromakey(benchmark::State& state) {
   graph->nb_threads = 1;  // one core, as for the keyer
   graph->thread_type = 0;
   AVFilterContext *src = nullptr, *key = nullptr, *sink = nullptr;
-  const std::string src_args = "video_size=" + std::to_string(kWidth) + "x" + std::to_string(kHeight) +
-                               ":pix_fmt=" + std::to_string(AV_PIX_FMT_YUVA444P) + ":time_base=1/30:pixel_aspect=1/1";
+  const std::string src_args =
+      "video_size=" + std::to_string(kWidth) + "x" + std::to_string(kHeight) +
+      ":pix_fmt=" + std::to_string(AV_PIX_FMT_YUVA444P) + ":time_base=1/30:pixel_aspect=1/1";
   // The scene's mean green (BGR 62, 168, 68 lit), tolerances as in FFmpeg's documentation examples.
-  if (avfilter_graph_create_filter(&src, avfilter_get_by_name("buffer"), "in", src_args.c_str(), nullptr,
-                                   graph.get()) < 0 ||
+  if (avfilter_graph_create_filter(&src, avfilter_get_by_name("buffer"), "in", src_args.c_str(),
+                                   nullptr, graph.get()) < 0 ||
       avfilter_graph_create_filter(&key, avfilter_get_by_name("chromakey"), "key",
-                                   "color=0x44A83E:similarity=0.12:blend=0.08", nullptr, graph.get()) < 0 ||
-      avfilter_graph_create_filter(&sink, avfilter_get_by_name("buffersink"), "out", nullptr, nullptr,
+                                   "color=0x44A83E:similarity=0.12:blend=0.08", nullptr,
                                    graph.get()) < 0 ||
+      avfilter_graph_create_filter(&sink, avfilter_get_by_name("buffersink"), "out", nullptr,
+                                   nullptr, graph.get()) < 0 ||
       avfilter_link(src, 0, key, 0) < 0 || avfilter_link(key, 0, sink, 0) < 0 ||
       avfilter_graph_config(graph.get(), nullptr) < 0) {
     state.SkipWithError("could not build the buffer -> chromakey -> buffersink graph");
@@ -202,9 +208,21 @@ void BM_FfmpegChromakey(benchmark::State& state) {
   state.SetItemsProcessed(n);
 }
 
-BENCHMARK(BM_KeyExtract)->Name("key/key_extract_1080p_rgb8")->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(2.0);
-BENCHMARK(BM_Read)->Name("key/baseline/read_1080p_rgb8")->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
-BENCHMARK(BM_FfmpegChromakey)->Name("key/ffmpeg_chromakey_1080p")->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(2.0);
+BENCHMARK(BM_KeyExtract)
+    ->Name("key/key_extract_1080p_rgb8")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->MinTime(2.0);
+BENCHMARK(BM_Read)
+    ->Name("key/baseline/read_1080p_rgb8")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->MinTime(1.0);
+BENCHMARK(BM_FfmpegChromakey)
+    ->Name("key/ffmpeg_chromakey_1080p")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->MinTime(2.0);
 
 // Keeps each case's frames/s so the suite can print ratios after the table.
 class Collector : public benchmark::ConsoleReporter {
@@ -248,7 +266,8 @@ int Run(const std::vector<std::string>& args) {
   nlohmann::json figures = {{"frame", "1920x1080 rgb8, one subject"}, {"threads", 1}};
   for (const auto& [name, value] : fps) figures["frames_per_second"][name] = value;
   if (fps.count(key) && fps.count(read)) figures["key_over_read"] = fps[key] / fps[read];
-  if (fps.count(key) && fps.count(ffmpeg)) figures["key_over_ffmpeg_chromakey"] = fps[key] / fps[ffmpeg];
+  if (fps.count(key) && fps.count(ffmpeg))
+    figures["key_over_ffmpeg_chromakey"] = fps[key] / fps[ffmpeg];
   if (json) {
     std::printf("%s\n", figures.dump(2).c_str());
     return 0;
@@ -259,7 +278,8 @@ int Run(const std::vector<std::string>& args) {
     if (fps.count(name)) std::printf("  %-32s %10.1f frames/s\n", name.c_str(), fps[name]);
   }
   if (figures.contains("key_over_read")) {
-    std::printf("  key + extract = %.3f x the read limit (goal >= 0.25)\n", figures["key_over_read"].get<double>());
+    std::printf("  key + extract = %.3f x the read limit (goal >= 0.25)\n",
+                figures["key_over_read"].get<double>());
   }
   if (figures.contains("key_over_ffmpeg_chromakey")) {
     std::printf("  key + extract = %.1f x FFmpeg chromakey (goal >> 50)\n",
@@ -268,8 +288,8 @@ int Run(const std::vector<std::string>& args) {
   return 0;
 }
 
-const bool kRegistered =
-    RegisterSuite({"key", "key + extract at 1080p on one core vs a plain read and FFmpeg chromakey", &Run});
+const bool kRegistered = RegisterSuite(
+    {"key", "key + extract at 1080p on one core vs a plain read and FFmpeg chromakey", &Run});
 
 }  // namespace
 }  // namespace ss::bench

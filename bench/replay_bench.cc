@@ -1,12 +1,15 @@
 // spritestation bench replay: how fast a recorded session replays and records, per codec.
-//   replay/CODEC_1080p_bgr8          ReplaySource over a 1920x1080 BGR8 session, as fast as possible
-//   replay/decode_only/CODEC         the same video through a bare VideoReader (no CSV, no queue, no thread);
+//   replay/CODEC_1080p_bgr8          ReplaySource over a 1920x1080 BGR8 session, as fast as
+//   possible replay/decode_only/CODEC         the same video through a bare VideoReader (no CSV, no
+//   queue, no thread);
 //                                    decode_only/ffv1 is the baseline the others are divided by
 //   replay/baseline/memcpy_1080p     the same frames memcpy'd from memory into a reused buffer
-//   replay/record_CODEC_1080p_bgr8   SessionWriter recording those frames (can a station keep up live?)
+//   replay/record_CODEC_1080p_bgr8   SessionWriter recording those frames (can a station keep up
+//   live?)
 // CODEC: ffv1 (the default: Golomb-Rice coder) and ffvhuff (core/recording_codecs.h).
 // Content: a green-screen studio frame (lit backdrop, a moving subject, sensor noise sigma 2).
-// Figures: frames/s, bytes a frame on disk, and each decode as a ratio to the baseline of the same run.
+// Figures: frames/s, bytes a frame on disk, and each decode as a ratio to the baseline of the same
+// run.
 #include <unistd.h>
 
 #include <cstdio>
@@ -37,7 +40,8 @@ constexpr int kFrames = 24;
 
 fs::path ScratchFolder() {
   static const fs::path dir = [] {
-    fs::path d = fs::temp_directory_path() / ("spritestation-replay-bench-" + std::to_string(getpid()));
+    fs::path d =
+        fs::temp_directory_path() / ("spritestation-replay-bench-" + std::to_string(getpid()));
     fs::create_directories(d);
     return d;
   }();
@@ -59,8 +63,10 @@ cv::Mat StudioFrame(int i) {
     }
   }
   const cv::Point centre(300 + i * 40, 600);
-  cv::ellipse(frame, centre, cv::Size(90, 260), 0, 0, 360, cv::Scalar(70, 110, 190), cv::FILLED, cv::LINE_AA);
-  cv::rectangle(frame, cv::Rect(centre.x - 90, centre.y - 40, 180, 30), cv::Scalar(50, 60, 120), cv::FILLED);
+  cv::ellipse(frame, centre, cv::Size(90, 260), 0, 0, 360, cv::Scalar(70, 110, 190), cv::FILLED,
+              cv::LINE_AA);
+  cv::rectangle(frame, cv::Rect(centre.x - 90, centre.y - 40, 180, 30), cv::Scalar(50, 60, 120),
+                cv::FILLED);
   cv::Mat noise(kHeight, kWidth, CV_16SC3);
   cv::randn(noise, 0, 2.0);
   cv::Mat noisy;
@@ -81,7 +87,8 @@ const std::vector<cv::Mat>& Frames() {
 }
 
 Frame AsFrame(const cv::Mat& m, int i) {
-  Frame f = Frame::Borrowed(PixelFormat::kBGR8, kWidth, kHeight, m.data, m.total() * m.elemSize(), nullptr);
+  Frame f = Frame::Borrowed(PixelFormat::kBGR8, kWidth, kHeight, m.data, m.total() * m.elemSize(),
+                            nullptr);
   f.sequence = static_cast<uint64_t>(i);
   f.timestamp_ns = i * 33'333'333LL;
   return f;
@@ -160,7 +167,8 @@ void BM_DecodeOnly(benchmark::State& state, const std::string& codec) {
     benchmark::DoNotOptimize(pixels.data());
   }
   state.SetItemsProcessed(frames);
-  state.counters["MB_per_frame_on_disk"] = static_cast<double>(fs::file_size(video)) / kFrames / 1e6;
+  state.counters["MB_per_frame_on_disk"] =
+      static_cast<double>(fs::file_size(video)) / kFrames / 1e6;
 }
 
 void BM_Memcpy(benchmark::State& state) {
@@ -191,18 +199,37 @@ void BM_Record(benchmark::State& state, const std::string& codec) {
 }
 
 BENCHMARK_CAPTURE(BM_Replay, ffv1, std::string("ffv1"))
-    ->Name("replay/ffv1_1080p_bgr8")->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(2.0);
+    ->Name("replay/ffv1_1080p_bgr8")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->MinTime(2.0);
 BENCHMARK_CAPTURE(BM_Replay, ffvhuff, std::string("ffvhuff"))
-    ->Name("replay/ffvhuff_1080p_bgr8")->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(2.0);
+    ->Name("replay/ffvhuff_1080p_bgr8")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->MinTime(2.0);
 BENCHMARK_CAPTURE(BM_DecodeOnly, ffv1, std::string("ffv1"))
-    ->Name("replay/decode_only/ffv1")->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(2.0);
+    ->Name("replay/decode_only/ffv1")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->MinTime(2.0);
 BENCHMARK_CAPTURE(BM_DecodeOnly, ffvhuff, std::string("ffvhuff"))
-    ->Name("replay/decode_only/ffvhuff")->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(2.0);
-BENCHMARK(BM_Memcpy)->Name("replay/baseline/memcpy_1080p")->Unit(benchmark::kMillisecond)->UseRealTime();
+    ->Name("replay/decode_only/ffvhuff")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->MinTime(2.0);
+BENCHMARK(BM_Memcpy)
+    ->Name("replay/baseline/memcpy_1080p")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 BENCHMARK_CAPTURE(BM_Record, ffv1, std::string("ffv1"))
-    ->Name("replay/record_ffv1_1080p_bgr8")->Unit(benchmark::kMillisecond)->UseRealTime();
+    ->Name("replay/record_ffv1_1080p_bgr8")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 BENCHMARK_CAPTURE(BM_Record, ffvhuff, std::string("ffvhuff"))
-    ->Name("replay/record_ffvhuff_1080p_bgr8")->Unit(benchmark::kMillisecond)->UseRealTime();
+    ->Name("replay/record_ffvhuff_1080p_bgr8")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 // Keeps each case's frames/s so the suite can print ratios after the table.
 class Collector : public benchmark::ConsoleReporter {
@@ -233,9 +260,10 @@ int Run(const std::vector<std::string>& args) {
   const char* baseline = "replay/decode_only/ffv1";
   std::printf("\nreplay figures (1920x1080 BGR8, %ld cores; ratios to %s in this run):\n",
               sysconf(_SC_NPROCESSORS_ONLN), baseline);
-  for (const char* name : {"replay/decode_only/ffv1", "replay/decode_only/ffvhuff",
-                           "replay/ffv1_1080p_bgr8", "replay/ffvhuff_1080p_bgr8", "replay/record_ffv1_1080p_bgr8",
-                           "replay/record_ffvhuff_1080p_bgr8", "replay/baseline/memcpy_1080p"}) {
+  for (const char* name :
+       {"replay/decode_only/ffv1", "replay/decode_only/ffvhuff", "replay/ffv1_1080p_bgr8",
+        "replay/ffvhuff_1080p_bgr8", "replay/record_ffv1_1080p_bgr8",
+        "replay/record_ffvhuff_1080p_bgr8", "replay/baseline/memcpy_1080p"}) {
     if (!fps.count(name)) continue;
     std::printf("  %-40s %8.1f frames/s", name, fps[name]);
     if (fps.count(baseline)) std::printf("  %6.2f x", fps[name] / fps[baseline]);
@@ -245,7 +273,8 @@ int Run(const std::vector<std::string>& args) {
   return 0;
 }
 
-const bool kRegistered = RegisterSuite({"replay", "session replay throughput at 1080p (frames/s) vs memcpy", &Run});
+const bool kRegistered =
+    RegisterSuite({"replay", "session replay throughput at 1080p (frames/s) vs memcpy", &Run});
 
 }  // namespace
 }  // namespace ss::bench

@@ -32,7 +32,9 @@ namespace ss::bench {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-double Since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+double Since(Clock::time_point t) {
+  return std::chrono::duration<double>(Clock::now() - t).count();
+}
 
 struct Args {
   int targets = 2000;
@@ -65,19 +67,30 @@ Args Parse(const std::vector<std::string>& given) {
       if (k + 1 >= argv.size()) throw InputError("bench skeleton", s + " needs a value");
       return std::stoi(argv[++k]);
     };
-    if (s == "--targets") a.targets = value();
-    else if (s == "--sources") a.sources = value();
-    else if (s == "--clip-frames") a.clip_frames = value();
-    else if (s == "--naive-rows") a.naive_rows = value();
-    else if (s == "--small-targets") a.small_targets = value();
-    else if (s == "--small-sources") a.small_sources = value();
-    else if (s == "--skip-quality") a.quality = false;
-    else if (s == "--json") a.json = true;
-    else if (s == "--gbench") a.gbench = true;
-    else throw InputError("bench skeleton", "unknown argument '" + s + "' (see bench/skeleton_bench.cc)");
+    if (s == "--targets")
+      a.targets = value();
+    else if (s == "--sources")
+      a.sources = value();
+    else if (s == "--clip-frames")
+      a.clip_frames = value();
+    else if (s == "--naive-rows")
+      a.naive_rows = value();
+    else if (s == "--small-targets")
+      a.small_targets = value();
+    else if (s == "--small-sources")
+      a.small_sources = value();
+    else if (s == "--skip-quality")
+      a.quality = false;
+    else if (s == "--json")
+      a.json = true;
+    else if (s == "--gbench")
+      a.gbench = true;
+    else
+      throw InputError("bench skeleton",
+                       "unknown argument '" + s + "' (see bench/skeleton_bench.cc)");
   }
-  if (a.targets < 10 || a.sources < 100 || a.clip_frames < 50 || a.naive_rows < 1 || a.small_targets < 2 ||
-      a.small_sources < 10) {
+  if (a.targets < 10 || a.sources < 100 || a.clip_frames < 50 || a.naive_rows < 1 ||
+      a.small_targets < 2 || a.small_sources < 10) {
     throw InputError("bench skeleton", "sizes too small");
   }
   return a;
@@ -124,7 +137,8 @@ std::vector<LabelledSkeletons> SourceClips(int total, int clip_frames) {
 
 // The quadratic DP: every predecessor p for every s, state (s, repeats) as in match_dp.h
 // (no listed transitions). Runs rows [0, rows) and returns the best value after them.
-double QuadraticDp(const CostRows& costs, const std::vector<int>& clip_starts, const MatchOptions& o, int rows) {
+double QuadraticDp(const CostRows& costs, const std::vector<int>& clip_starts,
+                   const MatchOptions& o, int rows) {
   const int S = costs.sources(), R = o.freeze_levels;
   const float inf = std::numeric_limits<float>::infinity();
   std::vector<int> clip(S);
@@ -151,8 +165,10 @@ double QuadraticDp(const CostRows& costs, const std::vector<int>& clip_starts, c
         const int d = s - p;
         float move = o.jump_cost;
         if (clip[p] == clip[s]) {
-          if (d >= 1 && d <= o.max_forward_step) move = o.skip_cost * static_cast<float>(d - 1);
-          else if (d < 0 && d >= -o.stutter_window) move = o.jump_cost + o.stutter_cost;
+          if (d >= 1 && d <= o.max_forward_step)
+            move = o.skip_cost * static_cast<float>(d - 1);
+          else if (d < 0 && d >= -o.stutter_window)
+            move = o.jump_cost + o.stutter_cost;
         }
         m = std::min(m, best[p] + move);
       }
@@ -196,8 +212,9 @@ double Accuracy(const std::vector<int>& path, const Problem& p) {
 }
 
 nlohmann::json StatsJson(const MatchStats& s, double accuracy) {
-  return {{"gesture_accuracy", accuracy}, {"freezes", s.freezes},   {"longest_freeze", s.longest_freeze},
-          {"stutters", s.stutters},       {"jumps", s.jumps},       {"skips", s.skips}};
+  return {
+      {"gesture_accuracy", accuracy}, {"freezes", s.freezes}, {"longest_freeze", s.longest_freeze},
+      {"stutters", s.stutters},       {"jumps", s.jumps},     {"skips", s.skips}};
 }
 
 // Google Benchmark cases on one T x S problem (built once, outside the timing), one thread:
@@ -208,48 +225,59 @@ int RunGbench(const Args& a) {
   static Problem* problem = nullptr;
   const auto t_make = Clock::now();
   problem = new Problem(MakeProblem(a.targets, a.sources, a.clip_frames));
-  std::printf("problem %d x %d in %zu clips built in %.1f s (not timed)\n", problem->target.sequence.size(),
-              static_cast<int>(problem->source_labels.size()), problem->clips.size(), Since(t_make));
+  std::printf("problem %d x %d in %zu clips built in %.1f s (not timed)\n",
+              problem->target.sequence.size(), static_cast<int>(problem->source_labels.size()),
+              problem->clips.size(), Since(t_make));
   const std::string size = std::to_string(a.targets) + "x" + std::to_string(a.sources);
-  benchmark::RegisterBenchmark(("BM_SkeletonMatchLinear/" + size).c_str(), [](benchmark::State& state) {
-    const Problem& p = *problem;
-    MatchResult r;
-    double describe_s = 0, solve_s = 0;
-    for (auto _ : state) {
-      auto t0 = Clock::now();
-      const PoseDescriptors td = ComputeDescriptors(p.target.sequence, {});
-      const PoseDescriptors sd = ComputeDescriptors(p.sequences, {});
-      const DescriptorCostRows costs(td, sd);
-      describe_s = Since(t0);
-      t0 = Clock::now();
-      r = SolveMatch(costs, p.clip_starts, MatchOptions{});
-      solve_s = Since(t0);
-      benchmark::DoNotOptimize(r.total_cost);
-    }
-    state.counters["describe_s"] = describe_s;
-    state.counters["solve_s"] = solve_s;
-    state.counters["cost_rows_s"] = r.cost_seconds;
-    state.counters["forward_s"] = r.forward_seconds;
-    state.counters["backward_s"] = r.backward_seconds;
-    state.counters["memory_mib"] = static_cast<double>(r.memory_bytes) / (1 << 20);
-    state.counters["gesture_accuracy"] = Accuracy(r.source_frames, p);
-  })->Unit(benchmark::kSecond)->Iterations(1)->UseRealTime();
+  benchmark::RegisterBenchmark(
+      ("BM_SkeletonMatchLinear/" + size).c_str(),
+      [](benchmark::State& state) {
+        const Problem& p = *problem;
+        MatchResult r;
+        double describe_s = 0, solve_s = 0;
+        for (auto _ : state) {
+          auto t0 = Clock::now();
+          const PoseDescriptors td = ComputeDescriptors(p.target.sequence, {});
+          const PoseDescriptors sd = ComputeDescriptors(p.sequences, {});
+          const DescriptorCostRows costs(td, sd);
+          describe_s = Since(t0);
+          t0 = Clock::now();
+          r = SolveMatch(costs, p.clip_starts, MatchOptions{});
+          solve_s = Since(t0);
+          benchmark::DoNotOptimize(r.total_cost);
+        }
+        state.counters["describe_s"] = describe_s;
+        state.counters["solve_s"] = solve_s;
+        state.counters["cost_rows_s"] = r.cost_seconds;
+        state.counters["forward_s"] = r.forward_seconds;
+        state.counters["backward_s"] = r.backward_seconds;
+        state.counters["memory_mib"] = static_cast<double>(r.memory_bytes) / (1 << 20);
+        state.counters["gesture_accuracy"] = Accuracy(r.source_frames, p);
+      })
+      ->Unit(benchmark::kSecond)
+      ->Iterations(1)
+      ->UseRealTime();
   const int rows = a.naive_rows + 1;
-  benchmark::RegisterBenchmark(("BM_SkeletonMatchQuadraticRows/" + size).c_str(), [rows](benchmark::State& state) {
-    const Problem& p = *problem;
-    const PoseDescriptors td = ComputeDescriptors(p.target.sequence, {});
-    const PoseDescriptors sd = ComputeDescriptors(p.sequences, {});
-    const DescriptorCostRows costs(td, sd);
-    double seconds = 0;
-    for (auto _ : state) {
-      const auto t0 = Clock::now();
-      benchmark::DoNotOptimize(QuadraticDp(costs, p.clip_starts, MatchOptions{}, rows));
-      seconds = Since(t0);
-    }
-    state.counters["rows"] = rows;
-    state.counters["s_per_row"] = seconds / rows;
-    state.counters["extrapolated_total_s"] = seconds / rows * costs.targets();
-  })->Unit(benchmark::kSecond)->Iterations(1)->UseRealTime();
+  benchmark::RegisterBenchmark(
+      ("BM_SkeletonMatchQuadraticRows/" + size).c_str(),
+      [rows](benchmark::State& state) {
+        const Problem& p = *problem;
+        const PoseDescriptors td = ComputeDescriptors(p.target.sequence, {});
+        const PoseDescriptors sd = ComputeDescriptors(p.sequences, {});
+        const DescriptorCostRows costs(td, sd);
+        double seconds = 0;
+        for (auto _ : state) {
+          const auto t0 = Clock::now();
+          benchmark::DoNotOptimize(QuadraticDp(costs, p.clip_starts, MatchOptions{}, rows));
+          seconds = Since(t0);
+        }
+        state.counters["rows"] = rows;
+        state.counters["s_per_row"] = seconds / rows;
+        state.counters["extrapolated_total_s"] = seconds / rows * costs.targets();
+      })
+      ->Unit(benchmark::kSecond)
+      ->Iterations(1)
+      ->UseRealTime();
   return RunGoogleBenchmarks("BM_SkeletonMatch", {});
 }
 
@@ -273,13 +301,14 @@ int Run(const std::vector<std::string>& argv) {
     const double naive = QuadraticDp(costs, p.clip_starts, options, costs.targets());
     const double naive_s = Since(t0);
     const bool same = std::abs(naive - linear.total_cost) <= 1e-3 * std::max(1.0, std::abs(naive));
-    result["small"] = {{"targets", costs.targets()},       {"sources", costs.sources()},
-                       {"linear_dp_s", linear_s},          {"quadratic_dp_s", naive_s},
-                       {"speedup", naive_s / linear_s},    {"linear_optimum", linear.total_cost},
-                       {"quadratic_optimum", naive},       {"same_optimum", same}};
-    std::printf("small %d x %d: linear DP %.3f s, quadratic DP %.3f s (x%.0f); optimum %.4f vs %.4f%s\n",
-                costs.targets(), costs.sources(), linear_s, naive_s, naive_s / linear_s, linear.total_cost, naive,
-                same ? "" : "  MISMATCH");
+    result["small"] = {{"targets", costs.targets()},    {"sources", costs.sources()},
+                       {"linear_dp_s", linear_s},       {"quadratic_dp_s", naive_s},
+                       {"speedup", naive_s / linear_s}, {"linear_optimum", linear.total_cost},
+                       {"quadratic_optimum", naive},    {"same_optimum", same}};
+    std::printf(
+        "small %d x %d: linear DP %.3f s, quadratic DP %.3f s (x%.0f); optimum %.4f vs %.4f%s\n",
+        costs.targets(), costs.sources(), linear_s, naive_s, naive_s / linear_s, linear.total_cost,
+        naive, same ? "" : "  MISMATCH");
     if (!same) return 1;
   }
 
@@ -317,13 +346,17 @@ int Run(const std::vector<std::string>& argv) {
                      {"quadratic_s_per_row", naive_row_s},
                      {"quadratic_total_s_extrapolated", naive_total_s},
                      {"speedup_extrapolated", naive_total_s / linear_s}};
-  std::printf("large %d x %d (%zu clips): descriptors %.2f s; linear DP %.2f s (costs %.2f, forward %.2f, backward "
-              "%.2f; %.1f MiB), %.0f us per target row\n",
-              costs.targets(), costs.sources(), p.clips.size(), describe_s, linear_s, linear.cost_seconds,
-              linear.forward_seconds, linear.backward_seconds, static_cast<double>(linear.memory_bytes) / (1 << 20),
-              linear_row_us);
-  std::printf("quadratic DP: %.3f s per target row over %d rows -> %.0f s for all %d rows (extrapolated): x%.0f\n",
-              naive_row_s, a.naive_rows + 1, naive_total_s, costs.targets(), naive_total_s / linear_s);
+  std::printf(
+      "large %d x %d (%zu clips): descriptors %.2f s; linear DP %.2f s (costs %.2f, forward %.2f, "
+      "backward "
+      "%.2f; %.1f MiB), %.0f us per target row\n",
+      costs.targets(), costs.sources(), p.clips.size(), describe_s, linear_s, linear.cost_seconds,
+      linear.forward_seconds, linear.backward_seconds,
+      static_cast<double>(linear.memory_bytes) / (1 << 20), linear_row_us);
+  std::printf(
+      "quadratic DP: %.3f s per target row over %d rows -> %.0f s for all %d rows (extrapolated): "
+      "x%.0f\n",
+      naive_row_s, a.naive_rows + 1, naive_total_s, costs.targets(), naive_total_s / linear_s);
 
   // 3. Quality on the large problem: without penalties, with them, refined.
   if (a.quality) {
@@ -342,8 +375,8 @@ int Run(const std::vector<std::string>& argv) {
                          {"target_movements", r.refined->target_movements.size()},
                          {"source_movements", r.refined->source_movements.size()}};
     auto line = [](const char* name, const MatchStats& s, double acc) {
-      std::printf("%-18s gesture accuracy %.1f%%, %d freezes (longest %d), %d stutters, %d jumps\n", name, 100 * acc,
-                  s.freezes, s.longest_freeze, s.stutters, s.jumps);
+      std::printf("%-18s gesture accuracy %.1f%%, %d freezes (longest %d), %d stutters, %d jumps\n",
+                  name, 100 * acc, s.freezes, s.longest_freeze, s.stutters, s.jumps);
     };
     line("without penalties:", r.without_penalties->stats, acc_without);
     line("with penalties:", r.with_penalties.stats, acc_with);
@@ -354,7 +387,8 @@ int Run(const std::vector<std::string>& argv) {
 }
 
 const bool kRegistered = RegisterSuite(
-    {"skeleton", "seed 003 skeleton matching: linear-per-row DP vs a quadratic DP, gesture accuracy", &Run});
+    {"skeleton",
+     "seed 003 skeleton matching: linear-per-row DP vs a quadratic DP, gesture accuracy", &Run});
 
 }  // namespace
 }  // namespace ss::bench

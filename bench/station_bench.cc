@@ -1,17 +1,19 @@
-// spritestation bench station [--cameras=N] [--size=WxH] [--fps=F] [--seconds=S] [--preview-streams=N]:
-// the live station on paced replay (the daemon's code: CameraRunner threads,
+// spritestation bench station [--cameras=N] [--size=WxH] [--fps=F] [--seconds=S]
+// [--preview-streams=N]: the live station on paced replay (the daemon's code: CameraRunner threads,
 // bank writer, TransitionWorker), as a Google Benchmark case run once for S
 // seconds of wall time. Cameras replay a synthetic animal session (made once,
 // cached under the temp dir) in real time, looping.
-//   station/live_ffv1_replay_...    cameras replaying the FFV1 session in real time (decoding included)
-//   station/live_from_memory_...    cameras delivering pre-decoded frames in real time, as a
-//                                   camera does: the station's own capacity. Counters: frames/s delivered, frames dropped (queue
-//                                   full / at source), capture-to-bank latency p50/p99,
-//                                   transitions pending (max), sprites/s stored
+//   station/live_ffv1_replay_...    cameras replaying the FFV1 session in real time (decoding
+//   included) station/live_from_memory_...    cameras delivering pre-decoded frames in real time,
+//   as a
+//                                   camera does: the station's own capacity. Counters: frames/s
+//                                   delivered, frames dropped (queue full / at source),
+//                                   capture-to-bank latency p50/p99, transitions pending (max),
+//                                   sprites/s stored
 //   station/live_from_memory_..._with_N_previews (--preview-streams=N): the same with the
 //                                   daemon's HTTP server and N console tiles open (each fetching
-//                                   raw / keyed / sprites views at 10 a second, and an event stream):
-//                                   an open console must cost no captured frame
+//                                   raw / keyed / sprites views at 10 a second, and an event
+//                                   stream): an open console must cost no captured frame
 //   station/baseline/decode_NxWxH   the same session replayed unpaced by ReplaySource:
 //                                   the machine's decode capacity for these cameras
 // The ratio printed: frames/s the cameras need / frames/s decoding alone gives.
@@ -19,15 +21,15 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
+#include <condition_variable>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
-#include <atomic>
-#include <condition_variable>
 #include <map>
 #include <mutex>
+#include <sstream>
 #include <thread>
 
 #include "bench/bench_registry.h"
@@ -54,8 +56,8 @@ struct StationBenchArgs {
 StationBenchArgs g_args;
 
 std::string Tag() {
-  return std::to_string(g_args.cameras) + "x" + std::to_string(g_args.width) + "x" + std::to_string(g_args.height) +
-         "@" + std::to_string(static_cast<int>(g_args.fps));
+  return std::to_string(g_args.cameras) + "x" + std::to_string(g_args.width) + "x" +
+         std::to_string(g_args.height) + "@" + std::to_string(static_cast<int>(g_args.fps));
 }
 
 // A synthetic session with as many cameras as asked, made once per shape.
@@ -74,8 +76,8 @@ std::string Session() {
   o.empty_lead_in_s = 1.5;
   o.write_mattes = false;
   o.threads = 2;
-  std::fprintf(stderr, "bench station: rendering a %d-camera %dx%d session into %s (once)...\n", o.cameras, o.width,
-               o.height, o.out_dir.c_str());
+  std::fprintf(stderr, "bench station: rendering a %d-camera %dx%d session into %s (once)...\n",
+               o.cameras, o.width, o.height, o.out_dir.c_str());
   synth::RenderStudioSession(o);
   return dir.string();
 }
@@ -91,7 +93,8 @@ class MemorySource : public FrameSource {
     const std::vector<Frame>& all = *frames_;
     if (all.empty()) return std::nullopt;
     const size_t n = all.size();
-    const int64_t span = all.back().timestamp_ns - all.front().timestamp_ns + (all.size() > 1 ? all[1].timestamp_ns - all[0].timestamp_ns : 0);
+    const int64_t span = all.back().timestamp_ns - all.front().timestamp_ns +
+                         (all.size() > 1 ? all[1].timestamp_ns - all[0].timestamp_ns : 0);
     Frame f = all[next_ % n];
     const uint64_t pass = next_ / n;
     f.camera = index_;
@@ -130,7 +133,8 @@ class MemorySource : public FrameSource {
 };
 
 // Every frame of one session camera, decoded (once per run).
-std::shared_ptr<const std::vector<Frame>> Decoded(const std::string& session, const std::string& camera) {
+std::shared_ptr<const std::vector<Frame>> Decoded(const std::string& session,
+                                                  const std::string& camera) {
   static std::map<std::string, std::shared_ptr<const std::vector<Frame>>> cache;
   auto& entry = cache[camera];
   if (!entry) {
@@ -140,7 +144,8 @@ std::shared_ptr<const std::vector<Frame>> Decoded(const std::string& session, co
     auto frames = std::make_shared<std::vector<Frame>>();
     while (auto f = source.Next()) {
       // Own the pixels: the replay reuses its buffers.
-      Frame copy = Frame::Owned(f->format, f->width, f->height, std::vector<uint8_t>(f->data, f->data + f->size));
+      Frame copy = Frame::Owned(f->format, f->width, f->height,
+                                std::vector<uint8_t>(f->data, f->data + f->size));
       copy.timestamp_ns = f->timestamp_ns;
       frames->push_back(std::move(copy));
     }
@@ -159,7 +164,8 @@ void Decode(benchmark::State& state) {
       ++frames;
     }
   }
-  state.counters["frames_per_s"] = benchmark::Counter(static_cast<double>(frames), benchmark::Counter::kIsRate);
+  state.counters["frames_per_s"] =
+      benchmark::Counter(static_cast<double>(frames), benchmark::Counter::kIsRate);
 }
 
 // What an open console costs: `n` browser tabs' worth of preview loops (each a tile fetching
@@ -172,8 +178,10 @@ class ConsoleLoad {
       threads_.emplace_back([this, port, k, cameras] {
         httplib::Client client("127.0.0.1", port);
         client.set_read_timeout(10, 0);
-        static const char* kViews[] = {"preview.jpg?view=raw", "preview.jpg?view=keyed", "sprites.json?x=1"};
-        const std::string path = "/api/cameras/cam" + std::to_string(k % cameras) + "/" + kViews[k % 3] + "&width=640";
+        static const char* kViews[] = {"preview.jpg?view=raw", "preview.jpg?view=keyed",
+                                       "sprites.json?x=1"};
+        const std::string path =
+            "/api/cameras/cam" + std::to_string(k % cameras) + "/" + kViews[k % 3] + "&width=640";
         while (!stop_) {
           const auto start = std::chrono::steady_clock::now();
           if (auto res = client.Get(path.c_str()); res && res->status == 200) ++images_;
@@ -204,7 +212,8 @@ void Live(benchmark::State& state, bool from_memory, int preview_streams) {
   if (from_memory) {
     for (int c = 0; c < g_args.cameras; ++c) Decoded(session, "cam" + std::to_string(c));
   }
-  const fs::path work = fs::temp_directory_path() / ("spritestation-station-bench-run-" + std::to_string(getpid()));
+  const fs::path work =
+      fs::temp_directory_path() / ("spritestation-station-bench-run-" + std::to_string(getpid()));
   fs::remove_all(work);
   fs::create_directories(work);
   for (auto _ : state) {
@@ -226,7 +235,8 @@ void Live(benchmark::State& state, bool from_memory, int preview_streams) {
     config.storage.stop_sprites_below_mib = 0;
     config.logging.level = "warn";
     if (from_memory) {
-      options.open_source = [&session](const CameraConfig& camera, int index) -> std::unique_ptr<FrameSource> {
+      options.open_source = [&session](const CameraConfig& camera,
+                                       int index) -> std::unique_ptr<FrameSource> {
         auto frames = Decoded(session, camera.name);
         SourceCamera sc;
         sc.name = camera.name;
@@ -250,7 +260,8 @@ void Live(benchmark::State& state, bool from_memory, int preview_streams) {
     station.StartSession("bench");
     int64_t pending_max = 0;
     const auto start = std::chrono::steady_clock::now();
-    while (std::chrono::steady_clock::now() - start < std::chrono::duration<double>(g_args.seconds)) {
+    while (std::chrono::steady_clock::now() - start <
+           std::chrono::duration<double>(g_args.seconds)) {
       std::this_thread::sleep_for(std::chrono::milliseconds(250));
       pending_max = std::max(pending_max, station.Status().transitions_pending);
     }
@@ -321,20 +332,25 @@ int Run(const std::vector<std::string>& args) {
       ->Unit(benchmark::kSecond)
       ->UseRealTime();
   if (g_args.preview_streams > 0) {
-    benchmark::RegisterBenchmark(
-        ("station/live_from_memory_" + Tag() + "_with_" + std::to_string(g_args.preview_streams) + "_previews").c_str(),
-        Live, true, g_args.preview_streams)
+    benchmark::RegisterBenchmark(("station/live_from_memory_" + Tag() + "_with_" +
+                                  std::to_string(g_args.preview_streams) + "_previews")
+                                     .c_str(),
+                                 Live, true, g_args.preview_streams)
         ->Iterations(1)
         ->Unit(benchmark::kSecond)
         ->UseRealTime();
   }
   const int rc = RunGoogleBenchmarks("station/", pass);
-  std::printf("cameras need %.0f frames/s (%d x %.0f)\n", g_args.cameras * g_args.fps, g_args.cameras, g_args.fps);
+  std::printf("cameras need %.0f frames/s (%d x %.0f)\n", g_args.cameras * g_args.fps,
+              g_args.cameras, g_args.fps);
   return rc;
 }
 
 const bool kRegistered =
-    RegisterSuite({"station", "the live station on paced replay: drops, latency, transitions lag (--cameras= --size= --fps= --seconds= --preview-streams=)", &Run});
+    RegisterSuite({"station",
+                   "the live station on paced replay: drops, latency, transitions lag (--cameras= "
+                   "--size= --fps= --seconds= --preview-streams=)",
+                   &Run});
 
 }  // namespace
 }  // namespace ss::bench

@@ -37,8 +37,9 @@ const char* Env(const char* name) {
 
 bool Inputs(benchmark::State& state) {
   if (!Env("SPRITESTATION_BENCH_POSTGRES") || !Env("SPRITESTATION_BENCH_BANK")) {
-    state.SkipWithError("SPRITESTATION_BENCH_POSTGRES and SPRITESTATION_BENCH_BANK are needed "
-                        "(scripts/bench-postgres.sh BUILD transitions sets both)");
+    state.SkipWithError(
+        "SPRITESTATION_BENCH_POSTGRES and SPRITESTATION_BENCH_BANK are needed "
+        "(scripts/bench-postgres.sh BUILD transitions sets both)");
     return false;
   }
   return true;
@@ -46,7 +47,8 @@ bool Inputs(benchmark::State& state) {
 
 void BM_SingleProcess(benchmark::State& state) {
   if (!Inputs(state)) return;
-  const fs::path copy = fs::temp_directory_path() / ("spritestation-workers-bench-" + std::to_string(getpid()) + ".db");
+  const fs::path copy = fs::temp_directory_path() /
+                        ("spritestation-workers-bench-" + std::to_string(getpid()) + ".db");
   BankUpdateSummary last;
   for (auto _ : state) {
     state.PauseTiming();
@@ -60,7 +62,8 @@ void BM_SingleProcess(benchmark::State& state) {
   fs::remove(copy);
   state.counters["sprites"] = static_cast<double>(last.sprites);
   state.counters["transitions"] = static_cast<double>(last.transitions);
-  state.counters["load_ms_per_sprite"] = 1e3 * last.seconds_load / static_cast<double>(std::max<int64_t>(1, last.sprites));
+  state.counters["load_ms_per_sprite"] =
+      1e3 * last.seconds_load / static_cast<double>(std::max<int64_t>(1, last.sprites));
   state.counters["pairs_s"] = last.seconds_build;
   state.counters["store_s"] = last.seconds_store;
 }
@@ -121,13 +124,25 @@ void BM_Workers(benchmark::State& state) {
   state.counters["units"] = static_cast<double>(sum.units);
   state.counters["transitions"] = static_cast<double>(sum.transitions);
   // Every worker indexes the whole bank: per sprite indexed, per transition stored.
-  state.counters["index_ms_per_sprite"] = 1e3 * index_s / static_cast<double>(std::max<int64_t>(1, sum.sprites_indexed));
+  state.counters["index_ms_per_sprite"] =
+      1e3 * index_s / static_cast<double>(std::max<int64_t>(1, sum.sprites_indexed));
   state.counters["pairs_s"] = pairs_s;
-  state.counters["upsert_ms_per_row"] = 1e3 * store_s / static_cast<double>(std::max<int64_t>(1, sum.transitions));
+  state.counters["upsert_ms_per_row"] =
+      1e3 * store_s / static_cast<double>(std::max<int64_t>(1, sum.transitions));
 }
 
-BENCHMARK(BM_SingleProcess)->Name("transitions/workers/single_process")->Unit(benchmark::kSecond)->Iterations(1)->UseRealTime();
-BENCHMARK(BM_Workers)->Name("transitions/workers")->Arg(1)->Arg(2)->Unit(benchmark::kSecond)->Iterations(1)->UseRealTime();
+BENCHMARK(BM_SingleProcess)
+    ->Name("transitions/workers/single_process")
+    ->Unit(benchmark::kSecond)
+    ->Iterations(1)
+    ->UseRealTime();
+BENCHMARK(BM_Workers)
+    ->Name("transitions/workers")
+    ->Arg(1)
+    ->Arg(2)
+    ->Unit(benchmark::kSecond)
+    ->Iterations(1)
+    ->UseRealTime();
 
 }  // namespace
 
@@ -138,7 +153,9 @@ int RunTransitionWorkers(const std::vector<std::string>& args) {
   const auto base = seconds.time.find("transitions/workers/single_process");
   if (base == seconds.time.end()) return 1;
   for (const auto& [name, s] : seconds.time) {
-    if (name != base->first) std::printf("%s: %.2f s = %.2f x the single-process build (%.2f s)\n", name.c_str(), s, s / base->second, base->second);
+    if (name != base->first)
+      std::printf("%s: %.2f s = %.2f x the single-process build (%.2f s)\n", name.c_str(), s,
+                  s / base->second, base->second);
   }
   return 0;
 }

@@ -33,7 +33,9 @@ namespace ss::bench {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-double Since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+double Since(Clock::time_point t) {
+  return std::chrono::duration<double>(Clock::now() - t).count();
+}
 // CPU seconds of the whole process (all threads): with other jobs on the machine, wall
 // time alone would hide whether the build itself or the contention is slow.
 double ProcessCpuSeconds() {
@@ -86,24 +88,42 @@ Args Parse(const std::vector<std::string>& argv) {
       if (k + 1 >= tokens.size()) throw InputError("bench transitions", s + " needs a value");
       return tokens[++k];
     };
-    if (s == "--sprites") a.sprites = std::stoi(value());
-    else if (s == "--incremental-base") a.incremental_base = std::stoi(value());
-    else if (s == "--adds") a.adds = std::stoi(value());
-    else if (s == "--rows") a.rows = std::stoi(value());
-    else if (s == "--threads") a.threads = std::stoi(value());
-    else if (s == "--labels") a.labels = std::stoi(value());
-    else if (s == "--near-miss") a.near_miss = std::stod(value());
-    else if (s == "--stage1-recall") a.stage1_recall = std::stod(value());
-    else if (s == "--stage2-bias-shift") a.stage2_bias_shift = std::stod(value());
-    else if (s == "--weights") a.weights_path = value();
-    else if (s == "--train-out") a.train_out = value();
-    else if (s == "--skip-incremental") a.incremental = false;
-    else if (s == "--micro") a.micro = true;
-    else if (s == "--json") a.json = true;
-    else if (s == "--sweep-stage2") a.sweep = true;
-    else throw InputError("bench transitions", "unknown argument '" + s + "' (see bench/transitions_bench.cc)");
+    if (s == "--sprites")
+      a.sprites = std::stoi(value());
+    else if (s == "--incremental-base")
+      a.incremental_base = std::stoi(value());
+    else if (s == "--adds")
+      a.adds = std::stoi(value());
+    else if (s == "--rows")
+      a.rows = std::stoi(value());
+    else if (s == "--threads")
+      a.threads = std::stoi(value());
+    else if (s == "--labels")
+      a.labels = std::stoi(value());
+    else if (s == "--near-miss")
+      a.near_miss = std::stod(value());
+    else if (s == "--stage1-recall")
+      a.stage1_recall = std::stod(value());
+    else if (s == "--stage2-bias-shift")
+      a.stage2_bias_shift = std::stod(value());
+    else if (s == "--weights")
+      a.weights_path = value();
+    else if (s == "--train-out")
+      a.train_out = value();
+    else if (s == "--skip-incremental")
+      a.incremental = false;
+    else if (s == "--micro")
+      a.micro = true;
+    else if (s == "--json")
+      a.json = true;
+    else if (s == "--sweep-stage2")
+      a.sweep = true;
+    else
+      throw InputError("bench transitions",
+                       "unknown argument '" + s + "' (see bench/transitions_bench.cc)");
   }
-  if (a.sprites < 100 || a.rows < 1 || a.threads < 1) throw InputError("bench transitions", "bad sizes");
+  if (a.sprites < 100 || a.rows < 1 || a.threads < 1)
+    throw InputError("bench transitions", "bad sizes");
   return a;
 }
 
@@ -165,12 +185,14 @@ TransitionWeights Train(const Args& a, nlohmann::json* out) {
       if (y[k]) positive_distances.push_back(label_fit.Distance(x[k]));
     }
   }
-  const PopulationSample sample = SamplePopulation(store, TransitionClassifier(w), a.rows, 7, a.threads);
+  const PopulationSample sample =
+      SamplePopulation(store, TransitionClassifier(w), a.rows, 7, a.threads);
   const Stage2Calibration s2 = CalibrateStage2(positive_distances, sample, positive_rate, &w);
   const Stage1Calibration s1 = FitStage1Filter(store, sample, a.stage1_recall, 7, &w);
   nlohmann::json training = nlohmann::json::parse(w.training_json);
-  training["source"] = "spritestation bench transitions --train-out: synthetic hamster set, seed 1, " +
-                       std::to_string(a.sprites) + " sprites (pipeline/transitions/synthetic.cc), labels from truth";
+  training["source"] =
+      "spritestation bench transitions --train-out: synthetic hamster set, seed 1, " +
+      std::to_string(a.sprites) + " sprites (pipeline/transitions/synthetic.cc), labels from truth";
   training["stage2_calibration"] = {{"positive_rate", positive_rate},
                                     {"sampled_rows", sample.rows.size()},
                                     {"threshold", s2.threshold},
@@ -189,18 +211,22 @@ TransitionWeights Train(const Args& a, nlohmann::json* out) {
   SaveWeights(w, a.train_out);
   (*out)["training"] = training;
   (*out)["training"]["seconds"] = Since(t0);
-  std::printf("trained on %zu labels (%lld accepts): stage 1 CV precision %.3f recall %.3f, stage 2 CV precision %.3f "
-              "recall %.3f\n",
-              labels.size(), static_cast<long long>(report.accepts), report.stage1.precision(),
-              report.stage1.recall(), report.stage2.precision(), report.stage2.recall());
-  std::printf("stage 2 set for the truth's positive rate %.3g (%.1f true partners per sprite): %.1f accepts per sprite, "
-              "estimated precision %.3f recall %.3f; stage 1 refitted to pass %.3f of them: %.1f candidates per sprite "
-              "-> %s\n",
-              positive_rate, positive_rate * (a.sprites - 1), s2.accepts_per_sprite, s2.precision, s2.recall,
-              a.stage1_recall, s1.candidates_per_sprite, a.train_out.c_str());
+  std::printf(
+      "trained on %zu labels (%lld accepts): stage 1 CV precision %.3f recall %.3f, stage 2 CV "
+      "precision %.3f "
+      "recall %.3f\n",
+      labels.size(), static_cast<long long>(report.accepts), report.stage1.precision(),
+      report.stage1.recall(), report.stage2.precision(), report.stage2.recall());
+  std::printf(
+      "stage 2 set for the truth's positive rate %.3g (%.1f true partners per sprite): %.1f "
+      "accepts per sprite, "
+      "estimated precision %.3f recall %.3f; stage 1 refitted to pass %.3f of them: %.1f "
+      "candidates per sprite "
+      "-> %s\n",
+      positive_rate, positive_rate * (a.sprites - 1), s2.accepts_per_sprite, s2.precision,
+      s2.recall, a.stage1_recall, s1.candidates_per_sprite, a.train_out.c_str());
   return w;
 }
-
 
 // The candidates of every 10th sprite (j > i), from the built index.
 std::vector<std::pair<int32_t, int32_t>> SampledCandidates(const TransitionBuilder& builder) {
@@ -233,7 +259,8 @@ void CompareCascades(const TransitionBuilder& builder, nlohmann::json* out) {
     PixelSums bound;
     bound.alpha_abs_diff = store.CoarseAlphaBound(i, j);
     bound.weight = 1;
-    return d + u2[4] * PixelDifferenceFromSums(bound, store.box(i), store.box(j)).alpha > c.stage2_threshold();
+    return d + u2[4] * PixelDifferenceFromSums(bound, store.box(i), store.box(j)).alpha >
+           c.stage2_threshold();
   };
   double ns[2] = {0, 0};
   int64_t accepts[2] = {0, 0}, pixel_reads[2] = {0, 0};
@@ -255,9 +282,12 @@ void CompareCascades(const TransitionBuilder& builder, nlohmann::json* out) {
     }
   }
   if (accepts[0] != accepts[1]) throw std::logic_error("the two cascades decided differently");
-  std::printf("  deciding %zu sampled stage-1 candidates on one core (CPU): 4x4 bound then pixels %.1f ns a candidate "
-              "(%.1f%% read pixels); with the level-2 signature %.1f ns (%.1f%% read pixels)\n",
-              pairs.size(), ns[0], 100.0 * pixel_reads[0] / pairs.size(), ns[1], 100.0 * pixel_reads[1] / pairs.size());
+  std::printf(
+      "  deciding %zu sampled stage-1 candidates on one core (CPU): 4x4 bound then pixels %.1f ns "
+      "a candidate "
+      "(%.1f%% read pixels); with the level-2 signature %.1f ns (%.1f%% read pixels)\n",
+      pairs.size(), ns[0], 100.0 * pixel_reads[0] / pairs.size(), ns[1],
+      100.0 * pixel_reads[1] / pairs.size());
   (*out)["cascade_ab"] = {{"sampled_candidates", pairs.size()},
                           {"coarse_only_ns_per_candidate", ns[0]},
                           {"coarse_only_pixel_reads", pixel_reads[0]},
@@ -283,9 +313,12 @@ void SweepStage2(const TransitionBuilder& builder, const TransitionWeights& weig
       accept += c.Stage2(builder.store(), i, j, &d);
     }
     // Each sampled row's candidates j > i: about half of its partners; per sprite = x 2.
-    std::printf("  stage-2 bias %+.2f (T2 %.3f): per sprite %.1f stage-2 evaluations, %.1f accepts -> ~%.0fx fewer "
-                "evaluations than brute force\n",
-                shift, c.stage2_threshold(), 2 * survive / rows, 2 * accept / rows, (n - 1) / (2 * survive / rows));
+    std::printf(
+        "  stage-2 bias %+.2f (T2 %.3f): per sprite %.1f stage-2 evaluations, %.1f accepts -> "
+        "~%.0fx fewer "
+        "evaluations than brute force\n",
+        shift, c.stage2_threshold(), 2 * survive / rows, 2 * accept / rows,
+        (n - 1) / (2 * survive / rows));
   }
 }
 
@@ -293,13 +326,16 @@ int Run(const std::vector<std::string>& argv) {
   const Args a = Parse(argv);
   SetLogLevel("warn");
   nlohmann::json result;
-  TransitionWeights weights = a.weights_path.empty() ? DefaultWeights() : LoadWeights(a.weights_path);
+  TransitionWeights weights =
+      a.weights_path.empty() ? DefaultWeights() : LoadWeights(a.weights_path);
   if (!a.train_out.empty()) weights = Train(a, &result);
   if (a.stage2_bias_shift != 0) {
     weights.stage2_bias += a.stage2_bias_shift;
-    std::printf("stage-2 bias shifted by %+g (threshold T2 %.4f -> %.4f): NOT the shipped operating point\n",
-                a.stage2_bias_shift, TransitionClassifier(weights).stage2_threshold() + a.stage2_bias_shift,
-                TransitionClassifier(weights).stage2_threshold());
+    std::printf(
+        "stage-2 bias shifted by %+g (threshold T2 %.4f -> %.4f): NOT the shipped operating "
+        "point\n",
+        a.stage2_bias_shift, TransitionClassifier(weights).stage2_threshold() + a.stage2_bias_shift,
+        TransitionClassifier(weights).stage2_threshold());
     result["stage2_bias_shift"] = a.stage2_bias_shift;
   }
   const double px_per_m = SyntheticSpriteOptions{}.px_per_m;
@@ -333,7 +369,8 @@ int Run(const std::vector<std::string>& argv) {
   std::shuffle(rows.begin(), rows.end(), rng);
   rows.resize(std::min<int32_t>(n, a.rows));
   std::atomic<size_t> cursor{0};
-  std::atomic<int64_t> brute_accepted{0}, brute_kept{0}, truth_pos{0}, kept_total{0}, kept_true{0}, brute_true{0};
+  std::atomic<int64_t> brute_accepted{0}, brute_kept{0}, truth_pos{0}, kept_total{0}, kept_true{0},
+      brute_true{0};
   t = Clock::now();
   auto work = [&] {
     const TruthLabelOptions truth_options;
@@ -373,19 +410,23 @@ int Run(const std::vector<std::string>& argv) {
   const double plain_cpu0 = ThreadCpuSeconds();
   for (size_t r = 0; r < plain_rows; ++r) {
     for (int32_t j = 0; j < n; ++j) {
-      if (j != rows[r]) sink += classifier.Stage2Accepts(classifier.Distance(store.Features(rows[r], j)));
+      if (j != rows[r])
+        sink += classifier.Stage2Accepts(classifier.Distance(store.Features(rows[r], j)));
     }
   }
   benchmark::DoNotOptimize(sink);
-  const double seconds_per_eval_core = (ThreadCpuSeconds() - plain_cpu0) / (static_cast<double>(plain_rows) * (n - 1));
+  const double seconds_per_eval_core =
+      (ThreadCpuSeconds() - plain_cpu0) / (static_cast<double>(plain_rows) * (n - 1));
   const double brute_seconds_core = all_pairs * seconds_per_eval_core;
   const double ratio = all_pairs / std::max<int64_t>(1, stats.stage2_evaluations);
   const double ratio_stage1 = all_pairs / std::max<int64_t>(1, stats.stage1_candidates);
-  const double recall_vs_brute = brute_accepted > 0 ? static_cast<double>(brute_kept) / brute_accepted : 1.0;
+  const double recall_vs_brute =
+      brute_accepted > 0 ? static_cast<double>(brute_kept) / brute_accepted : 1.0;
   const double precision_truth = kept_total > 0 ? static_cast<double>(kept_true) / kept_total : 0.0;
   const double recall_truth = truth_pos > 0 ? static_cast<double>(kept_true) / truth_pos : 0.0;
 
-  // Transition-level quality against truth: i -> j is right when the truth accepts {i,j}, {i+1,j}, {i,j-1}.
+  // Transition-level quality against truth: i -> j is right when the truth accepts {i,j}, {i+1,j},
+  // {i,j-1}.
   const TruthLabelOptions truth_options;
   std::unordered_set<int32_t> row_set(rows.begin(), rows.end());
   int64_t t_found = 0, t_true = 0, t_truth_total = 0;
@@ -410,66 +451,89 @@ int Run(const std::vector<std::string>& argv) {
     }
   }
 
-  std::printf("\n== transitions: full build, %d synthetic sprites (%lld clips, mirrors included), %d threads ==\n", n,
-              static_cast<long long>(stats.clips), a.threads);
-  std::printf("  build: %.2f s (images %.2f s, index %.3f s, stage 1 + stage 2 %.2f s, transitions %.2f s)"
-              "   goal <= 60 s: %s\n",
-              seconds_build, stats.seconds_images, stats.seconds_index, stats.seconds_pairs, seconds_transitions,
-              seconds_build <= 60 ? "met" : "MISSED");
-  std::printf("  CPU time of the build %.2f s over %d threads (machine load average %.1f before it)\n", cpu_build,
-              a.threads, load_before);
-  std::printf("  stage 1 (k-d tree): %lld candidates of %.0f pairs (%.0fx fewer); silhouette signature rejects %lld "
-              "of them without reading a pixel\n",
-              static_cast<long long>(stats.stage1_candidates), all_pairs, ratio_stage1,
-              static_cast<long long>(stats.signature_rejected));
-  std::printf("  stage-2 evaluations: %lld of %.0f pairs -> %.0fx fewer than brute force   goal >= 1000x: %s\n",
-              static_cast<long long>(stats.stage2_evaluations), all_pairs, ratio, ratio >= 1000 ? "met" : "MISSED");
-  std::printf("  accepts per sprite (kept pairs x 2 / sprites): %.1f; at most all_pairs / 1000 = %.0f evaluations for "
-              "1000x\n",
-              2.0 * stats.kept_pairs / n, all_pairs / 1000);
-  std::printf("  brute force (extrapolated: stage 2 alone timed on %zu rows x %d pairs, %.0f ns each, CPU time of one "
-              "core): %.0f s on one core, %.0f s on %d; the two-stage build (%.2f s CPU) needs %.0fx less CPU\n",
-              plain_rows, n - 1, seconds_per_eval_core * 1e9, brute_seconds_core, brute_seconds_core / a.threads,
-              a.threads, cpu_build, brute_seconds_core / cpu_build);
-  std::printf("  (recall and quality below: all %zu sampled rows x %d = %.3g pairs judged by brute force, %.1f s)\n",
-              rows.size(), n - 1, evaluations, seconds_sample);
-  std::printf("  kept %lld pairs, %zu transitions; of the %lld pairs brute force accepts in the sampled rows, kept "
-              "%.4f   goal >= 0.99: %s\n",
-              static_cast<long long>(stats.kept_pairs), transitions.size(), static_cast<long long>(brute_accepted.load()),
-              recall_vs_brute, recall_vs_brute >= 0.99 ? "met" : "MISSED");
-  std::printf("  against synthetic truth (sampled rows; same pose, every key point within %.1f mm; "
-              "%.1f true partners per sprite): pairs precision %.3f recall %.3f; transitions precision %.3f recall %.3f\n",
-              truth_options.max_keypoint_displacement_m * 1e3,
-              static_cast<double>(truth_pos) / rows.size(), precision_truth, recall_truth, t_found ? static_cast<double>(t_true) / t_found : 0.0,
-              t_truth_total ? static_cast<double>(t_true) / t_truth_total : 0.0);
+  std::printf(
+      "\n== transitions: full build, %d synthetic sprites (%lld clips, mirrors included), %d "
+      "threads ==\n",
+      n, static_cast<long long>(stats.clips), a.threads);
+  std::printf(
+      "  build: %.2f s (images %.2f s, index %.3f s, stage 1 + stage 2 %.2f s, transitions %.2f s)"
+      "   goal <= 60 s: %s\n",
+      seconds_build, stats.seconds_images, stats.seconds_index, stats.seconds_pairs,
+      seconds_transitions, seconds_build <= 60 ? "met" : "MISSED");
+  std::printf(
+      "  CPU time of the build %.2f s over %d threads (machine load average %.1f before it)\n",
+      cpu_build, a.threads, load_before);
+  std::printf(
+      "  stage 1 (k-d tree): %lld candidates of %.0f pairs (%.0fx fewer); silhouette signature "
+      "rejects %lld "
+      "of them without reading a pixel\n",
+      static_cast<long long>(stats.stage1_candidates), all_pairs, ratio_stage1,
+      static_cast<long long>(stats.signature_rejected));
+  std::printf(
+      "  stage-2 evaluations: %lld of %.0f pairs -> %.0fx fewer than brute force   goal >= 1000x: "
+      "%s\n",
+      static_cast<long long>(stats.stage2_evaluations), all_pairs, ratio,
+      ratio >= 1000 ? "met" : "MISSED");
+  std::printf(
+      "  accepts per sprite (kept pairs x 2 / sprites): %.1f; at most all_pairs / 1000 = %.0f "
+      "evaluations for "
+      "1000x\n",
+      2.0 * stats.kept_pairs / n, all_pairs / 1000);
+  std::printf(
+      "  brute force (extrapolated: stage 2 alone timed on %zu rows x %d pairs, %.0f ns each, CPU "
+      "time of one "
+      "core): %.0f s on one core, %.0f s on %d; the two-stage build (%.2f s CPU) needs %.0fx less "
+      "CPU\n",
+      plain_rows, n - 1, seconds_per_eval_core * 1e9, brute_seconds_core,
+      brute_seconds_core / a.threads, a.threads, cpu_build, brute_seconds_core / cpu_build);
+  std::printf(
+      "  (recall and quality below: all %zu sampled rows x %d = %.3g pairs judged by brute force, "
+      "%.1f s)\n",
+      rows.size(), n - 1, evaluations, seconds_sample);
+  std::printf(
+      "  kept %lld pairs, %zu transitions; of the %lld pairs brute force accepts in the sampled "
+      "rows, kept "
+      "%.4f   goal >= 0.99: %s\n",
+      static_cast<long long>(stats.kept_pairs), transitions.size(),
+      static_cast<long long>(brute_accepted.load()), recall_vs_brute,
+      recall_vs_brute >= 0.99 ? "met" : "MISSED");
+  std::printf(
+      "  against synthetic truth (sampled rows; same pose, every key point within %.1f mm; "
+      "%.1f true partners per sprite): pairs precision %.3f recall %.3f; transitions precision "
+      "%.3f recall %.3f\n",
+      truth_options.max_keypoint_displacement_m * 1e3, static_cast<double>(truth_pos) / rows.size(),
+      precision_truth, recall_truth, t_found ? static_cast<double>(t_true) / t_found : 0.0,
+      t_truth_total ? static_cast<double>(t_true) / t_truth_total : 0.0);
   CompareCascades(builder, &result);
   if (a.sweep) SweepStage2(builder, weights);
-  result["full_build"] = {{"sprites", n},
-                          {"clips", stats.clips},
-                          {"threads", a.threads},
-                          {"seconds", seconds_build},
-                          {"cpu_seconds", cpu_build},
-                          {"load_average_before", load_before},
-                          {"seconds_generate_synthetic", seconds_generate},
-                          {"stage1_candidates", stats.stage1_candidates},
-                          {"signature_rejected", stats.signature_rejected},
-                          {"stage2_evaluations", stats.stage2_evaluations},
-                          {"fewer_stage1_candidates_ratio", ratio_stage1},
-                          {"all_pairs", all_pairs},
-                          {"fewer_evaluations_ratio", ratio},
-                          {"kept_pairs", stats.kept_pairs},
-                          {"transitions", transitions.size()},
-                          {"brute_force_sampled_rows", rows.size()},
-                          {"brute_force_ns_per_evaluation_one_core", seconds_per_eval_core * 1e9},
-                          {"brute_force_timed_rows", plain_rows},
-                          {"cpu_ratio_brute_force_vs_build", brute_seconds_core / cpu_build},
-                          {"brute_force_seconds_extrapolated_one_core", brute_seconds_core},
-                          {"recall_of_brute_force_accepts", recall_vs_brute},
-                          {"brute_force_accepts_sampled", brute_accepted.load()},
-                          {"truth_pair_precision", precision_truth},
-                          {"truth_pair_recall", recall_truth},
-                          {"truth_transition_precision", t_found ? static_cast<double>(t_true) / t_found : 0.0},
-                          {"truth_transition_recall", t_truth_total ? static_cast<double>(t_true) / t_truth_total : 0.0}};
+  result["full_build"] = {
+      {"sprites", n},
+      {"clips", stats.clips},
+      {"threads", a.threads},
+      {"seconds", seconds_build},
+      {"cpu_seconds", cpu_build},
+      {"load_average_before", load_before},
+      {"seconds_generate_synthetic", seconds_generate},
+      {"stage1_candidates", stats.stage1_candidates},
+      {"signature_rejected", stats.signature_rejected},
+      {"stage2_evaluations", stats.stage2_evaluations},
+      {"fewer_stage1_candidates_ratio", ratio_stage1},
+      {"all_pairs", all_pairs},
+      {"fewer_evaluations_ratio", ratio},
+      {"kept_pairs", stats.kept_pairs},
+      {"transitions", transitions.size()},
+      {"brute_force_sampled_rows", rows.size()},
+      {"brute_force_ns_per_evaluation_one_core", seconds_per_eval_core * 1e9},
+      {"brute_force_timed_rows", plain_rows},
+      {"cpu_ratio_brute_force_vs_build", brute_seconds_core / cpu_build},
+      {"brute_force_seconds_extrapolated_one_core", brute_seconds_core},
+      {"recall_of_brute_force_accepts", recall_vs_brute},
+      {"brute_force_accepts_sampled", brute_accepted.load()},
+      {"truth_pair_precision", precision_truth},
+      {"truth_pair_recall", recall_truth},
+      {"truth_transition_precision", t_found ? static_cast<double>(t_true) / t_found : 0.0},
+      {"truth_transition_recall",
+       t_truth_total ? static_cast<double>(t_true) / t_truth_total : 0.0}};
 
   // ---- incremental ----
   if (a.incremental) {
@@ -477,9 +541,11 @@ int Run(const std::vector<std::string>& argv) {
     const auto live_inputs = AsSpriteInputs(live);
     TransitionBuilder inc(weights, px_per_m);
     t = Clock::now();
-    inc.BuildFromScratch(std::span(live_inputs).first(a.incremental_base), BuildOptions{.threads = a.threads});
+    inc.BuildFromScratch(std::span(live_inputs).first(a.incremental_base),
+                         BuildOptions{.threads = a.threads});
     const double seconds_base = Since(t);
-    for (int k = 0; k < a.incremental_base; ++k) std::vector<uint8_t>().swap(live[k].billboard.rgba);
+    for (int k = 0; k < a.incremental_base; ++k)
+      std::vector<uint8_t>().swap(live[k].billboard.rgba);
     std::vector<double> ms, cpu_ms;
     int64_t new_transitions = 0, appended = 0;
     const int64_t candidates_before = inc.stats().stage1_candidates;
@@ -496,25 +562,38 @@ int Run(const std::vector<std::string>& argv) {
     }
     std::vector<double> sorted = ms;
     std::sort(sorted.begin(), sorted.end());
-    const double median = sorted[sorted.size() / 2], p90 = sorted[sorted.size() * 9 / 10], worst = sorted.back();
+    const double median = sorted[sorted.size() / 2], p90 = sorted[sorted.size() * 9 / 10],
+                 worst = sorted.back();
     std::sort(cpu_ms.begin(), cpu_ms.end());
     const double median_cpu = cpu_ms[cpu_ms.size() / 2];
-    std::printf("\n== transitions: incremental, one sprite at a time onto %d sprites (one core) ==\n",
-                a.incremental_base);
-    std::printf("  base build %.1f s; %d adds (%lld appended to an existing clip): median %.3f ms, p90 %.3f ms, max "
-                "%.3f ms (the max includes a k-d tree rebuild)   goal median <= 2 ms: %s\n",
-                seconds_base, a.adds, static_cast<long long>(appended), median, p90, worst,
-                median <= 2 ? "met" : "MISSED");
+    std::printf(
+        "\n== transitions: incremental, one sprite at a time onto %d sprites (one core) ==\n",
+        a.incremental_base);
+    std::printf(
+        "  base build %.1f s; %d adds (%lld appended to an existing clip): median %.3f ms, p90 "
+        "%.3f ms, max "
+        "%.3f ms (the max includes a k-d tree rebuild)   goal median <= 2 ms: %s\n",
+        seconds_base, a.adds, static_cast<long long>(appended), median, p90, worst,
+        median <= 2 ? "met" : "MISSED");
     std::printf("  median CPU time of one add (this thread): %.3f ms\n", median_cpu);
-    std::printf("  per add: %.1f stage-1 candidates, %.1f stage-2 evaluations, %.2f new transitions\n",
-                static_cast<double>(inc.stats().stage1_candidates - candidates_before) / a.adds,
-                static_cast<double>(inc.stats().stage2_evaluations - evaluations_before) / a.adds,
-                static_cast<double>(new_transitions) / a.adds);
-    result["incremental"] = {{"base_sprites", a.incremental_base}, {"adds", a.adds},         {"median_ms", median}, {"median_cpu_ms", median_cpu},
-                             {"p90_ms", p90},                      {"max_ms", worst},        {"base_build_seconds", seconds_base},
-                             {"appended_to_clip", appended},
-                             {"stage1_candidates_per_add", static_cast<double>(inc.stats().stage1_candidates - candidates_before) / a.adds},
-                             {"stage2_evaluations_per_add", static_cast<double>(inc.stats().stage2_evaluations - evaluations_before) / a.adds}};
+    std::printf(
+        "  per add: %.1f stage-1 candidates, %.1f stage-2 evaluations, %.2f new transitions\n",
+        static_cast<double>(inc.stats().stage1_candidates - candidates_before) / a.adds,
+        static_cast<double>(inc.stats().stage2_evaluations - evaluations_before) / a.adds,
+        static_cast<double>(new_transitions) / a.adds);
+    result["incremental"] = {
+        {"base_sprites", a.incremental_base},
+        {"adds", a.adds},
+        {"median_ms", median},
+        {"median_cpu_ms", median_cpu},
+        {"p90_ms", p90},
+        {"max_ms", worst},
+        {"base_build_seconds", seconds_base},
+        {"appended_to_clip", appended},
+        {"stage1_candidates_per_add",
+         static_cast<double>(inc.stats().stage1_candidates - candidates_before) / a.adds},
+        {"stage2_evaluations_per_add",
+         static_cast<double>(inc.stats().stage2_evaluations - evaluations_before) / a.adds}};
   }
   if (a.json) std::printf("%s\n", result.dump(2).c_str());
   if (a.micro) return RunGoogleBenchmarks("BM_Transitions", {"--benchmark_min_time=0.2"});
@@ -542,7 +621,8 @@ void BM_TransitionsPixelKernelScalar(benchmark::State& state) {
   std::vector<uint8_t> a, b;
   int stride;
   Images(&a, &b, &stride);
-  for (auto _ : state) benchmark::DoNotOptimize(SumPixelDifferencesScalar(a.data(), b.data(), stride));
+  for (auto _ : state)
+    benchmark::DoNotOptimize(SumPixelDifferencesScalar(a.data(), b.data(), stride));
   state.SetItemsProcessed(state.iterations());
 }
 BENCHMARK(BM_TransitionsPixelKernelSimd);
@@ -555,14 +635,17 @@ int RunTransitionWorkers(const std::vector<std::string>& args);  // transition_w
 namespace {
 
 int RunOrWorkers(const std::vector<std::string>& args) {
-  if (!args.empty() && args.front() == "--workers") return RunTransitionWorkers({args.begin() + 1, args.end()});
+  if (!args.empty() && args.front() == "--workers")
+    return RunTransitionWorkers({args.begin() + 1, args.end()});
   return Run(args);
 }
 
 const bool registered = RegisterSuite(
     {"transitions",
-     "two-stage transition search on a synthetic 30k-sprite bank vs brute force; incremental add at 60k "
-     "[--sprites N --threads T --rows R --weights F --train-out F --stage2-bias-shift X --sweep-stage2 --skip-incremental --micro --json]; --workers: PostgreSQL transition workers "
+     "two-stage transition search on a synthetic 30k-sprite bank vs brute force; incremental add "
+     "at 60k "
+     "[--sprites N --threads T --rows R --weights F --train-out F --stage2-bias-shift X "
+     "--sweep-stage2 --skip-incremental --micro --json]; --workers: PostgreSQL transition workers "
      "(scripts/bench-postgres.sh BUILD transitions)",
      &RunOrWorkers});
 

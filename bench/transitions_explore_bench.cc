@@ -774,10 +774,11 @@ int Run(const std::vector<std::string>& argv) {
       print(cands[a].name + " & " + cands[b].name + " x" + std::to_string(best_ratio).substr(0, 4),
             best);
       // The thresholds of the best transitions F1: x_a <= t * unit_a AND x_b <= t * unit_b * ratio.
-      std::printf("    thresholds (transitions' best): %s <= %.4g, %s <= %.4g; (pairs' best): %.4g, %.4g\n",
-                  cands[a].name.c_str(), best.second.threshold * cands[a].unit, cands[b].name.c_str(),
-                  best.second.threshold * cands[b].unit * best_ratio, best.first.threshold * cands[a].unit,
-                  best.first.threshold * cands[b].unit * best_ratio);
+      std::printf(
+          "    thresholds (transitions' best): %s <= %.4g, %s <= %.4g; (pairs' best): %.4g, %.4g\n",
+          cands[a].name.c_str(), best.second.threshold * cands[a].unit, cands[b].name.c_str(),
+          best.second.threshold * cands[b].unit * best_ratio, best.first.threshold * cands[a].unit,
+          best.first.threshold * cands[b].unit * best_ratio);
     }
   }
   std::printf(

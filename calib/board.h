@@ -17,10 +17,10 @@ enum class BoardKind { kChessboard, kCharuco };
 
 struct BoardSpec {
   BoardKind kind = BoardKind::kChessboard;
-  int squares_x = 10;               // squares along x (columns)
-  int squares_y = 7;                // squares along y (rows)
-  double square_m = 0.03;           // side of one square, metres
-  double marker_m = 0.0;            // ChArUco: side of one marker, metres
+  int squares_x = 10;                      // squares along x (columns)
+  int squares_y = 7;                       // squares along y (rows)
+  double square_m = 0.03;                  // side of one square, metres
+  double marker_m = 0.0;                   // ChArUco: side of one marker, metres
   std::string dictionary = "DICT_4X4_50";  // ChArUco: OpenCV predefined dictionary name
 
   int corners_x() const { return squares_x - 1; }  // inner corners per row

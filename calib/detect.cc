@@ -37,7 +37,8 @@ float SampleBilinear(const cv::Mat& grey, double x, double y) {
 }
 
 // 10-90% rise of the intensity profile across the edge through `mid`, along unit `normal`.
-double EdgeRise(const cv::Mat& grey, const Eigen::Vector2d& mid, const Eigen::Vector2d& normal, double half) {
+double EdgeRise(const cv::Mat& grey, const Eigen::Vector2d& mid, const Eigen::Vector2d& normal,
+                double half) {
   constexpr double kStep = 0.25;
   const int n = static_cast<int>(std::floor(half / kStep));
   if (n < 4) return NAN;
@@ -92,12 +93,14 @@ void SortById(std::vector<int>& ids, std::vector<Eigen::Vector2d>& pixels) {
 
 // findChessboardCornersSB may order the grid mirrored or turned by 180 degrees;
 // puts it in the board's own order (printed face seen, top-left square black).
-void NormalizeChessboardOrder(const BoardSpec& board, const cv::Mat& grey, std::vector<Eigen::Vector2d>& pixels) {
+void NormalizeChessboardOrder(const BoardSpec& board, const cv::Mat& grey,
+                              std::vector<Eigen::Vector2d>& pixels) {
   const int cx = board.corners_x(), cy = board.corners_y();
   auto at = [&](int row, int col) -> Eigen::Vector2d& { return pixels[row * cx + col]; };
   const Eigen::Vector2d dx = at(0, 1) - at(0, 0), dy = at(1, 0) - at(0, 0);
   if (dx.x() * dy.y() - dx.y() * dy.x() < 0) {  // mirrored: the columns run backwards
-    for (int r = 0; r < cy; ++r) std::reverse(pixels.begin() + r * cx, pixels.begin() + (r + 1) * cx);
+    for (int r = 0; r < cy; ++r)
+      std::reverse(pixels.begin() + r * cx, pixels.begin() + (r + 1) * cx);
   }
   std::vector<cv::Point2f> src, dst;
   for (int id = 0; id < board.corner_count(); ++id) {
@@ -126,12 +129,14 @@ void NormalizeChessboardOrder(const BoardSpec& board, const cv::Mat& grey, std::
   }
 }
 
-void DetectChessboard(const BoardSpec& board, const cv::Mat& grey, const DetectOptions& options, BoardView& view) {
+void DetectChessboard(const BoardSpec& board, const cv::Mat& grey, const DetectOptions& options,
+                      BoardView& view) {
   std::vector<cv::Point2f> corners;
   const bool exhaustive = options.exhaustive;
   const bool found = cv::findChessboardCornersSB(
       grey, cv::Size(board.corners_x(), board.corners_y()), corners,
-      cv::CALIB_CB_NORMALIZE_IMAGE | (exhaustive ? cv::CALIB_CB_EXHAUSTIVE : 0) | cv::CALIB_CB_ACCURACY);
+      cv::CALIB_CB_NORMALIZE_IMAGE | (exhaustive ? cv::CALIB_CB_EXHAUSTIVE : 0) |
+          cv::CALIB_CB_ACCURACY);
   if (!found || static_cast<int>(corners.size()) != board.corner_count()) {
     view.rejection = "no chessboard with " + std::to_string(board.corners_x()) + "x" +
                      std::to_string(board.corners_y()) + " inner corners found";
@@ -145,9 +150,11 @@ void DetectChessboard(const BoardSpec& board, const cv::Mat& grey, const DetectO
   for (int r = 0; r < board.corners_y(); ++r) {
     for (int c = 0; c < board.corners_x(); ++c) {
       const int i = r * board.corners_x() + c;
-      if (c + 1 < board.corners_x()) spacing = std::min(spacing, static_cast<double>(cv::norm(corners[i] - corners[i + 1])));
+      if (c + 1 < board.corners_x())
+        spacing = std::min(spacing, static_cast<double>(cv::norm(corners[i] - corners[i + 1])));
       if (r + 1 < board.corners_y()) {
-        spacing = std::min(spacing, static_cast<double>(cv::norm(corners[i] - corners[i + board.corners_x()])));
+        spacing = std::min(
+            spacing, static_cast<double>(cv::norm(corners[i] - corners[i + board.corners_x()])));
       }
     }
   }
@@ -178,9 +185,10 @@ void DetectCharuco(const BoardSpec& board, const cv::Mat& grey, BoardView& view)
   int own = 0;
   for (int id : marker_ids) own += (id >= 0 && id < board_markers) ? 1 : 0;
   if (own == 0) {
-    view.rejection = std::to_string(marker_ids.size()) + " markers found, none with an id of this " +
-                     std::to_string(board.squares_x) + "x" + std::to_string(board.squares_y) +
-                     " board (0.." + std::to_string(board_markers - 1) + "): does the board spec match?";
+    view.rejection = std::to_string(marker_ids.size()) +
+                     " markers found, none with an id of this " + std::to_string(board.squares_x) +
+                     "x" + std::to_string(board.squares_y) + " board (0.." +
+                     std::to_string(board_markers - 1) + "): does the board spec match?";
     return;
   }
   std::vector<cv::Point2f> corners;
@@ -196,7 +204,8 @@ void DetectCharuco(const BoardSpec& board, const cv::Mat& grey, BoardView& view)
   for (size_t i = 0; i + 1 < corners.size(); ++i) {
     spacing = std::min(spacing, static_cast<double>(cv::norm(corners[i] - corners[i + 1])));
   }
-  const int half = std::clamp(static_cast<int>(spacing * (board.square_m - board.marker_m) / board.square_m / 2.5), 2, 5);
+  const int half = std::clamp(
+      static_cast<int>(spacing * (board.square_m - board.marker_m) / board.square_m / 2.5), 2, 5);
   cv::cornerSubPix(grey, corners, cv::Size(half, half), cv::Size(-1, -1),
                    cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 40, 0.005));
   for (size_t i = 0; i < ids.size(); ++i) {
@@ -214,16 +223,20 @@ void CheckGeometry(const BoardSpec& board, const DetectOptions& options, BoardVi
     return;
   }
   std::vector<int> rows, cols;
-  for (int id : view.ids) rows.push_back(id / board.corners_x()), cols.push_back(id % board.corners_x());
+  for (int id : view.ids)
+    rows.push_back(id / board.corners_x()), cols.push_back(id % board.corners_x());
   std::sort(rows.begin(), rows.end());
   std::sort(cols.begin(), cols.end());
-  const auto distinct = [](std::vector<int>& v) { return std::unique(v.begin(), v.end()) - v.begin(); };
+  const auto distinct = [](std::vector<int>& v) {
+    return std::unique(v.begin(), v.end()) - v.begin();
+  };
   if (distinct(rows) < 2 || distinct(cols) < 2) {
     view.rejection = "degenerate: the detected corners lie on one line of the board";
     return;
   }
   std::vector<cv::Point2f> points, hull;
-  for (const auto& p : view.pixels) points.emplace_back(static_cast<float>(p.x()), static_cast<float>(p.y()));
+  for (const auto& p : view.pixels)
+    points.emplace_back(static_cast<float>(p.x()), static_cast<float>(p.y()));
   cv::convexHull(points, hull);
   const double fraction = cv::contourArea(hull) / (static_cast<double>(view.width) * view.height);
   if (fraction < options.min_area_fraction) {
@@ -242,14 +255,16 @@ double MeasureEdgeWidth(const BoardSpec& board, const cv::Mat& grey, const std::
   }
   // Half length of the profile as a fraction of the corner spacing: it must stay
   // off the next edge (chessboard) or the marker inside a white square (ChArUco).
-  const double reach = board.kind == BoardKind::kChessboard
-                           ? 0.4
-                           : std::min(0.4, 0.85 * (board.square_m - board.marker_m) / 2 / board.square_m);
+  const double reach =
+      board.kind == BoardKind::kChessboard
+          ? 0.4
+          : std::min(0.4, 0.85 * (board.square_m - board.marker_m) / 2 / board.square_m);
   std::vector<double> widths;
   const int cx = board.corners_x();
   for (int id = 0; id < board.corner_count(); ++id) {
     if (index[id] < 0) continue;
-    for (int neighbour : {id % cx + 1 < cx ? id + 1 : -1, id + cx < board.corner_count() ? id + cx : -1}) {
+    for (int neighbour :
+         {id % cx + 1 < cx ? id + 1 : -1, id + cx < board.corner_count() ? id + cx : -1}) {
       if (neighbour < 0 || index[neighbour] < 0) continue;
       const Eigen::Vector2d a = pixels[index[id]], b = pixels[index[neighbour]];
       const Eigen::Vector2d along = b - a;

@@ -15,12 +15,15 @@ namespace {
 GroundPolygon Checked(std::vector<Eigen::Vector2d> points, const std::string& field) {
   if (points.size() < 3) throw InputError(field, "a floor polygon needs at least 3 points");
   if (points.size() > GroundPolygon::kMaxVertices) {
-    throw InputError(field, std::to_string(points.size()) + " points; a floor polygon has at most " +
+    throw InputError(field, std::to_string(points.size()) +
+                                " points; a floor polygon has at most " +
                                 std::to_string(GroundPolygon::kMaxVertices));
   }
   GroundPolygon polygon(std::move(points));
   if (!polygon.IsSimple()) {
-    throw InputError(field, "the floor polygon crosses itself, repeats a point or has no area; give its corners in order");
+    throw InputError(field,
+                     "the floor polygon crosses itself, repeats a point or has no area; give its "
+                     "corners in order");
   }
   return polygon;
 }
@@ -33,14 +36,16 @@ std::string Number(double v) {
 
 }  // namespace
 
-GroundPolygon FloorPolygonFromPoints(const std::vector<Eigen::Vector2d>& points_in_ground, const std::string& field) {
+GroundPolygon FloorPolygonFromPoints(const std::vector<Eigen::Vector2d>& points_in_ground,
+                                     const std::string& field) {
   for (const auto& p : points_in_ground) {
     if (!p.allFinite()) throw InputError(field, "a point is not a finite number");
   }
   return Checked(points_in_ground, field);
 }
 
-GroundPolygon FloorPolygonFromPixels(const CameraModel& model, const std::vector<Eigen::Vector2d>& pixels,
+GroundPolygon FloorPolygonFromPixels(const CameraModel& model,
+                                     const std::vector<Eigen::Vector2d>& pixels,
                                      const std::string& field) {
   std::vector<Eigen::Vector2d> points;
   for (size_t i = 0; i < pixels.size(); ++i) {
@@ -54,11 +59,14 @@ GroundPolygon FloorPolygonFromPixels(const CameraModel& model, const std::vector
   return Checked(points, field);
 }
 
-GroundPolygon FindGreenFloor(const CameraModel& model, const cv::Mat& bgr, const GreenFloorOptions& options) {
-  if (bgr.empty() || bgr.type() != CV_8UC3) throw InputError("image", "expected an 8-bit colour image");
+GroundPolygon FindGreenFloor(const CameraModel& model, const cv::Mat& bgr,
+                             const GreenFloorOptions& options) {
+  if (bgr.empty() || bgr.type() != CV_8UC3)
+    throw InputError("image", "expected an 8-bit colour image");
   if (bgr.cols != model.width() || bgr.rows != model.height()) {
-    throw InputError("image", "the image is " + std::to_string(bgr.cols) + "x" + std::to_string(bgr.rows) +
-                                  " but the camera model's imager is " + std::to_string(model.width()) + "x" +
+    throw InputError("image", "the image is " + std::to_string(bgr.cols) + "x" +
+                                  std::to_string(bgr.rows) + " but the camera model's imager is " +
+                                  std::to_string(model.width()) + "x" +
                                   std::to_string(model.height()));
   }
   cv::Mat mask(bgr.size(), CV_8U, cv::Scalar(0));
@@ -93,7 +101,8 @@ GroundPolygon FindGreenFloor(const CameraModel& model, const cv::Mat& bgr, const
   const int n = cv::connectedComponentsWithStats(mask, labels, stats, centroids, 8);
   int best = -1;
   for (int i = 1; i < n; ++i) {
-    if (best < 0 || stats.at<int>(i, cv::CC_STAT_AREA) > stats.at<int>(best, cv::CC_STAT_AREA)) best = i;
+    if (best < 0 || stats.at<int>(i, cv::CC_STAT_AREA) > stats.at<int>(best, cv::CC_STAT_AREA))
+      best = i;
   }
   if (best < 0) throw InputError("image", "no green floor region in view");
   cv::Mat region = labels == best;
@@ -107,15 +116,19 @@ GroundPolygon FindGreenFloor(const CameraModel& model, const cv::Mat& bgr, const
   std::vector<cv::Point2f> on_floor_mm;
   for (const cv::Point& p : contours[largest]) {
     const auto hit = IntersectGround(model.RayInGround(Eigen::Vector2d(p.x, p.y)));
-    if (hit) on_floor_mm.emplace_back(static_cast<float>(hit->x() * 1000), static_cast<float>(hit->y() * 1000));
+    if (hit)
+      on_floor_mm.emplace_back(static_cast<float>(hit->x() * 1000),
+                               static_cast<float>(hit->y() * 1000));
   }
-  if (on_floor_mm.size() < 3) throw InputError("image", "the green region does not lie on the floor");
+  if (on_floor_mm.size() < 3)
+    throw InputError("image", "the green region does not lie on the floor");
   std::vector<cv::Point2f> simple;
   cv::approxPolyDP(on_floor_mm, simple, options.simplify_m * 1000, true);
   std::vector<Eigen::Vector2d> vertices;
   for (const auto& p : simple) vertices.emplace_back(p.x / 1000.0, p.y / 1000.0);
   GroundPolygon polygon(vertices);
-  if (!polygon.IsSimple()) throw WorkError("image", "the green floor's outline does not give a simple polygon");
+  if (!polygon.IsSimple())
+    throw WorkError("image", "the green floor's outline does not give a simple polygon");
   // Counter-clockwise, like the studio's own floor.
   double twice_area = 0;
   for (size_t i = 0; i < vertices.size(); ++i) {
@@ -123,7 +136,8 @@ GroundPolygon FindGreenFloor(const CameraModel& model, const cv::Mat& bgr, const
     const auto& b = vertices[(i + 1) % vertices.size()];
     twice_area += a.x() * b.y() - b.x() * a.y();
   }
-  if (twice_area < 0) polygon = GroundPolygon(std::vector<Eigen::Vector2d>(vertices.rbegin(), vertices.rend()));
+  if (twice_area < 0)
+    polygon = GroundPolygon(std::vector<Eigen::Vector2d>(vertices.rbegin(), vertices.rend()));
   return polygon;
 }
 
@@ -147,7 +161,8 @@ std::vector<Eigen::Vector2d> ParsePointList(const std::string& text, const std::
 std::string EnclosureYaml(const GroundPolygon& floor, double wall_height_m) {
   std::ostringstream o;
   o << "enclosure:\n  floor:\n";
-  for (const auto& v : floor.vertices()) o << "    - [" << Number(v.x()) << ", " << Number(v.y()) << "]\n";
+  for (const auto& v : floor.vertices())
+    o << "    - [" << Number(v.x()) << ", " << Number(v.y()) << "]\n";
   o << "  wall_height_m: " << Number(wall_height_m) << "\n";
   return o.str();
 }
@@ -161,9 +176,13 @@ std::string ReplaceEnclosureFloor(const std::string& config_yaml, const GroundPo
     while (std::getline(in, line)) lines.push_back(line);
   }
   auto indent = [](const std::string& l) { return l.find_first_not_of(' '); };
-  auto blank = [&](const std::string& l) { const size_t i = indent(l); return i == std::string::npos || l[i] == '#'; };
+  auto blank = [&](const std::string& l) {
+    const size_t i = indent(l);
+    return i == std::string::npos || l[i] == '#';
+  };
   std::ostringstream floor_text;
-  for (const auto& v : floor.vertices()) floor_text << "    - [" << Number(v.x()) << ", " << Number(v.y()) << "]\n";
+  for (const auto& v : floor.vertices())
+    floor_text << "    - [" << Number(v.x()) << ", " << Number(v.y()) << "]\n";
   std::vector<std::string> out;
   size_t i = 0;
   bool done = false;
@@ -184,7 +203,8 @@ std::string ReplaceEnclosureFloor(const std::string& config_yaml, const GroundPo
           }
           std::istringstream f(floor_text.str());
           std::string fl;
-          while (std::getline(f, fl)) out.push_back(std::string(in + 2, ' ') + fl.substr(fl.find('-')));
+          while (std::getline(f, fl))
+            out.push_back(std::string(in + 2, ' ') + fl.substr(fl.find('-')));
           k = j - 1;
           replaced = true;
         } else {

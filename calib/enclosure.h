@@ -21,18 +21,20 @@ GroundPolygon FloorPolygonFromPoints(const std::vector<Eigen::Vector2d>& points_
                                      const std::string& field = "--points");
 
 // The floor points seen at these pixels of a posed camera (cam_from_ground set).
-GroundPolygon FloorPolygonFromPixels(const CameraModel& model, const std::vector<Eigen::Vector2d>& pixels,
+GroundPolygon FloorPolygonFromPixels(const CameraModel& model,
+                                     const std::vector<Eigen::Vector2d>& pixels,
                                      const std::string& field = "--pixels");
 
 struct GreenFloorOptions {
   double min_green_excess = 30;  // G - max(R, B), 8-bit levels, for a pixel to count as green
-  bool split_walls = true;       // green walls are darker than the lit floor: keep the brighter green
-  double simplify_m = 0.01;      // polygon simplification tolerance on the floor
+  bool split_walls = true;   // green walls are darker than the lit floor: keep the brighter green
+  double simplify_m = 0.01;  // polygon simplification tolerance on the floor
 };
 
 // The largest connected green floor region in `bgr`, carried onto the floor.
 // InputError when the image holds no green region or its size does not match the model.
-GroundPolygon FindGreenFloor(const CameraModel& model, const cv::Mat& bgr, const GreenFloorOptions& options = {});
+GroundPolygon FindGreenFloor(const CameraModel& model, const cv::Mat& bgr,
+                             const GreenFloorOptions& options = {});
 
 // Parses "x,y x,y ..." (or ';'-separated) into points; InputError naming `field`.
 std::vector<Eigen::Vector2d> ParsePointList(const std::string& text, const std::string& field);

@@ -19,7 +19,8 @@ namespace ss::calib {
 
 Rigid3 FloorBoardPose(double x_m, double y_m, double yaw_deg, double thickness_m) {
   const Eigen::Matrix3d flip = Eigen::Vector3d(1, -1, -1).asDiagonal();
-  const Eigen::Matrix3d yaw = Eigen::AngleAxisd(yaw_deg * M_PI / 180, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  const Eigen::Matrix3d yaw =
+      Eigen::AngleAxisd(yaw_deg * M_PI / 180, Eigen::Vector3d::UnitZ()).toRotationMatrix();
   return {yaw * flip, Eigen::Vector3d(x_m, y_m, thickness_m)};
 }
 
@@ -33,7 +34,9 @@ BoardView AverageStillViews(const std::vector<BoardView>& views, double max_moti
     ++used;
     for (size_t i = 0; i < v.ids.size(); ++i) by_id[v.ids[i]].push_back(v.pixels[i]);
   }
-  if (!first) throw InputError(views.empty() ? "views" : views.front().source, "no accepted view of the board");
+  if (!first)
+    throw InputError(views.empty() ? "views" : views.front().source,
+                     "no accepted view of the board");
   BoardView out = *first;
   out.ids.clear();
   out.pixels.clear();
@@ -45,9 +48,10 @@ BoardView AverageStillViews(const std::vector<BoardView>& views, double max_moti
     mean /= static_cast<double>(pts.size());
     for (const auto& p : pts) {
       if ((p - mean).norm() > max_motion_px) {
-        throw InputError(first->source, "the board moved between the views averaged for the ground (corner " +
-                                            std::to_string(id) + " moved " + std::to_string((p - mean).norm()) +
-                                            " px); keep it still on the floor");
+        throw InputError(first->source,
+                         "the board moved between the views averaged for the ground (corner " +
+                             std::to_string(id) + " moved " + std::to_string((p - mean).norm()) +
+                             " px); keep it still on the floor");
       }
     }
     out.ids.push_back(id);
@@ -56,8 +60,9 @@ BoardView AverageStillViews(const std::vector<BoardView>& views, double max_moti
   return out;
 }
 
-GroundResult SolveGroundPose(const CameraModel& model, const BoardSpec& board, const BoardView& view,
-                             const Rigid3& ground_from_board, const std::string& camera) {
+GroundResult SolveGroundPose(const CameraModel& model, const BoardSpec& board,
+                             const BoardView& view, const Rigid3& ground_from_board,
+                             const std::string& camera) {
   if (view.ids.size() < 4 || view.ids.size() != view.pixels.size()) {
     throw InputError(view.source, "the floor board needs at least 4 detected corners");
   }
@@ -70,9 +75,11 @@ GroundResult SolveGroundPose(const CameraModel& model, const BoardSpec& board, c
     if (!rays[i].allFinite() || rays[i].z() <= 0) continue;
     const Eigen::Vector3d p = board.Corner(view.ids[i]);
     object.emplace_back(static_cast<float>(p.x()), static_cast<float>(p.y()), 0.f);
-    normalized.emplace_back(static_cast<float>(rays[i].x() / rays[i].z()), static_cast<float>(rays[i].y() / rays[i].z()));
+    normalized.emplace_back(static_cast<float>(rays[i].x() / rays[i].z()),
+                            static_cast<float>(rays[i].y() / rays[i].z()));
   }
-  if (object.size() < 4) throw WorkError(view.source, "the lens model cannot unproject the floor board's corners");
+  if (object.size() < 4)
+    throw WorkError(view.source, "the lens model cannot unproject the floor board's corners");
   cv::Mat rvec, tvec;
   const cv::Mat eye = cv::Mat::eye(3, 3, CV_64F);
   if (!cv::solvePnP(object, normalized, eye, cv::noArray(), rvec, tvec, false, cv::SOLVEPNP_IPPE)) {
@@ -90,8 +97,10 @@ GroundResult SolveGroundPose(const CameraModel& model, const BoardSpec& board, c
   }
   const int w = board.corners_x(), h = board.corners_y();
   std::vector<mrcal_point3_t> pool(w * h, mrcal_point3_t{{0, 0, -1}});
-  for (size_t i = 0; i < view.ids.size(); ++i) pool[view.ids[i]] = mrcal_point3_t{{view.pixels[i].x(), view.pixels[i].y(), 1}};
-  const Rigid3 mrcal_to_ours{Eigen::Matrix3d::Identity(), Eigen::Vector3d(board.square_m, board.square_m, 0)};
+  for (size_t i = 0; i < view.ids.size(); ++i)
+    pool[view.ids[i]] = mrcal_point3_t{{view.pixels[i].x(), view.pixels[i].y(), 1}};
+  const Rigid3 mrcal_to_ours{Eigen::Matrix3d::Identity(),
+                             Eigen::Vector3d(board.square_m, board.square_m, 0)};
   Rigid3 cam_from_mrcal = cam_from_board * mrcal_to_ours;
   double frt[6];
   cam_from_mrcal.ToRt(frt);
@@ -108,10 +117,10 @@ GroundResult SolveGroundPose(const CameraModel& model, const BoardSpec& board, c
   mrcal_problem_constants_t constants{-1.0, -1.0};
   mrcal_calobject_warp_t warp{};
   std::vector<double> x(mrcal_num_measurements(1, 0, w, h, 1, 0, 1, 0, 0, sel, &lens));
-  const mrcal_stats_t stats =
-      mrcal_optimize(nullptr, -1, x.data(), static_cast<int>(x.size() * sizeof(double)), intrinsics.data(), nullptr,
-                     &frame, nullptr, &warp, 1, 0, 1, 0, 0, &ob, nullptr, 1, 0, pool.data(), &lens, imager, sel,
-                     &constants, board.square_m, w, h, false, false);
+  const mrcal_stats_t stats = mrcal_optimize(
+      nullptr, -1, x.data(), static_cast<int>(x.size() * sizeof(double)), intrinsics.data(),
+      nullptr, &frame, nullptr, &warp, 1, 0, 1, 0, 0, &ob, nullptr, 1, 0, pool.data(), &lens,
+      imager, sel, &constants, board.square_m, w, h, false, false);
   if (std::isfinite(stats.rms_reproj_error__pixels) && stats.rms_reproj_error__pixels >= 0) {
     const double r2[6] = {frame.r.x, frame.r.y, frame.r.z, frame.t.x, frame.t.y, frame.t.z};
     cam_from_board = Rigid3::FromRt(r2) * mrcal_to_ours.Inverse();

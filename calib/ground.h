@@ -30,16 +30,17 @@ struct GroundResult {
   std::string camera;
   Rigid3 cam_from_ground;
   Eigen::Vector3d centre_in_ground = Eigen::Vector3d::Zero();  // camera position, metres
-  double height_m = 0;                // camera height above the floor
-  double optical_axis_down_deg = 0;   // angle of the optical axis below the horizon
-  double rms_px = 0, worst_px = 0;    // the floor board's reprojection
+  double height_m = 0;                                         // camera height above the floor
+  double optical_axis_down_deg = 0;  // angle of the optical axis below the horizon
+  double rms_px = 0, worst_px = 0;   // the floor board's reprojection
   int corners = 0;
 };
 
 // Solves one camera's pose against the ground. InputError when the view has
 // fewer than 4 corners; WorkError when the pose cannot be found.
-GroundResult SolveGroundPose(const CameraModel& model, const BoardSpec& board, const BoardView& view,
-                             const Rigid3& ground_from_board, const std::string& camera = "camera");
+GroundResult SolveGroundPose(const CameraModel& model, const BoardSpec& board,
+                             const BoardView& view, const Rigid3& ground_from_board,
+                             const std::string& camera = "camera");
 
 // Corners seen by camera a, carried through the board plane into camera b,
 // against b's own detections of the same corners.

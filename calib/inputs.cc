@@ -27,12 +27,15 @@ std::vector<CameraViews> DetectInSession(const std::string& dir, const BoardSpec
   std::vector<CameraViews> out;
   std::vector<int> wanted(info.cameras.size(), -1), every(info.cameras.size(), 1);
   for (const auto& name : sample.cameras) {
-    const bool known = std::any_of(info.cameras.begin(), info.cameras.end(), [&](const auto& c) { return c.name == name; });
-    if (!known) throw InputError(dir + "/session.json", "no camera named \"" + name + "\" in the session");
+    const bool known = std::any_of(info.cameras.begin(), info.cameras.end(),
+                                   [&](const auto& c) { return c.name == name; });
+    if (!known)
+      throw InputError(dir + "/session.json", "no camera named \"" + name + "\" in the session");
   }
   for (size_t i = 0; i < info.cameras.size(); ++i) {
     const auto& c = info.cameras[i];
-    if (!sample.cameras.empty() && std::find(sample.cameras.begin(), sample.cameras.end(), c.name) == sample.cameras.end()) {
+    if (!sample.cameras.empty() &&
+        std::find(sample.cameras.begin(), sample.cameras.end(), c.name) == sample.cameras.end()) {
       continue;
     }
     wanted[i] = static_cast<int>(out.size());
@@ -44,17 +47,21 @@ std::vector<CameraViews> DetectInSession(const std::string& dir, const BoardSpec
     const auto rows = ReadFrameCsv((fs::path(dir) / c.frames_csv).string());
     int span = static_cast<int>(rows.size()) - sample.first;
     if (sample.count > 0) span = std::min(span, sample.count);
-    every[i] = sample.every > 0 ? sample.every : std::max(1, (span + sample.max_views - 1) / std::max(1, sample.max_views));
+    every[i] = sample.every > 0
+                   ? sample.every
+                   : std::max(1, (span + sample.max_views - 1) / std::max(1, sample.max_views));
     out.push_back(std::move(v));
   }
-  if (out.empty()) throw InputError(dir + "/session.json", "the session has no camera to calibrate");
+  if (out.empty())
+    throw InputError(dir + "/session.json", "the session has no camera to calibrate");
   ReplaySource source(dir);
   std::vector<int> index(info.cameras.size(), -1);
   cv::Mat bgr;
   while (auto frame = source.Next()) {
     const int cam = frame->camera;
     const int i = ++index[cam];
-    if (wanted[cam] < 0 || i < sample.first || (sample.count > 0 && i >= sample.first + sample.count) ||
+    if (wanted[cam] < 0 || i < sample.first ||
+        (sample.count > 0 && i >= sample.first + sample.count) ||
         (i - sample.first) % every[cam] != 0) {
       continue;
     }
@@ -80,7 +87,8 @@ std::vector<CameraViews> DetectInSession(const std::string& dir, const BoardSpec
 
 CameraViews DetectInImages(const std::vector<std::string>& paths, const BoardSpec& board,
                            const DetectOptions& detect, const std::string& name) {
-  static const std::set<std::string> kImageExt = {".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff", ".pgm", ".ppm"};
+  static const std::set<std::string> kImageExt = {".png", ".jpg",  ".jpeg", ".bmp",
+                                                  ".tif", ".tiff", ".pgm",  ".ppm"};
   std::vector<std::string> files;
   for (const auto& p : paths) {
     std::error_code ec;
@@ -115,8 +123,9 @@ CameraViews DetectInImages(const std::vector<std::string>& paths, const BoardSpe
     } else {
       if (out.width == 0) out.width = image.cols, out.height = image.rows;
       if (image.cols != out.width || image.rows != out.height) {
-        throw InputError(files[i], "image is " + std::to_string(image.cols) + "x" + std::to_string(image.rows) +
-                                       " but the first was " + std::to_string(out.width) + "x" +
+        throw InputError(files[i], "image is " + std::to_string(image.cols) + "x" +
+                                       std::to_string(image.rows) + " but the first was " +
+                                       std::to_string(out.width) + "x" +
                                        std::to_string(out.height) + " (one camera per call)");
       }
       view = DetectBoard(board, image, detect, files[i]);
@@ -124,7 +133,9 @@ CameraViews DetectInImages(const std::vector<std::string>& paths, const BoardSpe
     out.views.push_back(std::move(view));
     out.frames.push_back(static_cast<int>(i));
   }
-  if (out.width == 0) throw InputError(files.front(), "none of the " + std::to_string(files.size()) + " images could be read");
+  if (out.width == 0)
+    throw InputError(files.front(),
+                     "none of the " + std::to_string(files.size()) + " images could be read");
   return out;
 }
 

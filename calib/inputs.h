@@ -12,18 +12,19 @@
 namespace ss::calib {
 
 struct CameraViews {
-  std::string name;                 // session camera name, or "camera0" for images
+  std::string name;  // session camera name, or "camera0" for images
   int width = 0, height = 0;
-  std::string model_path;           // the session's .cameramodel for this camera ("" when none)
-  std::vector<BoardView> views;     // one per sampled frame / image
-  std::vector<int> frames;          // per view: frame index (the same index = the same instant across cameras)
+  std::string model_path;        // the session's .cameramodel for this camera ("" when none)
+  std::vector<BoardView> views;  // one per sampled frame / image
+  std::vector<int>
+      frames;  // per view: frame index (the same index = the same instant across cameras)
 };
 
 struct SampleOptions {
-  int every = 0;           // use every N-th frame; 0 = spread `max_views` over the session
-  int max_views = 40;      // per camera
-  int first = 0;           // skip frames before this index
-  int count = 0;           // 0 = to the end; else this many frames from `first`
+  int every = 0;       // use every N-th frame; 0 = spread `max_views` over the session
+  int max_views = 40;  // per camera
+  int first = 0;       // skip frames before this index
+  int count = 0;       // 0 = to the end; else this many frames from `first`
   std::vector<std::string> cameras;  // only these session cameras ("" = all)
 };
 

@@ -19,7 +19,8 @@ std::string MrcalCornersVnl(const BoardSpec& board, const std::vector<CameraView
     for (size_t i = 0; i < cam.views.size(); ++i) {
       const BoardView& v = cam.views[i];
       if (!v.accepted) continue;
-      const std::string name = MrcalViewName(cam.name, i < cam.frames.size() ? cam.frames[i] : static_cast<int>(i));
+      const std::string name =
+          MrcalViewName(cam.name, i < cam.frames.size() ? cam.frames[i] : static_cast<int>(i));
       std::vector<const Eigen::Vector2d*> grid(board.corner_count(), nullptr);
       for (size_t k = 0; k < v.ids.size(); ++k) {
         if (v.ids[k] >= 0 && v.ids[k] < board.corner_count()) grid[v.ids[k]] = &v.pixels[k];
@@ -42,10 +43,13 @@ std::string MrcalCalibrateCommand(const BoardSpec& board, const std::vector<Came
                                   const std::string& lensmodel, double focal_px) {
   std::ostringstream o;
   // The tool's shebang is the Debian python (which has the mrcal module).
-  o << "mkdir -p '" << out_dir << "' && /usr/bin/python3 /usr/bin/mrcal-calibrate-cameras --corners-cache '" << vnl_path << "' --lensmodel "
-    << lensmodel << " --focal " << focal_px << " --object-spacing " << board.square_m << " --object-width-n "
-    << board.corners_x() << " --object-height-n " << board.corners_y();
-  if (!cameras.empty()) o << " --imagersize " << cameras.front().width << " " << cameras.front().height;
+  o << "mkdir -p '" << out_dir
+    << "' && /usr/bin/python3 /usr/bin/mrcal-calibrate-cameras --corners-cache '" << vnl_path
+    << "' --lensmodel " << lensmodel << " --focal " << focal_px << " --object-spacing "
+    << board.square_m << " --object-width-n " << board.corners_x() << " --object-height-n "
+    << board.corners_y();
+  if (!cameras.empty())
+    o << " --imagersize " << cameras.front().width << " " << cameras.front().height;
   o << " --outdir '" << out_dir << "'";
   for (const auto& cam : cameras) o << " '" << cam.name << "-frame*.png'";
   return o.str();

@@ -16,16 +16,20 @@ namespace {
 std::vector<std::string> ParameterNames(const std::string& lensmodel, int count) {
   std::vector<std::string> names = {"fx", "fy", "cx", "cy"};
   if (lensmodel.rfind("LENSMODEL_OPENCV", 0) == 0) {
-    for (const char* n : {"k1", "k2", "p1", "p2", "k3", "k4", "k5", "k6", "s1", "s2", "s3", "s4"}) names.push_back(n);
+    for (const char* n : {"k1", "k2", "p1", "p2", "k3", "k4", "k5", "k6", "s1", "s2", "s3", "s4"})
+      names.push_back(n);
   } else if (lensmodel.rfind("LENSMODEL_CAHVOR", 0) == 0) {
-    for (const char* n : {"alpha", "beta", "r0", "r1", "r2", "e0", "e1", "e2", "linearity"}) names.push_back(n);
+    for (const char* n : {"alpha", "beta", "r0", "r1", "r2", "e0", "e1", "e2", "linearity"})
+      names.push_back(n);
   }
-  for (int i = static_cast<int>(names.size()); i < count; ++i) names.push_back("d" + std::to_string(i - 4));
+  for (int i = static_cast<int>(names.size()); i < count; ++i)
+    names.push_back("d" + std::to_string(i - 4));
   names.resize(count);
   return names;
 }
 
-std::vector<const CornerResidual*> CameraCorners(const SolveSummary& s, int camera, bool inliers_only) {
+std::vector<const CornerResidual*> CameraCorners(const SolveSummary& s, int camera,
+                                                 bool inliers_only) {
   std::vector<const CornerResidual*> out;
   for (const auto& c : s.corners) {
     if (c.camera == camera && (!inliers_only || !c.outlier)) out.push_back(&c);
@@ -100,11 +104,14 @@ CameraReport MakeCameraReport(const BoardSpec& board, const SolveSummary& soluti
   std::vector<bool> seen(solution.observation_frame.size(), false);
   for (const auto* c : CameraCorners(solution, camera, false)) seen[c->observation] = true;
   const Rigid3 cam_from_ref = m.cam_from_ground();
-  const Eigen::Vector3d centre(board.squares_x * board.square_m / 2, board.squares_y * board.square_m / 2, 0);
+  const Eigen::Vector3d centre(board.squares_x * board.square_m / 2,
+                               board.squares_y * board.square_m / 2, 0);
   for (size_t i = 0; i < seen.size(); ++i) {
     if (!seen[i]) continue;
-    const Rigid3 cam_from_board = cam_from_ref * solution.ref_from_board[solution.observation_frame[i]];
-    const double tilt = std::acos(std::min(1.0, std::abs(cam_from_board.rotation(2, 2)))) * 180 / M_PI;
+    const Rigid3 cam_from_board =
+        cam_from_ref * solution.ref_from_board[solution.observation_frame[i]];
+    const double tilt =
+        std::acos(std::min(1.0, std::abs(cam_from_board.rotation(2, 2)))) * 180 / M_PI;
     r.max_tilt_deg = std::max(r.max_tilt_deg, tilt);
     distances.push_back((cam_from_board * centre).norm());
   }
@@ -112,11 +119,13 @@ CameraReport MakeCameraReport(const BoardSpec& board, const SolveSummary& soluti
     std::nth_element(distances.begin(), distances.begin() + distances.size() / 2, distances.end());
     r.working_distance_m = distances[distances.size() / 2];
     r.projection_stdev_centre_px =
-        ProjectionStdev(solution, board, camera, {(m.width() - 1) / 2.0, (m.height() - 1) / 2.0}, r.working_distance_m);
+        ProjectionStdev(solution, board, camera, {(m.width() - 1) / 2.0, (m.height() - 1) / 2.0},
+                        r.working_distance_m);
     double worst = 0;
     for (int gy = 0; gy < 4; ++gy) {
       for (int gx = 0; gx < 5; ++gx) {
-        const Eigen::Vector2d q((m.width() - 1) * (0.05 + 0.9 * gx / 4.0), (m.height() - 1) * (0.05 + 0.9 * gy / 3.0));
+        const Eigen::Vector2d q((m.width() - 1) * (0.05 + 0.9 * gx / 4.0),
+                                (m.height() - 1) * (0.05 + 0.9 * gy / 3.0));
         worst = std::max(worst, ProjectionStdev(solution, board, camera, q, r.working_distance_m));
       }
     }
@@ -125,8 +134,8 @@ CameraReport MakeCameraReport(const BoardSpec& board, const SolveSummary& soluti
 
   char buf[256];
   if (r.views_accepted < options.min_views) {
-    std::snprintf(buf, sizeof buf, "too few views: %d accepted (need %d); capture more board views", r.views_accepted,
-                  options.min_views);
+    std::snprintf(buf, sizeof buf, "too few views: %d accepted (need %d); capture more board views",
+                  r.views_accepted, options.min_views);
     r.reasons.push_back(buf);
   }
   if (r.coverage < options.min_coverage || !r.empty_regions.empty()) {
@@ -137,18 +146,21 @@ CameraReport MakeCameraReport(const BoardSpec& board, const SolveSummary& soluti
     r.reasons.push_back(std::string(buf) + (where.empty() ? "" : "; cover the " + where));
   }
   if (!(r.rms_px <= options.max_rms_px)) {
-    std::snprintf(buf, sizeof buf,
-                  "high residuals: RMS %.3f px (limit %.2f px); check the board spec, flatness and focus",
-                  r.rms_px, options.max_rms_px);
+    std::snprintf(
+        buf, sizeof buf,
+        "high residuals: RMS %.3f px (limit %.2f px); check the board spec, flatness and focus",
+        r.rms_px, options.max_rms_px);
     r.reasons.push_back(buf);
   }
   if (!(r.worst_px <= options.max_worst_px)) {
-    std::snprintf(buf, sizeof buf, "worst corner off by %.2f px (limit %.1f px); see the residual plot",
-                  r.worst_px, options.max_worst_px);
+    std::snprintf(buf, sizeof buf,
+                  "worst corner off by %.2f px (limit %.1f px); see the residual plot", r.worst_px,
+                  options.max_worst_px);
     r.reasons.push_back(buf);
   }
   if (r.max_tilt_deg < options.min_tilt_deg) {
-    std::snprintf(buf, sizeof buf, "views too frontal: most tilted view %.0f deg (need %.0f); tilt the board more",
+    std::snprintf(buf, sizeof buf,
+                  "views too frontal: most tilted view %.0f deg (need %.0f); tilt the board more",
                   r.max_tilt_deg, options.min_tilt_deg);
     r.reasons.push_back(buf);
   }
@@ -156,9 +168,11 @@ CameraReport MakeCameraReport(const BoardSpec& board, const SolveSummary& soluti
     for (size_t i = 0; i < 4 && i < r.intrinsics.size() && i < r.intrinsics_stdev.size(); ++i) {
       const double percent = 1.96 * r.intrinsics_stdev[i] / std::abs(r.intrinsics[i]) * 100;
       if (!(percent <= options.max_stdev_percent)) {
-        std::snprintf(buf, sizeof buf, "%s known to %.2f%% only (1.96 sigma; need %.2f%%); capture more views, "
-                      "tilted and nearer the edges", i < r.parameter_names.size() ? r.parameter_names[i].c_str() : "?",
-                      percent, options.max_stdev_percent);
+        std::snprintf(buf, sizeof buf,
+                      "%s known to %.2f%% only (1.96 sigma; need %.2f%%); capture more views, "
+                      "tilted and nearer the edges",
+                      i < r.parameter_names.size() ? r.parameter_names[i].c_str() : "?", percent,
+                      options.max_stdev_percent);
         r.reasons.push_back(buf);
       }
     }
@@ -212,16 +226,19 @@ void WriteResidualPlot(const std::string& path, const SolveSummary& solution, in
       continue;
     }
     const double mag = c->residual.norm();
-    const cv::Scalar colour = mag <= rms ? cv::Scalar(80, 200, 80) : mag <= 2 * rms ? cv::Scalar(0, 220, 255)
-                                                                                   : cv::Scalar(60, 60, 255);
+    const cv::Scalar colour = mag <= rms       ? cv::Scalar(80, 200, 80)
+                              : mag <= 2 * rms ? cv::Scalar(0, 220, 255)
+                                               : cv::Scalar(60, 60, 255);
     const cv::Point2d b = a + cv::Point2d(c->residual.x(), c->residual.y()) * gain * scale;
     cv::line(canvas, a, b, colour, 1, cv::LINE_AA);
     cv::circle(canvas, a, 1, colour, -1);
   }
   char text[200];
-  std::snprintf(text, sizeof text, "residuals x%.0f   RMS %.3f px   worst %.3f px   outliers %d (magenta)", gain, rms,
+  std::snprintf(text, sizeof text,
+                "residuals x%.0f   RMS %.3f px   worst %.3f px   outliers %d (magenta)", gain, rms,
                 solution.worst_px.at(camera), solution.outliers.at(camera));
-  cv::putText(canvas, text, {8, 18}, cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
+  cv::putText(canvas, text, {8, 18}, cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar(255, 255, 255), 1,
+              cv::LINE_AA);
   // Histogram of |residual|, 40 bins up to 3x the 95th percentile.
   const int bins = 40;
   const double top = std::max(1e-3, 3 * p95);
@@ -231,11 +248,12 @@ void WriteResidualPlot(const std::string& path, const SolveSummary& solution, in
   const int bw = std::max(1, (w - 20) / bins);
   for (int i = 0; i < bins; ++i) {
     const int bh = hist[i] * (hist_h - 40) / peak;
-    cv::rectangle(canvas, cv::Rect(10 + i * bw, h + hist_h - 20 - bh, bw - 1, bh), cv::Scalar(200, 200, 200), -1);
+    cv::rectangle(canvas, cv::Rect(10 + i * bw, h + hist_h - 20 - bh, bw - 1, bh),
+                  cv::Scalar(200, 200, 200), -1);
   }
   std::snprintf(text, sizeof text, "|residual| histogram, 0 .. %.2f px", top);
-  cv::putText(canvas, text, {10, h + hist_h - 5}, cv::FONT_HERSHEY_SIMPLEX, 0.45, cv::Scalar(255, 255, 255), 1,
-              cv::LINE_AA);
+  cv::putText(canvas, text, {10, h + hist_h - 5}, cv::FONT_HERSHEY_SIMPLEX, 0.45,
+              cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
   WritePng(path, canvas);
 }
 
@@ -253,19 +271,26 @@ void WriteCoverageMap(const std::string& path, const SolveSummary& solution, int
   cv::applyColorMap(levels, coloured, cv::COLORMAP_INFERNO);
   cv::resize(coloured, canvas, cv::Size(w, h), 0, 0, cv::INTER_NEAREST);
   for (const auto* c : CameraCorners(solution, camera, true)) {
-    cv::circle(canvas, cv::Point2d(c->observed.x() * scale, c->observed.y() * scale), 1, cv::Scalar(255, 255, 255), -1);
+    cv::circle(canvas, cv::Point2d(c->observed.x() * scale, c->observed.y() * scale), 1,
+               cv::Scalar(255, 255, 255), -1);
   }
-  for (int gx = 1; gx < options.grid_x; ++gx) cv::line(canvas, {gx * w / options.grid_x, 0}, {gx * w / options.grid_x, h}, cv::Scalar(90, 90, 90));
-  for (int gy = 1; gy < options.grid_y; ++gy) cv::line(canvas, {0, gy * h / options.grid_y}, {w, gy * h / options.grid_y}, cv::Scalar(90, 90, 90));
+  for (int gx = 1; gx < options.grid_x; ++gx)
+    cv::line(canvas, {gx * w / options.grid_x, 0}, {gx * w / options.grid_x, h},
+             cv::Scalar(90, 90, 90));
+  for (int gy = 1; gy < options.grid_y; ++gy)
+    cv::line(canvas, {0, gy * h / options.grid_y}, {w, gy * h / options.grid_y},
+             cv::Scalar(90, 90, 90));
   char text[160];
   std::snprintf(text, sizeof text, "coverage %.0f%% of %dx%d cells, up to %.0f corners per cell",
-                100.0 * cv::countNonZero(counts) / counts.total(), options.grid_x, options.grid_y, peak);
-  cv::putText(canvas, text, {8, 18}, cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
+                100.0 * cv::countNonZero(counts) / counts.total(), options.grid_x, options.grid_y,
+                peak);
+  cv::putText(canvas, text, {8, 18}, cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar(255, 255, 255), 1,
+              cv::LINE_AA);
   WritePng(path, canvas);
 }
 
-void WriteUncertaintyMap(const std::string& path, const SolveSummary& solution, const BoardSpec& board, int camera,
-                         double distance_m) {
+void WriteUncertaintyMap(const std::string& path, const SolveSummary& solution,
+                         const BoardSpec& board, int camera, double distance_m) {
   const CameraModel& m = solution.models.at(camera);
   const double scale = std::min(1.0, 960.0 / m.width());
   const int w = static_cast<int>(m.width() * scale), h = static_cast<int>(m.height() * scale);
@@ -275,13 +300,15 @@ void WriteUncertaintyMap(const std::string& path, const SolveSummary& solution, 
   double worst = 0;
   for (int gy = 0; gy < kY; ++gy) {
     for (int gx = 0; gx < kX; ++gx) {
-      const Eigen::Vector2d q((m.width() - 1) * gx / (kX - 1.0), (m.height() - 1) * gy / (kY - 1.0));
+      const Eigen::Vector2d q((m.width() - 1) * gx / (kX - 1.0),
+                              (m.height() - 1) * gy / (kY - 1.0));
       const double s = ProjectionStdev(solution, board, camera, q, distance_m);
       samples.at<float>(gy, gx) = std::isfinite(s) ? static_cast<float>(s) : 0.f;
       if (std::isfinite(s)) worst = std::max(worst, s);
     }
   }
-  const double centre = ProjectionStdev(solution, board, camera, {(m.width() - 1) / 2.0, (m.height() - 1) / 2.0}, distance_m);
+  const double centre = ProjectionStdev(
+      solution, board, camera, {(m.width() - 1) / 2.0, (m.height() - 1) / 2.0}, distance_m);
   cv::Mat smooth, levels, canvas;
   cv::resize(samples, smooth, cv::Size(w, h), 0, 0, cv::INTER_CUBIC);
   // Colour scale 0 .. max(1 px, worst): a good calibration stays dark everywhere.
@@ -298,23 +325,27 @@ void WriteUncertaintyMap(const std::string& path, const SolveSummary& solution, 
     if (!contours.empty() && !contours.front().empty()) {
       char label[32];
       std::snprintf(label, sizeof label, "%.2g", c);
-      cv::putText(canvas, label, contours.front()[contours.front().size() / 2], cv::FONT_HERSHEY_SIMPLEX, 0.4,
-                  cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
+      cv::putText(canvas, label, contours.front()[contours.front().size() / 2],
+                  cv::FONT_HERSHEY_SIMPLEX, 0.4, cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
     }
   }
   char text[200];
-  std::snprintf(text, sizeof text, "projection uncertainty at %.2f m: centre %.3f px, worst %.3f px (1 sigma)",
+  std::snprintf(text, sizeof text,
+                "projection uncertainty at %.2f m: centre %.3f px, worst %.3f px (1 sigma)",
                 distance_m, centre, worst);
-  cv::putText(canvas, text, {8, 18}, cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
+  cv::putText(canvas, text, {8, 18}, cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar(255, 255, 255), 1,
+              cv::LINE_AA);
   // The scale bar.
   const int bar_w = std::min(200, w / 3), bar_x = w - bar_w - 10, bar_y = h - 24;
   for (int x = 0; x < bar_w; ++x) {
     cv::Mat one(1, 1, CV_8U, cv::Scalar(255 * x / std::max(1, bar_w - 1))), colour;
     cv::applyColorMap(one, colour, cv::COLORMAP_VIRIDIS);
-    cv::line(canvas, {bar_x + x, bar_y}, {bar_x + x, bar_y + 10}, cv::Scalar(colour.at<cv::Vec3b>(0, 0)));
+    cv::line(canvas, {bar_x + x, bar_y}, {bar_x + x, bar_y + 10},
+             cv::Scalar(colour.at<cv::Vec3b>(0, 0)));
   }
   std::snprintf(text, sizeof text, "0 .. %.2f px", top);
-  cv::putText(canvas, text, {bar_x, bar_y - 4}, cv::FONT_HERSHEY_SIMPLEX, 0.4, cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
+  cv::putText(canvas, text, {bar_x, bar_y - 4}, cv::FONT_HERSHEY_SIMPLEX, 0.4,
+              cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
   WritePng(path, canvas);
 }
 
@@ -326,16 +357,20 @@ nlohmann::json ToJson(const CameraReport& r) {
   j["reasons"] = r.reasons;
   j["views_accepted"] = r.views_accepted;
   j["views_rejected"] = nlohmann::json::array();
-  for (const auto& [view, reason] : r.rejected) j["views_rejected"].push_back({{"view", view}, {"reason", reason}});
-  auto num = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); };
+  for (const auto& [view, reason] : r.rejected)
+    j["views_rejected"].push_back({{"view", view}, {"reason", reason}});
+  auto num = [](double v) {
+    return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr);
+  };
   j["rms_px"] = num(r.rms_px);
   j["worst_px"] = num(r.worst_px);
   j["outlier_corners"] = r.outliers;
   j["parameters"] = nlohmann::json::array();
   for (size_t i = 0; i < r.intrinsics.size(); ++i) {
-    j["parameters"].push_back({{"name", r.parameter_names[i]},
-                               {"value", r.intrinsics[i]},
-                               {"stdev", num(i < r.intrinsics_stdev.size() ? r.intrinsics_stdev[i] : NAN)}});
+    j["parameters"].push_back(
+        {{"name", r.parameter_names[i]},
+         {"value", r.intrinsics[i]},
+         {"stdev", num(i < r.intrinsics_stdev.size() ? r.intrinsics_stdev[i] : NAN)}});
   }
   j["coverage"] = r.coverage;
   j["empty_regions"] = r.empty_regions;
@@ -343,7 +378,8 @@ nlohmann::json ToJson(const CameraReport& r) {
   j["working_distance_m"] = r.working_distance_m;
   j["projection_stdev_px"] = {{"centre", num(r.projection_stdev_centre_px)},
                               {"worst", num(r.projection_stdev_worst_px)}};
-  j["files"] = {{"model", r.model_file}, {"residuals", r.residual_png}, {"coverage", r.coverage_png}};
+  j["files"] = {
+      {"model", r.model_file}, {"residuals", r.residual_png}, {"coverage", r.coverage_png}};
   return j;
 }
 
@@ -351,28 +387,32 @@ std::string ToText(const CameraReport& r) {
   std::ostringstream o;
   char buf[256];
   o << r.camera << ": " << (r.good ? "GOOD" : "REJECTED") << "\n";
-  std::snprintf(buf, sizeof buf, "  views %d accepted, %zu rejected; RMS %.3f px, worst %.3f px, %d outlier corners\n",
-                r.views_accepted, r.rejected.size(), r.rms_px, r.worst_px, r.outliers);
+  std::snprintf(
+      buf, sizeof buf,
+      "  views %d accepted, %zu rejected; RMS %.3f px, worst %.3f px, %d outlier corners\n",
+      r.views_accepted, r.rejected.size(), r.rms_px, r.worst_px, r.outliers);
   o << buf;
   if (!r.intrinsics.empty()) {
     o << "  ";
     for (size_t i = 0; i < r.intrinsics.size() && i < 4; ++i) {
-      std::snprintf(buf, sizeof buf, "%s %.2f +- %.3f  ", r.parameter_names[i].c_str(), r.intrinsics[i],
-                    i < r.intrinsics_stdev.size() ? r.intrinsics_stdev[i] : NAN);
+      std::snprintf(buf, sizeof buf, "%s %.2f +- %.3f  ", r.parameter_names[i].c_str(),
+                    r.intrinsics[i], i < r.intrinsics_stdev.size() ? r.intrinsics_stdev[i] : NAN);
       o << buf;
     }
-    std::snprintf(buf, sizeof buf,
-                  "\n  coverage %.0f%%, most tilted view %.0f deg; projection uncertainty at %.2f m: %.3f px "
-                  "(centre), %.3f px (worst)\n",
-                  r.coverage * 100, r.max_tilt_deg, r.working_distance_m, r.projection_stdev_centre_px,
-                  r.projection_stdev_worst_px);
+    std::snprintf(
+        buf, sizeof buf,
+        "\n  coverage %.0f%%, most tilted view %.0f deg; projection uncertainty at %.2f m: %.3f px "
+        "(centre), %.3f px (worst)\n",
+        r.coverage * 100, r.max_tilt_deg, r.working_distance_m, r.projection_stdev_centre_px,
+        r.projection_stdev_worst_px);
     o << buf;
   }
   for (const auto& reason : r.reasons) o << "  - " << reason << "\n";
   for (size_t i = 0; i < r.rejected.size() && i < 5; ++i) {
     o << "  view " << r.rejected[i].first << " rejected: " << r.rejected[i].second << "\n";
   }
-  if (r.rejected.size() > 5) o << "  ... " << r.rejected.size() - 5 << " more rejected views in the JSON report\n";
+  if (r.rejected.size() > 5)
+    o << "  ... " << r.rejected.size() - 5 << " more rejected views in the JSON report\n";
   return o.str();
 }
 

@@ -35,7 +35,9 @@ Rigid3 FromPose(const mrcal_pose_t& p) {
 }
 
 // mrcal's board frame has its origin on corner 0; ours one square before it.
-Rigid3 MrcalFromOurBoard(double square) { return {Eigen::Matrix3d::Identity(), Eigen::Vector3d(-square, -square, 0)}; }
+Rigid3 MrcalFromOurBoard(double square) {
+  return {Eigen::Matrix3d::Identity(), Eigen::Vector3d(-square, -square, 0)};
+}
 
 // The whole mrcal problem: the arrays mrcal_optimize and its callback take.
 struct Problem {
@@ -72,19 +74,21 @@ struct Problem {
   mrcal_stats_t Optimize(mrcal_problem_selections_t s, std::vector<double>* x) {
     x->assign(Nmeasurements(s), 0.0);
     return mrcal_optimize(nullptr, -1, x->data(), static_cast<int>(x->size() * sizeof(double)),
-                          intrinsics.data(), extrinsics.empty() ? nullptr : extrinsics.data(), frames.data(),
-                          nullptr, &warp, ncam, ncam - 1, nframes, 0, 0, obs.data(), nullptr, Nobs(), 0,
-                          pool.data(), &lens, imagersizes.data(), s, &constants, spacing, w, h, false, false);
+                          intrinsics.data(), extrinsics.empty() ? nullptr : extrinsics.data(),
+                          frames.data(), nullptr, &warp, ncam, ncam - 1, nframes, 0, 0, obs.data(),
+                          nullptr, Nobs(), 0, pool.data(), &lens, imagersizes.data(), s, &constants,
+                          spacing, w, h, false, false);
   }
   // mrcal's residual vector at the current state.
   bool Residuals(mrcal_problem_selections_t s, std::vector<double>* x) const {
     std::vector<double> b(Nstate(s));
     x->assign(Nmeasurements(s), 0.0);
-    return mrcal_optimizer_callback(b.data(), static_cast<int>(b.size() * sizeof(double)), x->data(),
-                                    static_cast<int>(x->size() * sizeof(double)), nullptr, intrinsics.data(),
-                                    extrinsics.empty() ? nullptr : extrinsics.data(), frames.data(), nullptr,
-                                    &warp, ncam, ncam - 1, nframes, 0, 0, obs.data(), nullptr, Nobs(), 0,
-                                    pool.data(), &lens, imagersizes.data(), s, &constants, spacing, w, h, false);
+    return mrcal_optimizer_callback(
+        b.data(), static_cast<int>(b.size() * sizeof(double)), x->data(),
+        static_cast<int>(x->size() * sizeof(double)), nullptr, intrinsics.data(),
+        extrinsics.empty() ? nullptr : extrinsics.data(), frames.data(), nullptr, &warp, ncam,
+        ncam - 1, nframes, 0, 0, obs.data(), nullptr, Nobs(), 0, pool.data(), &lens,
+        imagersizes.data(), s, &constants, spacing, w, h, false);
   }
   // Our state layout: intrinsics, extrinsics (rt), frames (rt), warp.
   std::vector<double> State() const {
@@ -134,21 +138,24 @@ std::vector<cv::Point3f> ObjectPoints(const BoardSpec& board, const BoardObserva
 
 std::vector<cv::Point2f> ImagePoints(const BoardObservation& o) {
   std::vector<cv::Point2f> pts;
-  for (const auto& q : o.pixels) pts.emplace_back(static_cast<float>(q.x()), static_cast<float>(q.y()));
+  for (const auto& q : o.pixels)
+    pts.emplace_back(static_cast<float>(q.x()), static_cast<float>(q.y()));
   return pts;
 }
 
 }  // namespace
 
 SolveSummary SolveBoards(const BoardSpec& board, const std::vector<SolveCamera>& cameras,
-                         const std::vector<BoardObservation>& observations, const SolveOptions& options) {
+                         const std::vector<BoardObservation>& observations,
+                         const SolveOptions& options) {
   auto log = Log("calib.solve");
   Problem p;
   if (!mrcal_lensmodel_from_name(&p.lens, options.lensmodel.c_str())) {
     throw InputError("--lensmodel", "unknown mrcal lens model \"" + options.lensmodel + "\"");
   }
   if (!mrcal_lensmodel_metadata(&p.lens).has_core) {
-    throw InputError("--lensmodel", options.lensmodel + " has no fx fy cx cy core; pick another model");
+    throw InputError("--lensmodel",
+                     options.lensmodel + " has no fx fy cx cy core; pick another model");
   }
   p.nparams = mrcal_lensmodel_num_params(&p.lens);
   p.ncam = static_cast<int>(cameras.size());
@@ -162,7 +169,8 @@ SolveSummary SolveBoards(const BoardSpec& board, const std::vector<SolveCamera>&
   std::map<int, int> frame_index;  // frame -> dense index
   std::vector<int> per_camera(p.ncam, 0);
   for (const auto& o : observations) {
-    if (o.camera < 0 || o.camera >= p.ncam) throw InputError(o.source, "observation of an unknown camera");
+    if (o.camera < 0 || o.camera >= p.ncam)
+      throw InputError(o.source, "observation of an unknown camera");
     if (o.ids.size() != o.pixels.size() || o.ids.size() < 4) {
       throw InputError(o.source, "an observation needs at least 4 corners");
     }
@@ -236,13 +244,15 @@ SolveSummary SolveBoards(const BoardSpec& board, const std::vector<SolveCamera>&
   }
   for (int c = 0; c < p.ncam; ++c) {
     if (!cam_known[c]) {
-      throw InputError(cameras[c].name, "shares no board view with " + cameras[0].name +
-                                            " (directly or through other cameras): its pose cannot be joined");
+      throw InputError(cameras[c].name,
+                       "shares no board view with " + cameras[0].name +
+                           " (directly or through other cameras): its pose cannot be joined");
     }
     if (c > 0) p.extrinsics.push_back(ToPose(cam_from_ref[c]));
   }
   const Rigid3 board_from_mrcal = MrcalFromOurBoard(board.square_m).Inverse();
-  for (int f = 0; f < p.nframes; ++f) p.frames.push_back(ToPose(ref_from_board[f] * board_from_mrcal));
+  for (int f = 0; f < p.nframes; ++f)
+    p.frames.push_back(ToPose(ref_from_board[f] * board_from_mrcal));
 
   // The observation pool: every corner of the grid, missing ones weighted -1.
   const int grid = p.w * p.h;
@@ -255,7 +265,8 @@ SolveSummary SolveBoards(const BoardSpec& board, const std::vector<SolveCamera>&
     ob.iframe = frame_index[o.frame];
     p.obs.push_back(ob);
     for (size_t j = 0; j < o.ids.size(); ++j) {
-      if (o.ids[j] < 0 || o.ids[j] >= grid) throw InputError(o.source, "corner id outside the board");
+      if (o.ids[j] < 0 || o.ids[j] >= grid)
+        throw InputError(o.source, "corner id outside the board");
       p.pool[i * grid + o.ids[j]] = mrcal_point3_t{{o.pixels[j].x(), o.pixels[j].y(), 1.0}};
     }
   }
@@ -275,7 +286,8 @@ SolveSummary SolveBoards(const BoardSpec& board, const std::vector<SolveCamera>&
   if (p.warp_on) {
     progress("stage 2 of 3: distortion, outliers rejected", 0.3);
     stats = p.Optimize(p.Selections(true, options.reject_outliers, false), &x);
-    log->debug("stage 2 (no board warp): RMS {:.3f} px, {} outliers", stats.rms_reproj_error__pixels, stats.Noutliers);
+    log->debug("stage 2 (no board warp): RMS {:.3f} px, {} outliers",
+               stats.rms_reproj_error__pixels, stats.Noutliers);
   }
   const auto final_sel = p.Selections(true, options.reject_outliers, p.warp_on);
   progress("stage 3 of 3: everything, the board's flex too", 0.55);
@@ -290,13 +302,16 @@ SolveSummary SolveBoards(const BoardSpec& board, const std::vector<SolveCamera>&
   out.board_warp[0] = p.warp.x2;
   out.board_warp[1] = p.warp.y2;
   char name[256];
-  if (!mrcal_lensmodel_name(name, sizeof name, &p.lens)) throw WorkError("mrcal", "cannot name the lens model");
+  if (!mrcal_lensmodel_name(name, sizeof name, &p.lens))
+    throw WorkError("mrcal", "cannot name the lens model");
   for (int c = 0; c < p.ncam; ++c) {
-    const std::vector<double> in(p.intrinsics.begin() + c * p.nparams, p.intrinsics.begin() + (c + 1) * p.nparams);
+    const std::vector<double> in(p.intrinsics.begin() + c * p.nparams,
+                                 p.intrinsics.begin() + (c + 1) * p.nparams);
     const Rigid3 pose = c == 0 ? Rigid3{} : FromPose(p.extrinsics[c - 1]);
     out.models.emplace_back(name, in, cameras[c].width, cameras[c].height, pose);
   }
-  for (int f = 0; f < p.nframes; ++f) out.ref_from_board.push_back(FromPose(p.frames[f]) * MrcalFromOurBoard(board.square_m));
+  for (int f = 0; f < p.nframes; ++f)
+    out.ref_from_board.push_back(FromPose(p.frames[f]) * MrcalFromOurBoard(board.square_m));
   out.frame_used.assign(p.nframes, true);
   for (const auto& ob : p.obs) out.observation_frame.push_back(ob.iframe);
 
@@ -357,14 +372,16 @@ SolveSummary SolveBoards(const BoardSpec& board, const std::vector<SolveCamera>&
       p.SetState(s);
       ok = ok && p.Residuals(final_sel, &xm);
       if (j == 0) jac.setZero(static_cast<int>(xp.size()), nstate);
-      for (size_t m = 0; m < xp.size(); ++m) jac(static_cast<int>(m), j) = (xp[m] - xm[m]) / (2 * steps[j]);
+      for (size_t m = 0; m < xp.size(); ++m)
+        jac(static_cast<int>(m), j) = (xp[m] - xm[m]) / (2 * steps[j]);
     }
     p.SetState(s0);
     if (ok) {
       const Eigen::MatrixXd jtj = jac.transpose() * jac;
       const Eigen::LDLT<Eigen::MatrixXd> ldlt(jtj);
       if (ldlt.info() == Eigen::Success) {
-        out.covariance = ldlt.solve(Eigen::MatrixXd::Identity(nstate, nstate)) * (out.pixel_sigma * out.pixel_sigma);
+        out.covariance = ldlt.solve(Eigen::MatrixXd::Identity(nstate, nstate)) *
+                         (out.pixel_sigma * out.pixel_sigma);
         for (int c = 0; c < p.ncam; ++c) {
           for (int i = 0; i < p.nparams; ++i) {
             const int idx = c * p.nparams + i;
@@ -373,19 +390,22 @@ SolveSummary SolveBoards(const BoardSpec& board, const std::vector<SolveCamera>&
         }
       }
     }
-    if (out.covariance.size() == 0) log->warn("no covariance: the problem is singular or mrcal's callback failed");
+    if (out.covariance.size() == 0)
+      log->warn("no covariance: the problem is singular or mrcal's callback failed");
   }
   char line[256];
-  std::snprintf(line, sizeof line, "%d camera(s), %d views, %s: RMS %.3f px, %d outlier corners", p.ncam, p.Nobs(),
-                name, all_n ? std::sqrt(all2 / all_n) : NAN, stats.Noutliers);
+  std::snprintf(line, sizeof line, "%d camera(s), %d views, %s: RMS %.3f px, %d outlier corners",
+                p.ncam, p.Nobs(), name, all_n ? std::sqrt(all2 / all_n) : NAN, stats.Noutliers);
   out.summary = line;
   log->info("{}", out.summary);
   return out;
 }
 
-double ProjectionStdev(const SolveSummary& solution, const BoardSpec& board, int camera, const Eigen::Vector2d& pixel,
-                       double distance_m) {
-  if (solution.covariance.size() == 0 || camera < 0 || camera >= static_cast<int>(solution.models.size())) return NAN;
+double ProjectionStdev(const SolveSummary& solution, const BoardSpec& board, int camera,
+                       const Eigen::Vector2d& pixel, double distance_m) {
+  if (solution.covariance.size() == 0 || camera < 0 ||
+      camera >= static_cast<int>(solution.models.size()))
+    return NAN;
   const CameraModel& model = solution.models[camera];
   mrcal_lensmodel_t lens{};
   if (!mrcal_lensmodel_from_name(&lens, model.lensmodel().c_str())) return NAN;
@@ -401,7 +421,8 @@ double ProjectionStdev(const SolveSummary& solution, const BoardSpec& board, int
   const Rigid3 cam_from_ref = camera == 0 ? Rigid3{} : pose_at(s0, ext0 + 6 * (camera - 1));
   const Eigen::Vector3d p_ref = cam_from_ref.Inverse() * p_cam;
   std::vector<Eigen::Vector3d> p_frame;
-  for (int f = 0; f < nframes; ++f) p_frame.push_back(pose_at(s0, frame0 + 6 * f).Inverse() * p_ref);
+  for (int f = 0; f < nframes; ++f)
+    p_frame.push_back(pose_at(s0, frame0 + 6 * f).Inverse() * p_ref);
   // q(state): mean over frames of the point carried back to the reference, then projected.
   auto project = [&](const std::vector<double>& s) {
     Eigen::Vector3d mean = Eigen::Vector3d::Zero();

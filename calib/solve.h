@@ -5,8 +5,9 @@
 // same instant (`frame`), which ties every camera's pose into one frame.
 // Seeded with OpenCV (initCameraMatrix2D, solvePnP), solved in stages as
 // mrcal-calibrate-cameras does (core only; everything but the board warp with
-// outlier rejection; then the warp too), so both reach the same optimum. The covariance of the solution comes from mrcal's own residual
-// function (mrcal_optimizer_callback) differentiated numerically.
+// outlier rejection; then the warp too), so both reach the same optimum. The covariance of the
+// solution comes from mrcal's own residual function (mrcal_optimizer_callback) differentiated
+// numerically.
 #include <functional>
 #include <string>
 #include <vector>
@@ -21,10 +22,10 @@ namespace ss::calib {
 
 // One camera's accepted view of the board at one instant.
 struct BoardObservation {
-  int camera = 0;                       // index into the cameras
-  int frame = 0;                        // instant; the same frame in two cameras = the same board pose
-  std::string source;                   // for messages: "cam0 frame 12", a file name
-  std::vector<int> ids;                 // inner-corner ids
+  int camera = 0;        // index into the cameras
+  int frame = 0;         // instant; the same frame in two cameras = the same board pose
+  std::string source;    // for messages: "cam0 frame 12", a file name
+  std::vector<int> ids;  // inner-corner ids
   std::vector<Eigen::Vector2d> pixels;  // observed corners
 };
 
@@ -34,10 +35,11 @@ struct SolveCamera {
 };
 
 struct SolveOptions {
-  std::string lensmodel = "LENSMODEL_OPENCV8";  // any mrcal model with an fx fy cx cy core, splined included
-  bool optimize_board_warp = true;    // mrcal's board flex (calobject_warp)
-  bool reject_outliers = true;        // mrcal's outlier rejection in the final stage
-  bool compute_covariance = true;     // needed for parameter and projection uncertainty
+  std::string lensmodel =
+      "LENSMODEL_OPENCV8";          // any mrcal model with an fx fy cx cy core, splined included
+  bool optimize_board_warp = true;  // mrcal's board flex (calobject_warp)
+  bool reject_outliers = true;      // mrcal's outlier rejection in the final stage
+  bool compute_covariance = true;   // needed for parameter and projection uncertainty
   // Called between the solve's stages ("stage 2 of 3: ...", fraction of the work done): the
   // console shows it while a solve runs.
   std::function<void(const std::string& stage, double fraction)> progress;
@@ -46,11 +48,11 @@ struct SolveOptions {
 // The residual of one observed corner after the solve.
 struct CornerResidual {
   int camera = 0;
-  int observation = 0;            // index into the observations
-  int id = 0;                     // corner id
-  Eigen::Vector2d observed;       // pixel
-  Eigen::Vector2d residual;       // projected - observed, pixels
-  bool outlier = false;           // thrown out by mrcal
+  int observation = 0;       // index into the observations
+  int id = 0;                // corner id
+  Eigen::Vector2d observed;  // pixel
+  Eigen::Vector2d residual;  // projected - observed, pixels
+  bool outlier = false;      // thrown out by mrcal
 };
 
 struct SolveSummary {
@@ -60,25 +62,26 @@ struct SolveSummary {
   std::vector<int> observation_frame;   // per observation: index into ref_from_board
   double board_warp[2] = {0, 0};        // mrcal calobject_warp (x2, y2), metres
   std::vector<CornerResidual> corners;  // every observed corner
-  std::vector<double> rms_px;           // per camera: sqrt(mean |residual|^2) over inliers (mrcal's RMS)
-  std::vector<double> worst_px;         // per camera: largest inlier |residual|
-  std::vector<int> outliers;            // per camera
-  double mrcal_rms_px = 0;              // as mrcal_optimize reported it
-  double pixel_sigma = 0;               // observation noise estimated from the residuals, per coordinate
+  std::vector<double> rms_px;    // per camera: sqrt(mean |residual|^2) over inliers (mrcal's RMS)
+  std::vector<double> worst_px;  // per camera: largest inlier |residual|
+  std::vector<int> outliers;     // per camera
+  double mrcal_rms_px = 0;       // as mrcal_optimize reported it
+  double pixel_sigma = 0;        // observation noise estimated from the residuals, per coordinate
   // Per camera: standard deviation of each intrinsic (mrcal order), from the covariance.
   std::vector<std::vector<double>> intrinsics_stdev;
   // The solved state and its covariance (internal layout; used by ProjectionStdev).
   std::vector<double> state;
   Eigen::MatrixXd covariance;
   int intrinsics_count = 0;
-  std::string summary;                  // one line
+  std::string summary;  // one line
 };
 
 // Solves. InputError (naming the camera or view) when a camera has no
 // observation, a camera shares no board view with the others, or an
 // observation has fewer than 4 corners; WorkError when mrcal fails.
 SolveSummary SolveBoards(const BoardSpec& board, const std::vector<SolveCamera>& cameras,
-                         const std::vector<BoardObservation>& observations, const SolveOptions& options = {});
+                         const std::vector<BoardObservation>& observations,
+                         const SolveOptions& options = {});
 
 // mrcal's projection uncertainty (the "mean-frames" method of mrcal 2.x): the
 // worst-direction standard deviation, in pixels, of the projection of the

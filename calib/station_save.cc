@@ -24,7 +24,9 @@ namespace fs = std::filesystem;
 // Writes `bytes` to `path` and flushes them to the disk; WorkError naming the file.
 void WriteDurably(const std::string& path, const std::string& bytes) {
   const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-  if (fd < 0) throw WorkError(fs::path(path).parent_path().string(), std::string("cannot write there: ") + std::strerror(errno));
+  if (fd < 0)
+    throw WorkError(fs::path(path).parent_path().string(),
+                    std::string("cannot write there: ") + std::strerror(errno));
   size_t done = 0;
   while (done < bytes.size()) {
     const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
@@ -60,11 +62,12 @@ struct Pending {
 
 std::string PreviousFileName(const std::string& path, const std::string& stamp) {
   const fs::path p(path);
-  return (p.parent_path() / (p.stem().string() + ".previous-" + stamp + p.extension().string())).string();
+  return (p.parent_path() / (p.stem().string() + ".previous-" + stamp + p.extension().string()))
+      .string();
 }
 
-std::string SetCameraModelPath(const std::string& config_yaml, const std::string& camera, const std::string& path,
-                               const std::string& origin) {
+std::string SetCameraModelPath(const std::string& config_yaml, const std::string& camera,
+                               const std::string& path, const std::string& origin) {
   std::vector<std::string> lines;
   {
     std::istringstream in(config_yaml);
@@ -92,7 +95,8 @@ std::string SetCameraModelPath(const std::string& config_yaml, const std::string
       ++end;
     }
     for (size_t k = i + 1; k < end; ++k) {
-      if (lines[k].size() > column && lines[k].compare(0, column, indent) == 0 && lines[k].compare(column, 6, "model:") == 0) {
+      if (lines[k].size() > column && lines[k].compare(0, column, indent) == 0 &&
+          lines[k].compare(column, 6, "model:") == 0) {
         lines[k] = indent + "model: " + value;
         goto joined;
       }
@@ -106,7 +110,8 @@ std::string SetCameraModelPath(const std::string& config_yaml, const std::string
   throw InputError(origin, "no entry \"name: " + camera + "\" under cameras: to set its model in");
 }
 
-StationSaveResult SaveStationCalibration(const StationConfig& config, const StationSaveRequest& request) {
+StationSaveResult SaveStationCalibration(const StationConfig& config,
+                                         const StationSaveRequest& request) {
   StationSaveResult result;
   result.config = config;
   std::string yaml;
@@ -127,8 +132,11 @@ StationSaveResult SaveStationCalibration(const StationConfig& config, const Stat
       if (target.empty()) {
         std::error_code ec;
         fs::create_directories(request.calibration_dir, ec);
-        if (ec) throw WorkError(request.calibration_dir, "cannot create the folder: " + ec.message());
-        target = fs::absolute(fs::path(request.calibration_dir) / (name + ".cameramodel")).lexically_normal().string();
+        if (ec)
+          throw WorkError(request.calibration_dir, "cannot create the folder: " + ec.message());
+        target = fs::absolute(fs::path(request.calibration_dir) / (name + ".cameramodel"))
+                     .lexically_normal()
+                     .string();
         camera->model = target;
         if (!yaml.empty()) yaml = SetCameraModelPath(yaml, name, target, request.config_path);
       }
@@ -153,11 +161,14 @@ StationSaveResult SaveStationCalibration(const StationConfig& config, const Stat
     if (!request.config_path.empty() && p.target == request.config_path) {
       // The models are in place now: the edited config must load as the station's, models and all.
       try {
-        ParseStationConfig(yaml, request.config_path, fs::path(request.config_path).parent_path().string());
+        ParseStationConfig(yaml, request.config_path,
+                           fs::path(request.config_path).parent_path().string());
       } catch (const std::exception& e) {
         ::unlink(p.temp.c_str());
-        throw InputError(request.config_path, std::string("the models were saved, but the config with them does not "
-                                                          "load (left as it was): ") + e.what());
+        throw InputError(request.config_path,
+                         std::string("the models were saved, but the config with them does not "
+                                     "load (left as it was): ") +
+                             e.what());
       }
     }
     std::error_code ec;
@@ -168,7 +179,8 @@ StationSaveResult SaveStationCalibration(const StationConfig& config, const Stat
         if (ec) {
           for (size_t k = i; k < pending.size(); ++k) ::unlink(pending[k].temp.c_str());
           throw WorkError(previous, "cannot keep the previous file: " + ec.message() +
-                                        (i > 0 ? " (the files before it were saved)" : " (nothing was changed)"));
+                                        (i > 0 ? " (the files before it were saved)"
+                                               : " (nothing was changed)"));
         }
       }
       result.previous.push_back(previous);
@@ -180,7 +192,9 @@ StationSaveResult SaveStationCalibration(const StationConfig& config, const Stat
     }
     result.files.push_back(p.target);
   }
-  Log("calib.save")->info("calibration saved: {} file(s), {} previous kept", result.files.size(), result.previous.size());
+  Log("calib.save")
+      ->info("calibration saved: {} file(s), {} previous kept", result.files.size(),
+             result.previous.size());
   return result;
 }
 

@@ -19,7 +19,7 @@ namespace ss::calib {
 
 struct StationSaveRequest {
   std::vector<std::pair<std::string, CameraModel>> models;  // (camera name, model)
-  std::optional<GroundPolygon> floor;                      // the enclosure, when found
+  std::optional<GroundPolygon> floor;                       // the enclosure, when found
   std::string config_path;      // the station's config file; "": none (only `config` changes)
   std::string calibration_dir;  // where models of cameras without `model:` go
   std::string stamp;            // UTC, for the previous files' names ("20261202T071000Z")
@@ -33,12 +33,13 @@ struct StationSaveResult {
 
 // WorkError naming the folder or file that cannot be written; InputError naming the camera
 // when it is not in `config` or the edited config does not hold.
-StationSaveResult SaveStationCalibration(const StationConfig& config, const StationSaveRequest& request);
+StationSaveResult SaveStationCalibration(const StationConfig& config,
+                                         const StationSaveRequest& request);
 
 // Sets `cameras[NAME].model` in a station config's YAML text, keeping everything else as
 // written; InputError naming `origin` when the camera's entry is not found.
-std::string SetCameraModelPath(const std::string& config_yaml, const std::string& camera, const std::string& path,
-                               const std::string& origin);
+std::string SetCameraModelPath(const std::string& config_yaml, const std::string& camera,
+                               const std::string& path, const std::string& origin);
 
 // "DIR/NAME.previous-STAMP.EXT" for "DIR/NAME.EXT".
 std::string PreviousFileName(const std::string& path, const std::string& stamp);

@@ -20,7 +20,8 @@ bool SameIds(const BoardView& a, const BoardView& b) { return a.ids == b.ids; }
 
 double MaxMotion(const BoardView& a, const BoardView& b) {
   double worst = 0;
-  for (size_t i = 0; i < a.pixels.size(); ++i) worst = std::max(worst, (a.pixels[i] - b.pixels[i]).norm());
+  for (size_t i = 0; i < a.pixels.size(); ++i)
+    worst = std::max(worst, (a.pixels[i] - b.pixels[i]).norm());
   return worst;
 }
 
@@ -34,30 +35,39 @@ std::string Fmt(const char* format, double a, double b = 0) {
 
 const char* WizardStepName(WizardStep step) {
   switch (step) {
-    case WizardStep::kIntrinsics: return "intrinsics";
-    case WizardStep::kGround: return "ground";
-    case WizardStep::kEnclosure: return "enclosure";
-    case WizardStep::kDone: return "done";
+    case WizardStep::kIntrinsics:
+      return "intrinsics";
+    case WizardStep::kGround:
+      return "ground";
+    case WizardStep::kEnclosure:
+      return "enclosure";
+    case WizardStep::kDone:
+      return "done";
   }
   return "?";
 }
 
-CalibrationWizard::CalibrationWizard(std::string camera, int width, int height, WizardOptions options)
+CalibrationWizard::CalibrationWizard(std::string camera, int width, int height,
+                                     WizardOptions options)
     : camera_(std::move(camera)), width_(width), height_(height), o_(std::move(options)) {
   coverage_ = cv::Mat(o_.verdict.grid_y, o_.verdict.grid_x, CV_32F, cv::Scalar(0));
   if (o_.intrinsics) {
     if (o_.intrinsics->width() != width_ || o_.intrinsics->height() != height_) {
-      throw InputError("--intrinsics", "the model's imager is " + std::to_string(o_.intrinsics->width()) + "x" +
-                                           std::to_string(o_.intrinsics->height()) + " but the camera delivers " +
-                                           std::to_string(width_) + "x" + std::to_string(height_));
+      throw InputError("--intrinsics",
+                       "the model's imager is " + std::to_string(o_.intrinsics->width()) + "x" +
+                           std::to_string(o_.intrinsics->height()) + " but the camera delivers " +
+                           std::to_string(width_) + "x" + std::to_string(height_));
     }
     intrinsics_model_ = o_.intrinsics;
     intrinsics_good_ = true;
     step_ = WizardStep::kGround;
   }
   next_solve_at_ = o_.verdict.min_views;
-  Event(-1, "start", {{"camera", camera_}, {"imager", {width_, height_}}, {"board", o_.board.ToString()},
-                      {"step", WizardStepName(step_)}});
+  Event(-1, "start",
+        {{"camera", camera_},
+         {"imager", {width_, height_}},
+         {"board", o_.board.ToString()},
+         {"step", WizardStepName(step_)}});
 }
 
 void CalibrationWizard::Event(int frame, const std::string& kind, nlohmann::json detail) {
@@ -83,7 +93,8 @@ double CalibrationWizard::Focal() const {
       for (size_t i = 0; i < v.ids.size(); ++i) {
         const Eigen::Vector3d p = o_.board.Corner(v.ids[i]);
         object.back().emplace_back(static_cast<float>(p.x()), static_cast<float>(p.y()), 0.f);
-        image.back().emplace_back(static_cast<float>(v.pixels[i].x()), static_cast<float>(v.pixels[i].y()));
+        image.back().emplace_back(static_cast<float>(v.pixels[i].x()),
+                                  static_cast<float>(v.pixels[i].y()));
       }
     }
     try {
@@ -107,7 +118,8 @@ CalibrationWizard::Captured CalibrationWizard::Describe(const BoardView& view) c
     sum += view.pixels[i];
     const Eigen::Vector3d p = o_.board.Corner(view.ids[i]);
     object.emplace_back(static_cast<float>(p.x()), static_cast<float>(p.y()), 0.f);
-    image.emplace_back(static_cast<float>(view.pixels[i].x()), static_cast<float>(view.pixels[i].y()));
+    image.emplace_back(static_cast<float>(view.pixels[i].x()),
+                       static_cast<float>(view.pixels[i].y()));
   }
   d.centre = sum / static_cast<double>(view.pixels.size());
   d.area = (hi - lo).prod();
@@ -130,8 +142,10 @@ bool CalibrationWizard::Novel(const BoardView& view, const Captured& d, std::str
   int new_cells = 0;
   cv::Mat seen = coverage_.clone();
   for (const auto& p : view.pixels) {
-    const int gx = std::clamp(static_cast<int>(p.x() / width_ * coverage_.cols), 0, coverage_.cols - 1);
-    const int gy = std::clamp(static_cast<int>(p.y() / height_ * coverage_.rows), 0, coverage_.rows - 1);
+    const int gx =
+        std::clamp(static_cast<int>(p.x() / width_ * coverage_.cols), 0, coverage_.cols - 1);
+    const int gy =
+        std::clamp(static_cast<int>(p.y() / height_ * coverage_.rows), 0, coverage_.rows - 1);
     if (seen.at<float>(gy, gx) == 0) ++new_cells, seen.at<float>(gy, gx) = 1;
   }
   if (described_.empty()) {
@@ -145,27 +159,36 @@ bool CalibrationWizard::Novel(const BoardView& view, const Captured& d, std::str
   const double diagonal = std::hypot(width_, height_);
   for (const auto& c : described_) {
     const bool moved = (d.centre - c.centre).norm() > o_.min_shift * diagonal;
-    const double turn = std::acos(std::clamp(std::abs(d.normal.dot(c.normal)), 0.0, 1.0)) * 180 / M_PI;
+    const double turn =
+        std::acos(std::clamp(std::abs(d.normal.dot(c.normal)), 0.0, 1.0)) * 180 / M_PI;
     const bool turned = turn > o_.min_tilt_change_deg;
-    const bool resized = std::abs(std::log(d.area / std::max(1.0, c.area))) > std::log1p(o_.min_scale_change);
+    const bool resized =
+        std::abs(std::log(d.area / std::max(1.0, c.area))) > std::log1p(o_.min_scale_change);
     if (!moved && !turned && !resized) return false;
   }
   *why = "new place, angle or size";
   return true;
 }
 
-void CalibrationWizard::Capture(const BoardView& view, const Captured& d, int frame, const std::string& why) {
+void CalibrationWizard::Capture(const BoardView& view, const Captured& d, int frame,
+                                const std::string& why) {
   views_.push_back(view);
   described_.push_back(d);
   for (const auto& p : view.pixels) {
-    const int gx = std::clamp(static_cast<int>(p.x() / width_ * coverage_.cols), 0, coverage_.cols - 1);
-    const int gy = std::clamp(static_cast<int>(p.y() / height_ * coverage_.rows), 0, coverage_.rows - 1);
+    const int gx =
+        std::clamp(static_cast<int>(p.x() / width_ * coverage_.cols), 0, coverage_.cols - 1);
+    const int gy =
+        std::clamp(static_cast<int>(p.y() / height_ * coverage_.rows), 0, coverage_.rows - 1);
     coverage_.at<float>(gy, gx) += 1;
   }
   const double tilt = std::acos(std::clamp(std::abs(d.normal.z()), 0.0, 1.0)) * 180 / M_PI;
   max_tilt_deg_ = std::max(max_tilt_deg_, tilt);
-  Event(frame, "capture", {{"view", static_cast<int>(views_.size())}, {"why", why}, {"corners", view.ids.size()},
-                           {"tilt_deg", tilt}, {"coverage", coverage_fraction()}});
+  Event(frame, "capture",
+        {{"view", static_cast<int>(views_.size())},
+         {"why", why},
+         {"corners", view.ids.size()},
+         {"tilt_deg", tilt},
+         {"coverage", coverage_fraction()}});
 }
 
 std::vector<std::string> CalibrationWizard::MissingForIntrinsics() const {
@@ -173,8 +196,8 @@ std::vector<std::string> CalibrationWizard::MissingForIntrinsics() const {
   for (const auto& region : EmptyRegions(coverage_)) out.push_back("cover the " + region);
   if (coverage_fraction() < o_.verdict.min_coverage) {
     if (out.empty()) {
-      out.push_back(Fmt("cover more of the image (%.0f%% of the cells, need %.0f%%)", coverage_fraction() * 100,
-                        o_.verdict.min_coverage * 100));
+      out.push_back(Fmt("cover more of the image (%.0f%% of the cells, need %.0f%%)",
+                        coverage_fraction() * 100, o_.verdict.min_coverage * 100));
     }
   }
   if (max_tilt_deg_ < o_.verdict.min_tilt_deg) {
@@ -182,8 +205,8 @@ std::vector<std::string> CalibrationWizard::MissingForIntrinsics() const {
                       o_.verdict.min_tilt_deg));
   }
   if (views() < o_.verdict.min_views) {
-    out.push_back("capture more views (" + std::to_string(views()) + " of " + std::to_string(o_.verdict.min_views) +
-                  ")");
+    out.push_back("capture more views (" + std::to_string(views()) + " of " +
+                  std::to_string(o_.verdict.min_views) + ")");
   }
   return out;
 }
@@ -195,7 +218,8 @@ bool CalibrationWizard::CriteriaMet() const {
 
 void CalibrationWizard::SolveIntrinsics(int frame) {
   std::vector<BoardObservation> obs;
-  for (size_t i = 0; i < views_.size(); ++i) obs.push_back({0, static_cast<int>(i), views_[i].source, views_[i].ids, views_[i].pixels});
+  for (size_t i = 0; i < views_.size(); ++i)
+    obs.push_back({0, static_cast<int>(i), views_[i].source, views_[i].ids, views_[i].pixels});
   try {
     solution_ = SolveBoards(o_.board, {{camera_, width_, height_}}, obs, o_.solve);
     report_ = MakeCameraReport(o_.board, *solution_, 0, views_, o_.verdict);
@@ -205,8 +229,11 @@ void CalibrationWizard::SolveIntrinsics(int frame) {
     report_ = FailedCameraReport(camera_, views_, e.what());
   }
   intrinsics_good_ = report_->good;
-  Event(frame, "solve", {{"views", views()}, {"verdict", intrinsics_good_ ? "good" : "rejected"},
-                         {"reasons", report_->reasons}, {"rms_px", solution_ ? solution_->rms_px[0] : NAN}});
+  Event(frame, "solve",
+        {{"views", views()},
+         {"verdict", intrinsics_good_ ? "good" : "rejected"},
+         {"reasons", report_->reasons},
+         {"rms_px", solution_ ? solution_->rms_px[0] : NAN}});
   if (intrinsics_good_) {
     intrinsics_model_ = solution_->models[0];
     intrinsics_model_->set_cam_from_ground(Rigid3{});
@@ -264,13 +291,15 @@ void CalibrationWizard::TryEmptyFloor(const cv::Mat& image, int frame) {
     // least what the frame with the board lying on it showed.
     const double with_board_m2 = floor_with_board_ ? floor_with_board_->Area() : 0.0;
     if (found.Area() < 0.95 * with_board_m2) {
-      Event(frame, "enclosure_rejected", {{"from", from}, {"area_m2", found.Area()}, {"with_board_m2", with_board_m2}});
+      Event(frame, "enclosure_rejected",
+            {{"from", from}, {"area_m2", found.Area()}, {"with_board_m2", with_board_m2}});
       return;
     }
     floor_ = std::move(found);
     floor_from_ = "green floor";
     step_ = WizardStep::kDone;
-    Event(frame, "enclosure", {{"from", from}, {"area_m2", floor_->Area()}, {"vertices", floor_->vertices().size()}});
+    Event(frame, "enclosure",
+          {{"from", from}, {"area_m2", floor_->Area()}, {"vertices", floor_->vertices().size()}});
   } catch (const std::runtime_error& e) {
     Event(frame, "enclosure_failed", {{"from", from}, {"reason", e.what()}});
   }
@@ -289,8 +318,9 @@ WizardFrame CalibrationWizard::Feed(const cv::Mat& image, int frame) {
   if (step_ == WizardStep::kDone) return out;
   if (image.cols != width_ || image.rows != height_) {
     throw InputError(camera_ + " frame " + std::to_string(frame),
-                     "the frame is " + std::to_string(image.cols) + "x" + std::to_string(image.rows) +
-                         ", the camera " + std::to_string(width_) + "x" + std::to_string(height_));
+                     "the frame is " + std::to_string(image.cols) + "x" +
+                         std::to_string(image.rows) + ", the camera " + std::to_string(width_) +
+                         "x" + std::to_string(height_));
   }
   // Detection is slow on frames without a board (0.1-0.4 s): while none is
   // in view, every 4th frame is searched; once one is, every frame.
@@ -310,7 +340,8 @@ WizardFrame CalibrationWizard::Feed(const cv::Mat& image, int frame) {
   if (!view.accepted) {
     run_.clear();
     run_used_ = false;
-  } else if (!run_.empty() && SameIds(run_.back(), view) && MaxMotion(run_.back(), view) < o_.still_px) {
+  } else if (!run_.empty() && SameIds(run_.back(), view) &&
+             MaxMotion(run_.back(), view) < o_.still_px) {
     run_.push_back(view);
   } else {
     run_ = {view};
@@ -346,7 +377,8 @@ WizardFrame CalibrationWizard::Feed(const cv::Mat& image, int frame) {
         } else if (views() >= o_.max_views) {
           SolveIntrinsics(frame);
           if (!intrinsics_good_) {
-            verdicts_.push_back("intrinsics: " + (report_->reasons.empty() ? "rejected" : report_->reasons.front()));
+            verdicts_.push_back("intrinsics: " +
+                                (report_->reasons.empty() ? "rejected" : report_->reasons.front()));
             step_ = WizardStep::kDone;
             Event(frame, "verdict", {{"reason", verdicts_.back()}});
           }
@@ -359,7 +391,8 @@ WizardFrame CalibrationWizard::Feed(const cv::Mat& image, int frame) {
     }
     if (step_ == WizardStep::kIntrinsics) {
       const std::vector<std::string> missing = MissingForIntrinsics();
-      if (!o_.auto_solve && missing.empty()) now.insert(now.begin(), "the views meet the criteria: solve");
+      if (!o_.auto_solve && missing.empty())
+        now.insert(now.begin(), "the views meet the criteria: solve");
       for (auto& m : missing) now.push_back(std::move(m));
     }
   }
@@ -371,9 +404,12 @@ WizardFrame CalibrationWizard::Feed(const cv::Mat& image, int frame) {
     } else {
       try {
         floor_view_ = AverageStillViews(run_, 2 * o_.still_px);
-        ground_ = SolveGroundPose(*intrinsics_model_, o_.board, floor_view_, o_.ground_from_board, camera_);
-        Event(frame, "ground", {{"height_m", ground_->height_m}, {"rms_px", ground_->rms_px},
-                                {"from", floor_view_.source}});
+        ground_ = SolveGroundPose(*intrinsics_model_, o_.board, floor_view_, o_.ground_from_board,
+                                  camera_);
+        Event(frame, "ground",
+              {{"height_m", ground_->height_m},
+               {"rms_px", ground_->rms_px},
+               {"from", floor_view_.source}});
         EnterEnclosure(frame, image);
       } catch (const std::runtime_error& e) {
         Event(frame, "ground_failed", {{"reason", e.what()}});
@@ -389,7 +425,9 @@ WizardFrame CalibrationWizard::Feed(const cv::Mat& image, int frame) {
       if (!floor_) empty_frames_ = 0;
     }
     if (step_ == WizardStep::kEnclosure) {
-      now.push_back("take the board off the floor and clear the floor: the empty green floor gives the enclosure");
+      now.push_back(
+          "take the board off the floor and clear the floor: the empty green floor gives the "
+          "enclosure");
     }
   }
   out.step = step_;
@@ -403,18 +441,21 @@ WizardFrame CalibrationWizard::Feed(const cv::Mat& image, int frame) {
 
 void CalibrationWizard::Solve(int frame) {
   if (step_ != WizardStep::kIntrinsics) {
-    throw InputError("solve", std::string("the intrinsics step is over (now: ") + WizardStepName(step_) + ")");
+    throw InputError(
+        "solve", std::string("the intrinsics step is over (now: ") + WizardStepName(step_) + ")");
   }
   constexpr int kMinToSolve = 3;
   if (views() < kMinToSolve) {
-    throw InputError("solve", std::to_string(views()) + " views captured; at least " + std::to_string(kMinToSolve) +
-                                  " are needed to solve (" + std::to_string(o_.verdict.min_views) + " to trust it)");
+    throw InputError("solve", std::to_string(views()) + " views captured; at least " +
+                                  std::to_string(kMinToSolve) + " are needed to solve (" +
+                                  std::to_string(o_.verdict.min_views) + " to trust it)");
   }
   SolveIntrinsics(frame);
 }
 
 void CalibrationWizard::DropView(size_t index, const std::string& why) {
-  Event(-1, "drop", {{"view", static_cast<int>(index) + 1}, {"why", why}, {"source", views_[index].source}});
+  Event(-1, "drop",
+        {{"view", static_cast<int>(index) + 1}, {"why", why}, {"source", views_[index].source}});
   views_.erase(views_.begin() + static_cast<std::ptrdiff_t>(index));
   described_.erase(described_.begin() + static_cast<std::ptrdiff_t>(index));
   // The coverage and the tilt are of the views that are left.
@@ -422,11 +463,14 @@ void CalibrationWizard::DropView(size_t index, const std::string& why) {
   max_tilt_deg_ = 0;
   for (size_t i = 0; i < views_.size(); ++i) {
     for (const auto& p : views_[i].pixels) {
-      const int gx = std::clamp(static_cast<int>(p.x() / width_ * coverage_.cols), 0, coverage_.cols - 1);
-      const int gy = std::clamp(static_cast<int>(p.y() / height_ * coverage_.rows), 0, coverage_.rows - 1);
+      const int gx =
+          std::clamp(static_cast<int>(p.x() / width_ * coverage_.cols), 0, coverage_.cols - 1);
+      const int gy =
+          std::clamp(static_cast<int>(p.y() / height_ * coverage_.rows), 0, coverage_.rows - 1);
       coverage_.at<float>(gy, gx) += 1;
     }
-    const double tilt = std::acos(std::clamp(std::abs(described_[i].normal.z()), 0.0, 1.0)) * 180 / M_PI;
+    const double tilt =
+        std::acos(std::clamp(std::abs(described_[i].normal.z()), 0.0, 1.0)) * 180 / M_PI;
     max_tilt_deg_ = std::max(max_tilt_deg_, tilt);
   }
   // The solve described views that changed.
@@ -475,7 +519,8 @@ void CalibrationWizard::DropWorst() {
 void CalibrationWizard::Redo(WizardStep step) {
   switch (step) {
     case WizardStep::kIntrinsics:
-      if (o_.intrinsics) throw InputError("step", "the intrinsics were given: redo the ground step instead");
+      if (o_.intrinsics)
+        throw InputError("step", "the intrinsics were given: redo the ground step instead");
       views_.clear();
       described_.clear();
       coverage_.setTo(0);
@@ -491,14 +536,16 @@ void CalibrationWizard::Redo(WizardStep step) {
       step_ = WizardStep::kIntrinsics;
       break;
     case WizardStep::kGround:
-      if (!intrinsics_model_ || !intrinsics_good_) throw InputError("step", "no trusted intrinsics yet: solve them first");
+      if (!intrinsics_model_ || !intrinsics_good_)
+        throw InputError("step", "no trusted intrinsics yet: solve them first");
       ground_.reset();
       floor_.reset();
       floor_with_board_.reset();
       step_ = WizardStep::kGround;
       break;
     case WizardStep::kEnclosure:
-      if (!ground_) throw InputError("step", "the camera is not posed yet: finish the ground step first");
+      if (!ground_)
+        throw InputError("step", "the camera is not posed yet: finish the ground step first");
       floor_.reset();
       step_ = WizardStep::kEnclosure;
       break;
@@ -515,15 +562,20 @@ void CalibrationWizard::Redo(WizardStep step) {
 
 void CalibrationWizard::SetFloorFromPixels(const std::vector<Eigen::Vector2d>& pixels) {
   const std::optional<CameraModel> posed = posed_model();
-  if (!posed) throw InputError("pixels", "the camera is not posed yet: finish the ground step first");
+  if (!posed)
+    throw InputError("pixels", "the camera is not posed yet: finish the ground step first");
   floor_ = FloorPolygonFromPixels(*posed, pixels, "pixels");
   floor_from_ = "clicked corners";
   step_ = WizardStep::kDone;
-  Event(-1, "enclosure", {{"from", floor_from_}, {"area_m2", floor_->Area()}, {"vertices", floor_->vertices().size()}});
+  Event(-1, "enclosure",
+        {{"from", floor_from_},
+         {"area_m2", floor_->Area()},
+         {"vertices", floor_->vertices().size()}});
 }
 
 void CalibrationWizard::DetectFloor(const cv::Mat& image) {
-  if (!posed_model()) throw InputError("detect", "the camera is not posed yet: finish the ground step first");
+  if (!posed_model())
+    throw InputError("detect", "the camera is not posed yet: finish the ground step first");
   try {
     floor_ = GreenFloorIn(image);
   } catch (const WorkError& e) {
@@ -531,7 +583,10 @@ void CalibrationWizard::DetectFloor(const cv::Mat& image) {
   }
   floor_from_ = "green floor";
   step_ = WizardStep::kDone;
-  Event(-1, "enclosure", {{"from", floor_from_}, {"area_m2", floor_->Area()}, {"vertices", floor_->vertices().size()}});
+  Event(-1, "enclosure",
+        {{"from", floor_from_},
+         {"area_m2", floor_->Area()},
+         {"vertices", floor_->vertices().size()}});
 }
 
 ViewDiversity CalibrationWizard::diversity() const {
@@ -558,8 +613,10 @@ ViewDiversity CalibrationWizard::diversity() const {
       skew = std::min(1.0, 2.0 * std::abs(M_PI / 2 - angle));
     }
     const double value[4] = {mean.x() / width_, mean.y() / height_,
-                             std::sqrt((b - a).prod() / (static_cast<double>(width_) * height_)), skew};
-    for (int k = 0; k < 4; ++k) lo[k] = std::min(lo[k], value[k]), hi[k] = std::max(hi[k], value[k]);
+                             std::sqrt((b - a).prod() / (static_cast<double>(width_) * height_)),
+                             skew};
+    for (int k = 0; k < 4; ++k)
+      lo[k] = std::min(lo[k], value[k]), hi[k] = std::max(hi[k], value[k]);
   }
   const double range[4] = {0.7, 0.7, 0.4, 0.5};  // ROS's param_ranges
   double* out[4] = {&d.x, &d.y, &d.size, &d.skew};
@@ -585,7 +642,8 @@ void CalibrationWizard::Finish() {
       verdicts_.push_back("intrinsics: " + reason);
       for (const auto& m : MissingForIntrinsics()) {
         const bool repeats = reason.find(m) != std::string::npos ||
-                             (m.rfind("capture more views", 0) == 0 && reason.find("too few views") != std::string::npos);
+                             (m.rfind("capture more views", 0) == 0 &&
+                              reason.find("too few views") != std::string::npos);
         if (!repeats) {
           verdicts_.push_back("intrinsics: " + m);
         }
@@ -596,34 +654,41 @@ void CalibrationWizard::Finish() {
     }
   }
   if (step_ == WizardStep::kGround) {
-    verdicts_.push_back("ground: no board lying still on the floor was seen; lay the board flat on the floor");
+    verdicts_.push_back(
+        "ground: no board lying still on the floor was seen; lay the board flat on the floor");
     step_ = WizardStep::kDone;
     Event(-1, "verdict", {{"reason", verdicts_.back()}});
     return;
   }
   if (step_ == WizardStep::kEnclosure) {
-    // No empty floor was seen: the frame with the board on the floor (the board is inside the floor's outline).
+    // No empty floor was seen: the frame with the board on the floor (the board is inside the
+    // floor's outline).
     const std::string from = "the frame with the board on the floor";
     if (floor_with_board_) {
       floor_ = floor_with_board_;
       floor_from_ = "green floor";
-      Event(-1, "enclosure", {{"from", from}, {"area_m2", floor_->Area()}, {"vertices", floor_->vertices().size()}});
+      Event(-1, "enclosure",
+            {{"from", from}, {"area_m2", floor_->Area()}, {"vertices", floor_->vertices().size()}});
     } else {
       Event(-1, "enclosure_failed", {{"from", from}, {"reason", floor_with_board_error_}});
-      verdicts_.push_back("enclosure: no green floor found; show the empty floor or give --floor-points");
+      verdicts_.push_back(
+          "enclosure: no green floor found; show the empty floor or give --floor-points");
       Event(-1, "verdict", {{"reason", verdicts_.back()}});
     }
     step_ = WizardStep::kDone;
   }
 }
 
-nlohmann::json WriteWizardOutputs(const CalibrationWizard& w, const std::string& out_dir, const VerdictOptions& verdict) {
+nlohmann::json WriteWizardOutputs(const CalibrationWizard& w, const std::string& out_dir,
+                                  const VerdictOptions& verdict) {
   namespace fs = std::filesystem;
   std::error_code ec;
   fs::create_directories(out_dir, ec);
   if (ec) throw WorkError(out_dir, "cannot create the output folder: " + ec.message());
   const std::string base = (fs::path(out_dir) / w.camera()).string();
-  auto num = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); };
+  auto num = [](double v) {
+    return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr);
+  };
   nlohmann::json j;
   j["camera"] = w.camera();
   j["verdict"] = w.verdicts().empty() ? "good" : "rejected";
@@ -648,7 +713,8 @@ nlohmann::json WriteWizardOutputs(const CalibrationWizard& w, const std::string&
     model_file = base + ".cameramodel";
     const GroundResult& g = *w.ground();
     j["ground"] = {{"height_m", g.height_m},
-                   {"centre_in_ground_m", {g.centre_in_ground.x(), g.centre_in_ground.y(), g.centre_in_ground.z()}},
+                   {"centre_in_ground_m",
+                    {g.centre_in_ground.x(), g.centre_in_ground.y(), g.centre_in_ground.z()}},
                    {"optical_axis_down_deg", g.optical_axis_down_deg},
                    {"board_rms_px", num(g.rms_px)},
                    {"board_worst_px", num(g.worst_px)},
@@ -661,8 +727,10 @@ nlohmann::json WriteWizardOutputs(const CalibrationWizard& w, const std::string&
     std::ofstream f(yaml);
     f << EnclosureYaml(*w.floor(), 0.0);
     if (!f) throw WorkError(yaml, "cannot write");
-    j["enclosure"] = {{"file", yaml}, {"area_m2", w.floor()->Area()}, {"vertices", nlohmann::json::array()}};
-    for (const auto& v : w.floor()->vertices()) j["enclosure"]["vertices"].push_back({v.x(), v.y()});
+    j["enclosure"] = {
+        {"file", yaml}, {"area_m2", w.floor()->Area()}, {"vertices", nlohmann::json::array()}};
+    for (const auto& v : w.floor()->vertices())
+      j["enclosure"]["vertices"].push_back({v.x(), v.y()});
   }
   j["model"] = model_file;
   j["log"] = w.log();

@@ -28,20 +28,22 @@ namespace ss::calib {
 struct WizardOptions {
   BoardSpec board;
   DetectOptions detect;
-  VerdictOptions verdict;          // min_views, min_coverage, min_tilt_deg, max_rms_px: when to stop, what to trust
+  VerdictOptions
+      verdict;  // min_views, min_coverage, min_tilt_deg, max_rms_px: when to stop, what to trust
   SolveOptions solve;
-  double still_px = 0.5;           // largest corner motion between two frames of a still board
-  int still_frames = 2;            // intrinsics: frames in a row the board must be still for a capture
-  double min_shift = 0.08;         // a new view differs from every captured one: its centre moved this
-                                   // fraction of the image diagonal, ...
-  double min_tilt_change_deg = 10; // ... or its tilt changed this much, ...
-  double min_scale_change = 0.25;  // ... or its size in the image this fraction, ...
-  int min_new_cells = 3;           // ... or it puts corners in this many empty coverage cells
-  int max_views = 30;              // intrinsics: solve what there is at this many views
-  int floor_still_frames = 5;      // ground: still this long = lying on the floor (a held board is not)
+  double still_px = 0.5;    // largest corner motion between two frames of a still board
+  int still_frames = 2;     // intrinsics: frames in a row the board must be still for a capture
+  double min_shift = 0.08;  // a new view differs from every captured one: its centre moved this
+                            // fraction of the image diagonal, ...
+  double min_tilt_change_deg = 10;  // ... or its tilt changed this much, ...
+  double min_scale_change = 0.25;   // ... or its size in the image this fraction, ...
+  int min_new_cells = 3;            // ... or it puts corners in this many empty coverage cells
+  int max_views = 30;               // intrinsics: solve what there is at this many views
+  int floor_still_frames = 5;  // ground: still this long = lying on the floor (a held board is not)
   Rigid3 ground_from_board = FloorBoardPose();
-  std::vector<Eigen::Vector2d> floor_points;  // enclosure in ground metres; empty: the largest green floor region
-  std::optional<CameraModel> intrinsics;      // known intrinsics: start at the ground step
+  std::vector<Eigen::Vector2d>
+      floor_points;  // enclosure in ground metres; empty: the largest green floor region
+  std::optional<CameraModel> intrinsics;  // known intrinsics: start at the ground step
   // false: the intrinsics are solved only when Solve() is called (the console's Solve button);
   // capturing stops at max_views.
   bool auto_solve = true;
@@ -143,17 +145,17 @@ class CalibrationWizard {
   int width_, height_;
   WizardOptions o_;
   WizardStep step_ = WizardStep::kIntrinsics;
-  std::vector<BoardView> run_;       // consecutive still detections ending at the last frame
-  bool run_used_ = false;            // the current still run was captured already
-  int empty_frames_ = 0;             // enclosure: frames in a row without a board
-  int fed_ = 0;                      // frames fed
-  bool last_detected_ = false;       // the board was found in the last frame
-  std::string last_rejection_;       // why the last searched frame had no board
-  std::vector<BoardView> views_;     // captured intrinsics views
+  std::vector<BoardView> run_;    // consecutive still detections ending at the last frame
+  bool run_used_ = false;         // the current still run was captured already
+  int empty_frames_ = 0;          // enclosure: frames in a row without a board
+  int fed_ = 0;                   // frames fed
+  bool last_detected_ = false;    // the board was found in the last frame
+  std::string last_rejection_;    // why the last searched frame had no board
+  std::vector<BoardView> views_;  // captured intrinsics views
   std::vector<Captured> described_;
   cv::Mat coverage_;
   double max_tilt_deg_ = 0;
-  int next_solve_at_ = 0;            // views needed before solving again after a failed verdict
+  int next_solve_at_ = 0;  // views needed before solving again after a failed verdict
   bool board_seen_ = false, intrinsics_good_ = false;
   std::optional<SolveSummary> solution_;
   std::optional<CameraReport> report_;

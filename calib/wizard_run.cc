@@ -10,7 +10,8 @@
 
 namespace ss::calib {
 
-WizardRunResult RunWizardOnSource(FrameSource& source, CalibrationWizard& wizard, const WizardRunOptions& options,
+WizardRunResult RunWizardOnSource(FrameSource& source, CalibrationWizard& wizard,
+                                  const WizardRunOptions& options,
                                   const std::function<void()>& after_frame) {
   // A live camera that stops delivering (unplugged, its stream ended) ends the run with what
   // it has; Next() itself waits for frames as long as the source lives. (The station's
@@ -22,7 +23,8 @@ WizardRunResult RunWizardOnSource(FrameSource& source, CalibrationWizard& wizard
   cv::Mat bgr;
   {
     std::jthread watchdog([&] {
-      const auto limit = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(options.silent_s));
+      const auto limit = std::chrono::duration_cast<Clock::duration>(
+          std::chrono::duration<double>(options.silent_s));
       while (reading.load()) {
         std::this_thread::sleep_for(std::chrono::milliseconds(100));
         if (Clock::now().time_since_epoch().count() - last_frame_ns.load() > limit.count()) {

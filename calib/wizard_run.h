@@ -12,8 +12,8 @@
 namespace ss::calib {
 
 struct WizardRunOptions {
-  int max_frames = 0;      // stop after this many frames; 0: until done or the stream ends
-  double silent_s = 5.0;   // a camera without a frame this long ends the run
+  int max_frames = 0;     // stop after this many frames; 0: until done or the stream ends
+  double silent_s = 5.0;  // a camera without a frame this long ends the run
 };
 
 struct WizardRunResult {
@@ -22,7 +22,8 @@ struct WizardRunResult {
 };
 
 // `after_frame` runs after each frame (progress, the wizard's log). Does not call Finish().
-WizardRunResult RunWizardOnSource(FrameSource& source, CalibrationWizard& wizard, const WizardRunOptions& options,
+WizardRunResult RunWizardOnSource(FrameSource& source, CalibrationWizard& wizard,
+                                  const WizardRunOptions& options,
                                   const std::function<void()>& after_frame = nullptr);
 
 }  // namespace ss::calib

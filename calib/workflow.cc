@@ -60,8 +60,8 @@ JobOutcome RunIntrinsics(const std::vector<CameraViews>& cameras, const Intrinsi
     if (accepted < kMinToSolve) {
       std::string reason;
       if (accepted == 0) {
-        reason = "no board (" + job.board.ToString() + ") found in any of the " + std::to_string(cam.views.size()) +
-                 " views";
+        reason = "no board (" + job.board.ToString() + ") found in any of the " +
+                 std::to_string(cam.views.size()) + " views";
         if (!cam.views.empty()) reason += " (first view: " + cam.views.front().rejection + ")";
         reason += "; check the board spec";
       } else {
@@ -75,7 +75,8 @@ JobOutcome RunIntrinsics(const std::vector<CameraViews>& cameras, const Intrinsi
     solve_cameras.push_back({cam.name, cam.width, cam.height});
     for (size_t i = 0; i < cam.views.size(); ++i) {
       const auto& v = cam.views[i];
-      if (v.accepted) observations.push_back({solve_index[c], cam.frames[i], v.source, v.ids, v.pixels});
+      if (v.accepted)
+        observations.push_back({solve_index[c], cam.frames[i], v.source, v.ids, v.pixels});
     }
   }
   std::optional<SolveSummary> solution;
@@ -92,7 +93,8 @@ JobOutcome RunIntrinsics(const std::vector<CameraViews>& cameras, const Intrinsi
   out.all_good = true;
   for (size_t c = 0; c < cameras.size(); ++c) {
     const int s = solve_index[c];
-    if (s >= 0 && !solution) reports[c] = FailedCameraReport(cameras[c].name, cameras[c].views, solve_error);
+    if (s >= 0 && !solution)
+      reports[c] = FailedCameraReport(cameras[c].name, cameras[c].views, solve_error);
     if (s >= 0 && solution) {
       CameraReport& r = reports[c];
       r = MakeCameraReport(job.board, *solution, s, cameras[c].views, job.verdict);
@@ -118,9 +120,11 @@ JobOutcome RunIntrinsics(const std::vector<CameraViews>& cameras, const Intrinsi
     j["summary"] = solution->summary;
     j["pixel_sigma"] = solution->pixel_sigma;
     j["board_warp_m"] = {solution->board_warp[0], solution->board_warp[1]};
-    j["poses"] = nlohmann::json::object();  // cam_from_ref as mrcal rt, reference = the first solved camera
+    j["poses"] =
+        nlohmann::json::object();  // cam_from_ref as mrcal rt, reference = the first solved camera
     for (size_t c = 0; c < cameras.size(); ++c) {
-      if (solve_index[c] >= 0) j["poses"][cameras[c].name] = PoseJson(solution->models[solve_index[c]].cam_from_ground());
+      if (solve_index[c] >= 0)
+        j["poses"][cameras[c].name] = PoseJson(solution->models[solve_index[c]].cam_from_ground());
     }
   }
   if (!solve_error.empty()) j["error"] = solve_error;
@@ -134,10 +138,11 @@ JobOutcome RunIntrinsics(const std::vector<CameraViews>& cameras, const Intrinsi
     }
     double focal = cameras.empty() ? 0 : 0.8 * cameras.front().width;
     if (solution) focal = solution->models.front().intrinsics()[0];
-    j["mrcal_cross_check"] = {{"corners", vnl},
-                              {"command", MrcalCalibrateCommand(job.board, cameras, vnl,
-                                                                (fs::path(job.out_dir) / "mrcal").string(),
-                                                                job.solve.lensmodel, std::round(focal))}};
+    j["mrcal_cross_check"] = {
+        {"corners", vnl},
+        {"command",
+         MrcalCalibrateCommand(job.board, cameras, vnl, (fs::path(job.out_dir) / "mrcal").string(),
+                               job.solve.lensmodel, std::round(focal))}};
   }
   j["cameras"] = nlohmann::json::array();
   std::ostringstream text;
@@ -152,9 +157,10 @@ JobOutcome RunIntrinsics(const std::vector<CameraViews>& cameras, const Intrinsi
   return out;
 }
 
-JobOutcome RunGround(const std::vector<CameraViews>& cameras, const std::vector<CameraModel>& models,
-                     const GroundJob& job) {
-  if (models.size() != cameras.size()) throw InputError("--models", "one camera model per camera is needed");
+JobOutcome RunGround(const std::vector<CameraViews>& cameras,
+                     const std::vector<CameraModel>& models, const GroundJob& job) {
+  if (models.size() != cameras.size())
+    throw InputError("--models", "one camera model per camera is needed");
   MakeDir(job.out_dir);
   JobOutcome out;
   out.all_good = true;
@@ -172,14 +178,15 @@ JobOutcome RunGround(const std::vector<CameraViews>& cameras, const std::vector<
     }
     if (still.empty()) {
       errors[c] = "no floor board seen";
-      if (!cameras[c].views.empty()) errors[c] += " (first view: " + cameras[c].views.front().rejection + ")";
+      if (!cameras[c].views.empty())
+        errors[c] += " (first view: " + cameras[c].views.front().rejection + ")";
       continue;
     }
     out.any_board = true;
     if (models[c].width() != cameras[c].width || models[c].height() != cameras[c].height) {
       errors[c] = "the model's imager is " + std::to_string(models[c].width()) + "x" +
-                  std::to_string(models[c].height()) + " but the views are " + std::to_string(cameras[c].width) +
-                  "x" + std::to_string(cameras[c].height);
+                  std::to_string(models[c].height()) + " but the views are " +
+                  std::to_string(cameras[c].width) + "x" + std::to_string(cameras[c].height);
       continue;
     }
     try {
@@ -189,7 +196,8 @@ JobOutcome RunGround(const std::vector<CameraViews>& cameras, const std::vector<
       used[c] = still.front();
     }
     try {
-      results[c] = SolveGroundPose(models[c], job.board, used[c], job.ground_from_board, cameras[c].name);
+      results[c] =
+          SolveGroundPose(models[c], job.board, used[c], job.ground_from_board, cameras[c].name);
     } catch (const std::runtime_error& e) {
       errors[c] = e.what();
     }
@@ -203,10 +211,12 @@ JobOutcome RunGround(const std::vector<CameraViews>& cameras, const std::vector<
         if (!results[k] || derived[k]) continue;
         GroundResult g;
         g.camera = cameras[c].name;
-        g.cam_from_ground = models[c].cam_from_ground() * models[k].cam_from_ground().Inverse() * results[k]->cam_from_ground;
+        g.cam_from_ground = models[c].cam_from_ground() * models[k].cam_from_ground().Inverse() *
+                            results[k]->cam_from_ground;
         g.centre_in_ground = g.cam_from_ground.Inverse().translation;
         g.height_m = g.centre_in_ground.z();
-        const Eigen::Vector3d axis = g.cam_from_ground.rotation.transpose() * Eigen::Vector3d::UnitZ();
+        const Eigen::Vector3d axis =
+            g.cam_from_ground.rotation.transpose() * Eigen::Vector3d::UnitZ();
         g.optical_axis_down_deg = std::asin(std::clamp(-axis.z(), -1.0, 1.0)) * 180 / M_PI;
         g.rms_px = g.worst_px = NAN;
         results[c] = g;
@@ -233,10 +243,13 @@ JobOutcome RunGround(const std::vector<CameraViews>& cameras, const std::vector<
     posed.set_cam_from_ground(g.cam_from_ground);
     const std::string file = (fs::path(job.out_dir) / (cameras[c].name + ".cameramodel")).string();
     posed.Write(file);
-    auto num = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); };
+    auto num = [](double v) {
+      return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr);
+    };
     cj["model"] = file;
     cj["cam_from_ground_rt"] = PoseJson(g.cam_from_ground);
-    cj["centre_in_ground_m"] = {g.centre_in_ground.x(), g.centre_in_ground.y(), g.centre_in_ground.z()};
+    cj["centre_in_ground_m"] = {g.centre_in_ground.x(), g.centre_in_ground.y(),
+                                g.centre_in_ground.z()};
     cj["height_m"] = g.height_m;
     cj["optical_axis_down_deg"] = g.optical_axis_down_deg;
     cj["board_rms_px"] = num(g.rms_px);
@@ -245,10 +258,12 @@ JobOutcome RunGround(const std::vector<CameraViews>& cameras, const std::vector<
     cj["from"] = derived[c] ? "rigid rig (no floor view)" : used[c].source;
     j["cameras"].push_back(cj);
     std::snprintf(buf, sizeof buf,
-                  "%s: height %.4f m, at (%.4f, %.4f) m, looking %.1f deg down; floor board RMS %.3f px, worst %.3f px "
+                  "%s: height %.4f m, at (%.4f, %.4f) m, looking %.1f deg down; floor board RMS "
+                  "%.3f px, worst %.3f px "
                   "(%d corners)%s\n",
-                  cameras[c].name.c_str(), g.height_m, g.centre_in_ground.x(), g.centre_in_ground.y(),
-                  g.optical_axis_down_deg, g.rms_px, g.worst_px, g.corners, derived[c] ? " [from the rigid rig]" : "");
+                  cameras[c].name.c_str(), g.height_m, g.centre_in_ground.x(),
+                  g.centre_in_ground.y(), g.optical_axis_down_deg, g.rms_px, g.worst_px, g.corners,
+                  derived[c] ? " [from the rigid rig]" : "");
     text << buf;
   }
   j["cross_checks"] = nlohmann::json::array();
@@ -260,10 +275,14 @@ JobOutcome RunGround(const std::vector<CameraViews>& cameras, const std::vector<
       mb.set_cam_from_ground(results[b]->cam_from_ground);
       const CrossCheck x = CrossReprojection(ma, used[a], mb, used[b], job.ground_from_board);
       if (x.points == 0) continue;
-      j["cross_checks"].push_back(
-          {{"from", cameras[a].name}, {"to", cameras[b].name}, {"points", x.points}, {"rms_px", x.rms_px}, {"worst_px", x.worst_px}});
-      std::snprintf(buf, sizeof buf, "  floor points %s -> %s: RMS %.3f px, worst %.3f px (%d points)\n",
-                    cameras[a].name.c_str(), cameras[b].name.c_str(), x.rms_px, x.worst_px, x.points);
+      j["cross_checks"].push_back({{"from", cameras[a].name},
+                                   {"to", cameras[b].name},
+                                   {"points", x.points},
+                                   {"rms_px", x.rms_px},
+                                   {"worst_px", x.worst_px}});
+      std::snprintf(
+          buf, sizeof buf, "  floor points %s -> %s: RMS %.3f px, worst %.3f px (%d points)\n",
+          cameras[a].name.c_str(), cameras[b].name.c_str(), x.rms_px, x.worst_px, x.points);
       text << buf;
     }
   }

@@ -20,15 +20,15 @@ struct IntrinsicsJob {
   BoardSpec board;
   SolveOptions solve;
   VerdictOptions verdict;
-  std::string out_dir;       // DIR/<camera>.cameramodel, .residuals.png, .coverage.png, intrinsics.json
+  std::string out_dir;  // DIR/<camera>.cameramodel, .residuals.png, .coverage.png, intrinsics.json
   bool write_rejected = false;  // also write the models of cameras whose verdict is "rejected"
 };
 
 struct JobOutcome {
-  nlohmann::json report;     // also written to the output folder
-  std::string text;          // for a person
-  bool all_good = false;     // every camera got a trusted result
-  bool any_board = false;    // the board was found at all (false: probably the wrong spec)
+  nlohmann::json report;   // also written to the output folder
+  std::string text;        // for a person
+  bool all_good = false;   // every camera got a trusted result
+  bool any_board = false;  // the board was found at all (false: probably the wrong spec)
 };
 
 // Solves every camera with enough accepted views (jointly when there are
@@ -39,13 +39,14 @@ JobOutcome RunIntrinsics(const std::vector<CameraViews>& cameras, const Intrinsi
 struct GroundJob {
   BoardSpec board;
   Rigid3 ground_from_board = FloorBoardPose();
-  std::string out_dir;       // DIR/<camera>.cameramodel with cam_from_ground, ground.json
-  int still_views = 5;       // accepted views averaged per camera
-  bool rigid = false;        // models share one reference (joint solve): cameras without a floor view follow the others
+  std::string out_dir;  // DIR/<camera>.cameramodel with cam_from_ground, ground.json
+  int still_views = 5;  // accepted views averaged per camera
+  bool rigid = false;   // models share one reference (joint solve): cameras without a floor view
+                        // follow the others
 };
 
 // `models[i]` holds camera i's intrinsics (and, with `rigid`, its pose in the shared reference).
-JobOutcome RunGround(const std::vector<CameraViews>& cameras, const std::vector<CameraModel>& models,
-                     const GroundJob& job);
+JobOutcome RunGround(const std::vector<CameraViews>& cameras,
+                     const std::vector<CameraModel>& models, const GroundJob& job);
 
 }  // namespace ss::calib

@@ -30,7 +30,9 @@ std::vector<const CameraBackend*> CameraBackends() { return Backends().All(); }
 std::optional<PixelFormat> PixelFormatOf(const CameraConfig& camera) {
   if (camera.pixel_format.empty()) return std::nullopt;
   const std::optional<PixelFormat> format = ParsePixelFormat(camera.pixel_format);
-  if (!format) throw InputError("cameras." + camera.name + ".pixel_format", "unknown '" + camera.pixel_format + "'");
+  if (!format)
+    throw InputError("cameras." + camera.name + ".pixel_format",
+                     "unknown '" + camera.pixel_format + "'");
   return format;
 }
 

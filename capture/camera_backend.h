@@ -41,7 +41,8 @@ const CameraBackend* FindCameraBackend(const std::string& name);
 // Every backend built in, by name.
 std::vector<const CameraBackend*> CameraBackends();
 
-// The config's pixel format; nullopt when unset. InputError naming cameras.NAME.pixel_format when unknown.
+// The config's pixel format; nullopt when unset. InputError naming cameras.NAME.pixel_format when
+// unknown.
 std::optional<PixelFormat> PixelFormatOf(const CameraConfig& camera);
 
 // What every live backend's options share, from the camera's config.

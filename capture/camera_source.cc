@@ -23,7 +23,8 @@ std::unique_ptr<FrameSource> OpenCameraSource(const CameraConfig& camera, int ca
     std::string built;
     for (const CameraBackend* b : CameraBackends()) built += (built.empty() ? "" : ", ") + b->name;
     throw InputError("cameras." + camera.name + ".source",
-                     "no backend \"" + camera.source + "\" is built into this spritestation (built in: " + built + ")");
+                     "no backend \"" + camera.source +
+                         "\" is built into this spritestation (built in: " + built + ")");
   }
   return backend->open(camera, camera_index);
 }
@@ -37,8 +38,9 @@ std::optional<CameraModel> ModelForCamera(const CameraConfig& camera) {
     if (c.model.empty()) return std::nullopt;
     return CameraModel::Read((fs::path(camera.session) / c.model).string());
   }
-  throw InputError(camera.session + "/session.json",
-                   "the session has no camera '" + SessionCameraName(camera) + "' (cameras." + camera.name + ")");
+  throw InputError(camera.session + "/session.json", "the session has no camera '" +
+                                                         SessionCameraName(camera) + "' (cameras." +
+                                                         camera.name + ")");
 }
 
 }  // namespace ss

@@ -12,7 +12,7 @@
 namespace ss {
 
 struct SourceCamera {
-  std::string name;        // "cam0", a serial number, "/dev/video0"
+  std::string name;  // "cam0", a serial number, "/dev/video0"
   int width = 0;
   int height = 0;
   PixelFormat format = PixelFormat::kBGR8;
@@ -22,9 +22,10 @@ struct SourceCamera {
 
 struct SourceStats {
   uint64_t frames_delivered = 0;
-  uint64_t frames_dropped = 0;   // lost at the device or in the file (sequence gaps, unreadable frames)
-  uint64_t errors = 0;           // recoverable errors (a corrupt frame, a timeout)
-  std::string last_error;        // names the file/device and the frame
+  uint64_t frames_dropped =
+      0;                   // lost at the device or in the file (sequence gaps, unreadable frames)
+  uint64_t errors = 0;     // recoverable errors (a corrupt frame, a timeout)
+  std::string last_error;  // names the file/device and the frame
 };
 
 class FrameSource {

@@ -10,10 +10,10 @@
 
 #include "core/bank_pixels.h"
 #include "core/bank_schema.h"
+#include "core/error.h"
 #include "core/sql.h"
 #include "core/sql_postgres.h"
 #include "core/sql_sqlite.h"
-#include "core/error.h"
 
 namespace ss {
 namespace {
@@ -21,9 +21,11 @@ namespace {
 namespace fs = std::filesystem;
 
 // The sprite columns in the order ReadSprite reads them; the bank assigns the id.
-#define SS_SPRITE_FIELDS                                                                                      \
-  "clip_id, camera_id, track_id, frame, timestamp_ns, mirrored, mirror_of, ground_x_m, ground_y_m, "          \
-  "velocity_x_m_s, velocity_y_m_s, mean_r, mean_g, mean_b, area_px, eccentricity, bbox_x, bbox_y, bbox_w, " \
+#define SS_SPRITE_FIELDS                                                                    \
+  "clip_id, camera_id, track_id, frame, timestamp_ns, mirrored, mirror_of, ground_x_m, "    \
+  "ground_y_m, "                                                                            \
+  "velocity_x_m_s, velocity_y_m_s, mean_r, mean_g, mean_b, area_px, eccentricity, bbox_x, " \
+  "bbox_y, bbox_w, "                                                                        \
   "bbox_h, billboard_w_px, billboard_h_px, px_per_m, anchor_x_px, anchor_y_px"
 constexpr const char* kSpriteColumns = "id, " SS_SPRITE_FIELDS;
 constexpr const char* kSpriteFields = SS_SPRITE_FIELDS;
@@ -48,8 +50,8 @@ SpriteRecord ReadSprite(const sql::Stmt& s) {
   r.mean_b = s.Real(14);
   r.area_px = s.Real(15);
   r.eccentricity = s.Real(16);
-  r.bbox_in_image = cv::Rect(static_cast<int>(s.Int(17)), static_cast<int>(s.Int(18)), static_cast<int>(s.Int(19)),
-                             static_cast<int>(s.Int(20)));
+  r.bbox_in_image = cv::Rect(static_cast<int>(s.Int(17)), static_cast<int>(s.Int(18)),
+                             static_cast<int>(s.Int(19)), static_cast<int>(s.Int(20)));
   r.billboard_width_px = static_cast<int>(s.Int(21));
   r.billboard_height_px = static_cast<int>(s.Int(22));
   r.px_per_m = s.Real(23);
@@ -70,7 +72,8 @@ ClipRecord ReadClip(const sql::Stmt& s) {
   return c;
 }
 
-constexpr const char* kClipColumns = "id, camera_id, track_id, first_frame, last_frame, complete, complete_seq";
+constexpr const char* kClipColumns =
+    "id, camera_id, track_id, first_frame, last_frame, complete, complete_seq";
 
 int64_t FileBytes(const std::string& path) {
   std::error_code ec;
@@ -99,7 +102,8 @@ Bank::ReadCache& Bank::cache() const {
   if (!cache_) {
     cache_ = std::unique_ptr<ReadCache>(new ReadCache{
         db_->Prepare("SELECT s.mirrored, p.width_px, p.height_px, p.codec, p.data FROM sprites s "
-                     "LEFT JOIN sprite_pixels p ON p.sprite_id = coalesce(s.mirror_of, s.id) WHERE s.id = ?"),
+                     "LEFT JOIN sprite_pixels p ON p.sprite_id = coalesce(s.mirror_of, s.id) WHERE "
+                     "s.id = ?"),
         {}});
   }
   return *cache_;
@@ -118,17 +122,20 @@ std::vector<SessionRecord> Bank::ListSessions() const {
 
 std::vector<CameraRecord> Bank::ListCameras() const {
   std::vector<CameraRecord> out;
-  auto s = db_->Prepare("SELECT id, session_id, name, cameramodel, width, height FROM cameras ORDER BY id");
+  auto s = db_->Prepare(
+      "SELECT id, session_id, name, cameramodel, width, height FROM cameras ORDER BY id");
   while (s.Step()) {
-    out.push_back({s.Int(0), s.Int(1), s.Text(2), s.Text(3), static_cast<int>(s.Int(4)), static_cast<int>(s.Int(5))});
+    out.push_back({s.Int(0), s.Int(1), s.Text(2), s.Text(3), static_cast<int>(s.Int(4)),
+                   static_cast<int>(s.Int(5))});
   }
   return out;
 }
 
 std::vector<ClipRecord> Bank::ListClips(int64_t completed_after_seq) const {
   std::vector<ClipRecord> out;
-  auto s = db_->Prepare(std::string("SELECT ") + kClipColumns +
-                        " FROM clips WHERE complete = 1 AND complete_seq > ? ORDER BY complete_seq");
+  auto s =
+      db_->Prepare(std::string("SELECT ") + kClipColumns +
+                   " FROM clips WHERE complete = 1 AND complete_seq > ? ORDER BY complete_seq");
   s.Bind(1, completed_after_seq);
   while (s.Step()) out.push_back(ReadClip(s));
   return out;
@@ -143,10 +150,11 @@ std::vector<ClipRecord> Bank::ListAllClips() const {
 
 std::vector<SpriteFeatures> Bank::LoadFeatures(int64_t completed_after_seq) const {
   std::vector<SpriteFeatures> out;
-  out.reserve(static_cast<size_t>(
-      db_->QueryInt("SELECT count(*) FROM sprites s JOIN clips c ON c.id = s.clip_id WHERE c.complete = 1")));
+  out.reserve(static_cast<size_t>(db_->QueryInt(
+      "SELECT count(*) FROM sprites s JOIN clips c ON c.id = s.clip_id WHERE c.complete = 1")));
   auto s = db_->Prepare(
-      "SELECT s.id, s.clip_id, s.frame, s.timestamp_ns, s.mirror_of, s.mirrored, s.ground_x_m, s.ground_y_m, "
+      "SELECT s.id, s.clip_id, s.frame, s.timestamp_ns, s.mirror_of, s.mirrored, s.ground_x_m, "
+      "s.ground_y_m, "
       "s.velocity_x_m_s, s.velocity_y_m_s, s.mean_r, s.mean_g, s.mean_b, s.area_px, s.eccentricity "
       "FROM clips c JOIN sprites s ON s.clip_id = c.id WHERE c.complete = 1 AND c.complete_seq > ? "
       "ORDER BY s.clip_id, s.mirrored, s.frame");
@@ -170,7 +178,8 @@ std::vector<SpriteFeatures> Bank::LoadFeatures(int64_t completed_after_seq) cons
     f.eccentricity = static_cast<float>(s.Real(14));
     if (!out.empty()) {
       SpriteFeatures& before = out.back();
-      if (before.clip_id == f.clip_id && before.mirrored == f.mirrored && before.frame + 1 == f.frame) {
+      if (before.clip_id == f.clip_id && before.mirrored == f.mirrored &&
+          before.frame + 1 == f.frame) {
         f.prev = static_cast<int32_t>(out.size() - 1);
         before.next = static_cast<int32_t>(out.size());
       }
@@ -201,7 +210,8 @@ SpritePixels Bank::LoadPixels(int64_t id) const {
   const bool mirrored = s.Int(0) != 0;
   SpritePixels pixels;
   try {
-    pixels = c.codec.Decode(s.Blob(4), s.Bytes(4), static_cast<int>(s.Int(1)), static_cast<int>(s.Int(2)), s.Text(3));
+    pixels = c.codec.Decode(s.Blob(4), s.Bytes(4), static_cast<int>(s.Int(1)),
+                            static_cast<int>(s.Int(2)), s.Text(3));
   } catch (const WorkError& e) {
     s.Reset();
     throw WorkError(path_, "sprite " + std::to_string(id) + ": " + e.what());
@@ -217,7 +227,8 @@ SpritePixels Bank::LoadPixels(int64_t id) const {
 std::vector<TransitionRecord> Bank::LoadTransitions() const {
   std::vector<TransitionRecord> out;
   out.reserve(static_cast<size_t>(db_->QueryInt("SELECT count(*) FROM transitions")));
-  auto s = db_->Prepare("SELECT from_sprite, to_sprite, d, cost FROM transitions ORDER BY from_sprite, to_sprite");
+  auto s = db_->Prepare(
+      "SELECT from_sprite, to_sprite, d, cost FROM transitions ORDER BY from_sprite, to_sprite");
   while (s.Step()) out.push_back({s.Int(0), s.Int(1), s.Real(2), s.Real(3)});
   return out;
 }
@@ -227,8 +238,9 @@ namespace {
 // The transitions whose `end` column ("from_sprite" or "to_sprite") is `sprite`.
 std::vector<TransitionRecord> TransitionsAt(sql::Db& db, const char* end, int64_t sprite) {
   std::vector<TransitionRecord> out;
-  auto s = db.Prepare(std::string("SELECT from_sprite, to_sprite, d, cost FROM transitions WHERE ") + end +
-                      " = ? ORDER BY from_sprite, to_sprite");
+  auto s =
+      db.Prepare(std::string("SELECT from_sprite, to_sprite, d, cost FROM transitions WHERE ") +
+                 end + " = ? ORDER BY from_sprite, to_sprite");
   s.Bind(1, sprite);
   while (s.Step()) out.push_back({s.Int(0), s.Int(1), s.Real(2), s.Real(3)});
   return out;
@@ -254,8 +266,9 @@ std::vector<SpriteRecord> Bank::LoadClipSprites(int64_t clip_id) const {
     out.push_back(ReadSprite(s));
     at[out.back().id] = out.size() - 1;
   }
-  auto tags = db_->Prepare("SELECT t.sprite_id, t.tag FROM sprite_tags t JOIN sprites s ON s.id = t.sprite_id "
-                           "WHERE s.clip_id = ? AND s.mirrored = 0 ORDER BY t.tag");
+  auto tags = db_->Prepare(
+      "SELECT t.sprite_id, t.tag FROM sprite_tags t JOIN sprites s ON s.id = t.sprite_id "
+      "WHERE s.clip_id = ? AND s.mirrored = 0 ORDER BY t.tag");
   tags.Bind(1, clip_id);
   while (tags.Step()) {
     const auto it = at.find(tags.Int(0));
@@ -264,9 +277,12 @@ std::vector<SpriteRecord> Bank::LoadClipSprites(int64_t clip_id) const {
   return out;
 }
 
-std::vector<int64_t> Bank::ClipSpriteIds(int64_t clip_id, int64_t first_frame, int64_t last_frame) const {
+std::vector<int64_t> Bank::ClipSpriteIds(int64_t clip_id, int64_t first_frame,
+                                         int64_t last_frame) const {
   std::vector<int64_t> out;
-  auto s = db_->Prepare("SELECT id FROM sprites WHERE clip_id = ? AND frame BETWEEN ? AND ? ORDER BY frame, mirrored");
+  auto s = db_->Prepare(
+      "SELECT id FROM sprites WHERE clip_id = ? AND frame BETWEEN ? AND ? ORDER BY frame, "
+      "mirrored");
   s.Bind(1, clip_id);
   s.Bind(2, first_frame);
   s.Bind(3, last_frame);
@@ -276,15 +292,17 @@ std::vector<int64_t> Bank::ClipSpriteIds(int64_t clip_id, int64_t first_frame, i
 
 std::map<int64_t, int64_t> Bank::CountClipSprites() const {
   std::map<int64_t, int64_t> out;
-  auto s = db_->Prepare("SELECT clip_id, count(*) FROM sprites WHERE mirrored = 0 GROUP BY clip_id");
+  auto s =
+      db_->Prepare("SELECT clip_id, count(*) FROM sprites WHERE mirrored = 0 GROUP BY clip_id");
   while (s.Step()) out[s.Int(0)] = s.Int(1);
   return out;
 }
 
 std::map<int64_t, std::map<std::string, int64_t>> Bank::CountClipTags() const {
   std::map<int64_t, std::map<std::string, int64_t>> out;
-  auto s = db_->Prepare("SELECT s.clip_id, t.tag, count(*) FROM sprite_tags t JOIN sprites s ON s.id = t.sprite_id "
-                        "WHERE s.mirrored = 0 GROUP BY s.clip_id, t.tag");
+  auto s = db_->Prepare(
+      "SELECT s.clip_id, t.tag, count(*) FROM sprite_tags t JOIN sprites s ON s.id = t.sprite_id "
+      "WHERE s.mirrored = 0 GROUP BY s.clip_id, t.tag");
   while (s.Step()) out[s.Int(0)][s.Text(1)] = s.Int(2);
   return out;
 }
@@ -306,8 +324,9 @@ std::optional<std::string> Bank::GetMeta(const std::string& key) const {
 
 std::vector<TransitionLabelRecord> Bank::LoadTransitionLabels() const {
   std::vector<TransitionLabelRecord> out;
-  auto s = db_->Prepare("SELECT from_sprite, to_sprite, label, labelled_at, source FROM transition_labels "
-                        "ORDER BY labelled_at, from_sprite, to_sprite");
+  auto s = db_->Prepare(
+      "SELECT from_sprite, to_sprite, label, labelled_at, source FROM transition_labels "
+      "ORDER BY labelled_at, from_sprite, to_sprite");
   while (s.Step()) out.push_back({s.Int(0), s.Int(1), s.Text(2), s.Text(3), s.Text(4)});
   return out;
 }
@@ -326,7 +345,8 @@ std::vector<double> Bank::BillboardScales() const {
   return out;
 }
 
-BankSnapshot::BankSnapshot(const Bank& bank) : snapshot_(std::make_unique<sql::ReadSnapshot>(*bank.db_)) {}
+BankSnapshot::BankSnapshot(const Bank& bank)
+    : snapshot_(std::make_unique<sql::ReadSnapshot>(*bank.db_)) {}
 
 BankSnapshot::~BankSnapshot() = default;
 
@@ -342,8 +362,8 @@ BankCounts Bank::Counts() const {
     c.clips_complete = db_->QueryInt("SELECT count(*) FROM clips WHERE complete = 1");
     c.sprites = db_->QueryInt("SELECT count(*) FROM sprites");
     c.mirrors = db_->QueryInt("SELECT count(*) FROM sprites WHERE mirrored = 1");
-    c.sprites_visible =
-        db_->QueryInt("SELECT count(*) FROM sprites s JOIN clips c ON c.id = s.clip_id WHERE c.complete = 1");
+    c.sprites_visible = db_->QueryInt(
+        "SELECT count(*) FROM sprites s JOIN clips c ON c.id = s.clip_id WHERE c.complete = 1");
     c.pixel_rows = db_->QueryInt("SELECT count(*) FROM sprite_pixels");
     c.pixel_bytes = db_->QueryInt("SELECT coalesce(sum(length(data)), 0) FROM sprite_pixels");
     c.transitions = db_->QueryInt("SELECT count(*) FROM transitions");
@@ -368,10 +388,12 @@ BankCounts Bank::Counts() const {
 
 struct BankWriter::Impl {
   explicit Impl(sql::Db& db)
-      : find_clip(db.Prepare(std::string("SELECT ") + kClipColumns +
-                             " FROM clips WHERE camera_id = ? AND track_id = ? AND first_frame = ?")),
-        insert_clip(db.Prepare("INSERT INTO clips (camera_id, track_id, first_frame, last_frame) VALUES (?, ?, ?, ?) "
-                               "RETURNING id")),
+      : find_clip(
+            db.Prepare(std::string("SELECT ") + kClipColumns +
+                       " FROM clips WHERE camera_id = ? AND track_id = ? AND first_frame = ?")),
+        insert_clip(db.Prepare(
+            "INSERT INTO clips (camera_id, track_id, first_frame, last_frame) VALUES (?, ?, ?, ?) "
+            "RETURNING id")),
         extend_clip(db.Prepare("UPDATE clips SET last_frame = ? WHERE id = ? AND last_frame < ?")),
         complete_clip(db.Prepare("UPDATE clips SET complete = 1, complete_seq = "
                                  "(SELECT coalesce(max(complete_seq), 0) + 1 FROM clips) "
@@ -380,16 +402,20 @@ struct BankWriter::Impl {
             std::string("INSERT INTO sprites (") + kSpriteFields +
             ") VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?) "
             "ON CONFLICT (camera_id, frame, track_id, mirrored) DO NOTHING RETURNING id")),
-        find_sprite(db.Prepare("SELECT id FROM sprites WHERE camera_id = ? AND frame = ? AND track_id = ? "
-                               "AND mirrored = ?")),
-        insert_pixels(db.Prepare("INSERT INTO sprite_pixels (sprite_id, width_px, height_px, codec, data) "
-                                 "VALUES (?, ?, ?, ?, ?) ON CONFLICT (sprite_id) DO UPDATE SET "
-                                 "width_px = excluded.width_px, height_px = excluded.height_px, "
-                                 "codec = excluded.codec, data = excluded.data")),
-        insert_tag(db.Prepare("INSERT INTO sprite_tags (sprite_id, tag) VALUES (?, ?) ON CONFLICT DO NOTHING")),
-        upsert_transition(db.Prepare("INSERT INTO transitions (from_sprite, to_sprite, d, cost) VALUES (?, ?, ?, ?) "
-                                     "ON CONFLICT (from_sprite, to_sprite) DO UPDATE SET "
-                                     "d = excluded.d, cost = excluded.cost")) {}
+        find_sprite(
+            db.Prepare("SELECT id FROM sprites WHERE camera_id = ? AND frame = ? AND track_id = ? "
+                       "AND mirrored = ?")),
+        insert_pixels(
+            db.Prepare("INSERT INTO sprite_pixels (sprite_id, width_px, height_px, codec, data) "
+                       "VALUES (?, ?, ?, ?, ?) ON CONFLICT (sprite_id) DO UPDATE SET "
+                       "width_px = excluded.width_px, height_px = excluded.height_px, "
+                       "codec = excluded.codec, data = excluded.data")),
+        insert_tag(db.Prepare(
+            "INSERT INTO sprite_tags (sprite_id, tag) VALUES (?, ?) ON CONFLICT DO NOTHING")),
+        upsert_transition(db.Prepare(
+            "INSERT INTO transitions (from_sprite, to_sprite, d, cost) VALUES (?, ?, ?, ?) "
+            "ON CONFLICT (from_sprite, to_sprite) DO UPDATE SET "
+            "d = excluded.d, cost = excluded.cost")) {}
 
   sql::Stmt find_clip, insert_clip, extend_clip, complete_clip;
   sql::Stmt insert_sprite, find_sprite, insert_pixels, insert_tag, upsert_transition;
@@ -407,8 +433,13 @@ int64_t BankWriter::AddSession(const SessionRecord& session) {
   if (session.uid.empty()) throw WorkError(path(), "a session needs a non-empty uid");
   sql::Transaction tx(db());
   auto insert = db().Prepare(
-      "INSERT INTO sessions (uid, name, created, source) VALUES (?, ?, ?, ?) ON CONFLICT (uid) DO NOTHING");
-  insert.Bind(1, session.uid).Bind(2, session.name).Bind(3, session.created).Bind(4, session.source).Step();
+      "INSERT INTO sessions (uid, name, created, source) VALUES (?, ?, ?, ?) ON CONFLICT (uid) DO "
+      "NOTHING");
+  insert.Bind(1, session.uid)
+      .Bind(2, session.name)
+      .Bind(3, session.created)
+      .Bind(4, session.source)
+      .Step();
   auto find = db().Prepare("SELECT id FROM sessions WHERE uid = ?");
   find.Bind(1, session.uid).Step();
   const int64_t id = find.Int(0);
@@ -435,7 +466,8 @@ int64_t BankWriter::AddCamera(int64_t session_id, const CameraRecord& camera) {
   sql::Transaction tx(db());
   auto session = db().Prepare("SELECT 1 FROM sessions WHERE id = ?");
   if (!session.Bind(1, session_id).Step()) {
-    throw WorkError(path(), "camera '" + camera.name + "': no session with id " + std::to_string(session_id));
+    throw WorkError(
+        path(), "camera '" + camera.name + "': no session with id " + std::to_string(session_id));
   }
   session.Reset();
   auto insert = db().Prepare(
@@ -455,20 +487,25 @@ int64_t BankWriter::AddCamera(int64_t session_id, const CameraRecord& camera) {
   return id;
 }
 
-AppendResult BankWriter::AppendClipBatch(const ClipRecord& clip, const std::vector<SpriteRecord>& sprites) {
-  const std::string where = path() + ": clip (camera " + std::to_string(clip.camera_id) + ", track " +
-                            std::to_string(clip.track_id) + ", first frame " + std::to_string(clip.first_frame) + ")";
+AppendResult BankWriter::AppendClipBatch(const ClipRecord& clip,
+                                         const std::vector<SpriteRecord>& sprites) {
+  const std::string where = path() + ": clip (camera " + std::to_string(clip.camera_id) +
+                            ", track " + std::to_string(clip.track_id) + ", first frame " +
+                            std::to_string(clip.first_frame) + ")";
   int64_t last_frame = std::max(clip.first_frame, clip.last_frame);
   for (const SpriteRecord& s : sprites) {
-    const std::string who = where + ", frame " + std::to_string(s.frame) + (s.mirrored ? " (mirrored)" : "");
+    const std::string who =
+        where + ", frame " + std::to_string(s.frame) + (s.mirrored ? " (mirrored)" : "");
     if (s.frame < clip.first_frame) throw WorkError(who, "sprite is before the clip's first frame");
     if (s.billboard_width_px <= 0 || s.billboard_height_px <= 0 || !(s.px_per_m > 0)) {
       throw WorkError(who, "billboard size and px_per_m must be positive");
     }
-    if (!s.mirrored && (s.pixels.bgra.cols != s.billboard_width_px || s.pixels.bgra.rows != s.billboard_height_px)) {
+    if (!s.mirrored && (s.pixels.bgra.cols != s.billboard_width_px ||
+                        s.pixels.bgra.rows != s.billboard_height_px)) {
       throw WorkError(who, "an original sprite needs billboard pixels of its billboard size (" +
-                               std::to_string(s.billboard_width_px) + "x" + std::to_string(s.billboard_height_px) +
-                               ", got " + std::to_string(s.pixels.bgra.cols) + "x" +
+                               std::to_string(s.billboard_width_px) + "x" +
+                               std::to_string(s.billboard_height_px) + ", got " +
+                               std::to_string(s.pixels.bgra.cols) + "x" +
                                std::to_string(s.pixels.bgra.rows) + ")");
     }
     last_frame = std::max(last_frame, s.frame);
@@ -484,8 +521,9 @@ AppendResult BankWriter::AppendClipBatch(const ClipRecord& clip, const std::vect
     w.find_clip.Reset();
     result.clip_id = stored.id;
     if (stored.complete && last_frame > stored.last_frame) {
-      throw WorkError(where, "the clip is complete up to frame " + std::to_string(stored.last_frame) +
-                                 "; a batch reaches frame " + std::to_string(last_frame));
+      throw WorkError(where, "the clip is complete up to frame " +
+                                 std::to_string(stored.last_frame) + "; a batch reaches frame " +
+                                 std::to_string(last_frame));
     }
     w.extend_clip.Reset();
     w.extend_clip.Bind(1, last_frame).Bind(2, stored.id).Bind(3, last_frame).Step();
@@ -495,7 +533,11 @@ AppendResult BankWriter::AppendClipBatch(const ClipRecord& clip, const std::vect
     if (!camera.Bind(1, clip.camera_id).Step()) throw WorkError(where, "no camera with that id");
     camera.Reset();
     w.insert_clip.Reset();
-    w.insert_clip.Bind(1, clip.camera_id).Bind(2, clip.track_id).Bind(3, clip.first_frame).Bind(4, last_frame).Step();
+    w.insert_clip.Bind(1, clip.camera_id)
+        .Bind(2, clip.track_id)
+        .Bind(3, clip.first_frame)
+        .Bind(4, last_frame)
+        .Step();
     result.clip_id = w.insert_clip.Int(0);
     w.insert_clip.Reset();
   }
@@ -517,14 +559,15 @@ AppendResult BankWriter::AppendClipBatch(const ClipRecord& clip, const std::vect
 namespace {
 
 // Binds one sprite's columns (kSpriteFields' order) from `first`; returns the next index.
-int BindSprite(sql::Stmt& q, int first, int64_t clip_id, const ClipRecord& clip, const SpriteRecord& s,
-               int64_t mirror_of) {
+int BindSprite(sql::Stmt& q, int first, int64_t clip_id, const ClipRecord& clip,
+               const SpriteRecord& s, int64_t mirror_of) {
   const double reals[] = {s.ground_x_m, s.ground_y_m, s.velocity_x_m_s, s.velocity_y_m_s, s.mean_r,
                           s.mean_g,     s.mean_b,     s.area_px,        s.eccentricity};
-  const int64_t box[] = {s.bbox_in_image.x, s.bbox_in_image.y, s.bbox_in_image.width, s.bbox_in_image.height,
-                         s.billboard_width_px, s.billboard_height_px};
+  const int64_t box[] = {s.bbox_in_image.x,      s.bbox_in_image.y,    s.bbox_in_image.width,
+                         s.bbox_in_image.height, s.billboard_width_px, s.billboard_height_px};
   int i = first;
-  for (int64_t v : {clip_id, clip.camera_id, clip.track_id, s.frame, s.timestamp_ns, int64_t{s.mirrored}}) {
+  for (int64_t v :
+       {clip_id, clip.camera_id, clip.track_id, s.frame, s.timestamp_ns, int64_t{s.mirrored}}) {
     q.Bind(i++, v);
   }
   if (s.mirrored) {
@@ -538,10 +581,10 @@ int BindSprite(sql::Stmt& q, int first, int64_t clip_id, const ClipRecord& clip,
   return i;
 }
 
-
 }  // namespace
 
-void BankWriter::AppendSpritesOneByOne(const ClipRecord& clip, int64_t clip_id, const std::vector<SpriteRecord>& sprites,
+void BankWriter::AppendSpritesOneByOne(const ClipRecord& clip, int64_t clip_id,
+                                       const std::vector<SpriteRecord>& sprites,
                                        const std::string& where, AppendResult* out) {
   Impl& w = *impl_;
   AppendResult& result = *out;
@@ -549,7 +592,10 @@ void BankWriter::AppendSpritesOneByOne(const ClipRecord& clip, int64_t clip_id, 
   result.sprite_ids.assign(sprites.size(), 0);
   auto find = [&](int64_t frame, bool mirrored) -> int64_t {
     w.find_sprite.Reset();
-    w.find_sprite.Bind(1, clip.camera_id).Bind(2, frame).Bind(3, clip.track_id).Bind(4, int64_t{mirrored});
+    w.find_sprite.Bind(1, clip.camera_id)
+        .Bind(2, frame)
+        .Bind(3, clip.track_id)
+        .Bind(4, int64_t{mirrored});
     const int64_t id = w.find_sprite.Step() ? w.find_sprite.Int(0) : 0;
     w.find_sprite.Reset();
     return id;
@@ -564,7 +610,8 @@ void BankWriter::AppendSpritesOneByOne(const ClipRecord& clip, int64_t clip_id, 
         mirror_of = find(s.frame, false);
         if (mirror_of == 0) {
           throw WorkError(where + ", frame " + std::to_string(s.frame),
-                          "a mirrored sprite needs its original (same camera, track and frame) in the bank or batch");
+                          "a mirrored sprite needs its original (same camera, track and frame) in "
+                          "the bank or batch");
         }
       }
       sql::Stmt& q = w.insert_sprite;
@@ -583,8 +630,12 @@ void BankWriter::AppendSpritesOneByOne(const ClipRecord& clip, int64_t clip_id, 
             throw WorkError(where + ", frame " + std::to_string(s.frame), e.what());
           }
           w.insert_pixels.Reset();
-          w.insert_pixels.Bind(1, id).Bind(2, int64_t{s.pixels.bgra.cols}).Bind(3, int64_t{s.pixels.bgra.rows});
-          w.insert_pixels.Bind(4, std::string_view(kPixelCodec)).BindBlob(5, blob->data(), blob->size()).Step();
+          w.insert_pixels.Bind(1, id)
+              .Bind(2, int64_t{s.pixels.bgra.cols})
+              .Bind(3, int64_t{s.pixels.bgra.rows});
+          w.insert_pixels.Bind(4, std::string_view(kPixelCodec))
+              .BindBlob(5, blob->data(), blob->size())
+              .Step();
         }
       } else {
         id = find(s.frame, s.mirrored);
@@ -598,12 +649,11 @@ void BankWriter::AppendSpritesOneByOne(const ClipRecord& clip, int64_t clip_id, 
   }
 }
 
-
 // A server a network hop away answers each statement in a round trip: the batch's sprites go
 // in a few statements of many rows each (originals, their pixels, mirrors), not one per sprite.
 void BankWriter::AppendSpritesManyRows(const ClipRecord& clip, int64_t clip_id,
-                                       const std::vector<SpriteRecord>& sprites, const std::string& where,
-                                       AppendResult* out) {
+                                       const std::vector<SpriteRecord>& sprites,
+                                       const std::string& where, AppendResult* out) {
   constexpr int kColumns = 25, kRowsPerStatement = 200;
   Impl& w = *impl_;
   AppendResult& result = *out;
@@ -614,8 +664,9 @@ void BankWriter::AppendSpritesManyRows(const ClipRecord& clip, int64_t clip_id,
   if (!sprites.empty()) {
     int64_t lo = sprites.front().frame, hi = lo;
     for (const SpriteRecord& s : sprites) lo = std::min(lo, s.frame), hi = std::max(hi, s.frame);
-    auto q = db().Prepare("SELECT id, frame, mirrored FROM sprites WHERE camera_id = ? AND track_id = ? "
-                          "AND frame BETWEEN ? AND ?");
+    auto q = db().Prepare(
+        "SELECT id, frame, mirrored FROM sprites WHERE camera_id = ? AND track_id = ? "
+        "AND frame BETWEEN ? AND ?");
     q.Bind(1, clip.camera_id).Bind(2, clip.track_id).Bind(3, lo).Bind(4, hi);
     while (q.Step()) ids[{q.Int(1), q.Int(2) != 0}] = q.Int(0);
   }
@@ -628,15 +679,17 @@ void BankWriter::AppendSpritesManyRows(const ClipRecord& clip, int64_t clip_id,
       if (ids.count({s.frame, s.mirrored})) continue;
       if (mirrors && !ids.count({s.frame, false})) {
         throw WorkError(where + ", frame " + std::to_string(s.frame),
-                        "a mirrored sprite needs its original (same camera, track and frame) in the bank or batch");
+                        "a mirrored sprite needs its original (same camera, track and frame) in "
+                        "the bank or batch");
       }
       fresh.push_back(i);
     }
     for (size_t at = 0; at < fresh.size(); at += kRowsPerStatement) {
       const size_t n = std::min<size_t>(kRowsPerStatement, fresh.size() - at);
-      auto q = db().Prepare(std::string("INSERT INTO sprites (") + kSpriteFields + ") VALUES " +
-                            sql::RowPlaceholders(static_cast<int>(n), kColumns) +
-                            " ON CONFLICT (camera_id, frame, track_id, mirrored) DO NOTHING RETURNING id, frame");
+      auto q = db().Prepare(
+          std::string("INSERT INTO sprites (") + kSpriteFields + ") VALUES " +
+          sql::RowPlaceholders(static_cast<int>(n), kColumns) +
+          " ON CONFLICT (camera_id, frame, track_id, mirrored) DO NOTHING RETURNING id, frame");
       int index = 1;
       for (size_t k = 0; k < n; ++k) {
         const SpriteRecord& s = sprites[fresh[at + k]];
@@ -647,12 +700,14 @@ void BankWriter::AppendSpritesManyRows(const ClipRecord& clip, int64_t clip_id,
       result.inserted += static_cast<int64_t>(inserted.size());
       for (const auto& [frame, id] : inserted) ids[{frame, mirrors}] = id;
       if (!mirrors && !inserted.empty()) {
-        auto p = db().Prepare("INSERT INTO sprite_pixels (sprite_id, width_px, height_px, codec, data) VALUES " +
-                              sql::RowPlaceholders(static_cast<int>(inserted.size()), 5) +
-                              " ON CONFLICT (sprite_id) DO UPDATE SET width_px = excluded.width_px, "
-                              "height_px = excluded.height_px, codec = excluded.codec, data = excluded.data");
+        auto p = db().Prepare(
+            "INSERT INTO sprite_pixels (sprite_id, width_px, height_px, codec, data) VALUES " +
+            sql::RowPlaceholders(static_cast<int>(inserted.size()), 5) +
+            " ON CONFLICT (sprite_id) DO UPDATE SET width_px = excluded.width_px, "
+            "height_px = excluded.height_px, codec = excluded.codec, data = excluded.data");
         std::map<int64_t, const SpriteRecord*> by_frame;
-        for (size_t k = 0; k < n; ++k) by_frame[sprites[fresh[at + k]].frame] = &sprites[fresh[at + k]];
+        for (size_t k = 0; k < n; ++k)
+          by_frame[sprites[fresh[at + k]].frame] = &sprites[fresh[at + k]];
         int pi = 1;
         for (const auto& [frame, id] : inserted) {
           const SpriteRecord& s = *by_frame.at(frame);
@@ -662,8 +717,11 @@ void BankWriter::AppendSpritesManyRows(const ClipRecord& clip, int64_t clip_id,
           } catch (const WorkError& e) {
             throw WorkError(where + ", frame " + std::to_string(s.frame), e.what());
           }
-          p.Bind(pi, id).Bind(pi + 1, int64_t{s.pixels.bgra.cols}).Bind(pi + 2, int64_t{s.pixels.bgra.rows});
-          p.Bind(pi + 3, std::string_view(kPixelCodec)).BindBlob(pi + 4, blob->data(), blob->size());
+          p.Bind(pi, id)
+              .Bind(pi + 1, int64_t{s.pixels.bgra.cols})
+              .Bind(pi + 2, int64_t{s.pixels.bgra.rows});
+          p.Bind(pi + 3, std::string_view(kPixelCodec))
+              .BindBlob(pi + 4, blob->data(), blob->size());
           pi += 5;
         }
         p.Step();
@@ -673,7 +731,8 @@ void BankWriter::AppendSpritesManyRows(const ClipRecord& clip, int64_t clip_id,
           return !ids.count({sprites[i].frame, mirrors});
         })) {
       // Another writer stored some of them meanwhile (ON CONFLICT skipped them): read their ids.
-      auto q = db().Prepare("SELECT id, frame FROM sprites WHERE camera_id = ? AND track_id = ? AND mirrored = ?");
+      auto q = db().Prepare(
+          "SELECT id, frame FROM sprites WHERE camera_id = ? AND track_id = ? AND mirrored = ?");
       q.Bind(1, clip.camera_id).Bind(2, clip.track_id).Bind(3, int64_t{mirrors});
       while (q.Step()) ids.try_emplace({q.Int(1), mirrors}, q.Int(0));
     }
@@ -704,15 +763,22 @@ void BankWriter::UpsertTransitions(const std::vector<TransitionRecord>& transiti
       for (size_t k = first; k < std::min(transitions.size(), first + kRows); ++k) {
         const TransitionRecord& t = transitions[k];
         const auto [it, fresh] = at.try_emplace({t.from_sprite, t.to_sprite}, chunk.size());
-        if (fresh) chunk.push_back(t);
-        else chunk[it->second] = t;
+        if (fresh)
+          chunk.push_back(t);
+        else
+          chunk[it->second] = t;
       }
-      sql::Stmt q = db().Prepare("INSERT INTO transitions (from_sprite, to_sprite, d, cost) VALUES " +
-                                 sql::RowPlaceholders(static_cast<int>(chunk.size()), 4) +
-                                 " ON CONFLICT (from_sprite, to_sprite) DO UPDATE SET d = excluded.d, cost = excluded.cost");
+      sql::Stmt q =
+          db().Prepare("INSERT INTO transitions (from_sprite, to_sprite, d, cost) VALUES " +
+                       sql::RowPlaceholders(static_cast<int>(chunk.size()), 4) +
+                       " ON CONFLICT (from_sprite, to_sprite) DO UPDATE SET d = excluded.d, cost = "
+                       "excluded.cost");
       for (size_t r = 0; r < chunk.size(); ++r) {
         const int i = static_cast<int>(4 * r);
-        q.Bind(i + 1, chunk[r].from_sprite).Bind(i + 2, chunk[r].to_sprite).Bind(i + 3, chunk[r].d).Bind(i + 4, chunk[r].cost);
+        q.Bind(i + 1, chunk[r].from_sprite)
+            .Bind(i + 2, chunk[r].to_sprite)
+            .Bind(i + 3, chunk[r].d)
+            .Bind(i + 4, chunk[r].cost);
       }
       q.Step();
     }
@@ -735,7 +801,8 @@ void BankWriter::Tag(const std::vector<int64_t>& sprite_ids, const std::string& 
   auto exists = db().Prepare("SELECT 1 FROM sprites WHERE id = ?");
   for (int64_t id : sprite_ids) {
     exists.Reset();
-    if (!exists.Bind(1, id).Step()) throw InputError(path(), "no sprite with id " + std::to_string(id));
+    if (!exists.Bind(1, id).Step())
+      throw InputError(path(), "no sprite with id " + std::to_string(id));
     impl_->insert_tag.Reset();
     impl_->insert_tag.Bind(1, id).Bind(2, tag).Step();
   }
@@ -754,16 +821,23 @@ void BankWriter::Untag(const std::vector<int64_t>& sprite_ids, const std::string
 }
 
 void BankWriter::SetMeta(const std::string& key, const std::string& value) {
-  if (key == "schema_version" || key == "application") throw WorkError(path(), "meta key '" + key + "' is reserved");
-  auto q = db().Prepare("INSERT INTO meta (key, value) VALUES (?, ?) ON CONFLICT (key) DO UPDATE SET value = excluded.value");
+  if (key == "schema_version" || key == "application")
+    throw WorkError(path(), "meta key '" + key + "' is reserved");
+  auto q = db().Prepare(
+      "INSERT INTO meta (key, value) VALUES (?, ?) ON CONFLICT (key) DO UPDATE SET value = "
+      "excluded.value");
   q.Bind(1, key).Bind(2, value).Step();
 }
 
 std::string BankWriter::KeepMeta(const std::string& key, const std::string& value) {
-  if (key == "schema_version" || key == "application") throw WorkError(path(), "meta key '" + key + "' is reserved");
+  if (key == "schema_version" || key == "application")
+    throw WorkError(path(), "meta key '" + key + "' is reserved");
   // One statement each: on PostgreSQL two writers inserting at once are ordered by the key's
   // unique index (the second does nothing), and both then read the first one's value.
-  db().Prepare("INSERT INTO meta (key, value) VALUES (?, ?) ON CONFLICT (key) DO NOTHING").Bind(1, key).Bind(2, value).Step();
+  db().Prepare("INSERT INTO meta (key, value) VALUES (?, ?) ON CONFLICT (key) DO NOTHING")
+      .Bind(1, key)
+      .Bind(2, value)
+      .Step();
   const std::optional<std::string> kept = GetMeta(key);
   if (!kept) throw WorkError(path(), "meta key '" + key + "' vanished after it was set");
   return *kept;
@@ -774,20 +848,26 @@ void BankWriter::SetTransitionLabel(const TransitionLabelRecord& label) {
     throw InputError("label", "expected yes, no or skip, got \"" + label.label + "\"");
   }
   if (label.from_sprite == label.to_sprite) {
-    throw InputError("label", "sprite " + std::to_string(label.from_sprite) + " paired with itself");
+    throw InputError("label",
+                     "sprite " + std::to_string(label.from_sprite) + " paired with itself");
   }
   sql::Transaction tx(db());
   auto exists = db().Prepare("SELECT 1 FROM sprites WHERE id = ?");
   for (int64_t id : {label.from_sprite, label.to_sprite}) {
     exists.Reset();
-    if (!exists.Bind(1, id).Step()) throw InputError(path(), "no sprite with id " + std::to_string(id));
+    if (!exists.Bind(1, id).Step())
+      throw InputError(path(), "no sprite with id " + std::to_string(id));
   }
   exists.Reset();
   auto q = db().Prepare(
-      "INSERT INTO transition_labels (from_sprite, to_sprite, label, labelled_at, source) VALUES (?, ?, ?, ?, ?) "
+      "INSERT INTO transition_labels (from_sprite, to_sprite, label, labelled_at, source) VALUES "
+      "(?, ?, ?, ?, ?) "
       "ON CONFLICT (from_sprite, to_sprite) DO UPDATE SET label = excluded.label, "
       "labelled_at = excluded.labelled_at, source = excluded.source");
-  q.Bind(1, label.from_sprite).Bind(2, label.to_sprite).Bind(3, label.label).Bind(4, label.labelled_at);
+  q.Bind(1, label.from_sprite)
+      .Bind(2, label.to_sprite)
+      .Bind(3, label.label)
+      .Bind(4, label.labelled_at);
   q.Bind(5, label.source).Step();
   q.Reset();
   tx.Commit();

@@ -19,18 +19,18 @@ namespace ss {
 namespace sql {
 class Db;
 class ReadSnapshot;
-}
+}  // namespace sql
 
 // Figures for `bank info`.
 struct BankCounts {
   int schema_version = 0;
   int64_t sessions = 0, cameras = 0;
   int64_t clips = 0, clips_complete = 0;
-  int64_t sprites = 0, mirrors = 0;       // all rows; `mirrors` of them are mirrored copies
-  int64_t sprites_visible = 0;            // sprites in complete clips (what readers see)
+  int64_t sprites = 0, mirrors = 0;         // all rows; `mirrors` of them are mirrored copies
+  int64_t sprites_visible = 0;              // sprites in complete clips (what readers see)
   int64_t pixel_rows = 0, pixel_bytes = 0;  // compressed billboard bytes
   int64_t transitions = 0;
-  int64_t tags = 0, tagged_sprites = 0;   // distinct tag names, sprites with a tag
+  int64_t tags = 0, tagged_sprites = 0;  // distinct tag names, sprites with a tag
   int64_t file_bytes = 0, wal_bytes = 0;
 };
 
@@ -69,7 +69,8 @@ class Bank {
   // A clip's original sprites (no mirrors, no pixels) with their tags, by frame.
   std::vector<SpriteRecord> LoadClipSprites(int64_t clip_id) const;
   // The ids of a clip's sprites at frames first..last (inclusive), with their mirrored copies.
-  std::vector<int64_t> ClipSpriteIds(int64_t clip_id, int64_t first_frame, int64_t last_frame) const;
+  std::vector<int64_t> ClipSpriteIds(int64_t clip_id, int64_t first_frame,
+                                     int64_t last_frame) const;
   // Original sprites per clip id, and per clip the number of its originals with each tag.
   std::map<int64_t, int64_t> CountClipSprites() const;
   std::map<int64_t, std::map<std::string, int64_t>> CountClipTags() const;
@@ -161,10 +162,12 @@ class BankWriter : public Bank {
  private:
   // AppendClipBatch's sprites: one statement each (SQLite, in-process), or a few statements of
   // many rows (PostgreSQL, where every statement is a round trip to the server).
-  void AppendSpritesOneByOne(const ClipRecord& clip, int64_t clip_id, const std::vector<SpriteRecord>& sprites,
-                             const std::string& where, AppendResult* out);
-  void AppendSpritesManyRows(const ClipRecord& clip, int64_t clip_id, const std::vector<SpriteRecord>& sprites,
-                             const std::string& where, AppendResult* out);
+  void AppendSpritesOneByOne(const ClipRecord& clip, int64_t clip_id,
+                             const std::vector<SpriteRecord>& sprites, const std::string& where,
+                             AppendResult* out);
+  void AppendSpritesManyRows(const ClipRecord& clip, int64_t clip_id,
+                             const std::vector<SpriteRecord>& sprites, const std::string& where,
+                             AppendResult* out);
 
   struct Impl;
   std::unique_ptr<Impl> impl_;

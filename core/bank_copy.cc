@@ -27,19 +27,31 @@ struct Table {
 
 constexpr Table kTables[] = {
     {"meta", "key, value", "tt", "key", "key"},
-    {"sessions", "id, uid, name, created, source", "ittt" "t", "id", "id"},
+    {"sessions", "id, uid, name, created, source",
+     "ittt"
+     "t",
+     "id", "id"},
     {"cameras", "id, session_id, name, cameramodel, width, height", "iittii", "id", "id"},
-    {"clips", "id, camera_id, track_id, first_frame, last_frame, complete, complete_seq", "iiiiiii", "id", "id"},
+    {"clips", "id, camera_id, track_id, first_frame, last_frame, complete, complete_seq", "iiiiiii",
+     "id", "id"},
     {"sprites",
-     "id, clip_id, camera_id, track_id, frame, timestamp_ns, mirrored, mirror_of, ground_x_m, ground_y_m, "
-     "velocity_x_m_s, velocity_y_m_s, mean_r, mean_g, mean_b, area_px, eccentricity, bbox_x, bbox_y, bbox_w, "
+     "id, clip_id, camera_id, track_id, frame, timestamp_ns, mirrored, mirror_of, ground_x_m, "
+     "ground_y_m, "
+     "velocity_x_m_s, velocity_y_m_s, mean_r, mean_g, mean_b, area_px, eccentricity, bbox_x, "
+     "bbox_y, bbox_w, "
      "bbox_h, billboard_w_px, billboard_h_px, px_per_m, anchor_x_px, anchor_y_px",
-     "iiiiiiii" "rrrrrrrrr" "iiiiii" "rrr", "id", "mirrored, id"},
+     "iiiiiiii"
+     "rrrrrrrrr"
+     "iiiiii"
+     "rrr",
+     "id", "mirrored, id"},
     {"sprite_tags", "sprite_id, tag", "it", "sprite_id, tag", "sprite_id, tag"},
-    {"sprite_pixels", "sprite_id, width_px, height_px, codec, data", "iiitb", "sprite_id", "sprite_id"},
-    {"transitions", "from_sprite, to_sprite, d, cost", "iirr", "from_sprite, to_sprite", "from_sprite, to_sprite"},
-    {"transition_labels", "from_sprite, to_sprite, label, labelled_at, source", "iittt", "from_sprite, to_sprite",
+    {"sprite_pixels", "sprite_id, width_px, height_px, codec, data", "iiitb", "sprite_id",
+     "sprite_id"},
+    {"transitions", "from_sprite, to_sprite, d, cost", "iirr", "from_sprite, to_sprite",
      "from_sprite, to_sprite"},
+    {"transition_labels", "from_sprite, to_sprite, label, labelled_at, source", "iittt",
+     "from_sprite, to_sprite", "from_sprite, to_sprite"},
 };
 
 // The tables whose ids a PostgreSQL bank draws from a sequence.
@@ -57,10 +69,18 @@ Value Read(const sql::Stmt& q, int col, char kind) {
   v.null = q.IsNull(col);
   if (v.null) return v;
   switch (kind) {
-    case 'i': v.i = q.Int(col); break;
-    case 'r': v.r = q.Real(col); break;
-    case 't': v.s = q.Text(col); break;
-    default: v.s.assign(static_cast<const char*>(q.Blob(col)), q.Bytes(col)); break;
+    case 'i':
+      v.i = q.Int(col);
+      break;
+    case 'r':
+      v.r = q.Real(col);
+      break;
+    case 't':
+      v.s = q.Text(col);
+      break;
+    default:
+      v.s.assign(static_cast<const char*>(q.Blob(col)), q.Bytes(col));
+      break;
   }
   return v;
 }
@@ -102,7 +122,8 @@ BankDigest Digest(const sql::Db& db) {
   Fnv fnv;
   for (const Table& t : kTables) {
     fnv.Add(t.name, std::strlen(t.name) + 1);
-    auto q = db.Prepare(std::string("SELECT ") + t.columns + " FROM " + t.name + " ORDER BY " + t.key_order);
+    auto q = db.Prepare(std::string("SELECT ") + t.columns + " FROM " + t.name + " ORDER BY " +
+                        t.key_order);
     const int n = static_cast<int>(std::strlen(t.kinds));
     int64_t rows = 0;
     while (q.Step()) {
@@ -118,7 +139,8 @@ BankDigest Digest(const sql::Db& db) {
 // Inserts rows many at a time: one statement of up to `per_statement` rows.
 class BatchInsert {
  public:
-  BatchInsert(sql::Db& db, const Table& t) : db_(db), table_(t), width_(static_cast<int>(std::strlen(t.kinds))) {
+  BatchInsert(sql::Db& db, const Table& t)
+      : db_(db), table_(t), width_(static_cast<int>(std::strlen(t.kinds))) {
     // SQLite takes at most 32766 parameters a statement, PostgreSQL 65535.
     per_statement_ = std::max(1, std::min(500, 30000 / width_));
   }
@@ -128,9 +150,10 @@ class BatchInsert {
   }
   void Flush() {
     if (rows_.empty()) return;
-    std::string sql = std::string("INSERT INTO ") + table_.name + " (" + table_.columns + ") VALUES " +
-                      sql::RowPlaceholders(static_cast<int>(rows_.size()), width_);
-    if (std::strcmp(table_.name, "meta") == 0) sql += " ON CONFLICT (key) DO UPDATE SET value = excluded.value";
+    std::string sql = std::string("INSERT INTO ") + table_.name + " (" + table_.columns +
+                      ") VALUES " + sql::RowPlaceholders(static_cast<int>(rows_.size()), width_);
+    if (std::strcmp(table_.name, "meta") == 0)
+      sql += " ON CONFLICT (key) DO UPDATE SET value = excluded.value";
     auto q = db_.Prepare(sql);
     int index = 1;
     for (const auto& row : rows_) {
@@ -175,14 +198,16 @@ BankDigest CopyBank(const std::string& from, const std::string& to) {
   sql::Db src = OpenBankDatabase(from, /*writable=*/false);
   sql::Db dst = OpenBankDatabase(to, /*writable=*/true);
   if (dst.QueryInt("SELECT count(*) FROM sessions") > 0) {
-    throw InputError(dst.path(), "holds sessions already: bank copy writes into an empty bank only");
+    throw InputError(dst.path(),
+                     "holds sessions already: bank copy writes into an empty bank only");
   }
   BankDigest copied;
   {
     sql::ReadSnapshot snapshot(src);
     sql::Transaction tx(dst);
     for (const Table& t : kTables) {
-      auto q = src.Prepare(std::string("SELECT ") + t.columns + " FROM " + t.name + " ORDER BY " + t.insert_order);
+      auto q = src.Prepare(std::string("SELECT ") + t.columns + " FROM " + t.name + " ORDER BY " +
+                           t.insert_order);
       const int n = static_cast<int>(std::strlen(t.kinds));
       BatchInsert insert(dst, t);
       int64_t rows = 0;
@@ -199,8 +224,10 @@ BankDigest CopyBank(const std::string& from, const std::string& to) {
     if (dst.dialect() == sql::Dialect::kPostgres) {
       // Rows came with their ids: the sequences go on after the largest.
       for (const char* table : kIdTables) {
-        dst.Exec(std::string("SELECT setval(pg_get_serial_sequence('") + table + "', 'id'), coalesce(max(id), 0) + 1, "
-                 "false) FROM " + table);
+        dst.Exec(std::string("SELECT setval(pg_get_serial_sequence('") + table +
+                 "', 'id'), coalesce(max(id), 0) + 1, "
+                 "false) FROM " +
+                 table);
       }
     }
     copied = Digest(src);
@@ -208,7 +235,8 @@ BankDigest CopyBank(const std::string& from, const std::string& to) {
   }
   const BankDigest written = DigestBank(to);
   if (written.digest != copied.digest) {
-    throw WorkError(dst.path(), "the copy's digest " + written.digest + " differs from the source's " + copied.digest);
+    throw WorkError(dst.path(), "the copy's digest " + written.digest +
+                                    " differs from the source's " + copied.digest);
   }
   return written;
 }

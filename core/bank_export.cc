@@ -13,8 +13,10 @@
 namespace ss {
 
 std::string SpriteCsvHeader() {
-  return "id,clip_id,camera_id,track_id,frame,timestamp_ns,mirrored,mirror_of,ground_x_m,ground_y_m,"
-         "velocity_x_m_s,velocity_y_m_s,mean_r,mean_g,mean_b,area_px,eccentricity,bbox_x,bbox_y,bbox_w,bbox_h,"
+  return "id,clip_id,camera_id,track_id,frame,timestamp_ns,mirrored,mirror_of,ground_x_m,ground_y_"
+         "m,"
+         "velocity_x_m_s,velocity_y_m_s,mean_r,mean_g,mean_b,area_px,eccentricity,bbox_x,bbox_y,"
+         "bbox_w,bbox_h,"
          "billboard_w_px,billboard_h_px,px_per_m,anchor_x_px,anchor_y_px,tags,png,shadow_png\n";
 }
 
@@ -25,13 +27,15 @@ std::string SpriteCsvRow(const SpriteRecord& s) {
   const std::string shadow_png = "sprite_" + std::to_string(s.id) + "_shadow.png";
   std::string tags;
   for (const auto& t : s.tags) tags += (tags.empty() ? "" : ";") + t;
-  for (size_t q = tags.find('"'); q != std::string::npos; q = tags.find('"', q + 2)) tags.insert(q, 1, '"');
-  csv << s.id << ',' << s.clip_id << ',' << s.camera_id << ',' << s.track_id << ',' << s.frame << ','
-      << s.timestamp_ns << ',' << int{s.mirrored} << ',' << s.mirror_of << ',' << s.ground_x_m << ','
-      << s.ground_y_m << ',' << s.velocity_x_m_s << ',' << s.velocity_y_m_s << ',' << s.mean_r << ',' << s.mean_g
-      << ',' << s.mean_b << ',' << s.area_px << ',' << s.eccentricity << ',' << s.bbox_in_image.x << ','
-      << s.bbox_in_image.y << ',' << s.bbox_in_image.width << ',' << s.bbox_in_image.height << ','
-      << s.billboard_width_px << ',' << s.billboard_height_px << ',' << s.px_per_m << ',' << s.anchor_x_px << ','
+  for (size_t q = tags.find('"'); q != std::string::npos; q = tags.find('"', q + 2))
+    tags.insert(q, 1, '"');
+  csv << s.id << ',' << s.clip_id << ',' << s.camera_id << ',' << s.track_id << ',' << s.frame
+      << ',' << s.timestamp_ns << ',' << int{s.mirrored} << ',' << s.mirror_of << ','
+      << s.ground_x_m << ',' << s.ground_y_m << ',' << s.velocity_x_m_s << ',' << s.velocity_y_m_s
+      << ',' << s.mean_r << ',' << s.mean_g << ',' << s.mean_b << ',' << s.area_px << ','
+      << s.eccentricity << ',' << s.bbox_in_image.x << ',' << s.bbox_in_image.y << ','
+      << s.bbox_in_image.width << ',' << s.bbox_in_image.height << ',' << s.billboard_width_px
+      << ',' << s.billboard_height_px << ',' << s.px_per_m << ',' << s.anchor_x_px << ','
       << s.anchor_y_px << ",\"" << tags << "\"," << png << ',' << shadow_png << '\n';
   return csv.str();
 }
@@ -58,7 +62,8 @@ int64_t ExportBank(const Bank& bank, const std::string& dir, const BankExportOpt
     const SpritePixels pixels = bank.LoadPixels(f.id);
     const std::string png = "sprite_" + std::to_string(s.id) + ".png";
     const std::string shadow_png = "sprite_" + std::to_string(s.id) + "_shadow.png";
-    if (!cv::imwrite((fs::path(dir) / png).string(), pixels.bgra)) throw WorkError((fs::path(dir) / png).string(), "cannot write");
+    if (!cv::imwrite((fs::path(dir) / png).string(), pixels.bgra))
+      throw WorkError((fs::path(dir) / png).string(), "cannot write");
     if (!cv::imwrite((fs::path(dir) / shadow_png).string(), pixels.shadow)) {
       throw WorkError((fs::path(dir) / shadow_png).string(), "cannot write");
     }

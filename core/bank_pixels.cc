@@ -32,9 +32,11 @@ const std::vector<uint8_t>& PixelCodec::Encode(const SpritePixels& pixels) {
   if (bgra.empty() || bgra.type() != CV_8UC4) {
     throw WorkError("billboard pixels", "bgra must be a non-empty CV_8UC4 image");
   }
-  if (!pixels.shadow.empty() && (pixels.shadow.type() != CV_8UC1 || pixels.shadow.size() != bgra.size())) {
+  if (!pixels.shadow.empty() &&
+      (pixels.shadow.type() != CV_8UC1 || pixels.shadow.size() != bgra.size())) {
     throw WorkError("billboard pixels", "shadow must be CV_8UC1 of the billboard's size (" +
-                                            std::to_string(bgra.cols) + "x" + std::to_string(bgra.rows) + ")");
+                                            std::to_string(bgra.cols) + "x" +
+                                            std::to_string(bgra.rows) + ")");
   }
   const size_t n = static_cast<size_t>(bgra.cols) * static_cast<size_t>(bgra.rows);
   raw_.resize(n * kPlanes);
@@ -50,36 +52,44 @@ const std::vector<uint8_t>& PixelCodec::Encode(const SpritePixels& pixels) {
       planes[3][i] = row[4 * x + 3];
     }
     if (!pixels.shadow.empty()) {
-      std::memcpy(planes[4] + static_cast<size_t>(y) * bgra.cols, pixels.shadow.ptr<uint8_t>(y), bgra.cols);
+      std::memcpy(planes[4] + static_cast<size_t>(y) * bgra.cols, pixels.shadow.ptr<uint8_t>(y),
+                  bgra.cols);
     }
   }
   if (pixels.shadow.empty()) std::memset(planes[4], 0, n);
   compressed_.resize(ZSTD_compressBound(raw_.size()));
-  const size_t size = ZSTD_compress2(cctx_, compressed_.data(), compressed_.size(), raw_.data(), raw_.size());
-  if (ZSTD_isError(size)) throw WorkError("billboard pixels", std::string("zstd: ") + ZSTD_getErrorName(size));
+  const size_t size =
+      ZSTD_compress2(cctx_, compressed_.data(), compressed_.size(), raw_.data(), raw_.size());
+  if (ZSTD_isError(size))
+    throw WorkError("billboard pixels", std::string("zstd: ") + ZSTD_getErrorName(size));
   compressed_.resize(size);
   return compressed_;
 }
 
-SpritePixels PixelCodec::Decode(const void* data, size_t size, int width, int height, const std::string& codec) {
-  if (codec != kPixelCodec) throw WorkError("billboard pixels", "unknown pixel codec '" + codec + "'");
+SpritePixels PixelCodec::Decode(const void* data, size_t size, int width, int height,
+                                const std::string& codec) {
+  if (codec != kPixelCodec)
+    throw WorkError("billboard pixels", "unknown pixel codec '" + codec + "'");
   if (width <= 0 || height <= 0) {
-    throw WorkError("billboard pixels", "bad size " + std::to_string(width) + "x" + std::to_string(height));
+    throw WorkError("billboard pixels",
+                    "bad size " + std::to_string(width) + "x" + std::to_string(height));
   }
   const size_t n = static_cast<size_t>(width) * static_cast<size_t>(height);
   const unsigned long long stated = ZSTD_getFrameContentSize(data, size);
   if (stated == ZSTD_CONTENTSIZE_ERROR) throw WorkError("billboard pixels", "not a zstd frame");
   if (stated != n * kPlanes) {
     throw WorkError("billboard pixels", "holds " + std::to_string(stated) + " bytes, expected " +
-                                            std::to_string(n * kPlanes) + " (" + std::to_string(width) + "x" +
-                                            std::to_string(height) + "x5)");
+                                            std::to_string(n * kPlanes) + " (" +
+                                            std::to_string(width) + "x" + std::to_string(height) +
+                                            "x5)");
   }
   raw_.resize(n * kPlanes);
   const size_t got = ZSTD_decompressDCtx(dctx_, raw_.data(), raw_.size(), data, size);
-  if (ZSTD_isError(got)) throw WorkError("billboard pixels", std::string("zstd: ") + ZSTD_getErrorName(got));
+  if (ZSTD_isError(got))
+    throw WorkError("billboard pixels", std::string("zstd: ") + ZSTD_getErrorName(got));
   if (got != n * kPlanes) {
-    throw WorkError("billboard pixels", "decompressed to " + std::to_string(got) + " bytes, expected " +
-                                            std::to_string(n * kPlanes));
+    throw WorkError("billboard pixels", "decompressed to " + std::to_string(got) +
+                                            " bytes, expected " + std::to_string(n * kPlanes));
   }
   SpritePixels pixels;
   pixels.bgra.create(height, width, CV_8UC4);

@@ -30,7 +30,8 @@ class PixelCodec {
   const std::vector<uint8_t>& Encode(const SpritePixels& pixels);
   // Decompresses a blob that should hold a width x height billboard. Throws WorkError
   // with the reason when the codec is unknown or the blob is not exactly that size.
-  SpritePixels Decode(const void* data, size_t size, int width, int height, const std::string& codec);
+  SpritePixels Decode(const void* data, size_t size, int width, int height,
+                      const std::string& codec);
 
  private:
   ZSTD_CCtx_s* cctx_ = nullptr;

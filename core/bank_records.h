@@ -12,29 +12,29 @@ namespace ss {
 
 // One recorded (or live) session; `uid` is stable so re-ingesting it adds nothing.
 struct SessionRecord {
-  int64_t id = 0;       // assigned by the bank
-  std::string uid;      // e.g. "<session name>@<created>"; unique in the bank
+  int64_t id = 0;   // assigned by the bank
+  std::string uid;  // e.g. "<session name>@<created>"; unique in the bank
   std::string name;
   std::string created;  // ISO 8601, UTC
   std::string source;   // where it came from (session directory, station name)
 };
 
 struct CameraRecord {
-  int64_t id = 0;          // assigned by the bank
-  int64_t session_id = 0;  // assigned by the bank
-  std::string name;        // "cam0"; unique within its session
-  std::string cameramodel; // the mrcal .cameramodel text (empty when uncalibrated)
-  int width = 0;           // image size in pixels
+  int64_t id = 0;           // assigned by the bank
+  int64_t session_id = 0;   // assigned by the bank
+  std::string name;         // "cam0"; unique within its session
+  std::string cameramodel;  // the mrcal .cameramodel text (empty when uncalibrated)
+  int width = 0;            // image size in pixels
   int height = 0;
 };
 
 // A clip: a run of consecutive usable frames of one tracked subject in one camera.
 // Identified by (camera_id, track_id, first_frame); readers see only complete clips.
 struct ClipRecord {
-  int64_t id = 0;            // assigned by the bank
+  int64_t id = 0;  // assigned by the bank
   int64_t camera_id = 0;
-  int64_t track_id = 0;      // the tracker's subject id within the camera
-  int64_t first_frame = 0;   // source frame indices, inclusive
+  int64_t track_id = 0;     // the tracker's subject id within the camera
+  int64_t first_frame = 0;  // source frame indices, inclusive
   int64_t last_frame = 0;
   bool complete = false;     // set by the batch that ends the clip
   int64_t complete_seq = 0;  // order in which clips completed (1, 2, ...); 0 while incomplete
@@ -48,14 +48,14 @@ struct SpritePixels {
 };
 
 struct SpriteRecord {
-  int64_t id = 0;         // assigned by the bank
-  int64_t clip_id = 0;    // set by the bank from the batch's clip
-  int64_t camera_id = 0;  // set by the bank from the clip
-  int64_t track_id = 0;   // set by the bank from the clip
-  int64_t frame = 0;      // source frame index in the camera's video
+  int64_t id = 0;            // assigned by the bank
+  int64_t clip_id = 0;       // set by the bank from the batch's clip
+  int64_t camera_id = 0;     // set by the bank from the clip
+  int64_t track_id = 0;      // set by the bank from the clip
+  int64_t frame = 0;         // source frame index in the camera's video
   int64_t timestamp_ns = 0;  // device timestamp of that frame
-  bool mirrored = false;  // the horizontally mirrored copy of the original at the same frame
-  int64_t mirror_of = 0;  // id of the original (mirrored sprites; set by the bank), else 0
+  bool mirrored = false;     // the horizontally mirrored copy of the original at the same frame
+  int64_t mirror_of = 0;     // id of the original (mirrored sprites; set by the bank), else 0
   double ground_x_m = 0, ground_y_m = 0;          // ground contact point
   double velocity_x_m_s = 0, velocity_y_m_s = 0;  // ground velocity (mirrored for the copy)
   double mean_r = 0, mean_g = 0, mean_b = 0;      // mean colour under the matte, 0..255
@@ -63,7 +63,7 @@ struct SpriteRecord {
   double eccentricity = 0;  // from the matte's second moments, 0 (round) .. 1 (a line)
   cv::Rect bbox_in_image;   // the sprite's box in the source image, pixels
   int billboard_width_px = 0, billboard_height_px = 0;
-  double px_per_m = 0;                    // billboard scale, the same for the whole bank
+  double px_per_m = 0;                      // billboard scale, the same for the whole bank
   double anchor_x_px = 0, anchor_y_px = 0;  // ground contact point in the billboard
   std::vector<std::string> tags;
   // Required for originals (billboard-sized); a mirrored sprite stores none: its
@@ -79,8 +79,9 @@ struct SpriteFeatures {
   int64_t frame = 0;
   int64_t timestamp_ns = 0;
   int64_t mirror_of = 0;  // 0 for originals
-  int32_t prev = -1;      // index (in the returned vector) of the same clip's sprite at frame-1, same mirrored flag
-  int32_t next = -1;      // ... at frame+1; -1 at the clip's ends
+  int32_t prev = -1;  // index (in the returned vector) of the same clip's sprite at frame-1, same
+                      // mirrored flag
+  int32_t next = -1;  // ... at frame+1; -1 at the clip's ends
   bool mirrored = false;
   float ground_x_m = 0, ground_y_m = 0, velocity_x_m_s = 0, velocity_y_m_s = 0;
   float mean_r = 0, mean_g = 0, mean_b = 0, area_px = 0, eccentricity = 0;

@@ -7,10 +7,10 @@
 #include <filesystem>
 #include <system_error>
 
-#include "core/sql_postgres.h"
-#include "core/sql_sqlite.h"
 #include "core/error.h"
 #include "core/log.h"
+#include "core/sql_postgres.h"
+#include "core/sql_sqlite.h"
 
 namespace ss {
 namespace {
@@ -247,7 +247,8 @@ CREATE INDEX transition_labels_by_to ON transition_labels (to_sprite);
 
 std::string Hex(int64_t v) {
   char buffer[32];
-  std::snprintf(buffer, sizeof(buffer), "0x%08llx", static_cast<unsigned long long>(v) & 0xffffffffULL);
+  std::snprintf(buffer, sizeof(buffer), "0x%08llx",
+                static_cast<unsigned long long>(v) & 0xffffffffULL);
   return buffer;
 }
 
@@ -259,8 +260,9 @@ void MigrateSqlite(sql::Db& db) {
   for (const auto& m : BankMigrations(sql::Dialect::kSqlite)) {
     if (m.version <= from) continue;
     // A new bank (from 0) is routine; an upgrade of an existing one is worth telling.
-    Log("core.bank")->log(from == 0 ? spdlog::level::debug : spdlog::level::info, "{}: schema version {} -> {} ({})",
-                          db.path(), m.version - 1, m.version, m.summary);
+    Log("core.bank")
+        ->log(from == 0 ? spdlog::level::debug : spdlog::level::info,
+              "{}: schema version {} -> {} ({})", db.path(), m.version - 1, m.version, m.summary);
     db.Exec(m.sql);
     db.Exec("PRAGMA application_id = " + std::to_string(kBankApplicationId));
     db.Exec("PRAGMA user_version = " + std::to_string(m.version));
@@ -285,11 +287,12 @@ void CheckVersion(const std::string& path, bool empty, bool is_bank, const std::
     throw InputError(path, "sprite bank schema version " + std::to_string(version) +
                                " is newer than this build reads (" + expected + ")");
   } else if (version < 1) {
-    throw InputError(path, "sprite bank schema version " + std::to_string(version) + " is unknown (" +
-                               expected + ")");
+    throw InputError(path, "sprite bank schema version " + std::to_string(version) +
+                               " is unknown (" + expected + ")");
   } else if (version < kBankSchemaVersion && !writable) {
-    throw InputError(path, "sprite bank schema version " + std::to_string(version) + " is older (" + expected +
-                               "); open it with a writer (spritestation bank upgrade) to upgrade it in place");
+    throw InputError(
+        path, "sprite bank schema version " + std::to_string(version) + " is older (" + expected +
+                  "); open it with a writer (spritestation bank upgrade) to upgrade it in place");
   }
 }
 
@@ -301,13 +304,15 @@ int PrepareSqlite(sql::Db& db, bool writable) {
   int64_t version = db.QueryInt("PRAGMA user_version");
   const int64_t objects = db.QueryInt("SELECT count(*) FROM sqlite_schema");
   CheckVersion(path, app_id == 0 && version == 0 && objects == 0, app_id == kBankApplicationId,
-               "application_id " + Hex(app_id) + ", expected " + Hex(kBankApplicationId), version, writable);
+               "application_id " + Hex(app_id) + ", expected " + Hex(kBankApplicationId), version,
+               writable);
 
   db.Exec("PRAGMA foreign_keys = ON");
   if (writable) {
     sql::Stmt mode = db.Prepare("PRAGMA journal_mode = WAL");
     if (!mode.Step() || mode.Text(0) != "wal") {
-      throw WorkError(path, "cannot switch the bank to WAL mode (journal_mode " + mode.Text(0) + ")");
+      throw WorkError(path,
+                      "cannot switch the bank to WAL mode (journal_mode " + mode.Text(0) + ")");
     }
     mode.Reset();
     db.Exec("PRAGMA synchronous = NORMAL");
@@ -332,12 +337,16 @@ PostgresState ReadPostgresState(sql::Db& db) {
   PostgresState state;
   const int64_t tables =
       db.QueryInt("SELECT count(*) FROM pg_catalog.pg_tables WHERE schemaname = current_schema()");
-  const bool has_meta = db.QueryInt("SELECT count(*) FROM pg_catalog.pg_tables WHERE schemaname = current_schema() "
-                                    "AND tablename = 'meta'") > 0;
+  const bool has_meta =
+      db.QueryInt(
+          "SELECT count(*) FROM pg_catalog.pg_tables WHERE schemaname = current_schema() "
+          "AND tablename = 'meta'") > 0;
   state.empty = tables == 0;
-  state.what_it_is = std::to_string(tables) + " tables in its schema, none of them a bank's meta table";
+  state.what_it_is =
+      std::to_string(tables) + " tables in its schema, none of them a bank's meta table";
   if (!has_meta) return state;
-  auto meta = db.Prepare("SELECT key, value FROM meta WHERE key IN ('application', 'schema_version')");
+  auto meta =
+      db.Prepare("SELECT key, value FROM meta WHERE key IN ('application', 'schema_version')");
   std::string application, version = "0";
   while (meta.Step()) (meta.Text(0) == "application" ? application : version) = meta.Text(1);
   state.is_bank = application == kApplication;
@@ -358,11 +367,13 @@ int PreparePostgres(sql::Db& db, bool writable) {
   CheckVersion(db.path(), state.empty, state.is_bank, state.what_it_is, state.version, writable);
   for (const auto& m : BankMigrations(sql::Dialect::kPostgres)) {
     if (m.version <= state.version) continue;
-    Log("core.bank")->log(state.version == 0 ? spdlog::level::debug : spdlog::level::info,
-                          "{}: schema version {} -> {} ({})", db.path(), m.version - 1, m.version, m.summary);
+    Log("core.bank")
+        ->log(state.version == 0 ? spdlog::level::debug : spdlog::level::info,
+              "{}: schema version {} -> {} ({})", db.path(), m.version - 1, m.version, m.summary);
     db.Exec(m.sql);
-    auto set = db.Prepare("INSERT INTO meta (key, value) VALUES ('schema_version', ?) "
-                          "ON CONFLICT (key) DO UPDATE SET value = excluded.value");
+    auto set = db.Prepare(
+        "INSERT INTO meta (key, value) VALUES ('schema_version', ?) "
+        "ON CONFLICT (key) DO UPDATE SET value = excluded.value");
     set.Bind(1, std::to_string(m.version)).Step();
   }
   tx.Commit();
@@ -388,7 +399,8 @@ std::string Normalize(std::string sql) {
 
 const std::vector<BankMigration>& BankMigrations(sql::Dialect dialect) {
   static const std::vector<BankMigration> sqlite = {
-      {1, "initial schema: sessions, cameras, clips, sprites, tags, pixels, transitions", kSchemaV1},
+      {1, "initial schema: sessions, cameras, clips, sprites, tags, pixels, transitions",
+       kSchemaV1},
       {2, "transition_labels: a person's yes / no / skip on sprite pairs", kSchemaV2},
   };
   static const std::vector<BankMigration> postgres = {
@@ -399,7 +411,8 @@ const std::vector<BankMigration>& BankMigrations(sql::Dialect dialect) {
 }
 
 int PrepareBankSchema(sql::Db& db, bool writable) {
-  return db.dialect() == sql::Dialect::kPostgres ? PreparePostgres(db, writable) : PrepareSqlite(db, writable);
+  return db.dialect() == sql::Dialect::kPostgres ? PreparePostgres(db, writable)
+                                                 : PrepareSqlite(db, writable);
 }
 
 sql::Db OpenBankDatabase(const std::string& path, bool writable) {
@@ -411,17 +424,19 @@ sql::Db OpenBankDatabase(const std::string& path, bool writable) {
   std::error_code ec;
   if (!writable) {
     if (!std::filesystem::exists(path, ec)) throw InputError(path, "no such sprite bank");
-    if (!std::filesystem::is_regular_file(path, ec)) throw InputError(path, "not a sprite bank (not a regular file)");
+    if (!std::filesystem::is_regular_file(path, ec))
+      throw InputError(path, "not a sprite bank (not a regular file)");
   }
-  const int flags =
-      (writable ? SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE : SQLITE_OPEN_READONLY) | SQLITE_OPEN_NOMUTEX;
+  const int flags = (writable ? SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE : SQLITE_OPEN_READONLY) |
+                    SQLITE_OPEN_NOMUTEX;
   sql::Db db = sql::OpenSqlite(path, flags);
   PrepareBankSchema(db, writable);
   return db;
 }
 
 int ReadSchemaVersion(const sql::Db& db) {
-  if (db.dialect() == sql::Dialect::kSqlite) return static_cast<int>(db.QueryInt("PRAGMA user_version"));
+  if (db.dialect() == sql::Dialect::kSqlite)
+    return static_cast<int>(db.QueryInt("PRAGMA user_version"));
   auto meta = db.Prepare("SELECT value FROM meta WHERE key = 'schema_version'");
   return meta.Step() ? std::atoi(meta.Text(0).c_str()) : 0;
 }
@@ -435,14 +450,16 @@ void SerializeClipCompletion(sql::Db& db) {
 std::vector<SchemaObject> ReadSchema(const sql::Db& db) {
   std::vector<SchemaObject> objects;
   sql::Stmt stmt = db.Prepare(
-      "SELECT type, name, sql FROM sqlite_schema WHERE name NOT LIKE 'sqlite_%' AND sql IS NOT NULL "
+      "SELECT type, name, sql FROM sqlite_schema WHERE name NOT LIKE 'sqlite_%' AND sql IS NOT "
+      "NULL "
       "ORDER BY type, name");
   while (stmt.Step()) objects.push_back({stmt.Text(0), stmt.Text(1), Normalize(stmt.Text(2))});
   return objects;
 }
 
 std::vector<SchemaObject> ExpectedSchema() {
-  sql::Db db = sql::OpenSqlite(":memory:", SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE | SQLITE_OPEN_MEMORY);
+  sql::Db db =
+      sql::OpenSqlite(":memory:", SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE | SQLITE_OPEN_MEMORY);
   for (const auto& m : BankMigrations(sql::Dialect::kSqlite)) db.Exec(m.sql);
   return ReadSchema(db);
 }

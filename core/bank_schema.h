@@ -12,7 +12,7 @@ namespace ss {
 namespace sql {
 class Db;
 enum class Dialect;
-}
+}  // namespace sql
 
 inline constexpr int kBankSchemaVersion = 2;
 // PRAGMA application_id of every bank: "SSBK".

@@ -15,8 +15,9 @@ constexpr const char* kNowMs = "(extract(epoch from clock_timestamp()) * 1000)::
 
 BankWorkQueue::BankWorkQueue(const std::string& bank) {
   if (!sql::IsPostgresAddress(bank)) {
-    throw InputError(bank, "shared transition work needs a PostgreSQL bank (postgresql://...); "
-                           "for a file, run `spritestation transitions BANK`");
+    throw InputError(bank,
+                     "shared transition work needs a PostgreSQL bank (postgresql://...); "
+                     "for a file, run `spritestation transitions BANK`");
   }
   db_ = std::make_unique<sql::Db>(OpenBankDatabase(bank, /*writable=*/true));
   sql::Transaction tx(*db_);
@@ -29,7 +30,8 @@ BankWorkQueue::BankWorkQueue(const std::string& bank) {
       " worker TEXT NOT NULL DEFAULT '',"
       " lease_until_ms BIGINT NOT NULL DEFAULT 0,"
       " attempts INTEGER NOT NULL DEFAULT 0);"
-      "CREATE INDEX IF NOT EXISTS transition_work_pending ON transition_work (complete_seq) WHERE done = 0");
+      "CREATE INDEX IF NOT EXISTS transition_work_pending ON transition_work (complete_seq) WHERE "
+      "done = 0");
   tx.Commit();
 }
 
@@ -46,11 +48,13 @@ int64_t BankWorkQueue::Register() {
 }
 
 std::optional<WorkUnit> BankWorkQueue::Claim(const std::string& worker, double lease_s) {
-  auto q = db_->Prepare(std::string("UPDATE transition_work SET worker = ?, lease_until_ms = ") + kNowMs +
-                        " + ?, attempts = attempts + 1 WHERE clip_id = (SELECT clip_id FROM transition_work "
-                        "WHERE done = 0 AND lease_until_ms < " + kNowMs +
-                        " ORDER BY complete_seq LIMIT 1 FOR UPDATE SKIP LOCKED) "
-                        "RETURNING clip_id, complete_seq, attempts");
+  auto q = db_->Prepare(
+      std::string("UPDATE transition_work SET worker = ?, lease_until_ms = ") + kNowMs +
+      " + ?, attempts = attempts + 1 WHERE clip_id = (SELECT clip_id FROM transition_work "
+      "WHERE done = 0 AND lease_until_ms < " +
+      kNowMs +
+      " ORDER BY complete_seq LIMIT 1 FOR UPDATE SKIP LOCKED) "
+      "RETURNING clip_id, complete_seq, attempts");
   q.Bind(1, worker).Bind(2, static_cast<int64_t>(lease_s * 1000));
   if (!q.Step()) return std::nullopt;
   return WorkUnit{q.Int(0), q.Int(1), static_cast<int>(q.Int(2))};
@@ -63,9 +67,10 @@ void BankWorkQueue::Done(int64_t clip_id) {
 
 WorkCounts BankWorkQueue::Counts() const {
   WorkCounts c;
-  auto q = db_->Prepare(std::string("SELECT coalesce(sum(CASE WHEN done = 0 AND lease_until_ms < ") + kNowMs +
-                        " THEN 1 ELSE 0 END), 0), coalesce(sum(CASE WHEN done = 0 AND lease_until_ms >= " + kNowMs +
-                        " THEN 1 ELSE 0 END), 0), coalesce(sum(done), 0) FROM transition_work");
+  auto q = db_->Prepare(
+      std::string("SELECT coalesce(sum(CASE WHEN done = 0 AND lease_until_ms < ") + kNowMs +
+      " THEN 1 ELSE 0 END), 0), coalesce(sum(CASE WHEN done = 0 AND lease_until_ms >= " + kNowMs +
+      " THEN 1 ELSE 0 END), 0), coalesce(sum(done), 0) FROM transition_work");
   if (q.Step()) c = {q.Int(0), q.Int(1), q.Int(2)};
   return c;
 }

@@ -227,7 +227,8 @@ CameraModel CameraModel::Parse(const std::string& text, const std::string& origi
   // without its newline (found by tests/fuzz: "# " crashes it): end every text with one.
   std::string terminated = text;
   if (terminated.back() != '\n') terminated.push_back('\n');
-  MrcalModelPtr m(mrcal_read_cameramodel_string(terminated.data(), static_cast<int>(terminated.size())));
+  MrcalModelPtr m(
+      mrcal_read_cameramodel_string(terminated.data(), static_cast<int>(terminated.size())));
   if (!m) throw InputError(origin, DiagnoseRefusal(text));
   for (double v : m->rt_cam_ref) {
     if (!std::isfinite(v))
@@ -239,13 +240,14 @@ CameraModel CameraModel::Parse(const std::string& text, const std::string& origi
   // length is 0 (or less) projects every point to the centre: nothing it sees could be keyed
   // or grounded. (A solver may still make such a model, to report it untrusted.)
   if (n >= 2 && !(intrinsics[0] > 0 && intrinsics[1] > 0)) {
-    throw InputError(origin, "focal lengths fx = " + std::to_string(intrinsics[0]) + ", fy = " +
-                                 std::to_string(intrinsics[1]) +
+    throw InputError(origin, "focal lengths fx = " + std::to_string(intrinsics[0]) +
+                                 ", fy = " + std::to_string(intrinsics[1]) +
                                  " (intrinsics[0], [1]) must be positive numbers of pixels");
   }
   try {
-    CameraModel model(LensName(m->lensmodel), std::move(intrinsics), static_cast<int>(m->imagersize[0]),
-                      static_cast<int>(m->imagersize[1]), Rigid3::FromRt(m->rt_cam_ref));
+    CameraModel model(LensName(m->lensmodel), std::move(intrinsics),
+                      static_cast<int>(m->imagersize[0]), static_cast<int>(m->imagersize[1]),
+                      Rigid3::FromRt(m->rt_cam_ref));
     model.rt_as_read_.emplace();
     std::copy(m->rt_cam_ref, m->rt_cam_ref + 6, model.rt_as_read_->begin());
     return model;

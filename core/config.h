@@ -19,14 +19,20 @@ namespace ss {
 inline constexpr int kConfigVersion = 1;
 
 // Closed sets are enums in the program and text only in the config file and the API.
-enum class WhiteBalanceMode { kDevice, kOnce, kManual };  // device: leave as is; once: auto, then lock
+enum class WhiteBalanceMode {
+  kDevice,
+  kOnce,
+  kManual
+};  // device: leave as is; once: auto, then lock
 enum class KeyingMethod { kChroma, kCleanPlate };
 enum class RecordingMode { kOff, kAll, kUsable };  // all frames, or those that gave a usable sprite
 
 inline constexpr EnumText<WhiteBalanceMode> kWhiteBalanceModeTexts[] = {
-    {WhiteBalanceMode::kDevice, "device"}, {WhiteBalanceMode::kOnce, "once"}, {WhiteBalanceMode::kManual, "manual"}};
-inline constexpr EnumText<KeyingMethod> kKeyingMethodTexts[] = {{KeyingMethod::kChroma, "chroma"},
-                                                               {KeyingMethod::kCleanPlate, "clean_plate"}};
+    {WhiteBalanceMode::kDevice, "device"},
+    {WhiteBalanceMode::kOnce, "once"},
+    {WhiteBalanceMode::kManual, "manual"}};
+inline constexpr EnumText<KeyingMethod> kKeyingMethodTexts[] = {
+    {KeyingMethod::kChroma, "chroma"}, {KeyingMethod::kCleanPlate, "clean_plate"}};
 inline constexpr EnumText<RecordingMode> kRecordingModeTexts[] = {
     {RecordingMode::kOff, "off"}, {RecordingMode::kAll, "all"}, {RecordingMode::kUsable, "usable"}};
 
@@ -36,9 +42,9 @@ const char* ToText(RecordingMode mode);
 
 struct WhiteBalanceConfig {
   WhiteBalanceMode mode = WhiteBalanceMode::kDevice;
-  double red_gain = 1.0;        // manual: red/green and blue/green balance ratios
+  double red_gain = 1.0;  // manual: red/green and blue/green balance ratios
   double blue_gain = 1.0;
-  double temperature_k = 0;     // manual: colour temperature instead of ratios (V4L2); 0 = unset
+  double temperature_k = 0;  // manual: colour temperature instead of ratios (V4L2); 0 = unset
   bool operator==(const WhiteBalanceConfig&) const = default;
 };
 
@@ -66,7 +72,7 @@ struct CameraConfig {
 
 struct KeyingConfig {
   KeyingMethod method = KeyingMethod::kChroma;
-  int training_frames = 30;       // empty-enclosure frames to learn from
+  int training_frames = 30;    // empty-enclosure frames to learn from
   double chroma_low = 20;      // chroma: key difference (8-bit levels) where alpha starts to fall
   double chroma_high = 60;     // chroma: ... and where it reaches 0 (fully background)
   double plate_low_sigma = 3;  // clean_plate: difference in noise sigmas where alpha starts to rise
@@ -93,9 +99,10 @@ struct PipelineConfig {
   int floor_margin_px = 3;       // floor pixels required around the silhouette
   double wall_margin_m = 0.005;  // contact point distance to keep from the floor polygon's edge
   double still_speed_m_per_s = 0.05;  // slower than this counts as not moving
-  double max_speed_m_per_s = 1.0;     // the tracker's speed limit: a subject faster than this starts a new clip
-  double max_still_s = 2.0;           // still periods longer than this are discarded
-  int min_clip_frames = 5;            // shorter clips are discarded
+  double max_speed_m_per_s =
+      1.0;  // the tracker's speed limit: a subject faster than this starts a new clip
+  double max_still_s = 2.0;  // still periods longer than this are discarded
+  int min_clip_frames = 5;   // shorter clips are discarded
   // Noise (docs/pipeline.md, `noise`): keyed background, not a subject. 0 turns a test off.
   double noise_min_solidity = 0.25;      // noise when the matte fills less of its convex hull
   double noise_recover_solidity = 0.30;  // a subject noise the frame before stays noise below this
@@ -106,14 +113,14 @@ struct PipelineConfig {
   // Billboard scale in pixels per metre, the same for the whole bank; 0 = `auto` (chosen from
   // the cameras, or the bank's own scale when it holds sprites: pipeline/run/bank_scale.h).
   double px_per_m = 0;
-  int workers = 0;                    // OpenCV threads inside a frame's work; 0 = OpenCV's default
-  int queue_frames = 8;               // per-camera queue between capture and pipeline
+  int workers = 0;       // OpenCV threads inside a frame's work; 0 = OpenCV's default
+  int queue_frames = 8;  // per-camera queue between capture and pipeline
   bool operator==(const PipelineConfig&) const = default;
 };
 
 struct StorageConfig {
-  std::string bank;                          // the sprite bank (absolute)
-  std::string recording_dir;                 // where recorded sessions go (absolute)
+  std::string bank;           // the sprite bank (absolute)
+  std::string recording_dir;  // where recorded sessions go (absolute)
   RecordingMode recording = RecordingMode::kOff;
   std::string recording_codec = "ffv1";      // "ffv1" | "mjpeg" | "h264"
   int64_t stop_recording_below_mib = 20480;  // free disk under which raw recording stops

@@ -23,6 +23,7 @@ struct ContactPointOptions {
 // The contact point of the silhouette in `alpha` (CV_8U, 255 = subject), in
 // `alpha`'s pixel coordinates (pixel centres at integers). False when no
 // pixel has alpha > 1/2.
-bool ContactPoint(const cv::Mat& alpha, cv::Point2d* point, const ContactPointOptions& options = {});
+bool ContactPoint(const cv::Mat& alpha, cv::Point2d* point,
+                  const ContactPointOptions& options = {});
 
 }  // namespace ss

@@ -78,8 +78,8 @@ Frame Frame::Owned(PixelFormat format, int width, int height, std::vector<uint8_
   return f;
 }
 
-Frame Frame::Borrowed(PixelFormat format, int width, int height, const uint8_t* data,
-                      size_t size, std::function<void()> release) {
+Frame Frame::Borrowed(PixelFormat format, int width, int height, const uint8_t* data, size_t size,
+                      std::function<void()> release) {
   Frame f;
   f.format = format;
   f.width = width;
@@ -139,12 +139,12 @@ void ToBgr(const Frame& frame, cv::Mat& bgr) {
       cv::cvtColor(cv::Mat(h * 3 / 2, w, CV_8UC1, data), bgr, cv::COLOR_YUV2BGR_NV12);
       return;
     case PixelFormat::kMJPEG: {
-      cv::Mat decoded = cv::imdecode(cv::Mat(1, static_cast<int>(frame.size), CV_8UC1, data),
-                                     cv::IMREAD_COLOR);
+      cv::Mat decoded =
+          cv::imdecode(cv::Mat(1, static_cast<int>(frame.size), CV_8UC1, data), cv::IMREAD_COLOR);
       if (decoded.empty() || decoded.cols != w || decoded.rows != h) {
-        throw InputError("frame " + std::to_string(frame.sequence),
-                         "MJPEG frame does not decode to " + std::to_string(w) + "x" +
-                             std::to_string(h));
+        throw InputError(
+            "frame " + std::to_string(frame.sequence),
+            "MJPEG frame does not decode to " + std::to_string(w) + "x" + std::to_string(h));
       }
       bgr = std::move(decoded);
       return;

@@ -34,21 +34,21 @@ std::optional<PixelFormat> ParsePixelFormat(const std::string& name);
 size_t FrameBytes(PixelFormat format, int width, int height);
 
 struct Frame {
-  int camera = 0;               // index of the camera within its session or station
-  uint64_t sequence = 0;        // device sequence number (gaps mean drops)
-  int64_t timestamp_ns = 0;     // device timestamp
+  int camera = 0;            // index of the camera within its session or station
+  uint64_t sequence = 0;     // device sequence number (gaps mean drops)
+  int64_t timestamp_ns = 0;  // device timestamp
   PixelFormat format = PixelFormat::kBGR8;
   int width = 0;
   int height = 0;
-  const uint8_t* data = nullptr;  // first byte of the pixels
-  size_t size = 0;                // bytes at data
+  const uint8_t* data = nullptr;        // first byte of the pixels
+  size_t size = 0;                      // bytes at data
   std::shared_ptr<const void> storage;  // keeps data alive (owned vector or borrowed buffer)
 
   // A frame owning a copy of its pixels.
   static Frame Owned(PixelFormat format, int width, int height, std::vector<uint8_t> pixels);
   // A frame borrowing `data`; `release` runs when the last copy of the frame is destroyed.
-  static Frame Borrowed(PixelFormat format, int width, int height, const uint8_t* data,
-                        size_t size, std::function<void()> release);
+  static Frame Borrowed(PixelFormat format, int width, int height, const uint8_t* data, size_t size,
+                        std::function<void()> release);
 };
 
 // Converts any frame to 8-bit BGR (OpenCV's order). Throws InputError naming the

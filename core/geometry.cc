@@ -92,7 +92,8 @@ GroundPolygonIndex::GroundPolygonIndex(const GroundPolygon& polygon) : polygon_(
   const size_t n = v.size();
   if (polygon_.empty() || n >= std::numeric_limits<uint32_t>::max() / 16) return;
   for (const Eigen::Vector2d& p : v) {
-    if (!(std::abs(p.x()) < kIndexedCoordinateLimit && std::abs(p.y()) < kIndexedCoordinateLimit)) return;
+    if (!(std::abs(p.x()) < kIndexedCoordinateLimit && std::abs(p.y()) < kIndexedCoordinateLimit))
+      return;
   }
   // Edge k runs from vertex k - 1 to vertex k, as the loops of SignedDistance take them.
   std::vector<Eigen::Vector2d> y_range(n);
@@ -113,13 +114,15 @@ GroundPolygonIndex::GroundPolygonIndex(const GroundPolygon& polygon) : polygon_(
   // (a comb's teeth) thus make few wide bands, and the memory stays linear in n.
   const double height = hi - lo;
   double bands = 2.0 * static_cast<double>(n);
-  if (spans > 0 && height > 0) bands = std::min(bands, 7.0 * static_cast<double>(n) * height / spans);
+  if (spans > 0 && height > 0)
+    bands = std::min(bands, 7.0 * static_cast<double>(n) * height / spans);
   bands_ = height > 0 ? static_cast<int>(std::clamp(bands, 1.0, 4194304.0)) : 1;
   y0_ = lo;
   scale_ = height > 0 ? bands_ / height : 0.0;
   band_start_.assign(static_cast<size_t>(bands_) + 1, 0);
   for (size_t k = 0; k < n; ++k) {
-    for (int b = Band(y_range[k][0]), last = Band(y_range[k][1]); b <= last; ++b) ++band_start_[b + 1];
+    for (int b = Band(y_range[k][0]), last = Band(y_range[k][1]); b <= last; ++b)
+      ++band_start_[b + 1];
   }
   for (int b = 0; b < bands_; ++b) band_start_[b + 1] += band_start_[b];
   band_edges_.resize(band_start_.back());
@@ -156,7 +159,8 @@ bool GroundPolygonIndex::Contains(const Eigen::Vector2d& p) const {
       const double x = a.x() + (p.y() - a.y()) * (b.x() - a.x()) / (b.y() - a.y());
       if (p.x() < x) inside = !inside;
     }
-    if (!on_edge && x_range_[k][0] <= p.x() && p.x() <= x_range_[k][1] && DistanceToSegment(p, b, a) == 0.0) {
+    if (!on_edge && x_range_[k][0] <= p.x() && p.x() <= x_range_[k][1] &&
+        DistanceToSegment(p, b, a) == 0.0) {
       on_edge = true;
     }
   }
@@ -301,7 +305,8 @@ class EdgeSweep {
     for (size_t first = 0; first < n_;) {
       // Every vertex at this point (more than one: the polygon passes it twice).
       size_t last = first + 1;
-      while (last < n_ && stops[last].x == stops[first].x && stops[last].y == stops[first].y) ++last;
+      while (last < n_ && stops[last].x == stops[first].x && stops[last].y == stops[first].y)
+        ++last;
       starting.clear();
       leaving.clear();
       for (size_t s = first; s < last; ++s) {
@@ -321,7 +326,8 @@ class EdgeSweep {
       }
       for (const size_t edge : leaving) {
         const auto it = where[edge];
-        if (it != crossed.begin() && std::next(it) != crossed.end() && Meet(*std::prev(it), *std::next(it))) {
+        if (it != crossed.begin() && std::next(it) != crossed.end() &&
+            Meet(*std::prev(it), *std::next(it))) {
           return true;
         }
         crossed.erase(it);

@@ -86,7 +86,8 @@ class GroundPolygonIndex {
   bool indexed_ = false;
   double y0_ = 0, scale_ = 0;
   int bands_ = 1;
-  std::vector<uint32_t> band_start_;  // band b's edges: band_edges_[band_start_[b] .. band_start_[b + 1])
+  std::vector<uint32_t>
+      band_start_;  // band b's edges: band_edges_[band_start_[b] .. band_start_[b + 1])
   std::vector<uint32_t> band_edges_;  // edge k runs from vertex k - 1 (n - 1 for k = 0) to vertex k
   std::vector<Eigen::Vector2d> x_range_;  // edge k's x extent, widened by its rounding reach
 };

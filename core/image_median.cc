@@ -12,10 +12,12 @@ cv::Mat PerPixelMedian(const std::vector<cv::Mat>& images, const std::string& wh
   if (first.empty() || first.depth() != CV_8U) throw InputError(what, "expected 8-bit images");
   for (size_t i = 1; i < images.size(); ++i) {
     if (images[i].size() != first.size() || images[i].type() != first.type()) {
-      throw InputError(what, "image " + std::to_string(i) + " is " + std::to_string(images[i].cols) + "x" +
-                                 std::to_string(images[i].rows) + " with " + std::to_string(images[i].channels()) +
-                                 " channel(s), image 0 " + std::to_string(first.cols) + "x" +
-                                 std::to_string(first.rows) + " with " + std::to_string(first.channels()));
+      throw InputError(what, "image " + std::to_string(i) + " is " +
+                                 std::to_string(images[i].cols) + "x" +
+                                 std::to_string(images[i].rows) + " with " +
+                                 std::to_string(images[i].channels()) + " channel(s), image 0 " +
+                                 std::to_string(first.cols) + "x" + std::to_string(first.rows) +
+                                 " with " + std::to_string(first.channels()));
     }
   }
   const size_t n = images.size(), middle = (n - 1) / 2;
@@ -28,7 +30,8 @@ cv::Mat PerPixelMedian(const std::vector<cv::Mat>& images, const std::string& wh
     uint8_t* dst = out.ptr<uint8_t>(y);
     for (int x = 0; x < row_bytes; ++x) {
       for (size_t i = 0; i < n; ++i) values[i] = rows[i][x];
-      std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(middle), values.end());
+      std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(middle),
+                       values.end());
       dst[x] = values[middle];
     }
   }

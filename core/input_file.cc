@@ -30,17 +30,20 @@ std::string ReadWithinLimit(std::istream& in, const std::string& path, const std
                             uintmax_t max_bytes) {
   const std::string limit = "larger than the " + Amount(max_bytes) + " " + what + " may be";
   std::error_code ec;
-  const uintmax_t size = std::filesystem::file_size(path, ec);  // fails for what is not a regular file
+  const uintmax_t size =
+      std::filesystem::file_size(path, ec);  // fails for what is not a regular file
   if (!ec && size > max_bytes) {
     const std::string bytes = std::to_string(size) + " bytes";
-    throw InputError(path, (Amount(size) == bytes ? bytes : Amount(size) + " (" + bytes + ")") + ": " + limit);
+    throw InputError(
+        path, (Amount(size) == bytes ? bytes : Amount(size) + " (" + bytes + ")") + ": " + limit);
   }
   std::string text;
   if (!ec) text.reserve(size);
   std::array<char, 65536> buffer;
   while (in.read(buffer.data(), buffer.size()) || in.gcount() > 0) {
     text.append(buffer.data(), static_cast<size_t>(in.gcount()));
-    if (text.size() > max_bytes) throw InputError(path, "more than " + Amount(max_bytes) + " read: " + limit);
+    if (text.size() > max_bytes)
+      throw InputError(path, "more than " + Amount(max_bytes) + " read: " + limit);
   }
   return text;
 }

@@ -7,9 +7,11 @@ const std::vector<RecordingCodec>& RecordingCodecs() {
       {"ffv1", true, true,
        "lossless, FFV1 level 3 (16 slices at 720p and up, a CRC per slice); the default"},
       {"ffvhuff", true, false,
-       "lossless (Huffyuv, colour as planes), several times faster to decode than ffv1 for more bytes; "
+       "lossless (Huffyuv, colour as planes), several times faster to decode than ffv1 for more "
+       "bytes; "
        "no checksums: a damaged frame is found only when it does not decode"},
-      {"mjpeg", false, false, "JPEG per frame (lossy); an MJPEG camera's JPEGs are stored as they came"},
+      {"mjpeg", false, false,
+       "JPEG per frame (lossy); an MJPEG camera's JPEGs are stored as they came"},
       {"h264", false, false, "libx264, zero latency, no B-frames (lossy)"},
   };
   return codecs;
@@ -27,8 +29,10 @@ std::string RecordingCodecNames() {
   const auto& codecs = RecordingCodecs();
   for (size_t i = 0; i < codecs.size(); ++i) {
     out += codecs[i].name;
-    if (i + 2 < codecs.size()) out += ", ";
-    else if (i + 2 == codecs.size()) out += " or ";
+    if (i + 2 < codecs.size())
+      out += ", ";
+    else if (i + 2 == codecs.size())
+      out += " or ";
   }
   return out;
 }

@@ -8,10 +8,11 @@
 namespace ss {
 
 struct RecordingCodec {
-  const char* name;      // as the config names it
-  bool lossless;         // frames decode to exactly the bytes the camera gave
-  bool damage_checked;   // every frame carries checksums: a damaged frame is found, not decoded wrong
-  const char* what;      // one line for the docs and messages
+  const char* name;  // as the config names it
+  bool lossless;     // frames decode to exactly the bytes the camera gave
+  bool
+      damage_checked;  // every frame carries checksums: a damaged frame is found, not decoded wrong
+  const char* what;    // one line for the docs and messages
 };
 
 // ffv1 (the default), ffvhuff, mjpeg, h264.

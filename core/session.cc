@@ -57,7 +57,8 @@ class Fields {
     if (!v.is_number_integer()) Fail(key, "expected a positive integer");
     const int64_t i = v.get<int64_t>();
     if (i <= 0) Fail(key, "expected a positive integer");
-    if (i > max) Fail(key, "expected at most " + std::to_string(max) + ", got " + std::to_string(i));
+    if (i > max)
+      Fail(key, "expected at most " + std::to_string(max) + ", got " + std::to_string(i));
     return static_cast<int>(i);
   }
   double PositiveNumber(const std::string& key) const {
@@ -75,7 +76,8 @@ class Fields {
       Fail(key, "expected a file name");
     }
     const fs::path p(s);
-    if (p.is_absolute()) Fail(key, "expected a path relative to the session folder, got '" + s + "'");
+    if (p.is_absolute())
+      Fail(key, "expected a path relative to the session folder, got '" + s + "'");
     for (const auto& part : p) {
       if (part == "..") Fail(key, "path '" + s + "' leaves the session folder");
     }
@@ -121,9 +123,10 @@ SessionCamera ParseCamera(const std::string& path, const json& j, size_t i) {
   const std::string format = f.String("pixel_format");
   const auto parsed = ParsePixelFormat(format);
   if (!parsed) {
-    f.Fail("pixel_format", "unknown pixel format '" + format +
-                               "' (expected mono8, bayer_rg8, bayer_gr8, bayer_gb8, bayer_bg8, rgb8, "
-                               "bgr8, yuyv, nv12 or mjpeg)");
+    f.Fail("pixel_format",
+           "unknown pixel format '" + format +
+               "' (expected mono8, bayer_rg8, bayer_gr8, bayer_gb8, bayer_bg8, rgb8, "
+               "bgr8, yuyv, nv12 or mjpeg)");
   }
   c.pixel_format = *parsed;
   c.codec = f.String("codec");
@@ -133,7 +136,8 @@ SessionCamera ParseCamera(const std::string& path, const json& j, size_t i) {
   if (c.pixel_format == PixelFormat::kMJPEG && c.codec != "mjpeg") {
     f.Fail("codec", "an mjpeg camera is stored as codec 'mjpeg', got '" + c.codec + "'");
   }
-  if ((c.pixel_format == PixelFormat::kYUYV || c.pixel_format == PixelFormat::kNV12) && c.width % 2 != 0) {
+  if ((c.pixel_format == PixelFormat::kYUYV || c.pixel_format == PixelFormat::kNV12) &&
+      c.width % 2 != 0) {
     f.Fail("width", format + " needs an even width, got " + std::to_string(c.width));
   }
   if (c.pixel_format == PixelFormat::kNV12 && c.height % 2 != 0) {
@@ -142,7 +146,8 @@ SessionCamera ParseCamera(const std::string& path, const json& j, size_t i) {
   c.fps = f.PositiveNumber("fps");
   if (f.Has("frames")) {
     const json& v = f.Get("frames");
-    if (!v.is_number_integer() || v.get<int64_t>() < 0) f.Fail("frames", "expected a non-negative integer");
+    if (!v.is_number_integer() || v.get<int64_t>() < 0)
+      f.Fail("frames", "expected a non-negative integer");
     c.frames = v.get<int64_t>();
   }
   return c;
@@ -184,7 +189,7 @@ SessionInfo ReadSessionInfo(const std::string& dir) {
   if (!in) {
     std::error_code ec;
     throw InputError(path, fs::exists(dir, ec) ? "cannot open (is this a recorded session?)"
-                                           : "no such session folder");
+                                               : "no such session folder");
   }
   std::stringstream text;
   text << in.rdbuf();
@@ -203,8 +208,8 @@ SessionInfo ReadSessionInfo(const std::string& dir) {
   info.format_version = version.get<int>();
   if (info.format_version != kSessionFormatVersion) {
     f.Fail("format_version", "unsupported version " + std::to_string(info.format_version) +
-                                 " (this build reads version " + std::to_string(kSessionFormatVersion) +
-                                 ")");
+                                 " (this build reads version " +
+                                 std::to_string(kSessionFormatVersion) + ")");
   }
   info.name = f.String("name");
   info.created = f.String("created");
@@ -261,7 +266,9 @@ std::vector<FrameRecord> ReadFrameCsv(const std::string& path) {
   std::stringstream buffer;
   buffer << in.rdbuf();
   const std::string text = buffer.str();
-  if (text.empty()) throw InputError(path, "empty file, expected the header line '" + std::string(kCsvHeader) + "'");
+  if (text.empty())
+    throw InputError(path,
+                     "empty file, expected the header line '" + std::string(kCsvHeader) + "'");
 
   std::vector<FrameRecord> records;
   size_t pos = 0;
@@ -276,8 +283,8 @@ std::vector<FrameRecord> ReadFrameCsv(const std::string& path) {
     const std::string where = path + ":" + std::to_string(line_no);
     if (line_no == 1) {
       if (line != kCsvHeader) {
-        throw InputError(where, "expected the header line '" + std::string(kCsvHeader) + "', got '" +
-                                    line.substr(0, 80) + "'");
+        throw InputError(where, "expected the header line '" + std::string(kCsvHeader) +
+                                    "', got '" + line.substr(0, 80) + "'");
       }
       continue;
     }
@@ -287,13 +294,14 @@ std::vector<FrameRecord> ReadFrameCsv(const std::string& path) {
       size_t start = 0;
       while (true) {
         const size_t comma = line.find(',', start);
-        fields.push_back(line.substr(start, comma == std::string::npos ? std::string::npos : comma - start));
+        fields.push_back(
+            line.substr(start, comma == std::string::npos ? std::string::npos : comma - start));
         if (comma == std::string::npos) break;
         start = comma + 1;
       }
       if (fields.size() != 4) {
-        throw InputError(where, "expected 4 comma-separated fields (" + std::string(kCsvHeader) + "), got " +
-                                    std::to_string(fields.size()));
+        throw InputError(where, "expected 4 comma-separated fields (" + std::string(kCsvHeader) +
+                                    "), got " + std::to_string(fields.size()));
       }
       FrameRecord r;
       r.index = ParseField<int64_t>(where, "index", fields[0]);
@@ -302,14 +310,15 @@ std::vector<FrameRecord> ReadFrameCsv(const std::string& path) {
       r.drops_before = ParseField<uint64_t>(where, "drops_before", fields[3]);
       const auto expected = static_cast<int64_t>(records.size());
       if (r.index != expected) {
-        throw InputError(where, "field 'index': expected " + std::to_string(expected) + " (rows count up from 0), got " +
-                                    std::to_string(r.index));
+        throw InputError(where, "field 'index': expected " + std::to_string(expected) +
+                                    " (rows count up from 0), got " + std::to_string(r.index));
       }
       records.push_back(r);
     } catch (const InputError& e) {
       // A last row without its newline is a write torn by a killed recorder: drop it.
       if (!terminated) {
-        Log("core.session")->warn("{}: ignoring the unterminated last row (recording interrupted?)", where);
+        Log("core.session")
+            ->warn("{}: ignoring the unterminated last row (recording interrupted?)", where);
         break;
       }
       throw;
@@ -330,10 +339,10 @@ void FrameCsvWriter::Append(const FrameRecord& record) {
   if (!out_.is_open()) throw WorkError(path_, "append after close");
   // One formatted row, handed to the OS in one write so a kill cannot split it.
   char row[96];
-  const int n = std::snprintf(row, sizeof(row), "%lld,%lld,%llu,%llu\n", static_cast<long long>(record.index),
-                              static_cast<long long>(record.timestamp_ns),
-                              static_cast<unsigned long long>(record.sequence),
-                              static_cast<unsigned long long>(record.drops_before));
+  const int n = std::snprintf(
+      row, sizeof(row), "%lld,%lld,%llu,%llu\n", static_cast<long long>(record.index),
+      static_cast<long long>(record.timestamp_ns), static_cast<unsigned long long>(record.sequence),
+      static_cast<unsigned long long>(record.drops_before));
   out_.write(row, n);
   out_.flush();
   if (!out_) throw WorkError(path_, "write failed (disk full?)");

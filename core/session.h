@@ -17,14 +17,15 @@ namespace ss {
 inline constexpr int kSessionFormatVersion = 1;
 
 struct SessionCamera {
-  std::string name;          // "cam0"; also the stem of its files
-  std::string video;         // file name relative to the session, e.g. "cam0.mkv"
-  std::string frames_csv;    // e.g. "cam0.frames.csv"
-  std::string model;         // e.g. "cam0.cameramodel"; empty when uncalibrated
+  std::string name;        // "cam0"; also the stem of its files
+  std::string video;       // file name relative to the session, e.g. "cam0.mkv"
+  std::string frames_csv;  // e.g. "cam0.frames.csv"
+  std::string model;       // e.g. "cam0.cameramodel"; empty when uncalibrated
   int width = 0;
   int height = 0;
-  PixelFormat pixel_format = PixelFormat::kBGR8;  // as the camera delivered it, and as replay returns it
-  std::string codec = "ffv1";                     // "ffv1" | "mjpeg" | "h264"
+  PixelFormat pixel_format =
+      PixelFormat::kBGR8;      // as the camera delivered it, and as replay returns it
+  std::string codec = "ffv1";  // "ffv1" | "mjpeg" | "h264"
   double fps = 30.0;
   // Frames recorded, written when the recording was closed; -1 while it runs or
   // after it was killed (then the CSV is all there is).
@@ -34,8 +35,8 @@ struct SessionCamera {
 struct SessionInfo {
   int format_version = kSessionFormatVersion;
   std::string name;
-  std::string created;       // ISO 8601, UTC
-  bool synthetic = false;    // true when truth/ is present
+  std::string created;     // ISO 8601, UTC
+  bool synthetic = false;  // true when truth/ is present
   std::vector<SessionCamera> cameras;
 };
 
@@ -57,7 +58,8 @@ std::vector<FrameRecord> ReadFrameCsv(const std::string& path);
 // Appends rows to a per-frame CSV, flushed row by row so a killed recorder keeps them.
 class FrameCsvWriter {
  public:
-  explicit FrameCsvWriter(const std::string& path);  // WorkError naming the file when it cannot open
+  explicit FrameCsvWriter(
+      const std::string& path);  // WorkError naming the file when it cannot open
   void Append(const FrameRecord& record);
   void Close();
 

@@ -59,7 +59,9 @@ class Stmt {
   Stmt& Bind(int index, int64_t value) { return impl_->Bind(index, value), *this; }
   Stmt& Bind(int index, double value) { return impl_->Bind(index, value), *this; }
   Stmt& Bind(int index, std::string_view text) { return impl_->Bind(index, text), *this; }
-  Stmt& BindBlob(int index, const void* data, size_t size) { return impl_->BindBlob(index, data, size), *this; }
+  Stmt& BindBlob(int index, const void* data, size_t size) {
+    return impl_->BindBlob(index, data, size), *this;
+  }
   Stmt& BindNull(int index) { return impl_->BindNull(index), *this; }
   // True when a row is ready; false when done. Throws on error.
   bool Step() { return impl_->Step(); }

@@ -32,7 +32,8 @@ std::string RedactAddress(const std::string& address) {
     }
   }
   // ...?password=secret&... -> password=***
-  for (size_t pos = out.find("password="); pos != std::string::npos; pos = out.find("password=", pos + 1)) {
+  for (size_t pos = out.find("password="); pos != std::string::npos;
+       pos = out.find("password=", pos + 1)) {
     const size_t value = pos + 9;
     const size_t end = out.find('&', value);
     out.replace(value, (end == std::string::npos ? out.size() : end) - value, "***");
@@ -48,7 +49,8 @@ std::string Trim(std::string text) {
 }
 
 // Throws the error that matches a failed result (see the file comment).
-[[noreturn]] void FailResult(PGconn* conn, const PGresult* result, const std::string& path, std::string_view what) {
+[[noreturn]] void FailResult(PGconn* conn, const PGresult* result, const std::string& path,
+                             std::string_view what) {
   const char* state = result ? PQresultErrorField(result, PG_DIAG_SQLSTATE) : nullptr;
   const std::string code = state ? state : "";
   std::string message = Trim(result ? PQresultErrorMessage(result) : "");
@@ -59,7 +61,8 @@ std::string Trim(std::string text) {
       code == "55P03" || code == "53300") {
     throw BusyError(path, reason);
   }
-  if (code == "XX001" || code == "XX002") throw CorruptError(path, "the database is damaged (" + reason + ")");
+  if (code == "XX001" || code == "XX002")
+    throw CorruptError(path, "the database is damaged (" + reason + ")");
   throw WorkError(path, reason);
 }
 
@@ -147,7 +150,8 @@ class PostgresStmt final : public StmtImpl {
     return blob_.data();
   }
   size_t Bytes(int col) const override {
-    if (PQftype(result_.get(), col) != kByteaOid) return static_cast<size_t>(PQgetlength(result_.get(), row_, col));
+    if (PQftype(result_.get(), col) != kByteaOid)
+      return static_cast<size_t>(PQgetlength(result_.get(), row_, col));
     Decode(col);
     return blob_.size();
   }
@@ -158,7 +162,8 @@ class PostgresStmt final : public StmtImpl {
 
   void Check(int index) const {
     if (index < 1 || index > static_cast<int>(values_.size())) {
-      throw WorkError("sql", "bind index " + std::to_string(index) + " outside 1.." + std::to_string(values_.size()));
+      throw WorkError("sql", "bind index " + std::to_string(index) + " outside 1.." +
+                                 std::to_string(values_.size()));
     }
   }
   void Set(int index, std::string value, int format) {
@@ -198,7 +203,8 @@ class PostgresStmt final : public StmtImpl {
 
 class PostgresDb final : public DbImpl {
  public:
-  PostgresDb(const std::string& address, bool read_only) : path_(RedactAddress(address)), read_only_(read_only) {
+  PostgresDb(const std::string& address, bool read_only)
+      : path_(RedactAddress(address)), read_only_(read_only) {
     const char* keys[] = {"connect_timeout", "fallback_application_name", "dbname", nullptr};
     const char* values[] = {"10", "spritestation", address.c_str(), nullptr};
     conn_ = PQconnectdbParams(keys, values, /*expand_dbname=*/1);
@@ -221,7 +227,8 @@ class PostgresDb final : public DbImpl {
   void Exec(const std::string& sql) override {
     Result r(PQexec(conn_, sql.c_str()));
     const auto status = PQresultStatus(r.get());
-    if (status != PGRES_COMMAND_OK && status != PGRES_TUPLES_OK) FailResult(conn_, r.get(), path_, Brief(sql));
+    if (status != PGRES_COMMAND_OK && status != PGRES_TUPLES_OK)
+      FailResult(conn_, r.get(), path_, Brief(sql));
   }
   std::unique_ptr<StmtImpl> Prepare(std::string_view sql) override {
     return std::make_unique<PostgresStmt>(*this, sql);
@@ -239,13 +246,18 @@ class PostgresDb final : public DbImpl {
     if (PQstatus(conn_) == CONNECTION_OK) PQclear(PQexec(conn_, "ROLLBACK"));
   }
 
-  static std::string Brief(std::string_view sql) { return "'" + std::string(sql.substr(0, 60)) + "'"; }
+  static std::string Brief(std::string_view sql) {
+    return "'" + std::string(sql.substr(0, 60)) + "'";
+  }
 
  private:
   // Once per connection: quiet notices (IF NOT EXISTS), and read-only when asked.
   void Configure() {
     PQsetNoticeProcessor(
-        conn_, [](void*, const char* message) { Log("core.bank")->debug("postgresql: {}", Trim(message)); },
+        conn_,
+        [](void*, const char* message) {
+          Log("core.bank")->debug("postgresql: {}", Trim(message));
+        },
         nullptr);
     Exec("SET client_min_messages = warning");
     if (read_only_) Exec("SET default_transaction_read_only = on");
@@ -255,7 +267,8 @@ class PostgresDb final : public DbImpl {
     if (PQstatus(conn_) == CONNECTION_OK) return;
     PQreset(conn_);
     if (PQstatus(conn_) != CONNECTION_OK) {
-      throw BusyError(path_, "connection lost and not re-established (" + Trim(PQerrorMessage(conn_)) + ")");
+      throw BusyError(
+          path_, "connection lost and not re-established (" + Trim(PQerrorMessage(conn_)) + ")");
     }
     Log("core.bank")->info("{}: connection re-established", path_);
     Configure();
@@ -282,7 +295,8 @@ bool PostgresStmt::Step() {
       values[i] = values_[i] ? values_[i]->data() : nullptr;
       lengths[i] = values_[i] ? static_cast<int>(values_[i]->size()) : 0;
     }
-    result_.reset(PQexecParams(db_.conn(), sql_.c_str(), n, nullptr, values.data(), lengths.data(), formats_.data(),
+    result_.reset(PQexecParams(db_.conn(), sql_.c_str(), n, nullptr, values.data(), lengths.data(),
+                               formats_.data(),
                                /*resultFormat=*/0));
     const auto status = PQresultStatus(result_.get());
     if (status != PGRES_COMMAND_OK && status != PGRES_TUPLES_OK) {

@@ -28,7 +28,8 @@ namespace {
 class SqliteStmt final : public StmtImpl {
  public:
   SqliteStmt(sqlite3* db, std::string_view sql, const std::string& path) : db_(db), path_(path) {
-    const int rc = sqlite3_prepare_v2(db, sql.data(), static_cast<int>(sql.size()), &stmt_, nullptr);
+    const int rc =
+        sqlite3_prepare_v2(db, sql.data(), static_cast<int>(sql.size()), &stmt_, nullptr);
     if (rc != SQLITE_OK) Fail(db, rc, path, "prepare '" + std::string(sql.substr(0, 60)) + "'");
   }
   ~SqliteStmt() override { sqlite3_finalize(stmt_); }
@@ -38,7 +39,8 @@ class SqliteStmt final : public StmtImpl {
   void Bind(int index, int64_t value) override { Check(sqlite3_bind_int64(stmt_, index, value)); }
   void Bind(int index, double value) override { Check(sqlite3_bind_double(stmt_, index, value)); }
   void Bind(int index, std::string_view text) override {
-    Check(sqlite3_bind_text(stmt_, index, text.data(), static_cast<int>(text.size()), SQLITE_TRANSIENT));
+    Check(sqlite3_bind_text(stmt_, index, text.data(), static_cast<int>(text.size()),
+                            SQLITE_TRANSIENT));
   }
   void BindBlob(int index, const void* data, size_t size) override {
     Check(sqlite3_bind_blob64(stmt_, index, data, size, SQLITE_TRANSIENT));
@@ -67,10 +69,13 @@ class SqliteStmt final : public StmtImpl {
   std::string Text(int col) const override {
     const auto* text = sqlite3_column_text(stmt_, col);
     if (!text) return {};
-    return std::string(reinterpret_cast<const char*>(text), static_cast<size_t>(sqlite3_column_bytes(stmt_, col)));
+    return std::string(reinterpret_cast<const char*>(text),
+                       static_cast<size_t>(sqlite3_column_bytes(stmt_, col)));
   }
   const void* Blob(int col) const override { return sqlite3_column_blob(stmt_, col); }
-  size_t Bytes(int col) const override { return static_cast<size_t>(sqlite3_column_bytes(stmt_, col)); }
+  size_t Bytes(int col) const override {
+    return static_cast<size_t>(sqlite3_column_bytes(stmt_, col));
+  }
   int64_t Changes() const override { return changes_; }
 
  private:
@@ -127,7 +132,9 @@ class SqliteDb final : public DbImpl {
 
 }  // namespace
 
-Db OpenSqlite(const std::string& path, int flags) { return Db(std::make_unique<SqliteDb>(path, flags)); }
+Db OpenSqlite(const std::string& path, int flags) {
+  return Db(std::make_unique<SqliteDb>(path, flags));
+}
 
 sqlite3* SqliteHandle(const Db& db) {
   auto* sqlite = dynamic_cast<SqliteDb*>(&db.impl());

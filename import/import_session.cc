@@ -84,7 +84,8 @@ GroundPolygon ReadFloorFile(const std::string& path) {
     vertices.emplace_back(p[0].get<double>(), p[1].get<double>());
   }
   if (vertices.size() > GroundPolygon::kMaxVertices)
-    throw InputError(path, "floor: " + std::to_string(vertices.size()) + " points; a floor polygon has at most " +
+    throw InputError(path, "floor: " + std::to_string(vertices.size()) +
+                               " points; a floor polygon has at most " +
                                std::to_string(GroundPolygon::kMaxVertices));
   GroundPolygon polygon(std::move(vertices));
   if (!polygon.IsSimple())
@@ -248,8 +249,10 @@ std::string IngestYaml(int empty_frames) {
          "  training_frames: " +
          std::to_string(empty_frames) +
          "\n"
-         "# People walk at ~1.4 m/s: past the tracker's default limit (1 m/s, for small animals) a\n"
-         "# walker's clip breaks every few frames (vtest.avi, first 30 s: 110 sprites kept at 1 m/s,\n"
+         "# People walk at ~1.4 m/s: past the tracker's default limit (1 m/s, for small animals) "
+         "a\n"
+         "# walker's clip breaks every few frames (vtest.avi, first 30 s: 110 sprites kept at 1 "
+         "m/s,\n"
          "# 495 at 2.5 m/s).\n"
          "pipeline:\n"
          "  max_speed_m_per_s: 2.5\n";

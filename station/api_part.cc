@@ -18,7 +18,9 @@ void ReplyError(httplib::Response& res, int status, const std::string& message) 
 }
 
 Handler Json(std::function<nlohmann::json(const httplib::Request&)> f) {
-  return [f = std::move(f)](const httplib::Request& req, httplib::Response& res) { Reply(res, 200, f(req)); };
+  return [f = std::move(f)](const httplib::Request& req, httplib::Response& res) {
+    Reply(res, 200, f(req));
+  };
 }
 
 nlohmann::json ObjectBody(const httplib::Request& req, std::initializer_list<const char*> fields) {
@@ -34,17 +36,20 @@ int64_t ParseInt(const std::string& text, const char* name, int64_t lo, int64_t 
     used = 0;
   }
   if (used == 0 || used != text.size() || v < lo || v > hi) {
-    throw InputError(name, "expected an integer from " + std::to_string(lo) + " to " + std::to_string(hi) + ", got \"" +
-                               text + "\"");
+    throw InputError(name, "expected an integer from " + std::to_string(lo) + " to " +
+                               std::to_string(hi) + ", got \"" + text + "\"");
   }
   return v;
 }
 
-int64_t IntParam(const httplib::Request& req, const char* name, int64_t fallback, int64_t lo, int64_t hi) {
+int64_t IntParam(const httplib::Request& req, const char* name, int64_t fallback, int64_t lo,
+                 int64_t hi) {
   return req.has_param(name) ? ParseInt(req.get_param_value(name), name, lo, hi) : fallback;
 }
 
-int64_t PathId(const httplib::Request& req, const char* what) { return ParseInt(req.matches[1], what, 1, INT64_MAX); }
+int64_t PathId(const httplib::Request& req, const char* what) {
+  return ParseInt(req.matches[1], what, 1, INT64_MAX);
+}
 
 std::string PathText(const httplib::Request& req, size_t i) { return req.matches[i]; }
 

@@ -52,7 +52,8 @@ nlohmann::json ObjectBody(const httplib::Request& req, std::initializer_list<con
 // `text` as a whole integer within [lo, hi]; InputError naming `name` otherwise.
 int64_t ParseInt(const std::string& text, const char* name, int64_t lo, int64_t hi);
 // An integer query parameter within [lo, hi], or `fallback` when absent.
-int64_t IntParam(const httplib::Request& req, const char* name, int64_t fallback, int64_t lo, int64_t hi);
+int64_t IntParam(const httplib::Request& req, const char* name, int64_t fallback, int64_t lo,
+                 int64_t hi);
 // The path's first group as an id >= 1.
 int64_t PathId(const httplib::Request& req, const char* what);
 // The path's group `i` as text.

@@ -55,19 +55,21 @@ std::vector<uint8_t> BankSpool::Encode(const ClipBatch& batch) {
   PixelCodec codec;
   json sprites = json::array();
   for (const SpriteRecord& s : batch.sprites) {
-    json j = {{"frame", s.frame},
-              {"timestamp_ns", s.timestamp_ns},
-              {"mirrored", s.mirrored},
-              {"ground", {s.ground_x_m, s.ground_y_m}},
-              {"velocity", {s.velocity_x_m_s, s.velocity_y_m_s}},
-              {"mean_rgb", {s.mean_r, s.mean_g, s.mean_b}},
-              {"area_px", s.area_px},
-              {"eccentricity", s.eccentricity},
-              {"bbox", {s.bbox_in_image.x, s.bbox_in_image.y, s.bbox_in_image.width, s.bbox_in_image.height}},
-              {"billboard", {s.billboard_width_px, s.billboard_height_px}},
-              {"px_per_m", s.px_per_m},
-              {"anchor", {s.anchor_x_px, s.anchor_y_px}},
-              {"tags", s.tags}};
+    json j = {
+        {"frame", s.frame},
+        {"timestamp_ns", s.timestamp_ns},
+        {"mirrored", s.mirrored},
+        {"ground", {s.ground_x_m, s.ground_y_m}},
+        {"velocity", {s.velocity_x_m_s, s.velocity_y_m_s}},
+        {"mean_rgb", {s.mean_r, s.mean_g, s.mean_b}},
+        {"area_px", s.area_px},
+        {"eccentricity", s.eccentricity},
+        {"bbox",
+         {s.bbox_in_image.x, s.bbox_in_image.y, s.bbox_in_image.width, s.bbox_in_image.height}},
+        {"billboard", {s.billboard_width_px, s.billboard_height_px}},
+        {"px_per_m", s.px_per_m},
+        {"anchor", {s.anchor_x_px, s.anchor_y_px}},
+        {"tags", s.tags}};
     if (!s.mirrored) j["pixels"] = json::binary(codec.Encode(s.pixels));
     sprites.push_back(std::move(j));
   }
@@ -110,7 +112,8 @@ ClipBatch BankSpool::Decode(const std::vector<uint8_t>& bytes, const std::string
       r.area_px = s.at("area_px").get<double>();
       r.eccentricity = s.at("eccentricity").get<double>();
       const json& b = s.at("bbox");
-      r.bbox_in_image = cv::Rect(b.at(0).get<int>(), b.at(1).get<int>(), b.at(2).get<int>(), b.at(3).get<int>());
+      r.bbox_in_image =
+          cv::Rect(b.at(0).get<int>(), b.at(1).get<int>(), b.at(2).get<int>(), b.at(3).get<int>());
       r.billboard_width_px = s.at("billboard").at(0).get<int>();
       r.billboard_height_px = s.at("billboard").at(1).get<int>();
       r.px_per_m = s.at("px_per_m").get<double>();
@@ -119,7 +122,8 @@ ClipBatch BankSpool::Decode(const std::vector<uint8_t>& bytes, const std::string
       r.tags = s.at("tags").get<std::vector<std::string>>();
       if (!r.mirrored) {
         const auto& blob = s.at("pixels").get_binary();
-        r.pixels = codec.Decode(blob.data(), blob.size(), r.billboard_width_px, r.billboard_height_px, kPixelCodec);
+        r.pixels = codec.Decode(blob.data(), blob.size(), r.billboard_width_px,
+                                r.billboard_height_px, kPixelCodec);
       }
       batch.sprites.push_back(std::move(r));
     }
@@ -131,15 +135,19 @@ ClipBatch BankSpool::Decode(const std::vector<uint8_t>& bytes, const std::string
   }
 }
 
-BankSpool::BankSpool(std::string dir, int64_t max_bytes) : dir_(std::move(dir)), max_bytes_(max_bytes) {
+BankSpool::BankSpool(std::string dir, int64_t max_bytes)
+    : dir_(std::move(dir)), max_bytes_(max_bytes) {
   std::error_code ec;
   fs::create_directories(dir_, ec);
-  if (ec || !fs::is_directory(dir_)) throw WorkError(dir_, "cannot make the spool folder: " + ec.message());
+  if (ec || !fs::is_directory(dir_))
+    throw WorkError(dir_, "cannot make the spool folder: " + ec.message());
   std::vector<std::string> names;
   for (const auto& entry : fs::directory_iterator(dir_, ec)) {
     const std::string name = entry.path().filename().string();
-    if (entry.is_regular_file() && name.size() == 18 && name.substr(12) == ".batch") names.push_back(name);
-    if (name.rfind(".writing-", 0) == 0) fs::remove(entry.path(), ec);  // a write cut short: never counted
+    if (entry.is_regular_file() && name.size() == 18 && name.substr(12) == ".batch")
+      names.push_back(name);
+    if (name.rfind(".writing-", 0) == 0)
+      fs::remove(entry.path(), ec);  // a write cut short: never counted
   }
   std::sort(names.begin(), names.end());
   for (const std::string& name : names) {
@@ -150,8 +158,8 @@ BankSpool::BankSpool(std::string dir, int64_t max_bytes) : dir_(std::move(dir)),
     next_ = std::max<uint64_t>(next_, std::strtoull(name.c_str(), nullptr, 10) + 1);
   }
   if (!files_.empty()) {
-    Log("station")->info("spool {}: {} batches ({} bytes) from an earlier run wait for the bank", dir_,
-                         files_.size(), bytes_);
+    Log("station")->info("spool {}: {} batches ({} bytes) from an earlier run wait for the bank",
+                         dir_, files_.size(), bytes_);
   }
 }
 
@@ -165,7 +173,8 @@ bool BankSpool::Push(const ClipBatch& batch) {
   if (fd < 0) throw WorkError(temp, std::string("cannot write: ") + std::strerror(errno));
   try {
     WriteAll(fd, bytes, temp);
-    if (::fsync(fd) != 0) throw WorkError(temp, std::string("cannot write: ") + std::strerror(errno));
+    if (::fsync(fd) != 0)
+      throw WorkError(temp, std::string("cannot write: ") + std::strerror(errno));
   } catch (...) {
     ::close(fd);
     ::unlink(temp.c_str());
@@ -187,7 +196,8 @@ std::optional<ClipBatch> BankSpool::Front() {
   while (!files_.empty()) {
     const File& f = files_.front();
     std::ifstream in(f.path, std::ios::binary);
-    std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(in)),
+                               std::istreambuf_iterator<char>());
     try {
       if (!in && !in.eof()) throw InputError(f.path, "cannot read");
       return Decode(bytes, f.path);

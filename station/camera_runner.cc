@@ -1,9 +1,9 @@
 #include "station/camera_runner.h"
 
 #include <algorithm>
-#include <cstdio>
 #include <atomic>
 #include <condition_variable>
+#include <cstdio>
 #include <deque>
 #include <exception>
 #include <future>
@@ -13,10 +13,10 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "capture/camera_source.h"
 #include "core/error.h"
 #include "core/log.h"
 #include "pipeline/run/bounded_queue.h"
-#include "capture/camera_source.h"
 
 namespace ss {
 namespace {
@@ -56,12 +56,18 @@ bool WaitForCameraCloses(double timeout_s) {
 
 const char* CameraStateName(CameraState state) {
   switch (state) {
-    case CameraState::kStarting: return "starting";
-    case CameraState::kTraining: return "training";
-    case CameraState::kLive: return "live";
-    case CameraState::kOffline: return "offline";
-    case CameraState::kFinished: return "finished";
-    case CameraState::kError: return "error";
+    case CameraState::kStarting:
+      return "starting";
+    case CameraState::kTraining:
+      return "training";
+    case CameraState::kLive:
+      return "live";
+    case CameraState::kOffline:
+      return "offline";
+    case CameraState::kFinished:
+      return "finished";
+    case CameraState::kError:
+      return "error";
   }
   return "unknown";
 }
@@ -105,8 +111,10 @@ struct CameraRunner::Impl {
   std::shared_ptr<const PreviewFrame> preview;
   std::shared_ptr<PreviewFrame> preview_spare;
   SteadyTime preview_time{};
-  std::atomic<double> preview_interval_s{0};  // options.preview_interval_s, then as the station sets it
-  // The exposure figures of the latest preview, measured at most once a second (on a reader's thread).
+  std::atomic<double> preview_interval_s{
+      0};  // options.preview_interval_s, then as the station sets it
+  // The exposure figures of the latest preview, measured at most once a second (on a reader's
+  // thread).
   mutable std::mutex exposure_mutex;
   mutable ExposureFigures exposure;
   mutable SteadyTime exposure_time{};
@@ -143,10 +151,18 @@ struct CameraRunner::Impl {
       message = keyer_message;
     }
     switch (phase) {
-      case KeyerPhase::kLearning: SetState(CameraState::kTraining, ""); break;
-      case KeyerPhase::kReady: SetState(CameraState::kLive, ""); break;
-      case KeyerPhase::kNoModel: SetState(CameraState::kLive, message); break;
-      case KeyerPhase::kFailed: SetState(CameraState::kError, message); break;
+      case KeyerPhase::kLearning:
+        SetState(CameraState::kTraining, "");
+        break;
+      case KeyerPhase::kReady:
+        SetState(CameraState::kLive, "");
+        break;
+      case KeyerPhase::kNoModel:
+        SetState(CameraState::kLive, message);
+        break;
+      case KeyerPhase::kFailed:
+        SetState(CameraState::kError, message);
+        break;
     }
   }
 
@@ -154,7 +170,8 @@ struct CameraRunner::Impl {
     std::lock_guard lock(status_mutex);
     if (status.state != state || status.message != message) {
       if (state == CameraState::kOffline || state == CameraState::kError) {
-        log->warn("{}: {}{}", options.camera.name, CameraStateName(state), message.empty() ? "" : ": " + message);
+        log->warn("{}: {}{}", options.camera.name, CameraStateName(state),
+                  message.empty() ? "" : ": " + message);
       } else {
         log->info("{}: {}", options.camera.name, CameraStateName(state));
       }
@@ -166,7 +183,8 @@ struct CameraRunner::Impl {
   // Sleeps for the backoff delay unless stopping.
   void Backoff(double seconds) {
     std::unique_lock lock(source_mutex);
-    backoff_wake.wait_for(lock, std::chrono::duration<double>(seconds), [&] { return stopping.load(); });
+    backoff_wake.wait_for(lock, std::chrono::duration<double>(seconds),
+                          [&] { return stopping.load(); });
   }
 
   // Closes the source on a thread of its own: a device that stopped answering can take
@@ -205,8 +223,9 @@ struct CameraRunner::Impl {
       }
       if (!src) {
         try {
-          std::shared_ptr<FrameSource> opened = options.open_source ? options.open_source(options.camera, index)
-                                                                    : OpenCameraSource(options.camera, index);
+          std::shared_ptr<FrameSource> opened = options.open_source
+                                                    ? options.open_source(options.camera, index)
+                                                    : OpenCameraSource(options.camera, index);
           {
             std::lock_guard lock(status_mutex);
             if (opened_once) ++status.reopens;
@@ -262,7 +281,8 @@ struct CameraRunner::Impl {
         ++status.frames_captured;
         last_frame_time = now;
         recent_frames.push_back(now);
-        while (!recent_frames.empty() && Seconds(now - recent_frames.front()) > 2.0) recent_frames.pop_front();
+        while (!recent_frames.empty() && Seconds(now - recent_frames.front()) > 2.0)
+          recent_frames.pop_front();
       }
       frame->camera = index;
       // A recording read as fast as it runs waits for the pipeline; a camera never does.
@@ -305,7 +325,8 @@ struct CameraRunner::Impl {
     target_applied.notify_all();
   }
 
-  void Sink(std::vector<ClipBatch>& out, const std::deque<std::pair<int64_t, SteadyTime>>& arrivals) {
+  void Sink(std::vector<ClipBatch>& out,
+            const std::deque<std::pair<int64_t, SteadyTime>>& arrivals) {
     for (ClipBatch& b : out) {
       if (b.clip.camera_id == 0) {
         std::lock_guard lock(status_mutex);
@@ -317,9 +338,11 @@ struct CameraRunner::Impl {
       sb.received.reserve(b.sprites.size());
       for (const SpriteRecord& s : b.sprites) {
         // Arrivals are in sequence order; a sprite's frame is its sequence number.
-        const auto it = std::lower_bound(arrivals.begin(), arrivals.end(), s.frame,
-                                         [](const auto& a, int64_t frame) { return a.first < frame; });
-        sb.received.push_back(it != arrivals.end() && it->first == s.frame ? it->second : Clock::now());
+        const auto it =
+            std::lower_bound(arrivals.begin(), arrivals.end(), s.frame,
+                             [](const auto& a, int64_t frame) { return a.first < frame; });
+        sb.received.push_back(it != arrivals.end() && it->first == s.frame ? it->second
+                                                                           : Clock::now());
       }
       sb.batch = std::move(b);
       sink(std::move(sb));
@@ -334,7 +357,8 @@ struct CameraRunner::Impl {
   }
 
   // `pipeline`: the frame went through it (its matte and candidates are shown); else only `bgr`.
-  void UpdatePreview(const cv::Mat& bgr, const CameraPipeline* pipeline, const Frame& frame, SteadyTime now) {
+  void UpdatePreview(const cv::Mat& bgr, const CameraPipeline* pipeline, const Frame& frame,
+                     SteadyTime now) {
     std::shared_ptr<PreviewFrame> next;
     {
       std::lock_guard lock(preview_mutex);
@@ -364,13 +388,16 @@ struct CameraRunner::Impl {
 
   // Once the keyer has learnt the enclosure (on its own thread): live, or in error if it failed.
   void PollTraining(std::future<void>& training, bool& pipeline_failed) {
-    if (!training.valid() || training.wait_for(std::chrono::seconds(0)) != std::future_status::ready) return;
+    if (!training.valid() ||
+        training.wait_for(std::chrono::seconds(0)) != std::future_status::ready)
+      return;
     try {
       training.get();  // rethrows what Train threw
       SetKeyerPhase(KeyerPhase::kReady, "");
     } catch (const std::exception& e) {
       // Without a keyer no sprite can be made: the camera streams for preview and recording.
-      SetKeyerPhase(KeyerPhase::kFailed, std::string("learning the empty enclosure failed: ") + e.what());
+      SetKeyerPhase(KeyerPhase::kFailed,
+                    std::string("learning the empty enclosure failed: ") + e.what());
       pipeline_failed = true;
     }
   }
@@ -389,7 +416,8 @@ struct CameraRunner::Impl {
     bool pipeline_failed = pipeline == nullptr;
     std::future<void> training;
     std::vector<ClipBatch> out;
-    std::deque<std::pair<int64_t, SteadyTime>> arrivals;  // recent frames' sequence and arrival time
+    std::deque<std::pair<int64_t, SteadyTime>>
+        arrivals;  // recent frames' sequence and arrival time
     cv::Mat bgr;
     while (true) {
       ApplyTarget(pipeline_failed ? nullptr : pipeline.get(), &out);
@@ -411,11 +439,13 @@ struct CameraRunner::Impl {
           const bool collect = !pipeline_failed && !training.valid();
           if (collect) {
             // Straight into the next pre-faulted slot of the training set: no allocation here.
-            if (training_set.empty()) training_set = PrefaultedImages(options.training_frames, frame.width, frame.height);
+            if (training_set.empty())
+              training_set = PrefaultedImages(options.training_frames, frame.width, frame.height);
             // A camera that reopened mid-collection numbers and times its frames from its own
             // start again: the frames before belong to another stream, so the set starts over
             // (else learnt_from's first frame came after its last).
-            if (training_collected > 0 && (frame.sequence <= training_last.first || frame.timestamp_ns <= training_last.second)) {
+            if (training_collected > 0 && (frame.sequence <= training_last.first ||
+                                           frame.timestamp_ns <= training_last.second)) {
               training_collected = 0;
             }
             training_last = {frame.sequence, frame.timestamp_ns};
@@ -427,13 +457,14 @@ struct CameraRunner::Impl {
             if (training_collected >= training_set.size()) {
               {
                 std::lock_guard lock(status_mutex);
-                status.learnt_from = {training_collected, static_cast<int64_t>(training_first.first),
+                status.learnt_from = {training_collected,
+                                      static_cast<int64_t>(training_first.first),
                                       static_cast<int64_t>(frame.sequence), training_first.second,
                                       frame.timestamp_ns};
               }
-              training = std::async(std::launch::async, [p = pipeline.get(), frames = std::move(training_set)] {
-                p->Train(frames);
-              });
+              training = std::async(
+                  std::launch::async,
+                  [p = pipeline.get(), frames = std::move(training_set)] { p->Train(frames); });
               training_set.clear();
               training_collected = 0;
               // A source that waits for us (a recording) is held back while the keyer learns, so
@@ -493,7 +524,7 @@ struct CameraRunner::Impl {
 
   std::atomic<bool> capture_done{false};
   std::atomic<bool> source_waits{false};  // the open source's WaitsForReader()
-  bool pipeline_done = false;  // under target_mutex
+  bool pipeline_done = false;             // under target_mutex
 };
 
 CameraRunner::CameraRunner(int index, CameraRunnerOptions options, BatchSink sink, FrameTap tap)
@@ -504,21 +535,24 @@ CameraRunner::CameraRunner(int index, CameraRunnerOptions options, BatchSink sin
   s.preview_interval_s = s.options.preview_interval_s;
   s.sink = std::move(sink);
   s.tap = std::move(tap);
-  s.queue = std::make_unique<BoundedQueue<Captured>>(static_cast<size_t>(std::max(1, s.options.queue_frames)));
+  s.queue = std::make_unique<BoundedQueue<Captured>>(
+      static_cast<size_t>(std::max(1, s.options.queue_frames)));
   s.status.name = s.options.camera.name;
   s.status.source = s.options.camera.source;
   s.status.has_model = s.options.model.has_value();
   s.status.queue_capacity = s.queue->capacity();
   if (s.options.model) {
     try {
-      s.pipeline = std::make_unique<CameraPipeline>(s.options.camera.name, 0, *s.options.model, s.options.floor,
-                                                    s.options.pipeline);
-      s.training_set = PrefaultedImages(s.options.training_frames, s.options.model->width(), s.options.model->height());
+      s.pipeline = std::make_unique<CameraPipeline>(s.options.camera.name, 0, *s.options.model,
+                                                    s.options.floor, s.options.pipeline);
+      s.training_set = PrefaultedImages(s.options.training_frames, s.options.model->width(),
+                                        s.options.model->height());
     } catch (const std::exception& e) {
       s.SetKeyerPhase(Impl::KeyerPhase::kFailed, e.what());
     }
   } else {
-    s.SetKeyerPhase(Impl::KeyerPhase::kNoModel, "no camera model: streams for preview and recording, stores no sprites");
+    s.SetKeyerPhase(Impl::KeyerPhase::kNoModel,
+                    "no camera model: streams for preview and recording, stores no sprites");
   }
 }
 
@@ -585,7 +619,8 @@ CameraStatus CameraRunner::StatusWithoutExposure() const {
   const Impl& s = *impl_;
   std::lock_guard lock(s.status_mutex);
   CameraStatus out = s.status;
-  const double span = s.recent_frames.size() >= 2 ? Seconds(s.recent_frames.back() - s.recent_frames.front()) : 0;
+  const double span =
+      s.recent_frames.size() >= 2 ? Seconds(s.recent_frames.back() - s.recent_frames.front()) : 0;
   out.fps = span > 0 ? (s.recent_frames.size() - 1) / span : 0;
   if (Seconds(Clock::now() - s.last_frame_time) > 2.0) out.fps = 0;
   out.dropped_at_source = s.source_dropped_base;

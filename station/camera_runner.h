@@ -29,7 +29,7 @@ using SteadyTime = std::chrono::steady_clock::time_point;
 
 // A clip batch on its way to the bank, with when each sprite's frame arrived.
 struct StationBatch {
-  int camera = 0;                 // runner index
+  int camera = 0;  // runner index
   ClipBatch batch;
   std::vector<SteadyTime> received;  // one per sprite of the batch
 };
@@ -39,18 +39,20 @@ const char* CameraStateName(CameraState state);
 
 struct CameraStatus {
   std::string name;
-  std::string source;            // replay | v4l2 | aravis | libcamera
+  std::string source;  // replay | v4l2 | aravis | libcamera
   CameraState state = CameraState::kStarting;
-  std::string message;           // why it is offline / in error; the last source problem
+  std::string message;  // why it is offline / in error; the last source problem
   int width = 0, height = 0;
   std::string pixel_format;
-  double fps = 0;                // frames delivered per second over the last ~2 s
-  uint64_t frames_captured = 0;  // delivered by the source
-  uint64_t frames_processed = 0; // through the pipeline (training frames included)
-  uint64_t dropped_queue_full = 0;   // the pipeline queue was full
-  uint64_t dropped_at_source = 0;    // lost before delivery: incomplete frames, sequence gaps, unreadable
-  uint64_t source_errors = 0;        // recoverable source problems (timeouts, corrupt frames)
-  uint64_t frames_while_learning = 0;  // arrived while the keyer learnt the empty enclosure (preview only)
+  double fps = 0;                   // frames delivered per second over the last ~2 s
+  uint64_t frames_captured = 0;     // delivered by the source
+  uint64_t frames_processed = 0;    // through the pipeline (training frames included)
+  uint64_t dropped_queue_full = 0;  // the pipeline queue was full
+  uint64_t dropped_at_source =
+      0;                       // lost before delivery: incomplete frames, sequence gaps, unreadable
+  uint64_t source_errors = 0;  // recoverable source problems (timeouts, corrupt frames)
+  uint64_t frames_while_learning =
+      0;  // arrived while the keyer learnt the empty enclosure (preview only)
   // The frames collected for the keyer to learn the empty enclosure from (set when the set is
   // complete and learning starts): how many, and the first and last one's sequence number and
   // timestamp (-1: none collected yet).
@@ -59,13 +61,13 @@ struct CameraStatus {
     int64_t first_sequence = -1, last_sequence = -1;
     int64_t first_timestamp_ns = -1, last_timestamp_ns = -1;
   } learnt_from;
-  uint64_t frames_rejected = 0;      // frames the pipeline refused (corrupt, another size); see message
-  uint64_t batches_unstored = 0;     // batches made with no capture session (not stored)
+  uint64_t frames_rejected = 0;  // frames the pipeline refused (corrupt, another size); see message
+  uint64_t batches_unstored = 0;  // batches made with no capture session (not stored)
   size_t queue_depth = 0, queue_capacity = 0;
-  uint64_t reopens = 0;          // times the camera was opened again after going offline
-  bool has_model = false;        // without one no sprite is stored (preview and recording only)
+  uint64_t reopens = 0;    // times the camera was opened again after going offline
+  bool has_model = false;  // without one no sprite is stored (preview and recording only)
   CameraPipelineStats pipeline;
-  ExposureFigures exposure;      // how the green screen is lit (latest preview, measured once a second)
+  ExposureFigures exposure;  // how the green screen is lit (latest preview, measured once a second)
 };
 
 struct CameraRunnerOptions {
@@ -78,7 +80,8 @@ struct CameraRunnerOptions {
   double offline_after_s = 3.0;  // no frame for this long: offline, closed and reopened
   double backoff_min_s = 0.5;    // first reopen delay, doubled up to backoff_max_s
   double backoff_max_s = 8.0;
-  double preview_interval_s = 0.2;  // a preview snapshot this often (set_preview_interval changes it)
+  double preview_interval_s =
+      0.2;  // a preview snapshot this often (set_preview_interval changes it)
   // Opens the camera; unset: OpenCameraSource (benchmarks put frames from memory here).
   std::function<std::unique_ptr<FrameSource>(const CameraConfig&, int camera_index)> open_source;
 };
@@ -92,8 +95,10 @@ class CameraRunner {
  public:
   // Called on the pipeline thread for every batch made while a bank camera is set.
   using BatchSink = std::function<void(StationBatch)>;
-  // Called on the pipeline thread for every frame (the recorder); `usable`: it gave a usable sprite.
-  using FrameTap = std::function<void(int camera, const Frame& frame, uint64_t drops_before, bool usable)>;
+  // Called on the pipeline thread for every frame (the recorder); `usable`: it gave a usable
+  // sprite.
+  using FrameTap =
+      std::function<void(int camera, const Frame& frame, uint64_t drops_before, bool usable)>;
 
   CameraRunner(int index, CameraRunnerOptions options, BatchSink sink, FrameTap tap);
   ~CameraRunner();  // Stop()

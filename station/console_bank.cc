@@ -22,7 +22,9 @@ nlohmann::json Transitions(std::vector<TransitionRecord> list, bool outgoing) {
   std::sort(list.begin(), list.end(), [](const auto& a, const auto& b) { return a.cost < b.cost; });
   nlohmann::json out = nlohmann::json::array();
   for (size_t k = 0; k < list.size() && k < kMaxTransitionsShown; ++k) {
-    out.push_back({{"sprite", outgoing ? list[k].to_sprite : list[k].from_sprite}, {"cost", list[k].cost}, {"d", list[k].d}});
+    out.push_back({{"sprite", outgoing ? list[k].to_sprite : list[k].from_sprite},
+                   {"cost", list[k].cost},
+                   {"d", list[k].d}});
   }
   return out;
 }
@@ -34,15 +36,21 @@ nlohmann::json ConsoleBank::Sessions() const {
   std::map<int64_t, nlohmann::json> by_id;
   nlohmann::json out = nlohmann::json::array();
   for (const SessionRecord& s : bank.ListSessions()) {
-    by_id[s.id] = {{"id", s.id}, {"name", s.name}, {"created", s.created}, {"source", s.source},
-                   {"cameras", nlohmann::json::array()}, {"clips", 0}, {"sprites", 0}};
+    by_id[s.id] = {{"id", s.id},
+                   {"name", s.name},
+                   {"created", s.created},
+                   {"source", s.source},
+                   {"cameras", nlohmann::json::array()},
+                   {"clips", 0},
+                   {"sprites", 0}};
   }
   std::map<int64_t, int64_t> session_of_camera;
   for (const CameraRecord& c : bank.ListCameras()) {
     session_of_camera[c.id] = c.session_id;
     auto it = by_id.find(c.session_id);
     if (it != by_id.end()) {
-      it->second["cameras"].push_back({{"id", c.id}, {"name", c.name}, {"width", c.width}, {"height", c.height}});
+      it->second["cameras"].push_back(
+          {{"id", c.id}, {"name", c.name}, {"width", c.width}, {"height", c.height}});
     }
   }
   const std::map<int64_t, int64_t> counts = bank.CountClipSprites();
@@ -51,7 +59,8 @@ nlohmann::json ConsoleBank::Sessions() const {
     if (it == by_id.end()) continue;
     it->second["clips"] = it->second["clips"].get<int64_t>() + 1;
     const auto n = counts.find(clip.id);
-    it->second["sprites"] = it->second["sprites"].get<int64_t>() + (n == counts.end() ? 0 : n->second);
+    it->second["sprites"] =
+        it->second["sprites"].get<int64_t>() + (n == counts.end() ? 0 : n->second);
   }
   for (auto& [id, s] : by_id) out.push_back(std::move(s));
   return out;
@@ -61,7 +70,9 @@ nlohmann::json ConsoleBank::Clips(int64_t session_id) const {
   const Bank bank(path_);
   bool found = false;
   for (const SessionRecord& s : bank.ListSessions()) found = found || s.id == session_id;
-  if (!found) throw NotFoundError("session", "no session with id " + std::to_string(session_id) + " in the bank");
+  if (!found)
+    throw NotFoundError("session",
+                        "no session with id " + std::to_string(session_id) + " in the bank");
   std::map<int64_t, std::string> cameras;
   for (const CameraRecord& c : bank.ListCameras()) {
     if (c.session_id == session_id) cameras[c.id] = c.name;
@@ -74,14 +85,15 @@ nlohmann::json ConsoleBank::Clips(int64_t session_id) const {
     if (camera == cameras.end()) continue;
     const auto n = counts.find(clip.id);
     const auto t = tags.find(clip.id);
-    out.push_back({{"id", clip.id},
-                   {"camera", camera->second},
-                   {"camera_id", clip.camera_id},
-                   {"track_id", clip.track_id},
-                   {"first_frame", clip.first_frame},
-                   {"last_frame", clip.last_frame},
-                   {"sprites", n == counts.end() ? 0 : n->second},
-                   {"tags", t == tags.end() ? nlohmann::json::object() : nlohmann::json(t->second)}});
+    out.push_back(
+        {{"id", clip.id},
+         {"camera", camera->second},
+         {"camera_id", clip.camera_id},
+         {"track_id", clip.track_id},
+         {"first_frame", clip.first_frame},
+         {"last_frame", clip.last_frame},
+         {"sprites", n == counts.end() ? 0 : n->second},
+         {"tags", t == tags.end() ? nlohmann::json::object() : nlohmann::json(t->second)}});
   }
   return out;
 }
@@ -89,8 +101,10 @@ nlohmann::json ConsoleBank::Clips(int64_t session_id) const {
 nlohmann::json ConsoleBank::ClipSprites(int64_t clip_id) const {
   const Bank bank(path_);
   const std::vector<ClipRecord> clips = bank.ListClips();
-  if (std::none_of(clips.begin(), clips.end(), [&](const ClipRecord& c) { return c.id == clip_id; })) {
-    throw NotFoundError("clip", "no complete clip with id " + std::to_string(clip_id) + " in the bank");
+  if (std::none_of(clips.begin(), clips.end(),
+                   [&](const ClipRecord& c) { return c.id == clip_id; })) {
+    throw NotFoundError("clip",
+                        "no complete clip with id " + std::to_string(clip_id) + " in the bank");
   }
   nlohmann::json out = nlohmann::json::array();
   for (const SpriteRecord& s : bank.LoadClipSprites(clip_id)) {
@@ -109,7 +123,8 @@ nlohmann::json ConsoleBank::Sprite(int64_t sprite_id) const {
   try {
     s = bank.LoadSprite(sprite_id);
   } catch (const InputError&) {
-    throw NotFoundError("sprite", "no sprite with id " + std::to_string(sprite_id) + " in the bank");
+    throw NotFoundError("sprite",
+                        "no sprite with id " + std::to_string(sprite_id) + " in the bank");
   }
   std::string camera, session;
   int64_t session_id = 0;
@@ -136,16 +151,19 @@ nlohmann::json ConsoleBank::Sprite(int64_t sprite_id) const {
           {"mirror_of", s.mirror_of},
           {"ground", {s.ground_x_m, s.ground_y_m}},
           {"velocity", {s.velocity_x_m_s, s.velocity_y_m_s}},
-          {"features", {{"velocity_m_s", {s.velocity_x_m_s, s.velocity_y_m_s}},
-                        {"mean_colour", {s.mean_r, s.mean_g, s.mean_b}},
-                        {"area_px", s.area_px},
-                        {"area_m2", area_m2},
-                        {"eccentricity", s.eccentricity}}},
-          {"bbox_in_image", {s.bbox_in_image.x, s.bbox_in_image.y, s.bbox_in_image.width, s.bbox_in_image.height}},
-          {"billboard", {{"width", s.billboard_width_px},
-                         {"height", s.billboard_height_px},
-                         {"px_per_m", s.px_per_m},
-                         {"anchor", {s.anchor_x_px, s.anchor_y_px}}}},
+          {"features",
+           {{"velocity_m_s", {s.velocity_x_m_s, s.velocity_y_m_s}},
+            {"mean_colour", {s.mean_r, s.mean_g, s.mean_b}},
+            {"area_px", s.area_px},
+            {"area_m2", area_m2},
+            {"eccentricity", s.eccentricity}}},
+          {"bbox_in_image",
+           {s.bbox_in_image.x, s.bbox_in_image.y, s.bbox_in_image.width, s.bbox_in_image.height}},
+          {"billboard",
+           {{"width", s.billboard_width_px},
+            {"height", s.billboard_height_px},
+            {"px_per_m", s.px_per_m},
+            {"anchor", {s.anchor_x_px, s.anchor_y_px}}}},
           {"tags", s.tags},
           {"transitions_out", Transitions(bank.LoadTransitionsFrom(sprite_id), true)},
           {"transitions_in", Transitions(bank.LoadTransitionsTo(sprite_id), false)}};
@@ -157,7 +175,8 @@ std::vector<uint8_t> ConsoleBank::BillboardPng(int64_t sprite_id, int max_height
   try {
     pixels = bank.LoadPixels(sprite_id);
   } catch (const InputError&) {
-    throw NotFoundError("sprite", "no sprite with id " + std::to_string(sprite_id) + " in the bank");
+    throw NotFoundError("sprite",
+                        "no sprite with id " + std::to_string(sprite_id) + " in the bank");
   }
   cv::Mat image = pixels.bgra;
   if (max_height > 0 && image.rows > max_height) {
@@ -178,7 +197,8 @@ int64_t ConsoleBank::Tag(const nlohmann::json& body, bool remove) const {
       ids = bank.ClipSpriteIds(r.clip, r.first_frame, r.last_frame);
       if (ids.empty()) {
         throw InputError("clip", "clip " + std::to_string(r.clip) + " has no sprites at frames " +
-                                     std::to_string(r.first_frame) + ".." + std::to_string(r.last_frame));
+                                     std::to_string(r.first_frame) + ".." +
+                                     std::to_string(r.last_frame));
       }
     }
   }
@@ -201,7 +221,9 @@ std::string ConsoleBank::ExportCsv(std::optional<int64_t> clip_id, const std::st
   std::vector<int64_t> ids;
   if (clip_id) {
     ids = bank.ClipSpriteIds(*clip_id, INT64_MIN, INT64_MAX);
-    if (ids.empty()) throw NotFoundError("clip", "no clip with id " + std::to_string(*clip_id) + " and sprites in the bank");
+    if (ids.empty())
+      throw NotFoundError(
+          "clip", "no clip with id " + std::to_string(*clip_id) + " and sprites in the bank");
   } else {
     ids = bank.SpritesTagged(tag);
   }

@@ -45,11 +45,12 @@ namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 using calib::WizardStep;
 
-constexpr size_t kQueueFrames = 4;     // frames waiting for a camera's wizard; more: the oldest goes
-constexpr int kGrid = 10;              // the coverage map's cells a side
-constexpr double kPublishS = 0.1;      // a camera's state and live view are refreshed this often
-constexpr double kGridStepM = 0.1;     // the floor grid drawn over a posed camera's view
-constexpr double kPlanReachM = 8.0;    // a view's rays above the horizon end this far away on the plan
+constexpr size_t kQueueFrames = 4;  // frames waiting for a camera's wizard; more: the oldest goes
+constexpr int kGrid = 10;           // the coverage map's cells a side
+constexpr double kPublishS = 0.1;   // a camera's state and live view are refreshed this often
+constexpr double kGridStepM = 0.1;  // the floor grid drawn over a posed camera's view
+constexpr double kPlanReachM =
+    8.0;  // a view's rays above the horizon end this far away on the plan
 
 std::string UtcStamp(const char* format) {
   const std::time_t now = std::time(nullptr);
@@ -60,7 +61,9 @@ std::string UtcStamp(const char* format) {
   return buf;
 }
 
-nlohmann::json Num(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
+nlohmann::json Num(double v) {
+  return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr);
+}
 
 nlohmann::json Points(const std::vector<Eigen::Vector2d>& points) {
   nlohmann::json out = nlohmann::json::array();
@@ -71,7 +74,8 @@ nlohmann::json Points(const std::vector<Eigen::Vector2d>& points) {
 // The 10 cm floor grid seen by a posed camera, as polylines in its pixels: lines across the
 // part of the floor it sees (within `reach` of the floor point below the image centre), cut
 // where they leave the image or pass behind the camera.
-std::vector<std::vector<Eigen::Vector2d>> FloorGrid(const CameraModel& posed, const std::vector<Eigen::Vector2d>& fov) {
+std::vector<std::vector<Eigen::Vector2d>> FloorGrid(const CameraModel& posed,
+                                                    const std::vector<Eigen::Vector2d>& fov) {
   std::vector<std::vector<Eigen::Vector2d>> lines;
   if (fov.size() < 3) return lines;
   Eigen::Vector2d lo = fov.front(), hi = lo;
@@ -90,8 +94,8 @@ std::vector<std::vector<Eigen::Vector2d>> FloorGrid(const CameraModel& posed, co
       Eigen::Vector2d px;
       if (inside) {
         px = posed.Project(in_cam);
-        inside = std::isfinite(px.x()) && std::isfinite(px.y()) && px.x() >= -0.1 * w && px.x() <= 1.1 * w &&
-                 px.y() >= -0.1 * h && px.y() <= 1.1 * h;
+        inside = std::isfinite(px.x()) && std::isfinite(px.y()) && px.x() >= -0.1 * w &&
+                 px.x() <= 1.1 * w && px.y() >= -0.1 * h && px.y() <= 1.1 * h;
       }
       if (inside) {
         run.push_back(px);
@@ -157,8 +161,14 @@ class CameraWork {
  public:
   CameraWork(std::string name, int index, const WizardSettings& settings, double fps_hint,
              std::atomic<uint64_t>* floor_counter)
-      : name_(std::move(name)), index_(index), settings_(settings), fps_hint_(fps_hint), floor_counter_(floor_counter) {
-    settings_.options.solve.progress = [this](const std::string& stage, double fraction) { SetBusy(stage, fraction); };
+      : name_(std::move(name)),
+        index_(index),
+        settings_(settings),
+        fps_hint_(fps_hint),
+        floor_counter_(floor_counter) {
+    settings_.options.solve.progress = [this](const std::string& stage, double fraction) {
+      SetBusy(stage, fraction);
+    };
     Publish(true);
     thread_ = std::thread([this] { Loop(); });
   }
@@ -210,10 +220,12 @@ class CameraWork {
   void StartSolve() {
     Run([](calib::CalibrationWizard& w) {
       if (w.step() != WizardStep::kIntrinsics) {
-        throw ConflictError("solve", std::string("the intrinsics step is over (now: ") + calib::WizardStepName(w.step()) + ")");
+        throw ConflictError("solve", std::string("the intrinsics step is over (now: ") +
+                                         calib::WizardStepName(w.step()) + ")");
       }
       if (w.views() < 3) {
-        throw ConflictError("solve", std::to_string(w.views()) + " views captured; at least 3 are needed to solve (" +
+        throw ConflictError("solve", std::to_string(w.views()) +
+                                         " views captured; at least 3 are needed to solve (" +
                                          std::to_string(w.views()) + " of the criteria's views)");
       }
       return 0;
@@ -252,7 +264,8 @@ class CameraWork {
 
   void SetBusy(const std::string& stage, double fraction) {
     std::lock_guard lock(state_mutex_);
-    busy_json_ = nlohmann::json{{"what", "solve"}, {"camera", name_}, {"stage", stage}, {"progress", fraction}};
+    busy_json_ = nlohmann::json{
+        {"what", "solve"}, {"camera", name_}, {"stage", stage}, {"progress", fraction}};
   }
 
   void Loop() {
@@ -288,7 +301,8 @@ class CameraWork {
         calib::WizardOptions o = settings_.options;
         const double fps = fps_hint_ > 0 ? fps_hint_ : 30.0;
         o.still_frames = std::max(2, static_cast<int>(std::lround(settings_.still_s * fps)));
-        o.floor_still_frames = std::max(3, static_cast<int>(std::lround(settings_.floor_still_s * fps)));
+        o.floor_still_frames =
+            std::max(3, static_cast<int>(std::lround(settings_.floor_still_s * fps)));
         wizard_ = std::make_unique<calib::CalibrationWizard>(name_, bgr_.cols, bgr_.rows, o);
       }
       const calib::WizardFrame out = wizard_->Feed(bgr_, static_cast<int>(frame.sequence));
@@ -315,7 +329,8 @@ class CameraWork {
         const double distance = wizard_->report() && wizard_->report()->working_distance_m > 0
                                     ? wizard_->report()->working_distance_m
                                     : 1.0;
-        calib::WriteUncertaintyMap(PlotPath("uncertainty"), *wizard_->solution(), settings_.options.board, 0, distance);
+        calib::WriteUncertaintyMap(PlotPath("uncertainty"), *wizard_->solution(),
+                                   settings_.options.board, 0, distance);
       }
       ++solves_;
       message_.clear();
@@ -334,10 +349,13 @@ class CameraWork {
     const calib::VerdictOptions& v = settings_.options.verdict;
     char buf[96];
     nlohmann::json list = nlohmann::json::array();
-    auto item = [&](const char* id, const std::string& label, nlohmann::json met, nlohmann::json value) {
-      list.push_back({{"id", id}, {"label", label}, {"met", std::move(met)}, {"value", std::move(value)}});
+    auto item = [&](const char* id, const std::string& label, nlohmann::json met,
+                    nlohmann::json value) {
+      list.push_back(
+          {{"id", id}, {"label", label}, {"met", std::move(met)}, {"value", std::move(value)}});
     };
-    item("views", "views ≥ " + std::to_string(v.min_views), w.views() >= v.min_views, std::to_string(w.views()));
+    item("views", "views ≥ " + std::to_string(v.min_views), w.views() >= v.min_views,
+         std::to_string(w.views()));
     std::snprintf(buf, sizeof buf, "coverage ≥ %.0f %%", v.min_coverage * 100);
     const std::vector<std::string> empty = calib::EmptyRegions(w.coverage());
     char value[64];
@@ -358,9 +376,12 @@ class CameraWork {
     }
     const char* names[4] = {"fx", "fy", "cx", "cy"};
     for (size_t i = 0; i < 4; ++i) {
-      std::snprintf(buf, sizeof buf, "%s known to ≤ %.2g %% (1.96 σ)", names[i], v.max_stdev_percent);
-      if (solved && i < report->intrinsics_stdev.size() && std::isfinite(report->intrinsics_stdev[i])) {
-        const double percent = 1.96 * report->intrinsics_stdev[i] / std::abs(report->intrinsics[i]) * 100;
+      std::snprintf(buf, sizeof buf, "%s known to ≤ %.2g %% (1.96 σ)", names[i],
+                    v.max_stdev_percent);
+      if (solved && i < report->intrinsics_stdev.size() &&
+          std::isfinite(report->intrinsics_stdev[i])) {
+        const double percent =
+            1.96 * report->intrinsics_stdev[i] / std::abs(report->intrinsics[i]) * 100;
         std::snprintf(value, sizeof value, "%.3f %%", percent);
         item(names[i], buf, percent <= v.max_stdev_percent, value);
       } else {
@@ -373,17 +394,20 @@ class CameraWork {
   nlohmann::json SolveJson(const calib::CalibrationWizard& w) const {
     const auto& report = w.report();
     if (!report) return nullptr;
-    nlohmann::json j = {{"verdict", report->good ? "good" : "rejected"}, {"reasons", report->reasons},
-                        {"rms_px", Num(report->rms_px)}, {"worst_px", Num(report->worst_px)},
+    nlohmann::json j = {{"verdict", report->good ? "good" : "rejected"},
+                        {"reasons", report->reasons},
+                        {"rms_px", Num(report->rms_px)},
+                        {"worst_px", Num(report->worst_px)},
                         {"views", report->views_accepted}};
     if (report->intrinsics.size() >= 4) {
       const char* names[4] = {"fx", "fy", "cx", "cy"};
       nlohmann::json in, pct;
       for (size_t i = 0; i < 4; ++i) {
         in[names[i]] = report->intrinsics[i];
-        pct[names[i]] = i < report->intrinsics_stdev.size()
-                            ? Num(1.96 * report->intrinsics_stdev[i] / std::abs(report->intrinsics[i]) * 100)
-                            : nlohmann::json(nullptr);
+        pct[names[i]] =
+            i < report->intrinsics_stdev.size()
+                ? Num(1.96 * report->intrinsics_stdev[i] / std::abs(report->intrinsics[i]) * 100)
+                : nlohmann::json(nullptr);
       }
       j["intrinsics"] = in;
       j["uncertainty_percent"] = pct;
@@ -392,7 +416,8 @@ class CameraWork {
                                   {"worst", Num(report->projection_stdev_worst_px)}};
     }
     if (w.solution()) {
-      const std::string query = "?run=" + std::to_string(settings_.run) + "&solve=" + std::to_string(solves_.load());
+      const std::string query =
+          "?run=" + std::to_string(settings_.run) + "&solve=" + std::to_string(solves_.load());
       j["residuals_png"] = "/api/calibration/cameras/" + name_ + "/residuals.png" + query;
       j["uncertainty_png"] = "/api/calibration/cameras/" + name_ + "/uncertainty.png" + query;
     }
@@ -409,12 +434,20 @@ class CameraWork {
     j["frames"] = frames_fed_;
     j["message"] = message_;
     if (!wizard_) {
-      j.update({{"width", nullptr}, {"height", nullptr},
-                {"step", settings_.options.intrinsics ? "ground" : "intrinsics"}, {"detected", false},
-                {"still", false}, {"guidance", {"waiting for the camera's first frame"}}, {"views", 0},
+      j.update({{"width", nullptr},
+                {"height", nullptr},
+                {"step", settings_.options.intrinsics ? "ground" : "intrinsics"},
+                {"detected", false},
+                {"still", false},
+                {"guidance", {"waiting for the camera's first frame"}},
+                {"views", 0},
                 {"coverage", {{"grid", nlohmann::json::array()}, {"fraction", 0}}},
-                {"diversity", {{"x", 0}, {"y", 0}, {"size", 0}, {"skew", 0}}}, {"checklist", nlohmann::json::array()},
-                {"solve", nullptr}, {"ground", nullptr}, {"enclosure", nullptr}, {"plan", nullptr}});
+                {"diversity", {{"x", 0}, {"y", 0}, {"size", 0}, {"skew", 0}}},
+                {"checklist", nlohmann::json::array()},
+                {"solve", nullptr},
+                {"ground", nullptr},
+                {"enclosure", nullptr},
+                {"plan", nullptr}});
       std::lock_guard lock(state_mutex_);
       state_ = std::move(j);
       return;
@@ -431,7 +464,8 @@ class CameraWork {
     nlohmann::json grid = nlohmann::json::array();
     for (int y = 0; y < w.coverage().rows; ++y) {
       nlohmann::json row = nlohmann::json::array();
-      for (int x = 0; x < w.coverage().cols; ++x) row.push_back(static_cast<int>(w.coverage().at<float>(y, x)));
+      for (int x = 0; x < w.coverage().cols; ++x)
+        row.push_back(static_cast<int>(w.coverage().at<float>(y, x)));
       grid.push_back(row);
     }
     j["coverage"] = {{"grid", grid}, {"fraction", w.coverage_fraction()}};
@@ -442,16 +476,18 @@ class CameraWork {
     const std::optional<CameraModel> posed = w.posed_model();
     if (posed && w.ground()) {
       const calib::GroundResult& g = *w.ground();
-      j["ground"] = {{"height_m", g.height_m},
-                     {"tilt_deg", g.optical_axis_down_deg},
-                     {"centre_m", {g.centre_in_ground.x(), g.centre_in_ground.y(), g.centre_in_ground.z()}},
-                     {"rms_px", Num(g.rms_px)}};
+      j["ground"] = {
+          {"height_m", g.height_m},
+          {"tilt_deg", g.optical_axis_down_deg},
+          {"centre_m", {g.centre_in_ground.x(), g.centre_in_ground.y(), g.centre_in_ground.z()}},
+          {"rms_px", Num(g.rms_px)}};
       if (fov_.empty()) {
         fov_ = FloorOfView(*posed);
         grid_ = FloorGrid(*posed, fov_);
       }
-      j["plan"] = {{"position_m", {g.centre_in_ground.x(), g.centre_in_ground.y(), g.centre_in_ground.z()}},
-                   {"fov_m", Points(fov_)}};
+      j["plan"] = {
+          {"position_m", {g.centre_in_ground.x(), g.centre_in_ground.y(), g.centre_in_ground.z()}},
+          {"fov_m", Points(fov_)}};
     } else {
       fov_.clear();
       grid_.clear();
@@ -460,13 +496,16 @@ class CameraWork {
     }
     std::vector<Eigen::Vector2d> floor_px;
     if (w.floor()) {
-      j["enclosure"] = {{"polygon_m", Points(w.floor()->vertices())}, {"area_m2", w.floor()->Area()},
+      j["enclosure"] = {{"polygon_m", Points(w.floor()->vertices())},
+                        {"area_m2", w.floor()->Area()},
                         {"from", w.floor_from()}};
-      if (!had_floor_ || w.floor()->vertices() != last_floor_) floor_order_.store(++*floor_counter_);
+      if (!had_floor_ || w.floor()->vertices() != last_floor_)
+        floor_order_.store(++*floor_counter_);
       last_floor_ = w.floor()->vertices();
       if (posed) {
         for (const auto& v : w.floor()->vertices()) {
-          const Eigen::Vector3d in_cam = posed->cam_from_ground() * Eigen::Vector3d(v.x(), v.y(), 0.0);
+          const Eigen::Vector3d in_cam =
+              posed->cam_from_ground() * Eigen::Vector3d(v.x(), v.y(), 0.0);
           if (in_cam.z() > 0.05) floor_px.push_back(posed->Project(in_cam));
         }
       }
@@ -571,7 +610,8 @@ struct ConsoleCalibration::Impl {
     return works;
   }
 
-  // The camera a request names (api::ParseCameraName), or every camera of the wizard when it names none.
+  // The camera a request names (api::ParseCameraName), or every camera of the wizard when it names
+  // none.
   std::vector<std::shared_ptr<CameraWork>> Chosen(const std::optional<std::string>& camera) const {
     if (!camera) {
       std::vector<std::shared_ptr<CameraWork>> all = Works();
@@ -609,7 +649,8 @@ struct ConsoleCalibration::Impl {
     if (!current) return;
     // Camera index (the station's config order) -> the wizard's camera of that name.
     const StationStatus status = current->Status();
-    auto by_index = std::make_shared<std::vector<std::shared_ptr<CameraWork>>>(status.cameras.size());
+    auto by_index =
+        std::make_shared<std::vector<std::shared_ptr<CameraWork>>>(status.cameras.size());
     for (size_t i = 0; i < status.cameras.size(); ++i) {
       for (const auto& w : routed) {
         if (w->name() == status.cameras[i].name) (*by_index)[i] = w;
@@ -645,14 +686,17 @@ struct ConsoleCalibration::Impl {
   nlohmann::json Start(const nlohmann::json& body) {
     const std::shared_ptr<Station> station = context.station();
     if (station->SessionActive()) {
-      throw ConflictError("session", "a capture session is running: stop it before calibrating (the board would be "
-                                     "stored as sprites)");
+      throw ConflictError(
+          "session",
+          "a capture session is running: stop it before calibrating (the board would be "
+          "stored as sprites)");
     }
     const StationStatus status = station->Status();
-    const api::CalibrationStartRequest r = api::ParseCalibrationStart(body, [&](const std::string& name) {
-      return std::any_of(status.cameras.begin(), status.cameras.end(),
-                         [&](const CameraStatus& c) { return c.name == name; });
-    });
+    const api::CalibrationStartRequest r =
+        api::ParseCalibrationStart(body, [&](const std::string& name) {
+          return std::any_of(status.cameras.begin(), status.cameras.end(),
+                             [&](const CameraStatus& c) { return c.name == name; });
+        });
     WizardSettings settings;
     calib::WizardOptions& o = settings.options;
     o.board = r.board;
@@ -667,7 +711,8 @@ struct ConsoleCalibration::Impl {
     settings.still_s = r.still_s.value_or(0.2);
     settings.floor_still_s = r.floor_still_s.value_or(1.0);
     const double* pose = r.board_pose;
-    o.ground_from_board = calib::FloorBoardPose(pose[0], pose[1], pose[2], r.board_thickness_m.value_or(0));
+    o.ground_from_board =
+        calib::FloorBoardPose(pose[0], pose[1], pose[2], r.board_thickness_m.value_or(0));
     const bool use_current = r.use_current_intrinsics;
     std::vector<std::string> names = r.cameras;
     if (names.empty()) {
@@ -681,20 +726,25 @@ struct ConsoleCalibration::Impl {
         for (const auto& c : config.cameras) {
           if (c.name == names[i]) model = ModelForCamera(c);
         }
-        if (!model) throw InputError("use_current_intrinsics", names[i] + " has no camera model yet: solve its intrinsics");
+        if (!model)
+          throw InputError("use_current_intrinsics",
+                           names[i] + " has no camera model yet: solve its intrinsics");
         current[i] = model;
       }
     }
     std::vector<std::string> warnings;
     if (o.board.kind == calib::BoardKind::kChessboard) {
       if (o.board.squares_x == o.board.squares_y) {
-        warnings.push_back("the board is square (" + std::to_string(o.board.squares_x) + "x" +
-                           std::to_string(o.board.squares_y) + " squares): its orientation is ambiguous, so views "
-                           "may be matched the wrong way round; use a board with an even and an odd side");
+        warnings.push_back(
+            "the board is square (" + std::to_string(o.board.squares_x) + "x" +
+            std::to_string(o.board.squares_y) +
+            " squares): its orientation is ambiguous, so views "
+            "may be matched the wrong way round; use a board with an even and an odd side");
       } else if (o.board.squares_x % 2 == o.board.squares_y % 2) {
         warnings.push_back("the board's sides (" + std::to_string(o.board.squares_x) + "x" +
                            std::to_string(o.board.squares_y) + " squares) are both " +
-                           (o.board.squares_x % 2 ? "odd" : "even") + ": it looks the same turned half round; "
+                           (o.board.squares_x % 2 ? "odd" : "even") +
+                           ": it looks the same turned half round; "
                            "use a board with an even and an odd side");
       }
     }
@@ -703,7 +753,9 @@ struct ConsoleCalibration::Impl {
     std::lock_guard lock(mutex);
     ++run;
     if (work_dir.empty()) {
-      work_dir = (fs::temp_directory_path() / ("spritestation-calibration-" + std::to_string(::getpid()))).string();
+      work_dir =
+          (fs::temp_directory_path() / ("spritestation-calibration-" + std::to_string(::getpid())))
+              .string();
     }
     settings.run = run;
     settings.work_dir = (fs::path(work_dir) / std::to_string(run)).string();
@@ -713,7 +765,8 @@ struct ConsoleCalibration::Impl {
       double fps = 0;
       int index = 0;
       for (size_t k = 0; k < status.cameras.size(); ++k) {
-        if (status.cameras[k].name == names[i]) fps = status.cameras[k].fps, index = static_cast<int>(k);
+        if (status.cameras[k].name == names[i])
+          fps = status.cameras[k].fps, index = static_cast<int>(k);
       }
       for (const auto& c : config.cameras) {
         if (c.name == names[i] && fps <= 0 && c.fps > 0) fps = c.fps;
@@ -725,9 +778,13 @@ struct ConsoleCalibration::Impl {
     this->warnings = warnings;
     error.clear();
     saved = nullptr;
-    options = {{"min_views", o.verdict.min_views}, {"max_views", o.max_views}, {"min_coverage", o.verdict.min_coverage},
-               {"max_rms_px", o.verdict.max_rms_px}, {"max_stdev_percent", o.verdict.max_stdev_percent},
-               {"min_tilt_deg", o.verdict.min_tilt_deg}, {"board_pose", {pose[0], pose[1], pose[2]}},
+    options = {{"min_views", o.verdict.min_views},
+               {"max_views", o.max_views},
+               {"min_coverage", o.verdict.min_coverage},
+               {"max_rms_px", o.verdict.max_rms_px},
+               {"max_stdev_percent", o.verdict.max_stdev_percent},
+               {"min_tilt_deg", o.verdict.min_tilt_deg},
+               {"board_pose", {pose[0], pose[1], pose[2]}},
                {"use_current_intrinsics", use_current}};
     log->info("calibration wizard started on {} camera(s), board {}", works.size(), board);
     return nullptr;
@@ -777,13 +834,15 @@ struct ConsoleCalibration::Impl {
         continue;  // no frame yet: nothing of it to save
       }
       if (model) request.models.emplace_back(w->name(), *model);
-      if (floor && w->floor_order() >= floor_order) floor_order = w->floor_order(), request.floor = floor;
+      if (floor && w->floor_order() >= floor_order)
+        floor_order = w->floor_order(), request.floor = floor;
     }
     if (request.models.empty()) {
       throw ConflictError("save", "no camera has trusted intrinsics yet: solve first");
     }
     const StationConfig config = context.host->live_config();
-    fs::path dir = context.config_path.empty() ? fs::path(config.storage.bank).parent_path() : fs::path(context.config_path).parent_path();
+    fs::path dir = context.config_path.empty() ? fs::path(config.storage.bank).parent_path()
+                                               : fs::path(context.config_path).parent_path();
     request.config_path = context.config_path;
     request.calibration_dir = (dir / "calibration").string();
     request.stamp = UtcStamp("%Y%m%dT%H%M%SZ");
@@ -795,9 +854,14 @@ struct ConsoleCalibration::Impl {
       error = std::string("not saved: ") + e.what() + " (nothing already saved was changed)";
       throw;
     }
-    nlohmann::json j = {{"at", UtcStamp("%Y-%m-%dT%H:%M:%SZ")}, {"files", result.files}, {"previous", result.previous},
-                        {"config", context.config_path.empty() ? nlohmann::json(nullptr) : nlohmann::json(context.config_path)},
-                        {"cameras", nlohmann::json::array()}, {"station_restarted", false}};
+    nlohmann::json j = {
+        {"at", UtcStamp("%Y-%m-%dT%H:%M:%SZ")},
+        {"files", result.files},
+        {"previous", result.previous},
+        {"config", context.config_path.empty() ? nlohmann::json(nullptr)
+                                               : nlohmann::json(context.config_path)},
+        {"cameras", nlohmann::json::array()},
+        {"station_restarted", false}};
     for (const auto& [name, model] : request.models) j["cameras"].push_back(name);
     {
       std::lock_guard lock(mutex);
@@ -805,7 +869,8 @@ struct ConsoleCalibration::Impl {
       error.clear();
     }
     log->info("calibration saved: {}", api::Dump(result.files));
-    // The live station restarts with them (a replay keeps running; the live station uses them when it stops).
+    // The live station restarts with them (a replay keeps running; the live station uses them when
+    // it stops).
     try {
       const bool restarted = context.host->ApplyLiveConfig(result.config);
       j["station_restarted"] = restarted;
@@ -833,14 +898,19 @@ struct ConsoleCalibration::Impl {
     j["error"] = error.empty() ? nlohmann::json(nullptr) : nlohmann::json(error);
     j["saved"] = saved;
     j["busy"] = nullptr;
-    if (saving) j["busy"] = {{"what", "save"}, {"camera", nullptr}, {"stage", "writing the files"}, {"progress", 0.5}};
+    if (saving)
+      j["busy"] = {
+          {"what", "save"}, {"camera", nullptr}, {"stage", "writing the files"}, {"progress", 0.5}};
     j["cameras"] = nlohmann::json::array();
     int least = 3;
     for (const auto& w : works) {
       nlohmann::json c = w->Snapshot();
       if (const auto busy = w->Busy()) j["busy"] = *busy;
       const std::string step = c.value("step", "intrinsics");
-      least = std::min(least, step == "intrinsics" ? 0 : step == "ground" ? 1 : step == "enclosure" ? 2 : 3);
+      least = std::min(least, step == "intrinsics"  ? 0
+                              : step == "ground"    ? 1
+                              : step == "enclosure" ? 2
+                                                    : 3);
       j["cameras"].push_back(std::move(c));
     }
     if (!active) {
@@ -899,13 +969,15 @@ void ConsoleCalibration::AddStatus(nlohmann::json& status) const {
         if (s.value("name", "") != c.value("name", "")) continue;
         const std::string state = s.value("state", "");
         online = state == "live" || state == "training" || state == "starting";
-        if (!online) message = state + (s.value("message", "").empty() ? "" : ": " + s.value("message", ""));
+        if (!online)
+          message = state + (s.value("message", "").empty() ? "" : ": " + s.value("message", ""));
       }
       c["online"] = online;
       if (!online && calibration.value("active", false)) {
         if (c.value("message", "").empty()) c["message"] = message;
         if (offline.empty()) {
-          offline = c.value("name", "") + " delivers no frames (" + (message.empty() ? "not in the station" : message) +
+          offline = c.value("name", "") + " delivers no frames (" +
+                    (message.empty() ? "not in the station" : message) +
                     "); the views captured so far are kept";
         }
       }
@@ -929,7 +1001,8 @@ std::vector<api::Route> ConsoleCalibration::Routes() {
     return [s, kind](const Request& req, Response& res) {
       const std::shared_ptr<CameraWork> w = s->Work(api::PathText(req));
       std::ifstream in(w->PlotPath(kind), std::ios::binary);
-      if (w->solves() == 0 || !in) throw NotFoundError(std::string(kind), "no solve of " + w->name() + " yet");
+      if (w->solves() == 0 || !in)
+        throw NotFoundError(std::string(kind), "no solve of " + w->name() + " yet");
       std::ostringstream bytes;
       bytes << in.rdbuf();
       res.set_header("Cache-Control", "no-store");
@@ -937,24 +1010,30 @@ std::vector<api::Route> ConsoleCalibration::Routes() {
     };
   };
   return {
-      {"GET", "/api/calibration", "GET /api/calibration", api::Json([this](const Request&) { return StateWithCameras(); })},
+      {"GET", "/api/calibration", "GET /api/calibration",
+       api::Json([this](const Request&) { return StateWithCameras(); })},
       {"POST", "/api/calibration/start",
-       "POST /api/calibration/start {\"board\", \"cameras\", \"board_pose\", \"board_thickness_m\", \"min_views\", "
-       "\"max_views\", \"min_coverage\", \"max_rms_px\", \"still_s\", \"floor_still_s\", \"use_current_intrinsics\"}",
+       "POST /api/calibration/start {\"board\", \"cameras\", \"board_pose\", "
+       "\"board_thickness_m\", \"min_views\", "
+       "\"max_views\", \"min_coverage\", \"max_rms_px\", \"still_s\", \"floor_still_s\", "
+       "\"use_current_intrinsics\"}",
        state_after([s](const Request& req) {
          s->Start(api::ObjectBody(req, api::kCalibrationStartFields));
          s->Retap();
        })},
-      {"POST", "/api/calibration/cancel", "POST /api/calibration/cancel", state_after([s](const Request& req) {
+      {"POST", "/api/calibration/cancel", "POST /api/calibration/cancel",
+       state_after([s](const Request& req) {
          api::ObjectBody(req, {});
          s->RequireActive();
          s->Stop();
          std::lock_guard lock(s->mutex);
          s->error.clear();
        })},
-      {"POST", "/api/calibration/drop", "POST /api/calibration/drop {\"camera\", \"which\": \"last\" | \"worst\"}",
+      {"POST", "/api/calibration/drop",
+       "POST /api/calibration/drop {\"camera\", \"which\": \"last\" | \"worst\"}",
        state_after([s](const Request& req) {
-         const api::CalibrationDropRequest r = api::ParseCalibrationDrop(api::ObjectBody(req, api::kCalibrationDropFields));
+         const api::CalibrationDropRequest r =
+             api::ParseCalibrationDrop(api::ObjectBody(req, api::kCalibrationDropFields));
          const std::string& which = r.which;
          for (const auto& w : s->Chosen(r.camera)) {
            w->Run([&](calib::CalibrationWizard& wiz) {
@@ -967,7 +1046,8 @@ std::vector<api::Route> ConsoleCalibration::Routes() {
            });
          }
        })},
-      {"POST", "/api/calibration/solve", "POST /api/calibration/solve {\"camera\"} (202: runs in the background)",
+      {"POST", "/api/calibration/solve",
+       "POST /api/calibration/solve {\"camera\"} (202: runs in the background)",
        [this, s](const Request& req, Response& res) {
          const nlohmann::json body = api::ObjectBody(req, api::kCalibrationSolveFields);
          s->RequireActive();
@@ -985,9 +1065,12 @@ std::vector<api::Route> ConsoleCalibration::Routes() {
          for (const auto& w : chosen) w->StartSolve();
          api::Reply(res, 202, StateWithCameras());
        }},
-      {"POST", "/api/calibration/redo", "POST /api/calibration/redo {\"camera\", \"step\": \"intrinsics\" | \"ground\" | \"enclosure\"}",
+      {"POST", "/api/calibration/redo",
+       "POST /api/calibration/redo {\"camera\", \"step\": \"intrinsics\" | \"ground\" | "
+       "\"enclosure\"}",
        state_after([s](const Request& req) {
-         const api::CalibrationRedoRequest r = api::ParseCalibrationRedo(api::ObjectBody(req, api::kCalibrationRedoFields));
+         const api::CalibrationRedoRequest r =
+             api::ParseCalibrationRedo(api::ObjectBody(req, api::kCalibrationRedoFields));
          const WizardStep step = r.step;
          for (const auto& w : s->Chosen(r.camera)) {
            w->Run([&](calib::CalibrationWizard& wiz) {
@@ -1003,27 +1086,32 @@ std::vector<api::Route> ConsoleCalibration::Routes() {
          s->saved = nullptr;
        })},
       {"POST", "/api/calibration/floor",
-       "POST /api/calibration/floor {\"camera\", \"detect\": true} | {\"camera\", \"pixels\": [[x, y], ...]}",
+       "POST /api/calibration/floor {\"camera\", \"detect\": true} | {\"camera\", \"pixels\": [[x, "
+       "y], ...]}",
        state_after([s](const Request& req) {
          const nlohmann::json body = api::ObjectBody(req, api::kCalibrationFloorFields);
          const std::shared_ptr<CameraWork> w = s->Chosen(api::ParseCameraName(body, true)).front();
          const api::CalibrationFloorRequest r = api::ParseCalibrationFloor(body);
          if (!r.detect) {
            w->Run([&](calib::CalibrationWizard& wiz) {
-             if (!wiz.posed_model()) throw ConflictError(w->name(), "is not posed yet: finish the ground step first");
+             if (!wiz.posed_model())
+               throw ConflictError(w->name(), "is not posed yet: finish the ground step first");
              wiz.SetFloorFromPixels(r.pixels);
              return 0;
            });
          } else {
            const LiveView live = w->Live();
            w->Run([&](calib::CalibrationWizard& wiz) {
-             if (!wiz.posed_model()) throw ConflictError(w->name(), "is not posed yet: finish the ground step first");
-             if (live.bgr.empty()) throw ConflictError(w->name(), "has no frame to find the floor in");
+             if (!wiz.posed_model())
+               throw ConflictError(w->name(), "is not posed yet: finish the ground step first");
+             if (live.bgr.empty())
+               throw ConflictError(w->name(), "has no frame to find the floor in");
              try {
                wiz.DetectFloor(live.bgr);
              } catch (const InputError& e) {
-               throw InputError("detect", std::string("no green floor found: ") + e.what() +
-                                              "; clear the floor, or click its corners on the image");
+               throw InputError("detect",
+                                std::string("no green floor found: ") + e.what() +
+                                    "; clear the floor, or click its corners on the image");
              }
              return 0;
            });
@@ -1031,18 +1119,21 @@ std::vector<api::Route> ConsoleCalibration::Routes() {
          std::lock_guard lock(s->mutex);
          s->saved = nullptr;
        })},
-      {"POST", "/api/calibration/save", "POST /api/calibration/save", api::Json([this, s](const Request& req) {
+      {"POST", "/api/calibration/save", "POST /api/calibration/save",
+       api::Json([this, s](const Request& req) {
          api::ObjectBody(req, {});
          s->Save();
          return StateWithCameras();
        })},
-      {"GET", R"(/api/calibration/cameras/([^/]+)/view\.json)", "GET /api/calibration/cameras/NAME/view.json?width=W",
+      {"GET", R"(/api/calibration/cameras/([^/]+)/view\.json)",
+       "GET /api/calibration/cameras/NAME/view.json?width=W",
        [s](const Request& req, Response& res) {
          const std::shared_ptr<CameraWork> w = s->Work(api::PathText(req));
          const int width = static_cast<int>(api::IntParam(req, "width", 640, 16, 4096));
          const LiveView live = w->Live();
          if (live.bgr.empty()) {
-           api::ReplyError(res, 503, "camera \"" + w->name() + "\" has delivered no frame to the wizard yet");
+           api::ReplyError(res, 503,
+                           "camera \"" + w->name() + "\" has delivered no frame to the wizard yet");
            return;
          }
          const double scale = std::min(1.0, static_cast<double>(width) / live.bgr.cols);
@@ -1050,17 +1141,23 @@ std::vector<api::Route> ConsoleCalibration::Routes() {
          if (scale < 1.0) cv::resize(live.bgr, image, cv::Size(), scale, scale, cv::INTER_AREA);
          nlohmann::json grid = nlohmann::json::array();
          for (const auto& line : live.grid) grid.push_back(Points(line));
-         const nlohmann::json j = {{"frame", live.sequence}, {"width", live.bgr.cols}, {"height", live.bgr.rows},
-                                   {"scale", scale}, {"image", "data:image/jpeg;base64," + Base64(EncodeJpeg(image))},
-                                   {"detected", live.detected}, {"still", live.still}, {"corners", Points(live.corners)},
-                                   {"grid", grid}, {"floor", Points(live.floor)}};
+         const nlohmann::json j = {{"frame", live.sequence},
+                                   {"width", live.bgr.cols},
+                                   {"height", live.bgr.rows},
+                                   {"scale", scale},
+                                   {"image", "data:image/jpeg;base64," + Base64(EncodeJpeg(image))},
+                                   {"detected", live.detected},
+                                   {"still", live.still},
+                                   {"corners", Points(live.corners)},
+                                   {"grid", grid},
+                                   {"floor", Points(live.floor)}};
          res.set_header("Cache-Control", "no-store");
          res.set_content(api::Dump(j), "application/json");
        }},
-      {"GET", R"(/api/calibration/cameras/([^/]+)/residuals\.png)", "GET /api/calibration/cameras/NAME/residuals.png",
-       camera_png("residuals")},
-      {"GET", R"(/api/calibration/cameras/([^/]+)/uncertainty\.png)", "GET /api/calibration/cameras/NAME/uncertainty.png",
-       camera_png("uncertainty")},
+      {"GET", R"(/api/calibration/cameras/([^/]+)/residuals\.png)",
+       "GET /api/calibration/cameras/NAME/residuals.png", camera_png("residuals")},
+      {"GET", R"(/api/calibration/cameras/([^/]+)/uncertainty\.png)",
+       "GET /api/calibration/cameras/NAME/uncertainty.png", camera_png("uncertainty")},
   };
 }
 

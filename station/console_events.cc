@@ -17,7 +17,8 @@ nlohmann::json MergePatch(const nlohmann::json& from, const nlohmann::json& to) 
     if (old == from.end()) {
       patch[it.key()] = it.value();
     } else if (*old != it.value()) {
-      patch[it.key()] = old->is_object() && it.value().is_object() ? MergePatch(*old, it.value()) : it.value();
+      patch[it.key()] =
+          old->is_object() && it.value().is_object() ? MergePatch(*old, it.value()) : it.value();
     }
   }
   return patch;
@@ -59,16 +60,19 @@ nlohmann::json ConsoleEvents::Sample(const nlohmann::json& status, double dt_s) 
     dropped += c["dropped"].value("total", 0.0);
     fps[c.value("name", "")] = c.value("fps", 0.0);
   }
-  const double dropped_per_s = last_dropped_ >= 0 && dt_s > 0 ? std::max(0.0, dropped - last_dropped_) / dt_s : 0;
+  const double dropped_per_s =
+      last_dropped_ >= 0 && dt_s > 0 ? std::max(0.0, dropped - last_dropped_) / dt_s : 0;
   last_dropped_ = dropped;
   const auto& bank = status["bank"];
-  return {{"t", std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count()},
-          {"sprites_per_s", bank.value("sprites_per_second", 0.0)},
-          {"latency_p50_ms", bank["latency_ms"].value("p50", 0.0)},
-          {"latency_p99_ms", bank["latency_ms"].value("p99", 0.0)},
-          {"transitions_pending", status["transitions"].value("pending", 0)},
-          {"dropped_per_s", dropped_per_s},
-          {"fps", fps}};
+  return {
+      {"t",
+       std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count()},
+      {"sprites_per_s", bank.value("sprites_per_second", 0.0)},
+      {"latency_p50_ms", bank["latency_ms"].value("p50", 0.0)},
+      {"latency_p99_ms", bank["latency_ms"].value("p99", 0.0)},
+      {"transitions_pending", status["transitions"].value("pending", 0)},
+      {"dropped_per_s", dropped_per_s},
+      {"fps", fps}};
 }
 
 void ConsoleEvents::Loop() {
@@ -78,7 +82,9 @@ void ConsoleEvents::Loop() {
   while (true) {
     {
       std::unique_lock lock(mutex_);
-      if (changed_.wait_for(lock, std::chrono::duration<double>(tick_s_), [&] { return stopping_; })) return;
+      if (changed_.wait_for(lock, std::chrono::duration<double>(tick_s_),
+                            [&] { return stopping_; }))
+        return;
     }
     nlohmann::json status;
     try {
@@ -147,8 +153,10 @@ std::string ConsoleEvents::Stream::Next() {
     });
     if (e.stopping_) return "";
     if (!woke) {
-      return Event(next_id_++, "heartbeat",
-                   {{"t", std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count()}});
+      return Event(
+          next_id_++, "heartbeat",
+          {{"t", std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch())
+                     .count()}});
     }
     std::string out;
     if (e.version_ != status_version_) {

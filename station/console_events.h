@@ -67,10 +67,10 @@ class ConsoleEvents {
   mutable std::mutex mutex_;
   std::condition_variable changed_;
   bool stopping_ = false;
-  nlohmann::json current_;        // the latest status
-  uint64_t version_ = 0;          // bumped when current_ changes
+  nlohmann::json current_;              // the latest status
+  uint64_t version_ = 0;                // bumped when current_ changes
   std::deque<nlohmann::json> history_;  // the last kHistory samples
-  uint64_t samples_ = 0;          // samples made so far (the newest is number samples_)
+  uint64_t samples_ = 0;                // samples made so far (the newest is number samples_)
   uint64_t connections_ = 0;
   // For per-second rates between samples.
   double last_dropped_ = -1;

@@ -42,7 +42,8 @@ using api::Route;
 namespace {
 
 constexpr int kFolds = 5;
-constexpr size_t kMaxCandidatesPerRow = 1000;  // stage-2 evaluations a row at most (a random subset)
+constexpr size_t kMaxCandidatesPerRow =
+    1000;  // stage-2 evaluations a row at most (a random subset)
 
 double Now() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
@@ -68,14 +69,15 @@ void CheckSprite(const Bank& bank, int64_t id) {
 }
 
 bool SameWindow(const ComparisonWindow& a, const ComparisonWindow& b) {
-  return a.width_m == b.width_m && a.height_m == b.height_m && a.cells_x == b.cells_x && a.cells_y == b.cells_y &&
-         a.align == b.align;
+  return a.width_m == b.width_m && a.height_m == b.height_m && a.cells_x == b.cells_x &&
+         a.cells_y == b.cells_y && a.align == b.align;
 }
 
 std::string Basename(const std::string& path) { return fs::path(path).filename().string(); }
 
 // A file in `dir` named prefix-STAMP.ext that does not exist yet (never over an older one).
-fs::path FreshName(const fs::path& dir, const std::string& prefix, const std::string& stamp, const std::string& ext) {
+fs::path FreshName(const fs::path& dir, const std::string& prefix, const std::string& stamp,
+                   const std::string& ext) {
   fs::path p = dir / (prefix + stamp + ext);
   for (int k = 2; fs::exists(p); ++k) p = dir / (prefix + stamp + "-" + std::to_string(k) + ext);
   return p;
@@ -92,14 +94,16 @@ void WriteText(const fs::path& path, const std::string& text) {
 // The cross-validated figures of a weights file's training record (stage "stage2" or "stage1").
 nlohmann::json CrossValidated(const nlohmann::json& training, const char* stage) {
   const std::string key = std::string(stage) + "_cross_validated";
-  if (!training.is_object() || !training.contains(key) || !training[key].is_object()) return nullptr;
+  if (!training.is_object() || !training.contains(key) || !training[key].is_object())
+    return nullptr;
   const nlohmann::json& cv = training[key];
   return {{"precision", cv.value("precision", 0.0)}, {"recall", cv.value("recall", 0.0)}};
 }
 
 }  // namespace
 
-std::string TransitionLabelsCsv(const std::vector<TransitionLabelRecord>& labels, double positive_rate) {
+std::string TransitionLabelsCsv(const std::vector<TransitionLabelRecord>& labels,
+                                double positive_rate) {
   std::string out;
   if (positive_rate > 0 && positive_rate < 1) {
     char text[64];
@@ -112,14 +116,16 @@ std::string TransitionLabelsCsv(const std::vector<TransitionLabelRecord>& labels
   std::vector<const TransitionLabelRecord*> sorted;
   for (const TransitionLabelRecord& l : labels) sorted.push_back(&l);
   std::stable_sort(sorted.begin(), sorted.end(), [](const auto* x, const auto* y) {
-    return std::make_tuple(std::min(x->from_sprite, x->to_sprite), std::max(x->from_sprite, x->to_sprite), x->from_sprite) <
-           std::make_tuple(std::min(y->from_sprite, y->to_sprite), std::max(y->from_sprite, y->to_sprite), y->from_sprite);
+    return std::make_tuple(std::min(x->from_sprite, x->to_sprite),
+                           std::max(x->from_sprite, x->to_sprite), x->from_sprite) <
+           std::make_tuple(std::min(y->from_sprite, y->to_sprite),
+                           std::max(y->from_sprite, y->to_sprite), y->from_sprite);
   });
   for (const TransitionLabelRecord* p : sorted) {
     const TransitionLabelRecord& l = *p;
     if (l.label != "yes" && l.label != "no") continue;
-    out += std::to_string(l.from_sprite) + "," + std::to_string(l.to_sprite) + "," + (l.label == "yes" ? "1" : "0") +
-           "\n";
+    out += std::to_string(l.from_sprite) + "," + std::to_string(l.to_sprite) + "," +
+           (l.label == "yes" ? "1" : "0") + "\n";
   }
   return out;
 }
@@ -176,24 +182,30 @@ struct ConsoleLabels::Pool {
       store->Append(loaded.inputs, threads);
       for (size_t k = 0; k < ids.size(); ++k) {
         const RgbaBillboard& bb = loaded.billboards[k];
-        meta.push_back({features[k]->clip_id, features[k]->frame, bb.width, bb.height, bb.anchor_x_px, bb.anchor_y_px});
+        meta.push_back({features[k]->clip_id, features[k]->frame, bb.width, bb.height,
+                        bb.anchor_x_px, bb.anchor_y_px});
       }
     }
     last_seq = max_seq;
   }
 
   // A pair of store indices as the page takes it (docs/console.md).
-  nlohmann::json PairJson(int32_t i, int32_t j, double d, const TransitionClassifier& classifier) const {
+  nlohmann::json PairJson(int32_t i, int32_t j, double d,
+                          const TransitionClassifier& classifier) const {
     const SpriteStore& s = *store;
     auto sprite_json = [&](int32_t k) {
-      return nlohmann::json{{"id", s.id(k)}, {"prev", s.id(s.prev(k))}, {"next", s.id(s.next(k))},
-                            {"clip", meta[k].clip}, {"frame", meta[k].frame}};
+      return nlohmann::json{{"id", s.id(k)},
+                            {"prev", s.id(s.prev(k))},
+                            {"next", s.id(s.next(k))},
+                            {"clip", meta[k].clip},
+                            {"frame", meta[k].frame}};
     };
     nlohmann::json billboards = nlohmann::json::object();
     for (int32_t k : {i, j}) {
       for (int32_t m : {s.prev(k), k, s.next(k)}) {
-        billboards[std::to_string(s.id(m))] = {
-            {"width", meta[m].width}, {"height", meta[m].height}, {"anchor", {meta[m].anchor_x, meta[m].anchor_y}}};
+        billboards[std::to_string(s.id(m))] = {{"width", meta[m].width},
+                                               {"height", meta[m].height},
+                                               {"anchor", {meta[m].anchor_x, meta[m].anchor_y}}};
       }
     }
     const double margin = d - classifier.stage2_threshold();
@@ -211,7 +223,9 @@ struct ConsoleLabels::Pool {
 };
 
 ConsoleLabels::ConsoleLabels(api::Context context, ConsoleLabelsOptions options)
-    : context_(std::move(context)), options_(std::move(options)), shared_(std::make_shared<Shared>()) {
+    : context_(std::move(context)),
+      options_(std::move(options)),
+      shared_(std::make_shared<Shared>()) {
   shared_->retrain = {{"state", "idle"}, {"progress", 0}, {"stage", ""}};
 }
 
@@ -243,7 +257,11 @@ std::pair<TransitionWeights, std::string> ConsoleLabels::WeightsInUse() const {
 nlohmann::json ConsoleLabels::Counts() const {
   const std::map<std::string, int64_t> n = Bank(BankPath()).CountTransitionLabels();
   const int64_t yes = n.at("yes"), no = n.at("no"), skip = n.at("skip");
-  return {{"yes", yes}, {"no", no}, {"skip", skip}, {"total", yes + no + skip}, {"exportable", yes + no}};
+  return {{"yes", yes},
+          {"no", no},
+          {"skip", skip},
+          {"total", yes + no + skip},
+          {"exportable", yes + no}};
 }
 
 nlohmann::json ConsoleLabels::Pairs(int count) {
@@ -258,12 +276,13 @@ nlohmann::json ConsoleLabels::Pairs(int count) {
   pool_->Update(options_.threads);
   const TransitionClassifier classifier(weights);
   const double threshold = classifier.stage2_threshold();
-  nlohmann::json out = {{"weights", weights_path.empty() ? "shipped defaults" : Basename(weights_path)},
-                        {"threshold", threshold},
-                        {"sprites", 0},
-                        {"searched", 0},
-                        {"candidates", 0},
-                        {"pairs", nlohmann::json::array()}};
+  nlohmann::json out = {
+      {"weights", weights_path.empty() ? "shipped defaults" : Basename(weights_path)},
+      {"threshold", threshold},
+      {"sprites", 0},
+      {"searched", 0},
+      {"candidates", 0},
+      {"pairs", nlohmann::json::array()}};
   if (!pool_->store || pool_->store->size() == 0) return out;
   const SpriteStore& store = *pool_->store;
   const int32_t n = store.size();
@@ -280,7 +299,8 @@ nlohmann::json ConsoleLabels::Pairs(int count) {
   }
   std::mt19937_64 rng(options_.seed);
   std::shuffle(rows.begin(), rows.end(), rng);
-  if (rows.size() > static_cast<size_t>(options_.candidate_rows)) rows.resize(options_.candidate_rows);
+  if (rows.size() > static_cast<size_t>(options_.candidate_rows))
+    rows.resize(options_.candidate_rows);
 
   Stage1Index index(classifier);
   index.Build(store.all_cheap());
@@ -299,7 +319,9 @@ nlohmann::json ConsoleLabels::Pairs(int count) {
     for (int32_t j : found) {
       if (j == i || !eligible(j)) continue;
       // Near frames of one clip are the clip itself, not a transition worth asking about.
-      if (store.clip(i) == store.clip(j) && std::abs(pool_->meta[i].frame - pool_->meta[j].frame) <= 2) continue;
+      if (store.clip(i) == store.clip(j) &&
+          std::abs(pool_->meta[i].frame - pool_->meta[j].frame) <= 2)
+        continue;
       const int64_t a = store.id(i), b = store.id(j);
       if (labelled.count({std::min(a, b), std::max(a, b)})) continue;
       if (!seen.insert({std::min(i, j), std::max(i, j)}).second) continue;
@@ -310,9 +332,10 @@ nlohmann::json ConsoleLabels::Pairs(int count) {
   out["sprites"] = n;
   out["searched"] = rows.size();
   out["candidates"] = candidates.size();
-  std::stable_sort(candidates.begin(), candidates.end(), [&](const Candidate& x, const Candidate& y) {
-    return std::abs(x.d - threshold) < std::abs(y.d - threshold);
-  });
+  std::stable_sort(candidates.begin(), candidates.end(),
+                   [&](const Candidate& x, const Candidate& y) {
+                     return std::abs(x.d - threshold) < std::abs(y.d - threshold);
+                   });
   // Each sprite (and its neighbours in the clip) in at most one pair of the answer, so the
   // questions are not the same pair shifted by a frame.
   std::unordered_set<int32_t> used;
@@ -330,7 +353,8 @@ nlohmann::json ConsoleLabels::Pairs(int count) {
 }
 
 nlohmann::json ConsoleLabels::Pair(int64_t from, int64_t to) {
-  if (from == to) throw InputError("to", "the same sprite as \"from\" (" + std::to_string(from) + ")");
+  if (from == to)
+    throw InputError("to", "the same sprite as \"from\" (" + std::to_string(from) + ")");
   const std::string bank = BankPath();
   {
     const Bank reader(bank);
@@ -348,13 +372,16 @@ nlohmann::json ConsoleLabels::Pair(int64_t from, int64_t to) {
   auto index = [&](int64_t id, const char* field) {
     const std::optional<int32_t> i = pool_->store ? pool_->store->IndexOf(id) : std::nullopt;
     if (!i) {
-      throw InputError(field, "sprite " + std::to_string(id) +
-                                  " is a mirrored copy or in a clip still being written: only originals of complete "
-                                  "clips are labelled");
+      throw InputError(
+          field,
+          "sprite " + std::to_string(id) +
+              " is a mirrored copy or in a clip still being written: only originals of complete "
+              "clips are labelled");
     }
     if (pool_->store->prev(*i) < 0 || pool_->store->next(*i) < 0) {
-      throw InputError(field, "sprite " + std::to_string(id) +
-                                  " is the first or last frame of its clip: the transition cannot be played");
+      throw InputError(
+          field, "sprite " + std::to_string(id) +
+                     " is the first or last frame of its clip: the transition cannot be played");
     }
     return *i;
   };
@@ -379,7 +406,8 @@ nlohmann::json ConsoleLabels::Store(const nlohmann::json& body) {
     std::lock_guard lock(shared_->mutex);
     shared_->dirty = true;
   }
-  return {{"stored", {{"from", from}, {"to", to}, {"label", label}, {"labelled_at", record.labelled_at}}},
+  return {{"stored",
+           {{"from", from}, {"to", to}, {"label", label}, {"labelled_at", record.labelled_at}}},
           {"labels", Counts()}};
 }
 
@@ -388,7 +416,8 @@ nlohmann::json ConsoleLabels::Undo(const nlohmann::json& body) {
   const int64_t from = r.from, to = r.to;
   const std::string bank = BankPath();
   if (!BankWriter(bank).RemoveTransitionLabel(from, to)) {
-    throw NotFoundError("label", "no label for the pair " + std::to_string(from) + " -> " + std::to_string(to));
+    throw NotFoundError(
+        "label", "no label for the pair " + std::to_string(from) + " -> " + std::to_string(to));
   }
   {
     std::lock_guard lock(shared_->mutex);
@@ -399,7 +428,8 @@ nlohmann::json ConsoleLabels::Undo(const nlohmann::json& body) {
 
 std::string ConsoleLabels::ExportCsv() const {
   const std::string bank = BankPath();
-  return TransitionLabelsCsv(Bank(bank).LoadTransitionLabels(), CalibratedPositiveRate(WeightsInUse().first));
+  return TransitionLabelsCsv(Bank(bank).LoadTransitionLabels(),
+                             CalibratedPositiveRate(WeightsInUse().first));
 }
 
 nlohmann::json ConsoleLabels::RetrainState() const {
@@ -412,35 +442,39 @@ nlohmann::json ConsoleLabels::StartRetrain() {
   {
     std::lock_guard lock(shared_->mutex);
     if (shared_->running) {
-      throw ConflictError("retrain", "a retrain is running (" + shared_->retrain.value("stage", std::string()) + ")");
+      throw ConflictError("retrain", "a retrain is running (" +
+                                         shared_->retrain.value("stage", std::string()) + ")");
     }
   }
   if (context_.host) {
     const std::shared_ptr<Station> station = context_.host->current();
     if (station && station->SessionActive()) {
-      throw ConflictError("session", "a capture session is running; stop it before retraining (the station "
-                                     "restarts with the new weights, which would end the session)");
+      throw ConflictError("session",
+                          "a capture session is running; stop it before retraining (the station "
+                          "restarts with the new weights, which would end the session)");
     }
   }
   const nlohmann::json n = Counts();
   const int64_t yes = n["yes"], no = n["no"];
   if (yes + no < options_.min_labels || yes == 0 || no == 0) {
     throw InputError("labels", std::to_string(yes) + " yes and " + std::to_string(no) +
-                                   " no: retraining needs at least " + std::to_string(options_.min_labels) +
+                                   " no: retraining needs at least " +
+                                   std::to_string(options_.min_labels) +
                                    " labels, some of each (skips do not count)");
   }
   auto [weights, path] = WeightsInUse();
   {
     std::lock_guard lock(shared_->mutex);
-    if (shared_->running || shared_->stop) throw ConflictError("retrain", "a retrain is running, or the server stops");
+    if (shared_->running || shared_->stop)
+      throw ConflictError("retrain", "a retrain is running, or the server stops");
     shared_->running = true;
     shared_->retrain = {{"state", "training"},
-                {"progress", 0.02},
-                {"stage", "exporting the labels"},
-                {"labels", yes + no},
-                {"accepts", yes},
-                {"started", UtcText(true)},
-                {"previous_weights", path.empty() ? "shipped defaults" : path}};
+                        {"progress", 0.02},
+                        {"stage", "exporting the labels"},
+                        {"labels", yes + no},
+                        {"accepts", yes},
+                        {"started", UtcText(true)},
+                        {"previous_weights", path.empty() ? "shipped defaults" : path}};
   }
   std::thread(RunRetrain, shared_, context_, options_, bank, std::move(weights)).detach();
   return RetrainState();
@@ -451,8 +485,9 @@ void ConsoleLabels::WaitRetrain() {
   shared_->changed.wait(lock, [&] { return !shared_->running; });
 }
 
-void ConsoleLabels::RunRetrain(std::shared_ptr<Shared> shared, api::Context context, ConsoleLabelsOptions options,
-                               std::string bank, TransitionWeights current) {
+void ConsoleLabels::RunRetrain(std::shared_ptr<Shared> shared, api::Context context,
+                               ConsoleLabelsOptions options, std::string bank,
+                               TransitionWeights current) {
   auto log = Log("station.labels");
   auto SetRetrain = [&](const std::function<void(nlohmann::json&)>& change) {
     std::lock_guard lock(shared->mutex);
@@ -470,7 +505,9 @@ void ConsoleLabels::RunRetrain(std::shared_ptr<Shared> shared, api::Context cont
     return shared->stop;
   };
   const auto t0 = std::chrono::steady_clock::now();
-  auto seconds = [](auto since) { return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count(); };
+  auto seconds = [](auto since) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
+  };
   try {
     // 1. The labels as `transitions train` reads them, kept beside the weights they make.
     const fs::path dir = fs::absolute(bank).parent_path() / "weights";
@@ -488,7 +525,8 @@ void ConsoleLabels::RunRetrain(std::shared_ptr<Shared> shared, api::Context cont
       r["stage"] = "training on " + r["labels"].dump() + " labels (" + std::to_string(kFolds) +
                    "-fold cross-validation), then calibrating on the bank";
       r["labels_file"] = labels_path.string();
-      r["positive_rate"] = positive_rate > 0 ? nlohmann::json(positive_rate) : nlohmann::json(nullptr);
+      r["positive_rate"] =
+          positive_rate > 0 ? nlohmann::json(positive_rate) : nlohmann::json(nullptr);
     });
     BankTrainOptions train;
     train.train.folds = kFolds;
@@ -503,15 +541,17 @@ void ConsoleLabels::RunRetrain(std::shared_ptr<Shared> shared, api::Context cont
     SaveWeights(result.weights, partial.string());
     fs::rename(partial, weights_path);
     const std::string fingerprint = WeightsFingerprint(result.weights);
-    log->info("retrained on {} labels: stage 2 precision {:.3f}, recall {:.3f}; weights {}", result.report.samples,
-              result.report.stage2.precision(), result.report.stage2.recall(), weights_path.string());
+    log->info("retrained on {} labels: stage 2 precision {:.3f}, recall {:.3f}; weights {}",
+              result.report.samples, result.report.stage2.precision(),
+              result.report.stage2.recall(), weights_path.string());
     SetRetrain([&](nlohmann::json& r) {
       r["state"] = "rebuilding";
       r["progress"] = 0.5;
       r["stage"] = "restarting the station with the new weights";
       r["precision"] = result.report.stage2.precision();
       r["recall"] = result.report.stage2.recall();
-      r["stage1"] = {{"precision", result.report.stage1.precision()}, {"recall", result.report.stage1.recall()}};
+      r["stage1"] = {{"precision", result.report.stage1.precision()},
+                     {"recall", result.report.stage1.recall()}};
       r["folds"] = result.report.folds;
       r["weights"] = weights_path.string();
       r["fingerprint"] = fingerprint;
@@ -530,13 +570,15 @@ void ConsoleLabels::RunRetrain(std::shared_ptr<Shared> shared, api::Context cont
       SetRetrain([&](nlohmann::json& r) {
         const bool load = stage == "load";
         r["progress"] = load ? 0.55 + 0.15 * f : 0.7 + 0.28 * f;
-        r["stage"] = std::string(load ? "rebuilding transitions: reading sprites " : "rebuilding transitions: searching ") +
+        r["stage"] = std::string(load ? "rebuilding transitions: reading sprites "
+                                      : "rebuilding transitions: searching ") +
                      std::to_string(done) + " / " + std::to_string(total);
       });
     };
     bool rebuilt_by_station = false;
     if (context.host) {
-      if (!enter_host()) throw WorkError("retrain", "the server stopped before the station used the new weights");
+      if (!enter_host())
+        throw WorkError("retrain", "the server stopped before the station used the new weights");
       struct Leave {
         Shared& s;
         ~Leave() {
@@ -554,7 +596,8 @@ void ConsoleLabels::RunRetrain(std::shared_ptr<Shared> shared, api::Context cont
         rebuilt_by_station = true;
         // The new station's transition worker rebuilds the table at its start.
         for (;;) {
-          if (stopping()) throw WorkError("retrain", "the server stopped while the transitions were rebuilt");
+          if (stopping())
+            throw WorkError("retrain", "the server stopped while the transitions were rebuilt");
           const std::shared_ptr<Station> station = context.host->current();
           const StationStatus st = station->Status();
           if (st.transitions_ready) {
@@ -562,7 +605,8 @@ void ConsoleLabels::RunRetrain(std::shared_ptr<Shared> shared, api::Context cont
             break;
           }
           if (!st.transitions_startup_stage.empty()) {
-            stage_progress(st.transitions_startup_stage, st.transitions_startup_done, st.transitions_startup_total);
+            stage_progress(st.transitions_startup_stage, st.transitions_startup_done,
+                           st.transitions_startup_total);
           }
           std::this_thread::sleep_for(std::chrono::milliseconds(100));
         }
@@ -583,11 +627,13 @@ void ConsoleLabels::RunRetrain(std::shared_ptr<Shared> shared, api::Context cont
     const Bank after(bank);
     const std::string table = after.GetMeta(kTransitionWeightsMetaKey).value_or("");
     if (table != fingerprint) {
-      throw WorkError(bank, "the transition table was made by weights " + table + ", not the new " + fingerprint);
+      throw WorkError(bank, "the transition table was made by weights " + table + ", not the new " +
+                                fingerprint);
     }
     const int64_t transitions = after.Counts().transitions;
     const double rebuild_s = seconds(t_rebuild);
-    log->info("transitions rebuilt with {}: {} transitions in {:.1f} s", weights_path.string(), transitions, rebuild_s);
+    log->info("transitions rebuilt with {}: {} transitions in {:.1f} s", weights_path.string(),
+              transitions, rebuild_s);
     SetRetrain([&](nlohmann::json& r) {
       r["state"] = "done";
       r["progress"] = 1.0;
@@ -656,7 +702,8 @@ void ConsoleLabels::RefreshStatus() const {
              {"fingerprint", fingerprint},
              {"table", table},
              {"cross_validated", CrossValidated(training, "stage2")},
-             {"positive_rate", CalibratedPositiveRate(w) > 0 ? nlohmann::json(CalibratedPositiveRate(w)) : nullptr}};
+             {"positive_rate",
+              CalibratedPositiveRate(w) > 0 ? nlohmann::json(CalibratedPositiveRate(w)) : nullptr}};
   std::lock_guard lock(status_mutex_);
   labels_status_ = std::move(labels);
   weights_status_ = std::move(weights);
@@ -680,26 +727,38 @@ void ConsoleLabels::AddStatus(nlohmann::json& status) const {
 
 std::vector<Route> ConsoleLabels::Routes() {
   return {
-      {"GET", "/api/labels", "GET /api/labels (counts)", Json([this](const httplib::Request&) { return Counts(); })},
+      {"GET", "/api/labels", "GET /api/labels (counts)",
+       Json([this](const httplib::Request&) { return Counts(); })},
       {"GET", "/api/labels/pairs", "GET /api/labels/pairs?count=N (least sure first)",
-       Json([this](const httplib::Request& req) { return Pairs(static_cast<int>(api::IntParam(req, "count", 10, 1, 100))); })},
-      {"GET", "/api/labels/pair", "GET /api/labels/pair?from=ID&to=ID (one pair, as pairs gives it)",
+       Json([this](const httplib::Request& req) {
+         return Pairs(static_cast<int>(api::IntParam(req, "count", 10, 1, 100)));
+       })},
+      {"GET", "/api/labels/pair",
+       "GET /api/labels/pair?from=ID&to=ID (one pair, as pairs gives it)",
        Json([this](const httplib::Request& req) {
          for (const char* field : {"from", "to"}) {
            if (!req.has_param(field)) throw InputError(field, "missing (?from=ID&to=ID)");
          }
-         return Pair(api::IntParam(req, "from", 0, 1, INT64_MAX), api::IntParam(req, "to", 0, 1, INT64_MAX));
+         return Pair(api::IntParam(req, "from", 0, 1, INT64_MAX),
+                     api::IntParam(req, "to", 0, 1, INT64_MAX));
        })},
-      {"POST", "/api/labels", "POST /api/labels {\"from\": ID, \"to\": ID, \"label\": \"yes\" | \"no\" | \"skip\"}",
-       Json([this](const httplib::Request& req) { return Store(ObjectBody(req, api::kLabelFields)); })},
+      {"POST", "/api/labels",
+       "POST /api/labels {\"from\": ID, \"to\": ID, \"label\": \"yes\" | \"no\" | \"skip\"}",
+       Json([this](const httplib::Request& req) {
+         return Store(ObjectBody(req, api::kLabelFields));
+       })},
       {"POST", "/api/labels/undo", "POST /api/labels/undo {\"from\": ID, \"to\": ID}",
-       Json([this](const httplib::Request& req) { return Undo(ObjectBody(req, api::kLabelUndoFields)); })},
-      {"GET", R"(/api/labels/export\.csv)", "GET /api/labels/export.csv (transitions train's labels CSV)",
+       Json([this](const httplib::Request& req) {
+         return Undo(ObjectBody(req, api::kLabelUndoFields));
+       })},
+      {"GET", R"(/api/labels/export\.csv)",
+       "GET /api/labels/export.csv (transitions train's labels CSV)",
        [this](const httplib::Request&, httplib::Response& res) {
          res.set_header("Content-Disposition", "attachment; filename=\"labels.csv\"");
          res.set_content(ExportCsv(), "text/csv; charset=utf-8");
        }},
-      {"POST", "/api/labels/retrain", "POST /api/labels/retrain (202; progress in the status' transitions.retrain)",
+      {"POST", "/api/labels/retrain",
+       "POST /api/labels/retrain (202; progress in the status' transitions.retrain)",
        [this](const httplib::Request& req, httplib::Response& res) {
          ObjectBody(req, {});
          Reply(res, 202, {{"retrain", StartRetrain()}});

@@ -27,17 +27,18 @@
 namespace ss {
 
 struct ConsoleLabelsOptions {
-  std::string bank;        // "" : the running station's bank (tests name one)
-  int threads = 2;         // training and, without a station, the rebuild
+  std::string bank;          // "" : the running station's bank (tests name one)
+  int threads = 2;           // training and, without a station, the rebuild
   int candidate_rows = 400;  // sprites whose stage-1 candidates are searched for uncertain pairs
-  uint64_t seed = 1;       // of the row sample
-  int min_labels = 10;     // yes + no labels a retrain needs (and both kinds)
+  uint64_t seed = 1;         // of the row sample
+  int min_labels = 10;       // yes + no labels a retrain needs (and both kinds)
 };
 
 // The labels CSV of `transitions train` (training.h ReadLabelsCsv): the header, then one
 // row per yes / no label (skips are left out) in pair order (by the smaller, then the larger
 // sprite id); a positive rate > 0 is written as the "# positive_rate=R" line first.
-std::string TransitionLabelsCsv(const std::vector<TransitionLabelRecord>& labels, double positive_rate);
+std::string TransitionLabelsCsv(const std::vector<TransitionLabelRecord>& labels,
+                                double positive_rate);
 
 // The positive rate the weights' stage 2 was calibrated for (training.stage2_calibration),
 // or -1 when they were not.
@@ -89,16 +90,16 @@ class ConsoleLabels : public api::Part {
     std::condition_variable changed;
     nlohmann::json retrain;  // the status' "retrain" member
     std::optional<std::pair<TransitionWeights, std::string>> own_weights;  // without a host
-    bool running = false;   // a retrain thread exists
+    bool running = false;  // a retrain thread exists
     bool using_host = false;
     bool stop = false;
-    bool dirty = true;      // the labels or weights changed: refresh the status
+    bool dirty = true;  // the labels or weights changed: refresh the status
   };
   std::string BankPath() const;
   // The weights in use: the host's (its stations run them), else this part's own.
   std::pair<TransitionWeights, std::string> WeightsInUse() const;
-  static void RunRetrain(std::shared_ptr<Shared> shared, api::Context context, ConsoleLabelsOptions options,
-                         std::string bank, TransitionWeights current);
+  static void RunRetrain(std::shared_ptr<Shared> shared, api::Context context,
+                         ConsoleLabelsOptions options, std::string bank, TransitionWeights current);
   void RefreshStatus() const;  // labels and weights from the bank (at most every 2 s)
 
   api::Context context_;

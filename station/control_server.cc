@@ -17,8 +17,8 @@
 #include "core/error.h"
 #include "core/error_kinds.h"
 #include "core/log.h"
-#include "station/console_bank.h"
 #include "station/api_part.h"
+#include "station/console_bank.h"
 #include "station/console_calibration.h"
 #include "station/console_events.h"
 #include "station/console_labels.h"
@@ -31,14 +31,14 @@ namespace ss {
 namespace {
 
 namespace fs = std::filesystem;
-using httplib::Request;
-using httplib::Response;
 using api::IntParam;
 using api::ObjectBody;
 using api::PathId;
 using api::Reply;
 using api::ReplyError;
 using api::Route;
+using httplib::Request;
+using httplib::Response;
 
 constexpr size_t kMaxBodyBytes = 1 << 20;  // every JSON body the API takes is far smaller
 // Each open connection holds an HTTP thread while it waits for its request (cpp-httplib 0.11
@@ -46,7 +46,7 @@ constexpr size_t kMaxBodyBytes = 1 << 20;  // every JSON body the API takes is f
 // leave the API answering: idle, they cost ~10 MB. A slow client keeps its thread for at most
 // the request deadline, and one address holds at most 64 of them (HttpLimits).
 constexpr int kHttpThreads = 600;
-constexpr int kHttpNice = 10;              // HTTP threads yield the cores to capture and the pipeline
+constexpr int kHttpNice = 10;  // HTTP threads yield the cores to capture and the pipeline
 
 // HTTP worker threads run at a lower priority than every other thread of the daemon:
 // a preview encode or a bank page never takes a core from capture.
@@ -75,7 +75,8 @@ std::string NameFromBody(const Request& req, bool required) {
 }
 
 std::string Lower(std::string text) {
-  std::transform(text.begin(), text.end(), text.begin(), [](unsigned char c) { return std::tolower(c); });
+  std::transform(text.begin(), text.end(), text.begin(),
+                 [](unsigned char c) { return std::tolower(c); });
   return text;
 }
 
@@ -167,27 +168,34 @@ struct ControlServer::Impl {
   // it (another site's page may not act) and the token. (The body is read after this: a POST's
   // JSON type is checked by its handler's wrapper.)
   httplib::Server::HandlerResponse Admit(const Request& req, Response& res) {
-    const bool api = req.path == "/metrics" || req.path == "/api" || req.path.rfind("/api/", 0) == 0;
+    const bool api =
+        req.path == "/metrics" || req.path == "/api" || req.path.rfind("/api/", 0) == 0;
     if (!api) return httplib::Server::HandlerResponse::Unhandled;
     const ControlConfig& config = options.config;
     const std::string host = HostName(req.get_header_value("Host"));
     if (config.token.empty() && !host.empty() && !IsLoopbackAddress(host)) {
-      ReplyError(res, 403, "Host: \"" + host + "\" is not a loopback name; this station (no control.token) answers only "
-                           "to localhost and 127.0.0.1");
+      ReplyError(res, 403,
+                 "Host: \"" + host +
+                     "\" is not a loopback name; this station (no control.token) answers only "
+                     "to localhost and 127.0.0.1");
       return httplib::Server::HandlerResponse::Handled;
     }
     const std::string origin = req.get_header_value("Origin");
     if (!origin.empty()) {
       const size_t scheme = origin.find("://");
-      const std::string origin_host = scheme == std::string::npos ? origin : origin.substr(scheme + 3);
+      const std::string origin_host =
+          scheme == std::string::npos ? origin : origin.substr(scheme + 3);
       if (Lower(origin_host) != Lower(req.get_header_value("Host"))) {
         ReplyError(res, 403, "Origin: a page of " + origin + " may not use this station's API");
         return httplib::Server::HandlerResponse::Handled;
       }
     }
-    if (!config.token.empty() && req.get_header_value("Authorization") != "Bearer " + config.token) {
+    if (!config.token.empty() &&
+        req.get_header_value("Authorization") != "Bearer " + config.token) {
       res.set_header("WWW-Authenticate", "Bearer");
-      ReplyError(res, 401, "Authorization: this station needs \"Authorization: Bearer TOKEN\" (control.token)");
+      ReplyError(
+          res, 401,
+          "Authorization: this station needs \"Authorization: Bearer TOKEN\" (control.token)");
       return httplib::Server::HandlerResponse::Handled;
     }
     return httplib::Server::HandlerResponse::Unhandled;
@@ -213,39 +221,45 @@ struct ControlServer::Impl {
     }
     res.set_header("Cache-Control", "no-cache");
     res.set_header("X-Content-Type-Options", "nosniff");
-    res.set_header("Content-Security-Policy",
-                   "default-src 'self'; img-src 'self' data: blob:; style-src 'self'; script-src 'self'; "
-                   "connect-src 'self'; frame-ancestors 'none'");
+    res.set_header(
+        "Content-Security-Policy",
+        "default-src 'self'; img-src 'self' data: blob:; style-src 'self'; script-src 'self'; "
+        "connect-src 'self'; frame-ancestors 'none'");
     res.status = 200;
     return true;
   }
 
   void Events(const Request&, Response& res) {
     if (events->connections() >= static_cast<uint64_t>(options.max_event_streams)) {
-      ReplyError(res, 503, "events: " + std::to_string(options.max_event_streams) +
-                               " event streams are open already (close a console tab)");
+      ReplyError(res, 503,
+                 "events: " + std::to_string(options.max_event_streams) +
+                     " event streams are open already (close a console tab)");
       return;
     }
     auto stream = std::make_shared<ConsoleEvents::Stream>(*events);
     res.set_header("Cache-Control", "no-store");
     res.set_header("X-Accel-Buffering", "no");
-    res.set_chunked_content_provider("text/event-stream", [stream](size_t, httplib::DataSink& sink) {
-      const std::string text = stream->Next();
-      if (text.empty()) {
-        sink.done();
-        return true;
-      }
-      return sink.write(text.data(), text.size());
-    });
+    res.set_chunked_content_provider("text/event-stream",
+                                     [stream](size_t, httplib::DataSink& sink) {
+                                       const std::string text = stream->Next();
+                                       if (text.empty()) {
+                                         sink.done();
+                                         return true;
+                                       }
+                                       return sink.write(text.data(), text.size());
+                                     });
   }
 
   void Preview(const Request& req, Response& res) {
     const std::string view = req.has_param("view") ? req.get_param_value("view") : "raw";
-    if (view != "raw" && view != "keyed") throw InputError("view", "expected raw or keyed, got \"" + view + "\"");
+    if (view != "raw" && view != "keyed")
+      throw InputError("view", "expected raw or keyed, got \"" + view + "\"");
     const int width = static_cast<int>(IntParam(req, "width", 640, 16, 4096));
-    const auto image = station()->Preview(req.matches[1], view == "keyed" ? PreviewView::kKeyed : PreviewView::kRaw, width);
+    const auto image = station()->Preview(
+        req.matches[1], view == "keyed" ? PreviewView::kKeyed : PreviewView::kRaw, width);
     if (!image) {
-      ReplyError(res, 503, "camera \"" + std::string(req.matches[1]) + "\" has delivered no frame yet");
+      ReplyError(res, 503,
+                 "camera \"" + std::string(req.matches[1]) + "\" has delivered no frame yet");
       return;
     }
     res.set_header("Cache-Control", "no-store");
@@ -253,14 +267,16 @@ struct ControlServer::Impl {
     res.set_header("X-Frame-Timestamp-Ns", std::to_string(image->timestamp_ns));
     res.set_header("X-Image-Width", std::to_string(image->width));
     res.set_header("X-Image-Height", std::to_string(image->height));
-    res.set_content(reinterpret_cast<const char*>(image->jpeg.data()), image->jpeg.size(), "image/jpeg");
+    res.set_content(reinterpret_cast<const char*>(image->jpeg.data()), image->jpeg.size(),
+                    "image/jpeg");
   }
 
   void Sprites(const Request& req, Response& res) {
     const int width = static_cast<int>(IntParam(req, "width", 640, 16, 4096));
     const auto json = station()->SpritesView(req.matches[1], width);
     if (!json) {
-      ReplyError(res, 503, "camera \"" + std::string(req.matches[1]) + "\" has delivered no frame yet");
+      ReplyError(res, 503,
+                 "camera \"" + std::string(req.matches[1]) + "\" has delivered no frame yet");
       return;
     }
     res.set_header("Cache-Control", "no-store");
@@ -268,7 +284,8 @@ struct ControlServer::Impl {
   }
 
   void ReplayStart(const Request& req, Response& res) {
-    const api::ReplayStartRequest r = api::ParseReplayStart(ObjectBody(req, api::kReplayStartFields));
+    const api::ReplayStartRequest r =
+        api::ParseReplayStart(ObjectBody(req, api::kReplayStartFields));
     host->StartReplay(r.path, r.paced, r.loop);
     Reply(res, 200, host->ModeJson());
   }
@@ -286,22 +303,28 @@ struct ControlServer::Impl {
       return [f](const Request& req, Response& res) { Reply(res, 200, f(req)); };
     };
     routes = {
-        {"GET", "/api", "GET /api: this list", [this](const Request&, Response& res) {
+        {"GET", "/api", "GET /api: this list",
+         [this](const Request&, Response& res) {
            nlohmann::json list = nlohmann::json::array();
            for (const Route& r : routes) list.push_back(r.listed);
            Reply(res, 200, {{"service", "spritestation"}, {"console", "/"}, {"endpoints", list}});
          }},
-        {"GET", "/api/status", "GET /api/status", json([this](const Request&) { return StatusJson(); })},
-        {"GET", "/metrics", "GET /metrics (Prometheus)", [this](const Request&, Response& res) {
+        {"GET", "/api/status", "GET /api/status",
+         json([this](const Request&) { return StatusJson(); })},
+        {"GET", "/metrics", "GET /metrics (Prometheus)",
+         [this](const Request&, Response& res) {
            res.set_content(StatusToPrometheus(Status()), "text/plain; version=0.0.4");
          }},
         {"GET", "/api/events", "GET /api/events (Server-Sent Events)",
          [this](const Request& req, Response& res) { Events(req, res); }},
-        {"GET", R"(/api/cameras/([^/]+)/preview\.jpg)", "GET /api/cameras/NAME/preview.jpg?view=raw|keyed&width=W",
+        {"GET", R"(/api/cameras/([^/]+)/preview\.jpg)",
+         "GET /api/cameras/NAME/preview.jpg?view=raw|keyed&width=W",
          [this](const Request& req, Response& res) { Preview(req, res); }},
-        {"GET", R"(/api/cameras/([^/]+)/sprites\.json)", "GET /api/cameras/NAME/sprites.json?width=W",
+        {"GET", R"(/api/cameras/([^/]+)/sprites\.json)",
+         "GET /api/cameras/NAME/sprites.json?width=W",
          [this](const Request& req, Response& res) { Sprites(req, res); }},
-        {"POST", "/api/session/start", "POST /api/session/start {\"name\": S}", json([this](const Request& req) {
+        {"POST", "/api/session/start", "POST /api/session/start {\"name\": S}",
+         json([this](const Request& req) {
            std::string name = NameFromBody(req, false);
            return SessionToJson(station()->StartSession(name.empty() ? "session" : name));
          })},
@@ -309,43 +332,53 @@ struct ControlServer::Impl {
            ObjectBody(req, {});
            return SessionToJson(station()->StopSession());
          })},
-        {"POST", "/api/session/rename", "POST /api/session/rename {\"name\": S}", json([this](const Request& req) {
+        {"POST", "/api/session/rename", "POST /api/session/rename {\"name\": S}",
+         json([this](const Request& req) {
            return SessionToJson(station()->RenameSession(NameFromBody(req, true)));
          })},
         {"GET", "/api/replay/sessions", "GET /api/replay/sessions", json([this](const Request&) {
-           return RecordedSessionsToJson(host->replay_roots(), FindRecordedSessions(host->replay_roots()));
+           return RecordedSessionsToJson(host->replay_roots(),
+                                         FindRecordedSessions(host->replay_roots()));
          })},
-        {"POST", "/api/replay/start", "POST /api/replay/start {\"path\": P, \"paced\": true, \"loop\": false}",
+        {"POST", "/api/replay/start",
+         "POST /api/replay/start {\"path\": P, \"paced\": true, \"loop\": false}",
          [this](const Request& req, Response& res) { ReplayStart(req, res); }},
         {"POST", "/api/replay/stop", "POST /api/replay/stop", json([this](const Request& req) {
            ObjectBody(req, {});
            host->StopReplay();
            return host->ModeJson();
          })},
-        {"GET", "/api/bank/sessions", "GET /api/bank/sessions", json([this](const Request&) { return Bank().Sessions(); })},
+        {"GET", "/api/bank/sessions", "GET /api/bank/sessions",
+         json([this](const Request&) { return Bank().Sessions(); })},
         {"GET", R"(/api/bank/sessions/([^/]+)/clips)", "GET /api/bank/sessions/ID/clips",
          json([this](const Request& req) { return Bank().Clips(PathId(req, "session")); })},
         {"GET", R"(/api/bank/clips/([^/]+)/sprites)", "GET /api/bank/clips/ID/sprites",
          json([this](const Request& req) { return Bank().ClipSprites(PathId(req, "clip")); })},
-        {"GET", R"(/api/bank/sprites/([^/]+)/billboard\.png)", "GET /api/bank/sprites/ID/billboard.png?height=H",
+        {"GET", R"(/api/bank/sprites/([^/]+)/billboard\.png)",
+         "GET /api/bank/sprites/ID/billboard.png?height=H",
          [this](const Request& req, Response& res) {
-           const auto png = Bank().BillboardPng(PathId(req, "sprite"), static_cast<int>(IntParam(req, "height", 0, 0, 4096)));
-           res.set_header("Cache-Control", "private, max-age=3600");  // a stored billboard never changes
+           const auto png = Bank().BillboardPng(
+               PathId(req, "sprite"), static_cast<int>(IntParam(req, "height", 0, 0, 4096)));
+           res.set_header("Cache-Control",
+                          "private, max-age=3600");  // a stored billboard never changes
            res.set_content(reinterpret_cast<const char*>(png.data()), png.size(), "image/png");
          }},
         {"GET", R"(/api/bank/sprites/([^/]+))", "GET /api/bank/sprites/ID",
          json([this](const Request& req) { return Bank().Sprite(PathId(req, "sprite")); })},
-        {"POST", "/api/bank/tag", "POST /api/bank/tag {\"tag\", \"sprites\" | \"clip\", \"first_frame\", \"last_frame\"}",
+        {"POST", "/api/bank/tag",
+         "POST /api/bank/tag {\"tag\", \"sprites\" | \"clip\", \"first_frame\", \"last_frame\"}",
          json([this](const Request& req) { return Tag(req, false); })},
         {"POST", "/api/bank/untag", "POST /api/bank/untag (as tag)",
          json([this](const Request& req) { return Tag(req, true); })},
-        {"GET", "/api/bank/export.csv", "GET /api/bank/export.csv?clip=ID|tag=T", [this](const Request& req, Response& res) {
+        {"GET", "/api/bank/export.csv", "GET /api/bank/export.csv?clip=ID|tag=T",
+         [this](const Request& req, Response& res) {
            std::optional<int64_t> clip;
            if (req.has_param("clip")) clip = IntParam(req, "clip", 0, 1, INT64_MAX);
            const std::string tag = req.has_param("tag") ? req.get_param_value("tag") : "";
            if (!clip && tag.empty()) throw InputError("clip", "give ?clip=ID or ?tag=T");
-           res.set_header("Content-Disposition", "attachment; filename=\"" +
-                                                     (clip ? "clip-" + std::to_string(*clip) : "tag-" + tag) + ".csv\"");
+           res.set_header("Content-Disposition",
+                          "attachment; filename=\"" +
+                              (clip ? "clip-" + std::to_string(*clip) : "tag-" + tag) + ".csv\"");
            res.set_content(Bank().ExportCsv(clip, tag), "text/csv; charset=utf-8");
          }},
     };
@@ -361,8 +394,10 @@ struct ControlServer::Impl {
     server.set_payload_max_length(kMaxBodyBytes);
     server.set_keep_alive_max_count(1000);
     server.set_read_timeout(10, 0);
-    server.set_write_timeout(5, 0);  // a stalled event stream is dropped after 5 s of blocked writes
-    server.set_pre_routing_handler([this](const Request& req, Response& res) { return Admit(req, res); });
+    server.set_write_timeout(5,
+                             0);  // a stalled event stream is dropped after 5 s of blocked writes
+    server.set_pre_routing_handler(
+        [this](const Request& req, Response& res) { return Admit(req, res); });
     for (const Route& r : routes) {
       auto handler = [h = r.handler](const Request& req, Response& res) {
         // A body must be JSON: a form or text/plain post from another site's page is refused
@@ -370,7 +405,9 @@ struct ControlServer::Impl {
         if (req.method == "POST" && !req.body.empty()) {
           const std::string type = req.get_header_value("Content-Type");
           if (type.rfind("application/json", 0) != 0) {
-            ReplyError(res, 415, "Content-Type: a request body must be JSON (application/json), got \"" + type + "\"");
+            ReplyError(res, 415,
+                       "Content-Type: a request body must be JSON (application/json), got \"" +
+                           type + "\"");
             return;
           }
         }
@@ -385,22 +422,28 @@ struct ControlServer::Impl {
     // The console's pages: everything else that GET asks for.
     server.Get(R"(/(|[A-Za-z0-9_\-./]+))", [this](const Request& req, Response& res) {
       if (req.path.rfind("/api/", 0) == 0 || !ServeWebFile(req.path, res)) {
-        ReplyError(res, 404, "no such endpoint or page: GET " + req.path + " (GET /api lists the endpoints)");
+        ReplyError(res, 404,
+                   "no such endpoint or page: GET " + req.path + " (GET /api lists the endpoints)");
       }
     });
     server.set_error_handler([this](const Request& req, Response& res) {
       if (!res.body.empty()) return;
-      // A request the HTTP server could not read whole (cpp-httplib's bare 400): the limit it broke.
+      // A request the HTTP server could not read whole (cpp-httplib's bare 400): the limit it
+      // broke.
       const HttpLimits& limits = server.limits();
       if (HttpServer::CurrentFault() == HttpServer::RequestFault::kTimedOut) {
         const int64_t ms = limits.request_deadline.count();
-        ReplyError(res, 408, "request: not received whole within " +
-                                 (ms % 1000 == 0 ? std::to_string(ms / 1000) + " s" : std::to_string(ms) + " ms") +
-                                 " of its first byte");
+        ReplyError(
+            res, 408,
+            "request: not received whole within " +
+                (ms % 1000 == 0 ? std::to_string(ms / 1000) + " s" : std::to_string(ms) + " ms") +
+                " of its first byte");
       } else if (HttpServer::CurrentFault() == HttpServer::RequestFault::kHeaderTooLarge) {
-        ReplyError(res, 431, "header: larger than " + std::to_string(limits.max_header_bytes) + " bytes");
+        ReplyError(res, 431,
+                   "header: larger than " + std::to_string(limits.max_header_bytes) + " bytes");
       } else if (res.status == 404) {
-        ReplyError(res, 404, "no such endpoint: " + req.method + " " + req.path + " (GET /api lists them)");
+        ReplyError(res, 404,
+                   "no such endpoint: " + req.method + " " + req.path + " (GET /api lists them)");
       } else if (res.status == 413) {
         ReplyError(res, 413, "body: larger than " + std::to_string(kMaxBodyBytes) + " bytes");
       } else if (res.status == 405 || res.status == 400) {
@@ -411,11 +454,13 @@ struct ControlServer::Impl {
 
   std::string Url() const {
     const bool v6 = options.config.address.find(':') != std::string::npos;
-    return "http://" + (v6 ? "[" + options.config.address + "]" : options.config.address) + ":" + std::to_string(port);
+    return "http://" + (v6 ? "[" + options.config.address + "]" : options.config.address) + ":" +
+           std::to_string(port);
   }
 };
 
-ControlServer::ControlServer(StationHost& host, ControlServerOptions options) : impl_(std::make_unique<Impl>()) {
+ControlServer::ControlServer(StationHost& host, ControlServerOptions options)
+    : impl_(std::make_unique<Impl>()) {
   impl_->host = &host;
   impl_->options = std::move(options);
   impl_->events = std::make_unique<ConsoleEvents>([s = impl_.get()] { return s->StatusJson(); });
@@ -426,15 +471,17 @@ ControlServer::~ControlServer() { Stop(); }
 
 int ControlServer::Start() {
   Impl& s = *impl_;
-  const std::string host = s.options.config.address == "localhost" ? "127.0.0.1" : s.options.config.address;
+  const std::string host =
+      s.options.config.address == "localhost" ? "127.0.0.1" : s.options.config.address;
   if (s.options.config.port == 0) {
     s.port = s.server.bind_to_any_port(host);
   } else {
     s.port = s.server.bind_to_port(host, s.options.config.port) ? s.options.config.port : -1;
   }
   if (s.port <= 0) {
-    throw WorkError("control " + s.options.config.address + ":" + std::to_string(s.options.config.port),
-                    "cannot listen there (address not on this machine, or the port is taken)");
+    throw WorkError(
+        "control " + s.options.config.address + ":" + std::to_string(s.options.config.port),
+        "cannot listen there (address not on this machine, or the port is taken)");
   }
   s.events->Start();
   s.thread = std::thread([&s] { s.server.listen_after_bind(); });

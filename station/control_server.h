@@ -27,7 +27,8 @@ struct ControlServerOptions {
   std::string web_dir;
   std::function<std::optional<std::string_view>(std::string_view path)> embedded;
   int max_event_streams = 16;  // open /api/events connections; more get 503
-  std::string config_path;     // the daemon's config file (the calibration wizard saves into it); "": none
+  std::string
+      config_path;  // the daemon's config file (the calibration wizard saves into it); "": none
 };
 
 class ControlServer {

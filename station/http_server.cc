@@ -24,7 +24,8 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 constexpr size_t kMaxDrainBytes = 64 << 10;  // read and dropped before a connection is closed
-constexpr auto kStopCheck = std::chrono::milliseconds(100);  // waits notice a stopping server this often
+constexpr auto kStopCheck =
+    std::chrono::milliseconds(100);  // waits notice a stopping server this often
 
 // The numeric address and port of a socket's peer (`peer`) or its own end; false when unknown.
 bool AddressOf(int sock, bool peer, std::string& ip, int& port) {
@@ -50,7 +51,8 @@ bool AddressOf(int sock, bool peer, std::string& ip, int& port) {
 
 // Methods whose body cpp-httplib reads (its detail::expect_content).
 bool ExpectsBody(const std::string& method) {
-  return method == "POST" || method == "PUT" || method == "PATCH" || method == "DELETE" || method == "PRI";
+  return method == "POST" || method == "PUT" || method == "PATCH" || method == "DELETE" ||
+         method == "PRI";
 }
 
 // One connection's socket as cpp-httplib reads and writes it, kept across the requests of a
@@ -138,8 +140,12 @@ class ConnectionStream final : public httplib::Stream {
     return n;
   }
 
-  void get_remote_ip_and_port(std::string& ip, int& port) const override { AddressOf(sock_, true, ip, port); }
-  void get_local_ip_and_port(std::string& ip, int& port) const override { AddressOf(sock_, false, ip, port); }
+  void get_remote_ip_and_port(std::string& ip, int& port) const override {
+    AddressOf(sock_, true, ip, port);
+  }
+  void get_local_ip_and_port(std::string& ip, int& port) const override {
+    AddressOf(sock_, false, ip, port);
+  }
   socket_t socket() const override { return sock_; }
 
  private:
@@ -157,7 +163,8 @@ class ConnectionStream final : public httplib::Stream {
       }
       const auto slice = std::min<Clock::duration>(until - now, kStopCheck);
       pollfd p{sock_, events, 0};
-      const int n = ::poll(&p, 1, static_cast<int>(std::chrono::ceil<std::chrono::milliseconds>(slice).count()));
+      const int n = ::poll(
+          &p, 1, static_cast<int>(std::chrono::ceil<std::chrono::milliseconds>(slice).count()));
       if (n > 0) return true;  // ready, or an error or hang-up that recv/send then reports
       if (n < 0 && errno != EINTR) return false;
     }
@@ -169,7 +176,7 @@ class ConnectionStream final : public httplib::Stream {
   const Clock::duration read_timeout_, write_timeout_;
   const size_t max_header_bytes_;
   std::array<char, 4096> buffer_{};
-  size_t off_ = 0, len_ = 0;  // the unread bytes of buffer_
+  size_t off_ = 0, len_ = 0;                   // the unread bytes of buffer_
   std::optional<Clock::time_point> deadline_;  // while a request is being read
   bool header_in_ = false;
   size_t header_bytes_ = 0;  // of the request line and header read so far
@@ -196,12 +203,13 @@ void Close(int sock) {
 // The 503 for a connection over the per-client limit, then closed.
 void Refuse(int sock, const std::string& address, int limit) {
   const std::string body =
-      nlohmann::json{{"error", "connections: " + std::to_string(limit) + " are open from " + address +
-                                   " already (the limit per client address)"}}
+      nlohmann::json{{"error", "connections: " + std::to_string(limit) + " are open from " +
+                                   address + " already (the limit per client address)"}}
           .dump() +
       "\n";
-  const std::string reply = "HTTP/1.1 503 Service Unavailable\r\nContent-Type: application/json\r\nContent-Length: " +
-                            std::to_string(body.size()) + "\r\nConnection: close\r\nRetry-After: 5\r\n\r\n" + body;
+  const std::string reply =
+      "HTTP/1.1 503 Service Unavailable\r\nContent-Type: application/json\r\nContent-Length: " +
+      std::to_string(body.size()) + "\r\nConnection: close\r\nRetry-After: 5\r\n\r\n" + body;
   (void)::send(sock, reply.data(), reply.size(), MSG_NOSIGNAL | MSG_DONTWAIT);
   Close(sock);
 }
@@ -210,9 +218,13 @@ void Refuse(int sock, const std::string& address, int limit) {
 
 HttpServer::HttpServer(HttpLimits limits) : limits_(limits) {}
 
-HttpCounters HttpServer::counters() const { return {open_.load(), refused_.load(), timed_out_.load()}; }
+HttpCounters HttpServer::counters() const {
+  return {open_.load(), refused_.load(), timed_out_.load()};
+}
 
-HttpServer::RequestFault HttpServer::CurrentFault() { return t_stream ? t_stream->fault() : RequestFault::kNone; }
+HttpServer::RequestFault HttpServer::CurrentFault() {
+  return t_stream ? t_stream->fault() : RequestFault::kNone;
+}
 
 bool HttpServer::Admit(const std::string& address) {
   std::lock_guard lock(mutex_);
@@ -239,15 +251,17 @@ bool HttpServer::process_and_close_socket(socket_t sock) {
   int port = 0;
   AddressOf(sock, true, address, port);
   if (!Admit(address)) {
-    Log("station.control")->debug("{}:{}: refused, {} connections are open from there", address, port,
-                                  limits_.max_connections_per_client);
+    Log("station.control")
+        ->debug("{}:{}: refused, {} connections are open from there", address, port,
+                limits_.max_connections_per_client);
     Refuse(sock, address, limits_.max_connections_per_client);
     return false;
   }
-  ConnectionStream stream(sock, svr_sock_,
-                          std::chrono::seconds(read_timeout_sec_) + std::chrono::microseconds(read_timeout_usec_),
-                          std::chrono::seconds(write_timeout_sec_) + std::chrono::microseconds(write_timeout_usec_),
-                          limits_.max_header_bytes);
+  ConnectionStream stream(
+      sock, svr_sock_,
+      std::chrono::seconds(read_timeout_sec_) + std::chrono::microseconds(read_timeout_usec_),
+      std::chrono::seconds(write_timeout_sec_) + std::chrono::microseconds(write_timeout_usec_),
+      limits_.max_header_bytes);
   t_stream = &stream;
   bool ret = false;
   // cpp-httplib's keep-alive loop (detail::process_server_socket_core), with the deadline.
@@ -259,9 +273,10 @@ bool HttpServer::process_and_close_socket(socket_t sock) {
                           [&stream](httplib::Request& req) { stream.HeaderIn(req); });
     if (stream.fault() != RequestFault::kNone) {
       if (stream.fault() == RequestFault::kTimedOut) ++timed_out_;
-      Log("station.control")->debug("{}:{}: closed, its request {}", address, port,
-                                    stream.fault() == RequestFault::kTimedOut ? "was not in whole by the deadline"
-                                                                              : "header was too large");
+      Log("station.control")
+          ->debug("{}:{}: closed, its request {}", address, port,
+                  stream.fault() == RequestFault::kTimedOut ? "was not in whole by the deadline"
+                                                            : "header was too large");
       break;
     }
     if (!ret || connection_closed) break;

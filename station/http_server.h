@@ -32,9 +32,9 @@
 namespace ss {
 
 struct HttpLimits {
-  int max_connections_per_client = 64;                  // open at once from one address
+  int max_connections_per_client = 64;                 // open at once from one address
   std::chrono::milliseconds request_deadline{10'000};  // first byte of a request -> all of it read
-  size_t max_header_bytes = 64 << 10;                   // request line and header together
+  size_t max_header_bytes = 64 << 10;                  // request line and header together
 };
 
 struct HttpCounters {

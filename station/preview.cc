@@ -27,9 +27,9 @@ std::vector<PreviewCandidate> PreviewCandidates(const std::vector<CandidateVerdi
       cv::compare(c.alpha, 127, mask, cv::CMP_GT);
       contours.clear();
       cv::findContours(mask, contours, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_SIMPLE, c.bbox.tl());
-      const auto largest = std::max_element(contours.begin(), contours.end(), [](const auto& a, const auto& b) {
-        return cv::contourArea(a) < cv::contourArea(b);
-      });
+      const auto largest = std::max_element(
+          contours.begin(), contours.end(),
+          [](const auto& a, const auto& b) { return cv::contourArea(a) < cv::contourArea(b); });
       if (largest != contours.end()) cv::approxPolyDP(*largest, p.outline, 1.0, true);
     }
     out.push_back(std::move(p));
@@ -39,7 +39,8 @@ std::vector<PreviewCandidate> PreviewCandidates(const std::vector<CandidateVerdi
 
 cv::Mat RenderPreview(const PreviewFrame& frame, PreviewView view, int max_width) {
   cv::Mat image;
-  const bool keyed = view == PreviewView::kKeyed && !frame.alpha.empty() && frame.alpha.size() == frame.bgr.size();
+  const bool keyed =
+      view == PreviewView::kKeyed && !frame.alpha.empty() && frame.alpha.size() == frame.bgr.size();
   if (!keyed) {
     image = frame.bgr;
   } else {
@@ -51,7 +52,8 @@ cv::Mat RenderPreview(const PreviewFrame& frame, PreviewView view, int max_width
       cv::Vec3b* dst = image.ptr<cv::Vec3b>(y);
       for (int x = 0; x < image.cols; ++x) {
         const int grey = 128 * (255 - (sh ? sh[x] : 0)) / 255;
-        for (int c = 0; c < 3; ++c) dst[x][c] = static_cast<uint8_t>((src[x][c] * a[x] + grey * (255 - a[x])) / 255);
+        for (int c = 0; c < 3; ++c)
+          dst[x][c] = static_cast<uint8_t>((src[x][c] * a[x] + grey * (255 - a[x])) / 255);
       }
     }
   }
@@ -59,7 +61,8 @@ cv::Mat RenderPreview(const PreviewFrame& frame, PreviewView view, int max_width
   const bool dim = view == PreviewView::kKeyed && !keyed;
   cv::Mat out;
   if (max_width > 0 && image.cols > max_width) {
-    const int height = std::max(1, static_cast<int>(std::lround(double(image.rows) * max_width / image.cols)));
+    const int height =
+        std::max(1, static_cast<int>(std::lround(double(image.rows) * max_width / image.cols)));
     cv::resize(image, out, cv::Size(max_width, height), 0, 0, cv::INTER_AREA);
   } else {
     out = dim ? image.clone() : image;  // a raw view at full size is the snapshot itself
@@ -75,7 +78,8 @@ std::vector<uint8_t> EncodeJpeg(const cv::Mat& bgr, int quality) {
 }
 
 std::string Base64(const std::vector<uint8_t>& bytes) {
-  static constexpr char kTable[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  static constexpr char kTable[] =
+      "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
   std::string out;
   out.reserve((bytes.size() + 2) / 3 * 4);
   size_t i = 0;
@@ -101,28 +105,27 @@ std::string Base64(const std::vector<uint8_t>& bytes) {
   return out;
 }
 
-nlohmann::json SpritesViewJson(const PreviewFrame& frame, bool storing, const std::string& image_data_url,
-                               double image_scale) {
+nlohmann::json SpritesViewJson(const PreviewFrame& frame, bool storing,
+                               const std::string& image_data_url, double image_scale) {
   nlohmann::json candidates = nlohmann::json::array();
   for (const PreviewCandidate& c : frame.candidates) {
     nlohmann::json outline = nlohmann::json::array();
     for (const cv::Point& p : c.outline) outline.push_back({p.x, p.y});
-    const char* verdict = c.reason != Discard::kNone ? DiscardName(c.reason) : storing ? "stored" : "usable";
-    candidates.push_back({{"bbox", {c.bbox.x, c.bbox.y, c.bbox.width, c.bbox.height}},
-                          {"outline", outline},
-                          {"contact", {c.contact.x, c.contact.y}},
-                          {"track", c.track},
-                          {"verdict", verdict},
-                          {"ground", c.ground ? nlohmann::json{c.ground->x(), c.ground->y()} : nlohmann::json()}});
+    const char* verdict = c.reason != Discard::kNone ? DiscardName(c.reason)
+                          : storing                  ? "stored"
+                                                     : "usable";
+    candidates.push_back(
+        {{"bbox", {c.bbox.x, c.bbox.y, c.bbox.width, c.bbox.height}},
+         {"outline", outline},
+         {"contact", {c.contact.x, c.contact.y}},
+         {"track", c.track},
+         {"verdict", verdict},
+         {"ground", c.ground ? nlohmann::json{c.ground->x(), c.ground->y()} : nlohmann::json()}});
   }
-  return {{"sequence", frame.sequence},
-          {"timestamp_ns", frame.timestamp_ns},
-          {"width", frame.bgr.cols},
-          {"height", frame.bgr.rows},
-          {"training", frame.training},
-          {"image", image_data_url},
-          {"scale", image_scale},
-          {"candidates", candidates}};
+  return {{"sequence", frame.sequence}, {"timestamp_ns", frame.timestamp_ns},
+          {"width", frame.bgr.cols},    {"height", frame.bgr.rows},
+          {"training", frame.training}, {"image", image_data_url},
+          {"scale", image_scale},       {"candidates", candidates}};
 }
 
 ExposureFigures MeasureExposure(const PreviewFrame& frame) {
@@ -134,7 +137,8 @@ ExposureFigures MeasureExposure(const PreviewFrame& frame) {
   e.histogram_g.assign(kBins, 0);
   e.histogram_b.assign(kBins, 0);
   const bool matte = !frame.alpha.empty() && frame.alpha.size() == frame.bgr.size();
-  std::vector<double> cell_sum(kCells * kCells, 0), cell_green(kCells * kCells, 0), cell_all(kCells * kCells, 0);
+  std::vector<double> cell_sum(kCells * kCells, 0), cell_green(kCells * kCells, 0),
+      cell_all(kCells * kCells, 0);
   uint64_t all = 0, green = 0, clipped = 0, dark = 0;
   for (int y = 0; y < frame.bgr.rows; y += kStep) {
     const cv::Vec3b* row = frame.bgr.ptr<cv::Vec3b>(y);
@@ -161,7 +165,8 @@ ExposureFigures MeasureExposure(const PreviewFrame& frame) {
   e.dark_percent = green ? 100.0 * dark / green : 0;
   std::vector<double> levels;
   for (int k = 0; k < kCells * kCells; ++k) {
-    if (cell_all[k] > 0 && cell_green[k] >= 0.5 * cell_all[k]) levels.push_back(cell_sum[k] / cell_green[k]);
+    if (cell_all[k] > 0 && cell_green[k] >= 0.5 * cell_all[k])
+      levels.push_back(cell_sum[k] / cell_green[k]);
   }
   if (!levels.empty()) {
     double mean = 0;

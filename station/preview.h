@@ -51,20 +51,21 @@ std::vector<uint8_t> EncodeJpeg(const cv::Mat& bgr, int quality = 80);
 
 // `verdict`: "stored" (usable while a session stores), "usable", or the discard reason.
 // Coordinates stay camera pixels; `image_data_url` is the raw view it belongs to.
-nlohmann::json SpritesViewJson(const PreviewFrame& frame, bool storing, const std::string& image_data_url,
-                               double image_scale);
+nlohmann::json SpritesViewJson(const PreviewFrame& frame, bool storing,
+                               const std::string& image_data_url, double image_scale);
 std::string Base64(const std::vector<uint8_t>& bytes);
 
 // How the green screen is lit, from one frame (every 2nd pixel of every 2nd row).
 // Green screen: green leads red and blue by 15 levels, and the matte (if any) says background.
 struct ExposureFigures {
   bool measured = false;
-  double green_fraction = 0;    // of the image
+  double green_fraction = 0;                                    // of the image
   std::vector<uint32_t> histogram_r, histogram_g, histogram_b;  // 32 bins over green-screen pixels
-  double clipped_percent = 0;   // pixels of the whole image with a channel at 255
-  double dark_percent = 0;      // green-screen pixels with green below 40
-  double green_uniformity = 0;  // 1 - std/mean of the green level over 8x8 cells mostly green screen
-  double green_min_max = 0;     // darkest cell's green over the brightest's
+  double clipped_percent = 0;  // pixels of the whole image with a channel at 255
+  double dark_percent = 0;     // green-screen pixels with green below 40
+  double green_uniformity =
+      0;                     // 1 - std/mean of the green level over 8x8 cells mostly green screen
+  double green_min_max = 0;  // darkest cell's green over the brightest's
 };
 ExposureFigures MeasureExposure(const PreviewFrame& frame);
 nlohmann::json ExposureToJson(const ExposureFigures& e);

@@ -18,7 +18,7 @@ struct StationRecorder::Impl {
   struct Camera {
     std::unique_ptr<BoundedQueue<Item>> queue;
     std::thread thread;
-    int writer_index = -1;    // SessionWriter's camera index, once added
+    int writer_index = -1;       // SessionWriter's camera index, once added
     uint64_t pending_drops = 0;  // under mutex
     bool failed = false;
   };
@@ -50,8 +50,8 @@ struct StationRecorder::Impl {
   }
 };
 
-StationRecorder::StationRecorder(std::string dir, std::string name, RecordingOptions options, bool usable_only,
-                                 int cameras, int queue_frames)
+StationRecorder::StationRecorder(std::string dir, std::string name, RecordingOptions options,
+                                 bool usable_only, int cameras, int queue_frames)
     : impl_(std::make_unique<Impl>()) {
   impl_->writer = std::make_unique<SessionWriter>(dir, name, options);
   impl_->usable_only = usable_only;
@@ -66,8 +66,8 @@ StationRecorder::StationRecorder(std::string dir, std::string name, RecordingOpt
 
 StationRecorder::~StationRecorder() { Close(); }
 
-void StationRecorder::Offer(int camera, const SourceCamera& source, const CameraModel* model, const Frame& frame,
-                            uint64_t drops_before, bool usable) {
+void StationRecorder::Offer(int camera, const SourceCamera& source, const CameraModel* model,
+                            const Frame& frame, uint64_t drops_before, bool usable) {
   Impl& s = *impl_;
   if (camera < 0 || static_cast<size_t>(camera) >= s.cameras.size()) return;
   if (s.usable_only && !usable) return;
@@ -88,7 +88,8 @@ void StationRecorder::Offer(int camera, const SourceCamera& source, const Camera
                             std::vector<uint8_t>(frame.data, frame.data + frame.size));
   copy.sequence = frame.sequence;
   copy.timestamp_ns = frame.timestamp_ns;
-  if (cam.queue->TryPush({std::move(copy), cam.pending_drops + (s.usable_only ? 0 : drops_before)})) {
+  if (cam.queue->TryPush(
+          {std::move(copy), cam.pending_drops + (s.usable_only ? 0 : drops_before)})) {
     cam.pending_drops = 0;
   } else {
     ++cam.pending_drops;

@@ -10,7 +10,8 @@ namespace ss::api {
 namespace {
 
 // An integer member; `at_least_one`: a sprite id (>= 1).
-int64_t IdField(const nlohmann::json& body, const char* field, const char* missing, bool at_least_one) {
+int64_t IdField(const nlohmann::json& body, const char* field, const char* missing,
+                bool at_least_one) {
   if (!body.contains(field)) throw InputError(field, missing);
   const nlohmann::json& v = body[field];
   if (at_least_one) {
@@ -34,8 +35,11 @@ nlohmann::json ObjectBody(const std::string& text, std::initializer_list<const c
   nlohmann::json body;
   // Refused while it is parsed: nlohmann::json writes and copies a value by recursion, so a body
   // of 1 MiB of brackets overflowed the HTTP thread's stack when an error message quoted it.
-  const nlohmann::json::parser_callback_t limit_depth = [](int depth, nlohmann::json::parse_event_t event, nlohmann::json&) {
-    if ((event == nlohmann::json::parse_event_t::object_start || event == nlohmann::json::parse_event_t::array_start) &&
+  const nlohmann::json::parser_callback_t limit_depth = [](int depth,
+                                                           nlohmann::json::parse_event_t event,
+                                                           nlohmann::json&) {
+    if ((event == nlohmann::json::parse_event_t::object_start ||
+         event == nlohmann::json::parse_event_t::array_start) &&
         depth >= kMaxBodyDepth) {
       throw InputError("body", "nested deeper than " + std::to_string(kMaxBodyDepth) + " levels");
     }
@@ -52,7 +56,8 @@ nlohmann::json ObjectBody(const std::string& text, std::initializer_list<const c
     if (std::none_of(fields.begin(), fields.end(), [&](const char* f) { return key == f; })) {
       std::string list;
       for (const char* f : fields) list += std::string(list.empty() ? "" : ", ") + "\"" + f + "\"";
-      throw InputError(key, "unknown field (the request takes " + (list.empty() ? std::string("none") : list) + ")");
+      throw InputError(key, "unknown field (the request takes " +
+                                (list.empty() ? std::string("none") : list) + ")");
     }
   }
   return body;
@@ -60,17 +65,21 @@ nlohmann::json ObjectBody(const std::string& text, std::initializer_list<const c
 
 std::string ParseSessionName(const nlohmann::json& body, bool required, bool sent_empty) {
   if (!body.contains("name")) {
-    if (required) throw InputError(sent_empty ? "body" : "name", "missing (expected {\"name\": \"...\"})");
+    if (required)
+      throw InputError(sent_empty ? "body" : "name", "missing (expected {\"name\": \"...\"})");
     return "";
   }
-  if (!body["name"].is_string()) throw InputError("name", "expected text, got " + Dump(body["name"]));
+  if (!body["name"].is_string())
+    throw InputError("name", "expected text, got " + Dump(body["name"]));
   return body["name"].get<std::string>();
 }
 
 ReplayStartRequest ParseReplayStart(const nlohmann::json& body) {
-  if (!body.contains("path") || !body["path"].is_string()) throw InputError("path", "expected the session's path (text)");
+  if (!body.contains("path") || !body["path"].is_string())
+    throw InputError("path", "expected the session's path (text)");
   for (const char* flag : {"paced", "loop"}) {
-    if (body.contains(flag) && !body[flag].is_boolean()) throw InputError(flag, "expected true or false");
+    if (body.contains(flag) && !body[flag].is_boolean())
+      throw InputError(flag, "expected true or false");
   }
   return {body["path"].get<std::string>(), body.value("paced", true), body.value("loop", false)};
 }
@@ -78,8 +87,11 @@ ReplayStartRequest ParseReplayStart(const nlohmann::json& body) {
 TagRequest ParseTag(const nlohmann::json& body) {
   if (!body.is_object()) throw InputError("body", "expected a JSON object");
   for (const auto& [key, value] : body.items()) {
-    if (key != "tag" && key != "sprites" && key != "clip" && key != "first_frame" && key != "last_frame") {
-      throw InputError(key, "unknown field (the request takes tag with sprites, or tag with clip, first_frame, last_frame)");
+    if (key != "tag" && key != "sprites" && key != "clip" && key != "first_frame" &&
+        key != "last_frame") {
+      throw InputError(key,
+                       "unknown field (the request takes tag with sprites, or tag with clip, "
+                       "first_frame, last_frame)");
     }
   }
   TagRequest r;
@@ -88,16 +100,21 @@ TagRequest ParseTag(const nlohmann::json& body) {
   if (r.tag.empty() || r.tag.size() > 64) throw InputError("tag", "a tag needs 1 to 64 characters");
   for (const char c : r.tag) {
     if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_' || c == '.')) {
-      throw InputError("tag", "\"" + r.tag + "\": only letters, digits, '-', '_' and '.' are allowed");
+      throw InputError("tag",
+                       "\"" + r.tag + "\": only letters, digits, '-', '_' and '.' are allowed");
     }
   }
   if (body.contains("sprites")) {
-    if (body.contains("clip")) throw InputError("clip", "give sprites or a clip's frames, not both");
+    if (body.contains("clip"))
+      throw InputError("clip", "give sprites or a clip's frames, not both");
     const nlohmann::json& list = body["sprites"];
-    if (!list.is_array() || list.empty()) throw InputError("sprites", "expected a non-empty list of sprite ids");
-    if (list.size() > kMaxTagSprites) throw InputError("sprites", "at most 100000 sprites a request");
+    if (!list.is_array() || list.empty())
+      throw InputError("sprites", "expected a non-empty list of sprite ids");
+    if (list.size() > kMaxTagSprites)
+      throw InputError("sprites", "at most 100000 sprites a request");
     for (const auto& v : list) {
-      if (!v.is_number_integer()) throw InputError("sprites", "expected integer ids, got " + Dump(v));
+      if (!v.is_number_integer())
+        throw InputError("sprites", "expected integer ids, got " + Dump(v));
       r.sprites.push_back(v.get<int64_t>());
     }
   } else {
@@ -111,13 +128,16 @@ TagRequest ParseTag(const nlohmann::json& body) {
 
 LabelRequest ParseLabel(const nlohmann::json& body) {
   LabelRequest r = ParseLabelUndo(body);
-  if (!body.contains("label")) throw InputError("label", "missing (expected \"yes\", \"no\" or \"skip\")");
-  if (!body["label"].is_string()) throw InputError("label", "expected \"yes\", \"no\" or \"skip\", got " + Dump(body["label"]));
+  if (!body.contains("label"))
+    throw InputError("label", "missing (expected \"yes\", \"no\" or \"skip\")");
+  if (!body["label"].is_string())
+    throw InputError("label", "expected \"yes\", \"no\" or \"skip\", got " + Dump(body["label"]));
   r.label = body["label"].get<std::string>();
   if (r.label != "yes" && r.label != "no" && r.label != "skip") {
     throw InputError("label", "expected \"yes\", \"no\" or \"skip\", got \"" + r.label + "\"");
   }
-  if (r.from == r.to) throw InputError("to", "the same sprite as \"from\" (" + std::to_string(r.from) + ")");
+  if (r.from == r.to)
+    throw InputError("to", "the same sprite as \"from\" (" + std::to_string(r.from) + ")");
   return r;
 }
 
@@ -133,12 +153,13 @@ std::optional<std::string> ParseCameraName(const nlohmann::json& body, bool requ
     if (required) throw InputError("camera", "missing (the camera's name)");
     return std::nullopt;
   }
-  if (!body["camera"].is_string()) throw InputError("camera", "expected the camera's name, got " + Dump(body["camera"]));
+  if (!body["camera"].is_string())
+    throw InputError("camera", "expected the camera's name, got " + Dump(body["camera"]));
   return body["camera"].get<std::string>();
 }
 
-CalibrationStartRequest ParseCalibrationStart(const nlohmann::json& body,
-                                              const std::function<bool(const std::string&)>& known_camera) {
+CalibrationStartRequest ParseCalibrationStart(
+    const nlohmann::json& body, const std::function<bool(const std::string&)>& known_camera) {
   if (!body.contains("board") || !body["board"].is_string()) {
     throw InputError("board", "expected the board's spec, e.g. \"chessboard:10x7:0.03\"");
   }
@@ -146,7 +167,8 @@ CalibrationStartRequest ParseCalibrationStart(const nlohmann::json& body,
   r.board = calib::ParseBoardSpec(body["board"].get<std::string>(), "board");
   auto number = [&](const char* field, double lo, double hi) -> std::optional<double> {
     if (!body.contains(field)) return std::nullopt;
-    if (!body[field].is_number()) throw InputError(field, "expected a number, got " + Dump(body[field]));
+    if (!body[field].is_number())
+      throw InputError(field, "expected a number, got " + Dump(body[field]));
     const double v = body[field].get<double>();
     if (!(v >= lo && v <= hi)) {
       std::ostringstream range;
@@ -163,24 +185,29 @@ CalibrationStartRequest ParseCalibrationStart(const nlohmann::json& body,
   r.floor_still_s = number("floor_still_s", 0, 60);
   if (body.contains("board_pose")) {
     const nlohmann::json& p = body["board_pose"];
-    if (!p.is_array() || p.size() != 3 || !p[0].is_number() || !p[1].is_number() || !p[2].is_number()) {
+    if (!p.is_array() || p.size() != 3 || !p[0].is_number() || !p[1].is_number() ||
+        !p[2].is_number()) {
       throw InputError("board_pose", "expected [x_m, y_m, yaw_deg], got " + Dump(p));
     }
     for (int i = 0; i < 3; ++i) r.board_pose[i] = p[static_cast<size_t>(i)].get<double>();
   }
   r.board_thickness_m = number("board_thickness_m", 0, 0.1);
   if (body.contains("use_current_intrinsics")) {
-    if (!body["use_current_intrinsics"].is_boolean()) throw InputError("use_current_intrinsics", "expected true or false");
+    if (!body["use_current_intrinsics"].is_boolean())
+      throw InputError("use_current_intrinsics", "expected true or false");
     r.use_current_intrinsics = body["use_current_intrinsics"].get<bool>();
   }
   if (body.contains("cameras")) {
     const nlohmann::json& c = body["cameras"];
-    if (!c.is_array() || c.empty()) throw InputError("cameras", "expected a list of camera names, got " + Dump(c));
+    if (!c.is_array() || c.empty())
+      throw InputError("cameras", "expected a list of camera names, got " + Dump(c));
     for (const auto& n : c) {
       if (!n.is_string()) throw InputError("cameras", "expected camera names, got " + Dump(n));
       const std::string name = n.get<std::string>();
-      if (!known_camera(name)) throw InputError("cameras", "no camera \"" + name + "\" in the station");
-      if (std::find(r.cameras.begin(), r.cameras.end(), name) == r.cameras.end()) r.cameras.push_back(name);
+      if (!known_camera(name))
+        throw InputError("cameras", "no camera \"" + name + "\" in the station");
+      if (std::find(r.cameras.begin(), r.cameras.end(), name) == r.cameras.end())
+        r.cameras.push_back(name);
     }
   }
   return r;
@@ -188,9 +215,11 @@ CalibrationStartRequest ParseCalibrationStart(const nlohmann::json& body,
 
 CalibrationDropRequest ParseCalibrationDrop(const nlohmann::json& body) {
   CalibrationDropRequest r;
-  r.which = body.value("which", nlohmann::json("last")).is_string() ? body.value("which", "last") : "";
+  r.which =
+      body.value("which", nlohmann::json("last")).is_string() ? body.value("which", "last") : "";
   if (r.which != "last" && r.which != "worst") {
-    throw InputError("which", "expected \"last\" or \"worst\", got " + Dump(body.value("which", nlohmann::json())));
+    throw InputError("which", "expected \"last\" or \"worst\", got " +
+                                  Dump(body.value("which", nlohmann::json())));
   }
   r.camera = *ParseCameraName(body, true);
   return r;
@@ -208,7 +237,8 @@ CalibrationRedoRequest ParseCalibrationRedo(const nlohmann::json& body) {
   } else if (s == "enclosure") {
     r.step = calib::WizardStep::kEnclosure;
   } else {
-    throw InputError("step", "expected \"intrinsics\", \"ground\" or \"enclosure\", got " + Dump(v));
+    throw InputError("step",
+                     "expected \"intrinsics\", \"ground\" or \"enclosure\", got " + Dump(v));
   }
   r.camera = ParseCameraName(body, false);
   return r;

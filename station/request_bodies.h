@@ -45,11 +45,11 @@ ReplayStartRequest ParseReplayStart(const nlohmann::json& body);
 
 // POST /api/bank/tag, /api/bank/untag {"tag", "sprites": [ids]} | {"tag", "clip", "first_frame",
 // "last_frame"} (a run of a clip's frames).
-inline constexpr std::initializer_list<const char*> kTagFields = {"tag", "sprites", "clip", "first_frame",
-                                                                  "last_frame"};
+inline constexpr std::initializer_list<const char*> kTagFields = {"tag", "sprites", "clip",
+                                                                  "first_frame", "last_frame"};
 struct TagRequest {
-  std::string tag;                 // 1 to 64 letters, digits, '-', '_', '.'
-  std::vector<int64_t> sprites;    // the sprites; empty: the clip's frames below
+  std::string tag;               // 1 to 64 letters, digits, '-', '_', '.'
+  std::vector<int64_t> sprites;  // the sprites; empty: the clip's frames below
   int64_t clip = 0, first_frame = 0, last_frame = 0;
 };
 inline constexpr size_t kMaxTagSprites = 100000;  // sprite ids in one request
@@ -75,8 +75,16 @@ std::optional<std::string> ParseCameraName(const nlohmann::json& body, bool requ
 // Absent numbers are nullopt (the handler's defaults). `known_camera` says whether the station has
 // a camera of that name.
 inline constexpr std::initializer_list<const char*> kCalibrationStartFields = {
-    "board",      "cameras",      "board_pose", "board_thickness_m", "min_views",
-    "max_views",  "min_coverage", "max_rms_px", "still_s",           "floor_still_s",
+    "board",
+    "cameras",
+    "board_pose",
+    "board_thickness_m",
+    "min_views",
+    "max_views",
+    "min_coverage",
+    "max_rms_px",
+    "still_s",
+    "floor_still_s",
     "use_current_intrinsics"};
 struct CalibrationStartRequest {
   calib::BoardSpec board;
@@ -86,8 +94,8 @@ struct CalibrationStartRequest {
   bool use_current_intrinsics = false;
   std::vector<std::string> cameras;  // each once, in the order given; empty: every camera
 };
-CalibrationStartRequest ParseCalibrationStart(const nlohmann::json& body,
-                                              const std::function<bool(const std::string&)>& known_camera);
+CalibrationStartRequest ParseCalibrationStart(
+    const nlohmann::json& body, const std::function<bool(const std::string&)>& known_camera);
 
 // POST /api/calibration/drop {"camera", "which": "last" | "worst"}.
 inline constexpr std::initializer_list<const char*> kCalibrationDropFields = {"camera", "which"};
@@ -110,9 +118,10 @@ CalibrationRedoRequest ParseCalibrationRedo(const nlohmann::json& body);
 
 // POST /api/calibration/floor {"camera", "detect": true} | {"camera", "pixels": [[x, y], ...]}:
 // what follows the camera (ParseCameraName(body, true) comes first).
-inline constexpr std::initializer_list<const char*> kCalibrationFloorFields = {"camera", "detect", "pixels"};
+inline constexpr std::initializer_list<const char*> kCalibrationFloorFields = {"camera", "detect",
+                                                                               "pixels"};
 struct CalibrationFloorRequest {
-  bool detect = false;                 // find the green floor in the camera's frame
+  bool detect = false;                  // find the green floor in the camera's frame
   std::vector<Eigen::Vector2d> pixels;  // else: the floor's corners in the camera's pixels
 };
 CalibrationFloorRequest ParseCalibrationFloor(const nlohmann::json& body);

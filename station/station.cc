@@ -8,26 +8,26 @@
 #include <deque>
 #include <filesystem>
 #include <map>
-#include <set>
-#include <tuple>
 #include <mutex>
+#include <set>
 #include <thread>
+#include <tuple>
 
 #include <nlohmann/json.hpp>
 #include <opencv2/core/utility.hpp>
 
+#include "capture/camera_source.h"
 #include "core/bank.h"
-#include "pipeline/run/bank_scale.h"
 #include "core/error.h"
 #include "core/error_kinds.h"
-#include "core/sql_postgres.h"
-#include "station/bank_spool.h"
 #include "core/log.h"
+#include "core/sql_postgres.h"
+#include "pipeline/run/bank_scale.h"
 #include "pipeline/run/bounded_queue.h"
 #include "pipeline/run/ingest.h"
-#include "capture/camera_source.h"
-#include "station/recorder.h"
 #include "pipeline/transitions/worker.h"
+#include "station/bank_spool.h"
+#include "station/recorder.h"
 
 namespace ss {
 namespace {
@@ -35,7 +35,8 @@ namespace {
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 
-// SIGTERM must finish within 5 s: from the start of Stop, the transition worker may drain this long.
+// SIGTERM must finish within 5 s: from the start of Stop, the transition worker may drain this
+// long.
 constexpr double kTransitionDrainS = 3.0;
 
 // Preview snapshots a camera takes, idle and while a session stores; each view of a snapshot is
@@ -55,13 +56,17 @@ std::string UtcNow(const char* format = "%Y-%m-%dT%H:%M:%SZ") {
 
 // A session name: what a studio user types, kept usable as a folder name.
 std::string CheckSessionName(const std::string& name) {
-  if (name.empty() || name.size() > 100) throw InputError("name", "a session name needs 1 to 100 characters");
+  if (name.empty() || name.size() > 100)
+    throw InputError("name", "a session name needs 1 to 100 characters");
   for (const char c : name) {
-    if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_' || c == '.' || c == ' ')) {
-      throw InputError("name", "\"" + name + "\": only letters, digits, space, '-', '_' and '.' are allowed");
+    if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_' || c == '.' ||
+          c == ' ')) {
+      throw InputError(
+          "name", "\"" + name + "\": only letters, digits, space, '-', '_' and '.' are allowed");
     }
   }
-  if (name == "." || name == "..") throw InputError("name", "\"" + name + "\" is not a session name");
+  if (name == "." || name == "..")
+    throw InputError("name", "\"" + name + "\" is not a session name");
   return name;
 }
 
@@ -77,7 +82,8 @@ int64_t FreeMib(fs::path path) {
 
 void ApplyLogging(const LoggingConfig& logging) {
   SetLogLevel(logging.level);
-  for (const auto& [component, level] : logging.components) Log(component)->set_level(spdlog::level::from_str(level));
+  for (const auto& [component, level] : logging.components)
+    Log(component)->set_level(spdlog::level::from_str(level));
 }
 
 }  // namespace
@@ -124,10 +130,11 @@ struct Station::Impl {
   uint64_t spool_batches = 0;
   int64_t spool_bytes = 0;
   static constexpr int kBusyAttempts = 6;  // with SQLite's 10 s busy timeout: up to a minute
-  std::deque<double> latencies_ms;                         // last 10,000
-  uint64_t latency_count = 0;                              // every sprite's, since start
+  std::deque<double> latencies_ms;         // last 10,000
+  uint64_t latency_count = 0;              // every sprite's, since start
   double latency_sum_ms = 0;
-  std::deque<std::pair<SteadyTime, uint64_t>> stored_log;  // (time, sprites_stored) samples for sprites/s
+  std::deque<std::pair<SteadyTime, uint64_t>>
+      stored_log;  // (time, sprites_stored) samples for sprites/s
   std::string bank_error;
   bool last_append_failed = false;  // until an append succeeds again
   StorageState storage_state = StorageState::kOk;
@@ -151,8 +158,10 @@ struct Station::Impl {
   // The cache entry of a camera's view, locked in `lock`; `frame` is set when the entry must be
   // made (again) from that snapshot, and `runner` to the camera's. nullptr before the camera's
   // first frame; NotFoundError for no such camera.
-  PreviewCache::Entry* CachedPreview(const std::string& camera, int view, int width, std::unique_lock<std::mutex>* lock,
-                                     std::shared_ptr<const PreviewFrame>* frame, const CameraRunner** runner) const {
+  PreviewCache::Entry* CachedPreview(const std::string& camera, int view, int width,
+                                     std::unique_lock<std::mutex>* lock,
+                                     std::shared_ptr<const PreviewFrame>* frame,
+                                     const CameraRunner** runner) const {
     for (size_t k = 0; k < runners.size(); ++k) {
       if (runners[k]->name() != camera) continue;
       PreviewCache& cache = *preview_caches[k];
@@ -248,15 +257,15 @@ struct Station::Impl {
           break;
         } catch (const BusyError& e) {
           if (attempt == attempts) throw;
-          log->warn("bank: {} (clip {}/{} from frame {}: try {} of {})", e.what(), clip.camera_id, clip.track_id,
-                    clip.first_frame, attempt + 1, attempts);
+          log->warn("bank: {} (clip {}/{} from frame {}: try {} of {})", e.what(), clip.camera_id,
+                    clip.track_id, clip.first_frame, attempt + 1, attempts);
           std::lock_guard lock(stats_mutex);
           ++batches_retried;
         }
       }
     } catch (const BusyError& e) {
-      log->warn("bank: {} (clip {}/{} from frame {}: kept in the spool until the bank answers)", e.what(),
-                clip.camera_id, clip.track_id, clip.first_frame);
+      log->warn("bank: {} (clip {}/{} from frame {}: kept in the spool until the bank answers)",
+                e.what(), clip.camera_id, clip.track_id, clip.first_frame);
       {
         std::lock_guard lock(stats_mutex);
         bank_error = e.what();
@@ -266,8 +275,8 @@ struct Station::Impl {
       return;
     } catch (const std::exception& e) {
       // A failed append is one rolled-back transaction: what was stored stays stored.
-      log->error("bank: {} (the rest of clip {}/{} from frame {} is not stored)", e.what(), clip.camera_id,
-                 clip.track_id, clip.first_frame);
+      log->error("bank: {} (the rest of clip {}/{} from frame {} is not stored)", e.what(),
+                 clip.camera_id, clip.track_id, clip.first_frame);
       if (!clip.complete) broken_clips.insert(key);
       std::lock_guard lock(stats_mutex);
       ++batches_failed;
@@ -295,9 +304,10 @@ struct Station::Impl {
       why = e.what();
     }
     const ClipRecord& clip = batch.clip;
-    log->error("bank: clip {}/{} from frame {} not stored and not spooled: {}", clip.camera_id, clip.track_id,
-               clip.first_frame, why);
-    if (!clip.complete) broken_clips.insert(std::make_tuple(clip.camera_id, clip.track_id, clip.first_frame));
+    log->error("bank: clip {}/{} from frame {} not stored and not spooled: {}", clip.camera_id,
+               clip.track_id, clip.first_frame, why);
+    if (!clip.complete)
+      broken_clips.insert(std::make_tuple(clip.camera_id, clip.track_id, clip.first_frame));
     std::lock_guard lock(stats_mutex);
     ++batches_failed;
     bank_error = why;
@@ -334,12 +344,14 @@ struct Station::Impl {
       spool_batches = spool->batches();
       spool_bytes = spool->bytes();
     }
-    if (drained > 0) log->info("bank: {} spooled batches stored, {} still waiting", drained, spool_batches);
+    if (drained > 0)
+      log->info("bank: {} spooled batches stored, {} still waiting", drained, spool_batches);
   }
 
   // Counts a batch the bank took (`received`: when each sprite's frame arrived, for the latency;
   // none for a batch from the spool) and hands its new sprites to the transitions worker.
-  void Stored(const ClipBatch& batch, const AppendResult& result, const std::vector<SteadyTime>* received) {
+  void Stored(const ClipBatch& batch, const AppendResult& result,
+              const std::vector<SteadyTime>* received) {
     const SteadyTime now = Clock::now();
     uint64_t originals = 0;
     {
@@ -358,7 +370,8 @@ struct Station::Impl {
       ++batches_stored;
       last_append_failed = false;
       stored_log.emplace_back(now, sprites_stored);
-      while (stored_log.size() > 2 && Seconds(now - stored_log.front().first) > 5.0) stored_log.pop_front();
+      while (stored_log.size() > 2 && Seconds(now - stored_log.front().first) > 5.0)
+        stored_log.pop_front();
     }
     {
       std::lock_guard lock(session_mutex);
@@ -383,7 +396,8 @@ struct Station::Impl {
     }
     std::lock_guard lock(recorder_mutex);
     if (!recorder) return;
-    const std::optional<SourceCamera> source = runners[static_cast<size_t>(camera)]->source_camera();
+    const std::optional<SourceCamera> source =
+        runners[static_cast<size_t>(camera)]->source_camera();
     if (!source) return;
     const std::optional<CameraModel>& model = models[static_cast<size_t>(camera)];
     recorder->Offer(camera, *source, model ? &*model : nullptr, frame, drops_before, usable);
@@ -399,8 +413,9 @@ struct Station::Impl {
     done->Close();
     std::lock_guard lock(recorder_mutex);
     last_recording = done->stats();
-    log->info("recording {} closed ({} frames, {} dropped){}", last_recording.dir, last_recording.frames_written,
-              last_recording.frames_dropped, why.empty() ? "" : ": " + why);
+    log->info("recording {} closed ({} frames, {} dropped){}", last_recording.dir,
+              last_recording.frames_written, last_recording.frames_dropped,
+              why.empty() ? "" : ": " + why);
   }
 
   void MonitorLoop() {
@@ -416,7 +431,8 @@ struct Station::Impl {
   void CheckDisk() {
     const StorageConfig storage = StorageSettings();
     // A PostgreSQL bank's disk is its server's (a full one fails appends: writes_failing).
-    int64_t free_mib = sql::IsPostgresAddress(storage.bank) ? -1 : FreeMib(fs::path(storage.bank).parent_path());
+    int64_t free_mib =
+        sql::IsPostgresAddress(storage.bank) ? -1 : FreeMib(fs::path(storage.bank).parent_path());
     if (storage.recording != RecordingMode::kOff) {
       const int64_t rec = FreeMib(storage.recording_dir);
       if (rec >= 0 && (free_mib < 0 || rec < free_mib)) free_mib = rec;
@@ -440,15 +456,18 @@ struct Station::Impl {
         std::lock_guard lock(recorder_mutex);
         recording = recorder != nullptr;
       }
-      if (recording) StopRecording("free disk space " + std::to_string(free_mib) + " MiB is below storage.stop_recording_below_mib");
+      if (recording)
+        StopRecording("free disk space " + std::to_string(free_mib) +
+                      " MiB is below storage.stop_recording_below_mib");
     }
     if (next != previous) {
       if (next == StorageState::kOk) {
         log->info("disk: {} MiB free, storage back to normal", free_mib);
       } else {
         log->warn("disk: {} MiB free: {}", free_mib,
-                  next == StorageState::kSpritesStopped ? "sprite storage stopped (storage.stop_sprites_below_mib)"
-                                            : "raw recording stopped (storage.stop_recording_below_mib)");
+                  next == StorageState::kSpritesStopped
+                      ? "sprite storage stopped (storage.stop_sprites_below_mib)"
+                      : "raw recording stopped (storage.stop_recording_below_mib)");
       }
     }
   }
@@ -471,7 +490,8 @@ Station::Station(StationOptions options) : impl_(std::make_unique<Impl>()) {
     for (const CameraConfig& c : config.cameras) {
       if (c.source == "replay") replay = &c;
     }
-    if (replay == nullptr) throw InputError("enclosure.floor", "the station needs the floor polygon");
+    if (replay == nullptr)
+      throw InputError("enclosure.floor", "the station needs the floor polygon");
     s.floor = FloorForSession(replay->session, config);
   } else {
     s.floor = config.enclosure.floor;
@@ -480,8 +500,10 @@ Station::Station(StationOptions options) : impl_(std::make_unique<Impl>()) {
     const CameraConfig& c = config.cameras[i];
     s.models.push_back(ModelForCamera(c));
     if (!s.models.back()) {
-      s.log->warn("{}: no camera model: it streams for preview and recording but stores no sprites "
-                  "(calibrate it: spritestation calibrate)", c.name);
+      s.log->warn(
+          "{}: no camera model: it streams for preview and recording but stores no sprites "
+          "(calibrate it: spritestation calibrate)",
+          c.name);
     }
   }
   ApplyLogging(config.logging);
@@ -496,7 +518,8 @@ void Station::Start() {
   s.bank_sprites = s.bank->Counts().sprites;
   {
     std::string spool_dir = config.storage.spool_dir;
-    if (spool_dir.empty()) spool_dir = s.bank->is_postgres() ? "spool" : config.storage.bank + ".spool";
+    if (spool_dir.empty())
+      spool_dir = s.bank->is_postgres() ? "spool" : config.storage.bank + ".spool";
     s.spool = std::make_unique<BankSpool>(spool_dir, config.storage.spool_max_mib * 1024 * 1024);
     s.spool_batches = s.spool->batches();
     s.spool_bytes = s.spool->bytes();
@@ -518,8 +541,8 @@ void Station::Start() {
     s.log->info("billboard scale {} px/m: {}", scale.px_per_m, scale.why);
   }
   if (s.options.transitions) {
-    s.transitions = std::make_unique<TransitionWorker>(config.storage.bank,
-                                                      s.options.weights ? *s.options.weights : DefaultWeights());
+    s.transitions = std::make_unique<TransitionWorker>(
+        config.storage.bank, s.options.weights ? *s.options.weights : DefaultWeights());
   }
   s.writer_thread = std::thread([&s] { s.WriterLoop(); });
 
@@ -543,7 +566,9 @@ void Station::Start() {
     o.open_source = s.options.open_source;
     s.runners.push_back(std::make_unique<CameraRunner>(
         static_cast<int>(i), std::move(o), [&s](StationBatch b) { s.Store(std::move(b)); },
-        [&s](int camera, const Frame& f, uint64_t drops, bool usable) { s.Tap(camera, f, drops, usable); }));
+        [&s](int camera, const Frame& f, uint64_t drops, bool usable) {
+          s.Tap(camera, f, drops, usable);
+        }));
     s.preview_caches.push_back(std::make_unique<PreviewCache>());
   }
   s.CheckDisk();  // before any session: a full disk refuses from the first frame
@@ -587,11 +612,14 @@ void Station::Stop() {
   if (s.transitions) {
     // The transitions of the last sprites get what is left of the stop's few seconds; what
     // remains is not lost: the worker brings complete clips up to date when it next starts.
-    const double left_s = kTransitionDrainS - std::chrono::duration<double>(Clock::now() - stop_start).count();
+    const double left_s =
+        kTransitionDrainS - std::chrono::duration<double>(Clock::now() - stop_start).count();
     s.transitions->WaitIdleFor(left_s);
     if (const int64_t deferred = s.transitions->Stop(); deferred > 0) {
-      s.log->warn("{} new sprites' transitions left for the next start (it brings complete clips up to date)",
-                  deferred);
+      s.log->warn(
+          "{} new sprites' transitions left for the next start (it brings complete clips up to "
+          "date)",
+          deferred);
     }
   }
   s.transitions.reset();
@@ -608,8 +636,10 @@ SessionStatus Station::StartSession(const std::string& requested_name) {
   const std::string name = CheckSessionName(requested_name);
   std::lock_guard control(s.control_mutex);
   std::unique_lock lock(s.session_mutex);
-  if (s.state != StationState::kRunning) throw ConflictError("session", "the station is not running");
-  if (s.session.active) throw ConflictError("session", "session \"" + s.session.name + "\" is running; stop it first");
+  if (s.state != StationState::kRunning)
+    throw ConflictError("session", "the station is not running");
+  if (s.session.active)
+    throw ConflictError("session", "session \"" + s.session.name + "\" is running; stop it first");
   const std::string created = UtcNow();
   SessionRecord record;
   record.uid = name + "@" + created;
@@ -648,7 +678,8 @@ SessionStatus Station::StartSession(const std::string& requested_name) {
     RecordingOptions recording;
     recording.codec = storage.recording_codec;
     try {
-      auto recorder = std::make_unique<StationRecorder>(dir.string(), name, recording, storage.recording == RecordingMode::kUsable,
+      auto recorder = std::make_unique<StationRecorder>(dir.string(), name, recording,
+                                                        storage.recording == RecordingMode::kUsable,
                                                         static_cast<int>(s.runners.size()));
       std::lock_guard rec_lock(s.recorder_mutex);
       s.recorder = std::move(recorder);
@@ -685,7 +716,8 @@ SessionStatus Station::StopSession() {
   s.session_active = false;
   for (auto& r : s.runners) r->set_preview_interval(kPreviewIntervalS);
   s.session.seconds = Seconds(Clock::now() - s.session_started);
-  s.log->info("session \"{}\" stopped: {} sprites stored", s.session.name, s.session.sprites_stored);
+  s.log->info("session \"{}\" stopped: {} sprites stored", s.session.name,
+              s.session.sprites_stored);
   return s.session;
 }
 
@@ -729,7 +761,8 @@ StationStatus Station::Status() const {
     out.batches_refused = s.batches_refused;
     out.bank_error = s.bank_error;
     out.storage_state = s.storage_state;
-    if (out.storage_state == StorageState::kOk && s.last_append_failed) out.storage_state = StorageState::kWritesFailing;
+    if (out.storage_state == StorageState::kOk && s.last_append_failed)
+      out.storage_state = StorageState::kWritesFailing;
     out.disk_free_mib = s.disk_free_mib;
     if (s.stored_log.size() >= 2) {
       const double span = Seconds(s.stored_log.back().first - s.stored_log.front().first);
@@ -784,12 +817,12 @@ std::optional<Station::PreviewImage> Station::Preview(const std::string& camera,
   std::unique_lock<std::mutex> lock;
   std::shared_ptr<const PreviewFrame> frame;
   const CameraRunner* runner = nullptr;
-  PreviewCache::Entry* entry =
-      impl_->CachedPreview(camera, view == PreviewView::kKeyed ? 1 : 0, width, &lock, &frame, &runner);
+  PreviewCache::Entry* entry = impl_->CachedPreview(camera, view == PreviewView::kKeyed ? 1 : 0,
+                                                    width, &lock, &frame, &runner);
   if (entry == nullptr) return std::nullopt;
   if (frame) {
-    entry->image = {EncodeJpeg(RenderPreview(*frame, view, width)), frame->sequence, frame->timestamp_ns,
-                    frame->bgr.cols, frame->bgr.rows};
+    entry->image = {EncodeJpeg(RenderPreview(*frame, view, width)), frame->sequence,
+                    frame->timestamp_ns, frame->bgr.cols, frame->bgr.rows};
   }
   return entry->image;
 }
@@ -806,7 +839,9 @@ std::optional<std::string> Station::SpritesView(const std::string& camera, int m
     const double scale = frame->bgr.cols > 0 ? double(image.cols) / frame->bgr.cols : 1.0;
     const bool storing = SessionActive() && runner->model().has_value();
     entry->sprites_json =
-        SpritesViewJson(*frame, storing, "data:image/jpeg;base64," + Base64(EncodeJpeg(image)), scale).dump();
+        SpritesViewJson(*frame, storing, "data:image/jpeg;base64," + Base64(EncodeJpeg(image)),
+                        scale)
+            .dump();
   }
   return entry->sprites_json;
 }
@@ -824,12 +859,18 @@ std::vector<std::string> Station::Reload(const StationConfig& config) {
   Impl& s = *impl_;
   std::vector<std::string> needs_restart;
   const StationConfig& old = s.options.config;
-  if (config.cameras != old.cameras) needs_restart.push_back("cameras: changed; restart the daemon to apply");
-  if (config.keying != old.keying) needs_restart.push_back("keying: changed; restart the daemon to apply");
-  if (config.enclosure != old.enclosure) needs_restart.push_back("enclosure: changed; restart the daemon to apply");
-  if (config.pipeline != old.pipeline) needs_restart.push_back("pipeline: changed; restart the daemon to apply");
-  if (config.control != old.control) needs_restart.push_back("control: changed; restart the daemon to apply");
-  if (config.storage.bank != old.storage.bank) needs_restart.push_back("storage.bank: changed; restart the daemon to apply");
+  if (config.cameras != old.cameras)
+    needs_restart.push_back("cameras: changed; restart the daemon to apply");
+  if (config.keying != old.keying)
+    needs_restart.push_back("keying: changed; restart the daemon to apply");
+  if (config.enclosure != old.enclosure)
+    needs_restart.push_back("enclosure: changed; restart the daemon to apply");
+  if (config.pipeline != old.pipeline)
+    needs_restart.push_back("pipeline: changed; restart the daemon to apply");
+  if (config.control != old.control)
+    needs_restart.push_back("control: changed; restart the daemon to apply");
+  if (config.storage.bank != old.storage.bank)
+    needs_restart.push_back("storage.bank: changed; restart the daemon to apply");
   {
     std::lock_guard lock(s.config_mutex);
     const std::string bank = s.options.config.storage.bank;

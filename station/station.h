@@ -15,18 +15,18 @@
 
 #include "capture/frame_source.h"
 #include "core/config.h"
+#include "pipeline/transitions/weights.h"
 #include "station/preview.h"
 #include "station/station_status.h"
-#include "pipeline/transitions/weights.h"
 
 namespace ss {
 
 struct StationOptions {
-  StationConfig config;                        // validated
-  std::optional<TransitionWeights> weights;    // unset: the shipped defaults
-  std::string weights_path;                    // the file `weights` came from (named in the status)
-  bool transitions = true;                     // keep the bank's transitions current
-  double offline_after_s = 3.0;                // a camera silent this long is reopened
+  StationConfig config;                      // validated
+  std::optional<TransitionWeights> weights;  // unset: the shipped defaults
+  std::string weights_path;                  // the file `weights` came from (named in the status)
+  bool transitions = true;                   // keep the bank's transitions current
+  double offline_after_s = 3.0;              // a camera silent this long is reopened
   // Opens each camera; unset: its configured backend (benchmarks replay from memory).
   std::function<std::unique_ptr<FrameSource>(const CameraConfig&, int camera_index)> open_source;
 };
@@ -64,7 +64,8 @@ class Station {
     int64_t timestamp_ns = 0;
     int width = 0, height = 0;  // the camera's full size
   };
-  std::optional<PreviewImage> Preview(const std::string& camera, PreviewView view, int max_width) const;
+  std::optional<PreviewImage> Preview(const std::string& camera, PreviewView view,
+                                      int max_width) const;
   // The sprites view (preview.h SpritesViewJson) as JSON text, made once per snapshot the same way.
   std::optional<std::string> SpritesView(const std::string& camera, int max_width) const;
   bool SessionActive() const;

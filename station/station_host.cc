@@ -21,10 +21,12 @@ std::vector<RecordedSessionEntry> FindRecordedSessions(const std::vector<std::st
     if (!fs::is_directory(root, ec)) continue;
     std::vector<fs::path> dirs;
     if (fs::exists(fs::path(root) / "session.json", ec)) dirs.push_back(root);
-    for (auto it = fs::recursive_directory_iterator(root, fs::directory_options::skip_permission_denied, ec);
+    for (auto it = fs::recursive_directory_iterator(
+             root, fs::directory_options::skip_permission_denied, ec);
          !ec && it != fs::recursive_directory_iterator(); it.increment(ec)) {
       if (it.depth() >= 1) it.disable_recursion_pending();
-      if (it->is_directory(ec) && fs::exists(it->path() / "session.json", ec)) dirs.push_back(it->path());
+      if (it->is_directory(ec) && fs::exists(it->path() / "session.json", ec))
+        dirs.push_back(it->path());
     }
     std::sort(dirs.begin(), dirs.end());
     for (const fs::path& dir : dirs) {
@@ -51,22 +53,27 @@ nlohmann::json RecordedSessionsToJson(const std::vector<std::string>& roots,
   for (const RecordedSessionEntry& e : sessions) {
     nlohmann::json cameras = nlohmann::json::array();
     for (const SessionCamera& c : e.info.cameras) {
-      cameras.push_back({{"name", c.name}, {"width", c.width}, {"height", c.height}, {"frames", c.frames}, {"fps", c.fps}});
+      cameras.push_back({{"name", c.name},
+                         {"width", c.width},
+                         {"height", c.height},
+                         {"frames", c.frames},
+                         {"fps", c.fps}});
     }
-    list.push_back({{"path", e.path},
-                    {"name", e.info.name.empty() ? fs::path(e.path).filename().string() : e.info.name},
-                    {"root", e.root},
-                    {"cameras", cameras},
-                    {"seconds", e.seconds},
-                    {"synthetic", e.info.synthetic},
-                    {"created", e.info.created},
-                    {"error", e.error}});
+    list.push_back(
+        {{"path", e.path},
+         {"name", e.info.name.empty() ? fs::path(e.path).filename().string() : e.info.name},
+         {"root", e.root},
+         {"cameras", cameras},
+         {"seconds", e.seconds},
+         {"synthetic", e.info.synthetic},
+         {"created", e.info.created},
+         {"error", e.error}});
   }
   return {{"roots", roots}, {"sessions", list}};
 }
 
-StationConfig ReplayStationConfig(const StationConfig& live, const SessionInfo& session, const std::string& dir,
-                                  bool paced, bool loop) {
+StationConfig ReplayStationConfig(const StationConfig& live, const SessionInfo& session,
+                                  const std::string& dir, bool paced, bool loop) {
   StationConfig c = live;
   c.cameras.clear();
   for (const SessionCamera& sc : session.cameras) {
@@ -134,7 +141,10 @@ void StationHost::StartReplay(const std::string& path, bool paced, bool loop) {
   const auto it = std::find_if(sessions.begin(), sessions.end(),
                                [&](const RecordedSessionEntry& e) { return e.path == wanted; });
   if (it == sessions.end()) {
-    throw InputError("path", "\"" + path + "\" is not a recorded session under the replay folders (GET /api/replay/sessions)");
+    throw InputError(
+        "path",
+        "\"" + path +
+            "\" is not a recorded session under the replay folders (GET /api/replay/sessions)");
   }
   if (!it->error.empty()) throw InputError("path", it->error);
   StationOptions options = live_;
@@ -146,7 +156,8 @@ void StationHost::StartReplay(const std::string& path, bool paced, bool loop) {
   try {
     Replace(options);
   } catch (const std::exception& e) {
-    log->error("replay of {} could not start: {}; back to the config's cameras", it->path, e.what());
+    log->error("replay of {} could not start: {}; back to the config's cameras", it->path,
+               e.what());
     Replace(live_);
     {
       std::lock_guard lock(mutex_);
@@ -159,7 +170,8 @@ void StationHost::StartReplay(const std::string& path, bool paced, bool loop) {
   replay_path_ = it->path;
   replay_paced_ = paced;
   replay_loop_ = loop;
-  log->info("replaying {} ({}, {})", it->path, paced ? "paced" : "as fast as it runs", loop ? "looping" : "once");
+  log->info("replaying {} ({}, {})", it->path, paced ? "paced" : "as fast as it runs",
+            loop ? "looping" : "once");
 }
 
 void StationHost::StopReplay() {
@@ -184,8 +196,10 @@ void StationHost::UseWeights(const TransitionWeights& weights, const std::string
   std::lock_guard sw(switch_mutex_);
   const std::shared_ptr<Station> station = current();
   if (station && station->SessionActive()) {
-    throw ConflictError("session", "a capture session is running; stop it first (the station restarts to use new "
-                                   "weights, which would end the session)");
+    throw ConflictError(
+        "session",
+        "a capture session is running; stop it first (the station restarts to use new "
+        "weights, which would end the session)");
   }
   const StationOptions before = running_;
   const std::optional<TransitionWeights> live_before = live_.weights;
@@ -204,12 +218,15 @@ void StationHost::UseWeights(const TransitionWeights& weights, const std::string
   try {
     Replace(next);
   } catch (const std::exception& e) {
-    log->error("the station could not start with the weights {}: {}; the previous weights run again", path, e.what());
+    log->error(
+        "the station could not start with the weights {}: {}; the previous weights run again", path,
+        e.what());
     set_live(live_before, live_path_before);
     Replace(before);
     throw;
   }
-  log->info("the station runs with the transition weights {}", path.empty() ? "shipped with the build" : path);
+  log->info("the station runs with the transition weights {}",
+            path.empty() ? "shipped with the build" : path);
 }
 
 StationConfig StationHost::live_config() const {
@@ -230,7 +247,9 @@ bool StationHost::ApplyLiveConfig(const StationConfig& config) {
   try {
     Replace(live_);
   } catch (const std::exception& e) {
-    Log("station")->error("the station could not start with the new config: {}; the previous one runs again", e.what());
+    Log("station")->error(
+        "the station could not start with the new config: {}; the previous one runs again",
+        e.what());
     {
       std::lock_guard lock(mutex_);
       live_ = previous;
@@ -244,7 +263,8 @@ bool StationHost::ApplyLiveConfig(const StationConfig& config) {
 nlohmann::json StationHost::ModeJson() const {
   std::lock_guard lock(mutex_);
   if (!replaying_) return {{"mode", "live"}, {"replay", nullptr}};
-  return {{"mode", "replay"}, {"replay", {{"path", replay_path_}, {"paced", replay_paced_}, {"loop", replay_loop_}}}};
+  return {{"mode", "replay"},
+          {"replay", {{"path", replay_path_}, {"paced", replay_paced_}, {"loop", replay_loop_}}}};
 }
 
 }  // namespace ss

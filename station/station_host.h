@@ -33,8 +33,8 @@ nlohmann::json RecordedSessionsToJson(const std::vector<std::string>& roots,
                                       const std::vector<RecordedSessionEntry>& sessions);
 
 // The config of a station replaying session `dir` in place of `live`'s cameras.
-StationConfig ReplayStationConfig(const StationConfig& live, const SessionInfo& session, const std::string& dir,
-                                  bool paced, bool loop);
+StationConfig ReplayStationConfig(const StationConfig& live, const SessionInfo& session,
+                                  const std::string& dir, bool paced, bool loop);
 
 class StationHost {
  public:
@@ -81,10 +81,11 @@ class StationHost {
   // Stops the running station and starts one from `options`. Under switch_mutex_.
   void Replace(StationOptions options);
 
-  StationOptions live_;     // written under switch_mutex_ and mutex_ (weights(), live_config() read it)
+  StationOptions
+      live_;  // written under switch_mutex_ and mutex_ (weights(), live_config() read it)
   StationOptions running_;  // what the current station was started from; under switch_mutex_
   std::vector<std::string> replay_roots_;
-  std::mutex switch_mutex_;  // one switch at a time
+  std::mutex switch_mutex_;   // one switch at a time
   mutable std::mutex mutex_;  // guards station_ and the mode below
   std::shared_ptr<Station> station_;
   bool replaying_ = false;

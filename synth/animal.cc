@@ -14,9 +14,10 @@ namespace {
 constexpr double kDeg = M_PI / 180.0;
 constexpr double kRearPitch = 72.0 * kDeg;  // upright on the hind legs
 constexpr double kLeanPitch = 50.0 * kDeg;  // front paws up on a wall
-constexpr double kBodyHalfWidth = 0.060;    // at scale 1, with the head turned: keeps it off the walls
-constexpr double kNoseReach = 0.108;        // at scale 1, nose tip ahead of the root
-constexpr double kTailReach = 0.088;        // at scale 1, tail end behind the root
+constexpr double kBodyHalfWidth =
+    0.060;                            // at scale 1, with the head turned: keeps it off the walls
+constexpr double kNoseReach = 0.108;  // at scale 1, nose tip ahead of the root
+constexpr double kTailReach = 0.088;  // at scale 1, tail end behind the root
 
 double Wrap(double a) { return std::remainder(a, 2.0 * M_PI); }
 double Frac(double x) { return x - std::floor(x); }
@@ -24,9 +25,15 @@ double Smooth(double t) {
   t = std::clamp(t, 0.0, 1.0);
   return t * t * (3.0 - 2.0 * t);
 }
-Eigen::Matrix3d RotY(double a) { return Eigen::AngleAxisd(a, Eigen::Vector3d::UnitY()).toRotationMatrix(); }
-Eigen::Matrix3d RotZ(double a) { return Eigen::AngleAxisd(a, Eigen::Vector3d::UnitZ()).toRotationMatrix(); }
-Eigen::Matrix3d RotX(double a) { return Eigen::AngleAxisd(a, Eigen::Vector3d::UnitX()).toRotationMatrix(); }
+Eigen::Matrix3d RotY(double a) {
+  return Eigen::AngleAxisd(a, Eigen::Vector3d::UnitY()).toRotationMatrix();
+}
+Eigen::Matrix3d RotZ(double a) {
+  return Eigen::AngleAxisd(a, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+}
+Eigen::Matrix3d RotX(double a) {
+  return Eigen::AngleAxisd(a, Eigen::Vector3d::UnitX()).toRotationMatrix();
+}
 
 // Largest x of a primitive (its support along +x).
 double SupportX(const Primitive& p) {
@@ -35,17 +42,17 @@ double SupportX(const Primitive& p) {
 }
 
 struct Leg {
-  Eigen::Vector3d joint;     // shoulder or hip, animal frame at scale 1
-  double paw_x, paw_y;       // neutral paw position
+  Eigen::Vector3d joint;  // shoulder or hip, animal frame at scale 1
+  double paw_x, paw_y;    // neutral paw position
   bool front;
   double walk_offset, trot_offset;  // phase offsets of the two gaits
 };
 
 // LH, LF, RH, RF lift in turn when walking; diagonal pairs when trotting.
 const Leg kLegs[4] = {
-    {{0.036, 0.022, 0.030}, 0.040, 0.026, true, 0.25, 0.0},    // left front
-    {{0.036, -0.022, 0.030}, 0.040, -0.026, true, 0.75, 0.5},  // right front
-    {{-0.040, 0.026, 0.028}, -0.038, 0.030, false, 0.0, 0.5},  // left hind
+    {{0.036, 0.022, 0.030}, 0.040, 0.026, true, 0.25, 0.0},      // left front
+    {{0.036, -0.022, 0.030}, 0.040, -0.026, true, 0.75, 0.5},    // right front
+    {{-0.040, 0.026, 0.028}, -0.038, 0.030, false, 0.0, 0.5},    // left hind
     {{-0.040, -0.026, 0.028}, -0.038, -0.030, false, 0.5, 0.0},  // right hind
 };
 
@@ -69,21 +76,26 @@ AnimalLook RandomAnimalLook(uint64_t seed) {
   return look;
 }
 
-std::vector<Primitive> AnimalPrimitives(const AnimalLook& look, const AnimalState& s, int subject, int slice) {
+std::vector<Primitive> AnimalPrimitives(const AnimalLook& look, const AnimalState& s, int subject,
+                                        int slice) {
   const double k = look.scale;
   std::vector<Primitive> out;
   out.reserve(20);
   // Animal frame -> ground.
   const Eigen::Matrix3d r_world = RotZ(s.heading_rad);
   const Eigen::Vector3d t_world(s.position.x(), s.position.y(), 0.0);
-  auto to_ground = [&](const Eigen::Vector3d& p) -> Eigen::Vector3d { return r_world * (k * p) + t_world; };
+  auto to_ground = [&](const Eigen::Vector3d& p) -> Eigen::Vector3d {
+    return r_world * (k * p) + t_world;
+  };
 
   // Upper body pitched about the hips: rearing and leaning.
   const double rear = Smooth(s.rear), lean = Smooth(s.lean);
   const double pitch = std::max(rear * kRearPitch, lean * kLeanPitch);
   const Eigen::Vector3d pivot(-0.040, 0.0, 0.028);
   const Eigen::Matrix3d r_pitch = RotY(-pitch);
-  auto body = [&](const Eigen::Vector3d& p) -> Eigen::Vector3d { return pivot + r_pitch * (p - pivot); };
+  auto body = [&](const Eigen::Vector3d& p) -> Eigen::Vector3d {
+    return pivot + r_pitch * (p - pivot);
+  };
 
   const double gait = std::clamp(s.stepping, 0.0, 1.0);
   const double bob = gait * (0.0015 + 0.0025 * s.trot) * std::cos(4.0 * M_PI * s.gait_phase);
@@ -115,14 +127,15 @@ std::vector<Primitive> AnimalPrimitives(const AnimalLook& look, const AnimalStat
   limb.colour2 = pink.colour;
   limb.texture = 0.1f;
 
-  auto ellipsoid = [&](const Eigen::Vector3d& centre, const Eigen::Matrix3d& rot, const Eigen::Vector3d& radii,
-                       const Material& m) {
+  auto ellipsoid = [&](const Eigen::Vector3d& centre, const Eigen::Matrix3d& rot,
+                       const Eigen::Vector3d& radii, const Material& m) {
     Primitive p = Primitive::Ellipsoid(to_ground(centre), r_world * rot, k * radii, m);
     p.subject = subject;
     p.slice = slice;
     out.push_back(p);
   };
-  auto capsule = [&](const Eigen::Vector3d& a, const Eigen::Vector3d& b, double radius, const Material& m) {
+  auto capsule = [&](const Eigen::Vector3d& a, const Eigen::Vector3d& b, double radius,
+                     const Material& m) {
     Primitive p = Primitive::Capsule(to_ground(a), to_ground(b), k * radius, m);
     p.subject = subject;
     p.slice = slice;
@@ -132,12 +145,12 @@ std::vector<Primitive> AnimalPrimitives(const AnimalLook& look, const AnimalStat
   const Eigen::Vector3d lift(0.0, 0.0, bob);
   const Eigen::Matrix3d r_body = r_pitch * RotX(sway * 0.3);
   // Torso (chest) and rump.
-  ellipsoid(body(Eigen::Vector3d(0.012, 0.0, 0.040)) + lift, r_body, Eigen::Vector3d(0.050, 0.038 * breathe, 0.034 * breathe),
-            mat(fur, 1));
-  ellipsoid(body(Eigen::Vector3d(-0.030, 0.0, 0.038)) + lift, r_body, Eigen::Vector3d(0.042, 0.043 * breathe, 0.036),
-            mat(fur, 2));
-  ellipsoid(body(Eigen::Vector3d(-0.074, 0.0, 0.028)) + lift, r_body * RotY(0.4), Eigen::Vector3d(0.011, 0.006, 0.006),
-            mat(pink, 3));
+  ellipsoid(body(Eigen::Vector3d(0.012, 0.0, 0.040)) + lift, r_body,
+            Eigen::Vector3d(0.050, 0.038 * breathe, 0.034 * breathe), mat(fur, 1));
+  ellipsoid(body(Eigen::Vector3d(-0.030, 0.0, 0.038)) + lift, r_body,
+            Eigen::Vector3d(0.042, 0.043 * breathe, 0.036), mat(fur, 2));
+  ellipsoid(body(Eigen::Vector3d(-0.074, 0.0, 0.028)) + lift, r_body * RotY(0.4),
+            Eigen::Vector3d(0.011, 0.006, 0.006), mat(pink, 3));
 
   // Head: hinged at the neck, turned by head_yaw, held more level than the body.
   const Eigen::Vector3d neck = body(Eigen::Vector3d(0.045, 0.0, 0.046)) + lift;
@@ -148,12 +161,13 @@ std::vector<Primitive> AnimalPrimitives(const AnimalLook& look, const AnimalStat
   };
   const Eigen::Vector3d head_centre(0.068, 0.0, 0.047);
   ellipsoid(head(head_centre), r_head, Eigen::Vector3d(0.033, 0.028, 0.027), mat(fur, 4));
-  ellipsoid(head(Eigen::Vector3d(0.058, 0.0, 0.036)), r_head, Eigen::Vector3d(0.022, 0.032, 0.019), mat(fur, 5));  // cheeks
-  ellipsoid(head(Eigen::Vector3d(0.099, 0.0, 0.045 + sniff)), r_head, Eigen::Vector3d(0.0055, 0.0065, 0.005),
-            mat(pink, 6));
+  ellipsoid(head(Eigen::Vector3d(0.058, 0.0, 0.036)), r_head, Eigen::Vector3d(0.022, 0.032, 0.019),
+            mat(fur, 5));  // cheeks
+  ellipsoid(head(Eigen::Vector3d(0.099, 0.0, 0.045 + sniff)), r_head,
+            Eigen::Vector3d(0.0055, 0.0065, 0.005), mat(pink, 6));
   for (int side : {-1, 1}) {
-    ellipsoid(head(Eigen::Vector3d(0.084, 0.0185 * side, 0.056)), r_head, Eigen::Vector3d(0.0055, 0.0055, 0.0055),
-              mat(eye, 7 + side));
+    ellipsoid(head(Eigen::Vector3d(0.084, 0.0185 * side, 0.056)), r_head,
+              Eigen::Vector3d(0.0055, 0.0055, 0.0055), mat(eye, 7 + side));
     Material ear = pink;
     ear.colour = look.fur * 0.6f + pink.colour * 0.4f;
     ellipsoid(head(Eigen::Vector3d(0.060, 0.019 * side, 0.073)), r_head * RotX(0.35 * side),
@@ -188,7 +202,8 @@ std::vector<Primitive> AnimalPrimitives(const AnimalLook& look, const AnimalStat
         Eigen::Vector3d raised = tucked;
         if (lean > rear) {
           raised = Eigen::Vector3d(0.0, leg.paw_y * 0.8, 0.0);
-          raised.x() = body(Eigen::Vector3d(0.101, 0.0, 0.046)).x() + 0.004;  // just ahead of the nose
+          raised.x() =
+              body(Eigen::Vector3d(0.101, 0.0, 0.046)).x() + 0.004;  // just ahead of the nose
           raised.z() = joint.z() + 0.012;
         }
         paw = paw + up * (raised - paw);
@@ -197,7 +212,8 @@ std::vector<Primitive> AnimalPrimitives(const AnimalLook& look, const AnimalStat
     Material leg_mat = limb;
     leg_mat.seed = static_cast<uint32_t>(Mix(look.seed, 20 + i));
     const double leg_r = leg.front ? 0.0072 : 0.0085;
-    const Eigen::Vector3d ankle = paw + Eigen::Vector3d(-0.002, 0.0, leg_r);  // the leg never dips below the floor
+    const Eigen::Vector3d ankle =
+        paw + Eigen::Vector3d(-0.002, 0.0, leg_r);  // the leg never dips below the floor
     capsule(joint, ankle, leg_r, leg_mat);
     Eigen::Matrix3d r_paw = Eigen::Matrix3d::Identity();
     if (leg.front && std::max(rear, lean) > 0.0) r_paw = RotY(-0.5 * pitch);
@@ -221,7 +237,10 @@ double ForwardReach(const AnimalLook& look, double lean) {
 AnimalBehaviour::AnimalBehaviour(const Studio& studio, const AnimalLook& look, uint64_t seed,
                                  const Eigen::Vector2d& start, double heading_rad,
                                  std::vector<Eigen::Vector3d> cameras)
-    : studio_(&studio), look_(look), cameras_(std::move(cameras)), rng_(StreamSeed(seed, "animal-behaviour")) {
+    : studio_(&studio),
+      look_(look),
+      cameras_(std::move(cameras)),
+      rng_(StreamSeed(seed, "animal-behaviour")) {
   state_.position = start;
   state_.heading_rad = heading_rad;
   state_.stride_m = 0.06 * look.scale;
@@ -258,7 +277,8 @@ bool AnimalBehaviour::TurnToward(double target_rad, double rate, double dt_s) {
 
 void AnimalBehaviour::Choose() {
   Rng& rng = rng_;
-  const bool moving = activity_ == Activity::kWalk || activity_ == Activity::kTrot || activity_ == Activity::kTurn;
+  const bool moving =
+      activity_ == Activity::kWalk || activity_ == Activity::kTrot || activity_ == Activity::kTurn;
   // Weights: idle, pause, walk, trot, turn, to-wall, to-camera (rare).
   const double w_moving[7] = {0.10, 0.33, 0.22, 0.08, 0.14, 0.09, 0.04};
   const double w_still[7] = {0.08, 0.04, 0.42, 0.12, 0.18, 0.11, 0.05};
@@ -295,7 +315,8 @@ void AnimalBehaviour::Choose() {
       break;
     case 4:
       activity_ = Activity::kTurn;
-      target_heading_ = Wrap(state_.heading_rad + (rng.Chance(0.5) ? 1 : -1) * rng.Uniform(60, 180) * kDeg);
+      target_heading_ =
+          Wrap(state_.heading_rad + (rng.Chance(0.5) ? 1 : -1) * rng.Uniform(60, 180) * kDeg);
       activity_left_s_ = 3.0;
       target_speed_ = 0.0;
       break;
@@ -319,9 +340,10 @@ void AnimalBehaviour::Choose() {
       activity_ = Activity::kToCamera;
       activity_left_s_ = 4.0;
       target_speed_ = 0.0;
-      const Eigen::Vector3d cam = cameras_.empty() ? Eigen::Vector3d(0, -1, 1)
-                                                   : cameras_[static_cast<size_t>(rng.UniformInt(
-                                                         0, static_cast<int>(cameras_.size()) - 1))];
+      const Eigen::Vector3d cam = cameras_.empty()
+                                      ? Eigen::Vector3d(0, -1, 1)
+                                      : cameras_[static_cast<size_t>(rng.UniformInt(
+                                            0, static_cast<int>(cameras_.size()) - 1))];
       target_heading_ = std::atan2(cam.y() - state_.position.y(), cam.x() - state_.position.x());
       break;
     }
@@ -370,7 +392,8 @@ void AnimalBehaviour::Integrate(double dt, const std::vector<Eigen::Vector2d>& o
         const double d = rel.norm();
         if (d < 0.25 * k && d > 1e-9) {
           const double bearing = Wrap(std::atan2(rel.y(), rel.x()) - s.heading_rad);
-          if (std::abs(bearing) < M_PI / 2) turn_rate += (bearing > 0 ? -1.0 : 1.0) * 2.5 * (1.0 - d / (0.25 * k));
+          if (std::abs(bearing) < M_PI / 2)
+            turn_rate += (bearing > 0 ? -1.0 : 1.0) * 2.5 * (1.0 - d / (0.25 * k));
         }
       }
       turn_rate = std::clamp(turn_rate, -4.0, 4.0);
@@ -379,7 +402,8 @@ void AnimalBehaviour::Integrate(double dt, const std::vector<Eigen::Vector2d>& o
         activity_ = Activity::kTurn;
         const double left = RoomAhead(s.position, s.heading_rad + M_PI / 2);
         const double right = RoomAhead(s.position, s.heading_rad - M_PI / 2);
-        target_heading_ = Wrap(s.heading_rad + (left >= right ? 1 : -1) * rng.Uniform(100, 170) * kDeg);
+        target_heading_ =
+            Wrap(s.heading_rad + (left >= right ? 1 : -1) * rng.Uniform(100, 170) * kDeg);
         activity_left_s_ = 3.0;
         target_speed_ = 0.0;
       } else if (activity_left_s_ <= 0) {
@@ -428,7 +452,8 @@ void AnimalBehaviour::Integrate(double dt, const std::vector<Eigen::Vector2d>& o
         s.lean = std::max(0.0, s.lean - dt / 0.5);
       }
       // The hind paws shuffle so that the front paws just touch the wall.
-      // (From where walking stopped at lean 0 to the paws 1.5 mm into the wall at lean 0.25 and up.)
+      // (From where walking stopped at lean 0 to the paws 1.5 mm into the wall at lean 0.25 and
+      // up.)
       const double contact = ForwardReach(look_, s.lean) - 0.0015;
       const double w = std::min(1.0, s.lean / 0.25);
       const double target_room = (1.0 - w) * (kNoseReach * k + 0.001) + w * contact;
@@ -440,7 +465,8 @@ void AnimalBehaviour::Integrate(double dt, const std::vector<Eigen::Vector2d>& o
       look_target_ = 0.0;
       if (stage_ == 3 && s.lean <= 0.0) {
         activity_ = Activity::kTurn;
-        target_heading_ = Wrap(s.heading_rad + (rng.Chance(0.5) ? 1 : -1) * rng.Uniform(120, 180) * kDeg);
+        target_heading_ =
+            Wrap(s.heading_rad + (rng.Chance(0.5) ? 1 : -1) * rng.Uniform(120, 180) * kDeg);
         activity_left_s_ = 3.0;
       }
       break;
@@ -501,7 +527,8 @@ void AnimalBehaviour::Integrate(double dt, const std::vector<Eigen::Vector2d>& o
   s.position = next;
   // Legs: one cycle per stride when moving, stepping on the spot when turning.
   const double target_trot = pose == "trot" ? 1.0 : 0.0;
-  const double target_step = std::clamp(s.speed_mps / (0.03 * k), 0.0, 1.0) + (pose == "turn" ? 1.0 : 0.0);
+  const double target_step =
+      std::clamp(s.speed_mps / (0.03 * k), 0.0, 1.0) + (pose == "turn" ? 1.0 : 0.0);
   s.stepping += std::clamp(std::min(1.0, target_step) - s.stepping, -5.0 * dt, 5.0 * dt);
   s.trot += std::clamp(target_trot - s.trot, -4.0 * dt, 4.0 * dt);
   s.stride_m = (0.06 + 0.03 * s.trot) * k;
@@ -509,7 +536,8 @@ void AnimalBehaviour::Integrate(double dt, const std::vector<Eigen::Vector2d>& o
   s.gait_phase = Frac(s.gait_phase + moved / s.stride_m + (pose == "turn" ? turned * 0.35 : 0.0));
   // The head looks around when idle, follows the turn when moving.
   if (pose == "idle" && rng.Chance(dt / 1.5)) look_target_ = rng.Uniform(-0.6, 0.6);
-  const double head_target = pose == "idle" ? look_target_ : std::clamp(0.25 * turn_rate, -0.5, 0.5);
+  const double head_target =
+      pose == "idle" ? look_target_ : std::clamp(0.25 * turn_rate, -0.5, 0.5);
   s.head_yaw_rad += std::clamp(head_target - s.head_yaw_rad, -3.0 * dt, 3.0 * dt);
   s.pose = pose;
 }

@@ -21,10 +21,10 @@ namespace ss::synth {
 
 // How one animal looks: size and coat.
 struct AnimalLook {
-  double scale = 1.0;                           // 1: body 0.16 m nose to tail
-  Eigen::Vector3f fur{0.22f, 0.42f, 0.68f};     // B G R albedo of the back
-  Eigen::Vector3f belly{0.72f, 0.82f, 0.88f};   // belly and muzzle
-  uint64_t seed = 0;                            // fur texture
+  double scale = 1.0;                          // 1: body 0.16 m nose to tail
+  Eigen::Vector3f fur{0.22f, 0.42f, 0.68f};    // B G R albedo of the back
+  Eigen::Vector3f belly{0.72f, 0.82f, 0.88f};  // belly and muzzle
+  uint64_t seed = 0;                           // fur texture
 };
 
 // A look drawn from a few coats (golden, grey, dark brown, cream) and sizes.
@@ -47,7 +47,8 @@ struct AnimalState {
 };
 
 // The body's primitives in the ground frame, tagged with `subject` and `slice`.
-std::vector<Primitive> AnimalPrimitives(const AnimalLook& look, const AnimalState& state, int subject, int slice = 0);
+std::vector<Primitive> AnimalPrimitives(const AnimalLook& look, const AnimalState& state,
+                                        int subject, int slice = 0);
 
 // Forward reach of the body (from the root, along the heading) at a lean of 0..1.
 double ForwardReach(const AnimalLook& look, double lean);
@@ -58,8 +59,9 @@ double LeanReach(const AnimalLook& look);
 class AnimalBehaviour {
  public:
   // `cameras`: ground positions of the camera centres (the animal rears facing one).
-  AnimalBehaviour(const Studio& studio, const AnimalLook& look, uint64_t seed, const Eigen::Vector2d& start,
-                  double heading_rad, std::vector<Eigen::Vector3d> cameras);
+  AnimalBehaviour(const Studio& studio, const AnimalLook& look, uint64_t seed,
+                  const Eigen::Vector2d& start, double heading_rad,
+                  std::vector<Eigen::Vector3d> cameras);
   // Advances by dt seconds; `others` are the other animals' roots (kept apart).
   void Step(double dt_s, const std::vector<Eigen::Vector2d>& others);
   const AnimalState& state() const { return state_; }
@@ -83,10 +85,10 @@ class AnimalBehaviour {
   double activity_left_s_ = 0.0;  // time left in the activity
   double target_speed_ = 0.0;
   double target_heading_ = 0.0;
-  double steer_ = 0.0;            // rad/s of the wander
-  double stage_s_ = 0.0;          // time in the current sub-stage (lean/stand hold)
-  int stage_ = 0;                 // sub-stage: 0 approach/turn, 1 up, 2 hold, 3 down
-  double look_target_ = 0.0;      // head yaw target
+  double steer_ = 0.0;        // rad/s of the wander
+  double stage_s_ = 0.0;      // time in the current sub-stage (lean/stand hold)
+  int stage_ = 0;             // sub-stage: 0 approach/turn, 1 up, 2 hold, 3 down
+  double look_target_ = 0.0;  // head yaw target
 };
 
 }  // namespace ss::synth

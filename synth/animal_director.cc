@@ -17,14 +17,16 @@ constexpr double kWallTouchM = 0.003;
 
 class AnimalDirector : public Director {
  public:
-  AnimalDirector(const Studio& studio, const std::vector<SynthCamera>& cameras, const DirectorOptions& options)
+  AnimalDirector(const Studio& studio, const std::vector<SynthCamera>& cameras,
+                 const DirectorOptions& options)
       : studio_(studio), options_(options) {
     std::vector<Eigen::Vector3d> centres;
     for (const auto& c : cameras) centres.push_back(c.CentreInGround());
     Rng rng(StreamSeed(options.seed, "animal-placement"));
     std::vector<Eigen::Vector2d> placed;
     for (int i = 0; i < options.subjects; ++i) {
-      const AnimalLook look = RandomAnimalLook(StreamSeed(options.seed, "animal", static_cast<uint64_t>(i)));
+      const AnimalLook look =
+          RandomAnimalLook(StreamSeed(options.seed, "animal", static_cast<uint64_t>(i)));
       // Starting places at least 0.2 m apart, away from the walls.
       Eigen::Vector2d p = Eigen::Vector2d::Zero();
       for (int attempt = 0; attempt < 200; ++attempt) {
@@ -35,8 +37,9 @@ class AnimalDirector : public Director {
         if (apart) break;
       }
       placed.push_back(p);
-      animals_.emplace_back(studio, look, StreamSeed(options.seed, "animal-behaviour", static_cast<uint64_t>(i)), p,
-                            rng.Uniform(-M_PI, M_PI), centres);
+      animals_.emplace_back(studio, look,
+                            StreamSeed(options.seed, "animal-behaviour", static_cast<uint64_t>(i)),
+                            p, rng.Uniform(-M_PI, M_PI), centres);
     }
   }
 
@@ -56,7 +59,8 @@ class AnimalDirector : public Director {
       const double t = time_s - exposure * s / slices;
       AdvanceTo(t);
       for (size_t i = 0; i < animals_.size(); ++i) {
-        auto prims = AnimalPrimitives(animals_[i].look(), animals_[i].state(), static_cast<int>(i), s);
+        auto prims =
+            AnimalPrimitives(animals_[i].look(), animals_[i].state(), static_cast<int>(i), s);
         out->scene.primitives.insert(out->scene.primitives.end(), prims.begin(), prims.end());
       }
     }
@@ -69,8 +73,10 @@ class AnimalDirector : public Director {
       t.speed_mps = st.speed_mps;
       t.gait_phase = st.gait_phase;
       t.pose = st.pose;
-      t.touches_wall = TouchesWall(studio_, out->scene.primitives, static_cast<int>(i), kWallTouchM);
-      t.leaves_floor = LeavesFloor(studio_, out->scene.primitives, static_cast<int>(i), kWallTouchM);
+      t.touches_wall =
+          TouchesWall(studio_, out->scene.primitives, static_cast<int>(i), kWallTouchM);
+      t.leaves_floor =
+          LeavesFloor(studio_, out->scene.primitives, static_cast<int>(i), kWallTouchM);
       t.height_m = TopHeight(out->scene.primitives, static_cast<int>(i));
       out->subjects.push_back(std::move(t));
     }
@@ -114,9 +120,11 @@ class AnimalDirector : public Director {
 
 }  // namespace
 
-std::unique_ptr<Director> MakeAnimalDirector(const Studio& studio, const std::vector<SynthCamera>& cameras,
+std::unique_ptr<Director> MakeAnimalDirector(const Studio& studio,
+                                             const std::vector<SynthCamera>& cameras,
                                              const DirectorOptions& options) {
-  if (studio.kind != StudioKind::kEnclosure) throw InputError("kind", "animals live in the enclosure studio");
+  if (studio.kind != StudioKind::kEnclosure)
+    throw InputError("kind", "animals live in the enclosure studio");
   return std::make_unique<AnimalDirector>(studio, cameras, options);
 }
 

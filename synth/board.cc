@@ -20,9 +20,11 @@ std::vector<Eigen::Vector3d> BoardSpec::InnerCorners() const {
 
 BoardTexture::BoardTexture(const BoardSpec& spec) : spec_(spec) {
   if (spec.kind == BoardKind::kCharuco) {
-    if (spec.dictionary != "DICT_4X4_50") throw InputError("board.dictionary", "only DICT_4X4_50 is drawn");
+    if (spec.dictionary != "DICT_4X4_50")
+      throw InputError("board.dictionary", "only DICT_4X4_50 is drawn");
     auto dict = cv::aruco::getPredefinedDictionary(cv::aruco::DICT_4X4_50);
-    auto board = cv::aruco::CharucoBoard::create(spec.squares_x, spec.squares_y, static_cast<float>(spec.square_m),
+    auto board = cv::aruco::CharucoBoard::create(spec.squares_x, spec.squares_y,
+                                                 static_cast<float>(spec.square_m),
                                                  static_cast<float>(spec.marker_m), dict);
     texels_per_m_ = 200.0 / spec.square_m;  // 200 texels per square
     const cv::Size size(static_cast<int>(std::lround(spec.width_m() * texels_per_m_)),

@@ -21,12 +21,12 @@ enum class BoardKind { kChessboard, kCharuco };
 
 struct BoardSpec {
   BoardKind kind = BoardKind::kChessboard;
-  int squares_x = 10;          // squares along x
-  int squares_y = 7;           // squares along y
-  double square_m = 0.03;      // side of one square
-  double marker_m = 0.0;       // ChArUco marker side
-  std::string dictionary;      // ChArUco: "DICT_4X4_50"
-  double margin_m = 0.02;      // white border around the checkered area
+  int squares_x = 10;      // squares along x
+  int squares_y = 7;       // squares along y
+  double square_m = 0.03;  // side of one square
+  double marker_m = 0.0;   // ChArUco marker side
+  std::string dictionary;  // ChArUco: "DICT_4X4_50"
+  double margin_m = 0.02;  // white border around the checkered area
 
   std::string Name() const { return kind == BoardKind::kChessboard ? "chessboard" : "charuco"; }
   double width_m() const { return squares_x * square_m; }
@@ -47,7 +47,7 @@ class BoardTexture {
 
  private:
   BoardSpec spec_;
-  cv::Mat charuco_;        // ChArUco print, 8-bit, kTexelsPerMetre
+  cv::Mat charuco_;  // ChArUco print, 8-bit, kTexelsPerMetre
   double texels_per_m_ = 0;
 };
 

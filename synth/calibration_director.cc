@@ -32,21 +32,22 @@ Rigid3 Interpolate(const Rigid3& a, const Rigid3& b, double s) {
 
 struct Segment {
   double start_s = 0, end_s = 0;
-  int board = 0;                 // index into specs
-  int camera = -1;               // -1: on the floor
-  std::vector<Rigid3> poses;     // ground_from_board, one per pose
+  int board = 0;              // index into specs
+  int camera = -1;            // -1: on the floor
+  std::vector<Rigid3> poses;  // ground_from_board, one per pose
 };
 
 class CalibrationDirector : public Director {
  public:
-  CalibrationDirector(const Studio& studio, const std::vector<SynthCamera>& cameras, const DirectorOptions& options,
-                      double seconds)
+  CalibrationDirector(const Studio& studio, const std::vector<SynthCamera>& cameras,
+                      const DirectorOptions& options, double seconds)
       : studio_(studio), cameras_(cameras) {
     const bool stage = studio.kind == StudioKind::kStage;
     specs_ = {ChessboardFor(stage), CharucoFor(stage)};
     for (const auto& s : specs_) textures_.push_back(std::make_unique<BoardTexture>(s));
     Rng rng(StreamSeed(options.seed, "calibration-boards"));
-    // Segments: camera 0 chessboard, camera 0 ChArUco, camera 1 ..., then the floor (one pose slot).
+    // Segments: camera 0 chessboard, camera 0 ChArUco, camera 1 ..., then the floor (one pose
+    // slot).
     const int hand_segments = 2 * static_cast<int>(cameras.size());
     const double floor_s = std::max(seconds * 0.1, std::min(1.0, seconds / (hand_segments + 1)));
     const double hand_s = (seconds - floor_s) / hand_segments;
@@ -75,7 +76,8 @@ class CalibrationDirector : public Director {
     floor_poses_.resize(2);
     const Eigen::Matrix3d face_up = Eigen::Vector3d(1, -1, -1).asDiagonal();
     floor_poses_[0].rotation = face_up;
-    floor_poses_[0].translation = Eigen::Vector3d(-0.5 * chess.width_m(), 0.5 * chess.height_m(), 0.001);
+    floor_poses_[0].translation =
+        Eigen::Vector3d(-0.5 * chess.width_m(), 0.5 * chess.height_m(), 0.001);
     const BoardSpec& charuco = specs_[1];
     const double gap = chess.margin_m + charuco.margin_m + 0.02;
     floor_poses_[1].rotation = face_up;
@@ -108,9 +110,11 @@ class CalibrationDirector : public Director {
     // Pose p is reached at start + (p + 0.6) * step and held until start + (p + 1) * step.
     const double step = (seg->end_s - seg->start_s) / static_cast<double>(seg->poses.size() - 1);
     const double u = (time_s - seg->start_s) / step;
-    const int p = std::min(static_cast<int>(seg->poses.size()) - 2, static_cast<int>(std::floor(u)));
+    const int p =
+        std::min(static_cast<int>(seg->poses.size()) - 2, static_cast<int>(std::floor(u)));
     const double s = Smooth((u - p) / 0.6);
-    Add(seg->board, Interpolate(seg->poses[static_cast<size_t>(p)], seg->poses[static_cast<size_t>(p + 1)], s),
+    Add(seg->board,
+        Interpolate(seg->poses[static_cast<size_t>(p)], seg->poses[static_cast<size_t>(p + 1)], s),
         "camera:" + cameras_[static_cast<size_t>(seg->camera)].name, out);
   }
 
@@ -123,10 +127,12 @@ class CalibrationDirector : public Director {
     const double fill = rng.Uniform(0.35, 0.65);
     const double depth = cam.lens.fx() * spec.width_m() / (fill * cam.width);
     // Where the board's centre appears: within the middle of the image, leaving room for the board.
-    const double room_x = std::max(0.0, 0.5 - 0.5 * fill - 0.06), room_y = std::max(0.0, 0.5 - 0.5 * fill * 1.2 - 0.06);
+    const double room_x = std::max(0.0, 0.5 - 0.5 * fill - 0.06),
+                 room_y = std::max(0.0, 0.5 - 0.5 * fill * 1.2 - 0.06);
     const Eigen::Vector2d px(cam.width * (0.5 + rng.Uniform(-room_x, room_x)),
                              cam.height * (0.5 + rng.Uniform(-room_y, room_y)));
-    const Eigen::Vector3d centre_in_cam = cam.lens.Unproject(px) / cam.lens.Unproject(px).z() * depth;
+    const Eigen::Vector3d centre_in_cam =
+        cam.lens.Unproject(px) / cam.lens.Unproject(px).z() * depth;
     const Eigen::Matrix3d tilt =
         (Eigen::AngleAxisd(rng.Uniform(-40, 40) * kDeg, Eigen::Vector3d::UnitX()) *
          Eigen::AngleAxisd(rng.Uniform(-40, 40) * kDeg, Eigen::Vector3d::UnitY()) *
@@ -134,11 +140,13 @@ class CalibrationDirector : public Director {
             .toRotationMatrix();
     Rigid3 cam_from_board;
     cam_from_board.rotation = tilt;
-    cam_from_board.translation = centre_in_cam - tilt * Eigen::Vector3d(0.5 * spec.width_m(), 0.5 * spec.height_m(), 0);
+    cam_from_board.translation =
+        centre_in_cam - tilt * Eigen::Vector3d(0.5 * spec.width_m(), 0.5 * spec.height_m(), 0);
     return cam.cam_from_ground.Inverse() * cam_from_board;
   }
 
-  void Add(int board, const Rigid3& ground_from_board, const std::string& placement, FrameSnapshot* out) const {
+  void Add(int board, const Rigid3& ground_from_board, const std::string& placement,
+           FrameSnapshot* out) const {
     BoardInstance inst;
     inst.texture = textures_[static_cast<size_t>(board)].get();
     inst.ground_from_board = ground_from_board;
@@ -156,7 +164,8 @@ class CalibrationDirector : public Director {
 
 }  // namespace
 
-std::unique_ptr<Director> MakeCalibrationDirector(const Studio& studio, const std::vector<SynthCamera>& cameras,
+std::unique_ptr<Director> MakeCalibrationDirector(const Studio& studio,
+                                                  const std::vector<SynthCamera>& cameras,
                                                   const DirectorOptions& options, double seconds) {
   return std::make_unique<CalibrationDirector>(studio, cameras, options, seconds);
 }

@@ -20,18 +20,21 @@ struct DirectorOptions {
 };
 
 // `subjects` animals with their behaviour models, placed apart on the floor.
-std::unique_ptr<Director> MakeAnimalDirector(const Studio& studio, const std::vector<SynthCamera>& cameras,
+std::unique_ptr<Director> MakeAnimalDirector(const Studio& studio,
+                                             const std::vector<SynthCamera>& cameras,
                                              const DirectorOptions& options);
 
 // Calibration boards (a chessboard and a ChArUco board) held in many poses
 // before each camera in turn, then lying flat on the floor. No subjects.
-std::unique_ptr<Director> MakeCalibrationDirector(const Studio& studio, const std::vector<SynthCamera>& cameras,
+std::unique_ptr<Director> MakeCalibrationDirector(const Studio& studio,
+                                                  const std::vector<SynthCamera>& cameras,
                                                   const DirectorOptions& options, double seconds);
 
 // Articulated figures on the stage: idle, walking, turning to face camera 0 and
 // holding the arm poses Y, M, C, A. The timeline depends on the seed only, so
 // both builds (options.figure_variant) perform the same sequence.
-std::unique_ptr<Director> MakeFigureDirector(const Studio& studio, const std::vector<SynthCamera>& cameras,
+std::unique_ptr<Director> MakeFigureDirector(const Studio& studio,
+                                             const std::vector<SynthCamera>& cameras,
                                              const DirectorOptions& options);
 
 }  // namespace ss::synth

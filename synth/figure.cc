@@ -10,8 +10,24 @@
 namespace ss::synth {
 namespace {
 
-enum Joint { kHead, kNeck, kShoulderL, kElbowL, kWristL, kShoulderR, kElbowR, kWristR, kPelvis, kHipL, kKneeL,
-             kAnkleL, kHipR, kKneeR, kAnkleR, kJointCount };
+enum Joint {
+  kHead,
+  kNeck,
+  kShoulderL,
+  kElbowL,
+  kWristL,
+  kShoulderR,
+  kElbowR,
+  kWristR,
+  kPelvis,
+  kHipL,
+  kKneeL,
+  kAnkleL,
+  kHipR,
+  kKneeR,
+  kAnkleR,
+  kJointCount
+};
 
 double Smooth(double t) {
   t = std::clamp(t, 0.0, 1.0);
@@ -24,9 +40,11 @@ struct ArmDirs {
 
 // One arm's directions for a pose. `side` +1 left, -1 right; vectors are given
 // as (forward, outward, up) and mirrored for the right arm.
-ArmDirs ArmFor(ArmPose pose, int side, const Eigen::Vector3d& shoulder, const Eigen::Vector3d& head_centre,
-               const FigureBuild& b) {
-  auto out = [side](double x, double o, double z) { return Eigen::Vector3d(x, side * o, z).normalized(); };
+ArmDirs ArmFor(ArmPose pose, int side, const Eigen::Vector3d& shoulder,
+               const Eigen::Vector3d& head_centre, const FigureBuild& b) {
+  auto out = [side](double x, double o, double z) {
+    return Eigen::Vector3d(x, side * o, z).normalized();
+  };
   const double s = b.height_m / 1.75;
   ArmDirs d;
   switch (pose) {
@@ -85,9 +103,9 @@ Material Plain(const Eigen::Vector3f& colour, uint64_t seed, float texture = 0.0
 }  // namespace
 
 const std::vector<std::string>& FigureJointNames() {
-  static const std::vector<std::string> names = {"head",  "neck",       "shoulder_l", "elbow_l", "wrist_l",
-                                                 "shoulder_r", "elbow_r", "wrist_r",    "pelvis",  "hip_l",
-                                                 "knee_l", "ankle_l",    "hip_r",      "knee_r",  "ankle_r"};
+  static const std::vector<std::string> names = {
+      "head",   "neck",  "shoulder_l", "elbow_l", "wrist_l", "shoulder_r", "elbow_r", "wrist_r",
+      "pelvis", "hip_l", "knee_l",     "ankle_l", "hip_r",   "knee_r",     "ankle_r"};
   return names;
 }
 
@@ -130,7 +148,8 @@ std::vector<Eigen::Vector3d> FigureJoints(const FigureBuild& b, const FigureStat
   const double phi = 2.0 * M_PI * st.gait_phase;
   std::vector<Eigen::Vector3d> j(kJointCount);
   // Trunk, in the figure frame with the pelvis over the origin.
-  const double sway = w * 0.025 * std::sin(phi) + (1.0 - w) * 0.012 * std::sin(2.0 * M_PI * 0.21 * st.time_s);
+  const double sway =
+      w * 0.025 * std::sin(phi) + (1.0 - w) * 0.012 * std::sin(2.0 * M_PI * 0.21 * st.time_s);
   const double breathe = 0.004 * std::sin(2.0 * M_PI * 0.25 * st.time_s);
   j[kPelvis] = {0.0, sway, b.hip_height_m + 0.03 * s};
   j[kNeck] = {0.02 * w, sway * 0.6, 0.857 * b.height_m + breathe};
@@ -154,24 +173,29 @@ std::vector<Eigen::Vector3d> FigureJoints(const FigureBuild& b, const FigureStat
   // Arms: blend of two poses, plus the walking swing.
   const double blend = Smooth(st.blend);
   for (int side : {1, -1}) {
-    const Eigen::Vector3d shoulder = j[kNeck] + Eigen::Vector3d(0.0, side * b.shoulder_half_m, -0.05 * s);
+    const Eigen::Vector3d shoulder =
+        j[kNeck] + Eigen::Vector3d(0.0, side * b.shoulder_half_m, -0.05 * s);
     const ArmDirs a = ArmFor(st.from, side, shoulder, j[kHead], b);
     const ArmDirs c = ArmFor(st.to, side, shoulder, j[kHead], b);
     Eigen::Vector3d upper = ((1.0 - blend) * a.upper + blend * c.upper).normalized();
     Eigen::Vector3d fore = ((1.0 - blend) * a.fore + blend * c.fore).normalized();
-    const bool resting = (st.to == ArmPose::kRest && blend > 0.5) || (st.from == ArmPose::kRest && blend < 0.5);
+    const bool resting =
+        (st.to == ArmPose::kRest && blend > 0.5) || (st.from == ArmPose::kRest && blend < 0.5);
     if (resting) {
       const double swing = -w * 0.38 * std::sin(phi + (side > 0 ? 0.0 : M_PI));
-      const Eigen::Matrix3d r = Eigen::AngleAxisd(-swing, Eigen::Vector3d::UnitY()).toRotationMatrix();
+      const Eigen::Matrix3d r =
+          Eigen::AngleAxisd(-swing, Eigen::Vector3d::UnitY()).toRotationMatrix();
       upper = r * upper;
-      fore = Eigen::AngleAxisd(-swing - 0.25 * w, Eigen::Vector3d::UnitY()).toRotationMatrix() * fore;
+      fore =
+          Eigen::AngleAxisd(-swing - 0.25 * w, Eigen::Vector3d::UnitY()).toRotationMatrix() * fore;
     }
     j[side > 0 ? kShoulderL : kShoulderR] = shoulder;
     j[side > 0 ? kElbowL : kElbowR] = shoulder + b.upper_arm_m * upper;
     j[side > 0 ? kWristL : kWristR] = shoulder + b.upper_arm_m * upper + b.forearm_m * fore;
   }
   // Figure frame -> ground.
-  const Eigen::Matrix3d r = Eigen::AngleAxisd(st.heading_rad, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  const Eigen::Matrix3d r =
+      Eigen::AngleAxisd(st.heading_rad, Eigen::Vector3d::UnitZ()).toRotationMatrix();
   const Eigen::Vector3d t(st.position.x(), st.position.y(), 0.0);
   for (auto& p : j) p = r * p + t;
   return j;
@@ -199,20 +223,26 @@ std::vector<Primitive> FigurePrimitives(const FigureBuild& b, const std::vector<
     return r;
   };
   const Material shirt = Cloth(b.shirt, Mix(seed, 1)), trousers = Cloth(b.trousers, Mix(seed, 2));
-  const Material skin = Plain(b.skin, Mix(seed, 3)), hair = Plain({0.08f, 0.10f, 0.14f}, Mix(seed, 4), 0.15f);
+  const Material skin = Plain(b.skin, Mix(seed, 3)),
+                 hair = Plain({0.08f, 0.10f, 0.14f}, Mix(seed, 4), 0.15f);
   const Material shoes = Plain({0.10f, 0.10f, 0.11f}, Mix(seed, 5));
   const Eigen::Vector3d spine = j[kNeck] - j[kPelvis];
   const Eigen::Matrix3d r_spine = frame(spine);
   // Trunk: hips, belly, chest with shoulders.
-  add(Primitive::Ellipsoid(j[kPelvis] + 0.02 * spine, r_spine, Eigen::Vector3d(0.12 * g, b.hip_half_m + 0.085 * g, 0.15 * s),
+  add(Primitive::Ellipsoid(j[kPelvis] + 0.02 * spine, r_spine,
+                           Eigen::Vector3d(0.12 * g, b.hip_half_m + 0.085 * g, 0.15 * s),
                            trousers));
-  add(Primitive::Ellipsoid(j[kPelvis] + 0.35 * spine, r_spine, Eigen::Vector3d(0.115 * g, 0.15 * g + 0.02, 0.17 * s), shirt));
+  add(Primitive::Ellipsoid(j[kPelvis] + 0.35 * spine, r_spine,
+                           Eigen::Vector3d(0.115 * g, 0.15 * g + 0.02, 0.17 * s), shirt));
   add(Primitive::Ellipsoid(j[kPelvis] + 0.68 * spine, r_spine,
-                           Eigen::Vector3d(0.125 * g, b.shoulder_half_m * 0.92 + 0.01, 0.20 * s), shirt));
-  for (int sh : {kShoulderL, kShoulderR}) add(Primitive::Capsule(j[sh], j[sh] - 0.03 * spine.normalized(), 0.062 * g, shirt));
+                           Eigen::Vector3d(0.125 * g, b.shoulder_half_m * 0.92 + 0.01, 0.20 * s),
+                           shirt));
+  for (int sh : {kShoulderL, kShoulderR})
+    add(Primitive::Capsule(j[sh], j[sh] - 0.03 * spine.normalized(), 0.062 * g, shirt));
   // Neck and head (hair on the back and top).
   const Eigen::Vector3d head_axis = j[kHead] - j[kNeck];
-  add(Primitive::Capsule(j[kNeck] - 0.02 * head_axis, j[kHead] - 0.55 * head_axis, 0.048 * g, skin));
+  add(Primitive::Capsule(j[kNeck] - 0.02 * head_axis, j[kHead] - 0.55 * head_axis, 0.048 * g,
+                         skin));
   const Eigen::Matrix3d r_head = frame(head_axis);
   add(Primitive::Ellipsoid(j[kHead], r_head, Eigen::Vector3d(0.098, 0.082, 0.115) * s, skin));
   add(Primitive::Ellipsoid(j[kHead] + r_head * Eigen::Vector3d(-0.02, 0.0, 0.03) * s, r_head,
@@ -226,11 +256,13 @@ std::vector<Primitive> FigurePrimitives(const FigureBuild& b, const std::vector<
     add(Primitive::Capsule(sleeve_end, j[el], 0.042 * g, skin));
     add(Primitive::Capsule(j[el], j[wr], 0.036 * g, skin));
     const Eigen::Vector3d hand_dir = (j[wr] - j[el]).normalized();
-    add(Primitive::Ellipsoid(j[wr] + 0.07 * s * hand_dir, frame(hand_dir), Eigen::Vector3d(0.028, 0.045, 0.075) * s, skin));
+    add(Primitive::Ellipsoid(j[wr] + 0.07 * s * hand_dir, frame(hand_dir),
+                             Eigen::Vector3d(0.028, 0.045, 0.075) * s, skin));
   }
   // Legs and shoes.
   for (int side = 0; side < 2; ++side) {
-    const int hp = side == 0 ? kHipL : kHipR, kn = side == 0 ? kKneeL : kKneeR, an = side == 0 ? kAnkleL : kAnkleR;
+    const int hp = side == 0 ? kHipL : kHipR, kn = side == 0 ? kKneeL : kKneeR,
+              an = side == 0 ? kAnkleL : kAnkleR;
     add(Primitive::Capsule(j[hp], j[kn], 0.078 * g, trousers));
     add(Primitive::Capsule(j[kn], j[an] + Eigen::Vector3d(0, 0, 0.02 * s), 0.058 * g, trousers));
     Eigen::Matrix3d r_foot;

@@ -25,7 +25,7 @@ struct FigureBuild {
   double hip_height_m = 0.92;
   double upper_arm_m = 0.30;
   double forearm_m = 0.27;
-  double girth = 1.0;             // body widths scale
+  double girth = 1.0;                          // body widths scale
   Eigen::Vector3f shirt{0.55f, 0.25f, 0.18f};  // B G R
   Eigen::Vector3f trousers{0.25f, 0.22f, 0.20f};
   Eigen::Vector3f skin{0.45f, 0.58f, 0.78f};
@@ -42,11 +42,11 @@ struct FigureState {
   Eigen::Vector2d position = Eigen::Vector2d::Zero();  // pelvis on the floor, ground x y
   double heading_rad = 0.0;
   double speed_mps = 0.0;
-  double gait_phase = 0.0;      // [0, 1): one cycle = two steps
-  double walking = 0.0;         // 0..1 amplitude of the walk cycle
+  double gait_phase = 0.0;  // [0, 1): one cycle = two steps
+  double walking = 0.0;     // 0..1 amplitude of the walk cycle
   ArmPose from = ArmPose::kRest, to = ArmPose::kRest;
-  double blend = 1.0;           // 0: `from`, 1: `to`
-  double time_s = 0.0;          // idle sway, breathing
+  double blend = 1.0;   // 0: `from`, 1: `to`
+  double time_s = 0.0;  // idle sway, breathing
   std::string pose = "idle";
 };
 
@@ -54,7 +54,8 @@ struct FigureState {
 std::vector<Eigen::Vector3d> FigureJoints(const FigureBuild& build, const FigureState& state);
 
 // The dressed body around those joints.
-std::vector<Primitive> FigurePrimitives(const FigureBuild& build, const std::vector<Eigen::Vector3d>& joints,
+std::vector<Primitive> FigurePrimitives(const FigureBuild& build,
+                                        const std::vector<Eigen::Vector3d>& joints,
                                         double heading_rad, int subject, uint64_t seed);
 
 }  // namespace ss::synth

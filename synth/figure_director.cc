@@ -22,9 +22,14 @@ double Wrap(double a) { return std::remainder(a, 2.0 * M_PI); }
 
 class FigureActor {
  public:
-  FigureActor(const FigureBuild& build, uint64_t seed, double lane_x, double lane_half, const Eigen::Vector2d& face,
-              const Studio& studio)
-      : build_(build), rng_(seed), lane_x_(lane_x), lane_half_(lane_half), face_(face), studio_(&studio) {
+  FigureActor(const FigureBuild& build, uint64_t seed, double lane_x, double lane_half,
+              const Eigen::Vector2d& face, const Studio& studio)
+      : build_(build),
+        rng_(seed),
+        lane_x_(lane_x),
+        lane_half_(lane_half),
+        face_(face),
+        studio_(&studio) {
     state_.position = {lane_x + rng_.Uniform(-lane_half, lane_half) * 0.6, rng_.Uniform(-0.4, 0.8)};
     state_.heading_rad = std::atan2(face.y() - state_.position.y(), face.x() - state_.position.x());
     Plan();
@@ -71,7 +76,8 @@ class FigureActor {
     // One walk cycle (two steps) per 1.35 m at full height.
     s.gait_phase += s.speed_mps * dt / (1.35 * build_.height_m / 1.75);
     s.gait_phase -= std::floor(s.gait_phase);
-    const double walk_target = std::min(1.0, s.speed_mps / 0.5) + (action_ == Action::kTurn ? 0.4 : 0.0);
+    const double walk_target =
+        std::min(1.0, s.speed_mps / 0.5) + (action_ == Action::kTurn ? 0.4 : 0.0);
     s.walking += std::clamp(std::min(1.0, walk_target) - s.walking, -3.0 * dt, 3.0 * dt);
   }
 
@@ -97,7 +103,8 @@ class FigureActor {
     plan_.push_back({Action::kWalk, 0, spot});
     plan_.push_back({Action::kTurn, 0, Eigen::Vector2d::Zero(), ArmPose::kRest, true});
     for (ArmPose p : {ArmPose::kY, ArmPose::kM, ArmPose::kC, ArmPose::kA}) {
-      plan_.push_back({Action::kGesture, kGestureIn + kGestureHold * rng_.Uniform(0.8, 1.3), {}, p});
+      plan_.push_back(
+          {Action::kGesture, kGestureIn + kGestureHold * rng_.Uniform(0.8, 1.3), {}, p});
     }
     plan_.push_back({Action::kGesture, kGestureIn + 0.2, {}, ArmPose::kRest});
     Next();
@@ -114,7 +121,8 @@ class FigureActor {
     left_s_ = item.seconds;
     target_ = item.target;
     if (item.action == Action::kTurn) {
-      const Eigen::Vector2d to = item.face_camera ? face_ - state_.position : item.target - state_.position;
+      const Eigen::Vector2d to =
+          item.face_camera ? face_ - state_.position : item.target - state_.position;
       target_heading_ = to.norm() > 1e-6 ? std::atan2(to.y(), to.x()) : state_.heading_rad;
     }
     if (item.action == Action::kGesture) {
@@ -139,7 +147,8 @@ class FigureActor {
 
 class FigureDirector : public Director {
  public:
-  FigureDirector(const Studio& studio, const std::vector<SynthCamera>& cameras, const DirectorOptions& options)
+  FigureDirector(const Studio& studio, const std::vector<SynthCamera>& cameras,
+                 const DirectorOptions& options)
       : studio_(studio), options_(options) {
     const Eigen::Vector3d cam = cameras.front().CentreInGround();
     const int n = std::max(1, options.subjects);
@@ -149,7 +158,8 @@ class FigureDirector : public Director {
       const double lane_x = -0.5 * span + (2 * i + 1) * lane_half;
       // Alternate builds when several figures share a session.
       const int variant = (options.figure_variant + i) % 2;
-      actors_.emplace_back(FigureBuildFor(variant), StreamSeed(options.seed, "figure-timeline", static_cast<uint64_t>(i)),
+      actors_.emplace_back(FigureBuildFor(variant),
+                           StreamSeed(options.seed, "figure-timeline", static_cast<uint64_t>(i)),
                            lane_x, std::max(0.05, lane_half - 0.35), cam.head<2>(), studio);
       variants_.push_back(variant);
     }
@@ -172,8 +182,9 @@ class FigureDirector : public Director {
       for (size_t i = 0; i < actors_.size(); ++i) {
         const auto& a = actors_[i];
         joints[i] = FigureJoints(a.build(), a.state());
-        auto prims = FigurePrimitives(a.build(), joints[i], a.state().heading_rad, static_cast<int>(i),
-                                      StreamSeed(options_.seed, "figure-look", i));
+        auto prims =
+            FigurePrimitives(a.build(), joints[i], a.state().heading_rad, static_cast<int>(i),
+                             StreamSeed(options_.seed, "figure-look", i));
         for (auto& p : prims) p.slice = sl;
         out->scene.primitives.insert(out->scene.primitives.end(), prims.begin(), prims.end());
       }
@@ -233,9 +244,11 @@ class FigureDirector : public Director {
 
 }  // namespace
 
-std::unique_ptr<Director> MakeFigureDirector(const Studio& studio, const std::vector<SynthCamera>& cameras,
+std::unique_ptr<Director> MakeFigureDirector(const Studio& studio,
+                                             const std::vector<SynthCamera>& cameras,
                                              const DirectorOptions& options) {
-  if (studio.kind != StudioKind::kStage) throw InputError("kind", "figures perform on the stage studio");
+  if (studio.kind != StudioKind::kStage)
+    throw InputError("kind", "figures perform on the stage studio");
   return std::make_unique<FigureDirector>(studio, cameras, options);
 }
 

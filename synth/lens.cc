@@ -11,14 +11,17 @@ namespace ss::synth {
 
 Lens::Lens(const std::string& lensmodel, const std::vector<double>& intrinsics) {
   if (lensmodel == "LENSMODEL_PINHOLE") {
-    if (intrinsics.size() != 4) throw InputError("lensmodel", "LENSMODEL_PINHOLE needs 4 intrinsics");
+    if (intrinsics.size() != 4)
+      throw InputError("lensmodel", "LENSMODEL_PINHOLE needs 4 intrinsics");
     distorted_ = false;
   } else if (lensmodel == "LENSMODEL_OPENCV8") {
-    if (intrinsics.size() != 12) throw InputError("lensmodel", "LENSMODEL_OPENCV8 needs 12 intrinsics");
+    if (intrinsics.size() != 12)
+      throw InputError("lensmodel", "LENSMODEL_OPENCV8 needs 12 intrinsics");
     distorted_ = true;
   } else {
-    throw InputError("lensmodel", "the synthetic studio renders LENSMODEL_PINHOLE or LENSMODEL_OPENCV8, not " +
-                                      lensmodel);
+    throw InputError(
+        "lensmodel",
+        "the synthetic studio renders LENSMODEL_PINHOLE or LENSMODEL_OPENCV8, not " + lensmodel);
   }
   for (size_t i = 0; i < intrinsics.size(); ++i) k_[i] = intrinsics[i];
 }
@@ -52,8 +55,10 @@ Eigen::Vector3d Lens::Unproject(const Eigen::Vector2d& pixel) const {
       if (f.squaredNorm() < 1e-24) break;
       const double h = 1e-7;
       Eigen::Matrix2d j;
-      j.col(0) = (Distort(n + Eigen::Vector2d(h, 0)) - Distort(n - Eigen::Vector2d(h, 0))) / (2 * h);
-      j.col(1) = (Distort(n + Eigen::Vector2d(0, h)) - Distort(n - Eigen::Vector2d(0, h))) / (2 * h);
+      j.col(0) =
+          (Distort(n + Eigen::Vector2d(h, 0)) - Distort(n - Eigen::Vector2d(h, 0))) / (2 * h);
+      j.col(1) =
+          (Distort(n + Eigen::Vector2d(0, h)) - Distort(n - Eigen::Vector2d(0, h))) / (2 * h);
       n -= j.inverse() * f;
     }
   }

@@ -40,15 +40,15 @@ class Lens {
 
 // One synthetic camera: its lens, imager size and pose against the ground.
 struct SynthCamera {
-  std::string name;                 // "cam0"
-  std::string lensmodel;            // "LENSMODEL_OPENCV8"
-  std::vector<double> intrinsics;   // mrcal order
+  std::string name;                // "cam0"
+  std::string lensmodel;           // "LENSMODEL_OPENCV8"
+  std::vector<double> intrinsics;  // mrcal order
   int width = 0;
   int height = 0;
   Rigid3 cam_from_ground;
   Lens lens;
-  double gain[3] = {1, 1, 1};       // per-channel sensor gains, B G R
-  double vignetting = 0.2;          // relative fall-off at the image corner
+  double gain[3] = {1, 1, 1};  // per-channel sensor gains, B G R
+  double vignetting = 0.2;     // relative fall-off at the image corner
 
   Eigen::Vector3d CentreInGround() const { return cam_from_ground.Inverse().translation; }
   Eigen::Vector2d ProjectGround(const Eigen::Vector3d& point_in_ground) const {

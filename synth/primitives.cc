@@ -68,8 +68,8 @@ std::vector<Eigen::Vector3d> Primitive::BoxPoints() const {
 namespace {
 
 // Contour circle of the ellipsoid {centre + axes s : |s| = 1} seen from `eye`.
-void EllipsoidContour(const Eigen::Vector3d& centre, const Eigen::Matrix3d& axes, const Eigen::Vector3d& eye,
-                      int n, std::vector<Eigen::Vector3d>* out) {
+void EllipsoidContour(const Eigen::Vector3d& centre, const Eigen::Matrix3d& axes,
+                      const Eigen::Vector3d& eye, int n, std::vector<Eigen::Vector3d>* out) {
   const Eigen::Vector3d o = axes.inverse() * (eye - centre);
   const double oo = o.squaredNorm();
   if (oo <= 1.0) return;
@@ -95,7 +95,8 @@ std::vector<Eigen::Vector3d> Primitive::ContourPoints(const Eigen::Vector3d& eye
     const int spheres = std::max(2, static_cast<int>(std::ceil(len / (0.4 * radius))) + 1);
     const Eigen::Matrix3d axes_r = radius * Eigen::Matrix3d::Identity();
     for (int i = 0; i < spheres; ++i) {
-      EllipsoidContour(a + (b - a) * (static_cast<double>(i) / (spheres - 1)), axes_r, eye, n, &pts);
+      EllipsoidContour(a + (b - a) * (static_cast<double>(i) / (spheres - 1)), axes_r, eye, n,
+                       &pts);
     }
   }
   return pts;
@@ -122,7 +123,8 @@ double Primitive::Intersect(const Eigen::Vector3d& origin, const Eigen::Vector3d
     return t > 0 ? t : -1;
   }
   const Eigen::Vector3d ba = b - a, oa = origin - a;
-  const double baba = ba.dot(ba), bard = ba.dot(d), baoa = ba.dot(oa), rdoa = d.dot(oa), oaoa = oa.dot(oa);
+  const double baba = ba.dot(ba), bard = ba.dot(d), baoa = ba.dot(oa), rdoa = d.dot(oa),
+               oaoa = oa.dot(oa);
   const double qa = baba - bard * bard, qb = baba * rdoa - baoa * bard,
                qc = baba * oaoa - baoa * baoa - radius * radius * baba;
   const double h = qb * qb - qa * qc;
@@ -248,8 +250,8 @@ Eigen::Vector3d LocalCoordinates(const Primitive& prim, const Eigen::Vector3d& p
 
 }  // namespace
 
-Eigen::Vector3d Shade(const Primitive& prim, const Eigen::Vector3d& point, const Eigen::Vector3d& view_dir,
-                      const Lighting& lighting) {
+Eigen::Vector3d Shade(const Primitive& prim, const Eigen::Vector3d& point,
+                      const Eigen::Vector3d& view_dir, const Lighting& lighting) {
   const Material& mat = prim.material;
   const Eigen::Vector3d n = prim.Normal(point);
   const Eigen::Vector3d local = LocalCoordinates(prim, point);
@@ -257,11 +259,13 @@ Eigen::Vector3d Shade(const Primitive& prim, const Eigen::Vector3d& point, const
   const double s = mat.texture_scale;
   switch (mat.pattern) {
     case Pattern::kPlain:
-      albedo *= 1.0 + mat.texture * ValueNoise3(mat.seed, local.x() * s, local.y() * s, local.z() * s);
+      albedo *=
+          1.0 + mat.texture * ValueNoise3(mat.seed, local.x() * s, local.y() * s, local.z() * s);
       break;
     case Pattern::kFur: {
       // Streaks along the local x axis (the body's length) and a lighter underside/muzzle.
-      const double fur = Fbm3(mat.seed, local.x() * s * 0.5, local.y() * s * 2.0, local.z() * s * 2.0, 3);
+      const double fur =
+          Fbm3(mat.seed, local.x() * s * 0.5, local.y() * s * 2.0, local.z() * s * 2.0, 3);
       const double belly = std::clamp((-local.z() - 0.25) / 0.35, 0.0, 1.0);
       const double muzzle = std::clamp((local.x() - 0.55) / 0.3, 0.0, 1.0);
       const double light = std::max(belly, muzzle);
@@ -271,15 +275,19 @@ Eigen::Vector3d Shade(const Primitive& prim, const Eigen::Vector3d& point, const
     }
     case Pattern::kLimb: {
       // Capsules: axis fraction 0 at a (upper end); ellipsoids: local z (lower end below).
-      const double lower = prim.shape == Shape::kCapsule ? std::clamp((local.x() - 0.6) / 0.3, 0.0, 1.0)
-                                                         : std::clamp((-local.z() - 0.2) / 0.4, 0.0, 1.0);
+      const double lower = prim.shape == Shape::kCapsule
+                               ? std::clamp((local.x() - 0.6) / 0.3, 0.0, 1.0)
+                               : std::clamp((-local.z() - 0.2) / 0.4, 0.0, 1.0);
       albedo = albedo * (1.0 - lower) + mat.colour2.cast<double>() * lower;
-      albedo *= 1.0 + mat.texture * ValueNoise3(mat.seed, local.x() * s, local.y() * s, local.z() * s);
+      albedo *=
+          1.0 + mat.texture * ValueNoise3(mat.seed, local.x() * s, local.y() * s, local.z() * s);
       break;
     }
     case Pattern::kCloth: {
-      const double folds = Fbm3(mat.seed, local.x() * s * 0.3, local.y() * s * 0.3, local.z() * s * 0.3, 2);
-      const double weave = ValueNoise3(Mix(mat.seed, 5), local.x() * s * 4, local.y() * s * 4, local.z() * s * 4);
+      const double folds =
+          Fbm3(mat.seed, local.x() * s * 0.3, local.y() * s * 0.3, local.z() * s * 0.3, 2);
+      const double weave =
+          ValueNoise3(Mix(mat.seed, 5), local.x() * s * 4, local.y() * s * 4, local.z() * s * 4);
       albedo *= 1.0 + mat.texture * (folds + 0.3 * weave);
       break;
     }

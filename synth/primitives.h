@@ -32,13 +32,14 @@ enum class Shape : uint8_t { kEllipsoid, kCapsule };
 
 struct Primitive {
   Shape shape = Shape::kEllipsoid;
-  int subject = 0;        // which subject it belongs to
-  int slice = 0;          // motion-blur time slice
+  int subject = 0;  // which subject it belongs to
+  int slice = 0;    // motion-blur time slice
   Material material;
-  Eigen::Vector3d centre = Eigen::Vector3d::Zero();      // ellipsoid
-  Eigen::Matrix3d axes = Eigen::Matrix3d::Identity();    // ellipsoid: columns = semi-axis vectors (ground)
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();  // ellipsoid
+  Eigen::Matrix3d axes =
+      Eigen::Matrix3d::Identity();  // ellipsoid: columns = semi-axis vectors (ground)
   Eigen::Vector3d a = Eigen::Vector3d::Zero(), b = Eigen::Vector3d::Zero();  // capsule end points
-  double radius = 0.0;                                   // capsule
+  double radius = 0.0;                                                       // capsule
 
   static Primitive Ellipsoid(const Eigen::Vector3d& centre, const Eigen::Matrix3d& rotation,
                              const Eigen::Vector3d& radii, const Material& material);
@@ -65,20 +66,20 @@ struct Lighting {
 };
 
 // Radiance (B G R, 0..255 before camera gain and vignetting) of a subject surface point.
-Eigen::Vector3d Shade(const Primitive& prim, const Eigen::Vector3d& point, const Eigen::Vector3d& view_dir,
-                      const Lighting& lighting);
+Eigen::Vector3d Shade(const Primitive& prim, const Eigen::Vector3d& point,
+                      const Eigen::Vector3d& view_dir, const Lighting& lighting);
 
 // A primitive in one camera's terms (floats, relative to the camera centre).
 struct PreparedPrimitive {
-  int index = 0;          // into the frame's primitive list
+  int index = 0;  // into the frame's primitive list
   int subject = 0;
   int slice = 0;
   Shape shape = Shape::kEllipsoid;
   int x0 = 0, y0 = 0, x1 = -1, y1 = -1;  // pixel bounding box, inclusive
-  float m[9] = {};        // ellipsoid: inverse of axes (row-major)
-  float o[3] = {};        // ellipsoid: eye in unit-sphere coordinates; capsule: eye - a
-  float c = 0;            // ellipsoid: |o|^2 - 1; capsule: r^2
-  float ba[3] = {};       // capsule: b - a
+  float m[9] = {};                       // ellipsoid: inverse of axes (row-major)
+  float o[3] = {};   // ellipsoid: eye in unit-sphere coordinates; capsule: eye - a
+  float c = 0;       // ellipsoid: |o|^2 - 1; capsule: r^2
+  float ba[3] = {};  // capsule: b - a
   float baba = 0, baoa = 0, oaoa = 0;
 
   // Hit distance along the unit direction `d`, or -1.

@@ -65,7 +65,8 @@ double ValueNoise2(uint64_t seed, double x, double y) {
 
 double ValueNoise3(uint64_t seed, double x, double y, double z) {
   const double fx = std::floor(x), fy = std::floor(y), fz = std::floor(z);
-  const auto ix = static_cast<int64_t>(fx), iy = static_cast<int64_t>(fy), iz = static_cast<int64_t>(fz);
+  const auto ix = static_cast<int64_t>(fx), iy = static_cast<int64_t>(fy),
+             iz = static_cast<int64_t>(fz);
   const double tx = Fade(x - fx), ty = Fade(y - fy), tz = Fade(z - fz);
   double v[2];
   for (int k = 0; k < 2; ++k) {

@@ -17,11 +17,11 @@ class Rng {
  public:
   explicit Rng(uint64_t seed) : engine_(seed) {}
   uint64_t Bits() { return engine_(); }
-  double Uniform();                                   // [0, 1), 53 bits
+  double Uniform();  // [0, 1), 53 bits
   double Uniform(double lo, double hi) { return lo + (hi - lo) * Uniform(); }
-  int UniformInt(int lo, int hi);                     // [lo, hi] inclusive
+  int UniformInt(int lo, int hi);  // [lo, hi] inclusive
   bool Chance(double probability) { return Uniform() < probability; }
-  double Normal();                                    // standard normal, Box-Muller
+  double Normal();  // standard normal, Box-Muller
   double Normal(double mean, double sigma) { return mean + sigma * Normal(); }
 
  private:

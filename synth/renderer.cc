@@ -13,12 +13,15 @@
 namespace ss::synth {
 namespace {
 
-inline uint8_t ToByte(double v) { return static_cast<uint8_t>(std::clamp(std::lround(v), 0L, 255L)); }
+inline uint8_t ToByte(double v) {
+  return static_cast<uint8_t>(std::clamp(std::lround(v), 0L, 255L));
+}
 
 cv::Rect Clip(cv::Rect r, int width, int height) { return r & cv::Rect(0, 0, width, height); }
 
 // Pixel box of the projections of `points`; the whole image when one is behind the camera.
-cv::Rect ProjectedBox(const SynthCamera& cam, const std::vector<Eigen::Vector3d>& points, double margin) {
+cv::Rect ProjectedBox(const SynthCamera& cam, const std::vector<Eigen::Vector3d>& points,
+                      double margin) {
   double x0 = 1e30, y0 = 1e30, x1 = -1e30, y1 = -1e30;
   for (const auto& p : points) {
     const Eigen::Vector2d px = cam.ProjectGround(p);
@@ -34,7 +37,8 @@ cv::Rect ProjectedBox(const SynthCamera& cam, const std::vector<Eigen::Vector3d>
   y1 = std::min(cam.height + 1.0, y1 + margin);
   if (x1 < x0 || y1 < y0) return {};
   const int ix0 = static_cast<int>(std::floor(x0)), iy0 = static_cast<int>(std::floor(y0));
-  return Clip(cv::Rect(ix0, iy0, static_cast<int>(std::ceil(x1)) - ix0 + 1, static_cast<int>(std::ceil(y1)) - iy0 + 1),
+  return Clip(cv::Rect(ix0, iy0, static_cast<int>(std::ceil(x1)) - ix0 + 1,
+                       static_cast<int>(std::ceil(y1)) - iy0 + 1),
               cam.width, cam.height);
 }
 
@@ -88,7 +92,8 @@ CameraRenderer::CameraRenderer(const SynthCamera& camera, const Studio& studio)
   for (int y = 0; y < h; ++y) {
     for (int x = 0; x < w; ++x) {
       const double r = std::hypot(x - cx, y - cy) / r_corner;
-      vignette_[y * w + x] = static_cast<float>(1.0 - camera_.vignetting * (0.7 * r * r + 0.3 * r * r * r * r));
+      vignette_[y * w + x] =
+          static_cast<float>(1.0 - camera_.vignetting * (0.7 * r * r + 0.3 * r * r * r * r));
     }
   }
   // The clean plate, 2 x 2 samples per pixel.
@@ -125,7 +130,8 @@ CameraRenderer::CameraRenderer(const SynthCamera& camera, const Studio& studio)
       for (int dy = -1; dy <= 1; ++dy) {
         for (int dx = -1; dx <= 1; ++dx) {
           const int xx = x + dx, yy = y + dy;
-          if (xx >= 0 && yy >= 0 && xx < w && yy < h) bg_edge_[static_cast<size_t>(yy) * w + xx] = 1;
+          if (xx >= 0 && yy >= 0 && xx < w && yy < h)
+            bg_edge_[static_cast<size_t>(yy) * w + xx] = 1;
         }
       }
     }
@@ -197,7 +203,8 @@ void CameraRenderer::DrawShadows(const FrameScene& scene, CameraImage* out) cons
       const Eigen::Matrix2d q = (p.axes * p.axes.transpose()).topLeftCorner<2, 2>();
       c.c = p.centre.head<2>();
       c.q_inv = q.inverse();
-      c.r_min = std::sqrt(std::max(1e-12, Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(q).eigenvalues().minCoeff()));
+      c.r_min = std::sqrt(std::max(
+          1e-12, Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(q).eigenvalues().minCoeff()));
       const Eigen::Vector2d ext(std::sqrt(q(0, 0)), std::sqrt(q(1, 1)));
       lo = c.c - ext;
       hi = c.c + ext;
@@ -238,7 +245,9 @@ void CameraRenderer::DrawShadows(const FrameScene& scene, CameraImage* out) cons
           sd = dn >= 1.0 ? rel.norm() * (1.0 - 1.0 / dn) : (dn - 1.0) * c.r_min;
         } else {
           const Eigen::Vector2d ab = c.b - c.a;
-          const double s = ab.squaredNorm() > 1e-18 ? std::clamp((p - c.a).dot(ab) / ab.squaredNorm(), 0.0, 1.0) : 0.0;
+          const double s = ab.squaredNorm() > 1e-18
+                               ? std::clamp((p - c.a).dot(ab) / ab.squaredNorm(), 0.0, 1.0)
+                               : 0.0;
           sd = (p - (c.a + s * ab)).norm() - c.radius;
         }
         const double hz = std::max(0.0, c.z_bottom - pz);
@@ -286,7 +295,8 @@ void CameraRenderer::DrawBoards(const FrameScene& scene, CameraImage* out) const
     const double m = spec.margin_m;
     std::vector<Eigen::Vector3d> corners;
     for (double x : {-m, spec.width_m() + m}) {
-      for (double y : {-m, spec.height_m() + m}) corners.push_back(board.ground_from_board * Eigen::Vector3d(x, y, 0));
+      for (double y : {-m, spec.height_m() + m})
+        corners.push_back(board.ground_from_board * Eigen::Vector3d(x, y, 0));
     }
     const cv::Rect box = ProjectedBox(camera_, corners, 3.0);
     const Eigen::Matrix3f rt = r.transpose().cast<float>();
@@ -304,10 +314,13 @@ void CameraRenderer::DrawBoards(const FrameScene& scene, CameraImage* out) const
       if (v < 0) return -1;
       return front ? v : 2;
     };
-    auto colour = [&](int v) -> const Eigen::Vector3d& { return v == 0 ? black : (v == 1 ? white : back); };
+    auto colour = [&](int v) -> const Eigen::Vector3d& {
+      return v == 0 ? black : (v == 1 ? white : back);
+    };
     for (int y = box.y; y < box.y + box.height; ++y) {
       for (int x = box.x; x < box.x + box.width; ++x) {
-        const float taps[5][2] = {{0.02f, 0.02f}, {0.98f, 0.02f}, {0.02f, 0.98f}, {0.98f, 0.98f}, {0.5f, 0.5f}};
+        const float taps[5][2] = {
+            {0.02f, 0.02f}, {0.98f, 0.02f}, {0.02f, 0.98f}, {0.98f, 0.98f}, {0.5f, 0.5f}};
         int v0 = -2;
         bool uniform = true;
         for (const auto& tap : taps) {
@@ -333,7 +346,8 @@ void CameraRenderer::DrawBoards(const FrameScene& scene, CameraImage* out) const
           constexpr int kBoardSamples = kSubsamples;
           static_assert(kBoardSamples == 16, "the n-rooks pattern below is for 16 samples");
           for (int s = 0; s < kBoardSamples; ++s) {
-            const float ox = (s + 0.5f) / kBoardSamples, oy = ((s * 7) % kBoardSamples + 0.5f) / kBoardSamples;
+            const float ox = (s + 0.5f) / kBoardSamples,
+                        oy = ((s * 7) % kBoardSamples + 0.5f) / kBoardSamples;
             const int v = sample(x, y, RayAt(x - 0.5f + ox, y - 0.5f + oy));
             if (v < 0) continue;
             sum += colour(v) / kBoardSamples;
@@ -342,7 +356,8 @@ void CameraRenderer::DrawBoards(const FrameScene& scene, CameraImage* out) const
         }
         const float vig = vignette_[static_cast<size_t>(y) * w + x];
         cv::Vec3b& px = out->bgr.at<cv::Vec3b>(y, x);
-        for (int k = 0; k < 3; ++k) px[k] = ToByte(sum[k] * camera_.gain[k] * vig + (1.0 - coverage) * px[k]);
+        for (int k = 0; k < 3; ++k)
+          px[k] = ToByte(sum[k] * camera_.gain[k] * vig + (1.0 - coverage) * px[k]);
       }
     }
   }
@@ -372,7 +387,7 @@ void CameraRenderer::DrawSubjects(const FrameScene& scene, CameraImage* out) con
   const float eye_z = static_cast<float>(eye_.z());
 
   struct Sample {
-    int prim = -1;      // index into `prepared`, -1 background
+    int prim = -1;  // index into `prepared`, -1 background
     float t = 0;
     uint64_t seen = 0;  // subjects hit at all (above the floor), occluded or not
   };
@@ -414,7 +429,8 @@ void CameraRenderer::DrawSubjects(const FrameScene& scene, CameraImage* out) con
       cv::Vec3b& px = out->bgr.at<cv::Vec3b>(y, x);
       // Uniform pixels (no motion blur only).
       if (slices == 1) {
-        const float taps[5][2] = {{0.02f, 0.02f}, {0.98f, 0.02f}, {0.02f, 0.98f}, {0.98f, 0.98f}, {0.5f, 0.5f}};
+        const float taps[5][2] = {
+            {0.02f, 0.02f}, {0.98f, 0.02f}, {0.02f, 0.98f}, {0.98f, 0.98f}, {0.5f, 0.5f}};
         Sample centre;
         bool uniform = true;
         int first = -2;
@@ -429,7 +445,8 @@ void CameraRenderer::DrawSubjects(const FrameScene& scene, CameraImage* out) con
         if (uniform && first == -1) continue;
         if (uniform) {
           const PreparedPrimitive& p = prepared[first];
-          const Eigen::Vector3d d = RayAt(static_cast<float>(x), static_cast<float>(y)).cast<double>();
+          const Eigen::Vector3d d =
+              RayAt(static_cast<float>(x), static_cast<float>(y)).cast<double>();
           const Eigen::Vector3d c = shade(first, eye_ + static_cast<double>(centre.t) * d, d);
           for (int k = 0; k < 3; ++k) px[k] = ToByte(c[k] * camera_.gain[k] * vig);
           alpha[p.subject].at<uint8_t>(y - all.y, x - all.x) = 255;
@@ -460,12 +477,14 @@ void CameraRenderer::DrawSubjects(const FrameScene& scene, CameraImage* out) con
         const Eigen::Vector3d point = eye_ + static_cast<double>(smp.t) * dd;
         int g = 0;
         while (g < n_groups && groups[g].prim != smp.prim) ++g;
-        if (g == n_groups) groups[n_groups++] = {smp.prim, 0, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
+        if (g == n_groups)
+          groups[n_groups++] = {smp.prim, 0, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
         groups[g].count += 1;
         groups[g].point += point;
         groups[g].dir += dd;
       }
-      for (int k = 0; k < scene.subjects; ++k) out->unoccluded_px[k] += seen_count[k] / double(kSubsamples);
+      for (int k = 0; k < scene.subjects; ++k)
+        out->unoccluded_px[k] += seen_count[k] / double(kSubsamples);
       if (covered == 0) continue;
       Eigen::Vector3d sum = Eigen::Vector3d::Zero();
       std::array<int, 64> subject_count{};
@@ -476,7 +495,8 @@ void CameraRenderer::DrawSubjects(const FrameScene& scene, CameraImage* out) con
         subject_count[prepared[gr.prim].subject] += gr.count;
       }
       const double coverage = static_cast<double>(covered) / kSubsamples;
-      for (int k = 0; k < 3; ++k) px[k] = ToByte(sum[k] * camera_.gain[k] * vig + (1.0 - coverage) * px[k]);
+      for (int k = 0; k < 3; ++k)
+        px[k] = ToByte(sum[k] * camera_.gain[k] * vig + (1.0 - coverage) * px[k]);
       for (int k = 0; k < scene.subjects; ++k) {
         if (subject_count[k] == 0) continue;
         alpha[k].at<uint8_t>(y - all.y, x - all.x) = ToByte(255.0 * subject_count[k] / kSubsamples);
@@ -499,7 +519,8 @@ Sensor::Sensor(uint64_t seed, int camera, double noise) : seed_(seed), camera_(c
   }
 }
 
-std::vector<uint8_t> Sensor::Capture(const cv::Mat& bgr, PixelFormat format, uint64_t frame_index) const {
+std::vector<uint8_t> Sensor::Capture(const cv::Mat& bgr, PixelFormat format,
+                                     uint64_t frame_index) const {
   const int w = bgr.cols, h = bgr.rows;
   Rng rng(StreamSeed(seed_, "sensor-frame", (static_cast<uint64_t>(camera_) << 40) ^ frame_index));
   const size_t table = table_.size();
@@ -543,7 +564,8 @@ std::vector<uint8_t> Sensor::Capture(const cv::Mat& bgr, PixelFormat format, uin
             const int channel = (y % 2 == 0) ? (x % 2 == 0 ? 2 : 1) : (x % 2 == 0 ? 1 : 0);
             v = src[3 * x + channel];
           } else {
-            v = static_cast<uint8_t>((src[3 * x] * 29 + src[3 * x + 1] * 150 + src[3 * x + 2] * 77 + 128) >> 8);
+            v = static_cast<uint8_t>(
+                (src[3 * x] * 29 + src[3 * x + 1] * 150 + src[3 * x + 2] * 77 + 128) >> 8);
           }
           dst[x] = noisy(v, n[x]);
         }
@@ -551,8 +573,9 @@ std::vector<uint8_t> Sensor::Capture(const cv::Mat& bgr, PixelFormat format, uin
       break;
     }
     default:
-      throw InputError("pixel-format", "the synthetic camera delivers rgb8, bgr8, bayer_rg8 or mono8, not " +
-                                           PixelFormatName(format));
+      throw InputError("pixel-format",
+                       "the synthetic camera delivers rgb8, bgr8, bayer_rg8 or mono8, not " +
+                           PixelFormatName(format));
   }
   return bytes;
 }

@@ -33,17 +33,17 @@ struct FrameScene {
 
 // A crop of a full-frame 8-bit matte.
 struct MatteLayer {
-  int subject = -1;    // -1: the shadow matte
-  cv::Rect box;        // in the image; empty when nothing is set
-  cv::Mat values;      // CV_8U, box.size()
+  int subject = -1;  // -1: the shadow matte
+  cv::Rect box;      // in the image; empty when nothing is set
+  cv::Mat values;    // CV_8U, box.size()
 };
 
 struct CameraImage {
-  cv::Mat bgr;                         // CV_8UC3 noise-free composite
-  std::vector<MatteLayer> alpha;       // one per subject (may be empty), index = subject
-  MatteLayer shadow;                   // how much the floor/walls were darkened (255 = black)
-  std::vector<double> visible_px;      // per subject: rendered coverage in pixels
-  std::vector<double> unoccluded_px;   // per subject: coverage had nothing been in front
+  cv::Mat bgr;                        // CV_8UC3 noise-free composite
+  std::vector<MatteLayer> alpha;      // one per subject (may be empty), index = subject
+  MatteLayer shadow;                  // how much the floor/walls were darkened (255 = black)
+  std::vector<double> visible_px;     // per subject: rendered coverage in pixels
+  std::vector<double> unoccluded_px;  // per subject: coverage had nothing been in front
 };
 
 inline constexpr int kSubsamples = 16;  // 4 x 4 per pixel
@@ -58,7 +58,9 @@ class CameraRenderer {
   Eigen::Vector3f RayAt(float x, float y) const;
   // Background point seen through the centre of pixel (x, y).
   Eigen::Vector3f BackgroundPoint(int x, int y) const { return bg_point_[y * camera_.width + x]; }
-  Surface BackgroundSurface(int x, int y) const { return static_cast<Surface>(bg_surface_[y * camera_.width + x]); }
+  Surface BackgroundSurface(int x, int y) const {
+    return static_cast<Surface>(bg_surface_[y * camera_.width + x]);
+  }
   void Render(const FrameScene& scene, CameraImage* out) const;
 
  private:
@@ -72,11 +74,11 @@ class CameraRenderer {
   const Studio* studio_;
   Eigen::Vector3d eye_;
   Lighting lighting_;
-  std::vector<float> corner_rays_;     // (W+1) x (H+1) x 3, unit, at pixel corners
+  std::vector<float> corner_rays_;  // (W+1) x (H+1) x 3, unit, at pixel corners
   std::vector<Eigen::Vector3f> bg_point_;
   std::vector<uint8_t> bg_surface_;
-  std::vector<int16_t> bg_quad_;       // quad seen at the pixel centre
-  std::vector<uint8_t> bg_edge_;       // 1 where more than one quad is in (or next to) the pixel
+  std::vector<int16_t> bg_quad_;        // quad seen at the pixel centre
+  std::vector<uint8_t> bg_edge_;        // 1 where more than one quad is in (or next to) the pixel
   std::vector<float> quad_n_, quad_k_;  // per quad: normal, n.(origin - eye)
   std::vector<float> vignette_;
   cv::Mat plate_;
@@ -93,8 +95,8 @@ class Sensor {
  private:
   uint64_t seed_;
   int camera_;
-  std::vector<float> table_;   // standard normal samples
-  float sigma_[256];           // noise sigma per intensity, in DN
+  std::vector<float> table_;  // standard normal samples
+  float sigma_[256];          // noise sigma per intensity, in DN
 };
 
 }  // namespace ss::synth

@@ -27,7 +27,8 @@ Quad MakeQuad(const Eigen::Vector3d& origin, Eigen::Vector3d u, Eigen::Vector3d 
   return q;
 }
 
-double SegmentDistance(const Eigen::Vector2d& p, const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+double SegmentDistance(const Eigen::Vector2d& p, const Eigen::Vector2d& a,
+                       const Eigen::Vector2d& b) {
   const Eigen::Vector2d ab = b - a;
   const double s = std::clamp((p - a).dot(ab) / ab.squaredNorm(), 0.0, 1.0);
   return (p - (a + s * ab)).norm();
@@ -47,7 +48,9 @@ Eigen::Vector3d GreenPaper(uint64_t seed, double s, double t) {
 
 }  // namespace
 
-std::string StudioKindName(StudioKind kind) { return kind == StudioKind::kEnclosure ? "enclosure" : "stage"; }
+std::string StudioKindName(StudioKind kind) {
+  return kind == StudioKind::kEnclosure ? "enclosure" : "stage";
+}
 
 Studio MakeStudio(StudioKind kind, uint64_t seed, bool room_backdrop) {
   Studio s;
@@ -73,23 +76,24 @@ Studio MakeStudio(StudioKind kind, uint64_t seed, bool room_backdrop) {
   s.floor = GroundPolygon({{-hx, -hy}, {hx, -hy}, {hx, hy}, {-hx, hy}});
   using V = Eigen::Vector3d;
   // [0]: the whole floor of the room; green where the floor polygon holds the point.
-  s.quads.push_back(MakeQuad(V(-room_x, -room_y, 0), V(2 * room_x, 0, 0), V(0, 2 * room_y, 0), V::UnitZ(),
-                             Surface::kRoomFloor, Surface::kRoomFloor));
+  s.quads.push_back(MakeQuad(V(-room_x, -room_y, 0), V(2 * room_x, 0, 0), V(0, 2 * room_y, 0),
+                             V::UnitZ(), Surface::kRoomFloor, Surface::kRoomFloor));
   // Room walls and ceiling, facing in.
-  s.quads.push_back(MakeQuad(V(-room_x, -room_y, 0), V(2 * room_x, 0, 0), V(0, 0, room_z), V::UnitY(),
-                             Surface::kRoomWall, Surface::kRoomWall));
-  s.quads.push_back(MakeQuad(V(-room_x, room_y, 0), V(2 * room_x, 0, 0), V(0, 0, room_z), -V::UnitY(),
-                             Surface::kRoomWall, Surface::kRoomWall));
-  s.quads.push_back(MakeQuad(V(-room_x, -room_y, 0), V(0, 2 * room_y, 0), V(0, 0, room_z), V::UnitX(),
-                             Surface::kRoomWall, Surface::kRoomWall));
-  s.quads.push_back(MakeQuad(V(room_x, -room_y, 0), V(0, 2 * room_y, 0), V(0, 0, room_z), -V::UnitX(),
-                             Surface::kRoomWall, Surface::kRoomWall));
-  s.quads.push_back(MakeQuad(V(-room_x, -room_y, room_z), V(2 * room_x, 0, 0), V(0, 2 * room_y, 0), -V::UnitZ(),
-                             Surface::kCeiling, Surface::kCeiling));
+  s.quads.push_back(MakeQuad(V(-room_x, -room_y, 0), V(2 * room_x, 0, 0), V(0, 0, room_z),
+                             V::UnitY(), Surface::kRoomWall, Surface::kRoomWall));
+  s.quads.push_back(MakeQuad(V(-room_x, room_y, 0), V(2 * room_x, 0, 0), V(0, 0, room_z),
+                             -V::UnitY(), Surface::kRoomWall, Surface::kRoomWall));
+  s.quads.push_back(MakeQuad(V(-room_x, -room_y, 0), V(0, 2 * room_y, 0), V(0, 0, room_z),
+                             V::UnitX(), Surface::kRoomWall, Surface::kRoomWall));
+  s.quads.push_back(MakeQuad(V(room_x, -room_y, 0), V(0, 2 * room_y, 0), V(0, 0, room_z),
+                             -V::UnitX(), Surface::kRoomWall, Surface::kRoomWall));
+  s.quads.push_back(MakeQuad(V(-room_x, -room_y, room_z), V(2 * room_x, 0, 0), V(0, 2 * room_y, 0),
+                             -V::UnitZ(), Surface::kCeiling, Surface::kCeiling));
   // Green walls, green on the inside.
   auto wall = [&](const V& a, const V& b, const V& inward) {
     s.green_walls.push_back(static_cast<int>(s.quads.size()));
-    s.quads.push_back(MakeQuad(a, b - a, V(0, 0, h), inward, Surface::kGreenWall, Surface::kWallOutside));
+    s.quads.push_back(
+        MakeQuad(a, b - a, V(0, 0, h), inward, Surface::kGreenWall, Surface::kWallOutside));
   };
   if (kind == StudioKind::kEnclosure) wall(V(-hx, -hy, 0), V(hx, -hy, 0), V::UnitY());
   wall(V(-hx, hy, 0), V(hx, hy, 0), -V::UnitY());
@@ -131,7 +135,9 @@ double Studio::DistanceToWall(const Eigen::Vector2d& p) const {
   return d;
 }
 
-Eigen::Vector3d Studio::FloorBounce() const { return 255.0 * Eigen::Vector3d(0.20, 0.60, 0.17) * 1.05; }
+Eigen::Vector3d Studio::FloorBounce() const {
+  return 255.0 * Eigen::Vector3d(0.20, 0.60, 0.17) * 1.05;
+}
 
 Eigen::Vector3d Studio::Radiance(const BackgroundHit& hit) const {
   const Eigen::Vector3d& p = hit.point;
@@ -147,7 +153,10 @@ Eigen::Vector3d Studio::Radiance(const BackgroundHit& hit) const {
       const double sheet_pos = (p.x() + half_x) / 0.5 + 0.37;
       const double sheet = std::floor(sheet_pos);
       const double seam = std::abs(sheet_pos - std::round(sheet_pos)) * 0.5;
-      albedo *= 1.0 + 0.035 * (static_cast<double>(Mix(seed, static_cast<uint64_t>(sheet + 100)) % 1000) / 500.0 - 1.0);
+      albedo *=
+          1.0 + 0.035 * (static_cast<double>(Mix(seed, static_cast<uint64_t>(sheet + 100)) % 1000) /
+                             500.0 -
+                         1.0);
       if (seam < 0.0015) albedo *= 0.9;
       const double rx = p.x() / half_x, ry = p.y() / half_y;
       double e = 1.08 - 0.14 * 0.5 * (rx * rx + ry * ry);
@@ -174,11 +183,13 @@ Eigen::Vector3d Studio::Radiance(const BackgroundHit& hit) const {
     }
     case Surface::kRoomFloor: {
       const double tile = 0.5;
-      const double fx = p.x() / tile - std::floor(p.x() / tile), fy = p.y() / tile - std::floor(p.y() / tile);
+      const double fx = p.x() / tile - std::floor(p.x() / tile),
+                   fy = p.y() / tile - std::floor(p.y() / tile);
       double albedo = 0.34 + 0.03 * Fbm2(Mix(seed, 13), p.x() / 0.2, p.y() / 0.2, 3);
       if (fx < 0.01 || fy < 0.01) albedo *= 0.8;
       const double r2 = p.head<2>().squaredNorm();
-      return 255.0 * Eigen::Vector3d(albedo * 0.97, albedo, albedo * 1.03) * (0.8 / (1.0 + 0.04 * r2));
+      return 255.0 * Eigen::Vector3d(albedo * 0.97, albedo, albedo * 1.03) *
+             (0.8 / (1.0 + 0.04 * r2));
     }
     case Surface::kRoomWall: {
       double albedo = 0.66 + 0.04 * Fbm2(Mix(seed, 17), (p.x() + p.y()) / 0.5, p.z() / 0.5, 3);
@@ -186,7 +197,8 @@ Eigen::Vector3d Studio::Radiance(const BackgroundHit& hit) const {
       return 255.0 * Eigen::Vector3d(albedo * 0.95, albedo, albedo * 1.04) * 0.45;
     }
     case Surface::kCeiling: {
-      const double fx = std::abs(std::fmod(p.x() + 100.25, 1.5) - 0.75), fy = std::abs(std::fmod(p.y() + 100.4, 1.5) - 0.75);
+      const double fx = std::abs(std::fmod(p.x() + 100.25, 1.5) - 0.75),
+                   fy = std::abs(std::fmod(p.y() + 100.4, 1.5) - 0.75);
       const double e = (fx < 0.3 && fy < 0.3) ? 1.6 : 0.35;
       return 255.0 * Eigen::Vector3d(0.8, 0.8, 0.8) * e;
     }
@@ -204,14 +216,16 @@ Rigid3 LookAt(const Eigen::Vector3d& centre, const Eigen::Vector3d& target, doub
   ground_from_cam.col(0) = x;
   ground_from_cam.col(1) = y;
   ground_from_cam.col(2) = z;
-  ground_from_cam = ground_from_cam * Eigen::AngleAxisd(roll_rad, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  ground_from_cam =
+      ground_from_cam * Eigen::AngleAxisd(roll_rad, Eigen::Vector3d::UnitZ()).toRotationMatrix();
   Rigid3 cam_from_ground;
   cam_from_ground.rotation = ground_from_cam.transpose();
   cam_from_ground.translation = -(cam_from_ground.rotation * centre);
   return cam_from_ground;
 }
 
-std::vector<SynthCamera> MakeCameras(const Studio& studio, int count, int width, int height, uint64_t seed) {
+std::vector<SynthCamera> MakeCameras(const Studio& studio, int count, int width, int height,
+                                     uint64_t seed) {
   Rng rng(StreamSeed(seed, StudioKindName(studio.kind) + "-cameras"));
   std::vector<SynthCamera> cameras;
   const bool enclosure = studio.kind == StudioKind::kEnclosure;
@@ -225,13 +239,21 @@ std::vector<SynthCamera> MakeCameras(const Studio& studio, int count, int width,
     const double fy = fx * rng.Uniform(0.998, 1.002);
     const double cx = (width - 1) / 2.0 + rng.Uniform(-0.015, 0.015) * width;
     const double cy = (height - 1) / 2.0 + rng.Uniform(-0.015, 0.015) * height;
-    const double r_corner = std::hypot(std::max(cx, width - cx) / fx, std::max(cy, height - cy) / fy);
+    const double r_corner =
+        std::hypot(std::max(cx, width - cx) / fx, std::max(cy, height - cy) / fy);
     for (int attempt = 0; attempt < 100; ++attempt) {
-      cam.intrinsics = {fx, fy, cx, cy,
-                        rng.Uniform(-0.28, 0.05), rng.Uniform(-0.04, 0.10),   // k1 k2
-                        rng.Uniform(-0.0012, 0.0012), rng.Uniform(-0.0012, 0.0012),  // p1 p2
-                        rng.Uniform(-0.015, 0.015), rng.Uniform(0.0, 0.06),  // k3 k4
-                        rng.Uniform(-0.01, 0.01), rng.Uniform(-0.005, 0.005)};  // k5 k6
+      cam.intrinsics = {fx,
+                        fy,
+                        cx,
+                        cy,
+                        rng.Uniform(-0.28, 0.05),
+                        rng.Uniform(-0.04, 0.10),  // k1 k2
+                        rng.Uniform(-0.0012, 0.0012),
+                        rng.Uniform(-0.0012, 0.0012),  // p1 p2
+                        rng.Uniform(-0.015, 0.015),
+                        rng.Uniform(0.0, 0.06),  // k3 k4
+                        rng.Uniform(-0.01, 0.01),
+                        rng.Uniform(-0.005, 0.005)};  // k5 k6
       cam.lens = Lens(cam.lensmodel, cam.intrinsics);
       if (cam.lens.MinRadialSlope(1.4 * r_corner) > 0.35) break;
     }
@@ -267,15 +289,17 @@ std::vector<SynthCamera> MakeCameras(const Studio& studio, int count, int width,
     }
     const double margin = 6.0;
     for (int attempt = 0; attempt < 60; ++attempt) {
-      const Eigen::Vector3d offset(std::cos(azimuth) * std::cos(elevation), std::sin(azimuth) * std::cos(elevation),
-                                   std::sin(elevation));
-      const Eigen::Vector3d centre = (enclosure ? Eigen::Vector3d::Zero() : Eigen::Vector3d(target.x(), target.y(), 0.9)) +
-                                     distance * offset;
+      const Eigen::Vector3d offset(std::cos(azimuth) * std::cos(elevation),
+                                   std::sin(azimuth) * std::cos(elevation), std::sin(elevation));
+      const Eigen::Vector3d centre =
+          (enclosure ? Eigen::Vector3d::Zero() : Eigen::Vector3d(target.x(), target.y(), 0.9)) +
+          distance * offset;
       cam.cam_from_ground = LookAt(centre, target, roll);
       bool all_in = true;
       for (const auto& p : must_see) {
         const Eigen::Vector2d px = cam.ProjectGround(p);
-        if (!(px.x() >= margin && px.y() >= margin && px.x() <= width - 1 - margin && px.y() <= height - 1 - margin)) {
+        if (!(px.x() >= margin && px.y() >= margin && px.x() <= width - 1 - margin &&
+              px.y() <= height - 1 - margin)) {
           all_in = false;
         }
       }

@@ -21,14 +21,14 @@ enum class Surface : int { kGreenFloor, kGreenWall, kWallOutside, kRoomFloor, kR
 
 struct Quad {
   Eigen::Vector3d origin;
-  Eigen::Vector3d u, v;        // edge vectors; the quad is origin + a u + b v, a, b in [0, 1]
-  Eigen::Vector3d normal;      // unit, u x v
+  Eigen::Vector3d u, v;    // edge vectors; the quad is origin + a u + b v, a, b in [0, 1]
+  Eigen::Vector3d normal;  // unit, u x v
   Surface front = Surface::kGreenWall;  // seen from the normal's side
   Surface back = Surface::kWallOutside;
 };
 
 struct BackgroundHit {
-  double t = 0.0;              // distance along the (unit) ray
+  double t = 0.0;  // distance along the (unit) ray
   int quad = -1;
   Surface surface = Surface::kRoomWall;
   Eigen::Vector3d point = Eigen::Vector3d::Zero();
@@ -37,14 +37,14 @@ struct BackgroundHit {
 
 struct Studio {
   StudioKind kind = StudioKind::kEnclosure;
-  double half_x = 0.6, half_y = 0.4;   // green floor: [-half_x, half_x] x [-half_y, half_y]
+  double half_x = 0.6, half_y = 0.4;  // green floor: [-half_x, half_x] x [-half_y, half_y]
   double wall_height = 0.25;
-  bool room_backdrop = true;           // false: everything outside the walls is green too
+  bool room_backdrop = true;  // false: everything outside the walls is green too
   uint64_t seed = 0;
-  GroundPolygon floor;                 // the green floor, counter-clockwise
-  std::vector<Quad> quads;             // [0] is the whole z = 0 plane of the room
-  std::vector<int> green_walls;        // indices into quads
-  double subject_scale = 0.1;          // typical subject size in metres (lighting, shadows)
+  GroundPolygon floor;           // the green floor, counter-clockwise
+  std::vector<Quad> quads;       // [0] is the whole z = 0 plane of the room
+  std::vector<int> green_walls;  // indices into quads
+  double subject_scale = 0.1;    // typical subject size in metres (lighting, shadows)
 
   // The first background surface along the ray (the room closes everything).
   BackgroundHit Trace(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction) const;
@@ -61,7 +61,8 @@ Studio MakeStudio(StudioKind kind, uint64_t seed, bool room_backdrop = true);
 
 // K cameras with OPENCV8 lenses, at different azimuths and heights, looking at
 // the floor. Depends only on (studio kind, count, size, seed).
-std::vector<SynthCamera> MakeCameras(const Studio& studio, int count, int width, int height, uint64_t seed);
+std::vector<SynthCamera> MakeCameras(const Studio& studio, int count, int width, int height,
+                                     uint64_t seed);
 
 // A camera pose looking from `centre` at `target` (ground frame, z up), rolled by `roll_rad`.
 Rigid3 LookAt(const Eigen::Vector3d& centre, const Eigen::Vector3d& target, double roll_rad);

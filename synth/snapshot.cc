@@ -9,13 +9,15 @@ namespace {
 
 // Largest value of dir . p over the primitive's points.
 double Support(const Primitive& p, const Eigen::Vector3d& dir) {
-  if (p.shape == Shape::kCapsule) return std::max(dir.dot(p.a), dir.dot(p.b)) + p.radius * dir.norm();
+  if (p.shape == Shape::kCapsule)
+    return std::max(dir.dot(p.a), dir.dot(p.b)) + p.radius * dir.norm();
   return dir.dot(p.centre) + (p.axes.transpose() * dir).norm();
 }
 
 }  // namespace
 
-bool TouchesWall(const Studio& studio, const std::vector<Primitive>& prims, int subject, double tolerance_m) {
+bool TouchesWall(const Studio& studio, const std::vector<Primitive>& prims, int subject,
+                 double tolerance_m) {
   for (int w : studio.green_walls) {
     const Quad& q = studio.quads[static_cast<size_t>(w)];
     // The wall's inward normal (front faces the floor) and its extent along the floor.
@@ -34,7 +36,8 @@ bool TouchesWall(const Studio& studio, const std::vector<Primitive>& prims, int 
   return false;
 }
 
-bool LeavesFloor(const Studio& studio, const std::vector<Primitive>& prims, int subject, double tolerance_m) {
+bool LeavesFloor(const Studio& studio, const std::vector<Primitive>& prims, int subject,
+                 double tolerance_m) {
   // Exact for a convex floor: a footprint leaves it when its support along an
   // edge's outward normal passes the edge.
   const auto& v = studio.floor.vertices();

@@ -17,23 +17,23 @@ namespace ss::synth {
 
 // Camera-independent truth of one subject at one frame.
 struct SubjectTruth {
-  std::string kind;              // "animal" | "figure"
+  std::string kind;                                    // "animal" | "figure"
   Eigen::Vector2d position = Eigen::Vector2d::Zero();  // root on the floor, ground x y
   double heading_rad = 0.0;
   double speed_mps = 0.0;
-  double gait_phase = 0.0;       // [0, 1)
-  std::string pose;              // walk, trot, turn, idle, lean, stand, Y, M, C, A, ...
-  bool touches_wall = false;     // some part within 3 mm of a green wall
-  bool leaves_floor = false;     // some part's footprint reaches beyond the floor polygon
-  double height_m = 0.0;         // top of the subject above the floor
+  double gait_phase = 0.0;              // [0, 1)
+  std::string pose;                     // walk, trot, turn, idle, lean, stand, Y, M, C, A, ...
+  bool touches_wall = false;            // some part within 3 mm of a green wall
+  bool leaves_floor = false;            // some part's footprint reaches beyond the floor polygon
+  double height_m = 0.0;                // top of the subject above the floor
   std::vector<Eigen::Vector3d> joints;  // figures: 3-D joints in JointNames() order
 };
 
 // A board in view and its pose.
 struct BoardTruth {
-  int board = 0;                 // index into the director's board specs
+  int board = 0;  // index into the director's board specs
   Rigid3 ground_from_board;
-  std::string placement;         // "camera:<name>" (held before a camera) | "floor"
+  std::string placement;  // "camera:<name>" (held before a camera) | "floor"
 };
 
 struct FrameSnapshot {
@@ -59,8 +59,10 @@ class Director {
 };
 
 // Touch and floor tests shared by the directors.
-bool TouchesWall(const Studio& studio, const std::vector<Primitive>& prims, int subject, double tolerance_m);
-bool LeavesFloor(const Studio& studio, const std::vector<Primitive>& prims, int subject, double tolerance_m);
+bool TouchesWall(const Studio& studio, const std::vector<Primitive>& prims, int subject,
+                 double tolerance_m);
+bool LeavesFloor(const Studio& studio, const std::vector<Primitive>& prims, int subject,
+                 double tolerance_m);
 double TopHeight(const std::vector<Primitive>& prims, int subject);
 
 }  // namespace ss::synth

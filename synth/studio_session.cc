@@ -35,7 +35,9 @@ using nlohmann::json;
 constexpr int kTruthVersion = 1;
 constexpr int kChunkFrames = 16;  // frames simulated ahead of the camera workers
 
-double Since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+double Since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
 
 // CPU seconds of the calling thread / of the whole process (the machine may be shared).
 double ThreadCpuS() {
@@ -88,7 +90,8 @@ void WriteJson(const std::string& path, const json& j) {
 }
 
 // Writes a full-frame 8-bit matte holding `layer` (zero elsewhere) as PNG.
-void WriteMatte(const std::string& path, const MatteLayer& layer, int width, int height, cv::Mat& scratch) {
+void WriteMatte(const std::string& path, const MatteLayer& layer, int width, int height,
+                cv::Mat& scratch) {
   scratch.create(height, width, CV_8U);
   scratch.setTo(0);
   if (!layer.box.empty()) layer.values.copyTo(scratch(layer.box));
@@ -104,7 +107,8 @@ struct LowestPoint {
   Eigen::Vector3d point_in_ground{NAN, NAN, NAN};
 };
 
-LowestPoint SilhouetteLowest(const SynthCamera& cam, const std::vector<Primitive>& prims, int subject) {
+LowestPoint SilhouetteLowest(const SynthCamera& cam, const std::vector<Primitive>& prims,
+                             int subject) {
   LowestPoint best;
   const Eigen::Vector3d eye = cam.CentreInGround();
   double best_y = -1e30;
@@ -129,8 +133,8 @@ struct CameraWork {
   std::unique_ptr<CameraRenderer> renderer;
   std::unique_ptr<Sensor> sensor;
   std::unique_ptr<CsvFile> views;
-  std::unique_ptr<CsvFile> joints;  // figures
-  std::unique_ptr<CsvFile> corners; // calibration
+  std::unique_ptr<CsvFile> joints;   // figures
+  std::unique_ptr<CsvFile> corners;  // calibration
   fs::path truth_dir;
   double render_s = 0, sensor_s = 0, encode_s = 0, truth_s = 0;
   CameraImage image;
@@ -151,7 +155,9 @@ std::string SynthKindName(SynthKind kind) {
   return "?";
 }
 
-int SynthOptions::frames() const { return std::max(1, static_cast<int>(std::lround(seconds * fps))); }
+int SynthOptions::frames() const {
+  return std::max(1, static_cast<int>(std::lround(seconds * fps)));
+}
 
 bool SynthOptions::IsValid(std::string* why) const {
   auto fail = [&](const std::string& reason) {
@@ -161,7 +167,8 @@ bool SynthOptions::IsValid(std::string* why) const {
   if (out_dir.empty()) return fail("--out: a session folder is needed");
   if (!(seconds > 0) || seconds > 3600) return fail("--seconds: expected 0 < S <= 3600");
   if (!(fps >= 1) || fps > 240) return fail("--fps: expected 1..240");
-  if (width < 64 || height < 48 || width > 4096 || height > 4096) return fail("--size: expected 64x48 .. 4096x4096");
+  if (width < 64 || height < 48 || width > 4096 || height > 4096)
+    return fail("--size: expected 64x48 .. 4096x4096");
   if (pixel_format == PixelFormat::kBayerRG8 && (width % 2 || height % 2)) {
     return fail("--size: bayer_rg8 needs an even width and height");
   }
@@ -176,8 +183,10 @@ bool SynthOptions::IsValid(std::string* why) const {
   if (!studio.empty() && studio != "enclosure" && studio != "stage") {
     return fail("--studio: expected enclosure or stage");
   }
-  if (kind == SynthKind::kAnimal && studio == "stage") return fail("--studio: animals live in the enclosure");
-  if (kind == SynthKind::kFigure && studio == "enclosure") return fail("--studio: figures perform on the stage");
+  if (kind == SynthKind::kAnimal && studio == "stage")
+    return fail("--studio: animals live in the enclosure");
+  if (kind == SynthKind::kFigure && studio == "enclosure")
+    return fail("--studio: figures perform on the stage");
   if (figure_variant < 0 || figure_variant > 1) return fail("--figure-variant: expected 0 or 1");
   return true;
 }
@@ -189,11 +198,13 @@ SynthSummary RenderStudioSession(const SynthOptions& o) {
   const double cpu_start = ProcessCpuS();
   auto log = Log("synth");
 
-  const StudioKind studio_kind = o.studio == "stage" || (o.studio.empty() && o.kind == SynthKind::kFigure)
-                                     ? StudioKind::kStage
-                                     : StudioKind::kEnclosure;
+  const StudioKind studio_kind =
+      o.studio == "stage" || (o.studio.empty() && o.kind == SynthKind::kFigure)
+          ? StudioKind::kStage
+          : StudioKind::kEnclosure;
   const Studio studio = MakeStudio(studio_kind, o.seed);
-  const std::vector<SynthCamera> cameras = MakeCameras(studio, o.cameras, o.width, o.height, o.seed);
+  const std::vector<SynthCamera> cameras =
+      MakeCameras(studio, o.cameras, o.width, o.height, o.seed);
   DirectorOptions dopt;
   dopt.subjects = o.subjects;
   dopt.seed = o.seed;
@@ -218,7 +229,8 @@ SynthSummary RenderStudioSession(const SynthOptions& o) {
   rec.synthetic = true;
   rec.codec = o.codec;
   rec.flush_interval_ms = 1000;
-  SessionWriter writer(o.out_dir, "synth-" + SynthKindName(o.kind) + "-seed" + std::to_string(o.seed), rec);
+  SessionWriter writer(o.out_dir,
+                       "synth-" + SynthKindName(o.kind) + "-seed" + std::to_string(o.seed), rec);
   const fs::path truth = fs::path(o.out_dir) / "truth";
   std::error_code ec;
   fs::create_directories(truth, ec);
@@ -230,7 +242,8 @@ SynthSummary RenderStudioSession(const SynthOptions& o) {
   const std::vector<BoardSpec>& board_specs = director->board_specs();
   for (size_t c = 0; c < cameras.size(); ++c) {
     const SynthCamera& cam = cameras[c];
-    const CameraModel model(cam.lensmodel, cam.intrinsics, cam.width, cam.height, cam.cam_from_ground);
+    const CameraModel model(cam.lensmodel, cam.intrinsics, cam.width, cam.height,
+                            cam.cam_from_ground);
     SourceCamera source;
     source.name = cam.name;
     source.width = cam.width;
@@ -250,14 +263,18 @@ SynthSummary RenderStudioSession(const SynthOptions& o) {
     w.sensor = std::make_unique<Sensor>(o.seed, static_cast<int>(c), o.noise);
     w.truth_dir = truth / cam.name;
     fs::create_directories(w.truth_dir / "shadow", ec);
-    for (int k = 0; k < subjects; ++k) fs::create_directories(w.truth_dir / ("alpha_s" + std::to_string(k)), ec);
-    if (ec) throw WorkError(w.truth_dir.string(), "cannot create the truth folder: " + ec.message());
-    w.views = std::make_unique<CsvFile>(
-        (w.truth_dir / "views.csv").string(),
-        "frame,subject,visible_px,unoccluded_px,box_x,box_y,box_w,box_h,lowest_x,lowest_y,lowest_gx,lowest_gy,"
-        "lowest_gz,lowest_ray_gx,lowest_ray_gy,root_x,root_y,contact_x,contact_y,contact_ray_gx,contact_ray_gy");
+    for (int k = 0; k < subjects; ++k)
+      fs::create_directories(w.truth_dir / ("alpha_s" + std::to_string(k)), ec);
+    if (ec)
+      throw WorkError(w.truth_dir.string(), "cannot create the truth folder: " + ec.message());
+    w.views = std::make_unique<CsvFile>((w.truth_dir / "views.csv").string(),
+                                        "frame,subject,visible_px,unoccluded_px,box_x,box_y,box_w,"
+                                        "box_h,lowest_x,lowest_y,lowest_gx,lowest_gy,"
+                                        "lowest_gz,lowest_ray_gx,lowest_ray_gy,root_x,root_y,"
+                                        "contact_x,contact_y,contact_ray_gx,contact_ray_gy");
     if (!joint_names.empty()) {
-      w.joints = std::make_unique<CsvFile>((w.truth_dir / "joints.csv").string(), "frame,subject,joint,name,x,y");
+      w.joints = std::make_unique<CsvFile>((w.truth_dir / "joints.csv").string(),
+                                           "frame,subject,joint,name,x,y");
     }
     if (!board_specs.empty()) {
       w.corners = std::make_unique<CsvFile>((w.truth_dir / "corners.csv").string(),
@@ -275,19 +292,24 @@ SynthSummary RenderStudioSession(const SynthOptions& o) {
   for (int wi : studio.green_walls) {
     const Quad& q = studio.quads[static_cast<size_t>(wi)];
     const Eigen::Vector3d a = q.origin, b = q.origin + (q.u.z() == 0 ? q.u : q.v);
-    floor_json["walls"].push_back({{"from", {a.x(), a.y()}}, {"to", {b.x(), b.y()}}, {"height_m", studio.wall_height}});
+    floor_json["walls"].push_back(
+        {{"from", {a.x(), a.y()}}, {"to", {b.x(), b.y()}}, {"height_m", studio.wall_height}});
   }
   WriteJson((truth / "floor.json").string(), floor_json);
-  CsvFile subjects_csv((truth / "subjects.csv").string(),
-                       "frame,timestamp_ns,subject,kind,x,y,heading_rad,speed_mps,gait_phase,pose,touches_wall,"
-                       "leaves_floor,height_m");
+  CsvFile subjects_csv(
+      (truth / "subjects.csv").string(),
+      "frame,timestamp_ns,subject,kind,x,y,heading_rad,speed_mps,gait_phase,pose,touches_wall,"
+      "leaves_floor,height_m");
   std::unique_ptr<CsvFile> boards_csv;
   if (!board_specs.empty()) {
     json boards;
     boards["frame"] =
-        "board frame (OpenCV's): origin at the top-left corner of the checkered area, x along the columns, "
-        "y along the rows, z into the board (the print is seen from -z); inner corner c (row-major, "
-        "squares_x - 1 per row) at ((col + 1) * square_m, (row + 1) * square_m, 0); the top-left square is black; "
+        "board frame (OpenCV's): origin at the top-left corner of the checkered area, x along the "
+        "columns, "
+        "y along the rows, z into the board (the print is seen from -z); inner corner c "
+        "(row-major, "
+        "squares_x - 1 per row) at ((col + 1) * square_m, (row + 1) * square_m, 0); the top-left "
+        "square is black; "
         "ChArUco corner ids are these inner-corner indices";
     boards["boards"] = json::array();
     for (size_t b = 0; b < board_specs.size(); ++b) {
@@ -305,14 +327,16 @@ SynthSummary RenderStudioSession(const SynthOptions& o) {
       }
       boards["boards"].push_back(j);
     }
-    boards["poses"] = "board_poses.csv: ground_from_board as mrcal rt (Rodrigues r, then t) per frame and board";
+    boards["poses"] =
+        "board_poses.csv: ground_from_board as mrcal rt (Rodrigues r, then t) per frame and board";
     WriteJson((truth / "boards.json").string(), boards);
     boards_csv = std::make_unique<CsvFile>((truth / "board_poses.csv").string(),
                                            "frame,timestamp_ns,board,placement,rx,ry,rz,tx,ty,tz");
   }
   std::unique_ptr<CsvFile> joints_csv;
   if (!joint_names.empty()) {
-    joints_csv = std::make_unique<CsvFile>((truth / "joints.csv").string(), "frame,subject,joint,name,x,y,z");
+    joints_csv = std::make_unique<CsvFile>((truth / "joints.csv").string(),
+                                           "frame,subject,joint,name,x,y,z");
   }
 
   SynthSummary summary;
@@ -339,7 +363,8 @@ SynthSummary RenderStudioSession(const SynthOptions& o) {
       w.renderer->Render(snap.scene, &w.image);
       w.render_s += (ThreadCpuS() - t0);
       t0 = ThreadCpuS();
-      std::vector<uint8_t> bytes = w.sensor->Capture(w.image.bgr, o.pixel_format, static_cast<uint64_t>(frame));
+      std::vector<uint8_t> bytes =
+          w.sensor->Capture(w.image.bgr, o.pixel_format, static_cast<uint64_t>(frame));
       w.sensor_s += (ThreadCpuS() - t0);
       t0 = ThreadCpuS();
       Frame f = Frame::Owned(o.pixel_format, cam.width, cam.height, std::move(bytes));
@@ -351,7 +376,8 @@ SynthSummary RenderStudioSession(const SynthOptions& o) {
       t0 = ThreadCpuS();
       if (o.write_mattes) {
         const std::string name = FrameName(frame);
-        WriteMatte((w.truth_dir / "shadow" / name).string(), w.image.shadow, cam.width, cam.height, w.scratch);
+        WriteMatte((w.truth_dir / "shadow" / name).string(), w.image.shadow, cam.width, cam.height,
+                   w.scratch);
         for (int k = 0; k < subjects; ++k) {
           WriteMatte((w.truth_dir / ("alpha_s" + std::to_string(k)) / name).string(),
                      w.image.alpha[static_cast<size_t>(k)], cam.width, cam.height, w.scratch);
@@ -363,7 +389,8 @@ SynthSummary RenderStudioSession(const SynthOptions& o) {
         const LowestPoint low = SilhouetteLowest(cam, snap.scene.primitives, k);
         Eigen::Vector2d ray_ground(NAN, NAN);
         if (std::isfinite(low.px.x())) {
-          const auto hit = IntersectGround({cam.CentreInGround(), cam.RayDirectionInGround(low.px)});
+          const auto hit =
+              IntersectGround({cam.CentreInGround(), cam.RayDirectionInGround(low.px)});
           if (hit) ray_ground = hit->head<2>();
         }
         const Eigen::Vector2d root_px = cam.ProjectGround({st.position.x(), st.position.y(), 0.0});
@@ -372,21 +399,24 @@ SynthSummary RenderStudioSession(const SynthOptions& o) {
         cv::Point2d contact;
         if (!layer.box.empty() && ContactPoint(layer.values, &contact)) {
           contact_px = {layer.box.x + contact.x, layer.box.y + contact.y};
-          const auto hit = IntersectGround({cam.CentreInGround(), cam.RayDirectionInGround(contact_px)});
+          const auto hit =
+              IntersectGround({cam.CentreInGround(), cam.RayDirectionInGround(contact_px)});
           if (hit) contact_ground = hit->head<2>();
         }
-        w.views->Row("%d,%d,%.4f,%.4f,%d,%d,%d,%d,%.4f,%.4f,%.6f,%.6f,%.6f,%.6f,%.6f,%.4f,%.4f,"
-                     "%.4f,%.4f,%.6f,%.6f",
-                     frame, k, w.image.visible_px[static_cast<size_t>(k)],
-                     w.image.unoccluded_px[static_cast<size_t>(k)],
-                     layer.box.x, layer.box.y, layer.box.width, layer.box.height, low.px.x(), low.px.y(),
-                     low.point_in_ground.x(), low.point_in_ground.y(), low.point_in_ground.z(), ray_ground.x(),
-                     ray_ground.y(), root_px.x(), root_px.y(), contact_px.x(), contact_px.y(), contact_ground.x(),
-                     contact_ground.y());
+        w.views->Row(
+            "%d,%d,%.4f,%.4f,%d,%d,%d,%d,%.4f,%.4f,%.6f,%.6f,%.6f,%.6f,%.6f,%.4f,%.4f,"
+            "%.4f,%.4f,%.6f,%.6f",
+            frame, k, w.image.visible_px[static_cast<size_t>(k)],
+            w.image.unoccluded_px[static_cast<size_t>(k)], layer.box.x, layer.box.y,
+            layer.box.width, layer.box.height, low.px.x(), low.px.y(), low.point_in_ground.x(),
+            low.point_in_ground.y(), low.point_in_ground.z(), ray_ground.x(), ray_ground.y(),
+            root_px.x(), root_px.y(), contact_px.x(), contact_px.y(), contact_ground.x(),
+            contact_ground.y());
         if (w.joints) {
           for (size_t j = 0; j < st.joints.size(); ++j) {
             const Eigen::Vector2d px = cam.ProjectGround(st.joints[j]);
-            w.joints->Row("%d,%d,%zu,%s,%.4f,%.4f", frame, k, j, joint_names[j].c_str(), px.x(), px.y());
+            w.joints->Row("%d,%d,%zu,%s,%.4f,%.4f", frame, k, j, joint_names[j].c_str(), px.x(),
+                          px.y());
           }
         }
       }
@@ -405,7 +435,8 @@ SynthSummary RenderStudioSession(const SynthOptions& o) {
               const double dist = (p - eye).norm();
               in_view = studio.Trace(eye, (p - eye) / dist).t > dist - 1e-4;
             }
-            w.corners->Row("%d,%d,%zu,%.4f,%.4f,%d", frame, bt.board, i, px.x(), px.y(), in_view ? 1 : 0);
+            w.corners->Row("%d,%d,%zu,%.4f,%.4f,%d", frame, bt.board, i, px.x(), px.y(),
+                           in_view ? 1 : 0);
           }
         }
       }
@@ -429,15 +460,17 @@ SynthSummary RenderStudioSession(const SynthOptions& o) {
       for (size_t k = 0; k < snap.subjects.size(); ++k) {
         const SubjectTruth& st = snap.subjects[k];
         subjects_csv.Row("%d,%lld,%zu,%s,%.6f,%.6f,%.6f,%.6f,%.6f,%s,%d,%d,%.6f", frame,
-                         static_cast<long long>(stamps[static_cast<size_t>(i)]), k, st.kind.c_str(), st.position.x(),
-                         st.position.y(), st.heading_rad, st.speed_mps, st.gait_phase, st.pose.c_str(),
-                         st.touches_wall ? 1 : 0, st.leaves_floor ? 1 : 0, st.height_m);
+                         static_cast<long long>(stamps[static_cast<size_t>(i)]), k, st.kind.c_str(),
+                         st.position.x(), st.position.y(), st.heading_rad, st.speed_mps,
+                         st.gait_phase, st.pose.c_str(), st.touches_wall ? 1 : 0,
+                         st.leaves_floor ? 1 : 0, st.height_m);
         summary.pose_frames[st.pose] += 1;
         if (st.touches_wall) ++summary.wall_touch_frames;
         if (joints_csv) {
           for (size_t j = 0; j < st.joints.size(); ++j) {
             const auto& p = st.joints[j];
-            joints_csv->Row("%d,%zu,%zu,%s,%.6f,%.6f,%.6f", frame, k, j, joint_names[j].c_str(), p.x(), p.y(), p.z());
+            joints_csv->Row("%d,%zu,%zu,%s,%.6f,%.6f,%.6f", frame, k, j, joint_names[j].c_str(),
+                            p.x(), p.y(), p.z());
           }
         }
       }
@@ -448,8 +481,8 @@ SynthSummary RenderStudioSession(const SynthOptions& o) {
           double rt[6];
           bt.ground_from_board.ToRt(rt);
           boards_csv->Row("%d,%lld,%d,%s,%.9f,%.9f,%.9f,%.9f,%.9f,%.9f", first + i,
-                          static_cast<long long>(stamps[static_cast<size_t>(i)]), bt.board, bt.placement.c_str(),
-                          rt[0], rt[1], rt[2], rt[3], rt[4], rt[5]);
+                          static_cast<long long>(stamps[static_cast<size_t>(i)]), bt.board,
+                          bt.placement.c_str(), rt[0], rt[1], rt[2], rt[3], rt[4], rt[5]);
         }
       }
     }
@@ -461,7 +494,8 @@ SynthSummary RenderStudioSession(const SynthOptions& o) {
       for (int t = 0; t < n_threads; ++t) {
         pool.emplace_back([&, t] {
           try {
-            for (size_t c = static_cast<size_t>(t); c < cameras.size(); c += static_cast<size_t>(n_threads)) {
+            for (size_t c = static_cast<size_t>(t); c < cameras.size();
+                 c += static_cast<size_t>(n_threads)) {
               render_camera(c, first, count);
             }
           } catch (const std::exception& e) {
@@ -507,10 +541,11 @@ SynthSummary RenderStudioSession(const SynthOptions& o) {
   t["floor"] = floor_json;
   t["cameras"] = json::array();
   for (const auto& cam : cameras) {
-    t["cameras"].push_back({{"name", cam.name},
-                            {"model", cam.name + ".cameramodel"},
-                            {"centre_in_ground", {cam.CentreInGround().x(), cam.CentreInGround().y(),
-                                                  cam.CentreInGround().z()}}});
+    t["cameras"].push_back(
+        {{"name", cam.name},
+         {"model", cam.name + ".cameramodel"},
+         {"centre_in_ground",
+          {cam.CentreInGround().x(), cam.CentreInGround().y(), cam.CentreInGround().z()}}});
   }
   t["subjects"] = json::parse(director->SubjectsJson());
   if (!joint_names.empty()) t["joint_names"] = joint_names;
@@ -531,10 +566,12 @@ SynthSummary RenderStudioSession(const SynthOptions& o) {
 
   summary.wall_s = Since(t_start);
   summary.cpu_s = ProcessCpuS() - cpu_start;
-  log->info("{}: {} frames x {} camera(s) of a {} session in {:.2f} s wall, {:.2f} s CPU ({:.2f} camera-seconds "
-            "per CPU-second)",
-            o.out_dir, summary.frames, summary.cameras, SynthKindName(o.kind), summary.wall_s, summary.cpu_s,
-            summary.CpuRealTimeFactor());
+  log->info(
+      "{}: {} frames x {} camera(s) of a {} session in {:.2f} s wall, {:.2f} s CPU ({:.2f} "
+      "camera-seconds "
+      "per CPU-second)",
+      o.out_dir, summary.frames, summary.cameras, SynthKindName(o.kind), summary.wall_s,
+      summary.cpu_s, summary.CpuRealTimeFactor());
   return summary;
 }
 

@@ -5,8 +5,8 @@
 //   truth/truth.json                 what the session holds, file patterns, options
 //   truth/floor.json                 the floor polygon and walls, ground frame
 //   truth/<cam>.cameramodel          the true camera models
-//   truth/subjects.csv               per frame and subject: position, heading, speed, gait, pose, ...
-//   truth/<cam>/views.csv            per frame, camera and subject: coverage, box, lowest point
+//   truth/subjects.csv               per frame and subject: position, heading, speed, gait, pose,
+//   ... truth/<cam>/views.csv            per frame, camera and subject: coverage, box, lowest point
 //   truth/<cam>/alpha_s<K>/<F>.png   per frame: subject K's alpha matte (8-bit, lossless)
 //   truth/<cam>/shadow/<F>.png       per frame: the contact-shadow matte (255 = black)
 //   (figure) truth/joints.csv, truth/<cam>/joints.csv; (calibration) truth/boards.json,
@@ -25,7 +25,7 @@ std::string SynthKindName(SynthKind kind);
 struct SynthOptions {
   std::string out_dir;
   SynthKind kind = SynthKind::kAnimal;
-  std::string studio;          // "enclosure" | "stage"; empty: stage for figures, else enclosure
+  std::string studio;  // "enclosure" | "stage"; empty: stage for figures, else enclosure
   double seconds = 10.0;
   double fps = 30.0;
   int width = 640;
@@ -55,20 +55,22 @@ struct SynthSummary {
   int cameras = 0;
   int subjects = 0;
   double fps = 0.0;
-  double wall_s = 0.0;          // whole run
-  double cpu_s = 0.0;           // whole run, CPU time of every thread (encoder threads included)
+  double wall_s = 0.0;  // whole run
+  double cpu_s = 0.0;   // whole run, CPU time of every thread (encoder threads included)
   // Stages in CPU seconds of the threads that ran them:
-  double simulate_s = 0.0;      // behaviour and scene building
-  double render_s = 0.0;        // ray casting, summed over cameras
-  double sensor_s = 0.0;        // noise and pixel format
-  double encode_s = 0.0;        // video writer
-  double truth_s = 0.0;         // mattes and tables
+  double simulate_s = 0.0;                 // behaviour and scene building
+  double render_s = 0.0;                   // ray casting, summed over cameras
+  double sensor_s = 0.0;                   // noise and pixel format
+  double encode_s = 0.0;                   // video writer
+  double truth_s = 0.0;                    // mattes and tables
   std::map<std::string, int> pose_frames;  // subject-frames per pose label
-  int wall_touch_frames = 0;    // subject-frames touching a wall
+  int wall_touch_frames = 0;               // subject-frames touching a wall
   // Seconds of footage per second of wall time (>= 1: all cameras kept up with real time).
   double RealTimeFactor() const { return wall_s > 0 && fps > 0 ? frames / fps / wall_s : 0.0; }
   // Camera-seconds of footage per CPU-second (>= 1: one core renders a camera in real time).
-  double CpuRealTimeFactor() const { return cpu_s > 0 && fps > 0 ? frames * cameras / fps / cpu_s : 0.0; }
+  double CpuRealTimeFactor() const {
+    return cpu_s > 0 && fps > 0 ? frames * cameras / fps / cpu_s : 0.0;
+  }
 };
 
 // Renders the session into options.out_dir (which must not exist or be empty).

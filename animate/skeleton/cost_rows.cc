@@ -15,8 +15,9 @@ namespace ss {
 DenseCostRows::DenseCostRows(int targets, int sources, std::vector<float> values)
     : targets_(targets), sources_(sources), values_(std::move(values)) {
   if (targets < 0 || sources <= 0 || values_.size() != static_cast<size_t>(targets) * sources) {
-    throw InputError("cost matrix", "expected " + std::to_string(targets) + " x " + std::to_string(sources) +
-                                        " values, got " + std::to_string(values_.size()));
+    throw InputError("cost matrix", "expected " + std::to_string(targets) + " x " +
+                                        std::to_string(sources) + " values, got " +
+                                        std::to_string(values_.size()));
   }
 }
 
@@ -27,15 +28,16 @@ float CostRows::At(int t, int s) const {
 }
 
 void DenseCostRows::Compute(int t0, int n, float* out) const {
-  std::memcpy(out, values_.data() + static_cast<size_t>(t0) * sources_, sizeof(float) * n * sources_);
+  std::memcpy(out, values_.data() + static_cast<size_t>(t0) * sources_,
+              sizeof(float) * n * sources_);
 }
 
 namespace {
 
 constexpr float kInf = std::numeric_limits<float>::infinity();
-constexpr int kLanes = 8;    // floats per vector
-constexpr int kChunk = 16;   // source frames per kernel step (two vectors)
-constexpr int kTile = 6;     // complete target frames per kernel step
+constexpr int kLanes = 8;   // floats per vector
+constexpr int kChunk = 16;  // source frames per kernel step (two vectors)
+constexpr int kTile = 6;    // complete target frames per kernel step
 
 typedef float v8f __attribute__((vector_size(32)));
 
@@ -51,8 +53,9 @@ inline v8f ClampPositive(v8f v) { return v > 0 ? v : v8f{}; }
 // out[t][s] = na[t] + nb[s] + sum_k a[t][k] * b[k][s] for TB targets and one chunk of
 // kChunk sources starting at s (`b` the chunk's packed features [k][kChunk], `nb` offset by s).
 template <int TB>
-__attribute__((always_inline)) inline void DenseChunk(const float* b, int dim, const float* nb, const float* a,
-                                                      const float* na, float* const* out) {
+__attribute__((always_inline)) inline void DenseChunk(const float* b, int dim, const float* nb,
+                                                      const float* a, const float* na,
+                                                      float* const* out) {
   v8f acc0[TB], acc1[TB];
   const v8f nb0 = Load(nb), nb1 = Load(nb + kLanes);
 #pragma GCC unroll 8
@@ -77,8 +80,9 @@ __attribute__((always_inline)) inline void DenseChunk(const float* b, int dim, c
 }
 
 template <int TB>
-__attribute__((always_inline)) inline void DenseRows(const float* b, int dim, const float* nb, const float* a,
-                                                     const float* na, float* const* rows, int count) {
+__attribute__((always_inline)) inline void DenseRows(const float* b, int dim, const float* nb,
+                                                     const float* a, const float* na,
+                                                     float* const* rows, int count) {
   float* out[TB];
   alignas(32) float tail[TB][kChunk];
   for (int s = 0; s < count; s += kChunk) {
@@ -94,15 +98,27 @@ __attribute__((always_inline)) inline void DenseRows(const float* b, int dim, co
 // Complete targets against every source: see DenseChunk. `b` is the packed block of the
 // first source (a multiple of kChunk). 1 <= tb <= kTile.
 __attribute__((target_clones("arch=x86-64-v3", "default"))) void DenseKernel(
-    const float* b, int dim, const float* nb, const float* a, const float* na, int tb, float* const* rows,
-    int count) {
+    const float* b, int dim, const float* nb, const float* a, const float* na, int tb,
+    float* const* rows, int count) {
   switch (tb) {
-    case 1: DenseRows<1>(b, dim, nb, a, na, rows, count); break;
-    case 2: DenseRows<2>(b, dim, nb, a, na, rows, count); break;
-    case 3: DenseRows<3>(b, dim, nb, a, na, rows, count); break;
-    case 4: DenseRows<4>(b, dim, nb, a, na, rows, count); break;
-    case 5: DenseRows<5>(b, dim, nb, a, na, rows, count); break;
-    default: DenseRows<kTile>(b, dim, nb, a, na, rows, count); break;
+    case 1:
+      DenseRows<1>(b, dim, nb, a, na, rows, count);
+      break;
+    case 2:
+      DenseRows<2>(b, dim, nb, a, na, rows, count);
+      break;
+    case 3:
+      DenseRows<3>(b, dim, nb, a, na, rows, count);
+      break;
+    case 4:
+      DenseRows<4>(b, dim, nb, a, na, rows, count);
+      break;
+    case 5:
+      DenseRows<5>(b, dim, nb, a, na, rows, count);
+      break;
+    default:
+      DenseRows<kTile>(b, dim, nb, a, na, rows, count);
+      break;
   }
 }
 
@@ -111,8 +127,9 @@ __attribute__((target_clones("arch=x86-64-v3", "default"))) void DenseKernel(
 // The body of SparseKernel, inlined into each of its clones. (Its own function, as DenseRows is
 // DenseKernel's: a clone built for AVX may not call Load or Store, built without, with a vector
 // argument or result; clang refuses it as an ABI change, GCC let it pass.)
-__attribute__((always_inline)) inline void SparseRow(const float* b, int dim, const int* features, int nfeatures,
-                                                     const float* w, const float* a, float* row, int count) {
+__attribute__((always_inline)) inline void SparseRow(const float* b, int dim, const int* features,
+                                                     int nfeatures, const float* w, const float* a,
+                                                     float* row, int count) {
   alignas(32) float tail[kLanes];
   // Up to `count` only: the last lanes of the padding may lie wholly past it (a negative
   // tail length here once overwrote the row).
@@ -133,18 +150,20 @@ __attribute__((always_inline)) inline void SparseRow(const float* b, int dim, co
 }
 
 __attribute__((target_clones("arch=x86-64-v3", "default"))) void SparseKernel(
-    const float* b, int dim, const int* features, int nfeatures, const float* w, const float* a, float* row,
-    int count) {
+    const float* b, int dim, const int* features, int nfeatures, const float* w, const float* a,
+    float* row, int count) {
   SparseRow(b, dim, features, nfeatures, w, a, row, count);
 }
 
 }  // namespace
 
-DescriptorCostRows::DescriptorCostRows(const PoseDescriptors& targets, const PoseDescriptors& sources,
-                                       float min_source_coverage)
+DescriptorCostRows::DescriptorCostRows(const PoseDescriptors& targets,
+                                       const PoseDescriptors& sources, float min_source_coverage)
     : targets_(&targets), sources_(&sources) {
   if (targets.layout.dim != sources.layout.dim || targets.layout.groups != sources.layout.groups) {
-    throw InputError("skeletons", "targets and sources have different descriptors (skeletons or options differ)");
+    throw InputError(
+        "skeletons",
+        "targets and sources have different descriptors (skeletons or options differ)");
   }
   const DescriptorLayout& layout = sources.layout;
   const int count = sources.count;
@@ -152,7 +171,8 @@ DescriptorCostRows::DescriptorCostRows(const PoseDescriptors& targets, const Pos
   source_features_.assign(static_cast<size_t>(layout.dim) * padded_, 0.0f);
   for (int k = 0; k < layout.dim; ++k) {
     for (int s = 0; s < count; ++s) {
-      source_features_[(static_cast<size_t>(s / kChunk) * layout.dim + k) * kChunk + s % kChunk] = sources.feature(k, s);
+      source_features_[(static_cast<size_t>(s / kChunk) * layout.dim + k) * kChunk + s % kChunk] =
+          sources.feature(k, s);
     }
   }
   source_norm_.assign(padded_, 0.0f);
@@ -195,8 +215,8 @@ void DescriptorCostRows::Compute(int t0, int n, float* out) const {
         w.push_back(layout.feature_weight[k] / tg.present_weight[t]);
         a.push_back(tg.feature(k, t));
       }
-      SparseKernel(source_features_.data(), dim, features.data(), static_cast<int>(features.size()), w.data(),
-                   a.data(), row, count);
+      SparseKernel(source_features_.data(), dim, features.data(), static_cast<int>(features.size()),
+                   w.data(), a.data(), row, count);
     }
     for (int s : incomplete_) row[s] = PoseCost(tg, t, src, s);
     for (int s : excluded_) row[s] = kInf;
@@ -213,7 +233,8 @@ void DescriptorCostRows::Compute(int t0, int n, float* out) const {
     for (int k = 0; k < dim; ++k) {
       const double v = tg.feature(k, t);
       norm += layout.feature_weight[k] * v * v;
-      a[i * dim + k] = static_cast<float>(-2.0 * layout.feature_weight[k] * v / layout.total_weight);
+      a[i * dim + k] =
+          static_cast<float>(-2.0 * layout.feature_weight[k] * v / layout.total_weight);
     }
     na[i] = static_cast<float>(norm / layout.total_weight);
     all_rows[i] = out + static_cast<size_t>(t - t0) * count;
@@ -225,8 +246,9 @@ void DescriptorCostRows::Compute(int t0, int n, float* out) const {
     for (size_t first = 0; first < nd; first += kTile) {
       const int tb = static_cast<int>(std::min<size_t>(kTile, nd - first));
       for (int i = 0; i < tb; ++i) rows[i] = all_rows[first + i] + s0;
-      DenseKernel(source_features_.data() + static_cast<size_t>(s0) * dim, dim, source_norm_.data() + s0,
-                  a.data() + first * dim, na.data() + first, tb, rows, block);
+      DenseKernel(source_features_.data() + static_cast<size_t>(s0) * dim, dim,
+                  source_norm_.data() + s0, a.data() + first * dim, na.data() + first, tb, rows,
+                  block);
     }
   }
   for (size_t i = 0; i < nd; ++i) {

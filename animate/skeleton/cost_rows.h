@@ -53,13 +53,13 @@ class DescriptorCostRows final : public CostRows {
  private:
   const PoseDescriptors* targets_;
   const PoseDescriptors* sources_;
-  int padded_ = 0;                   // sources rounded up to the kernel's width
+  int padded_ = 0;  // sources rounded up to the kernel's width
   // Packed per chunk of 16 sources: [(s / 16) * dim + k) * 16 + s % 16], so a kernel step
   // reads one contiguous run (dim x 16 floats) instead of dim rows a whole source row apart.
   std::vector<float> source_features_;
-  std::vector<float> source_norm_;      // sum_k w_k b_k^2 / W, complete sources
-  std::vector<int> incomplete_;         // usable but incomplete source frames
-  std::vector<int> excluded_;           // coverage below the minimum
+  std::vector<float> source_norm_;  // sum_k w_k b_k^2 / W, complete sources
+  std::vector<int> incomplete_;     // usable but incomplete source frames
+  std::vector<int> excluded_;       // coverage below the minimum
 };
 
 }  // namespace ss

@@ -17,12 +17,15 @@ bool DescriptorOptions::IsValid(std::string* why) const {
   }
   if (angle_weight + ratio_weight <= 0) return fail("angle_weight + ratio_weight must be > 0");
   if (!(min_limb_px >= 0)) return fail("min_limb_px must be >= 0");
-  if (!(no_overlap_cost >= 0) || !std::isfinite(no_overlap_cost)) return fail("no_overlap_cost must be finite, >= 0");
-  if (!(motion_weight >= 0) || !std::isfinite(motion_weight)) return fail("motion_weight must be finite, >= 0");
+  if (!(no_overlap_cost >= 0) || !std::isfinite(no_overlap_cost))
+    return fail("no_overlap_cost must be finite, >= 0");
+  if (!(motion_weight >= 0) || !std::isfinite(motion_weight))
+    return fail("motion_weight must be finite, >= 0");
   if (motion_weight > 0 && !(motion_window_s > 0 && std::isfinite(motion_window_s))) {
     return fail("motion_window_s must be > 0 seconds");
   }
-  if (motion_weight > 0 && !(motion_scale > 0 && std::isfinite(motion_scale))) return fail("motion_scale must be > 0");
+  if (motion_weight > 0 && !(motion_scale > 0 && std::isfinite(motion_scale)))
+    return fail("motion_scale must be > 0");
   if (!(root_motion_weight >= 0) || !std::isfinite(root_motion_weight)) {
     return fail("root_motion_weight must be finite, >= 0");
   }
@@ -40,8 +43,9 @@ DescriptorLayout MakeDescriptorLayout(const SkeletonDef& def, const DescriptorOp
   layout.groups = layout.pairs + (orientation ? 1 : 0);
   layout.dim = 3 * layout.pairs + (orientation ? 2 : 0);
   for (int p = 0; p < layout.pairs; ++p) {
-    layout.feature_weight.insert(layout.feature_weight.end(),
-                                 {options.angle_weight / 2, options.angle_weight / 2, options.ratio_weight});
+    layout.feature_weight.insert(
+        layout.feature_weight.end(),
+        {options.angle_weight / 2, options.angle_weight / 2, options.ratio_weight});
     layout.feature_group.insert(layout.feature_group.end(), {p, p, p});
     layout.group_weight.push_back(options.angle_weight + options.ratio_weight);
   }
@@ -106,8 +110,10 @@ void Describe(const SkeletonDef& def, const SkeletonFrame& frame, const Descript
     out->present[p * n + i] = ok ? 1 : 0;
     if (!ok) continue;
     const double lu = std::hypot(u.x, u.y), lv = std::hypot(v.x, v.y);
-    const double cos_angle = (static_cast<double>(u.x) * v.x + static_cast<double>(u.y) * v.y) / (lu * lv);
-    const double sin_angle = (static_cast<double>(u.x) * v.y - static_cast<double>(u.y) * v.x) / (lu * lv);
+    const double cos_angle =
+        (static_cast<double>(u.x) * v.x + static_cast<double>(u.y) * v.y) / (lu * lv);
+    const double sin_angle =
+        (static_cast<double>(u.x) * v.y - static_cast<double>(u.y) * v.x) / (lu * lv);
     out->features[(3 * p) * n + i] = static_cast<float>(cos_angle);
     out->features[(3 * p + 1) * n + i] = static_cast<float>(sin_angle);
     out->features[(3 * p + 2) * n + i] = static_cast<float>(std::log(lv / lu));
@@ -144,7 +150,8 @@ void NormalizeRatios(PoseDescriptors* d, int begin, int end) {
     const size_t mid = values.size() / 2;
     std::nth_element(values.begin(), values.begin() + mid, values.end());
     float median = values[mid];
-    if (values.size() % 2 == 0) median = (median + *std::max_element(values.begin(), values.begin() + mid)) / 2;
+    if (values.size() % 2 == 0)
+      median = (median + *std::max_element(values.begin(), values.begin() + mid)) / 2;
     for (int i = begin; i < end; ++i) {
       if (d->present[p * n + i]) ratio[i] -= median;
     }
@@ -155,15 +162,16 @@ void NormalizeRatios(PoseDescriptors* d, int begin, int end) {
 // per frame, the frames a (the last at or before t - h) and b (the first at or after
 // t + h), clipped to the clip; Δt = t_b - t_a must lie in [h, 4h] (shorter: a clip too
 // short to measure; longer: a gap in the frame numbers).
-void DescribeMotion(const SkeletonSequence& clip, double fps, const DescriptorOptions& options, PoseDescriptors* d,
-                    int begin) {
+void DescribeMotion(const SkeletonSequence& clip, double fps, const DescriptorOptions& options,
+                    PoseDescriptors* d, int begin) {
   const DescriptorLayout& layout = d->layout;
   if (layout.first_motion_group == layout.groups) return;
   const size_t count = d->count;
   const int n = clip.size();
   const double h = options.motion_window_s;
   auto time = [&](int i) { return static_cast<double>(clip.frames[i].frame) / fps; };
-  const double eps = 1e-3 / fps;  // a thousandth of a frame: 0.2f is not 0.2 nor 5 frames at 25 fps exactly
+  const double eps =
+      1e-3 / fps;  // a thousandth of a frame: 0.2f is not 0.2 nor 5 frames at 25 fps exactly
   int a = 0, b = 0;
   for (int i = 0; i < n; ++i) {
     const double t = time(i);
@@ -177,12 +185,14 @@ void DescribeMotion(const SkeletonSequence& clip, double fps, const DescriptorOp
       if (!d->has(p, ia) || !d->has(p, ib)) continue;
       double sum = 0;
       for (int k = 3 * p; k < 3 * p + 3; ++k) {
-        const double diff = static_cast<double>(d->features[k * count + ib]) - d->features[k * count + ia];
+        const double diff =
+            static_cast<double>(d->features[k * count + ib]) - d->features[k * count + ia];
         sum += diff * diff;
       }
       const double rate = std::sqrt(sum) / dt;
       const int g = layout.first_motion_group + p;
-      d->features[(layout.first_motion_feature + p) * count + ii] = static_cast<float>(rate / (rate + options.motion_scale));
+      d->features[(layout.first_motion_feature + p) * count + ii] =
+          static_cast<float>(rate / (rate + options.motion_scale));
       d->present[g * count + ii] = 1;
       d->present_weight[ii] += layout.group_weight[g];
     }
@@ -192,13 +202,18 @@ void DescribeMotion(const SkeletonSequence& clip, double fps, const DescriptorOp
     const Limb& root = clip.skeleton.limbs[clip.skeleton.root_limb];
     const auto& ja = clip.frames[a].joints;
     const auto& jb = clip.frames[b].joints;
-    if (!ja[root.from].present || !ja[root.to].present || !jb[root.from].present || !jb[root.to].present) continue;
-    const double length = (std::hypot(ja[root.to].x_px - ja[root.from].x_px, ja[root.to].y_px - ja[root.from].y_px) +
-                           std::hypot(jb[root.to].x_px - jb[root.from].x_px, jb[root.to].y_px - jb[root.from].y_px)) /
-                          2;
+    if (!ja[root.from].present || !ja[root.to].present || !jb[root.from].present ||
+        !jb[root.to].present)
+      continue;
+    const double length =
+        (std::hypot(ja[root.to].x_px - ja[root.from].x_px, ja[root.to].y_px - ja[root.from].y_px) +
+         std::hypot(jb[root.to].x_px - jb[root.from].x_px, jb[root.to].y_px - jb[root.from].y_px)) /
+        2;
     if (!(length >= std::max(options.min_limb_px, 1e-6f))) continue;
-    const double dx = (jb[root.from].x_px + jb[root.to].x_px - ja[root.from].x_px - ja[root.to].x_px) / 2.0;
-    const double dy = (jb[root.from].y_px + jb[root.to].y_px - ja[root.from].y_px - ja[root.to].y_px) / 2.0;
+    const double dx =
+        (jb[root.from].x_px + jb[root.to].x_px - ja[root.from].x_px - ja[root.to].x_px) / 2.0;
+    const double dy =
+        (jb[root.from].y_px + jb[root.to].y_px - ja[root.from].y_px - ja[root.to].y_px) / 2.0;
     const double speed = std::hypot(dx, dy) / length / dt;
     d->features[(layout.first_motion_feature + layout.pairs) * count + ii] =
         static_cast<float>(speed / (speed + options.root_motion_scale));
@@ -219,10 +234,10 @@ PoseDescriptors ComputeDescriptors(const std::vector<const SkeletonSequence*>& c
   d.layout = MakeDescriptorLayout(def, options);
   for (const auto* clip : clips) {
     const auto& limbs = clip->skeleton.limbs;
-    const bool same_limbs = limbs.size() == def.limbs.size() &&
-                            std::equal(limbs.begin(), limbs.end(), def.limbs.begin(), [](const Limb& x, const Limb& y) {
-                              return x.from == y.from && x.to == y.to;
-                            });
+    const bool same_limbs =
+        limbs.size() == def.limbs.size() &&
+        std::equal(limbs.begin(), limbs.end(), def.limbs.begin(),
+                   [](const Limb& x, const Limb& y) { return x.from == y.from && x.to == y.to; });
     if (clip->skeleton.joints != def.joints || !same_limbs) {
       throw InputError(clip->clip.empty() ? "skeletons" : clip->clip,
                        "skeleton '" + clip->skeleton.name + "' differs from '" + def.name +
@@ -240,8 +255,9 @@ PoseDescriptors ComputeDescriptors(const std::vector<const SkeletonSequence*>& c
     for (const auto& frame : clip->frames) {
       if (frame.joints.size() != def.joints.size()) {
         throw InputError(clip->clip.empty() ? "skeletons" : clip->clip,
-                         "frame " + std::to_string(frame.frame) + " has " + std::to_string(frame.joints.size()) +
-                             " joints, skeleton '" + def.name + "' has " + std::to_string(def.joints.size()));
+                         "frame " + std::to_string(frame.frame) + " has " +
+                             std::to_string(frame.joints.size()) + " joints, skeleton '" +
+                             def.name + "' has " + std::to_string(def.joints.size()));
       }
       Describe(def, frame, options, &d, i++);
     }
@@ -254,7 +270,8 @@ PoseDescriptors ComputeDescriptors(const std::vector<const SkeletonSequence*>& c
   return d;
 }
 
-PoseDescriptors ComputeDescriptors(const SkeletonSequence& sequence, const DescriptorOptions& options) {
+PoseDescriptors ComputeDescriptors(const SkeletonSequence& sequence,
+                                   const DescriptorOptions& options) {
   return ComputeDescriptors(std::vector<const SkeletonSequence*>{&sequence}, options);
 }
 
@@ -280,7 +297,8 @@ float PoseCost(const PoseDescriptors& a, int i, const PoseDescriptors& b, int j,
 
 std::vector<float> SequentialCost(const PoseDescriptors& sequence) {
   std::vector<float> cost;
-  for (int t = 0; t + 1 < sequence.count; ++t) cost.push_back(PoseCost(sequence, t, sequence, t + 1, false));
+  for (int t = 0; t + 1 < sequence.count; ++t)
+    cost.push_back(PoseCost(sequence, t, sequence, t + 1, false));
   return cost;
 }
 

@@ -38,18 +38,18 @@
 namespace ss {
 
 struct DescriptorOptions {
-  float angle_weight = 1.0f;        // per limb pair, on 1 - cos(Δangle)
-  float ratio_weight = 0.5f;        // per limb pair, on (Δ log length ratio)^2
+  float angle_weight = 1.0f;         // per limb pair, on 1 - cos(Δangle)
+  float ratio_weight = 0.5f;         // per limb pair, on (Δ log length ratio)^2
   float orientation_weight = 0.25f;  // root limb's image orientation; 0 = rotation invariant
-  bool normalize_ratios = false;    // subtract each sequence's median log ratio per pair
-  float min_limb_px = 1.0f;         // shorter limbs leave their terms undefined
-  float no_overlap_cost = 1.0f;     // cost when two frames share no term
-  float motion_weight = 1.0f;       // per limb pair, on (Δμ)^2; 0 = poses only
-  float motion_window_s = 0.2f;     // seconds before and after a frame the rate is measured over
-  float motion_scale = 0.25f;       // rate (1/s) at which μ = 1/2
-  float root_motion_weight = 2.0f;  // on (Δν)^2; 0 = none (only with motion_weight > 0)
-  float root_motion_scale = 0.15f;  // root speed (root lengths per second) at which ν = 1/2
-  double default_fps = 30;          // for sequences that do not give theirs
+  bool normalize_ratios = false;     // subtract each sequence's median log ratio per pair
+  float min_limb_px = 1.0f;          // shorter limbs leave their terms undefined
+  float no_overlap_cost = 1.0f;      // cost when two frames share no term
+  float motion_weight = 1.0f;        // per limb pair, on (Δμ)^2; 0 = poses only
+  float motion_window_s = 0.2f;      // seconds before and after a frame the rate is measured over
+  float motion_scale = 0.25f;        // rate (1/s) at which μ = 1/2
+  float root_motion_weight = 2.0f;   // on (Δν)^2; 0 = none (only with motion_weight > 0)
+  float root_motion_scale = 0.15f;   // root speed (root lengths per second) at which ν = 1/2
+  double default_fps = 30;           // for sequences that do not give theirs
   bool IsValid(std::string* why) const;
 };
 
@@ -64,9 +64,9 @@ struct DescriptorLayout {
   int groups = 0;
   std::vector<float> feature_weight;  // w_k: the 1 - cos terms are 1/2 |Δ(cos, sin)|^2
   std::vector<int> feature_group;
-  std::vector<float> group_weight;    // W_g: sum of its terms' weights
+  std::vector<float> group_weight;  // W_g: sum of its terms' weights
   float total_weight = 0;
-  float pose_total_weight = 0;        // of the groups before the motion terms
+  float pose_total_weight = 0;  // of the groups before the motion terms
   float no_overlap_cost = 1.0f;
 };
 
@@ -93,7 +93,8 @@ struct PoseDescriptors {
 };
 
 // Descriptors of every frame of `sequence`.
-PoseDescriptors ComputeDescriptors(const SkeletonSequence& sequence, const DescriptorOptions& options);
+PoseDescriptors ComputeDescriptors(const SkeletonSequence& sequence,
+                                   const DescriptorOptions& options);
 // Of several clips (same skeleton definition) one after the other; throws InputError when
 // their definitions differ.
 PoseDescriptors ComputeDescriptors(const std::vector<const SkeletonSequence*>& clips,
@@ -102,7 +103,8 @@ PoseDescriptors ComputeDescriptors(const std::vector<const SkeletonSequence*>& c
 // The cost between frame i of `a` (a target) and frame j of `b` (a source), from the
 // definition above; 0 when target frame i has no term at all. `motion` = false leaves the
 // motion terms out (the refinement's movement detector compares poses only).
-float PoseCost(const PoseDescriptors& a, int i, const PoseDescriptors& b, int j, bool motion = true);
+float PoseCost(const PoseDescriptors& a, int i, const PoseDescriptors& b, int j,
+               bool motion = true);
 
 // cost(x_t, x_{t+1}) for t = 0..n-2, poses only: how much the sequence moves per frame (§2.3).
 std::vector<float> SequentialCost(const PoseDescriptors& sequence);

@@ -52,7 +52,8 @@ std::optional<float> ParseCell(const std::string& cell, const std::string& where
 }
 
 std::optional<int64_t> ParseInteger(const std::string& text) {
-  if (text.empty() || !std::all_of(text.begin(), text.end(), [](char c) { return c >= '0' && c <= '9'; })) {
+  if (text.empty() ||
+      !std::all_of(text.begin(), text.end(), [](char c) { return c >= '0' && c <= '9'; })) {
     return std::nullopt;
   }
   try {
@@ -109,7 +110,8 @@ SkeletonSequence ImportDeepLabCutCsv(const std::string& path, const JointMapping
     break;
   }
   if (!header_row.count("bodyparts") || !header_row.count("coords")) {
-    throw InputError(path, "not a DeepLabCut CSV: the 'bodyparts' and 'coords' header rows are missing");
+    throw InputError(path,
+                     "not a DeepLabCut CSV: the 'bodyparts' and 'coords' header rows are missing");
   }
   const auto& bodyparts = header[header_row["bodyparts"]];
   const auto& coords = header[header_row["coords"]];
@@ -123,7 +125,8 @@ SkeletonSequence ImportDeepLabCutCsv(const std::string& path, const JointMapping
     }
   }
   size_t leading = 1;
-  while (leading < width && coords[leading] != "x" && coords[leading] != "y" && coords[leading] != "likelihood") {
+  while (leading < width && coords[leading] != "x" && coords[leading] != "y" &&
+         coords[leading] != "likelihood") {
     ++leading;
   }
   std::string individual = options.individual;
@@ -131,26 +134,35 @@ SkeletonSequence ImportDeepLabCutCsv(const std::string& path, const JointMapping
   std::vector<DlcPart> parts;
   for (size_t c = leading; c < width; ++c) {
     if (individuals && (*individuals)[c] != individual) continue;
-    auto it = std::find_if(parts.begin(), parts.end(), [&](const DlcPart& p) { return p.name == bodyparts[c]; });
+    auto it = std::find_if(parts.begin(), parts.end(),
+                           [&](const DlcPart& p) { return p.name == bodyparts[c]; });
     if (it == parts.end()) {
       parts.push_back({bodyparts[c]});
       it = parts.end() - 1;
     }
     const int col = static_cast<int>(c);
-    if (coords[c] == "x") it->x = col;
-    else if (coords[c] == "y") it->y = col;
-    else if (coords[c] == "likelihood") it->likelihood = col;
-    else throw InputError(path, "coords column " + std::to_string(c) + ": unknown coordinate '" + coords[c] + "'");
+    if (coords[c] == "x")
+      it->x = col;
+    else if (coords[c] == "y")
+      it->y = col;
+    else if (coords[c] == "likelihood")
+      it->likelihood = col;
+    else
+      throw InputError(
+          path, "coords column " + std::to_string(c) + ": unknown coordinate '" + coords[c] + "'");
   }
   if (parts.empty()) {
-    throw InputError(path, individuals ? "no columns for individual '" + individual + "'" : "no body part columns");
+    throw InputError(path, individuals ? "no columns for individual '" + individual + "'"
+                                       : "no body part columns");
   }
   std::vector<std::string> names;
   for (const auto& p : parts) {
-    if (p.x < 0 || p.y < 0) throw InputError(path, "body part '" + p.name + "' lacks an x or a y column");
+    if (p.x < 0 || p.y < 0)
+      throw InputError(path, "body part '" + p.name + "' lacks an x or a y column");
     names.push_back(p.name);
   }
-  const ResolvedMapping resolved = ResolveMapping(mapping, names, path, options.min_confidence.value_or(0.6f));
+  const ResolvedMapping resolved =
+      ResolveMapping(mapping, names, path, options.min_confidence.value_or(0.6f));
   // An explicit option wins over the mapping file.
   ResolvedMapping use = resolved;
   if (options.min_confidence) use.min_confidence = *options.min_confidence;
@@ -170,10 +182,12 @@ SkeletonSequence ImportDeepLabCutCsv(const std::string& path, const JointMapping
     std::vector<Keypoint> keypoints(parts.size());
     for (size_t k = 0; k < parts.size(); ++k) {
       const DlcPart& p = parts[k];
-      const std::string at = where + " (frame " + std::to_string(frame) + ") body part '" + p.name + "'";
+      const std::string at =
+          where + " (frame " + std::to_string(frame) + ") body part '" + p.name + "'";
       const auto x = ParseCell(cells[p.x], at);
       const auto y = ParseCell(cells[p.y], at);
-      const auto l = p.likelihood >= 0 ? ParseCell(cells[p.likelihood], at) : std::optional<float>(1.0f);
+      const auto l =
+          p.likelihood >= 0 ? ParseCell(cells[p.likelihood], at) : std::optional<float>(1.0f);
       if (x && y && l) keypoints[k] = {*x, *y, *l, true};
     }
     if (!sequence.frames.empty() && frame <= sequence.frames.back().frame) {
@@ -189,12 +203,13 @@ SkeletonSequence ImportDeepLabCutCsv(const std::string& path, const JointMapping
 
 namespace {
 SkeletonSequence ImportOpenPoseJsonUnchecked(const std::string& path, const JointMapping& mapping,
-                                    const ImportOptions& options) {
+                                             const ImportOptions& options) {
   std::vector<std::string> files;
   std::error_code ec;
   if (fs::is_directory(path, ec)) {
     for (const auto& entry : fs::directory_iterator(path)) {
-      if (entry.is_regular_file() && entry.path().extension() == ".json") files.push_back(entry.path().string());
+      if (entry.is_regular_file() && entry.path().extension() == ".json")
+        files.push_back(entry.path().string());
     }
     std::sort(files.begin(), files.end());
     if (files.empty()) throw InputError(path, "no OpenPose .json files in this folder");
@@ -203,9 +218,9 @@ SkeletonSequence ImportOpenPoseJsonUnchecked(const std::string& path, const Join
   } else {
     throw InputError(path, "no such file or folder");
   }
-  static const std::vector<std::string> kCoco18 = {"Nose", "Neck", "RShoulder", "RElbow", "RWrist", "LShoulder",
-                                                   "LElbow", "LWrist", "RHip", "RKnee", "RAnkle", "LHip",
-                                                   "LKnee", "LAnkle", "REye", "LEye", "REar", "LEar"};
+  static const std::vector<std::string> kCoco18 = {
+      "Nose",  "Neck",   "RShoulder", "RElbow", "RWrist", "LShoulder", "LElbow", "LWrist", "RHip",
+      "RKnee", "RAnkle", "LHip",      "LKnee",  "LAnkle", "REye",      "LEye",   "REar",   "LEar"};
   static const std::regex kNumbered(R"((\d+)_keypoints$)");
   SkeletonSequence sequence = NewSequence(mapping, path);
   std::optional<ResolvedMapping> resolved;
@@ -216,9 +231,11 @@ SkeletonSequence ImportOpenPoseJsonUnchecked(const std::string& path, const Join
     const std::string stem = fs::path(file).stem().string();
     std::smatch match;
     int64_t frame = ordinal;
-    if (std::regex_search(stem, match, kNumbered)) frame = ParseInteger(match[1].str()).value_or(ordinal);
+    if (std::regex_search(stem, match, kNumbered))
+      frame = ParseInteger(match[1].str()).value_or(ordinal);
     ++ordinal;
-    if (!sequence.frames.empty() && frame <= sequence.frames.back().frame) frame = sequence.frames.back().frame + 1;
+    if (!sequence.frames.empty() && frame <= sequence.frames.back().frame)
+      frame = sequence.frames.back().frame + 1;
     const auto people = json.find("people");
     if (!json.is_object() || people == json.end() || !people->is_array()) {
       throw InputError(file, "not an OpenPose keypoint file: no 'people' array");
@@ -248,7 +265,8 @@ SkeletonSequence ImportOpenPoseJsonUnchecked(const std::string& path, const Join
                                 options.min_confidence.value_or(0.2f));
       if (options.min_confidence) resolved->min_confidence = *options.min_confidence;
     } else if (n != layout) {
-      throw InputError(file, "has " + std::to_string(n) + " keypoints, earlier files have " + std::to_string(layout));
+      throw InputError(file, "has " + std::to_string(n) + " keypoints, earlier files have " +
+                                 std::to_string(layout));
     }
     std::vector<Keypoint> keypoints(n);
     for (int i = 0; i < n; ++i) {
@@ -259,11 +277,13 @@ SkeletonSequence ImportOpenPoseJsonUnchecked(const std::string& path, const Join
         throw InputError(file, "keypoint " + std::to_string(i) + " is not numeric");
       }
       const float conf = c.get<float>();
-      if (conf > 0) keypoints[i] = {x.get<float>(), y.get<float>(), conf, true};  // c = 0: not detected
+      if (conf > 0)
+        keypoints[i] = {x.get<float>(), y.get<float>(), conf, true};  // c = 0: not detected
     }
     sequence.frames.push_back(MapKeypoints(*resolved, keypoints, frame));
   }
-  if (layout < 0) Log("animate.skeleton")->warn("{}: no file holds person {}", path, options.person);
+  if (layout < 0)
+    Log("animate.skeleton")->warn("{}: no file holds person {}", path, options.person);
   return sequence;
 }
 }  // namespace
@@ -280,7 +300,7 @@ SkeletonSequence ImportOpenPoseJson(const std::string& path, const JointMapping&
 
 namespace {
 SkeletonSequence ImportCocoKeypointsUnchecked(const std::string& path, const JointMapping& mapping,
-                                     const ImportOptions& options) {
+                                              const ImportOptions& options) {
   const nlohmann::json json = ReadJsonFile(path);
   const auto annotations = json.find("annotations");
   if (!json.is_object() || annotations == json.end() || !annotations->is_array()) {
@@ -297,7 +317,8 @@ SkeletonSequence ImportCocoKeypointsUnchecked(const std::string& path, const Joi
       break;
     }
   }
-  ResolvedMapping resolved = ResolveMapping(mapping, names, path, options.min_confidence.value_or(0.5f));
+  ResolvedMapping resolved =
+      ResolveMapping(mapping, names, path, options.min_confidence.value_or(0.5f));
   if (options.min_confidence) resolved.min_confidence = *options.min_confidence;
 
   // Per image the annotation with the most labelled keypoints.
@@ -305,12 +326,14 @@ SkeletonSequence ImportCocoKeypointsUnchecked(const std::string& path, const Joi
   for (size_t a = 0; a < annotations->size(); ++a) {
     const auto& ann = (*annotations)[a];
     const std::string where = path + ": annotations[" + std::to_string(a) + "]";
-    if (!ann.contains("image_id") || !ann["image_id"].is_number_integer()) throw InputError(where, "no image_id");
+    if (!ann.contains("image_id") || !ann["image_id"].is_number_integer())
+      throw InputError(where, "no image_id");
     if (category >= 0 && ann.contains("category_id") && ann["category_id"] != category) continue;
     const auto kp = ann.find("keypoints");
     if (kp == ann.end() || !kp->is_array() || kp->size() != 3 * names.size()) {
-      throw InputError(where, "keypoints must be [x, y, v] * " + std::to_string(names.size()) + ", got " +
-                                  std::to_string(kp == ann.end() ? 0 : kp->size()) + " numbers");
+      throw InputError(where, "keypoints must be [x, y, v] * " + std::to_string(names.size()) +
+                                  ", got " + std::to_string(kp == ann.end() ? 0 : kp->size()) +
+                                  " numbers");
     }
     int labelled = 0;
     for (size_t i = 2; i < kp->size(); i += 3) labelled += (*kp)[i].get<double>() > 0 ? 1 : 0;
@@ -321,7 +344,8 @@ SkeletonSequence ImportCocoKeypointsUnchecked(const std::string& path, const Joi
   std::vector<int64_t> images;
   if (const auto imgs = json.find("images"); imgs != json.end() && imgs->is_array()) {
     for (const auto& img : *imgs) {
-      if (img.contains("id") && img["id"].is_number_integer()) images.push_back(img["id"].get<int64_t>());
+      if (img.contains("id") && img["id"].is_number_integer())
+        images.push_back(img["id"].get<int64_t>());
     }
   }
   for (const auto& [image, unused] : best) images.push_back(image);
@@ -341,7 +365,9 @@ SkeletonSequence ImportCocoKeypointsUnchecked(const std::string& path, const Joi
     for (size_t i = 0; i < names.size(); ++i) {
       const double v = kp[3 * i + 2].get<double>();
       // v: 0 not labelled, 1 labelled but hidden, 2 labelled and visible.
-      if (v > 0) keypoints[i] = {kp[3 * i].get<float>(), kp[3 * i + 1].get<float>(), v >= 2 ? 1.0f : 0.5f, true};
+      if (v > 0)
+        keypoints[i] = {kp[3 * i].get<float>(), kp[3 * i + 1].get<float>(), v >= 2 ? 1.0f : 0.5f,
+                        true};
     }
     sequence.frames.push_back(MapKeypoints(resolved, keypoints, image));
   }
@@ -372,8 +398,9 @@ JointMapping IdentityMapping(const SkeletonDef& def) {
 }
 
 namespace {
-SkeletonSequence ImportSynthTruthUnchecked(const std::string& path, const std::string& camera, const JointMapping& mapping,
-                                  const ImportOptions& options) {
+SkeletonSequence ImportSynthTruthUnchecked(const std::string& path, const std::string& camera,
+                                           const JointMapping& mapping,
+                                           const ImportOptions& options) {
   // Find the truth folder and the CSV.
   fs::path truth_dir, csv;
   if (fs::is_regular_file(path)) {
@@ -384,10 +411,12 @@ SkeletonSequence ImportSynthTruthUnchecked(const std::string& path, const std::s
   } else if (fs::exists(fs::path(path) / "truth.json")) {
     truth_dir = path;
   } else {
-    throw InputError(path, "not a synthetic session, its truth folder or a <camera>/joints.csv (no truth.json)");
+    throw InputError(
+        path, "not a synthetic session, its truth folder or a <camera>/joints.csv (no truth.json)");
   }
   nlohmann::json truth;
-  if (fs::exists(truth_dir / "truth.json")) truth = ReadJsonFile((truth_dir / "truth.json").string());
+  if (fs::exists(truth_dir / "truth.json"))
+    truth = ReadJsonFile((truth_dir / "truth.json").string());
   std::string cam = camera;
   if (csv.empty()) {
     if (cam.empty()) {
@@ -407,7 +436,8 @@ SkeletonSequence ImportSynthTruthUnchecked(const std::string& path, const std::s
   const auto header = SplitCsvLine(line);
   auto column = [&](const std::string& name) {
     const auto it = std::find(header.begin(), header.end(), name);
-    if (it == header.end()) throw InputError(csv.string(), "no '" + name + "' column in the header");
+    if (it == header.end())
+      throw InputError(csv.string(), "no '" + name + "' column in the header");
     return static_cast<size_t>(it - header.begin());
   };
   const size_t c_frame = column("frame"), c_subject = column("subject"), c_name = column("name"),
@@ -439,14 +469,16 @@ SkeletonSequence ImportSynthTruthUnchecked(const std::string& path, const std::s
   if (frames.empty()) {
     throw InputError(csv.string(), "no rows for subject " + std::to_string(options.person));
   }
-  ResolvedMapping resolved = ResolveMapping(mapping, names, csv.string(), options.min_confidence.value_or(0.0f));
+  ResolvedMapping resolved =
+      ResolveMapping(mapping, names, csv.string(), options.min_confidence.value_or(0.0f));
   if (options.min_confidence) resolved.min_confidence = *options.min_confidence;
 
   SkeletonSequence sequence;
   sequence.skeleton = mapping.skeleton;
   std::string session = truth_dir.parent_path().filename().string();
   const fs::path session_json = truth_dir.parent_path() / "session.json";
-  if (fs::exists(session_json)) session = ReadJsonFile(session_json.string()).value("name", session);
+  if (fs::exists(session_json))
+    session = ReadJsonFile(session_json.string()).value("name", session);
   sequence.clip = session + "/" + cam;
   sequence.fps = truth.is_object() ? truth.value("fps", 0.0) : 0.0;
   for (const auto& [frame, by_index] : frames) {
@@ -458,8 +490,8 @@ SkeletonSequence ImportSynthTruthUnchecked(const std::string& path, const std::s
 }
 }  // namespace
 
-SkeletonSequence ImportSynthTruth(const std::string& path, const std::string& camera, const JointMapping& mapping,
-                                  const ImportOptions& options) {
+SkeletonSequence ImportSynthTruth(const std::string& path, const std::string& camera,
+                                  const JointMapping& mapping, const ImportOptions& options) {
   // A field of the wrong JSON type (an array where a name belongs) is the file's fault.
   try {
     return ImportSynthTruthUnchecked(path, camera, mapping, options);

@@ -18,7 +18,8 @@ struct ImportOptions {
   std::optional<float> min_confidence;
   std::string individual;  // DeepLabCut multi-animal: which individual (empty: the first)
   int person = 0;          // OpenPose: index into people[]; synth truth: the subject
-  int category_id = -1;    // COCO: the category whose annotations are read (-1: the first with keypoints)
+  int category_id =
+      -1;  // COCO: the category whose annotations are read (-1: the first with keypoints)
 };
 
 // DeepLabCut's CSV: header rows scorer / [individuals] / bodyparts / coords (x, y,
@@ -45,8 +46,8 @@ SkeletonSequence ImportCocoKeypoints(const std::string& path, const JointMapping
 // first camera in truth.json. Keypoints are the truth's joint names; every projected joint
 // is present with confidence 1 (also when hidden behind the body: it is the truth). The
 // clip is SESSION/CAMERA, as `skeleton track` names it, and fps comes from truth.json.
-SkeletonSequence ImportSynthTruth(const std::string& path, const std::string& camera, const JointMapping& mapping,
-                                  const ImportOptions& options = {});
+SkeletonSequence ImportSynthTruth(const std::string& path, const std::string& camera,
+                                  const JointMapping& mapping, const ImportOptions& options = {});
 
 // A mapping taking each joint of `def` from the keypoint of the same name.
 JointMapping IdentityMapping(const SkeletonDef& def);

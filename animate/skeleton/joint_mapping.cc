@@ -27,11 +27,12 @@ JointMapping JointMappingFromJson(const nlohmann::json& json, const std::string&
   if (json.value("format", std::string()) != "spritestation.joint_mapping") {
     throw InputError(context, "format: expected \"spritestation.joint_mapping\"");
   }
-  if (!json.contains("version") || json["version"] != 1) throw InputError(context, "version: only version 1 is known");
+  if (!json.contains("version") || json["version"] != 1)
+    throw InputError(context, "version: only version 1 is known");
   JointMapping mapping;
   mapping.context = context;
-  mapping.skeleton = SkeletonDefFromJson(json.contains("skeleton") ? json["skeleton"] : nlohmann::json("human14"),
-                                         context);
+  mapping.skeleton = SkeletonDefFromJson(
+      json.contains("skeleton") ? json["skeleton"] : nlohmann::json("human14"), context);
   mapping.sources.resize(mapping.skeleton.joints.size());
   if (const auto it = json.find("min_confidence"); it != json.end()) {
     if (!it->is_number() || it->get<double>() < 0 || it->get<double>() > 1) {
@@ -46,7 +47,9 @@ JointMapping JointMappingFromJson(const nlohmann::json& json, const std::string&
   for (const auto& [joint, value] : joints->items()) {
     const auto j = mapping.skeleton.JointIndex(joint);
     const std::string where = context + ": joints." + joint;
-    if (!j) throw InputError(where, "skeleton '" + mapping.skeleton.name + "' has no joint named '" + joint + "'");
+    if (!j)
+      throw InputError(
+          where, "skeleton '" + mapping.skeleton.name + "' has no joint named '" + joint + "'");
     if (value.is_array()) {
       if (value.empty()) throw InputError(where, "an empty list of keypoints");
       for (const auto& v : value) mapping.sources[*j].push_back(KeypointFromJson(v, where));
@@ -69,71 +72,73 @@ JointMapping LoadJointMapping(const std::string& path) {
 
 const std::vector<std::string>& Body25KeypointNames() {
   static const std::vector<std::string> names = {
-      "Nose",  "Neck",  "RShoulder", "RElbow",    "RWrist", "LShoulder", "LElbow",    "LWrist",    "MidHip",
-      "RHip",  "RKnee", "RAnkle",    "LHip",      "LKnee",  "LAnkle",    "REye",      "LEye",      "REar",
-      "LEar",  "LBigToe", "LSmallToe", "LHeel",   "RBigToe", "RSmallToe", "RHeel"};
+      "Nose",   "Neck",    "RShoulder", "RElbow", "RWrist", "LShoulder", "LElbow",
+      "LWrist", "MidHip",  "RHip",      "RKnee",  "RAnkle", "LHip",      "LKnee",
+      "LAnkle", "REye",    "LEye",      "REar",   "LEar",   "LBigToe",   "LSmallToe",
+      "LHeel",  "RBigToe", "RSmallToe", "RHeel"};
   return names;
 }
 
 const std::vector<std::string>& Coco17KeypointNames() {
   static const std::vector<std::string> names = {
-      "nose",        "left_eye",   "right_eye",  "left_ear",   "right_ear",  "left_shoulder",
+      "nose",           "left_eye",   "right_eye",   "left_ear",   "right_ear",   "left_shoulder",
       "right_shoulder", "left_elbow", "right_elbow", "left_wrist", "right_wrist", "left_hip",
-      "right_hip",   "left_knee",  "right_knee", "left_ankle", "right_ankle"};
+      "right_hip",      "left_knee",  "right_knee",  "left_ankle", "right_ankle"};
   return names;
 }
 
 const JointMapping& Body25ToHuman14() {
-  static const JointMapping mapping = JointMappingFromJson(
-      {{"format", "spritestation.joint_mapping"},
-       {"version", 1},
-       {"skeleton", "human14"},
-       {"joints",
-        {{"head", "Nose"},
-         {"neck", "Neck"},
-         {"shoulder_l", "LShoulder"},
-         {"elbow_l", "LElbow"},
-         {"wrist_l", "LWrist"},
-         {"shoulder_r", "RShoulder"},
-         {"elbow_r", "RElbow"},
-         {"wrist_r", "RWrist"},
-         {"pelvis", "MidHip"},
-         {"hip_l", "LHip"},
-         {"knee_l", "LKnee"},
-         {"ankle_l", "LAnkle"},
-         {"hip_r", "RHip"},
-         {"knee_r", "RKnee"},
-         {"ankle_r", "RAnkle"}}}},
-      "builtin:body25_to_human14");
+  static const JointMapping mapping =
+      JointMappingFromJson({{"format", "spritestation.joint_mapping"},
+                            {"version", 1},
+                            {"skeleton", "human14"},
+                            {"joints",
+                             {{"head", "Nose"},
+                              {"neck", "Neck"},
+                              {"shoulder_l", "LShoulder"},
+                              {"elbow_l", "LElbow"},
+                              {"wrist_l", "LWrist"},
+                              {"shoulder_r", "RShoulder"},
+                              {"elbow_r", "RElbow"},
+                              {"wrist_r", "RWrist"},
+                              {"pelvis", "MidHip"},
+                              {"hip_l", "LHip"},
+                              {"knee_l", "LKnee"},
+                              {"ankle_l", "LAnkle"},
+                              {"hip_r", "RHip"},
+                              {"knee_r", "RKnee"},
+                              {"ankle_r", "RAnkle"}}}},
+                           "builtin:body25_to_human14");
   return mapping;
 }
 
 const JointMapping& Coco17ToHuman14() {
-  static const JointMapping mapping = JointMappingFromJson(
-      {{"format", "spritestation.joint_mapping"},
-       {"version", 1},
-       {"skeleton", "human14"},
-       {"joints",
-        {{"head", "nose"},
-         {"neck", {"left_shoulder", "right_shoulder"}},
-         {"shoulder_l", "left_shoulder"},
-         {"elbow_l", "left_elbow"},
-         {"wrist_l", "left_wrist"},
-         {"shoulder_r", "right_shoulder"},
-         {"elbow_r", "right_elbow"},
-         {"wrist_r", "right_wrist"},
-         {"pelvis", {"left_hip", "right_hip"}},
-         {"hip_l", "left_hip"},
-         {"knee_l", "left_knee"},
-         {"ankle_l", "left_ankle"},
-         {"hip_r", "right_hip"},
-         {"knee_r", "right_knee"},
-         {"ankle_r", "right_ankle"}}}},
-      "builtin:coco17_to_human14");
+  static const JointMapping mapping =
+      JointMappingFromJson({{"format", "spritestation.joint_mapping"},
+                            {"version", 1},
+                            {"skeleton", "human14"},
+                            {"joints",
+                             {{"head", "nose"},
+                              {"neck", {"left_shoulder", "right_shoulder"}},
+                              {"shoulder_l", "left_shoulder"},
+                              {"elbow_l", "left_elbow"},
+                              {"wrist_l", "left_wrist"},
+                              {"shoulder_r", "right_shoulder"},
+                              {"elbow_r", "right_elbow"},
+                              {"wrist_r", "right_wrist"},
+                              {"pelvis", {"left_hip", "right_hip"}},
+                              {"hip_l", "left_hip"},
+                              {"knee_l", "left_knee"},
+                              {"ankle_l", "left_ankle"},
+                              {"hip_r", "right_hip"},
+                              {"knee_r", "right_knee"},
+                              {"ankle_r", "right_ankle"}}}},
+                           "builtin:coco17_to_human14");
   return mapping;
 }
 
-ResolvedMapping ResolveMapping(const JointMapping& mapping, const std::vector<std::string>& keypoint_names,
+ResolvedMapping ResolveMapping(const JointMapping& mapping,
+                               const std::vector<std::string>& keypoint_names,
                                const std::string& data_context, float min_confidence) {
   ResolvedMapping resolved;
   resolved.min_confidence = mapping.min_confidence.value_or(min_confidence);
@@ -148,10 +153,11 @@ ResolvedMapping ResolveMapping(const JointMapping& mapping, const std::vector<st
       if (index < 0 || index >= static_cast<int>(keypoint_names.size())) {
         std::string known;
         for (const auto& n : keypoint_names) known += (known.empty() ? "" : ", ") + n;
-        throw InputError(mapping.context, "joint '" + mapping.skeleton.joints[j] + "' maps to keypoint " +
-                                              KeypointLabel(key) + ", which " + data_context +
-                                              " does not have (it has " + std::to_string(keypoint_names.size()) +
-                                              ": " + known + ")");
+        throw InputError(mapping.context,
+                         "joint '" + mapping.skeleton.joints[j] + "' maps to keypoint " +
+                             KeypointLabel(key) + ", which " + data_context +
+                             " does not have (it has " + std::to_string(keypoint_names.size()) +
+                             ": " + known + ")");
       }
       resolved.sources[j].push_back(index);
     }
@@ -159,7 +165,8 @@ ResolvedMapping ResolveMapping(const JointMapping& mapping, const std::vector<st
   return resolved;
 }
 
-SkeletonFrame MapKeypoints(const ResolvedMapping& mapping, const std::vector<Keypoint>& keypoints, int64_t frame) {
+SkeletonFrame MapKeypoints(const ResolvedMapping& mapping, const std::vector<Keypoint>& keypoints,
+                           int64_t frame) {
   SkeletonFrame out;
   out.frame = frame;
   out.joints.resize(mapping.sources.size());

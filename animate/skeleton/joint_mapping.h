@@ -20,7 +20,7 @@ struct SourceKeypoint {
 };
 
 struct JointMapping {
-  std::string context;  // the mapping file, for error messages
+  std::string context;   // the mapping file, for error messages
   SkeletonDef skeleton;  // the joints produced
   // Per joint of `skeleton`: the keypoints averaged into it; empty = never observed.
   std::vector<std::vector<SourceKeypoint>> sources;
@@ -47,7 +47,8 @@ struct ResolvedMapping {
 // Resolves names and checks indices against `keypoint_names` (the file's layout; an index
 // must be below keypoint_names.size()). Throws InputError naming the mapping file, the
 // joint and `data_context` when a keypoint does not exist there.
-ResolvedMapping ResolveMapping(const JointMapping& mapping, const std::vector<std::string>& keypoint_names,
+ResolvedMapping ResolveMapping(const JointMapping& mapping,
+                               const std::vector<std::string>& keypoint_names,
                                const std::string& data_context, float min_confidence);
 
 // One source keypoint as read from a file.

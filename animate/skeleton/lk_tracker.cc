@@ -32,7 +32,8 @@ LkJointTracker::LkJointTracker(SkeletonDef skeleton, LkOptions options)
   result_.sequence.skeleton = skeleton_;
 }
 
-void LkJointTracker::AddFrame(const cv::Mat& image, const std::vector<bool>& occluded, const SkeletonFrame* given) {
+void LkJointTracker::AddFrame(const cv::Mat& image, const std::vector<bool>& occluded,
+                              const SkeletonFrame* given) {
   const std::string where = "tracking frame " + std::to_string(frame_);
   if (image.empty() || image.depth() != CV_8U || (image.channels() != 1 && image.channels() != 3)) {
     throw InputError(where, "expected an 8-bit grey or BGR image");
@@ -44,12 +45,14 @@ void LkJointTracker::AddFrame(const cv::Mat& image, const std::vector<bool>& occ
   }
   const size_t joints = skeleton_.joints.size();
   if (!occluded.empty() && occluded.size() != joints) {
-    throw InputError(where, "occlusion marks for " + std::to_string(occluded.size()) + " joints, skeleton '" +
-                                skeleton_.name + "' has " + std::to_string(joints));
+    throw InputError(where, "occlusion marks for " + std::to_string(occluded.size()) +
+                                " joints, skeleton '" + skeleton_.name + "' has " +
+                                std::to_string(joints));
   }
   if (given && given->joints.size() != joints) {
-    throw InputError(where, "given joints: " + std::to_string(given->joints.size()) + ", skeleton '" +
-                                skeleton_.name + "' has " + std::to_string(joints));
+    throw InputError(where, "given joints: " + std::to_string(given->joints.size()) +
+                                ", skeleton '" + skeleton_.name + "' has " +
+                                std::to_string(joints));
   }
   if (frame_ == 0 && !given) throw InputError(where, "the first frame needs the user's joints");
   cv::Mat grey;
@@ -75,8 +78,8 @@ void LkJointTracker::AddFrame(const cv::Mat& image, const std::vector<bool>& occ
     if (marks[j] || seen_[j].frame < 0) continue;
     by_source[seen_[j].frame].push_back(static_cast<int>(j));
   }
-  const cv::TermCriteria criteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, options_.max_iterations,
-                                  options_.epsilon);
+  const cv::TermCriteria criteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS,
+                                  options_.max_iterations, options_.epsilon);
   for (const auto& [source_frame, list] : by_source) {
     std::vector<cv::Mat> source_pyramid;
     int source_levels = levels;
@@ -91,11 +94,14 @@ void LkJointTracker::AddFrame(const cv::Mat& image, const std::vector<bool>& occ
     for (int j : list) from.push_back(seen_[j].position);
     std::vector<uchar> status, back_status;
     std::vector<float> error;
-    cv::calcOpticalFlowPyrLK(source_pyramid, pyramid, from, to, status, error, window, use_levels, criteria);
-    cv::calcOpticalFlowPyrLK(pyramid, source_pyramid, to, back, back_status, error, window, use_levels, criteria);
+    cv::calcOpticalFlowPyrLK(source_pyramid, pyramid, from, to, status, error, window, use_levels,
+                             criteria);
+    cv::calcOpticalFlowPyrLK(pyramid, source_pyramid, to, back, back_status, error, window,
+                             use_levels, criteria);
     for (size_t i = 0; i < list.size(); ++i) {
       const int j = list[i];
-      const bool inside = to[i].x >= 0 && to[i].y >= 0 && to[i].x < size_.width && to[i].y < size_.height;
+      const bool inside =
+          to[i].x >= 0 && to[i].y >= 0 && to[i].x < size_.width && to[i].y < size_.height;
       if (!status[i] || !back_status[i] || !inside) {
         result_.failures.push_back({frame_, j, "lost", -1.0f});
         continue;
@@ -115,7 +121,8 @@ void LkJointTracker::AddFrame(const cv::Mat& image, const std::vector<bool>& occ
     if (s.frame >= 0 && s.frame < frame_) needed.insert(s.frame);
   }
   if (frame_ > 0 && needed.count(frame_ - 1)) kept_[frame_ - 1] = previous_grey_;
-  for (auto it = kept_.begin(); it != kept_.end();) it = needed.count(it->first) ? std::next(it) : kept_.erase(it);
+  for (auto it = kept_.begin(); it != kept_.end();)
+    it = needed.count(it->first) ? std::next(it) : kept_.erase(it);
   previous_grey_ = grey;
   previous_pyramid_ = std::move(pyramid);
   occluded_.push_back(marks);
@@ -143,7 +150,8 @@ TrackingResult LkJointTracker::Finish() {
         cv::Point2f v0 = (p1 - p0) / span, v1 = v0;
         for (int c = context; c >= 1; --c) {
           if (seen(before - c)) {
-            v0 = (p0 - cv::Point2f(at(before - c).x_px, at(before - c).y_px)) / static_cast<float>(c);
+            v0 = (p0 - cv::Point2f(at(before - c).x_px, at(before - c).y_px)) /
+                 static_cast<float>(c);
             break;
           }
         }
@@ -180,7 +188,8 @@ TrackingResult TrackJoints(const std::vector<cv::Mat>& images, const SkeletonFra
   const std::vector<bool> all(skeleton.joints.size(), true);
   for (size_t i = 0; i < images.size(); ++i) {
     const bool occluded = !occluded_frames.empty() && occluded_frames[i];
-    tracker.AddFrame(images[i], occluded && i > 0 ? all : std::vector<bool>{}, i == 0 ? &first : nullptr);
+    tracker.AddFrame(images[i], occluded && i > 0 ? all : std::vector<bool>{},
+                     i == 0 ? &first : nullptr);
   }
   return tracker.Finish();
 }

@@ -16,8 +16,8 @@
 namespace ss {
 
 struct LkOptions {
-  int window_px = 21;                    // side of the search window at each level
-  int pyramid_levels = 3;                // levels above the image (0 = no pyramid)
+  int window_px = 21;      // side of the search window at each level
+  int pyramid_levels = 3;  // levels above the image (0 = no pyramid)
   int max_iterations = 30;
   double epsilon = 0.01;                 // pixels: the iteration stops below this update
   float max_forward_backward_px = 1.0f;  // tracking back must land this close to the start
@@ -26,7 +26,7 @@ struct LkOptions {
 };
 
 struct TrackingFailure {
-  int frame = 0;   // index into the sequence
+  int frame = 0;  // index into the sequence
   int joint = 0;
   std::string reason;              // "lost" (flow status 0) or "forward-backward"
   float forward_backward_px = -1;  // the error, when the flow converged both ways
@@ -48,7 +48,8 @@ class LkJointTracker {
   // none). `given`: joints the user placed in this frame (required for the first frame;
   // later, present joints re-seed the tracking). Throws InputError for a bad image, a
   // wrong joint count or a first frame without given joints.
-  void AddFrame(const cv::Mat& image, const std::vector<bool>& occluded = {}, const SkeletonFrame* given = nullptr);
+  void AddFrame(const cv::Mat& image, const std::vector<bool>& occluded = {},
+                const SkeletonFrame* given = nullptr);
 
   // Interpolates the occlusions and returns the sequence (frame numbers 0, 1, ...).
   TrackingResult Finish();

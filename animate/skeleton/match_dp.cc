@@ -28,13 +28,17 @@ bool MatchOptions::IsValid(std::string* why) const {
     return false;
   };
   for (float v : {skip_cost, jump_cost, freeze_cost, stutter_cost}) {
-    if (!(v >= 0) || !std::isfinite(v)) return fail("skip, jump, freeze and stutter costs must be finite and >= 0");
+    if (!(v >= 0) || !std::isfinite(v))
+      return fail("skip, jump, freeze and stutter costs must be finite and >= 0");
   }
-  if (max_forward_step < 1 || max_forward_step > 64) return fail("max_forward_step must be within 1..64");
+  if (max_forward_step < 1 || max_forward_step > 64)
+    return fail("max_forward_step must be within 1..64");
   if (stutter_window < 0 || stutter_window > 64) return fail("stutter_window must be within 0..64");
   if (freeze_levels < 1 || freeze_levels > 7) return fail("freeze_levels must be within 1..7");
   if (skip_cost * static_cast<float>(max_forward_step - 1) > jump_cost) {
-    return fail("a forward skip may not cost more than a jump: skip_cost * (max_forward_step - 1) <= jump_cost");
+    return fail(
+        "a forward skip may not cost more than a jump: skip_cost * (max_forward_step - 1) <= "
+        "jump_cost");
   }
   for (size_t i = 0; i < transitions.size(); ++i) {
     if (!(transitions[i].cost >= 0) || !std::isfinite(transitions[i].cost)) {
@@ -53,10 +57,11 @@ MatchOptions MatchOptions::WithoutPenalties() const {
 
 std::string MatchResult::Summary() const {
   std::ostringstream s;
-  s << source_frames.size() << " target frames, cost " << total_cost << " (matching " << matching_cost << "), "
-    << stats.freezes << " freezes in " << stats.freeze_runs << " runs (longest " << stats.longest_freeze << "), "
-    << stats.stutters << " stutters, " << stats.skips << " skips, " << stats.jumps << " jumps, " << stats.listed
-    << " listed; " << cost_seconds << " s costs, " << forward_seconds << " s forward, " << backward_seconds
+  s << source_frames.size() << " target frames, cost " << total_cost << " (matching "
+    << matching_cost << "), " << stats.freezes << " freezes in " << stats.freeze_runs
+    << " runs (longest " << stats.longest_freeze << "), " << stats.stutters << " stutters, "
+    << stats.skips << " skips, " << stats.jumps << " jumps, " << stats.listed << " listed; "
+    << cost_seconds << " s costs, " << forward_seconds << " s forward, " << backward_seconds
     << " s backward, " << memory_bytes / (1 << 20) << " MiB ("
     << (walked_decisions ? "decisions" : "checkpoints") << ")";
   return s.str();
@@ -97,8 +102,8 @@ void CheckStarts(const std::vector<int>& starts, int count, const std::string& w
     if (starts[i] <= starts[i - 1]) throw InputError(what, "must be ascending");
   }
   if (starts.back() >= count) {
-    throw InputError(what, "start " + std::to_string(starts.back()) + " is beyond the " + std::to_string(count) +
-                               " frames");
+    throw InputError(what, "start " + std::to_string(starts.back()) + " is beyond the " +
+                               std::to_string(count) + " frames");
   }
 }
 
@@ -115,13 +120,14 @@ std::vector<int> SegmentIds(const std::vector<int>& starts, int count) {
 // The rules of one kind of row: free rows (pass one, and the first frame of each target
 // movement) or rows inside a target movement (the refinement's second pass).
 struct RowRules {
-  std::vector<int> seg_begin, seg_end;  // segments: clips (free) or source movements (inside), end inclusive
-  std::vector<float> fwd_limit;         // per s: forward steps allowed, min(Kf, s - segment begin)
-  std::vector<float> back_limit;        // per s: backward steps allowed, min(W, segment end - s)
+  std::vector<int> seg_begin,
+      seg_end;  // segments: clips (free) or source movements (inside), end inclusive
+  std::vector<float> fwd_limit;          // per s: forward steps allowed, min(Kf, s - segment begin)
+  std::vector<float> back_limit;         // per s: backward steps allowed, min(W, segment end - s)
   std::vector<SourceTransition> listed;  // applicable transitions, sorted by `to`
-  std::vector<int> listed_begin;        // listed transitions into s: [listed_begin[s], listed_begin[s+1])
-  std::vector<int> edges;               // s where a limit is below Kf or W (near a segment's ends)
-  bool local_jumps = false;             // jumps stay inside the segment and cost λ per frame more
+  std::vector<int> listed_begin;  // listed transitions into s: [listed_begin[s], listed_begin[s+1])
+  std::vector<int> edges;         // s where a limit is below Kf or W (near a segment's ends)
+  bool local_jumps = false;       // jumps stay inside the segment and cost λ per frame more
 };
 
 RowRules MakeRules(const std::vector<int>& starts, int count, const MatchOptions& o, bool local) {
@@ -146,8 +152,9 @@ RowRules MakeRules(const std::vector<int>& starts, int count, const MatchOptions
     if (local && seg[tr.from] != seg[tr.to]) continue;
     rules.listed.push_back(tr);
   }
-  std::stable_sort(rules.listed.begin(), rules.listed.end(),
-                   [](const SourceTransition& a, const SourceTransition& b) { return a.to < b.to; });
+  std::stable_sort(
+      rules.listed.begin(), rules.listed.end(),
+      [](const SourceTransition& a, const SourceTransition& b) { return a.to < b.to; });
   rules.listed_begin.assign(count + 1, 0);
   for (const auto& tr : rules.listed) ++rules.listed_begin[tr.to + 1];
   for (int s = 0; s < count; ++s) rules.listed_begin[s + 1] += rules.listed_begin[s];
@@ -165,8 +172,8 @@ struct Row {
   std::vector<float> v;          // [r * stride + s]
   std::vector<float> m_storage;  // pad + stride + pad
   float* m = nullptr;
-  float min = kInf;              // min_s M(s)
-  std::vector<TopEntry> top;     // the smallest M(s), ascending
+  float min = kInf;           // min_s M(s)
+  std::vector<TopEntry> top;  // the smallest M(s), ascending
 
   void Allocate(int levels, size_t stride, int pad) {
     v.assign(static_cast<size_t>(levels + 1) * stride, kInf);
@@ -177,25 +184,25 @@ struct Row {
 
 // Arguments of the vectorized row step.
 struct StepArgs {
-  const float* cost;      // c_t(s)
-  const float* m;         // M_{t-1}(s), padded
-  const float* vprev;     // V_{t-1}(s, r), [r * stride + s]
+  const float* cost;   // c_t(s)
+  const float* m;      // M_{t-1}(s), padded
+  const float* vprev;  // V_{t-1}(s, r), [r * stride + s]
   float* vcur;
   float* mcur;
-  uint8_t* record;        // nullptr, or per s what `mode` says (RecordMode)
-  int mode;               // RecordMode when record is set
+  uint8_t* record;  // nullptr, or per s what `mode` says (RecordMode)
+  int mode;         // RecordMode when record is set
   const float* fwd_limit;
   const float* back_limit;
-  const float* jump;      // per s (local jumps) or nullptr
-  float jump_const;       // J + min M outside the window (global jumps; fixed up later where wrong)
-  const float* skip;      // [k], k = 1..Kf
-  const float* stutter;   // [k], k = 1..W
-  const float* freeze;    // [r], r = 1..R
+  const float* jump;     // per s (local jumps) or nullptr
+  float jump_const;      // J + min M outside the window (global jumps; fixed up later where wrong)
+  const float* skip;     // [k], k = 1..Kf
+  const float* stutter;  // [k], k = 1..W
+  const float* freeze;   // [r], r = 1..R
   int kf, w, levels;
   size_t stride;
-  int count;              // s in [0, count), count a multiple of kLanes
-  float offset;           // subtracted from every value (the previous row's minimum)
-  bool masked;            // apply fwd_limit / back_limit; false: the caller redoes the edges
+  int count;     // s in [0, count), count a multiple of kLanes
+  float offset;  // subtracted from every value (the previous row's minimum)
+  bool masked;   // apply fwd_limit / back_limit; false: the caller redoes the edges
 };
 
 // The row step; kMasked = false ignores the segment limits (every window full), for rules
@@ -283,12 +290,14 @@ __attribute__((always_inline)) inline void StepBody(const StepArgs& args) {
     mm = Min(mm, vtop);
     Store(a.mcur + s, mm);
     if constexpr (kMode == kArgOnly || kMode == kPacked) {
-      const v8i code = kMode == kPacked ? (arg | (from_below & 8) | (move << 4)) : (arg | (from_below & 8));
+      const v8i code =
+          kMode == kPacked ? (arg | (from_below & 8) | (move << 4)) : (arg | (from_below & 8));
       const v8u8 bytes = __builtin_convertvector(code, v8u8);  // one 8-byte store, not eight
       std::memcpy(a.record + s, &bytes, sizeof(bytes));
     } else if constexpr (kMode == kWide) {
       const v8u16 words = __builtin_convertvector(arg | (from_below & 8) | (move << 8), v8u16);
-      std::memcpy(a.record + 2 * static_cast<size_t>(s), &words, sizeof(words));  // little endian: low byte first
+      std::memcpy(a.record + 2 * static_cast<size_t>(s), &words,
+                  sizeof(words));  // little endian: low byte first
     }
   }
 }
@@ -297,13 +306,17 @@ template <bool kMasked>
 __attribute__((always_inline)) inline void StepModes(const StepArgs& args) {
   if (!args.record) return StepBody<kMasked, 0>(args);
   switch (args.mode) {
-    case kArgOnly: return StepBody<kMasked, kArgOnly>(args);
-    case kPacked: return StepBody<kMasked, kPacked>(args);
-    default: return StepBody<kMasked, kWide>(args);
+    case kArgOnly:
+      return StepBody<kMasked, kArgOnly>(args);
+    case kPacked:
+      return StepBody<kMasked, kPacked>(args);
+    default:
+      return StepBody<kMasked, kWide>(args);
   }
 }
 
-__attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default"))) void StepKernel(const StepArgs& args) {
+__attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default"))) void StepKernel(
+    const StepArgs& args) {
   if (args.masked) {
     StepModes<true>(args);
   } else {
@@ -328,14 +341,16 @@ class Engine {
   // Row t's costs, computing the tile of up to kCostTile rows from t (not past `end`) first
   // when t is not in the current one.
   const float* CostRow(int t, int end) {
-    if (t >= tile_first_ + tile_count_ || t < tile_first_) ComputeCosts(t, std::min(kCostTile, end - t), &cost_seconds_);
+    if (t >= tile_first_ + tile_count_ || t < tile_first_)
+      ComputeCosts(t, std::min(kCostTile, end - t), &cost_seconds_);
     return tile_.data() + static_cast<size_t>(t - tile_first_) * S_;
   }
   void Init(const float* c, Row* row, uint8_t* record);
   // One row; `record` (nullptr: none) receives what mode_ says. With moves recorded, a
   // listed transition that wins the cell goes to listed_choice_, and a local row's jump
   // sources to `jump_source`.
-  void Step(int t, const float* c, const Row& prev, Row* cur, uint8_t* record, int32_t* jump_source = nullptr);
+  void Step(int t, const float* c, const Row& prev, Row* cur, uint8_t* record,
+            int32_t* jump_source = nullptr);
   // The scalar cell update (tail and fix-ups); `jump` = J + the best allowed jump source.
   void Cell(int s, const float* c, const Row& prev, const RowRules& rules, float jump, Row* cur,
             uint8_t* record) const;
@@ -346,7 +361,8 @@ class Engine {
   float GlobalJump(const std::vector<TopEntry>& top, int s, const RowRules& rules) const;
   // The state at t-1 that the optimal path into (t, s, r) comes from.
   std::pair<int, int> Predecessor(int t, int s, int r, const float* m_prev, const uint8_t* rec_prev,
-                                  const uint8_t* rec_cur, const std::vector<TopEntry>& top_prev) const;
+                                  const uint8_t* rec_cur,
+                                  const std::vector<TopEntry>& top_prev) const;
   void StateFromCheckpoint(const std::vector<float>& v, Row* row, uint8_t* record) const;
   bool MovesRecorded() const { return mode_ == kPacked || mode_ == kWide; }
   int RecordBytes() const { return mode_ == kWide ? 2 : 1; }
@@ -369,12 +385,12 @@ class Engine {
   std::vector<float> jump_, suffix_;
   std::vector<int32_t> suffix_at_;  // where suffix_[x] is reached (LocalJumps with sources)
   double cost_seconds_ = 0;
-  int mode_ = kArgOnly;  // what Step and Cell record (RecordMode)
+  int mode_ = kArgOnly;                             // what Step and Cell record (RecordMode)
   std::vector<std::pair<int, int>> listed_choice_;  // (s, from) of cells a listed transition wins
 };
 
-Engine::Engine(const CostRows& costs, const std::vector<int>& clip_starts, const MatchOptions& options,
-               const MovementConstraint* movements)
+Engine::Engine(const CostRows& costs, const std::vector<int>& clip_starts,
+               const MatchOptions& options, const MovementConstraint* movements)
     : costs_(costs), o_(options), movements_(movements) {
   std::string why;
   if (!options.IsValid(&why)) throw InputError("match options", why);
@@ -394,7 +410,8 @@ Engine::Engine(const CostRows& costs, const std::vector<int>& clip_starts, const
   pad_ = std::max(o_.max_forward_step, o_.stutter_window) + kLanes;
   free_ = MakeRules(clip_starts, S_, o_, false);
   skip_.assign(o_.max_forward_step + 1, 0.0f);
-  for (int k = 2; k <= o_.max_forward_step; ++k) skip_[k] = o_.skip_cost * static_cast<float>(k - 1);
+  for (int k = 2; k <= o_.max_forward_step; ++k)
+    skip_[k] = o_.skip_cost * static_cast<float>(k - 1);
   stutter_.assign(o_.stutter_window + 1, o_.jump_cost + o_.stutter_cost);
   freeze_.assign(R_ + 1, 0.0f);
   for (int r = 1; r <= R_; ++r) freeze_[r] = o_.freeze_cost * static_cast<float>(r);
@@ -406,7 +423,8 @@ Engine::Engine(const CostRows& costs, const std::vector<int>& clip_starts, const
     CheckStarts(m.source_starts, S_, "source movement starts");
     for (int c : clip_starts) {
       if (!std::binary_search(m.source_starts.begin(), m.source_starts.end(), c)) {
-        throw InputError("source movement starts", "clip start " + std::to_string(c) + " is not a movement start");
+        throw InputError("source movement starts",
+                         "clip start " + std::to_string(c) + " is not a movement start");
       }
     }
     if (T_ > 0) CheckStarts(m.target_starts, T_, "target movement starts");
@@ -416,7 +434,8 @@ Engine::Engine(const CostRows& costs, const std::vector<int>& clip_starts, const
     if (T_ > 0) inside_row_[0] = 0;
     local_stutter_.assign(o_.stutter_window + 1, 0.0f);
     for (int k = 1; k <= o_.stutter_window; ++k) {
-      local_stutter_[k] = (o_.jump_cost + o_.stutter_cost) + m.jump_cost_per_frame * static_cast<float>(k);
+      local_stutter_[k] =
+          (o_.jump_cost + o_.stutter_cost) + m.jump_cost_per_frame * static_cast<float>(k);
     }
     jump_.assign(stride_, kInf);
     suffix_.assign(S_ + 1, kInf);
@@ -482,8 +501,8 @@ namespace {
 // Engine::LocalJumps; kSources also keeps where each best jump comes from (the first
 // source frame reaching it, prefix before suffix, as Predecessor() would pick).
 template <bool kSources>
-void LocalJumpsOf(const RowRules& rules, const float* m, float lambda, float jump, int w, float* out,
-                  int32_t* source, float* suffix, int32_t* suffix_at) {
+void LocalJumpsOf(const RowRules& rules, const float* m, float lambda, float jump, int w,
+                  float* out, int32_t* source, float* suffix, int32_t* suffix_at) {
   for (size_t g = 0; g < rules.seg_begin.size(); ++g) {
     const int a = rules.seg_begin[g], b = rules.seg_end[g];
     float run = kInf;  // min over s' < s of M(s') - λ (s' - a)
@@ -525,15 +544,16 @@ void LocalJumpsOf(const RowRules& rules, const float* m, float lambda, float jum
 void Engine::LocalJumps(const RowRules& rules, const float* m, float* out, int32_t* source) {
   const float lambda = movements_->jump_cost_per_frame;
   if (source) {
-    LocalJumpsOf<true>(rules, m, lambda, o_.jump_cost, o_.stutter_window, out, source, suffix_.data(),
-                       suffix_at_.data());
+    LocalJumpsOf<true>(rules, m, lambda, o_.jump_cost, o_.stutter_window, out, source,
+                       suffix_.data(), suffix_at_.data());
   } else {
-    LocalJumpsOf<false>(rules, m, lambda, o_.jump_cost, o_.stutter_window, out, nullptr, suffix_.data(), nullptr);
+    LocalJumpsOf<false>(rules, m, lambda, o_.jump_cost, o_.stutter_window, out, nullptr,
+                        suffix_.data(), nullptr);
   }
 }
 
-void Engine::Cell(int s, const float* c, const Row& prev, const RowRules& rules, float jump, Row* cur,
-                  uint8_t* record) const {
+void Engine::Cell(int s, const float* c, const Row& prev, const RowRules& rules, float jump,
+                  Row* cur, uint8_t* record) const {
   const float* m = prev.m;
   const float* stutter = rules.local_jumps ? local_stutter_.data() : stutter_.data();
   const int kf = o_.max_forward_step;
@@ -584,12 +604,14 @@ void Engine::Cell(int s, const float* c, const Row& prev, const RowRules& rules,
   }
 }
 
-void Engine::Step(int t, const float* c, const Row& prev, Row* cur, uint8_t* record, int32_t* jump_source) {
+void Engine::Step(int t, const float* c, const Row& prev, Row* cur, uint8_t* record,
+                  int32_t* jump_source) {
   const RowRules& rules = Rules(t);
   const bool local = rules.local_jumps;
   const bool moves = record && MovesRecorded();
   if (local) LocalJumps(rules, prev.m, jump_.data(), moves ? jump_source : nullptr);
-  const float jump_const = local ? kInf : o_.jump_cost + prev.top.front().value;  // J + the row minimum
+  const float jump_const =
+      local ? kInf : o_.jump_cost + prev.top.front().value;  // J + the row minimum
   StepArgs a;
   a.cost = c;
   a.m = prev.m;
@@ -642,15 +664,18 @@ void Engine::Step(int t, const float* c, const Row& prev, Row* cur, uint8_t* rec
       cur->v[s] = v0;
       if (v0 < cur->m[s]) {
         cur->m[s] = v0;
-        if (record) record[mode_ == kWide ? 2 * static_cast<size_t>(s) : s] &= static_cast<uint8_t>(~7);
+        if (record)
+          record[mode_ == kWide ? 2 * static_cast<size_t>(s) : s] &= static_cast<uint8_t>(~7);
       }
     }
     if (!moves) continue;
     // The move into (s, 0) as Predecessor() decides it: a listed transition wins when it is
     // below every rule move and the listed ones before it.
     float best = local ? jump_[s] : GlobalJump(prev.top, s, rules);
-    for (int k = 1; k <= static_cast<int>(rules.fwd_limit[s]); ++k) best = Min(best, prev.m[s - k] + skip_[k]);
-    for (int k = 1; k <= static_cast<int>(rules.back_limit[s]); ++k) best = Min(best, prev.m[s + k] + stutter[k]);
+    for (int k = 1; k <= static_cast<int>(rules.fwd_limit[s]); ++k)
+      best = Min(best, prev.m[s - k] + skip_[k]);
+    for (int k = 1; k <= static_cast<int>(rules.back_limit[s]); ++k)
+      best = Min(best, prev.m[s + k] + stutter[k]);
     int from = -1;
     for (int l = rules.listed_begin[s]; l < rules.listed_begin[s + 1]; ++l) {
       const float cand = prev.m[rules.listed[l].from] + rules.listed[l].cost;
@@ -664,8 +689,9 @@ void Engine::Step(int t, const float* c, const Row& prev, Row* cur, uint8_t* rec
   Finish(cur, t);
 }
 
-std::pair<int, int> Engine::Predecessor(int t, int s, int r, const float* m_prev, const uint8_t* rec_prev,
-                                        const uint8_t* rec_cur, const std::vector<TopEntry>& top_prev) const {
+std::pair<int, int> Engine::Predecessor(int t, int s, int r, const float* m_prev,
+                                        const uint8_t* rec_prev, const uint8_t* rec_cur,
+                                        const std::vector<TopEntry>& top_prev) const {
   if (r > 0 && r < R_) return {s, r - 1};
   if (r == R_) return {s, (rec_cur[s] & 8) ? R_ - 1 : R_};
   const RowRules& rules = Rules(t);
@@ -677,20 +703,27 @@ std::pair<int, int> Engine::Predecessor(int t, int s, int r, const float* m_prev
       from = source;
     }
   };
-  for (int k = 1; k <= static_cast<int>(rules.fwd_limit[s]); ++k) consider(m_prev[s - k] + skip_[k], s - k);
+  for (int k = 1; k <= static_cast<int>(rules.fwd_limit[s]); ++k)
+    consider(m_prev[s - k] + skip_[k], s - k);
   const float* stutter = rules.local_jumps ? local_stutter_.data() : stutter_.data();
-  for (int k = 1; k <= static_cast<int>(rules.back_limit[s]); ++k) consider(m_prev[s + k] + stutter[k], s + k);
+  for (int k = 1; k <= static_cast<int>(rules.back_limit[s]); ++k)
+    consider(m_prev[s + k] + stutter[k], s + k);
   if (rules.local_jumps) {
     const float lambda = movements_->jump_cost_per_frame;
-    const auto g = std::upper_bound(rules.seg_begin.begin(), rules.seg_begin.end(), s) - rules.seg_begin.begin() - 1;
+    const auto g = std::upper_bound(rules.seg_begin.begin(), rules.seg_begin.end(), s) -
+                   rules.seg_begin.begin() - 1;
     const int a = rules.seg_begin[g], b = rules.seg_end[g];
     for (int x = a; x < s; ++x) {
-      consider(((m_prev[x] - lambda * static_cast<float>(x - a)) + lambda * static_cast<float>(s - a)) + o_.jump_cost,
-               x);
+      consider(
+          ((m_prev[x] - lambda * static_cast<float>(x - a)) + lambda * static_cast<float>(s - a)) +
+              o_.jump_cost,
+          x);
     }
     for (int x = s + o_.stutter_window + 1; x <= b; ++x) {
-      consider(((m_prev[x] + lambda * static_cast<float>(x - a)) - lambda * static_cast<float>(s - a)) + o_.jump_cost,
-               x);
+      consider(
+          ((m_prev[x] + lambda * static_cast<float>(x - a)) - lambda * static_cast<float>(s - a)) +
+              o_.jump_cost,
+          x);
     }
   } else {
     const int last = s + static_cast<int>(rules.back_limit[s]);
@@ -704,7 +737,8 @@ std::pair<int, int> Engine::Predecessor(int t, int s, int r, const float* m_prev
   for (int l = rules.listed_begin[s]; l < rules.listed_begin[s + 1]; ++l) {
     consider(m_prev[rules.listed[l].from] + rules.listed[l].cost, rules.listed[l].from);
   }
-  if (from < 0) throw WorkError("match", "backtracking lost the path at target frame " + std::to_string(t));
+  if (from < 0)
+    throw WorkError("match", "backtracking lost the path at target frame " + std::to_string(t));
   return {from, rec_prev[from] & 7};
 }
 
@@ -752,7 +786,8 @@ bool Engine::SolveWithDecisions(MatchResult* out) {
   for (int t = 1; t < T_; ++t) {
     if (Rules(t).local_jumps) local_row[t] = local_rows++;
   }
-  const size_t need = static_cast<size_t>(T_) * row_bytes + static_cast<size_t>(local_rows) * S_ * sizeof(int32_t) +
+  const size_t need = static_cast<size_t>(T_) * row_bytes +
+                      static_cast<size_t>(local_rows) * S_ * sizeof(int32_t) +
                       static_cast<size_t>(T_) * top_size * sizeof(int32_t);
   // Within the budget and within half the memory the system has available now: the pages
   // are populated at once, and under overcommit an mmap past what is there would not fail
@@ -762,13 +797,15 @@ bool Engine::SolveWithDecisions(MatchResult* out) {
     mode_ = kArgOnly;
     return false;
   }
-  const auto start = std::chrono::steady_clock::now();  // the forward pass includes the store's pages
+  const auto start =
+      std::chrono::steady_clock::now();  // the forward pass includes the store's pages
   // The decisions, then the jump sources, mapped with their pages at once (MAP_POPULATE):
   // a page fault at a time made the forward pass visibly slower (+39 % instead of +7 %
   // over no store at 2,000 x 100,000). Every byte is written by its row's step.
   const size_t decision_bytes = (static_cast<size_t>(T_) * row_bytes + 63) / 64 * 64;
   const size_t map_bytes = decision_bytes + static_cast<size_t>(local_rows) * S_ * sizeof(int32_t);
-  void* map = mmap(nullptr, map_bytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS | MAP_POPULATE, -1, 0);
+  void* map = mmap(nullptr, map_bytes, PROT_READ | PROT_WRITE,
+                   MAP_PRIVATE | MAP_ANONYMOUS | MAP_POPULATE, -1, 0);
   if (map == MAP_FAILED) {
     mode_ = kArgOnly;
     return false;
@@ -776,8 +813,9 @@ bool Engine::SolveWithDecisions(MatchResult* out) {
   const auto unmap = [map_bytes](uint8_t* p) { munmap(p, map_bytes); };
   const std::unique_ptr<uint8_t[], decltype(unmap)> decisions(static_cast<uint8_t*>(map), unmap);
   int32_t* const jump_sources = reinterpret_cast<int32_t*>(decisions.get() + decision_bytes);
-  std::vector<int32_t> tops(static_cast<size_t>(T_) * top_size, -1);  // each row's top list, its indices
-  std::vector<size_t> listed_begin(T_ + 1, 0);                        // row t's listed choices
+  std::vector<int32_t> tops(static_cast<size_t>(T_) * top_size,
+                            -1);                // each row's top list, its indices
+  std::vector<size_t> listed_begin(T_ + 1, 0);  // row t's listed choices
   listed_choice_.clear();
   MatchResult& result = *out;
   Row rows[2];
@@ -798,8 +836,11 @@ bool Engine::SolveWithDecisions(MatchResult* out) {
     // The cells listed transitions win are kept aside (8 bytes each); should they push the
     // store past the limit (a bank whose transitions win most cells), start over without.
     if (need + listed_choice_.capacity() * sizeof(listed_choice_[0]) > limit) {
-      Log("animate.match")->warn("{} x {}: the listed transitions' choices pass the decision budget at row {}; "
-                                 "solving again with checkpoints", T_, S_, t);
+      Log("animate.match")
+          ->warn(
+              "{} x {}: the listed transitions' choices pass the decision budget at row {}; "
+              "solving again with checkpoints",
+              T_, S_, t);
       std::vector<std::pair<int, int>>().swap(listed_choice_);
       cost_seconds_ = 0;  // the checkpoint pass times its own costs
       mode_ = kArgOnly;
@@ -816,7 +857,9 @@ bool Engine::SolveWithDecisions(MatchResult* out) {
   // Backward: a walk over the stored decisions.
   const auto back_start = std::chrono::steady_clock::now();
   const int kf = o_.max_forward_step, w = o_.stutter_window;
-  const auto low = [&](int t, int s) { return decisions[static_cast<size_t>(t) * row_bytes + s * RecordBytes()]; };
+  const auto low = [&](int t, int s) {
+    return decisions[static_cast<size_t>(t) * row_bytes + s * RecordBytes()];
+  };
   const auto move = [&](int t, int s) {
     const uint8_t* rec = decisions.get() + static_cast<size_t>(t) * row_bytes;
     return mode_ == kWide ? static_cast<int>(rec[2 * static_cast<size_t>(s) + 1]) : rec[s] >> 4;
@@ -839,7 +882,8 @@ bool Engine::SolveWithDecisions(MatchResult* out) {
     int from = -1;
     const auto first = listed_choice_.begin() + static_cast<std::ptrdiff_t>(listed_begin[t]);
     const auto last = listed_choice_.begin() + static_cast<std::ptrdiff_t>(listed_begin[t + 1]);
-    const auto listed = std::lower_bound(first, last, std::make_pair(s, std::numeric_limits<int>::min()));
+    const auto listed =
+        std::lower_bound(first, last, std::make_pair(s, std::numeric_limits<int>::min()));
     if (listed != last && listed->first == s) {
       from = listed->second;
     } else {
@@ -871,7 +915,8 @@ bool Engine::SolveWithDecisions(MatchResult* out) {
   }
   result.cost_seconds = cost_seconds_;
   result.backward_seconds = Seconds(back_start);
-  result.memory_bytes = map_bytes + tops.size() * sizeof(int32_t) + listed_begin.size() * sizeof(size_t) +
+  result.memory_bytes = map_bytes + tops.size() * sizeof(int32_t) +
+                        listed_begin.size() * sizeof(size_t) +
                         listed_choice_.capacity() * sizeof(listed_choice_[0]);
   result.walked_decisions = true;
   mode_ = kArgOnly;
@@ -884,7 +929,8 @@ void Engine::SolveWithCheckpoints(MatchResult* out) {
   const auto start = std::chrono::steady_clock::now();
   // Block length K balances the checkpoints ((T/K) rows of (R+1) floats per source) and one
   // block of M rows and record bytes (K rows of 5 bytes per source).
-  const int block = std::clamp(static_cast<int>(std::lround(std::sqrt(T_ * 4.0 * (R_ + 1) / 5.0))), 1, T_);
+  const int block =
+      std::clamp(static_cast<int>(std::lround(std::sqrt(T_ * 4.0 * (R_ + 1) / 5.0))), 1, T_);
   const int blocks = (T_ + block - 1) / block;
   std::vector<std::vector<float>> checkpoints(blocks - 1);
   Row rows[2];
@@ -899,7 +945,8 @@ void Engine::SolveWithCheckpoints(MatchResult* out) {
       offset += rows[1 - cur].min;
       Step(t, c, rows[1 - cur], &rows[cur], nullptr);
     }
-    if ((t + 1) % block == 0 && (t + 1) / block < blocks) checkpoints[(t + 1) / block - 1] = rows[cur].v;
+    if ((t + 1) % block == 0 && (t + 1) / block < blocks)
+      checkpoints[(t + 1) / block - 1] = rows[cur].v;
     cur = 1 - cur;
   }
   result.total_cost = offset + rows[1 - cur].min;
@@ -966,8 +1013,8 @@ void Engine::SolveWithCheckpoints(MatchResult* out) {
 
 }  // namespace
 
-MatchResult SolveMatch(const CostRows& costs, const std::vector<int>& clip_starts, const MatchOptions& options,
-                       const MovementConstraint* movements) {
+MatchResult SolveMatch(const CostRows& costs, const std::vector<int>& clip_starts,
+                       const MatchOptions& options, const MovementConstraint* movements) {
   Engine engine(costs, clip_starts, options, movements);
   MatchResult result = engine.Solve();
   if (!result.source_frames.empty()) {
@@ -985,7 +1032,8 @@ namespace {
 // The cost of move s' -> s at a free row, by the rules (listed transitions aside).
 double RuleCost(int from, int to, const std::vector<int>& clip, const MatchOptions& o) {
   const int d = to - from;
-  if (clip[from] == clip[to] && d >= 1 && d <= o.max_forward_step) return o.skip_cost * static_cast<double>(d - 1);
+  if (clip[from] == clip[to] && d >= 1 && d <= o.max_forward_step)
+    return o.skip_cost * static_cast<double>(d - 1);
   if (clip[from] == clip[to] && d < 0 && -d <= o.stutter_window) {
     return static_cast<double>(o.jump_cost) + o.stutter_cost;
   }
@@ -1002,11 +1050,13 @@ double ListedCost(int from, int to, const MatchOptions& o) {
 
 }  // namespace
 
-double PathCost(const CostRows& costs, const std::vector<int>& clip_starts, const MatchOptions& options,
-                const MovementConstraint* movements, const std::vector<int>& path, double* matching_cost) {
+double PathCost(const CostRows& costs, const std::vector<int>& clip_starts,
+                const MatchOptions& options, const MovementConstraint* movements,
+                const std::vector<int>& path, double* matching_cost) {
   const double inf = std::numeric_limits<double>::infinity();
   const int T = costs.targets(), S = costs.sources();
-  if (static_cast<int>(path.size()) != T) throw InputError("path", "needs one source frame per target frame");
+  if (static_cast<int>(path.size()) != T)
+    throw InputError("path", "needs one source frame per target frame");
   const std::vector<int> clip = SegmentIds(clip_starts, S);
   std::vector<int> movement;
   std::vector<uint8_t> inside(T, 0);
@@ -1020,7 +1070,8 @@ double PathCost(const CostRows& costs, const std::vector<int>& clip_starts, cons
   int run = 0;
   for (int t = 0; t < T; ++t) {
     const int s = path[t];
-    if (s < 0 || s >= S) throw InputError("path", "source frame " + std::to_string(s) + " out of range");
+    if (s < 0 || s >= S)
+      throw InputError("path", "source frame " + std::to_string(s) + " out of range");
     match += costs.At(t, s);
     if (t == 0) continue;
     const int from = path[t - 1];
@@ -1045,7 +1096,8 @@ double PathCost(const CostRows& costs, const std::vector<int>& clip_starts, cons
   return total + match;
 }
 
-MatchStats AnalyzePath(const std::vector<int>& path, const std::vector<int>& clip_starts, const MatchOptions& options) {
+MatchStats AnalyzePath(const std::vector<int>& path, const std::vector<int>& clip_starts,
+                       const MatchOptions& options) {
   MatchStats stats;
   if (path.empty()) return stats;
   const int S = *std::max_element(path.begin(), path.end()) + 1;

@@ -32,13 +32,13 @@ struct SourceTransition {
 };
 
 struct MatchOptions {
-  int max_forward_step = 3;    // Kf
-  float skip_cost = 0.01f;     // per source frame skipped by a forward step
-  float jump_cost = 0.3f;      // J
-  float freeze_cost = 0.02f;   // the k-th repeat in a row costs freeze_cost * min(k, freeze_levels)
-  int freeze_levels = 4;       // R, the run-length counter's cap (1..7)
-  int stutter_window = 8;      // W
-  float stutter_cost = 0.3f;   // added to J for a backward move of 1..W frames
+  int max_forward_step = 3;   // Kf
+  float skip_cost = 0.01f;    // per source frame skipped by a forward step
+  float jump_cost = 0.3f;     // J
+  float freeze_cost = 0.02f;  // the k-th repeat in a row costs freeze_cost * min(k, freeze_levels)
+  int freeze_levels = 4;      // R, the run-length counter's cap (1..7)
+  int stutter_window = 8;     // W
+  float stutter_cost = 0.3f;  // added to J for a backward move of 1..W frames
   std::vector<SourceTransition> transitions;
   // The forward pass keeps every cell's decision (T x S bytes, twice that when Kf + W > 14,
   // plus 4 bytes a cell on rows inside a target movement) when that fits here; otherwise
@@ -82,22 +82,24 @@ struct MatchResult {
   double cost_seconds = 0;      // computing cost rows (both passes)
   double forward_seconds = 0;   // the DP rows of the forward pass
   double backward_seconds = 0;  // backtracking (and, without decisions, recomputing blocks)
-  size_t memory_bytes = 0;      // what the backtrack keeps: decisions and top lists, or checkpoints and one block
-  bool walked_decisions = false;  // the backtrack walked stored decisions (else recomputed from checkpoints)
+  size_t memory_bytes =
+      0;  // what the backtrack keeps: decisions and top lists, or checkpoints and one block
+  bool walked_decisions =
+      false;  // the backtrack walked stored decisions (else recomputed from checkpoints)
   std::string Summary() const;  // one line
 };
 
 // The optimal path. `clip_starts`: first flat source index of each clip (0 first,
 // ascending); moves across clips are jumps. Throws InputError for invalid options or
 // layouts, WorkError when every path is forbidden (e.g. every source frame excluded).
-MatchResult SolveMatch(const CostRows& costs, const std::vector<int>& clip_starts, const MatchOptions& options,
-                       const MovementConstraint* movements = nullptr);
+MatchResult SolveMatch(const CostRows& costs, const std::vector<int>& clip_starts,
+                       const MatchOptions& options, const MovementConstraint* movements = nullptr);
 
 // The objective of a given path, straight from the definition (the reference the DP is
 // tested against); +inf for a forbidden path. `matching_cost` receives sum_t c_t(s_t).
-double PathCost(const CostRows& costs, const std::vector<int>& clip_starts, const MatchOptions& options,
-                const MovementConstraint* movements, const std::vector<int>& path,
-                double* matching_cost = nullptr);
+double PathCost(const CostRows& costs, const std::vector<int>& clip_starts,
+                const MatchOptions& options, const MovementConstraint* movements,
+                const std::vector<int>& path, double* matching_cost = nullptr);
 
 // Counts freezes, stutters, skips, jumps and listed moves along a path.
 MatchStats AnalyzePath(const std::vector<int>& path, const std::vector<int>& clip_starts,

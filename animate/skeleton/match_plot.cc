@@ -40,34 +40,40 @@ void DrawPanel(cv::Mat& canvas, const PlotPanel& panel, int source_count, const 
   for (int t = 0; t < targets; t += xstep) {
     const cv::Point p = px(t, 0);
     cv::line(canvas, {p.x, area.y + area.height}, {p.x, area.y + area.height + 4}, black, 1);
-    cv::putText(canvas, std::to_string(t), {p.x - 10, area.y + area.height + 17}, font, 0.38, black, 1, cv::LINE_AA);
+    cv::putText(canvas, std::to_string(t), {p.x - 10, area.y + area.height + 17}, font, 0.38, black,
+                1, cv::LINE_AA);
   }
   for (int s = 0; s < sources; s += ystep) {
     const cv::Point p = px(0, s);
     cv::line(canvas, {area.x - 4, p.y}, {area.x, p.y}, black, 1);
     cv::putText(canvas, std::to_string(s), {4, p.y + 4}, font, 0.38, black, 1, cv::LINE_AA);
   }
-  cv::putText(canvas, "target frame", {area.x + area.width / 2 - 40, canvas.rows - 6}, font, 0.42, black, 1,
-              cv::LINE_AA);
+  cv::putText(canvas, "target frame", {area.x + area.width / 2 - 40, canvas.rows - 6}, font, 0.42,
+              black, 1, cv::LINE_AA);
   cv::putText(canvas, panel.title, {area.x, 20}, font, 0.5, black, 1, cv::LINE_AA);
   const auto& f = panel.source_frames;
-  for (size_t t = 1; t < f.size(); ++t) cv::line(canvas, px(t - 1, f[t - 1]), px(t, f[t]), grid, 1, cv::LINE_AA);
+  for (size_t t = 1; t < f.size(); ++t)
+    cv::line(canvas, px(t - 1, f[t - 1]), px(t, f[t]), grid, 1, cv::LINE_AA);
   for (size_t t = 0; t < f.size(); ++t) {
-    cv::Scalar colour(200, 90, 20);                                          // blue: a move
-    if (t > 0 && f[t] == f[t - 1]) colour = cv::Scalar(30, 30, 220);         // red: a freeze
-    else if (t > 0 && f[t] < f[t - 1] && f[t - 1] - f[t] <= o.stutter_window) colour = cv::Scalar(0, 140, 255);
+    cv::Scalar colour(200, 90, 20);  // blue: a move
+    if (t > 0 && f[t] == f[t - 1])
+      colour = cv::Scalar(30, 30, 220);  // red: a freeze
+    else if (t > 0 && f[t] < f[t - 1] && f[t - 1] - f[t] <= o.stutter_window)
+      colour = cv::Scalar(0, 140, 255);
     cv::circle(canvas, px(t, f[t]), 2, colour, cv::FILLED, cv::LINE_AA);
   }
 }
 
 }  // namespace
 
-cv::Mat PlotMatch(const std::vector<PlotPanel>& panels, int source_count, const PlotOptions& options) {
+cv::Mat PlotMatch(const std::vector<PlotPanel>& panels, int source_count,
+                  const PlotOptions& options) {
   const cv::Size size = options.panel_size;
   if (panels.empty() || size.width < 120 || size.height < 100) {
     throw InputError("plot", "needs at least one panel of at least 120 x 100 pixels");
   }
-  cv::Mat canvas(size.height, size.width * static_cast<int>(panels.size()), CV_8UC3, cv::Scalar(255, 255, 255));
+  cv::Mat canvas(size.height, size.width * static_cast<int>(panels.size()), CV_8UC3,
+                 cv::Scalar(255, 255, 255));
   for (size_t i = 0; i < panels.size(); ++i) {
     cv::Mat view = canvas(cv::Rect(static_cast<int>(i) * size.width, 0, size.width, size.height));
     DrawPanel(view, panels[i], source_count, options);

@@ -16,14 +16,15 @@ struct PlotPanel {
 };
 
 struct PlotOptions {
-  cv::Size panel_size{640, 480};  // pixels per panel
-  int stutter_window = 8;         // a backward step of up to this many frames is a stutter
-  std::vector<int> clip_starts;   // drawn as faint horizontal lines
+  cv::Size panel_size{640, 480};      // pixels per panel
+  int stutter_window = 8;             // a backward step of up to this many frames is a stutter
+  std::vector<int> clip_starts;       // drawn as faint horizontal lines
   std::vector<int> target_movements;  // drawn as faint vertical lines
 };
 
 // The panels side by side, BGR. `source_count` sets the vertical range.
-cv::Mat PlotMatch(const std::vector<PlotPanel>& panels, int source_count, const PlotOptions& options = {});
+cv::Mat PlotMatch(const std::vector<PlotPanel>& panels, int source_count,
+                  const PlotOptions& options = {});
 
 // PlotMatch written as PNG; throws WorkError when the file cannot be written.
 void WriteMatchPlot(const std::string& path, const std::vector<PlotPanel>& panels, int source_count,

@@ -10,12 +10,14 @@ namespace ss {
 
 MovementFrames MovementWindows(const MovementOptions& options, double fps) {
   if (!(fps > 0)) throw InputError("refine", "the frame rate must be > 0");
-  auto frames = [&](double seconds) { return std::max(1, static_cast<int>(std::lround(seconds * fps))); };
+  auto frames = [&](double seconds) {
+    return std::max(1, static_cast<int>(std::lround(seconds * fps)));
+  };
   return {frames(options.lag_s), frames(options.smoothing_s), frames(options.min_length_s)};
 }
 
-std::vector<int> FindMovements(const std::vector<float>& sequential_cost, const MovementOptions& options,
-                               double fps) {
+std::vector<int> FindMovements(const std::vector<float>& sequential_cost,
+                               const MovementOptions& options, double fps) {
   const MovementFrames windows = MovementWindows(options, fps);
   const int n = static_cast<int>(sequential_cost.size());  // frames - 1
   std::vector<int> starts = {0};
@@ -34,7 +36,8 @@ std::vector<int> FindMovements(const std::vector<float>& sequential_cost, const 
   }
   std::vector<float> sorted = sequential_cost;
   std::nth_element(sorted.begin(), sorted.begin() + n / 2, sorted.end());
-  const double threshold = std::max<double>(options.min_prominence, options.noise_factor * sorted[n / 2]);
+  const double threshold =
+      std::max<double>(options.min_prominence, options.noise_factor * sorted[n / 2]);
   // Local maxima (the first frame of a plateau) and their prominence.
   struct Peak {
     int t;
@@ -50,7 +53,8 @@ std::vector<int> FindMovements(const std::vector<float>& sequential_cost, const 
   }
   // Highest first; a boundary (frame t + 1 starts the next movement) too close to a kept
   // one or to either end is dropped.
-  std::sort(peaks.begin(), peaks.end(), [](const Peak& a, const Peak& b) { return a.height > b.height; });
+  std::sort(peaks.begin(), peaks.end(),
+            [](const Peak& a, const Peak& b) { return a.height > b.height; });
   const int frames = n + 1;
   std::vector<int> kept;
   for (const auto& p : peaks) {
@@ -69,7 +73,8 @@ std::vector<float> MovementCost(const PoseDescriptors& frames, int begin, int en
   const int l = std::max(1, lag);
   std::vector<float> q;
   for (int t = begin; t + 1 < end; ++t) {
-    q.push_back(PoseCost(frames, std::max(begin, t + 1 - l), frames, std::min(end - 1, t + l), false));
+    q.push_back(
+        PoseCost(frames, std::max(begin, t + 1 - l), frames, std::min(end - 1, t + l), false));
   }
   return q;
 }
@@ -82,12 +87,14 @@ std::vector<int> FindMovements(const PoseDescriptors& frames, const std::vector<
     const int end = c + 1 < clip_starts.size() ? clip_starts[c + 1] : frames.count;
     const double fps = FrameRateAt(frames, begin);
     const int lag = MovementWindows(options, fps).lag;
-    for (int s : FindMovements(MovementCost(frames, begin, end, lag), options, fps)) starts.push_back(begin + s);
+    for (int s : FindMovements(MovementCost(frames, begin, end, lag), options, fps))
+      starts.push_back(begin + s);
   }
   return starts;
 }
 
-std::vector<int> AverageWithinSegments(const std::vector<int>& frames, const std::vector<int>& starts, int window) {
+std::vector<int> AverageWithinSegments(const std::vector<int>& frames,
+                                       const std::vector<int>& starts, int window) {
   std::vector<int> out = frames;
   const int half = std::max(0, window / 2);
   if (half == 0) return out;
@@ -108,12 +115,14 @@ std::vector<int> AverageWithinSegments(const std::vector<int>& frames, const std
   return out;
 }
 
-std::vector<int> SplitByFirstPass(const std::vector<int>& target_starts, const std::vector<int>& source_starts,
+std::vector<int> SplitByFirstPass(const std::vector<int>& target_starts,
+                                  const std::vector<int>& source_starts,
                                   const std::vector<int>& first_pass, int min_length) {
   const int n = static_cast<int>(first_pass.size());
   std::vector<long> movement(n);  // the source movement of each first-pass frame
   for (int t = 0; t < n; ++t) {
-    movement[t] = std::upper_bound(source_starts.begin(), source_starts.end(), first_pass[t]) - source_starts.begin();
+    movement[t] = std::upper_bound(source_starts.begin(), source_starts.end(), first_pass[t]) -
+                  source_starts.begin();
   }
   std::vector<int> out = target_starts;
   for (size_t g = 0; g < target_starts.size(); ++g) {
@@ -136,9 +145,10 @@ std::vector<int> SplitByFirstPass(const std::vector<int>& target_starts, const s
   return out;
 }
 
-RefineResult RefineMatch(const CostRows& costs, const PoseDescriptors& targets, const PoseDescriptors& sources,
-                         const std::vector<int>& clip_starts, const MatchOptions& options,
-                         const RefineOptions& refine, const std::vector<int>* first_pass) {
+RefineResult RefineMatch(const CostRows& costs, const PoseDescriptors& targets,
+                         const PoseDescriptors& sources, const std::vector<int>& clip_starts,
+                         const MatchOptions& options, const RefineOptions& refine,
+                         const std::vector<int>* first_pass) {
   if (targets.count != costs.targets() || sources.count != costs.sources()) {
     throw InputError("refine", "the descriptors do not match the cost rows");
   }
@@ -147,8 +157,9 @@ RefineResult RefineMatch(const CostRows& costs, const PoseDescriptors& targets, 
   result.target_movements = FindMovements(targets, {0}, refine.movements);
   result.source_movements = FindMovements(sources, clip_starts, refine.movements);
   if (first_pass != nullptr && static_cast<int>(first_pass->size()) != targets.count) {
-    throw InputError("refine", "the first pass has " + std::to_string(first_pass->size()) + " frames for " +
-                                   std::to_string(targets.count) + " target frames");
+    throw InputError("refine", "the first pass has " + std::to_string(first_pass->size()) +
+                                   " frames for " + std::to_string(targets.count) +
+                                   " target frames");
   }
   if (first_pass != nullptr && targets.count > 0) {
     const int min_length = MovementWindows(refine.movements, FrameRateAt(targets, 0)).min_length;
@@ -161,8 +172,8 @@ RefineResult RefineMatch(const CostRows& costs, const PoseDescriptors& targets, 
   constraint.jump_cost_per_frame = refine.jump_cost_per_frame;
   if (targets.count == 0) return result;
   result.second_pass = SolveMatch(costs, clip_starts, options, &constraint);
-  result.source_frames =
-      AverageWithinSegments(result.second_pass.source_frames, result.target_movements, refine.averaging_window);
+  result.source_frames = AverageWithinSegments(result.second_pass.source_frames,
+                                               result.target_movements, refine.averaging_window);
   result.stats = AnalyzePath(result.source_frames, clip_starts, options);
   result.total_cost = PathCost(costs, clip_starts, options, &constraint, result.source_frames);
   return result;

@@ -21,8 +21,8 @@ struct MovementOptions {
   // sequential cost). A wider lag lifts a movement's change above tracking noise, which
   // is the same at every lag.
   double lag_s = 4.0 / 30;
-  double smoothing_s = 5.0 / 30;  // centred moving average of the sequential cost first
-  double min_length_s = 8.0 / 30; // of two boundaries closer than this the weaker goes
+  double smoothing_s = 5.0 / 30;   // centred moving average of the sequential cost first
+  double min_length_s = 8.0 / 30;  // of two boundaries closer than this the weaker goes
   // A peak's height over the higher of its two bases must reach
   // max(min_prominence, noise_factor * median cost): the median is the noise floor of
   // tracked or imported joints, whose jitter alone makes peaks.
@@ -38,8 +38,8 @@ MovementFrames MovementWindows(const MovementOptions& options, double fps);
 
 // First frame of each movement (0 first) of one sequence at `fps`, from its sequential
 // cost (the lag is not used here: the costs are given).
-std::vector<int> FindMovements(const std::vector<float>& sequential_cost, const MovementOptions& options,
-                               double fps = 30);
+std::vector<int> FindMovements(const std::vector<float>& sequential_cost,
+                               const MovementOptions& options, double fps = 30);
 // The pose change across each gap t | t+1 of frames [begin, end): cost(x_{t+1-lag}, x_{t+lag}),
 // clipped to the range (end - begin - 1 values).
 std::vector<float> MovementCost(const PoseDescriptors& frames, int begin, int end, int lag);
@@ -69,18 +69,21 @@ struct RefineResult {
 // where that choice moves to another source movement for at least the minimum length
 // (SplitByFirstPass): locomotion has no peak of pose change inside it, so idle, turn and
 // walk can form one target movement that the source holds as several.
-RefineResult RefineMatch(const CostRows& costs, const PoseDescriptors& targets, const PoseDescriptors& sources,
-                         const std::vector<int>& clip_starts, const MatchOptions& options,
-                         const RefineOptions& refine = {}, const std::vector<int>* first_pass = nullptr);
+RefineResult RefineMatch(const CostRows& costs, const PoseDescriptors& targets,
+                         const PoseDescriptors& sources, const std::vector<int>& clip_starts,
+                         const MatchOptions& options, const RefineOptions& refine = {},
+                         const std::vector<int>* first_pass = nullptr);
 
 // `target_starts` plus, inside each target movement, the start of every run of at least
 // `min_length` frames whose `first_pass` frames lie in one source movement, when that
 // source movement differs from the previous such run's (shorter runs join the run after).
-std::vector<int> SplitByFirstPass(const std::vector<int>& target_starts, const std::vector<int>& source_starts,
+std::vector<int> SplitByFirstPass(const std::vector<int>& target_starts,
+                                  const std::vector<int>& source_starts,
                                   const std::vector<int>& first_pass, int min_length);
 
 // Centred moving average of `frames` inside each segment [starts[i], starts[i+1]),
 // rounded to the nearest frame.
-std::vector<int> AverageWithinSegments(const std::vector<int>& frames, const std::vector<int>& starts, int window);
+std::vector<int> AverageWithinSegments(const std::vector<int>& frames,
+                                       const std::vector<int>& starts, int window);
 
 }  // namespace ss

@@ -26,7 +26,8 @@ SkeletonDef MakeSkeletonDef(std::string name, std::vector<std::string> joints,
   std::set<std::string> seen;
   for (const auto& joint : def.joints) {
     if (joint.empty()) throw InputError(context, "a joint has an empty name");
-    if (!seen.insert(joint).second) throw InputError(context, "joint '" + joint + "' is listed twice");
+    if (!seen.insert(joint).second)
+      throw InputError(context, "joint '" + joint + "' is listed twice");
   }
   std::set<std::pair<int, int>> seen_limbs;
   for (const auto& [from, to] : limbs) {
@@ -50,7 +51,8 @@ SkeletonDef MakeSkeletonDef(std::string name, std::vector<std::string> joints,
       if (def.limbs[l].from == j || def.limbs[l].to == j) at_joint.push_back(l);
     }
     for (size_t p = 0; p < at_joint.size(); ++p) {
-      for (size_t q = p + 1; q < at_joint.size(); ++q) def.pairs.push_back({j, at_joint[p], at_joint[q]});
+      for (size_t q = p + 1; q < at_joint.size(); ++q)
+        def.pairs.push_back({j, at_joint[p], at_joint[q]});
     }
   }
   if (def.pairs.empty()) {
@@ -62,8 +64,8 @@ SkeletonDef MakeSkeletonDef(std::string name, std::vector<std::string> joints,
 const SkeletonDef& HumanSkeleton() {
   static const SkeletonDef def = MakeSkeletonDef(
       "human14",
-      {"head", "neck", "shoulder_l", "elbow_l", "wrist_l", "shoulder_r", "elbow_r", "wrist_r", "pelvis",
-       "hip_l", "knee_l", "ankle_l", "hip_r", "knee_r", "ankle_r"},
+      {"head", "neck", "shoulder_l", "elbow_l", "wrist_l", "shoulder_r", "elbow_r", "wrist_r",
+       "pelvis", "hip_l", "knee_l", "ankle_l", "hip_r", "knee_r", "ankle_r"},
       {{"pelvis", "neck"},
        {"neck", "head"},
        {"neck", "shoulder_l"},
@@ -89,7 +91,8 @@ std::optional<SkeletonDef> BuiltinSkeleton(std::string_view name) {
 
 namespace {
 
-std::pair<std::string, std::string> LimbFromJson(const nlohmann::json& limb, const std::string& context) {
+std::pair<std::string, std::string> LimbFromJson(const nlohmann::json& limb,
+                                                 const std::string& context) {
   if (!limb.is_array() || limb.size() != 2 || !limb[0].is_string() || !limb[1].is_string()) {
     throw InputError(context, "a limb must be [\"joint\", \"joint\"], got " + limb.dump());
   }
@@ -101,10 +104,12 @@ std::pair<std::string, std::string> LimbFromJson(const nlohmann::json& limb, con
 SkeletonDef SkeletonDefFromJson(const nlohmann::json& json, const std::string& context) {
   if (json.is_string()) {
     auto builtin = BuiltinSkeleton(json.get<std::string>());
-    if (!builtin) throw InputError(context, "no built-in skeleton named '" + json.get<std::string>() + "'");
+    if (!builtin)
+      throw InputError(context, "no built-in skeleton named '" + json.get<std::string>() + "'");
     return *builtin;
   }
-  if (!json.is_object()) throw InputError(context, "skeleton: expected an object or a built-in name");
+  if (!json.is_object())
+    throw InputError(context, "skeleton: expected an object or a built-in name");
   const auto joints_it = json.find("joints");
   const auto limbs_it = json.find("limbs");
   if (joints_it == json.end() || !joints_it->is_array()) {
@@ -115,7 +120,8 @@ SkeletonDef SkeletonDefFromJson(const nlohmann::json& json, const std::string& c
   }
   std::vector<std::string> joints;
   for (const auto& j : *joints_it) {
-    if (!j.is_string()) throw InputError(context, "skeleton: joint names must be strings, got " + j.dump());
+    if (!j.is_string())
+      throw InputError(context, "skeleton: joint names must be strings, got " + j.dump());
     joints.push_back(j.get<std::string>());
   }
   std::vector<std::pair<std::string, std::string>> limbs;

@@ -31,8 +31,8 @@ struct SkeletonDef {
   std::string name;                 // "human14", "quadruped", ...
   std::vector<std::string> joints;  // unique names, in the order frames store them
   std::vector<Limb> limbs;
-  int root_limb = 0;                // limb whose image orientation the descriptor may weigh
-  std::vector<LimbPair> pairs;      // every pair of limbs sharing a joint (derived)
+  int root_limb = 0;            // limb whose image orientation the descriptor may weigh
+  std::vector<LimbPair> pairs;  // every pair of limbs sharing a joint (derived)
 
   int joint_count() const { return static_cast<int>(joints.size()); }
   int limb_count() const { return static_cast<int>(limbs.size()); }

@@ -43,8 +43,8 @@ SkeletonFrame SkeletonFrameFromJson(const nlohmann::json& joints, const Skeleton
   frame.joints.resize(def.joints.size());
   if (joints.is_array()) {
     if (joints.size() != def.joints.size()) {
-      throw InputError(where, "has " + std::to_string(joints.size()) + " joints, skeleton '" + def.name +
-                                  "' has " + std::to_string(def.joints.size()));
+      throw InputError(where, "has " + std::to_string(joints.size()) + " joints, skeleton '" +
+                                  def.name + "' has " + std::to_string(def.joints.size()));
     }
     for (size_t j = 0; j < joints.size(); ++j) {
       frame.joints[j] = JointFromJson(joints[j], where + " joint '" + def.joints[j] + "'");
@@ -60,7 +60,8 @@ SkeletonFrame SkeletonFrameFromJson(const nlohmann::json& joints, const Skeleton
   for (int j = 0; j < def.joint_count(); ++j) {
     const auto it = joints.find(def.joints[j]);
     if (it == joints.end()) {
-      throw InputError(where, "joint '" + def.joints[j] + "' is missing (write null for an unseen joint)");
+      throw InputError(where,
+                       "joint '" + def.joints[j] + "' is missing (write null for an unseen joint)");
     }
     frame.joints[j] = JointFromJson(*it, where + " joint '" + def.joints[j] + "'");
   }
@@ -72,12 +73,13 @@ SkeletonSequence SkeletonSequenceFromJson(const nlohmann::json& json, const std:
   if (json.value("format", std::string()) != kFormat) {
     throw InputError(context, std::string("format: expected \"") + kFormat + "\"");
   }
-  if (!json.contains("version") || !json["version"].is_number_integer() || json["version"].get<int>() != 1) {
+  if (!json.contains("version") || !json["version"].is_number_integer() ||
+      json["version"].get<int>() != 1) {
     throw InputError(context, "version: only version 1 is known");
   }
   SkeletonSequence sequence;
-  sequence.skeleton = SkeletonDefFromJson(json.contains("skeleton") ? json["skeleton"] : nlohmann::json("human14"),
-                                          context);
+  sequence.skeleton = SkeletonDefFromJson(
+      json.contains("skeleton") ? json["skeleton"] : nlohmann::json("human14"), context);
   sequence.clip = json.value("clip", std::string());
   if (json.contains("fps")) {
     if (!json["fps"].is_number() || json["fps"].get<double>() < 0) {
@@ -94,16 +96,20 @@ SkeletonSequence SkeletonSequenceFromJson(const nlohmann::json& json, const std:
   for (size_t i = 0; i < frames_it->size(); ++i) {
     const auto& f = (*frames_it)[i];
     std::string where = context + ": frames[" + std::to_string(i) + "]";
-    if (!f.is_object() || !f.contains("joints")) throw InputError(where, "expected {\"frame\", \"joints\"}");
-    if (f.contains("frame") && !f["frame"].is_number_integer()) throw InputError(where, "frame: expected an integer");
-    const int64_t number = f.contains("frame") ? f["frame"].get<int64_t>() : static_cast<int64_t>(i);
+    if (!f.is_object() || !f.contains("joints"))
+      throw InputError(where, "expected {\"frame\", \"joints\"}");
+    if (f.contains("frame") && !f["frame"].is_number_integer())
+      throw InputError(where, "frame: expected an integer");
+    const int64_t number =
+        f.contains("frame") ? f["frame"].get<int64_t>() : static_cast<int64_t>(i);
     if (number <= previous) throw InputError(where, "frame numbers must increase");
     previous = number;
     where += " (frame " + std::to_string(number) + ")";
     SkeletonFrame frame = SkeletonFrameFromJson(f["joints"], def, where);
     frame.frame = number;
     if (const auto it = f.find("interpolated"); it != f.end()) {
-      if (!it->is_array()) throw InputError(where, "'interpolated' must be an array of joint names");
+      if (!it->is_array())
+        throw InputError(where, "'interpolated' must be an array of joint names");
       for (const auto& name : *it) {
         const auto j = name.is_string() ? def.JointIndex(name.get<std::string>()) : std::nullopt;
         if (!j) throw InputError(where, "interpolated: unknown joint " + name.dump());

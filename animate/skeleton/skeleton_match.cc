@@ -8,20 +8,23 @@
 
 namespace ss {
 
-SkeletonMatchResult MatchSkeletons(const SkeletonSequence& target, const std::vector<const SkeletonSequence*>& clips,
+SkeletonMatchResult MatchSkeletons(const SkeletonSequence& target,
+                                   const std::vector<const SkeletonSequence*>& clips,
                                    const SkeletonMatchOptions& options) {
   if (clips.empty()) throw InputError("sources", "no source clip");
   SkeletonMatchResult result;
   int flat = 0;
   for (const auto* clip : clips) {
-    if (clip->frames.empty()) throw InputError(clip->clip.empty() ? "sources" : clip->clip, "a clip without frames");
+    if (clip->frames.empty())
+      throw InputError(clip->clip.empty() ? "sources" : clip->clip, "a clip without frames");
     result.clip_starts.push_back(flat);
     flat += clip->size();
   }
   const PoseDescriptors sources = ComputeDescriptors(clips, options.descriptor);
   const PoseDescriptors targets = ComputeDescriptors(target, options.descriptor);
   if (targets.layout.dim != sources.layout.dim) {
-    throw InputError(target.clip.empty() ? "target" : target.clip, "the target's skeleton differs from the sources'");
+    throw InputError(target.clip.empty() ? "target" : target.clip,
+                     "the target's skeleton differs from the sources'");
   }
   const DescriptorCostRows costs(targets, sources, options.min_source_coverage);
   if (costs.usable_sources() == 0) {
@@ -29,22 +32,26 @@ SkeletonMatchResult MatchSkeletons(const SkeletonSequence& target, const std::ve
   }
   result.with_penalties = SolveMatch(costs, result.clip_starts, options.match);
   if (options.compare_without_penalties) {
-    result.without_penalties = SolveMatch(costs, result.clip_starts, options.match.WithoutPenalties());
+    result.without_penalties =
+        SolveMatch(costs, result.clip_starts, options.match.WithoutPenalties());
   }
   result.source_frames = result.with_penalties.source_frames;
   if (options.refine_enabled) {
-    result.refined = RefineMatch(costs, targets, sources, result.clip_starts, options.match, options.refine,
-                                 &result.with_penalties.source_frames);
+    result.refined = RefineMatch(costs, targets, sources, result.clip_starts, options.match,
+                                 options.refine, &result.with_penalties.source_frames);
     result.source_frames = result.refined->source_frames;
   }
   for (int s : result.source_frames) {
-    int c = static_cast<int>(std::upper_bound(result.clip_starts.begin(), result.clip_starts.end(), s) -
-                             result.clip_starts.begin()) - 1;
+    int c =
+        static_cast<int>(std::upper_bound(result.clip_starts.begin(), result.clip_starts.end(), s) -
+                         result.clip_starts.begin()) -
+        1;
     const int index = s - result.clip_starts[c];
     result.chosen.push_back({c, index, clips[c]->frames[index].frame});
   }
-  Log("animate.match")->info("matched {} target frames to {} source frames in {} clips: {}", target.size(), flat,
-                             clips.size(), result.with_penalties.Summary());
+  Log("animate.match")
+      ->info("matched {} target frames to {} source frames in {} clips: {}", target.size(), flat,
+             clips.size(), result.with_penalties.Summary());
   return result;
 }
 

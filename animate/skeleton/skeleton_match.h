@@ -19,27 +19,29 @@ struct SkeletonMatchOptions {
   RefineOptions refine;
   bool refine_enabled = true;
   bool compare_without_penalties = true;  // also solve without the penalties (Figure 2a)
-  float min_source_coverage = 0.5f;       // source frames with less of the pose terms' weight are never chosen
+  float min_source_coverage =
+      0.5f;  // source frames with less of the pose terms' weight are never chosen
 };
 
 // A source frame as the caller knows it.
 struct ClipFrame {
-  int clip = 0;     // index into the source clips
-  int index = 0;    // index into that clip's frames
+  int clip = 0;       // index into the source clips
+  int index = 0;      // index into that clip's frames
   int64_t frame = 0;  // its frame number (SkeletonFrame::frame)
 };
 
 struct SkeletonMatchResult {
-  std::vector<int> clip_starts;     // flat index of each clip's first frame
-  MatchResult with_penalties;       // pass one
+  std::vector<int> clip_starts;  // flat index of each clip's first frame
+  MatchResult with_penalties;    // pass one
   std::optional<MatchResult> without_penalties;
   std::optional<RefineResult> refined;
-  std::vector<int> source_frames;   // the final choice (refined when enabled), flat
-  std::vector<ClipFrame> chosen;    // the same as clip frames
+  std::vector<int> source_frames;  // the final choice (refined when enabled), flat
+  std::vector<ClipFrame> chosen;   // the same as clip frames
 };
 
 // Throws InputError when the skeletons differ or a sequence is empty.
-SkeletonMatchResult MatchSkeletons(const SkeletonSequence& target, const std::vector<const SkeletonSequence*>& clips,
+SkeletonMatchResult MatchSkeletons(const SkeletonSequence& target,
+                                   const std::vector<const SkeletonSequence*>& clips,
                                    const SkeletonMatchOptions& options = {});
 
 }  // namespace ss

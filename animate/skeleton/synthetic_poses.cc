@@ -13,16 +13,24 @@ constexpr float kDeg = 3.14159265f / 180.0f;
 struct Pose {
   float arm_l = 10, elbow_l = 10, arm_r = 10, elbow_r = 10;
   float leg_l = 4, knee_l = 0, leg_r = 4, knee_r = 0;
-  float forearm_scale_l = 1, forearm_scale_r = 1;  // foreshortening of a forearm swinging out of plane
-  float lean = 0;                                    // torso tilt
+  float forearm_scale_l = 1,
+        forearm_scale_r = 1;  // foreshortening of a forearm swinging out of plane
+  float lean = 0;             // torso tilt
 };
 
 Pose Blend(const Pose& a, const Pose& b, float u) {
   auto mix = [u](float x, float y) { return x + (y - x) * u; };
-  return {mix(a.arm_l, b.arm_l),     mix(a.elbow_l, b.elbow_l),   mix(a.arm_r, b.arm_r),
-          mix(a.elbow_r, b.elbow_r), mix(a.leg_l, b.leg_l),       mix(a.knee_l, b.knee_l),
-          mix(a.leg_r, b.leg_r),     mix(a.knee_r, b.knee_r),     mix(a.forearm_scale_l, b.forearm_scale_l),
-          mix(a.forearm_scale_r, b.forearm_scale_r), mix(a.lean, b.lean)};
+  return {mix(a.arm_l, b.arm_l),
+          mix(a.elbow_l, b.elbow_l),
+          mix(a.arm_r, b.arm_r),
+          mix(a.elbow_r, b.elbow_r),
+          mix(a.leg_l, b.leg_l),
+          mix(a.knee_l, b.knee_l),
+          mix(a.leg_r, b.leg_r),
+          mix(a.knee_r, b.knee_r),
+          mix(a.forearm_scale_l, b.forearm_scale_l),
+          mix(a.forearm_scale_r, b.forearm_scale_r),
+          mix(a.lean, b.lean)};
 }
 
 // The pose of `gesture` at phase `phase` (frames into the gesture).
@@ -72,8 +80,8 @@ Pose GesturePose(Gesture gesture, float phase) {
   return p;
 }
 
-SkeletonFrame Draw(const Pose& p, const BodyProportions& b, const GestureScriptOptions& o, std::mt19937& rng,
-                   int64_t frame) {
+SkeletonFrame Draw(const Pose& p, const BodyProportions& b, const GestureScriptOptions& o,
+                   std::mt19937& rng, int64_t frame) {
   const SkeletonDef& def = HumanSkeleton();
   SkeletonFrame f = EmptySkeletonFrame(def, frame);
   std::normal_distribution<float> noise(0.0f, o.noise_px);
@@ -120,12 +128,18 @@ SkeletonFrame Draw(const Pose& p, const BodyProportions& b, const GestureScriptO
 
 std::string GestureName(Gesture gesture) {
   switch (gesture) {
-    case Gesture::kIdle: return "idle";
-    case Gesture::kY: return "Y";
-    case Gesture::kM: return "M";
-    case Gesture::kC: return "C";
-    case Gesture::kA: return "A";
-    case Gesture::kWalk: return "walk";
+    case Gesture::kIdle:
+      return "idle";
+    case Gesture::kY:
+      return "Y";
+    case Gesture::kM:
+      return "M";
+    case Gesture::kC:
+      return "C";
+    case Gesture::kA:
+      return "A";
+    case Gesture::kWalk:
+      return "walk";
   }
   return "?";
 }
@@ -143,7 +157,8 @@ BodyProportions OtherBody() {
   return b;
 }
 
-LabelledSkeletons MakeGestureSequence(const std::vector<std::pair<Gesture, int>>& script, const BodyProportions& body,
+LabelledSkeletons MakeGestureSequence(const std::vector<std::pair<Gesture, int>>& script,
+                                      const BodyProportions& body,
                                       const GestureScriptOptions& options) {
   LabelledSkeletons out;
   out.sequence.skeleton = HumanSkeleton();
@@ -155,11 +170,13 @@ LabelledSkeletons MakeGestureSequence(const std::vector<std::pair<Gesture, int>>
   Gesture last_label = Gesture::kIdle;
   bool first = true;
   for (const auto& [gesture, hold] : script) {
-    const int blend = first ? 0 : std::max(1, static_cast<int>(std::lround(options.transition_frames / step)));
+    const int blend =
+        first ? 0 : std::max(1, static_cast<int>(std::lround(options.transition_frames / step)));
     for (int i = 0; i < blend; ++i) {
       const float u = static_cast<float>(i + 1) / (blend + 1);
       const float smooth = u * u * (3 - 2 * u);
-      out.sequence.frames.push_back(Draw(Blend(last, GesturePose(gesture, 0), smooth), body, options, rng, frame++));
+      out.sequence.frames.push_back(
+          Draw(Blend(last, GesturePose(gesture, 0), smooth), body, options, rng, frame++));
       out.labels.push_back(u < 0.5f ? last_label : gesture);
     }
     const int frames = std::max(1, static_cast<int>(std::lround(hold / step)));

@@ -19,11 +19,11 @@ std::string GestureName(Gesture gesture);
 // Segment lengths in body units (the pelvis-to-neck length is 1 for the default body).
 struct BodyProportions {
   float torso = 1.0f;
-  float head = 0.35f;       // neck to head
-  float shoulder = 0.4f;    // neck to each shoulder
+  float head = 0.35f;     // neck to head
+  float shoulder = 0.4f;  // neck to each shoulder
   float upper_arm = 0.6f;
   float forearm = 0.55f;
-  float hip = 0.2f;         // pelvis to each hip
+  float hip = 0.2f;  // pelvis to each hip
   float thigh = 0.9f;
   float shin = 0.85f;
 };
@@ -32,10 +32,10 @@ struct BodyProportions {
 BodyProportions OtherBody();
 
 struct GestureScriptOptions {
-  int transition_frames = 8;  // frames blending from one gesture into the next
-  float speed = 1.0f;         // > 1: faster (fewer frames per step)
-  float noise_px = 0.0f;      // Gaussian noise on every joint, pixels
-  float scale_px = 100.0f;    // pixels per body unit
+  int transition_frames = 8;     // frames blending from one gesture into the next
+  float speed = 1.0f;            // > 1: faster (fewer frames per step)
+  float noise_px = 0.0f;         // Gaussian noise on every joint, pixels
+  float scale_px = 100.0f;       // pixels per body unit
   float x_px = 320, y_px = 300;  // pelvis position
   uint32_t seed = 1;
 };
@@ -47,6 +47,7 @@ struct LabelledSkeletons {
 
 // Plays `script` (gesture, frames held) with `body`.
 LabelledSkeletons MakeGestureSequence(const std::vector<std::pair<Gesture, int>>& script,
-                                      const BodyProportions& body, const GestureScriptOptions& options = {});
+                                      const BodyProportions& body,
+                                      const GestureScriptOptions& options = {});
 
 }  // namespace ss

@@ -75,24 +75,32 @@ struct AravisSource::Impl {
   // raw Bayer camera, Aravis's fake camera) is refused: the keyer needs the colours fixed.
   void SetWhiteBalance(ArvCamera* cam, const AravisOptions& o) {
     const std::string field = "white_balance";
-    const auto has = [&](const char* feature) { return arv_camera_is_feature_available(cam, feature, nullptr); };
+    const auto has = [&](const char* feature) {
+      return arv_camera_is_feature_available(cam, feature, nullptr);
+    };
     GErrorHolder error;
     if (o.white_balance == WhiteBalanceMode::kOnce) {
       if (!has("BalanceWhiteAuto")) {
-        throw InputError(field, label + " has no BalanceWhiteAuto feature, so it cannot balance once (use mode device)");
+        throw InputError(
+            field,
+            label +
+                " has no BalanceWhiteAuto feature, so it cannot balance once (use mode device)");
       }
       arv_camera_set_string(cam, "BalanceWhiteAuto", "Once", error.out());
       Check(error, field, "BalanceWhiteAuto = Once");
       return;
     }
     if (!has("BalanceRatio") || !has("BalanceRatioSelector")) {
-      throw InputError(field, label + " has no BalanceRatio feature: set its white balance on the camera and use mode device");
+      throw InputError(field, label +
+                                  " has no BalanceRatio feature: set its white balance on the "
+                                  "camera and use mode device");
     }
     if (has("BalanceWhiteAuto")) {
       arv_camera_set_string(cam, "BalanceWhiteAuto", "Off", error.out());
       Check(error, field, "BalanceWhiteAuto = Off");
     }
-    for (const auto& [channel, ratio] : {std::pair<const char*, double>{"Red", o.red_ratio}, {"Blue", o.blue_ratio}}) {
+    for (const auto& [channel, ratio] :
+         {std::pair<const char*, double>{"Red", o.red_ratio}, {"Blue", o.blue_ratio}}) {
       arv_camera_set_string(cam, "BalanceRatioSelector", channel, error.out());
       Check(error, field, std::string("BalanceRatioSelector = ") + channel);
       arv_camera_set_float(cam, "BalanceRatio", ratio, error.out());
@@ -118,7 +126,8 @@ struct AravisSource::Impl {
     } else {
       delta = id + 0xffff - last_id;  // wrapped: ids run 65535, 1, 2, ...
     }
-    if (delta > 1) sequence_gaps += delta - 1 - std::min<uint64_t>(delta - 1, incomplete_since_last);
+    if (delta > 1)
+      sequence_gaps += delta - 1 - std::min<uint64_t>(delta - 1, incomplete_since_last);
     incomplete_since_last = 0;
     last_id = id;
     sequence += delta;
@@ -135,11 +144,13 @@ struct AravisSource::Impl {
 AravisSource::AravisSource(AravisOptions options) : impl_(std::make_unique<Impl>()) {
   Impl& s = *impl_;
   s.options = options;
-  s.label = "aravis camera '" + (options.camera.empty() ? std::string("(first found)") : options.camera) + "'";
-  if (options.buffers < 2) throw InputError("buffers", "expected 2 or more, got " + std::to_string(options.buffers));
+  s.label = "aravis camera '" +
+            (options.camera.empty() ? std::string("(first found)") : options.camera) + "'";
+  if (options.buffers < 2)
+    throw InputError("buffers", "expected 2 or more, got " + std::to_string(options.buffers));
   if ((options.width > 0) != (options.height > 0)) {
-    throw InputError("width/height", "give both or neither (got " + std::to_string(options.width) + "x" +
-                                         std::to_string(options.height) + ")");
+    throw InputError("width/height", "give both or neither (got " + std::to_string(options.width) +
+                                         "x" + std::to_string(options.height) + ")");
   }
 
   GErrorHolder error;
@@ -148,12 +159,14 @@ AravisSource::AravisSource(AravisOptions options) : impl_(std::make_unique<Impl>
   // found it at, so the stream is set up on the interface that reaches it (on
   // loopback, opening by id would aim the stream at another interface).
   std::string target = options.camera;
-  GInetAddress* literal = options.camera.empty() ? nullptr : g_inet_address_new_from_string(options.camera.c_str());
+  GInetAddress* literal =
+      options.camera.empty() ? nullptr : g_inet_address_new_from_string(options.camera.c_str());
   if (literal != nullptr) {
     g_object_unref(literal);
   } else if (!options.camera.empty()) {
     for (const auto& d : ListAravisDevices()) {
-      if ((d.id == options.camera || d.serial == options.camera) && d.protocol == "GigEVision" && !d.address.empty()) {
+      if ((d.id == options.camera || d.serial == options.camera) && d.protocol == "GigEVision" &&
+          !d.address.empty()) {
         target = d.address;
         break;
       }
@@ -161,8 +174,10 @@ AravisSource::AravisSource(AravisOptions options) : impl_(std::make_unique<Impl>
   }
   holder->camera.reset(arv_camera_new(target.empty() ? nullptr : target.c_str(), error.out()));
   if (!holder->camera) {
-    throw WorkError(s.label, "cannot open: " + (error ? error.message() : std::string("not found")) +
-                                 " (is it connected and reachable? `spritestation cameras` lists what Aravis sees)");
+    throw WorkError(
+        s.label,
+        "cannot open: " + (error ? error.message() : std::string("not found")) +
+            " (is it connected and reachable? `spritestation cameras` lists what Aravis sees)");
   }
   ArvCamera* cam = holder->camera.get();
   const std::string serial = Str(arv_camera_get_device_serial_number(cam, error.out()));
@@ -172,15 +187,18 @@ AravisSource::AravisSource(AravisOptions options) : impl_(std::make_unique<Impl>
   if (options.pixel_format) {
     const auto code = GenicamPixelFormat(*options.pixel_format);
     if (!code) {
-      throw InputError("pixel_format", PixelFormatName(*options.pixel_format) +
-                                           " is not a GigE/USB3 Vision format (use mono8, bayer_*8, rgb8, bgr8, yuyv)");
+      throw InputError(
+          "pixel_format",
+          PixelFormatName(*options.pixel_format) +
+              " is not a GigE/USB3 Vision format (use mono8, bayer_*8, rgb8, bgr8, yuyv)");
     }
     arv_camera_set_pixel_format(cam, static_cast<ArvPixelFormat>(*code), error.out());
     s.Check(error, "pixel_format", GenicamPixelFormatName(*code));
   }
   if (options.width > 0) {
     arv_camera_set_region(cam, 0, 0, options.width, options.height, error.out());
-    s.Check(error, "width/height", std::to_string(options.width) + "x" + std::to_string(options.height));
+    s.Check(error, "width/height",
+            std::to_string(options.width) + "x" + std::to_string(options.height));
   }
   if (options.exposure_us > 0) {
     if (arv_camera_is_exposure_auto_available(cam, nullptr)) {
@@ -212,7 +230,9 @@ AravisSource::AravisSource(AravisOptions options) : impl_(std::make_unique<Impl>
       s.Check(error, "packet_size", std::to_string(options.packet_size) + " bytes");
     } else {
       arv_camera_gv_auto_packet_size(cam, error.out());
-      if (error) Log("capture.aravis")->warn("{}: packet size negotiation failed: {}", s.label, error.message());
+      if (error)
+        Log("capture.aravis")
+            ->warn("{}: packet size negotiation failed: {}", s.label, error.message());
       error.Clear();
     }
     s.packet_size = static_cast<int>(arv_camera_gv_get_packet_size(cam, nullptr));
@@ -223,9 +243,11 @@ AravisSource::AravisSource(AravisOptions options) : impl_(std::make_unique<Impl>
   s.Check(error, "pixel_format", "reading the pixel format");
   const auto format = FromGenicamPixelFormat(code);
   if (!format) {
-    throw InputError("pixel_format", s.label + " delivers " + GenicamPixelFormatName(code) +
-                                         ", which SpriteStation does not read (choose Mono8, Bayer*8, RGB8, BGR8 or "
-                                         "YUV422_8 in the camera config)");
+    throw InputError(
+        "pixel_format",
+        s.label + " delivers " + GenicamPixelFormatName(code) +
+            ", which SpriteStation does not read (choose Mono8, Bayer*8, RGB8, BGR8 or "
+            "YUV422_8 in the camera config)");
   }
   s.format = *format;
   gint x = 0, y = 0, width = 0, height = 0;
@@ -240,12 +262,14 @@ AravisSource::AravisSource(AravisOptions options) : impl_(std::make_unique<Impl>
   ArvStream* stream = holder->stream.get();
   if (ARV_IS_GV_STREAM(stream)) {
     g_object_set(stream, "packet-resend",
-                 options.packet_resend ? ARV_GV_STREAM_PACKET_RESEND_ALWAYS : ARV_GV_STREAM_PACKET_RESEND_NEVER,
+                 options.packet_resend ? ARV_GV_STREAM_PACKET_RESEND_ALWAYS
+                                       : ARV_GV_STREAM_PACKET_RESEND_NEVER,
                  nullptr);
   }
   const guint payload = arv_camera_get_payload(cam, error.out());
   s.Check(error, "payload", "reading the payload size");
-  for (int i = 0; i < options.buffers; ++i) arv_stream_push_buffer(stream, arv_buffer_new(payload, nullptr));
+  for (int i = 0; i < options.buffers; ++i)
+    arv_stream_push_buffer(stream, arv_buffer_new(payload, nullptr));
 
   SourceCamera sc;
   sc.name = !options.name.empty() ? options.name : (!serial.empty() ? serial : options.camera);
@@ -258,14 +282,16 @@ AravisSource::AravisSource(AravisOptions options) : impl_(std::make_unique<Impl>
 
   arv_camera_start_acquisition(cam, error.out());
   if (error) throw WorkError(s.label, "cannot start acquisition: " + error.message());
-  Log("capture.aravis")->info("{}: {} {} streaming {} {}x{} at {:.1f} frames/s, packet size {}, resend {}", s.label,
-                              model, serial, PixelFormatName(s.format), width, height, fps, s.packet_size,
-                              options.packet_resend ? "on" : "off");
+  Log("capture.aravis")
+      ->info("{}: {} {} streaming {} {}x{} at {:.1f} frames/s, packet size {}, resend {}", s.label,
+             model, serial, PixelFormatName(s.format), width, height, fps, s.packet_size,
+             options.packet_resend ? "on" : "off");
 }
 
 AravisSource::~AravisSource() {
   Stop();
-  if (impl_->holder && impl_->holder->camera) arv_camera_stop_acquisition(impl_->holder->camera.get(), nullptr);
+  if (impl_->holder && impl_->holder->camera)
+    arv_camera_stop_acquisition(impl_->holder->camera.get(), nullptr);
 }
 
 const std::vector<SourceCamera>& AravisSource::cameras() const { return impl_->cameras; }
@@ -302,23 +328,26 @@ std::optional<Frame> AravisSource::Next() {
     if (status != ARV_BUFFER_STATUS_SUCCESS) {
       problem = "incomplete frame (status " + std::to_string(static_cast<int>(status)) + ")";
     } else if (arv_buffer_get_payload_type(buffer) != ARV_BUFFER_PAYLOAD_TYPE_IMAGE) {
-      problem = "not an image (payload type " + std::to_string(static_cast<int>(arv_buffer_get_payload_type(buffer))) +
-                ")";
+      problem = "not an image (payload type " +
+                std::to_string(static_cast<int>(arv_buffer_get_payload_type(buffer))) + ")";
     } else {
       data = static_cast<const uint8_t*>(arv_buffer_get_image_data(buffer, &size));
       width = arv_buffer_get_image_width(buffer);
       height = arv_buffer_get_image_height(buffer);
     }
-    if (problem.empty() && FromGenicamPixelFormat(arv_buffer_get_image_pixel_format(buffer)) != s.format) {
-      problem = "pixel format changed to " + GenicamPixelFormatName(arv_buffer_get_image_pixel_format(buffer));
-    } else if (problem.empty() && (data == nullptr || size < FrameBytes(s.format, width, height) || width <= 0 || height <= 0)) {
-      problem = "short frame (" + std::to_string(size) + " bytes for " + std::to_string(width) + "x" +
-                std::to_string(height) + ")";
+    if (problem.empty() &&
+        FromGenicamPixelFormat(arv_buffer_get_image_pixel_format(buffer)) != s.format) {
+      problem = "pixel format changed to " +
+                GenicamPixelFormatName(arv_buffer_get_image_pixel_format(buffer));
+    } else if (problem.empty() && (data == nullptr || size < FrameBytes(s.format, width, height) ||
+                                   width <= 0 || height <= 0)) {
+      problem = "short frame (" + std::to_string(size) + " bytes for " + std::to_string(width) +
+                "x" + std::to_string(height) + ")";
     }
     if (!problem.empty()) {
       ++s.totals.frames_dropped;
-      s.Problem(s.label + ": frame " + std::to_string(sequence) + " (block id " + std::to_string(id) +
-                "): " + problem);
+      s.Problem(s.label + ": frame " + std::to_string(sequence) + " (block id " +
+                std::to_string(id) + "): " + problem);
       lock.unlock();
       arv_stream_push_buffer(stream, buffer);
       continue;
@@ -328,8 +357,9 @@ std::optional<Frame> AravisSource::Next() {
     uint64_t timestamp_ns = arv_buffer_get_timestamp(buffer);
     if (timestamp_ns == 0) timestamp_ns = arv_buffer_get_system_timestamp(buffer);
     auto holder = s.holder;
-    Frame f = Frame::Borrowed(s.format, width, height, data, FrameBytes(s.format, width, height),
-                              [holder, buffer] { arv_stream_push_buffer(holder->stream.get(), buffer); });
+    Frame f =
+        Frame::Borrowed(s.format, width, height, data, FrameBytes(s.format, width, height),
+                        [holder, buffer] { arv_stream_push_buffer(holder->stream.get(), buffer); });
     f.camera = s.options.camera_index;
     f.sequence = sequence;
     f.timestamp_ns = static_cast<int64_t>(timestamp_ns);
@@ -349,7 +379,9 @@ SourceStats AravisSource::stats() const {
 
 AravisStreamStats AravisSource::stream_stats() const {
   ArvStream* stream = impl_->holder->stream.get();
-  auto info = [stream](const char* name) { return arv_stream_get_info_uint64_by_name(stream, name); };
+  auto info = [stream](const char* name) {
+    return arv_stream_get_info_uint64_by_name(stream, name);
+  };
   AravisStreamStats out;
   out.completed = info("n_completed_buffers");
   out.failures = info("n_failures");

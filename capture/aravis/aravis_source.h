@@ -22,42 +22,43 @@
 namespace ss {
 
 struct AravisOptions {
-  std::string camera;                       // device id, serial number or IP address ("" = the first camera found)
-  std::string name;                         // SourceCamera::name ("" = the device id)
-  int camera_index = 0;                     // Frame::camera of every frame
+  std::string camera;    // device id, serial number or IP address ("" = the first camera found)
+  std::string name;      // SourceCamera::name ("" = the device id)
+  int camera_index = 0;  // Frame::camera of every frame
   std::optional<PixelFormat> pixel_format;  // unset = keep the camera's
   int width = 0;                            // region size; 0 = keep the camera's
   int height = 0;
-  double exposure_us = 0.0;                 // > 0: set it and turn auto exposure off (a keyer needs it fixed)
-  double gain = -1.0;                       // >= 0: set it and turn auto gain off
-  double fps = 0.0;                         // > 0: set the acquisition frame rate
-  WhiteBalanceMode white_balance = WhiteBalanceMode::kDevice;  // device: leave it; once: auto once, then locked
-  double red_ratio = 1.0, blue_ratio = 1.0; // manual: BalanceRatio of red and of blue (green = 1)
-  bool packet_resend = true;                // ask the camera to resend lost GVSP packets
-  int packet_size = 0;                      // GVSP packet bytes; 0 = negotiate the largest that passes
-  int buffers = 16;                         // stream buffers (frames held by consumers count against them)
-  int frame_timeout_ms = 2000;              // no frame for this long counts as one error (the stream goes on)
+  double exposure_us = 0.0;  // > 0: set it and turn auto exposure off (a keyer needs it fixed)
+  double gain = -1.0;        // >= 0: set it and turn auto gain off
+  double fps = 0.0;          // > 0: set the acquisition frame rate
+  WhiteBalanceMode white_balance =
+      WhiteBalanceMode::kDevice;             // device: leave it; once: auto once, then locked
+  double red_ratio = 1.0, blue_ratio = 1.0;  // manual: BalanceRatio of red and of blue (green = 1)
+  bool packet_resend = true;                 // ask the camera to resend lost GVSP packets
+  int packet_size = 0;          // GVSP packet bytes; 0 = negotiate the largest that passes
+  int buffers = 16;             // stream buffers (frames held by consumers count against them)
+  int frame_timeout_ms = 2000;  // no frame for this long counts as one error (the stream goes on)
 };
 
 // The stream's own counters (Aravis's ArvStream infos).
 struct AravisStreamStats {
-  uint64_t completed = 0;          // buffers filled completely
-  uint64_t failures = 0;           // buffers given up (missing packets, size mismatch, aborted)
-  uint64_t underruns = 0;          // frames lost because no empty buffer was queued
-  uint64_t timeouts = 0;           // buffers that timed out waiting for packets
-  uint64_t missing_frames = 0;     // frames never seen (block id jumps)
+  uint64_t completed = 0;       // buffers filled completely
+  uint64_t failures = 0;        // buffers given up (missing packets, size mismatch, aborted)
+  uint64_t underruns = 0;       // frames lost because no empty buffer was queued
+  uint64_t timeouts = 0;        // buffers that timed out waiting for packets
+  uint64_t missing_frames = 0;  // frames never seen (block id jumps)
   uint64_t received_packets = 0;
   uint64_t missing_packets = 0;
   uint64_t resend_requests = 0;
   uint64_t resent_packets = 0;
   uint64_t transferred_bytes = 0;
-  uint64_t sequence_gaps = 0;      // frames the delivered block ids skip (seen by this backend)
+  uint64_t sequence_gaps = 0;  // frames the delivered block ids skip (seen by this backend)
 };
 
 // One camera Aravis can see.
 struct AravisDeviceInfo {
-  std::string id;        // what AravisOptions::camera accepts
-  std::string address;   // IP address (GigE) or USB path
+  std::string id;       // what AravisOptions::camera accepts
+  std::string address;  // IP address (GigE) or USB path
   std::string vendor;
   std::string model;
   std::string serial;

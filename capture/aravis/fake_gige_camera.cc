@@ -46,7 +46,9 @@ void BayerLayout(PixelFormat f, int layout[2][2]) {
 
 void ConvertForGigE(const Frame& frame, PixelFormat target, std::vector<uint8_t>& out) {
   const size_t bytes = FrameBytes(target, frame.width, frame.height);
-  if (bytes == 0) throw InputError("pixel_format", PixelFormatName(target) + " cannot be streamed over GigE Vision");
+  if (bytes == 0)
+    throw InputError("pixel_format",
+                     PixelFormatName(target) + " cannot be streamed over GigE Vision");
   out.resize(bytes);
   if (frame.format == target) {
     std::memcpy(out.data(), frame.data, std::min(bytes, frame.size));
@@ -55,7 +57,8 @@ void ConvertForGigE(const Frame& frame, PixelFormat target, std::vector<uint8_t>
   const cv::Mat bgr = ToBgr(frame);
   switch (target) {
     case PixelFormat::kMono8:
-      cv::cvtColor(bgr, cv::Mat(frame.height, frame.width, CV_8UC1, out.data()), cv::COLOR_BGR2GRAY);
+      cv::cvtColor(bgr, cv::Mat(frame.height, frame.width, CV_8UC1, out.data()),
+                   cv::COLOR_BGR2GRAY);
       return;
     case PixelFormat::kRGB8:
       cv::cvtColor(bgr, cv::Mat(frame.height, frame.width, CV_8UC3, out.data()), cv::COLOR_BGR2RGB);
@@ -77,7 +80,8 @@ void ConvertForGigE(const Frame& frame, PixelFormat target, std::vector<uint8_t>
       return;
     }
     default:
-      throw InputError("pixel_format", PixelFormatName(target) + " cannot be streamed by the emulated camera");
+      throw InputError("pixel_format",
+                       PixelFormatName(target) + " cannot be streamed by the emulated camera");
   }
 }
 
@@ -94,7 +98,7 @@ struct FakeGigECamera::Impl {
   GObjectPtr<ArvGvFakeCamera> gv;
 
   // Touched only by the fake camera's thread, inside the fill callback:
-  std::optional<Frame> last;     // the frame served last (repeated once a finite replay ends)
+  std::optional<Frame> last;  // the frame served last (repeated once a finite replay ends)
   std::vector<uint8_t> converted;
   std::atomic<uint64_t> served{0};
   std::atomic<bool> finished{false};
@@ -113,7 +117,8 @@ struct FakeGigECamera::Impl {
       }
       if (!got) {
         finished.store(true);
-        Log("capture.fakecam")->info("{}: the session has been served; repeating its last frame", device_id);
+        Log("capture.fakecam")
+            ->info("{}: the session has been served; repeating its last frame", device_id);
       }
     }
     const int w = arv_buffer_get_image_width(buffer);
@@ -121,7 +126,8 @@ struct FakeGigECamera::Impl {
     const auto target = FromGenicamPixelFormat(code);
     size_t capacity = 0;
     // The fake camera allocates the buffer for the payload of the current registers.
-    auto* data = const_cast<uint8_t*>(static_cast<const uint8_t*>(arv_buffer_get_data(buffer, &capacity)));
+    auto* data =
+        const_cast<uint8_t*>(static_cast<const uint8_t*>(arv_buffer_get_data(buffer, &capacity)));
     const size_t bytes = target ? FrameBytes(*target, w, h) : 0;
     if (data == nullptr || bytes == 0) return;
     std::memset(data, 0, bytes);
@@ -134,13 +140,14 @@ struct FakeGigECamera::Impl {
     const size_t row_bytes = std::min(src_stride, dst_stride);
     const int rows = std::min(h, last->height);
     for (int y = 0; y < rows; ++y) {
-      std::memcpy(data + static_cast<size_t>(y) * dst_stride, converted.data() + static_cast<size_t>(y) * src_stride,
-                  row_bytes);
+      std::memcpy(data + static_cast<size_t>(y) * dst_stride,
+                  converted.data() + static_cast<size_t>(y) * src_stride, row_bytes);
     }
     if ((w != last->width || h != last->height) && !warned_geometry) {
       warned_geometry = true;
-      Log("capture.fakecam")->warn("{}: client asked for {}x{}, the session is {}x{}; frames are cropped/padded",
-                                   device_id, w, h, last->width, last->height);
+      Log("capture.fakecam")
+          ->warn("{}: client asked for {}x{}, the session is {}x{}; frames are cropped/padded",
+                 device_id, w, h, last->width, last->height);
     }
     arv_buffer_set_timestamp(buffer, static_cast<guint64>(last->timestamp_ns));
     served.fetch_add(1);
@@ -162,7 +169,8 @@ FakeGigECamera::FakeGigECamera(const std::string& session_dir, FakeGigEOptions o
   Impl& s = *impl_;
   s.options = options;
   if (options.lost_packet_ratio < 0 || options.lost_packet_ratio > 1) {
-    throw InputError("lost_packet_ratio", "expected 0..1, got " + std::to_string(options.lost_packet_ratio));
+    throw InputError("lost_packet_ratio",
+                     "expected 0..1, got " + std::to_string(options.lost_packet_ratio));
   }
   if (options.serial.empty() || options.serial.size() >= 16) {
     throw InputError("serial", "expected 1 to 15 characters, got '" + options.serial + "'");
@@ -179,20 +187,23 @@ FakeGigECamera::FakeGigECamera(const std::string& session_dir, FakeGigEOptions o
     }
   }
   if (s.camera_index < 0) {
-    throw InputError("camera", "session " + session_dir + " has no camera '" + options.camera + "'");
+    throw InputError("camera",
+                     "session " + session_dir + " has no camera '" + options.camera + "'");
   }
   const SourceCamera& cam = cams[static_cast<size_t>(s.camera_index)];
   s.session_format = cam.format;
   s.format = options.pixel_format ? *options.pixel_format
                                   : (GigECarries(cam.format) ? cam.format : PixelFormat::kRGB8);
   if (!GigECarries(s.format)) {
-    throw InputError("pixel_format", PixelFormatName(s.format) +
-                                         " is not offered by the emulated camera (mono8, bayer_rg8, bayer_gr8, "
-                                         "bayer_gb8, bayer_bg8, rgb8)");
+    throw InputError("pixel_format",
+                     PixelFormatName(s.format) +
+                         " is not offered by the emulated camera (mono8, bayer_rg8, bayer_gr8, "
+                         "bayer_gb8, bayer_bg8, rgb8)");
   }
   if (cam.width > ARV_FAKE_CAMERA_SENSOR_WIDTH || cam.height > ARV_FAKE_CAMERA_SENSOR_HEIGHT) {
-    throw InputError(session_dir, "camera '" + cam.name + "' is " + std::to_string(cam.width) + "x" +
-                                      std::to_string(cam.height) + ", larger than the emulated sensor (2048x2048)");
+    throw InputError(session_dir, "camera '" + cam.name + "' is " + std::to_string(cam.width) +
+                                      "x" + std::to_string(cam.height) +
+                                      ", larger than the emulated sensor (2048x2048)");
   }
   s.width = cam.width;
   s.height = cam.height;
@@ -202,20 +213,26 @@ FakeGigECamera::FakeGigECamera(const std::string& session_dir, FakeGigEOptions o
   s.gv.reset(arv_gv_fake_camera_new(options.address.c_str(), options.serial.c_str()));
   if (!s.gv || !arv_gv_fake_camera_is_running(s.gv.get())) {
     throw WorkError("address " + options.address,
-                    "cannot serve GigE Vision there (no interface with that name or address, or UDP port 3956 is "
+                    "cannot serve GigE Vision there (no interface with that name or address, or "
+                    "UDP port 3956 is "
                     "already taken by another camera)");
   }
-  if (options.lost_packet_ratio > 0) g_object_set(s.gv.get(), "gvsp-lost-ratio", options.lost_packet_ratio, nullptr);
+  if (options.lost_packet_ratio > 0)
+    g_object_set(s.gv.get(), "gvsp-lost-ratio", options.lost_packet_ratio, nullptr);
   ArvFakeCamera* fake = arv_gv_fake_camera_get_fake_camera(s.gv.get());
-  arv_fake_camera_write_register(fake, ARV_FAKE_CAMERA_REGISTER_WIDTH, static_cast<guint32>(s.width));
-  arv_fake_camera_write_register(fake, ARV_FAKE_CAMERA_REGISTER_HEIGHT, static_cast<guint32>(s.height));
-  arv_fake_camera_write_register(fake, ARV_FAKE_CAMERA_REGISTER_PIXEL_FORMAT, *GenicamPixelFormat(s.format));
+  arv_fake_camera_write_register(fake, ARV_FAKE_CAMERA_REGISTER_WIDTH,
+                                 static_cast<guint32>(s.width));
+  arv_fake_camera_write_register(fake, ARV_FAKE_CAMERA_REGISTER_HEIGHT,
+                                 static_cast<guint32>(s.height));
+  arv_fake_camera_write_register(fake, ARV_FAKE_CAMERA_REGISTER_PIXEL_FORMAT,
+                                 *GenicamPixelFormat(s.format));
   arv_fake_camera_write_register(fake, ARV_FAKE_CAMERA_REGISTER_ACQUISITION_FRAME_PERIOD_US,
                                  static_cast<guint32>(1e6 / s.fps + 0.5));
   arv_fake_camera_set_fill_pattern(fake, &Impl::FillPattern, &s);
-  Log("capture.fakecam")->info("{} serving {} camera '{}' ({} {}x{} at {:.2f} frames/s) on {}", s.device_id,
-                               session_dir, cam.name, PixelFormatName(s.format), s.width, s.height, s.fps,
-                               options.address);
+  Log("capture.fakecam")
+      ->info("{} serving {} camera '{}' ({} {}x{} at {:.2f} frames/s) on {}", s.device_id,
+             session_dir, cam.name, PixelFormatName(s.format), s.width, s.height, s.fps,
+             options.address);
 }
 
 FakeGigECamera::~FakeGigECamera() {
@@ -237,8 +254,8 @@ uint32_t FakeGigECamera::exposure_us() const {
 }
 uint32_t FakeGigECamera::gain() const {
   guint32 value = 0;
-  arv_fake_camera_read_register(arv_gv_fake_camera_get_fake_camera(impl_->gv.get()), ARV_FAKE_CAMERA_REGISTER_GAIN_RAW,
-                                &value);
+  arv_fake_camera_read_register(arv_gv_fake_camera_get_fake_camera(impl_->gv.get()),
+                                ARV_FAKE_CAMERA_REGISTER_GAIN_RAW, &value);
   return value;
 }
 bool FakeGigECamera::finished() const { return impl_->finished.load(); }

@@ -6,17 +6,18 @@
 namespace ss {
 
 void RegisterLibcameraCameraBackend() {
-  RegisterCameraBackend({"libcamera", "cameras behind libcamera's pipeline handlers",
-                         [](const CameraConfig& camera, int camera_index) -> std::unique_ptr<FrameSource> {
-                           return std::make_unique<LibcameraSource>(LibcameraOptionsFromConfig(camera, camera_index));
-                         },
-                         [] {
-                           std::vector<FoundCamera> out;
-                           for (const auto& d : ListLibcameraCameras()) {
-                             out.push_back({"libcamera", d.id, d.model, "libcamera", d.location, ""});
-                           }
-                           return out;
-                         }});
+  RegisterCameraBackend(
+      {"libcamera", "cameras behind libcamera's pipeline handlers",
+       [](const CameraConfig& camera, int camera_index) -> std::unique_ptr<FrameSource> {
+         return std::make_unique<LibcameraSource>(LibcameraOptionsFromConfig(camera, camera_index));
+       },
+       [] {
+         std::vector<FoundCamera> out;
+         for (const auto& d : ListLibcameraCameras()) {
+           out.push_back({"libcamera", d.id, d.model, "libcamera", d.location, ""});
+         }
+         return out;
+       }});
 }
 
 }  // namespace ss

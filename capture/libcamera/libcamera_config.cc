@@ -32,8 +32,9 @@ LibcameraOptions LibcameraOptionsFromConfig(const CameraConfig& camera, int came
       break;
     case WhiteBalanceMode::kManual:
       if (wb.temperature_k > 0) {
-        throw InputError(field + "white_balance.temperature_k",
-                         "libcamera fixes white balance as red/blue ColourGains: give red_gain and blue_gain");
+        throw InputError(
+            field + "white_balance.temperature_k",
+            "libcamera fixes white balance as red/blue ColourGains: give red_gain and blue_gain");
       }
       o.white_balance = LibcameraWhiteBalance::kManual;
       o.red_gain = wb.red_gain;

@@ -8,10 +8,11 @@
 namespace ss::av {
 namespace {
 
-void CopyPlane(const uint8_t* src, int src_stride, uint8_t* dst, int dst_stride, int row_bytes, int rows) {
+void CopyPlane(const uint8_t* src, int src_stride, uint8_t* dst, int dst_stride, int row_bytes,
+               int rows) {
   for (int y = 0; y < rows; ++y) {
-    std::memcpy(dst + static_cast<ptrdiff_t>(y) * dst_stride, src + static_cast<ptrdiff_t>(y) * src_stride,
-                static_cast<size_t>(row_bytes));
+    std::memcpy(dst + static_cast<ptrdiff_t>(y) * dst_stride,
+                src + static_cast<ptrdiff_t>(y) * src_stride, static_cast<size_t>(row_bytes));
   }
 }
 
@@ -42,7 +43,8 @@ bool IsLosslessStorage(int av_format, PixelFormat format) {
   const AVPixelFormat storage = LosslessStorageFormat(format);
   if (av_format == storage) return true;
   // Colour as planes (ffvhuff), or as B G R A.
-  return storage == AV_PIX_FMT_BGR0 && (av_format == AV_PIX_FMT_GBRP || av_format == AV_PIX_FMT_BGRA);
+  return storage == AV_PIX_FMT_BGR0 &&
+         (av_format == AV_PIX_FMT_GBRP || av_format == AV_PIX_FMT_BGRA);
 }
 
 void RawToStorage(const uint8_t* src, PixelFormat format, int width, int height, AVFrame* dst) {
@@ -53,9 +55,10 @@ void RawToStorage(const uint8_t* src, PixelFormat format, int width, int height,
       cv::Mat in(height, width, CV_8UC3, s);
       if (dst->format == AV_PIX_FMT_GBRP) {
         // Planes G, B, R.
-        cv::Mat planes[3] = {cv::Mat(height, width, CV_8UC1, dst->data[0], static_cast<size_t>(dst->linesize[0])),
-                             cv::Mat(height, width, CV_8UC1, dst->data[1], static_cast<size_t>(dst->linesize[1])),
-                             cv::Mat(height, width, CV_8UC1, dst->data[2], static_cast<size_t>(dst->linesize[2]))};
+        cv::Mat planes[3] = {
+            cv::Mat(height, width, CV_8UC1, dst->data[0], static_cast<size_t>(dst->linesize[0])),
+            cv::Mat(height, width, CV_8UC1, dst->data[1], static_cast<size_t>(dst->linesize[1])),
+            cv::Mat(height, width, CV_8UC1, dst->data[2], static_cast<size_t>(dst->linesize[2]))};
         const bool bgr = format == PixelFormat::kBGR8;
         const int from_to[] = {1, 0, bgr ? 0 : 2, 1, bgr ? 2 : 0, 2};
         cv::mixChannels(&in, 1, planes, 3, from_to, 3);

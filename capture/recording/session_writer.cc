@@ -34,8 +34,8 @@ std::string NowIso8601Utc() {
 std::string SafeStem(const std::string& name, const std::string& fallback) {
   std::string stem;
   for (char c : name) {
-    const bool ok = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' ||
-                    c == '-' || c == '.';
+    const bool ok = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') ||
+                    c == '_' || c == '-' || c == '.';
     stem += ok ? c : '_';
   }
   while (!stem.empty() && (stem.front() == '_' || stem.front() == '.')) stem.erase(stem.begin());
@@ -49,8 +49,8 @@ struct SessionWriter::Impl {
     SessionCamera meta;
     std::unique_ptr<VideoWriter> video;
     std::unique_ptr<FrameCsvWriter> csv;
-    std::mutex mutex;                  // guards everything below and the writers
-    std::deque<FrameRecord> pending;   // rows whose frames are not yet on disk
+    std::mutex mutex;                 // guards everything below and the writers
+    std::deque<FrameRecord> pending;  // rows whose frames are not yet on disk
     int64_t frames_written = 0;
     int64_t rows_written = 0;
     int64_t first_timestamp_ns = 0;
@@ -85,7 +85,8 @@ struct SessionWriter::Impl {
 
   // True when the oldest frame not yet on disk has waited flush_interval_ms. Caller holds c.mutex.
   bool FlushDue(const Camera& c, Clock::time_point now) const {
-    return !c.pending.empty() && now - c.oldest_pending >= std::chrono::milliseconds(options.flush_interval_ms);
+    return !c.pending.empty() &&
+           now - c.oldest_pending >= std::chrono::milliseconds(options.flush_interval_ms);
   }
 
   // Flushes cameras whose oldest unflushed frame has waited flush_interval_ms.
@@ -115,17 +116,21 @@ struct SessionWriter::Impl {
   }
 };
 
-SessionWriter::SessionWriter(const std::string& dir, const std::string& name, RecordingOptions options)
+SessionWriter::SessionWriter(const std::string& dir, const std::string& name,
+                             RecordingOptions options)
     : impl_(std::make_unique<Impl>()) {
   if (FindRecordingCodec(options.codec) == nullptr) {
-    throw InputError("codec", "unknown codec '" + options.codec + "' (expected " + RecordingCodecNames() + ")");
+    throw InputError(
+        "codec", "unknown codec '" + options.codec + "' (expected " + RecordingCodecNames() + ")");
   }
   if (options.flush_interval_ms < 0) {
-    throw InputError("flush_interval_ms", "expected 0 or more, got " + std::to_string(options.flush_interval_ms));
+    throw InputError("flush_interval_ms",
+                     "expected 0 or more, got " + std::to_string(options.flush_interval_ms));
   }
   std::error_code ec;
   if (fs::exists(dir, ec) && !(fs::is_directory(dir, ec) && fs::is_empty(dir, ec))) {
-    throw WorkError(dir, "exists and is not an empty folder; a session is recorded into a new folder");
+    throw WorkError(dir,
+                    "exists and is not an empty folder; a session is recorded into a new folder");
   }
   fs::create_directories(dir, ec);
   if (ec) throw WorkError(dir, "cannot create the session folder: " + ec.message());
@@ -150,12 +155,14 @@ int SessionWriter::AddCamera(const SourceCamera& camera, const CameraModel* mode
   std::lock_guard<std::mutex> lock(impl_->cameras_mutex);
   if (impl_->closed) throw WorkError(impl_->dir, "camera added after Close()");
   const int index = static_cast<int>(impl_->cameras.size());
-  const std::string where = impl_->dir + ": camera " + std::to_string(index) + " ('" + camera.name + "')";
+  const std::string where =
+      impl_->dir + ": camera " + std::to_string(index) + " ('" + camera.name + "')";
   if (camera.width <= 0 || camera.height <= 0) {
-    throw InputError(where, "size " + std::to_string(camera.width) + "x" + std::to_string(camera.height) +
-                                " is not positive");
+    throw InputError(where, "size " + std::to_string(camera.width) + "x" +
+                                std::to_string(camera.height) + " is not positive");
   }
-  if ((camera.format == PixelFormat::kYUYV || camera.format == PixelFormat::kNV12) && camera.width % 2 != 0) {
+  if ((camera.format == PixelFormat::kYUYV || camera.format == PixelFormat::kNV12) &&
+      camera.width % 2 != 0) {
     throw InputError(where, PixelFormatName(camera.format) + " needs an even width");
   }
   if (camera.format == PixelFormat::kNV12 && camera.height % 2 != 0) {
@@ -166,7 +173,8 @@ int SessionWriter::AddCamera(const SourceCamera& camera, const CameraModel* mode
   std::set<std::string> taken;
   for (const auto& c : impl_->cameras) taken.insert(c->meta.name);
   std::string stem = SafeStem(camera.name, "cam" + std::to_string(index));
-  for (int n = 2; taken.count(stem) != 0; ++n) stem = SafeStem(camera.name, "cam") + "-" + std::to_string(n);
+  for (int n = 2; taken.count(stem) != 0; ++n)
+    stem = SafeStem(camera.name, "cam") + "-" + std::to_string(n);
 
   auto cam = std::make_unique<Impl::Camera>();
   SessionCamera& meta = cam->meta;
@@ -179,22 +187,23 @@ int SessionWriter::AddCamera(const SourceCamera& camera, const CameraModel* mode
   meta.codec = camera.format == PixelFormat::kMJPEG ? "mjpeg" : impl_->options.codec;
   meta.fps = camera.fps > 0 ? camera.fps : 30.0;
   if (camera.fps <= 0) {
-    Log("capture.recording")->info("{}: frame rate unknown, recording it as 30 fps (timestamps stay exact)", where);
+    Log("capture.recording")
+        ->info("{}: frame rate unknown, recording it as 30 fps (timestamps stay exact)", where);
   }
   const fs::path dir(impl_->dir);
   if (model != nullptr) {
     meta.model = stem + ".cameramodel";
     model->Write((dir / meta.model).string());
   }
-  cam->video = std::make_unique<VideoWriter>((dir / meta.video).string(), meta.pixel_format, meta.width,
-                                             meta.height, meta.fps, meta.codec);
+  cam->video = std::make_unique<VideoWriter>((dir / meta.video).string(), meta.pixel_format,
+                                             meta.width, meta.height, meta.fps, meta.codec);
   cam->csv = std::make_unique<FrameCsvWriter>((dir / meta.frames_csv).string());
   impl_->info.cameras.push_back(meta);
   WriteSessionInfo(impl_->dir, impl_->info);
   impl_->cameras.push_back(std::move(cam));
-  Log("capture.recording")->info("{}: recording camera '{}' ({} {}x{}, {}) into {}", impl_->dir, stem,
-                                 PixelFormatName(meta.pixel_format), meta.width, meta.height, meta.codec,
-                                 meta.video);
+  Log("capture.recording")
+      ->info("{}: recording camera '{}' ({} {}x{}, {}) into {}", impl_->dir, stem,
+             PixelFormatName(meta.pixel_format), meta.width, meta.height, meta.codec, meta.video);
   return index;
 }
 
@@ -204,21 +213,25 @@ void SessionWriter::Write(const Frame& frame, uint64_t drops_before) {
     std::lock_guard<std::mutex> lock(impl_->cameras_mutex);
     if (impl_->closed) throw WorkError(impl_->dir, "frame written after Close()");
     if (frame.camera < 0 || frame.camera >= static_cast<int>(impl_->cameras.size())) {
-      throw InputError(impl_->dir, "frame for camera " + std::to_string(frame.camera) + ", but the session has " +
+      throw InputError(impl_->dir, "frame for camera " + std::to_string(frame.camera) +
+                                       ", but the session has " +
                                        std::to_string(impl_->cameras.size()) + " camera(s)");
     }
     cam = impl_->cameras[static_cast<size_t>(frame.camera)].get();
   }
   const SessionCamera& meta = cam->meta;
-  const std::string where = impl_->dir + ": camera '" + meta.name + "' frame " + std::to_string(frame.sequence);
-  if (frame.format != meta.pixel_format || frame.width != meta.width || frame.height != meta.height) {
-    throw InputError(where, "is " + PixelFormatName(frame.format) + " " + std::to_string(frame.width) + "x" +
-                                std::to_string(frame.height) + ", the camera records " +
-                                PixelFormatName(meta.pixel_format) + " " + std::to_string(meta.width) + "x" +
-                                std::to_string(meta.height));
+  const std::string where =
+      impl_->dir + ": camera '" + meta.name + "' frame " + std::to_string(frame.sequence);
+  if (frame.format != meta.pixel_format || frame.width != meta.width ||
+      frame.height != meta.height) {
+    throw InputError(where, "is " + PixelFormatName(frame.format) + " " +
+                                std::to_string(frame.width) + "x" + std::to_string(frame.height) +
+                                ", the camera records " + PixelFormatName(meta.pixel_format) + " " +
+                                std::to_string(meta.width) + "x" + std::to_string(meta.height));
   }
   const size_t expected = FrameBytes(frame.format, frame.width, frame.height);
-  if (frame.data == nullptr || (expected != 0 && frame.size != expected) || (expected == 0 && frame.size == 0)) {
+  if (frame.data == nullptr || (expected != 0 && frame.size != expected) ||
+      (expected == 0 && frame.size == 0)) {
     throw InputError(where, "holds " + std::to_string(frame.size) + " bytes, expected " +
                                 (expected != 0 ? std::to_string(expected) : std::string("a JPEG")));
   }

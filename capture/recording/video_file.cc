@@ -28,7 +28,8 @@ void Check(int ret, const std::string& path, const std::string& what) {
 
 std::string Extension(const std::string& path) {
   std::string ext = std::filesystem::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return std::tolower(c); });
   return ext;
 }
 
@@ -92,7 +93,8 @@ VideoFileWriter::VideoFileWriter(const std::string& path, int width, int height,
     throw InputError("--codec", "expected h264, ffv1 or mjpeg, got " + codec);
   }
   if (ext == ".mp4" && codec != "h264") {
-    throw InputError("--codec", "an .mp4 file is written as h264 (or mpeg4 without libx264), not " + codec);
+    throw InputError("--codec",
+                     "an .mp4 file is written as h264 (or mpeg4 without libx264), not " + codec);
   }
   if (width < 2 || height < 2 || !(fps > 0) || !std::isfinite(fps)) {
     throw InputError(path, "needs a size of at least 2x2 and a frame rate > 0");
@@ -112,8 +114,9 @@ VideoFileWriter::VideoFileWriter(const std::string& path, int width, int height,
   if (encoder == nullptr) throw WorkError(path, "this FFmpeg build has no encoder for " + codec);
   s.encoder_name = encoder->name;
   if (coded != AV_PIX_FMT_BGR0 && (width % 2 != 0 || height % 2 != 0)) {
-    throw InputError(path, "4:2:0 video needs an even size, the camera is " + std::to_string(width) +
-                               "x" + std::to_string(height) + " (use a folder for PNG frames)");
+    throw InputError(path, "4:2:0 video needs an even size, the camera is " +
+                               std::to_string(width) + "x" + std::to_string(height) +
+                               " (use a folder for PNG frames)");
   }
 
   Check(avformat_alloc_output_context2(&s.output, nullptr, ext == ".mp4" ? "mp4" : "matroska",
@@ -153,7 +156,8 @@ VideoFileWriter::VideoFileWriter(const std::string& path, int width, int height,
   const int opened = avcodec_open2(c, encoder, &options);
   av_dict_free(&options);
   Check(opened, path, "cannot open the " + s.encoder_name + " encoder");
-  Check(avcodec_parameters_from_context(s.stream->codecpar, c), path, "cannot set stream parameters");
+  Check(avcodec_parameters_from_context(s.stream->codecpar, c), path,
+        "cannot set stream parameters");
   s.stream->time_base = c->time_base;
   s.stream->avg_frame_rate = rate;
 
@@ -250,10 +254,9 @@ std::vector<cv::Mat> ReadVideoFrames(const std::string& path) {
       const int r = avcodec_receive_frame(context.get(), frame.get());
       if (r == AVERROR(EAGAIN) || r == AVERROR_EOF) return;
       if (r < 0) throw InputError(path, "damaged video data (" + av::ErrorText(r) + ")");
-      sws.reset(sws_getCachedContext(sws.release(), frame->width, frame->height,
-                                     static_cast<AVPixelFormat>(frame->format), frame->width,
-                                     frame->height, AV_PIX_FMT_BGR24, SWS_BICUBIC, nullptr, nullptr,
-                                     nullptr));
+      sws.reset(sws_getCachedContext(
+          sws.release(), frame->width, frame->height, static_cast<AVPixelFormat>(frame->format),
+          frame->width, frame->height, AV_PIX_FMT_BGR24, SWS_BICUBIC, nullptr, nullptr, nullptr));
       if (!sws) throw WorkError(path, "cannot convert the decoded frames to BGR");
       cv::Mat bgr(frame->height, frame->width, CV_8UC3);
       uint8_t* dst[4] = {bgr.data, nullptr, nullptr, nullptr};
@@ -267,7 +270,8 @@ std::vector<cv::Mat> ReadVideoFrames(const std::string& path) {
     if (packet->stream_index == index) {
       ret = avcodec_send_packet(context.get(), packet.get());
       av_packet_unref(packet.get());
-      if (ret < 0 && ret != AVERROR(EAGAIN)) throw InputError(path, "damaged video data (" + av::ErrorText(ret) + ")");
+      if (ret < 0 && ret != AVERROR(EAGAIN))
+        throw InputError(path, "damaged video data (" + av::ErrorText(ret) + ")");
       drain();
     } else {
       av_packet_unref(packet.get());

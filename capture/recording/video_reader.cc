@@ -90,12 +90,14 @@ struct VideoReader::Decoder {
     }
     context.reset(avcodec_alloc_context3(codec));
     if (!context) throw WorkError(path, "out of memory allocating the decoder");
-    if (avcodec_parameters_to_context(context.get(), par) < 0) throw InputError(path, "bad codec parameters");
+    if (avcodec_parameters_to_context(context.get(), par) < 0)
+      throw InputError(path, "bad codec parameters");
     context->pkt_timebase = stream->time_base;
     context->thread_count = thread_count;
     const int opened = avcodec_open2(context.get(), codec, nullptr);
     if (opened < 0) {
-      throw InputError(path, std::string("cannot open the ") + codec->name + " decoder (" + av::ErrorText(opened) + ")");
+      throw InputError(path, std::string("cannot open the ") + codec->name + " decoder (" +
+                                 av::ErrorText(opened) + ")");
     }
   }
 
@@ -124,20 +126,22 @@ struct VideoReader::Decoder {
       return r;
     }
     if (!sws || sws_source_format != frame->format) {
-      sws.reset(sws_getContext(width, height, static_cast<AVPixelFormat>(frame->format), width, height,
-                               av::RawPixelFormat(format), SWS_BICUBIC | SWS_ACCURATE_RND, nullptr, nullptr,
-                               nullptr));
+      sws.reset(sws_getContext(width, height, static_cast<AVPixelFormat>(frame->format), width,
+                               height, av::RawPixelFormat(format), SWS_BICUBIC | SWS_ACCURATE_RND,
+                               nullptr, nullptr, nullptr));
       sws_source_format = frame->format;
       if (!sws) {
         r.status = Status::kCorrupt;
         r.problem = std::string("cannot convert ") +
-                    av_get_pix_fmt_name(static_cast<AVPixelFormat>(frame->format)) + " to " + PixelFormatName(format);
+                    av_get_pix_fmt_name(static_cast<AVPixelFormat>(frame->format)) + " to " +
+                    PixelFormatName(format);
         return r;
       }
     }
     uint8_t* dst_data[4] = {nullptr};
     int dst_lines[4] = {0};
-    av_image_fill_arrays(dst_data, dst_lines, pixels.data(), av::RawPixelFormat(format), width, height, 1);
+    av_image_fill_arrays(dst_data, dst_lines, pixels.data(), av::RawPixelFormat(format), width,
+                         height, 1);
     sws_scale(sws.get(), frame->data, frame->linesize, 0, height, dst_data, dst_lines);
     return r;
   }
@@ -147,10 +151,10 @@ struct VideoReader::Decoder {
 // packet as a Job with one decoder thread; results are handed out in file order.
 struct VideoReader::Parallel {
   struct Job {
-    av::PacketPtr packet;          // null for damage found while demuxing
-    Result result;                 // set by the decoder thread (or by the demuxer)
-    std::vector<uint8_t> pixels;   // the decoded frame
-    bool done = false;             // guarded by mutex
+    av::PacketPtr packet;         // null for damage found while demuxing
+    Result result;                // set by the decoder thread (or by the demuxer)
+    std::vector<uint8_t> pixels;  // the decoded frame
+    bool done = false;            // guarded by mutex
   };
   struct Worker {
     std::unique_ptr<Decoder> decoder;
@@ -169,9 +173,11 @@ struct VideoReader::Parallel {
   std::condition_variable finished;
   bool stopping = false;
 
-  Parallel(const VideoReader* r, const AVStream* stream, int threads) : reader(r), workers(threads) {
+  Parallel(const VideoReader* r, const AVStream* stream, int threads)
+      : reader(r), workers(threads) {
     for (Worker& w : workers) w.decoder = std::make_unique<Decoder>(r->path_, stream, 1);
-    for (size_t i = 0; i < workers.size(); ++i) workers[i].thread = std::thread([this, i] { Run(workers[i]); });
+    for (size_t i = 0; i < workers.size(); ++i)
+      workers[i].thread = std::thread([this, i] { Run(workers[i]); });
   }
 
   ~Parallel() {
@@ -225,7 +231,8 @@ struct VideoReader::Parallel {
     Result bad;
     bad.status = Status::kCorrupt;
     bad.pts_ms = pts_ms;
-    if (reader->check_slice_crc_ && !Ffv1SlicesIntact(packet->data, static_cast<size_t>(packet->size), &bad.problem)) {
+    if (reader->check_slice_crc_ &&
+        !Ffv1SlicesIntact(packet->data, static_cast<size_t>(packet->size), &bad.problem)) {
       return bad;
     }
     const int sent = avcodec_send_packet(d.context.get(), packet);
@@ -262,7 +269,8 @@ struct VideoReader::Parallel {
   }
 };
 
-VideoReader::VideoReader(const std::string& path, PixelFormat format, int width, int height, int decode_threads)
+VideoReader::VideoReader(const std::string& path, PixelFormat format, int width, int height,
+                         int decode_threads)
     : path_(path), format_(format), width_(width), height_(height) {
   av::InstallLogBridge();
   passthrough_ = format == PixelFormat::kMJPEG;
@@ -270,7 +278,8 @@ VideoReader::VideoReader(const std::string& path, PixelFormat format, int width,
   if (!std::filesystem::is_regular_file(path, ec)) throw InputError(path, "no such video file");
 
   AVFormatContext* raw = nullptr;
-  const int ret = avformat_open_input(&raw, path.c_str(), av_find_input_format("matroska"), nullptr);
+  const int ret =
+      avformat_open_input(&raw, path.c_str(), av_find_input_format("matroska"), nullptr);
   if (ret < 0) throw InputError(path, "not a readable Matroska file (" + av::ErrorText(ret) + ")");
   input_.reset(raw);
   // No avformat_find_stream_info: the Matroska header carries what we need,
@@ -286,8 +295,9 @@ VideoReader::VideoReader(const std::string& path, PixelFormat format, int width,
   time_base_ = stream->time_base;
   const AVCodecParameters* par = stream->codecpar;
   if (par->width != width || par->height != height) {
-    throw InputError(path, "video is " + std::to_string(par->width) + "x" + std::to_string(par->height) +
-                               ", session.json says " + std::to_string(width) + "x" + std::to_string(height));
+    throw InputError(path, "video is " + std::to_string(par->width) + "x" +
+                               std::to_string(par->height) + ", session.json says " +
+                               std::to_string(width) + "x" + std::to_string(height));
   }
   packet_ = av::NewPacket();
   if (passthrough_) {
@@ -297,21 +307,26 @@ VideoReader::VideoReader(const std::string& path, PixelFormat format, int width,
     }
     return;
   }
-  const AVDictionaryEntry* crc = av_dict_get(stream->metadata, "SPRITESTATION_SLICECRC", nullptr, 0);
-  check_slice_crc_ = par->codec_id == AV_CODEC_ID_FFV1 && crc != nullptr && std::strcmp(crc->value, "1") == 0;
+  const AVDictionaryEntry* crc =
+      av_dict_get(stream->metadata, "SPRITESTATION_SLICECRC", nullptr, 0);
+  check_slice_crc_ =
+      par->codec_id == AV_CODEC_ID_FFV1 && crc != nullptr && std::strcmp(crc->value, "1") == 0;
 
   int threads = decode_threads;
   if (threads <= 0) threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   if (threads >= 2 && DecodesFramesIndependently(par)) {
     parallel_ = std::make_unique<Parallel>(this, stream, threads);
   } else {
-    decoder_ = std::make_unique<Decoder>(path, stream, 0);  // slice threads for FFV1, frame threads for H.264
+    decoder_ = std::make_unique<Decoder>(path, stream,
+                                         0);  // slice threads for FFV1, frame threads for H.264
   }
 }
 
 VideoReader::~VideoReader() = default;
 
-int VideoReader::decode_threads() const { return parallel_ ? static_cast<int>(parallel_->workers.size()) : 1; }
+int VideoReader::decode_threads() const {
+  return parallel_ ? static_cast<int>(parallel_->workers.size()) : 1;
+}
 
 VideoReader::Demuxed VideoReader::ReadPacket() {
   using Kind = Demuxed::Kind;
@@ -356,7 +371,8 @@ VideoReader::Result VideoReader::Next(std::vector<uint8_t>& pixels) {
 
 VideoReader::Result VideoReader::NextParallel(std::vector<uint8_t>& pixels) {
   // Keep every decoder thread busy: demux up to a few packets each ahead of the caller.
-  while (!draining_ && parallel_->jobs.size() < kPacketsAheadPerThread * parallel_->workers.size()) {
+  while (!draining_ &&
+         parallel_->jobs.size() < kPacketsAheadPerThread * parallel_->workers.size()) {
     Demuxed d = ReadPacket();
     if (d.kind == Demuxed::Kind::kEnd) break;
     auto job = std::make_unique<Parallel::Job>();
@@ -391,7 +407,8 @@ VideoReader::Result VideoReader::NextSequential(std::vector<uint8_t>& pixels) {
           return r;
         }
         const int64_t ts = decoder_->frame->best_effort_timestamp;
-        const int64_t pts_ms = ts == AV_NOPTS_VALUE ? last_sent_pts_ms_ : av_rescale_q(ts, time_base_, kMillis);
+        const int64_t pts_ms =
+            ts == AV_NOPTS_VALUE ? last_sent_pts_ms_ : av_rescale_q(ts, time_base_, kMillis);
         r = decoder_->Take(format_, width_, height_, pixels);
         r.pts_ms = pts_ms;
         return r;
@@ -413,7 +430,8 @@ VideoReader::Result VideoReader::NextSequential(std::vector<uint8_t>& pixels) {
       if (draining_ && !passthrough_) avcodec_send_packet(decoder_->context.get(), nullptr);
       return bad;
     }
-    if (check_slice_crc_ && !Ffv1SlicesIntact(packet_->data, static_cast<size_t>(packet_->size), &bad.problem)) {
+    if (check_slice_crc_ &&
+        !Ffv1SlicesIntact(packet_->data, static_cast<size_t>(packet_->size), &bad.problem)) {
       av_packet_unref(packet_.get());
       return bad;
     }

@@ -40,7 +40,8 @@ class VideoReader {
   // the file when it is missing, not Matroska, or holds no decodable video.
   // decode_threads: 1 = one decoder (FFmpeg's slice threads), 0 = one decoder
   // thread per core, N >= 2 = N decoder threads (intra-only codecs; see above).
-  VideoReader(const std::string& path, PixelFormat format, int width, int height, int decode_threads = 1);
+  VideoReader(const std::string& path, PixelFormat format, int width, int height,
+              int decode_threads = 1);
   ~VideoReader();
   VideoReader(const VideoReader&) = delete;
   VideoReader& operator=(const VideoReader&) = delete;
@@ -71,7 +72,7 @@ class VideoReader {
   PixelFormat format_;
   int width_;
   int height_;
-  bool passthrough_ = false;   // MJPEG camera: packets are the frames
+  bool passthrough_ = false;  // MJPEG camera: packets are the frames
   bool check_slice_crc_ = false;
   bool draining_ = false;
   int consecutive_read_errors_ = 0;
@@ -84,7 +85,8 @@ class VideoReader {
   av::PacketPtr packet_;
 };
 
-// Checks every slice CRC of an FFV1 (level 3, slicecrc) packet; false with the reason when one fails.
+// Checks every slice CRC of an FFV1 (level 3, slicecrc) packet; false with the reason when one
+// fails.
 bool Ffv1SlicesIntact(const uint8_t* data, size_t size, std::string* why);
 
 }  // namespace ss

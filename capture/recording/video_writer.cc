@@ -11,9 +11,9 @@ extern "C" {
 }
 
 #include "capture/recording/pixel_layout.h"
-#include "core/recording_codecs.h"
 #include "core/error.h"
 #include "core/log.h"
+#include "core/recording_codecs.h"
 
 namespace ss {
 namespace {
@@ -55,8 +55,8 @@ std::vector<int64_t> VideoPtsForRecords(const std::vector<FrameRecord>& records)
   return pts;
 }
 
-VideoWriter::VideoWriter(const std::string& path, PixelFormat format, int width, int height, double fps,
-                         const std::string& codec)
+VideoWriter::VideoWriter(const std::string& path, PixelFormat format, int width, int height,
+                         double fps, const std::string& codec)
     : path_(path), format_(format), width_(width), height_(height) {
   av::InstallLogBridge();
   passthrough_ = format == PixelFormat::kMJPEG;
@@ -132,8 +132,10 @@ VideoWriter::VideoWriter(const std::string& path, PixelFormat format, int width,
       c->global_quality = FF_QP2LAMBDA * 2;
     }
     if (output_->oformat->flags & AVFMT_GLOBALHEADER) c->flags |= AV_CODEC_FLAG_GLOBAL_HEADER;
-    Check(avcodec_open2(c, encoder, &options.d), path, std::string("cannot open the ") + encoder->name + " encoder");
-    Check(avcodec_parameters_from_context(stream_->codecpar, c), path, "cannot set stream parameters");
+    Check(avcodec_open2(c, encoder, &options.d), path,
+          std::string("cannot open the ") + encoder->name + " encoder");
+    Check(avcodec_parameters_from_context(stream_->codecpar, c), path,
+          "cannot set stream parameters");
 
     frame_ = av::NewFrame();
     frame_->format = coded_format;
@@ -141,9 +143,11 @@ VideoWriter::VideoWriter(const std::string& path, PixelFormat format, int width,
     frame_->height = height;
     Check(av_frame_get_buffer(frame_.get(), 0), path, "cannot allocate a frame");
     if (!lossless_) {
-      sws_.reset(sws_getContext(width, height, av::RawPixelFormat(format), width, height, coded_format,
-                                SWS_BICUBIC | SWS_ACCURATE_RND, nullptr, nullptr, nullptr));
-      if (!sws_) throw WorkError(path, "cannot convert " + PixelFormatName(format) + " for " + codec);
+      sws_.reset(sws_getContext(width, height, av::RawPixelFormat(format), width, height,
+                                coded_format, SWS_BICUBIC | SWS_ACCURATE_RND, nullptr, nullptr,
+                                nullptr));
+      if (!sws_)
+        throw WorkError(path, "cannot convert " + PixelFormatName(format) + " for " + codec);
     }
   }
   // The reader checks FFV1 slice CRCs only on files that say they carry them.
@@ -154,7 +158,8 @@ VideoWriter::VideoWriter(const std::string& path, PixelFormat format, int width,
   Dict mux_options;
   // The muxer closes a cluster after at most a second of video on its own; Flush() does it sooner.
   mux_options.Set("cluster_time_limit", "1000");
-  Check(avformat_write_header(output_.get(), &mux_options.d), path, "cannot write the Matroska header");
+  Check(avformat_write_header(output_.get(), &mux_options.d), path,
+        "cannot write the Matroska header");
   avio_flush(output_->pb);
   packet_ = av::NewPacket();
 }
@@ -184,7 +189,8 @@ void VideoWriter::Write(const uint8_t* data, size_t size, int64_t pts_ms) {
   } else {
     uint8_t* src_data[4] = {nullptr};
     int src_lines[4] = {0};
-    Check(av_image_fill_arrays(src_data, src_lines, data, av::RawPixelFormat(format_), width_, height_, 1),
+    Check(av_image_fill_arrays(src_data, src_lines, data, av::RawPixelFormat(format_), width_,
+                               height_, 1),
           path_, "bad source frame");
     sws_scale(sws_.get(), src_data, src_lines, 0, height_, frame_->data, frame_->linesize);
   }
@@ -205,7 +211,8 @@ void VideoWriter::Encode(AVFrame* frame) {
 
 void VideoWriter::Mux(AVPacket* packet) {
   packet->stream_index = stream_->index;
-  // av_write_frame: one stream needs no interleaving queue, so the packet goes straight to the cluster.
+  // av_write_frame: one stream needs no interleaving queue, so the packet goes straight to the
+  // cluster.
   Check(av_write_frame(output_.get(), packet), path_, "cannot write a frame (disk full?)");
   ++frames_muxed_;
 }

@@ -10,7 +10,8 @@ void RegisterReplayCameraBackend() {
                            ReplayOptions options;
                            options.realtime = camera.realtime;
                            options.loops = camera.loop ? 0 : 1;
-                           options.camera = camera.session_camera.empty() ? camera.name : camera.session_camera;
+                           options.camera =
+                               camera.session_camera.empty() ? camera.name : camera.session_camera;
                            return std::make_unique<ReplaySource>(camera.session, options);
                          },
                          nullptr});

@@ -53,8 +53,8 @@ struct ReplaySource::Impl {
     std::string video_path;
     std::string csv_path;
     std::vector<FrameRecord> records;
-    std::vector<int64_t> pts_ms;       // each row's timestamp in the video
-    uint64_t sequence_span = 1;        // sequence shift per pass
+    std::vector<int64_t> pts_ms;  // each row's timestamp in the video
+    uint64_t sequence_span = 1;   // sequence shift per pass
     std::shared_ptr<BufferPool> pool = std::make_shared<BufferPool>();
     std::thread decoder;
     // Guarded by Impl::mutex:
@@ -96,7 +96,9 @@ struct ReplaySource::Impl {
   // Waits for room in the camera's queue and hands it a frame; false when stopped.
   bool Push(Camera& cam, Frame frame) {
     std::unique_lock<std::mutex> lock(mutex);
-    changed.wait(lock, [&] { return stopped || cam.ready.size() < static_cast<size_t>(options.frames_ahead); });
+    changed.wait(lock, [&] {
+      return stopped || cam.ready.size() < static_cast<size_t>(options.frames_ahead);
+    });
     if (stopped) return false;
     cam.ready.push_back(std::move(frame));
     changed.notify_all();
@@ -108,7 +110,8 @@ struct ReplaySource::Impl {
     return stopped;
   }
 
-  // One pass over a camera's video; false when the replay was stopped or the file cannot be read at all.
+  // One pass over a camera's video; false when the replay was stopped or the file cannot be read at
+  // all.
   bool DecodePass(Camera& cam, int pass) {
     std::unique_ptr<VideoReader> reader;
     try {
@@ -122,8 +125,8 @@ struct ReplaySource::Impl {
     }
     const int64_t shift_ns = pass_span_ns * pass;
     const uint64_t shift_seq = cam.sequence_span * static_cast<uint64_t>(pass);
-    size_t row = 0;           // next CSV row not yet accounted for
-    uint64_t unrowed = 0;     // video frames past the CSV
+    size_t row = 0;        // next CSV row not yet accounted for
+    uint64_t unrowed = 0;  // video frames past the CSV
     auto buffer = cam.pool->Take();
     while (true) {
       if (Stopped()) return false;
@@ -133,16 +136,19 @@ struct ReplaySource::Impl {
         // Container damage that names no frame. Past the CSV's last row it is the
         // cut-off tail of an interrupted recording, which is expected.
         if (pass == 0) {
-          const std::string where = cam.video_path + ": after frame " + std::to_string(static_cast<int64_t>(row) - 1);
+          const std::string where =
+              cam.video_path + ": after frame " + std::to_string(static_cast<int64_t>(row) - 1);
           if (row < cam.records.size()) {
             Problem(cam, where + ": " + r.problem);
           } else {
-            Log("capture.replay")->warn("{}: {} (past the last frame in {})", where, r.problem, cam.csv_path);
+            Log("capture.replay")
+                ->warn("{}: {} (past the last frame in {})", where, r.problem, cam.csv_path);
           }
         }
         continue;
       }
-      // The frame's CSV row, found through its timestamp; rows jumped over are missing from the video.
+      // The frame's CSV row, found through its timestamp; rows jumped over are missing from the
+      // video.
       size_t at = row;
       while (at < cam.pts_ms.size() && cam.pts_ms[at] < r.pts_ms) ++at;
       if (at == cam.pts_ms.size() || cam.pts_ms[at] != r.pts_ms) {
@@ -152,8 +158,9 @@ struct ReplaySource::Impl {
       }
       if (at > row) {
         if (pass == 0) {
-          Problem(cam, cam.video_path + ": frames " + std::to_string(row) + ".." + std::to_string(at - 1) +
-                           " listed in " + cam.csv_path + " are missing from the video");
+          Problem(cam, cam.video_path + ": frames " + std::to_string(row) + ".." +
+                           std::to_string(at - 1) + " listed in " + cam.csv_path +
+                           " are missing from the video");
         }
         std::lock_guard<std::mutex> lock(mutex);
         cam.stats.frames_unreadable += at - row;
@@ -169,8 +176,9 @@ struct ReplaySource::Impl {
       const FrameRecord& rec = cam.records[at];
       std::vector<uint8_t>* raw = buffer.release();
       auto pool = cam.pool;
-      Frame f = Frame::Borrowed(cam.meta.pixel_format, cam.meta.width, cam.meta.height, raw->data(), raw->size(),
-                                [pool, raw] { pool->Give(std::unique_ptr<std::vector<uint8_t>>(raw)); });
+      Frame f = Frame::Borrowed(
+          cam.meta.pixel_format, cam.meta.width, cam.meta.height, raw->data(), raw->size(),
+          [pool, raw] { pool->Give(std::unique_ptr<std::vector<uint8_t>>(raw)); });
       f.camera = cam.index;
       f.timestamp_ns = rec.timestamp_ns + shift_ns;
       f.sequence = rec.sequence + shift_seq;
@@ -188,8 +196,11 @@ struct ReplaySource::Impl {
     }
     if (unrowed > 0) {
       if (pass == 0) {
-        Log("capture.replay")->warn("{}: {} frame(s) at the end are not listed in {} (recording interrupted?); "
-                                    "skipped", cam.video_path, unrowed, cam.csv_path);
+        Log("capture.replay")
+            ->warn(
+                "{}: {} frame(s) at the end are not listed in {} (recording interrupted?); "
+                "skipped",
+                cam.video_path, unrowed, cam.csv_path);
       }
       std::lock_guard<std::mutex> lock(mutex);
       cam.stats.frames_without_row += unrowed;
@@ -217,14 +228,17 @@ struct ReplaySource::Impl {
   static uint64_t RecordedGaps(const std::vector<FrameRecord>& records) {
     uint64_t gaps = 0;
     for (size_t i = 1; i < records.size(); ++i) {
-      if (records[i].sequence > records[i - 1].sequence + 1) gaps += records[i].sequence - records[i - 1].sequence - 1;
+      if (records[i].sequence > records[i - 1].sequence + 1)
+        gaps += records[i].sequence - records[i - 1].sequence - 1;
     }
     return gaps;
   }
 };
 
-ReplaySource::ReplaySource(const std::string& dir, ReplayOptions options) : impl_(std::make_unique<Impl>()) {
-  if (options.loops < 0) throw InputError("loops", "expected 0 (forever) or more, got " + std::to_string(options.loops));
+ReplaySource::ReplaySource(const std::string& dir, ReplayOptions options)
+    : impl_(std::make_unique<Impl>()) {
+  if (options.loops < 0)
+    throw InputError("loops", "expected 0 (forever) or more, got " + std::to_string(options.loops));
   if (options.frames_ahead < 1) options.frames_ahead = 1;
   Impl& s = *impl_;
   s.dir = dir;
@@ -258,8 +272,10 @@ ReplaySource::ReplaySource(const std::string& dir, ReplayOptions options) : impl
     cam->pts_ms = VideoPtsForRecords(cam->records);
     if (cam->meta.frames > static_cast<int64_t>(cam->records.size())) {
       // Fewer rows than the closed recording wrote (more rows: the video check reports it).
-      s.Problem(*cam, cam->csv_path + ": lists " + std::to_string(cam->records.size()) + " frames, but the recording "
-                          "was closed with " + std::to_string(cam->meta.frames) + " (" +
+      s.Problem(*cam, cam->csv_path + ": lists " + std::to_string(cam->records.size()) +
+                          " frames, but the recording "
+                          "was closed with " +
+                          std::to_string(cam->meta.frames) + " (" +
                           (root / "session.json").string() + "); the CSV is truncated");
     }
     cam->stats.name = cam->meta.name;
@@ -290,20 +306,23 @@ ReplaySource::ReplaySource(const std::string& dir, ReplayOptions options) : impl
         const CameraModel model = CameraModel::Read(model_path);
         if (model.width() != sc.width || model.height() != sc.height) {
           throw InputError(model_path, "imager is " + std::to_string(model.width()) + "x" +
-                                           std::to_string(model.height()) + ", the camera records " +
-                                           std::to_string(sc.width) + "x" + std::to_string(sc.height));
+                                           std::to_string(model.height()) +
+                                           ", the camera records " + std::to_string(sc.width) +
+                                           "x" + std::to_string(sc.height));
         }
         sc.model_path = model_path;
       } catch (const InputError& e) {
-        s.Problem(*cam, std::string(e.what()) + " (camera '" + cam->meta.name + "' replays without its model)");
+        s.Problem(*cam, std::string(e.what()) + " (camera '" + cam->meta.name +
+                            "' replays without its model)");
       }
     }
     s.source_cameras.push_back(sc);
     s.cams.push_back(std::move(cam));
   }
   s.pass_span_ns = (last - first) + period;
-  Log("capture.replay")->debug("{}: replaying {} camera(s){}", dir, s.cams.size(),
-                               options.realtime ? " in real time" : "");
+  Log("capture.replay")
+      ->debug("{}: replaying {} camera(s){}", dir, s.cams.size(),
+              options.realtime ? " in real time" : "");
   for (auto& cam : s.cams) {
     Impl::Camera* c = cam.get();
     c->decoder = std::thread([&s, c] { s.DecodeCamera(*c); });
@@ -332,7 +351,8 @@ std::optional<Frame> ReplaySource::Next() {
         if (!cam->finished) return false;
         continue;
       }
-      if (pick == nullptr || cam->ready.front().timestamp_ns < pick->ready.front().timestamp_ns) pick = cam.get();
+      if (pick == nullptr || cam->ready.front().timestamp_ns < pick->ready.front().timestamp_ns)
+        pick = cam.get();
     }
     return true;
   });
@@ -347,7 +367,8 @@ std::optional<Frame> ReplaySource::Next() {
       s.wall_start = Clock::now();
       s.first_timestamp_ns = frame.timestamp_ns;
     }
-    const auto due = s.wall_start + std::chrono::nanoseconds(frame.timestamp_ns - s.first_timestamp_ns);
+    const auto due =
+        s.wall_start + std::chrono::nanoseconds(frame.timestamp_ns - s.first_timestamp_ns);
     s.changed.wait_until(lock, due, [&] { return s.stopped; });
     if (s.stopped) return std::nullopt;
   }

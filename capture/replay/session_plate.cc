@@ -11,8 +11,10 @@
 
 namespace ss {
 
-SessionPlate ReadSessionPlate(const std::string& session_dir, const std::string& camera, const PlateOptions& o) {
-  if (o.first_frame < 0) throw InputError("first_frame", "must be >= 0, got " + std::to_string(o.first_frame));
+SessionPlate ReadSessionPlate(const std::string& session_dir, const std::string& camera,
+                              const PlateOptions& o) {
+  if (o.first_frame < 0)
+    throw InputError("first_frame", "must be >= 0, got " + std::to_string(o.first_frame));
   if (o.last_frame < o.first_frame) {
     throw InputError("last_frame", std::to_string(o.last_frame) + " is before the first frame " +
                                        std::to_string(o.first_frame));
@@ -30,7 +32,8 @@ SessionPlate ReadSessionPlate(const std::string& session_dir, const std::string&
     for (int64_t f = o.first_frame; f <= o.last_frame; ++f) wanted.push_back(f);
   } else {
     for (int k = 0; k < o.samples; ++k) {
-      wanted.push_back(o.first_frame + static_cast<int64_t>(std::floor((k + 0.5) * static_cast<double>(span) / o.samples)));
+      wanted.push_back(o.first_frame + static_cast<int64_t>(std::floor(
+                                           (k + 0.5) * static_cast<double>(span) / o.samples)));
     }
   }
   SessionPlate plate;
@@ -54,8 +57,9 @@ SessionPlate ReadSessionPlate(const std::string& session_dir, const std::string&
   source.Stop();
   if (frames.empty()) {
     throw InputError(session_dir, "camera " + camera + " has no readable frame in frames " +
-                                      std::to_string(o.first_frame) + ".." + std::to_string(o.last_frame) +
-                                      " (it has " + std::to_string(index + 1) + ")");
+                                      std::to_string(o.first_frame) + ".." +
+                                      std::to_string(o.last_frame) + " (it has " +
+                                      std::to_string(index + 1) + ")");
   }
   plate.frames_used = static_cast<int>(frames.size());
   plate.bgr = PerPixelMedian(frames, session_dir + " camera " + camera);

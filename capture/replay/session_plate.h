@@ -11,13 +11,14 @@
 namespace ss {
 
 struct PlateOptions {
-  int64_t first_frame = 0;  // the range of the camera's frames (0-based, as replayed: unreadable ones skipped)
+  int64_t first_frame =
+      0;  // the range of the camera's frames (0-based, as replayed: unreadable ones skipped)
   int64_t last_frame = 29;  // inclusive
   int samples = 30;         // frames taken, spread evenly over the range (all of them when fewer)
 };
 
 struct SessionPlate {
-  cv::Mat bgr;                  // CV_8UC3, the camera's size
+  cv::Mat bgr;  // CV_8UC3, the camera's size
   int frames_used = 0;
   int64_t first_frame = 0, last_frame = 0;  // the frames used, first and last
   int64_t first_timestamp_ns = 0, last_timestamp_ns = 0;

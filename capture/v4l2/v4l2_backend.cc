@@ -7,22 +7,25 @@
 namespace ss {
 
 void RegisterV4l2CameraBackend() {
-  RegisterCameraBackend({"v4l2", "V4L2 webcams and capture cards",
-                         [](const CameraConfig& camera, int camera_index) -> std::unique_ptr<FrameSource> {
-                           V4l2Options options;
-                           options.device = camera.device;
-                           SetLiveOptions(camera, camera_index, options);
-                           if (camera.gain_db) options.gain = static_cast<int>(std::lround(*camera.gain_db));
-                           const WhiteBalanceConfig& wb = camera.white_balance;
-                           if (wb.mode == WhiteBalanceMode::kOnce) options.white_balance_once = true;
-                           if (wb.mode == WhiteBalanceMode::kManual) options.white_balance_k = static_cast<int>(std::lround(wb.temperature_k));
-                           return std::make_unique<V4l2Source>(options);
-                         },
-                         [] {
-                           std::vector<FoundCamera> out;
-                           for (const auto& d : ListV4l2Devices()) out.push_back({"v4l2", d.path, d.card, d.driver, d.bus, ""});
-                           return out;
-                         }});
+  RegisterCameraBackend(
+      {"v4l2", "V4L2 webcams and capture cards",
+       [](const CameraConfig& camera, int camera_index) -> std::unique_ptr<FrameSource> {
+         V4l2Options options;
+         options.device = camera.device;
+         SetLiveOptions(camera, camera_index, options);
+         if (camera.gain_db) options.gain = static_cast<int>(std::lround(*camera.gain_db));
+         const WhiteBalanceConfig& wb = camera.white_balance;
+         if (wb.mode == WhiteBalanceMode::kOnce) options.white_balance_once = true;
+         if (wb.mode == WhiteBalanceMode::kManual)
+           options.white_balance_k = static_cast<int>(std::lround(wb.temperature_k));
+         return std::make_unique<V4l2Source>(options);
+       },
+       [] {
+         std::vector<FoundCamera> out;
+         for (const auto& d : ListV4l2Devices())
+           out.push_back({"v4l2", d.path, d.card, d.driver, d.bus, ""});
+         return out;
+       }});
 }
 
 }  // namespace ss

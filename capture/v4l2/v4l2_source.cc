@@ -37,10 +37,10 @@ struct FormatEntry {
 };
 
 constexpr FormatEntry kFormats[] = {
-    {PixelFormat::kYUYV, V4L2_PIX_FMT_YUYV},     {PixelFormat::kNV12, V4L2_PIX_FMT_NV12},
-    {PixelFormat::kMJPEG, V4L2_PIX_FMT_MJPEG},   {PixelFormat::kMJPEG, V4L2_PIX_FMT_JPEG},
-    {PixelFormat::kRGB8, V4L2_PIX_FMT_RGB24},    {PixelFormat::kBGR8, V4L2_PIX_FMT_BGR24},
-    {PixelFormat::kMono8, V4L2_PIX_FMT_GREY},    {PixelFormat::kBayerRG8, V4L2_PIX_FMT_SRGGB8},
+    {PixelFormat::kYUYV, V4L2_PIX_FMT_YUYV},       {PixelFormat::kNV12, V4L2_PIX_FMT_NV12},
+    {PixelFormat::kMJPEG, V4L2_PIX_FMT_MJPEG},     {PixelFormat::kMJPEG, V4L2_PIX_FMT_JPEG},
+    {PixelFormat::kRGB8, V4L2_PIX_FMT_RGB24},      {PixelFormat::kBGR8, V4L2_PIX_FMT_BGR24},
+    {PixelFormat::kMono8, V4L2_PIX_FMT_GREY},      {PixelFormat::kBayerRG8, V4L2_PIX_FMT_SRGGB8},
     {PixelFormat::kBayerGR8, V4L2_PIX_FMT_SGRBG8}, {PixelFormat::kBayerGB8, V4L2_PIX_FMT_SGBRG8},
     {PixelFormat::kBayerBG8, V4L2_PIX_FMT_SBGGR8},
 };
@@ -109,9 +109,12 @@ int OpenDevice(const std::string& path) {
   const int fd = open(path.c_str(), O_RDWR | O_NONBLOCK | O_CLOEXEC);
   if (fd >= 0) return fd;
   if (errno == ENOENT || errno == ENXIO || errno == ENODEV) {
-    throw WorkError(path, "no such device (is the camera plugged in? `spritestation cameras` lists what is present)");
+    throw WorkError(
+        path,
+        "no such device (is the camera plugged in? `spritestation cameras` lists what is present)");
   }
-  if (errno == EACCES) throw WorkError(path, "permission denied (add the user to the 'video' group)");
+  if (errno == EACCES)
+    throw WorkError(path, "permission denied (add the user to the 'video' group)");
   if (errno == EBUSY) throw WorkError(path, "busy: another program holds the device");
   throw WorkError(path, "cannot open: " + Errno());
 }
@@ -147,7 +150,8 @@ std::vector<V4l2DeviceInfo> ListV4l2Devices() {
     const int fd = open(path.c_str(), O_RDWR | O_NONBLOCK | O_CLOEXEC);
     if (fd < 0) continue;
     v4l2_capability cap{};
-    if (Xioctl(fd, VIDIOC_QUERYCAP, &cap) == 0 && (CaptureCaps(cap) & V4L2_CAP_VIDEO_CAPTURE) != 0) {
+    if (Xioctl(fd, VIDIOC_QUERYCAP, &cap) == 0 &&
+        (CaptureCaps(cap) & V4L2_CAP_VIDEO_CAPTURE) != 0) {
       V4l2DeviceInfo d;
       d.path = path;
       d.driver = reinterpret_cast<const char*>(cap.driver);
@@ -155,7 +159,8 @@ std::vector<V4l2DeviceInfo> ListV4l2Devices() {
       d.bus = reinterpret_cast<const char*>(cap.bus_info);
       for (uint32_t fourcc : OfferedFourccs(fd)) {
         const auto f = FromFourcc(fourcc);
-        if (f && std::find(d.formats.begin(), d.formats.end(), *f) == d.formats.end()) d.formats.push_back(*f);
+        if (f && std::find(d.formats.begin(), d.formats.end(), *f) == d.formats.end())
+          d.formats.push_back(*f);
       }
       out.push_back(d);
     }
@@ -186,7 +191,8 @@ struct V4l2Source::Impl {
   std::optional<v4l2_queryctrl> Query(uint32_t id) const {
     v4l2_queryctrl q{};
     q.id = id;
-    if (Xioctl(device->fd, VIDIOC_QUERYCTRL, &q) < 0 || (q.flags & V4L2_CTRL_FLAG_DISABLED) != 0) return std::nullopt;
+    if (Xioctl(device->fd, VIDIOC_QUERYCTRL, &q) < 0 || (q.flags & V4L2_CTRL_FLAG_DISABLED) != 0)
+      return std::nullopt;
     return q;
   }
 
@@ -195,34 +201,39 @@ struct V4l2Source::Impl {
     const auto q = Query(id);
     if (!q) throw InputError(field, path() + " has no " + what + " control");
     if (value < q->minimum || value > q->maximum) {
-      throw InputError(field, path() + ": " + what + " " + std::to_string(value) + " is outside the device's range " +
-                                  std::to_string(q->minimum) + ".." + std::to_string(q->maximum));
+      throw InputError(field, path() + ": " + what + " " + std::to_string(value) +
+                                  " is outside the device's range " + std::to_string(q->minimum) +
+                                  ".." + std::to_string(q->maximum));
     }
     v4l2_control c{};
     c.id = id;
     c.value = value;
     if (Xioctl(device->fd, VIDIOC_S_CTRL, &c) < 0) {
-      throw InputError(field, path() + " refuses " + what + " = " + std::to_string(value) + ": " + Errno());
+      throw InputError(
+          field, path() + " refuses " + what + " = " + std::to_string(value) + ": " + Errno());
     }
     v4l2_control back{};
     back.id = id;
     if (Xioctl(device->fd, VIDIOC_G_CTRL, &back) == 0 && back.value != value) {
-      throw InputError(field, path() + ": " + what + " set to " + std::to_string(value) + " reads back as " +
-                                  std::to_string(back.value));
+      throw InputError(field, path() + ": " + what + " set to " + std::to_string(value) +
+                                  " reads back as " + std::to_string(back.value));
     }
   }
 
   // Presses a button control (an action such as a one-time white balance).
   void Trigger(uint32_t id, const std::string& field, const std::string& what) {
-    if (!Query(id)) throw InputError(field, path() + " cannot do " + what + " (it has no such control)");
+    if (!Query(id))
+      throw InputError(field, path() + " cannot do " + what + " (it has no such control)");
     v4l2_control c{};
     c.id = id;
     c.value = 1;
-    if (Xioctl(device->fd, VIDIOC_S_CTRL, &c) < 0) throw InputError(field, path() + " refuses " + what + ": " + Errno());
+    if (Xioctl(device->fd, VIDIOC_S_CTRL, &c) < 0)
+      throw InputError(field, path() + " refuses " + what + ": " + Errno());
   }
 
   // Turns an automatic mode off when the device has it.
-  void ManualIfPresent(uint32_t id, int32_t manual_value, const std::string& field, const std::string& what) {
+  void ManualIfPresent(uint32_t id, int32_t manual_value, const std::string& field,
+                       const std::string& what) {
     if (Query(id)) SetControl(id, manual_value, field, what);
   }
 
@@ -236,10 +247,11 @@ struct V4l2Source::Impl {
 V4l2Source::V4l2Source(V4l2Options options) : impl_(std::make_unique<Impl>()) {
   Impl& s = *impl_;
   s.options = options;
-  if (options.buffers < 2) throw InputError("buffers", "expected 2 or more, got " + std::to_string(options.buffers));
+  if (options.buffers < 2)
+    throw InputError("buffers", "expected 2 or more, got " + std::to_string(options.buffers));
   if ((options.width > 0) != (options.height > 0)) {
-    throw InputError("width/height", "give both or neither (got " + std::to_string(options.width) + "x" +
-                                         std::to_string(options.height) + ")");
+    throw InputError("width/height", "give both or neither (got " + std::to_string(options.width) +
+                                         "x" + std::to_string(options.height) + ")");
   }
   auto device = std::make_shared<Device>();
   device->path = options.device;
@@ -249,7 +261,8 @@ V4l2Source::V4l2Source(V4l2Options options) : impl_(std::make_unique<Impl>()) {
   const std::string& path = options.device;
 
   v4l2_capability cap{};
-  if (Xioctl(fd, VIDIOC_QUERYCAP, &cap) < 0) throw InputError(path, "not a V4L2 device (" + Errno() + ")");
+  if (Xioctl(fd, VIDIOC_QUERYCAP, &cap) < 0)
+    throw InputError(path, "not a V4L2 device (" + Errno() + ")");
   const uint32_t caps = CaptureCaps(cap);
   if ((caps & V4L2_CAP_VIDEO_CAPTURE) == 0) {
     throw InputError(path, (caps & V4L2_CAP_VIDEO_CAPTURE_MPLANE) != 0
@@ -261,7 +274,8 @@ V4l2Source::V4l2Source(V4l2Options options) : impl_(std::make_unique<Impl>()) {
   // Format and size.
   v4l2_format fmt{};
   fmt.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
-  if (Xioctl(fd, VIDIOC_G_FMT, &fmt) < 0) throw WorkError(path, "cannot read the format: " + Errno());
+  if (Xioctl(fd, VIDIOC_G_FMT, &fmt) < 0)
+    throw WorkError(path, "cannot read the format: " + Errno());
   const std::vector<uint32_t> offered = OfferedFourccs(fd);
   std::string offered_names;
   for (uint32_t f : offered) offered_names += (offered_names.empty() ? "" : ", ") + FourccName(f);
@@ -274,12 +288,15 @@ V4l2Source::V4l2Source(V4l2Options options) : impl_(std::make_unique<Impl>()) {
       want = V4L2_PIX_FMT_JPEG;
     }
     if (want == 0 || std::find(offered.begin(), offered.end(), want) == offered.end()) {
-      throw InputError("pixel_format", path + " does not offer " + PixelFormatName(*options.pixel_format) +
+      throw InputError("pixel_format", path + " does not offer " +
+                                           PixelFormatName(*options.pixel_format) +
                                            " (it offers: " + offered_names + ")");
     }
   }
-  const uint32_t want_w = options.width > 0 ? static_cast<uint32_t>(options.width) : fmt.fmt.pix.width;
-  const uint32_t want_h = options.height > 0 ? static_cast<uint32_t>(options.height) : fmt.fmt.pix.height;
+  const uint32_t want_w =
+      options.width > 0 ? static_cast<uint32_t>(options.width) : fmt.fmt.pix.width;
+  const uint32_t want_h =
+      options.height > 0 ? static_cast<uint32_t>(options.height) : fmt.fmt.pix.height;
   fmt.fmt.pix.pixelformat = want;
   fmt.fmt.pix.width = want_w;
   fmt.fmt.pix.height = want_h;
@@ -291,17 +308,18 @@ V4l2Source::V4l2Source(V4l2Options options) : impl_(std::make_unique<Impl>()) {
   }
   const auto format = FromFourcc(fmt.fmt.pix.pixelformat);
   if (!format) {
-    throw InputError("pixel_format", path + " switched to " + FourccName(fmt.fmt.pix.pixelformat) +
-                                         ", which SpriteStation does not read (it offers: " + offered_names + ")");
+    throw InputError("pixel_format",
+                     path + " switched to " + FourccName(fmt.fmt.pix.pixelformat) +
+                         ", which SpriteStation does not read (it offers: " + offered_names + ")");
   }
   if (fmt.fmt.pix.pixelformat != want) {
-    throw InputError("pixel_format", path + " does not take " + FourccName(want) + " (it offers: " + offered_names +
-                                         ")");
+    throw InputError("pixel_format", path + " does not take " + FourccName(want) +
+                                         " (it offers: " + offered_names + ")");
   }
   if (fmt.fmt.pix.width != want_w || fmt.fmt.pix.height != want_h) {
     throw InputError("width/height", path + " cannot capture " + FourccName(want) + " at " +
-                                         std::to_string(want_w) + "x" + std::to_string(want_h) + " (nearest: " +
-                                         std::to_string(fmt.fmt.pix.width) + "x" +
+                                         std::to_string(want_w) + "x" + std::to_string(want_h) +
+                                         " (nearest: " + std::to_string(fmt.fmt.pix.width) + "x" +
                                          std::to_string(fmt.fmt.pix.height) + ")");
   }
   s.format = *format;
@@ -316,12 +334,15 @@ V4l2Source::V4l2Source(V4l2Options options) : impl_(std::make_unique<Impl>()) {
   v4l2_streamparm parm{};
   parm.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
   if (options.fps > 0) {
-    if (Xioctl(fd, VIDIOC_G_PARM, &parm) < 0 || (parm.parm.capture.capability & V4L2_CAP_TIMEPERFRAME) == 0) {
+    if (Xioctl(fd, VIDIOC_G_PARM, &parm) < 0 ||
+        (parm.parm.capture.capability & V4L2_CAP_TIMEPERFRAME) == 0) {
       throw InputError("fps", path + " does not let the frame rate be set");
     }
     parm.parm.capture.timeperframe.numerator = 1000;
-    parm.parm.capture.timeperframe.denominator = static_cast<uint32_t>(std::lround(options.fps * 1000));
-    if (Xioctl(fd, VIDIOC_S_PARM, &parm) < 0) throw InputError("fps", path + " refuses the frame rate: " + Errno());
+    parm.parm.capture.timeperframe.denominator =
+        static_cast<uint32_t>(std::lround(options.fps * 1000));
+    if (Xioctl(fd, VIDIOC_S_PARM, &parm) < 0)
+      throw InputError("fps", path + " refuses the frame rate: " + Errno());
   }
   if (Xioctl(fd, VIDIOC_G_PARM, &parm) == 0 && parm.parm.capture.timeperframe.numerator > 0) {
     fps = static_cast<double>(parm.parm.capture.timeperframe.denominator) /
@@ -331,8 +352,9 @@ V4l2Source::V4l2Source(V4l2Options options) : impl_(std::make_unique<Impl>()) {
   // Exposure, gain and white balance: automatic modes off, values set and read back.
   if (options.exposure_us > 0) {
     s.ManualIfPresent(V4L2_CID_EXPOSURE_AUTO, V4L2_EXPOSURE_MANUAL, "exposure_us", "auto exposure");
-    s.SetControl(V4L2_CID_EXPOSURE_ABSOLUTE, static_cast<int32_t>(std::lround(options.exposure_us / 100.0)),
-                 "exposure_us", "exposure (100 us units)");
+    s.SetControl(V4L2_CID_EXPOSURE_ABSOLUTE,
+                 static_cast<int32_t>(std::lround(options.exposure_us / 100.0)), "exposure_us",
+                 "exposure (100 us units)");
   }
   if (options.gain >= 0) {
     s.ManualIfPresent(V4L2_CID_AUTOGAIN, 0, "gain", "auto gain");
@@ -356,13 +378,15 @@ V4l2Source::V4l2Source(V4l2Options options) : impl_(std::make_unique<Impl>()) {
     if (errno == EBUSY) throw WorkError(path, "busy: another program is streaming from it");
     throw WorkError(path, "cannot get streaming buffers: " + Errno());
   }
-  if (req.count < 2) throw WorkError(path, "the driver gave " + std::to_string(req.count) + " buffer(s); need 2");
+  if (req.count < 2)
+    throw WorkError(path, "the driver gave " + std::to_string(req.count) + " buffer(s); need 2");
   for (uint32_t i = 0; i < req.count; ++i) {
     v4l2_buffer b{};
     b.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
     b.memory = V4L2_MEMORY_MMAP;
     b.index = i;
-    if (Xioctl(fd, VIDIOC_QUERYBUF, &b) < 0) throw WorkError(path, "cannot query buffer: " + Errno());
+    if (Xioctl(fd, VIDIOC_QUERYBUF, &b) < 0)
+      throw WorkError(path, "cannot query buffer: " + Errno());
     Device::Mapping m;
     m.length = b.length;
     m.start = mmap(nullptr, b.length, PROT_READ | PROT_WRITE, MAP_SHARED, fd, b.m.offset);
@@ -390,9 +414,10 @@ V4l2Source::V4l2Source(V4l2Options options) : impl_(std::make_unique<Impl>()) {
   sc.format = s.format;
   sc.fps = fps;
   s.cameras.push_back(sc);
-  Log("capture.v4l2")->info("{}: {} ({}) streaming {} {}x{} at {:.2f} frames/s, {} buffers", path,
-                            reinterpret_cast<const char*>(cap.card), reinterpret_cast<const char*>(cap.driver),
-                            FourccName(fmt.fmt.pix.pixelformat), s.width, s.height, fps, req.count);
+  Log("capture.v4l2")
+      ->info("{}: {} ({}) streaming {} {}x{} at {:.2f} frames/s, {} buffers", path,
+             reinterpret_cast<const char*>(cap.card), reinterpret_cast<const char*>(cap.driver),
+             FourccName(fmt.fmt.pix.pixelformat), s.width, s.height, fps, req.count);
 }
 
 V4l2Source::~V4l2Source() {
@@ -433,11 +458,14 @@ std::optional<Frame> V4l2Source::Next() {
     std::unique_lock<std::mutex> lock(s.mutex);
     s.waited_ms = 0;
     const uint64_t sequence = b.sequence;
-    if (s.have_sequence && sequence > s.last_sequence + 1) s.totals.frames_dropped += sequence - s.last_sequence - 1;
+    if (s.have_sequence && sequence > s.last_sequence + 1)
+      s.totals.frames_dropped += sequence - s.last_sequence - 1;
     s.have_sequence = true;
     s.last_sequence = sequence;
-    const size_t expected = s.format == PixelFormat::kMJPEG ? 1 : s.stride * static_cast<size_t>(s.height) *
-                                                                        (s.format == PixelFormat::kNV12 ? 3 : 2) / 2;
+    const size_t expected = s.format == PixelFormat::kMJPEG
+                                ? 1
+                                : s.stride * static_cast<size_t>(s.height) *
+                                      (s.format == PixelFormat::kNV12 ? 3 : 2) / 2;
     std::string problem;
     if ((b.flags & V4L2_BUF_FLAG_ERROR) != 0) {
       problem = "the driver flagged it corrupt";
@@ -461,17 +489,20 @@ std::optional<Frame> V4l2Source::Next() {
     if (s.format == PixelFormat::kMJPEG) {
       auto device = s.device;
       const uint32_t index = b.index;
-      f = Frame::Borrowed(s.format, s.width, s.height, data, b.bytesused, [device, index] { device->Queue(index); });
+      f = Frame::Borrowed(s.format, s.width, s.height, data, b.bytesused,
+                          [device, index] { device->Queue(index); });
     } else if (s.stride == s.packed_stride) {
       auto device = s.device;
       const uint32_t index = b.index;
-      f = Frame::Borrowed(s.format, s.width, s.height, data, FrameBytes(s.format, s.width, s.height),
+      f = Frame::Borrowed(s.format, s.width, s.height, data,
+                          FrameBytes(s.format, s.width, s.height),
                           [device, index] { device->Queue(index); });
     } else {
       // Rows padded by the driver: repack into an owned frame and hand the buffer straight back.
       std::vector<uint8_t> pixels(FrameBytes(s.format, s.width, s.height));
       const size_t rows = pixels.size() / s.packed_stride;
-      for (size_t y = 0; y < rows; ++y) std::memcpy(&pixels[y * s.packed_stride], data + y * s.stride, s.packed_stride);
+      for (size_t y = 0; y < rows; ++y)
+        std::memcpy(&pixels[y * s.packed_stride], data + y * s.stride, s.packed_stride);
       s.device->Queue(b.index);
       f = Frame::Owned(s.format, s.width, s.height, std::move(pixels));
     }

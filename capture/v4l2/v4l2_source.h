@@ -23,21 +23,21 @@ struct V4l2Options {
   std::optional<PixelFormat> pixel_format;  // unset = keep the driver's current format
   int width = 0;                            // 0 = keep the driver's current size
   int height = 0;
-  double fps = 0.0;                         // > 0: ask for this frame rate
-  double exposure_us = 0.0;                 // > 0: manual exposure (V4L2_CID_EXPOSURE_ABSOLUTE, 100 us units)
-  int gain = -1;                            // >= 0: auto gain off, V4L2_CID_GAIN
-  int white_balance_k = 0;                  // > 0: auto white balance off, colour temperature in kelvin
-  bool white_balance_once = false;          // balance once (V4L2_CID_DO_WHITE_BALANCE), then hold it
-  int buffers = 4;                          // mmap buffers requested
-  int frame_timeout_ms = 2000;              // no frame for this long counts as one error
+  double fps = 0.0;          // > 0: ask for this frame rate
+  double exposure_us = 0.0;  // > 0: manual exposure (V4L2_CID_EXPOSURE_ABSOLUTE, 100 us units)
+  int gain = -1;             // >= 0: auto gain off, V4L2_CID_GAIN
+  int white_balance_k = 0;   // > 0: auto white balance off, colour temperature in kelvin
+  bool white_balance_once = false;  // balance once (V4L2_CID_DO_WHITE_BALANCE), then hold it
+  int buffers = 4;                  // mmap buffers requested
+  int frame_timeout_ms = 2000;      // no frame for this long counts as one error
 };
 
 // A capture device found under /dev.
 struct V4l2DeviceInfo {
-  std::string path;     // "/dev/video0"
-  std::string driver;   // "uvcvideo", "vivid"
-  std::string card;     // the device's name
-  std::string bus;      // "usb-0000:00:14.0-1", "platform:vivid-000"
+  std::string path;                  // "/dev/video0"
+  std::string driver;                // "uvcvideo", "vivid"
+  std::string card;                  // the device's name
+  std::string bus;                   // "usb-0000:00:14.0-1", "platform:vivid-000"
   std::vector<PixelFormat> formats;  // the ones SpriteStation reads
 };
 

@@ -51,7 +51,8 @@ SpriteDescription DescribeBillboard(const cv::Mat& bgra) {
 }
 
 Eigen::Vector2d EstimateVelocity(const std::vector<int64_t>& timestamps_ns,
-                                 const std::vector<Eigen::Vector2d>& points_in_ground, int i, int half_window) {
+                                 const std::vector<Eigen::Vector2d>& points_in_ground, int i,
+                                 int half_window) {
   const int n = static_cast<int>(points_in_ground.size());
   const int lo = std::max(0, i - half_window), hi = std::min(n - 1, i + half_window);
   if (hi <= lo) return Eigen::Vector2d::Zero();
@@ -70,9 +71,9 @@ Eigen::Vector2d EstimateVelocity(const std::vector<int64_t>& timestamps_ns,
   return denom > 0 ? Eigen::Vector2d((m * stp - st * sp) / denom) : Eigen::Vector2d::Zero();
 }
 
-std::vector<Eigen::Vector2d> EstimateVelocities(const std::vector<int64_t>& timestamps_ns,
-                                                const std::vector<Eigen::Vector2d>& points_in_ground,
-                                                int half_window) {
+std::vector<Eigen::Vector2d> EstimateVelocities(
+    const std::vector<int64_t>& timestamps_ns, const std::vector<Eigen::Vector2d>& points_in_ground,
+    int half_window) {
   if (timestamps_ns.size() != points_in_ground.size()) {
     throw InputError("velocities", "as many timestamps as points are needed");
   }

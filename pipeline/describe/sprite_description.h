@@ -12,9 +12,10 @@
 namespace ss {
 
 struct SpriteDescription {
-  double mean_r = 0, mean_g = 0, mean_b = 0;  // mean colour under the matte (alpha-weighted), 0..255
-  double area_px = 0;                         // sum of alpha / 255, billboard pixels
-  double eccentricity = 0;                    // sqrt(1 - l_min / l_max) of the alpha-weighted second moments
+  double mean_r = 0, mean_g = 0,
+         mean_b = 0;        // mean colour under the matte (alpha-weighted), 0..255
+  double area_px = 0;       // sum of alpha / 255, billboard pixels
+  double eccentricity = 0;  // sqrt(1 - l_min / l_max) of the alpha-weighted second moments
 };
 
 // Throws InputError when `bgra` is not CV_8UC4. An empty matte describes as all zeros.
@@ -25,9 +26,10 @@ SpriteDescription DescribeBillboard(const cv::Mat& bgra);
 // clip's ends; a one-frame clip stands still). `timestamps_ns` must increase.
 // The same for frame `i` alone.
 Eigen::Vector2d EstimateVelocity(const std::vector<int64_t>& timestamps_ns,
-                                 const std::vector<Eigen::Vector2d>& points_in_ground, int i, int half_window = 2);
-std::vector<Eigen::Vector2d> EstimateVelocities(const std::vector<int64_t>& timestamps_ns,
-                                                const std::vector<Eigen::Vector2d>& points_in_ground,
-                                                int half_window = 2);
+                                 const std::vector<Eigen::Vector2d>& points_in_ground, int i,
+                                 int half_window = 2);
+std::vector<Eigen::Vector2d> EstimateVelocities(
+    const std::vector<int64_t>& timestamps_ns, const std::vector<Eigen::Vector2d>& points_in_ground,
+    int half_window = 2);
 
 }  // namespace ss

@@ -72,7 +72,8 @@ cv::Mat View(std::vector<uint8_t>& bytes, cv::Size size, int type) {
 Extractor::Extractor(ExtractorOptions options) : options_(options) {
   if (options_.min_area < 0) throw InputError("extract.min_area", "must not be negative");
   if (options_.margin_px < 0) throw InputError("extract.margin_px", "must not be negative");
-  if (options_.alpha_min < 1 || options_.alpha_min > 255) throw InputError("extract.alpha_min", "must be within 1..255");
+  if (options_.alpha_min < 1 || options_.alpha_min > 255)
+    throw InputError("extract.alpha_min", "must be within 1..255");
   if (options_.shadow_min < 1 || options_.shadow_min > 255) {
     throw InputError("extract.shadow_min", "must be within 1..255");
   }

@@ -14,14 +14,14 @@
 namespace ss {
 
 struct Candidate {
-  int region = 0;            // the KeyRegion id it came from
-  cv::Rect bbox;             // frame pixels: subject box + margin, grown to hold its shadow
-  cv::Mat alpha;             // CV_8U, bbox-sized
-  cv::Mat colour;            // CV_8UC3, bbox-sized, spill removed
-  cv::Mat shadow;            // CV_8U, bbox-sized contact shadow (floor darkening, 255 = black)
-  cv::Point2d contact_point;  // frame pixels: the sprite's contact point (core/contact_point.h):
-                              // y the lowest point, x the centre of the silhouette's bottom band
-  double area = 0;           // sum of alpha / 255, pixels
+  int region = 0;               // the KeyRegion id it came from
+  cv::Rect bbox;                // frame pixels: subject box + margin, grown to hold its shadow
+  cv::Mat alpha;                // CV_8U, bbox-sized
+  cv::Mat colour;               // CV_8UC3, bbox-sized, spill removed
+  cv::Mat shadow;               // CV_8U, bbox-sized contact shadow (floor darkening, 255 = black)
+  cv::Point2d contact_point;    // frame pixels: the sprite's contact point (core/contact_point.h):
+                                // y the lowest point, x the centre of the silhouette's bottom band
+  double area = 0;              // sum of alpha / 255, pixels
   bool touches_border = false;  // the subject (alpha >= alpha_min) reaches the frame's edge
 };
 

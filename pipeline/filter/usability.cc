@@ -8,17 +8,28 @@ namespace ss {
 
 const char* DiscardName(Discard reason) {
   switch (reason) {
-    case Discard::kNone: return "kept";
-    case Discard::kTooSmall: return "too_small";
-    case Discard::kTouchesBorder: return "touches_border";
-    case Discard::kNoGroundHit: return "no_ground_hit";
-    case Discard::kLeavesFloor: return "leaves_floor";
-    case Discard::kTouchesWall: return "touches_wall";
-    case Discard::kStill: return "still";
-    case Discard::kShortClip: return "short_clip";
-    case Discard::kTooLarge: return "too_large";
-    case Discard::kNoise: return "noise";
-    case Discard::kCount: break;
+    case Discard::kNone:
+      return "kept";
+    case Discard::kTooSmall:
+      return "too_small";
+    case Discard::kTouchesBorder:
+      return "touches_border";
+    case Discard::kNoGroundHit:
+      return "no_ground_hit";
+    case Discard::kLeavesFloor:
+      return "leaves_floor";
+    case Discard::kTouchesWall:
+      return "touches_wall";
+    case Discard::kStill:
+      return "still";
+    case Discard::kShortClip:
+      return "short_clip";
+    case Discard::kTooLarge:
+      return "too_large";
+    case Discard::kNoise:
+      return "noise";
+    case Discard::kCount:
+      break;
   }
   return "unknown";
 }
@@ -53,14 +64,17 @@ class PixelRays {
     const Eigen::Vector3d d = (1 - v) * ((1 - u) * Node(i, j) + u * Node(i1, j)) +
                               v * ((1 - u) * Node(i, j1) + u * Node(i1, j1));
     if (d.allFinite()) return d;
-    return camera_.RayInGround(Eigen::Vector2d(x, y)).direction;  // a node outside the lens's valid region
+    return camera_.RayInGround(Eigen::Vector2d(x, y))
+        .direction;  // a node outside the lens's valid region
   }
 
   int cols() const { return cols_; }
   int rows() const { return rows_; }
 
  private:
-  const Eigen::Vector3d& Node(int i, int j) const { return rays_[static_cast<size_t>(j) * cols_ + i]; }
+  const Eigen::Vector3d& Node(int i, int j) const {
+    return rays_[static_cast<size_t>(j) * cols_ + i];
+  }
 
   const CameraModel& camera_;
   int step_, cols_ = 0, rows_ = 0;
@@ -95,7 +109,8 @@ cv::Mat FloorPixels(const CameraModel& camera, double wall_height_m,
   return FloorPixels(camera, PixelRays(camera, FloorMask::kRayGridStepPx), wall_height_m, contains);
 }
 
-FloorMask::FloorMask(const CameraModel& camera, const GroundPolygon& floor, const UsabilityOptions& options)
+FloorMask::FloorMask(const CameraModel& camera, const GroundPolygon& floor,
+                     const UsabilityOptions& options)
     : floor_(floor), floor_index_(floor), options_(options) {
   const PixelRays rays(camera, kRayGridStepPx);
   centre_ = camera.CentreInGround();
@@ -105,7 +120,8 @@ FloorMask::FloorMask(const CameraModel& camera, const GroundPolygon& floor, cons
   for (int j = 0; j < ray_rows_; ++j) {
     for (int i = 0; i < ray_cols_; ++i) {
       rays_.push_back(rays.Direction(std::min(i * kRayGridStepPx, camera.width() - 1),
-                                     std::min(j * kRayGridStepPx, camera.height() - 1)).cast<float>());
+                                     std::min(j * kRayGridStepPx, camera.height() - 1))
+                          .cast<float>());
     }
   }
   mask_ = FloorPixels(camera, rays, options_.wall_height_m,
@@ -116,12 +132,16 @@ FloorMask::FloorMask(const CameraModel& camera, const GroundPolygon& floor, cons
 
 bool FloorMask::SeesBehind(int x, int y, const Eigen::Vector2d& point_in_ground) const {
   if (!(options_.wall_check_height_m > 0) || rays_.empty()) return false;
-  const int i = std::min(x / kRayGridStepPx, ray_cols_ - 1), j = std::min(y / kRayGridStepPx, ray_rows_ - 1);
+  const int i = std::min(x / kRayGridStepPx, ray_cols_ - 1),
+            j = std::min(y / kRayGridStepPx, ray_rows_ - 1);
   const double u = static_cast<double>(x - i * kRayGridStepPx) / kRayGridStepPx;
   const double v = static_cast<double>(y - j * kRayGridStepPx) / kRayGridStepPx;
   const int i1 = std::min(i + 1, ray_cols_ - 1), j1 = std::min(j + 1, ray_rows_ - 1);
-  const auto node = [&](int a, int b) { return rays_[static_cast<size_t>(b) * ray_cols_ + a].cast<double>(); };
-  const Eigen::Vector3d d = (1 - v) * ((1 - u) * node(i, j) + u * node(i1, j)) + v * ((1 - u) * node(i, j1) + u * node(i1, j1));
+  const auto node = [&](int a, int b) {
+    return rays_[static_cast<size_t>(b) * ray_cols_ + a].cast<double>();
+  };
+  const Eigen::Vector3d d = (1 - v) * ((1 - u) * node(i, j) + u * node(i1, j)) +
+                            v * ((1 - u) * node(i, j1) + u * node(i1, j1));
   if (!d.allFinite()) return false;
   // Past the floor: the ray meets the ground outside the polygon, or never.
   if (d.z() < 0) {
@@ -147,28 +167,33 @@ void FloorMask::Restrict(const cv::Mat& seen) {
   not_floor_integral_ /= 255;
 }
 
-Discard FloorMask::Check(const cv::Mat& alpha_crop, cv::Point offset, const Eigen::Vector2d& point_in_ground) const {
+Discard FloorMask::Check(const cv::Mat& alpha_crop, cv::Point offset,
+                         const Eigen::Vector2d& point_in_ground) const {
   const cv::Rect box(offset, alpha_crop.size());
   const int b = options_.border_margin_px;
-  if (box.x < b || box.y < b || box.x + box.width > mask_.cols - b || box.y + box.height > mask_.rows - b) {
+  if (box.x < b || box.y < b || box.x + box.width > mask_.cols - b ||
+      box.y + box.height > mask_.rows - b) {
     return Discard::kTouchesBorder;
   }
-  if (!floor_.ContainsWithMargin(point_in_ground, options_.wall_margin_m)) return Discard::kLeavesFloor;
+  if (!floor_.ContainsWithMargin(point_in_ground, options_.wall_margin_m))
+    return Discard::kLeavesFloor;
 
   // Fast path: the whole crop grown by the margin is floor.
   const int m = options_.floor_margin_px;
   const cv::Rect grown = cv::Rect(box.x - m, box.y - m, box.width + 2 * m, box.height + 2 * m) &
                          cv::Rect(0, 0, mask_.cols, mask_.rows);
   const auto at = [&](int y, int x) { return not_floor_integral_.at<int>(y, x); };
-  const int not_floor = at(grown.y + grown.height, grown.x + grown.width) - at(grown.y, grown.x + grown.width) -
-                        at(grown.y + grown.height, grown.x) + at(grown.y, grown.x);
+  const int not_floor = at(grown.y + grown.height, grown.x + grown.width) -
+                        at(grown.y, grown.x + grown.width) - at(grown.y + grown.height, grown.x) +
+                        at(grown.y, grown.x);
   if (not_floor == 0) return Discard::kNone;
 
   // Slow path: the silhouette grown by the margin must not cover non-floor pixels.
   cv::Mat solid = alpha_crop > 127;
   cv::Mat padded;
   cv::copyMakeBorder(solid, padded, m, m, m, m, cv::BORDER_CONSTANT, cv::Scalar(0));
-  cv::dilate(padded, padded, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * m + 1, 2 * m + 1)));
+  cv::dilate(padded, padded,
+             cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * m + 1, 2 * m + 1)));
   for (int y = 0; y < padded.rows; ++y) {
     const int iy = box.y - m + y;
     if (iy < 0 || iy >= mask_.rows) continue;
@@ -232,7 +257,8 @@ MatteShape MeasureMatteShape(const cv::Mat& alpha_crop, double thick_px) {
 }
 
 MatteShape MeasureMatteShape(const cv::Mat& alpha_crop, const NoiseOptions& tests) {
-  return Measure(alpha_crop, tests.thick_px, tests.min_largest_share > 0, tests.min_thick_share > 0);
+  return Measure(alpha_crop, tests.thick_px, tests.min_largest_share > 0,
+                 tests.min_thick_share > 0);
 }
 
 bool IsNoise(const MatteShape& shape, const NoiseOptions& o) {
@@ -248,7 +274,8 @@ void NoiseFilter::NextFrame() {
 bool NoiseFilter::IsNoise(int subject, const MatteShape& shape) {
   const auto before = last_.find(subject);
   const bool was_noise = before != last_.end() && before->second;
-  const bool noise = ss::IsNoise(shape, options_) || (was_noise && shape.solidity < options_.recover_solidity);
+  const bool noise =
+      ss::IsNoise(shape, options_) || (was_noise && shape.solidity < options_.recover_solidity);
   current_[subject] = noise;
   return noise;
 }
@@ -263,7 +290,8 @@ bool StillnessFilter::IsStill(int subject, int64_t timestamp_ns, const Eigen::Ve
   }
   s.history.push_back({timestamp_ns, point});
   // Keep the newest sample at least a window old as the reference, nothing older.
-  while (s.history.size() > 2 && s.history[1].timestamp_ns <= timestamp_ns - window_ns_) s.history.pop_front();
+  while (s.history.size() > 2 && s.history[1].timestamp_ns <= timestamp_ns - window_ns_)
+    s.history.pop_front();
   const Sample& ref = s.history.front();
   if (timestamp_ns - ref.timestamp_ns < window_ns_) return false;  // too little history: moving
   const double dt = (timestamp_ns - ref.timestamp_ns) * 1e-9;

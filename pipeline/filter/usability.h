@@ -28,7 +28,7 @@ enum class Discard {
   kStill,          // part of an extended period without motion
   kShortClip,      // its clip was too short to give transitions
   kTooLarge,       // its billboard at the bank's scale (pipeline.px_per_m) exceeds the size limit
-  kNoise,          // keyed background, not a subject: scattered specks, thin lines, a soft haze (NoiseRule)
+  kNoise,  // keyed background, not a subject: scattered specks, thin lines, a soft haze (NoiseRule)
   kCount,
 };
 const char* DiscardName(Discard reason);  // "too_small", "touches_border", ...
@@ -37,23 +37,24 @@ const char* DiscardName(Discard reason);  // "too_small", "touches_border", ...
 using DiscardCounts = std::array<uint64_t, static_cast<size_t>(Discard::kCount)>;
 
 struct UsabilityOptions {
-  int border_margin_px = 2;       // distance to keep from the image border
-  int floor_margin_px = 3;        // floor pixels required around the silhouette
-  double wall_margin_m = 0.005;   // contact point distance to keep from the polygon edge
-  double wall_height_m = 0.0;     // walls occlude the floor behind them up to this height
-  // A non-floor pixel under the silhouette is not counted (touches_wall) when it sees past the floor
-  // (its ray meets the ground outside the floor polygon, or never) and passes more than this high
-  // over the subject's contact point: background behind a tall subject's upper part, not something
-  // in front of it (what stands on the floor in front of a subject hides its lowest part first).
+  int border_margin_px = 2;      // distance to keep from the image border
+  int floor_margin_px = 3;       // floor pixels required around the silhouette
+  double wall_margin_m = 0.005;  // contact point distance to keep from the polygon edge
+  double wall_height_m = 0.0;    // walls occlude the floor behind them up to this height
+  // A non-floor pixel under the silhouette is not counted (touches_wall) when it sees past the
+  // floor (its ray meets the ground outside the floor polygon, or never) and passes more than this
+  // high over the subject's contact point: background behind a tall subject's upper part, not
+  // something in front of it (what stands on the floor in front of a subject hides its lowest part
+  // first).
   double wall_check_height_m = 0.3;
 };
 
 // The shape of a candidate's matte (its alpha crop at full resolution), for telling a subject from
 // keyed background (issue 19). The matte is `alpha > 127` ("solid").
 struct MatteShape {
-  double area_px = 0;        // solid pixels
-  double solidity = 0;       // solid pixels / their convex hull's area (1: convex; specks, rings: low)
-  double thick_share = 0;    // of the solid pixels, those more than `thick_px` from the matte's edge
+  double area_px = 0;   // solid pixels
+  double solidity = 0;  // solid pixels / their convex hull's area (1: convex; specks, rings: low)
+  double thick_share = 0;  // of the solid pixels, those more than `thick_px` from the matte's edge
   double largest_share = 0;  // of the solid pixels, those in the largest 8-connected part
   double mean_alpha = 0;     // mean alpha / 255 over the pixels of alpha >= 16 (a soft haze: low)
 };
@@ -65,11 +66,11 @@ MatteShape MeasureMatteShape(const cv::Mat& alpha_crop, double thick_px);
 // when set, one with too little interior, too scattered or too soft. A threshold of 0 turns its
 // test off. Defaults: measured on vtest.avi and the synthetic sessions (docs/pipeline.md).
 struct NoiseOptions {
-  double thick_px = 2.0;            // MatteShape::thick_px
-  double min_solidity = 0.25;       // noise when solidity is below this
-  double min_thick_share = 0.0;     // ... or thick_share
-  double min_largest_share = 0.0;   // ... or largest_share
-  double min_mean_alpha = 0.0;      // ... or mean_alpha
+  double thick_px = 2.0;           // MatteShape::thick_px
+  double min_solidity = 0.25;      // noise when solidity is below this
+  double min_thick_share = 0.0;    // ... or thick_share
+  double min_largest_share = 0.0;  // ... or largest_share
+  double min_mean_alpha = 0.0;     // ... or mean_alpha
   // A subject whose previous frame was noise stays noise until its solidity reaches this
   // (keyed background flickers about the threshold; 0: no memory).
   double recover_solidity = 0.30;
@@ -110,7 +111,8 @@ class FloorMask {
 
   FloorMask(const CameraModel& camera, const GroundPolygon& floor, const UsabilityOptions& options);
   // Usability of one sprite from its alpha crop at `offset` and its contact point.
-  Discard Check(const cv::Mat& alpha_crop, cv::Point offset, const Eigen::Vector2d& point_in_ground) const;
+  Discard Check(const cv::Mat& alpha_crop, cv::Point offset,
+                const Eigen::Vector2d& point_in_ground) const;
   const cv::Mat& mask() const { return mask_; }  // 255 where the camera sees floor
   // Keeps as floor only the pixels of the geometric floor where `seen` (CV_8U, the image size) is
   // non-zero: the keyer's green, so that a wall's outside or a cable in front of the floor is not
@@ -121,8 +123,8 @@ class FloorMask {
   GroundPolygon floor_;
   GroundPolygonIndex floor_index_;  // floor_'s Contains for every pixel
   UsabilityOptions options_;
-  Eigen::Vector3d centre_;                  // the camera's centre on the ground frame
-  std::vector<Eigen::Vector3f> rays_;       // ground-frame ray directions every kRayGridStepPx
+  Eigen::Vector3d centre_;             // the camera's centre on the ground frame
+  std::vector<Eigen::Vector3f> rays_;  // ground-frame ray directions every kRayGridStepPx
   int ray_cols_ = 0, ray_rows_ = 0;
   // The pixel sees past the floor, over the contact point higher than wall_check_height_m.
   bool SeesBehind(int x, int y, const Eigen::Vector2d& point_in_ground) const;

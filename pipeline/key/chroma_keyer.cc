@@ -35,7 +35,8 @@ struct PixelKey {
 inline PixelKey KeyPixel(int b, int g, int r, float key_hi, float gain, int32_t luma_floor,
                          float inv_luma, float shadow_base, int shadow_min) {
   const int luma4 = b + 2 * g + r;
-  const float key4 = static_cast<float>(g - std::max(b, r)) / static_cast<float>(std::max(luma4, luma_floor));
+  const float key4 =
+      static_cast<float>(g - std::max(b, r)) / static_cast<float>(std::max(luma4, luma_floor));
   const int alpha = std::clamp(static_cast<int>((key_hi - key4) * gain + 0.5f), 0, 255);
   const int dark = static_cast<int>(shadow_base - static_cast<float>(luma4) * inv_luma + 0.5f);
   const int shade = dark >= shadow_min ? dark : 0;
@@ -58,8 +59,10 @@ bool ChromaKeyerOptions::IsValid(std::string* why) const {
   check(o.min_key > 0, "min_key", "must be positive");
   check(o.max_unkeyable >= 0 && o.max_unkeyable <= 1, "max_unkeyable", "must be within [0, 1]");
   check(o.despill_bias >= 0 && o.despill_bias <= 1, "despill_bias", "must be within [0, 1]");
-  check(o.despill_strength >= 0 && o.despill_strength <= 1, "despill_strength", "must be within [0, 1]");
-  check(o.key_low_levels < 0 || o.key_high_levels > o.key_low_levels, "high", "must be above keying.chroma.low");
+  check(o.despill_strength >= 0 && o.despill_strength <= 1, "despill_strength",
+        "must be within [0, 1]");
+  check(o.key_low_levels < 0 || o.key_high_levels > o.key_low_levels, "high",
+        "must be above keying.chroma.low");
   return check.ok();
 }
 
@@ -76,7 +79,8 @@ void ChromaKeyer::Train(const std::vector<cv::Mat>& empty_bgr) {
   // cell that is part green, part something else (a wall's outside at the floor's edge) models
   // its green part: over all its pixels the spread would be so wide that nothing is ever keyed
   // there, not even on the green. Its other pixels are then found not keyable (below).
-  std::vector<double> sum_y(cells, 0), sum_k(cells, 0), sum_kk(cells, 0), count(cells, 0), all(cells, 0);
+  std::vector<double> sum_y(cells, 0), sum_k(cells, 0), sum_kk(cells, 0), count(cells, 0),
+      all(cells, 0);
   std::vector<float> pixel_key(static_cast<size_t>(size_.width) * size_.height, 0.f);
   for (const cv::Mat& frame : empty_bgr) {
     for (int y = 0; y < size_.height; ++y) {
@@ -117,11 +121,12 @@ void ChromaKeyer::Train(const std::vector<cv::Mat>& empty_bgr) {
   unkeyable_fraction_ = 1.0 - static_cast<double>(n_green) / cells;
   if (n_green == 0 || unkeyable_fraction_ > options_.max_unkeyable) {
     size_ = {};
-    throw InputError("chroma keyer training",
-                     "only " + std::to_string(static_cast<int>(100 * (1 - unkeyable_fraction_))) +
-                         "% of the empty enclosure is green enough (key (G-max(R,B))/luma >= " +
-                         std::to_string(options_.min_key) +
-                         "); is it a green screen? the clean-plate keyer handles other backgrounds");
+    throw InputError(
+        "chroma keyer training",
+        "only " + std::to_string(static_cast<int>(100 * (1 - unkeyable_fraction_))) +
+            "% of the empty enclosure is green enough (key (G-max(R,B))/luma >= " +
+            std::to_string(options_.min_key) +
+            "); is it a green screen? the clean-plate keyer handles other backgrounds");
   }
   const double mean_luma = luma_sum / n_green, mean_key = key_sum / n_green,
                mean_spread = spread_sum / n_green;
@@ -134,8 +139,9 @@ void ChromaKeyer::Train(const std::vector<cv::Mat>& empty_bgr) {
     }
   }
   if (unkeyable_fraction_ > 0) {
-    Log("pipeline.key")->warn("chroma keyer: {:.1f}% of the enclosure is not green and is never keyed",
-                              100 * unkeyable_fraction_);
+    Log("pipeline.key")
+        ->warn("chroma keyer: {:.1f}% of the enclosure is not green and is never keyed",
+               100 * unkeyable_fraction_);
   }
 
   // Kernel units: luma4 = B + 2G + R = 4 Y, key4 = (G - max(R,B)) / luma4 = k / 4,
@@ -143,7 +149,8 @@ void ChromaKeyer::Train(const std::vector<cv::Mat>& empty_bgr) {
   const auto& o = options_;
   auto params = [&o](double l, double k, double sd, bool is_green, float* f, int32_t* luma_floor) {
     double key_hi = k - std::max(o.min_margin * k, o.noise_z * sd), ramp = o.ramp * k;
-    if (o.key_low_levels >= 0 && o.key_high_levels > o.key_low_levels) {  // levels at the floor's luma l
+    if (o.key_low_levels >= 0 &&
+        o.key_high_levels > o.key_low_levels) {  // levels at the floor's luma l
       key_hi = std::min(key_hi, o.key_high_levels / l);
       ramp = std::max(key_hi - o.key_low_levels / l, 0.05 * k);
     }
@@ -161,7 +168,8 @@ void ChromaKeyer::Train(const std::vector<cv::Mat>& empty_bgr) {
     for (int cx = 0; cx < cols; ++cx) {
       const size_t c = static_cast<size_t>(cy) * cols + cx;
       params(luma[c], key[c], spread[c], green[c], f, &floor4);
-      for (int p = 0; p < kFloatParams; ++p) cell_f_[(static_cast<size_t>(cy) * kFloatParams + p) * cols + cx] = f[p];
+      for (int p = 0; p < kFloatParams; ++p)
+        cell_f_[(static_cast<size_t>(cy) * kFloatParams + p) * cols + cx] = f[p];
       cell_floor_[c] = floor4;
     }
   }
@@ -176,10 +184,12 @@ void ChromaKeyer::Train(const std::vector<cv::Mat>& empty_bgr) {
       const double fx = std::clamp((x - s / 2) / static_cast<double>(s), 0.0, cols - 1.0);
       const int c0 = static_cast<int>(fx), c1 = std::min(c0 + 1, cols - 1);
       const double t = fx - c0;
-      const size_t i0 = static_cast<size_t>(cy) * cols + c0, i1 = static_cast<size_t>(cy) * cols + c1;
+      const size_t i0 = static_cast<size_t>(cy) * cols + c0,
+                   i1 = static_cast<size_t>(cy) * cols + c1;
       params(luma[i0] * (1 - t) + luma[i1] * t, key[i0] * (1 - t) + key[i1] * t,
              spread[i0] * (1 - t) + spread[i1] * t, green[t < 0.5 ? i0 : i1], f, &floor4);
-      for (int p = 0; p < kFloatParams; ++p) band_f_[(static_cast<size_t>(cy) * kFloatParams + p) * w + x] = f[p];
+      for (int p = 0; p < kFloatParams; ++p)
+        band_f_[(static_cast<size_t>(cy) * kFloatParams + p) * w + x] = f[p];
       band_floor_[static_cast<size_t>(cy) * w + x] = floor4;
     }
   }
@@ -194,8 +204,9 @@ void ChromaKeyer::Train(const std::vector<cv::Mat>& empty_bgr) {
       const uint8_t* px = frame.ptr<uint8_t>(y);
       uint32_t* sum = &alpha_sum[static_cast<size_t>(y) * w];
       for (int x = 0; x < size_.width; ++x, px += 3) {
-        const PixelKey k = KeyPixel(px[0], px[1], px[2], p.f[kKeyHi][x], p.f[kGain][x], p.luma_floor[x],
-                                    p.f[kInvLuma][x], p.f[kShadowBase][x], shadow_min);
+        const PixelKey k =
+            KeyPixel(px[0], px[1], px[2], p.f[kKeyHi][x], p.f[kGain][x], p.luma_floor[x],
+                     p.f[kInvLuma][x], p.f[kShadowBase][x], shadow_min);
         sum[x] += static_cast<uint32_t>(k.alpha);
       }
     }
@@ -211,11 +222,14 @@ void ChromaKeyer::Train(const std::vector<cv::Mat>& empty_bgr) {
     masked += !keyable;
   }
   if (masked > 0) {
-    Log("pipeline.key")->info("chroma keyer: {} pixels ({:.2f}%) of the empty enclosure are not green, never keyed",
-                              masked, 100.0 * masked / alpha_sum.size());
+    Log("pipeline.key")
+        ->info(
+            "chroma keyer: {} pixels ({:.2f}%) of the empty enclosure are not green, never keyed",
+            masked, 100.0 * masked / alpha_sum.size());
   }
-  Log("pipeline.key")->debug("chroma keyer trained on {} frames {}x{}: key {:.3f}, luma {:.1f}, noise {:.4f}",
-                             empty_bgr.size(), size_.width, size_.height, mean_key, mean_luma, mean_spread);
+  Log("pipeline.key")
+      ->debug("chroma keyer trained on {} frames {}x{}: key {:.3f}, luma {:.1f}, noise {:.4f}",
+              empty_bgr.size(), size_.width, size_.height, mean_key, mean_luma, mean_spread);
 }
 
 cv::Mat ChromaKeyer::GreenMask() const {
@@ -234,7 +248,8 @@ cv::Mat ChromaKeyer::GreenMask() const {
 ChromaKeyer::Params ChromaKeyer::BandParams(int cell_row) const {
   const size_t w = static_cast<size_t>(size_.width);
   Params p;
-  for (int i = 0; i < kFloatParams; ++i) p.f[i] = &band_f_[(static_cast<size_t>(cell_row) * kFloatParams + i) * w];
+  for (int i = 0; i < kFloatParams; ++i)
+    p.f[i] = &band_f_[(static_cast<size_t>(cell_row) * kFloatParams + i) * w];
   p.luma_floor = &band_floor_[static_cast<size_t>(cell_row) * w];
   return p;
 }
@@ -242,7 +257,8 @@ ChromaKeyer::Params ChromaKeyer::BandParams(int cell_row) const {
 ChromaKeyer::Params ChromaKeyer::CellParams(int cell_row) const {
   const size_t cols = static_cast<size_t>(cols_);
   Params p;
-  for (int i = 0; i < kFloatParams; ++i) p.f[i] = &cell_f_[(static_cast<size_t>(cell_row) * kFloatParams + i) * cols];
+  for (int i = 0; i < kFloatParams; ++i)
+    p.f[i] = &cell_f_[(static_cast<size_t>(cell_row) * kFloatParams + i) * cols];
   p.luma_floor = &cell_floor_[static_cast<size_t>(cell_row) * cols];
   return p;
 }
@@ -253,19 +269,21 @@ namespace {
 // output B G R either way.
 template <bool kRgb>
 __attribute__((always_inline)) inline void ChromaRowImpl(
-    const uint8_t* __restrict in, int x0, int x1, const float* __restrict key_hi, const float* __restrict gain,
-    const int32_t* __restrict luma_floor, const float* __restrict inv_luma, const float* __restrict shadow_base,
-    int shadow_min, int despill256, int strength256, const uint8_t* __restrict keyable,
-    uint8_t* __restrict alpha, uint8_t* __restrict shadow, uint8_t* __restrict colour) {
+    const uint8_t* __restrict in, int x0, int x1, const float* __restrict key_hi,
+    const float* __restrict gain, const int32_t* __restrict luma_floor,
+    const float* __restrict inv_luma, const float* __restrict shadow_base, int shadow_min,
+    int despill256, int strength256, const uint8_t* __restrict keyable, uint8_t* __restrict alpha,
+    uint8_t* __restrict shadow, uint8_t* __restrict colour) {
   constexpr int kB = kRgb ? 2 : 0, kR = kRgb ? 0 : 2;
   for (int x = x0; x < x1; ++x) {
     const int b = in[3 * x + kB], g = in[3 * x + 1], r = in[3 * x + kR];
-    const PixelKey k =
-        KeyPixel(b, g, r, key_hi[x], gain[x], luma_floor[x], inv_luma[x], shadow_base[x], shadow_min);
+    const PixelKey k = KeyPixel(b, g, r, key_hi[x], gain[x], luma_floor[x], inv_luma[x],
+                                shadow_base[x], shadow_min);
     alpha[x] = static_cast<uint8_t>(k.alpha) & keyable[x];
     shadow[x] = static_cast<uint8_t>(k.shadow) & keyable[x];
     colour[3 * x] = static_cast<uint8_t>(b);
-    // Despill: the share `strength` of G above max(R, B) - bias * (max(R, B) - min(R, B)) is removed.
+    // Despill: the share `strength` of G above max(R, B) - bias * (max(R, B) - min(R, B)) is
+    // removed.
     const int hi = std::max(b, r), lo = std::min(b, r);
     const int excess = std::max(g - (hi - (((hi - lo) * despill256 + 128) >> 8)), 0);
     colour[3 * x + 1] = static_cast<uint8_t>(g - ((excess * strength256 + 128) >> 8));
@@ -275,15 +293,15 @@ __attribute__((always_inline)) inline void ChromaRowImpl(
 
 // Cloned per instruction set: the de-interleave of 3-byte pixels needs SSSE3
 // shuffles to vectorize; plain SSE2 runs it scalar.
-#define SS_CHROMA_ROW(NAME, RGB)                                                                              \
-  __attribute__((target_clones("avx2", "ssse3", "default"))) void NAME(                                     \
-      const uint8_t* __restrict in, int x0, int x1, const float* __restrict key_hi,                          \
-      const float* __restrict gain, const int32_t* __restrict luma_floor, const float* __restrict inv_luma, \
-      const float* __restrict shadow_base, int shadow_min, int despill256, int strength256,                 \
-      const uint8_t* __restrict keyable, uint8_t* __restrict alpha, uint8_t* __restrict shadow,              \
-      uint8_t* __restrict colour) {                                                                          \
-    ChromaRowImpl<RGB>(in, x0, x1, key_hi, gain, luma_floor, inv_luma, shadow_base, shadow_min, despill256, \
-                       strength256, keyable, alpha, shadow, colour);                                         \
+#define SS_CHROMA_ROW(NAME, RGB)                                                                \
+  __attribute__((target_clones("avx2", "ssse3", "default"))) void NAME(                         \
+      const uint8_t* __restrict in, int x0, int x1, const float* __restrict key_hi,             \
+      const float* __restrict gain, const int32_t* __restrict luma_floor,                       \
+      const float* __restrict inv_luma, const float* __restrict shadow_base, int shadow_min,    \
+      int despill256, int strength256, const uint8_t* __restrict keyable,                       \
+      uint8_t* __restrict alpha, uint8_t* __restrict shadow, uint8_t* __restrict colour) {      \
+    ChromaRowImpl<RGB>(in, x0, x1, key_hi, gain, luma_floor, inv_luma, shadow_base, shadow_min, \
+                       despill256, strength256, keyable, alpha, shadow, colour);                \
   }
 SS_CHROMA_ROW(ChromaRowBgr, false)
 SS_CHROMA_ROW(ChromaRowRgb, true)
@@ -291,36 +309,40 @@ SS_CHROMA_ROW(ChromaRowRgb, true)
 
 }  // namespace
 
-void ChromaKeyer::SampleRow(const uint8_t* row, ChannelOrder /*order*/, int cell_row, uint8_t* foreground,
-                            uint8_t* shade) const {
+void ChromaKeyer::SampleRow(const uint8_t* row, ChannelOrder /*order*/, int cell_row,
+                            uint8_t* foreground, uint8_t* shade) const {
   const Params p = CellParams(cell_row);
   const int coarse_alpha = static_cast<int>(std::lround(255 * options_.coarse_alpha));
   const int coarse_shadow = static_cast<int>(std::lround(255 * options_.coarse_shadow));
   const int shadow_min = static_cast<int>(std::lround(255 * options_.shadow_min));
   const uint8_t* keyable = &keyable_[static_cast<size_t>(SampleY(cell_row)) * size_.width];
   for (int cx = 0; cx < cols_; ++cx) {
-    const uint8_t* px = row + 3 * SampleX(cx);  // B and R may be swapped: the key is symmetric in them
-    const PixelKey k = KeyPixel(px[0], px[1], px[2], p.f[kKeyHi][cx], p.f[kGain][cx], p.luma_floor[cx],
-                                p.f[kInvLuma][cx], p.f[kShadowBase][cx], shadow_min);
+    const uint8_t* px =
+        row + 3 * SampleX(cx);  // B and R may be swapped: the key is symmetric in them
+    const PixelKey k =
+        KeyPixel(px[0], px[1], px[2], p.f[kKeyHi][cx], p.f[kGain][cx], p.luma_floor[cx],
+                 p.f[kInvLuma][cx], p.f[kShadowBase][cx], shadow_min);
     const bool green = keyable[SampleX(cx)] != 0;
     foreground[cx] = green && k.alpha > coarse_alpha;
     shade[cx] = green && k.shadow > coarse_shadow;
   }
 }
 
-void ChromaKeyer::FineRow(const uint8_t* row, ChannelOrder order, int y, int x0, int x1, uint8_t* alpha,
-                          uint8_t* shadow, uint8_t* colour) const {
+void ChromaKeyer::FineRow(const uint8_t* row, ChannelOrder order, int y, int x0, int x1,
+                          uint8_t* alpha, uint8_t* shadow, uint8_t* colour) const {
   const Params p = BandParams(std::min(y / grid_.step, rows_ - 1));
   const int shadow_min = static_cast<int>(std::lround(255 * options_.shadow_min));
   const int despill256 = static_cast<int>(std::lround(256 * options_.despill_bias));
   const int strength256 = static_cast<int>(std::lround(256 * options_.despill_strength));
   const uint8_t* keyable = &keyable_[static_cast<size_t>(y) * size_.width];
   if (order == ChannelOrder::kRgb) {
-    ChromaRowRgb(row, x0, x1, p.f[kKeyHi], p.f[kGain], p.luma_floor, p.f[kInvLuma], p.f[kShadowBase], shadow_min,
-                 despill256, strength256, keyable, alpha, shadow, colour);
+    ChromaRowRgb(row, x0, x1, p.f[kKeyHi], p.f[kGain], p.luma_floor, p.f[kInvLuma],
+                 p.f[kShadowBase], shadow_min, despill256, strength256, keyable, alpha, shadow,
+                 colour);
   } else {
-    ChromaRowBgr(row, x0, x1, p.f[kKeyHi], p.f[kGain], p.luma_floor, p.f[kInvLuma], p.f[kShadowBase], shadow_min,
-                 despill256, strength256, keyable, alpha, shadow, colour);
+    ChromaRowBgr(row, x0, x1, p.f[kKeyHi], p.f[kGain], p.luma_floor, p.f[kInvLuma],
+                 p.f[kShadowBase], shadow_min, despill256, strength256, keyable, alpha, shadow,
+                 colour);
   }
 }
 

@@ -21,24 +21,27 @@ struct KeyingConfig;
 
 struct ChromaKeyerOptions {
   GridOptions grid;
-  double noise_z = 5.0;         // background tolerance in noise std of the learned key...
-  double min_margin = 0.2;      // ...and at least this fraction of the learned key
-  double ramp = 0.6;            // alpha goes 0 -> 1 over this fraction of the learned key
-  double dark_floor = 0.2;      // luma below this fraction of the floor's counts as subject, not shadow
+  double noise_z = 5.0;     // background tolerance in noise std of the learned key...
+  double min_margin = 0.2;  // ...and at least this fraction of the learned key
+  double ramp = 0.6;        // alpha goes 0 -> 1 over this fraction of the learned key
+  double dark_floor = 0.2;  // luma below this fraction of the floor's counts as subject, not shadow
   double shadow_min = 0.06;     // darkening below this is noise: no shadow
   double coarse_alpha = 0.25;   // a sample with a larger alpha marks its cell as foreground
   double coarse_shadow = 0.12;  // a sample darkened more marks its cell as shaded
-  double min_key = 0.1;         // training cells with a smaller key k_bg are not green and never keyed
-  double max_unkeyable = 0.9;   // training fails when more than this fraction of cells is not green
-  double despill_bias = 0.5;    // G <= max(R,B) - bias * (max(R,B) - min(R,B)): 0 keeps yellows, 0.5 = mean(R,B)
-  double despill_strength = 1;  // share of the green above that limit removed: 0 = no despill, 1 = all
-  bool shadow = true;           // false: no contact-shadow layer (and no shaded cells)
+  double min_key = 0.1;  // training cells with a smaller key k_bg are not green and never keyed
+  double max_unkeyable = 0.9;  // training fails when more than this fraction of cells is not green
+  double despill_bias =
+      0.5;  // G <= max(R,B) - bias * (max(R,B) - min(R,B)): 0 keeps yellows, 0.5 = mean(R,B)
+  double despill_strength =
+      1;               // share of the green above that limit removed: 0 = no despill, 1 = all
+  bool shadow = true;  // false: no contact-shadow layer (and no shaded cells)
   // When both are >= 0 (the station config's keying.chroma.low/high): the key in 8-bit levels of
   // G - max(R, B) at the floor's brightness, k * Y_bg, where alpha is 1 (<= low) and 0 (>= high);
-  // `high` never reaches into the floor's own noise (min_margin, noise_z). Else min_margin and ramp.
+  // `high` never reaches into the floor's own noise (min_margin, noise_z). Else min_margin and
+  // ramp.
   double key_low_levels = -1;
   double key_high_levels = -1;
-  bool global_model = false;    // one reference for the whole frame: the naive keyer, for comparison
+  bool global_model = false;  // one reference for the whole frame: the naive keyer, for comparison
   // False with "FIELD: reason" in `why` when a value is out of its range.
   bool IsValid(std::string* why) const;
 };
@@ -58,12 +61,13 @@ class ChromaKeyer : public Keyer {
   // not (the room, a wall's outside, a cable): no subject is ever seen against those pixels.
   cv::Mat GreenMask() const;
   cv::Mat KeyableMask() const override { return GreenMask(); }
+
  protected:
   // Key and shadow are symmetric in R and B: only the colour layer minds the order.
   void SampleRow(const uint8_t* row, ChannelOrder order, int cell_row, uint8_t* foreground,
                  uint8_t* shade) const override;
-  void FineRow(const uint8_t* row, ChannelOrder order, int y, int x0, int x1, uint8_t* alpha, uint8_t* shadow,
-               uint8_t* colour) const override;
+  void FineRow(const uint8_t* row, ChannelOrder order, int y, int x0, int x1, uint8_t* alpha,
+               uint8_t* shadow, uint8_t* colour) const override;
 
  private:
   // The key's parameters at one place, in the units of the kernel (luma4 =
@@ -82,8 +86,9 @@ class ChromaKeyer : public Keyer {
   std::vector<int32_t> cell_floor_;  // rows_ x cols_
   std::vector<float> band_f_;        // rows_ x kFloatParams x width: at every pixel of a cell row
   std::vector<int32_t> band_floor_;  // rows_ x width
-  std::vector<uint8_t> keyable_;     // width x height: 0xFF where the empty enclosure is green, else 0
-  std::vector<uint8_t> green_px_;    // width x height: 0xFF where the pixel's own training key is green
+  std::vector<uint8_t> keyable_;  // width x height: 0xFF where the empty enclosure is green, else 0
+  std::vector<uint8_t>
+      green_px_;  // width x height: 0xFF where the pixel's own training key is green
   double unkeyable_fraction_ = 0;
 };
 

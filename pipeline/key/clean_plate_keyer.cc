@@ -21,21 +21,23 @@ struct PixelKey {
 
 // The clean-plate key of one pixel p against plate colour mu (docs/keying.md).
 // No branches and no floating-point min/max, so that loops of it vectorize.
-inline PixelKey PlatePixel(int b, int g, int r, int mu_b, int mu_g, int mu_r, float tolerance, float gain,
-                           float dark_floor, int shadow_min) {
+inline PixelKey PlatePixel(int b, int g, int r, int mu_b, int mu_g, int mu_r, float tolerance,
+                           float gain, float dark_floor, int shadow_min) {
   const float pb = static_cast<float>(b), pg = static_cast<float>(g), pr = static_cast<float>(r);
-  const float ub = static_cast<float>(mu_b), ug = static_cast<float>(mu_g), ur = static_cast<float>(mu_r);
+  const float ub = static_cast<float>(mu_b), ug = static_cast<float>(mu_g),
+              ur = static_cast<float>(mu_r);
   const float mu2 = ub * ub + ug * ug + ur * ur + 1.f;
   const float ratio = (pb * ub + pg * ug + pr * ur) / mu2;  // brightness relative to the plate
   const float eb = pb - ratio * ub, eg = pg - ratio * ug, er = pr - ratio * ur;
-  const float chroma = std::sqrt(eb * eb + eg * eg + er * er);  // levels off the plate's colour line
+  const float chroma =
+      std::sqrt(eb * eb + eg * eg + er * er);  // levels off the plate's colour line
   const float mu_norm = std::sqrt(mu2);
   // Distance from "the plate, possibly in shadow", in quarter levels.
   const int brighter = static_cast<int>((ratio - 1.f) * mu_norm * 4.f);
   const int too_dark = static_cast<int>((dark_floor - ratio) * mu_norm * 4.f);
   const int distance4 = std::max(static_cast<int>(chroma * 4.f), std::max(brighter, too_dark));
-  const int alpha =
-      std::clamp(static_cast<int>((static_cast<float>(distance4) * 0.25f - tolerance) * gain + 0.5f), 0, 255);
+  const int alpha = std::clamp(
+      static_cast<int>((static_cast<float>(distance4) * 0.25f - tolerance) * gain + 0.5f), 0, 255);
   const int dark = static_cast<int>(255.f - ratio * 255.f + 0.5f);
   const int shade = dark >= shadow_min ? dark : 0;
   return {alpha, ((shade * (255 - alpha) + 128) * 257) >> 16};
@@ -44,15 +46,15 @@ inline PixelKey PlatePixel(int b, int g, int r, int mu_b, int mu_g, int mu_r, fl
 // The fine pass over one row span; kRgb: the input is R G B (the plate and
 // the colour output are B G R either way).
 template <bool kRgb>
-__attribute__((always_inline)) inline void PlateRowImpl(const uint8_t* __restrict in, const uint8_t* __restrict plate,
-                                                        const float* __restrict tolerance, int x0, int x1, float gain,
-                                                        float dark_floor, int shadow_min, uint8_t* __restrict alpha,
-                                                        uint8_t* __restrict shadow, uint8_t* __restrict colour) {
+__attribute__((always_inline)) inline void PlateRowImpl(
+    const uint8_t* __restrict in, const uint8_t* __restrict plate,
+    const float* __restrict tolerance, int x0, int x1, float gain, float dark_floor, int shadow_min,
+    uint8_t* __restrict alpha, uint8_t* __restrict shadow, uint8_t* __restrict colour) {
   constexpr int kB = kRgb ? 2 : 0, kR = kRgb ? 0 : 2;
   for (int x = x0; x < x1; ++x) {
     const int b = in[3 * x + kB], g = in[3 * x + 1], r = in[3 * x + kR];
-    const PixelKey k = PlatePixel(b, g, r, plate[3 * x], plate[3 * x + 1], plate[3 * x + 2], tolerance[x], gain,
-                                  dark_floor, shadow_min);
+    const PixelKey k = PlatePixel(b, g, r, plate[3 * x], plate[3 * x + 1], plate[3 * x + 2],
+                                  tolerance[x], gain, dark_floor, shadow_min);
     alpha[x] = static_cast<uint8_t>(k.alpha);
     shadow[x] = static_cast<uint8_t>(k.shadow);
     colour[3 * x] = static_cast<uint8_t>(b);  // no spill to remove on a non-green plate
@@ -61,12 +63,14 @@ __attribute__((always_inline)) inline void PlateRowImpl(const uint8_t* __restric
   }
 }
 
-#define SS_PLATE_ROW(NAME, RGB)                                                                              \
-  __attribute__((target_clones("avx2", "ssse3", "default"))) void NAME(                                    \
-      const uint8_t* __restrict in, const uint8_t* __restrict plate, const float* __restrict tolerance,     \
-      int x0, int x1, float gain, float dark_floor, int shadow_min, uint8_t* __restrict alpha,              \
-      uint8_t* __restrict shadow, uint8_t* __restrict colour) {                                             \
-    PlateRowImpl<RGB>(in, plate, tolerance, x0, x1, gain, dark_floor, shadow_min, alpha, shadow, colour);   \
+#define SS_PLATE_ROW(NAME, RGB)                                                                  \
+  __attribute__((target_clones("avx2", "ssse3", "default"))) void NAME(                          \
+      const uint8_t* __restrict in, const uint8_t* __restrict plate,                             \
+      const float* __restrict tolerance, int x0, int x1, float gain, float dark_floor,           \
+      int shadow_min, uint8_t* __restrict alpha, uint8_t* __restrict shadow,                     \
+      uint8_t* __restrict colour) {                                                              \
+    PlateRowImpl<RGB>(in, plate, tolerance, x0, x1, gain, dark_floor, shadow_min, alpha, shadow, \
+                      colour);                                                                   \
   }
 SS_PLATE_ROW(PlateRowBgr, false)
 SS_PLATE_ROW(PlateRowRgb, true)
@@ -134,15 +138,17 @@ void CleanPlateKeyer::Train(const std::vector<cv::Mat>& empty_bgr) {
     ramp_ = std::max(1.0, options_.ramp_sigma * cv::mean(sigma)[0] * std::sqrt(1.0 + 1.0 / n));
   }
   if (empty_bgr.size() < 2) {
-    Log("pipeline.key")->warn("clean-plate keyer trained on one frame: noise std is the floor {:.1f}",
-                              options_.min_sigma);
+    Log("pipeline.key")
+        ->warn("clean-plate keyer trained on one frame: noise std is the floor {:.1f}",
+               options_.min_sigma);
   }
-  Log("pipeline.key")->debug("clean-plate keyer trained on {} frames {}x{}, mean tolerance {:.1f} levels",
-                             empty_bgr.size(), size_.width, size_.height, cv::mean(tolerance_)[0]);
+  Log("pipeline.key")
+      ->debug("clean-plate keyer trained on {} frames {}x{}, mean tolerance {:.1f} levels",
+              empty_bgr.size(), size_.width, size_.height, cv::mean(tolerance_)[0]);
 }
 
-void CleanPlateKeyer::SampleRow(const uint8_t* row, ChannelOrder order, int cell_row, uint8_t* foreground,
-                                uint8_t* shade) const {
+void CleanPlateKeyer::SampleRow(const uint8_t* row, ChannelOrder order, int cell_row,
+                                uint8_t* foreground, uint8_t* shade) const {
   const int kb = order == ChannelOrder::kRgb ? 2 : 0;
   const int y = SampleY(cell_row);
   const uint8_t* plate = plate_.ptr<uint8_t>(y);
@@ -156,23 +162,24 @@ void CleanPlateKeyer::SampleRow(const uint8_t* row, ChannelOrder order, int cell
     const int x = SampleX(cx);
     const uint8_t* p = row + 3 * x;
     const uint8_t* u = plate + 3 * x;
-    const PixelKey k = PlatePixel(p[kb], p[1], p[2 - kb], u[0], u[1], u[2], tolerance[x], gain, dark_floor, shadow_min);
+    const PixelKey k = PlatePixel(p[kb], p[1], p[2 - kb], u[0], u[1], u[2], tolerance[x], gain,
+                                  dark_floor, shadow_min);
     foreground[cx] = k.alpha > coarse_alpha;
     shade[cx] = k.shadow > coarse_shadow;
   }
 }
 
-void CleanPlateKeyer::FineRow(const uint8_t* row, ChannelOrder order, int y, int x0, int x1, uint8_t* alpha,
-                              uint8_t* shadow, uint8_t* colour) const {
+void CleanPlateKeyer::FineRow(const uint8_t* row, ChannelOrder order, int y, int x0, int x1,
+                              uint8_t* alpha, uint8_t* shadow, uint8_t* colour) const {
   const float gain = static_cast<float>(255 / ramp_);
   const float dark_floor = static_cast<float>(options_.dark_floor);
   const int shadow_min = ShadowMin();
   if (order == ChannelOrder::kRgb) {
-    PlateRowRgb(row, plate_.ptr<uint8_t>(y), tolerance_.ptr<float>(y), x0, x1, gain, dark_floor, shadow_min, alpha,
-                shadow, colour);
+    PlateRowRgb(row, plate_.ptr<uint8_t>(y), tolerance_.ptr<float>(y), x0, x1, gain, dark_floor,
+                shadow_min, alpha, shadow, colour);
   } else {
-    PlateRowBgr(row, plate_.ptr<uint8_t>(y), tolerance_.ptr<float>(y), x0, x1, gain, dark_floor, shadow_min, alpha,
-                shadow, colour);
+    PlateRowBgr(row, plate_.ptr<uint8_t>(y), tolerance_.ptr<float>(y), x0, x1, gain, dark_floor,
+                shadow_min, alpha, shadow, colour);
   }
 }
 

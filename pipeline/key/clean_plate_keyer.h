@@ -17,15 +17,17 @@ struct KeyingConfig;
 
 struct CleanPlateKeyerOptions {
   GridOptions grid;
-  double noise_z = 4.0;         // background tolerance, noise std (the false-positive rate of a 1-D z test)
-  double min_sigma = 2.0;       // noise std floor, levels of 255 (a single empty frame has no spread)
-  double ramp = 30.0;           // alpha goes 0 -> 1 over this many levels beyond the tolerance
-  double dark_floor = 0.3;      // darker than this fraction of the plate is subject, not shadow
-  double shadow_min = 0.06;     // darkening below this is noise: no shadow
+  double noise_z =
+      4.0;  // background tolerance, noise std (the false-positive rate of a 1-D z test)
+  double min_sigma = 2.0;    // noise std floor, levels of 255 (a single empty frame has no spread)
+  double ramp = 30.0;        // alpha goes 0 -> 1 over this many levels beyond the tolerance
+  double dark_floor = 0.3;   // darker than this fraction of the plate is subject, not shadow
+  double shadow_min = 0.06;  // darkening below this is noise: no shadow
   double coarse_alpha = 0.25;   // a sample with a larger alpha marks its cell as foreground
   double coarse_shadow = 0.12;  // a sample darkened more marks its cell as shaded
-  double ramp_sigma = 0;        // > 0: the ramp is this many of the plate's mean noise std instead of `ramp`
-  bool shadow = true;           // false: no contact-shadow layer (and no shaded cells)
+  double ramp_sigma =
+      0;               // > 0: the ramp is this many of the plate's mean noise std instead of `ramp`
+  bool shadow = true;  // false: no contact-shadow layer (and no shaded cells)
   // False with "FIELD: reason" in `why` when a value is out of its range.
   bool IsValid(std::string* why) const;
 };
@@ -40,15 +42,17 @@ class CleanPlateKeyer : public Keyer {
   std::string name() const override { return "clean-plate"; }
   void Train(const std::vector<cv::Mat>& empty_bgr) override;
   const CleanPlateKeyerOptions& options() const { return options_; }
-  const cv::Mat& plate() const { return plate_; }        // CV_8UC3, mean empty frame
-  const cv::Mat& tolerance() const { return tolerance_; }  // CV_32F, levels, per pixel (docs/keying.md)
-  double ramp_levels() const { return ramp_; }              // alpha's ramp beyond the tolerance (after Train)
+  const cv::Mat& plate() const { return plate_; }  // CV_8UC3, mean empty frame
+  const cv::Mat& tolerance() const {
+    return tolerance_;
+  }                                             // CV_32F, levels, per pixel (docs/keying.md)
+  double ramp_levels() const { return ramp_; }  // alpha's ramp beyond the tolerance (after Train)
 
  protected:
   void SampleRow(const uint8_t* row, ChannelOrder order, int cell_row, uint8_t* foreground,
                  uint8_t* shade) const override;
-  void FineRow(const uint8_t* row, ChannelOrder order, int y, int x0, int x1, uint8_t* alpha, uint8_t* shadow,
-               uint8_t* colour) const override;
+  void FineRow(const uint8_t* row, ChannelOrder order, int y, int x0, int x1, uint8_t* alpha,
+               uint8_t* shadow, uint8_t* colour) const override;
 
  private:
   CleanPlateKeyerOptions options_;

@@ -13,7 +13,9 @@ struct CellBox {
   cv::Rect Rect() const { return cv::Rect(x0, y0, x1 - x0 + 1, y1 - y0 + 1); }
 };
 
-std::string SizeText(cv::Size s) { return std::to_string(s.width) + "x" + std::to_string(s.height); }
+std::string SizeText(cv::Size s) {
+  return std::to_string(s.width) + "x" + std::to_string(s.height);
+}
 
 }  // namespace
 
@@ -22,7 +24,8 @@ Keyer::Keyer(GridOptions grid) : grid_(grid) {
     throw InputError("keying.step", "must be within 2..64 px, got " + std::to_string(grid_.step));
   }
   if (grid_.margin_px < 0) throw InputError("keying.margin_px", "must not be negative");
-  if (grid_.shadow_reach_cells < 0) throw InputError("keying.shadow_reach_cells", "must not be negative");
+  if (grid_.shadow_reach_cells < 0)
+    throw InputError("keying.shadow_reach_cells", "must not be negative");
 }
 
 void Keyer::StartTraining(const std::vector<cv::Mat>& empty_bgr, const std::string& keyer) {
@@ -34,7 +37,8 @@ void Keyer::StartTraining(const std::vector<cv::Mat>& empty_bgr, const std::stri
     if (f.empty()) throw InputError(what, "empty image");
     if (f.type() != CV_8UC3) throw InputError(what, "expected 8-bit BGR (CV_8UC3)");
     if (f.size() != size) {
-      throw InputError(what, "size " + SizeText(f.size()) + " differs from frame 0's " + SizeText(size));
+      throw InputError(what,
+                       "size " + SizeText(f.size()) + " differs from frame 0's " + SizeText(size));
     }
   }
   size_ = size;
@@ -52,9 +56,10 @@ void Keyer::Key(const Frame& frame, cv::Mat& bgr_scratch, Matte& matte) const {
     return;
   }
   if (frame.format == PixelFormat::kMono8) {
-    throw InputError("frame " + std::to_string(frame.sequence),
-                     "mono8 frames carry no colour for the " + name() +
-                         " keyer; a colour format is needed (rgb8, bgr8, bayer_*, yuyv, nv12, mjpeg)");
+    throw InputError(
+        "frame " + std::to_string(frame.sequence),
+        "mono8 frames carry no colour for the " + name() +
+            " keyer; a colour format is needed (rgb8, bgr8, bayer_*, yuyv, nv12, mjpeg)");
   }
   ToBgr(frame, bgr_scratch);
   Key(bgr_scratch, ChannelOrder::kBgr, matte);
@@ -63,11 +68,12 @@ void Keyer::Key(const Frame& frame, cv::Mat& bgr_scratch, Matte& matte) const {
 void Keyer::Key(const cv::Mat& image, ChannelOrder order, Matte& matte) const {
   if (!trained()) throw WorkError(name() + " keyer", "used before Train() saw the empty enclosure");
   if (image.type() != CV_8UC3) {
-    throw InputError("frame", "expected 8-bit 3-channel pixels (CV_8UC3) for " + name() + " keying");
+    throw InputError("frame",
+                     "expected 8-bit 3-channel pixels (CV_8UC3) for " + name() + " keying");
   }
   if (image.size() != size_) {
-    throw InputError("frame", "size " + SizeText(image.size()) + " differs from the " + SizeText(size_) +
-                                  " the " + name() + " keyer was trained on");
+    throw InputError("frame", "size " + SizeText(image.size()) + " differs from the " +
+                                  SizeText(size_) + " the " + name() + " keyer was trained on");
   }
   Prepare(matte);
   CoarsePass(image, order, matte.coarse);
@@ -75,15 +81,16 @@ void Keyer::Key(const cv::Mat& image, ChannelOrder order, Matte& matte) const {
   for (const KeyRegion& r : matte.regions) {
     const int x0 = r.box.x, x1 = r.box.x + r.box.width;
     for (int y = r.box.y; y < r.box.y + r.box.height; ++y) {
-      FineRow(image.ptr<uint8_t>(y), order, y, x0, x1, matte.alpha.ptr<uint8_t>(y), matte.shadow.ptr<uint8_t>(y),
-              matte.colour.ptr<uint8_t>(y));
+      FineRow(image.ptr<uint8_t>(y), order, y, x0, x1, matte.alpha.ptr<uint8_t>(y),
+              matte.shadow.ptr<uint8_t>(y), matte.colour.ptr<uint8_t>(y));
     }
   }
 }
 
 void Keyer::Prepare(Matte& matte) const {
   if (matte.alpha.size() != size_ || matte.alpha.type() != CV_8U || matte.shadow.size() != size_ ||
-      matte.shadow.type() != CV_8U || matte.colour.size() != size_ || matte.colour.type() != CV_8UC3) {
+      matte.shadow.type() != CV_8U || matte.colour.size() != size_ ||
+      matte.colour.type() != CV_8UC3) {
     matte.alpha.create(size_, CV_8U);
     matte.alpha.setTo(0);
     matte.shadow.create(size_, CV_8U);
@@ -113,7 +120,8 @@ void Keyer::Prepare(Matte& matte) const {
 
 void Keyer::CoarsePass(const cv::Mat& image, ChannelOrder order, CoarseGrid& g) const {
   for (int cy = 0; cy < rows_; ++cy) {
-    SampleRow(image.ptr<uint8_t>(SampleY(cy)), order, cy, &g.foreground[static_cast<size_t>(cy) * cols_],
+    SampleRow(image.ptr<uint8_t>(SampleY(cy)), order, cy,
+              &g.foreground[static_cast<size_t>(cy) * cols_],
               &g.shade[static_cast<size_t>(cy) * cols_]);
   }
 }
@@ -152,7 +160,8 @@ void Keyer::FindRegions(CoarseGrid& g, std::vector<KeyRegion>& regions) const {
       const int c = queue[head++];
       const int cx = c % cols, cy = c / cols;
       region.foreground_cells += g.foreground[c];
-      box = {std::min(box.x0, cx), std::min(box.y0, cy), std::max(box.x1, cx), std::max(box.y1, cy)};
+      box = {std::min(box.x0, cx), std::min(box.y0, cy), std::max(box.x1, cx),
+             std::max(box.y1, cy)};
       for (int ny = std::max(cy - 1, 0); ny <= std::min(cy + 1, rows - 1); ++ny) {
         for (int nx = std::max(cx - 1, 0); nx <= std::min(cx + 1, cols - 1); ++nx) {
           const int nc = ny * cols + nx;

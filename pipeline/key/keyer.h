@@ -38,8 +38,8 @@ class OptionChecks {
 };
 
 struct GridOptions {
-  int step = 8;                // coarse sampling step, px; anything >= step + 2 px across is sampled
-  int margin_px = 6;           // added around each region's cell box
+  int step = 8;       // coarse sampling step, px; anything >= step + 2 px across is sampled
+  int margin_px = 6;  // added around each region's cell box
   int shadow_reach_cells = 6;  // shaded cells join a region up to this many cells away from it
 };
 
@@ -80,8 +80,8 @@ class Keyer {
                          uint8_t* shade) const = 0;
   // Full-resolution key of pixels [x0, x1) of image row y. Output pointers
   // address pixel 0 of the row (colour: 3 bytes per pixel, BGR).
-  virtual void FineRow(const uint8_t* row, ChannelOrder order, int y, int x0, int x1, uint8_t* alpha,
-                       uint8_t* shadow, uint8_t* colour) const = 0;
+  virtual void FineRow(const uint8_t* row, ChannelOrder order, int y, int x0, int x1,
+                       uint8_t* alpha, uint8_t* shadow, uint8_t* colour) const = 0;
   // Checks training frames (non-empty, 8-bit BGR, one size); sets size_ and the grid shape.
   void StartTraining(const std::vector<cv::Mat>& empty_bgr, const std::string& keyer);
 
@@ -89,7 +89,7 @@ class Keyer {
   int SampleY(int cy) const { return std::min(cy * grid_.step + grid_.step / 2, size_.height - 1); }
 
   GridOptions grid_;
-  cv::Size size_;          // trained frame size; width 0 until trained
+  cv::Size size_;            // trained frame size; width 0 until trained
   int cols_ = 0, rows_ = 0;  // coarse cells
 
  private:

@@ -14,8 +14,8 @@ namespace ss {
 // The coarse pass's view of a frame: one cell per `step` x `step` pixels,
 // sampled at the cell centre.
 struct CoarseGrid {
-  int step = 0;            // cell size, pixels
-  int cols = 0, rows = 0;  // cells across and down
+  int step = 0;                     // cell size, pixels
+  int cols = 0, rows = 0;           // cells across and down
   std::vector<uint8_t> foreground;  // cols*rows, 1 where the sample is not background
   std::vector<uint8_t> shade;       // cols*rows, 1 where the sample is darkened background
   std::vector<int32_t> label;       // cols*rows, component id (1..) of each region cell, 0 none
@@ -25,16 +25,17 @@ struct CoarseGrid {
 
 // One connected part of the coarse grid: the box where the fine pass ran.
 struct KeyRegion {
-  int id = 0;              // its label in CoarseGrid::label
-  cv::Rect box;            // pixels, cell box + margin, clipped to the frame
-  cv::Rect cells;          // the region's cells (coarse grid coordinates)
+  int id = 0;      // its label in CoarseGrid::label
+  cv::Rect box;    // pixels, cell box + margin, clipped to the frame
+  cv::Rect cells;  // the region's cells (coarse grid coordinates)
   int foreground_cells = 0;
   bool overlaps_other = false;  // its box intersects another region's box
 };
 
 struct Matte {
   cv::Mat alpha;   // CV_8U, 255 = subject, 0 = background
-  cv::Mat shadow;  // CV_8U, floor darkening relative to the empty enclosure (255 = black), outside the subject
+  cv::Mat shadow;  // CV_8U, floor darkening relative to the empty enclosure (255 = black), outside
+                   // the subject
   cv::Mat colour;  // CV_8UC3, the frame's colour with spill removed; valid inside regions only
   std::vector<KeyRegion> regions;  // where the fine pass ran this frame
   CoarseGrid coarse;

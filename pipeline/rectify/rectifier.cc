@@ -17,8 +17,9 @@ constexpr int kGridStep = 8;
 
 // Builds a remap from a `size` target to image pixels minus `offset`, where
 // target pixel (u, v) is the ground-frame point `origin + u*du + v*dv`.
-void BuildPlaneMap(const CameraModel& camera, const Eigen::Vector3d& origin, const Eigen::Vector3d& du,
-                   const Eigen::Vector3d& dv, cv::Size size, cv::Point offset, cv::Mat& map) {
+void BuildPlaneMap(const CameraModel& camera, const Eigen::Vector3d& origin,
+                   const Eigen::Vector3d& du, const Eigen::Vector3d& dv, cv::Size size,
+                   cv::Point offset, cv::Mat& map) {
   const int gw = (size.width + kGridStep - 1) / kGridStep + 1;
   const int gh = (size.height + kGridStep - 1) / kGridStep + 1;
   std::vector<Eigen::Vector2f> grid(static_cast<size_t>(gw) * gh);
@@ -48,9 +49,12 @@ void BuildPlaneMap(const CameraModel& camera, const Eigen::Vector3d& origin, con
   }
 }
 
-// Where the ray through `pixel` meets the vertical plane through `point` with normal `n` (horizontal).
-std::optional<Eigen::Vector3d> IntersectVerticalPlane(const CameraModel& camera, const Eigen::Vector2d& pixel,
-                                                      const Eigen::Vector3d& point, const Eigen::Vector3d& n) {
+// Where the ray through `pixel` meets the vertical plane through `point` with normal `n`
+// (horizontal).
+std::optional<Eigen::Vector3d> IntersectVerticalPlane(const CameraModel& camera,
+                                                      const Eigen::Vector2d& pixel,
+                                                      const Eigen::Vector3d& point,
+                                                      const Eigen::Vector3d& n) {
   const Ray ray = camera.RayInGround(pixel);
   const double denom = ray.direction.dot(n);
   if (std::abs(denom) < 1e-12) return std::nullopt;
@@ -61,7 +65,8 @@ std::optional<Eigen::Vector3d> IntersectVerticalPlane(const CameraModel& camera,
 
 }  // namespace
 
-std::optional<Billboard> Rectifier::Rectify(const CameraModel& camera, const SpriteView& view, Refusal* why) const {
+std::optional<Billboard> Rectifier::Rectify(const CameraModel& camera, const SpriteView& view,
+                                            Refusal* why) const {
   if (why != nullptr) *why = {};
   if (view.bgr == nullptr || view.alpha == nullptr || view.bgr->empty() ||
       view.bgr->size() != view.alpha->size()) {
@@ -89,9 +94,10 @@ std::optional<Billboard> Rectifier::Rectify(const CameraModel& camera, const Spr
   const double x1 = x0 + solid.width, y1 = y0 + solid.height;
   double min_r = 0, max_r = 0, max_h = 0;
   bool any = false;
-  for (const Eigen::Vector2d& px : {Eigen::Vector2d(x0, y0), Eigen::Vector2d(x1, y0), Eigen::Vector2d(x0, y1),
-                                   Eigen::Vector2d(x1, y1), Eigen::Vector2d((x0 + x1) / 2, y0),
-                                   Eigen::Vector2d(x0, (y0 + y1) / 2), Eigen::Vector2d(x1, (y0 + y1) / 2)}) {
+  for (const Eigen::Vector2d& px :
+       {Eigen::Vector2d(x0, y0), Eigen::Vector2d(x1, y0), Eigen::Vector2d(x0, y1),
+        Eigen::Vector2d(x1, y1), Eigen::Vector2d((x0 + x1) / 2, y0),
+        Eigen::Vector2d(x0, (y0 + y1) / 2), Eigen::Vector2d(x1, (y0 + y1) / 2)}) {
     const auto hit = IntersectVerticalPlane(camera, px, *contact, n);
     if (!hit) continue;
     const Eigen::Vector3d d = *hit - *contact;
@@ -110,9 +116,10 @@ std::optional<Billboard> Rectifier::Rectify(const CameraModel& camera, const Spr
     if (why != nullptr && (width > options_.max_side_px || height > options_.max_side_px)) {
       *why = {true, width, height};
     }
-    Log("pipeline.rectify")->trace("billboard {}x{} px refused (max {}): crop {}x{}+{}+{}, contact ({:.1f}, {:.1f})",
-                                   width, height, options_.max_side_px, view.bgr->cols, view.bgr->rows, view.offset.x,
-                                   view.offset.y, view.contact_px.x(), view.contact_px.y());
+    Log("pipeline.rectify")
+        ->trace("billboard {}x{} px refused (max {}): crop {}x{}+{}+{}, contact ({:.1f}, {:.1f})",
+                width, height, options_.max_side_px, view.bgr->cols, view.bgr->rows, view.offset.x,
+                view.offset.y, view.contact_px.x(), view.contact_px.y());
     return std::nullopt;
   }
 
@@ -124,12 +131,15 @@ std::optional<Billboard> Rectifier::Rectify(const CameraModel& camera, const Spr
   out.anchor_px = Eigen::Vector2d((width - 1) / 2.0, height - 1.0);
 
   // Billboard pixel (u, v) is the point contact + right*(u - a_u)/s + up*(a_v - v)/s.
-  const Eigen::Vector3d origin = *contact - right3 * (out.anchor_px.x() / s) + up * (out.anchor_px.y() / s);
+  const Eigen::Vector3d origin =
+      *contact - right3 * (out.anchor_px.x() / s) + up * (out.anchor_px.y() / s);
   cv::Mat map;
   BuildPlaneMap(camera, origin, right3 / s, -up / s, cv::Size(width, height), view.offset, map);
   cv::Mat bgr, alpha;
-  cv::remap(*view.bgr, bgr, map, cv::noArray(), cv::INTER_LINEAR, cv::BORDER_CONSTANT, cv::Scalar::all(0));
-  cv::remap(*view.alpha, alpha, map, cv::noArray(), cv::INTER_LINEAR, cv::BORDER_CONSTANT, cv::Scalar(0));
+  cv::remap(*view.bgr, bgr, map, cv::noArray(), cv::INTER_LINEAR, cv::BORDER_CONSTANT,
+            cv::Scalar::all(0));
+  cv::remap(*view.alpha, alpha, map, cv::noArray(), cv::INTER_LINEAR, cv::BORDER_CONSTANT,
+            cv::Scalar(0));
   cv::Mat channels[4];
   cv::split(bgr, channels);
   channels[3] = alpha;

@@ -46,17 +46,19 @@ class Rectifier {
   explicit Rectifier(RectifierOptions options = {}) : options_(options) {}
   // Why Rectify made no billboard.
   struct Refusal {
-    bool too_large = false;     // else: the contact point's ray misses the floor, or degenerate
+    bool too_large = false;  // else: the contact point's ray misses the floor, or degenerate
     int width_px = 0, height_px = 0;  // the billboard it would have made (too_large)
   };
   // nullopt when the contact point's ray misses the floor, the billboard is degenerate, or it
   // would exceed max_side_px at px_per_m; `why` (when given) says which.
-  std::optional<Billboard> Rectify(const CameraModel& camera, const SpriteView& view, Refusal* why = nullptr) const;
+  std::optional<Billboard> Rectify(const CameraModel& camera, const SpriteView& view,
+                                   Refusal* why = nullptr) const;
   // The horizontally mirrored billboard (seed 000 §2): the image flipped about
   // its vertical axis and the anchor with it; place and axes unchanged.
   static Billboard Mirror(const Billboard& billboard);
   // A ground velocity seen in the mirror: its component along `right` flips.
-  static Eigen::Vector2d MirrorVelocity(const Billboard& billboard, const Eigen::Vector2d& velocity);
+  static Eigen::Vector2d MirrorVelocity(const Billboard& billboard,
+                                        const Eigen::Vector2d& velocity);
 
   const RectifierOptions& options() const { return options_; }
 

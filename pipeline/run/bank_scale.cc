@@ -19,8 +19,8 @@ Eigen::Vector2d Centre(const GroundPolygon& floor) {
 }
 
 bool InImage(const CameraModel& model, const Eigen::Vector2d& px) {
-  return std::isfinite(px.x()) && std::isfinite(px.y()) && px.x() >= 0 && px.y() >= 0 && px.x() <= model.width() &&
-         px.y() <= model.height();
+  return std::isfinite(px.x()) && std::isfinite(px.y()) && px.x() >= 0 && px.y() >= 0 &&
+         px.x() <= model.width() && px.y() <= model.height();
 }
 
 // The camera sees the ground point in its image: it projects inside, and the ray back through that
@@ -59,7 +59,8 @@ double FloorPixelsPerMetre(const CameraModel& model, const GroundPolygon& floor)
 
 double TallestVisibleM(const CameraModel& model, const GroundPolygon& floor) {
   if (floor.empty()) return 0;
-  double min_x = floor.vertices()[0].x(), max_x = min_x, min_y = floor.vertices()[0].y(), max_y = min_y;
+  double min_x = floor.vertices()[0].x(), max_x = min_x, min_y = floor.vertices()[0].y(),
+         max_y = min_y;
   for (const Eigen::Vector2d& v : floor.vertices()) {
     min_x = std::min(min_x, v.x()), max_x = std::max(max_x, v.x());
     min_y = std::min(min_y, v.y()), max_y = std::max(max_y, v.y());
@@ -71,9 +72,12 @@ double TallestVisibleM(const CameraModel& model, const GroundPolygon& floor) {
   double tallest = 0;
   for (int i = 0; i <= kGrid; ++i) {
     for (int j = 0; j <= kGrid; ++j) {
-      const Eigen::Vector2d g(min_x + (max_x - min_x) * i / kGrid, min_y + (max_y - min_y) * j / kGrid);
+      const Eigen::Vector2d g(min_x + (max_x - min_x) * i / kGrid,
+                              min_y + (max_y - min_y) * j / kGrid);
       if (!floor.Contains(g) || !Sees(model, {g.x(), g.y(), 0.0})) continue;
-      const auto seen = [&](double z) { return InImage(model, model.ProjectGround({g.x(), g.y(), z})); };
+      const auto seen = [&](double z) {
+        return InImage(model, model.ProjectGround({g.x(), g.y(), z}));
+      };
       double z = 0;
       while (z < kMax && seen(z + kCoarse)) z += kCoarse;
       while (z < kMax && seen(z + kFine)) z += kFine;
@@ -86,21 +90,24 @@ double TallestVisibleM(const CameraModel& model, const GroundPolygon& floor) {
 
 BankScale ChooseBankScale(const BankScaleInputs& in) {
   if (in.bank_scales.size() > 1) {
-    throw InputError(in.bank_path, "its sprites are stored at " + std::to_string(in.bank_scales.size()) +
-                                       " billboard scales (" + Num(in.bank_scales.front()) + " to " +
-                                       Num(in.bank_scales.back()) + " px/m): one bank must use one scale");
+    throw InputError(in.bank_path,
+                     "its sprites are stored at " + std::to_string(in.bank_scales.size()) +
+                         " billboard scales (" + Num(in.bank_scales.front()) + " to " +
+                         Num(in.bank_scales.back()) + " px/m): one bank must use one scale");
   }
   if (in.bank_scales.size() == 1) {
     const double bank = in.bank_scales.front();
     if (in.configured > 0 && in.configured != bank) {
       throw InputError("pipeline.px_per_m",
-                       "is " + Num(in.configured) + " but bank " + in.bank_path + " stores its sprites at " +
-                           Num(bank) + " px/m, and one bank keeps one scale: set pipeline.px_per_m to " + Num(bank) +
-                           " or auto, or store into another bank");
+                       "is " + Num(in.configured) + " but bank " + in.bank_path +
+                           " stores its sprites at " + Num(bank) +
+                           " px/m, and one bank keeps one scale: set pipeline.px_per_m to " +
+                           Num(bank) + " or auto, or store into another bank");
     }
     return {bank, "the bank's own scale (it holds sprites at " + Num(bank) + " px/m)"};
   }
-  if (in.configured > 0) return {in.configured, "pipeline.px_per_m " + Num(in.configured) + " (configured)"};
+  if (in.configured > 0)
+    return {in.configured, "pipeline.px_per_m " + Num(in.configured) + " (configured)"};
 
   // auto, empty bank: the finest camera's ground resolution, capped by what fits.
   double finest = 0, tallest = 0;
@@ -109,14 +116,16 @@ BankScale ChooseBankScale(const BankScaleInputs& in) {
     tallest = std::max(tallest, TallestVisibleM(*m, in.floor));
   }
   if (!(finest > 0)) {
-    throw InputError("pipeline.px_per_m", "auto: no camera sees the floor's centre, so the billboard scale cannot "
-                                          "be chosen from the cameras; give pipeline.px_per_m a number");
+    throw InputError("pipeline.px_per_m",
+                     "auto: no camera sees the floor's centre, so the billboard scale cannot "
+                     "be chosen from the cameras; give pipeline.px_per_m a number");
   }
   // The billboard of a subject `tallest` high: ceil((tallest + margin) * s) + 1 <= max_side_px.
   const double fit = tallest > 0 ? (in.max_side_px - 2) / (tallest + in.margin_m) : finest;
   const double chosen = RoundDown(std::min(finest, fit));
   std::string why = fmt::format(
-      "auto: the finest camera sees {:.0f} px/m at the floor's centre; the tallest thing a camera sees whole on the "
+      "auto: the finest camera sees {:.0f} px/m at the floor's centre; the tallest thing a camera "
+      "sees whole on the "
       "floor is {:.2f} m, which fits {} px up to {:.0f} px/m; {} px/m (two digits, rounded down)",
       finest, tallest, in.max_side_px, fit, Num(chosen));
   return {chosen, why};
@@ -146,11 +155,13 @@ BankScale ChooseAndKeepBankScale(BankWriter& bank, BankScaleInputs in) {
     } else {
       in.bank_scales.push_back(recorded);
       std::sort(in.bank_scales.begin(), in.bank_scales.end());
-      in.bank_scales.erase(std::unique(in.bank_scales.begin(), in.bank_scales.end()), in.bank_scales.end());
+      in.bank_scales.erase(std::unique(in.bank_scales.begin(), in.bank_scales.end()),
+                           in.bank_scales.end());
     }
   }
   BankScale chosen = ChooseBankScale(in);
-  const double kept = RecordedScale(bank, bank.KeepMeta(kBankScaleMetaKey, fmt::format("{:.17g}", chosen.px_per_m)));
+  const double kept = RecordedScale(
+      bank, bank.KeepMeta(kBankScaleMetaKey, fmt::format("{:.17g}", chosen.px_per_m)));
   if (kept != chosen.px_per_m) {
     // Another writer chose first, between our read and our write: its scale is the bank's.
     in.bank_scales = {kept};

@@ -27,13 +27,13 @@ struct BankScale {
 };
 
 struct BankScaleInputs {
-  double configured = 0;             // pipeline.px_per_m; 0 = auto
-  std::vector<double> bank_scales;   // Bank::BillboardScales() of the bank
-  std::string bank_path;             // for messages
+  double configured = 0;                   // pipeline.px_per_m; 0 = auto
+  std::vector<double> bank_scales;         // Bank::BillboardScales() of the bank
+  std::string bank_path;                   // for messages
   std::vector<const CameraModel*> models;  // the cameras that store sprites
   GroundPolygon floor;
-  int max_side_px = 512;             // RectifierOptions::max_side_px
-  double margin_m = 0.01;            // RectifierOptions::margin_m
+  int max_side_px = 512;   // RectifierOptions::max_side_px
+  double margin_m = 0.01;  // RectifierOptions::margin_m
 };
 
 // InputError naming both scales when a configured number differs from the scale the bank

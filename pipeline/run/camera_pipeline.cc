@@ -75,8 +75,9 @@ CameraPipeline::CameraPipeline(std::string name, int64_t camera_id, CameraModel 
       batcher_(camera_id, options.batch),
       log_(Log("pipeline.run")) {
   if (!(options_.rectify.px_per_m > 0)) {
-    throw InputError("pipeline.px_per_m", "camera " + name_ + ": the bank's billboard scale was not chosen "
-                                          "(ChooseBankScale resolves auto)");
+    throw InputError("pipeline.px_per_m", "camera " + name_ +
+                                              ": the bank's billboard scale was not chosen "
+                                              "(ChooseBankScale resolves auto)");
   }
 }
 
@@ -86,15 +87,17 @@ CameraPipeline::CameraPipeline(CameraPipeline&&) noexcept = default;
 void CameraPipeline::Train(const std::vector<cv::Mat>& empty_bgr) {
   for (const cv::Mat& m : empty_bgr) {
     if (m.cols != model_.width() || m.rows != model_.height()) {
-      throw InputError(name_, "training frame is " + std::to_string(m.cols) + "x" + std::to_string(m.rows) +
-                                  " but the camera model is " + std::to_string(model_.width()) + "x" +
+      throw InputError(name_, "training frame is " + std::to_string(m.cols) + "x" +
+                                  std::to_string(m.rows) + " but the camera model is " +
+                                  std::to_string(model_.width()) + "x" +
                                   std::to_string(model_.height()));
     }
   }
   keyer_->Train(empty_bgr);
   // What is not green in the empty enclosure is not floor either: a wall's outside hiding the
   // floor behind it, the room (whatever wall height the config says).
-  if (const cv::Mat keyable = keyer_->KeyableMask(); !keyable.empty()) floor_mask_.Restrict(keyable);
+  if (const cv::Mat keyable = keyer_->KeyableMask(); !keyable.empty())
+    floor_mask_.Restrict(keyable);
   stats_.training_frames += empty_bgr.size();
   stats_.frames += empty_bgr.size();
 }
@@ -102,12 +105,13 @@ void CameraPipeline::Train(const std::vector<cv::Mat>& empty_bgr) {
 bool CameraPipeline::trained() const { return keyer_->trained(); }
 
 void CameraPipeline::Process(const Frame& frame, std::vector<ClipBatch>* out) {
-  if (!keyer_->trained()) throw WorkError(name_, "the keyer has not learnt the empty enclosure yet");
+  if (!keyer_->trained())
+    throw WorkError(name_, "the keyer has not learnt the empty enclosure yet");
   if (frame.width != model_.width() || frame.height != model_.height()) {
     throw InputError(name_ + " frame " + std::to_string(frame.sequence),
-                     "frame is " + std::to_string(frame.width) + "x" + std::to_string(frame.height) +
-                         " but the camera (and its model) is " + std::to_string(model_.width()) + "x" +
-                         std::to_string(model_.height()));
+                     "frame is " + std::to_string(frame.width) + "x" +
+                         std::to_string(frame.height) + " but the camera (and its model) is " +
+                         std::to_string(model_.width()) + "x" + std::to_string(model_.height()));
   }
   ++stats_.frames;
   // A gap in the sequence numbers is a lost frame: clips cannot run across it.
@@ -136,7 +140,8 @@ void CameraPipeline::Process(const Frame& frame, std::vector<ClipBatch>* out) {
   std::vector<TrackInput> inputs;
   verdicts_.clear();
   for (const Candidate& c : candidates) {
-    const auto hit = IntersectGround(model_.RayInGround(Eigen::Vector2d(c.contact_point.x, c.contact_point.y)));
+    const auto hit =
+        IntersectGround(model_.RayInGround(Eigen::Vector2d(c.contact_point.x, c.contact_point.y)));
     if (!hit) {
       ++stats_.discards[static_cast<size_t>(Discard::kNoGroundHit)];
       verdicts_.push_back({&c, -1, std::nullopt, Discard::kNoGroundHit});
@@ -154,17 +159,20 @@ void CameraPipeline::Process(const Frame& frame, std::vector<ClipBatch>* out) {
   std::vector<std::optional<Billboard>> billboards(subjects.size());
   for (size_t k = 0; k < subjects.size(); ++k) {
     const Candidate& c = *grounded[k];
-    Discard reason = c.touches_border ? Discard::kTouchesBorder : floor_mask_.Check(c.alpha, c.bbox.tl(), points[k]);
+    Discard reason = c.touches_border ? Discard::kTouchesBorder
+                                      : floor_mask_.Check(c.alpha, c.bbox.tl(), points[k]);
     if (reason == Discard::kNone) {
       const bool trace = log_->should_log(spdlog::level::trace);  // then every feature, for the log
-      const MatteShape shape =
-          trace ? MeasureMatteShape(c.alpha, options_.noise.thick_px) : MeasureMatteShape(c.alpha, options_.noise);
+      const MatteShape shape = trace ? MeasureMatteShape(c.alpha, options_.noise.thick_px)
+                                     : MeasureMatteShape(c.alpha, options_.noise);
       if (noise_.IsNoise(subjects[k], shape)) reason = Discard::kNoise;
       if (trace) {
-        log_->trace("{} frame {} subject {} box {}x{}+{}+{} shape area {:.0f} solidity {:.3f} thick {:.3f} "
-                    "largest {:.3f} mean_alpha {:.3f}",
-                    name_, frame.sequence, subjects[k], c.bbox.width, c.bbox.height, c.bbox.x, c.bbox.y,
-                    shape.area_px, shape.solidity, shape.thick_share, shape.largest_share, shape.mean_alpha);
+        log_->trace(
+            "{} frame {} subject {} box {}x{}+{}+{} shape area {:.0f} solidity {:.3f} thick {:.3f} "
+            "largest {:.3f} mean_alpha {:.3f}",
+            name_, frame.sequence, subjects[k], c.bbox.width, c.bbox.height, c.bbox.x, c.bbox.y,
+            shape.area_px, shape.solidity, shape.thick_share, shape.largest_share,
+            shape.mean_alpha);
       }
     }
     const bool still = stillness_.IsStill(subjects[k], frame.timestamp_ns, points[k]);
@@ -176,12 +184,15 @@ void CameraPipeline::Process(const Frame& frame, std::vector<ClipBatch>* out) {
       billboards[k] = rectifier_.Rectify(model_, view, &why);
       if (!billboards[k]) {
         reason = why.too_large ? Discard::kTooLarge : Discard::kNoGroundHit;
-        if (why.too_large && (!last_too_large_log_ || Clock::now() - *last_too_large_log_ > std::chrono::seconds(10))) {
+        if (why.too_large && (!last_too_large_log_ ||
+                              Clock::now() - *last_too_large_log_ > std::chrono::seconds(10))) {
           last_too_large_log_ = Clock::now();
-          log_->warn("{} frame {}: a sprite's billboard would be {}x{} px at pipeline.px_per_m {}, over the {} px "
-                     "limit: refused as too_large (a subject this big needs a smaller px_per_m)",
-                     name_, frame.sequence, why.width_px, why.height_px, rectifier_.options().px_per_m,
-                     rectifier_.options().max_side_px);
+          log_->warn(
+              "{} frame {}: a sprite's billboard would be {}x{} px at pipeline.px_per_m {}, over "
+              "the {} px "
+              "limit: refused as too_large (a subject this big needs a smaller px_per_m)",
+              name_, frame.sequence, why.width_px, why.height_px, rectifier_.options().px_per_m,
+              rectifier_.options().max_side_px);
         }
       }
     }
@@ -193,8 +204,9 @@ void CameraPipeline::Process(const Frame& frame, std::vector<ClipBatch>* out) {
       ++stats_.discards[static_cast<size_t>(reason)];
     }
     if (log_->should_log(spdlog::level::trace)) {
-      log_->trace("{} frame {} subject {} at ({:.4f}, {:.4f}) box {}x{}+{}+{}: {}", name_, frame.sequence, subjects[k],
-                  points[k].x(), points[k].y(), c.bbox.width, c.bbox.height, c.bbox.x, c.bbox.y, DiscardName(reason));
+      log_->trace("{} frame {} subject {} at ({:.4f}, {:.4f}) box {}x{}+{}+{}: {}", name_,
+                  frame.sequence, subjects[k], points[k].x(), points[k].y(), c.bbox.width,
+                  c.bbox.height, c.bbox.x, c.bbox.y, DiscardName(reason));
     }
   }
 

@@ -11,8 +11,8 @@
 #include <string>
 #include <vector>
 
-#include <opencv2/core.hpp>
 #include <spdlog/logger.h>
+#include <opencv2/core.hpp>
 
 #include "core/camera_model.h"
 #include "core/config.h"
@@ -48,22 +48,23 @@ struct CameraPipelineOptions {
 CameraPipelineOptions PipelineOptionsFromConfig(const StationConfig& config);
 
 struct CameraPipelineStats {
-  uint64_t frames = 0;          // frames processed (training frames included)
-  uint64_t training_frames = 0; // of them, learnt as the empty enclosure
-  uint64_t candidates = 0;      // blobs the extractor found above the noise size
-  uint64_t sequence_gaps = 0;   // breaks in the sequence numbers (drops): open clips end there
-  DiscardCounts discards{};     // by reason; [kNone] counts usable sprites (in clips long enough so far)
-  uint64_t stored_sprites = 0;  // originals handed to the bank (mirrors not counted)
-  uint64_t clips = 0;           // complete clips handed to the bank
+  uint64_t frames = 0;           // frames processed (training frames included)
+  uint64_t training_frames = 0;  // of them, learnt as the empty enclosure
+  uint64_t candidates = 0;       // blobs the extractor found above the noise size
+  uint64_t sequence_gaps = 0;    // breaks in the sequence numbers (drops): open clips end there
+  DiscardCounts
+      discards{};  // by reason; [kNone] counts usable sprites (in clips long enough so far)
+  uint64_t stored_sprites = 0;               // originals handed to the bank (mirrors not counted)
+  uint64_t clips = 0;                        // complete clips handed to the bank
   double seconds_key = 0, seconds_rest = 0;  // thread time in keying+extracting, in the rest
 };
 
 // What became of one candidate of the last processed frame (the console's sprites view).
 struct CandidateVerdict {
   const Candidate* candidate = nullptr;  // the extractor's; valid until the next Process
-  int track = -1;                        // the tracker's subject id; -1 when its ray missed the floor
+  int track = -1;  // the tracker's subject id; -1 when its ray missed the floor
   std::optional<Eigen::Vector2d> ground;  // contact point on the floor, metres
-  Discard reason = Discard::kNone;       // kNone: usable (it joins a clip)
+  Discard reason = Discard::kNone;        // kNone: usable (it joins a clip)
 };
 
 class CameraPipeline {
@@ -96,7 +97,8 @@ class CameraPipeline {
   const std::string& name() const { return name_; }
   const CameraModel& model() const { return model_; }
   const CameraPipelineStats& stats() const { return stats_; }
-  // Sprites that passed every filter so far, short clips included (grows by the frame's usable ones).
+  // Sprites that passed every filter so far, short clips included (grows by the frame's usable
+  // ones).
   uint64_t usable_sprites() const { return usable_total_; }
   const FloorMask& floor_mask() const { return floor_mask_; }
   const Keyer& keyer() const { return *keyer_; }  // as configured (PipelineOptionsFromConfig)

@@ -16,7 +16,8 @@ cv::Mat FitShadow(const cv::Mat& patch, cv::Size size) {
   if (patch.empty()) return out;
   const int dx = (size.width - 1) / 2 - (patch.cols - 1) / 2;
   const int dy = (size.height - 1) / 2 - (patch.rows - 1) / 2;
-  const cv::Rect in_out = cv::Rect(dx, dy, patch.cols, patch.rows) & cv::Rect(0, 0, size.width, size.height);
+  const cv::Rect in_out =
+      cv::Rect(dx, dy, patch.cols, patch.rows) & cv::Rect(0, 0, size.width, size.height);
   if (in_out.empty()) return out;
   patch(in_out - cv::Point(dx, dy)).copyTo(out(in_out));
   return out;
@@ -65,7 +66,8 @@ SpriteRecord MirrorRecord(const SpriteRecord& original, const MadeSprite& s) {
 
 ClipBatcher::ClipBatcher(int64_t camera_id, ClipBatcherOptions options)
     : camera_id_(camera_id), options_(options) {
-  if (options_.min_clip_frames < 1) throw InputError("pipeline.min_clip_frames", "must be at least 1");
+  if (options_.min_clip_frames < 1)
+    throw InputError("pipeline.min_clip_frames", "must be at least 1");
   if (options_.batch_frames < 1) throw InputError("clip batch size", "must be at least 1");
   options_.velocity_half_window = std::max(0, options_.velocity_half_window);
 }
@@ -80,7 +82,8 @@ void ClipBatcher::Add(int64_t clip, int subject, MadeSprite sprite, std::vector<
     throw WorkError("clip " + std::to_string(clip), "frames of a clip must be consecutive");
   }
   open.timestamps_ns.push_back(sprite.timestamp_ns);
-  open.points.emplace_back(sprite.billboard.point_in_ground.x(), sprite.billboard.point_in_ground.y());
+  open.points.emplace_back(sprite.billboard.point_in_ground.x(),
+                           sprite.billboard.point_in_ground.y());
   open.pending.push_back(std::move(sprite));
 
   const size_t length = open.points.size();
@@ -132,14 +135,16 @@ void ClipBatcher::Emit(Open& open, size_t count, bool complete, std::vector<Clip
       batch.sprites.push_back(std::move(original));
     }
   }
-  open.pending.erase(open.pending.begin(), open.pending.begin() + static_cast<std::ptrdiff_t>(count));
+  open.pending.erase(open.pending.begin(),
+                     open.pending.begin() + static_cast<std::ptrdiff_t>(count));
   stored_originals_ += count;
   open.started = true;
   if (!batch.sprites.empty() || complete) out->push_back(std::move(batch));
 }
 
 void ClipBatcher::set_camera_id(int64_t camera_id) {
-  if (!clips_.empty()) throw WorkError("clip batcher", "cannot change the bank camera while clips are open");
+  if (!clips_.empty())
+    throw WorkError("clip batcher", "cannot change the bank camera while clips are open");
   camera_id_ = camera_id;
 }
 

@@ -21,14 +21,14 @@ namespace ss {
 
 struct ClipBatcherOptions {
   int min_clip_frames = 5;
-  int batch_frames = 60;          // sprites per batch once a clip is long enough
-  int velocity_half_window = 2;   // frames each side for the velocity slope
-  bool mirrors = true;            // store the mirrored copy of every sprite
+  int batch_frames = 60;         // sprites per batch once a clip is long enough
+  int velocity_half_window = 2;  // frames each side for the velocity slope
+  bool mirrors = true;           // store the mirrored copy of every sprite
 };
 
 // One usable sprite of a clip, as the pipeline made it.
 struct MadeSprite {
-  int64_t frame = 0;         // device sequence number (consecutive within a clip)
+  int64_t frame = 0;  // device sequence number (consecutive within a clip)
   int64_t timestamp_ns = 0;
   cv::Rect bbox_in_image;
   Billboard billboard;
@@ -54,8 +54,12 @@ class ClipBatcher {
   // The bank camera of the clips to come (a new capture session); only with no open clip.
   void set_camera_id(int64_t camera_id);
 
-  uint64_t short_clip_sprites() const { return short_clip_sprites_; }  // originals dropped in short clips
-  uint64_t stored_originals() const { return stored_originals_; }      // originals handed out in batches
+  uint64_t short_clip_sprites() const {
+    return short_clip_sprites_;
+  }  // originals dropped in short clips
+  uint64_t stored_originals() const {
+    return stored_originals_;
+  }  // originals handed out in batches
   uint64_t clips_completed() const { return clips_completed_; }
   size_t open_clips() const { return clips_.size(); }
 
@@ -63,10 +67,10 @@ class ClipBatcher {
   struct Open {
     int subject = 0;
     int64_t first_frame = 0;
-    std::vector<int64_t> timestamps_ns;       // every frame of the clip so far
-    std::vector<Eigen::Vector2d> points;      // their contact points
-    std::vector<MadeSprite> pending;          // not yet handed out: the last pending.size() frames
-    bool started = false;                     // a first batch went out
+    std::vector<int64_t> timestamps_ns;   // every frame of the clip so far
+    std::vector<Eigen::Vector2d> points;  // their contact points
+    std::vector<MadeSprite> pending;      // not yet handed out: the last pending.size() frames
+    bool started = false;                 // a first batch went out
   };
   // Hands out the first `count` pending sprites of `open`.
   void Emit(Open& open, size_t count, bool complete, std::vector<ClipBatch>* out);

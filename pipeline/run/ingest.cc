@@ -44,10 +44,13 @@ std::optional<GroundPolygon> ReadFloorJson(const fs::path& path) {
       break;
     }
   }
-  if (floor != nullptr && floor->is_object() && floor->contains("vertices")) floor = &(*floor)["vertices"];
-  if (floor == nullptr || !floor->is_array()) throw InputError(path.string(), "expected a \"floor\" list of [x, y] points");
+  if (floor != nullptr && floor->is_object() && floor->contains("vertices"))
+    floor = &(*floor)["vertices"];
+  if (floor == nullptr || !floor->is_array())
+    throw InputError(path.string(), "expected a \"floor\" list of [x, y] points");
   if (floor->size() > GroundPolygon::kMaxVertices) {
-    throw InputError(path.string(), "floor: " + std::to_string(floor->size()) + " points; a floor polygon has at most " +
+    throw InputError(path.string(), "floor: " + std::to_string(floor->size()) +
+                                        " points; a floor polygon has at most " +
                                         std::to_string(GroundPolygon::kMaxVertices));
   }
   std::vector<Eigen::Vector2d> vertices;
@@ -61,7 +64,8 @@ std::optional<GroundPolygon> ReadFloorJson(const fs::path& path) {
     }
   }
   GroundPolygon polygon(std::move(vertices));
-  if (!polygon.IsSimple()) throw InputError(path.string(), "floor: not a simple polygon of at least 3 points");
+  if (!polygon.IsSimple())
+    throw InputError(path.string(), "floor: not a simple polygon of at least 3 points");
   return polygon;
 }
 
@@ -81,8 +85,9 @@ GroundPolygon FloorForSession(const std::string& session_dir, const StationConfi
   for (const fs::path& candidate : {dir / "enclosure.json", dir / "truth" / "floor.json"}) {
     if (auto polygon = ReadFloorJson(candidate)) return *polygon;
   }
-  throw InputError(session_dir, "no floor polygon: give enclosure.floor in the config (--config), or put "
-                                "enclosure.json in the session");
+  throw InputError(session_dir,
+                   "no floor polygon: give enclosure.floor in the config (--config), or put "
+                   "enclosure.json in the session");
 }
 
 IngestSummary IngestSession(const IngestOptions& options) {
@@ -101,28 +106,33 @@ IngestSummary IngestSession(const IngestOptions& options) {
   std::vector<CameraModel> models;
   for (const SessionCamera& cam : info.cameras) {
     if (cam.model.empty()) {
-      throw InputError(options.session_dir + "/session.json",
-                       "camera " + cam.name + " has no camera model; the pipeline needs it to find the ground");
+      throw InputError(
+          options.session_dir + "/session.json",
+          "camera " + cam.name + " has no camera model; the pipeline needs it to find the ground");
     }
     models.push_back(CameraModel::Read((fs::path(options.session_dir) / cam.model).string()));
     if (models.back().width() != cam.width || models.back().height() != cam.height) {
       throw InputError((fs::path(options.session_dir) / cam.model).string(),
                        "the model is for " + std::to_string(models.back().width()) + "x" +
-                           std::to_string(models.back().height()) + " images but camera " + cam.name + " records " +
-                           std::to_string(cam.width) + "x" + std::to_string(cam.height));
+                           std::to_string(models.back().height()) + " images but camera " +
+                           cam.name + " records " + std::to_string(cam.width) + "x" +
+                           std::to_string(cam.height));
     }
   }
   CameraPipelineOptions pipeline_options = PipelineOptionsFromConfig(config);
-  const TransitionWeights transition_weights =
-      options.transition_weights.empty() ? DefaultWeights() : LoadWeights(options.transition_weights);
+  const TransitionWeights transition_weights = options.transition_weights.empty()
+                                                   ? DefaultWeights()
+                                                   : LoadWeights(options.transition_weights);
 
   // A damaged bank is not written into: what it holds is still readable by `bank export` and
   // `bank verify` says where it is damaged; appending could only spread the damage.
   if (const std::vector<std::string> damage = QuickCheckBank(options.bank_path); !damage.empty()) {
-    throw InputError(options.bank_path, "the bank does not pass SQLite's quick check (" + damage.front() +
-                                            (damage.size() > 1 ? ", and " + std::to_string(damage.size() - 1) + " more" : "") +
-                                            "); nothing was written. Run `spritestation bank verify " +
-                                            options.bank_path + "` to see the damage");
+    throw InputError(
+        options.bank_path,
+        "the bank does not pass SQLite's quick check (" + damage.front() +
+            (damage.size() > 1 ? ", and " + std::to_string(damage.size() - 1) + " more" : "") +
+            "); nothing was written. Run `spritestation bank verify " + options.bank_path +
+            "` to see the damage");
   }
   BankWriter bank(options.bank_path);
   IngestSummary summary;
@@ -157,8 +167,8 @@ IngestSummary IngestSession(const IngestOptions& options) {
     record.height = cam.height;
     cameras[c].name = cam.name;
     cameras[c].camera_id = bank.AddCamera(summary.session_id, record);
-    cameras[c].pipeline = std::make_unique<CameraPipeline>(cam.name, cameras[c].camera_id, models[c], floor,
-                                                           pipeline_options);
+    cameras[c].pipeline = std::make_unique<CameraPipeline>(cam.name, cameras[c].camera_id,
+                                                           models[c], floor, pipeline_options);
     cameras[c].frames = std::make_unique<BoundedQueue<Frame>>(4);
   }
 
@@ -181,7 +191,8 @@ IngestSummary IngestSession(const IngestOptions& options) {
   // The transition worker reads and writes the bank through its own connections; the
   // writer thread only queues each batch's ids with it.
   std::unique_ptr<TransitionWorker> transitions;
-  if (options.transitions) transitions = std::make_unique<TransitionWorker>(options.bank_path, transition_weights, 1);
+  if (options.transitions)
+    transitions = std::make_unique<TransitionWorker>(options.bank_path, transition_weights, 1);
 
   std::atomic<uint64_t> frames_done{0}, rows_inserted{0}, batch_count{0}, stored{0};
   std::thread writer([&] {
@@ -265,10 +276,14 @@ IngestSummary IngestSession(const IngestOptions& options) {
     summary.transitions_stored = t.transitions_stored;
     summary.transition_sprites = t.sprites;
     summary.transitions_error = t.last_error;
-    summary.seconds_transitions_wait = std::chrono::duration<double>(Clock::now() - wait_start).count();
+    summary.seconds_transitions_wait =
+        std::chrono::duration<double>(Clock::now() - wait_start).count();
     if (!t.last_error.empty()) {
-      Log("pipeline.ingest")->error("{}: the transition table may be incomplete ({}); run 'spritestation transitions "
-                                    "{}' to rebuild it", options.bank_path, t.last_error, options.bank_path);
+      Log("pipeline.ingest")
+          ->error(
+              "{}: the transition table may be incomplete ({}); run 'spritestation transitions "
+              "{}' to rebuild it",
+              options.bank_path, t.last_error, options.bank_path);
     }
   }
 
@@ -277,7 +292,8 @@ IngestSummary IngestSession(const IngestOptions& options) {
   for (size_t c = 0; c < cameras.size(); ++c) {
     CameraWork& w = cameras[c];
     const CameraPipelineStats& s = w.pipeline->stats();
-    summary.cameras.push_back({w.name, w.camera_id, s, c < replay_stats.size() ? replay_stats[c] : ReplayCameraStats{}});
+    summary.cameras.push_back(
+        {w.name, w.camera_id, s, c < replay_stats.size() ? replay_stats[c] : ReplayCameraStats{}});
     summary.frames += s.frames;
     summary.sprites_kept += s.stored_sprites;
     for (size_t r = 0; r < summary.discards.size(); ++r) summary.discards[r] += s.discards[r];
@@ -286,7 +302,8 @@ IngestSummary IngestSession(const IngestOptions& options) {
   summary.batches = batch_count;
   summary.seconds = std::chrono::duration<double>(Clock::now() - start).count();
   summary.frames_per_second = summary.seconds > 0 ? summary.frames / summary.seconds : 0;
-  if (options.progress) options.progress({frames_done.load(), frames_total, stored.load(), summary.seconds});
+  if (options.progress)
+    options.progress({frames_done.load(), frames_total, stored.load(), summary.seconds});
   return summary;
 }
 

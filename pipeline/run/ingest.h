@@ -33,7 +33,8 @@ struct IngestOptions {
   std::string session_dir;
   std::string bank_path;
   StationConfig config;  // keying, enclosure and pipeline sections are used
-  std::function<void(const IngestProgress&)> progress;  // a few times a second, from the calling thread
+  std::function<void(const IngestProgress&)>
+      progress;                    // a few times a second, from the calling thread
   bool transitions = true;         // keep the transition table current (TransitionWorker)
   std::string transition_weights;  // weights file; empty: the shipped default weights
   // Decoder threads per camera (ReplayOptions::decode_threads): 0 = one per core, 1 = frames
@@ -45,28 +46,29 @@ struct IngestCamera {
   std::string name;
   int64_t bank_camera_id = 0;
   CameraPipelineStats stats;
-  ReplayCameraStats replay;  // what its recording held: unreadable frames, each problem naming the file and frame
+  ReplayCameraStats
+      replay;  // what its recording held: unreadable frames, each problem naming the file and frame
 };
 
 struct IngestSummary {
   std::string session_name;
   int64_t session_id = 0;
   std::vector<IngestCamera> cameras;
-  uint64_t frames = 0;            // frames through the pipelines (training frames included)
-  uint64_t sprites_kept = 0;      // usable originals handed to the bank
-  uint64_t rows_inserted = 0;     // new sprite rows (originals + mirrors); 0 on a re-ingest
+  uint64_t frames = 0;         // frames through the pipelines (training frames included)
+  uint64_t sprites_kept = 0;   // usable originals handed to the bank
+  uint64_t rows_inserted = 0;  // new sprite rows (originals + mirrors); 0 on a re-ingest
   uint64_t batches = 0;
-  double px_per_m = 0;            // the bank's billboard scale the sprites were made at
-  std::string px_per_m_why;       // how it was chosen (ChooseBankScale)
-  DiscardCounts discards{};       // summed over cameras
-  SourceStats source;             // what the replay could not read
+  double px_per_m = 0;       // the bank's billboard scale the sprites were made at
+  std::string px_per_m_why;  // how it was chosen (ChooseBankScale)
+  DiscardCounts discards{};  // summed over cameras
+  SourceStats source;        // what the replay could not read
   double seconds = 0;
   double frames_per_second = 0;
-  bool transitions = false;           // the transition worker ran
-  int64_t transitions_stored = 0;     // transitions it wrote (its start-up table included)
-  int64_t transition_sprites = 0;     // sprites it knows at the end
+  bool transitions = false;             // the transition worker ran
+  int64_t transitions_stored = 0;       // transitions it wrote (its start-up table included)
+  int64_t transition_sprites = 0;       // sprites it knows at the end
   double seconds_transitions_wait = 0;  // waiting for it after the last batch was stored
-  std::string transitions_error;      // its last error ("" when none): the table may be incomplete
+  std::string transitions_error;  // its last error ("" when none): the table may be incomplete
 };
 
 // The floor polygon for a session: the config's `enclosure.floor` when given,

@@ -7,7 +7,9 @@
 namespace ss {
 
 std::vector<int> Tracker::Update(int64_t timestamp_ns, const std::vector<TrackInput>& inputs) {
-  std::erase_if(subjects_, [&](const Subject& s) { return timestamp_ns - s.last_seen_ns > options_.forget_after_ns; });
+  std::erase_if(subjects_, [&](const Subject& s) {
+    return timestamp_ns - s.last_seen_ns > options_.forget_after_ns;
+  });
 
   // Every admissible (distance, input, subject) pair, matched greedily by distance.
   std::vector<std::tuple<double, size_t, size_t>> pairs;
@@ -53,7 +55,8 @@ std::vector<ClipCutter::Event> ClipCutter::Update(const std::vector<int>& subjec
     }
   }
   for (size_t i = 0; i < subjects.size(); ++i) {
-    const auto it = std::find_if(open_.begin(), open_.end(), [&](const Open& o) { return o.subject == subjects[i]; });
+    const auto it = std::find_if(open_.begin(), open_.end(),
+                                 [&](const Open& o) { return o.subject == subjects[i]; });
     const bool was_open = it != open_.end();
     if (usable[i]) {
       const int64_t clip = was_open ? it->clip : next_clip_++;

@@ -11,9 +11,9 @@
 namespace ss {
 
 struct TrackerOptions {
-  double max_speed_m_per_s = 1.0;   // a subject cannot move faster than this
-  double reach_slack_m = 0.02;      // plus this, for keying jitter of the contact point
-  double max_area_ratio = 2.5;      // a blob that grows or shrinks more is not the same sprite
+  double max_speed_m_per_s = 1.0;  // a subject cannot move faster than this
+  double reach_slack_m = 0.02;     // plus this, for keying jitter of the contact point
+  double max_area_ratio = 2.5;     // a blob that grows or shrinks more is not the same sprite
   int64_t forget_after_ns = 500'000'000;
 };
 
@@ -47,8 +47,8 @@ class ClipCutter {
  public:
   struct Event {
     int subject;
-    int64_t clip;     // the clip the frame joins, -1 when the frame is not usable
-    bool closes;      // a clip closed (the subject's previous clip, `closed_clip`)
+    int64_t clip;  // the clip the frame joins, -1 when the frame is not usable
+    bool closes;   // a clip closed (the subject's previous clip, `closed_clip`)
     int64_t closed_clip = -1;
   };
   // Call once per frame with every subject seen and whether its sprite is usable.

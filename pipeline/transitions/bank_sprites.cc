@@ -19,7 +19,8 @@ CheapFeatures CheapFromRecord(const SpriteRecord& s) {
   return f;
 }
 
-RgbaBillboard BillboardFromPixels(const SpritePixels& pixels, double anchor_x_px, double anchor_y_px) {
+RgbaBillboard BillboardFromPixels(const SpritePixels& pixels, double anchor_x_px,
+                                  double anchor_y_px) {
   if (pixels.bgra.type() != CV_8UC4) throw WorkError("billboard", "bank pixels are not 8-bit BGRA");
   RgbaBillboard b;
   b.width = pixels.bgra.cols;
@@ -28,7 +29,8 @@ RgbaBillboard BillboardFromPixels(const SpritePixels& pixels, double anchor_x_px
   b.anchor_y_px = anchor_y_px;
   b.rgba.resize(static_cast<size_t>(b.width) * b.height * 4);
   const size_t row_bytes = static_cast<size_t>(b.width) * 4;
-  for (int y = 0; y < b.height; ++y) std::memcpy(b.rgba.data() + y * row_bytes, pixels.bgra.ptr(y), row_bytes);
+  for (int y = 0; y < b.height; ++y)
+    std::memcpy(b.rgba.data() + y * row_bytes, pixels.bgra.ptr(y), row_bytes);
   return b;
 }
 
@@ -46,13 +48,15 @@ void AddSprite(const Bank& bank, const SpriteRecord& r, SegmentKeys* keys, BankS
   const std::string who = "sprite " + std::to_string(r.id);
   if (out->px_per_m == 0) out->px_per_m = r.px_per_m;
   if (r.px_per_m != out->px_per_m) {
-    throw InputError(bank.path(), who + " has px_per_m " + std::to_string(r.px_per_m) + ", the others " +
-                                      std::to_string(out->px_per_m) + ": one bank must use one billboard scale");
+    throw InputError(bank.path(), who + " has px_per_m " + std::to_string(r.px_per_m) +
+                                      ", the others " + std::to_string(out->px_per_m) +
+                                      ": one bank must use one billboard scale");
   }
   RgbaBillboard b = BillboardFromPixels(bank.LoadPixels(r.id), r.anchor_x_px, r.anchor_y_px);
   out->ids.push_back(r.id);
   out->billboards.push_back(std::move(b));
-  out->inputs.push_back({r.id, keys->Key(r.clip_id, r.mirrored, r.frame), CheapFromRecord(r), nullptr});
+  out->inputs.push_back(
+      {r.id, keys->Key(r.clip_id, r.mirrored, r.frame), CheapFromRecord(r), nullptr});
 }
 
 void Link(BankSprites* out) {
@@ -61,8 +65,10 @@ void Link(BankSprites* out) {
 
 }  // namespace
 
-BankSprites LoadBankSprites(const Bank& bank, SegmentKeys* keys, const std::function<void(size_t, size_t)>& progress) {
-  const std::vector<SpriteFeatures> features = bank.LoadFeatures();  // ordered by (clip, mirrored, frame)
+BankSprites LoadBankSprites(const Bank& bank, SegmentKeys* keys,
+                            const std::function<void(size_t, size_t)>& progress) {
+  const std::vector<SpriteFeatures> features =
+      bank.LoadFeatures();  // ordered by (clip, mirrored, frame)
   BankSprites out;
   out.ids.reserve(features.size());
   out.inputs.reserve(features.size());
@@ -78,7 +84,8 @@ BankSprites LoadBankSprites(const Bank& bank, SegmentKeys* keys, const std::func
   return out;
 }
 
-BankSprites LoadBankSpritesById(const Bank& bank, std::span<const int64_t> ids, SegmentKeys* keys, double px_per_m) {
+BankSprites LoadBankSpritesById(const Bank& bank, std::span<const int64_t> ids, SegmentKeys* keys,
+                                double px_per_m) {
   BankSprites out;
   out.px_per_m = px_per_m;
   out.ids.reserve(ids.size());

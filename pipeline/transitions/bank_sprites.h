@@ -21,7 +21,8 @@ namespace ss {
 CheapFeatures CheapFromRecord(const SpriteRecord& sprite);
 
 // The bank's billboard (BGRA, anchor in pixel-centre coordinates) as an RgbaBillboard.
-RgbaBillboard BillboardFromPixels(const SpritePixels& pixels, double anchor_x_px, double anchor_y_px);
+RgbaBillboard BillboardFromPixels(const SpritePixels& pixels, double anchor_x_px,
+                                  double anchor_y_px);
 
 // Gives every sprite its segment key in arrival order: a sprite continues the segment of
 // its (clip, mirrored) when its frame is the last one's + 1, else starts a new one.
@@ -40,10 +41,10 @@ class SegmentKeys {
 // Sprites loaded from a bank, owning their billboards; inputs() views them.
 struct BankSprites {
   std::vector<int64_t> ids;
-  std::vector<SpriteInput> inputs;       // billboard pointers into `billboards`
+  std::vector<SpriteInput> inputs;  // billboard pointers into `billboards`
   std::vector<RgbaBillboard> billboards;
-  double px_per_m = 0;                   // the bank's billboard scale (the same for all)
-  int64_t clips = 0;                     // complete clips they came from
+  double px_per_m = 0;  // the bank's billboard scale (the same for all)
+  int64_t clips = 0;    // complete clips they came from
 };
 
 // Loads the sprites of every complete clip, ordered by (clip, mirrored, frame), their

@@ -71,8 +71,8 @@ BankTrainResult TrainOnBank(const std::string& labels_path, const std::string& b
         for (size_t k = 0; k < labels.size(); ++k) {
           if (y[k]) positive_distances.push_back(label_fit.Distance(x[k]));
         }
-        const PopulationSample sample = SamplePopulation(all, label_fit, options.calibration_rows, options.train.seed,
-                                                         options.threads);
+        const PopulationSample sample = SamplePopulation(all, label_fit, options.calibration_rows,
+                                                         options.train.seed, options.threads);
         result.stage2 = CalibrateStage2(positive_distances, sample, positive_rate, &result.weights);
         result.stage2_calibrated = true;
         training["stage2_calibration"] = {{"positive_rate", positive_rate},
@@ -83,24 +83,27 @@ BankTrainResult TrainOnBank(const std::string& labels_path, const std::string& b
                                           {"estimated_recall", result.stage2.recall},
                                           {"bias", result.weights.stage2_bias}};
         if (options.stage1_recall > 0) {
-          result.stage1 = FitStage1Filter(all, sample, options.stage1_recall, options.train.seed, &result.weights);
+          result.stage1 = FitStage1Filter(all, sample, options.stage1_recall, options.train.seed,
+                                          &result.weights);
           result.calibration_accepts = result.stage1.stage2_accepts;
         }
       } else {
-        const auto accepted = SampleStage2Accepted(all, TransitionClassifier(result.weights),
-                                                   options.calibration_rows, options.train.seed, options.threads);
+        const auto accepted =
+            SampleStage2Accepted(all, TransitionClassifier(result.weights),
+                                 options.calibration_rows, options.train.seed, options.threads);
         CalibrateStage1(accepted, options.stage1_recall, &result.weights);
         result.calibration_accepts = static_cast<int64_t>(accepted.size());
       }
     }
     if (options.stage1_recall > 0) {
-      training["stage1_calibration"] = {{"target_recall_of_stage2", options.stage1_recall},
-                                        {"refitted_as_filter", result.stage2_calibrated},
-                                        {"stage2_accepted_pairs_sampled", result.calibration_accepts},
-                                        {"sampled_rows", options.calibration_rows},
-                                        {"candidates_per_sprite", result.stage1.candidates_per_sprite},
-                                        {"bias_from_labels", result.stage1_bias_from_labels},
-                                        {"bias", result.weights.stage1_bias}};
+      training["stage1_calibration"] = {
+          {"target_recall_of_stage2", options.stage1_recall},
+          {"refitted_as_filter", result.stage2_calibrated},
+          {"stage2_accepted_pairs_sampled", result.calibration_accepts},
+          {"sampled_rows", options.calibration_rows},
+          {"candidates_per_sprite", result.stage1.candidates_per_sprite},
+          {"bias_from_labels", result.stage1_bias_from_labels},
+          {"bias", result.weights.stage1_bias}};
     }
   }
   result.weights.training_json = training.dump();
@@ -135,8 +138,9 @@ std::unordered_map<int64_t, std::vector<TruthRow>> ReadSubjects(const std::strin
     }
     throw InputError(path, "no column '" + name + "' in the header");
   };
-  const size_t c_ts = column("timestamp_ns"), c_x = column("x"), c_y = column("y"), c_heading = column("heading_rad"),
-               c_phase = column("gait_phase"), c_pose = column("pose");
+  const size_t c_ts = column("timestamp_ns"), c_x = column("x"), c_y = column("y"),
+               c_heading = column("heading_rad"), c_phase = column("gait_phase"),
+               c_pose = column("pose");
   std::unordered_map<int64_t, std::vector<TruthRow>> rows;
   int line_number = 1;
   while (std::getline(in, line)) {
@@ -144,8 +148,9 @@ std::unordered_map<int64_t, std::vector<TruthRow>> ReadSubjects(const std::strin
     if (line.empty()) continue;
     const std::vector<std::string> f = SplitCsv(line);
     if (f.size() < header.size()) {
-      throw InputError(path + ":" + std::to_string(line_number), "expected " + std::to_string(header.size()) +
-                                                                      " fields, got " + std::to_string(f.size()));
+      throw InputError(
+          path + ":" + std::to_string(line_number),
+          "expected " + std::to_string(header.size()) + " fields, got " + std::to_string(f.size()));
     }
     try {
       TruthRow r;
@@ -156,7 +161,8 @@ std::unordered_map<int64_t, std::vector<TruthRow>> ReadSubjects(const std::strin
       r.truth.pose = f[c_pose];
       rows[std::stoll(f[c_ts])].push_back(r);
     } catch (const std::logic_error&) {
-      throw InputError(path + ":" + std::to_string(line_number), "a number does not parse: '" + line + "'");
+      throw InputError(path + ":" + std::to_string(line_number),
+                       "a number does not parse: '" + line + "'");
     }
   }
   return rows;
@@ -170,8 +176,9 @@ std::string Normal(const std::string& p) {
 
 }  // namespace
 
-TruthLabelSummary LabelBankFromTruth(const std::string& session_dir, const std::string& bank_path, size_t count,
-                                     const TruthLabelOptions& options, uint64_t seed) {
+TruthLabelSummary LabelBankFromTruth(const std::string& session_dir, const std::string& bank_path,
+                                     size_t count, const TruthLabelOptions& options,
+                                     uint64_t seed) {
   const auto subjects = ReadSubjects((fs::path(session_dir) / "truth" / "subjects.csv").string());
   const Bank bank(bank_path);
   // The bank's record of this session: by its source directory, else the only session.
@@ -182,8 +189,9 @@ TruthLabelSummary LabelBankFromTruth(const std::string& session_dir, const std::
   }
   if (session_id == 0 && sessions.size() == 1) {
     session_id = sessions[0].id;
-    Log("pipeline.transitions")->warn("{}: its one session came from '{}', not '{}'; matching by timestamps", bank_path,
-                                      sessions[0].source, session_dir);
+    Log("pipeline.transitions")
+        ->warn("{}: its one session came from '{}', not '{}'; matching by timestamps", bank_path,
+               sessions[0].source, session_dir);
   }
   if (session_id == 0) {
     throw InputError(bank_path, "holds no session ingested from '" + session_dir + "' (" +
@@ -226,10 +234,11 @@ TruthLabelSummary LabelBankFromTruth(const std::string& session_dir, const std::
     truth.push_back(best->truth);
   }
   if (ids.size() < 2) {
-    throw InputError(bank_path, std::to_string(ids.size()) + " sprites of session '" + session_dir +
-                                    "' match its truth (by timestamp and ground position within 0.15 m; " +
-                                    std::to_string(summary.sprites_unmatched) +
-                                    " do not): at least two are needed to make labels");
+    throw InputError(bank_path,
+                     std::to_string(ids.size()) + " sprites of session '" + session_dir +
+                         "' match its truth (by timestamp and ground position within 0.15 m; " +
+                         std::to_string(summary.sprites_unmatched) +
+                         " do not): at least two are needed to make labels");
   }
   summary.labels = LabelsFromTruth(ids, truth, count, options, seed);
   summary.positive_rate = TruthPositiveRate(truth, options, 2000, seed);

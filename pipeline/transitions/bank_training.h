@@ -13,8 +13,9 @@ namespace ss {
 
 struct BankTrainOptions {
   TrainOptions train;
-  ComparisonWindow window;     // the pixel features' window (recorded in the weights)
-  double stage1_recall = 0.999;  // of stage-2 accepts stage 1 must pass in the sample (0 = keep the label fit)
+  ComparisonWindow window;  // the pixel features' window (recorded in the weights)
+  double stage1_recall =
+      0.999;  // of stage-2 accepts stage 1 must pass in the sample (0 = keep the label fit)
   // Share of all sprite pairs that are true transitions; < 0: the labels file's
   // "# positive_rate=" line; none there: stage 2 keeps the label fit's (50/50) bias.
   double positive_rate = -1;
@@ -24,20 +25,20 @@ struct BankTrainOptions {
 
 struct BankTrainResult {
   TransitionWeights weights;
-  TrainReport report;  // cross-validated precision/recall of both stages on the labels
+  TrainReport report;               // cross-validated precision/recall of both stages on the labels
   int64_t calibration_accepts = 0;  // stage-2 accepted pairs the stage-1 bias was set on
   double stage1_bias_from_labels = 0;
-  bool stage2_calibrated = false;   // a positive rate was known
+  bool stage2_calibrated = false;  // a positive rate was known
   Stage2Calibration stage2;
-  Stage1Calibration stage1;         // when stage2_calibrated and stage1_recall > 0
+  Stage1Calibration stage1;  // when stage2_calibrated and stage1_recall > 0
 };
 
 // Trains both stages on the labelled pairs of `bank_path`'s sprites. With a positive rate
 // (options or the labels file) stage 2's threshold is then set for it on a brute-force
 // sample of the bank (CalibrateStage2) and stage 1 refitted as its filter
 // (FitStage1Filter); without one, only the stage-1 bias is set so that stage 1 passes
-// `stage1_recall` of what stage 2 accepts on the bank. InputError naming the labels file or the bank for an
-// unknown sprite, too few labels or one class only.
+// `stage1_recall` of what stage 2 accepts on the bank. InputError naming the labels file or the
+// bank for an unknown sprite, too few labels or one class only.
 BankTrainResult TrainOnBank(const std::string& labels_path, const std::string& bank_path,
                             const BankTrainOptions& options);
 
@@ -53,7 +54,7 @@ struct TruthLabelSummary {
 // the bank (matched by timestamp, then by nearest subject within 0.15 m). Mirrored
 // sprites are left out (their truth heading depends on the camera). InputError naming
 // the session or the bank when the truth is missing or no sprite matches.
-TruthLabelSummary LabelBankFromTruth(const std::string& session_dir, const std::string& bank_path, size_t count,
-                                     const TruthLabelOptions& options, uint64_t seed);
+TruthLabelSummary LabelBankFromTruth(const std::string& session_dir, const std::string& bank_path,
+                                     size_t count, const TruthLabelOptions& options, uint64_t seed);
 
 }  // namespace ss

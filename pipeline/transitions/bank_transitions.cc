@@ -44,7 +44,8 @@ std::vector<TransitionRecord> ToRecords(const std::vector<Transition>& transitio
 }
 
 StoreResult StoreTransitionTable(BankWriter& bank, const std::vector<Transition>& transitions,
-                                 const std::string& fingerprint, const std::unordered_set<int64_t>& sprites) {
+                                 const std::string& fingerprint,
+                                 const std::unordered_set<int64_t>& sprites) {
   StoreResult r;
   std::vector<TransitionRecord> existing = bank.LoadTransitions();  // sorted by (from, to)
   // Transitions of sprites outside the set (e.g. of clips still being written) stay as they are.
@@ -58,18 +59,21 @@ StoreResult StoreTransitionTable(BankWriter& bank, const std::vector<Transition>
   // Merge the two sorted lists.
   size_t a = 0, b = 0;
   while (a < existing.size() || b < transitions.size()) {
-    const bool take_old = b == transitions.size() ||
-                          (a < existing.size() && std::pair(existing[a].from_sprite, existing[a].to_sprite) <
-                                                      std::pair(transitions[b].from, transitions[b].to));
-    const bool take_new = a == existing.size() ||
-                          (b < transitions.size() && std::pair(transitions[b].from, transitions[b].to) <
-                                                         std::pair(existing[a].from_sprite, existing[a].to_sprite));
+    const bool take_old =
+        b == transitions.size() ||
+        (a < existing.size() && std::pair(existing[a].from_sprite, existing[a].to_sprite) <
+                                    std::pair(transitions[b].from, transitions[b].to));
+    const bool take_new =
+        a == existing.size() ||
+        (b < transitions.size() && std::pair(transitions[b].from, transitions[b].to) <
+                                       std::pair(existing[a].from_sprite, existing[a].to_sprite));
     if (take_old) {
       ++r.removed;
       ++a;
     } else if (take_new) {
       ++r.added;
-      write.push_back({transitions[b].from, transitions[b].to, transitions[b].distance, transitions[b].cost});
+      write.push_back(
+          {transitions[b].from, transitions[b].to, transitions[b].distance, transitions[b].cost});
       ++b;
     } else {
       const Transition& t = transitions[b];
@@ -94,11 +98,13 @@ StoreResult StoreTransitionTable(BankWriter& bank, const std::vector<Transition>
   return r;
 }
 
-BankUpdateSummary UpdateBankTransitions(const std::string& bank_path, const BankUpdateOptions& options) {
+BankUpdateSummary UpdateBankTransitions(const std::string& bank_path,
+                                        const BankUpdateOptions& options) {
   auto log = Log("pipeline.transitions");
   BankUpdateSummary s;
   s.bank = bank_path;
-  const TransitionClassifier check(options.weights);  // InputError for invalid weights, before any work
+  const TransitionClassifier check(
+      options.weights);  // InputError for invalid weights, before any work
   {
     // Read-only first: a missing file or a non-bank is an InputError, never a new bank.
     const Bank probe(bank_path);
@@ -114,8 +120,10 @@ BankUpdateSummary UpdateBankTransitions(const std::string& bank_path, const Bank
   s.sprites = static_cast<int64_t>(sprites.inputs.size());
   s.clips = sprites.clips;
   if (sprites.inputs.empty()) {
-    throw InputError(bank_path, "the bank holds no sprites in complete clips: there is nothing to find transitions "
-                                "between (ingest a session first)");
+    throw InputError(
+        bank_path,
+        "the bank holds no sprites in complete clips: there is nothing to find transitions "
+        "between (ingest a session first)");
   }
   t = std::chrono::steady_clock::now();
   TransitionBuilder real(options.weights, sprites.px_per_m);
@@ -130,17 +138,19 @@ BankUpdateSummary UpdateBankTransitions(const std::string& bank_path, const Bank
   s.build = real.stats();
   s.transitions = static_cast<int64_t>(transitions.size());
   if (s.clips == 1) {
-    s.notes.push_back("the bank has one clip: its transitions only jump within it (and its mirror)");
+    s.notes.push_back(
+        "the bank has one clip: its transitions only jump within it (and its mirror)");
   }
   if (s.transitions == 0) {
-    s.notes.push_back("no transitions found: the clips share no similar frames under these weights");
+    s.notes.push_back(
+        "no transitions found: the clips share no similar frames under these weights");
   }
   t = std::chrono::steady_clock::now();
   const std::unordered_set<int64_t> universe(sprites.ids.begin(), sprites.ids.end());
   s.store = StoreTransitionTable(bank, transitions, WeightsFingerprint(options.weights), universe);
   s.seconds_store = SecondsSince(t);
-  log->info("{}: {} sprites, {} transitions ({} added, {} changed, {} removed{})", bank_path, s.sprites,
-            s.transitions, s.store.added, s.store.changed, s.store.removed,
+  log->info("{}: {} sprites, {} transitions ({} added, {} changed, {} removed{})", bank_path,
+            s.sprites, s.transitions, s.store.added, s.store.changed, s.store.removed,
             s.store.replaced_all ? ", table replaced" : "");
   return s;
 }
@@ -168,22 +178,26 @@ std::string BankUpdateSummary::ToJson() const {
 std::string BankUpdateSummary::ToText() const {
   std::string out;
   char line[512];
-  std::snprintf(line, sizeof(line), "%s: %lld sprites in %lld clips\n", bank.c_str(), static_cast<long long>(sprites),
-                static_cast<long long>(clips));
+  std::snprintf(line, sizeof(line), "%s: %lld sprites in %lld clips\n", bank.c_str(),
+                static_cast<long long>(sprites), static_cast<long long>(clips));
   out += line;
   const double all_pairs = 0.5 * static_cast<double>(sprites) * (static_cast<double>(sprites) - 1);
-  std::snprintf(line, sizeof(line),
-                "  stage-1 candidates %lld, stage-2 evaluations %lld of %.0f pairs, kept pairs %lld\n",
-                static_cast<long long>(build.stage1_candidates), static_cast<long long>(build.stage2_evaluations),
-                all_pairs, static_cast<long long>(build.kept_pairs));
+  std::snprintf(
+      line, sizeof(line),
+      "  stage-1 candidates %lld, stage-2 evaluations %lld of %.0f pairs, kept pairs %lld\n",
+      static_cast<long long>(build.stage1_candidates),
+      static_cast<long long>(build.stage2_evaluations), all_pairs,
+      static_cast<long long>(build.kept_pairs));
   out += line;
-  std::snprintf(line, sizeof(line), "  transitions %lld: %lld added, %lld changed, %lld unchanged, %lld removed%s\n",
+  std::snprintf(line, sizeof(line),
+                "  transitions %lld: %lld added, %lld changed, %lld unchanged, %lld removed%s\n",
                 static_cast<long long>(transitions), static_cast<long long>(store.added),
                 static_cast<long long>(store.changed), static_cast<long long>(store.unchanged),
-                static_cast<long long>(store.removed), store.replaced_all ? " (table replaced)" : "");
+                static_cast<long long>(store.removed),
+                store.replaced_all ? " (table replaced)" : "");
   out += line;
-  std::snprintf(line, sizeof(line), "  time: load %.2f s, build %.2f s, store %.2f s\n", seconds_load, seconds_build,
-                seconds_store);
+  std::snprintf(line, sizeof(line), "  time: load %.2f s, build %.2f s, store %.2f s\n",
+                seconds_load, seconds_build, seconds_store);
   out += line;
   for (const std::string& n : notes) out += "  note: " + n + "\n";
   return out;

@@ -32,7 +32,8 @@ struct StoreResult {
 // with weights `fingerprint`: writes only the differences when the table was made with
 // the same weights and nothing must go; else clears the table and writes everything.
 StoreResult StoreTransitionTable(BankWriter& bank, const std::vector<Transition>& transitions,
-                                 const std::string& fingerprint, const std::unordered_set<int64_t>& sprites);
+                                 const std::string& fingerprint,
+                                 const std::unordered_set<int64_t>& sprites);
 
 std::vector<TransitionRecord> ToRecords(const std::vector<Transition>& transitions);
 
@@ -57,6 +58,7 @@ struct BankUpdateSummary {
 
 // Finds the transitions of every sprite of the complete clips of `bank_path` and stores
 // them. InputError naming the bank when it is missing, not a bank, or holds no sprites.
-BankUpdateSummary UpdateBankTransitions(const std::string& bank_path, const BankUpdateOptions& options);
+BankUpdateSummary UpdateBankTransitions(const std::string& bank_path,
+                                        const BankUpdateOptions& options);
 
 }  // namespace ss

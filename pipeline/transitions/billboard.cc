@@ -9,8 +9,8 @@ namespace ss {
 
 void ValidateBillboard(const RgbaBillboard& b) {
   if (b.width <= 0 || b.height <= 0) {
-    throw InputError("billboard", "size " + std::to_string(b.width) + "x" + std::to_string(b.height) +
-                                      " is empty");
+    throw InputError("billboard", "size " + std::to_string(b.width) + "x" +
+                                      std::to_string(b.height) + " is empty");
   }
   if (b.rgba.size() != static_cast<size_t>(b.width) * b.height * 4) {
     throw InputError("billboard", "holds " + std::to_string(b.rgba.size()) + " bytes, expected " +
@@ -18,11 +18,13 @@ void ValidateBillboard(const RgbaBillboard& b) {
                                       " for RGBA " + std::to_string(b.width) + "x" +
                                       std::to_string(b.height));
   }
-  const bool inside = std::isfinite(b.anchor_x_px) && std::isfinite(b.anchor_y_px) && b.anchor_x_px >= -0.5 &&
-                      b.anchor_x_px <= b.width - 0.5 && b.anchor_y_px >= -0.5 && b.anchor_y_px <= b.height - 0.5;
+  const bool inside = std::isfinite(b.anchor_x_px) && std::isfinite(b.anchor_y_px) &&
+                      b.anchor_x_px >= -0.5 && b.anchor_x_px <= b.width - 0.5 &&
+                      b.anchor_y_px >= -0.5 && b.anchor_y_px <= b.height - 0.5;
   if (!inside) {
     throw InputError("billboard", "anchor (" + std::to_string(b.anchor_x_px) + ", " +
-                                      std::to_string(b.anchor_y_px) + ") lies outside the billboard");
+                                      std::to_string(b.anchor_y_px) +
+                                      ") lies outside the billboard");
   }
 }
 

@@ -22,7 +22,9 @@ struct RgbaBillboard {
   double anchor_y_px = 0;
   std::vector<uint8_t> rgba;  // width * height * 4 bytes: R, G, B, A (or B, G, R, A)
 
-  const uint8_t* Pixel(int x, int y) const { return rgba.data() + (static_cast<size_t>(y) * width + x) * 4; }
+  const uint8_t* Pixel(int x, int y) const {
+    return rgba.data() + (static_cast<size_t>(y) * width + x) * 4;
+  }
 };
 
 // The four cheap features of one sprite (precomputed once, compared many times).

@@ -22,7 +22,8 @@ double SecondsSince(std::chrono::steady_clock::time_point start) {
 TransitionBuilder::TransitionBuilder(const TransitionWeights& weights, double px_per_m)
     : classifier_(weights), store_(weights.window, px_per_m), index_(classifier_) {}
 
-const TransitionBuilder::Neighbour* TransitionBuilder::Find(const std::vector<Neighbour>& list, int32_t index) {
+const TransitionBuilder::Neighbour* TransitionBuilder::Find(const std::vector<Neighbour>& list,
+                                                            int32_t index) {
   auto it = std::lower_bound(list.begin(), list.end(), index,
                              [](const Neighbour& n, int32_t i) { return n.index < i; });
   return it != list.end() && it->index == index ? &*it : nullptr;
@@ -40,8 +41,11 @@ double TransitionBuilder::KeptDistance(int32_t i, int32_t j) const {
   return n ? n->distance : -1.0;
 }
 
-void TransitionBuilder::BuildFromScratch(std::span<const SpriteInput> sprites, const BuildOptions& options) {
-  if (sprites.empty()) throw InputError("sprites", "the set is empty: there are no sprites to find transitions between");
+void TransitionBuilder::BuildFromScratch(std::span<const SpriteInput> sprites,
+                                         const BuildOptions& options) {
+  if (sprites.empty())
+    throw InputError("sprites",
+                     "the set is empty: there are no sprites to find transitions between");
   auto log = Log("pipeline.transitions");
   store_.Clear();
   neighbours_.clear();
@@ -115,7 +119,8 @@ void TransitionBuilder::BuildFromScratch(std::span<const SpriteInput> sprites, c
     neighbours_[f.j].push_back({f.i, f.distance});
   }
   for (auto& list : neighbours_) {
-    std::sort(list.begin(), list.end(), [](const Neighbour& a, const Neighbour& b) { return a.index < b.index; });
+    std::sort(list.begin(), list.end(),
+              [](const Neighbour& a, const Neighbour& b) { return a.index < b.index; });
   }
   stats_.seconds_pairs = SecondsSince(start);
   stats_.sprites = n;
@@ -128,9 +133,11 @@ void TransitionBuilder::BuildFromScratch(std::span<const SpriteInput> sprites, c
     stats_.notes.push_back("one clip: every transition stays inside it");
     log->warn("the sprite set has one clip: every transition stays inside it");
   }
-  log->info("{} sprites in {} clips: {} stage-1 candidates, {} stage-2 evaluations, {} kept pairs ({:.2f} s)", n,
-            stats_.clips, stats_.stage1_candidates, stats_.stage2_evaluations, stats_.kept_pairs,
-            stats_.seconds_images + stats_.seconds_index + stats_.seconds_pairs);
+  log->info(
+      "{} sprites in {} clips: {} stage-1 candidates, {} stage-2 evaluations, {} kept pairs "
+      "({:.2f} s)",
+      n, stats_.clips, stats_.stage1_candidates, stats_.stage2_evaluations, stats_.kept_pairs,
+      stats_.seconds_images + stats_.seconds_index + stats_.seconds_pairs);
 }
 
 TransitionDelta TransitionBuilder::Add(std::span<const SpriteInput> sprites) {
@@ -160,7 +167,8 @@ TransitionDelta TransitionBuilder::Add(std::span<const SpriteInput> sprites) {
       const int64_t a = store_.id(s), b = store_.id(j);
       delta.pairs.push_back({std::min(a, b), std::max(a, b), d});
     }
-    std::sort(mine.begin(), mine.end(), [](const Neighbour& a, const Neighbour& b) { return a.index < b.index; });
+    std::sort(mine.begin(), mine.end(),
+              [](const Neighbour& a, const Neighbour& b) { return a.index < b.index; });
     stats_.kept_pairs += static_cast<int64_t>(mine.size());
     // New transitions: out of the clip end that s extends, and into s.
     const int32_t p = store_.prev(s);
@@ -195,7 +203,7 @@ TransitionDelta TransitionBuilder::AddPairsOf(int32_t first, int32_t end) {
       if (h + 8 < hits.size()) store_.PrefetchCoarse(hits[h + 8]);
       const int32_t j = hits[h];
       if (j == s || (j >= first && j < end && j > s)) continue;  // within the range: each pair once
-      if (Find(neighbours_[s], j)) continue;                       // found by an earlier unit here
+      if (Find(neighbours_[s], j)) continue;                     // found by an earlier unit here
       if (classifier_.SignatureRejects(store_, s, j)) {
         ++stats_.signature_rejected;
         continue;
@@ -215,7 +223,9 @@ TransitionDelta TransitionBuilder::AddPairsOf(int32_t first, int32_t end) {
     TransitionsInto(i, &delta.transitions);
   }
   std::sort(delta.transitions.begin(), delta.transitions.end(),
-            [](const Transition& a, const Transition& b) { return a.from != b.from ? a.from < b.from : a.to < b.to; });
+            [](const Transition& a, const Transition& b) {
+              return a.from != b.from ? a.from < b.from : a.to < b.to;
+            });
   delta.transitions.erase(std::unique(delta.transitions.begin(), delta.transitions.end(),
                                       [](const Transition& a, const Transition& b) {
                                         return a.from == b.from && a.to == b.to;
@@ -231,7 +241,7 @@ void TransitionBuilder::TransitionsFrom(int32_t i, std::vector<Transition>* out)
   for (const Neighbour& n : neighbours_[successor]) {  // {i+1, j} kept
     const int32_t j = n.index;
     const int32_t before_j = store_.prev(j);
-    if (before_j < 0) continue;  // j is a clip's first frame: no j-1
+    if (before_j < 0) continue;               // j is a clip's first frame: no j-1
     const Neighbour* direct = Find(mine, j);  // {i, j} kept (never true for j == i)
     if (!direct) continue;
     if (const Neighbour* m = Find(mine, before_j)) {  // {i, j-1} kept
@@ -273,8 +283,9 @@ std::vector<KeptPair> TransitionBuilder::KeptPairs() const {
 std::vector<Transition> TransitionBuilder::Transitions() const {
   std::vector<Transition> out;
   for (int32_t i = 0; i < store_.size(); ++i) TransitionsFrom(i, &out);
-  std::sort(out.begin(), out.end(),
-            [](const Transition& x, const Transition& y) { return std::tie(x.from, x.to) < std::tie(y.from, y.to); });
+  std::sort(out.begin(), out.end(), [](const Transition& x, const Transition& y) {
+    return std::tie(x.from, x.to) < std::tie(y.from, y.to);
+  });
   return out;
 }
 

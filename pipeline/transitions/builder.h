@@ -42,7 +42,8 @@ struct TransitionDelta {
 
 struct BuildOptions {
   int threads = 2;
-  std::function<void(size_t done, size_t total)> progress;  // called from worker threads, serialized
+  std::function<void(size_t done, size_t total)>
+      progress;  // called from worker threads, serialized
 };
 
 struct BuildStats {
@@ -80,8 +81,8 @@ class TransitionBuilder {
   // is the table a single builder makes.
   TransitionDelta AddPairsOf(int32_t first, int32_t end);
 
-  std::vector<KeptPair> KeptPairs() const;       // sorted by (sprite_a, sprite_b)
-  std::vector<Transition> Transitions() const;   // sorted by (from, to)
+  std::vector<KeptPair> KeptPairs() const;      // sorted by (sprite_a, sprite_b)
+  std::vector<Transition> Transitions() const;  // sorted by (from, to)
   int64_t TransitionCount() const;
 
   const SpriteStore& store() const { return store_; }

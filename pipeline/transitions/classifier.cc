@@ -38,7 +38,8 @@ double AlphaFeature(uint64_t alpha_abs_diff, const CellBox& a, const CellBox& b)
 bool TransitionClassifier::SignatureRejects(const SpriteStore& store, int32_t i, int32_t j) const {
   const CheapDifference cheap = CheapDiff(store.cheap(i), store.cheap(j));
   if (linf()) {
-    return cheap[0] > weights_.linf_max_velocity_mps || store.SignatureLinfExceeds(i, j, linf_alpha_limit_);
+    return cheap[0] > weights_.linf_max_velocity_mps ||
+           store.SignatureLinfExceeds(i, j, linf_alpha_limit_);
   }
   if (colour_blob()) return cheap[0] > weights_.colour_blob_max_velocity_mps;
   // d is Distance()'s prefix, and the alpha feature is monotone in its numerator, so
@@ -51,13 +52,16 @@ bool TransitionClassifier::SignatureRejects(const SpriteStore& store, int32_t i,
   return d + u2_[4] * AlphaFeature(store.SignatureAlphaBound(i, j), box_i, box_j) > t2_;
 }
 
-bool TransitionClassifier::Stage2(const SpriteStore& store, int32_t i, int32_t j, double* distance) const {
+bool TransitionClassifier::Stage2(const SpriteStore& store, int32_t i, int32_t j,
+                                  double* distance) const {
   const CheapDifference cheap = CheapDiff(store.cheap(i), store.cheap(j));
   if (linf()) {
     if (cheap[0] > weights_.linf_max_velocity_mps) return false;
-    const int worst = MaxAlphaDifference(store.image(i), store.image(j), store.window().PlaneStride());
+    const int worst =
+        MaxAlphaDifference(store.image(i), store.image(j), store.window().PlaneStride());
     if (worst > linf_alpha_limit_) return false;
-    *distance = std::max(cheap[0] / weights_.linf_max_velocity_mps, worst / (255.0 * weights_.linf_max_alpha));
+    *distance = std::max(cheap[0] / weights_.linf_max_velocity_mps,
+                         worst / (255.0 * weights_.linf_max_alpha));
     return true;
   }
   if (colour_blob()) {
@@ -76,8 +80,9 @@ bool TransitionClassifier::Stage2(const SpriteStore& store, int32_t i, int32_t j
   const int stride = store.window().PlaneStride();
   const double alpha = AlphaFeature(SumAlphaDifference(a, b, stride), store.box(i), store.box(j));
   if (d + u2_[4] * alpha > t2_) return false;
-  const PairFeatures x = MakePairFeatures(cheap, PixelDifferenceFromSums(SumPixelDifferences(a, b, stride),
-                                                                         store.box(i), store.box(j)));
+  const PairFeatures x = MakePairFeatures(
+      cheap,
+      PixelDifferenceFromSums(SumPixelDifferences(a, b, stride), store.box(i), store.box(j)));
   const double full = Distance(x);
   if (full > t2_) return false;
   *distance = full;

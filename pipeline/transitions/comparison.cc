@@ -17,8 +17,10 @@ bool ComparisonWindow::IsValid(std::string* why) const {
     if (why) *why = reason;
     return false;
   };
-  if (!(width_m > 0) || !std::isfinite(width_m)) return fail("width_m must be a positive number of metres");
-  if (!(height_m > 0) || !std::isfinite(height_m)) return fail("height_m must be a positive number of metres");
+  if (!(width_m > 0) || !std::isfinite(width_m))
+    return fail("width_m must be a positive number of metres");
+  if (!(height_m > 0) || !std::isfinite(height_m))
+    return fail("height_m must be a positive number of metres");
   if (cells_x < 1 || cells_y < 1) return fail("cells_x and cells_y must be at least 1");
   if (Cells() > 4096) return fail("cells_x * cells_y must be at most 4096");
   return true;
@@ -37,7 +39,8 @@ struct Overlap {
   int pixel;
   double weight;  // overlap length in pixels
 };
-std::vector<std::vector<Overlap>> AxisOverlaps(double start_px, double cell_px, int cells, int pixels) {
+std::vector<std::vector<Overlap>> AxisOverlaps(double start_px, double cell_px, int cells,
+                                               int pixels) {
   std::vector<std::vector<Overlap>> out(cells);
   for (int c = 0; c < cells; ++c) {
     const double lo = start_px + c * cell_px, hi = lo + cell_px;
@@ -103,7 +106,8 @@ CellBox MakeComparisonImage(const RgbaBillboard& b, double px_per_m, const Compa
         }
       }
       for (int u = 0; u < window.cells_x; ++u) {
-        for (int k = 0; k < 4; ++k) cell_sums[(v * window.cells_x + u) * 4 + k] += ry.weight * row_sums[u * 4 + k];
+        for (int k = 0; k < 4; ++k)
+          cell_sums[(v * window.cells_x + u) * 4 + k] += ry.weight * row_sums[u * 4 + k];
       }
     }
   }
@@ -120,7 +124,8 @@ CellBox MakeComparisonImage(const RgbaBillboard& b, double px_per_m, const Compa
       if (alpha <= 0) continue;
       plane_a[cell] = static_cast<uint8_t>(std::min(255L, alpha));
       for (int c = 0; c < 3; ++c) {
-        plane_rgb[c][cell] = static_cast<uint8_t>(std::clamp(std::lround(s[1 + c] / s[0]), 0L, 255L));
+        plane_rgb[c][cell] =
+            static_cast<uint8_t>(std::clamp(std::lround(s[1 + c] / s[0]), 0L, 255L));
       }
       box.x0 = std::min<int16_t>(box.x0, u);
       box.y0 = std::min<int16_t>(box.y0, v);
@@ -224,8 +229,9 @@ Kernel ChooseKernel() { return __builtin_cpu_supports("avx2") ? &SumAvx2 : &SumS
 uint64_t AlphaSse2(const uint8_t* a, const uint8_t* b, int stride) {
   __m128i sad = _mm_setzero_si128();
   for (int k = 0; k < stride; k += 16) {
-    sad = _mm_add_epi64(sad, _mm_sad_epu8(_mm_loadu_si128(reinterpret_cast<const __m128i*>(a + k)),
-                                          _mm_loadu_si128(reinterpret_cast<const __m128i*>(b + k))));
+    sad =
+        _mm_add_epi64(sad, _mm_sad_epu8(_mm_loadu_si128(reinterpret_cast<const __m128i*>(a + k)),
+                                        _mm_loadu_si128(reinterpret_cast<const __m128i*>(b + k))));
   }
   alignas(16) uint64_t s64[2];
   _mm_store_si128(reinterpret_cast<__m128i*>(s64), sad);
@@ -234,8 +240,9 @@ uint64_t AlphaSse2(const uint8_t* a, const uint8_t* b, int stride) {
 __attribute__((target("avx2"))) uint64_t AlphaAvx2(const uint8_t* a, const uint8_t* b, int stride) {
   __m256i sad = _mm256_setzero_si256();
   for (int k = 0; k < stride; k += 32) {
-    sad = _mm256_add_epi64(sad, _mm256_sad_epu8(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(a + k)),
-                                                _mm256_loadu_si256(reinterpret_cast<const __m256i*>(b + k))));
+    sad = _mm256_add_epi64(
+        sad, _mm256_sad_epu8(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(a + k)),
+                             _mm256_loadu_si256(reinterpret_cast<const __m256i*>(b + k))));
   }
   alignas(32) uint64_t s64[4];
   _mm256_store_si256(reinterpret_cast<__m256i*>(s64), sad);
@@ -254,14 +261,16 @@ uint64_t SumAlphaDifference(const uint8_t* a, const uint8_t* b, int stride) {
 int MaxAlphaDifference(const uint8_t* a, const uint8_t* b, int stride) {
   uint8_t worst = 0;  // a plain loop the compiler vectorizes (max of |a - b| on bytes)
   for (int k = 0; k < stride; ++k) {
-    const uint8_t d = a[k] > b[k] ? static_cast<uint8_t>(a[k] - b[k]) : static_cast<uint8_t>(b[k] - a[k]);
+    const uint8_t d =
+        a[k] > b[k] ? static_cast<uint8_t>(a[k] - b[k]) : static_cast<uint8_t>(b[k] - a[k]);
     worst = std::max(worst, d);
   }
   return worst;
 }
 
 int LargestColourBlob(const uint8_t* a, const uint8_t* b, const ComparisonWindow& window) {
-  const int w = window.cells_x, h = window.cells_y, n = window.Cells(), stride = window.PlaneStride();
+  const int w = window.cells_x, h = window.cells_y, n = window.Cells(),
+            stride = window.PlaneStride();
   std::vector<uint8_t> mark(n, 0);
   int marked = 0;
   for (int k = 0; k < n; ++k) {
@@ -303,7 +312,8 @@ PixelSums SumPixelDifferences(const uint8_t* a, const uint8_t* b, int stride) {
   return kernel(a, b, stride);
 }
 
-PixelDifference PixelDifferenceFromSums(const PixelSums& s, const CellBox& box_a, const CellBox& box_b) {
+PixelDifference PixelDifferenceFromSums(const PixelSums& s, const CellBox& box_a,
+                                        const CellBox& box_b) {
   PixelDifference d;
   const int area = BoxArea(UnionBox(box_a, box_b));
   d.alpha = area > 0 ? static_cast<double>(s.alpha_abs_diff) / (255.0 * area) : 0.0;

@@ -49,8 +49,8 @@ inline int BoxArea(const CellBox& b) { return b.empty() ? 0 : (b.x1 - b.x0) * (b
 // cell alpha = mean alpha over the cell, cell colour = alpha-weighted mean colour.
 // Writes window.ImageBytes() bytes at `image` (planes A, R, G, B; padding zeroed);
 // returns the box of non-zero alpha cells.
-CellBox MakeComparisonImage(const RgbaBillboard& billboard, double px_per_m, const ComparisonWindow& window,
-                            uint8_t* image);
+CellBox MakeComparisonImage(const RgbaBillboard& billboard, double px_per_m,
+                            const ComparisonWindow& window, uint8_t* image);
 
 // The two stage-2 pixel features of a sprite pair.
 struct PixelDifference {
@@ -74,10 +74,12 @@ uint64_t SumAlphaDifference(const uint8_t* image_a, const uint8_t* image_b, int 
 int MaxAlphaDifference(const uint8_t* image_a, const uint8_t* image_b, int stride);
 // The colour_blob stage 2's pixel feature: the most cells in one 4-connected blob of cells
 // opaque in both (A >= 128) whose colours differ by |dR| + |dG| + |dB| >= 90. Symmetric.
-int LargestColourBlob(const uint8_t* image_a, const uint8_t* image_b, const ComparisonWindow& window);
+int LargestColourBlob(const uint8_t* image_a, const uint8_t* image_b,
+                      const ComparisonWindow& window);
 // Plain loop, the reference the SIMD kernels are tested against.
 PixelSums SumPixelDifferencesScalar(const uint8_t* image_a, const uint8_t* image_b, int stride);
 // The features from the sums and the two alpha boxes.
-PixelDifference PixelDifferenceFromSums(const PixelSums& sums, const CellBox& box_a, const CellBox& box_b);
+PixelDifference PixelDifferenceFromSums(const PixelSums& sums, const CellBox& box_a,
+                                        const CellBox& box_b);
 
 }  // namespace ss

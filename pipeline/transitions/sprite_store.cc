@@ -74,7 +74,8 @@ void SpriteStore::ComputeSignature(int32_t i) {
   constexpr int kBlocks = kSignatureGrid * kSignatureGrid;
   const int cx = window_.cells_x, cy = window_.cells_y;
   for (int v = 0; v < cy; ++v) {
-    const int block_row = v * kSignatureGrid / cy, coarse_row = v * 4 / cy, band = v * kSignatureBands / cy;
+    const int block_row = v * kSignatureGrid / cy, coarse_row = v * 4 / cy,
+              band = v * kSignatureBands / cy;
     for (int u = 0; u < cx; ++u) {
       const uint32_t a = alpha[v * cx + u];
       coarse[coarse_row * 4 + u * 4 / cx] += a;
@@ -83,8 +84,10 @@ void SpriteStore::ComputeSignature(int32_t i) {
       sig[kBlocks + kSignatureBands + u * kSignatureBands / cx] += a;
     }
   }
-  for (int k = 0; k < kCoarseBlocks; ++k) coarse_[i][k] = static_cast<uint16_t>(std::min(coarse[k], kSignatureMax));
-  for (int k = 0; k < kSignatureValues; ++k) signature_[i][k] = static_cast<uint16_t>(std::min(sig[k], kSignatureMax));
+  for (int k = 0; k < kCoarseBlocks; ++k)
+    coarse_[i][k] = static_cast<uint16_t>(std::min(coarse[k], kSignatureMax));
+  for (int k = 0; k < kSignatureValues; ++k)
+    signature_[i][k] = static_cast<uint16_t>(std::min(sig[k], kSignatureMax));
 }
 
 namespace {
@@ -96,7 +99,8 @@ inline __m128i AbsDifferenceSums(const uint16_t* a, const uint16_t* b, int vecto
   for (int k = 0; k < vectors; ++k) {
     const __m128i x = _mm_load_si128(reinterpret_cast<const __m128i*>(a) + k);
     const __m128i y = _mm_load_si128(reinterpret_cast<const __m128i*>(b) + k);
-    const __m128i d = _mm_or_si128(_mm_subs_epu16(x, y), _mm_subs_epu16(y, x));  // <= 32767: a valid int16
+    const __m128i d =
+        _mm_or_si128(_mm_subs_epu16(x, y), _mm_subs_epu16(y, x));  // <= 32767: a valid int16
     sum = _mm_add_epi32(sum, _mm_madd_epi16(d, ones));
   }
   return sum;
@@ -118,9 +122,10 @@ uint64_t SpriteStore::SignatureAlphaBound(int32_t i, int32_t j) const {
   const uint16_t* a = signature_[i].data();
   const uint16_t* b = signature_[j].data();
   const uint64_t blocks = HorizontalSum(AbsDifferenceSums(a, b, kBlocks / 8));
-  const uint64_t rows = HorizontalSum(AbsDifferenceSums(a + kBlocks, b + kBlocks, kSignatureBands / 8));
-  const uint64_t cols = HorizontalSum(
-      AbsDifferenceSums(a + kBlocks + kSignatureBands, b + kBlocks + kSignatureBands, kSignatureBands / 8));
+  const uint64_t rows =
+      HorizontalSum(AbsDifferenceSums(a + kBlocks, b + kBlocks, kSignatureBands / 8));
+  const uint64_t cols = HorizontalSum(AbsDifferenceSums(
+      a + kBlocks + kSignatureBands, b + kBlocks + kSignatureBands, kSignatureBands / 8));
   return std::max({blocks, rows, cols});
 }
 
@@ -184,7 +189,8 @@ int32_t SpriteStore::Append(std::span<const SpriteInput> sprites, int threads) {
       for (size_t k = begin; k < end; ++k) {
         const int32_t i = first + static_cast<int32_t>(k);
         try {
-          boxes_[i] = MakeComparisonImage(*sprites[k].billboard, px_per_m_, window_, mutable_image(i));
+          boxes_[i] =
+              MakeComparisonImage(*sprites[k].billboard, px_per_m_, window_, mutable_image(i));
           ComputeSignature(i);
         } catch (...) {
           std::lock_guard<std::mutex> lock(error_mutex);
@@ -193,7 +199,8 @@ int32_t SpriteStore::Append(std::span<const SpriteInput> sprites, int threads) {
       }
     }
   };
-  const int workers = std::clamp(threads, 1, static_cast<int>(std::max<size_t>(1, sprites.size() / 256)));
+  const int workers =
+      std::clamp(threads, 1, static_cast<int>(std::max<size_t>(1, sprites.size() / 256)));
   std::vector<std::thread> pool;
   for (int t = 1; t < workers; ++t) pool.emplace_back(work);
   work();

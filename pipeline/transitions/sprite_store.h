@@ -37,12 +37,15 @@ class SpriteStore {
 
   int64_t id(int32_t i) const { return ids_[i]; }
   int64_t clip(int32_t i) const { return clips_[i]; }
-  int32_t prev(int32_t i) const { return prev_[i]; }  // predecessor in its clip, -1 for a first frame
+  int32_t prev(int32_t i) const {
+    return prev_[i];
+  }  // predecessor in its clip, -1 for a first frame
   int32_t next(int32_t i) const { return next_[i]; }  // successor in its clip, -1 for a last frame
   const CheapFeatures& cheap(int32_t i) const { return cheap_[i]; }
   const std::vector<CheapFeatures>& all_cheap() const { return cheap_; }
   const uint8_t* image(int32_t i) const {
-    return chunks_[i >> kChunkShift].get() + static_cast<size_t>(i & (kChunkSize - 1)) * image_bytes_;
+    return chunks_[i >> kChunkShift].get() +
+           static_cast<size_t>(i & (kChunkSize - 1)) * image_bytes_;
   }
   const CellBox& box(int32_t i) const { return boxes_[i]; }
   // The silhouette signature (docs/transitions.md "Silhouette signature"): the alpha plane
@@ -73,7 +76,8 @@ class SpriteStore {
   double px_per_m() const { return px_per_m_; }
 
   PixelDifference Pixels(int32_t i, int32_t j) const {
-    return PixelDifferenceFromSums(SumPixelDifferences(image(i), image(j), window_.PlaneStride()), box(i), box(j));
+    return PixelDifferenceFromSums(SumPixelDifferences(image(i), image(j), window_.PlaneStride()),
+                                   box(i), box(j));
   }
   PairFeatures Features(int32_t i, int32_t j) const {
     return MakePairFeatures(CheapDiff(cheap(i), cheap(j)), Pixels(i, j));
@@ -85,7 +89,8 @@ class SpriteStore {
   // Fills coarse_[i] and signature_[i] from the alpha plane of image(i).
   void ComputeSignature(int32_t i);
   uint8_t* mutable_image(int32_t i) {
-    return chunks_[i >> kChunkShift].get() + static_cast<size_t>(i & (kChunkSize - 1)) * image_bytes_;
+    return chunks_[i >> kChunkShift].get() +
+           static_cast<size_t>(i & (kChunkSize - 1)) * image_bytes_;
   }
 
   ComparisonWindow window_;
@@ -99,7 +104,7 @@ class SpriteStore {
   struct alignas(64) Signature : std::array<uint16_t, kSignatureValues> {};
   std::vector<Coarse> coarse_;
   std::vector<Signature> signature_;
-  std::array<uint32_t, kCoarseBlocks> coarse_cells_{};       // cells in each level-1 part
+  std::array<uint32_t, kCoarseBlocks> coarse_cells_{};        // cells in each level-1 part
   std::array<uint32_t, kSignatureValues> signature_cells_{};  // cells in each level-2 part
   std::vector<std::unique_ptr<uint8_t[]>> chunks_;
   std::unordered_map<int64_t, int32_t> index_of_;

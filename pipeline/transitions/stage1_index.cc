@@ -10,8 +10,9 @@ Stage1Index::Stage1Index(const TransitionClassifier& classifier)
 
 Stage1Index::Point Stage1Index::Scaled(const CheapFeatures& f) const {
   const CheapDifference& u = classifier_.stage1_unit_weights();
-  return {u[0] * f.velocity_x_mps, u[0] * f.velocity_y_mps, u[1] * f.colour[0], u[1] * f.colour[1],
-          u[1] * f.colour[2],       u[2] * f.area_m2,       u[3] * f.eccentricity};
+  return {u[0] * f.velocity_x_mps, u[0] * f.velocity_y_mps, u[1] * f.colour[0],
+          u[1] * f.colour[1],      u[1] * f.colour[2],      u[2] * f.area_m2,
+          u[3] * f.eccentricity};
 }
 
 void Stage1Index::Build(std::span<const CheapFeatures> points) {
@@ -21,7 +22,8 @@ void Stage1Index::Build(std::span<const CheapFeatures> points) {
   max_abs_coordinate_ = 0;
   for (const CheapFeatures& f : raw_) {
     scaled_.push_back(Scaled(f));
-    for (double c : scaled_.back()) max_abs_coordinate_ = std::max(max_abs_coordinate_, std::abs(c));
+    for (double c : scaled_.back())
+      max_abs_coordinate_ = std::max(max_abs_coordinate_, std::abs(c));
   }
   Rebuild();
 }

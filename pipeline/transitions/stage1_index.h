@@ -49,10 +49,10 @@ class Stage1Index {
 
   TransitionClassifier classifier_;
   double threshold_;
-  double slack_ = 0;  // pruning tolerance for rounding (decisions never use it)
-  std::vector<CheapFeatures> raw_;  // by index
-  std::vector<Point> scaled_;       // by index
-  std::vector<int32_t> order_;      // tree points, leaf ranges contiguous
+  double slack_ = 0;                     // pruning tolerance for rounding (decisions never use it)
+  std::vector<CheapFeatures> raw_;       // by index
+  std::vector<Point> scaled_;            // by index
+  std::vector<int32_t> order_;           // tree points, leaf ranges contiguous
   std::vector<CheapFeatures> tree_raw_;  // raw_ in order_ order (sequential leaf scans)
   std::vector<Node> nodes_;
   double max_abs_coordinate_ = 0;

@@ -10,9 +10,9 @@ namespace ss {
 
 namespace {
 
-constexpr double kWidthM = 0.22;   // billboard size (metres)
+constexpr double kWidthM = 0.22;  // billboard size (metres)
 constexpr double kHeightM = 0.17;
-constexpr int kSuper = 2;          // supersampling per axis
+constexpr int kSuper = 2;  // supersampling per axis
 
 using Rgb = std::array<double, 3>;
 
@@ -28,15 +28,21 @@ class Canvas {
     covered_.assign(static_cast<size_t>(w_) * h_, 0);
   }
   // Paints every sample whose centre lies in the ellipse; colour may depend on (x, z).
-  void Ellipse(double cx, double cz, double ax, double az, const std::function<Rgb(double, double)>& colour) {
+  void Ellipse(double cx, double cz, double ax, double az,
+               const std::function<Rgb(double, double)>& colour) {
     if (ax <= 0 || az <= 0) return;
-    Span(cx - ax, cz - az, cx + ax, cz + az, [&](double x, double z) {
-      const double u = (x - cx) / ax, v = (z - cz) / az;
-      return u * u + v * v <= 1.0;
-    }, colour);
+    Span(
+        cx - ax, cz - az, cx + ax, cz + az,
+        [&](double x, double z) {
+          const double u = (x - cx) / ax, v = (z - cz) / az;
+          return u * u + v * v <= 1.0;
+        },
+        colour);
   }
   void Rect(double x0, double z0, double x1, double z1, const Rgb& colour) {
-    Span(x0, z0, x1, z1, [](double, double) { return true; }, [&](double, double) { return colour; });
+    Span(
+        x0, z0, x1, z1, [](double, double) { return true; },
+        [&](double, double) { return colour; });
   }
   RgbaBillboard Resolve(std::mt19937_64& rng, int noise) const {
     RgbaBillboard b;
@@ -58,7 +64,9 @@ class Canvas {
         }
         if (count == 0) continue;
         uint8_t* p = b.rgba.data() + (static_cast<size_t>(y) * b.width + x) * 4;
-        for (int c = 0; c < 3; ++c) p[c] = static_cast<uint8_t>(std::clamp(std::lround(sum[c] / count) + jitter(rng), 0L, 255L));
+        for (int c = 0; c < 3; ++c)
+          p[c] =
+              static_cast<uint8_t>(std::clamp(std::lround(sum[c] / count) + jitter(rng), 0L, 255L));
         p[3] = static_cast<uint8_t>(count * 255 / (kSuper * kSuper));
       }
     }
@@ -84,7 +92,8 @@ class Canvas {
   }
 
  private:
-  void Span(double x0, double z0, double x1, double z1, const std::function<bool(double, double)>& inside,
+  void Span(double x0, double z0, double x1, double z1,
+            const std::function<bool(double, double)>& inside,
             const std::function<Rgb(double, double)>& colour) {
     const int sx0 = std::max(0, static_cast<int>(std::floor((x0 + kWidthM / 2) * scale_)));
     const int sx1 = std::min(w_ - 1, static_cast<int>(std::ceil((x1 + kWidthM / 2) * scale_)));
@@ -109,14 +118,16 @@ class Canvas {
   std::vector<uint8_t> covered_;
 };
 
-Rgb Shade(const Rgb& c, double brightness) { return {c[0] * brightness, c[1] * brightness, c[2] * brightness}; }
+Rgb Shade(const Rgb& c, double brightness) {
+  return {c[0] * brightness, c[1] * brightness, c[2] * brightness};
+}
 
 struct State {
   std::string pose = "walk";
-  double heading = 0;     // radians; the camera looks along +y, so sin(heading) < 0 faces it
-  double turn_rate = 0;   // radians per frame
-  double speed = 0.08;    // m/s
-  double phase = 0;       // cycles of the pose's motion: the gait, the idle sniff, the standing sway
+  double heading = 0;    // radians; the camera looks along +y, so sin(heading) < 0 faces it
+  double turn_rate = 0;  // radians per frame
+  double speed = 0.08;   // m/s
+  double phase = 0;      // cycles of the pose's motion: the gait, the idle sniff, the standing sway
   double brightness = 1;
   double size = 1;
 };
@@ -136,7 +147,8 @@ Geometry Layout(const State& s) {
   Geometry g;
   const double c = std::cos(s.heading), sn = std::sin(s.heading), k = s.size;
   const bool gait = s.pose == "walk" || s.pose == "trot";
-  const double stretch = gait ? (s.pose == "trot" ? 0.12 : 0.06) * std::sin(4 * M_PI * s.phase) : 0.0;
+  const double stretch =
+      gait ? (s.pose == "trot" ? 0.12 : 0.06) * std::sin(4 * M_PI * s.phase) : 0.0;
   double head_f;
   if (s.pose == "stand") {
     // Standing up, swaying: the head circles once per cycle.
@@ -219,7 +231,8 @@ std::vector<std::pair<HeadPiece, EllipseShape>> HeadShapes(const Geometry& g, co
   }
   if (facing) {
     out.push_back({HeadPiece::kFace,
-                   {head_x + 0.5 * r * c, head_z - 0.25 * r, 0.6 * r * (0.4 + 0.6 * std::abs(sn)), 0.45 * r}});
+                   {head_x + 0.5 * r * c, head_z - 0.25 * r, 0.6 * r * (0.4 + 0.6 * std::abs(sn)),
+                    0.45 * r}});
   }
   const double eye_x = head_x + 0.45 * r * c;
   if (facing || std::abs(c) > 0.3) {
@@ -236,7 +249,8 @@ std::vector<int> PaintOrder(const Geometry& g) {
   for (int l = 0; l < legs; ++l) parts.push_back({g.legs[l].depth, l});
   parts.push_back({0.0, legs});
   parts.push_back({g.head_depth, legs + 1});
-  std::stable_sort(parts.begin(), parts.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
+  std::stable_sort(parts.begin(), parts.end(),
+                   [](const auto& a, const auto& b) { return a.first > b.first; });
   std::vector<int> order;
   for (const auto& p : parts) order.push_back(p.second);
   return order;
@@ -249,7 +263,8 @@ std::vector<int> PaintOrder(const Geometry& g) {
 // extreme behind the head, a foot behind a nearer leg.
 std::vector<double> Keypoints(const State& s, std::vector<uint8_t>* visible) {
   const Geometry g = Layout(s);
-  std::vector<double> p = {g.head_x, g.head_z, g.body_ax, g.body_z, -g.body_ax, g.body_z, 0.0, g.body_z + g.body_az};
+  std::vector<double> p = {g.head_x,   g.head_z, g.body_ax, g.body_z,
+                           -g.body_ax, g.body_z, 0.0,       g.body_z + g.body_az};
   for (const Geometry::Leg& l : g.legs) {
     p.push_back(l.x);
     p.push_back(l.lift);
@@ -309,24 +324,24 @@ RgbaBillboard Render(const State& s, double px_per_m, std::mt19937_64& rng, int 
   }
   const EllipseShape body_shape = BodyShape(g);
   parts.push_back([&canvas, body_shape, body_z, fur, belly, stripe] {
-                     const double body_az = body_shape.az;
-                     canvas.Ellipse(body_shape.cx, body_shape.cz, body_shape.ax, body_shape.az,
-                                    [=](double, double z) {
-                                      if (z < body_z - 0.45 * body_az) return belly;
-                                      if (z > body_z + 0.7 * body_az) return stripe;
-                                      return fur;
-                                    });
+    const double body_az = body_shape.az;
+    canvas.Ellipse(body_shape.cx, body_shape.cz, body_shape.ax, body_shape.az,
+                   [=](double, double z) {
+                     if (z < body_z - 0.45 * body_az) return belly;
+                     if (z > body_z + 0.7 * body_az) return stripe;
+                     return fur;
                    });
+  });
   const auto head_shapes = HeadShapes(g, s);
   parts.push_back([=, &canvas] {
-                     for (const auto& [piece, e] : head_shapes) {
-                       const Rgb colour = piece == HeadPiece::kHead  ? fur
-                                          : piece == HeadPiece::kEar ? ear
-                                          : piece == HeadPiece::kFace ? face
-                                                                      : eye;
-                       canvas.Ellipse(e.cx, e.cz, e.ax, e.az, [=](double, double) { return colour; });
-                     }
-                   });
+    for (const auto& [piece, e] : head_shapes) {
+      const Rgb colour = piece == HeadPiece::kHead   ? fur
+                         : piece == HeadPiece::kEar  ? ear
+                         : piece == HeadPiece::kFace ? face
+                                                     : eye;
+      canvas.Ellipse(e.cx, e.cz, e.ax, e.az, [=](double, double) { return colour; });
+    }
+  });
   for (int part : PaintOrder(g)) parts[part]();
   return canvas.Resolve(rng, noise);
 }
@@ -358,8 +373,9 @@ std::vector<SyntheticSprite> MakeSyntheticSprites(const SyntheticSpriteOptions& 
   int64_t clip = 0;
   while (static_cast<int>(out.size()) < o.frames) {
     ++clip;
-    const int length = std::min(o.frames - static_cast<int>(out.size()),
-                                std::uniform_int_distribution<int>(o.min_clip_frames, o.max_clip_frames)(rng));
+    const int length =
+        std::min(o.frames - static_cast<int>(out.size()),
+                 std::uniform_int_distribution<int>(o.min_clip_frames, o.max_clip_frames)(rng));
     State s;
     s.pose = PickPose(rng);
     s.heading = uniform(rng) * 2 * M_PI;
@@ -377,7 +393,8 @@ std::vector<SyntheticSprite> MakeSyntheticSprites(const SyntheticSpriteOptions& 
         s.heading = std::remainder(s.heading + s.turn_rate, 2 * M_PI);
         const double target = PoseSpeed(s.pose);
         s.speed = std::max(0.0, s.speed + 0.1 * (target - s.speed) + 0.004 * normal(rng));
-        const double hz = gait ? s.speed / (s.pose == "trot" ? 0.10 : 0.07) : (s.pose == "idle" ? 0.7 : 0.4);
+        const double hz =
+            gait ? s.speed / (s.pose == "trot" ? 0.10 : 0.07) : (s.pose == "idle" ? 0.7 : 0.4);
         s.phase = std::fmod(s.phase + hz / o.fps, 1.0);
         s.brightness = std::clamp(s.brightness + 0.001 * normal(rng), 0.95, 1.05);
       }
@@ -389,8 +406,10 @@ std::vector<SyntheticSprite> MakeSyntheticSprites(const SyntheticSpriteOptions& 
       sprite.cheap = DescribeBillboard(sprite.billboard, o.px_per_m);
       const double moving = gait ? s.speed : 0.0;
       sprite.speed_mps = moving;
-      sprite.cheap.velocity_x_mps = moving * std::cos(s.heading) + o.velocity_noise_mps * normal(rng);
-      sprite.cheap.velocity_y_mps = moving * std::sin(s.heading) + o.velocity_noise_mps * normal(rng);
+      sprite.cheap.velocity_x_mps =
+          moving * std::cos(s.heading) + o.velocity_noise_mps * normal(rng);
+      sprite.cheap.velocity_y_mps =
+          moving * std::sin(s.heading) + o.velocity_noise_mps * normal(rng);
       sprite.truth.pose = s.pose;
       sprite.truth.heading_rad = s.heading;
       sprite.truth.gait_phase = s.phase;

@@ -2,9 +2,9 @@
 // A synthetic sprite set for tests and the "transitions" benchmark: clips of a
 // hamster-like animal whose truth (pose, heading, speed, gait phase, lighting) follows
 // a random walk (every pose has a motion cycle: the gait, an idle sniff, a standing
-// sway; its phase is the truth's gait_phase), rendered into small RGBA billboards at a fixed px_per_m with the
-// cheap features computed from them, plus the horizontally mirrored clips.
-// (The full studio renderer is synth/; this one only needs to exercise transitions.)
+// sway; its phase is the truth's gait_phase), rendered into small RGBA billboards at a fixed
+// px_per_m with the cheap features computed from them, plus the horizontally mirrored clips. (The
+// full studio renderer is synth/; this one only needs to exercise transitions.)
 #include <cstdint>
 #include <vector>
 
@@ -15,7 +15,7 @@
 namespace ss {
 
 struct SyntheticSpriteOptions {
-  int frames = 15000;       // originals; mirrors double the count
+  int frames = 15000;  // originals; mirrors double the count
   bool mirrors = true;
   double px_per_m = 250;
   double fps = 30;

@@ -37,7 +37,8 @@ std::vector<Label> ReadLabelsCsv(const std::string& path, double* positive_rate)
         try {
           size_t used = 0;
           const double rate = std::stod(line.substr(key.size()), &used);
-          if (used != line.size() - key.size() || !(rate > 0 && rate < 1)) throw std::invalid_argument("range");
+          if (used != line.size() - key.size() || !(rate > 0 && rate < 1))
+            throw std::invalid_argument("range");
           if (positive_rate) *positive_rate = rate;
         } catch (const std::exception&) {
           throw InputError(where, "positive_rate must be a number in (0, 1): '" + line + "'");
@@ -48,7 +49,8 @@ std::vector<Label> ReadLabelsCsv(const std::string& path, double* positive_rate)
     if (line.empty()) continue;
     if (!header_seen) {
       if (line != "sprite_i,sprite_j,accept") {
-        throw InputError(where, "expected the header 'sprite_i,sprite_j,accept', got '" + line + "'");
+        throw InputError(where,
+                         "expected the header 'sprite_i,sprite_j,accept', got '" + line + "'");
       }
       header_seen = true;
       continue;
@@ -56,7 +58,8 @@ std::vector<Label> ReadLabelsCsv(const std::string& path, double* positive_rate)
     std::stringstream ss(line);
     std::string fields[3], extra;
     for (auto& f : fields) {
-      if (!std::getline(ss, f, ',')) throw InputError(where, "expected 3 comma-separated fields: '" + line + "'");
+      if (!std::getline(ss, f, ','))
+        throw InputError(where, "expected 3 comma-separated fields: '" + line + "'");
     }
     if (std::getline(ss, extra, ',')) throw InputError(where, "more than 3 fields: '" + line + "'");
     Label label;
@@ -83,7 +86,8 @@ std::vector<Label> ReadLabelsCsv(const std::string& path, double* positive_rate)
   return labels;
 }
 
-void WriteLabelsCsv(const std::vector<Label>& labels, const std::string& path, double positive_rate) {
+void WriteLabelsCsv(const std::vector<Label>& labels, const std::string& path,
+                    double positive_rate) {
   std::ofstream out(path, std::ios::trunc);
   if (!out) throw WorkError(path, "cannot open for writing");
   if (positive_rate >= 0) {
@@ -92,7 +96,8 @@ void WriteLabelsCsv(const std::vector<Label>& labels, const std::string& path, d
     out << text;
   }
   out << "sprite_i,sprite_j,accept\n";
-  for (const Label& l : labels) out << l.sprite_i << ',' << l.sprite_j << ',' << (l.accept ? 1 : 0) << '\n';
+  for (const Label& l : labels)
+    out << l.sprite_i << ',' << l.sprite_j << ',' << (l.accept ? 1 : 0) << '\n';
   out.close();
   if (!out) throw WorkError(path, "write failed");
 }
@@ -102,7 +107,9 @@ void WriteLabelsCsv(const std::vector<Label>& labels, const std::string& path, d
 namespace {
 
 double Softplus(double s) { return s > 0 ? s + std::log1p(std::exp(-s)) : std::log1p(std::exp(s)); }
-double Sigmoid(double s) { return s >= 0 ? 1.0 / (1.0 + std::exp(-s)) : std::exp(s) / (1.0 + std::exp(s)); }
+double Sigmoid(double s) {
+  return s >= 0 ? 1.0 / (1.0 + std::exp(-s)) : std::exp(s) / (1.0 + std::exp(s));
+}
 
 struct Problem {
   std::span<const double> z;
@@ -150,7 +157,8 @@ struct Problem {
         next[a] = 0;
         for (int b = 0; b < d; ++b) next[a] += m[a * d + b] * v[b];
       }
-      const double norm = std::sqrt(std::inner_product(next.begin(), next.end(), next.begin(), 0.0));
+      const double norm =
+          std::sqrt(std::inner_product(next.begin(), next.end(), next.begin(), 0.0));
       if (norm == 0) break;
       lambda = norm;
       for (int a = 0; a < d; ++a) v[a] = next[a] / norm;
@@ -202,7 +210,8 @@ LinearModel FitLogistic(std::span<const double> z, int dims, std::span<const uin
       for (int k = 0; k <= dims; ++k) y[k] = x[k] + (t - 1.0) / t_next * (x[k] - x_prev[k]);
       t = t_next;
     }
-    const bool small = std::abs(previous_loss - loss) <= options.tolerance * std::max(1.0, std::abs(loss));
+    const bool small =
+        std::abs(previous_loss - loss) <= options.tolerance * std::max(1.0, std::abs(loss));
     stalls = small ? stalls + 1 : 0;
     previous_loss = loss;
     if (stalls >= 20) break;
@@ -260,8 +269,9 @@ Standardization Standardize(std::span<const PairFeatures> x, std::span<const siz
 }
 
 // Fits one stage on the first `dims` features of `rows`.
-LinearModel FitStage(std::span<const PairFeatures> x, std::span<const uint8_t> accept, std::span<const size_t> rows,
-                     const Standardization& s, int dims, const LogisticOptions& options) {
+LinearModel FitStage(std::span<const PairFeatures> x, std::span<const uint8_t> accept,
+                     std::span<const size_t> rows, const Standardization& s, int dims,
+                     const LogisticOptions& options) {
   std::vector<double> z(rows.size() * dims);
   std::vector<uint8_t> y(rows.size());
   for (size_t r = 0; r < rows.size(); ++r) {
@@ -287,18 +297,21 @@ void Count(Confusion* c, bool predicted, bool truth) {
 }  // namespace
 
 TransitionWeights TrainWeights(std::span<const PairFeatures> x, std::span<const uint8_t> accept,
-                               const ComparisonWindow& window, const TrainOptions& options, TrainReport* report) {
+                               const ComparisonWindow& window, const TrainOptions& options,
+                               TrainReport* report) {
   const size_t n = x.size();
   if (accept.size() != n) throw WorkError("TrainWeights: features and labels disagree");
   const int folds = std::max(2, options.folds);
   size_t accepts = 0;
   for (uint8_t a : accept) accepts += a ? 1 : 0;
   if (n < static_cast<size_t>(2 * folds)) {
-    throw InputError("labels", std::to_string(n) + " labelled pairs; at least " + std::to_string(2 * folds) +
-                                   " are needed for " + std::to_string(folds) + "-fold cross-validation");
+    throw InputError("labels", std::to_string(n) + " labelled pairs; at least " +
+                                   std::to_string(2 * folds) + " are needed for " +
+                                   std::to_string(folds) + "-fold cross-validation");
   }
   if (accepts == 0 || accepts == n) {
-    throw InputError("labels", std::string("every labelled pair is ") + (accepts == 0 ? "a reject" : "an accept") +
+    throw InputError("labels", std::string("every labelled pair is ") +
+                                   (accepts == 0 ? "a reject" : "an accept") +
                                    ": both classes are needed");
   }
   TrainReport local;
@@ -312,7 +325,8 @@ TransitionWeights TrainWeights(std::span<const PairFeatures> x, std::span<const 
   std::shuffle(order.begin(), order.end(), rng);
   for (int f = 0; f < folds; ++f) {
     std::vector<size_t> train, test;
-    for (size_t r = 0; r < n; ++r) (static_cast<int>(r % folds) == f ? test : train).push_back(order[r]);
+    for (size_t r = 0; r < n; ++r)
+      (static_cast<int>(r % folds) == f ? test : train).push_back(order[r]);
     const Standardization s = Standardize(x, train);
     const LinearModel m1 = FitStage(x, accept, train, s, kCheapFeatureCount, options.logistic);
     const LinearModel m2 = FitStage(x, accept, train, s, kPairFeatureCount, options.logistic);
@@ -342,8 +356,9 @@ TransitionWeights TrainWeights(std::span<const PairFeatures> x, std::span<const 
 
 // ---- stage 1 as a filter for stage 2 ----
 
-std::vector<CheapDifference> SampleStage2Accepted(const SpriteStore& store, const TransitionClassifier& classifier,
-                                                  int rows, uint64_t seed, int threads) {
+std::vector<CheapDifference> SampleStage2Accepted(const SpriteStore& store,
+                                                  const TransitionClassifier& classifier, int rows,
+                                                  uint64_t seed, int threads) {
   const int32_t n = store.size();
   std::vector<int32_t> sample(n);
   std::iota(sample.begin(), sample.end(), 0);
@@ -360,7 +375,8 @@ std::vector<CheapDifference> SampleStage2Accepted(const SpriteStore& store, cons
       for (int32_t j = 0; j < n; ++j) {
         if (j == i) continue;
         const PairFeatures f = store.Features(i, j);
-        if (classifier.Stage2Accepts(classifier.Distance(f))) local.push_back({f[0], f[1], f[2], f[3]});
+        if (classifier.Stage2Accepts(classifier.Distance(f)))
+          local.push_back({f[0], f[1], f[2], f[3]});
       }
     }
     std::lock_guard<std::mutex> lock(mutex);
@@ -373,8 +389,8 @@ std::vector<CheapDifference> SampleStage2Accepted(const SpriteStore& store, cons
   return out;
 }
 
-PopulationSample SamplePopulation(const SpriteStore& store, const TransitionClassifier& classifier, int rows,
-                                  uint64_t seed, int threads) {
+PopulationSample SamplePopulation(const SpriteStore& store, const TransitionClassifier& classifier,
+                                  int rows, uint64_t seed, int threads) {
   PopulationSample out;
   const int32_t n = store.size();
   out.sprites = n;
@@ -407,25 +423,31 @@ namespace {
 // The stage-2 threshold t2 = sum_k u2_k mean_k - b (TransitionClassifier), solved for b.
 void SetStage2Threshold(double threshold, TransitionWeights* w) {
   double at_zero = 0;
-  for (int k = 0; k < kPairFeatureCount; ++k) at_zero += w->stage2_weights[k] / w->feature_scale[k] * w->feature_mean[k];
+  for (int k = 0; k < kPairFeatureCount; ++k)
+    at_zero += w->stage2_weights[k] / w->feature_scale[k] * w->feature_mean[k];
   w->stage2_bias = at_zero - threshold;
 }
 
 }  // namespace
 
-Stage2Calibration CalibrateStage2(std::span<const double> positive_distances, const PopulationSample& sample,
-                                  double positive_rate, TransitionWeights* w) {
-  if (positive_distances.empty()) throw InputError("labels", "no accepted pair: stage 2 cannot be calibrated");
+Stage2Calibration CalibrateStage2(std::span<const double> positive_distances,
+                                  const PopulationSample& sample, double positive_rate,
+                                  TransitionWeights* w) {
+  if (positive_distances.empty())
+    throw InputError("labels", "no accepted pair: stage 2 cannot be calibrated");
   if (!(positive_rate > 0 && positive_rate < 1)) {
-    throw InputError("labels", "the positive rate must be in (0, 1), got " + std::to_string(positive_rate));
+    throw InputError("labels",
+                     "the positive rate must be in (0, 1), got " + std::to_string(positive_rate));
   }
-  if (sample.rows.empty() || sample.sprites < 2) throw InputError("sprites", "no sample to calibrate stage 2 on");
+  if (sample.rows.empty() || sample.sprites < 2)
+    throw InputError("sprites", "no sample to calibrate stage 2 on");
   std::vector<double> positives(positive_distances.begin(), positive_distances.end());
   std::sort(positives.begin(), positives.end());
   // Only the smallest distances can matter: at most a few times the expected positives.
   const double pairs = sample.pairs();
   const double expected_true = positive_rate * pairs;
-  const size_t keep = std::min<size_t>(sample.distance.size(), static_cast<size_t>(20 * expected_true) + 1000);
+  const size_t keep =
+      std::min<size_t>(sample.distance.size(), static_cast<size_t>(20 * expected_true) + 1000);
   std::vector<float> d(sample.distance.begin(), sample.distance.end());
   std::nth_element(d.begin(), d.begin() + (keep - 1), d.end());
   d.resize(keep);
@@ -437,8 +459,10 @@ Stage2Calibration CalibrateStage2(std::span<const double> positive_distances, co
     if (!std::isfinite(d[k])) break;
     if (k + 1 < d.size() && d[k + 1] == d[k]) continue;  // the last of equal values
     const double t = d[k];
-    const double recall = static_cast<double>(std::upper_bound(positives.begin(), positives.end(), t) -
-                                              positives.begin()) / positives.size();
+    const double recall =
+        static_cast<double>(std::upper_bound(positives.begin(), positives.end(), t) -
+                            positives.begin()) /
+        positives.size();
     const double accepted = static_cast<double>(k + 1);
     const double precision = std::min(1.0, expected_true * recall / accepted);
     const double f1 = precision + recall > 0 ? 2 * precision * recall / (precision + recall) : 0.0;
@@ -450,14 +474,15 @@ Stage2Calibration CalibrateStage2(std::span<const double> positive_distances, co
       best.accepts_per_sprite = accepted / sample.rows.size();
     }
   }
-  if (best.threshold < 0) throw InputError("labels", "no stage-2 threshold accepts a labelled transition");
+  if (best.threshold < 0)
+    throw InputError("labels", "no stage-2 threshold accepts a labelled transition");
   // Nudge so that rounding keeps the chosen pairs inside.
   SetStage2Threshold(best.threshold + 1e-7 * (1.0 + std::abs(best.threshold)), w);
   return best;
 }
 
-Stage1Calibration FitStage1Filter(const SpriteStore& store, const PopulationSample& sample, double recall,
-                                  uint64_t seed, TransitionWeights* w) {
+Stage1Calibration FitStage1Filter(const SpriteStore& store, const PopulationSample& sample,
+                                  double recall, uint64_t seed, TransitionWeights* w) {
   const TransitionClassifier classifier(*w);
   const int32_t n = sample.sprites;
   std::mt19937_64 rng(seed);
@@ -468,7 +493,8 @@ Stage1Calibration FitStage1Filter(const SpriteStore& store, const PopulationSamp
   c.recall = recall;
   c.stage2_accepts = positives;
   if (positives == 0) return c;
-  const double negative_share = std::min(1.0, 20.0 * positives / std::max(1.0, sample.pairs() - positives));
+  const double negative_share =
+      std::min(1.0, 20.0 * positives / std::max(1.0, sample.pairs() - positives));
   std::bernoulli_distribution take(negative_share);
   std::vector<CheapDifference> x;
   std::vector<uint8_t> y;
@@ -505,14 +531,16 @@ Stage1Calibration FitStage1Filter(const SpriteStore& store, const PopulationSamp
   const TransitionClassifier filter(*w);
   int64_t candidates = 0;
   for (int32_t i : sample.rows) {
-    for (int32_t j = 0; j < n; ++j) candidates += j != i && filter.Stage1Accepts(store.cheap(i), store.cheap(j));
+    for (int32_t j = 0; j < n; ++j)
+      candidates += j != i && filter.Stage1Accepts(store.cheap(i), store.cheap(j));
   }
   c.candidates_per_sprite = static_cast<double>(candidates) / sample.rows.size();
   c.fewer_than_all = candidates > 0 ? sample.pairs() / candidates : INFINITY;
   return c;
 }
 
-double CalibrateStage1(std::span<const CheapDifference> accepted, double recall, TransitionWeights* w) {
+double CalibrateStage1(std::span<const CheapDifference> accepted, double recall,
+                       TransitionWeights* w) {
   const double previous = w->stage1_bias;
   if (accepted.empty()) return previous;
   std::vector<double> values;

@@ -21,7 +21,8 @@ double PhaseDifference(double a, double b) {
 }
 
 double KeypointDisplacement(const SpriteTruth& a, const SpriteTruth& b) {
-  if (a.keypoints_m.empty() || a.keypoints_m.size() != b.keypoints_m.size() || a.keypoints_m.size() % 2 != 0) {
+  if (a.keypoints_m.empty() || a.keypoints_m.size() != b.keypoints_m.size() ||
+      a.keypoints_m.size() % 2 != 0) {
     return INFINITY;
   }
   const size_t points = a.keypoints_m.size() / 2;
@@ -31,7 +32,8 @@ double KeypointDisplacement(const SpriteTruth& a, const SpriteTruth& b) {
   double worst = 0;
   for (size_t k = 0; k < a.keypoints_m.size(); k += 2) {
     if (!va.empty() && !vb.empty() && !va[k / 2] && !vb[k / 2]) continue;
-    worst = std::max(worst, std::hypot(a.keypoints_m[k] - b.keypoints_m[k], a.keypoints_m[k + 1] - b.keypoints_m[k + 1]));
+    worst = std::max(worst, std::hypot(a.keypoints_m[k] - b.keypoints_m[k],
+                                       a.keypoints_m[k + 1] - b.keypoints_m[k + 1]));
   }
   return worst;
 }
@@ -43,7 +45,8 @@ bool Within(const SpriteTruth& a, const SpriteTruth& b, const TruthLabelOptions&
   if (!a.keypoints_m.empty() && !b.keypoints_m.empty()) {
     return KeypointDisplacement(a, b) <= factor * o.max_keypoint_displacement_m;
   }
-  if (HeadingDifference(a.heading_rad, b.heading_rad) > factor * o.max_heading_difference_rad) return false;
+  if (HeadingDifference(a.heading_rad, b.heading_rad) > factor * o.max_heading_difference_rad)
+    return false;
   const bool a_gait = !std::isnan(a.gait_phase), b_gait = !std::isnan(b.gait_phase);
   if (a_gait != b_gait) return false;
   return !a_gait || PhaseDifference(a.gait_phase, b.gait_phase) <= factor * o.max_phase_difference;
@@ -55,8 +58,8 @@ bool TruthAccepts(const SpriteTruth& a, const SpriteTruth& b, const TruthLabelOp
   return Within(a, b, options, 1.0);
 }
 
-double TruthPositiveRate(std::span<const SpriteTruth> truth, const TruthLabelOptions& options, int rows,
-                         uint64_t seed) {
+double TruthPositiveRate(std::span<const SpriteTruth> truth, const TruthLabelOptions& options,
+                         int rows, uint64_t seed) {
   const size_t n = truth.size();
   if (n < 2) return 0.0;
   std::vector<size_t> sample(n);
@@ -73,8 +76,8 @@ double TruthPositiveRate(std::span<const SpriteTruth> truth, const TruthLabelOpt
   return positives / (static_cast<double>(sample.size()) * static_cast<double>(n - 1));
 }
 
-std::vector<Label> LabelsFromTruth(std::span<const int64_t> ids, std::span<const SpriteTruth> truth, size_t count,
-                                   const TruthLabelOptions& options, uint64_t seed) {
+std::vector<Label> LabelsFromTruth(std::span<const int64_t> ids, std::span<const SpriteTruth> truth,
+                                   size_t count, const TruthLabelOptions& options, uint64_t seed) {
   const size_t n = truth.size();
   if (ids.size() != n) throw WorkError("LabelsFromTruth: ids and truth disagree");
   if (n < 2) throw InputError("truth", "at least two sprites are needed to make labels");
@@ -87,12 +90,13 @@ std::vector<Label> LabelsFromTruth(std::span<const int64_t> ids, std::span<const
     labels.push_back({ids[i], ids[j], accept});
     return true;
   };
-  const size_t want_accepts = count / 2, want_near = static_cast<size_t>((count - want_accepts) *
-                                                                          options.near_miss_fraction);
+  const size_t want_accepts = count / 2,
+               want_near = static_cast<size_t>((count - want_accepts) * options.near_miss_fraction);
   // Accepts and near misses: scan all partners of random sprites.
   size_t accepts = 0, near = 0;
   std::vector<size_t> partners, misses;
-  for (size_t attempt = 0; attempt < 20 * count && (accepts < want_accepts || near < want_near); ++attempt) {
+  for (size_t attempt = 0; attempt < 20 * count && (accepts < want_accepts || near < want_near);
+       ++attempt) {
     const size_t i = pick(rng);
     partners.clear();
     misses.clear();
@@ -105,14 +109,17 @@ std::vector<Label> LabelsFromTruth(std::span<const int64_t> ids, std::span<const
       }
     }
     if (accepts < want_accepts && !partners.empty()) {
-      accepts += add(i, partners[std::uniform_int_distribution<size_t>(0, partners.size() - 1)(rng)], true);
+      accepts += add(
+          i, partners[std::uniform_int_distribution<size_t>(0, partners.size() - 1)(rng)], true);
     }
     if (near < want_near && !misses.empty()) {
-      near += add(i, misses[std::uniform_int_distribution<size_t>(0, misses.size() - 1)(rng)], false);
+      near +=
+          add(i, misses[std::uniform_int_distribution<size_t>(0, misses.size() - 1)(rng)], false);
     }
   }
   // Uniform random rejects for the rest.
-  for (size_t attempt = 0; attempt < 20 * count && labels.size() < accepts + (count - want_accepts); ++attempt) {
+  for (size_t attempt = 0; attempt < 20 * count && labels.size() < accepts + (count - want_accepts);
+       ++attempt) {
     const size_t i = pick(rng), j = pick(rng);
     if (!TruthAccepts(truth[i], truth[j], options)) add(i, j, false);
   }

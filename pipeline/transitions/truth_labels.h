@@ -19,8 +19,8 @@
 namespace ss {
 
 struct SpriteTruth {
-  std::string pose;                 // "walk", "trot", "idle", "stand", ...
-  double heading_rad = 0;           // facing direction on the ground
+  std::string pose;                  // "walk", "trot", "idle", "stand", ...
+  double heading_rad = 0;            // facing direction on the ground
   double gait_phase = std::nan("");  // cycles in [0, 1); NaN when the pose has no gait
   // Optional: key points as (x, z) pairs in the billboard plane, metres, x from the body
   // centre, z up from the floor; the same points in the same order per pose.
@@ -33,7 +33,8 @@ struct SpriteTruth {
 struct TruthLabelOptions {
   double max_heading_difference_rad = 6.0 * M_PI / 180.0;
   double max_phase_difference = 0.04;  // cycles, circular
-  double max_keypoint_displacement_m = 0.004;  // when both truths have key points (1 px at 250 px/m)
+  double max_keypoint_displacement_m =
+      0.004;  // when both truths have key points (1 px at 250 px/m)
   // Rejects sampled as near misses (same pose, heading and phase within `near_miss_factor`
   // times the tolerances) rather than uniformly; the rest are uniform random rejects.
   double near_miss_fraction = 0.5;
@@ -52,12 +53,12 @@ bool TruthAccepts(const SpriteTruth& a, const SpriteTruth& b, const TruthLabelOp
 
 // The share of sprite pairs the truth accepts, from `rows` random sprites against all
 // others (every pair when rows >= n): the prior stage 2 is calibrated for.
-double TruthPositiveRate(std::span<const SpriteTruth> truth, const TruthLabelOptions& options, int rows,
-                         uint64_t seed);
+double TruthPositiveRate(std::span<const SpriteTruth> truth, const TruthLabelOptions& options,
+                         int rows, uint64_t seed);
 
 // About `count` labelled pairs of distinct sprites: half accepts (as many as exist), half
 // rejects. `ids[k]` is the bank id of the sprite with truth `truth[k]`. Deterministic per seed.
-std::vector<Label> LabelsFromTruth(std::span<const int64_t> ids, std::span<const SpriteTruth> truth, size_t count,
-                                   const TruthLabelOptions& options, uint64_t seed);
+std::vector<Label> LabelsFromTruth(std::span<const int64_t> ids, std::span<const SpriteTruth> truth,
+                                   size_t count, const TruthLabelOptions& options, uint64_t seed);
 
 }  // namespace ss

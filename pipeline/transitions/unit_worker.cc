@@ -36,8 +36,9 @@ UnitWorker::UnitWorker(const std::string& bank, UnitWorkerOptions options)
   const std::string fingerprint = WeightsFingerprint(options_.weights);
   const std::optional<std::string> made_with = reader_.GetMeta(kTransitionWeightsMetaKey);
   if (made_with && *made_with != fingerprint && reader_.Counts().transitions > 0) {
-    throw InputError(reader_.path(), "its transitions were made with other weights (" + *made_with +
-                                         "); rebuild them with `spritestation transitions BANK` first");
+    throw InputError(reader_.path(),
+                     "its transitions were made with other weights (" + *made_with +
+                         "); rebuild them with `spritestation transitions BANK` first");
   }
   if (!made_with) writer_.SetMeta(kTransitionWeightsMetaKey, fingerprint);
 }
@@ -65,7 +66,8 @@ void UnitWorker::CatchUp() {
   for (size_t k = 0; k < clips.size(); ++k) {
     const int32_t index = first + static_cast<int32_t>(k);
     auto [it, fresh] = clip_range_.try_emplace(clips[k], index, index + 1);
-    if (!fresh) it->second.second = index + 1;  // a clip's sprites are one run (LoadFeatures' order)
+    if (!fresh)
+      it->second.second = index + 1;  // a clip's sprites are one run (LoadFeatures' order)
     if (fresh) ++stats_.clips_indexed;
   }
   stats_.sprites_indexed += static_cast<int64_t>(ids.size());
@@ -89,7 +91,8 @@ bool UnitWorker::RunOne() {
     return true;
   }
   auto t0 = std::chrono::steady_clock::now();
-  const int64_t evaluations = builder_->stats().stage2_evaluations, kept = builder_->stats().kept_pairs;
+  const int64_t evaluations = builder_->stats().stage2_evaluations,
+                kept = builder_->stats().kept_pairs;
   const TransitionDelta delta = builder_->AddPairsOf(range->second.first, range->second.second);
   stats_.seconds_pairs += SecondsSince(t0);
   stats_.stage2_evaluations += builder_->stats().stage2_evaluations - evaluations;
@@ -98,16 +101,18 @@ bool UnitWorker::RunOne() {
   t0 = std::chrono::steady_clock::now();
   const std::vector<TransitionRecord> records = ToRecords(delta.transitions);
   for (size_t i = 0; i < records.size(); i += kRowsPerTransaction) {
-    const auto end = records.begin() + static_cast<std::ptrdiff_t>(std::min(records.size(), i + kRowsPerTransaction));
-    writer_.UpsertTransitions(std::vector<TransitionRecord>(records.begin() + static_cast<std::ptrdiff_t>(i), end));
+    const auto end = records.begin() +
+                     static_cast<std::ptrdiff_t>(std::min(records.size(), i + kRowsPerTransaction));
+    writer_.UpsertTransitions(
+        std::vector<TransitionRecord>(records.begin() + static_cast<std::ptrdiff_t>(i), end));
   }
   queue_.Done(unit->clip_id);
   stats_.seconds_store += SecondsSince(t0);
   stats_.transitions += static_cast<int64_t>(records.size());
   ++stats_.units;
   Log("pipeline.transitions")
-      ->debug("{}: unit clip {} (seq {}, try {}): {} transitions", options_.name, unit->clip_id, unit->complete_seq,
-              unit->attempts, records.size());
+      ->debug("{}: unit clip {} (seq {}, try {}): {} transitions", options_.name, unit->clip_id,
+              unit->complete_seq, unit->attempts, records.size());
   return true;
 }
 

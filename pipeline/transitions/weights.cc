@@ -27,7 +27,8 @@ class FieldReader {
     std::string::size_type start = 0;
     while (true) {
       const auto dot = field.find('.', start);
-      const std::string key = field.substr(start, dot == std::string::npos ? std::string::npos : dot - start);
+      const std::string key =
+          field.substr(start, dot == std::string::npos ? std::string::npos : dot - start);
       if (!node->is_object() || !node->contains(key)) Fail(field, "missing");
       node = &(*node)[key];
       if (dot == std::string::npos) return *node;
@@ -82,13 +83,15 @@ bool TransitionWeights::IsValid(std::string* why) const {
       return fail("feature_scale", "element " + std::to_string(k) + " must be positive");
     }
     if (!(stage2_weights[k] >= 0) || !std::isfinite(stage2_weights[k])) {
-      return fail("stage2.weights", "element " + std::to_string(k) + " must be a non-negative number");
+      return fail("stage2.weights",
+                  "element " + std::to_string(k) + " must be a non-negative number");
     }
   }
   for (int k = 0; k < kCheapFeatureCount; ++k) {
     if (!(stage1_weights[k] >= 0) || !std::isfinite(stage1_weights[k])) {
-      return fail("stage1.weights", "element " + std::to_string(k) +
-                                        " must be non-negative (stage 1 must accept a weighted-L1 ball)");
+      return fail("stage1.weights",
+                  "element " + std::to_string(k) +
+                      " must be non-negative (stage 1 must accept a weighted-L1 ball)");
     }
   }
   if (!std::isfinite(stage1_bias)) return fail("stage1.bias", "not finite");
@@ -131,7 +134,8 @@ TransitionWeights ParseWeights(const std::string& text, const std::string& sourc
   const json& names = r.Get("features");
   json expected = json::array();
   for (const auto& n : FeatureNames()) expected.push_back(n);
-  if (names != expected) r.Fail("features", "expected " + expected.dump() + ", got " + names.dump());
+  if (names != expected)
+    r.Fail("features", "expected " + expected.dump() + ", got " + names.dump());
 
   TransitionWeights w;
   w.window.width_m = r.Number("comparison_window.width_m");
@@ -144,7 +148,8 @@ TransitionWeights ParseWeights(const std::string& text, const std::string& sourc
   } else if (align == "contact_point") {
     w.window.align = HorizontalAlignment::kContactPoint;
   } else {
-    r.Fail("comparison_window.align", "expected \"alpha_centroid\" or \"contact_point\", got " + align.dump());
+    r.Fail("comparison_window.align",
+           "expected \"alpha_centroid\" or \"contact_point\", got " + align.dump());
   }
   w.feature_mean = r.Numbers<kPairFeatureCount>("feature_mean");
   w.feature_scale = r.Numbers<kPairFeatureCount>("feature_scale");
@@ -168,7 +173,8 @@ TransitionWeights ParseWeights(const std::string& text, const std::string& sourc
       w.colour_blob_max_velocity_mps = r.Number("stage2.colour_blob.max_velocity_mps");
       w.colour_blob_max_cells = r.Integer("stage2.colour_blob.max_blob_cells");
     } else {
-      r.Fail("stage2.variant", "expected \"paper\", \"linf\" or \"colour_blob\", got " + variant.dump());
+      r.Fail("stage2.variant",
+             "expected \"paper\", \"linf\" or \"colour_blob\", got " + variant.dump());
     }
   }
   if (root.contains("training")) {
@@ -196,19 +202,21 @@ std::string WeightsToJson(const TransitionWeights& w) {
   const bool blob = w.stage2_variant == Stage2Variant::kColourBlob;
   root["version"] = linf || blob ? 2 : 1;  // the paper variant is written as version 1 was
   root["features"] = FeatureNames();
-  root["comparison_window"] = {{"width_m", w.window.width_m},
-                               {"height_m", w.window.height_m},
-                               {"cells_x", w.window.cells_x},
-                               {"cells_y", w.window.cells_y},
-                               {"align", w.window.align == HorizontalAlignment::kAlphaCentroid ? "alpha_centroid"
-                                                                                              : "contact_point"}};
+  root["comparison_window"] = {
+      {"width_m", w.window.width_m},
+      {"height_m", w.window.height_m},
+      {"cells_x", w.window.cells_x},
+      {"cells_y", w.window.cells_y},
+      {"align",
+       w.window.align == HorizontalAlignment::kAlphaCentroid ? "alpha_centroid" : "contact_point"}};
   root["feature_mean"] = w.feature_mean;
   root["feature_scale"] = w.feature_scale;
   root["stage1"] = {{"weights", w.stage1_weights}, {"bias", w.stage1_bias}};
   root["stage2"] = {{"weights", w.stage2_weights}, {"bias", w.stage2_bias}};
   if (linf) {
     root["stage2"]["variant"] = "linf";
-    root["stage2"]["linf"] = {{"max_velocity_mps", w.linf_max_velocity_mps}, {"max_alpha_linf", w.linf_max_alpha}};
+    root["stage2"]["linf"] = {{"max_velocity_mps", w.linf_max_velocity_mps},
+                              {"max_alpha_linf", w.linf_max_alpha}};
   }
   if (blob) {
     root["stage2"]["variant"] = "colour_blob";

@@ -20,7 +20,8 @@ inline constexpr int kWeightsFileVersion = 2;
 enum class Stage2Variant {
   kPaper,  // D = sum_k u2_k x_k <= T2 on the six features
   kLinf,   // velocity <= max_velocity_mps AND the largest cell alpha difference <= max_alpha_linf
-  kColourBlob,  // velocity <= max_velocity_mps AND the largest colour-difference blob <= max_blob_cells
+  kColourBlob,  // velocity <= max_velocity_mps AND the largest colour-difference blob <=
+                // max_blob_cells
 };
 inline constexpr const char* kWeightsFileFormat = "spritestation-transition-weights";
 
@@ -33,11 +34,12 @@ struct TransitionWeights {
   PairFeatures stage2_weights{};
   double stage2_bias = 0;
   Stage2Variant stage2_variant = Stage2Variant::kPaper;
-  double linf_max_velocity_mps = 0;  // linf: ||v_i - v_j|| bound (m/s), > 0
-  double linf_max_alpha = 0;         // linf: max_cells |A_i - A_j| / 255 bound, in (0, 1]
+  double linf_max_velocity_mps = 0;         // linf: ||v_i - v_j|| bound (m/s), > 0
+  double linf_max_alpha = 0;                // linf: max_cells |A_i - A_j| / 255 bound, in (0, 1]
   double colour_blob_max_velocity_mps = 0;  // colour_blob: ||v_i - v_j|| bound (m/s), > 0
   int colour_blob_max_cells = 0;            // colour_blob: LargestColourBlob bound (cells), >= 0
-  std::string training_json = "{}";  // provenance and cross-validation figures (free form JSON object)
+  std::string training_json =
+      "{}";  // provenance and cross-validation figures (free form JSON object)
 
   // False (with the field and the reason) unless every field is usable.
   bool IsValid(std::string* why) const;

@@ -31,9 +31,11 @@ struct TransitionWorker::State {
   SegmentKeys keys;
 };
 
-TransitionWorker::TransitionWorker(std::string bank_path, const TransitionWeights& weights, int startup_threads)
+TransitionWorker::TransitionWorker(std::string bank_path, const TransitionWeights& weights,
+                                   int startup_threads)
     : bank_path_(std::move(bank_path)), state_(std::make_unique<State>()) {
-  const TransitionClassifier check(weights);  // InputError for invalid weights, in the caller's thread
+  const TransitionClassifier check(
+      weights);  // InputError for invalid weights, in the caller's thread
   state_->weights = weights;
   state_->startup_threads = std::max(1, startup_threads);
   thread_ = std::thread([this] { Run(); });
@@ -58,9 +60,9 @@ void TransitionWorker::WaitIdle() {
 
 bool TransitionWorker::WaitIdleFor(double seconds) {
   std::unique_lock<std::mutex> lock(mutex_);
-  return idle_.wait_for(lock, std::chrono::duration<double>(std::max(0.0, seconds)),
-                        [&] { return stop_ || (!busy_ && queue_.empty()); }) &&
-         !stop_;
+  return idle_.wait_for(lock, std::chrono::duration<double>(std::max(0.0, seconds)), [&] {
+    return stop_ || (!busy_ && queue_.empty());
+  }) && !stop_;
 }
 
 int64_t TransitionWorker::Stop() {
@@ -111,11 +113,12 @@ void TransitionWorker::Run() {
     const BankSprites sprites = LoadBankSprites(*s.reader, &s.keys, progress("load"));
     if (!sprites.inputs.empty()) {
       s.builder = std::make_unique<TransitionBuilder>(s.weights, sprites.px_per_m);
-      s.builder->BuildFromScratch(sprites.inputs,
-                                  BuildOptions{.threads = s.startup_threads, .progress = progress("pairs")});
+      s.builder->BuildFromScratch(sprites.inputs, BuildOptions{.threads = s.startup_threads,
+                                                               .progress = progress("pairs")});
       const auto transitions = s.builder->Transitions();
       const std::unordered_set<int64_t> universe(sprites.ids.begin(), sprites.ids.end());
-      const StoreResult r = StoreTransitionTable(*s.writer, transitions, WeightsFingerprint(s.weights), universe);
+      const StoreResult r =
+          StoreTransitionTable(*s.writer, transitions, WeightsFingerprint(s.weights), universe);
       stored = r.replaced_all ? static_cast<int64_t>(transitions.size()) : r.added + r.changed;
       known = static_cast<int64_t>(sprites.inputs.size());
     } else {
@@ -161,7 +164,8 @@ void TransitionWorker::Run() {
       if (!fresh.empty()) {
         const double scale = s.builder ? s.builder->store().px_per_m() : 0.0;
         const BankSprites sprites = LoadBankSpritesById(*s.reader, fresh, &s.keys, scale);
-        if (!s.builder) s.builder = std::make_unique<TransitionBuilder>(s.weights, sprites.px_per_m);
+        if (!s.builder)
+          s.builder = std::make_unique<TransitionBuilder>(s.weights, sprites.px_per_m);
         const TransitionDelta delta = s.builder->Add(sprites.inputs);
         if (!delta.transitions.empty()) {
           // A few thousand rows a transaction: a round of a large bank holds tens of thousands,
@@ -170,8 +174,10 @@ void TransitionWorker::Run() {
           // so rows stored before a failure are simply stored again by a rebuild.
           const std::vector<TransitionRecord> records = ToRecords(delta.transitions);
           for (size_t i = 0; i < records.size(); i += kRowsPerTransaction) {
-            const auto end = records.begin() + static_cast<std::ptrdiff_t>(std::min(records.size(), i + kRowsPerTransaction));
-            s.writer->UpsertTransitions(std::vector<TransitionRecord>(records.begin() + static_cast<std::ptrdiff_t>(i), end));
+            const auto end = records.begin() + static_cast<std::ptrdiff_t>(std::min(
+                                                   records.size(), i + kRowsPerTransaction));
+            s.writer->UpsertTransitions(std::vector<TransitionRecord>(
+                records.begin() + static_cast<std::ptrdiff_t>(i), end));
           }
         }
         added_sprites = static_cast<int64_t>(fresh.size());
@@ -180,7 +186,8 @@ void TransitionWorker::Run() {
     } catch (const std::exception& e) {
       fail(e.what());
     }
-    const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    const double ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     {
       std::lock_guard<std::mutex> lock(mutex_);
       ++stats_.rounds;
@@ -203,7 +210,8 @@ void TransitionWorker::RunUnits() {
   std::unique_ptr<UnitWorker> units;
   try {
     units = std::make_unique<UnitWorker>(
-        bank_path_, UnitWorkerOptions{.weights = state_->weights, .load_threads = state_->startup_threads});
+        bank_path_,
+        UnitWorkerOptions{.weights = state_->weights, .load_threads = state_->startup_threads});
   } catch (const std::exception& e) {
     Fail(std::string("start-up: ") + e.what());
   }
@@ -239,7 +247,8 @@ void TransitionWorker::RunUnits() {
     } catch (const std::exception& e) {
       Fail(e.what());
     }
-    const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    const double ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     std::unique_lock<std::mutex> lock(mutex_);
     const UnitWorkerStats& u = units->stats();
     stats_.rounds = u.units;

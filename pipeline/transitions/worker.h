@@ -28,14 +28,14 @@
 namespace ss {
 
 struct TransitionWorkerStats {
-  bool ready = false;           // the start-up build is done
-  int64_t sprites = 0;          // sprites the worker knows (start-up + submitted)
-  int64_t queued = 0;           // submitted, not yet processed
-  int64_t rounds = 0;           // rounds of submitted sprites processed
+  bool ready = false;              // the start-up build is done
+  int64_t sprites = 0;             // sprites the worker knows (start-up + submitted)
+  int64_t queued = 0;              // submitted, not yet processed
+  int64_t rounds = 0;              // rounds of submitted sprites processed
   int64_t transitions_stored = 0;  // written since start (start-up table included)
   int64_t failed_rounds = 0;
-  std::string last_error;       // of the last failed round (or start-up)
-  double last_round_ms = 0;     // find + store time of the last round
+  std::string last_error;    // of the last failed round (or start-up)
+  double last_round_ms = 0;  // find + store time of the last round
   // While the start-up build runs: "load" (sprites read) or "pairs" (sprites searched), with
   // sprites done of total; "" once it is done.
   std::string startup_stage;
@@ -46,7 +46,8 @@ class TransitionWorker {
  public:
   // Starts the thread. Invalid weights throw InputError here; a bank that cannot be
   // opened shows up as stats().last_error (the thread then drops what is submitted).
-  TransitionWorker(std::string bank_path, const TransitionWeights& weights, int startup_threads = 1);
+  TransitionWorker(std::string bank_path, const TransitionWeights& weights,
+                   int startup_threads = 1);
   ~TransitionWorker();  // Stop()
   TransitionWorker(const TransitionWorker&) = delete;
   TransitionWorker& operator=(const TransitionWorker&) = delete;

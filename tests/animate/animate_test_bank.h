@@ -34,21 +34,24 @@ struct WalkerBank {
     cv::ellipse(p.bgra, {kWidth / 2, kHeight / 2}, {kWidth / 2 - 2, kHeight / 2 - 2}, 0, 0, 360,
                 colour, cv::FILLED);
     p.shadow = cv::Mat(kHeight, kWidth, CV_8UC1, cv::Scalar(0));
-    cv::ellipse(p.shadow, {kWidth / 2, kHeight / 2}, {12, 12}, 0, 0, 360, cv::Scalar(160), cv::FILLED);
+    cv::ellipse(p.shadow, {kWidth / 2, kHeight / 2}, {12, 12}, 0, 0, 360, cv::Scalar(160),
+                cv::FILLED);
     return p;
   }
 
   static WalkerBank Write(const std::string& path) {
     WalkerBank out;
     BankWriter bank(path);
-    const int64_t session = bank.AddSession({0, "test@walker", "walker", "2026-01-01T00:00:00Z", "test"});
+    const int64_t session =
+        bank.AddSession({0, "test@walker", "walker", "2026-01-01T00:00:00Z", "test"});
     const int64_t camera = bank.AddCamera(session, {0, 0, "cam0", "", 640, 480});
     for (int c = 0; c < 9; ++c) {
       const bool standing = c == 8;
       const int n = standing ? kStandFrames : kClipFrames;
       const double a = 2 * std::numbers::pi * c / 8;
-      const Eigen::Vector2d v = standing ? Eigen::Vector2d(0, 0)
-                                         : Eigen::Vector2d(std::cos(a) * kSpeed_m_s, std::sin(a) * kSpeed_m_s);
+      const Eigen::Vector2d v =
+          standing ? Eigen::Vector2d(0, 0)
+                   : Eigen::Vector2d(std::cos(a) * kSpeed_m_s, std::sin(a) * kSpeed_m_s);
       ClipRecord clip;
       clip.camera_id = camera;
       clip.track_id = c + 1;
@@ -110,8 +113,9 @@ inline CameraModel LookAtCamera(int width, int height, double focal_px,
   cam_from_ground.rotation.row(1) = y.transpose();
   cam_from_ground.rotation.row(2) = z.transpose();
   cam_from_ground.translation = -(cam_from_ground.rotation * centre_in_ground);
-  return CameraModel("LENSMODEL_PINHOLE", {focal_px, focal_px, (width - 1) / 2.0, (height - 1) / 2.0},
-                     width, height, cam_from_ground);
+  return CameraModel("LENSMODEL_PINHOLE",
+                     {focal_px, focal_px, (width - 1) / 2.0, (height - 1) / 2.0}, width, height,
+                     cam_from_ground);
 }
 
 }  // namespace ss::testing

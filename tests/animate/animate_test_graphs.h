@@ -54,9 +54,7 @@ struct WalkingGraph {
     }
     for (int m = 0; m < kStand; ++m) frames.push_back({9, Eigen::Vector2d::Zero(), {"standing"}});
     std::vector<TransitionEdge> edges{{kRing - 1, 0, 0.0}};
-    auto angle_diff = [&](double a, double b) {
-      return std::abs(std::remainder(a - b, two_pi));
-    };
+    auto angle_diff = [&](double a, double b) { return std::abs(std::remainder(a - b, two_pi)); };
     for (int d = 0; d < 8; ++d) {
       const double phi = two_pi * d / 8;
       edges.push_back({Straight(d, kStraight - 1), Straight(d, 0), 0.05});

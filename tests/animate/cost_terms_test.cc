@@ -62,8 +62,8 @@ TEST_F(CostTermsTest, LocationAtAStepARangeAndTheEnd) {
   // Steps 3..6: (2,1) then (2,2) held: 1 + 0 + 0 + 0.
   EXPECT_DOUBLE_EQ(
       Eval(LocationTerm(0, StepWindow::Range(3, 6), LocationTarget::Fixed({2, 2}), 1.0)), 1.0);
-  EXPECT_DOUBLE_EQ(Eval(LocationTerm(0, StepWindow::LastStep(), LocationTarget::Fixed({0, 2}), 0.5)),
-                   2.0);
+  EXPECT_DOUBLE_EQ(
+      Eval(LocationTerm(0, StepWindow::LastStep(), LocationTarget::Fixed({0, 2}), 0.5)), 2.0);
   // The whole sequence against (1,0): 1 + 0 + 1 + 2 + 5.
   EXPECT_DOUBLE_EQ(Eval(LocationTerm(0, StepWindow::All(), LocationTarget::Fixed({1, 0}), 1.0)),
                    9.0);
@@ -131,8 +131,9 @@ TEST_F(CostTermsTest, PathFollowsSegmentsAndChargesTheUnreachedPart) {
 }
 
 TEST_F(CostTermsTest, CollisionIsConicalAndHoldsFinishedSprites) {
-  tracks_[0] = MakeTrack(graph_, {0, 1, 2}, Anchor::kStart, Vector2d(0, 0));   // (0,0) (1,0) (2,0)
-  tracks_.push_back(MakeTrack(graph_, {3, 4, 5}, Anchor::kStart, Vector2d(1, -1)));  // (1,-1) (1,0) (1,1)
+  tracks_[0] = MakeTrack(graph_, {0, 1, 2}, Anchor::kStart, Vector2d(0, 0));  // (0,0) (1,0) (2,0)
+  tracks_.push_back(
+      MakeTrack(graph_, {3, 4, 5}, Anchor::kStart, Vector2d(1, -1)));  // (1,-1) (1,0) (1,1)
   const CollisionTerm term(0, 1, 1.5, 2.0);
   EXPECT_NEAR(Eval(term), 2.0 * (1.5 - std::sqrt(2.0)) * 2 + 2.0 * 1.5, 1e-12);
   EXPECT_EQ(term.CountViolations(TrackPointers(tracks_)), 3);
@@ -155,11 +156,13 @@ TEST_F(CostTermsTest, FramePoseOverAWindowOrAfterAPath) {
   // Steps 5 and 6 come after the end: the pose is not shown there.
   EXPECT_DOUBLE_EQ(Eval(FrameTerm(0, g, StepWindow::Range(3, 6), 5.0)), 10.0);
   // After passing (2,0) (at step 2) for 2 steps: steps 2 (frame 2, off) and 3 (on).
-  const FrameTerm after(0, g, StepWindow::All(), 5.0, PathTrigger{0, Polyline({{0, 0}, {2, 0}}), 2});
+  const FrameTerm after(0, g, StepWindow::All(), 5.0,
+                        PathTrigger{0, Polyline({{0, 0}, {2, 0}}), 2});
   EXPECT_DOUBLE_EQ(Eval(after), 5.0);
   EXPECT_EQ(after.Window(TrackPointers(tracks_)), std::make_pair(2, 4));
   // A path never passed opens the window at the end: every step is a violation.
-  const FrameTerm never(0, g, StepWindow::All(), 5.0, PathTrigger{0, Polyline({{0, 0}, {9, 0}}), 3});
+  const FrameTerm never(0, g, StepWindow::All(), 5.0,
+                        PathTrigger{0, Polyline({{0, 0}, {9, 0}}), 3});
   EXPECT_DOUBLE_EQ(Eval(never), 15.0);
 }
 
@@ -177,7 +180,8 @@ TEST_F(CostTermsTest, ProblemSumsAndBreaksDownByKind) {
   SpriteSpec spec;
   problem.AddSprite(spec);
   problem.AddTerm(std::make_unique<LengthTerm>(0, 10, 0.5));
-  problem.AddTerm(std::make_unique<LocationTerm>(0, StepWindow::At(2), LocationTarget::Fixed({2, 3}), 3.0));
+  problem.AddTerm(
+      std::make_unique<LocationTerm>(0, StepWindow::At(2), LocationTarget::Fixed({2, 3}), 3.0));
   const CostBreakdown cost = problem.Evaluate(tracks_);
   EXPECT_DOUBLE_EQ(cost.total, 0.5 + 2.5 + 27.0);
   EXPECT_DOUBLE_EQ(cost.by_kind.at("smoothness"), 0.5);
@@ -195,13 +199,15 @@ TEST_F(CostTermsTest, ConstraintFigures) {
   Problem problem(graph_);
   for (int s = 0; s < 2; ++s) problem.AddSprite(SpriteSpec{});
   // 0.5 m beside sprite 0 until it turns, then on it; its end (2,3) is never reached.
-  problem.AddTerm(std::make_unique<PathTerm>(0, Polyline({{0, 0.5}, {2, 0.5}, {2, 3}}), PathStrengths{}));
+  problem.AddTerm(
+      std::make_unique<PathTerm>(0, Polyline({{0, 0.5}, {2, 0.5}, {2, 3}}), PathStrengths{}));
   // Sprite 1 passes (2, 0.5) at step 2, on the line.
   problem.AddTerm(std::make_unique<PathTerm>(1, Polyline({{2, -1}, {2, 0.5}}), PathStrengths{}));
   // Distances sqrt(5), 1, 1, 0, 1: one step closer than 0.5 m.
   problem.AddTerm(std::make_unique<CollisionTerm>(0, 1, 0.5, 1.0));
   // Steps 2..4 show frames 2, 3, 4: one off the set {3, 4}.
-  auto g = std::make_shared<std::vector<bool>>(std::vector<bool>{false, false, false, true, true, false});
+  auto g = std::make_shared<std::vector<bool>>(
+      std::vector<bool>{false, false, false, true, true, false});
   problem.AddTerm(std::make_unique<FrameTerm>(0, g, StepWindow::Range(2, 4), 1.0));
   problem.AddTerm(std::make_unique<LengthTerm>(0, 5, 1.0));
   problem.AddTerm(std::make_unique<LengthTerm>(1, 4, 1.0));  // 3 frames: short
@@ -221,14 +227,20 @@ TEST(CostTermCache, IncrementalEqualsFullEvaluation) {
   auto g = std::make_shared<std::vector<bool>>(graph.FramesWithTag("special"));
   std::vector<std::unique_ptr<CostTerm>> terms;
   terms.push_back(std::make_unique<SmoothnessTerm>(graph, 0, 1.5));
-  terms.push_back(std::make_unique<LocationTerm>(0, StepWindow::Range(3, 30), LocationTarget::Fixed({0.2, 0.1}), 2.0));
-  terms.push_back(std::make_unique<LocationTerm>(0, StepWindow{5, true, 0, true}, LocationTarget::Fixed({0.5, 0}), 1.0));
-  terms.push_back(std::make_unique<LocationTerm>(0, StepWindow::All(), LocationTarget::Follow(1, {-0.2, 0.1}), 1.0));
-  terms.push_back(std::make_unique<LocationTerm>(1, StepWindow::All(), LocationTarget::Follow(0, {-0.2, 0.1}), 1.0));
-  terms.push_back(std::make_unique<PathTerm>(0, Polyline({{0, 0}, {0.3, 0}, {0.3, 0.3}}), PathStrengths{1, 2, 3}));
+  terms.push_back(std::make_unique<LocationTerm>(0, StepWindow::Range(3, 30),
+                                                 LocationTarget::Fixed({0.2, 0.1}), 2.0));
+  terms.push_back(std::make_unique<LocationTerm>(0, StepWindow{5, true, 0, true},
+                                                 LocationTarget::Fixed({0.5, 0}), 1.0));
+  terms.push_back(std::make_unique<LocationTerm>(0, StepWindow::All(),
+                                                 LocationTarget::Follow(1, {-0.2, 0.1}), 1.0));
+  terms.push_back(std::make_unique<LocationTerm>(1, StepWindow::All(),
+                                                 LocationTarget::Follow(0, {-0.2, 0.1}), 1.0));
+  terms.push_back(std::make_unique<PathTerm>(0, Polyline({{0, 0}, {0.3, 0}, {0.3, 0.3}}),
+                                             PathStrengths{1, 2, 3}));
   terms.push_back(std::make_unique<CollisionTerm>(0, 1, 0.3, 2.0));
   terms.push_back(std::make_unique<FrameTerm>(0, g, StepWindow::Range(4, 12), 1.0));
-  terms.push_back(std::make_unique<FrameTerm>(1, g, StepWindow::All(), 1.0, PathTrigger{0, Polyline({{0, 0}, {0.1, 0}}), 5}));
+  terms.push_back(std::make_unique<FrameTerm>(1, g, StepWindow::All(), 1.0,
+                                              PathTrigger{0, Polyline({{0, 0}, {0.1, 0}}), 5}));
   terms.push_back(std::make_unique<LengthTerm>(0, 25, 1.0));
   terms.push_back(std::make_unique<FastFrameTerm>(0, 0.08, 1.0));
 
@@ -243,8 +255,9 @@ TEST(CostTermCache, IncrementalEqualsFullEvaluation) {
     return frames;
   };
   for (int trial = 0; trial < 200; ++trial) {
-    std::vector<Track> before{MakeTrack(graph, random_walk(20 + trial % 17), Anchor::kStart, {0, 0}),
-                              MakeTrack(graph, random_walk(15 + trial % 13), Anchor::kStart, {0.1, 0})};
+    std::vector<Track> before{
+        MakeTrack(graph, random_walk(20 + trial % 17), Anchor::kStart, {0, 0}),
+        MakeTrack(graph, random_walk(15 + trial % 13), Anchor::kStart, {0.1, 0})};
     // Sprite (trial % 2) keeps a prefix and gets a new random tail.
     const int s = trial % 2;
     const int k = static_cast<int>(rng() % before[s].size());

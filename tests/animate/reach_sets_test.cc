@@ -58,9 +58,9 @@ void CheckAgainstBruteForce(uint64_t seed, int set_size, double step, bool with_
   const auto dist = AllPairs(graph, entry, step);
   const ReachOptions options{set_size, threads, step};
   for (ReachDirection direction : {ReachDirection::kForward, ReachDirection::kBackward}) {
-    const ReachSets sets = ReachSets::Build(graph, direction, options,
-                                            with_entry ? std::span<const double>(entry)
-                                                       : std::span<const double>());
+    const ReachSets sets =
+        ReachSets::Build(graph, direction, options,
+                         with_entry ? std::span<const double>(entry) : std::span<const double>());
     const bool forward = direction == ReachDirection::kForward;
     for (int root = 0; root < graph.num_frames(); ++root) {
       auto d = [&](int t) { return forward ? dist[root][t] : dist[t][root]; };

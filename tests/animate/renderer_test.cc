@@ -49,14 +49,17 @@ TEST(Renderer, PlacesTheBillboardAtTheProjectedGroundPosition) {
     ASSERT_EQ(image.type(), CV_8UC4);
     // The red mark's centre is 1 px above the contact point, the blue one 1 px below the top.
     const Eigen::Vector3d contact(ground.x(), ground.y(), 0.0);
-    const Eigen::Vector2d red = camera.ProjectGround(contact + Eigen::Vector3d(0, 0, 1.0 / kPxPerM));
-    const Eigen::Vector2d blue = camera.ProjectGround(contact + Eigen::Vector3d(0, 0, 79.0 / kPxPerM));
+    const Eigen::Vector2d red =
+        camera.ProjectGround(contact + Eigen::Vector3d(0, 0, 1.0 / kPxPerM));
+    const Eigen::Vector2d blue =
+        camera.ProjectGround(contact + Eigen::Vector3d(0, 0, 79.0 / kPxPerM));
     EXPECT_LT((Centroid(image, {0, 0, 255}) - red).norm(), 0.75)
-        << ground.transpose() << " found " << Centroid(image, {0, 0, 255}).transpose() << " expected " << red.transpose();
+        << ground.transpose() << " found " << Centroid(image, {0, 0, 255}).transpose()
+        << " expected " << red.transpose();
     EXPECT_LT((Centroid(image, {255, 0, 0}) - blue).norm(), 0.75) << ground.transpose();
     // Nothing else is drawn: the background is transparent.
     EXPECT_EQ(image.at<cv::Vec4b>(5, 5)[3], 0);
-    EXPECT_LT(cv::countNonZero(image.reshape(1).colRange(3, 4) != 0) , 50);
+    EXPECT_LT(cv::countNonZero(image.reshape(1).colRange(3, 4) != 0), 50);
   }
 }
 
@@ -74,10 +77,18 @@ TEST(Renderer, TheBillboardFacesTheCamera) {
   const Eigen::Vector3d mid(ground.x(), ground.y(), 20.0 / kPxPerM);
   const Eigen::Vector2d a = camera.ProjectGround(mid - right * (100.0 / kPxPerM));
   const Eigen::Vector2d b = camera.ProjectGround(mid + right * (100.0 / kPxPerM));
-  EXPECT_GT(image.at<cv::Vec4b>(static_cast<int>(std::lround(a.y())), static_cast<int>(std::lround(a.x())) + 2)[3], 200);
-  EXPECT_GT(image.at<cv::Vec4b>(static_cast<int>(std::lround(b.y())), static_cast<int>(std::lround(b.x())) - 2)[3], 200);
-  EXPECT_EQ(image.at<cv::Vec4b>(static_cast<int>(std::lround(a.y())), static_cast<int>(std::lround(a.x())) - 3)[3], 0);
-  EXPECT_EQ(image.at<cv::Vec4b>(static_cast<int>(std::lround(b.y())), static_cast<int>(std::lround(b.x())) + 3)[3], 0);
+  EXPECT_GT(image.at<cv::Vec4b>(static_cast<int>(std::lround(a.y())),
+                                static_cast<int>(std::lround(a.x())) + 2)[3],
+            200);
+  EXPECT_GT(image.at<cv::Vec4b>(static_cast<int>(std::lround(b.y())),
+                                static_cast<int>(std::lround(b.x())) - 2)[3],
+            200);
+  EXPECT_EQ(image.at<cv::Vec4b>(static_cast<int>(std::lround(a.y())),
+                                static_cast<int>(std::lround(a.x())) - 3)[3],
+            0);
+  EXPECT_EQ(image.at<cv::Vec4b>(static_cast<int>(std::lround(b.y())),
+                                static_cast<int>(std::lround(b.x())) + 3)[3],
+            0);
 }
 
 TEST(Renderer, NearSpritesCoverFarOnesWhateverTheOrder) {
@@ -89,7 +100,8 @@ TEST(Renderer, NearSpritesCoverFarOnesWhateverTheOrder) {
   const PlacedSprite near_s{&near_px, Eigen::Vector2d(50, 200), kPxPerM, Eigen::Vector2d(0, -1)};
   const PlacedSprite far_s{&far_px, Eigen::Vector2d(100, 400), kPxPerM, Eigen::Vector2d(0, 0.5)};
   const Eigen::Vector2d probe = camera.ProjectGround({0, -1, 0.45});
-  const cv::Point at(static_cast<int>(std::lround(probe.x())), static_cast<int>(std::lround(probe.y())));
+  const cv::Point at(static_cast<int>(std::lround(probe.x())),
+                     static_cast<int>(std::lround(probe.y())));
   ASSERT_EQ(renderer.Render({far_s}).at<cv::Vec4b>(at), cv::Vec4b(255, 0, 0, 255));  // they overlap
   const cv::Mat a = renderer.Render({near_s, far_s});
   const cv::Mat b = renderer.Render({far_s, near_s});

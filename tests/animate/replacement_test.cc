@@ -44,14 +44,14 @@ TEST(Replacement, EveryKeptMoveIsValidAndTheCostNeverIncreases) {
   const Polyline path({{0, 0}, {1.5, 0}, {1.5, 1.0}});
   problem.AddTerm(std::make_unique<PathTerm>(0, path, PathStrengths{0.5, 4.0, 3.0}));
   auto standing = std::make_shared<std::vector<bool>>(graph.FramesWithTag("standing"));
-  problem.AddTerm(std::make_unique<FrameTerm>(0, standing, StepWindow::All(), 1.0,
-                                              PathTrigger{0, path, 8}));
-  problem.AddTerm(std::make_unique<FrameTerm>(1, standing, StepWindow::All(), 1.0,
-                                              PathTrigger{0, path, 8}));
+  problem.AddTerm(
+      std::make_unique<FrameTerm>(0, standing, StepWindow::All(), 1.0, PathTrigger{0, path, 8}));
+  problem.AddTerm(
+      std::make_unique<FrameTerm>(1, standing, StepWindow::All(), 1.0, PathTrigger{0, path, 8}));
   problem.AddTerm(std::make_unique<LocationTerm>(1, StepWindow::All(),
                                                  LocationTarget::Follow(0, {-0.3, 0.2}), 2.0));
-  problem.AddTerm(std::make_unique<LocationTerm>(2, StepWindow::At(0),
-                                                 LocationTarget::Fixed({-0.5, 0}), 1.0));
+  problem.AddTerm(
+      std::make_unique<LocationTerm>(2, StepWindow::At(0), LocationTarget::Fixed({-0.5, 0}), 1.0));
   for (int a = 0; a < 3; ++a) {
     for (int b = a + 1; b < 3; ++b) {
       problem.AddTerm(std::make_unique<CollisionTerm>(a, b, 0.2, 5.0));
@@ -78,8 +78,9 @@ TEST(Replacement, EveryKeptMoveIsValidAndTheCostNeverIncreases) {
     }
     last_restart = point.restart;
     for (int s = 0; s < 3; ++s) {  // the states follow the frames and the anchors
-      const Track rebuilt = MakeTrack(graph, tracks[s].frames, s == 2 ? Anchor::kEnd : Anchor::kStart,
-                                      s == 2 ? Vector2d(0.5, 0.5) : tracks[s].positions_m[0]);
+      const Track rebuilt =
+          MakeTrack(graph, tracks[s].frames, s == 2 ? Anchor::kEnd : Anchor::kStart,
+                    s == 2 ? Vector2d(0.5, 0.5) : tracks[s].positions_m[0]);
       for (int t = 0; t < tracks[s].size(); ++t) {
         if (!tracks[s].positions_m[t].isApprox(rebuilt.positions_m[t], 1e-9)) all_valid = false;
       }
@@ -120,8 +121,8 @@ TEST(Replacement, AnticipatesALaterLocationBetterThanBeamSearchAtTheSameBudget) 
   const Vector2d corner(1.5, 1.0);
   problem.AddTerm(std::make_unique<LocationTerm>(0, StepWindow::Range(0, 78),
                                                  LocationTarget::Fixed({0, 0}), 0.05));
-  problem.AddTerm(std::make_unique<LocationTerm>(0, StepWindow::At(79),
-                                                 LocationTarget::Fixed(corner), 100.0));
+  problem.AddTerm(
+      std::make_unique<LocationTerm>(0, StepWindow::At(79), LocationTarget::Fixed(corner), 100.0));
   problem.AddTerm(std::make_unique<LengthTerm>(0, 80, 10.0));
   constexpr double kBudget = 1.5;
 
@@ -170,7 +171,8 @@ TEST(Replacement, AFollowerCopiesItsLeadersStandUp) {
   problem.AddTerm(std::make_unique<PathTerm>(0, path, PathStrengths{0.5, 20.0, 20.0}));
   auto standing = std::make_shared<std::vector<bool>>(graph.FramesWithTag("standing"));
   auto frame_term = [&](int s) {
-    return std::make_unique<FrameTerm>(s, standing, StepWindow::All(), 2.0, PathTrigger{0, path, 15});
+    return std::make_unique<FrameTerm>(s, standing, StepWindow::All(), 2.0,
+                                       PathTrigger{0, path, 15});
   };
   problem.AddTerm(frame_term(0));
   auto follower_frames = frame_term(1);
@@ -182,9 +184,11 @@ TEST(Replacement, AFollowerCopiesItsLeadersStandUp) {
   // A follower one frame long, its leader walking 1.6 m on along +x: held, it is out of
   // formation by ~1 m at step 20 and more later.
   std::vector<int> straight;
-  for (int m = 0; m < 32; ++m) straight.push_back(WalkingGraph::Straight(0, m % WalkingGraph::kStraight));
-  const std::vector<Track> short_follower{problem.MakeSpriteTrack(0, straight),
-                                          problem.MakeSpriteTrack(1, {WalkingGraph::Straight(0, 0)})};
+  for (int m = 0; m < 32; ++m)
+    straight.push_back(WalkingGraph::Straight(0, m % WalkingGraph::kStraight));
+  const std::vector<Track> short_follower{
+      problem.MakeSpriteTrack(0, straight),
+      problem.MakeSpriteTrack(1, {WalkingGraph::Straight(0, 0)})};
   const auto location = [&](const std::vector<Track>& tracks) {
     return problem.Evaluate(tracks).by_kind.at("location");
   };
@@ -211,7 +215,8 @@ TEST(Replacement, AFollowerCopiesItsLeadersStandUp) {
   const CostBreakdown cost = problem.Evaluate(tracks);
   EXPECT_EQ(cost.violations.at("path"), 0) << "the leader never reaches the end of its path";
   EXPECT_LE(cost.violations.at("frame"), 3) << "the leader does not stand up";
-  EXPECT_LT(location(tracks), 5.0);  // it starts 0.2 m off its place: ~5 × 0.04 per step until there
+  EXPECT_LT(location(tracks),
+            5.0);  // it starts 0.2 m off its place: ~5 × 0.04 per step until there
 }
 
 TEST(Replacement, FollowsAPathToItsEnd) {
@@ -247,7 +252,8 @@ TEST(Replacement, PicksAimedAtACollisionAreDrawnOnlyWhereOneIs) {
     std::vector<int> east, west;
     if (!collide) east = {44, 45, 46, 47, 0};
     for (int m = 0; m < 120; ++m) {
-      if (static_cast<int>(east.size()) < 120) east.push_back(WalkingGraph::Straight(0, m % WalkingGraph::kStraight));
+      if (static_cast<int>(east.size()) < 120)
+        east.push_back(WalkingGraph::Straight(0, m % WalkingGraph::kStraight));
       west.push_back(WalkingGraph::Straight(4, m % WalkingGraph::kStraight));
     }
     const double length = WalkingGraph::kSpeed * 119;
@@ -259,8 +265,10 @@ TEST(Replacement, PicksAimedAtACollisionAreDrawnOnlyWhereOneIs) {
     b.initial_sequence = west;
     b.anchor_m = Vector2d(length, 0.08);
     problem->AddSprite(b);
-    problem->AddTerm(std::make_unique<PathTerm>(0, Polyline({{0, 0}, {length, 0}}), PathStrengths{0.2, 20.0, 1.0}));
-    problem->AddTerm(std::make_unique<PathTerm>(1, Polyline({{length, 0.08}, {0, 0.08}}), PathStrengths{0.2, 20.0, 1.0}));
+    problem->AddTerm(std::make_unique<PathTerm>(0, Polyline({{0, 0}, {length, 0}}),
+                                                PathStrengths{0.2, 20.0, 1.0}));
+    problem->AddTerm(std::make_unique<PathTerm>(1, Polyline({{length, 0.08}, {0, 0.08}}),
+                                                PathStrengths{0.2, 20.0, 1.0}));
     if (collide) problem->AddTerm(std::make_unique<CollisionTerm>(0, 1, 0.10, 50.0));
     return problem;
   };
@@ -275,8 +283,9 @@ TEST(Replacement, PicksAimedAtACollisionAreDrawnOnlyWhereOneIs) {
   };
 
   const auto colliding = passing(true);
-  const std::vector<Track> given{colliding->MakeSpriteTrack(0, colliding->sprite(0).initial_sequence),
-                                 colliding->MakeSpriteTrack(1, colliding->sprite(1).initial_sequence)};
+  const std::vector<Track> given{
+      colliding->MakeSpriteTrack(0, colliding->sprite(0).initial_sequence),
+      colliding->MakeSpriteTrack(1, colliding->sprite(1).initial_sequence)};
   const int before = colliding->Evaluate(given).violations.at("collision");
   EXPECT_EQ(before, 2);  // steps 59 and 60: 5 cm apart along x, 8 cm across
   Summary aimed;
@@ -306,8 +315,8 @@ TEST(Replacement, FreeStartsAndEndAnchorsMeetTheirLocations) {
   problem.AddSprite(free_spec);
   // Two targets 1.5 m apart along x, 39 steps apart: only a start near (-1, 0) walking
   // +x can meet both.
-  problem.AddTerm(std::make_unique<LocationTerm>(0, StepWindow::At(0),
-                                                 LocationTarget::Fixed({-1, 0}), 10.0));
+  problem.AddTerm(
+      std::make_unique<LocationTerm>(0, StepWindow::At(0), LocationTarget::Fixed({-1, 0}), 10.0));
   problem.AddTerm(std::make_unique<LocationTerm>(0, StepWindow::LastStep(),
                                                  LocationTarget::Fixed({0.5, 0}), 10.0));
   problem.AddTerm(std::make_unique<LengthTerm>(0, 40, 10.0));

@@ -10,8 +10,8 @@
 
 #include "animate/animate_run.h"
 #include "animate/sequence_io.h"
-#include "capture/recording/video_file.h"
 #include "animate_test_bank.h"
+#include "capture/recording/video_file.h"
 #include "tests/support/test_support.h"
 
 namespace ss {
@@ -24,7 +24,8 @@ class SceneTest : public ::testing::Test {
  protected:
   void SetUp() override {
     testing::WalkerBank::Write(dir_ / "walker.ssbank");
-    testing::LookAtCamera(320, 240, 300, {0.5, -3, 2.5}, {0.5, 0.5, 0}).Write(dir_ / "virtual.cameramodel");
+    testing::LookAtCamera(320, 240, 300, {0.5, -3, 2.5}, {0.5, 0.5, 0})
+        .Write(dir_ / "virtual.cameramodel");
     cv::imwrite(dir_ / "floor.png", cv::Mat(240, 320, CV_8UC3, cv::Scalar(90, 140, 170)));
   }
   std::string WriteSpec(const std::string& body) {
@@ -56,7 +57,8 @@ sprites:
   EXPECT_LT(result.figures.max_path_deviation_m, 0.15);
   // The path's end is reached: some step comes within 10 cm of (1, 1).
   double closest = 1e9;
-  for (const Eigen::Vector2d& p : track.positions_m) closest = std::min(closest, (p - Eigen::Vector2d(1, 1)).norm());
+  for (const Eigen::Vector2d& p : track.positions_m)
+    closest = std::min(closest, (p - Eigen::Vector2d(1, 1)).norm());
   EXPECT_LT(closest, 0.1);
   EXPECT_TRUE(scene->problem().IsValid(result.tracks));
   EXPECT_LE(result.summary.final_cost.total, result.summary.initial_cost.total);
@@ -101,7 +103,8 @@ collisions:
   - {sprites: [a, b], min_distance_m: 0.2, strength: 50}
 )");
   const std::string seq = dir_ / "seq.json";
-  const auto animate = testing::RunSpritestation("animate " + spec + " --out " + seq + " --json --time-budget 2");
+  const auto animate =
+      testing::RunSpritestation("animate " + spec + " --out " + seq + " --json --time-budget 2");
   ASSERT_EQ(animate.exit_code, 0) << animate.output;
   EXPECT_NE(animate.output.find("\"final_cost\""), std::string::npos);
   EXPECT_TRUE(fs::exists(dir_ / "seq.cost.png"));
@@ -114,24 +117,29 @@ collisions:
   const auto render = testing::RunSpritestation("render " + seq + " --out " + (dir_ / "frames"));
   ASSERT_EQ(render.exit_code, 0) << render.output;
   int pngs = 0;
-  for (const auto& e : fs::directory_iterator(dir_ / "frames")) pngs += e.path().extension() == ".png";
+  for (const auto& e : fs::directory_iterator(dir_ / "frames"))
+    pngs += e.path().extension() == ".png";
   EXPECT_EQ(pngs, 40);
   const cv::Mat first = cv::imread(dir_ / "frames/frame_000000.png", cv::IMREAD_UNCHANGED);
   ASSERT_EQ(first.type(), CV_8UC4);
   EXPECT_EQ(first.size(), cv::Size(320, 240));
 
-  const auto video = testing::RunSpritestation("render " + seq + " --out " + (dir_ / "anim.mkv") + " --codec ffv1");
+  const auto video = testing::RunSpritestation("render " + seq + " --out " + (dir_ / "anim.mkv") +
+                                               " --codec ffv1");
   ASSERT_EQ(video.exit_code, 0) << video.output;
   EXPECT_GT(fs::file_size(dir_ / "anim.mkv"), 1000u);
   EXPECT_EQ(ReadVideoFrames(dir_ / "anim.mkv").size(), 40u);
-  const auto mp4 = testing::RunSpritestation("render " + seq + " --out " + (dir_ / "anim.mp4") + " --json");
+  const auto mp4 =
+      testing::RunSpritestation("render " + seq + " --out " + (dir_ / "anim.mp4") + " --json");
   ASSERT_EQ(mp4.exit_code, 0) << mp4.output;
   EXPECT_EQ(ReadVideoFrames(dir_ / "anim.mp4").size(), 40u);
 
-  const std::string bad = WriteSpec("frame_rate: 30\nlength: 40\nsprites:\n  - name: a\n    start: [0, zero]\n");
+  const std::string bad =
+      WriteSpec("frame_rate: 30\nlength: 40\nsprites:\n  - name: a\n    start: [0, zero]\n");
   const auto refused = testing::RunSpritestation("animate " + bad + " --out " + seq);
   EXPECT_EQ(refused.exit_code, 2);
-  EXPECT_NE(refused.output.find("scene.yaml:8: sprites[0].start[1]: expected a number"), std::string::npos)
+  EXPECT_NE(refused.output.find("scene.yaml:8: sprites[0].start[1]: expected a number"),
+            std::string::npos)
       << refused.output;
 }
 

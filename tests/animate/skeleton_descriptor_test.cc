@@ -28,7 +28,8 @@ const Script& AllGestures() {
 }
 
 // Every joint mapped by x -> scale * x + offset (and optionally rotated about the origin).
-SkeletonSequence Transformed(const SkeletonSequence& in, float scale, float dx, float dy, float radians = 0) {
+SkeletonSequence Transformed(const SkeletonSequence& in, float scale, float dx, float dy,
+                             float radians = 0) {
   SkeletonSequence out = in;
   const float c = std::cos(radians), s = std::sin(radians);
   for (auto& f : out.frames) {
@@ -64,7 +65,8 @@ TEST(SkeletonDescriptor, InvariantToTranslationAndScale) {
   const PoseDescriptors c = ComputeDescriptors(shrunk, {});
   ASSERT_EQ(a.count, b.count);
   for (size_t k = 0; k < a.features.size(); ++k) {
-    ASSERT_NEAR(a.features[k], b.features[k], 1e-4) << "feature " << k / a.count << " frame " << k % a.count;
+    ASSERT_NEAR(a.features[k], b.features[k], 1e-4)
+        << "feature " << k / a.count << " frame " << k % a.count;
     ASSERT_NEAR(a.features[k], c.features[k], 1e-4);
   }
   for (int i = 0; i < a.count; i += 7) {
@@ -89,7 +91,8 @@ TEST(SkeletonDescriptor, RotationOnlyChangesTheOrientationTerm) {
   // pair motion terms and the root's motion (both unchanged by the rotation).
   ASSERT_EQ(a.layout.groups, 17 + 1 + 17 + 1);
   const float expected = 0.25f * (1 - std::cos(0.5f)) /
-                         (17 * 1.5f + 0.25f + 17 * with_orientation.motion_weight + with_orientation.root_motion_weight);
+                         (17 * 1.5f + 0.25f + 17 * with_orientation.motion_weight +
+                          with_orientation.root_motion_weight);
   for (int i = 0; i < a.count; i += 11) {
     EXPECT_NEAR(PoseCost(a, i, b, i), expected, 1e-5);
     EXPECT_LT(PoseCost(a0, i, b0, i), 1e-6);
@@ -109,7 +112,8 @@ TEST(SkeletonDescriptor, AnglesIgnoreBodyProportionsAndNormalizedRatiosToo) {
     for (int i = 0; i < a.count; ++i) {
       ASSERT_NEAR(a.feature(3 * p, i), b.feature(3 * p, i), 1e-4);
       ASSERT_NEAR(a.feature(3 * p + 1, i), b.feature(3 * p + 1, i), 1e-4);
-      ratio_gap = std::max(ratio_gap, std::abs(static_cast<double>(a.feature(3 * p + 2, i)) - b.feature(3 * p + 2, i)));
+      ratio_gap = std::max(ratio_gap, std::abs(static_cast<double>(a.feature(3 * p + 2, i)) -
+                                               b.feature(3 * p + 2, i)));
     }
   }
   EXPECT_GT(ratio_gap, 0.1);  // the raw ratios do see the proportions
@@ -178,15 +182,15 @@ SkeletonSequence Subsampled(const SkeletonSequence& in, int step) {
 
 TEST(SkeletonDescriptor, MotionTermIsMeasuredInSecondsAndTellsMovingFromHolding) {
   // idle 30, Y 30 (with a blend into it), walk 56 at 25 fps.
-  const LabelledSkeletons poses =
-      MakeGestureSequence({{Gesture::kIdle, 30}, {Gesture::kY, 30}, {Gesture::kWalk, 56}}, BodyProportions{});
+  const LabelledSkeletons poses = MakeGestureSequence(
+      {{Gesture::kIdle, 30}, {Gesture::kY, 30}, {Gesture::kWalk, 56}}, BodyProportions{});
   ASSERT_EQ(poses.sequence.fps, 25);
   DescriptorOptions o;
   o.motion_window_s = 0.24f;  // 6 frames at 25 fps, 2 at 25 / 3
   const PoseDescriptors d = ComputeDescriptors(poses.sequence, o);
   const PoseDescriptors third = ComputeDescriptors(Subsampled(poses.sequence, 3), o);
   const int m0 = d.layout.first_motion_feature;
-  ASSERT_EQ(d.layout.dim, m0 + d.layout.pairs + 1);  // and the root's
+  ASSERT_EQ(d.layout.dim, m0 + d.layout.pairs + 1);     // and the root's
   auto motion = [&](const PoseDescriptors& x, int i) {  // the mean pair motion feature
     float sum = 0;
     for (int p = 0; p < x.layout.pairs; ++p) sum += x.feature(m0 + p, i);
@@ -196,7 +200,8 @@ TEST(SkeletonDescriptor, MotionTermIsMeasuredInSecondsAndTellsMovingFromHolding)
   // ends fall on the same instants), though a frame then spans three times the change.
   for (int i = 2; i + 2 < third.count; ++i) {
     for (int p = 0; p <= d.layout.pairs; ++p) {  // and the root's
-      ASSERT_NEAR(third.feature(m0 + p, i), d.feature(m0 + p, 3 * i), 1e-5) << "pair " << p << " frame " << 3 * i;
+      ASSERT_NEAR(third.feature(m0 + p, i), d.feature(m0 + p, 3 * i), 1e-5)
+          << "pair " << p << " frame " << 3 * i;
     }
   }
   // The idle and the held Y only sway (3 degrees; the idle's sway, at 0.2 rad of phase a
@@ -213,11 +218,13 @@ TEST(SkeletonDescriptor, MotionTermIsMeasuredInSecondsAndTellsMovingFromHolding)
   EXPECT_GT(motion(d, 33), 0.18f);  // in the blend into Y
   // Across clips: each clip's motion comes from its own frames and frame rate.
   const SkeletonSequence slow = Subsampled(poses.sequence, 3);
-  const PoseDescriptors both = ComputeDescriptors(std::vector<const SkeletonSequence*>{&poses.sequence, &slow}, o);
+  const PoseDescriptors both =
+      ComputeDescriptors(std::vector<const SkeletonSequence*>{&poses.sequence, &slow}, o);
   ASSERT_EQ(both.clip_starts, (std::vector<int>{0, d.count}));
   EXPECT_EQ(FrameRateAt(both, d.count + 1), 25.0 / 3);
   for (int i = 0; i < third.count; ++i) {
-    for (int k = 0; k < d.layout.dim; ++k) ASSERT_EQ(both.feature(k, d.count + i), third.feature(k, i));
+    for (int k = 0; k < d.layout.dim; ++k)
+      ASSERT_EQ(both.feature(k, d.count + i), third.feature(k, i));
   }
   // A clip shorter than the window and a gap in the frame numbers leave the motion out.
   SkeletonSequence gap = poses.sequence;
@@ -235,7 +242,8 @@ TEST(SkeletonDescriptor, CostRowsAgreeWithPoseCost) {
   std::mt19937 rng(4);
   GestureScriptOptions noisy;
   noisy.noise_px = 2.0f;
-  const LabelledSkeletons t = MakeGestureSequence({{Gesture::kY, 20}, {Gesture::kWalk, 30}}, OtherBody(), noisy);
+  const LabelledSkeletons t =
+      MakeGestureSequence({{Gesture::kY, 20}, {Gesture::kWalk, 30}}, OtherBody(), noisy);
   SkeletonSequence targets = t.sequence;
   SkeletonSequence sources = MakeGestureSequence(AllGestures(), BodyProportions{}).sequence;
   std::uniform_int_distribution<int> joint(0, 14);
@@ -260,7 +268,8 @@ TEST(SkeletonDescriptor, CostRowsAgreeWithPoseCost) {
           EXPECT_TRUE(std::isinf(got));
           continue;
         }
-        ASSERT_NEAR(got, PoseCost(td, t0 + i, sd, s), 1e-4) << "target " << t0 + i << " source " << s;
+        ASSERT_NEAR(got, PoseCost(td, t0 + i, sd, s), 1e-4)
+            << "target " << t0 + i << " source " << s;
       }
     }
   }
@@ -270,9 +279,9 @@ TEST(SkeletonDescriptor, DifferentSkeletonsAreRefused) {
   const LabelledSkeletons poses = MakeGestureSequence({{Gesture::kY, 5}}, BodyProportions{});
   SkeletonSequence other;
   other.clip = "quadruped.json";
-  other.skeleton = MakeSkeletonDef("quadruped", {"snout", "withers", "tail", "front", "hind"},
-                                   {{"withers", "snout"}, {"withers", "tail"}, {"withers", "front"}, {"tail", "hind"}},
-                                   "test");
+  other.skeleton = MakeSkeletonDef(
+      "quadruped", {"snout", "withers", "tail", "front", "hind"},
+      {{"withers", "snout"}, {"withers", "tail"}, {"withers", "front"}, {"tail", "hind"}}, "test");
   other.frames.push_back(EmptySkeletonFrame(other.skeleton, 0));
   try {
     ComputeDescriptors(std::vector<const SkeletonSequence*>{&poses.sequence, &other}, {});

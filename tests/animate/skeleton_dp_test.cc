@@ -51,7 +51,8 @@ MatchOptions RandomOptions(std::mt19937& rng, int sources) {
   o.stutter_cost = 0.3f * u(rng);
   const int listed = static_cast<int>(rng() % 4);
   for (int i = 0; i < listed; ++i) {
-    o.transitions.push_back({static_cast<int>(rng() % sources), static_cast<int>(rng() % sources), 0.2f * u(rng)});
+    o.transitions.push_back(
+        {static_cast<int>(rng() % sources), static_cast<int>(rng() % sources), 0.2f * u(rng)});
   }
   return o;
 }
@@ -105,7 +106,8 @@ double QuadraticDp(const DenseCostRows& costs, const std::vector<int>& clips, co
     std::fill(next.begin(), next.end(), inf);
     for (int s = 0; s < S; ++s) {
       for (int r = 1; r <= R; ++r) {  // stays
-        const double from = r < R ? v[s * (R + 1) + r - 1] : std::min(v[s * (R + 1) + R - 1], v[s * (R + 1) + R]);
+        const double from =
+            r < R ? v[s * (R + 1) + r - 1] : std::min(v[s * (R + 1) + R - 1], v[s * (R + 1) + R]);
         next[s * (R + 1) + r] = from + o.freeze_cost * r + costs.at(t, s);
       }
       for (int p = 0; p < S; ++p) {  // moves p -> s: the cost of the two-frame path minus its parts
@@ -120,7 +122,8 @@ double QuadraticDp(const DenseCostRows& costs, const std::vector<int>& clips, co
         const MovementConstraint* use = nullptr;
         if (m) {
           local = *m;
-          const bool inside = !std::binary_search(m->target_starts.begin(), m->target_starts.end(), t);
+          const bool inside =
+              !std::binary_search(m->target_starts.begin(), m->target_starts.end(), t);
           local.target_starts = inside ? std::vector<int>{0} : std::vector<int>{0, 1};
           use = &local;
         }
@@ -151,7 +154,8 @@ TEST(SkeletonDp, MatchesQuadraticDpOnLargerCases) {
     EXPECT_NEAR(PathCost(costs, clips, o, nullptr, free.source_frames), free.total_cost, 1e-4);
     const MatchResult constrained = SolveMatch(costs, clips, o, &m);
     EXPECT_NEAR(constrained.total_cost, QuadraticDp(costs, clips, o, &m), 1e-4);
-    EXPECT_NEAR(PathCost(costs, clips, o, &m, constrained.source_frames), constrained.total_cost, 1e-4);
+    EXPECT_NEAR(PathCost(costs, clips, o, &m, constrained.source_frames), constrained.total_cost,
+                1e-4);
   }
 }
 
@@ -174,14 +178,16 @@ TEST(SkeletonDp, StoredDecisionsGiveTheCheckpointPath) {
   std::mt19937 rng(19);
   for (int trial = 0; trial < 24; ++trial) {
     const bool constrained = trial % 2 == 1;
-    const bool grid = trial % 5 == 2;  // 0/1 costs, free skips and stutters: equal candidates everywhere
+    const bool grid =
+        trial % 5 == 2;  // 0/1 costs, free skips and stutters: equal candidates everywhere
     const bool wide = trial % 3 == 0;  // move codes above 15: two bytes a cell
     const int T = trial % 4 == 0 ? 160 : 30 + 3 * trial, S = 45 + 5 * trial;
     DenseCostRows costs = RandomCosts(T, S, rng, trial % 4 == 1 ? 0.05f : 0.0f);
     if (grid) {
       std::vector<float> values(static_cast<size_t>(T) * S);
       for (int t = 0; t < T; ++t) {
-        for (int s = 0; s < S; ++s) values[static_cast<size_t>(t) * S + s] = costs.at(t, s) < 0.7f ? 0.0f : 1.0f;
+        for (int s = 0; s < S; ++s)
+          values[static_cast<size_t>(t) * S + s] = costs.at(t, s) < 0.7f ? 0.0f : 1.0f;
       }
       costs = DenseCostRows(T, S, std::move(values));
     }
@@ -202,7 +208,8 @@ TEST(SkeletonDp, StoredDecisionsGiveTheCheckpointPath) {
     }
     if (trial % 3 == 1) {
       for (int i = 0; i < 25; ++i) {
-        o.transitions.push_back({static_cast<int>(rng() % S), static_cast<int>(rng() % S), 0.05f * (i % 4)});
+        o.transitions.push_back(
+            {static_cast<int>(rng() % S), static_cast<int>(rng() % S), 0.05f * (i % 4)});
       }
     }
     MovementConstraint m;
@@ -219,7 +226,8 @@ TEST(SkeletonDp, StoredDecisionsGiveTheCheckpointPath) {
     EXPECT_FALSE(recomputed.walked_decisions);
     EXPECT_EQ(stored.source_frames, recomputed.source_frames);
     EXPECT_EQ(stored.total_cost, recomputed.total_cost);
-    EXPECT_NEAR(PathCost(costs, clips, o, constraint, stored.source_frames), stored.total_cost, 1e-3);
+    EXPECT_NEAR(PathCost(costs, clips, o, constraint, stored.source_frames), stored.total_cost,
+                1e-3);
     EXPECT_GE(stored.memory_bytes, static_cast<size_t>(T) * S);  // at least a byte a cell
   }
 }
@@ -242,7 +250,8 @@ TEST(SkeletonDp, ListedChoicesPastTheBudgetFallBackToCheckpoints) {
   const MatchResult stored = SolveMatch(costs, clips, roomy);
   ASSERT_TRUE(stored.walked_decisions);
   // What the decisions need without the listed choices: a byte a cell and the top lists.
-  tight.max_decision_bytes = static_cast<size_t>(T) * S + static_cast<size_t>(T) * (o.stutter_window + 2) * 4 + 64;
+  tight.max_decision_bytes =
+      static_cast<size_t>(T) * S + static_cast<size_t>(T) * (o.stutter_window + 2) * 4 + 64;
   const MatchResult fallen = SolveMatch(costs, clips, tight);
   EXPECT_FALSE(fallen.walked_decisions);
   EXPECT_EQ(stored.source_frames, reference.source_frames);
@@ -278,7 +287,9 @@ TEST(SkeletonDp, StoredDecisionsBreakTiesLikeTheCheckpointPath) {
 }
 
 // Cost matrix with `value` everywhere and chosen cells overridden.
-std::vector<float> Filled(int T, int S, float value) { return std::vector<float>(static_cast<size_t>(T) * S, value); }
+std::vector<float> Filled(int T, int S, float value) {
+  return std::vector<float>(static_cast<size_t>(T) * S, value);
+}
 
 TEST(SkeletonDp, FreezePenaltyRemovesFreezes) {
   // Source 0..4 is the motion at half the target's rate (each frame matches two target
@@ -379,7 +390,8 @@ TEST(SkeletonDp, MovementConstraintKeepsOneSourceMovement) {
   // the per-frame best does.
   const int T = 6, S = 12;
   std::vector<float> c = Filled(T, S, 0.5f);
-  for (int t = 0; t < T; ++t) c[t * S + (t == 3 ? 9 : t)] = 0.0f;  // frame 3 prefers the other movement
+  for (int t = 0; t < T; ++t)
+    c[t * S + (t == 3 ? 9 : t)] = 0.0f;  // frame 3 prefers the other movement
   const DenseCostRows costs(T, S, c);
   MatchOptions o;
   o.jump_cost = 0.05f;

@@ -6,8 +6,8 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
-#include <functional>
 #include <fstream>
+#include <functional>
 
 #include <nlohmann/json.hpp>
 
@@ -51,7 +51,7 @@ TEST(SkeletonImporters, DeepLabCutAnalysisCsv) {
   EXPECT_NEAR(s.frames[0].joints[1].confidence, 0.97f, 1e-6);  // the ears' lower likelihood
   EXPECT_FALSE(Present(s, 2, "hindpaw"));  // likelihood 0.31 < DeepLabCut's pcutoff 0.6
   EXPECT_TRUE(Present(s, 2, "snout"));
-  EXPECT_FALSE(Present(s, 3, "snout"));    // 0.45
+  EXPECT_FALSE(Present(s, 3, "snout"));  // 0.45
   // An explicit threshold wins.
   ImportOptions loose;
   loose.min_confidence = 0.3f;
@@ -109,7 +109,8 @@ TEST(SkeletonImporters, OpenPoseBody25Folder) {
 }
 
 TEST(SkeletonImporters, CocoPersonKeypoints) {
-  const SkeletonSequence s = ImportCocoKeypoints(Data("coco_person_keypoints.json"), Coco17ToHuman14());
+  const SkeletonSequence s =
+      ImportCocoKeypoints(Data("coco_person_keypoints.json"), Coco17ToHuman14());
   ASSERT_EQ(s.size(), 3);
   EXPECT_EQ(s.frames[0].frame, 7);  // image ids
   EXPECT_EQ(s.frames[2].frame, 9);
@@ -120,16 +121,18 @@ TEST(SkeletonImporters, CocoPersonKeypoints) {
   ExpectJoint(s, 1, "head", 326, 102);
   ExpectJoint(s, 1, "wrist_l", 398, 216);  // v = 1 (hidden) is kept at the default 0.5
   EXPECT_NEAR(s.frames[1].joints[*s.skeleton.JointIndex("wrist_l")].confidence, 0.5f, 1e-6);
-  EXPECT_FALSE(Present(s, 1, "ankle_r"));  // v = 0
+  EXPECT_FALSE(Present(s, 1, "ankle_r"));                            // v = 0
   for (const auto& j : s.frames[2].joints) EXPECT_FALSE(j.present);  // image 9: no annotation
   ImportOptions visible_only;
   visible_only.min_confidence = 0.9f;
-  EXPECT_FALSE(Present(ImportCocoKeypoints(Data("coco_person_keypoints.json"), Coco17ToHuman14(), visible_only),
-                       1, "wrist_l"));
+  EXPECT_FALSE(Present(
+      ImportCocoKeypoints(Data("coco_person_keypoints.json"), Coco17ToHuman14(), visible_only), 1,
+      "wrist_l"));
 }
 
 TEST(SkeletonImporters, ImportedSequenceRoundTripsThroughJson) {
-  const SkeletonSequence s = ImportDeepLabCutCsv(Data("dlc_mouse.csv"), LoadJointMapping(Data("mouse_mapping.json")));
+  const SkeletonSequence s =
+      ImportDeepLabCutCsv(Data("dlc_mouse.csv"), LoadJointMapping(Data("mouse_mapping.json")));
   testing::ScratchDir dir;
   WriteSkeletonSequence(s, dir / "mouse.json");
   const SkeletonSequence back = ReadSkeletonSequence(dir / "mouse.json");
@@ -139,7 +142,8 @@ TEST(SkeletonImporters, ImportedSequenceRoundTripsThroughJson) {
   for (int f = 0; f < s.size(); ++f) {
     for (size_t j = 0; j < s.skeleton.joints.size(); ++j) {
       EXPECT_EQ(back.frames[f].joints[j].present, s.frames[f].joints[j].present);
-      if (s.frames[f].joints[j].present) EXPECT_NEAR(back.frames[f].joints[j].x_px, s.frames[f].joints[j].x_px, 1e-3);
+      if (s.frames[f].joints[j].present)
+        EXPECT_NEAR(back.frames[f].joints[j].x_px, s.frames[f].joints[j].x_px, 1e-3);
     }
   }
 }
@@ -168,25 +172,32 @@ TEST(SkeletonImporters, ErrorsNameTheFileAndTheReason) {
   bad = nlohmann::json::parse(std::ifstream(Data("mouse_mapping.json")));
   bad["joints"]["tail_tip"] = "tailbase";
   std::ofstream(dir / "unknown_joint.json") << bad.dump();
-  EXPECT_NE(ErrorOf([&] { LoadJointMapping(dir / "unknown_joint.json"); }).find("no joint named 'tail_tip'"),
+  EXPECT_NE(ErrorOf([&] {
+              LoadJointMapping(dir / "unknown_joint.json");
+            }).find("no joint named 'tail_tip'"),
             std::string::npos);
   // A DeepLabCut row with a column missing.
   std::ifstream in(Data("dlc_mouse.csv"));
   std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   text.erase(text.rfind(','));
   std::ofstream(dir / "short.csv") << text << "\n";
-  const std::string s = ErrorOf([&] { ImportDeepLabCutCsv(dir / "short.csv", LoadJointMapping(Data("mouse_mapping.json"))); });
+  const std::string s = ErrorOf([&] {
+    ImportDeepLabCutCsv(dir / "short.csv", LoadJointMapping(Data("mouse_mapping.json")));
+  });
   EXPECT_NE(s.find("short.csv: line 7"), std::string::npos) << s;
   // Not the expected format at all.
-  EXPECT_NE(ErrorOf([&] { ImportDeepLabCutCsv(Data("coco_person_keypoints.json"), Body25ToHuman14()); })
-                .find("not a DeepLabCut CSV"),
+  EXPECT_NE(ErrorOf([&] {
+              ImportDeepLabCutCsv(Data("coco_person_keypoints.json"), Body25ToHuman14());
+            }).find("not a DeepLabCut CSV"),
             std::string::npos);
-  EXPECT_NE(ErrorOf([&] { ImportCocoKeypoints(Data("openpose_ymca/ymca_000000000000_keypoints.json"),
-                                              Coco17ToHuman14()); })
-                .find("no 'annotations' array"),
+  EXPECT_NE(ErrorOf([&] {
+              ImportCocoKeypoints(Data("openpose_ymca/ymca_000000000000_keypoints.json"),
+                                  Coco17ToHuman14());
+            }).find("no 'annotations' array"),
             std::string::npos);
-  EXPECT_NE(ErrorOf([&] { ImportOpenPoseJson(Data("coco_person_keypoints.json"), Body25ToHuman14()); })
-                .find("no 'people' array"),
+  EXPECT_NE(ErrorOf([&] {
+              ImportOpenPoseJson(Data("coco_person_keypoints.json"), Body25ToHuman14());
+            }).find("no 'people' array"),
             std::string::npos);
 }
 
@@ -197,7 +208,8 @@ TEST(SkeletonImporters, SynthJointTruth) {
   const std::filesystem::path session = dir.path() / "sess";
   std::filesystem::create_directories(session / "truth" / "cam1");
   std::ofstream(session / "session.json") << R"({"name": "figure-7", "format_version": 1})";
-  std::ofstream(session / "truth" / "truth.json") << R"({"fps": 12.5, "cameras": [{"name": "cam1"}]})";
+  std::ofstream(session / "truth" / "truth.json")
+      << R"({"fps": 12.5, "cameras": [{"name": "cam1"}]})";
   {
     std::ofstream csv(session / "truth" / "cam1" / "joints.csv");
     csv << "frame,subject,joint,name,x,y,hidden\n";
@@ -205,15 +217,16 @@ TEST(SkeletonImporters, SynthJointTruth) {
     for (int f = 0; f < 2; ++f) {
       for (int subject = 1; subject >= 0; --subject) {
         for (int j = static_cast<int>(names.size()) - 1; j >= 0; --j) {
-          csv << f << "," << subject << "," << j << "," << names[j] << "," << 100 * subject + 10 * j + f << ","
-              << 200 + j << ",0\n";
+          csv << f << "," << subject << "," << j << "," << names[j] << ","
+              << 100 * subject + 10 * j + f << "," << 200 + j << ",0\n";
         }
       }
     }
   }
   ImportOptions options;
   options.person = 1;
-  const SkeletonSequence s = ImportSynthTruth(session.string(), "", IdentityMapping(HumanSkeleton()), options);
+  const SkeletonSequence s =
+      ImportSynthTruth(session.string(), "", IdentityMapping(HumanSkeleton()), options);
   ASSERT_EQ(s.size(), 2);
   EXPECT_EQ(s.clip, "figure-7/cam1");
   EXPECT_DOUBLE_EQ(s.fps, 12.5);
@@ -222,12 +235,14 @@ TEST(SkeletonImporters, SynthJointTruth) {
   ExpectJoint(s, 1, "wrist_l", 141, 204);
   ExpectJoint(s, 1, "ankle_r", 241, 214);
   // The CSV itself works too, subject 0 by default; a subject that is not there is an error.
-  const SkeletonSequence s0 = ImportSynthTruth((session / "truth" / "cam1" / "joints.csv").string(), "",
-                                               IdentityMapping(HumanSkeleton()));
+  const SkeletonSequence s0 = ImportSynthTruth((session / "truth" / "cam1" / "joints.csv").string(),
+                                               "", IdentityMapping(HumanSkeleton()));
   ExpectJoint(s0, 1, "neck", 11, 201);
   options.person = 5;
-  EXPECT_THROW(ImportSynthTruth(session.string(), "", IdentityMapping(HumanSkeleton()), options), InputError);
-  EXPECT_THROW(ImportSynthTruth(dir.path().string(), "", IdentityMapping(HumanSkeleton())), InputError);
+  EXPECT_THROW(ImportSynthTruth(session.string(), "", IdentityMapping(HumanSkeleton()), options),
+               InputError);
+  EXPECT_THROW(ImportSynthTruth(dir.path().string(), "", IdentityMapping(HumanSkeleton())),
+               InputError);
 }
 
 }  // namespace

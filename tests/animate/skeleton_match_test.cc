@@ -32,9 +32,12 @@ LabelledSkeletons Target() {
   GestureScriptOptions o;
   o.noise_px = 1.0f;
   o.seed = 3;
-  return MakeGestureSequence(
-      {{Gesture::kY, 30}, {Gesture::kM, 30}, {Gesture::kC, 30}, {Gesture::kA, 30}, {Gesture::kWalk, 40}},
-      BodyProportions{}, o);
+  return MakeGestureSequence({{Gesture::kY, 30},
+                              {Gesture::kM, 30},
+                              {Gesture::kC, 30},
+                              {Gesture::kA, 30},
+                              {Gesture::kWalk, 40}},
+                             BodyProportions{}, o);
 }
 
 LabelledSkeletons Source() {
@@ -44,12 +47,18 @@ LabelledSkeletons Source() {
   o.scale_px = 70;
   o.x_px = 150;
   o.seed = 9;
-  return MakeGestureSequence({{Gesture::kWalk, 50}, {Gesture::kA, 35}, {Gesture::kIdle, 30}, {Gesture::kC, 35},
-                              {Gesture::kY, 35}, {Gesture::kWalk, 30}, {Gesture::kM, 35}},
+  return MakeGestureSequence({{Gesture::kWalk, 50},
+                              {Gesture::kA, 35},
+                              {Gesture::kIdle, 30},
+                              {Gesture::kC, 35},
+                              {Gesture::kY, 35},
+                              {Gesture::kWalk, 30},
+                              {Gesture::kM, 35}},
                              OtherBody(), o);
 }
 
-double Accuracy(const std::vector<int>& path, const LabelledSkeletons& t, const LabelledSkeletons& s) {
+double Accuracy(const std::vector<int>& path, const LabelledSkeletons& t,
+                const LabelledSkeletons& s) {
   int same = 0;
   for (size_t i = 0; i < path.size(); ++i) same += t.labels[i] == s.labels[path[i]];
   return static_cast<double>(same) / static_cast<double>(path.size());
@@ -100,12 +109,14 @@ TEST(SkeletonMatch, MatchCommandWritesTheChoiceAndTheFigure2Plot) {
   second.frames.erase(second.frames.begin(), second.frames.begin() + split);
   const std::string a = Write(dir, "source_a", first);
   const std::string b = Write(dir, "source_b", second);
-  const auto run = testing::RunSpritestation("match " + t + " --source " + a + " --source " + b + " --out " +
-                                             (dir / "seq.json") + " --plot " + (dir / "plot.png") + " --normalize-ratios --json");
+  const auto run = testing::RunSpritestation("match " + t + " --source " + a + " --source " + b +
+                                             " --out " + (dir / "seq.json") + " --plot " +
+                                             (dir / "plot.png") + " --normalize-ratios --json");
   ASSERT_EQ(run.exit_code, 0) << run.output;
   const nlohmann::json report = nlohmann::json::parse(run.output.substr(run.output.find('{')));
   EXPECT_EQ(report["target_frames"], target.sequence.size());
-  EXPECT_GT(report["without_penalties"]["freezes"].get<int>(), report["with_penalties"]["freezes"].get<int>());
+  EXPECT_GT(report["without_penalties"]["freezes"].get<int>(),
+            report["with_penalties"]["freezes"].get<int>());
   const nlohmann::json seq = ReadJson(dir / "seq.json");
   EXPECT_EQ(seq["format"], "spritestation.skeleton_match");
   EXPECT_EQ(seq["version"], 1);
@@ -131,7 +142,8 @@ TEST(SkeletonMatch, MatchCommandWritesTheChoiceAndTheFigure2Plot) {
 // A bank holding the source clip's frames as sprites of camera "cam0" of session "studio".
 std::vector<int64_t> MakeBank(const std::string& path, int frames) {
   BankWriter w(path);
-  const int64_t session = w.AddSession({0, "studio@test", "studio", "2026-11-23T10:00:00Z", "test"});
+  const int64_t session =
+      w.AddSession({0, "studio@test", "studio", "2026-11-23T10:00:00Z", "test"});
   CameraRecord camera;
   camera.name = "cam0";
   camera.width = 640;
@@ -176,8 +188,9 @@ TEST(SkeletonMatch, MatchCommandWithABankWritesRenderableSequences) {
   WriteSkeletonSequence(s, dir / "source.json");
   const std::string t = Write(dir, "target", target.sequence);
   const std::vector<int64_t> ids = MakeBank(dir / "bank.sqlite", s.size());
-  const auto run = testing::RunSpritestation("match " + t + " --source " + (dir / "source.json") + " --bank " +
-                                             (dir / "bank.sqlite") + " --out " + (dir / "seq.json"));
+  const auto run =
+      testing::RunSpritestation("match " + t + " --source " + (dir / "source.json") + " --bank " +
+                                (dir / "bank.sqlite") + " --out " + (dir / "seq.json"));
   ASSERT_EQ(run.exit_code, 0) << run.output;
   const SequenceFile file = ReadSequenceFile(dir / "seq.json");
   ASSERT_EQ(file.sprites.size(), 1u);
@@ -187,7 +200,7 @@ TEST(SkeletonMatch, MatchCommandWithABankWritesRenderableSequences) {
   const nlohmann::json match = file.summary["skeleton_match"];
   for (size_t i = 0; i < steps.size(); ++i) {
     const int64_t frame = match["frames"][i]["frame"].get<int64_t>();
-    EXPECT_NE(frame, 5);                  // no sprite: never chosen
+    EXPECT_NE(frame, 5);                        // no sprite: never chosen
     EXPECT_EQ(steps[i].sprite_id, ids[frame]);  // the sprite of the chosen frame
     EXPECT_NEAR(file.sprites[0].positions_m[i].x(), 1.5, 1e-9);
   }
@@ -199,8 +212,9 @@ TEST(SkeletonMatch, MatchCommandWithABankWritesRenderableSequences) {
     const int64_t other_session = w.AddSession({0, "b@x", "b", "", ""});
     w.AddCamera(other_session, CameraRecord{0, 0, "cam1", "", 640, 480});
   }
-  const auto bad = testing::RunSpritestation("match " + t + " --source " + (dir / "other.json") + " --bank " +
-                                             (dir / "bank.sqlite") + " --out " + (dir / "x.json"));
+  const auto bad =
+      testing::RunSpritestation("match " + t + " --source " + (dir / "other.json") + " --bank " +
+                                (dir / "bank.sqlite") + " --out " + (dir / "x.json"));
   EXPECT_EQ(bad.exit_code, 2) << bad.output;
   EXPECT_NE(bad.output.find("other/cam3"), std::string::npos) << bad.output;
 }
@@ -212,16 +226,18 @@ TEST(SkeletonMatch, MatchCommandRefusesBadInput) {
   nlohmann::json broken = SkeletonSequenceToJson(Source().sequence);
   broken["frames"][3]["joints"].erase("knee_l");
   std::ofstream(dir / "broken.json") << broken.dump();
-  const auto r = testing::RunSpritestation("match " + t + " --source " + (dir / "broken.json") + " --out " +
-                                           (dir / "x.json"));
+  const auto r = testing::RunSpritestation("match " + t + " --source " + (dir / "broken.json") +
+                                           " --out " + (dir / "x.json"));
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_NE(r.output.find("broken.json"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("'knee_l' is missing"), std::string::npos) << r.output;
   // A source on another skeleton.
-  const auto q = testing::RunSpritestation("skeleton import --format deeplabcut " + Data("dlc_mouse.csv") +
-                                           " --mapping " + Data("mouse_mapping.json") + " --out " + (dir / "m.json"));
+  const auto q = testing::RunSpritestation(
+      "skeleton import --format deeplabcut " + Data("dlc_mouse.csv") + " --mapping " +
+      Data("mouse_mapping.json") + " --out " + (dir / "m.json"));
   ASSERT_EQ(q.exit_code, 0) << q.output;
-  const auto m = testing::RunSpritestation("match " + t + " --source " + (dir / "m.json") + " --out " + (dir / "x.json"));
+  const auto m = testing::RunSpritestation("match " + t + " --source " + (dir / "m.json") +
+                                           " --out " + (dir / "x.json"));
   EXPECT_EQ(m.exit_code, 2) << m.output;
   EXPECT_NE(m.output.find("skeleton differs"), std::string::npos) << m.output;
   EXPECT_FALSE(std::filesystem::exists(dir / "x.json"));
@@ -230,24 +246,26 @@ TEST(SkeletonMatch, MatchCommandRefusesBadInput) {
 TEST(SkeletonMatch, ImportCommandReadsEachFormat) {
   testing::ScratchDir dir;
   auto import = [&](const std::string& args) {
-    const auto r = testing::RunSpritestation("skeleton import " + args + " --out " + (dir / "s.json") + " --json");
+    const auto r = testing::RunSpritestation("skeleton import " + args + " --out " +
+                                             (dir / "s.json") + " --json");
     EXPECT_EQ(r.exit_code, 0) << r.output;
     return ReadSkeletonSequence(dir / "s.json");
   };
-  const SkeletonSequence d =
-      import("--format deeplabcut " + Data("dlc_mouse.csv") + " --mapping " + Data("mouse_mapping.json"));
+  const SkeletonSequence d = import("--format deeplabcut " + Data("dlc_mouse.csv") + " --mapping " +
+                                    Data("mouse_mapping.json"));
   EXPECT_EQ(d.skeleton.name, "mouse5");
   EXPECT_EQ(d.size(), 4);
   const SkeletonSequence o = import("--format openpose " + Data("openpose_ymca"));
   EXPECT_EQ(o.size(), 3);
   EXPECT_NEAR(o.frames[0].joints[*o.skeleton.JointIndex("wrist_l")].x_px, 395.0f, 1e-3);
-  const SkeletonSequence c = import("--format coco " + Data("coco_person_keypoints.json") + " --min-confidence 0.9");
+  const SkeletonSequence c =
+      import("--format coco " + Data("coco_person_keypoints.json") + " --min-confidence 0.9");
   EXPECT_EQ(c.frames[1].frame, 8);
   EXPECT_FALSE(c.frames[1].joints[*c.skeleton.JointIndex("wrist_l")].present);  // hidden, below 0.9
   // DeepLabCut needs a mapping; unknown formats are usage errors.
   const auto no_mapping =
-      testing::RunSpritestation("skeleton import --format deeplabcut " + Data("dlc_mouse.csv") + " --out " +
-                                (dir / "x.json"));
+      testing::RunSpritestation("skeleton import --format deeplabcut " + Data("dlc_mouse.csv") +
+                                " --out " + (dir / "x.json"));
   EXPECT_EQ(no_mapping.exit_code, 2);
   EXPECT_NE(no_mapping.output.find("--mapping"), std::string::npos) << no_mapping.output;
   EXPECT_EQ(testing::RunSpritestation("skeleton import --format bvh x --out y").exit_code, 2);

@@ -40,11 +40,13 @@ TEST(SkeletonRefine, WeakAndCrowdedPeaksAreDropped) {
   o.min_prominence = 0.05f;
   // 85: too weak; 48: 3 frames after the stronger 45; 3: too close to the start.
   // (The two crowded bumps merge into one peak at 46, so its movement starts at 47.)
-  const auto q = Bumps(99, {{3, 0.5f}, {20, 0.5f}, {45, 0.4f}, {48, 0.3f}, {70, 0.3f}, {85, 0.03f}});
+  const auto q =
+      Bumps(99, {{3, 0.5f}, {20, 0.5f}, {45, 0.4f}, {48, 0.3f}, {70, 0.3f}, {85, 0.03f}});
   EXPECT_EQ(FindMovements(q, o), (std::vector<int>{0, 21, 47, 71}));
   o.min_prominence = 0.01f;
   EXPECT_EQ(FindMovements(q, o), (std::vector<int>{0, 21, 47, 71, 86}));
-  EXPECT_EQ(FindMovements(std::vector<float>(50, 0.2f), o), (std::vector<int>{0}));  // no peak, one movement
+  EXPECT_EQ(FindMovements(std::vector<float>(50, 0.2f), o),
+            (std::vector<int>{0}));  // no peak, one movement
   // Relative to the noise floor: on a floor of 0.01 the 0.03 bump is noise for a factor of 4.
   o.noise_factor = 4;
   EXPECT_EQ(FindMovements(q, o), (std::vector<int>{0, 21, 47, 71}));
@@ -82,7 +84,11 @@ struct Script {
 
 Script Ymca() {
   Script s;
-  s.steps = {{Gesture::kIdle, 30}, {Gesture::kY, 30}, {Gesture::kM, 30}, {Gesture::kC, 30}, {Gesture::kA, 30}};
+  s.steps = {{Gesture::kIdle, 30},
+             {Gesture::kY, 30},
+             {Gesture::kM, 30},
+             {Gesture::kC, 30},
+             {Gesture::kA, 30}};
   const int blend = GestureScriptOptions{}.transition_frames;
   int at = 30;
   for (int i = 1; i < 5; ++i) {
@@ -100,7 +106,8 @@ TEST(SkeletonRefine, GestureBoundariesFallInTheTransitions) {
     SCOPED_TRACE("noise " + std::to_string(noise));
     GestureScriptOptions o;
     o.noise_px = noise;
-    const PoseDescriptors d = ComputeDescriptors(MakeGestureSequence(script.steps, OtherBody(), o).sequence, {});
+    const PoseDescriptors d =
+        ComputeDescriptors(MakeGestureSequence(script.steps, OtherBody(), o).sequence, {});
     const std::vector<int> starts = FindMovements(d, {0}, MovementOptions{});
     ASSERT_EQ(starts.size(), script.blends.size() + 1) << ::testing::PrintToString(starts);
     for (size_t i = 0; i < script.blends.size(); ++i) {
@@ -109,7 +116,8 @@ TEST(SkeletonRefine, GestureBoundariesFallInTheTransitions) {
     }
   }
   // lag 1 is the plain sequential cost.
-  const PoseDescriptors d = ComputeDescriptors(MakeGestureSequence(script.steps, OtherBody()).sequence, {});
+  const PoseDescriptors d =
+      ComputeDescriptors(MakeGestureSequence(script.steps, OtherBody()).sequence, {});
   EXPECT_EQ(MovementCost(d, 0, d.count, 1), SequentialCost(d));
 }
 
@@ -135,7 +143,8 @@ TEST(SkeletonRefine, JumpPenaltyInsideAMovement) {
   m.jump_cost_per_frame = 0.05f;
   MovementConstraint none = m;
   none.jump_cost_per_frame = 0;
-  EXPECT_NEAR(PathCost(costs, {0}, o, &m, free.source_frames) - PathCost(costs, {0}, o, &none, free.source_frames),
+  EXPECT_NEAR(PathCost(costs, {0}, o, &m, free.source_frames) -
+                  PathCost(costs, {0}, o, &none, free.source_frames),
               16 * 0.05, 1e-5);  // 4 -> 20
   const MatchResult penalized = SolveMatch(costs, {0}, o, &m);
   for (int t = 0; t < T; ++t) EXPECT_EQ(penalized.source_frames[t], t);
@@ -147,11 +156,13 @@ TEST(SkeletonRefine, JumpPenaltyInsideAMovement) {
 
 TEST(SkeletonRefine, AveragingWindowStaysInsideEachMovement) {
   const std::vector<int> frames = {10, 10, 20, 20, 20, 50, 50, 50};
-  EXPECT_EQ(AverageWithinSegments(frames, {0, 5}, 3), (std::vector<int>{10, 13, 17, 20, 20, 50, 50, 50}));
+  EXPECT_EQ(AverageWithinSegments(frames, {0, 5}, 3),
+            (std::vector<int>{10, 13, 17, 20, 20, 50, 50, 50}));
   EXPECT_EQ(AverageWithinSegments(frames, {0, 5}, 1), frames);
   // Forward play with a stutter (two steps on, one back) becomes a steady run.
   const std::vector<int> stutter = {10, 12, 11, 13, 12, 14, 13, 15};
-  EXPECT_EQ(AverageWithinSegments(stutter, {0}, 3), (std::vector<int>{11, 11, 12, 12, 13, 13, 14, 14}));
+  EXPECT_EQ(AverageWithinSegments(stutter, {0}, 3),
+            (std::vector<int>{11, 11, 12, 12, 13, 13, 14, 14}));
 }
 
 TEST(SkeletonRefine, TargetMovementsAreCutWhereTheFirstPassChangesSourceMovement) {
@@ -159,15 +170,18 @@ TEST(SkeletonRefine, TargetMovementsAreCutWhereTheFirstPassChangesSourceMovement
   const std::vector<int> source_starts{0, 10, 30};
   std::vector<int> first_pass;
   for (int t = 0; t < 10; ++t) first_pass.push_back(12 + t);  // movement 1
-  first_pass.push_back(5);                                     // movement 0 for 2 frames: too short
+  first_pass.push_back(5);                                    // movement 0 for 2 frames: too short
   first_pass.push_back(6);
-  for (int t = 12; t < 20; ++t) first_pass.push_back(31 + t);  // movement 2 for 8 frames: a cut at 12
-  for (int t = 20; t < 26; ++t) first_pass.push_back(40 + t);  // still movement 2, its own target movement
+  for (int t = 12; t < 20; ++t)
+    first_pass.push_back(31 + t);  // movement 2 for 8 frames: a cut at 12
+  for (int t = 20; t < 26; ++t)
+    first_pass.push_back(40 + t);  // still movement 2, its own target movement
   EXPECT_EQ(SplitByFirstPass({0, 20}, source_starts, first_pass, 3), (std::vector<int>{0, 12, 20}));
   // With a minimum of 9 frames the 8-frame run is not a movement of its own either.
   EXPECT_EQ(SplitByFirstPass({0, 20}, source_starts, first_pass, 9), (std::vector<int>{0, 20}));
   // A first pass inside one source movement cuts nothing.
-  EXPECT_EQ(SplitByFirstPass({0, 20}, source_starts, std::vector<int>(26, 15), 3), (std::vector<int>{0, 20}));
+  EXPECT_EQ(SplitByFirstPass({0, 20}, source_starts, std::vector<int>(26, 15), 3),
+            (std::vector<int>{0, 20}));
 }
 
 TEST(SkeletonRefine, OneSourceMovementPerTargetMovement) {
@@ -175,15 +189,22 @@ TEST(SkeletonRefine, OneSourceMovementPerTargetMovement) {
   // and at another speed, with walking between them.
   // (No idle in the target: the synthetic idle pose is also a phase of the walk, so
   // "idle" matched to standing walk frames would count as a wrong label.)
-  const LabelledSkeletons target = MakeGestureSequence(
-      {{Gesture::kY, 30}, {Gesture::kM, 30}, {Gesture::kC, 30}, {Gesture::kA, 30}, {Gesture::kWalk, 40}},
-      BodyProportions{});
+  const LabelledSkeletons target = MakeGestureSequence({{Gesture::kY, 30},
+                                                        {Gesture::kM, 30},
+                                                        {Gesture::kC, 30},
+                                                        {Gesture::kA, 30},
+                                                        {Gesture::kWalk, 40}},
+                                                       BodyProportions{});
   GestureScriptOptions slow;
   slow.speed = 0.8f;
-  const LabelledSkeletons source = MakeGestureSequence(
-      {{Gesture::kWalk, 40}, {Gesture::kA, 30}, {Gesture::kC, 30}, {Gesture::kIdle, 30}, {Gesture::kM, 30},
-       {Gesture::kWalk, 40}, {Gesture::kY, 30}},
-      OtherBody(), slow);
+  const LabelledSkeletons source = MakeGestureSequence({{Gesture::kWalk, 40},
+                                                        {Gesture::kA, 30},
+                                                        {Gesture::kC, 30},
+                                                        {Gesture::kIdle, 30},
+                                                        {Gesture::kM, 30},
+                                                        {Gesture::kWalk, 40},
+                                                        {Gesture::kY, 30}},
+                                                       OtherBody(), slow);
   const PoseDescriptors td = ComputeDescriptors(target.sequence, {});
   const PoseDescriptors sd = ComputeDescriptors(source.sequence, {});
   const DescriptorCostRows costs(td, sd);
@@ -193,7 +214,8 @@ TEST(SkeletonRefine, OneSourceMovementPerTargetMovement) {
   ASSERT_GE(r.target_movements.size(), 4u);
   ASSERT_GE(r.source_movements.size(), 7u);
   auto source_movement = [&](int s) {
-    return std::upper_bound(r.source_movements.begin(), r.source_movements.end(), s) - r.source_movements.begin();
+    return std::upper_bound(r.source_movements.begin(), r.source_movements.end(), s) -
+           r.source_movements.begin();
   };
   for (size_t m = 0; m < r.target_movements.size(); ++m) {
     const int begin = r.target_movements[m];

@@ -32,7 +32,8 @@ SkeletonSequence Truth() {
   o.scale_px = 80;
   o.x_px = 250;
   o.y_px = 250;
-  SkeletonSequence s = MakeGestureSequence({{Gesture::kWalk, kFrames}}, BodyProportions{}, o).sequence;
+  SkeletonSequence s =
+      MakeGestureSequence({{Gesture::kWalk, kFrames}}, BodyProportions{}, o).sequence;
   for (int f = 0; f < s.size(); ++f) {
     for (auto& j : s.frames[f].joints) j.x_px += 2.0f * f;
   }
@@ -51,7 +52,8 @@ cv::Mat Render(const SkeletonFrame& frame, bool occluded) {
   for (const Limb& l : def.limbs) {
     const JointSample& a = frame.joints[l.from];
     const JointSample& b = frame.joints[l.to];
-    cv::line(image, Fixed(a.x_px, a.y_px), Fixed(b.x_px, b.y_px), cv::Scalar(120), 2, cv::LINE_AA, 4);
+    cv::line(image, Fixed(a.x_px, a.y_px), Fixed(b.x_px, b.y_px), cv::Scalar(120), 2, cv::LINE_AA,
+             4);
   }
   for (const JointSample& j : frame.joints) {
     cv::circle(image, Fixed(j.x_px, j.y_px), 6 * 16, cv::Scalar(35), cv::FILLED, cv::LINE_AA, 4);
@@ -59,7 +61,8 @@ cv::Mat Render(const SkeletonFrame& frame, bool occluded) {
   }
   if (occluded) {
     const JointSample& pelvis = frame.joints[*def.JointIndex("pelvis")];
-    cv::rectangle(image, cv::Rect(static_cast<int>(pelvis.x_px) + 8, 100, 140, 360), cv::Scalar(90), cv::FILLED);
+    cv::rectangle(image, cv::Rect(static_cast<int>(pelvis.x_px) + 8, 100, 140, 360), cv::Scalar(90),
+                  cv::FILLED);
   }
   cv::Mat noise(image.size(), CV_16SC1);
   cv::randn(noise, 0, 2.0);
@@ -74,12 +77,15 @@ std::vector<cv::Mat> RenderClip(const SkeletonSequence& truth, bool with_occlude
   cv::setRNGSeed(5);
   std::vector<cv::Mat> images;
   for (int f = 0; f < truth.size(); ++f) {
-    images.push_back(Render(truth.frames[f], with_occluder && f >= kOccludedFrom && f <= kOccludedTo));
+    images.push_back(
+        Render(truth.frames[f], with_occluder && f >= kOccludedFrom && f <= kOccludedTo));
   }
   return images;
 }
 
-float Error(const JointSample& a, const JointSample& b) { return std::hypot(a.x_px - b.x_px, a.y_px - b.y_px); }
+float Error(const JointSample& a, const JointSample& b) {
+  return std::hypot(a.x_px - b.x_px, a.y_px - b.y_px);
+}
 
 // The joints the occluder hides (the subject's left is the image's right).
 bool UnderOccluder(const std::string& joint) {
@@ -92,7 +98,8 @@ TEST(SkeletonTracking, TracksAWalkingFigureWithinAPixel) {
   const std::vector<cv::Mat> images = RenderClip(truth, false);
   const TrackingResult r = TrackJoints(images, truth.frames[0], {}, HumanSkeleton());
   ASSERT_EQ(r.sequence.size(), kFrames);
-  EXPECT_TRUE(r.failures.empty()) << r.failures.size() << " failures, first in frame " << r.failures[0].frame;
+  EXPECT_TRUE(r.failures.empty()) << r.failures.size() << " failures, first in frame "
+                                  << r.failures[0].frame;
   std::vector<float> errors;
   for (int f = 1; f < kFrames; ++f) {
     for (size_t j = 0; j < truth.frames[f].joints.size(); ++j) {
@@ -115,7 +122,8 @@ TEST(SkeletonTracking, MarkedOcclusionIsInterpolated) {
   std::vector<bool> occluded(kFrames, false);
   for (int f = kOccludedFrom; f <= kOccludedTo; ++f) occluded[f] = true;
   const TrackingResult r = TrackJoints(images, truth.frames[0], occluded, HumanSkeleton());
-  EXPECT_TRUE(r.failures.empty()) << r.failures.size() << " failures, first in frame " << r.failures[0].frame;
+  EXPECT_TRUE(r.failures.empty()) << r.failures.size() << " failures, first in frame "
+                                  << r.failures[0].frame;
   float worst_interpolated = 0, worst_tracked = 0;
   for (int f = 1; f < kFrames; ++f) {
     for (size_t j = 0; j < truth.frames[f].joints.size(); ++j) {
@@ -139,7 +147,8 @@ TEST(SkeletonTracking, UnmarkedOcclusionIsReportedPerFrame) {
   ASSERT_FALSE(r.failures.empty());
   bool first_occluded_frame = false;
   for (const TrackingFailure& failure : r.failures) {
-    SCOPED_TRACE("frame " + std::to_string(failure.frame) + " joint " + HumanSkeleton().joints[failure.joint]);
+    SCOPED_TRACE("frame " + std::to_string(failure.frame) + " joint " +
+                 HumanSkeleton().joints[failure.joint]);
     EXPECT_GE(failure.frame, kOccludedFrom);
     EXPECT_TRUE(failure.reason == "lost" || failure.reason == "forward-backward");
     // A failed joint is left missing in that frame.
@@ -157,7 +166,8 @@ TEST(SkeletonTracking, UnmarkedOcclusionIsReportedPerFrame) {
       if (!got.present) continue;
       SCOPED_TRACE("frame " + std::to_string(f) + " joint " + HumanSkeleton().joints[j]);
       EXPECT_LT(Error(got, truth.frames[f].joints[j]), 2.0f);
-      EXPECT_FALSE(f >= kOccludedFrom && f <= kOccludedTo && UnderOccluder(HumanSkeleton().joints[j]));
+      EXPECT_FALSE(f >= kOccludedFrom && f <= kOccludedTo &&
+                   UnderOccluder(HumanSkeleton().joints[j]));
     }
   }
 }
@@ -176,13 +186,15 @@ TEST(SkeletonTracking, TrackCommandOnAFolderOfFrames) {
   }
   nlohmann::json joints = nlohmann::json::object();
   for (size_t j = 0; j < truth.frames[0].joints.size(); ++j) {
-    joints[HumanSkeleton().joints[j]] = {truth.frames[0].joints[j].x_px, truth.frames[0].joints[j].y_px};
+    joints[HumanSkeleton().joints[j]] = {truth.frames[0].joints[j].x_px,
+                                         truth.frames[0].joints[j].y_px};
   }
-  std::ofstream(dir / "init.json") << nlohmann::json{{"skeleton", "human14"}, {"joints", joints}}.dump();
-  const auto run = testing::RunSpritestation("skeleton track " + (dir / "frames") + " --init " + (dir / "init.json") +
-                                             " --out " + (dir / "skel.json") + " --occluded " +
-                                             std::to_string(kOccludedFrom) + "-" + std::to_string(kOccludedTo) +
-                                             " --json");
+  std::ofstream(dir / "init.json")
+      << nlohmann::json{{"skeleton", "human14"}, {"joints", joints}}.dump();
+  const auto run = testing::RunSpritestation("skeleton track " + (dir / "frames") + " --init " +
+                                             (dir / "init.json") + " --out " + (dir / "skel.json") +
+                                             " --occluded " + std::to_string(kOccludedFrom) + "-" +
+                                             std::to_string(kOccludedTo) + " --json");
   ASSERT_EQ(run.exit_code, 0) << run.output;
   const nlohmann::json report = nlohmann::json::parse(run.output.substr(run.output.find('{')));
   EXPECT_EQ(report["frames"], kFrames);
@@ -201,13 +213,15 @@ TEST(SkeletonTracking, TrackCommandOnAFolderOfFrames) {
   }
   EXPECT_LT(worst, 3.0f);
   // Bad input: an occluded frame past the clip, a missing initial joint.
-  const auto past = testing::RunSpritestation("skeleton track " + (dir / "frames") + " --init " + (dir / "init.json") +
-                                              " --out " + (dir / "x.json") + " --occluded 100");
+  const auto past = testing::RunSpritestation("skeleton track " + (dir / "frames") + " --init " +
+                                              (dir / "init.json") + " --out " + (dir / "x.json") +
+                                              " --occluded 100");
   EXPECT_EQ(past.exit_code, 2) << past.output;
   joints.erase("wrist_r");
   std::ofstream(dir / "bad_init.json") << nlohmann::json{{"joints", joints}}.dump();
-  const auto bad = testing::RunSpritestation("skeleton track " + (dir / "frames") + " --init " +
-                                             (dir / "bad_init.json") + " --out " + (dir / "x.json"));
+  const auto bad =
+      testing::RunSpritestation("skeleton track " + (dir / "frames") + " --init " +
+                                (dir / "bad_init.json") + " --out " + (dir / "x.json"));
   EXPECT_EQ(bad.exit_code, 2) << bad.output;
   EXPECT_NE(bad.output.find("'wrist_r' is missing"), std::string::npos) << bad.output;
 }

@@ -147,9 +147,10 @@ TEST_F(SpecTest, BadSpecsNameTheLineAndTheField) {
   EXPECT_EQ(ErrorOf(Edit("frame_rate: 25", "frame_rate: fast")),
             o + ":2: frame_rate: expected a number, got \"fast\"");
   EXPECT_EQ(ErrorOf(Edit("frame_rate: 25", "frame_rate: -3")), o + ":2: frame_rate: must be > 0");
-  EXPECT_EQ(ErrorOf(Edit("frame_rate: 25", "frame_rat: 25")),
-            o + ":2: frame_rat: unknown field (expected one of: version, frame_rate, length, camera, "
-                "background, banks, sprites, collisions, fast_frames, optimizer)");
+  EXPECT_EQ(
+      ErrorOf(Edit("frame_rate: 25", "frame_rat: 25")),
+      o + ":2: frame_rat: unknown field (expected one of: version, frame_rate, length, camera, "
+          "background, banks, sprites, collisions, fast_frames, optimizer)");
   EXPECT_EQ(ErrorOf(Edit("camera: virtual.cameramodel", "camera: nowhere.cameramodel")),
             o + ":4: camera: no such file: " + (dir_ / "nowhere.cameramodel"));
   EXPECT_EQ(ErrorOf(Edit("direction_strength: 2", "direction_strength: -2")),
@@ -164,9 +165,10 @@ TEST_F(SpecTest, BadSpecsNameTheLineAndTheField) {
             o + ":20: sprites[1].constraints[1].frames.to: ends before it starts");
   EXPECT_EQ(ErrorOf(Edit("    start: free\n", "")),
             o + ":15: sprites[1].start: required: [x, y], free, or end: [x, y] instead");
-  EXPECT_EQ(ErrorOf(Edit("- location: {target: [1, 1]", "- loiter: {target: [1, 1]")),
-            o + ":14: sprites[0].constraints[2].loiter: unknown constraint (expected location, path or "
-                "frames)");
+  EXPECT_EQ(
+      ErrorOf(Edit("- location: {target: [1, 1]", "- loiter: {target: [1, 1]")),
+      o + ":14: sprites[0].constraints[2].loiter: unknown constraint (expected location, path or "
+          "frames)");
   EXPECT_EQ(ErrorOf(Edit("min_distance_m: 0.25", "min_distance_m: 0")),
             o + ":22: collisions[0].min_distance_m: must be > 0");
   EXPECT_EQ(ErrorOf(Edit("name: follower", "name: lead")),
@@ -202,8 +204,9 @@ TEST_F(SpecTest, ConstraintsTheBankCannotMeetNameTheirLine) {
     Scene::Load(ParseAnimationSpec(Edit("tag: standing", "tag: sitting"), Origin()));
     FAIL() << "no error";
   } catch (const InputError& e) {
-    EXPECT_EQ(std::string(e.what()), Origin() + ":13: sprites[0].constraints[1].frames.tag: no sprite "
-                                                "of the banks carries the tag sitting");
+    EXPECT_EQ(std::string(e.what()), Origin() +
+                                         ":13: sprites[0].constraints[1].frames.tag: no sprite "
+                                         "of the banks carries the tag sitting");
   }
 }
 
@@ -226,7 +229,8 @@ TEST_F(SpecTest, AFileOverTheLimitIsRefusedBeforeItIsRead) {
     ADD_FAILURE() << "no error";
   } catch (const InputError& e) {
     EXPECT_EQ(std::string(e.what()),
-              Origin() + ": 238.4 MiB (250000000 bytes): larger than the 16 MiB an animation spec may be");
+              Origin() +
+                  ": 238.4 MiB (250000000 bytes): larger than the 16 MiB an animation spec may be");
   }
 }
 
@@ -234,7 +238,8 @@ TEST_F(SpecTest, AFileOverTheLimitIsRefusedBeforeItIsRead) {
 TEST_F(SpecTest, TheDocumentedExamplesAreValid) {
   namespace fs = std::filesystem;
   const fs::path examples = fs::path(ss::testing::SourcePath("docs/examples"));
-  for (const char* name : {"hamster.ssbank", "fly.ssbank", "floor.png"}) std::ofstream(dir_ / name) << "x";
+  for (const char* name : {"hamster.ssbank", "fly.ssbank", "floor.png"})
+    std::ofstream(dir_ / name) << "x";
   int count = 0;
   for (const auto& entry : fs::directory_iterator(examples)) {
     if (entry.path().extension() != ".yaml") continue;

@@ -64,8 +64,8 @@ TEST_P(VideoFileTest, DecodesToTheFramesWrittenWithTheSpriteWhereItWasProjected)
   for (int k = 0; k < kFrames; ++k) {
     ASSERT_EQ(frames[k].size(), cv::Size(320, 240));
     const Eigen::Vector2d found = RedCentroid(frames[k]);
-    EXPECT_LT((found - expected[k]).norm(), 1.5)
-        << "frame " << k << " found " << found.transpose() << " expected " << expected[k].transpose();
+    EXPECT_LT((found - expected[k]).norm(), 1.5) << "frame " << k << " found " << found.transpose()
+                                                 << " expected " << expected[k].transpose();
   }
   // The floor stays the floor away from the sprite.
   const cv::Vec3b corner = frames[kFrames / 2].at<cv::Vec3b>(10, 10);

@@ -20,7 +20,8 @@ namespace ss::testing {
 
 inline calib::BoardSpec ToCalibBoard(const synth::BoardSpec& s) {
   calib::BoardSpec b;
-  b.kind = s.kind == synth::BoardKind::kChessboard ? calib::BoardKind::kChessboard : calib::BoardKind::kCharuco;
+  b.kind = s.kind == synth::BoardKind::kChessboard ? calib::BoardKind::kChessboard
+                                                   : calib::BoardKind::kCharuco;
   b.squares_x = s.squares_x;
   b.squares_y = s.squares_y;
   b.square_m = s.square_m;
@@ -35,8 +36,9 @@ inline CameraModel TrueModel(const synth::SynthCamera& cam) {
 }
 
 // Renders the camera's view of the boards, with sensor noise (`noise` 1 = typical).
-inline cv::Mat RenderBoards(const synth::CameraRenderer& renderer, const std::vector<synth::BoardInstance>& boards,
-                            double noise, uint64_t frame) {
+inline cv::Mat RenderBoards(const synth::CameraRenderer& renderer,
+                            const std::vector<synth::BoardInstance>& boards, double noise,
+                            uint64_t frame) {
   synth::FrameScene scene;
   scene.boards = boards;
   synth::CameraImage image;
@@ -48,7 +50,8 @@ inline cv::Mat RenderBoards(const synth::CameraRenderer& renderer, const std::ve
 }
 
 inline Eigen::Matrix3d Rot(double rx, double ry, double rz) {
-  return (Eigen::AngleAxisd(rz, Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(ry, Eigen::Vector3d::UnitY()) *
+  return (Eigen::AngleAxisd(rz, Eigen::Vector3d::UnitZ()) *
+          Eigen::AngleAxisd(ry, Eigen::Vector3d::UnitY()) *
           Eigen::AngleAxisd(rx, Eigen::Vector3d::UnitX()))
       .toRotationMatrix();
 }
@@ -56,8 +59,9 @@ inline Eigen::Matrix3d Rot(double rx, double ry, double rz) {
 // A board pose in front of the camera: its centre towards the normalized image
 // point (u, v) in [-1, 1] at `depth_m`, tilted about the board's x and y axes.
 // Pulled towards the image centre until the whole board (with margin) is in view.
-inline Rigid3 CamFromBoardInView(const synth::SynthCamera& cam, const synth::BoardSpec& spec, double u, double v,
-                                 double depth_m, double tilt_x, double tilt_y, double roll) {
+inline Rigid3 CamFromBoardInView(const synth::SynthCamera& cam, const synth::BoardSpec& spec,
+                                 double u, double v, double depth_m, double tilt_x, double tilt_y,
+                                 double roll) {
   const Eigen::Matrix3d r = Rot(tilt_x, tilt_y, roll);
   const Eigen::Vector3d centre_in_board(spec.width_m() / 2, spec.height_m() / 2, 0);
   for (int attempt = 0; attempt < 40; ++attempt) {
@@ -72,7 +76,8 @@ inline Rigid3 CamFromBoardInView(const synth::SynthCamera& cam, const synth::Boa
     for (double x : {-m, spec.width_m() + m}) {
       for (double y : {-m, spec.height_m() + m}) {
         const Eigen::Vector2d q = cam.lens.Project(cam_from_board * Eigen::Vector3d(x, y, 0));
-        inside = inside && q.x() > 4 && q.y() > 4 && q.x() < cam.width - 5 && q.y() < cam.height - 5;
+        inside =
+            inside && q.x() > 4 && q.y() > 4 && q.x() < cam.width - 5 && q.y() < cam.height - 5;
       }
     }
     if (inside) return cam_from_board;
@@ -81,7 +86,8 @@ inline Rigid3 CamFromBoardInView(const synth::SynthCamera& cam, const synth::Boa
 }
 
 // A varied set of board poses for an intrinsic calibration (camera frame).
-inline std::vector<Rigid3> CalibrationPoses(const synth::SynthCamera& cam, const synth::BoardSpec& spec, int count,
+inline std::vector<Rigid3> CalibrationPoses(const synth::SynthCamera& cam,
+                                            const synth::BoardSpec& spec, int count,
                                             double depth_m) {
   std::vector<Rigid3> poses;
   const double kDeg = M_PI / 180;

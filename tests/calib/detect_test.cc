@@ -105,7 +105,8 @@ TEST(DetectBoard, RejectsWithReasons) {
   EXPECT_FALSE(blur.accepted);
   EXPECT_NE(blur.rejection.find("blurred"), std::string::npos) << blur.rejection;
   // A spec that does not match the board in view.
-  const BoardView wrong = DetectBoard(ParseBoardSpec("chessboard:8x6:0.03"), sharp, {}, "wrong spec");
+  const BoardView wrong =
+      DetectBoard(ParseBoardSpec("chessboard:8x6:0.03"), sharp, {}, "wrong spec");
   EXPECT_FALSE(wrong.accepted);
   // Too small in the image.
   DetectOptions strict;

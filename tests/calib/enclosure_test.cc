@@ -14,9 +14,11 @@ namespace {
 using ss::testing::TrueModel;
 
 TEST(FloorPolygon, FromGroundPointsIsCheckedAndNamed) {
-  const GroundPolygon p = FloorPolygonFromPoints(ParsePointList("-0.6,-0.4 0.6,-0.4 0.6,0.4;-0.6,0.4", "--points"));
+  const GroundPolygon p =
+      FloorPolygonFromPoints(ParsePointList("-0.6,-0.4 0.6,-0.4 0.6,0.4;-0.6,0.4", "--points"));
   EXPECT_NEAR(p.Area(), 0.96, 1e-12);
-  EXPECT_THROW(FloorPolygonFromPoints(ParsePointList("0,0 1,1 1,0 0,1", "--points")), InputError);  // crosses itself
+  EXPECT_THROW(FloorPolygonFromPoints(ParsePointList("0,0 1,1 1,0 0,1", "--points")),
+               InputError);  // crosses itself
   EXPECT_THROW(FloorPolygonFromPoints(ParsePointList("0,0 1,1", "--points")), InputError);
   try {
     ParsePointList("0,0 1;1", "--points");
@@ -31,10 +33,12 @@ TEST(FloorPolygon, FromPixelsLandsOnTheTrueFloorCorners) {
   const synth::SynthCamera cam = synth::MakeCameras(studio, 1, 640, 480, 5)[0];
   const CameraModel model = TrueModel(cam);
   std::vector<Eigen::Vector2d> pixels;
-  for (const auto& v : studio.floor.vertices()) pixels.push_back(cam.ProjectGround({v.x(), v.y(), 0}));
+  for (const auto& v : studio.floor.vertices())
+    pixels.push_back(cam.ProjectGround({v.x(), v.y(), 0}));
   const GroundPolygon p = FloorPolygonFromPixels(model, pixels);
   ASSERT_EQ(p.vertices().size(), studio.floor.vertices().size());
-  for (size_t i = 0; i < pixels.size(); ++i) EXPECT_LT((p.vertices()[i] - studio.floor.vertices()[i]).norm(), 1e-6);
+  for (size_t i = 0; i < pixels.size(); ++i)
+    EXPECT_LT((p.vertices()[i] - studio.floor.vertices()[i]).norm(), 1e-6);
   // A pixel above the horizon does not look at the floor.
   EXPECT_THROW(FloorPolygonFromPixels(model, {{320, -5000}, {0, 0}, {10, 10}}), InputError);
 }
@@ -80,8 +84,8 @@ TEST(FloorPolygon, ReplacesTheConfigsFloorKeepingTheRest) {
   EXPECT_EQ(c.pipeline.min_area_px, 500);
   EXPECT_NE(updated.find("# keep me"), std::string::npos);
   // A config without an enclosure gets one.
-  const StationConfig added = ParseStationConfig(ReplaceEnclosureFloor("version: 1\n", floor, "s.yaml"), "s.yaml", ".",
-                                                 nullptr, o);
+  const StationConfig added = ParseStationConfig(
+      ReplaceEnclosureFloor("version: 1\n", floor, "s.yaml"), "s.yaml", ".", nullptr, o);
   EXPECT_NEAR(added.enclosure.floor.Area(), 0.6, 1e-9);
 }
 

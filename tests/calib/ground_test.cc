@@ -23,15 +23,18 @@ double AngleDeg(const Eigen::Matrix3d& a, const Eigen::Matrix3d& b) {
 struct FloorScene {
   synth::Studio studio = synth::MakeStudio(synth::StudioKind::kEnclosure, 21);
   std::vector<synth::SynthCamera> cams = synth::MakeCameras(studio, 2, 640, 480, 21);
-  synth::BoardSpec spec = synth::ChessboardFor(true);  // 0.7 m x 0.49 m, fits the 1.2 m x 0.8 m floor
+  synth::BoardSpec spec =
+      synth::ChessboardFor(true);  // 0.7 m x 0.49 m, fits the 1.2 m x 0.8 m floor
   synth::BoardTexture texture{spec};
-  Rigid3 ground_from_board = FloorBoardPose(-0.33, 0.26, 4.0, 0.001);  // 1 mm thick: off the floor for the renderer
+  Rigid3 ground_from_board =
+      FloorBoardPose(-0.33, 0.26, 4.0, 0.001);  // 1 mm thick: off the floor for the renderer
 };
 
 TEST(FloorBoardPose, IsFaceUpOnTheFloor) {
   const Rigid3 g = FloorBoardPose(0.1, 0.2, 30, 0.004);
   EXPECT_NEAR(g.rotation.determinant(), 1.0, 1e-12);
-  EXPECT_NEAR((g.rotation.col(2) - Eigen::Vector3d(0, 0, -1)).norm(), 0.0, 1e-12);  // board z points down
+  EXPECT_NEAR((g.rotation.col(2) - Eigen::Vector3d(0, 0, -1)).norm(), 0.0,
+              1e-12);  // board z points down
   EXPECT_NEAR((g * Eigen::Vector3d(0, 0, 0) - Eigen::Vector3d(0.1, 0.2, 0.004)).norm(), 0.0, 1e-12);
 }
 
@@ -45,7 +48,8 @@ TEST(SolveGroundPose, RecoversEachCameraAndAgreesAcrossCameras) {
     // Three noisy frames of the still board, averaged.
     std::vector<BoardView> still;
     for (int f = 0; f < 3; ++f) {
-      const cv::Mat image = RenderBoards(renderer, {{&s.texture, s.ground_from_board}}, 1.0, 100 + f);
+      const cv::Mat image =
+          RenderBoards(renderer, {{&s.texture, s.ground_from_board}}, 1.0, 100 + f);
       still.push_back(DetectBoard(board, image, {}, s.cams[c].name));
       ASSERT_TRUE(still.back().accepted) << still.back().rejection;
     }
@@ -53,7 +57,8 @@ TEST(SolveGroundPose, RecoversEachCameraAndAgreesAcrossCameras) {
     Eigen::Vector2d mean_err = Eigen::Vector2d::Zero();
     double worst_err = 0;
     for (size_t i = 0; i < view.ids.size(); ++i) {
-      const Eigen::Vector2d e = view.pixels[i] - s.cams[c].ProjectGround(s.ground_from_board * board.Corner(view.ids[i]));
+      const Eigen::Vector2d e =
+          view.pixels[i] - s.cams[c].ProjectGround(s.ground_from_board * board.Corner(view.ids[i]));
       mean_err += e / static_cast<double>(view.ids.size());
       worst_err = std::max(worst_err, e.norm());
     }
@@ -61,11 +66,14 @@ TEST(SolveGroundPose, RecoversEachCameraAndAgreesAcrossCameras) {
     EXPECT_LT(worst_err, 0.3) << "mean " << mean_err.transpose();
     CameraModel unposed = TrueModel(s.cams[c]);
     unposed.set_cam_from_ground({});
-    const GroundResult g = SolveGroundPose(unposed, board, view, s.ground_from_board, s.cams[c].name);
+    const GroundResult g =
+        SolveGroundPose(unposed, board, view, s.ground_from_board, s.cams[c].name);
     const Eigen::Vector3d truth = s.cams[c].CentreInGround();
-    RecordProperty("centre_mm_" + s.cams[c].name, std::to_string((g.centre_in_ground - truth).norm() * 1000));
-    RecordProperty("angle_deg_" + s.cams[c].name,
-                   std::to_string(AngleDeg(g.cam_from_ground.rotation, s.cams[c].cam_from_ground.rotation)));
+    RecordProperty("centre_mm_" + s.cams[c].name,
+                   std::to_string((g.centre_in_ground - truth).norm() * 1000));
+    RecordProperty(
+        "angle_deg_" + s.cams[c].name,
+        std::to_string(AngleDeg(g.cam_from_ground.rotation, s.cams[c].cam_from_ground.rotation)));
     // Issue 6 asks for 2 mm and 0.1 deg: measured 1.3 / 0.35 mm and 0.048 / 0.015 deg
     // (2-5 mm and 0.12-0.17 deg before the corners were refined with cornerSubPix).
     EXPECT_LT((g.centre_in_ground - truth).norm(), 0.002) << s.cams[c].name;
@@ -77,7 +85,8 @@ TEST(SolveGroundPose, RecoversEachCameraAndAgreesAcrossCameras) {
     models.push_back(posed);
     views.push_back(view);
   }
-  const CrossCheck x = CrossReprojection(models[0], views[0], models[1], views[1], s.ground_from_board);
+  const CrossCheck x =
+      CrossReprojection(models[0], views[0], models[1], views[1], s.ground_from_board);
   EXPECT_GT(x.points, 20);
   EXPECT_LT(x.worst_px, 1.0);
 }
@@ -93,7 +102,8 @@ TEST(SolveGroundPose, SmallFloorBoardMeetsTheIssueNumbers) {
   const std::vector<synth::SynthCamera> cams = synth::MakeCameras(studio, 1, 640, 480, 5);
   const synth::BoardSpec spec = synth::ChessboardFor(false);
   const synth::BoardTexture texture{spec};
-  const Rigid3 ground_from_board = FloorBoardPose(-0.5 * spec.width_m(), 0.5 * spec.height_m(), 0.0, 0.001);
+  const Rigid3 ground_from_board =
+      FloorBoardPose(-0.5 * spec.width_m(), 0.5 * spec.height_m(), 0.0, 0.001);
   const BoardSpec board = ToCalibBoard(spec);
   const synth::CameraRenderer renderer(cams[0], studio);
   std::vector<BoardView> still;
@@ -107,13 +117,14 @@ TEST(SolveGroundPose, SmallFloorBoardMeetsTheIssueNumbers) {
   Eigen::Vector2d mean_err = Eigen::Vector2d::Zero();
   double sum2 = 0;
   for (size_t i = 0; i < view.ids.size(); ++i) {
-    const Eigen::Vector2d e = view.pixels[i] - cams[0].ProjectGround(ground_from_board * board.Corner(view.ids[i]));
+    const Eigen::Vector2d e =
+        view.pixels[i] - cams[0].ProjectGround(ground_from_board * board.Corner(view.ids[i]));
     mean_err += e / static_cast<double>(view.ids.size());
     sum2 += e.squaredNorm();
   }
   const double rms = std::sqrt(sum2 / static_cast<double>(view.ids.size()));
   EXPECT_LT(mean_err.norm(), 0.03) << mean_err.transpose();  // was 0.07 px with SB corners alone
-  EXPECT_LT(rms, 0.12);                                       // was 0.16 px
+  EXPECT_LT(rms, 0.12);                                      // was 0.16 px
   CameraModel unposed = TrueModel(cams[0]);
   unposed.set_cam_from_ground({});
   const GroundResult g = SolveGroundPose(unposed, board, view, ground_from_board, cams[0].name);
@@ -151,18 +162,23 @@ TEST(SolveBoards, JointSolveGivesBothCamerasInOneFrame) {
     // The board held face-up above the floor, tilted and turned.
     const double tx = ((f % 5) - 2) * 12 * kDeg, ty = (((f * 3) % 5) - 2) * 12 * kDeg;
     const Eigen::Matrix3d r = Rot(tx, ty, f * 25 * kDeg) * FloorBoardPose().rotation;
-    const Eigen::Vector3d centre(0.12 * std::sin(f * 1.3), 0.08 * std::cos(f * 1.7), 0.22 + 0.03 * (f % 4));
-    const Rigid3 ground_from_board{r, centre - r * Eigen::Vector3d(s.spec.width_m() / 2, s.spec.height_m() / 2, 0)};
+    const Eigen::Vector3d centre(0.12 * std::sin(f * 1.3), 0.08 * std::cos(f * 1.7),
+                                 0.22 + 0.03 * (f % 4));
+    const Rigid3 ground_from_board{
+        r, centre - r * Eigen::Vector3d(s.spec.width_m() / 2, s.spec.height_m() / 2, 0)};
     for (size_t c = 0; c < s.cams.size(); ++c) {
-      const cv::Mat image = RenderBoards(renderers[c], {{&s.texture, ground_from_board}}, 1.0, 200 + f);
-      const BoardView v = DetectBoard(board, image, {}, s.cams[c].name + " frame " + std::to_string(f));
+      const cv::Mat image =
+          RenderBoards(renderers[c], {{&s.texture, ground_from_board}}, 1.0, 200 + f);
+      const BoardView v =
+          DetectBoard(board, image, {}, s.cams[c].name + " frame " + std::to_string(f));
       if (v.accepted) obs.push_back({static_cast<int>(c), f, v.source, v.ids, v.pixels});
     }
   }
   ASSERT_GE(obs.size(), 14u);
   SolveOptions options;
   options.compute_covariance = false;
-  const SolveSummary sol = SolveBoards(board, {{"cam0", 640, 480}, {"cam1", 640, 480}}, obs, options);
+  const SolveSummary sol =
+      SolveBoards(board, {{"cam0", 640, 480}, {"cam1", 640, 480}}, obs, options);
   const Rigid3 truth = s.cams[1].cam_from_ground * s.cams[0].cam_from_ground.Inverse();
   const Rigid3 got = sol.models[1].cam_from_ground();  // cam1_from_cam0
   // Measured: 5.3 mm and 0.23 deg (both lenses solved too, from boards ~1.3 m away).

@@ -35,9 +35,11 @@ TEST(MrcalCornersVnl, OneFullGridPerAcceptedViewWithMissingCornersMarked) {
   EXPECT_EQ(lines[6], "cam1-frame000007.png 50 60.125 0");
   EXPECT_EQ(MrcalViewName("cam1", 8), "cam1-frame000008.png");
 
-  const std::string cmd = MrcalCalibrateCommand(board, {cam}, "/d/corners.vnl", "/d/mrcal", "LENSMODEL_OPENCV8", 500);
-  for (const char* part : {"--object-width-n 3", "--object-height-n 2", "--object-spacing 0.04",
-                           "--imagersize 640 480", "'cam1-frame*.png'", "--corners-cache '/d/corners.vnl'"}) {
+  const std::string cmd =
+      MrcalCalibrateCommand(board, {cam}, "/d/corners.vnl", "/d/mrcal", "LENSMODEL_OPENCV8", 500);
+  for (const char* part :
+       {"--object-width-n 3", "--object-height-n 2", "--object-spacing 0.04",
+        "--imagersize 640 480", "'cam1-frame*.png'", "--corners-cache '/d/corners.vnl'"}) {
     EXPECT_NE(cmd.find(part), std::string::npos) << part << " in " << cmd;
   }
 }

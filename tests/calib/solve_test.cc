@@ -24,7 +24,8 @@ struct Rig {
 };
 
 // Renders and detects `count` views of camera 0; returns views and observations.
-void Views(const Rig& rig, int count, std::vector<BoardView>* views, std::vector<BoardObservation>* obs) {
+void Views(const Rig& rig, int count, std::vector<BoardView>* views,
+           std::vector<BoardObservation>* obs) {
   const synth::CameraRenderer renderer(rig.cams[0], rig.studio);
   const auto poses = CalibrationPoses(rig.cams[0], rig.spec, count, 0.5);
   for (int i = 0; i < count; ++i) {
@@ -104,11 +105,14 @@ TEST(SolveBoards, FrontalViewsOnlyGiveAVerdictNotATrustedModel) {
   const BoardSpec board = ToCalibBoard(rig.spec);
   std::vector<BoardView> views;
   std::vector<BoardObservation> obs;
-  const double places[][2] = {{-0.5, -0.4}, {0.5, -0.4}, {-0.5, 0.4}, {0.5, 0.4}, {0, 0}, {0, -0.5}, {0, 0.5}, {-0.6, 0}};
+  const double places[][2] = {{-0.5, -0.4}, {0.5, -0.4}, {-0.5, 0.4}, {0.5, 0.4},
+                              {0, 0},       {0, -0.5},   {0, 0.5},    {-0.6, 0}};
   int i = 0;
   for (const auto& p : places) {
-    const Rigid3 cam_from_board = ss::testing::CamFromBoardInView(rig.cams[0], rig.spec, p[0], p[1], 0.5, 0, 0, 0.05 * i);
-    const cv::Mat image = RenderBoards(renderer, {{&rig.texture, rig.cams[0].cam_from_ground.Inverse() * cam_from_board}}, 1.0, i);
+    const Rigid3 cam_from_board =
+        ss::testing::CamFromBoardInView(rig.cams[0], rig.spec, p[0], p[1], 0.5, 0, 0, 0.05 * i);
+    const cv::Mat image = RenderBoards(
+        renderer, {{&rig.texture, rig.cams[0].cam_from_ground.Inverse() * cam_from_board}}, 1.0, i);
     BoardView v = DetectBoard(board, image, {}, "frontal" + std::to_string(i));
     if (v.accepted) obs.push_back({0, i, v.source, v.ids, v.pixels});
     views.push_back(std::move(v));
@@ -125,7 +129,8 @@ TEST(SolveBoards, FrontalViewsOnlyGiveAVerdictNotATrustedModel) {
   EXPECT_FALSE(r.good);
   EXPECT_LT(r.max_tilt_deg, 10.0);
   bool named = false;
-  for (const auto& reason : r.reasons) named = named || reason.find("tilt the board more") != std::string::npos;
+  for (const auto& reason : r.reasons)
+    named = named || reason.find("tilt the board more") != std::string::npos;
   EXPECT_TRUE(named) << ::testing::PrintToString(r.reasons);
 }
 

@@ -59,16 +59,21 @@ CameraModel Model(int seed) {
 
 TEST(SetCameraModelPath, AddsOrReplacesTheKeyInTheCamerasEntryOnly) {
   std::string yaml = SetCameraModelPath(kConfig, "right", "/m/right.cameramodel", "station.yaml");
-  EXPECT_NE(yaml.find("  - name: right\n    model: \"/m/right.cameramodel\"\n    source: aravis\n    address: 127.0.0.2"),
-            std::string::npos) << yaml;
+  EXPECT_NE(yaml.find("  - name: right\n    model: \"/m/right.cameramodel\"\n    source: aravis\n  "
+                      "  address: 127.0.0.2"),
+            std::string::npos)
+      << yaml;
   EXPECT_NE(yaml.find("# the studio's cameras"), std::string::npos);
-  EXPECT_NE(yaml.find("  - name: left   # by the door\n    source: aravis"), std::string::npos) << yaml;
+  EXPECT_NE(yaml.find("  - name: left   # by the door\n    source: aravis"), std::string::npos)
+      << yaml;
   // Again: the key is replaced, not added twice.
   yaml = SetCameraModelPath(yaml, "right", "/m/new.cameramodel", "station.yaml");
   EXPECT_EQ(yaml.find("right.cameramodel"), std::string::npos) << yaml;
   EXPECT_EQ(yaml.find("model:"), yaml.rfind("model:"));
   yaml = SetCameraModelPath(yaml, "left", "/m/left.cameramodel", "station.yaml");
-  EXPECT_NE(yaml.find("  - name: left   # by the door\n    model: \"/m/left.cameramodel\""), std::string::npos) << yaml;
+  EXPECT_NE(yaml.find("  - name: left   # by the door\n    model: \"/m/left.cameramodel\""),
+            std::string::npos)
+      << yaml;
   try {
     SetCameraModelPath(kConfig, "middle", "/m/x", "station.yaml");
     FAIL();
@@ -93,7 +98,8 @@ TEST(SaveStationCalibration, WritesModelsAndConfigAndKeepsWhatTheyReplace) {
   const std::string model_path = dir / "calibration/left.cameramodel";
   ASSERT_EQ(first.files.size(), 2u);
   EXPECT_EQ(first.files[0], model_path);
-  EXPECT_EQ(first.previous, std::vector<std::string>{dir / "station.previous-20261202T070000Z.yaml"});
+  EXPECT_EQ(first.previous,
+            std::vector<std::string>{dir / "station.previous-20261202T070000Z.yaml"});
   EXPECT_EQ(Read(first.previous[0]), kConfig);
   // The saved config loads with the model and the floor; the other camera is as it was.
   const StationConfig saved = LoadStationConfig(config_path);
@@ -108,7 +114,8 @@ TEST(SaveStationCalibration, WritesModelsAndConfigAndKeepsWhatTheyReplace) {
   request.stamp = "20261202T080000Z";
   const StationSaveResult second = SaveStationCalibration(saved, request);
   EXPECT_EQ(CameraModel::Read(model_path).intrinsics(), Model(2).intrinsics());
-  EXPECT_EQ(CameraModel::Read(dir / "calibration/left.previous-20261202T080000Z.cameramodel").intrinsics(),
+  EXPECT_EQ(CameraModel::Read(dir / "calibration/left.previous-20261202T080000Z.cameramodel")
+                .intrinsics(),
             Model(1).intrinsics());
   for (const auto& e : fs::recursive_directory_iterator(dir.path())) {
     EXPECT_EQ(e.path().string().find(".saving-"), std::string::npos) << e.path();
@@ -163,7 +170,8 @@ TEST(SaveStationCalibration, AFolderThatCannotBeWrittenChangesNothing) {
     SaveStationCalibration(LoadStationConfig(config_path), blocked);
     ADD_FAILURE() << "saved under a file";
   } catch (const WorkError& e) {
-    EXPECT_NE(std::string(e.what()).find(dir / "blocked/calibration"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find(dir / "blocked/calibration"), std::string::npos)
+        << e.what();
   }
   EXPECT_EQ(Read(config_path), kConfig);
   // An unknown camera is named.

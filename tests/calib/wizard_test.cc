@@ -18,7 +18,8 @@ using ss::testing::ToCalibBoard;
 using ss::testing::TrueModel;
 
 bool Has(const std::vector<std::string>& lines, const std::string& text) {
-  return std::any_of(lines.begin(), lines.end(), [&](const std::string& l) { return l.find(text) != std::string::npos; });
+  return std::any_of(lines.begin(), lines.end(),
+                     [&](const std::string& l) { return l.find(text) != std::string::npos; });
 }
 
 WizardOptions Options(const BoardSpec& board) {
@@ -71,8 +72,10 @@ TEST(CalibrationWizard, CapturesAStillBoardOnceAndOnlyANewViewAgain) {
   CalibrationWizard w("cam0", 320, 240, Options(ToCalibBoard(spec)));
   // (clang 14, the sanitizer build's, cannot capture structured bindings: a lambda takes members.)
   auto frame_of = [&board_studio](const Rigid3& cam_from_board, int n) {
-    return RenderBoards(board_studio.renderer,
-                        {{&board_studio.texture, board_studio.cam.cam_from_ground.Inverse() * cam_from_board}}, 1.0, n);
+    return RenderBoards(
+        board_studio.renderer,
+        {{&board_studio.texture, board_studio.cam.cam_from_ground.Inverse() * cam_from_board}}, 1.0,
+        n);
   };
   const Rigid3 a = CamFromBoardInView(cam, spec, -0.4, -0.3, 0.5, 0.4, 0.1, 0.05);
   const Rigid3 b = CamFromBoardInView(cam, spec, 0.4, 0.3, 0.55, -0.3, 0.3, -0.1);
@@ -114,7 +117,8 @@ TEST(CalibrationWizard, TheEnclosureWaitsForAFloorNothingHides) {
   o.floor_still_frames = 3;
   CalibrationWizard w("cam0", 640, 480, o);
   int n = 0;
-  for (int i = 0; i < 4; ++i, ++n) w.Feed(RenderBoards(renderer, {{&texture, o.ground_from_board}}, 1.0, n), n);
+  for (int i = 0; i < 4; ++i, ++n)
+    w.Feed(RenderBoards(renderer, {{&texture, o.ground_from_board}}, 1.0, n), n);
   ASSERT_TRUE(w.ground_good());
   ASSERT_EQ(w.step(), WizardStep::kEnclosure);
   for (int i = 0; i < 4; ++i, ++n) {
@@ -126,7 +130,8 @@ TEST(CalibrationWizard, TheEnclosureWaitsForAFloorNothingHides) {
   EXPECT_EQ(w.step(), WizardStep::kEnclosure);
   EXPECT_FALSE(w.enclosure_good());
   const auto& log = w.log();
-  const bool rejected = std::any_of(log.begin(), log.end(), [](const auto& e) { return e["event"] == "enclosure_rejected"; });
+  const bool rejected = std::any_of(
+      log.begin(), log.end(), [](const auto& e) { return e["event"] == "enclosure_rejected"; });
   EXPECT_TRUE(rejected) << log.dump();
   for (int i = 0; i < 4 && !w.done(); ++i, ++n) w.Feed(RenderBoards(renderer, {}, 1.0, n), n);
   ASSERT_TRUE(w.enclosure_good()) << log.dump();

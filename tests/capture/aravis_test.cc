@@ -87,13 +87,15 @@ Received Receive(AravisOptions options, int count, PixelFormat format, Expected 
     if (index < 0) continue;
     const std::vector<uint8_t> want = expected(index);
     EXPECT_EQ(frame->size, want.size());
-    EXPECT_EQ(std::memcmp(frame->data, want.data(), std::min(want.size(), frame->size)), 0) << "session frame " << index;
+    EXPECT_EQ(std::memcmp(frame->data, want.data(), std::min(want.size(), frame->size)), 0)
+        << "session frame " << index;
   }
   const AravisStreamStats s = source.stream_stats();
   const SourceStats totals = source.stats();
   EXPECT_EQ(totals.frames_delivered, static_cast<uint64_t>(count));
   EXPECT_GE(s.completed, static_cast<uint64_t>(count));
-  EXPECT_GE(s.received_packets, static_cast<uint64_t>(count) * 3);  // leader, data, trailer at the least
+  EXPECT_GE(s.received_packets,
+            static_cast<uint64_t>(count) * 3);  // leader, data, trailer at the least
   EXPECT_GE(s.transferred_bytes, static_cast<uint64_t>(count) * FrameBytes(format, kW, kH));
   return {s, totals, last_sequence - first_sequence + 1};
 }
@@ -121,7 +123,8 @@ TEST(AravisFakecam, Mono8SessionArrivesBitExactByAddress) {
   EXPECT_EQ(cam->exposure_us(), 5000u);
   EXPECT_EQ(cam->gain(), 3u);
   EXPECT_GE(cam->frames_served(), static_cast<uint64_t>(2 * kFrames + 3));
-  // Every sequence number between the first and last frame is either delivered or counted as dropped.
+  // Every sequence number between the first and last frame is either delivered or counted as
+  // dropped.
   EXPECT_EQ(r.sequence_span, 2 * kFrames + 3 + r.totals.frames_dropped);
   EXPECT_EQ(r.totals.frames_dropped, r.stream.failures + r.stream.sequence_gaps);
 }
@@ -135,14 +138,16 @@ TEST(AravisFakecam, BgrSessionStreamsAsRgb8AndBayerAsIsByDeviceId) {
     fo.serial = "SSTRGB";
     fo.fps = 100;
     auto cam = StartFakecam(bgr_session, fo);
-    EXPECT_EQ(cam->pixel_format(), PixelFormat::kRGB8);  // GigE's fake camera carries RGB8, not BGR8
+    EXPECT_EQ(cam->pixel_format(),
+              PixelFormat::kRGB8);  // GigE's fake camera carries RGB8, not BGR8
     AravisOptions ao;
     ao.camera = cam->device_id();  // found by discovery, not by address
     ao.packet_size = 8000;
     Receive(ao, kFrames + 2, PixelFormat::kRGB8, [](int i) {
       auto bgr = TestPixels(PixelFormat::kBGR8, kW, kH, 0, static_cast<uint64_t>(i));
       std::vector<uint8_t> rgb(bgr.size());
-      cv::cvtColor(cv::Mat(kH, kW, CV_8UC3, bgr.data()), cv::Mat(kH, kW, CV_8UC3, rgb.data()), cv::COLOR_BGR2RGB);
+      cv::cvtColor(cv::Mat(kH, kW, CV_8UC3, bgr.data()), cv::Mat(kH, kW, CV_8UC3, rgb.data()),
+                   cv::COLOR_BGR2RGB);
       return rgb;
     });
   }
@@ -155,8 +160,9 @@ TEST(AravisFakecam, BgrSessionStreamsAsRgb8AndBayerAsIsByDeviceId) {
   AravisOptions ao;
   ao.camera = "127.0.0.1";
   ao.packet_size = 8000;
-  Receive(ao, kFrames, PixelFormat::kBayerGR8,
-          [](int i) { return TestPixels(PixelFormat::kBayerGR8, kW, kH, 0, static_cast<uint64_t>(i)); });
+  Receive(ao, kFrames, PixelFormat::kBayerGR8, [](int i) {
+    return TestPixels(PixelFormat::kBayerGR8, kW, kH, 0, static_cast<uint64_t>(i));
+  });
 }
 
 // Aravis 0.8's fake camera ignores resend requests, so a frame that lost a
@@ -251,6 +257,8 @@ TEST(AravisFakecam, UnreadableSessionIsRefusedBeforeServing) {
 
 #else
 
-TEST(AravisFakecam, SkippedWithoutAravis) { GTEST_SKIP() << "built without the Aravis backend (SPRITESTATION_ARAVIS)"; }
+TEST(AravisFakecam, SkippedWithoutAravis) {
+  GTEST_SKIP() << "built without the Aravis backend (SPRITESTATION_ARAVIS)";
+}
 
 #endif

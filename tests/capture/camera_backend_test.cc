@@ -38,10 +38,11 @@ TEST(CameraBackends, AnUnknownSourceIsRefusedByFieldWithWhatIsBuiltIn) {
 }
 
 TEST(CameraBackends, ANewBackendIsFoundOnceAndOnlyOnce) {
-  CameraBackend test{"test-pattern", "a backend of this test", [](const CameraConfig&, int) {
-                       return std::unique_ptr<FrameSource>();
-                     },
-                     [] { return std::vector<FoundCamera>{{"test-pattern", "tp0", "", "", "", ""}}; }};
+  CameraBackend test{"test-pattern", "a backend of this test",
+                     [](const CameraConfig&, int) { return std::unique_ptr<FrameSource>(); },
+                     [] {
+                       return std::vector<FoundCamera>{{"test-pattern", "tp0", "", "", "", ""}};
+                     }};
   RegisterCameraBackend(test);
   const CameraBackend* found = FindCameraBackend("test-pattern");
   ASSERT_NE(found, nullptr);

@@ -80,7 +80,8 @@ TEST_P(LosslessRoundTrip, ReplaysBitExactWithTimestampsAndSequences) {
     EXPECT_EQ(f->timestamp_ns, t0 + i * 33'333'333LL + (i % 3) * 1'000'117LL);
     const auto expected = TestPixels(c.format, c.width, c.height, 0, seq);
     ASSERT_EQ(f->size, expected.size());
-    EXPECT_EQ(std::memcmp(f->data, expected.data(), expected.size()), 0) << "frame " << i << " differs";
+    EXPECT_EQ(std::memcmp(f->data, expected.data(), expected.size()), 0)
+        << "frame " << i << " differs";
     ++i;
   }
   EXPECT_EQ(i, count);
@@ -93,16 +94,23 @@ TEST_P(LosslessRoundTrip, ReplaysBitExactWithTimestampsAndSequences) {
   EXPECT_EQ(rows[6].drops_before, 2u);
 }
 
-INSTANTIATE_TEST_SUITE_P(
-    Formats, LosslessRoundTrip,
-    ::testing::Values(FormatCase{PixelFormat::kBGR8, 96, 64}, FormatCase{PixelFormat::kRGB8, 97, 63},
-                      FormatCase{PixelFormat::kMono8, 64, 48}, FormatCase{PixelFormat::kBayerRG8, 96, 64},
-                      FormatCase{PixelFormat::kBayerGB8, 80, 60}, FormatCase{PixelFormat::kYUYV, 96, 64},
-                      FormatCase{PixelFormat::kNV12, 96, 64}, FormatCase{PixelFormat::kBGR8, 96, 64, "ffvhuff"},
-                      FormatCase{PixelFormat::kRGB8, 97, 63, "ffvhuff"}, FormatCase{PixelFormat::kMono8, 64, 48, "ffvhuff"},
-                      FormatCase{PixelFormat::kBayerGB8, 80, 60, "ffvhuff"}, FormatCase{PixelFormat::kYUYV, 96, 64, "ffvhuff"},
-                      FormatCase{PixelFormat::kNV12, 96, 64, "ffvhuff"}),
-    [](const auto& info) { return PixelFormatName(info.param.format) + "_" + info.param.codec; });
+INSTANTIATE_TEST_SUITE_P(Formats, LosslessRoundTrip,
+                         ::testing::Values(FormatCase{PixelFormat::kBGR8, 96, 64},
+                                           FormatCase{PixelFormat::kRGB8, 97, 63},
+                                           FormatCase{PixelFormat::kMono8, 64, 48},
+                                           FormatCase{PixelFormat::kBayerRG8, 96, 64},
+                                           FormatCase{PixelFormat::kBayerGB8, 80, 60},
+                                           FormatCase{PixelFormat::kYUYV, 96, 64},
+                                           FormatCase{PixelFormat::kNV12, 96, 64},
+                                           FormatCase{PixelFormat::kBGR8, 96, 64, "ffvhuff"},
+                                           FormatCase{PixelFormat::kRGB8, 97, 63, "ffvhuff"},
+                                           FormatCase{PixelFormat::kMono8, 64, 48, "ffvhuff"},
+                                           FormatCase{PixelFormat::kBayerGB8, 80, 60, "ffvhuff"},
+                                           FormatCase{PixelFormat::kYUYV, 96, 64, "ffvhuff"},
+                                           FormatCase{PixelFormat::kNV12, 96, 64, "ffvhuff"}),
+                         [](const auto& info) {
+                           return PixelFormatName(info.param.format) + "_" + info.param.codec;
+                         });
 
 TEST(Recording, MjpegCameraKeepsItsJpegs) {
   ScratchDir dir;
@@ -148,7 +156,8 @@ TEST(Recording, LossyCodecsReplayCloseInTheCameraFormat) {
     for (PixelFormat format : {PixelFormat::kBGR8, PixelFormat::kBayerBG8, PixelFormat::kYUYV}) {
       ScratchDir dir;
       const std::string session = dir / "s";
-      RecordTestSession(session, format, 128, 96, 8, {.codec = codec}, 33'000'000, 0, /*smooth=*/true);
+      RecordTestSession(session, format, 128, 96, 8, {.codec = codec}, 33'000'000, 0,
+                        /*smooth=*/true);
       EXPECT_EQ(ReadSessionInfo(session).cameras[0].codec, codec);
       const auto frames = ReplayAll(session);
       ASSERT_EQ(frames.size(), 8u) << codec;
@@ -157,7 +166,8 @@ TEST(Recording, LossyCodecsReplayCloseInTheCameraFormat) {
         EXPECT_EQ(frames[i].sequence, i);
         const auto expected = TestPixels(format, 128, 96, 0, i, true);
         ASSERT_EQ(frames[i].size, expected.size());
-        EXPECT_GT(Psnr(frames[i], expected), 30.0) << codec << " " << PixelFormatName(format) << " frame " << i;
+        EXPECT_GT(Psnr(frames[i], expected), 30.0)
+            << codec << " " << PixelFormatName(format) << " frame " << i;
       }
     }
   }
@@ -213,15 +223,19 @@ TEST(Recording, DeviceNamesBecomeSafeUniqueFileStems) {
 TEST(Replay, MergesCamerasInTimestampOrder) {
   ScratchDir dir;
   const std::string session = dir / "s";
-  // cam0 (BGR8) every 10 ms from 0; cam1 (Bayer) every 15 ms from 3 ms; one tie at 30 ms... none: 3+15k.
+  // cam0 (BGR8) every 10 ms from 0; cam1 (Bayer) every 15 ms from 3 ms; one tie at 30 ms... none:
+  // 3+15k.
   {
     SessionWriter writer(session, "two");
     const int a = writer.AddCamera(TestCamera("left", PixelFormat::kBGR8, 48, 32, 100), nullptr);
-    const int b = writer.AddCamera(TestCamera("right", PixelFormat::kBayerGR8, 40, 30, 66.7), nullptr);
+    const int b =
+        writer.AddCamera(TestCamera("right", PixelFormat::kBayerGR8, 40, 30, 66.7), nullptr);
     // Written out of global order on purpose: the replay orders by device time.
-    for (int i = 0; i < 20; ++i) writer.Write(TestFrame(PixelFormat::kBGR8, 48, 32, a, i, i * 10'000'000LL));
+    for (int i = 0; i < 20; ++i)
+      writer.Write(TestFrame(PixelFormat::kBGR8, 48, 32, a, i, i * 10'000'000LL));
     for (int i = 0; i < 14; ++i) {
-      writer.Write(TestFrame(PixelFormat::kBayerGR8, 40, 30, b, 1000 + i, 3'000'000LL + i * 15'000'000LL));
+      writer.Write(
+          TestFrame(PixelFormat::kBayerGR8, 40, 30, b, 1000 + i, 3'000'000LL + i * 15'000'000LL));
     }
   }
   const auto frames = ReplayAll(session);
@@ -307,8 +321,9 @@ TEST_P(ParallelDecoding, GivesTheFramesOneDecoderGivesInFileOrder) {
 INSTANTIATE_TEST_SUITE_P(
     LosslessCodecs, ParallelDecoding,
     ::testing::Combine(::testing::Values("ffv1", "ffvhuff"),
-                       ::testing::Values(PixelFormat::kBGR8, PixelFormat::kRGB8, PixelFormat::kMono8,
-                                         PixelFormat::kYUYV, PixelFormat::kNV12)),
+                       ::testing::Values(PixelFormat::kBGR8, PixelFormat::kRGB8,
+                                         PixelFormat::kMono8, PixelFormat::kYUYV,
+                                         PixelFormat::kNV12)),
     [](const auto& info) {
       return std::get<0>(info.param) + "_" + PixelFormatName(std::get<1>(info.param));
     });
@@ -316,7 +331,8 @@ INSTANTIATE_TEST_SUITE_P(
 TEST(ParallelDecoding, LossyCodecsKeepOneDecoder) {
   ScratchDir dir;
   const std::string session = dir / "s";
-  RecordTestSession(session, PixelFormat::kBGR8, 96, 64, 5, {.codec = "h264"}, 33'000'000, 1'000'000'000, true);
+  RecordTestSession(session, PixelFormat::kBGR8, 96, 64, 5, {.codec = "h264"}, 33'000'000,
+                    1'000'000'000, true);
   EXPECT_EQ(VideoReader(session + "/cam0.mkv", PixelFormat::kBGR8, 96, 64, 4).decode_threads(), 1);
   EXPECT_EQ(ReplayAll(session, {.decode_threads = 4}).size(), 5u);
 }

@@ -37,7 +37,9 @@ int64_t MonotonicNs() {
   return ts.tv_sec * 1'000'000'000LL + ts.tv_nsec;
 }
 
-bool Contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+bool Contains(const std::string& text, const std::string& part) {
+  return text.find(part) != std::string::npos;
+}
 
 std::string AllProblems(const ReplaySource& source) {
   std::string all;
@@ -52,7 +54,8 @@ void ExpectFramesIntact(const std::vector<Frame>& frames, PixelFormat format, in
   for (const auto& f : frames) {
     const auto expected = TestPixels(format, w, h, f.camera, f.sequence);
     ASSERT_EQ(f.size, expected.size());
-    EXPECT_EQ(std::memcmp(f.data, expected.data(), expected.size()), 0) << "sequence " << f.sequence;
+    EXPECT_EQ(std::memcmp(f.data, expected.data(), expected.size()), 0)
+        << "sequence " << f.sequence;
   }
 }
 
@@ -63,7 +66,8 @@ void ExpectFramesIntact(const std::vector<Frame>& frames, PixelFormat format, in
 // inherits no threads (OpenCV's pool, sanitizer runtimes) from the parent.
 TEST(KilledRecorder, RecorderProcess) {
   const char* session = std::getenv("SS_TEST_RECORDER_DIR");
-  if (session == nullptr) GTEST_SKIP() << "runs only as the child process of the other KilledRecorder tests";
+  if (session == nullptr)
+    GTEST_SKIP() << "runs only as the child process of the other KilledRecorder tests";
   const int stop_after = std::atoi(std::getenv("SS_TEST_RECORDER_FRAMES"));
   SessionWriter writer(session, "killed");
   const int cam = writer.AddCamera(TestCamera("cam0", PixelFormat::kBGR8, 320, 240, 60), nullptr);
@@ -80,7 +84,8 @@ pid_t StartRecorder(const std::string& session, int stop_after) {
   if (pid != 0) return pid;
   setenv("SS_TEST_RECORDER_DIR", session.c_str(), 1);
   setenv("SS_TEST_RECORDER_FRAMES", std::to_string(stop_after).c_str(), 1);
-  execl("/proc/self/exe", "capture_tests", "--gtest_filter=KilledRecorder.RecorderProcess", nullptr);
+  execl("/proc/self/exe", "capture_tests", "--gtest_filter=KilledRecorder.RecorderProcess",
+        nullptr);
   _exit(127);
 }
 
@@ -128,7 +133,8 @@ TEST(KilledRecorder, AllButTheLastSecondIsReadable) {
   ExpectFramesIntact(frames, PixelFormat::kBGR8, 320, 240);
   // ...reaching to within a second of the kill: every older frame survived.
   EXPECT_LT(kill_ns - frames.back().timestamp_ns, 1'000'000'000LL)
-      << "last readable frame is " << (kill_ns - frames.back().timestamp_ns) / 1e6 << " ms older than the kill";
+      << "last readable frame is " << (kill_ns - frames.back().timestamp_ns) / 1e6
+      << " ms older than the kill";
   // The CSV never lists a frame the video lost, so the replay sees no damage.
   const SourceStats stats = source.stats();
   EXPECT_EQ(stats.errors, 0u) << AllProblems(source);
@@ -141,7 +147,8 @@ TEST(KilledRecorder, FramesWrittenBeforeAPauseAreFlushedInTheBackground) {
   const std::string session = dir / "s";
   const pid_t pid = StartRecorder(session, 10);  // 10 frames, then nothing more is written
   const bool written = WaitFor([&] { return std::filesystem::exists(session + ".written"); }, 60);
-  std::this_thread::sleep_for(std::chrono::milliseconds(1000));  // the writer itself does nothing now
+  std::this_thread::sleep_for(
+      std::chrono::milliseconds(1000));  // the writer itself does nothing now
   Kill(pid);
   ASSERT_TRUE(written) << "the recorder never finished its 10 frames";
   ReplaySource source(session);
@@ -177,8 +184,9 @@ TEST_P(DamagedVideo, TruncatedFileReplaysItsReadablePartAndNamesTheFile) {
   EXPECT_GE(stats.errors, 1u);
   EXPECT_EQ(stats.frames_dropped, 30u - frames.size());
   EXPECT_TRUE(Contains(stats.last_error, video)) << stats.last_error;
-  EXPECT_TRUE(Contains(AllProblems(source), video + ": video ends after " + std::to_string(frames.size()) +
-                                                " of the 30 frames listed in " + session + "/cam0.frames.csv"))
+  EXPECT_TRUE(Contains(AllProblems(source),
+                       video + ": video ends after " + std::to_string(frames.size()) +
+                           " of the 30 frames listed in " + session + "/cam0.frames.csv"))
       << AllProblems(source);
 
   const auto cli = RunSpritestation("replay " + session);
@@ -205,7 +213,8 @@ TEST_P(DamagedVideo, CutAnywhereTheReadablePrefixReplaysIntact) {
     previous = frames.size();
     if (frames.size() < 20) {
       EXPECT_GE(source.stats().errors, 1u) << "cut " << cut << ": missing frames went unreported";
-      EXPECT_TRUE(Contains(source.stats().last_error, session + "/cam0.mkv")) << source.stats().last_error;
+      EXPECT_TRUE(Contains(source.stats().last_error, session + "/cam0.mkv"))
+          << source.stats().last_error;
     }
   }
   EXPECT_EQ(previous, 20u);
@@ -269,12 +278,14 @@ TEST(DamagedCsv, GarbageCsvIsAnInputErrorNamingTheFile) {
   const std::string session = dir / "s";
   RecordTestSession(session, PixelFormat::kBGR8, 32, 32, 5);
   const std::string csv = session + "/cam0.frames.csv";
-  std::ofstream(csv, std::ios::trunc) << "index,timestamp_ns,sequence,drops_before\n0,100,0,0\n1,bogus,1,0\n";
+  std::ofstream(csv, std::ios::trunc)
+      << "index,timestamp_ns,sequence,drops_before\n0,100,0,0\n1,bogus,1,0\n";
   try {
     ReplaySource source(session);
     FAIL() << "no error";
   } catch (const InputError& e) {
-    EXPECT_EQ(std::string(e.what()), csv + ":3: field 'timestamp_ns': expected an integer, got 'bogus'");
+    EXPECT_EQ(std::string(e.what()),
+              csv + ":3: field 'timestamp_ns': expected an integer, got 'bogus'");
   }
   const auto cli = RunSpritestation("replay " + session);
   EXPECT_EQ(cli.exit_code, 2) << cli.output;
@@ -291,7 +302,8 @@ TEST(DamagedCsv, CsvLongerThanVideoIsReportedNotFatal) {
   while (auto f = source.Next()) frames.push_back(std::move(*f));
   EXPECT_EQ(frames.size(), 6u);
   EXPECT_EQ(source.stats().errors, 1u);
-  EXPECT_TRUE(Contains(source.stats().last_error, "video ends after 6 of the 7 frames")) << source.stats().last_error;
+  EXPECT_TRUE(Contains(source.stats().last_error, "video ends after 6 of the 7 frames"))
+      << source.stats().last_error;
 }
 
 TEST(Pacing, RealTimeKeepsTheOriginalSpacing) {
@@ -305,7 +317,8 @@ TEST(Pacing, RealTimeKeepsTheOriginalSpacing) {
   ASSERT_EQ(arrivals.size(), 8u);
   // A paced frame never arrives before its time (no upper bound: the machine may be busy).
   for (size_t i = 0; i < arrivals.size(); ++i) {
-    EXPECT_GE(arrivals[i], std::chrono::milliseconds(50 * static_cast<int>(i)) - std::chrono::milliseconds(1))
+    EXPECT_GE(arrivals[i],
+              std::chrono::milliseconds(50 * static_cast<int>(i)) - std::chrono::milliseconds(1))
         << "frame " << i;
   }
 }
@@ -313,7 +326,8 @@ TEST(Pacing, RealTimeKeepsTheOriginalSpacing) {
 TEST(Pacing, StopReleasesAWaitingNext) {
   ScratchDir dir;
   const std::string session = dir / "s";
-  RecordTestSession(session, PixelFormat::kMono8, 32, 32, 2, {}, 3600'000'000'000LL);  // an hour apart
+  RecordTestSession(session, PixelFormat::kMono8, 32, 32, 2, {},
+                    3600'000'000'000LL);  // an hour apart
   ReplaySource source(session, {.realtime = true});
   ASSERT_TRUE(source.Next().has_value());
   std::thread stopper([&] {

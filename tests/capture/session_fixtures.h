@@ -13,16 +13,18 @@ namespace ss::testing {
 // Deterministic pixels for (camera, sequence): a gradient plus hash noise, so
 // every byte value occurs and neighbouring frames differ. `smooth` drops the
 // noise (for the lossy codecs).
-inline std::vector<uint8_t> TestPixels(PixelFormat format, int width, int height, int camera, uint64_t sequence,
-                                       bool smooth = false) {
+inline std::vector<uint8_t> TestPixels(PixelFormat format, int width, int height, int camera,
+                                       uint64_t sequence, bool smooth = false) {
   std::vector<uint8_t> bytes(FrameBytes(format, width, height));
   const size_t row = bytes.size() / static_cast<size_t>(height);
   for (size_t i = 0; i < bytes.size(); ++i) {
     const size_t x = i % row;
     const size_t y = i / row;
-    uint32_t v = static_cast<uint32_t>(x / 2 + y + sequence * 3 + static_cast<uint64_t>(camera) * 50);
+    uint32_t v =
+        static_cast<uint32_t>(x / 2 + y + sequence * 3 + static_cast<uint64_t>(camera) * 50);
     if (!smooth) {
-      uint32_t h = static_cast<uint32_t>(i * 2654435761u) ^ static_cast<uint32_t>(sequence * 40503u + camera);
+      uint32_t h = static_cast<uint32_t>(i * 2654435761u) ^
+                   static_cast<uint32_t>(sequence * 40503u + camera);
       h ^= h >> 13;
       if ((h & 7) == 0) v ^= h >> 5;  // sparse noise: an eighth of the bytes
     }
@@ -33,7 +35,8 @@ inline std::vector<uint8_t> TestPixels(PixelFormat format, int width, int height
 
 inline Frame TestFrame(PixelFormat format, int width, int height, int camera, uint64_t sequence,
                        int64_t timestamp_ns, bool smooth = false) {
-  Frame f = Frame::Owned(format, width, height, TestPixels(format, width, height, camera, sequence, smooth));
+  Frame f = Frame::Owned(format, width, height,
+                         TestPixels(format, width, height, camera, sequence, smooth));
   f.camera = camera;
   f.sequence = sequence;
   f.timestamp_ns = timestamp_ns;
@@ -53,13 +56,15 @@ inline SourceCamera TestCamera(const std::string& name, PixelFormat format, int 
 
 // Records one camera: frames 0..count-1, sequence = frame number + first_sequence,
 // timestamps every `period_ns` from `t0_ns`.
-inline void RecordTestSession(const std::string& dir, PixelFormat format, int width, int height, int count,
-                              RecordingOptions options = {}, int64_t period_ns = 33'000'000,
-                              int64_t t0_ns = 1'000'000'000, bool smooth = false) {
+inline void RecordTestSession(const std::string& dir, PixelFormat format, int width, int height,
+                              int count, RecordingOptions options = {},
+                              int64_t period_ns = 33'000'000, int64_t t0_ns = 1'000'000'000,
+                              bool smooth = false) {
   SessionWriter writer(dir, "test", options);
   const int cam = writer.AddCamera(TestCamera("cam0", format, width, height), nullptr);
   for (int i = 0; i < count; ++i) {
-    writer.Write(TestFrame(format, width, height, cam, static_cast<uint64_t>(i), t0_ns + i * period_ns, smooth));
+    writer.Write(TestFrame(format, width, height, cam, static_cast<uint64_t>(i),
+                           t0_ns + i * period_ns, smooth));
   }
   writer.Close();
 }

@@ -31,7 +31,8 @@ std::vector<Frame> ReplayIntact(const std::string& session, PixelFormat format, 
   while (auto f = source.Next()) {
     const auto expected = TestPixels(format, w, h, f->camera, f->sequence);
     EXPECT_EQ(f->size, expected.size());
-    EXPECT_EQ(std::memcmp(f->data, expected.data(), std::min(f->size, expected.size())), 0) << f->sequence;
+    EXPECT_EQ(std::memcmp(f->data, expected.data(), std::min(f->size, expected.size())), 0)
+        << f->sequence;
     frames.push_back(std::move(*f));
   }
   EXPECT_EQ(source.stats().errors, 0u) << source.stats().last_error;
@@ -44,7 +45,8 @@ TEST(WriterFlush, IntervalZeroPutsEveryFrameOnDiskBeforeWriteReturns) {
   SessionWriter writer(session, "sync", {.flush_interval_ms = 0});
   const int cam = writer.AddCamera(TestCamera("cam0", PixelFormat::kBGR8, 64, 48), nullptr);
   for (uint64_t seq = 0; seq < 6; ++seq) {
-    writer.Write(TestFrame(PixelFormat::kBGR8, 64, 48, cam, seq, 1'000'000'000 + static_cast<int64_t>(seq) * 33'000'000));
+    writer.Write(TestFrame(PixelFormat::kBGR8, 64, 48, cam, seq,
+                           1'000'000'000 + static_cast<int64_t>(seq) * 33'000'000));
     // The writer is still open: what a kill right now would leave.
     ASSERT_EQ(CsvRows(session + "/cam0.frames.csv"), seq + 1);
     const auto frames = ReplayIntact(session, PixelFormat::kBGR8, 64, 48);
@@ -62,7 +64,8 @@ TEST(WriterFlush, WhileWritingTheCsvListsOnlyFramesTheVideoHolds) {
   const int cam = writer.AddCamera(TestCamera("cam0", PixelFormat::kMono8, 32, 32), nullptr);
   uint64_t seq = 0;
   auto write = [&] {
-    writer.Write(TestFrame(PixelFormat::kMono8, 32, 32, cam, seq, static_cast<int64_t>(seq) * 5'000'000));
+    writer.Write(
+        TestFrame(PixelFormat::kMono8, 32, 32, cam, seq, static_cast<int64_t>(seq) * 5'000'000));
     ++seq;
   };
   const auto start = std::chrono::steady_clock::now();
@@ -89,8 +92,11 @@ TEST(WriterFlush, FramesBeforeAPauseReachTheDiskWithoutFurtherWrites) {
   const int a = writer.AddCamera(TestCamera("a", PixelFormat::kYUYV, 32, 16), nullptr);
   const int b = writer.AddCamera(TestCamera("b", PixelFormat::kBGR8, 16, 16), nullptr);
   for (uint64_t seq = 0; seq < 7; ++seq) {
-    writer.Write(TestFrame(PixelFormat::kYUYV, 32, 16, a, seq, static_cast<int64_t>(seq) * 10'000'000));
-    if (seq < 3) writer.Write(TestFrame(PixelFormat::kBGR8, 16, 16, b, seq, static_cast<int64_t>(seq) * 10'000'000 + 1));
+    writer.Write(
+        TestFrame(PixelFormat::kYUYV, 32, 16, a, seq, static_cast<int64_t>(seq) * 10'000'000));
+    if (seq < 3)
+      writer.Write(TestFrame(PixelFormat::kBGR8, 16, 16, b, seq,
+                             static_cast<int64_t>(seq) * 10'000'000 + 1));
   }
   // Nothing more is written: the background flusher must bring both cameras to disk.
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(20);

@@ -34,39 +34,46 @@ std::string Describe(const Bank& bank) {
   for (auto& [id, r] : rank) r = next++;
   auto Id = [&](int64_t id) { return static_cast<long long>(rank.at(id)); };
   std::string out;
-  for (const auto& s : bank.ListSessions()) out += "session " + std::to_string(s.id) + " " + s.uid + " " + s.name + "\n";
+  for (const auto& s : bank.ListSessions())
+    out += "session " + std::to_string(s.id) + " " + s.uid + " " + s.name + "\n";
   for (const auto& c : bank.ListCameras()) {
     out += "camera " + std::to_string(c.id) + " " + c.name + " " + std::to_string(c.width) + "x" +
            std::to_string(c.height) + " model " + std::to_string(c.cameramodel.size()) + "\n";
   }
   for (const auto& c : bank.ListAllClips()) {
-    out += "clip " + std::to_string(c.id) + " " + std::to_string(c.first_frame) + ".." + std::to_string(c.last_frame) +
-           " complete " + std::to_string(c.complete_seq) + "\n";
+    out += "clip " + std::to_string(c.id) + " " + std::to_string(c.first_frame) + ".." +
+           std::to_string(c.last_frame) + " complete " + std::to_string(c.complete_seq) + "\n";
   }
   for (const auto& f : bank.LoadFeatures()) {
     const SpriteRecord s = bank.LoadSprite(f.id);
     char line[512];
-    std::snprintf(line, sizeof(line), "sprite %lld clip %lld frame %lld m%d of %lld %.17g %.17g %.17g %.17g %.17g %.17g\n",
-                  Id(s.id), static_cast<long long>(s.clip_id), static_cast<long long>(s.frame),
-                  s.mirrored ? 1 : 0, Id(s.mirror_of), s.ground_x_m, s.ground_y_m,
-                  s.velocity_x_m_s, s.mean_g, s.area_px, s.anchor_y_px);
+    std::snprintf(
+        line, sizeof(line),
+        "sprite %lld clip %lld frame %lld m%d of %lld %.17g %.17g %.17g %.17g %.17g %.17g\n",
+        Id(s.id), static_cast<long long>(s.clip_id), static_cast<long long>(s.frame),
+        s.mirrored ? 1 : 0, Id(s.mirror_of), s.ground_x_m, s.ground_y_m, s.velocity_x_m_s, s.mean_g,
+        s.area_px, s.anchor_y_px);
     out += line;
     for (const auto& t : s.tags) out += " tag " + t + "\n";
     const SpritePixels p = bank.LoadPixels(f.id);
-    out += " pixels " + std::to_string(cv::sum(p.bgra)[0] + 7 * cv::sum(p.bgra)[3] + 3 * cv::sum(p.shadow)[0]) + "\n";
+    out += " pixels " +
+           std::to_string(cv::sum(p.bgra)[0] + 7 * cv::sum(p.bgra)[3] + 3 * cv::sum(p.shadow)[0]) +
+           "\n";
   }
   for (const auto& t : bank.LoadTransitions()) {
     char line[128];
-    std::snprintf(line, sizeof(line), "transition %lld %lld %.17g %.17g\n", Id(t.from_sprite), Id(t.to_sprite), t.d,
-                  t.cost);
+    std::snprintf(line, sizeof(line), "transition %lld %lld %.17g %.17g\n", Id(t.from_sprite),
+                  Id(t.to_sprite), t.d, t.cost);
     out += line;
   }
   for (const auto& l : bank.LoadTransitionLabels()) {
-    out += "label " + std::to_string(Id(l.from_sprite)) + " " + std::to_string(Id(l.to_sprite)) + " " + l.label + "\n";
+    out += "label " + std::to_string(Id(l.from_sprite)) + " " + std::to_string(Id(l.to_sprite)) +
+           " " + l.label + "\n";
   }
   const BankCounts c = bank.Counts();
-  out += "counts " + std::to_string(c.sprites) + " " + std::to_string(c.mirrors) + " " + std::to_string(c.transitions) +
-         " " + std::to_string(c.tags) + " " + std::to_string(c.pixel_rows) + " v" + std::to_string(c.schema_version);
+  out += "counts " + std::to_string(c.sprites) + " " + std::to_string(c.mirrors) + " " +
+         std::to_string(c.transitions) + " " + std::to_string(c.tags) + " " +
+         std::to_string(c.pixel_rows) + " v" + std::to_string(c.schema_version);
   return out;
 }
 
@@ -75,7 +82,8 @@ std::string Describe(const Bank& bank) {
 void WriteScenario(const std::string& path) {
   BankWriter w(path);
   const Fixture fx = Register(w);
-  const int64_t session2 = w.AddSession({0, "second@2026", "second", "2026-12-02T10:00:00Z", "test"});
+  const int64_t session2 =
+      w.AddSession({0, "second@2026", "second", "2026-12-02T10:00:00Z", "test"});
   const int64_t camera2 = w.AddCamera(session2, {0, 0, "cam1", "# a model\n", 640, 480});
   std::vector<SpriteRecord> batch = MakeBatch(10, 14, 7);
   batch[1].tags = {"walk", "left"};
@@ -132,7 +140,8 @@ TEST(BankPostgres, HoldsWhatASqliteBankHolds) {
   BankWriter w(pg);
   std::vector<SpriteRecord> orphan = {MakeMirror(MakeSprite(99, 7))};
   EXPECT_THROW(w.AppendClipBatch(Clip(1, 7, 99, true), orphan), WorkError);
-  EXPECT_THROW(w.AppendClipBatch(Clip(1, 7, 10, true), MakeBatch(17, 17, 7)), WorkError);  // complete clip grows
+  EXPECT_THROW(w.AppendClipBatch(Clip(1, 7, 10, true), MakeBatch(17, 17, 7)),
+               WorkError);  // complete clip grows
   EXPECT_THROW(w.Tag({123456}, "x"), InputError);
   EXPECT_EQ(Describe(Bank(pg)), want);
 }
@@ -160,7 +169,9 @@ TEST(BankPostgres, ADatabaseThatIsNotABankIsNamedWithoutItsPassword) {
     Bank bank(empty);
     FAIL() << "an empty database opened as a bank";
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("not a sprite bank (an empty database)"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("not a sprite bank (an empty database)"),
+              std::string::npos)
+        << e.what();
   }
   const std::string unreachable = "postgresql://spritestation@127.0.0.1:1/bank";
   EXPECT_THROW(Bank{unreachable}, BusyError);
@@ -299,7 +310,8 @@ void SnapshotAndKeptMeta(const std::string& path) {
   // A pair given twice in one call keeps its last values (PostgreSQL stores many rows a
   // statement, and one statement may not touch a row twice).
   const auto f = w.LoadFeatures();
-  w.UpsertTransitions({{f[3].id, f[8].id, 0.125, 0.5}, {f[4].id, f[8].id, 1, 1}, {f[3].id, f[8].id, 0.25, 0.75}});
+  w.UpsertTransitions(
+      {{f[3].id, f[8].id, 0.125, 0.5}, {f[4].id, f[8].id, 1, 1}, {f[3].id, f[8].id, 0.25, 0.75}});
   const auto from = reader.LoadTransitionsFrom(f[3].id);
   ASSERT_EQ(from.size(), 1u);
   EXPECT_EQ(from[0].d, 0.25);

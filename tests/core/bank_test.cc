@@ -21,9 +21,9 @@
 
 #include "core/bank_export.h"
 #include "core/bank_schema.h"
-#include "core/sql.h"
 #include "core/bank_verify.h"
 #include "core/error.h"
+#include "core/sql.h"
 #include "tests/support/bank_fixtures.h"
 #include "tests/support/test_support.h"
 
@@ -184,7 +184,8 @@ TEST(Bank, ReappendingTheSameSessionAddsNothing) {
     results.push_back(w.AppendClipBatch(Clip(fx.camera, 2, 3, true), MakeBatch(3, 6, 2)));
     w.Tag({results[0].sprite_ids[0]}, "keep");
     for (size_t i = 0; i < results.size(); ++i) {
-      EXPECT_EQ(results[i].inserted, run == 0 ? static_cast<int64_t>(results[i].sprite_ids.size()) : 0);
+      EXPECT_EQ(results[i].inserted,
+                run == 0 ? static_cast<int64_t>(results[i].sprite_ids.size()) : 0);
       if (run == 1) {
         EXPECT_EQ(results[i].clip_id, first[i].clip_id);
         EXPECT_EQ(results[i].sprite_ids, first[i].sprite_ids);
@@ -270,10 +271,12 @@ TEST(Bank, ReaderIsNotBlockedByAnOpenWriteTransaction) {
   // Another connection holds a write transaction with uncommitted rows.
   sqlite3* db = nullptr;
   ASSERT_EQ(sqlite3_open(path.c_str(), &db), SQLITE_OK);
-  ASSERT_EQ(sqlite3_exec(db, "BEGIN IMMEDIATE; INSERT INTO sessions (uid) VALUES ('pending');"
-                             "DELETE FROM transitions; UPDATE clips SET complete = 0, complete_seq = NULL;",
-                         nullptr, nullptr, nullptr),
-            SQLITE_OK)
+  ASSERT_EQ(
+      sqlite3_exec(db,
+                   "BEGIN IMMEDIATE; INSERT INTO sessions (uid) VALUES ('pending');"
+                   "DELETE FROM transitions; UPDATE clips SET complete = 0, complete_seq = NULL;",
+                   nullptr, nullptr, nullptr),
+      SQLITE_OK)
       << sqlite3_errmsg(db);
   const BankCounts during = reader.Counts();  // would fail with SQLITE_BUSY without WAL
   EXPECT_EQ(during.sessions, 1);
@@ -305,10 +308,12 @@ TEST(Bank, ConcurrentReaderDuringWrites) {
         for (const auto& f : features) ++per_clip[f.clip_id];
         for (const auto& [clip, n] : per_clip) {
           if (n != 2 * kBatches * kFramesPerBatch) {
-            reader_errors.push_back("clip " + std::to_string(clip) + " visible with " + std::to_string(n) + " sprites");
+            reader_errors.push_back("clip " + std::to_string(clip) + " visible with " +
+                                    std::to_string(n) + " sprites");
           }
         }
-        if (static_cast<int64_t>(per_clip.size()) < last_clips) reader_errors.push_back("clips went backwards");
+        if (static_cast<int64_t>(per_clip.size()) < last_clips)
+          reader_errors.push_back("clips went backwards");
         last_clips = static_cast<int64_t>(per_clip.size());
         reads.fetch_add(1);
         if (done) break;
@@ -322,12 +327,14 @@ TEST(Bank, ConcurrentReaderDuringWrites) {
   for (int clip = 0; clip < kClips; ++clip) {
     for (int b = 0; b < kBatches; ++b) {
       const int64_t first = b * kFramesPerBatch;
-      w.AppendClipBatch(Clip(fx.camera, clip, 0, b == kBatches - 1), MakeBatch(first, first + kFramesPerBatch - 1, clip));
+      w.AppendClipBatch(Clip(fx.camera, clip, 0, b == kBatches - 1),
+                        MakeBatch(first, first + kFramesPerBatch - 1, clip));
       if (b == 0) {
         // Let the reader read at least once while this clip is half written.
         const int target = reads.load() + 1;
         const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(20);
-        while (reads.load() < target && std::chrono::steady_clock::now() < deadline) std::this_thread::yield();
+        while (reads.load() < target && std::chrono::steady_clock::now() < deadline)
+          std::this_thread::yield();
       }
     }
   }
@@ -385,7 +392,8 @@ TEST(Bank, WriterKilledMidAppendLeavesEveryCommittedBatch) {
   for (const auto& [track, b] : committed) {
     const std::string where = " WHERE track_id = " + std::to_string(track) + " AND frame BETWEEN " +
                               std::to_string(b * 10) + " AND " + std::to_string(b * 10 + 9);
-    EXPECT_EQ(RawCount(path, "SELECT count(*) FROM sprites" + where), 20) << "track " << track << " batch " << b;
+    EXPECT_EQ(RawCount(path, "SELECT count(*) FROM sprites" + where), 20)
+        << "track " << track << " batch " << b;
   }
   // The batch in flight is all there or not at all.
   const int64_t sprites = RawCount(path, "SELECT count(*) FROM sprites");
@@ -422,7 +430,8 @@ TEST(Bank, WrongSchemaVersionNamesTheFileAndVersions) {
       const std::string what = e.what();
       EXPECT_NE(what.find(path), std::string::npos) << what;
       EXPECT_NE(what.find("99"), std::string::npos) << what;
-      EXPECT_NE(what.find("expected " + std::to_string(kBankSchemaVersion)), std::string::npos) << what;
+      EXPECT_NE(what.find("expected " + std::to_string(kBankSchemaVersion)), std::string::npos)
+          << what;
     }
   }
   EXPECT_THROW(VerifyBank(path), InputError);
@@ -434,7 +443,8 @@ TEST(Bank, AVersionOneBankIsUpgradedInPlaceAndKeepsItsSprites) {
   // A bank as version 1 made it: its migration alone, then one clip.
   RawExec(path, BankMigrations(sql::Dialect::kSqlite).at(0).sql);
   RawExec(path, "PRAGMA application_id = " + std::to_string(kBankApplicationId) +
-                    "; PRAGMA user_version = 1; INSERT INTO meta (key, value) VALUES ('schema_version', '1')");
+                    "; PRAGMA user_version = 1; INSERT INTO meta (key, value) VALUES "
+                    "('schema_version', '1')");
   EXPECT_THROW(Bank b(path), InputError) << "a reader asks for the upgrade";
   int64_t first = 0;
   {
@@ -457,7 +467,8 @@ TEST(Bank, AVersionOneBankIsUpgradedInPlaceAndKeepsItsSprites) {
   EXPECT_EQ(labels[0].label, "skip");
   EXPECT_EQ(labels[1].from_sprite, first);
   EXPECT_EQ(labels[1].label, "no");
-  EXPECT_EQ(b.CountTransitionLabels(), (std::map<std::string, int64_t>{{"no", 1}, {"skip", 1}, {"yes", 0}}));
+  EXPECT_EQ(b.CountTransitionLabels(),
+            (std::map<std::string, int64_t>{{"no", 1}, {"skip", 1}, {"yes", 0}}));
   EXPECT_TRUE(w.RemoveTransitionLabel(first + 2, first));
   EXPECT_FALSE(w.RemoveTransitionLabel(first + 2, first));
   EXPECT_EQ(b.LoadTransitionLabels().size(), 1u);
@@ -492,7 +503,6 @@ TEST(Bank, FilesThatAreNotBanksAreInputErrors) {
   EXPECT_EQ(w.schema_version(), kBankSchemaVersion);
 }
 
-
 TEST(Bank, VerifyFindsEachKindOfDamage) {
   struct Damage {
     const char* name;
@@ -500,12 +510,16 @@ TEST(Bank, VerifyFindsEachKindOfDamage) {
     const char* expect;  // a word the problem report must contain
   };
   const Damage damages[] = {
-      {"pixel blob", "UPDATE sprite_pixels SET data = x'28b52ffd0000' WHERE sprite_id = 1", "pixels"},
+      {"pixel blob", "UPDATE sprite_pixels SET data = x'28b52ffd0000' WHERE sprite_id = 1",
+       "pixels"},
       {"pixel size", "UPDATE sprite_pixels SET width_px = 8 WHERE sprite_id = 1", "pixels"},
-      {"mirror speed", "UPDATE sprites SET velocity_x_m_s = 5 WHERE mirrored = 1 AND frame = 2", "mirror"},
+      {"mirror speed", "UPDATE sprites SET velocity_x_m_s = 5 WHERE mirrored = 1 AND frame = 2",
+       "mirror"},
       {"clip range", "UPDATE clips SET last_frame = last_frame + 3 WHERE complete = 1", "clip"},
-      {"lost sprite", "DELETE FROM sprites WHERE mirrored = 0 AND frame = 3 AND track_id = 1", "clip"},
-      {"foreign key", "PRAGMA foreign_keys = OFF; DELETE FROM clips WHERE complete = 0", "foreign key"},
+      {"lost sprite", "DELETE FROM sprites WHERE mirrored = 0 AND frame = 3 AND track_id = 1",
+       "clip"},
+      {"foreign key", "PRAGMA foreign_keys = OFF; DELETE FROM clips WHERE complete = 0",
+       "foreign key"},
       {"schema", "DROP INDEX sprites_by_clip", "schema"},
   };
   for (const Damage& d : damages) {
@@ -537,7 +551,6 @@ TEST(Bank, VerifyFindsDamagedPages) {
   const BankVerifyReport r = VerifyBank(path);
   EXPECT_FALSE(r.ok());
 }
-
 
 }  // namespace
 }  // namespace ss

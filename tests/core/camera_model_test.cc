@@ -447,7 +447,8 @@ TEST(CameraModel, BadFilesNameTheFileAndTheReason) {
       // A file cut short inside a string (libmrcal's parser read past the end of it: tests/fuzz).
       {"cut.cameramodel", "# SpriteStation camera model\n{\n    'lensmodel': 'LENSMODEL_PIN",
        "a quoted string at line 3 is not closed (is the file cut short?)"},
-      {"cut2.cameramodel", "{ 'lensmodel': 'LENSMODEL_PINHOLE\\", "a quoted string at line 1 is not closed"},
+      {"cut2.cameramodel", "{ 'lensmodel': 'LENSMODEL_PINHOLE\\",
+       "a quoted string at line 1 is not closed"},
   };
   for (const Case& c : cases) {
     const std::string path = dir / c.file;

@@ -19,8 +19,7 @@ namespace {
 using ss::testing::ScratchDir;
 namespace fs = std::filesystem;
 
-const std::string kExample =
-    fs::path(ss::testing::SourcePath("docs/station.example.yaml"));
+const std::string kExample = fs::path(ss::testing::SourcePath("docs/station.example.yaml"));
 
 ConfigOptions NoFileChecks() {
   ConfigOptions o;
@@ -55,7 +54,8 @@ TEST(StationConfig, AFloorPolygonHasABoundedSize) {
     std::string text = "[";
     for (size_t i = 0; i < points; ++i) {
       const double a = 2 * M_PI * static_cast<double>(i) / static_cast<double>(points);
-      text += (i ? ", [" : "[") + std::to_string(10 * std::cos(a)) + ", " + std::to_string(10 * std::sin(a)) + "]";
+      text += (i ? ", [" : "[") + std::to_string(10 * std::cos(a)) + ", " +
+              std::to_string(10 * std::sin(a)) + "]";
     }
     return text + "]";
   };
@@ -63,8 +63,8 @@ TEST(StationConfig, AFloorPolygonHasABoundedSize) {
   const StationConfig cfg = Parse(kOneCamera + "enclosure:\n  floor: " + floor(kMax) + "\n");
   EXPECT_EQ(cfg.enclosure.floor.vertices().size(), kMax);
   const std::string error = ErrorOf(kOneCamera + "enclosure:\n  floor: " + floor(kMax + 1) + "\n");
-  EXPECT_NE(error.find("enclosure.floor: " + std::to_string(kMax + 1) + " points; a floor polygon has at most " +
-                       std::to_string(kMax)),
+  EXPECT_NE(error.find("enclosure.floor: " + std::to_string(kMax + 1) +
+                       " points; a floor polygon has at most " + std::to_string(kMax)),
             std::string::npos)
       << error.substr(0, 300);
 }
@@ -259,13 +259,16 @@ TEST(StationConfig, ValueErrorsNameFieldAndLine) {
       {kOneCamera + "    white_balance: {mode: once, red_gain: 1.2}\n",
        "station.yaml:5: cameras[0].white_balance.red_gain: only applies with mode: manual"},
       {kOneCamera + "    white_balance: {mode: manual, red_gain: 1.2, temperature_k: 5600}\n",
-       "station.yaml:5: cameras[0].white_balance.temperature_k: give either the red/blue gains or a colour "
+       "station.yaml:5: cameras[0].white_balance.temperature_k: give either the red/blue gains or "
+       "a colour "
        "temperature, not both"},
       {kOneCamera + "    white_balance: {mode: manual, red_gain: 1.2}\n",
-       "station.yaml:5: cameras[0].white_balance.temperature_k: V4L2 devices fix white balance as a colour "
+       "station.yaml:5: cameras[0].white_balance.temperature_k: V4L2 devices fix white balance as "
+       "a colour "
        "temperature: give temperature_k"},
       {kOneCamera + "    white_balance: {mode: manual, temperature_k: 560}\n",
-       "station.yaml:5: cameras[0].white_balance.temperature_k: expected a colour temperature of 1500-15000 K, "
+       "station.yaml:5: cameras[0].white_balance.temperature_k: expected a colour temperature of "
+       "1500-15000 K, "
        "got 560"},
       {kOneCamera + kOneCamera.substr(9),
        "station.yaml:5: cameras[1].name: \"cam0\" is already the name of cameras[0]"},
@@ -276,7 +279,8 @@ TEST(StationConfig, ValueErrorsNameFieldAndLine) {
       {"pipeline:\n  px_per_m: 0\n",
        "station.yaml:2: pipeline.px_per_m: expected auto or a positive number, got 0"},
       {"pipeline:\n  px_per_m: big\n",
-       "station.yaml:2: pipeline.px_per_m: expected auto or a positive number of pixels per metre, got \"big\""},
+       "station.yaml:2: pipeline.px_per_m: expected auto or a positive number of pixels per metre, "
+       "got \"big\""},
       {"pipeline:\n  min_area_px: 0\n",
        "station.yaml:2: pipeline.min_area_px: expected at least 1 pixel, got 0"},
       {"storage:\n  recording: some\n",
@@ -326,7 +330,8 @@ TEST(StationConfig, EveryErrorIsReportedAtOnce) {
 TEST(StationConfig, NoiseThresholds) {
   const StationConfig cfg = Parse(
       "pipeline:\n  noise_min_solidity: 0\n  noise_recover_solidity: 0.4\n  noise_thick_px: 3\n"
-      "  noise_min_thick_share: 0.2\n  noise_min_largest_share: 0.5\n  noise_min_mean_alpha: 0.6\n");
+      "  noise_min_thick_share: 0.2\n  noise_min_largest_share: 0.5\n  noise_min_mean_alpha: "
+      "0.6\n");
   EXPECT_EQ(cfg.pipeline.noise_min_solidity, 0);
   EXPECT_EQ(cfg.pipeline.noise_recover_solidity, 0.4);
   EXPECT_EQ(cfg.pipeline.noise_thick_px, 3);
@@ -334,8 +339,11 @@ TEST(StationConfig, NoiseThresholds) {
   EXPECT_EQ(cfg.pipeline.noise_min_largest_share, 0.5);
   EXPECT_EQ(cfg.pipeline.noise_min_mean_alpha, 0.6);
   const std::string share = ErrorOf("pipeline:\n  noise_min_solidity: 1.5\n");
-  EXPECT_NE(share.find("pipeline.noise_min_solidity: expected a share from 0 to 1"), std::string::npos) << share;
-  EXPECT_NE(ErrorOf("pipeline:\n  noise_thick_px: -1\n").find("pipeline.noise_thick_px"), std::string::npos);
+  EXPECT_NE(share.find("pipeline.noise_min_solidity: expected a share from 0 to 1"),
+            std::string::npos)
+      << share;
+  EXPECT_NE(ErrorOf("pipeline:\n  noise_thick_px: -1\n").find("pipeline.noise_thick_px"),
+            std::string::npos);
 }
 
 TEST(StationConfig, SyntaxErrorsAndBadFiles) {
@@ -459,7 +467,8 @@ TEST(StationConfig, ValidatesConfigsBuiltInCode) {
   const ConfigReport report = ValidateStationConfig(cfg, "code", {}, NoFileChecks());
   EXPECT_EQ(report.status, ConfigStatus::kInvalid);
   ASSERT_EQ(report.errors.size(), 2u);
-  EXPECT_EQ(report.errors[0], "code: pipeline.px_per_m: expected auto or a positive number, got -5");
+  EXPECT_EQ(report.errors[0],
+            "code: pipeline.px_per_m: expected auto or a positive number, got -5");
   EXPECT_EQ(report.errors[1].rfind("code: control.token: required", 0), 0u) << report.errors[1];
 }
 

@@ -15,7 +15,8 @@ namespace {
 cv::Mat Gradient(int w, int h) {
   cv::Mat bgr(h, w, CV_8UC3);
   for (int y = 0; y < h; ++y) {
-    for (int x = 0; x < w; ++x) bgr.at<cv::Vec3b>(y, x) = cv::Vec3b(x * 4 % 256, y * 8 % 256, (x + y) % 256);
+    for (int x = 0; x < w; ++x)
+      bgr.at<cv::Vec3b>(y, x) = cv::Vec3b(x * 4 % 256, y * 8 % 256, (x + y) % 256);
   }
   return bgr;
 }
@@ -27,8 +28,8 @@ Frame FromMat(PixelFormat format, const cv::Mat& m) {
 }
 
 TEST(PixelFormat, NamesRoundTrip) {
-  for (const char* name : {"mono8", "bayer_rg8", "bayer_gr8", "bayer_gb8", "bayer_bg8", "rgb8", "bgr8",
-                           "yuyv", "nv12", "mjpeg"}) {
+  for (const char* name : {"mono8", "bayer_rg8", "bayer_gr8", "bayer_gb8", "bayer_bg8", "rgb8",
+                           "bgr8", "yuyv", "nv12", "mjpeg"}) {
     auto f = ParsePixelFormat(name);
     ASSERT_TRUE(f.has_value()) << name;
     EXPECT_EQ(PixelFormatName(*f), name);
@@ -124,7 +125,8 @@ TEST(Frame, BorrowedReleasesWhenTheLastCopyDies) {
   std::vector<uint8_t> buffer(12, 7);
   int released = 0;
   {
-    Frame a = Frame::Borrowed(PixelFormat::kMono8, 4, 3, buffer.data(), buffer.size(), [&] { ++released; });
+    Frame a = Frame::Borrowed(PixelFormat::kMono8, 4, 3, buffer.data(), buffer.size(),
+                              [&] { ++released; });
     Frame b = a;
     EXPECT_EQ(b.data, buffer.data());
     a = Frame();

@@ -201,7 +201,8 @@ std::vector<Poly> Variants(const Poly& p, std::mt19937& rng) {
   std::reverse(r.begin(), r.end());
   out.push_back(r);
   Poly rotated = p;
-  std::rotate(rotated.begin(), rotated.begin() + static_cast<long>(rng() % p.size()), rotated.end());
+  std::rotate(rotated.begin(), rotated.begin() + static_cast<long>(rng() % p.size()),
+              rotated.end());
   out.push_back(rotated);
   Poly swapped = p, mirrored = p, scaled = p;
   for (size_t i = 0; i < p.size(); ++i) {
@@ -223,9 +224,10 @@ struct Agreement {
     const bool brute = testing::BruteForceIsSimple(p);
     if (sweep != brute) {
       std::string text;
-      for (const Vector2d& v : p) text += "(" + std::to_string(v.x()) + ", " + std::to_string(v.y()) + ") ";
-      ADD_FAILURE() << what << ": sweep says " << sweep << ", the brute force " << brute << " for " << p.size()
-                    << " vertices: " << text.substr(0, 2000);
+      for (const Vector2d& v : p)
+        text += "(" + std::to_string(v.x()) + ", " + std::to_string(v.y()) + ") ";
+      ADD_FAILURE() << what << ": sweep says " << sweep << ", the brute force " << brute << " for "
+                    << p.size() << " vertices: " << text.substr(0, 2000);
     }
     ++(brute ? simple : not_simple);
   }
@@ -237,7 +239,8 @@ TEST(GroundPolygon, IsSimpleAgreesWithTheBruteForceOnRandomGridPolygons) {
   for (int i = 0; i < 20000; ++i) {
     const int grid = 2 + i % 7;
     const Poly p = GridPolygon(rng, grid, 3 + rng() % 9);
-    for (const Poly& v : Variants(p, rng)) a.Check(v, "grid " + std::to_string(grid) + " case " + std::to_string(i));
+    for (const Poly& v : Variants(p, rng))
+      a.Check(v, "grid " + std::to_string(grid) + " case " + std::to_string(i));
   }
   std::printf("random grid polygons: %d simple, %d not\n", a.simple, a.not_simple);
   EXPECT_GT(a.simple, 1000);
@@ -282,10 +285,13 @@ TEST(GroundPolygon, IsSimpleAgreesWithTheBruteForceOnAdversarialPolygons) {
   // Collinear: every vertex on one line; straight vertices; an edge running back over another.
   check({{0, 0}, {1, 1}, {2, 2}, {3, 3}}, "all on a line");
   check({{0, 0}, {1, 0}, {2, 0}, {2, 1}, {0, 1}}, "a straight vertex");
-  check({{0, 0}, {1, 0}, {2, 0}, {3, 0}, {3, 1}, {2, 1}, {1, 1}, {0, 1}}, "straight vertices both sides");
+  check({{0, 0}, {1, 0}, {2, 0}, {3, 0}, {3, 1}, {2, 1}, {1, 1}, {0, 1}},
+        "straight vertices both sides");
   check({{0, 0}, {4, 0}, {4, 2}, {3, 0}, {2, 0}, {1, 2}}, "a notch down onto the bottom edge");
-  check({{0, 0}, {4, 0}, {4, 2}, {2, 2}, {2, 0}, {1, 0}, {1, 2}, {0, 2}}, "edges overlapping on one line");
-  check({{0, 0}, {4, 0}, {4, 4}, {0, 4}, {0, 3}, {2, 3}, {2, 1}, {0, 1}}, "a gap closed on the left edge");
+  check({{0, 0}, {4, 0}, {4, 2}, {2, 2}, {2, 0}, {1, 0}, {1, 2}, {0, 2}},
+        "edges overlapping on one line");
+  check({{0, 0}, {4, 0}, {4, 4}, {0, 4}, {0, 3}, {2, 3}, {2, 1}, {0, 1}},
+        "a gap closed on the left edge");
   // Repeated vertices: in a row, or a figure of eight through one point.
   check({{0, 0}, {2, 0}, {2, 0}, {2, 2}, {0, 2}}, "a vertex twice in a row");
   check({{0, 0}, {2, 0}, {1, 1}, {2, 2}, {0, 2}, {1, 1}}, "two loops through one vertex");
@@ -293,13 +299,18 @@ TEST(GroundPolygon, IsSimpleAgreesWithTheBruteForceOnAdversarialPolygons) {
   // Spikes: out and back along one line (folds), or a thin one through another edge.
   check({{0, 0}, {4, 0}, {4, 4}, {2, 4}, {2, 6}, {2, 4}, {0, 4}}, "a spike out and straight back");
   check({{0, 0}, {4, 0}, {4, 4}, {2, 4}, {2, 6}, {2, 5}, {0, 4}}, "a spike folding back half way");
-  check({{0, 0}, {4, 0}, {4, 4}, {2, 4}, {2, -1}, {1.9, 4}, {0, 4}}, "a spike through the bottom edge");
-  check({{0, 0}, {4, 0}, {4, 4}, {2, 4}, {2, 0}, {1.9, 4}, {0, 4}}, "a spike down to the bottom edge");
-  check({{0, 0}, {4, 0}, {4, 4}, {2, 4}, {2, 0.5}, {1.9, 4}, {0, 4}}, "a spike short of the bottom edge");
+  check({{0, 0}, {4, 0}, {4, 4}, {2, 4}, {2, -1}, {1.9, 4}, {0, 4}},
+        "a spike through the bottom edge");
+  check({{0, 0}, {4, 0}, {4, 4}, {2, 4}, {2, 0}, {1.9, 4}, {0, 4}},
+        "a spike down to the bottom edge");
+  check({{0, 0}, {4, 0}, {4, 4}, {2, 4}, {2, 0.5}, {1.9, 4}, {0, 4}},
+        "a spike short of the bottom edge");
   // Tiny crossings: a notch's tip a hair above, on or below the bottom edge (exact in doubles).
-  for (double delta : {0x1p-20, 0x1p-30, 0x1p-40, 0x1p-50, 1e-12, 0.0, -1e-12, -0x1p-50, -0x1p-40, -0x1p-20}) {
+  for (double delta :
+       {0x1p-20, 0x1p-30, 0x1p-40, 0x1p-50, 1e-12, 0.0, -1e-12, -0x1p-50, -0x1p-40, -0x1p-20}) {
     check({{0, 0}, {4, 0}, {4, 4}, {2, delta}, {0, 4}}, "notch tip at " + std::to_string(delta));
-    check({{0, 0}, {4, 0}, {4, 4}, {2, 4}, {2 + delta, 0}, {1, 4}, {0, 4}}, "leaning spike at " + std::to_string(delta));
+    check({{0, 0}, {4, 0}, {4, 4}, {2, 4}, {2 + delta, 0}, {1, 4}, {0, 4}},
+          "leaning spike at " + std::to_string(delta));
   }
   // The same tiny crossings turned by an angle: rounded, but the old arithmetic still gets their
   // signs right at these sizes.
@@ -340,12 +351,14 @@ TEST(GroundPolygon, IsSimpleIsExactWhereTheOldArithmeticRounded) {
       return (cross > 0) - (cross < 0);
     };
     const size_t n = p.size();
-    const auto meet = [&](const Vector2d& a, const Vector2d& b, const Vector2d& c, const Vector2d& d) {
-      const int o1 = orientation(a, b, c), o2 = orientation(a, b, d), o3 = orientation(c, d, a), o4 = orientation(c, d, b);
+    const auto meet = [&](const Vector2d& a, const Vector2d& b, const Vector2d& c,
+                          const Vector2d& d) {
+      const int o1 = orientation(a, b, c), o2 = orientation(a, b, d), o3 = orientation(c, d, a),
+                o4 = orientation(c, d, b);
       if (o1 != o2 && o3 != o4) return true;
       using testing::reference::OnSegment;
-      return (o1 == 0 && OnSegment(a, b, c)) || (o2 == 0 && OnSegment(a, b, d)) || (o3 == 0 && OnSegment(c, d, a)) ||
-             (o4 == 0 && OnSegment(c, d, b));
+      return (o1 == 0 && OnSegment(a, b, c)) || (o2 == 0 && OnSegment(a, b, d)) ||
+             (o3 == 0 && OnSegment(c, d, a)) || (o4 == 0 && OnSegment(c, d, b));
     };
     for (size_t i = 0; i < n; ++i) {
       const Vector2d &a = p[i], &b = p[(i + 1) % n];
@@ -368,15 +381,16 @@ TEST(GroundPolygon, IsSimpleIsExactWhereTheOldArithmeticRounded) {
   std::uniform_int_distribution<int> nudge(-2, 2);
   int simple = 0, not_simple = 0, old_differs = 0;
   for (int i = 0; i < 20000; ++i) {
-    Poly p = i % 2 ? GridPolygon(rng, 3 + i % 5, 4 + rng() % 6) : Comb(1 + rng() % 3, 1 + rng() % 3);
+    Poly p =
+        i % 2 ? GridPolygon(rng, 3 + i % 5, 4 + rng() % 6) : Comb(1 + rng() % 3, 1 + rng() % 3);
     for (Vector2d& v : p) v = v * 0x1p40 + Vector2d(nudge(rng), nudge(rng));
     const bool truth = exact(p);
     EXPECT_EQ(GroundPolygon(p).IsSimple(), truth) << "case " << i;
     old_differs += testing::BruteForceIsSimple(p) != truth;
     ++(truth ? simple : not_simple);
   }
-  std::printf("near-degenerate polygons: %d simple, %d not; the old check was wrong on %d\n", simple, not_simple,
-              old_differs);
+  std::printf("near-degenerate polygons: %d simple, %d not; the old check was wrong on %d\n",
+              simple, not_simple, old_differs);
   EXPECT_GT(simple, 1000);
   EXPECT_GT(not_simple, 1000);
 }
@@ -392,8 +406,10 @@ std::vector<Vector2d> ProbePoints(const Poly& p, std::mt19937& rng, size_t rando
     hi = hi.cwiseMax(v);
   }
   const Vector2d pad = 0.1 * (hi - lo) + Vector2d::Constant(1e-300);
-  std::uniform_real_distribution<double> ux(lo.x() - pad.x(), hi.x() + pad.x()), uy(lo.y() - pad.y(), hi.y() + pad.y());
-  const size_t stride = std::max<size_t>(1, p.size() / 500);  // at most ~500 vertices probed closely
+  std::uniform_real_distribution<double> ux(lo.x() - pad.x(), hi.x() + pad.x()),
+      uy(lo.y() - pad.y(), hi.y() + pad.y());
+  const size_t stride =
+      std::max<size_t>(1, p.size() / 500);  // at most ~500 vertices probed closely
   for (size_t i = 0; i < p.size(); i += stride) {
     const Vector2d& a = p[i];
     const Vector2d& b = p[(i + 1) % p.size()];
@@ -409,8 +425,9 @@ std::vector<Vector2d> ProbePoints(const Poly& p, std::mt19937& rng, size_t rando
   }
   for (size_t i = 0; i < random; ++i) points.push_back({ux(rng), uy(rng)});
   const double inf = std::numeric_limits<double>::infinity();
-  for (const Vector2d& far : {Vector2d(1e300, 0), Vector2d(0, -1e300), Vector2d(-inf, lo.y()), Vector2d(lo.x(), inf),
-                              Vector2d(std::nan(""), 0), Vector2d(-inf, 0.5 * (lo.y() + hi.y()))}) {
+  for (const Vector2d& far :
+       {Vector2d(1e300, 0), Vector2d(0, -1e300), Vector2d(-inf, lo.y()), Vector2d(lo.x(), inf),
+        Vector2d(std::nan(""), 0), Vector2d(-inf, 0.5 * (lo.y() + hi.y()))}) {
     points.push_back(far);
   }
   return points;
@@ -425,8 +442,8 @@ struct IndexAgreement {
       const double distance = polygon.SignedDistance(q);  // Contains is distance >= 0
       const bool all_edges = distance >= 0.0;
       if (index.Contains(q) != all_edges && ++failures <= 10) {
-        ADD_FAILURE() << what << " (" << p.size() << " vertices): the index says " << !all_edges << " at ("
-                      << q.x() << ", " << q.y() << "), every edge " << all_edges;
+        ADD_FAILURE() << what << " (" << p.size() << " vertices): the index says " << !all_edges
+                      << " at (" << q.x() << ", " << q.y() << "), every edge " << all_edges;
       }
       ++(all_edges ? inside : outside);
       if (distance == 0.0) ++on_boundary;
@@ -437,15 +454,18 @@ struct IndexAgreement {
 TEST(GroundPolygonIndex, AnswersAsEveryEdgeDoesOnRandomAndAdversarialPolygons) {
   std::mt19937 rng(24);
   IndexAgreement a;
-  // Random grid polygons, simple or not (collinear points, repeats, touching edges), seen otherwise.
+  // Random grid polygons, simple or not (collinear points, repeats, touching edges), seen
+  // otherwise.
   for (int i = 0; i < 1000; ++i) {
     const Poly p = GridPolygon(rng, 2 + i % 7, 3 + rng() % 9);
     for (const Poly& v : Variants(p, rng)) a.Check(v, rng, "grid case " + std::to_string(i), 20);
   }
   // Stars (zigzag edges: many cross a horizontal line) and combs (teeth spanning the height: few,
   // wide bands), up to 2,000 vertices (each probe tests every edge the old way).
-  for (size_t n : {3, 17, 300, 2000}) a.Check(Star(n, rng, 0.9), rng, "star " + std::to_string(n), 1000);
-  for (size_t teeth : {1, 10, 500}) a.Check(Comb(teeth), rng, "comb " + std::to_string(teeth), 1000);
+  for (size_t n : {3, 17, 300, 2000})
+    a.Check(Star(n, rng, 0.9), rng, "star " + std::to_string(n), 1000);
+  for (size_t teeth : {1, 10, 500})
+    a.Check(Comb(teeth), rng, "comb " + std::to_string(teeth), 1000);
   // Scales: a floor in metres far from the origin, tiny coordinates (squares underflow: a point
   // near an edge is "on" it), huge ones (beyond the index's reach: the polygon answers).
   Poly offset = Star(300, rng, 0.5), tiny = offset, huge = offset;
@@ -461,7 +481,8 @@ TEST(GroundPolygonIndex, AnswersAsEveryEdgeDoesOnRandomAndAdversarialPolygons) {
   a.Check({{0, 1}, {2, 1}, {5, 1}}, rng, "flat");
   a.Check({{0, 0}, {4, 0}, {4, 4}, {4, 8}, {4, 4}, {0, 4}}, rng, "spike");
   a.Check({{0, 0}, {1, 1}}, rng, "two vertices");
-  std::printf("index agreement: %d inside (%d on the boundary), %d outside\n", a.inside, a.on_boundary, a.outside);
+  std::printf("index agreement: %d inside (%d on the boundary), %d outside\n", a.inside,
+              a.on_boundary, a.outside);
   EXPECT_EQ(a.failures, 0);
   EXPECT_GT(a.inside, 5000);
   EXPECT_GT(a.on_boundary, 2000);

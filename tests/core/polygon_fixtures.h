@@ -43,18 +43,20 @@ inline std::vector<Eigen::Vector2d> Star(size_t n, std::mt19937& rng, double r_m
 
 namespace reference {
 
-inline int Orientation(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector2d& c) {
+inline int Orientation(const Eigen::Vector2d& a, const Eigen::Vector2d& b,
+                       const Eigen::Vector2d& c) {
   const double cross = (b - a).x() * (c - a).y() - (b - a).y() * (c - a).x();
   return (cross > 0) - (cross < 0);
 }
 
-inline bool OnSegment(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector2d& p) {
+inline bool OnSegment(const Eigen::Vector2d& a, const Eigen::Vector2d& b,
+                      const Eigen::Vector2d& p) {
   return std::min(a.x(), b.x()) <= p.x() && p.x() <= std::max(a.x(), b.x()) &&
          std::min(a.y(), b.y()) <= p.y() && p.y() <= std::max(a.y(), b.y());
 }
 
-inline bool SegmentsMeet(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector2d& c,
-                         const Eigen::Vector2d& d) {
+inline bool SegmentsMeet(const Eigen::Vector2d& a, const Eigen::Vector2d& b,
+                         const Eigen::Vector2d& c, const Eigen::Vector2d& d) {
   const int o1 = Orientation(a, b, c), o2 = Orientation(a, b, d);
   const int o3 = Orientation(c, d, a), o4 = Orientation(c, d, b);
   if (o1 != o2 && o3 != o4) return true;

@@ -49,7 +49,8 @@ void WriteText(const std::string& path, const std::string& text) {
   std::ofstream(path, std::ios::binary) << text;
 }
 
-// Writes TwoCameras() as JSON after `edit` and returns the InputError message of reading it ("" if none).
+// Writes TwoCameras() as JSON after `edit` and returns the InputError message of reading it ("" if
+// none).
 std::string ReadEdited(const ScratchDir& dir, const std::function<void(nlohmann::json&)>& edit) {
   WriteSessionInfo(dir.path().string(), TwoCameras());
   nlohmann::json j;
@@ -104,29 +105,38 @@ TEST(SessionInfo, ErrorsNameTheFileAndTheField) {
   expect([](auto& j) { j["cameras"][0]["height"] = 1.5; },
          "field 'cameras[0].height': expected a positive integer");
   expect([](auto& j) { j["cameras"][0].erase("fps"); }, "field 'cameras[0].fps': missing");
-  expect([](auto& j) { j["cameras"][0]["fps"] = 0; }, "field 'cameras[0].fps': expected a positive number");
+  expect([](auto& j) { j["cameras"][0]["fps"] = 0; },
+         "field 'cameras[0].fps': expected a positive number");
   expect([](auto& j) { j["format_version"] = 2; },
          "field 'format_version': unsupported version 2 (this build reads version 1)");
   expect([](auto& j) { j["synthetic"] = "yes"; }, "field 'synthetic': expected true or false");
-  expect([](auto& j) { j["cameras"] = nlohmann::json::object(); }, "field 'cameras': expected an array");
-  expect([](auto& j) { j["cameras"][1]["name"] = "cam0"; }, "field 'cameras[1].name': camera 'cam0' appears twice");
+  expect([](auto& j) { j["cameras"] = nlohmann::json::object(); },
+         "field 'cameras': expected an array");
+  expect([](auto& j) { j["cameras"][1]["name"] = "cam0"; },
+         "field 'cameras[1].name': camera 'cam0' appears twice");
   expect([](auto& j) { j["cameras"][0]["video"] = "../elsewhere.mkv"; },
          "field 'cameras[0].video': path '../elsewhere.mkv' leaves the session folder");
   expect([](auto& j) { j["cameras"][0]["frames_csv"] = "/etc/passwd"; },
-         "field 'cameras[0].frames_csv': expected a path relative to the session folder, got '/etc/passwd'");
-  expect([](auto& j) { j["cameras"][0]["name"] = "a/b"; },
-         "field 'cameras[0].name': 'a/b' is not a plain file stem (letters, digits, '_', '-', '.')");
+         "field 'cameras[0].frames_csv': expected a path relative to the session folder, got "
+         "'/etc/passwd'");
+  expect(
+      [](auto& j) { j["cameras"][0]["name"] = "a/b"; },
+      "field 'cameras[0].name': 'a/b' is not a plain file stem (letters, digits, '_', '-', '.')");
   expect([](auto& j) { j["cameras"][1]["codec"] = "ffv1"; },
          "field 'cameras[1].codec': an mjpeg camera is stored as codec 'mjpeg', got 'ffv1'");
   expect([](auto& j) { j["cameras"][0]["codec"] = "vp9"; },
          "field 'cameras[0].codec': unknown codec 'vp9' (expected ffv1, ffvhuff, mjpeg or h264)");
-  const std::string bad_format = ReadEdited(dir, [](auto& j) { j["cameras"][0]["pixel_format"] = "rgb16"; });
-  EXPECT_NE(bad_format.find("field 'cameras[0].pixel_format': unknown pixel format 'rgb16'"), std::string::npos)
+  const std::string bad_format =
+      ReadEdited(dir, [](auto& j) { j["cameras"][0]["pixel_format"] = "rgb16"; });
+  EXPECT_NE(bad_format.find("field 'cameras[0].pixel_format': unknown pixel format 'rgb16'"),
+            std::string::npos)
       << bad_format;
-  expect([](auto& j) {
-    j["cameras"][0]["pixel_format"] = "nv12";
-    j["cameras"][0]["height"] = 1081;
-  }, "field 'cameras[0].height': nv12 needs an even height, got 1081");
+  expect(
+      [](auto& j) {
+        j["cameras"][0]["pixel_format"] = "nv12";
+        j["cameras"][0]["height"] = 1081;
+      },
+      "field 'cameras[0].height': nv12 needs an even height, got 1081");
   EXPECT_EQ(ReadEdited(dir, [](auto& j) { j["unknown_future_field"] = 1; }), "");  // ignored
 }
 
@@ -143,7 +153,8 @@ TEST(SessionInfo, NotJsonOrMissing) {
     ReadSessionInfo(dir.path().string());
     FAIL() << "no error for broken JSON";
   } catch (const InputError& e) {
-    EXPECT_EQ(std::string(e.what()).rfind((dir / "session.json") + ": not valid JSON", 0), 0u) << e.what();
+    EXPECT_EQ(std::string(e.what()).rfind((dir / "session.json") + ": not valid JSON", 0), 0u)
+        << e.what();
   }
   WriteText(dir / "session.json", "[1, 2]");
   EXPECT_THROW(ReadSessionInfo(dir.path().string()), InputError);
@@ -207,20 +218,29 @@ TEST(FrameCsv, MalformedRowsNameTheFileAndLine) {
   ScratchDir dir;
   const std::string p = dir / "bad.csv";
   const std::string h = "index,timestamp_ns,sequence,drops_before\n";
-  EXPECT_EQ(CsvError(dir, ""), p + ": empty file, expected the header line 'index,timestamp_ns,sequence,drops_before'");
+  EXPECT_EQ(
+      CsvError(dir, ""),
+      p + ": empty file, expected the header line 'index,timestamp_ns,sequence,drops_before'");
   EXPECT_EQ(CsvError(dir, "frame,time\n0,1\n"),
-            p + ":1: expected the header line 'index,timestamp_ns,sequence,drops_before', got 'frame,time'");
+            p + ":1: expected the header line 'index,timestamp_ns,sequence,drops_before', got "
+                "'frame,time'");
   EXPECT_EQ(CsvError(dir, h + "0,100,7,0\n1,200,8\n"),
-            p + ":3: expected 4 comma-separated fields (index,timestamp_ns,sequence,drops_before), got 3");
-  EXPECT_EQ(CsvError(dir, h + "0,1e9,7,0\n"), p + ":2: field 'timestamp_ns': expected an integer, got '1e9'");
-  EXPECT_EQ(CsvError(dir, h + "0,100,-7,0\n"), p + ":2: field 'sequence': expected a non-negative integer, got '-7'");
-  EXPECT_EQ(CsvError(dir, h + "0,100,7,\n"), p + ":2: field 'drops_before': expected a non-negative integer, got ''");
+            p + ":3: expected 4 comma-separated fields (index,timestamp_ns,sequence,drops_before), "
+                "got 3");
+  EXPECT_EQ(CsvError(dir, h + "0,1e9,7,0\n"),
+            p + ":2: field 'timestamp_ns': expected an integer, got '1e9'");
+  EXPECT_EQ(CsvError(dir, h + "0,100,-7,0\n"),
+            p + ":2: field 'sequence': expected a non-negative integer, got '-7'");
+  EXPECT_EQ(CsvError(dir, h + "0,100,7,\n"),
+            p + ":2: field 'drops_before': expected a non-negative integer, got ''");
   EXPECT_EQ(CsvError(dir, h + "0,100,7,0\n2,200,8,0\n"),
             p + ":3: field 'index': expected 1 (rows count up from 0), got 2");
   EXPECT_EQ(CsvError(dir, h + "0,100,7,0\n\n1,200,8,0\n"),
-            p + ":3: expected 4 comma-separated fields (index,timestamp_ns,sequence,drops_before), got 1");
-  EXPECT_EQ(CsvError(dir, "\x89PNG\r\n\x1a\n garbage"),
-            p + ":1: expected the header line 'index,timestamp_ns,sequence,drops_before', got '\x89PNG'");
+            p + ":3: expected 4 comma-separated fields (index,timestamp_ns,sequence,drops_before), "
+                "got 1");
+  EXPECT_EQ(
+      CsvError(dir, "\x89PNG\r\n\x1a\n garbage"),
+      p + ":1: expected the header line 'index,timestamp_ns,sequence,drops_before', got '\x89PNG'");
 }
 
 TEST(FrameCsv, TornLastRowOfAKilledRecorderIsDropped) {

@@ -19,7 +19,6 @@ namespace {
 
 using namespace ss::testing;  // NOLINT: the bank fixtures, ScratchDir, RunSpritestation
 
-
 TEST(BankCli, InfoJsonReportsTheCounts) {
   ScratchDir dir;
   const std::string path = dir / "bank.db";
@@ -90,7 +89,8 @@ TEST(BankCli, TagAndExport) {
   r = RunSpritestation("bank export " + path + " --out " + out + " --json");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_EQ(nlohmann::json::parse(r.output)["sprites"], 12);
-  const cv::Mat png = cv::imread(out + "/sprite_" + std::to_string(sprite) + ".png", cv::IMREAD_UNCHANGED);
+  const cv::Mat png =
+      cv::imread(out + "/sprite_" + std::to_string(sprite) + ".png", cv::IMREAD_UNCHANGED);
   EXPECT_TRUE(SameMat(png, Bank(path).LoadPixels(sprite).bgra));
   std::ifstream csv(out + "/sprites.csv");
   int lines = 0;
@@ -123,20 +123,24 @@ TEST(BankCli, EveryCommandRefusesFilesThatAreNotBanksAndChangesNothing) {
   for (const std::string& path : {empty, newer, text}) {
     SCOPED_TRACE(path);
     const std::string before = FileBytesOf(path);
-    for (const std::string& command : {"bank info " + path + " --json", "bank verify " + path + " --json",
-                                       "bank tag " + path + " --sprites 1 --tag hero",
-                                       "bank export " + path + " --out " + (dir / "out") + " --json"}) {
+    for (const std::string& command :
+         {"bank info " + path + " --json", "bank verify " + path + " --json",
+          "bank tag " + path + " --sprites 1 --tag hero",
+          "bank export " + path + " --out " + (dir / "out") + " --json"}) {
       const auto r = RunSpritestation(command);
       EXPECT_EQ(r.exit_code, 2) << command << "\n" << r.output;
-      EXPECT_NE(r.output.find("spritestation: error: " + path + ": "), std::string::npos) << command << "\n"
-                                                                                           << r.output;
+      EXPECT_NE(r.output.find("spritestation: error: " + path + ": "), std::string::npos)
+          << command << "\n"
+          << r.output;
     }
-    EXPECT_EQ(FileBytesOf(path), before) << "the file was changed";  // an empty file did not become a bank
+    EXPECT_EQ(FileBytesOf(path), before)
+        << "the file was changed";  // an empty file did not become a bank
   }
   EXPECT_FALSE(std::filesystem::exists((dir / "out") + "/sprites.csv"));
   const auto r = RunSpritestation("bank info " + (dir / "missing.db"));
   EXPECT_EQ(r.exit_code, 2) << r.output;
-  EXPECT_NE(r.output.find((dir / "missing.db") + ": no such sprite bank"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find((dir / "missing.db") + ": no such sprite bank"), std::string::npos)
+      << r.output;
   EXPECT_FALSE(std::filesystem::exists(dir / "missing.db"));
 }
 
@@ -167,17 +171,20 @@ TEST(BankCli, TagRemoveAndJson) {
   ScratchDir dir;
   const std::string path = dir / "bank.db";
   const int64_t sprite = SmallBank(path);
-  auto r = RunSpritestation("bank tag " + path + " --sprites " + std::to_string(sprite) + " --tag walk --json");
+  auto r = RunSpritestation("bank tag " + path + " --sprites " + std::to_string(sprite) +
+                            " --tag walk --json");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   auto j = JsonIn(r.output);
   EXPECT_EQ(j["sprites_with_tag"], 1);
   EXPECT_EQ(Bank(path).LoadSprite(sprite).tags, std::vector<std::string>{"walk"});
-  r = RunSpritestation("bank tag " + path + " --sprites " + std::to_string(sprite) + " --tag walk --remove --json");
+  r = RunSpritestation("bank tag " + path + " --sprites " + std::to_string(sprite) +
+                       " --tag walk --remove --json");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_EQ(JsonIn(r.output)["sprites_with_tag"], 0);
   EXPECT_TRUE(Bank(path).LoadSprite(sprite).tags.empty());
   // An unknown id rejects the whole call: the known one is not tagged either.
-  r = RunSpritestation("bank tag " + path + " --sprites " + std::to_string(sprite) + ",4242 --tag walk");
+  r = RunSpritestation("bank tag " + path + " --sprites " + std::to_string(sprite) +
+                       ",4242 --tag walk");
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_NE(r.output.find(path + ": no sprite with id 4242"), std::string::npos) << r.output;
   EXPECT_TRUE(Bank(path).SpritesTagged("walk").empty());
@@ -186,10 +193,10 @@ TEST(BankCli, TagRemoveAndJson) {
   r = RunSpritestation("bank export " + path + " --out " + (dir / "hero") + " --tag hero --json");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_EQ(JsonIn(r.output)["sprites"], 1);
-  EXPECT_TRUE(std::filesystem::exists((dir / "hero") + "/sprite_" + std::to_string(sprite) + ".png"));
+  EXPECT_TRUE(
+      std::filesystem::exists((dir / "hero") + "/sprite_" + std::to_string(sprite) + ".png"));
   EXPECT_TRUE(VerifyBank(path).ok());
 }
 
 }  // namespace
 }  // namespace ss
-

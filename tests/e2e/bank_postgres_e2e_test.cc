@@ -25,9 +25,10 @@ TEST(BankPostgresCli, IngestTransitionsAndCopyGiveTheSameBankAsAFile) {
   PostgresServer server;
   ASSERT_TRUE(server.ok());
   ScratchDir dir;
-  const auto synth = RunSpritestation("synth --out " + dir / "session" +
-                                      " --kind animal --seconds 5 --fps 30 --size 480x360 --cameras 1 --subjects 1 "
-                                      "--seed 5");
+  const auto synth = RunSpritestation(
+      "synth --out " + dir / "session" +
+      " --kind animal --seconds 5 --fps 30 --size 480x360 --cameras 1 --subjects 1 "
+      "--seed 5");
   ASSERT_EQ(synth.exit_code, 0) << synth.output;
   const std::string file = dir / "bank.db", back = dir / "back.db";
   const std::string pg = server.CreateDatabase("studio");
@@ -41,8 +42,8 @@ TEST(BankPostgresCli, IngestTransitionsAndCopyGiveTheSameBankAsAFile) {
   ASSERT_GT(a["transitions_stored"].get<int>(), 0);
 
   const nlohmann::json fa = Json("bank info " + file), fb = Json("bank info " + pg);
-  for (const char* key : {"sessions", "cameras", "clips_complete", "sprites", "mirrors", "pixel_rows", "pixel_bytes",
-                          "transitions"}) {
+  for (const char* key : {"sessions", "cameras", "clips_complete", "sprites", "mirrors",
+                          "pixel_rows", "pixel_bytes", "transitions"}) {
     EXPECT_EQ(fb[key], fa[key]) << key;
   }
   // A full rebuild of the transitions from the PostgreSQL bank finds the same table.

@@ -57,8 +57,9 @@ class CalibrateEndToEnd : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     dir_ = new ScratchDir();
-    const auto r = RunSpritestation("--log-level warn synth --out " + *dir_ / "session" +
-                                    " --kind calibration --seconds 24 --fps 3 --size 640x480 --cameras 1 --seed 5");
+    const auto r = RunSpritestation(
+        "--log-level warn synth --out " + *dir_ / "session" +
+        " --kind calibration --seconds 24 --fps 3 --size 640x480 --cameras 1 --seed 5");
     ASSERT_EQ(r.exit_code, 0) << r.output;
   }
   static void TearDownTestSuite() { delete dir_; }
@@ -69,9 +70,10 @@ ScratchDir* CalibrateEndToEnd::dir_ = nullptr;
 TEST_F(CalibrateEndToEnd, IntrinsicsThenGroundMatchTheTruth) {
   const std::string session = *dir_ / "session";
   const CameraModel truth = CameraModel::Read(session + "/truth/cam0.cameramodel");
-  const auto r = RunSpritestation("--log-level warn calibrate intrinsics " + session + " --board " + kBoard +
-                                  " --camera cam0 --first 0 --count " + std::to_string(kChessFrames) +
-                                  " --every 1 --min-views 8 --out " + *dir_ / "intrinsics" + " --json");
+  const auto r =
+      RunSpritestation("--log-level warn calibrate intrinsics " + session + " --board " + kBoard +
+                       " --camera cam0 --first 0 --count " + std::to_string(kChessFrames) +
+                       " --every 1 --min-views 8 --out " + *dir_ / "intrinsics" + " --json");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const nlohmann::json j = JsonInOutput(r.output);
   ASSERT_TRUE(j.is_object()) << r.output;
@@ -86,10 +88,10 @@ TEST_F(CalibrateEndToEnd, IntrinsicsThenGroundMatchTheTruth) {
   EXPECT_TRUE(std::filesystem::exists(*dir_ / "intrinsics/cam0.coverage.png"));
 
   // The chessboard lies on the floor with its frame at (-W/2, H/2, 1 mm), face up.
-  const auto g = RunSpritestation("--log-level warn calibrate ground " + session + " --board " + kBoard +
-                                  " --first " + std::to_string(kFloorFirst) + " --models " + *dir_ / "intrinsics" +
-                                  " --board-pose -0.15 0.105 0 --board-thickness 0.001 --out " + *dir_ / "ground" +
-                                  " --json");
+  const auto g = RunSpritestation(
+      "--log-level warn calibrate ground " + session + " --board " + kBoard + " --first " +
+      std::to_string(kFloorFirst) + " --models " + *dir_ / "intrinsics" +
+      " --board-pose -0.15 0.105 0 --board-thickness 0.001 --out " + *dir_ / "ground" + " --json");
   ASSERT_EQ(g.exit_code, 0) << g.output;
   const CameraModel posed = CameraModel::Read(*dir_ / "ground/cam0.cameramodel");
   EXPECT_EQ(posed.intrinsics(), solved.intrinsics());
@@ -97,13 +99,16 @@ TEST_F(CalibrateEndToEnd, IntrinsicsThenGroundMatchTheTruth) {
   // images: issue 6's 2 mm / 0.1 deg (measured 1.75 mm, 0.062 deg; seed 5).
   EXPECT_LT((posed.CentreInGround() - truth.CentreInGround()).norm(), 0.002);
   const double angle = Eigen::AngleAxisd(posed.cam_from_ground().rotation *
-                                         truth.cam_from_ground().rotation.transpose()).angle() * 180 / M_PI;
+                                         truth.cam_from_ground().rotation.transpose())
+                           .angle() *
+                       180 / M_PI;
   EXPECT_LT(angle, 0.1);
 }
 
 TEST_F(CalibrateEndToEnd, AWrongBoardSpecGivesAClearError) {
   const auto r = RunSpritestation("--log-level warn calibrate intrinsics " + *dir_ / "session" +
-                                  " --board chessboard:12x9:0.03 --camera cam0 --count 10 --out " + *dir_ / "wrong");
+                                  " --board chessboard:12x9:0.03 --camera cam0 --count 10 --out " +
+                                  *dir_ / "wrong");
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_NE(r.output.find("no board"), std::string::npos) << r.output;
   EXPECT_FALSE(std::filesystem::exists(*dir_ / "wrong/cam0.cameramodel"));
@@ -115,8 +120,8 @@ TEST_F(CalibrateEndToEnd, UnreadableImagesAreNamedAndGiveNoModel) {
   for (const char* name : {"a.png", "b.png"}) {
     std::ofstream(images + "/" + name) << "not an image";
   }
-  const auto r = RunSpritestation("--log-level warn calibrate intrinsics " + images + " --board " + kBoard +
-                                  " --out " + *dir_ / "garbage_out");
+  const auto r = RunSpritestation("--log-level warn calibrate intrinsics " + images + " --board " +
+                                  kBoard + " --out " + *dir_ / "garbage_out");
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_NE(r.output.find("could be read"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("a.png"), std::string::npos) << r.output;
@@ -124,8 +129,9 @@ TEST_F(CalibrateEndToEnd, UnreadableImagesAreNamedAndGiveNoModel) {
 }
 
 TEST_F(CalibrateEndToEnd, TooFewViewsGiveAVerdictAndNoModel) {
-  const auto r = RunSpritestation("--log-level warn calibrate intrinsics " + *dir_ / "session" + " --board " + kBoard +
-                                  " --camera cam0 --first 0 --count 4 --every 1 --out " + *dir_ / "few" + " --json");
+  const auto r = RunSpritestation(
+      "--log-level warn calibrate intrinsics " + *dir_ / "session" + " --board " + kBoard +
+      " --camera cam0 --first 0 --count 4 --every 1 --out " + *dir_ / "few" + " --json");
   EXPECT_EQ(r.exit_code, 1) << r.output;
   EXPECT_NE(r.output.find("too few views"), std::string::npos) << r.output;
   EXPECT_FALSE(std::filesystem::exists(*dir_ / "few/cam0.cameramodel"));
@@ -134,11 +140,13 @@ TEST_F(CalibrateEndToEnd, TooFewViewsGiveAVerdictAndNoModel) {
 TEST_F(CalibrateEndToEnd, CharucoIntrinsicsMatchTheTruth) {
   const std::string session = *dir_ / "session";
   const CameraModel truth = CameraModel::Read(session + "/truth/cam0.cameramodel");
-  // The director's ChArUco segment covers less of the image than the chessboard's: 43% of the cells.
-  const auto r = RunSpritestation("--log-level warn calibrate intrinsics " + session + " --board " + kCharuco +
-                                  " --camera cam0 --first " + std::to_string(kCharucoFirst) + " --count " +
-                                  std::to_string(kCharucoFrames) + " --every 1 --min-views 8 --min-coverage 0.35 --out " +
-                                  *dir_ / "charuco" + " --json");
+  // The director's ChArUco segment covers less of the image than the chessboard's: 43% of the
+  // cells.
+  const auto r = RunSpritestation(
+      "--log-level warn calibrate intrinsics " + session + " --board " + kCharuco +
+      " --camera cam0 --first " + std::to_string(kCharucoFirst) + " --count " +
+      std::to_string(kCharucoFrames) + " --every 1 --min-views 8 --min-coverage 0.35 --out " +
+      *dir_ / "charuco" + " --json");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const nlohmann::json j = JsonInOutput(r.output);
   ASSERT_TRUE(j.is_object()) << r.output;
@@ -156,27 +164,33 @@ TEST_F(CalibrateEndToEnd, CharucoIntrinsicsMatchTheTruth) {
 // must agree with mrcal-calibrate-cameras within mrcal's reported uncertainty.
 TEST_F(CalibrateEndToEnd, AgreesWithMrcalCalibrateCameras) {
   for (const char* path : {"/usr/bin/mrcal-calibrate-cameras", "/usr/bin/python3"}) {
-    if (!std::filesystem::exists(path)) GTEST_SKIP() << path << " is missing (Debian package mrcal)";
+    if (!std::filesystem::exists(path))
+      GTEST_SKIP() << path << " is missing (Debian package mrcal)";
   }
   if (Shell("/usr/bin/python3 -c 'import mrcal'").exit_code != 0) {
     GTEST_SKIP() << "/usr/bin/python3 cannot import mrcal (Debian package python3-mrcal)";
   }
   const std::string session = *dir_ / "session";
   const std::string out = *dir_ / "vs_mrcal";
-  const auto r = RunSpritestation("--log-level warn calibrate intrinsics " + session + " --board " + kBoard +
-                                  " --camera cam0 --first 0 --count " + std::to_string(kChessFrames) +
-                                  " --every 2 --min-views 8 --min-coverage 0.4 --out " + out + " --json");
+  const auto r =
+      RunSpritestation("--log-level warn calibrate intrinsics " + session + " --board " + kBoard +
+                       " --camera cam0 --first 0 --count " + std::to_string(kChessFrames) +
+                       " --every 2 --min-views 8 --min-coverage 0.4 --out " + out + " --json");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const nlohmann::json j = JsonInOutput(r.output);
   ASSERT_TRUE(j.is_object()) << r.output;
   ASSERT_TRUE(std::filesystem::exists(out + "/corners.vnl"));
   // mrcal seeds itself from a rough focal length, not from our answer.
-  const auto m = Shell("mkdir -p " + out + "/mrcal && /usr/bin/python3 /usr/bin/mrcal-calibrate-cameras --corners-cache " +
-                       out + "/corners.vnl --lensmodel LENSMODEL_OPENCV8 --focal 450 --object-spacing 0.03 "
-                       "--object-width-n 9 --object-height-n 6 --imagersize 640 480 --outdir " + out + "/mrcal 'cam0-frame*.png'");
+  const auto m =
+      Shell("mkdir -p " + out +
+            "/mrcal && /usr/bin/python3 /usr/bin/mrcal-calibrate-cameras --corners-cache " + out +
+            "/corners.vnl --lensmodel LENSMODEL_OPENCV8 --focal 450 --object-spacing 0.03 "
+            "--object-width-n 9 --object-height-n 6 --imagersize 640 480 --outdir " +
+            out + "/mrcal 'cam0-frame*.png'");
   ASSERT_EQ(m.exit_code, 0) << m.output;
   const CameraModel ours = CameraModel::Read(out + "/cam0.cameramodel");
-  const CameraModel theirs = CameraModel::Read(out + "/mrcal/camera-0.cameramodel");  // through libmrcal
+  const CameraModel theirs =
+      CameraModel::Read(out + "/mrcal/camera-0.cameramodel");  // through libmrcal
   const CameraModel truth = CameraModel::Read(session + "/truth/cam0.cameramodel");
   ASSERT_EQ(theirs.lensmodel(), ours.lensmodel());
 
@@ -188,8 +202,9 @@ TEST_F(CalibrateEndToEnd, AgreesWithMrcalCalibrateCameras) {
     for (double v : {0.1, 0.5, 0.9}) grid.emplace_back(639 * u, 479 * v);
   }
   for (const auto& q : grid) pixels << q.x() << "," << q.y() << " ";
-  const auto u = Shell("/usr/bin/python3 " + testing::SourcePath("tests/e2e/mrcal_uncertainty.py") + " " + out +
-                       "/mrcal/camera-0.cameramodel " + std::to_string(distance) + " '" + pixels.str() + "'");
+  const auto u = Shell("/usr/bin/python3 " + testing::SourcePath("tests/e2e/mrcal_uncertainty.py") +
+                       " " + out + "/mrcal/camera-0.cameramodel " + std::to_string(distance) +
+                       " '" + pixels.str() + "'");
   ASSERT_EQ(u.exit_code, 0) << u.output;
   const nlohmann::json unc = JsonInOutput(u.output);
   ASSERT_TRUE(unc.is_object()) << u.output;
@@ -199,9 +214,11 @@ TEST_F(CalibrateEndToEnd, AgreesWithMrcalCalibrateCameras) {
     const double sigma = unc["intrinsics_stdev"][i].get<double>();
     const double ours_sigma = j["cameras"][0]["parameters"][i]["stdev"].get<double>();
     const double diff = ours.intrinsics()[i] - theirs.intrinsics()[i];
-    std::printf("%s: ours %.4f +- %.4f, mrcal %.4f +- %.4f, truth %.4f; ours - mrcal = %.2e px = %.2e sigma\n",
-                names[i], ours.intrinsics()[i], ours_sigma, theirs.intrinsics()[i], sigma, truth.intrinsics()[i], diff,
-                diff / sigma);
+    std::printf(
+        "%s: ours %.4f +- %.4f, mrcal %.4f +- %.4f, truth %.4f; ours - mrcal = %.2e px = %.2e "
+        "sigma\n",
+        names[i], ours.intrinsics()[i], ours_sigma, theirs.intrinsics()[i], sigma,
+        truth.intrinsics()[i], diff, diff / sigma);
     // Same corners, same model, same solver stages: the same optimum (measured 1e-7 px).
     EXPECT_LT(std::abs(diff), 0.1 * sigma) << names[i];
     // Our covariance (numerical Jacobian) against mrcal's (analytic): the same size.
@@ -215,14 +232,14 @@ TEST_F(CalibrateEndToEnd, AgreesWithMrcalCalibrateCameras) {
     const double stdev = unc["projection"][k]["stdev_px"].get<double>();
     const Eigen::Vector3d p = ours.Unproject(grid[k]).normalized() * distance;
     const double diff = (theirs.Project(p) - grid[k]).norm();
-    std::printf("pixel (%.0f, %.0f): |ours - mrcal| %.2e px, mrcal projection stdev %.4f px\n", grid[k].x(),
-                grid[k].y(), diff, stdev);
+    std::printf("pixel (%.0f, %.0f): |ours - mrcal| %.2e px, mrcal projection stdev %.4f px\n",
+                grid[k].x(), grid[k].y(), diff, stdev);
     EXPECT_LT(diff, stdev) << grid[k].transpose();
   }
   const double centre_ours = j["cameras"][0]["projection_stdev_px"]["centre"].get<double>();
   const double centre_theirs = unc["projection"][4]["stdev_px"].get<double>();
-  std::printf("projection stdev at the centre, %.3f m: ours %.4f px, mrcal %.4f px\n", distance, centre_ours,
-              centre_theirs);
+  std::printf("projection stdev at the centre, %.3f m: ours %.4f px, mrcal %.4f px\n", distance,
+              centre_ours, centre_theirs);
   EXPECT_NEAR(centre_ours, centre_theirs, 0.3 * centre_theirs);
 }
 

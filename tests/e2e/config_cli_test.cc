@@ -14,7 +14,8 @@ namespace fs = std::filesystem;
 using ss::testing::ScratchDir;
 
 const std::string kExample = fs::path(ss::testing::SourcePath("docs/station.example.yaml"));
-const std::string kOneCamera = "cameras:\n  - name: cam0\n    source: v4l2\n    device: /dev/video0\n";
+const std::string kOneCamera =
+    "cameras:\n  - name: cam0\n    source: v4l2\n    device: /dev/video0\n";
 
 // `spritestation config check`: exit codes and messages of the real executable.
 TEST(StationConfig, CheckCommand) {
@@ -54,12 +55,18 @@ TEST(StationConfig, OversizedFilesAreRefusedWithExitCode2) {
   }
   auto r = ss::testing::RunSpritestation("config check " + config);
   EXPECT_EQ(r.exit_code, 2) << r.output;
-  EXPECT_NE(r.output.find(config + ": 238.4 MiB (250000000 bytes): larger than the 16 MiB a config file may be"),
-            std::string::npos) << r.output;
+  EXPECT_NE(
+      r.output.find(config +
+                    ": 238.4 MiB (250000000 bytes): larger than the 16 MiB a config file may be"),
+      std::string::npos)
+      << r.output;
   r = ss::testing::RunSpritestation("animate " + spec + " --out " + (dir / "out.json"));
   EXPECT_EQ(r.exit_code, 2) << r.output;
-  EXPECT_NE(r.output.find(spec + ": 238.4 MiB (250000000 bytes): larger than the 16 MiB an animation spec may be"),
-            std::string::npos) << r.output;
+  EXPECT_NE(
+      r.output.find(
+          spec + ": 238.4 MiB (250000000 bytes): larger than the 16 MiB an animation spec may be"),
+      std::string::npos)
+      << r.output;
 }
 
 }  // namespace

@@ -19,8 +19,9 @@ class IngestEndToEnd : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     dir_ = new ScratchDir();
-    const auto r = RunSpritestation("synth --out " + *dir_ / "session" +
-                                    " --kind animal --seconds 6 --fps 30 --size 480x360 --cameras 2 --subjects 1 --seed 11");
+    const auto r = RunSpritestation(
+        "synth --out " + *dir_ / "session" +
+        " --kind animal --seconds 6 --fps 30 --size 480x360 --cameras 2 --subjects 1 --seed 11");
     ASSERT_EQ(r.exit_code, 0) << r.output;
   }
   static void TearDownTestSuite() { delete dir_; }
@@ -30,15 +31,17 @@ ScratchDir* IngestEndToEnd::dir_ = nullptr;
 
 TEST_F(IngestEndToEnd, KeepsUsableSpritesAndCountsEveryDiscard) {
   const std::string bank = *dir_ / "a.bank";
-  const auto r = RunSpritestation("--log-level warn ingest " + *dir_ / "session" + " --bank " + bank + " --json");
+  const auto r = RunSpritestation("--log-level warn ingest " + *dir_ / "session" + " --bank " +
+                                  bank + " --json");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const nlohmann::json j = JsonInOutput(r.output);
   ASSERT_TRUE(j.is_object()) << r.output;
   EXPECT_EQ(j["frames"].get<int>(), 2 * 6 * 30);
   EXPECT_GT(j["sprites_kept"].get<int>(), 30) << r.output;
-  EXPECT_EQ(j["rows_inserted"].get<int>(), 2 * j["sprites_kept"].get<int>());  // each with its mirror
-  for (const char* reason : {"too_small", "touches_border", "no_ground_hit", "leaves_floor", "touches_wall", "noise",
-                             "still", "short_clip"}) {
+  EXPECT_EQ(j["rows_inserted"].get<int>(),
+            2 * j["sprites_kept"].get<int>());  // each with its mirror
+  for (const char* reason : {"too_small", "touches_border", "no_ground_hit", "leaves_floor",
+                             "touches_wall", "noise", "still", "short_clip"}) {
     EXPECT_TRUE(j["discards"].contains(reason)) << reason;
   }
   ASSERT_EQ(j["cameras"].size(), 2u);
@@ -54,18 +57,21 @@ TEST_F(IngestEndToEnd, KeepsUsableSpritesAndCountsEveryDiscard) {
 
 TEST_F(IngestEndToEnd, IngestingTwiceStoresNothingNew) {
   const std::string bank = *dir_ / "b.bank";
-  const std::string cmd = "--log-level warn ingest " + *dir_ / "session" + " --bank " + bank + " --json";
+  const std::string cmd =
+      "--log-level warn ingest " + *dir_ / "session" + " --bank " + bank + " --json";
   const auto first = RunSpritestation(cmd);
   ASSERT_EQ(first.exit_code, 0) << first.output;
   const auto second = RunSpritestation(cmd);
   ASSERT_EQ(second.exit_code, 0) << second.output;
   EXPECT_GT(JsonInOutput(first.output)["rows_inserted"].get<int>(), 0);
   EXPECT_EQ(JsonInOutput(second.output)["rows_inserted"].get<int>(), 0);
-  EXPECT_EQ(JsonInOutput(second.output)["sprites_kept"], JsonInOutput(first.output)["sprites_kept"]);
+  EXPECT_EQ(JsonInOutput(second.output)["sprites_kept"],
+            JsonInOutput(first.output)["sprites_kept"]);
 }
 
 TEST_F(IngestEndToEnd, BadInputNamesTheFile) {
-  const auto missing = RunSpritestation("ingest " + *dir_ / "nowhere" + " --bank " + *dir_ / "c.bank");
+  const auto missing =
+      RunSpritestation("ingest " + *dir_ / "nowhere" + " --bank " + *dir_ / "c.bank");
   EXPECT_EQ(missing.exit_code, 2) << missing.output;
   EXPECT_NE(missing.output.find("nowhere"), std::string::npos) << missing.output;
   const auto no_bank = RunSpritestation("ingest " + *dir_ / "session");
@@ -77,7 +83,8 @@ TEST_F(IngestEndToEnd, BadInputNamesTheFile) {
 TEST_F(IngestEndToEnd, ADamagedBankIsRefusedAndLeftAsItWas) {
   namespace fs = std::filesystem;
   const std::string bank = *dir_ / "damaged.bank";
-  auto r = RunSpritestation("--log-level warn ingest " + *dir_ / "session" + " --bank " + bank + " --no-transitions");
+  auto r = RunSpritestation("--log-level warn ingest " + *dir_ / "session" + " --bank " + bank +
+                            " --no-transitions");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   ASSERT_GT(fs::file_size(bank), 3 * 4096u);
   {
@@ -87,9 +94,12 @@ TEST_F(IngestEndToEnd, ADamagedBankIsRefusedAndLeftAsItWas) {
     f.write(garbage.data(), static_cast<std::streamsize>(garbage.size()));
   }
   const auto before = testing::RunCommand("md5sum < " + bank);
-  r = RunSpritestation("--log-level warn ingest " + *dir_ / "session" + " --bank " + bank + " --no-transitions");
+  r = RunSpritestation("--log-level warn ingest " + *dir_ / "session" + " --bank " + bank +
+                       " --no-transitions");
   EXPECT_EQ(r.exit_code, 2) << r.output;
-  EXPECT_NE(r.output.find(bank + ": the bank does not pass SQLite's quick check"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find(bank + ": the bank does not pass SQLite's quick check"),
+            std::string::npos)
+      << r.output;
   EXPECT_NE(r.output.find("bank verify"), std::string::npos) << r.output;
   EXPECT_EQ(testing::RunCommand("md5sum < " + bank).output, before.output);
 }
@@ -105,9 +115,11 @@ TEST_F(IngestEndToEnd, ACameraThatCannotBeReadIsAFailureNamedAfterTheRest) {
     video << "this is not a Matroska file";
   }
   const std::string bank = *dir_ / "damaged.bank";
-  const auto r = RunSpritestation("--log-level warn ingest " + damaged.string() + " --bank " + bank + " --json");
+  const auto r = RunSpritestation("--log-level warn ingest " + damaged.string() + " --bank " +
+                                  bank + " --json");
   EXPECT_EQ(r.exit_code, 1) << r.output;
-  EXPECT_NE(r.output.find("camera cam1: no frame of it could be read"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("camera cam1: no frame of it could be read"), std::string::npos)
+      << r.output;
   const auto j = JsonInOutput(r.output);
   ASSERT_TRUE(j.contains("cameras")) << r.output;
   int64_t kept_cam0 = -1;
@@ -130,8 +142,8 @@ TEST_F(IngestEndToEnd, ATruncatedRecordingIsAFailureNamingTheFileAfterStoringWha
   const fs::path video = damaged / "cam0.mkv";
   fs::resize_file(video, fs::file_size(video) * 7 / 10);
   const std::string bank = *dir_ / "truncated.bank";
-  const auto r = RunSpritestation("--log-level warn ingest " + damaged.string() + " --bank " + bank +
-                                  " --no-transitions --json");
+  const auto r = RunSpritestation("--log-level warn ingest " + damaged.string() + " --bank " +
+                                  bank + " --no-transitions --json");
   EXPECT_EQ(r.exit_code, 1) << r.output;
   EXPECT_NE(r.output.find("camera cam0: "), std::string::npos) << r.output;
   EXPECT_NE(r.output.find(video.string() + ": video ends after "), std::string::npos) << r.output;
@@ -152,7 +164,8 @@ TEST_F(IngestEndToEnd, ATruncatedRecordingIsAFailureNamingTheFileAfterStoringWha
   EXPECT_EQ(j["failed"].size(), 1u) << r.output;
   const auto info = RunSpritestation("--log-level warn bank info " + bank + " --json");
   ASSERT_EQ(info.exit_code, 0) << info.output;
-  EXPECT_EQ(JsonInOutput(info.output)["sprites"].get<int>(), j["rows_inserted"].get<int>()) << info.output;
+  EXPECT_EQ(JsonInOutput(info.output)["sprites"].get<int>(), j["rows_inserted"].get<int>())
+      << info.output;
   EXPECT_GT(j["rows_inserted"].get<int>(), 0) << r.output;
 }
 
@@ -173,10 +186,11 @@ TEST_F(IngestEndToEnd, ACorruptFrameIsAFailureNamingTheFileAndTheFrame) {
     file.write(bytes, sizeof(bytes));
   }
   const std::string bank = *dir_ / "corrupt.bank";
-  const auto r = RunSpritestation("--log-level warn ingest " + damaged.string() + " --bank " + bank +
-                                  " --no-transitions --json");
+  const auto r = RunSpritestation("--log-level warn ingest " + damaged.string() + " --bank " +
+                                  bank + " --no-transitions --json");
   EXPECT_EQ(r.exit_code, 1) << r.output;
-  EXPECT_NE(r.output.find(" of 180 frames could not be read (" + video.string() + ": frame "), std::string::npos)
+  EXPECT_NE(r.output.find(" of 180 frames could not be read (" + video.string() + ": frame "),
+            std::string::npos)
       << r.output;
   const auto j = JsonInOutput(r.output);
   ASSERT_TRUE(j.contains("cameras")) << r.output;
@@ -199,10 +213,12 @@ TEST_F(IngestEndToEnd, ACorruptFrameIsAFailureNamingTheFileAndTheFrame) {
 // same bank as with the decoder threads.
 TEST(IngestCodecs, FfvhuffAndFfv1GiveTheSameBankWithAnyNumberOfDecoders) {
   ScratchDir dir;
-  const std::string common = " --kind animal --seconds 5 --fps 10 --size 1920x1080 --cameras 1 --subjects 1 --seed 4"
-                             " --empty-lead-in 3 --no-mattes --noise 1";
+  const std::string common =
+      " --kind animal --seconds 5 --fps 10 --size 1920x1080 --cameras 1 --subjects 1 --seed 4"
+      " --empty-lead-in 3 --no-mattes --noise 1";
   for (const std::string codec : {"ffv1", "ffvhuff"}) {
-    const auto r = RunSpritestation("--log-level warn synth --out " + dir / codec + common + " --codec " + codec);
+    const auto r = RunSpritestation("--log-level warn synth --out " + dir / codec + common +
+                                    " --codec " + codec);
     ASSERT_EQ(r.exit_code, 0) << r.output;
   }
   struct Run {
@@ -222,18 +238,19 @@ TEST(IngestCodecs, FfvhuffAndFfv1GiveTheSameBankWithAnyNumberOfDecoders) {
     ASSERT_TRUE(j.is_object()) << r.output;
     EXPECT_GT(j["sprites_kept"].get<int>(), 5) << run.codec << ": " << r.output;
     // Every stored number and every billboard's bytes, in order.
-    r = testing::RunCommand("sqlite3 -readonly " + bank +
-                            " \"SELECT s.frame, s.track_id, s.mirrored, s.ground_x_m, s.ground_y_m, s.mean_r, s.mean_g,"
-                            " s.mean_b, s.area_px, s.bbox_x, s.bbox_y, s.bbox_w, s.bbox_h, hex(p.data)"
-                            " FROM sprites s JOIN sprite_pixels p ON p.sprite_id = s.id ORDER BY s.id\"");
+    r = testing::RunCommand(
+        "sqlite3 -readonly " + bank +
+        " \"SELECT s.frame, s.track_id, s.mirrored, s.ground_x_m, s.ground_y_m, s.mean_r, s.mean_g,"
+        " s.mean_b, s.area_px, s.bbox_x, s.bbox_y, s.bbox_w, s.bbox_h, hex(p.data)"
+        " FROM sprites s JOIN sprite_pixels p ON p.sprite_id = s.id ORDER BY s.id\"");
     ASSERT_EQ(r.exit_code, 0) << r.output;
     digest[index++] = r.output;
   }
   EXPECT_FALSE(digest[0].empty());
   for (int i = 1; i < 4; ++i) {
-    EXPECT_TRUE(digest[0] == digest[i]) << runs[i].codec << " with --decode-threads " << runs[i].decoders
-                                        << ": the banks differ (" << digest[0].size() << " vs " << digest[i].size()
-                                        << " bytes of rows)";
+    EXPECT_TRUE(digest[0] == digest[i])
+        << runs[i].codec << " with --decode-threads " << runs[i].decoders << ": the banks differ ("
+        << digest[0].size() << " vs " << digest[i].size() << " bytes of rows)";
   }
 }
 

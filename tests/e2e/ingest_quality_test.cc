@@ -39,14 +39,14 @@ using testing::RunSpritestation;
 using testing::ScratchDir;
 
 // The station config's defaults (core/config.h PipelineConfig, ExtractorOptions).
-constexpr int kBorderMarginPx = 2;     // pipeline.border_margin_px
-constexpr int kExtractMarginPx = 4;    // the extractor's margin around the subject's box
-constexpr double kStillSpeed = 0.05;   // pipeline.still_speed_m_per_s
-constexpr double kMaxStillS = 2.0;     // pipeline.max_still_s
+constexpr int kBorderMarginPx = 2;       // pipeline.border_margin_px
+constexpr int kExtractMarginPx = 4;      // the extractor's margin around the subject's box
+constexpr double kStillSpeed = 0.05;     // pipeline.still_speed_m_per_s
+constexpr double kMaxStillS = 2.0;       // pipeline.max_still_s
 constexpr double kStillJitterM = 0.002;  // StillnessFilter's least distance
 constexpr double kWindowS = 0.5;         // StillnessFilter's window
-constexpr int kMinClipFrames = 5;      // pipeline.min_clip_frames
-constexpr int kFloorMarginPx = 3;      // pipeline.floor_margin_px
+constexpr int kMinClipFrames = 5;        // pipeline.min_clip_frames
+constexpr int kFloorMarginPx = 3;        // pipeline.floor_margin_px
 // The keyed silhouette differs from the true one by a pixel or two: a frame whose true silhouette
 // is within kFloorMarginPx +- kSlackPx of a wall in the image is neither counted as usable nor as
 // seen against a wall.
@@ -54,15 +54,18 @@ constexpr int kSlackPx = 2;
 
 // The session: 2 cameras (1.25-1.7 m from the enclosure's centre), one animal.
 constexpr const char* kSynthArgs =
-    " --kind animal --seconds 7 --fps 30 --size 480x360 --cameras 2 --subjects 1 --seed 5 --threads 2";
+    " --kind animal --seconds 7 --fps 30 --size 480x360 --cameras 2 --subjects 1 --seed 5 "
+    "--threads 2";
 
 // One camera-frame of the subject, as the truth has it.
 struct TruthView {
   bool present = false;
-  bool usable = false;       // on the floor, no wall, no border, fully visible, moving, in a long enough run
+  bool usable =
+      false;  // on the floor, no wall, no border, fully visible, moving, in a long enough run
   bool touches_wall = false;
   bool leaves_floor = false;
-  bool against_wall = false;  // the true silhouette (grown by 1 px) covers image pixels that are not floor
+  bool against_wall =
+      false;  // the true silhouette (grown by 1 px) covers image pixels that are not floor
   double camera_distance_m = 0;  // camera centre to the true contact point, on the floor
   double gx = NAN, gy = NAN;     // the true contact point on the floor
 };
@@ -70,9 +73,12 @@ struct TruthView {
 struct Measured {
   std::vector<double> ground_errors_m;  // kept sprites at 1-2 m from their camera
   int usable_frames = 0, usable_kept = 0;
-  int kept = 0, kept_touching_wall = 0, kept_off_floor = 0, kept_against_wall = 0, kept_unmatched = 0;
+  int kept = 0, kept_touching_wall = 0, kept_off_floor = 0, kept_against_wall = 0,
+      kept_unmatched = 0;
   std::string missed;  // usable camera-frames not in the bank ("cam0:123 ...")
-  double recall() const { return usable_frames ? static_cast<double>(usable_kept) / usable_frames : 0.0; }
+  double recall() const {
+    return usable_frames ? static_cast<double>(usable_kept) / usable_frames : 0.0;
+  }
 };
 
 double Quantile(std::vector<double> v, double q) {
@@ -83,8 +89,9 @@ double Quantile(std::vector<double> v, double q) {
   return i + 1 < v.size() ? v[i] + (at - i) * (v[i + 1] - v[i]) : v[i];
 }
 
-// Frames still for longer than allowed, by the stillness filter's rule (pipeline/filter/usability.h)
-// applied to the true root: still when it moved less than kStillSpeed over the last kWindowS.
+// Frames still for longer than allowed, by the stillness filter's rule
+// (pipeline/filter/usability.h) applied to the true root: still when it moved less than kStillSpeed
+// over the last kWindowS.
 std::vector<bool> StillFrames(const std::vector<testing::CsvRow>& subjects, double fps) {
   std::vector<bool> still(subjects.size(), false);
   const auto stamp = [fps](size_t f) { return std::llround(static_cast<double>(f) * 1e9 / fps); };
@@ -121,7 +128,8 @@ cv::Mat FloorSeen(const CameraModel& model, const GroundPolygon& floor, double w
     for (int x = 0; x < model.width(); ++x) {
       const auto g = IntersectGround(model.RayInGround(Eigen::Vector2d(x, y)));
       if (!g || !floor.Contains(g->head<2>())) continue;
-      const Eigen::Vector3d top = centre + (centre.z() - wall_height_m) / centre.z() * (*g - centre);
+      const Eigen::Vector3d top =
+          centre + (centre.z() - wall_height_m) / centre.z() * (*g - centre);
       if (floor.Contains(top.head<2>())) mask.at<uint8_t>(y, x) = 255;
     }
   }
@@ -132,7 +140,8 @@ cv::Mat FloorSeen(const CameraModel& model, const GroundPolygon& floor, double w
 bool CoversNotFloor(const cv::Mat& alpha, const cv::Mat& floor_seen, int grow_px) {
   cv::Mat solid = alpha > 127;
   if (grow_px > 0) {
-    cv::dilate(solid, solid, cv::getStructuringElement(cv::MORPH_ELLIPSE, {2 * grow_px + 1, 2 * grow_px + 1}));
+    cv::dilate(solid, solid,
+               cv::getStructuringElement(cv::MORPH_ELLIPSE, {2 * grow_px + 1, 2 * grow_px + 1}));
   }
   return cv::countNonZero(solid & (floor_seen == 0)) > 0;
 }
@@ -145,12 +154,14 @@ std::map<std::string, std::vector<TruthView>> ReadTruth(const fs::path& session,
   std::ifstream floor_file(truth / "floor.json");
   const nlohmann::json floor_json = nlohmann::json::parse(floor_file);
   std::vector<Eigen::Vector2d> corners;
-  for (const auto& v : floor_json["polygon"]) corners.emplace_back(v[0].get<double>(), v[1].get<double>());
+  for (const auto& v : floor_json["polygon"])
+    corners.emplace_back(v[0].get<double>(), v[1].get<double>());
   const GroundPolygon floor(corners);
   const double wall_height_m = floor_json["walls"].at(0)["height_m"].get<double>();
   std::map<std::string, std::vector<TruthView>> out;
   for (const char* cam : {"cam0", "cam1"}) {
-    const CameraModel model = CameraModel::Read((truth / (std::string(cam) + ".cameramodel")).string());
+    const CameraModel model =
+        CameraModel::Read((truth / (std::string(cam) + ".cameramodel")).string());
     const Eigen::Vector3d centre = model.CentreInGround();
     const cv::Mat floor_seen = FloorSeen(model, floor, wall_height_m);
     std::vector<TruthView>& views = out[cam];
@@ -168,7 +179,8 @@ std::map<std::string, std::vector<TruthView>> ReadTruth(const fs::path& session,
       t.camera_distance_m = (Eigen::Vector3d(t.gx, t.gy, 0.0) - centre).norm();
       char png[32];
       std::snprintf(png, sizeof(png), "%06zu.png", f);
-      const cv::Mat alpha = cv::imread((truth / cam / "alpha_s0" / png).string(), cv::IMREAD_UNCHANGED);
+      const cv::Mat alpha =
+          cv::imread((truth / cam / "alpha_s0" / png).string(), cv::IMREAD_UNCHANGED);
       t.against_wall = CoversNotFloor(alpha, floor_seen, 1);
       const bool clear_of_walls = !CoversNotFloor(alpha, floor_seen, kFloorMarginPx + kSlackPx);
       const int m = kBorderMarginPx + kExtractMarginPx;
@@ -176,8 +188,8 @@ std::map<std::string, std::vector<TruthView>> ReadTruth(const fs::path& session,
                           Num(v, "box_x") + Num(v, "box_w") <= model.width() - m &&
                           Num(v, "box_y") + Num(v, "box_h") <= model.height() - m;
       const bool unhidden = Num(v, "unoccluded_px") - Num(v, "visible_px") <= 0.5;
-      t.usable = inside && unhidden && clear_of_walls && !t.touches_wall && !t.leaves_floor && !still[f] &&
-                 std::isfinite(t.gx);
+      t.usable = inside && unhidden && clear_of_walls && !t.touches_wall && !t.leaves_floor &&
+                 !still[f] && std::isfinite(t.gx);
     }
     // Runs shorter than a clip cannot be kept (short_clip): not counted as usable.
     for (size_t f = 0; f < views.size();) {
@@ -197,14 +209,15 @@ class IngestQuality : public ::testing::Test {
   static void SetUpTestSuite() {
     dir_ = new ScratchDir();
     const std::string session = *dir_ / "session";
-    // SPRITESTATION_QUALITY_SYNTH replaces the session's options (2 cameras, 1 subject, 30 fps kept)
-    // to measure longer sessions (bench/RESULTS.md, "pipeline quality").
+    // SPRITESTATION_QUALITY_SYNTH replaces the session's options (2 cameras, 1 subject, 30 fps
+    // kept) to measure longer sessions (bench/RESULTS.md, "pipeline quality").
     const char* args = std::getenv("SPRITESTATION_QUALITY_SYNTH");
-    const auto synth = RunSpritestation("--log-level warn synth --out " + session + (args ? args : kSynthArgs));
+    const auto synth =
+        RunSpritestation("--log-level warn synth --out " + session + (args ? args : kSynthArgs));
     ASSERT_EQ(synth.exit_code, 0) << synth.output;
     const std::string bank_path = *dir_ / "q.bank";
-    const auto ingest =
-        RunSpritestation("--log-level warn ingest " + session + " --bank " + bank_path + " --no-transitions --json");
+    const auto ingest = RunSpritestation("--log-level warn ingest " + session + " --bank " +
+                                         bank_path + " --no-transitions --json");
     ASSERT_EQ(ingest.exit_code, 0) << ingest.output;
     summary_ = new nlohmann::json(JsonInOutput(ingest.output));
 
@@ -213,7 +226,8 @@ class IngestQuality : public ::testing::Test {
     std::map<int64_t, std::string> camera_names;
     for (const CameraRecord& c : bank.ListCameras()) camera_names[c.id] = c.name;
     std::map<int64_t, std::string> clip_camera;
-    for (const ClipRecord& c : bank.ListAllClips()) clip_camera[c.id] = camera_names.at(c.camera_id);
+    for (const ClipRecord& c : bank.ListAllClips())
+      clip_camera[c.id] = camera_names.at(c.camera_id);
     measured_ = new Measured();
     Measured& m = *measured_;
     std::set<std::pair<std::string, int64_t>> kept;
@@ -243,11 +257,14 @@ class IngestQuality : public ::testing::Test {
         if (!got) m.missed += " " + cam + ":" + std::to_string(f);
       }
     }
-    std::printf("ingest quality: %zu sprites at 1-2 m, ground error median %.2f mm, p90 %.2f mm, max %.2f mm; "
-                "recall %d/%d = %.4f; kept %d (touching a wall %d, off the floor %d, against a wall %d)\n",
-                m.ground_errors_m.size(), 1e3 * Quantile(m.ground_errors_m, 0.5),
-                1e3 * Quantile(m.ground_errors_m, 0.9), 1e3 * Quantile(m.ground_errors_m, 1.0), m.usable_kept,
-                m.usable_frames, m.recall(), m.kept, m.kept_touching_wall, m.kept_off_floor, m.kept_against_wall);
+    std::printf(
+        "ingest quality: %zu sprites at 1-2 m, ground error median %.2f mm, p90 %.2f mm, max %.2f "
+        "mm; "
+        "recall %d/%d = %.4f; kept %d (touching a wall %d, off the floor %d, against a wall %d)\n",
+        m.ground_errors_m.size(), 1e3 * Quantile(m.ground_errors_m, 0.5),
+        1e3 * Quantile(m.ground_errors_m, 0.9), 1e3 * Quantile(m.ground_errors_m, 1.0),
+        m.usable_kept, m.usable_frames, m.recall(), m.kept, m.kept_touching_wall, m.kept_off_floor,
+        m.kept_against_wall);
     std::printf("usable frames not kept:%s\n", m.missed.c_str());
     std::printf("ingest summary: %s\n", summary_->dump().c_str());
   }
@@ -279,8 +296,8 @@ TEST_F(IngestQuality, KeepsNearlyEveryUsableFrame) {
   const Measured& m = *measured_;
   ASSERT_GE(m.usable_frames, 100) << "the session has too few usable frames to measure recall";
   RecordProperty("recall", std::to_string(m.recall()));
-  EXPECT_GE(m.recall(), 0.98) << m.usable_kept << " of " << m.usable_frames << " usable frames kept; "
-                              << summary_->dump();
+  EXPECT_GE(m.recall(), 0.98) << m.usable_kept << " of " << m.usable_frames
+                              << " usable frames kept; " << summary_->dump();
   // Every candidate here is the hamster: none is keyed background (issue 19's noise rule).
   EXPECT_EQ((*summary_)["discards"]["noise"], 0) << summary_->dump();
 }
@@ -291,7 +308,8 @@ TEST_F(IngestQuality, KeepsNoFrameTouchingAWallOrLeavingTheFloor) {
   ASSERT_GT(m.kept, 0);
   EXPECT_EQ(m.kept_touching_wall, 0);
   EXPECT_EQ(m.kept_off_floor, 0);
-  EXPECT_EQ(m.kept_against_wall, 0) << "kept sprites seen against a wall (or partly behind one) in the image";
+  EXPECT_EQ(m.kept_against_wall, 0)
+      << "kept sprites seen against a wall (or partly behind one) in the image";
   EXPECT_EQ(m.kept_unmatched, 0) << "kept sprites of frames where the truth has no subject";
 }
 

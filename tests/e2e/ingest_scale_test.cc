@@ -31,24 +31,29 @@ class IngestScale : public ::testing::Test {
              {"figure", "--kind figure --seconds 3 --fps 10 --seed 3 --empty-lead-in 0.5"},
              // Long enough for every pose (arms up in M and Y: the least solid mattes).
              {"poses", "--kind figure --seconds 10 --fps 10 --seed 9 --empty-lead-in 0.5"}}) {
-      const auto r = RunSpritestation("--log-level warn synth --out " + *dir_ / name +
-                                      " --size 480x360 --cameras 1 --subjects 1 --no-mattes --threads 2 " + args);
+      const auto r = RunSpritestation(
+          "--log-level warn synth --out " + *dir_ / name +
+          " --size 480x360 --cameras 1 --subjects 1 --no-mattes --threads 2 " + args);
       ASSERT_EQ(r.exit_code, 0) << r.output;
     }
     // The figure session's 5 empty frames teach the keyer (keying.training_frames).
     std::ofstream(*dir_ / "figure.yaml") << "keying:\n  training_frames: 5\n";
     std::ofstream(*dir_ / "figure_noise_off.yaml")
-        << "keying:\n  training_frames: 5\npipeline:\n  noise_min_solidity: 0\n  noise_recover_solidity: 0\n";
-    std::ofstream(*dir_ / "figure800.yaml") << "keying:\n  training_frames: 5\npipeline:\n  px_per_m: 800\n";
+        << "keying:\n  training_frames: 5\npipeline:\n  noise_min_solidity: 0\n  "
+           "noise_recover_solidity: 0\n";
+    std::ofstream(*dir_ / "figure800.yaml")
+        << "keying:\n  training_frames: 5\npipeline:\n  px_per_m: 800\n";
     for (const int px_per_m : {300, 500, 800}) {
       std::ofstream(*dir_ / ("px" + std::to_string(px_per_m) + ".yaml"))
           << "pipeline:\n  px_per_m: " << px_per_m << "\n";
     }
   }
   static void TearDownTestSuite() { delete dir_; }
-  static nlohmann::json Ingest(const std::string& session, const std::string& bank, const std::string& config = "") {
-    const auto r = RunSpritestation("--log-level warn ingest " + *dir_ / session + " --bank " + *dir_ / bank +
-                                    (config.empty() ? "" : " --config " + *dir_ / config) + " --no-transitions --json");
+  static nlohmann::json Ingest(const std::string& session, const std::string& bank,
+                               const std::string& config = "") {
+    const auto r = RunSpritestation(
+        "--log-level warn ingest " + *dir_ / session + " --bank " + *dir_ / bank +
+        (config.empty() ? "" : " --config " + *dir_ / config) + " --no-transitions --json");
     EXPECT_EQ(r.exit_code, 0) << r.output;
     return JsonInOutput(r.output);
   }
@@ -62,7 +67,8 @@ double TallestInTruth(const std::string& session) {
   std::string line;
   std::getline(in, line);
   double tallest = 0;
-  while (std::getline(in, line)) tallest = std::max(tallest, std::stod(line.substr(line.rfind(',') + 1)));
+  while (std::getline(in, line))
+    tallest = std::max(tallest, std::stod(line.substr(line.rfind(',') + 1)));
   return tallest;
 }
 
@@ -103,11 +109,13 @@ TEST_F(IngestScale, ANumberOverridesAndTheBankKeepsItsScale) {
   // auto into a bank that holds sprites: the bank's scale.
   const nlohmann::json second = Ingest("figure", "kept.bank", "figure.yaml");
   EXPECT_EQ(second["px_per_m"].get<double>(), 500);
-  EXPECT_NE(second["px_per_m_why"].get<std::string>().find("bank"), std::string::npos) << second["px_per_m_why"];
+  EXPECT_NE(second["px_per_m_why"].get<std::string>().find("bank"), std::string::npos)
+      << second["px_per_m_why"];
   EXPECT_EQ(Bank((*dir_ / "kept.bank")).BillboardScales(), std::vector<double>{500});
   // Another number: refused before anything is stored, naming both scales.
-  const auto refused = RunSpritestation("--log-level warn ingest " + *dir_ / "figure" + " --bank " +
-                                        *dir_ / "kept.bank" + " --config " + *dir_ / "px300.yaml" + " --json");
+  const auto refused =
+      RunSpritestation("--log-level warn ingest " + *dir_ / "figure" + " --bank " +
+                       *dir_ / "kept.bank" + " --config " + *dir_ / "px300.yaml" + " --json");
   EXPECT_EQ(refused.exit_code, 2) << refused.output;
   EXPECT_NE(refused.output.find("pipeline.px_per_m"), std::string::npos) << refused.output;
   EXPECT_NE(refused.output.find("300"), std::string::npos) << refused.output;

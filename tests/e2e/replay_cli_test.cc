@@ -23,7 +23,9 @@ using ss::testing::ScratchDir;
 using ss::testing::TestCamera;
 using ss::testing::TestFrame;
 
-bool Contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+bool Contains(const std::string& text, const std::string& part) {
+  return text.find(part) != std::string::npos;
+}
 
 // The JSON report inside the command's output (stderr's log lines and error come after it).
 nlohmann::json JsonReport(const std::string& output) {
@@ -34,8 +36,8 @@ nlohmann::json JsonReport(const std::string& output) {
 }
 
 // Two cameras with known timing, sequence gaps and recorded drops:
-//   wide: 10 frames every 40 ms from 2 s, sequences 0..4, 7..11 (a gap of 2; drops_before 2 at the 6th)
-//   tele: 5 frames every 100 ms from 2.01 s, sequences 50..54
+//   wide: 10 frames every 40 ms from 2 s, sequences 0..4, 7..11 (a gap of 2; drops_before 2 at the
+//   6th) tele: 5 frames every 100 ms from 2.01 s, sequences 50..54
 // `model` gives `wide` a camera model.
 void RecordKnownSession(const std::string& session, const CameraModel* model) {
   SessionWriter writer(session, "known");
@@ -43,7 +45,9 @@ void RecordKnownSession(const std::string& session, const CameraModel* model) {
   const int tele = writer.AddCamera(TestCamera("tele", PixelFormat::kMono8, 32, 32, 10), nullptr);
   for (int i = 0; i < 10; ++i) {
     const uint64_t seq = static_cast<uint64_t>(i < 5 ? i : i + 2);
-    writer.Write(TestFrame(PixelFormat::kBGR8, 64, 48, wide, seq, 2'000'000'000LL + i * 40'000'000LL), i == 5 ? 2 : 0);
+    writer.Write(
+        TestFrame(PixelFormat::kBGR8, 64, 48, wide, seq, 2'000'000'000LL + i * 40'000'000LL),
+        i == 5 ? 2 : 0);
   }
   for (int i = 0; i < 5; ++i) {
     writer.Write(TestFrame(PixelFormat::kMono8, 32, 32, tele, 50 + static_cast<uint64_t>(i),
@@ -53,7 +57,8 @@ void RecordKnownSession(const std::string& session, const CameraModel* model) {
 }
 
 CameraModel PinholeModel(int width, int height) {
-  return CameraModel("LENSMODEL_PINHOLE", {100, 100, width / 2.0 - 0.5, height / 2.0 - 0.5}, width, height, Rigid3());
+  return CameraModel("LENSMODEL_PINHOLE", {100, 100, width / 2.0 - 0.5, height / 2.0 - 0.5}, width,
+                     height, Rigid3());
 }
 
 TEST(ReplayCli, JsonReportsFramesGapsDropsSpanAndRatePerCamera) {
@@ -125,7 +130,8 @@ TEST(ReplayCli, MissingCameraModelIsNamedAndTheFramesStillReplay) {
   std::filesystem::remove(model_path);
 
   ReplaySource source(session);
-  EXPECT_EQ(source.cameras()[0].model_path, "");  // nobody downstream gets a path that does not load
+  EXPECT_EQ(source.cameras()[0].model_path,
+            "");  // nobody downstream gets a path that does not load
   int frames = 0;
   while (source.Next()) ++frames;
   EXPECT_EQ(frames, 15);
@@ -147,7 +153,8 @@ TEST(ReplayCli, BrokenOrMismatchedCameraModelIsNamed) {
   const CameraModel model = PinholeModel(64, 48);
   RecordKnownSession(session, &model);
   const std::string model_path = session + "/wide.cameramodel";
-  std::ofstream(model_path, std::ios::trunc) << "{ 'lensmodel': 'LENSMODEL_PINHOLE', 'intrinsics': [1, 2";
+  std::ofstream(model_path, std::ios::trunc)
+      << "{ 'lensmodel': 'LENSMODEL_PINHOLE', 'intrinsics': [1, 2";
   auto r = RunSpritestation("replay " + session);
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_TRUE(Contains(r.output, model_path)) << r.output;
@@ -155,7 +162,8 @@ TEST(ReplayCli, BrokenOrMismatchedCameraModelIsNamed) {
   PinholeModel(640, 480).Write(model_path);  // a model of another camera
   ReplaySource source(session);
   EXPECT_EQ(source.stats().errors, 1u);
-  EXPECT_TRUE(Contains(source.stats().last_error, model_path + ": imager is 640x480, the camera records 64x48"))
+  EXPECT_TRUE(Contains(source.stats().last_error,
+                       model_path + ": imager is 640x480, the camera records 64x48"))
       << source.stats().last_error;
 }
 
@@ -183,7 +191,8 @@ TEST(ReplayCli, BadSessionsExitTwoNamingTheFile) {
   std::ofstream(broken + "/session.json", std::ios::trunc) << bad;
   r = RunSpritestation("replay " + broken);
   EXPECT_EQ(r.exit_code, 2) << r.output;
-  EXPECT_TRUE(Contains(r.output, broken + "/session.json: field 'cameras[0].fps': expected a positive number"))
+  EXPECT_TRUE(Contains(
+      r.output, broken + "/session.json: field 'cameras[0].fps': expected a positive number"))
       << r.output;
 
   // A CSV cut in the middle of a row is read up to its last whole row, and the cut is reported.
@@ -192,8 +201,10 @@ TEST(ReplayCli, BadSessionsExitTwoNamingTheFile) {
   const std::string csv = cut + "/tele.frames.csv";
   std::filesystem::resize_file(csv, std::filesystem::file_size(csv) - 5);
   r = RunSpritestation("replay " + cut + " --json");
-  EXPECT_EQ(r.exit_code, 2) << r.output;  // the recording was closed with 5 frames: the CSV lost one
-  EXPECT_TRUE(Contains(r.output, csv + ": lists 4 frames, but the recording was closed with 5")) << r.output;
+  EXPECT_EQ(r.exit_code, 2)
+      << r.output;  // the recording was closed with 5 frames: the CSV lost one
+  EXPECT_TRUE(Contains(r.output, csv + ": lists 4 frames, but the recording was closed with 5"))
+      << r.output;
   const auto j = JsonReport(r.output);
   ASSERT_TRUE(j.is_object()) << r.output;
   EXPECT_EQ(j["cameras"][1]["frames"], 4);

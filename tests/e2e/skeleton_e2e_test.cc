@@ -32,7 +32,9 @@ std::map<int, std::string> PoseLabels(const std::string& session) {
   std::vector<std::string> header;
   std::stringstream hs(line);
   for (std::string c; std::getline(hs, c, ',');) header.push_back(c);
-  const auto col = [&](const std::string& n) { return std::find(header.begin(), header.end(), n) - header.begin(); };
+  const auto col = [&](const std::string& n) {
+    return std::find(header.begin(), header.end(), n) - header.begin();
+  };
   const size_t c_frame = col("frame"), c_subject = col("subject"), c_pose = col("pose");
   std::map<int, std::string> labels;
   while (std::getline(in, line)) {
@@ -57,7 +59,8 @@ std::map<int, std::vector<std::pair<double, double>>> Joints(const nlohmann::jso
   for (const auto& f : sequence["frames"]) {
     auto& joints = out[f["frame"].get<int>()];
     for (const auto& j : f["joints"]) {  // an array, or an object in definition order
-      joints.push_back(j.is_array() ? std::make_pair(j[0].get<double>(), j[1].get<double>()) : std::make_pair(nan, nan));
+      joints.push_back(j.is_array() ? std::make_pair(j[0].get<double>(), j[1].get<double>())
+                                    : std::make_pair(nan, nan));
     }
   }
   return out;
@@ -71,13 +74,15 @@ class SkeletonEndToEnd : public ::testing::Test {
     // Target: the other build (--figure-variant 1) with seed 5, so another timeline.
     // 480x360 at 10 fps keeps the rendering near 15 s on the shared machine (640x480: ~30 s).
     for (const auto& [name, args] : std::vector<std::pair<std::string, std::string>>{
-             {"source", "--seed 3 --seconds 15"}, {"target", "--seed 5 --figure-variant 1 --seconds 12"}}) {
-      const auto r = RunSpritestation("--log-level warn synth --out " + *dir_ / name +
-                                      " --kind figure --size 480x360 --fps 10 --cameras 1 --no-mattes --threads 2 " +
-                                      args);
+             {"source", "--seed 3 --seconds 15"},
+             {"target", "--seed 5 --figure-variant 1 --seconds 12"}}) {
+      const auto r = RunSpritestation(
+          "--log-level warn synth --out " + *dir_ / name +
+          " --kind figure --size 480x360 --fps 10 --cameras 1 --no-mattes --threads 2 " + args);
       ASSERT_EQ(r.exit_code, 0) << r.output;
-      const auto i = RunSpritestation("--log-level warn skeleton import --format synth " + *dir_ / name + " --out " +
-                                      *dir_ / (name + ".skel.json") + " --json");
+      const auto i =
+          RunSpritestation("--log-level warn skeleton import --format synth " + *dir_ / name +
+                           " --out " + *dir_ / (name + ".skel.json") + " --json");
       ASSERT_EQ(i.exit_code, 0) << i.output;
     }
   }
@@ -88,8 +93,9 @@ ScratchDir* SkeletonEndToEnd::dir_ = nullptr;
 
 TEST_F(SkeletonEndToEnd, ImportedTruthMatchesGesturesWithoutLongFreezes) {
   const std::string out = *dir_ / "match.json";
-  const auto r = RunSpritestation("--log-level warn match " + *dir_ / "target.skel.json" + " --source " +
-                                  *dir_ / "source.skel.json" + " --out " + out + " --json");
+  const auto r =
+      RunSpritestation("--log-level warn match " + *dir_ / "target.skel.json" + " --source " +
+                       *dir_ / "source.skel.json" + " --out " + out + " --json");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const nlohmann::json m = ReadJson(out);
   const auto target_labels = PoseLabels(*dir_ / "target");
@@ -123,10 +129,12 @@ TEST_F(SkeletonEndToEnd, ImportedTruthMatchesGesturesWithoutLongFreezes) {
   const Score with = score(m["passes"]["with_penalties"]["frames"]);
   const Score without = score(m["passes"]["without_penalties"]["frames"]);
   const Score refined = score(m["frames"]);
-  std::printf("gesture accuracy without / with penalties / refined: %.3f / %.3f / %.3f (arm gestures Y M C A: "
-              "%.3f / %.3f / %.3f; turn and walk: %.3f / %.3f / %.3f)\n",
-              without.all(), with.all(), refined.all(), without.arms(), with.arms(), refined.arms(),
-              without.moving(), with.moving(), refined.moving());
+  std::printf(
+      "gesture accuracy without / with penalties / refined: %.3f / %.3f / %.3f (arm gestures Y M C "
+      "A: "
+      "%.3f / %.3f / %.3f; turn and walk: %.3f / %.3f / %.3f)\n",
+      without.all(), with.all(), refined.all(), without.arms(), with.arms(), refined.arms(),
+      without.moving(), with.moving(), refined.moving());
   ASSERT_EQ(with.frames, static_cast<int>(target_labels.size()));
   ASSERT_GT(with.arm_frames, 40);
   ASSERT_GT(with.moving_frames, 20);  // turn 17, walk 8 (frames 20-35 and 111-119)
@@ -152,11 +160,13 @@ TEST_F(SkeletonEndToEnd, ImportedTruthMatchesGesturesWithoutLongFreezes) {
   const auto& chosen = m["passes"]["with_penalties"]["frames"];
   int run = 0, longest = 0;
   for (size_t t = 1; t < chosen.size(); ++t) {
-    const bool repeat = chosen[t]["clip"] == chosen[t - 1]["clip"] && chosen[t]["frame"] == chosen[t - 1]["frame"];
+    const bool repeat =
+        chosen[t]["clip"] == chosen[t - 1]["clip"] && chosen[t]["frame"] == chosen[t - 1]["frame"];
     const auto& a = target_joints.at(chosen[t - 1]["target_frame"].get<int>());
     const auto& b = target_joints.at(chosen[t]["target_frame"].get<int>());
     double moved = 0;
-    for (size_t j = 0; j < a.size(); ++j) moved = std::max(moved, std::hypot(a[j].first - b[j].first, a[j].second - b[j].second));
+    for (size_t j = 0; j < a.size(); ++j)
+      moved = std::max(moved, std::hypot(a[j].first - b[j].first, a[j].second - b[j].second));
     run = repeat && moved > 1.0 ? run + 1 : 0;
     longest = std::max(longest, run);
   }
@@ -170,8 +180,9 @@ TEST_F(SkeletonEndToEnd, LucasKanadeTrackingAgainstTruth) {
   nlohmann::json init = ReadJson(*dir_ / "target.skel.json");
   init["frames"] = nlohmann::json::array({init["frames"][0]});
   std::ofstream(*dir_ / "init.json") << init.dump();
-  const auto r = RunSpritestation("--log-level warn skeleton track " + *dir_ / "target" + " --init " +
-                                  *dir_ / "init.json" + " --out " + *dir_ / "tracked.json" + " --json");
+  const auto r =
+      RunSpritestation("--log-level warn skeleton track " + *dir_ / "target" + " --init " +
+                       *dir_ / "init.json" + " --out " + *dir_ / "tracked.json" + " --json");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const auto truth = Joints(ReadJson(*dir_ / "target.skel.json"));
   const auto tracked = Joints(ReadJson(*dir_ / "tracked.json"));
@@ -185,15 +196,18 @@ TEST_F(SkeletonEndToEnd, LucasKanadeTrackingAgainstTruth) {
         ++missing;
         continue;
       }
-      errors.push_back(std::hypot(joints[j].first - want[j].first, joints[j].second - want[j].second));
+      errors.push_back(
+          std::hypot(joints[j].first - want[j].first, joints[j].second - want[j].second));
     }
   }
   ASSERT_FALSE(errors.empty());
   std::sort(errors.begin(), errors.end());
   const double median = errors[errors.size() / 2], p90 = errors[errors.size() * 9 / 10];
-  std::printf("Lucas-Kanade vs truth: median %.2f px, 90th percentile %.2f px over %zu tracked joints; %d of %d "
-              "joint-frames lost (%.0f%%)\n",
-              median, p90, errors.size(), missing, total, 100.0 * missing / total);
+  std::printf(
+      "Lucas-Kanade vs truth: median %.2f px, 90th percentile %.2f px over %zu tracked joints; %d "
+      "of %d "
+      "joint-frames lost (%.0f%%)\n",
+      median, p90, errors.size(), missing, total, 100.0 * missing / total);
   // Measured at 480x360: 0.70 px median, 12.3 px p90, 31 % lost; at 640x480 (same seeds,
   // bench/RESULTS.md): 0.52 / 1.97 px, 36 % lost. Limbs crossing the body in the turns and
   // the fast arm moves at 10 fps fail the forward-backward check or drift.

@@ -14,8 +14,9 @@ using ss::testing::ScratchDir;
 
 TEST(SynthCommand, RendersAndRejectsBadOptions) {
   ScratchDir dir;
-  auto ok = ss::testing::RunSpritestation("synth --out " + (dir / "s") +
-                                          " --seconds 0.5 --fps 10 --size 128x96 --cameras 1 --seed 3 --json");
+  auto ok = ss::testing::RunSpritestation(
+      "synth --out " + (dir / "s") +
+      " --seconds 0.5 --fps 10 --size 128x96 --cameras 1 --seed 3 --json");
   ASSERT_EQ(ok.exit_code, 0) << ok.output;
   const auto start = ok.output.find('{');
   ASSERT_NE(start, std::string::npos) << ok.output;

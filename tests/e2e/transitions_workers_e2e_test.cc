@@ -24,7 +24,6 @@ using testing::QueryInt;
 using testing::RunSpritestation;
 using testing::ScratchDir;
 
-
 void ExpectSameTransitions(const std::string& got_bank, const std::string& want_bank) {
   const auto got = Bank(got_bank).LoadTransitions();
   const auto want = Bank(want_bank).LoadTransitions();
@@ -32,8 +31,8 @@ void ExpectSameTransitions(const std::string& got_bank, const std::string& want_
   ASSERT_EQ(got.size(), want.size());
   size_t differ = 0;
   for (size_t k = 0; k < want.size(); ++k) {
-    if (got[k].from_sprite != want[k].from_sprite || got[k].to_sprite != want[k].to_sprite || got[k].d != want[k].d ||
-        got[k].cost != want[k].cost) {
+    if (got[k].from_sprite != want[k].from_sprite || got[k].to_sprite != want[k].to_sprite ||
+        got[k].d != want[k].d || got[k].cost != want[k].cost) {
       ++differ;
     }
   }
@@ -44,13 +43,14 @@ TEST(TransitionWorkers, TwoWorkersAndAKilledOneMakeTheSingleProcessTable) {
   PostgresServer server;
   ASSERT_TRUE(server.ok());
   ScratchDir dir;
-  const auto synth = RunSpritestation("synth --out " + dir / "session" +
-                                      " --kind animal --seconds 8 --fps 30 --size 480x360 --cameras 2 --subjects 2 "
-                                      "--seed 21");
+  const auto synth = RunSpritestation(
+      "synth --out " + dir / "session" +
+      " --kind animal --seconds 8 --fps 30 --size 480x360 --cameras 2 --subjects 2 "
+      "--seed 21");
   ASSERT_EQ(synth.exit_code, 0) << synth.output;
   const std::string pg = server.CreateDatabase("studio");
-  const auto ingest =
-      RunSpritestation("--log-level warn ingest " + dir / "session" + " --bank " + pg + " --no-transitions --json");
+  const auto ingest = RunSpritestation("--log-level warn ingest " + dir / "session" + " --bank " +
+                                       pg + " --no-transitions --json");
   ASSERT_EQ(ingest.exit_code, 0) << ingest.output;
   // The single-process build, on a copy made before any worker ran.
   const std::string single = dir / "single.db";
@@ -62,14 +62,16 @@ TEST(TransitionWorkers, TwoWorkersAndAKilledOneMakeTheSingleProcessTable) {
 
   // A worker that claims a unit and is killed before it stores anything: its lease (2 s) runs out.
   setenv("SPRITESTATION_WORKER_TEST_PAUSE_S", "60", 1);
-  BackgroundCommand victim("--log-level warn transitions worker --bank " + pg + " --name victim --lease 2",
-                           dir / "victim.log");
+  BackgroundCommand victim(
+      "--log-level warn transitions worker --bank " + pg + " --name victim --lease 2",
+      dir / "victim.log");
   unsetenv("SPRITESTATION_WORKER_TEST_PAUSE_S");
   int64_t claimed = 0;
   for (int i = 0; i < 300 && claimed == 0; ++i) {
     std::this_thread::sleep_for(std::chrono::milliseconds(100));
     // The worker makes its work table when it starts.
-    if (QueryInt(pg, "SELECT count(*) FROM pg_tables WHERE tablename = 'transition_work'") == 0) continue;
+    if (QueryInt(pg, "SELECT count(*) FROM pg_tables WHERE tablename = 'transition_work'") == 0)
+      continue;
     claimed = QueryInt(pg, "SELECT count(*) FROM transition_work WHERE worker = 'victim'");
   }
   ASSERT_EQ(claimed, 1) << victim.output();
@@ -77,16 +79,20 @@ TEST(TransitionWorkers, TwoWorkersAndAKilledOneMakeTheSingleProcessTable) {
   victim.Wait(10);
 
   // Two workers at once do everything, the killed unit included.
-  BackgroundCommand a("--log-level warn transitions worker --bank " + pg + " --name a --exit-when-idle --json",
-                      dir / "a.log");
-  BackgroundCommand b("--log-level warn transitions worker --bank " + pg + " --name b --exit-when-idle --json",
-                      dir / "b.log");
+  BackgroundCommand a(
+      "--log-level warn transitions worker --bank " + pg + " --name a --exit-when-idle --json",
+      dir / "a.log");
+  BackgroundCommand b(
+      "--log-level warn transitions worker --bank " + pg + " --name b --exit-when-idle --json",
+      dir / "b.log");
   ASSERT_EQ(a.Wait(300), 0) << a.output();
   ASSERT_EQ(b.Wait(300), 0) << b.output();
   const nlohmann::json ja = JsonInOutput(a.output()), jb = JsonInOutput(b.output());
-  EXPECT_EQ(ja["units"].get<int64_t>() + jb["units"].get<int64_t>(), clips) << a.output() << b.output();
+  EXPECT_EQ(ja["units"].get<int64_t>() + jb["units"].get<int64_t>(), clips)
+      << a.output() << b.output();
   EXPECT_EQ(QueryInt(pg, "SELECT count(*) FROM transition_work WHERE done = 1"), clips);
-  EXPECT_EQ(QueryInt(pg, "SELECT count(*) FROM transition_work WHERE attempts >= 2"), 1);  // the killed one, redone
+  EXPECT_EQ(QueryInt(pg, "SELECT count(*) FROM transition_work WHERE attempts >= 2"),
+            1);  // the killed one, redone
 
   const std::string shared = dir / "shared.db";
   ASSERT_EQ(RunSpritestation("--log-level warn bank copy " + pg + " " + shared).exit_code, 0);

@@ -7,6 +7,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     ss::ConfigReport report;
     ss::ConfigOptions options;
     options.check_files = false;  // the paths it names need not exist
-    ss::ParseStationConfig(ss::fuzz::Text(data, size), "fuzz.yaml", ss::fuzz::ScratchDir(), &report, options);
+    ss::ParseStationConfig(ss::fuzz::Text(data, size), "fuzz.yaml", ss::fuzz::ScratchDir(), &report,
+                           options);
   });
 }

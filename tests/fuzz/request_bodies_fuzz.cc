@@ -26,16 +26,21 @@ void Route(const std::string& text, std::initializer_list<const char*> fields, F
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::string text = ss::fuzz::Text(data, size);
-  const auto known_camera = [](const std::string& name) { return name == "cam0" || name == "cam1"; };
+  const auto known_camera = [](const std::string& name) {
+    return name == "cam0" || name == "cam1";
+  };
   // session/stop, replay/stop, calibration/cancel, calibration/save, labels/retrain: no members.
   Route(text, {}, [](const nlohmann::json&) {});
-  Route(text, kSessionFields, [&](const nlohmann::json& b) { ParseSessionName(b, false, text.empty()); });  // start
-  Route(text, kSessionFields, [&](const nlohmann::json& b) { ParseSessionName(b, true, text.empty()); });   // rename
+  Route(text, kSessionFields,
+        [&](const nlohmann::json& b) { ParseSessionName(b, false, text.empty()); });  // start
+  Route(text, kSessionFields,
+        [&](const nlohmann::json& b) { ParseSessionName(b, true, text.empty()); });  // rename
   Route(text, kReplayStartFields, [](const nlohmann::json& b) { ParseReplayStart(b); });
   Route(text, kTagFields, [](const nlohmann::json& b) { ParseTag(b); });  // bank/tag, bank/untag
   Route(text, kLabelFields, [](const nlohmann::json& b) { ParseLabel(b); });
   Route(text, kLabelUndoFields, [](const nlohmann::json& b) { ParseLabelUndo(b); });
-  Route(text, kCalibrationStartFields, [&](const nlohmann::json& b) { ParseCalibrationStart(b, known_camera); });
+  Route(text, kCalibrationStartFields,
+        [&](const nlohmann::json& b) { ParseCalibrationStart(b, known_camera); });
   Route(text, kCalibrationDropFields, [](const nlohmann::json& b) { ParseCalibrationDrop(b); });
   Route(text, kCalibrationSolveFields, [](const nlohmann::json& b) { ParseCameraName(b, false); });
   Route(text, kCalibrationRedoFields, [](const nlohmann::json& b) { ParseCalibrationRedo(b); });

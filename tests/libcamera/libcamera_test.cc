@@ -9,11 +9,11 @@
 #include <map>
 #include <string>
 
+#include "capture/camera_source.h"
 #include "capture/libcamera/libcamera_config.h"
 #include "capture/libcamera/libcamera_source.h"
 #include "core/config.h"
 #include "core/error.h"
-#include "capture/camera_source.h"
 #include "tests/support/test_support.h"
 
 namespace ss {

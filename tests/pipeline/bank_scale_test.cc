@@ -11,7 +11,8 @@ namespace ss {
 namespace {
 
 // A pinhole camera at `centre` looking at `target`.
-CameraModel LookAt(const Eigen::Vector3d& centre, const Eigen::Vector3d& target, double f, int width, int height) {
+CameraModel LookAt(const Eigen::Vector3d& centre, const Eigen::Vector3d& target, double f,
+                   int width, int height) {
   const Eigen::Vector3d z = (target - centre).normalized();
   const Eigen::Vector3d x = z.cross(Eigen::Vector3d::UnitZ()).normalized();
   Rigid3 cam_from_ground;
@@ -19,8 +20,8 @@ CameraModel LookAt(const Eigen::Vector3d& centre, const Eigen::Vector3d& target,
   cam_from_ground.rotation.row(1) = z.cross(x);
   cam_from_ground.rotation.row(2) = z;
   cam_from_ground.translation = -(cam_from_ground.rotation * centre);
-  return CameraModel("LENSMODEL_PINHOLE", {f, f, (width - 1) / 2.0, (height - 1) / 2.0}, width, height,
-                     cam_from_ground);
+  return CameraModel("LENSMODEL_PINHOLE", {f, f, (width - 1) / 2.0, (height - 1) / 2.0}, width,
+                     height, cam_from_ground);
 }
 
 // The billboard height of an upright subject `h` metres tall at scale s (Rectifier::Rectify).
@@ -37,7 +38,8 @@ TEST(BankScale, AnAnimalEnclosureGetsItsFinestCamerasResolution) {
   in.models = {&near, &far};
   in.floor = kEnclosure;
   const BankScale s = ChooseBankScale(in);
-  const double finest = std::max(FloorPixelsPerMetre(near, kEnclosure), FloorPixelsPerMetre(far, kEnclosure));
+  const double finest =
+      std::max(FloorPixelsPerMetre(near, kEnclosure), FloorPixelsPerMetre(far, kEnclosure));
   EXPECT_GT(finest, 300);  // f / distance = 400, foreshortened along the view
   EXPECT_LE(s.px_per_m, finest);
   EXPECT_GT(s.px_per_m, 0.95 * finest);  // only rounded down to two digits

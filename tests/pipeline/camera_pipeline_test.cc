@@ -16,7 +16,9 @@ CameraModel DownCamera() {
   return CameraModel("LENSMODEL_PINHOLE", {500, 500, 320, 240}, 640, 480, cam_from_ground);
 }
 
-GroundPolygon Floor() { return GroundPolygon({{-0.3, -0.2}, {0.3, -0.2}, {0.3, 0.2}, {-0.3, 0.2}}); }
+GroundPolygon Floor() {
+  return GroundPolygon({{-0.3, -0.2}, {0.3, -0.2}, {0.3, 0.2}, {-0.3, 0.2}});
+}
 
 // An evenly lit green screen.
 Frame Green(int width, int height, uint64_t sequence) {
@@ -50,8 +52,8 @@ std::string MessageOf(const std::function<void()>& f) {
 }
 
 TEST(CameraPipelineInput, AMissingModelIsRefusedNamingTheCamera) {
-  const std::string message =
-      MessageOf([] { CameraPipeline p("side", 1, CameraModel(), Floor(), CameraPipelineOptions{}); });
+  const std::string message = MessageOf(
+      [] { CameraPipeline p("side", 1, CameraModel(), Floor(), CameraPipelineOptions{}); });
   EXPECT_NE(message.find("side"), std::string::npos) << message;
   EXPECT_NE(message.find("no model"), std::string::npos) << message;
 }

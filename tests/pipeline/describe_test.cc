@@ -14,8 +14,8 @@ namespace {
 TEST(DescribeBillboard, EllipseGivesItsAreaColourAndEccentricity) {
   cv::Mat bgra(200, 300, CV_8UC4, cv::Scalar(0, 0, 0, 0));
   const double a = 80, b = 30;  // semi-axes, pixels; rotated 30 degrees
-  cv::ellipse(bgra, cv::Point(150, 100), cv::Size(static_cast<int>(a), static_cast<int>(b)), 30, 0, 360,
-              cv::Scalar(10, 200, 90, 255), cv::FILLED);
+  cv::ellipse(bgra, cv::Point(150, 100), cv::Size(static_cast<int>(a), static_cast<int>(b)), 30, 0,
+              360, cv::Scalar(10, 200, 90, 255), cv::FILLED);
   const SpriteDescription d = DescribeBillboard(bgra);
   // OpenCV fills every pixel the outline touches: the area of the half-pixel-grown ellipse.
   EXPECT_NEAR(d.area_px, M_PI * (a + 0.5) * (b + 0.5), 0.01 * M_PI * a * b);
@@ -62,7 +62,8 @@ TEST(EstimateVelocities, RecoversAConstantVelocityDespiteUnevenTiming) {
 
 TEST(EstimateVelocities, OneFrameStandsStillAndNoiseIsSmoothed) {
   EXPECT_EQ(EstimateVelocities({5}, {Eigen::Vector2d(1, 1)})[0], Eigen::Vector2d::Zero());
-  // Alternating +-1 mm jitter on a still subject: the 5-frame slope stays far below the jitter's 6 cm/s.
+  // Alternating +-1 mm jitter on a still subject: the 5-frame slope stays far below the jitter's 6
+  // cm/s.
   std::vector<int64_t> t;
   std::vector<Eigen::Vector2d> p;
   for (int i = 0; i < 20; ++i) {

@@ -80,7 +80,8 @@ TEST_F(ExtractorTest, OneSubjectGivesItsBoxAlphaShadowAndLowestPoint) {
   // Box: the true subject (alpha > 0) plus the margin, and the keyed shadow, all inside.
   const cv::Rect truth_box = cv::boundingRect(f.alpha > 0);
   const int m = extractor.options().margin_px;
-  const cv::Rect with_margin(truth_box.x - m, truth_box.y - m, truth_box.width + 2 * m, truth_box.height + 2 * m);
+  const cv::Rect with_margin(truth_box.x - m, truth_box.y - m, truth_box.width + 2 * m,
+                             truth_box.height + 2 * m);
   EXPECT_EQ(c.bbox & with_margin, with_margin) << c.bbox << " should hold " << with_margin;
   const cv::Rect shadow_box = cv::boundingRect(matte_.shadow >= extractor.options().shadow_min);
   ASSERT_FALSE(shadow_box.empty());
@@ -97,7 +98,8 @@ TEST_F(ExtractorTest, OneSubjectGivesItsBoxAlphaShadowAndLowestPoint) {
   // The keyed shadow under the subject is the true darkening.
   const cv::Mat in_shadow = ((f.darkening > 0.15) & (f.alpha == 0))(c.bbox);
   ASSERT_GT(cv::countNonZero(in_shadow), 300);
-  EXPECT_NEAR(cv::mean(c.shadow, in_shadow)[0] / 255, cv::mean(f.darkening(c.bbox), in_shadow)[0], 0.05);
+  EXPECT_NEAR(cv::mean(c.shadow, in_shadow)[0] / 255, cv::mean(f.darkening(c.bbox), in_shadow)[0],
+              0.05);
   // Colour inside the subject is the frame's.
   const cv::Mat inside = (f.alpha >= 1)(c.bbox) & (f.rim == 0)(c.bbox);
   cv::Mat diff;
@@ -114,8 +116,8 @@ TEST_F(ExtractorTest, OneSubjectGivesItsBoxAlphaShadowAndLowestPoint) {
 }
 
 TEST_F(ExtractorTest, SeveralSubjectsEachGetTheirOwnCandidate) {
-  const std::vector<SceneSubject> subjects = {Hamster({130.2, 110.5}), Hamster({470.6, 140.3}, 45, 30),
-                                              Hamster({300.3, 370.8}, 70, 45)};
+  const std::vector<SceneSubject> subjects = {
+      Hamster({130.2, 110.5}), Hamster({470.6, 140.3}, 45, 30), Hamster({300.3, 370.8}, 70, 45)};
   const SceneFrame f = Key(subjects);
   Extractor extractor;
   const std::vector<Candidate>& cands = extractor.Extract(matte_);
@@ -138,17 +140,20 @@ TEST_F(ExtractorTest, OverlappingBoxesDoNotShareSubjects) {
   const std::vector<SceneSubject> subjects = {Hamster({200.3, 180.2}), Hamster({345.7, 262.4})};
   const SceneFrame f = Key(subjects);
   ASSERT_EQ(matte_.regions.size(), 2u) << "the subjects' cells touch: move them apart";
-  ASSERT_TRUE(matte_.regions[0].overlaps_other) << "the boxes do not overlap: move the subjects closer";
+  ASSERT_TRUE(matte_.regions[0].overlaps_other)
+      << "the boxes do not overlap: move the subjects closer";
   Extractor extractor;
   const std::vector<Candidate>& cands = extractor.Extract(matte_);
   ASSERT_EQ(cands.size(), 2u);
   for (size_t i = 0; i < subjects.size(); ++i) {
     const Candidate* c = At(cands, subjects[i].centre);
     ASSERT_NE(c, nullptr);
-    const cv::Mat own = TruthOf(scene_, subjects[i], 1), other = TruthOf(scene_, subjects[1 - i], 1);
+    const cv::Mat own = TruthOf(scene_, subjects[i], 1),
+                  other = TruthOf(scene_, subjects[1 - i], 1);
     const cv::Mat pasted = Pasted(*c, f.bgr.size());
     EXPECT_GE(testing::SoftIoU(own, pasted), 0.95) << "subject " << i;
-    EXPECT_EQ(cv::countNonZero(pasted & (other > 0)), 0) << "subject " << i << " holds the other's pixels";
+    EXPECT_EQ(cv::countNonZero(pasted & (other > 0)), 0)
+        << "subject " << i << " holds the other's pixels";
     EXPECT_NEAR(c->area, cv::sum(own)[0], 0.02 * cv::sum(own)[0]) << "subject " << i;
   }
 }

@@ -23,22 +23,22 @@ struct SceneBar {  // a thin straight part (a leg), axis from its centre
 
 struct SceneSubject {
   cv::Point2d centre{320, 240};
-  double rx = 60, ry = 40;           // ellipse radii, px; rx = 0: no ellipse (bars only)
+  double rx = 60, ry = 40;  // ellipse radii, px; rx = 0: no ellipse (bars only)
   std::vector<SceneBar> bars;
-  cv::Vec3d colour{40, 70, 125};     // BGR brown
-  double texture = 0.25;             // relative brightness variation of the fur
-  double spill = 70;                 // green added within 4 px of the rim
-  double shadow_depth = 0.45;        // darkening at the shadow's centre
+  cv::Vec3d colour{40, 70, 125};  // BGR brown
+  double texture = 0.25;          // relative brightness variation of the fur
+  double spill = 70;              // green added within 4 px of the rim
+  double shadow_depth = 0.45;     // darkening at the shadow's centre
 };
 
 struct SceneOptions {
   cv::Size size{640, 480};
-  bool green = true;          // false: a textured blue-grey carpet
-  double vignetting = 0.5;    // darkening in the corners
-  double unevenness = 0.12;   // low-frequency brightness variation
-  double tint = 1.0;          // low-frequency variation of the green's hue (0: flat green)
-  double noise_sigma = 3.0;   // per channel, levels
-  double edge_px = 2.0;       // width of the soft edge's alpha ramp
+  bool green = true;         // false: a textured blue-grey carpet
+  double vignetting = 0.5;   // darkening in the corners
+  double unevenness = 0.12;  // low-frequency brightness variation
+  double tint = 1.0;         // low-frequency variation of the green's hue (0: flat green)
+  double noise_sigma = 3.0;  // per channel, levels
+  double edge_px = 2.0;      // width of the soft edge's alpha ramp
   uint64_t seed = 1;
 };
 
@@ -67,13 +67,16 @@ class KeyScene {
       for (int x = 0; x < w; ++x) {
         const double u = static_cast<double>(x) / w, v = static_cast<double>(y) / h;
         const double r2 = ((u - 0.5) * (u - 0.5) + (v - 0.5) * (v - 0.5)) / 0.5;
-        const double light = (1 - o_.vignetting * r2) *
-                             (1 + o_.unevenness * (std::sin(6.28 * 1.3 * u + p[0]) + std::sin(6.28 * 0.9 * v + p[1])) / 2);
+        const double light =
+            (1 - o_.vignetting * r2) *
+            (1 + o_.unevenness *
+                     (std::sin(6.28 * 1.3 * u + p[0]) + std::sin(6.28 * 0.9 * v + p[1])) / 2);
         cv::Vec3d c;
         if (o_.green) {
           const double t1 = std::sin(6.28 * (0.8 * u + 0.5 * v) + p[2]);
           const double t2 = std::sin(6.28 * (0.6 * u - 0.9 * v) + p[3]);
-          c = {62 + o_.tint * 28 * t2, 168, 55 + o_.tint * 42 * std::max(t1, 0.0) + o_.tint * 8 * t1};
+          c = {62 + o_.tint * 28 * t2, 168,
+               55 + o_.tint * 42 * std::max(t1, 0.0) + o_.tint * 8 * t1};
         } else {
           const double t = 0.6 * fine.at<float>(y, x) + 0.4 * coarse.at<float>(y, x);
           const double s = std::sin(6.28 * 9 * u + p[4]) * std::sin(6.28 * 7 * v + p[5]);
@@ -105,7 +108,8 @@ class KeyScene {
       for (int y = 0; y < h; ++y) {
         for (int x = 0; x < w; ++x) {
           const double dx = x - sc.x, dy = y - sc.y;
-          const double dark = s.shadow_depth * std::exp(-(dx * dx / (2 * sx * sx) + dy * dy / (2 * sy * sy)));
+          const double dark =
+              s.shadow_depth * std::exp(-(dx * dx / (2 * sx * sx) + dy * dy / (2 * sy * sy)));
           float& d = f.darkening.at<float>(y, x);
           d = static_cast<float>(1 - (1 - d) * (1 - dark));
           const double sd = SignedDistance(s, x, y);
@@ -132,7 +136,8 @@ class KeyScene {
       for (int x = 0; x < w; ++x) {
         const float a = f.alpha.at<float>(y, x);
         const cv::Vec3f bg = floor_.at<cv::Vec3f>(y, x) * (1 - f.darkening.at<float>(y, x));
-        out.at<cv::Vec3f>(y, x) = a * colour.at<cv::Vec3f>(y, x) + (1 - a) * bg + noise.at<cv::Vec3f>(y, x);
+        out.at<cv::Vec3f>(y, x) =
+            a * colour.at<cv::Vec3f>(y, x) + (1 - a) * bg + noise.at<cv::Vec3f>(y, x);
       }
     }
     out.convertTo(f.bgr, CV_8UC3);  // rounds and saturates
@@ -159,8 +164,10 @@ class KeyScene {
     for (const SceneBar& b : s.bars) {
       const double a = b.angle_deg * CV_PI / 180;
       const double dx = x - b.centre.x, dy = y - b.centre.y;
-      const double along = dx * std::cos(a) + dy * std::sin(a), across = -dx * std::sin(a) + dy * std::cos(a);
-      best = std::min(best, std::max(std::abs(along) - b.length / 2, std::abs(across) - b.width / 2));
+      const double along = dx * std::cos(a) + dy * std::sin(a),
+                   across = -dx * std::sin(a) + dy * std::cos(a);
+      best =
+          std::min(best, std::max(std::abs(along) - b.length / 2, std::abs(across) - b.width / 2));
     }
     return best;
   }

@@ -44,8 +44,9 @@ std::vector<KeyedFrame> KeySynthSession(uint64_t seed, PixelFormat format, int f
   cv::Mat scratch;
   std::vector<cv::Mat> empty;
   for (int i = 0; i < 4; ++i) {
-    const Frame f = Frame::Owned(format, kWidth, kHeight,
-                                 sensor.Capture(renderer.clean_plate(), format, 1'000'000 + static_cast<uint64_t>(i)));
+    const Frame f = Frame::Owned(
+        format, kWidth, kHeight,
+        sensor.Capture(renderer.clean_plate(), format, 1'000'000 + static_cast<uint64_t>(i)));
     empty.push_back(ToBgr(f));
   }
   ChromaKeyer keyer(keyer_options);
@@ -64,7 +65,8 @@ std::vector<KeyedFrame> KeySynthSession(uint64_t seed, PixelFormat format, int f
     const int frame = i * stride;
     director->Frame(frame / 30.0, &snap);
     renderer.Render(snap.scene, &image);
-    const Frame f = Frame::Owned(format, kWidth, kHeight, sensor.Capture(image.bgr, format, static_cast<uint64_t>(frame)));
+    const Frame f = Frame::Owned(format, kWidth, kHeight,
+                                 sensor.Capture(image.bgr, format, static_cast<uint64_t>(frame)));
     keyer.Key(f, scratch, matte);
     cv::Mat truth = cv::Mat::zeros(kHeight, kWidth, CV_32F);
     for (const MatteLayer& layer : image.alpha) {

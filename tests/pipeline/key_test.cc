@@ -43,7 +43,8 @@ double MeanOver(const cv::Mat& values, const cv::Mat& mask) {
 // Alpha above 1/10 farther than `px` from the true subject.
 int StrayAlpha(const SceneFrame& f, const cv::Mat& alpha, int px) {
   cv::Mat near = f.alpha > 0;
-  cv::dilate(near, near, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * px + 1, 2 * px + 1)));
+  cv::dilate(near, near,
+             cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * px + 1, 2 * px + 1)));
   return cv::countNonZero((alpha > 25) & ~near);
 }
 
@@ -62,7 +63,8 @@ TEST(ChromaKeyer, SoftAlphaMatchesTruthOnUnevenGreen) {
   KeyScene scene(SceneOptions{});
   ChromaKeyer keyer;
   keyer.Train(EmptyFrames(scene, 6));
-  for (const cv::Point2d c : {cv::Point2d(320.3, 240.6), cv::Point2d(90.5, 80.2), cv::Point2d(560.7, 420.4)}) {
+  for (const cv::Point2d c :
+       {cv::Point2d(320.3, 240.6), cv::Point2d(90.5, 80.2), cv::Point2d(560.7, 420.4)}) {
     const Quality q = KeyQuality(keyer, scene.Render({Hamster(c)}, 1));
     EXPECT_GE(q.soft_iou, 0.95) << "subject at " << c;
     EXPECT_GE(q.binary_iou, 0.97) << "subject at " << c;
@@ -266,7 +268,8 @@ Frame AsFormat(const cv::Mat& bgr, PixelFormat format) {
       for (int y = 0; y < h; ++y) {
         for (int x = 0; x < w; x += 2) {
           const size_t c = static_cast<size_t>(y / 2) * (w / 2) + x / 2;
-          bytes.insert(bytes.end(), {yp[static_cast<size_t>(y) * w + x], up[c], yp[static_cast<size_t>(y) * w + x + 1], vp[c]});
+          bytes.insert(bytes.end(), {yp[static_cast<size_t>(y) * w + x], up[c],
+                                     yp[static_cast<size_t>(y) * w + x + 1], vp[c]});
         }
       }
     }

@@ -11,9 +11,9 @@ namespace {
 CameraModel LookAtOrigin(double distance, double height) {
   const Eigen::Vector3d centre(0.0, -distance, height);
   const Eigen::Vector3d target(0.0, 0.0, 0.05);
-  const Eigen::Vector3d z = (target - centre).normalized();          // optical axis
+  const Eigen::Vector3d z = (target - centre).normalized();                  // optical axis
   const Eigen::Vector3d x = z.cross(Eigen::Vector3d::UnitZ()).normalized();  // image right
-  const Eigen::Vector3d y = z.cross(x);                              // image down
+  const Eigen::Vector3d y = z.cross(x);                                      // image down
   Rigid3 cam_from_ground;
   cam_from_ground.rotation.row(0) = x;
   cam_from_ground.rotation.row(1) = y;
@@ -70,11 +70,14 @@ Render RenderCard(const CameraModel& cam, double w, double h) {
 struct Crop {
   cv::Mat bgr, alpha, shadow;
   cv::Point offset;
-  SpriteView View(const Eigen::Vector2d& contact_px) const { return {&bgr, &alpha, &shadow, offset, contact_px}; }
+  SpriteView View(const Eigen::Vector2d& contact_px) const {
+    return {&bgr, &alpha, &shadow, offset, contact_px};
+  }
 };
 Crop CropOf(const Render& r) {
   cv::Rect box = cv::boundingRect((r.alpha > 0) | (r.shadow > 0));
-  box = cv::Rect(box.x - 4, box.y - 4, box.width + 8, box.height + 8) & cv::Rect(0, 0, r.bgr.cols, r.bgr.rows);
+  box = cv::Rect(box.x - 4, box.y - 4, box.width + 8, box.height + 8) &
+        cv::Rect(0, 0, r.bgr.cols, r.bgr.rows);
   return {r.bgr(box), r.alpha(box), r.shadow(box), box.tl()};
 }
 
@@ -117,15 +120,17 @@ TEST(Rectifier, MirrorFlipsContentAndVelocityAcrossTheView) {
   Render r = RenderCard(cam, 0.06, 0.04);
   // Paint the card's left half (as the camera sees it) blue.
   const cv::Rect full = cv::boundingRect(r.alpha);
-  r.bgr(cv::Rect(full.x, full.y, full.width / 2, full.height)).setTo(cv::Scalar(255, 0, 0), r.alpha(cv::Rect(full.x, full.y, full.width / 2, full.height)));
+  r.bgr(cv::Rect(full.x, full.y, full.width / 2, full.height))
+      .setTo(cv::Scalar(255, 0, 0), r.alpha(cv::Rect(full.x, full.y, full.width / 2, full.height)));
   const Crop crop = CropOf(r);
   const auto bb = Rectifier().Rectify(cam, crop.View(r.contact_px));
   ASSERT_TRUE(bb);
   const Billboard m = Rectifier::Mirror(*bb);
   const cv::Rect box = AlphaBox(bb->bgra);
   const int y = box.y + box.height / 2;
-  EXPECT_GT(bb->bgra.at<cv::Vec4b>(y, box.x + 2)[0], 200);                   // blue on the left
-  EXPECT_GT(m.bgra.at<cv::Vec4b>(y, m.bgra.cols - 1 - (box.x + 2))[0], 200);  // on the right in the mirror
+  EXPECT_GT(bb->bgra.at<cv::Vec4b>(y, box.x + 2)[0], 200);  // blue on the left
+  EXPECT_GT(m.bgra.at<cv::Vec4b>(y, m.bgra.cols - 1 - (box.x + 2))[0],
+            200);  // on the right in the mirror
   EXPECT_NEAR(m.anchor_px.x(), bb->bgra.cols - 1 - bb->anchor_px.x(), 1e-9);
   EXPECT_NE(m.bgra.data, bb->bgra.data);  // the original keeps its own pixels
   // Walking to the camera's right becomes walking to its left; toward the camera stays.
@@ -162,4 +167,3 @@ TEST(Rectifier, ABillboardOverTheSizeLimitIsTooLargeNotAMissedFloor) {
 
 }  // namespace
 }  // namespace ss
-

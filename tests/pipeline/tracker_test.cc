@@ -13,7 +13,8 @@ TEST(Tracker, TwoSubjectsKeepTheirIdsWhileCrossingPaths) {
   std::vector<int> first;
   for (int f = 0; f < 60; ++f) {
     const double x = -0.3 + 0.3 * f / 30.0;
-    const std::vector<TrackInput> in = {{Eigen::Vector2d(x, 0.0), 1000}, {Eigen::Vector2d(-x, 0.04), 1000}};
+    const std::vector<TrackInput> in = {{Eigen::Vector2d(x, 0.0), 1000},
+                                        {Eigen::Vector2d(-x, 0.04), 1000}};
     const auto ids = tracker.Update(f * kFrameNs, in);
     if (f == 0) first = ids;
     EXPECT_EQ(ids, first) << "frame " << f;

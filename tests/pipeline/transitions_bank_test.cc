@@ -23,7 +23,9 @@ namespace ss {
 namespace {
 
 // Generous weights for the synthetic set so that many pairs and transitions exist.
-TransitionWeights Generous() { return testing::UnitWeights({0.03, 30, 0.0006, 0.04, 0.12, 12}, 4.0, 3.0); }
+TransitionWeights Generous() {
+  return testing::UnitWeights({0.03, 30, 0.0006, 0.04, 0.12, 12}, 4.0, 3.0);
+}
 
 constexpr int64_t kFrameNs = 33'333'333;
 
@@ -99,7 +101,8 @@ class BankFiller {
     camera_ = writer_.AddCamera(session, {0, 0, "cam0", "", 640, 480});
   }
   // Stores one clip; fills bank_id for its sprites.
-  void Add(const ClipOfSprites& c, int batch, const std::function<void(const std::vector<int64_t>&)>& stored = {}) {
+  void Add(const ClipOfSprites& c, int batch,
+           const std::function<void(const std::vector<int64_t>&)>& stored = {}) {
     ClipRecord clip;
     clip.camera_id = camera_;
     clip.track_id = c.clip;
@@ -242,21 +245,25 @@ TEST(TransitionBank, EmptyBankOneClipAndMissingBank) {
   TransitionWorker missing(dir / "missing2.db", Generous());
   missing.WaitIdle();
   EXPECT_EQ(missing.stats().failed_rounds, 1);
-  EXPECT_NE(missing.stats().last_error.find("missing2.db"), std::string::npos) << missing.stats().last_error;
+  EXPECT_NE(missing.stats().last_error.find("missing2.db"), std::string::npos)
+      << missing.stats().last_error;
 }
 
-// A session folder whose truth/subjects.csv describes the synthetic sprites as stored by BankFiller.
+// A session folder whose truth/subjects.csv describes the synthetic sprites as stored by
+// BankFiller.
 void WriteTruth(const std::string& session_dir, const std::vector<SyntheticSprite>& sprites) {
   std::filesystem::create_directories(std::filesystem::path(session_dir) / "truth");
   std::ofstream out(std::filesystem::path(session_dir) / "truth" / "subjects.csv");
   out.precision(17);
-  out << "frame,timestamp_ns,subject,kind,x,y,heading_rad,speed_mps,gait_phase,pose,touches_wall,leaves_floor,"
+  out << "frame,timestamp_ns,subject,kind,x,y,heading_rad,speed_mps,gait_phase,pose,touches_wall,"
+         "leaves_floor,"
          "height_m\n";
   int64_t frame = 100;
   for (const auto& c : Clips(sprites)) {
     for (const SyntheticSprite* s : c.originals) {
-      out << frame << ',' << frame * kFrameNs << ",0,animal," << 0.001 * frame << ",0.5," << s->truth.heading_rad
-          << ',' << s->speed_mps << ',' << s->truth.gait_phase << ',' << s->truth.pose << ",0,0,0.1\n";
+      out << frame << ',' << frame * kFrameNs << ",0,animal," << 0.001 * frame << ",0.5,"
+          << s->truth.heading_rad << ',' << s->speed_mps << ',' << s->truth.gait_phase << ','
+          << s->truth.pose << ",0,0,0.1\n";
       // A second subject far away must not be matched.
       out << frame << ',' << frame * kFrameNs << ",1,animal,5,5,0,0,0.5,stand,0,0,0.1\n";
       ++frame;
@@ -271,7 +278,8 @@ TEST(TransitionBank, LabelsFromSessionTruth) {
   BankFiller filler(dir / "bank.db");
   for (const auto& c : Clips(sprites)) filler.Add(c, 40);
   WriteTruth(dir / "session", sprites);
-  const TruthLabelSummary s = LabelBankFromTruth(dir / "session", dir / "bank.db", 200, TruthLabelOptions{}, 1);
+  const TruthLabelSummary s =
+      LabelBankFromTruth(dir / "session", dir / "bank.db", 200, TruthLabelOptions{}, 1);
   EXPECT_EQ(s.sprites_matched, 300);
   EXPECT_EQ(s.mirrored_skipped, 300);
   ASSERT_EQ(s.labels.size(), 200u);
@@ -285,7 +293,8 @@ TEST(TransitionBank, LabelsFromSessionTruth) {
     EXPECT_EQ(l.accept, TruthAccepts(a, b, phase_only));
     EXPECT_FALSE(by_bank_id.at(l.sprite_i)->id > 300) << "mirrors are left out";
   }
-  EXPECT_THROW(LabelBankFromTruth(dir / "nosession", dir / "bank.db", 200, TruthLabelOptions{}, 1), InputError);
+  EXPECT_THROW(LabelBankFromTruth(dir / "nosession", dir / "bank.db", 200, TruthLabelOptions{}, 1),
+               InputError);
 }
 
 TEST(TransitionBank, CommandLine) {
@@ -297,11 +306,12 @@ TEST(TransitionBank, CommandLine) {
   const std::string bank = dir / "bank.db";
 
   // label -> train -> build with the trained weights.
-  auto r = testing::RunSpritestation("transitions label --from-truth " + (dir / "session") + " --bank " + bank +
-                                     " --out " + (dir / "labels.csv") + " --count 300");
+  auto r =
+      testing::RunSpritestation("transitions label --from-truth " + (dir / "session") + " --bank " +
+                                bank + " --out " + (dir / "labels.csv") + " --count 300");
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  r = testing::RunSpritestation("transitions train " + (dir / "labels.csv") + " --bank " + bank + " --out " +
-                                (dir / "w.json") + " --threads 1");
+  r = testing::RunSpritestation("transitions train " + (dir / "labels.csv") + " --bank " + bank +
+                                " --out " + (dir / "w.json") + " --threads 1");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("stage 2 (all 6 features):   precision"), std::string::npos) << r.output;
   // The labels carry the truth's positive rate, so stage 2 is set for it and stage 1 refitted.
@@ -312,17 +322,21 @@ TEST(TransitionBank, CommandLine) {
   EXPECT_NE(r.output.find("stage 2 then set for the positive rate"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("stage 1 refitted as its filter"), std::string::npos) << r.output;
   EXPECT_NO_THROW(LoadWeights(dir / "w.json"));
-  r = testing::RunSpritestation("transitions " + bank + " --weights " + (dir / "w.json") + " --json");
+  r = testing::RunSpritestation("transitions " + bank + " --weights " + (dir / "w.json") +
+                                " --json");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const auto j = nlohmann::json::parse(r.output.substr(r.output.find('{')));
   EXPECT_EQ(j["sprites"], 600);
-  EXPECT_EQ(j["transitions"].get<int64_t>(), static_cast<int64_t>(Bank(bank).LoadTransitions().size()));
+  EXPECT_EQ(j["transitions"].get<int64_t>(),
+            static_cast<int64_t>(Bank(bank).LoadTransitions().size()));
   r = testing::RunSpritestation("transitions " + bank);
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  EXPECT_NE(r.output.find("finding transitions"), std::string::npos) << "progress lines: " << r.output;
+  EXPECT_NE(r.output.find("finding transitions"), std::string::npos)
+      << "progress lines: " << r.output;
 
   // Clear messages: wrong weights file, empty bank, no bank, labels naming unknown sprites.
-  std::ofstream(dir / "bad.json") << R"({"format": "spritestation-transition-weights", "version": 7})";
+  std::ofstream(dir / "bad.json")
+      << R"({"format": "spritestation-transition-weights", "version": 7})";
   r = testing::RunSpritestation("transitions " + bank + " --weights " + (dir / "bad.json"));
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_NE(r.output.find("bad.json"), std::string::npos) << r.output;
@@ -335,8 +349,8 @@ TEST(TransitionBank, CommandLine) {
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_NE(r.output.find("no such sprite bank"), std::string::npos) << r.output;
   std::ofstream(dir / "unknown.csv") << "sprite_i,sprite_j,accept\n1,999999,1\n";
-  r = testing::RunSpritestation("transitions train " + (dir / "unknown.csv") + " --bank " + bank + " --out " +
-                                (dir / "w2.json"));
+  r = testing::RunSpritestation("transitions train " + (dir / "unknown.csv") + " --bank " + bank +
+                                " --out " + (dir / "w2.json"));
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_NE(r.output.find("999999"), std::string::npos) << r.output;
 }

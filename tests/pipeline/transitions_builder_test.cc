@@ -42,9 +42,9 @@ TEST(TransitionBuilder, CostMatchesFormulaOnHandMadeClips) {
   // Clip A: sprites 1 2 3 4 with v = 0, 0.6, 1.2, 1.8; clip B: 11 12 13 with v = 0.1, 0.7, 1.3.
   // Kept pairs (|dv| <= 1): {1,2} {2,3} {3,4} {11,12} {12,13} (0.6 each), {1,11} .1, {1,12} .7,
   // {2,11} .5, {2,12} .1, {2,13} .7, {3,12} .5, {3,13} .1, {4,13} .5.
-  const std::vector<SpriteInput> in = {At(1, 100, 0, &dot),   At(2, 100, 0.6, &dot),  At(3, 100, 1.2, &dot),
-                                       At(4, 100, 1.8, &dot), At(11, 200, 0.1, &dot), At(12, 200, 0.7, &dot),
-                                       At(13, 200, 1.3, &dot)};
+  const std::vector<SpriteInput> in = {
+      At(1, 100, 0, &dot),    At(2, 100, 0.6, &dot),  At(3, 100, 1.2, &dot), At(4, 100, 1.8, &dot),
+      At(11, 200, 0.1, &dot), At(12, 200, 0.7, &dot), At(13, 200, 1.3, &dot)};
   TransitionBuilder builder(VelocityOnly(), 100.0);
   builder.BuildFromScratch(in);
   EXPECT_EQ(builder.KeptPairs().size(), 13u);
@@ -59,8 +59,9 @@ TEST(TransitionBuilder, CostMatchesFormulaOnHandMadeClips) {
     int64_t from, to;
     double d, c;
   };
-  const std::vector<Want> want = {{1, 12, .7, .2}, {2, 12, .1, 1.0}, {2, 13, .7, .2}, {3, 13, .1, 1.0},
-                                  {11, 2, .5, .2}, {12, 2, .1, 1.4}, {12, 3, .5, .2}};
+  const std::vector<Want> want = {{1, 12, .7, .2},  {2, 12, .1, 1.0}, {2, 13, .7, .2},
+                                  {3, 13, .1, 1.0}, {11, 2, .5, .2},  {12, 2, .1, 1.4},
+                                  {12, 3, .5, .2}};
   const auto t = builder.Transitions();
   ASSERT_EQ(t.size(), want.size());
   const auto& s = builder.store();
@@ -80,8 +81,8 @@ TEST(TransitionBuilder, CostMatchesFormulaOnHandMadeClips) {
 TEST(TransitionBuilder, ClipEndsAndRepeatsAreNotTransitions) {
   const RgbaBillboard dot = Dot();
   // One clip 1..5 with v = 0, .5, 0, .5, 0: every pair is kept.
-  const std::vector<SpriteInput> in = {At(1, 7, 0, &dot), At(2, 7, .5, &dot), At(3, 7, 0, &dot), At(4, 7, .5, &dot),
-                                       At(5, 7, 0, &dot)};
+  const std::vector<SpriteInput> in = {At(1, 7, 0, &dot), At(2, 7, .5, &dot), At(3, 7, 0, &dot),
+                                       At(4, 7, .5, &dot), At(5, 7, 0, &dot)};
   TransitionBuilder builder(VelocityOnly(), 100.0);
   builder.BuildFromScratch(in);
   EXPECT_EQ(builder.KeptPairs().size(), 10u);
@@ -162,7 +163,9 @@ TEST(TransitionBuilder, IncrementalEqualsFromScratch) {
   EXPECT_EQ(live_builder.KeptPairs(), pairs);
   EXPECT_EQ(live_builder.Transitions(), transitions);
   // The deltas hold every transition exactly once (none reported twice, none missed).
-  auto by_key = [](const Transition& a, const Transition& b) { return std::tie(a.from, a.to) < std::tie(b.from, b.to); };
+  auto by_key = [](const Transition& a, const Transition& b) {
+    return std::tie(a.from, a.to) < std::tie(b.from, b.to);
+  };
   std::sort(seen.begin(), seen.end(), by_key);
   EXPECT_EQ(seen, transitions);
   std::sort(seen_pairs.begin(), seen_pairs.end(), [](const KeptPair& a, const KeptPair& b) {

@@ -80,7 +80,8 @@ TEST(TransitionCalibration, StageTwoThresholdFollowsTheRarePositiveRate) {
   std::vector<double> labels;
   for (int k = 0; k < 500; ++k) labels.push_back(unit(rng));
   TransitionWeights w = DefaultWeights();
-  const Stage2Calibration c = CalibrateStage2(labels, sample, static_cast<double>(positives) / (n - 1), &w);
+  const Stage2Calibration c =
+      CalibrateStage2(labels, sample, static_cast<double>(positives) / (n - 1), &w);
   // The true F1 at the chosen threshold vs the best possible.
   auto f1_at = [&](double t) {
     int64_t tp = 0, accepted = 0;
@@ -90,7 +91,8 @@ TEST(TransitionCalibration, StageTwoThresholdFollowsTheRarePositiveRate) {
         tp += truth[j];
       }
     }
-    const double p = accepted ? static_cast<double>(tp) / accepted : 0, r = static_cast<double>(tp) / positives;
+    const double p = accepted ? static_cast<double>(tp) / accepted : 0,
+                 r = static_cast<double>(tp) / positives;
     return p + r > 0 ? 2 * p * r / (p + r) : 0.0;
   };
   double best = 0;
@@ -98,13 +100,15 @@ TEST(TransitionCalibration, StageTwoThresholdFollowsTheRarePositiveRate) {
   EXPECT_GT(c.threshold, 0.2);
   EXPECT_LT(c.threshold, 0.45);
   EXPECT_GT(f1_at(c.threshold), 0.9 * best);
-  EXPECT_LE(c.accepts_per_sprite, c.recall * positives / c.precision + 1e-6);  // precision is capped at 1
+  EXPECT_LE(c.accepts_per_sprite,
+            c.recall * positives / c.precision + 1e-6);  // precision is capped at 1
   // The weights now accept exactly up to that threshold.
   const TransitionClassifier classifier(w);
   EXPECT_NEAR(classifier.stage2_threshold(), c.threshold, 1e-6 * (1 + c.threshold));
   // A prior ten times too high would accept far more.
   TransitionWeights naive = DefaultWeights();
-  const Stage2Calibration wrong = CalibrateStage2(labels, sample, 10.0 * positives / (n - 1), &naive);
+  const Stage2Calibration wrong =
+      CalibrateStage2(labels, sample, 10.0 * positives / (n - 1), &naive);
   EXPECT_GT(wrong.threshold, c.threshold + 0.2);
   EXPECT_THROW(CalibrateStage2({}, sample, 0.001, &w), InputError);
   EXPECT_THROW(CalibrateStage2(labels, sample, 0.0, &w), InputError);
@@ -140,7 +144,8 @@ TEST(TransitionCalibration, StageOneRefittedAsAFilterPassesTheRequestedShare) {
     }
     EXPECT_EQ(accepts, c.stage2_accepts);
     EXPECT_GE(passed, static_cast<int64_t>(std::ceil(recall * accepts)) - 1) << recall;
-    EXPECT_NEAR(c.candidates_per_sprite, static_cast<double>(candidates) / sample.rows.size(), 1e-9);
+    EXPECT_NEAR(c.candidates_per_sprite, static_cast<double>(candidates) / sample.rows.size(),
+                1e-9);
     EXPECT_LT(c.candidates_per_sprite, 0.5 * (store.size() - 1)) << "stage 1 must filter";
     for (double u : v.stage1_weights) EXPECT_GE(u, 0.0);
   }
@@ -155,7 +160,8 @@ TEST(TransitionCalibration, PositiveRateOfTheTruthAndInTheLabelsFile) {
   const TruthLabelOptions o;
   int64_t positives = 0;
   for (size_t i = 0; i < truth.size(); ++i) {
-    for (size_t j = 0; j < truth.size(); ++j) positives += i != j && TruthAccepts(truth[i], truth[j], o);
+    for (size_t j = 0; j < truth.size(); ++j)
+      positives += i != j && TruthAccepts(truth[i], truth[j], o);
   }
   const double exact = static_cast<double>(positives) / (truth.size() * (truth.size() - 1.0));
   ASSERT_GT(exact, 0);

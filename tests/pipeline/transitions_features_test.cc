@@ -145,8 +145,8 @@ TEST(TransitionFeatures, ComparisonImageAveragesAreas) {
   MakeComparisonImage(b, 100.0, w, image.data());
   const int s = w.PlaneStride();
   // The cell is 2 x 2 px = 4 px^2 and holds column 0 entirely: 2 opaque px^2.
-  EXPECT_EQ(image[0], 128);          // 255 * 2 / 4 = 127.5
-  EXPECT_EQ(image[s], 100);          // alpha-weighted mean of red 200 and 0
+  EXPECT_EQ(image[0], 128);  // 255 * 2 / 4 = 127.5
+  EXPECT_EQ(image[s], 100);  // alpha-weighted mean of red 200 and 0
   EXPECT_EQ(image[3 * s], 100);
 }
 
@@ -179,7 +179,8 @@ TEST(TransitionFeatures, PixelDifferencesOnHandMadePair) {
     for (int x = 1; x < 4; ++x) Paint(b, x, y, 110, 90, 100, 255);
   }
   SpriteStore store(w, 100.0);
-  std::vector<SpriteInput> in = {{1, 1, DescribeBillboard(a, 100), &a}, {2, 2, DescribeBillboard(b, 100), &b}};
+  std::vector<SpriteInput> in = {{1, 1, DescribeBillboard(a, 100), &a},
+                                 {2, 2, DescribeBillboard(b, 100), &b}};
   store.Append(in);
   // Union window: columns 0..3 x 4 rows = 16 cells; alpha differs on columns 0 and 3 (8 cells).
   const PixelDifference d = store.Pixels(0, 1);
@@ -237,7 +238,8 @@ TEST(TransitionFeatures, SixFeaturesSymmetricOnSyntheticSprites) {
 
 TEST(TransitionFeatures, SimdKernelEqualsScalar) {
   std::mt19937 rng(7);
-  for (const auto& [cx, cy] : {std::pair{32, 32}, std::pair{5, 4}, std::pair{64, 64}, std::pair{17, 9}}) {
+  for (const auto& [cx, cy] :
+       {std::pair{32, 32}, std::pair{5, 4}, std::pair{64, 64}, std::pair{17, 9}}) {
     ComparisonWindow w;
     w.cells_x = cx;
     w.cells_y = cy;
@@ -254,7 +256,8 @@ TEST(TransitionFeatures, SimdKernelEqualsScalar) {
       const PixelSums slow = SumPixelDifferencesScalar(a.data(), b.data(), s);
       EXPECT_EQ(fast.alpha_abs_diff, slow.alpha_abs_diff);
       EXPECT_EQ(fast.weight, slow.weight);
-      EXPECT_EQ(fast.weighted_colour, slow.weighted_colour) << cx << "x" << cy << " trial " << trial;
+      EXPECT_EQ(fast.weighted_colour, slow.weighted_colour)
+          << cx << "x" << cy << " trial " << trial;
     }
   }
 }

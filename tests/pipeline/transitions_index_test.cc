@@ -37,7 +37,8 @@ std::vector<CheapFeatures> Points(int n, uint64_t seed) {
   return out;
 }
 
-void ExpectSameAnswers(const Stage1Index& index, const std::vector<CheapFeatures>& queries, int64_t* total) {
+void ExpectSameAnswers(const Stage1Index& index, const std::vector<CheapFeatures>& queries,
+                       int64_t* total) {
   std::vector<int32_t> fast, slow;
   for (const CheapFeatures& q : queries) {
     fast.clear();
@@ -59,7 +60,8 @@ TEST(TransitionIndex, TreeEqualsLinearScan) {
     EXPECT_EQ(index.tree_size(), 4000);
     int64_t total = 0;
     ExpectSameAnswers(index, points, &total);
-    EXPECT_GT(total, 4000) << "the test must find pairs beyond each point itself (t1 = " << t1 << ")";
+    EXPECT_GT(total, 4000) << "the test must find pairs beyond each point itself (t1 = " << t1
+                           << ")";
     EXPECT_LT(total, 4000LL * 4000 / 4) << "and must not accept everything";
   }
 }

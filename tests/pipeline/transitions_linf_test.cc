@@ -39,7 +39,8 @@ struct Cell {
   uint8_t alpha;
 };
 
-RgbaBillboard Sprite(const std::vector<Cell>& cells, const std::array<uint8_t, 3>& rgb = {200, 100, 50}) {
+RgbaBillboard Sprite(const std::vector<Cell>& cells,
+                     const std::array<uint8_t, 3>& rgb = {200, 100, 50}) {
   RgbaBillboard b;
   b.width = 32;
   b.height = 32;
@@ -65,7 +66,8 @@ std::vector<Cell> Rectangle(int x0, int y0, int x1, int y1, uint8_t alpha) {
 }
 
 // Linf weights: stage 1 = the velocity bound alone (so it passes every pair stage 2 can keep).
-TransitionWeights LinfWeights(const ComparisonWindow& window, double max_velocity, double max_alpha) {
+TransitionWeights LinfWeights(const ComparisonWindow& window, double max_velocity,
+                              double max_alpha) {
   TransitionWeights w = testing::UnitWeights({1, 1, 1, 1, 1, 1}, max_velocity, 1);
   w.window = window;
   w.stage1_weights = {1, 0, 0, 0};
@@ -81,11 +83,11 @@ int Linf(const SpriteStore& s, int32_t i, int32_t j) {
 
 TEST(TransitionLinf, FeatureOnHandMadePairs) {
   std::vector<RgbaBillboard> sprites = {
-      Sprite(Rectangle(8, 10, 20, 32, 255)),                  // 0: body
-      Sprite(Rectangle(8, 10, 20, 32, 255)),                  // 1: the same
-      Sprite(Rectangle(8, 10, 20, 32, 185)),                  // 2: the same, fainter by 70
-      Sprite(Rectangle(9, 10, 21, 32, 255)),                  // 3: 0 moved one cell right
-      Sprite([] {                                             // 4: 0 with one cell fainter by 30
+      Sprite(Rectangle(8, 10, 20, 32, 255)),  // 0: body
+      Sprite(Rectangle(8, 10, 20, 32, 255)),  // 1: the same
+      Sprite(Rectangle(8, 10, 20, 32, 185)),  // 2: the same, fainter by 70
+      Sprite(Rectangle(9, 10, 21, 32, 255)),  // 3: 0 moved one cell right
+      Sprite([] {                             // 4: 0 with one cell fainter by 30
         auto c = Rectangle(8, 10, 20, 32, 255);
         c[5].alpha = 225;
         return c;
@@ -95,7 +97,8 @@ TEST(TransitionLinf, FeatureOnHandMadePairs) {
   for (size_t k = 0; k < sprites.size(); ++k) {
     CheapFeatures cheap;
     cheap.velocity_x_mps = 0.01 * static_cast<double>(k);  // velocity differences 0.01 per index
-    inputs.push_back({static_cast<int64_t>(k + 1), static_cast<int64_t>(k + 1), cheap, &sprites[k]});
+    inputs.push_back(
+        {static_cast<int64_t>(k + 1), static_cast<int64_t>(k + 1), cheap, &sprites[k]});
   }
   SpriteStore s(CellPerPixel(), 100.0);
   s.Append(inputs);
@@ -116,9 +119,9 @@ TEST(TransitionLinf, FeatureOnHandMadePairs) {
   double d = -1;
   EXPECT_TRUE(c.Stage2(s, 0, 1, &d));  // velocity 0.01, linf 0
   EXPECT_NEAR(d, 0.01 / 0.025, 1e-12);
-  EXPECT_FALSE(c.Stage2(s, 0, 2, &d));  // linf 70 > 40
-  EXPECT_FALSE(c.Stage2(s, 0, 3, &d));  // linf 255
-  EXPECT_FALSE(c.Stage2(s, 0, 4, &d));  // linf 30 but velocity 0.04 > 0.025
+  EXPECT_FALSE(c.Stage2(s, 0, 2, &d));          // linf 70 > 40
+  EXPECT_FALSE(c.Stage2(s, 0, 3, &d));          // linf 255
+  EXPECT_FALSE(c.Stage2(s, 0, 4, &d));          // linf 30 but velocity 0.04 > 0.025
   EXPECT_TRUE(c.Stage2(s, 3, 4, &d) == false);  // linf 255
   const TransitionClassifier loose(LinfWeights(CellPerPixel(), 0.05, 40.0 / 255));
   double d04 = -1, d40 = -1;
@@ -135,7 +138,8 @@ std::vector<RgbaBillboard> RandomSprites(std::mt19937& rng, int count) {
     const int blobs = 1 + static_cast<int>(rng() % 4);
     for (int b = 0; b < blobs; ++b) {
       const int x0 = rng() % 26, y0 = rng() % 26;
-      for (const Cell& c : Rectangle(x0, y0, x0 + 1 + rng() % 6, y0 + 1 + rng() % 6, rng() % 256)) cells.push_back(c);
+      for (const Cell& c : Rectangle(x0, y0, x0 + 1 + rng() % 6, y0 + 1 + rng() % 6, rng() % 256))
+        cells.push_back(c);
     }
     sprites.push_back(Sprite(cells));
   }
@@ -163,7 +167,8 @@ TEST(TransitionLinf, BoundNeverRejectsWhatTheFullEvaluationAccepts) {
         exceeding += exceeds;
       }
     }
-    if (limit <= 60) EXPECT_GT(proven, exceeding / 10) << "limit " << limit << ": the bound must prove something";
+    if (limit <= 60)
+      EXPECT_GT(proven, exceeding / 10) << "limit " << limit << ": the bound must prove something";
   }
 }
 
@@ -198,7 +203,8 @@ TEST(TransitionLinf, FilterIsExactOnSyntheticSprites) {
         if (full) {
           ASSERT_GE(d, 0.0);
           ASSERT_LE(d, 1.0);
-          ASSERT_TRUE(c.Stage1Accepts(store.cheap(i), store.cheap(j))) << "stage 1 must pass what stage 2 keeps";
+          ASSERT_TRUE(c.Stage1Accepts(store.cheap(i), store.cheap(j)))
+              << "stage 1 must pass what stage 2 keeps";
         }
         (full ? kept : rejected) += 1;
         filtered += excluded;
@@ -217,7 +223,8 @@ TEST(TransitionLinf, FilterIsExactOnSyntheticSprites) {
 }
 
 // Paints `cells` of an existing sprite with another colour (alpha kept).
-RgbaBillboard Recolour(RgbaBillboard b, const std::vector<Cell>& cells, const std::array<uint8_t, 3>& rgb) {
+RgbaBillboard Recolour(RgbaBillboard b, const std::vector<Cell>& cells,
+                       const std::array<uint8_t, 3>& rgb) {
   for (const Cell& c : cells) {
     uint8_t* p = b.rgba.data() + (static_cast<size_t>(c.y) * 32 + c.x) * 4;
     p[0] = rgb[0];
@@ -229,13 +236,17 @@ RgbaBillboard Recolour(RgbaBillboard b, const std::vector<Cell>& cells, const st
 
 TEST(TransitionColourBlob, FeatureOnHandMadePairs) {
   const RgbaBillboard body = Sprite(Rectangle(8, 10, 20, 32, 255));
-  RgbaBillboard two_patches = Recolour(body, Rectangle(9, 12, 12, 14, 255), {90, 100, 50});  // 3 x 2, dR 110
-  two_patches = Recolour(two_patches, Rectangle(15, 20, 17, 21, 255), {200, 40, 20});          // 2 x 1, 90
-  const RgbaBillboard faint = Recolour(body, Rectangle(9, 12, 12, 14, 255), {150, 80, 40});      // dR+dG+dB 80
+  RgbaBillboard two_patches =
+      Recolour(body, Rectangle(9, 12, 12, 14, 255), {90, 100, 50});  // 3 x 2, dR 110
+  two_patches = Recolour(two_patches, Rectangle(15, 20, 17, 21, 255), {200, 40, 20});  // 2 x 1, 90
+  const RgbaBillboard faint =
+      Recolour(body, Rectangle(9, 12, 12, 14, 255), {150, 80, 40});  // dR+dG+dB 80
   RgbaBillboard half_transparent = Sprite(Rectangle(8, 10, 20, 32, 255));
-  for (const Cell& c : Rectangle(9, 12, 12, 14, 0)) half_transparent.rgba[(c.y * 32 + c.x) * 4 + 3] = 100;
+  for (const Cell& c : Rectangle(9, 12, 12, 14, 0))
+    half_transparent.rgba[(c.y * 32 + c.x) * 4 + 3] = 100;
   half_transparent = Recolour(half_transparent, Rectangle(9, 12, 12, 14, 255), {90, 100, 50});
-  const RgbaBillboard diagonal = Recolour(body, {{9, 12, 255}, {10, 13, 255}}, {0, 0, 0});  // not 4-connected
+  const RgbaBillboard diagonal =
+      Recolour(body, {{9, 12, 255}, {10, 13, 255}}, {0, 0, 0});  // not 4-connected
   const std::vector<RgbaBillboard> sprites = {body, two_patches, faint, half_transparent, diagonal};
   std::vector<SpriteInput> inputs;
   for (size_t k = 0; k < sprites.size(); ++k) {
@@ -243,7 +254,9 @@ TEST(TransitionColourBlob, FeatureOnHandMadePairs) {
   }
   SpriteStore s(CellPerPixel(), 100.0);
   s.Append(inputs);
-  auto blob = [&](int32_t i, int32_t j) { return LargestColourBlob(s.image(i), s.image(j), s.window()); };
+  auto blob = [&](int32_t i, int32_t j) {
+    return LargestColourBlob(s.image(i), s.image(j), s.window());
+  };
   EXPECT_EQ(blob(0, 1), 6);  // the larger of the two patches
   EXPECT_EQ(blob(0, 2), 0);  // below the colour step
   EXPECT_EQ(blob(0, 3), 0);  // the patch is not opaque in both
@@ -347,19 +360,26 @@ TEST(TransitionLinf, WeightsFileCarriesTheVariant) {
   };
   EXPECT_EQ(with([](auto&) {}), "");
   EXPECT_EQ(with([](auto& j) { j["stage2"]["variant"] = "paper"; }), "");
-  EXPECT_NE(with([](auto& j) { j["stage2"]["variant"] = "max"; }).find("field 'stage2.variant'"), std::string::npos);
-  EXPECT_NE(with([](auto& j) { j["stage2"].erase("variant"); }).find("field 'stage2.variant': missing"),
+  EXPECT_NE(with([](auto& j) { j["stage2"]["variant"] = "max"; }).find("field 'stage2.variant'"),
             std::string::npos);
-  EXPECT_NE(with([](auto& j) { j["stage2"]["linf"].erase("max_alpha_linf"); })
-                .find("field 'stage2.linf.max_alpha_linf': missing"),
+  EXPECT_NE(
+      with([](auto& j) { j["stage2"].erase("variant"); }).find("field 'stage2.variant': missing"),
+      std::string::npos);
+  EXPECT_NE(with([](auto& j) {
+              j["stage2"]["linf"].erase("max_alpha_linf");
+            }).find("field 'stage2.linf.max_alpha_linf': missing"),
             std::string::npos);
-  EXPECT_NE(with([](auto& j) { j["stage2"]["linf"]["max_alpha_linf"] = 1.5; }).find("field 'stage2.linf.max_alpha_linf'"),
+  EXPECT_NE(with([](auto& j) {
+              j["stage2"]["linf"]["max_alpha_linf"] = 1.5;
+            }).find("field 'stage2.linf.max_alpha_linf'"),
             std::string::npos);
-  EXPECT_NE(with([](auto& j) { j["stage2"]["linf"]["max_velocity_mps"] = -0.1; })
-                .find("field 'stage2.linf.max_velocity_mps'"),
+  EXPECT_NE(with([](auto& j) {
+              j["stage2"]["linf"]["max_velocity_mps"] = -0.1;
+            }).find("field 'stage2.linf.max_velocity_mps'"),
             std::string::npos);
-  EXPECT_NE(with([](auto& j) { j["stage2"]["linf"]["max_velocity_mps"] = "fast"; })
-                .find("field 'stage2.linf.max_velocity_mps'"),
+  EXPECT_NE(with([](auto& j) {
+              j["stage2"]["linf"]["max_velocity_mps"] = "fast";
+            }).find("field 'stage2.linf.max_velocity_mps'"),
             std::string::npos);
   // The colour_blob variant's fields.
   TransitionWeights b = w;
@@ -378,17 +398,21 @@ TEST(TransitionLinf, WeightsFileCarriesTheVariant) {
     edit(j);
     return ErrorOf(j.dump());
   };
-  EXPECT_NE(bwith([](auto& j) { j["stage2"]["colour_blob"]["max_blob_cells"] = -1; })
-                .find("field 'stage2.colour_blob.max_blob_cells'"),
+  EXPECT_NE(bwith([](auto& j) {
+              j["stage2"]["colour_blob"]["max_blob_cells"] = -1;
+            }).find("field 'stage2.colour_blob.max_blob_cells'"),
             std::string::npos);
-  EXPECT_NE(bwith([](auto& j) { j["stage2"]["colour_blob"]["max_blob_cells"] = 2.5; })
-                .find("field 'stage2.colour_blob.max_blob_cells'"),
+  EXPECT_NE(bwith([](auto& j) {
+              j["stage2"]["colour_blob"]["max_blob_cells"] = 2.5;
+            }).find("field 'stage2.colour_blob.max_blob_cells'"),
             std::string::npos);
-  EXPECT_NE(bwith([](auto& j) { j["stage2"]["colour_blob"].erase("max_velocity_mps"); })
-                .find("field 'stage2.colour_blob.max_velocity_mps': missing"),
+  EXPECT_NE(bwith([](auto& j) {
+              j["stage2"]["colour_blob"].erase("max_velocity_mps");
+            }).find("field 'stage2.colour_blob.max_velocity_mps': missing"),
             std::string::npos);
   // A version-1 file has no variant: one that names one is refused rather than misread.
-  EXPECT_NE(with([](auto& j) { j["version"] = 1; }).find("field 'stage2.variant'"), std::string::npos);
+  EXPECT_NE(with([](auto& j) { j["version"] = 1; }).find("field 'stage2.variant'"),
+            std::string::npos);
 }
 
 }  // namespace

@@ -60,7 +60,8 @@ SpriteStore StoreOf(const std::vector<RgbaBillboard>& billboards) {
   SpriteStore store(CellPerPixel(), 100.0);
   std::vector<SpriteInput> inputs;
   for (size_t k = 0; k < billboards.size(); ++k) {
-    inputs.push_back({static_cast<int64_t>(k + 1), static_cast<int64_t>(k + 1), {}, &billboards[k]});
+    inputs.push_back(
+        {static_cast<int64_t>(k + 1), static_cast<int64_t>(k + 1), {}, &billboards[k]});
   }
   store.Append(inputs);
   return store;
@@ -72,14 +73,14 @@ uint64_t Exact(const SpriteStore& s, int32_t i, int32_t j) {
 
 TEST(TransitionSignature, BoundsOnHandMadeSprites) {
   const std::vector<RgbaBillboard> sprites = {
-      Sprite(Rectangle(8, 10, 20, 32, 255)),                          // 0: body
-      Sprite(Rectangle(10, 14, 18, 30, 255)),                         // 1: inside 0
-      Sprite(Rectangle(10, 10, 14, 32, 255)),                         // 2: a bar ...
-      Sprite({{0, 0, 255}, {1, 1, 255}}),                             // 3: a diagonal pair ...
-      Sprite({{1, 0, 255}, {0, 1, 255}}),                             // 4: ... and the other diagonal
-      Sprite(Rectangle(0, 0, 32, 32, 255)),                           // 5: everything
+      Sprite(Rectangle(8, 10, 20, 32, 255)),   // 0: body
+      Sprite(Rectangle(10, 14, 18, 30, 255)),  // 1: inside 0
+      Sprite(Rectangle(10, 10, 14, 32, 255)),  // 2: a bar ...
+      Sprite({{0, 0, 255}, {1, 1, 255}}),      // 3: a diagonal pair ...
+      Sprite({{1, 0, 255}, {0, 1, 255}}),      // 4: ... and the other diagonal
+      Sprite(Rectangle(0, 0, 32, 32, 255)),    // 5: everything
       Sprite({{3, 3, 100}, {30, 29, 7}, {16, 16, 255}, {17, 16, 1}}),  // 6: scattered alphas
-      Sprite(Rectangle(8, 10, 12, 32, 255)),                          // 7: ... and it 2 cells to the left
+      Sprite(Rectangle(8, 10, 12, 32, 255)),  // 7: ... and it 2 cells to the left
   };
   const SpriteStore s = StoreOf(sprites);
   // The images hold the painted alphas, so the exact difference is known by hand.
@@ -116,7 +117,8 @@ TEST(TransitionSignature, BoundsOnRandomSprites) {
     const int blobs = 1 + static_cast<int>(rng() % 4);
     for (int b = 0; b < blobs; ++b) {
       const int x0 = rng() % 28, y0 = rng() % 28;
-      for (const Cell& c : Rectangle(x0, y0, x0 + 1 + rng() % 4, y0 + 1 + rng() % 4, rng() % 256)) cells.push_back(c);
+      for (const Cell& c : Rectangle(x0, y0, x0 + 1 + rng() % 4, y0 + 1 + rng() % 4, rng() % 256))
+        cells.push_back(c);
     }
     sprites.push_back(Sprite(cells));
   }
@@ -159,7 +161,8 @@ TEST(TransitionSignature, NeverRejectsAPairStageTwoAccepts) {
         signature_rejected += excluded;
       }
     }
-    EXPECT_GT(accepted, 0) << "shift " << shift << ": some pairs must be accepted for the test to mean anything";
+    EXPECT_GT(accepted, 0) << "shift " << shift
+                           << ": some pairs must be accepted for the test to mean anything";
     EXPECT_GT(signature_rejected, rejected / 2) << "shift " << shift;
 
     TransitionBuilder builder(w, so.px_per_m);

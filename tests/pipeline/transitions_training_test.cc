@@ -43,7 +43,8 @@ Generated Generate(const PairFeatures& u, double t, double sharpness, int n, uin
   Generated g;
   for (int i = 0; i < n; ++i) {
     PairFeatures x;
-    for (int k = 0; k < kPairFeatureCount; ++k) x[k] = scale[k] * std::abs(std::log(uniform(rng) + 1e-12)) * 0.7;
+    for (int k = 0; k < kPairFeatureCount; ++k)
+      x[k] = scale[k] * std::abs(std::log(uniform(rng) + 1e-12)) * 0.7;
     double s = -t;
     for (int k = 0; k < kPairFeatureCount; ++k) s += u[k] * x[k];
     const double p_accept = 1.0 / (1.0 + std::exp(sharpness * s));
@@ -105,7 +106,8 @@ TEST(TransitionTraining, WeightsStayNonNegative) {
   // weight; the projected fit must hold it at exactly 0.
   Generated g = Generate({5.0, 0.02, 0, 0, 0, 0}, 1.0, 50, 3000, 3);
   for (size_t i = 0; i < g.x.size(); ++i) g.x[i][5] = g.accept[i] ? 40 + g.x[i][5] : g.x[i][5];
-  const TransitionWeights w = TrainWeights(g.x, g.accept, ComparisonWindow{}, TrainOptions{}, nullptr);
+  const TransitionWeights w =
+      TrainWeights(g.x, g.accept, ComparisonWindow{}, TrainOptions{}, nullptr);
   for (double v : w.stage1_weights) EXPECT_GE(v, 0.0);
   for (double v : w.stage2_weights) EXPECT_GE(v, 0.0);
   EXPECT_EQ(w.stage2_weights[5], 0.0);
@@ -114,12 +116,14 @@ TEST(TransitionTraining, WeightsStayNonNegative) {
   free.non_negative = false;
   std::vector<double> z;
   for (const auto& x : g.x) z.push_back((x[5] - 20) / 20);
-  EXPECT_LT(FitLogistic(z, 1, g.accept, free).weights[0], 0.0) << "the data must really pull the weight negative";
+  EXPECT_LT(FitLogistic(z, 1, g.accept, free).weights[0], 0.0)
+      << "the data must really pull the weight negative";
 }
 
 TEST(TransitionTraining, TooFewOrOneClassIsAnInputError) {
   Generated g = Generate({1, 0, 0, 0, 0, 0}, 0.05, 1e6, 6, 4);
-  EXPECT_THROW(TrainWeights(g.x, g.accept, ComparisonWindow{}, TrainOptions{}, nullptr), InputError);
+  EXPECT_THROW(TrainWeights(g.x, g.accept, ComparisonWindow{}, TrainOptions{}, nullptr),
+               InputError);
   g = Generate({1, 0, 0, 0, 0, 0}, 1e9, 1, 100, 4);  // everything accepted
   try {
     TrainWeights(g.x, g.accept, ComparisonWindow{}, TrainOptions{}, nullptr);
@@ -145,8 +149,8 @@ TEST(TransitionTraining, CalibrationKeepsTheRequestedRecall) {
 }
 
 TEST(TransitionTraining, TruthLabels) {
-  SpriteTruth a{"walk", 0.1, 0.98}, b{"walk", 0.1 + 0.1, 0.015}, c{"trot", 0.1, 0.98}, d{"idle", 3.0, std::nan("")},
-      e{"idle", 3.0 + 2 * M_PI - 0.05, std::nan("")};
+  SpriteTruth a{"walk", 0.1, 0.98}, b{"walk", 0.1 + 0.1, 0.015}, c{"trot", 0.1, 0.98},
+      d{"idle", 3.0, std::nan("")}, e{"idle", 3.0 + 2 * M_PI - 0.05, std::nan("")};
   const TruthLabelOptions o;
   EXPECT_TRUE(TruthAccepts(a, b, o));  // heading 5.7 deg apart, phase 0.035 apart across the wrap
   EXPECT_TRUE(TruthAccepts(b, a, o));
@@ -241,7 +245,8 @@ TEST(TransitionTraining, KeypointTruth) {
     for (size_t i = 0; i < got.size(); ++i) {
       size_t match = got.size();
       for (size_t q = 0; q < want.size(); ++q) {
-        if (std::abs(got[i].first - want[q].first) < 1e-9 && std::abs(got[i].second - want[q].second) < 1e-9 &&
+        if (std::abs(got[i].first - want[q].first) < 1e-9 &&
+            std::abs(got[i].second - want[q].second) < 1e-9 &&
             (match == got.size() || pv[q] == mv[i])) {
           match = q;
         }
@@ -314,7 +319,8 @@ TEST(TransitionTraining, TrainsOnSyntheticTruth) {
   TrainWeights(x, y, ComparisonWindow{}, TrainOptions{}, &report);
   EXPECT_GT(report.stage2.precision(), 0.8);
   EXPECT_GT(report.stage2.recall(), 0.8);
-  EXPECT_GE(report.stage2.precision() + report.stage2.recall(), report.stage1.precision() + report.stage1.recall() - 0.02)
+  EXPECT_GE(report.stage2.precision() + report.stage2.recall(),
+            report.stage1.precision() + report.stage1.recall() - 0.02)
       << "the pixel features must not make stage 2 worse than stage 1";
 }
 
@@ -392,25 +398,40 @@ TEST(TransitionWeightsFile, WrongFilesNameTheFileAndField) {
   EXPECT_NE(ErrorOf("{not json").find("w.json: not valid JSON"), std::string::npos);
   EXPECT_NE(ErrorOf("[1,2]").find("top level"), std::string::npos);
 
-  nlohmann::json good = nlohmann::json::parse(WeightsToJson(testing::UnitWeights({1, 1, 1, 1, 1, 1}, 1, 1)));
+  nlohmann::json good =
+      nlohmann::json::parse(WeightsToJson(testing::UnitWeights({1, 1, 1, 1, 1, 1}, 1, 1)));
   EXPECT_EQ(ErrorOf(good.dump()), "");
   auto with = [&](const std::function<void(nlohmann::json&)>& edit) {
     nlohmann::json j = good;
     edit(j);
     return ErrorOf(j.dump());
   };
-  EXPECT_NE(with([](auto& j) { j["version"] = 3; }).find("field 'version'"), std::string::npos);  // 2 exists now
+  EXPECT_NE(with([](auto& j) { j["version"] = 3; }).find("field 'version'"),
+            std::string::npos);  // 2 exists now
   EXPECT_NE(with([](auto& j) { j["format"] = "other"; }).find("field 'format'"), std::string::npos);
-  EXPECT_NE(with([](auto& j) { j["stage1"]["weights"][2] = -0.5; }).find("field 'stage1.weights'"), std::string::npos);
-  EXPECT_NE(with([](auto& j) { j["stage1"]["weights"] = {1, 2}; }).find("field 'stage1.weights'"), std::string::npos);
-  EXPECT_NE(with([](auto& j) { j["stage2"].erase("bias"); }).find("field 'stage2.bias': missing"), std::string::npos);
-  EXPECT_NE(with([](auto& j) { j["stage2"]["bias"] = "x"; }).find("field 'stage2.bias'"), std::string::npos);
-  EXPECT_NE(with([](auto& j) { j["feature_scale"][0] = 0; }).find("field 'feature_scale'"), std::string::npos);
-  EXPECT_NE(with([](auto& j) { j["features"][0] = "speed"; }).find("field 'features'"), std::string::npos);
-  EXPECT_NE(with([](auto& j) { j["comparison_window"]["cells_x"] = 0; }).find("comparison_window"), std::string::npos);
-  EXPECT_NE(with([](auto& j) { j["comparison_window"]["align"] = "left"; }).find("comparison_window.align"),
+  EXPECT_NE(with([](auto& j) { j["stage1"]["weights"][2] = -0.5; }).find("field 'stage1.weights'"),
             std::string::npos);
-  EXPECT_NE(with([](auto& j) { j.erase("comparison_window"); }).find("field 'comparison_window.width_m': missing"),
+  EXPECT_NE(with([](auto& j) {
+              j["stage1"]["weights"] = {1, 2};
+            }).find("field 'stage1.weights'"),
+            std::string::npos);
+  EXPECT_NE(with([](auto& j) { j["stage2"].erase("bias"); }).find("field 'stage2.bias': missing"),
+            std::string::npos);
+  EXPECT_NE(with([](auto& j) { j["stage2"]["bias"] = "x"; }).find("field 'stage2.bias'"),
+            std::string::npos);
+  EXPECT_NE(with([](auto& j) { j["feature_scale"][0] = 0; }).find("field 'feature_scale'"),
+            std::string::npos);
+  EXPECT_NE(with([](auto& j) { j["features"][0] = "speed"; }).find("field 'features'"),
+            std::string::npos);
+  EXPECT_NE(with([](auto& j) { j["comparison_window"]["cells_x"] = 0; }).find("comparison_window"),
+            std::string::npos);
+  EXPECT_NE(with([](auto& j) {
+              j["comparison_window"]["align"] = "left";
+            }).find("comparison_window.align"),
+            std::string::npos);
+  EXPECT_NE(with([](auto& j) {
+              j.erase("comparison_window");
+            }).find("field 'comparison_window.width_m': missing"),
             std::string::npos);
   // A builder refuses invalid weights the same way.
   TransitionWeights bad = testing::UnitWeights({1, 1, 1, 1, 1, 1}, 1, 1);

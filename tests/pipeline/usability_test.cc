@@ -16,7 +16,8 @@ namespace {
 // so that the 0.6 x 0.4 m floor fills the middle of a 640x480 image.
 CameraModel DownCamera() {
   Rigid3 cam_from_ground;
-  cam_from_ground.rotation << 1, 0, 0, 0, -1, 0, 0, 0, -1;  // x right, y down the image = -y ground, z down
+  cam_from_ground.rotation << 1, 0, 0, 0, -1, 0, 0, 0,
+      -1;  // x right, y down the image = -y ground, z down
   cam_from_ground.translation = Eigen::Vector3d(0, 0, 1.0);
   return CameraModel("LENSMODEL_PINHOLE", {500, 500, 320, 240}, 640, 480, cam_from_ground);
 }
@@ -42,12 +43,13 @@ TEST(FloorMask, InterpolatedRaysMatchExactUnprojection) {
   const double tilt = 35.0 * M_PI / 180.0;
   Rigid3 cam_from_ground;
   // Camera looking along ground +y, tilted down: x right, y down, z forward.
-  cam_from_ground.rotation << 1, 0, 0,  //
+  cam_from_ground.rotation << 1, 0, 0,      //
       0, -std::sin(tilt), -std::cos(tilt),  //
       0, std::cos(tilt), -std::sin(tilt);
   const Eigen::Vector3d centre(0.1, -1.2, 1.6);
   cam_from_ground.translation = -cam_from_ground.rotation * centre;
-  const CameraModel cam("LENSMODEL_OPENCV8", {420, 425, 322, 236, -0.28, 0.09, 0.001, -0.002, -0.012, 0, 0, 0}, 640, 480,
+  const CameraModel cam("LENSMODEL_OPENCV8",
+                        {420, 425, 322, 236, -0.28, 0.09, 0.001, -0.002, -0.012, 0, 0, 0}, 640, 480,
                         cam_from_ground);
   const GroundPolygon floor({{-2.0, -0.2}, {2.1, -0.3}, {2.2, 3.9}, {-1.9, 4.0}});
   UsabilityOptions options;
@@ -76,7 +78,8 @@ TEST(FloorMask, InterpolatedRaysMatchExactUnprojection) {
   cv::erode(exact, shrunk, cv::Mat());
   cv::compare(grown, shrunk, edge, cv::CMP_NE);
   EXPECT_EQ(cv::countNonZero(differ & ~edge), 0);
-  EXPECT_LE(cv::countNonZero(differ), floor_pixels / 1000) << "of " << floor_pixels << " floor pixels";
+  EXPECT_LE(cv::countNonZero(differ), floor_pixels / 1000)
+      << "of " << floor_pixels << " floor pixels";
 }
 
 // Issue 20: the mask tested every pixel against every edge (~13 s a 640x480 camera at 10,000
@@ -87,13 +90,14 @@ TEST(FloorMask, InterpolatedRaysMatchExactUnprojection) {
 TEST(FloorMask, TheIndexedMaskIsTheMaskOfEveryEdge) {
   const double tilt = 35.0 * M_PI / 180.0;
   Rigid3 cam_from_ground;
-  cam_from_ground.rotation << 1, 0, 0,  //
+  cam_from_ground.rotation << 1, 0, 0,      //
       0, -std::sin(tilt), -std::cos(tilt),  //
       0, std::cos(tilt), -std::sin(tilt);
   const Eigen::Vector3d centre(0.1, -1.2, 1.6);
   cam_from_ground.translation = -cam_from_ground.rotation * centre;
-  const CameraModel tilted("LENSMODEL_OPENCV8", {420, 425, 322, 236, -0.28, 0.09, 0.001, -0.002, -0.012, 0, 0, 0},
-                           640, 480, cam_from_ground);
+  const CameraModel tilted("LENSMODEL_OPENCV8",
+                           {420, 425, 322, 236, -0.28, 0.09, 0.001, -0.002, -0.012, 0, 0, 0}, 640,
+                           480, cam_from_ground);
   const CameraModel down = DownCamera();
 
   std::mt19937 rng(20);
@@ -118,7 +122,9 @@ TEST(FloorMask, TheIndexedMaskIsTheMaskOfEveryEdge) {
   floors.emplace_back("comb", GroundPolygon(comb));
   // Straight down at 1 m, f = 500: pixel x sees ground x = (x - 320) / 500, multiples of 1/500 m:
   // a polygon on that grid puts ground points on (or within rounding of) its vertices and edges.
-  floors.emplace_back("grid-aligned", GroundPolygon({{-0.3, -0.2}, {0.3, -0.2}, {0.3, 0.2}, {0.0, 0.0}, {-0.3, 0.2}}));
+  floors.emplace_back(
+      "grid-aligned",
+      GroundPolygon({{-0.3, -0.2}, {0.3, -0.2}, {0.3, 0.2}, {0.0, 0.0}, {-0.3, 0.2}}));
 
   for (const auto& named : floors) {
     const std::string& name = named.first;
@@ -130,8 +136,8 @@ TEST(FloorMask, TheIndexedMaskIsTheMaskOfEveryEdge) {
         UsabilityOptions options;
         options.wall_height_m = wall_height_m;
         const FloorMask mask(*cam, floor, options);
-        const cv::Mat every_edge =
-            FloorPixels(*cam, wall_height_m, [&](const Eigen::Vector2d& p) { return floor.Contains(p); });
+        const cv::Mat every_edge = FloorPixels(
+            *cam, wall_height_m, [&](const Eigen::Vector2d& p) { return floor.Contains(p); });
         cv::Mat differ;
         cv::compare(mask.mask(), every_edge, differ, cv::CMP_NE);
         EXPECT_EQ(cv::countNonZero(differ), 0) << name << ", walls " << wall_height_m << ", camera "
@@ -182,7 +188,8 @@ TEST(FloorMask, ATallSubjectSeenAgainstTheBackgroundIsNotTouchingAWall) {
   EXPECT_EQ(FloorMask(cam, stage, {}).Check(middle, offset, {0.0, 0.5}), Discard::kNone);
   UsabilityOptions every_pixel;  // the check before: any non-floor pixel under the silhouette
   every_pixel.wall_check_height_m = 0;
-  EXPECT_EQ(FloorMask(cam, stage, every_pixel).Check(middle, offset, {0.0, 0.5}), Discard::kTouchesWall);
+  EXPECT_EQ(FloorMask(cam, stage, every_pixel).Check(middle, offset, {0.0, 0.5}),
+            Discard::kTouchesWall);
   // Against the back wall its legs are seen past the floor too: that is touching the wall.
   const cv::Mat back = person({0.0, 2.95}, &offset);
   EXPECT_EQ(FloorMask(cam, stage, {}).Check(back, offset, {0.0, 2.95}), Discard::kTouchesWall);
@@ -223,7 +230,8 @@ TEST(MatteShape, ASolidFigureIsThickSolidAndWhole) {
   cv::Mat a = Blank(60, 120);
   cv::ellipse(a, {30, 60}, {14, 50}, 0, 0, 360, cv::Scalar(255), cv::FILLED);
   const MatteShape s = MeasureMatteShape(a, 2.0);
-  EXPECT_NEAR(s.area_px, CV_PI * 14.5 * 50.5, 0.03 * CV_PI * 14.5 * 50.5);  // drawn with its outline
+  EXPECT_NEAR(s.area_px, CV_PI * 14.5 * 50.5,
+              0.03 * CV_PI * 14.5 * 50.5);  // drawn with its outline
   EXPECT_GT(s.solidity, 0.95);
   EXPECT_GT(s.thick_share, 0.8);
   EXPECT_DOUBLE_EQ(s.largest_share, 1.0);

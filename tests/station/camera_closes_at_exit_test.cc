@@ -10,7 +10,9 @@ namespace {
 
 class WaitForCameraClosesAtExit : public ::testing::Environment {
  public:
-  void TearDown() override { EXPECT_TRUE(ss::WaitForCameraCloses(30.0)) << "a camera source is still closing"; }
+  void TearDown() override {
+    EXPECT_TRUE(ss::WaitForCameraCloses(30.0)) << "a camera source is still closing";
+  }
 };
 
 [[maybe_unused]] ::testing::Environment* const kWaitForCloses =

@@ -17,11 +17,13 @@ namespace {
 // `fail_after` frames, as an unplugged camera does.
 class GreenSource : public FrameSource {
  public:
-  GreenSource(int fail_after) : fail_after_(fail_after), cameras_{{"cam0", 320, 240, PixelFormat::kBGR8, 30, ""}} {}
+  GreenSource(int fail_after)
+      : fail_after_(fail_after), cameras_{{"cam0", 320, 240, PixelFormat::kBGR8, 30, ""}} {}
   const std::vector<SourceCamera>& cameras() const override { return cameras_; }
   std::optional<Frame> Next() override {
     if (stopped_) return std::nullopt;
-    if (fail_after_ >= 0 && next_ >= static_cast<uint64_t>(fail_after_)) throw WorkError("cam0", "unplugged");
+    if (fail_after_ >= 0 && next_ >= static_cast<uint64_t>(fail_after_))
+      throw WorkError("cam0", "unplugged");
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
     std::vector<uint8_t> pixels(320 * 240 * 3);
     for (size_t i = 0; i < pixels.size(); i += 3) {
@@ -62,7 +64,8 @@ TEST(CameraRunner, AReopenedCameraLearnsFromItsNewStreamOnly) {
   o.open_source = [&](const CameraConfig&, int) -> std::unique_ptr<FrameSource> {
     return std::make_unique<GreenSource>(opens++ == 0 ? 12 : -1);
   };
-  CameraRunner runner(0, o, [](StationBatch) {}, nullptr);
+  CameraRunner runner(
+      0, o, [](StationBatch) {}, nullptr);
   runner.Start();
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(20);
   CameraStatus status = runner.status();

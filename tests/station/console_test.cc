@@ -28,7 +28,8 @@ namespace {
 using ss::testing::ScratchDir;
 
 // Splits an event stream's text into (event name, data) pairs, checking the ids count up.
-std::vector<std::pair<std::string, nlohmann::json>> ParseEvents(const std::string& text, uint64_t* next_id) {
+std::vector<std::pair<std::string, nlohmann::json>> ParseEvents(const std::string& text,
+                                                                uint64_t* next_id) {
   std::vector<std::pair<std::string, nlohmann::json>> out;
   size_t at = 0;
   while (at < text.size()) {
@@ -56,10 +57,11 @@ TEST(Console, MergePatchTurnsOneStateIntoTheOther) {
                             {"session", {{"active", false}, {"name", ""}}},
                             {"cameras", {{{"name", "cam0"}, {"fps", 30.0}}}},
                             {"gone", 1}};
-  const nlohmann::json b = {{"state", "running"},
-                            {"session", {{"active", true}, {"name", "take 1"}}},
-                            {"cameras", {{{"name", "cam0"}, {"fps", 29.5}}, {{"name", "cam1"}, {"fps", 30.0}}}},
-                            {"new", {{"x", 2}}}};
+  const nlohmann::json b = {
+      {"state", "running"},
+      {"session", {{"active", true}, {"name", "take 1"}}},
+      {"cameras", {{{"name", "cam0"}, {"fps", 29.5}}, {{"name", "cam1"}, {"fps", 30.0}}}},
+      {"new", {{"x", 2}}}};
   const nlohmann::json patch = MergePatch(a, b);
   EXPECT_FALSE(patch.contains("state"));  // unchanged members are not sent
   EXPECT_TRUE(patch["gone"].is_null());
@@ -112,7 +114,8 @@ TEST(Console, ExposureFiguresMeasureTheGreenScreen) {
   EXPECT_NEAR(even.clipped_percent, 100.0 * 200 * 10 / (400 * 200), 0.5);
   EXPECT_NEAR(even.green_uniformity, 1.0, 1e-9);
   EXPECT_NEAR(even.green_min_max, 1.0, 1e-9);
-  EXPECT_EQ(even.histogram_g[180 * 32 / 256], static_cast<uint32_t>(100 * 100));  // every 2nd pixel and row
+  EXPECT_EQ(even.histogram_g[180 * 32 / 256],
+            static_cast<uint32_t>(100 * 100));  // every 2nd pixel and row
   // Now lit from one side: green falls from 220 to 60 across the screen.
   for (int x = 0; x < 200; ++x) {
     const int g = 220 - x * 160 / 200;
@@ -192,7 +195,8 @@ TEST(Console, ReplayFoldersListSessionsAndMakeAReplayConfig) {
   WriteSessionInfo(dir / "a/walk", info);
   std::filesystem::create_directories(dir.path() / "broken");
   std::ofstream(dir / "broken/session.json") << "{not json";
-  const auto sessions = FindRecordedSessions({dir.path().string(), (dir.path() / "missing").string()});
+  const auto sessions =
+      FindRecordedSessions({dir.path().string(), (dir.path() / "missing").string()});
   ASSERT_EQ(sessions.size(), 2u);
   EXPECT_EQ(sessions[0].path, (dir.path() / "a" / "walk").string());
   EXPECT_EQ(sessions[0].info.cameras.size(), 2u);
@@ -243,7 +247,8 @@ TEST(Console, TheBankViewShowsClipsSpritesAndTagsARunOfFrames) {
   std::vector<int64_t> ids;
   {
     BankWriter w(path);
-    const int64_t session = w.AddSession({0, "take-1@x", "take 1", "2026-12-01T10:00:00Z", "station"});
+    const int64_t session =
+        w.AddSession({0, "take-1@x", "take 1", "2026-12-01T10:00:00Z", "station"});
     const int64_t camera = w.AddCamera(session, {0, 0, "cam0", "", 640, 480});
     std::vector<SpriteRecord> batch;
     for (int64_t f = 10; f < 16; ++f) {
@@ -288,7 +293,9 @@ TEST(Console, TheBankViewShowsClipsSpritesAndTagsARunOfFrames) {
   EXPECT_EQ(image.size(), cv::Size(10, 20));
   EXPECT_EQ(image.channels(), 4);
   // Frames 11..13 tagged: their originals and mirrors.
-  EXPECT_EQ(bank.Tag({{"tag", "stand"}, {"clip", clip_id}, {"first_frame", 11}, {"last_frame", 13}}, false), 6);
+  EXPECT_EQ(bank.Tag({{"tag", "stand"}, {"clip", clip_id}, {"first_frame", 11}, {"last_frame", 13}},
+                     false),
+            6);
   EXPECT_EQ(Bank(path).SpritesTagged("stand").size(), 6u);
   EXPECT_EQ(bank.Clips(sessions[0]["id"])[0]["tags"]["stand"], 3);
   EXPECT_THROW(bank.Tag({{"tag", "bad tag!"}, {"sprites", {ids[0]}}}, false), InputError);

@@ -32,8 +32,8 @@ using ss::testing::ScratchDir;
 // A bank of synthetic clips (originals and mirrors) with each original's truth.
 struct SyntheticBank {
   std::string path;
-  std::vector<int64_t> originals;   // bank ids
-  std::vector<SpriteTruth> truth;   // of originals[k]
+  std::vector<int64_t> originals;  // bank ids
+  std::vector<SpriteTruth> truth;  // of originals[k]
 };
 
 SyntheticBank MakeBank(const std::string& path, int frames) {
@@ -70,8 +70,9 @@ SyntheticBank MakeBank(const std::string& path, int frames) {
     r.anchor_y_px = s.billboard.anchor_y_px;
     r.bbox_in_image = cv::Rect(0, 0, s.billboard.width, s.billboard.height);
     if (!mirrored) {
-      r.pixels.bgra =
-          cv::Mat(s.billboard.height, s.billboard.width, CV_8UC4, const_cast<uint8_t*>(s.billboard.rgba.data())).clone();
+      r.pixels.bgra = cv::Mat(s.billboard.height, s.billboard.width, CV_8UC4,
+                              const_cast<uint8_t*>(s.billboard.rgba.data()))
+                          .clone();
     }
     return r;
   };
@@ -133,7 +134,8 @@ TEST(ConsoleLabels, StoresCountsExportsAndNamesBadInput) {
   labels.Store({{"from", a}, {"to", b}, {"label", "yes"}});
   labels.Store({{"from", b}, {"to", c}, {"label", "no"}});
   const nlohmann::json last = labels.Store({{"from", a}, {"to", c}, {"label", "skip"}});
-  EXPECT_EQ(last["labels"], (nlohmann::json{{"yes", 1}, {"no", 1}, {"skip", 1}, {"total", 3}, {"exportable", 2}}));
+  EXPECT_EQ(last["labels"],
+            (nlohmann::json{{"yes", 1}, {"no", 1}, {"skip", 1}, {"total", 3}, {"exportable", 2}}));
   // Stored in the bank, as it was said.
   const auto rows = Bank(bank.path).LoadTransitionLabels();
   ASSERT_EQ(rows.size(), 3u);
@@ -145,8 +147,9 @@ TEST(ConsoleLabels, StoresCountsExportsAndNamesBadInput) {
   const std::string csv = labels.ExportCsv();
   char rate_line[64];
   std::snprintf(rate_line, sizeof(rate_line), "# positive_rate=%.9g\n", rate);
-  EXPECT_EQ(csv, std::string(rate_line) + "sprite_i,sprite_j,accept\n" + std::to_string(a) + "," + std::to_string(b) +
-                     ",1\n" + std::to_string(b) + "," + std::to_string(c) + ",0\n");
+  EXPECT_EQ(csv, std::string(rate_line) + "sprite_i,sprite_j,accept\n" + std::to_string(a) + "," +
+                     std::to_string(b) + ",1\n" + std::to_string(b) + "," + std::to_string(c) +
+                     ",0\n");
 
   // Bad input names what is wrong.
   std::string e = ErrorOf([&] { labels.Store({{"from", a}, {"to", 999999}, {"label", "yes"}}); });
@@ -157,10 +160,19 @@ TEST(ConsoleLabels, StoresCountsExportsAndNamesBadInput) {
   EXPECT_EQ(e.rfind("label:", 0), 0u) << e;
   EXPECT_NE(e.find("maybe"), std::string::npos) << e;
   EXPECT_EQ(ErrorOf([&] { labels.Store({{"from", a}, {"to", b}}); }).rfind("label:", 0), 0u);
-  EXPECT_EQ(ErrorOf([&] { labels.Store({{"from", a}, {"to", b}, {"label", 1}}); }).rfind("label:", 0), 0u);
-  EXPECT_EQ(ErrorOf([&] { labels.Store({{"from", "x"}, {"to", b}, {"label", "yes"}}); }).rfind("from:", 0), 0u);
+  EXPECT_EQ(ErrorOf([&] {
+              labels.Store({{"from", a}, {"to", b}, {"label", 1}});
+            }).rfind("label:", 0),
+            0u);
+  EXPECT_EQ(ErrorOf([&] {
+              labels.Store({{"from", "x"}, {"to", b}, {"label", "yes"}});
+            }).rfind("from:", 0),
+            0u);
   EXPECT_EQ(ErrorOf([&] { labels.Store({{"from", a}, {"label", "yes"}}); }).rfind("to:", 0), 0u);
-  EXPECT_EQ(ErrorOf([&] { labels.Store({{"from", a}, {"to", a}, {"label", "yes"}}); }).rfind("to:", 0), 0u);
+  EXPECT_EQ(ErrorOf([&] {
+              labels.Store({{"from", a}, {"to", a}, {"label", "yes"}});
+            }).rfind("to:", 0),
+            0u);
   EXPECT_EQ(Bank(bank.path).LoadTransitionLabels().size(), 3u) << "nothing stored by bad input";
   // Undo removes one; a second undo of it is a 404.
   EXPECT_EQ(labels.Undo({{"from", a}, {"to", c}})["labels"]["skip"], 0);
@@ -207,7 +219,8 @@ TEST(ConsoleLabels, AsksTheLeastSurePairsFirstAndNeverAgain) {
         if (j == i || store.prev(j) < 0 || store.next(j) < 0) continue;
         if (store.clip(i) == store.clip(j) && std::abs(i - j) <= 2) continue;
         if (!classifier.Stage1Accepts(store.cheap(i), store.cheap(j))) continue;
-        best = std::min(best, std::abs(classifier.Distance(store.Features(i, j)) - classifier.stage2_threshold()));
+        best = std::min(best, std::abs(classifier.Distance(store.Features(i, j)) -
+                                       classifier.stage2_threshold()));
       }
     }
     EXPECT_NEAR(std::abs(pairs[0]["margin"].get<double>()), best, 1e-9);
@@ -231,7 +244,11 @@ TEST(ConsoleLabels, AsksTheLeastSurePairsFirstAndNeverAgain) {
   std::string e = ErrorOf([&] { labels.Pair(pairs[1]["from"], 999999); });
   EXPECT_EQ(e, "sprite: no sprite with id 999999 in the bank");
   e = ErrorOf([&] { labels.Pair(bank.originals[0], pairs[1]["to"]); });  // a clip's first frame
-  EXPECT_EQ(e.rfind("from: sprite " + std::to_string(bank.originals[0]) + " is the first or last frame", 0), 0u) << e;
+  EXPECT_EQ(
+      e.rfind("from: sprite " + std::to_string(bank.originals[0]) + " is the first or last frame",
+              0),
+      0u)
+      << e;
   // A labelled pair (in either order) is not asked again.
   labels.Store({{"from", pairs[0]["to"]}, {"to", pairs[0]["from"]}, {"label", "skip"}});
   const nlohmann::json again = labels.Pairs(8);
@@ -239,7 +256,8 @@ TEST(ConsoleLabels, AsksTheLeastSurePairsFirstAndNeverAgain) {
     EXPECT_FALSE(p["from"] == pairs[0]["from"] && p["to"] == pairs[0]["to"]);
     EXPECT_FALSE(p["from"] == pairs[0]["to"] && p["to"] == pairs[0]["from"]);
   }
-  EXPECT_GE(std::abs(again["pairs"][0]["margin"].get<double>()), std::abs(pairs[0]["margin"].get<double>()));
+  EXPECT_GE(std::abs(again["pairs"][0]["margin"].get<double>()),
+            std::abs(pairs[0]["margin"].get<double>()));
 }
 
 TEST(ConsoleLabels, TheExportTrainsAndARetrainRebuildsTheTable) {
@@ -247,7 +265,8 @@ TEST(ConsoleLabels, TheExportTrainsAndARetrainRebuildsTheTable) {
   const SyntheticBank bank = MakeBank(dir / "bank.db", 600);
   ConsoleLabels labels = Labels(bank);
   // A person who judges as the truth does: labels of the bank's originals, half accepts.
-  const std::vector<Label> truth = LabelsFromTruth(bank.originals, bank.truth, 240, TruthLabelOptions{}, 7);
+  const std::vector<Label> truth =
+      LabelsFromTruth(bank.originals, bank.truth, 240, TruthLabelOptions{}, 7);
   ASSERT_GT(truth.size(), 200u);
   for (const Label& l : truth) {
     labels.Store({{"from", l.sprite_i}, {"to", l.sprite_j}, {"label", l.accept ? "yes" : "no"}});
@@ -278,7 +297,8 @@ TEST(ConsoleLabels, TheExportTrainsAndARetrainRebuildsTheTable) {
   const nlohmann::json r = labels.RetrainState();
   ASSERT_EQ(r["state"], "done") << r.dump(1);
   EXPECT_EQ(r["progress"], 1.0);
-  EXPECT_NEAR(r["precision"].get<double>(), trained.report.stage2.precision(), 1e-12) << "the same folds";
+  EXPECT_NEAR(r["precision"].get<double>(), trained.report.stage2.precision(), 1e-12)
+      << "the same folds";
   EXPECT_NEAR(r["recall"].get<double>(), trained.report.stage2.recall(), 1e-12);
   const std::string weights_path = r["weights"];
   EXPECT_EQ(fs::path(weights_path).parent_path(), fs::path(dir / "weights"));

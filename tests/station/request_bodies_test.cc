@@ -38,7 +38,9 @@ TEST(RequestBodies, ObjectBodyTakesAnObjectWithTheRoutesMembersOnly) {
 // stack when the error message quoted the value (nlohmann::json writes by recursion), and the
 // daemon died. Bodies nest 32 levels at most; the API needs 3.
 TEST(RequestBodies, ADeeplyNestedBodyIsRefusedWhileItIsParsed) {
-  const auto nested = [](size_t depth) { return R"({"name": )" + std::string(depth, '[') + std::string(depth, ']') + "}"; };
+  const auto nested = [](size_t depth) {
+    return R"({"name": )" + std::string(depth, '[') + std::string(depth, ']') + "}";
+  };
   const std::string deep = nested(524000);
   ASSERT_LE(deep.size(), 1u << 20);
   try {
@@ -57,34 +59,51 @@ TEST(RequestBodies, SessionReplayAndTagRequests) {
   EXPECT_EQ(ParseSessionName(Body("", kSessionFields), false, true), "");
   EXPECT_EQ(FieldOf([] { ParseSessionName(Body("", kSessionFields), true, true); }), "body");
   EXPECT_EQ(FieldOf([] { ParseSessionName(Body("{}", kSessionFields), true, false); }), "name");
-  EXPECT_EQ(FieldOf([] { ParseSessionName(Body(R"({"name": 1})", kSessionFields), false, false); }), "name");
+  EXPECT_EQ(FieldOf([] { ParseSessionName(Body(R"({"name": 1})", kSessionFields), false, false); }),
+            "name");
 
-  const ReplayStartRequest replay = ParseReplayStart(Body(R"({"path": "/s", "loop": true})", kReplayStartFields));
+  const ReplayStartRequest replay =
+      ParseReplayStart(Body(R"({"path": "/s", "loop": true})", kReplayStartFields));
   EXPECT_EQ(replay.path, "/s");
   EXPECT_TRUE(replay.paced);
   EXPECT_TRUE(replay.loop);
-  EXPECT_EQ(FieldOf([] { ParseReplayStart(Body(R"({"path": "/s", "paced": 1})", kReplayStartFields)); }), "paced");
+  EXPECT_EQ(
+      FieldOf([] { ParseReplayStart(Body(R"({"path": "/s", "paced": 1})", kReplayStartFields)); }),
+      "paced");
 
   const TagRequest sprites = ParseTag(Body(R"({"tag": "walk", "sprites": [3, 4]})", kTagFields));
   EXPECT_EQ(sprites.sprites, (std::vector<int64_t>{3, 4}));
-  const TagRequest run = ParseTag(Body(R"({"tag": "walk", "clip": 2, "first_frame": 5, "last_frame": 9})", kTagFields));
+  const TagRequest run = ParseTag(
+      Body(R"({"tag": "walk", "clip": 2, "first_frame": 5, "last_frame": 9})", kTagFields));
   EXPECT_TRUE(run.sprites.empty());
   EXPECT_EQ(run.clip, 2);
   EXPECT_EQ(run.last_frame, 9);
-  EXPECT_EQ(FieldOf([] { ParseTag(Body(R"({"tag": "a b", "sprites": [1]})", kTagFields)); }), "tag");
-  EXPECT_EQ(FieldOf([] { ParseTag(Body(R"({"tag": "a", "sprites": []})", kTagFields)); }), "sprites");
-  EXPECT_EQ(FieldOf([] { ParseTag(Body(R"({"tag": "a", "clip": 1, "first_frame": 5, "last_frame": 4})", kTagFields)); }),
-            "last_frame");
+  EXPECT_EQ(FieldOf([] { ParseTag(Body(R"({"tag": "a b", "sprites": [1]})", kTagFields)); }),
+            "tag");
+  EXPECT_EQ(FieldOf([] { ParseTag(Body(R"({"tag": "a", "sprites": []})", kTagFields)); }),
+            "sprites");
+  EXPECT_EQ(
+      FieldOf([] {
+        ParseTag(Body(R"({"tag": "a", "clip": 1, "first_frame": 5, "last_frame": 4})", kTagFields));
+      }),
+      "last_frame");
 }
 
 TEST(RequestBodies, LabelRequests) {
-  const LabelRequest label = ParseLabel(Body(R"({"from": 1, "to": 2, "label": "yes"})", kLabelFields));
+  const LabelRequest label =
+      ParseLabel(Body(R"({"from": 1, "to": 2, "label": "yes"})", kLabelFields));
   EXPECT_EQ(label.from, 1);
   EXPECT_EQ(label.to, 2);
   EXPECT_EQ(label.label, "yes");
-  EXPECT_EQ(FieldOf([] { ParseLabel(Body(R"({"from": 0, "to": 2, "label": "yes"})", kLabelFields)); }), "from");
-  EXPECT_EQ(FieldOf([] { ParseLabel(Body(R"({"from": 2, "to": 2, "label": "yes"})", kLabelFields)); }), "to");
-  EXPECT_EQ(FieldOf([] { ParseLabel(Body(R"({"from": 1, "to": 2, "label": "maybe"})", kLabelFields)); }), "label");
+  EXPECT_EQ(
+      FieldOf([] { ParseLabel(Body(R"({"from": 0, "to": 2, "label": "yes"})", kLabelFields)); }),
+      "from");
+  EXPECT_EQ(
+      FieldOf([] { ParseLabel(Body(R"({"from": 2, "to": 2, "label": "yes"})", kLabelFields)); }),
+      "to");
+  EXPECT_EQ(
+      FieldOf([] { ParseLabel(Body(R"({"from": 1, "to": 2, "label": "maybe"})", kLabelFields)); }),
+      "label");
   EXPECT_EQ(ParseLabelUndo(Body(R"({"from": 7, "to": 8})", kLabelUndoFields)).to, 8);
 }
 
@@ -107,36 +126,62 @@ TEST(RequestBodies, CalibrationWizardRequests) {
   EXPECT_EQ(start_field(R"({"cameras": ["cam0"]})"), "board");
   EXPECT_EQ(start_field(R"({"board": "chessboard:2x7:0.03"})"), "board");
   EXPECT_EQ(start_field(R"({"board": "chessboard:10x7:0.03", "min_views": 1})"), "min_views");
-  EXPECT_EQ(start_field(R"({"board": "chessboard:10x7:0.03", "board_pose": [1, 2]})"), "board_pose");
+  EXPECT_EQ(start_field(R"({"board": "chessboard:10x7:0.03", "board_pose": [1, 2]})"),
+            "board_pose");
   EXPECT_EQ(start_field(R"({"board": "chessboard:10x7:0.03", "cameras": ["cam9"]})"), "cameras");
 
-  const CalibrationDropRequest drop = ParseCalibrationDrop(Body(R"({"camera": "cam0"})", kCalibrationDropFields));
+  const CalibrationDropRequest drop =
+      ParseCalibrationDrop(Body(R"({"camera": "cam0"})", kCalibrationDropFields));
   EXPECT_EQ(drop.which, "last");
   EXPECT_EQ(drop.camera, "cam0");
-  EXPECT_EQ(FieldOf([] { ParseCalibrationDrop(Body(R"({"camera": "cam0", "which": "best"})", kCalibrationDropFields)); }),
+  EXPECT_EQ(FieldOf([] {
+              ParseCalibrationDrop(
+                  Body(R"({"camera": "cam0", "which": "best"})", kCalibrationDropFields));
+            }),
             "which");
-  EXPECT_EQ(FieldOf([] { ParseCalibrationDrop(Body(R"({"which": "worst"})", kCalibrationDropFields)); }), "camera");
+  EXPECT_EQ(
+      FieldOf([] { ParseCalibrationDrop(Body(R"({"which": "worst"})", kCalibrationDropFields)); }),
+      "camera");
 
   EXPECT_FALSE(ParseCameraName(Body("", kCalibrationSolveFields), false));
-  EXPECT_EQ(FieldOf([] { ParseCameraName(Body(R"({"camera": 3})", kCalibrationSolveFields), false); }), "camera");
+  EXPECT_EQ(
+      FieldOf([] { ParseCameraName(Body(R"({"camera": 3})", kCalibrationSolveFields), false); }),
+      "camera");
 
-  const CalibrationRedoRequest redo = ParseCalibrationRedo(Body(R"({"step": "ground"})", kCalibrationRedoFields));
+  const CalibrationRedoRequest redo =
+      ParseCalibrationRedo(Body(R"({"step": "ground"})", kCalibrationRedoFields));
   EXPECT_EQ(redo.step, calib::WizardStep::kGround);
   EXPECT_FALSE(redo.camera);
-  EXPECT_EQ(FieldOf([] { ParseCalibrationRedo(Body(R"({"step": "done"})", kCalibrationRedoFields)); }), "step");
+  EXPECT_EQ(
+      FieldOf([] { ParseCalibrationRedo(Body(R"({"step": "done"})", kCalibrationRedoFields)); }),
+      "step");
 
-  EXPECT_TRUE(ParseCalibrationFloor(Body(R"({"camera": "cam0", "detect": true})", kCalibrationFloorFields)).detect);
-  const CalibrationFloorRequest floor =
-      ParseCalibrationFloor(Body(R"({"camera": "cam0", "pixels": [[1, 2], [3, 4], [5, 6.5]]})", kCalibrationFloorFields));
+  EXPECT_TRUE(
+      ParseCalibrationFloor(Body(R"({"camera": "cam0", "detect": true})", kCalibrationFloorFields))
+          .detect);
+  const CalibrationFloorRequest floor = ParseCalibrationFloor(
+      Body(R"({"camera": "cam0", "pixels": [[1, 2], [3, 4], [5, 6.5]]})", kCalibrationFloorFields));
   ASSERT_EQ(floor.pixels.size(), 3u);
   EXPECT_EQ(floor.pixels[2], Eigen::Vector2d(5, 6.5));
-  EXPECT_EQ(FieldOf([] { ParseCalibrationFloor(Body(R"({"pixels": [[1]]})", kCalibrationFloorFields)); }), "pixels");
-  EXPECT_EQ(FieldOf([] { ParseCalibrationFloor(Body(R"({"camera": "cam0"})", kCalibrationFloorFields)); }), "body");
-  EXPECT_EQ(FieldOf([] { ParseCalibrationFloor(Body(R"({"camera": "cam0", "detect": false})", kCalibrationFloorFields)); }),
+  EXPECT_EQ(
+      FieldOf([] { ParseCalibrationFloor(Body(R"({"pixels": [[1]]})", kCalibrationFloorFields)); }),
+      "pixels");
+  EXPECT_EQ(FieldOf([] {
+              ParseCalibrationFloor(Body(R"({"camera": "cam0"})", kCalibrationFloorFields));
+            }),
             "body");
-  // Found by fuzzing: a "detect" that is not a boolean let nlohmann::json's type_error escape (500).
-  EXPECT_EQ(FieldOf([] { ParseCalibrationFloor(Body(R"({"camera": "cam0", "detect": 1})", kCalibrationFloorFields)); }),
-            "detect");
+  EXPECT_EQ(FieldOf([] {
+              ParseCalibrationFloor(
+                  Body(R"({"camera": "cam0", "detect": false})", kCalibrationFloorFields));
+            }),
+            "body");
+  // Found by fuzzing: a "detect" that is not a boolean let nlohmann::json's type_error escape
+  // (500).
+  EXPECT_EQ(
+      FieldOf([] {
+        ParseCalibrationFloor(Body(R"({"camera": "cam0", "detect": 1})", kCalibrationFloorFields));
+      }),
+      "detect");
 }
 
 }  // namespace

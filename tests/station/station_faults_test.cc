@@ -13,11 +13,11 @@
 #include <gtest/gtest.h>
 #include <sqlite3.h>
 
+#include <nlohmann/json.hpp>
 #include "core/bank.h"
 #include "core/bank_verify.h"
 #include "station/station.h"
 #include "station/station_status.h"
-#include <nlohmann/json.hpp>
 #include "synth/studio_session.h"
 #include "tests/station/replay_station.h"
 #include "tests/support/test_support.h"
@@ -44,20 +44,23 @@ struct FileSizeLimit {
 };
 
 TEST(StationFaults, AFullDiskSaysWritesFailLosesNothingAndResumes) {
-  signal(SIGXFSZ, SIG_IGN);  // a write past the limit fails with EFBIG instead of killing the process
+  signal(SIGXFSZ,
+         SIG_IGN);  // a write past the limit fails with EFBIG instead of killing the process
   testing::ScratchDir dir;
   StationOptions options = OneReplayCamera(dir);
   options.config.logging.level = "warn";
   Station station(options);
   station.Start();
   station.StartSession("full disk");
-  ASSERT_TRUE(WaitFor(station, [](const StationStatus& s) { return s.batches_stored >= 3; }, 30))
+  ASSERT_TRUE(WaitFor(
+      station, [](const StationStatus& s) { return s.batches_stored >= 3; }, 30))
       << "no batch stored before the disk filled: " << StatusToJson(station.Status()).dump(2);
   EXPECT_EQ(station.Status().storage_state, StorageState::kOk);
 
   FileSizeLimit limit;
   limit.Set(4096);  // every file of this process is "full" past 4 KiB
-  ASSERT_TRUE(WaitFor(station, [](const StationStatus& s) { return s.batches_failed >= 2; }, 30))
+  ASSERT_TRUE(WaitFor(
+      station, [](const StationStatus& s) { return s.batches_failed >= 2; }, 30))
       << "no append failed on a full disk";
   const StationStatus failing = station.Status();
   EXPECT_EQ(failing.storage_state, StorageState::kWritesFailing);
@@ -65,7 +68,8 @@ TEST(StationFaults, AFullDiskSaysWritesFailLosesNothingAndResumes) {
   const uint64_t stored_before = failing.batches_stored;
 
   limit.Lift();  // space comes back
-  ASSERT_TRUE(WaitFor(station, [&](const StationStatus& s) { return s.batches_stored > stored_before + 2; }, 30))
+  ASSERT_TRUE(WaitFor(
+      station, [&](const StationStatus& s) { return s.batches_stored > stored_before + 2; }, 30))
       << "storage did not resume: " << station.Status().bank_error;
   EXPECT_EQ(station.Status().storage_state, StorageState::kOk);
   station.StopSession();
@@ -87,7 +91,8 @@ TEST(StationFaults, ABankLockedPastTheBusyTimeoutLosesNoBatch) {
   Station station(options);
   station.Start();
   station.StartSession("locked");
-  ASSERT_TRUE(WaitFor(station, [](const StationStatus& s) { return s.batches_stored >= 3; }, 30))
+  ASSERT_TRUE(WaitFor(
+      station, [](const StationStatus& s) { return s.batches_stored >= 3; }, 30))
       << "no batch stored: " << StatusToJson(station.Status()).dump(2);
 
   {
@@ -100,12 +105,14 @@ TEST(StationFaults, ABankLockedPastTheBusyTimeoutLosesNoBatch) {
   }
   const uint64_t retried = station.Status().batches_retried;
   const uint64_t stored_then = station.Status().batches_stored;
-  ASSERT_TRUE(WaitFor(station, [&](const StationStatus& s) { return s.batches_stored > stored_then + 2; }, 30))
+  ASSERT_TRUE(WaitFor(
+      station, [&](const StationStatus& s) { return s.batches_stored > stored_then + 2; }, 30))
       << "storage did not go on: " << station.Status().bank_error;
   station.StopSession();
   station.Stop();
   const StationStatus end = station.Status();
-  EXPECT_GE(retried, 1u) << "the lock outlived the busy timeout, so an append had to be tried again";
+  EXPECT_GE(retried, 1u)
+      << "the lock outlived the busy timeout, so an append had to be tried again";
   EXPECT_EQ(end.batches_failed, 0u) << end.bank_error;
   EXPECT_EQ(end.storage_state, StorageState::kOk);
   const BankVerifyReport verify = VerifyBank(options.config.storage.bank);

@@ -32,12 +32,14 @@ TEST(StationPostgres, TenSecondsWithoutTheDatabaseLoseNoSprite) {
   Station station(options);
   station.Start();
   station.StartSession("outage");
-  ASSERT_TRUE(WaitFor(station, [](const StationStatus& s) { return s.batches_stored >= 3; }, 60))
+  ASSERT_TRUE(WaitFor(
+      station, [](const StationStatus& s) { return s.batches_stored >= 3; }, 60))
       << "no batch stored before the outage";
 
   server.Stop();
   const auto stopped = std::chrono::steady_clock::now();
-  ASSERT_TRUE(WaitFor(station, [](const StationStatus& s) { return s.spool_batches >= 2; }, 30))
+  ASSERT_TRUE(WaitFor(
+      station, [](const StationStatus& s) { return s.spool_batches >= 2; }, 30))
       << "batches were not spooled while the database was away";
   const StationStatus during = station.Status();
   EXPECT_EQ(during.storage_state, StorageState::kWritesFailing);
@@ -45,10 +47,12 @@ TEST(StationPostgres, TenSecondsWithoutTheDatabaseLoseNoSprite) {
   std::this_thread::sleep_until(stopped + std::chrono::seconds(10));
   ASSERT_TRUE(server.Start()) << server.log();
 
-  ASSERT_TRUE(WaitFor(station, [](const StationStatus& s) { return s.spool_batches == 0; }, 60))
+  ASSERT_TRUE(WaitFor(
+      station, [](const StationStatus& s) { return s.spool_batches == 0; }, 60))
       << "the spool was not drained";
   const uint64_t spooled = station.Status().batches_spooled;
-  ASSERT_TRUE(WaitFor(station, [](const StationStatus& s) { return s.storage_state == StorageState::kOk; }, 30));
+  ASSERT_TRUE(WaitFor(
+      station, [](const StationStatus& s) { return s.storage_state == StorageState::kOk; }, 30));
   station.StopSession();
   station.Stop();
   const StationStatus end = station.Status();

@@ -19,8 +19,9 @@ SpritePixels MakePixels(int w, int h, uint32_t seed) {
       const double dx = (x - w / 2.0) / (w * 0.3), dy = (y - h / 2.0) / (h * 0.45);
       const double r = dx * dx + dy * dy;
       const auto a = static_cast<uint8_t>(r < 0.8 ? 255 : r < 1.0 ? (1.0 - r) * 1275 : 0);
-      p.bgra.at<cv::Vec4b>(y, x) = {static_cast<uint8_t>(rng() % 256), static_cast<uint8_t>(x * 3 + seed),
-                                    static_cast<uint8_t>(y * 2), a};
+      p.bgra.at<cv::Vec4b>(y, x) = {static_cast<uint8_t>(rng() % 256),
+                                    static_cast<uint8_t>(x * 3 + seed), static_cast<uint8_t>(y * 2),
+                                    a};
       p.shadow.at<uint8_t>(y, x) = static_cast<uint8_t>(y > h * 0.85 ? 100 + rng() % 50 : 0);
     }
   }
@@ -74,7 +75,8 @@ std::vector<SpriteRecord> MakeBatch(int64_t first, int64_t last, int64_t track, 
 
 Fixture Register(BankWriter& w) {
   Fixture f;
-  f.session = w.AddSession({0, "synth-a@2024-01-01T00:00:00Z", "synth-a", "2024-01-01T00:00:00Z", "/rec/synth-a"});
+  f.session = w.AddSession(
+      {0, "synth-a@2024-01-01T00:00:00Z", "synth-a", "2024-01-01T00:00:00Z", "/rec/synth-a"});
   f.camera = w.AddCamera(f.session, {0, 0, "cam0", "# mrcal model text\n", 1280, 720});
   return f;
 }
@@ -92,7 +94,8 @@ int64_t RawCount(const std::string& path, const std::string& sql) {
   sqlite3* db = nullptr;
   sqlite3_open_v2(path.c_str(), &db, SQLITE_OPEN_READONLY, nullptr);
   sqlite3_stmt* stmt = nullptr;
-  EXPECT_EQ(sqlite3_prepare_v2(db, sql.c_str(), -1, &stmt, nullptr), SQLITE_OK) << sqlite3_errmsg(db);
+  EXPECT_EQ(sqlite3_prepare_v2(db, sql.c_str(), -1, &stmt, nullptr), SQLITE_OK)
+      << sqlite3_errmsg(db);
   const int64_t n = sqlite3_step(stmt) == SQLITE_ROW ? sqlite3_column_int64(stmt, 0) : -1;
   sqlite3_finalize(stmt);
   sqlite3_close(db);
@@ -103,7 +106,8 @@ void RawExec(const std::string& path, const std::string& sql) {
   sqlite3* db = nullptr;
   ASSERT_EQ(sqlite3_open(path.c_str(), &db), SQLITE_OK);
   char* error = nullptr;
-  EXPECT_EQ(sqlite3_exec(db, sql.c_str(), nullptr, nullptr, &error), SQLITE_OK) << (error ? error : "");
+  EXPECT_EQ(sqlite3_exec(db, sql.c_str(), nullptr, nullptr, &error), SQLITE_OK)
+      << (error ? error : "");
   sqlite3_free(error);
   sqlite3_close(db);
 }

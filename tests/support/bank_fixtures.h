@@ -19,7 +19,8 @@ SpriteRecord MakeSprite(int64_t frame, int64_t track, int w = 32, int h = 48);
 // The mirrored copy of `o`.
 SpriteRecord MakeMirror(const SpriteRecord& o);
 // Originals and mirrors for frames [first, last] of one track.
-std::vector<SpriteRecord> MakeBatch(int64_t first, int64_t last, int64_t track, bool mirrors = true);
+std::vector<SpriteRecord> MakeBatch(int64_t first, int64_t last, int64_t track,
+                                    bool mirrors = true);
 
 struct Fixture {
   int64_t session = 0, camera = 0;

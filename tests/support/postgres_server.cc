@@ -1,5 +1,7 @@
 #include "tests/support/postgres_server.h"
 
+#include <fcntl.h>
+#include <grp.h>
 #include <gtest/gtest.h>
 #include <libpq-fe.h>
 #include <netinet/in.h>
@@ -8,8 +10,6 @@
 #include <sys/socket.h>
 #include <sys/wait.h>
 #include <unistd.h>
-#include <fcntl.h>
-#include <grp.h>
 
 #include <chrono>
 #include <cstdlib>
@@ -99,9 +99,10 @@ PostgresServer::PostgresServer() {
       return;
     }
   }
-  const int code = WaitExit(Spawn({bin_ + "/initdb", "--pgdata=" + dir_ + "/data", "--username=spritestation",
-                                   "--auth=trust", "--encoding=UTF8", "--locale=C", "--no-sync"},
-                                  dir_ + "/log"));
+  const int code =
+      WaitExit(Spawn({bin_ + "/initdb", "--pgdata=" + dir_ + "/data", "--username=spritestation",
+                      "--auth=trust", "--encoding=UTF8", "--locale=C", "--no-sync"},
+                     dir_ + "/log"));
   if (code != 0) {
     ADD_FAILURE() << "initdb failed (exit " << code << "):\n" << log();
     return;
@@ -123,8 +124,8 @@ PostgresServer::~PostgresServer() {
 bool PostgresServer::Start() {
   if (ok()) return true;
   // fsync off: a test's server need not survive a power cut; it does survive a crash of ours.
-  pid_ = Spawn({bin_ + "/postgres", "-D", dir_ + "/data", "-p", std::to_string(port_), "-k", dir_, "-c",
-                "listen_addresses=127.0.0.1", "-c", "fsync=off", "-c", "max_connections=100"},
+  pid_ = Spawn({bin_ + "/postgres", "-D", dir_ + "/data", "-p", std::to_string(port_), "-k", dir_,
+                "-c", "listen_addresses=127.0.0.1", "-c", "fsync=off", "-c", "max_connections=100"},
                dir_ + "/log");
   const std::string address = Address("postgres");
   for (int i = 0; i < 300; ++i) {  // up to 30 s on a loaded machine
@@ -153,7 +154,8 @@ std::string PostgresServer::Address(const std::string& name) const {
 std::string PostgresServer::CreateDatabase(const std::string& name) {
   PGconn* conn = PQconnectdb(Address("postgres").c_str());
   PGresult* r = PQexec(conn, ("CREATE DATABASE \"" + name + "\"").c_str());
-  if (PQresultStatus(r) != PGRES_COMMAND_OK) ADD_FAILURE() << "CREATE DATABASE " << name << ": " << PQerrorMessage(conn);
+  if (PQresultStatus(r) != PGRES_COMMAND_OK)
+    ADD_FAILURE() << "CREATE DATABASE " << name << ": " << PQerrorMessage(conn);
   PQclear(r);
   PQfinish(conn);
   return Address(name);

@@ -19,7 +19,8 @@ class PostgresServer {
 
   bool ok() const { return pid_ > 0; }
   int port() const { return port_; }
-  // Creates database `name` and returns its address, postgresql://spritestation@127.0.0.1:PORT/name.
+  // Creates database `name` and returns its address,
+  // postgresql://spritestation@127.0.0.1:PORT/name.
   std::string CreateDatabase(const std::string& name);
   // The address of database `name` (without creating it).
   std::string Address(const std::string& name) const;
@@ -31,8 +32,8 @@ class PostgresServer {
   std::string log() const;
 
  private:
-  std::string dir_;   // the server's folder: data/, socket, log
-  std::string bin_;   // /usr/lib/postgresql/<version>/bin
+  std::string dir_;  // the server's folder: data/, socket, log
+  std::string bin_;  // /usr/lib/postgresql/<version>/bin
   int port_ = 0;
   int pid_ = -1;
 };

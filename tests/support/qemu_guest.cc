@@ -29,8 +29,8 @@ void CpioWriter::Finish() {
 
 void CpioWriter::Entry(const std::string& name, unsigned mode, const std::string& data) {
   char header[111];
-  std::snprintf(header, sizeof header, "070701%08X%08X%08X%08X%08X%08X%08X%08X%08X%08X%08X%08X%08X", ino_++, mode, 0u,
-                0u, 1u, 0u, static_cast<unsigned>(data.size()), 0u, 0u, 0u, 0u,
+  std::snprintf(header, sizeof header, "070701%08X%08X%08X%08X%08X%08X%08X%08X%08X%08X%08X%08X%08X",
+                ino_++, mode, 0u, 0u, 1u, 0u, static_cast<unsigned>(data.size()), 0u, 0u, 0u, 0u,
                 static_cast<unsigned>(name.size() + 1), 0u);
   out_.write(header, 110);
   out_.write(name.c_str(), static_cast<std::streamsize>(name.size() + 1));
@@ -44,7 +44,8 @@ void CpioWriter::Pad(size_t n) {
   out_.write(zeros, static_cast<std::streamsize>((4 - n % 4) % 4));
 }
 
-bool FindKernelWithModules(const std::vector<std::string>& module_names, fs::path* kernel, fs::path* modules_dir) {
+bool FindKernelWithModules(const std::vector<std::string>& module_names, fs::path* kernel,
+                           fs::path* modules_dir) {
   std::error_code ec;
   std::vector<fs::path> kernels;
   for (const auto& e : fs::directory_iterator("/boot", ec)) {
@@ -53,7 +54,8 @@ bool FindKernelWithModules(const std::vector<std::string>& module_names, fs::pat
   std::sort(kernels.rbegin(), kernels.rend());
   for (const auto& k : kernels) {
     const fs::path mods = fs::path("/lib/modules") / k.filename().string().substr(8);
-    const std::string dep = fs::exists(mods / "modules.dep") ? ReadFileBytes(mods / "modules.dep") : "";
+    const std::string dep =
+        fs::exists(mods / "modules.dep") ? ReadFileBytes(mods / "modules.dep") : "";
     bool all = !dep.empty();
     for (const auto& m : module_names) all = all && dep.find("/" + m + ".ko") != std::string::npos;
     if (all) {
@@ -65,7 +67,8 @@ bool FindKernelWithModules(const std::vector<std::string>& module_names, fs::pat
   return false;
 }
 
-std::vector<std::string> ModuleLoadOrder(const fs::path& modules_dir, const std::vector<std::string>& module_names) {
+std::vector<std::string> ModuleLoadOrder(const fs::path& modules_dir,
+                                         const std::vector<std::string>& module_names) {
   std::map<std::string, std::vector<std::string>> deps;
   std::map<std::string, std::string> path_of;
   std::istringstream in(ReadFileBytes(modules_dir / "modules.dep"));
@@ -131,7 +134,8 @@ std::string ElfInterpreter(const std::string& path) {
     Elf64_Phdr ph;
     std::memcpy(&ph, bytes.data() + at, sizeof ph);
     if (ph.p_type == PT_INTERP && ph.p_offset + ph.p_filesz <= bytes.size()) {
-      return std::string(bytes.data() + ph.p_offset, strnlen(bytes.data() + ph.p_offset, ph.p_filesz));
+      return std::string(bytes.data() + ph.p_offset,
+                         strnlen(bytes.data() + ph.p_offset, ph.p_filesz));
     }
   }
   return "";

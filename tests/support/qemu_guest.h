@@ -34,8 +34,8 @@ class CpioWriter {
 
 // The newest kernel under /boot whose modules (/lib/modules/VERSION) include every one of
 // `module_names` ("vivid", "dummy_hcd"...); false when there is none.
-bool FindKernelWithModules(const std::vector<std::string>& module_names, std::filesystem::path* kernel,
-                           std::filesystem::path* modules_dir);
+bool FindKernelWithModules(const std::vector<std::string>& module_names,
+                           std::filesystem::path* kernel, std::filesystem::path* modules_dir);
 
 // Module paths (relative to `modules_dir`) in load order: each module after its
 // dependencies (modules.dep), for every one of `module_names`.

@@ -6,12 +6,12 @@
 #include <array>
 #include <chrono>
 #include <csignal>
-#include <fstream>
-#include <sstream>
-#include <thread>
 #include <cstdio>
 #include <cstdlib>
+#include <fstream>
 #include <random>
+#include <sstream>
+#include <thread>
 
 #include <gtest/gtest.h>
 
@@ -50,15 +50,18 @@ CommandResult RunCommand(const std::string& shell_command) {
   if (!pipe) return result;
   std::array<char, 4096> buffer{};
   size_t n = 0;
-  while ((n = fread(buffer.data(), 1, buffer.size(), pipe)) > 0) result.output.append(buffer.data(), n);
+  while ((n = fread(buffer.data(), 1, buffer.size(), pipe)) > 0)
+    result.output.append(buffer.data(), n);
   const int status = pclose(pipe);
   result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
   return result;
 }
 
-BackgroundCommand::BackgroundCommand(const std::string& args, const std::string& log_path) : log_path_(log_path) {
+BackgroundCommand::BackgroundCommand(const std::string& args, const std::string& log_path)
+    : log_path_(log_path) {
   const char* bin = std::getenv("SPRITESTATION_BIN");
-  const std::string command = "exec " + std::string(bin ? bin : "spritestation") + " " + args + " > '" + log_path + "' 2>&1";
+  const std::string command = "exec " + std::string(bin ? bin : "spritestation") + " " + args +
+                              " > '" + log_path + "' 2>&1";
   pid_ = fork();
   if (pid_ == 0) {
     execl("/bin/sh", "sh", "-c", command.c_str(), static_cast<char*>(nullptr));

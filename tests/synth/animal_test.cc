@@ -93,7 +93,8 @@ TEST(AnimalBehaviour, ShowsEveryBehaviourAndStaysOnTheFloor) {
     lean_frames += run.lean_frames;
     lean_touching += run.lean_touching;
   }
-  for (const char* pose : {"walk", "trot", "turn", "idle", "lean", "stand"}) EXPECT_TRUE(seen.count(pose)) << pose;
+  for (const char* pose : {"walk", "trot", "turn", "idle", "lean", "stand"})
+    EXPECT_TRUE(seen.count(pose)) << pose;
   ASSERT_GT(lean_frames, 0);
   EXPECT_EQ(lean_touching, lean_frames);  // leaning means paws on the wall
 }

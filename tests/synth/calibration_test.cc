@@ -74,12 +74,14 @@ TEST(CalibrationSession, BoardCornersAreWhereOpenCvFindsThem) {
       if (board == 0 && all_in) {
         std::vector<cv::Point2f> found;
         if (!cv::findChessboardCorners(gray, cv::Size(9, 6), found)) continue;
-        cv::cornerSubPix(gray, found, cv::Size(4, 4), cv::Size(-1, -1),
-                         cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 40, 0.01));
+        cv::cornerSubPix(
+            gray, found, cv::Size(4, 4), cv::Size(-1, -1),
+            cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 40, 0.01));
         ++chess_found;
         for (const auto& p : found) {  // OpenCV may start from either end: match by nearest
           double best = 1e9;
-          for (const auto& c : truth_corners) best = std::min(best, (c.px - Eigen::Vector2d(p.x, p.y)).norm());
+          for (const auto& c : truth_corners)
+            best = std::min(best, (c.px - Eigen::Vector2d(p.x, p.y)).norm());
           worst = std::max(worst, best);
           EXPECT_LT(best, 0.5) << "frame " << frame;
         }
@@ -93,8 +95,9 @@ TEST(CalibrationSession, BoardCornersAreWhereOpenCvFindsThem) {
         cv::aruco::interpolateCornersCharuco(markers, ids, gray, charuco, found, found_ids);
         if (found_ids.size() < 6) continue;
         // The same saddle-point refinement as for the chessboard.
-        cv::cornerSubPix(gray, found, cv::Size(3, 3), cv::Size(-1, -1),
-                         cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 40, 0.01));
+        cv::cornerSubPix(
+            gray, found, cv::Size(3, 3), cv::Size(-1, -1),
+            cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 40, 0.01));
         ++charuco_found;
         double sum = 0;
         for (size_t i = 0; i < found.size(); ++i) {

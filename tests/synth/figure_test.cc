@@ -20,10 +20,26 @@ namespace {
 
 namespace fs = std::filesystem;
 
-enum { kHead, kNeck, kShoulderL, kElbowL, kWristL, kShoulderR, kElbowR, kWristR, kPelvis, kHipL, kKneeL, kAnkleL,
-       kHipR, kKneeR, kAnkleR };
+enum {
+  kHead,
+  kNeck,
+  kShoulderL,
+  kElbowL,
+  kWristL,
+  kShoulderR,
+  kElbowR,
+  kWristR,
+  kPelvis,
+  kHipL,
+  kKneeL,
+  kAnkleL,
+  kHipR,
+  kKneeR,
+  kAnkleR
+};
 
-std::vector<Eigen::Vector3d> Pose(const FigureBuild& b, ArmPose arms, double walking = 0, double phase = 0) {
+std::vector<Eigen::Vector3d> Pose(const FigureBuild& b, ArmPose arms, double walking = 0,
+                                  double phase = 0) {
   FigureState s;
   s.to = arms;
   s.blend = 1.0;
@@ -86,7 +102,8 @@ TEST(Figure, BothBuildsPerformTheSameTimeline) {
     EXPECT_FALSE(a.subjects[0].leaves_floor);
     poses.insert(a.subjects[0].pose);
   }
-  for (const char* p : {"idle", "walk", "turn", "Y", "M", "C", "A"}) EXPECT_TRUE(poses.count(p)) << p;
+  for (const char* p : {"idle", "walk", "turn", "Y", "M", "C", "A"})
+    EXPECT_TRUE(poses.count(p)) << p;
   EXPECT_GT(a.subjects[0].height_m, b.subjects[0].height_m + 0.1);
 }
 
@@ -113,13 +130,15 @@ TEST(FigureSession, JointsProjectOntoTheRenderedFigure) {
       const int f = std::stoi(row.at("frame"));
       char name[32];
       std::snprintf(name, sizeof(name), "%06d.png", f);
-      const cv::Mat alpha = cv::imread((truth / cam / "alpha_s0" / name).string(), cv::IMREAD_UNCHANGED);
+      const cv::Mat alpha =
+          cv::imread((truth / cam / "alpha_s0" / name).string(), cv::IMREAD_UNCHANGED);
       const double x = ss::testing::Num(row, "x"), y = ss::testing::Num(row, "y");
       const int xi = static_cast<int>(std::lround(x)), yi = static_cast<int>(std::lround(y));
       if (xi < 1 || yi < 1 || xi >= alpha.cols - 1 || yi >= alpha.rows - 1) continue;
       double best = 0;
       for (int dy = -1; dy <= 1; ++dy) {
-        for (int dx = -1; dx <= 1; ++dx) best = std::max(best, static_cast<double>(alpha.at<uint8_t>(yi + dy, xi + dx)));
+        for (int dx = -1; dx <= 1; ++dx)
+          best = std::max(best, static_cast<double>(alpha.at<uint8_t>(yi + dy, xi + dx)));
       }
       EXPECT_GT(best, 0) << cam << " frame " << f << " " << row.at("name");
       ++checked;

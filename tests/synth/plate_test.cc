@@ -21,7 +21,9 @@ namespace {
 
 using ss::testing::ScratchDir;
 
-cv::Mat Filled(int rows, int cols, int type, cv::Scalar value) { return cv::Mat(rows, cols, type, value); }
+cv::Mat Filled(int rows, int cols, int type, cv::Scalar value) {
+  return cv::Mat(rows, cols, type, value);
+}
 
 TEST(PerPixelMedian, TakesEachBytesMedianAndIgnoresAPassingSubject) {
   // Five frames of a grey floor; a bright "subject" crosses pixel (1, 2) in two of them and
@@ -34,7 +36,8 @@ TEST(PerPixelMedian, TakesEachBytesMedianAndIgnoresAPassingSubject) {
   const cv::Mat m = PerPixelMedian(stack);
   ASSERT_EQ(m.type(), CV_8UC3);
   EXPECT_EQ(m.at<cv::Vec3b>(2, 3), cv::Vec3b(102, 50, 10));
-  // (1, 2): blue of 100, 255, 102, 250, 104 -> 104; green 50, 255, 50, 0, 50 -> 50; red 10, 255, 10, 255, 10 -> 10
+  // (1, 2): blue of 100, 255, 102, 250, 104 -> 104; green 50, 255, 50, 0, 50 -> 50; red 10, 255,
+  // 10, 255, 10 -> 10
   EXPECT_EQ(m.at<cv::Vec3b>(1, 2), cv::Vec3b(104, 50, 10));
   // (0, 0): blue 100, 101, 102, 103, 0 -> 101
   EXPECT_EQ(m.at<cv::Vec3b>(0, 0), cv::Vec3b(101, 50, 10));
@@ -97,8 +100,10 @@ TEST(SessionPlate, IsTheNoiseFreeEmptyEnclosure) {
   ReplaySource source(o.out_dir, one_camera);
   const cv::Mat first = ToBgr(*source.Next());
   source.Stop();
-  const double single = MeanAbsDifference(first, truth), median = MeanAbsDifference(plate.bgr, truth);
-  std::printf("plate: mean |frame 0 - truth| %.3f, mean |median of 15 - truth| %.3f levels\n", single, median);
+  const double single = MeanAbsDifference(first, truth),
+               median = MeanAbsDifference(plate.bgr, truth);
+  std::printf("plate: mean |frame 0 - truth| %.3f, mean |median of 15 - truth| %.3f levels\n",
+              single, median);
   EXPECT_LT(median, 0.6 * single);
   EXPECT_LT(median, 0.8);
 
@@ -137,7 +142,8 @@ TEST(SessionPlate, NamesAnUnknownCameraAndAnEmptyRange) {
     ReadSessionPlate(o.out_dir, "cam0", past);
     FAIL() << "a range past the end was accepted";
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("no readable frame in frames 100..110 (it has 4)"), std::string::npos)
+    EXPECT_NE(std::string(e.what()).find("no readable frame in frames 100..110 (it has 4)"),
+              std::string::npos)
         << e.what();
   }
   PlateOptions backwards;

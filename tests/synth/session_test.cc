@@ -79,10 +79,12 @@ TEST(SynthSession, MatteCoversExactlyTheRenderedSubject) {
     const auto views = ReadCsv((fs::path(with.out_dir) / "truth" / cam / "views.csv").string());
     ASSERT_EQ(views.size(), 20u);
     for (int f = 0; f < 20; ++f) {
-      const cv::Mat alpha = cv::imread((fs::path(with.out_dir) / "truth" / cam / "alpha_s0" / Png(f)).string(),
-                                       cv::IMREAD_UNCHANGED);
-      const cv::Mat shadow = cv::imread((fs::path(with.out_dir) / "truth" / cam / "shadow" / Png(f)).string(),
-                                        cv::IMREAD_UNCHANGED);
+      const cv::Mat alpha =
+          cv::imread((fs::path(with.out_dir) / "truth" / cam / "alpha_s0" / Png(f)).string(),
+                     cv::IMREAD_UNCHANGED);
+      const cv::Mat shadow =
+          cv::imread((fs::path(with.out_dir) / "truth" / cam / "shadow" / Png(f)).string(),
+                     cv::IMREAD_UNCHANGED);
       ASSERT_EQ(alpha.type(), CV_8U);
       ASSERT_EQ(alpha.size(), a[c][f].size());
       cv::Mat diff;
@@ -137,8 +139,10 @@ TEST(SynthSession, LowestPointAndContactMatchTheMatte) {
       const int f = std::stoi(v.at("frame"));
       if (Num(v, "unoccluded_px") - Num(v, "visible_px") > 0.5) continue;  // partly hidden
       if (subjects[static_cast<size_t>(f)].at("touches_wall") == "1") continue;
-      const cv::Mat alpha = cv::imread((truth / cam / "alpha_s0" / Png(f)).string(), cv::IMREAD_UNCHANGED);
-      // The extractor's lowest point: the lowest row with alpha > 1/2, then where alpha falls through 1/2.
+      const cv::Mat alpha =
+          cv::imread((truth / cam / "alpha_s0" / Png(f)).string(), cv::IMREAD_UNCHANGED);
+      // The extractor's lowest point: the lowest row with alpha > 1/2, then where alpha falls
+      // through 1/2.
       int row = -1;
       for (int y = alpha.rows - 1; y >= 0 && row < 0; --y) {
         for (int x = 0; x < alpha.cols; ++x) {
@@ -154,29 +158,33 @@ TEST(SynthSession, LowestPointAndContactMatchTheMatte) {
           sum_x += x;
           ++n;
           here = std::max(here, static_cast<double>(alpha.at<uint8_t>(row, x)));
-          if (row + 1 < alpha.rows) below = std::max(below, static_cast<double>(alpha.at<uint8_t>(row + 1, x)));
+          if (row + 1 < alpha.rows)
+            below = std::max(below, static_cast<double>(alpha.at<uint8_t>(row + 1, x)));
         }
       }
       const double low_y = row + (here - 127.5) / std::max(1.0, here - below);
       const Eigen::Vector2d matte_low(sum_x / n, low_y);
       const Eigen::Vector2d truth_low(Num(v, "lowest_x"), Num(v, "lowest_y"));
       EXPECT_NEAR(truth_low.y(), matte_low.y(), 1.5) << cam << " frame " << f;
-      // Along a nearly level bottom edge x is ill-defined: the truth must lie on the matte's lowest row.
+      // Along a nearly level bottom edge x is ill-defined: the truth must lie on the matte's lowest
+      // row.
       EXPECT_GE(truth_low.x(), row_x0 - 1.5) << cam << " frame " << f;
       EXPECT_LE(truth_low.x(), row_x1 + 1.5) << cam << " frame " << f;
       ++checked;
       // Where the lowest point is a paw on the floor, the true ground point under it
       // projects onto the sprite's lowest point.
       if (Num(v, "lowest_gz") < 0.001) {
-        const Eigen::Vector2d px = model.ProjectGround({Num(v, "lowest_gx"), Num(v, "lowest_gy"), 0.0});
+        const Eigen::Vector2d px =
+            model.ProjectGround({Num(v, "lowest_gx"), Num(v, "lowest_gy"), 0.0});
         EXPECT_NEAR(px.y(), matte_low.y(), 1.5) << cam << " frame " << f;
         EXPECT_GE(px.x(), row_x0 - 1.5) << cam << " frame " << f;
         EXPECT_LE(px.x(), row_x1 + 1.5) << cam << " frame " << f;
         ++contacts;
       }
       // The root (the floor under the body) projects inside the sprite's box.
-      const Eigen::Vector2d root = model.ProjectGround({Num(subjects[static_cast<size_t>(f)], "x"),
-                                                        Num(subjects[static_cast<size_t>(f)], "y"), 0.0});
+      const Eigen::Vector2d root =
+          model.ProjectGround({Num(subjects[static_cast<size_t>(f)], "x"),
+                               Num(subjects[static_cast<size_t>(f)], "y"), 0.0});
       EXPECT_NEAR(root.x(), Num(v, "root_x"), 1e-3);
       EXPECT_GE(root.x(), Num(v, "box_x") - 1);
       EXPECT_LE(root.x(), Num(v, "box_x") + Num(v, "box_w") + 1);
@@ -213,13 +221,15 @@ TEST(SynthSession, SameSeedSameBytesOtherSeedOtherSession) {
   for (size_t cam = 0; cam < fa.size(); ++cam) {
     ASSERT_EQ(fa[cam].size(), fb[cam].size());
     for (size_t i = 0; i < fa[cam].size(); ++i) {
-      EXPECT_EQ(cv::norm(fa[cam][i], fb[cam][i], cv::NORM_INF), 0.0) << "camera " << cam << " frame " << i;
+      EXPECT_EQ(cv::norm(fa[cam][i], fb[cam][i], cv::NORM_INF), 0.0)
+          << "camera " << cam << " frame " << i;
       EXPECT_GT(cv::norm(fa[cam][i], fc[cam][i], cv::NORM_L1), 0.0);
     }
   }
   EXPECT_NE(ReadFile(fs::path(a.out_dir) / "truth" / "subjects.csv"),
             ReadFile(fs::path(c.out_dir) / "truth" / "subjects.csv"));
-  EXPECT_NE(ReadFile(fs::path(a.out_dir) / "cam0.cameramodel"), ReadFile(fs::path(c.out_dir) / "cam0.cameramodel"));
+  EXPECT_NE(ReadFile(fs::path(a.out_dir) / "cam0.cameramodel"),
+            ReadFile(fs::path(c.out_dir) / "cam0.cameramodel"));
 }
 
 TEST(SynthSession, ReplaysLikeARecordingInItsPixelFormat) {
@@ -250,7 +260,8 @@ TEST(SynthSession, ReplaysLikeARecordingInItsPixelFormat) {
   EXPECT_EQ(source.stats().errors, 0u);
   // The true models are the session's models; the floor polygon is in truth/.
   for (const auto& cam : info.cameras) {
-    EXPECT_EQ(ReadFile(fs::path(o.out_dir) / cam.model), ReadFile(fs::path(o.out_dir) / "truth" / cam.model));
+    EXPECT_EQ(ReadFile(fs::path(o.out_dir) / cam.model),
+              ReadFile(fs::path(o.out_dir) / "truth" / cam.model));
   }
   const auto floor = nlohmann::json::parse(ReadFile(fs::path(o.out_dir) / "truth" / "floor.json"));
   EXPECT_EQ(floor["polygon"].size(), 4u);

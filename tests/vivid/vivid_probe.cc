@@ -22,7 +22,9 @@ void Check(const std::string& name, bool ok, const std::string& detail) {
   if (!ok) ++failures;
 }
 
-bool Contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
+bool Contains(const std::string& s, const std::string& part) {
+  return s.find(part) != std::string::npos;
+}
 
 // Mean luma of a column band of a YUYV frame's lower half (Y at every even
 // byte), below the text vivid draws in the top-left corner.
@@ -58,13 +60,15 @@ void StreamYuyv() {
   o.gain = 42;
   ss::V4l2Source source(o);
   const auto& cam = source.cameras().at(0);
-  Check("yuyv_format", cam.format == ss::PixelFormat::kYUYV && cam.width == 640 && cam.height == 480,
-        ss::PixelFormatName(cam.format) + " " + std::to_string(cam.width) + "x" + std::to_string(cam.height) +
-            " fps " + std::to_string(cam.fps));
+  Check("yuyv_format",
+        cam.format == ss::PixelFormat::kYUYV && cam.width == 640 && cam.height == 480,
+        ss::PixelFormatName(cam.format) + " " + std::to_string(cam.width) + "x" +
+            std::to_string(cam.height) + " fps " + std::to_string(cam.fps));
   const auto gain = source.control(V4L2_CID_GAIN);
   const auto autogain = source.control(V4L2_CID_AUTOGAIN);
   Check("gain_locked", gain && *gain == 42 && autogain && *autogain == 0,
-        "gain " + std::to_string(gain.value_or(-1)) + " autogain " + std::to_string(autogain.value_or(-1)));
+        "gain " + std::to_string(gain.value_or(-1)) + " autogain " +
+            std::to_string(autogain.value_or(-1)));
 
   // A second opener while streaming: the device is busy.
   ss::V4l2Options again = o;
@@ -92,17 +96,20 @@ void StreamYuyv() {
     last_sequence = f->sequence;
     last_ns = f->timestamp_ns;
     if (frames == 10) {
-      left = MeanLuma(*f, 8, 72);      // vivid's default pattern: 75% colour bars, white first (Y 180)
+      left = MeanLuma(*f, 8, 72);  // vivid's default pattern: 75% colour bars, white first (Y 180)
       right = MeanLuma(*f, 568, 632);  // ... black last (Y 16)
     }
   }
   const auto stats = source.stats();
-  Check("yuyv_frames", frames == 30 && sizes_ok, std::to_string(frames) + " frames of 640x480 YUYV");
-  Check("yuyv_sequence", sequence_ok && last_sequence - first_sequence + 1 == 30 + stats.frames_dropped,
-        "sequence " + std::to_string(first_sequence) + ".." + std::to_string(last_sequence) + ", dropped " +
-            std::to_string(stats.frames_dropped));
+  Check("yuyv_frames", frames == 30 && sizes_ok,
+        std::to_string(frames) + " frames of 640x480 YUYV");
+  Check("yuyv_sequence",
+        sequence_ok && last_sequence - first_sequence + 1 == 30 + stats.frames_dropped,
+        "sequence " + std::to_string(first_sequence) + ".." + std::to_string(last_sequence) +
+            ", dropped " + std::to_string(stats.frames_dropped));
   Check("yuyv_timestamps", time_ok && last_ns > first_ns,
-        "device timestamps " + std::to_string(first_ns) + ".." + std::to_string(last_ns) + " ns, mean interval " +
+        "device timestamps " + std::to_string(first_ns) + ".." + std::to_string(last_ns) +
+            " ns, mean interval " +
             std::to_string(frames > 1 ? (last_ns - first_ns) / (frames - 1) : 0) + " ns");
   Check("yuyv_colour_bars", left > 160 && right < 40,
         "mean luma left " + std::to_string(left) + " right " + std::to_string(right));
@@ -122,7 +129,8 @@ void StreamFormat(const std::string& name, ss::PixelFormat format) {
       if (!f) break;
       sizes_ok = sizes_ok && f->format == format && f->size == ss::FrameBytes(format, 640, 480);
     }
-    Check(name, frames == 3 && sizes_ok, std::to_string(frames) + " frames of " + ss::PixelFormatName(format));
+    Check(name, frames == 3 && sizes_ok,
+          std::to_string(frames) + " frames of " + ss::PixelFormatName(format));
   } catch (const std::exception& e) {
     Check(name, false, e.what());
   }

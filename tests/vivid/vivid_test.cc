@@ -35,11 +35,14 @@ using ss::testing::ModuleBytes;
 const auto& ReadFile = ss::testing::ReadFileBytes;
 
 TEST(Vivid, V4l2BackendStreamsFromTheRealDriverUnderQemu) {
-  const std::string qemu = FindProgram({"/usr/bin/qemu-system-x86_64", "/usr/local/bin/qemu-system-x86_64"});
-  if (qemu.empty()) GTEST_SKIP() << "qemu-system-x86_64 not installed (Debian package qemu-system-x86)";
+  const std::string qemu =
+      FindProgram({"/usr/bin/qemu-system-x86_64", "/usr/local/bin/qemu-system-x86_64"});
+  if (qemu.empty())
+    GTEST_SKIP() << "qemu-system-x86_64 not installed (Debian package qemu-system-x86)";
   fs::path kernel, modules;
   if (!ss::testing::FindKernelWithModules({"vivid"}, &kernel, &modules)) {
-    GTEST_SKIP() << "no kernel with the vivid module under /boot and /lib/modules (Debian package linux-image-amd64)";
+    GTEST_SKIP() << "no kernel with the vivid module under /boot and /lib/modules (Debian package "
+                    "linux-image-amd64)";
   }
   const std::string busybox = FindProgram({"/bin/busybox", "/usr/bin/busybox"});
   if (busybox.empty()) GTEST_SKIP() << "busybox not installed (Debian package busybox-static)";
@@ -48,7 +51,8 @@ TEST(Vivid, V4l2BackendStreamsFromTheRealDriverUnderQemu) {
   }
   const std::string probe = VIVID_PROBE_PATH;
   ASSERT_TRUE(fs::exists(probe)) << probe;
-  ASSERT_TRUE(IsStaticExecutable(probe)) << probe << " must be statically linked to run in the guest";
+  ASSERT_TRUE(IsStaticExecutable(probe))
+      << probe << " must be statically linked to run in the guest";
 
   ss::testing::ScratchDir dir;
   const fs::path initrd = dir.path() / "initrd.cpio";
@@ -68,14 +72,16 @@ TEST(Vivid, V4l2BackendStreamsFromTheRealDriverUnderQemu) {
     ASSERT_TRUE(ModuleBytes(modules / order[i], &bytes)) << "cannot read " << modules / order[i];
     const std::string name = "lib/modules/" + std::to_string(i) + "_" +
                              fs::path(order[i]).filename().string().substr(
-                                 0, fs::path(order[i]).filename().string().find(".ko")) + ".ko";
+                                 0, fs::path(order[i]).filename().string().find(".ko")) +
+                             ".ko";
     cpio.File(name, bytes, false);
     const bool is_vivid = i + 1 == order.size();
     init += "/bin/busybox insmod /" + name + (is_vivid ? " n_devs=1 node_types=0x1" : "") +
             " || echo INSMOD_FAILED " + name + "\n";
   }
   init +=
-      "i=0; while [ ! -e /dev/video0 ] && [ $i -lt 100 ]; do /bin/busybox sleep 0.1; i=$((i+1)); done\n"
+      "i=0; while [ ! -e /dev/video0 ] && [ $i -lt 100 ]; do /bin/busybox sleep 0.1; i=$((i+1)); "
+      "done\n"
       "/probe\n"
       "echo PROBE_EXIT $?\n"
       "/bin/busybox poweroff -f\n";
@@ -84,14 +90,17 @@ TEST(Vivid, V4l2BackendStreamsFromTheRealDriverUnderQemu) {
   ASSERT_TRUE(cpio.ok());
 
   const fs::path log = dir.path() / "console.txt";
-  const std::string command = "timeout -k 5 170 " + qemu + " -accel tcg -m 512 -smp 1 -nographic -no-reboot -nic none" +
+  const std::string command = "timeout -k 5 170 " + qemu +
+                              " -accel tcg -m 512 -smp 1 -nographic -no-reboot -nic none" +
                               " -kernel " + kernel.string() + " -initrd " + initrd.string() +
-                              " -append 'console=ttyS0 panic=-1 loglevel=3 no_timer_check mitigations=off rdinit=/init' < /dev/null > " +
+                              " -append 'console=ttyS0 panic=-1 loglevel=3 no_timer_check "
+                              "mitigations=off rdinit=/init' < /dev/null > " +
                               log.string() + " 2>&1";
   const int rc = std::system(command.c_str());
   const std::string console = ReadFile(log);
   ASSERT_NE(console.find("PROBE_DONE"), std::string::npos)
-      << "the probe did not finish (qemu exit " << rc << "); console:\n" << console;
+      << "the probe did not finish (qemu exit " << rc << "); console:\n"
+      << console;
   EXPECT_EQ(console.find("INSMOD_FAILED"), std::string::npos) << console;
 
   std::map<std::string, std::string> checks;
@@ -110,9 +119,11 @@ TEST(Vivid, V4l2BackendStreamsFromTheRealDriverUnderQemu) {
   }
   for (const char* expected :
        {"list_devices", "yuyv_format", "gain_locked", "busy_device", "yuyv_frames", "yuyv_sequence",
-        "yuyv_timestamps", "yuyv_colour_bars", "nv12_frames", "grey_frames", "rgb24_frames", "bgr24_frames",
-        "unsupported_format", "unsupported_size", "missing_exposure_control", "missing_device", "not_v4l2"}) {
-    EXPECT_TRUE(checks.count(expected)) << "the probe never reported " << expected << "; console:\n" << console;
+        "yuyv_timestamps", "yuyv_colour_bars", "nv12_frames", "grey_frames", "rgb24_frames",
+        "bgr24_frames", "unsupported_format", "unsupported_size", "missing_exposure_control",
+        "missing_device", "not_v4l2"}) {
+    EXPECT_TRUE(checks.count(expected)) << "the probe never reported " << expected << "; console:\n"
+                                        << console;
   }
   EXPECT_NE(console.find("PROBE_EXIT 0"), std::string::npos);
 }

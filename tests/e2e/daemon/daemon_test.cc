@@ -7,18 +7,18 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
-#include <map>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <thread>
 
 // Eigen before httplib: <resolv.h> (through httplib) defines _res, a name Eigen uses.
-#include <Eigen/Geometry>
 #include <arpa/inet.h>
 #include <netinet/in.h>
 #include <poll.h>
 #include <sys/socket.h>
 #include <unistd.h>
+#include <Eigen/Geometry>
 
 #include <gtest/gtest.h>
 #include <httplib.h>
@@ -78,7 +78,9 @@ std::string ReadUntilClosed(int fd, double timeout_s, bool* closed = nullptr) {
 // body (by its Content-Length) is read whole; -1 when the answer is not in within `timeout_s`.
 int KeepAliveGet(int fd, const std::string& path, double timeout_s) {
   const std::string request = "GET " + path + " HTTP/1.1\r\nHost: 127.0.0.1\r\n\r\n";
-  if (::send(fd, request.data(), request.size(), MSG_NOSIGNAL) != static_cast<ssize_t>(request.size())) return -1;
+  if (::send(fd, request.data(), request.size(), MSG_NOSIGNAL) !=
+      static_cast<ssize_t>(request.size()))
+    return -1;
   std::string text;
   const auto deadline = Clock::now() + std::chrono::duration<double>(timeout_s);
   while (Clock::now() < deadline) {
@@ -86,7 +88,8 @@ int KeepAliveGet(int fd, const std::string& path, double timeout_s) {
     if (head != std::string::npos) {
       const size_t at = text.find("Content-Length: ");
       if (at == std::string::npos || at > head) return -1;
-      if (text.size() >= head + 4 + std::stoul(text.substr(at + 16))) return std::stoi(text.substr(9, 3));
+      if (text.size() >= head + 4 + std::stoul(text.substr(at + 16)))
+        return std::stoi(text.substr(9, 3));
     }
     pollfd p{fd, POLLIN, 0};
     if (::poll(&p, 1, 20) <= 0) continue;
@@ -107,42 +110,48 @@ class DaemonTest : public ::testing::Test {
   }
 
   // A fakecam serving one camera of the shared session at `address` (finite: one pass).
-  std::unique_ptr<BackgroundCommand> Fakecam(const std::string& camera, const std::string& address, int loops = 1,
-                                             const std::string& extra = "") {
-    auto cam = std::make_unique<BackgroundCommand>("fakecam " + session_->dir + " --camera " + camera + " --address " +
-                                                       address + " --serial " + camera + " --loop " +
-                                                       std::to_string(loops) + " " + extra,
-                                                   dir_ / ("fakecam-" + camera + ".log"));
+  std::unique_ptr<BackgroundCommand> Fakecam(const std::string& camera, const std::string& address,
+                                             int loops = 1, const std::string& extra = "") {
+    auto cam = std::make_unique<BackgroundCommand>(
+        "fakecam " + session_->dir + " --camera " + camera + " --address " + address +
+            " --serial " + camera + " --loop " + std::to_string(loops) + " " + extra,
+        dir_ / ("fakecam-" + camera + ".log"));
     EXPECT_TRUE(cam->WaitForOutput("fakecam: serving", 20)) << cam->output();
     return cam;
   }
 
   // A station config; `cameras` is the YAML list, `extra` more top-level sections.
-  std::string Config(const std::string& cameras, const std::string& extra = "", const std::string& storage = "") {
+  std::string Config(const std::string& cameras, const std::string& extra = "",
+                     const std::string& storage = "") {
     // `extra` goes under control: when it starts with two spaces, else it is a top-level section.
     const std::string path = dir_ / "station.yaml";
     std::ofstream out(path);
-    out << "version: 1\ncameras:\n" << cameras << "enclosure:\n  floor: " << session_->floor_yaml << "\n"
-        << "storage:\n  bank: " << bank() << "\n  recording_dir: " << (dir_ / "recordings") << "\n" << storage
-        << "control:\n  port: 0\n" << extra;
+    out << "version: 1\ncameras:\n"
+        << cameras << "enclosure:\n  floor: " << session_->floor_yaml << "\n"
+        << "storage:\n  bank: " << bank() << "\n  recording_dir: " << (dir_ / "recordings") << "\n"
+        << storage << "control:\n  port: 0\n"
+        << extra;
     return path;
   }
   std::string GigECameras() const {
-    return "  - name: cam0\n    source: aravis\n    address: 127.0.0.1\n    model: " + session_->dir +
+    return "  - name: cam0\n    source: aravis\n    address: 127.0.0.1\n    model: " +
+           session_->dir +
            "/cam0.cameramodel\n"
-           "  - name: cam1\n    source: aravis\n    address: 127.0.0.2\n    model: " + session_->dir +
-           "/cam1.cameramodel\n";
+           "  - name: cam1\n    source: aravis\n    address: 127.0.0.2\n    model: " +
+           session_->dir + "/cam1.cameramodel\n";
   }
   std::string ReplayCamera(bool loop = false) const {
-    return "  - name: cam0\n    source: replay\n    session: " + session_->dir + "\n    loop: " +
-           (loop ? "true" : "false") + "\n";
+    return "  - name: cam0\n    source: replay\n    session: " + session_->dir +
+           "\n    loop: " + (loop ? "true" : "false") + "\n";
   }
   std::string bank() const { return dir_ / "station.bank"; }
 
   // Starts the daemon and connects a client to its control API.
-  std::unique_ptr<BackgroundCommand> Daemon(const std::string& config, const std::string& args = "") {
-    auto daemon = std::make_unique<BackgroundCommand>("daemon --config " + config + " " + args,
-                                                      dir_ / ("daemon-" + std::to_string(++daemons_) + ".log"));
+  std::unique_ptr<BackgroundCommand> Daemon(const std::string& config,
+                                            const std::string& args = "") {
+    auto daemon = std::make_unique<BackgroundCommand>(
+        "daemon --config " + config + " " + args,
+        dir_ / ("daemon-" + std::to_string(++daemons_) + ".log"));
     EXPECT_TRUE(daemon->WaitForOutput("daemon: control API on", 30)) << daemon->output();
     const std::string out = daemon->output();
     const size_t at = out.find("(port ");
@@ -203,10 +212,14 @@ TEST_F(DaemonTest, TwoEmulatedGigECamerasStoreWhatIngestFinds) {
   auto daemon = Daemon(Config(GigECameras()), "--session take-1");
 
   // Both cameras stream and learn the empty enclosure, then the session runs.
-  ASSERT_TRUE(WaitStatus([](const nlohmann::json& s) {
-    return s["cameras"][0]["state"] == "live" && s["cameras"][1]["state"] == "live";
-  }, 20)) << Status().dump(2) << daemon->output();
-  const auto renamed = client_->Post("/api/session/rename", R"({"name": "take 1 walk"})", "application/json");
+  ASSERT_TRUE(WaitStatus(
+      [](const nlohmann::json& s) {
+        return s["cameras"][0]["state"] == "live" && s["cameras"][1]["state"] == "live";
+      },
+      20))
+      << Status().dump(2) << daemon->output();
+  const auto renamed =
+      client_->Post("/api/session/rename", R"({"name": "take 1 walk"})", "application/json");
   ASSERT_TRUE(renamed);
   EXPECT_EQ(renamed->status, 200) << renamed->body;
 
@@ -215,7 +228,8 @@ TEST_F(DaemonTest, TwoEmulatedGigECamerasStoreWhatIngestFinds) {
     const auto jpeg = client_->Get(std::string("/api/cameras/cam1/preview.jpg?view=") + view);
     ASSERT_TRUE(jpeg);
     ASSERT_EQ(jpeg->status, 200) << jpeg->body;
-    const cv::Mat image = cv::imdecode(std::vector<uint8_t>(jpeg->body.begin(), jpeg->body.end()), cv::IMREAD_COLOR);
+    const cv::Mat image =
+        cv::imdecode(std::vector<uint8_t>(jpeg->body.begin(), jpeg->body.end()), cv::IMREAD_COLOR);
     EXPECT_EQ(image.cols, 640);
     EXPECT_EQ(image.rows, 480);
   }
@@ -233,7 +247,8 @@ TEST_F(DaemonTest, TwoEmulatedGigECamerasStoreWhatIngestFinds) {
   const nlohmann::json status = Status();
   const auto metrics = client_->Get("/metrics");
   ASSERT_TRUE(metrics);
-  EXPECT_NE(metrics->body.find("spritestation_frames_dropped_total{camera=\"cam0\",cause=\"queue_full\"}"),
+  EXPECT_NE(metrics->body.find(
+                "spritestation_frames_dropped_total{camera=\"cam0\",cause=\"queue_full\"}"),
             std::string::npos);
   EXPECT_NE(metrics->body.find("spritestation_sprites_stored_total " +
                                std::to_string(status["bank"]["sprites_stored"].get<int64_t>())),
@@ -274,18 +289,22 @@ TEST_F(DaemonTest, TwoEmulatedGigECamerasStoreWhatIngestFinds) {
     // full, incomplete, sequence gaps), seen while the keyer was still learning, and the tail
     // of the pass that never arrived (no later frame shows that gap; the session has 150).
     const int64_t captured = cam["frames_captured"].get<int64_t>();
-    const int64_t unreceived = std::max<int64_t>(0, 150 - captured - cam["dropped"]["at_source"].get<int64_t>());
-    const int64_t dropped = cam["dropped"]["total"].get<int64_t>() + cam["sequence_gaps"].get<int64_t>() +
+    const int64_t unreceived =
+        std::max<int64_t>(0, 150 - captured - cam["dropped"]["at_source"].get<int64_t>());
+    const int64_t dropped = cam["dropped"]["total"].get<int64_t>() +
+                            cam["sequence_gaps"].get<int64_t>() +
                             cam["frames_while_learning"].get<int64_t>() + unreceived;
     const nlohmann::json& learnt = cam["learnt_from"];
     ASSERT_EQ(learnt["frames"], 30) << status.dump(2);
-    // (By the last frame's timestamp: frame 0's is 0, which GigE Vision delivers as the host's time.)
+    // (By the last frame's timestamp: frame 0's is 0, which GigE Vision delivers as the host's
+    // time.)
     const bool ingests_keyer =
         learnt["last_timestamp_ns"] == RecordedTimestamp(name, 29) &&
         learnt["last_sequence"].get<int64_t>() - learnt["first_sequence"].get<int64_t>() == 29;
-    // Said in the log and the test's properties, so a run that only met the bounded comparison shows.
-    std::printf("%s: the live keyer learnt from %s frames (%s)\n", name.c_str(), ingests_keyer ? "ingest's" : "other",
-                learnt.dump().c_str());
+    // Said in the log and the test's properties, so a run that only met the bounded comparison
+    // shows.
+    std::printf("%s: the live keyer learnt from %s frames (%s)\n", name.c_str(),
+                ingests_keyer ? "ingest's" : "other", learnt.dump().c_str());
     RecordProperty(name + "_keyer", ingests_keyer ? "ingest's frames" : "other frames");
     ASSERT_TRUE(ingest.count(name)) << name;
     static const std::map<int64_t, BankSprite> kNone;
@@ -296,8 +315,9 @@ TEST_F(DaemonTest, TwoEmulatedGigECamerasStoreWhatIngestFinds) {
     for (const auto& [t, s] : expected) missing += got.count(t) ? 0 : 1;
     for (const auto& [t, s] : got) {
       if (!expected.count(t)) {
-        EXPECT_FALSE(ingests_keyer) << name << ": a sprite at " << t << " that ingest did not store, with ingest's keyer\n"
-                                    << cam.dump(2);
+        EXPECT_FALSE(ingests_keyer)
+            << name << ": a sprite at " << t << " that ingest did not store, with ingest's keyer\n"
+            << cam.dump(2);
         ++extra;
         continue;
       }
@@ -309,9 +329,11 @@ TEST_F(DaemonTest, TwoEmulatedGigECamerasStoreWhatIngestFinds) {
     // velocity windows around the gap are what may be missing.
     const size_t keying_noise = ingests_keyer ? 0 : std::max<size_t>(10, expected.size() / 3);
     EXPECT_LE(missing, static_cast<size_t>(dropped) * 6 + keying_noise)
-        << name << ": " << missing << " of " << expected.size() << " sprites missing with " << dropped
-        << " frames dropped\n" << cam.dump(2);
-    EXPECT_LE(extra, keying_noise) << name << ": " << extra << " sprites ingest did not store\n" << cam.dump(2);
+        << name << ": " << missing << " of " << expected.size() << " sprites missing with "
+        << dropped << " frames dropped\n"
+        << cam.dump(2);
+    EXPECT_LE(extra, keying_noise) << name << ": " << extra << " sprites ingest did not store\n"
+                                   << cam.dump(2);
     EXPECT_GT(expected.size(), 5u) << name;
     compared += expected.size();
   }
@@ -321,16 +343,21 @@ TEST_F(DaemonTest, TwoEmulatedGigECamerasStoreWhatIngestFinds) {
 
 TEST_F(DaemonTest, LostPacketsAreCountedAndTheStationGoesOn) {
   auto cam0 = Fakecam("cam0", "127.0.0.1", 1, "--lost-packets 0.0005");
-  auto daemon = Daemon(Config("  - name: cam0\n    source: aravis\n    address: 127.0.0.1\n    packet_resend: false\n"
-                              "    model: " + session_->dir + "/cam0.cameramodel\n"),
-                       "--session lossy");
+  auto daemon = Daemon(
+      Config(
+          "  - name: cam0\n    source: aravis\n    address: 127.0.0.1\n    packet_resend: false\n"
+          "    model: " +
+          session_->dir + "/cam0.cameramodel\n"),
+      "--session lossy");
   EXPECT_EQ(cam0->Wait(30), 0) << cam0->output();
   const nlohmann::json status = Status();
   const nlohmann::json& cam = Camera(status, "cam0");
-  // 0.05% of the ~660 packets of each frame lost without resend: about 3 frames in 10 are incomplete.
+  // 0.05% of the ~660 packets of each frame lost without resend: about 3 frames in 10 are
+  // incomplete.
   EXPECT_GT(cam["dropped"]["at_source"].get<int64_t>(), 5) << status.dump(2);
   EXPECT_GT(cam["frames_captured"].get<int64_t>(), 20) << status.dump(2);
-  // Every frame of the pass is accounted for (a finished fake camera repeats its last frame until it exits).
+  // Every frame of the pass is accounted for (a finished fake camera repeats its last frame until
+  // it exits).
   EXPECT_GE(cam["frames_captured"].get<int64_t>() + cam["dropped"]["at_source"].get<int64_t>(), 150)
       << status.dump(2);
   EXPECT_LE(cam["frames_captured"].get<int64_t>() + cam["dropped"]["at_source"].get<int64_t>(), 160)
@@ -339,7 +366,8 @@ TEST_F(DaemonTest, LostPacketsAreCountedAndTheStationGoesOn) {
   // of sequence numbers it took (status learnt_from: how the live keyer may differ from ingest's).
   const nlohmann::json& learnt = cam["learnt_from"];
   EXPECT_EQ(learnt["frames"], 30) << status.dump(2);
-  EXPECT_GT(learnt["last_sequence"].get<int64_t>() - learnt["first_sequence"].get<int64_t>(), 29) << status.dump(2);
+  EXPECT_GT(learnt["last_sequence"].get<int64_t>() - learnt["first_sequence"].get<int64_t>(), 29)
+      << status.dump(2);
   EXPECT_GT(learnt["last_timestamp_ns"].get<int64_t>(), 0) << status.dump(2);
   daemon->Signal(SIGTERM);
   EXPECT_EQ(daemon->Wait(10), 0) << daemon->output();
@@ -348,20 +376,26 @@ TEST_F(DaemonTest, LostPacketsAreCountedAndTheStationGoesOn) {
 
 TEST_F(DaemonTest, ACameraThatVanishesIsReopenedWhenItComesBack) {
   auto cam0 = Fakecam("cam0", "127.0.0.1", 0);
-  auto daemon = Daemon(Config("  - name: cam0\n    source: aravis\n    address: 127.0.0.1\n    model: " +
-                              session_->dir + "/cam0.cameramodel\n"),
-                       "--offline-after 1");
-  ASSERT_TRUE(WaitStatus([](const nlohmann::json& s) { return s["cameras"][0]["state"] == "live"; }, 30))
+  auto daemon =
+      Daemon(Config("  - name: cam0\n    source: aravis\n    address: 127.0.0.1\n    model: " +
+                    session_->dir + "/cam0.cameramodel\n"),
+             "--offline-after 1");
+  ASSERT_TRUE(
+      WaitStatus([](const nlohmann::json& s) { return s["cameras"][0]["state"] == "live"; }, 30))
       << Status().dump(2);
   cam0->Signal(SIGKILL);
   cam0->Wait(5);
-  ASSERT_TRUE(WaitStatus([](const nlohmann::json& s) { return s["cameras"][0]["state"] == "offline"; }, 15))
+  ASSERT_TRUE(
+      WaitStatus([](const nlohmann::json& s) { return s["cameras"][0]["state"] == "offline"; }, 15))
       << Status().dump(2);
   const int64_t before = Status()["cameras"][0]["frames_captured"].get<int64_t>();
   cam0 = Fakecam("cam0", "127.0.0.1", 0);
-  ASSERT_TRUE(WaitStatus([&](const nlohmann::json& s) {
-    return s["cameras"][0]["reopens"] >= 1 && s["cameras"][0]["frames_captured"] > before + 10;
-  }, 30)) << Status().dump(2) << daemon->output();
+  ASSERT_TRUE(WaitStatus(
+      [&](const nlohmann::json& s) {
+        return s["cameras"][0]["reopens"] >= 1 && s["cameras"][0]["frames_captured"] > before + 10;
+      },
+      30))
+      << Status().dump(2) << daemon->output();
   // Its keyer learnt the enclosure before it vanished: reopened, it is live, not training again.
   EXPECT_EQ(Status()["cameras"][0]["state"], "live") << Status().dump(2);
   daemon->Signal(SIGTERM);
@@ -374,7 +408,8 @@ TEST_F(DaemonTest, SigkillDuringASessionLeavesAVerifiableBank) {
   ASSERT_TRUE(WaitStatus([](const nlohmann::json& s) { return s["cameras"][0]["clips"] >= 1; }, 40))
       << Status().dump(2) << daemon->output();
   const int64_t complete = Status()["bank"]["sprites_stored"].get<int64_t>();
-  ASSERT_TRUE(WaitStatus([&](const nlohmann::json& s) { return s["bank"]["sprites_stored"] > complete + 10; }, 40))
+  ASSERT_TRUE(WaitStatus(
+      [&](const nlohmann::json& s) { return s["bank"]["sprites_stored"] > complete + 10; }, 40))
       << Status().dump(2);
   daemon->Signal(SIGKILL);
   daemon->Wait(5);
@@ -382,16 +417,19 @@ TEST_F(DaemonTest, SigkillDuringASessionLeavesAVerifiableBank) {
   EXPECT_EQ(verify.exit_code, 0) << verify.output;
   const CommandResult info = RunSpritestation("bank info " + bank() + " --json");
   // The complete clip is there (originals and mirrors); the open one is not shown to readers.
-  EXPECT_GE(JsonInOutput(info.output)["sprites_visible"].get<int64_t>(), 2 * (complete - 5)) << info.output;
+  EXPECT_GE(JsonInOutput(info.output)["sprites_visible"].get<int64_t>(), 2 * (complete - 5))
+      << info.output;
 }
 
 TEST_F(DaemonTest, ADiskNearlyFullStopsRecordingFirstThenSprites) {
   // Recording limit above the free space: sprites are stored, nothing is recorded.
   {
-    auto daemon = Daemon(Config(ReplayCamera(), "", "  recording: all\n  stop_recording_below_mib: 1000000000\n"
-                                                    "  stop_sprites_below_mib: 0\n"),
+    auto daemon = Daemon(Config(ReplayCamera(), "",
+                                "  recording: all\n  stop_recording_below_mib: 1000000000\n"
+                                "  stop_sprites_below_mib: 0\n"),
                          "--session no-recording");
-    ASSERT_TRUE(WaitStatus([](const nlohmann::json& s) { return s["cameras"][0]["state"] == "finished"; }, 30))
+    ASSERT_TRUE(WaitStatus(
+        [](const nlohmann::json& s) { return s["cameras"][0]["state"] == "finished"; }, 30))
         << Status().dump(2);
     const nlohmann::json status = Status();
     EXPECT_EQ(status["storage"]["state"], "recording_stopped");
@@ -402,8 +440,10 @@ TEST_F(DaemonTest, ADiskNearlyFullStopsRecordingFirstThenSprites) {
   }
   // Sprite limit above the free space: nothing more is stored, the bank stays whole.
   const size_t stored = SpritesByCamera(bank())["cam0"].size();
-  auto daemon = Daemon(Config(ReplayCamera(), "", "  stop_sprites_below_mib: 1000000000\n"), "--session full");
-  ASSERT_TRUE(WaitStatus([](const nlohmann::json& s) { return s["cameras"][0]["state"] == "finished"; }, 30))
+  auto daemon = Daemon(Config(ReplayCamera(), "", "  stop_sprites_below_mib: 1000000000\n"),
+                       "--session full");
+  ASSERT_TRUE(WaitStatus(
+      [](const nlohmann::json& s) { return s["cameras"][0]["state"] == "finished"; }, 30))
       << Status().dump(2);
   const auto stopped = client_->Post("/api/session/stop", "", "application/json");
   ASSERT_TRUE(stopped);
@@ -417,10 +457,12 @@ TEST_F(DaemonTest, ADiskNearlyFullStopsRecordingFirstThenSprites) {
 }
 
 TEST_F(DaemonTest, RecordsTheSessionItStores) {
-  auto daemon = Daemon(Config(ReplayCamera(), "", "  recording: all\n  stop_recording_below_mib: 0\n"
-                                                  "  stop_sprites_below_mib: 0\n"),
+  auto daemon = Daemon(Config(ReplayCamera(), "",
+                              "  recording: all\n  stop_recording_below_mib: 0\n"
+                              "  stop_sprites_below_mib: 0\n"),
                        "--session recorded");
-  ASSERT_TRUE(WaitStatus([](const nlohmann::json& s) { return s["cameras"][0]["state"] == "finished"; }, 30))
+  ASSERT_TRUE(WaitStatus(
+      [](const nlohmann::json& s) { return s["cameras"][0]["state"] == "finished"; }, 30))
       << Status().dump(2);
   const auto stopped = client_->Post("/api/session/stop", "", "application/json");
   ASSERT_TRUE(stopped);
@@ -429,10 +471,12 @@ TEST_F(DaemonTest, RecordsTheSessionItStores) {
   daemon->Signal(SIGTERM);
   EXPECT_EQ(daemon->Wait(10), 0);
   // The recording replays: every frame the recorder wrote.
-  const CommandResult replay = RunSpritestation("replay " + session["recording_dir"].get<std::string>() + " --json");
+  const CommandResult replay =
+      RunSpritestation("replay " + session["recording_dir"].get<std::string>() + " --json");
   ASSERT_EQ(replay.exit_code, 0) << replay.output;
   const nlohmann::json r = JsonInOutput(replay.output);
-  EXPECT_EQ(r["frames"].get<int64_t>(), status["storage"]["frames_recorded"].get<int64_t>()) << replay.output;
+  EXPECT_EQ(r["frames"].get<int64_t>(), status["storage"]["frames_recorded"].get<int64_t>())
+      << replay.output;
   EXPECT_GT(r["frames"].get<int64_t>(), 100) << replay.output;
 }
 
@@ -453,7 +497,8 @@ TEST_F(DaemonTest, EventStreamsStreamPatchesAndStalledOnesStarveNothing) {
   const size_t patch = text.find("event: patch");
   ASSERT_NE(patch, std::string::npos) << text.substr(0, 300);
   const size_t data = text.find("data: ", text.find("event: snapshot"));
-  const nlohmann::json snapshot = nlohmann::json::parse(text.substr(data + 6, text.find('\n', data) - data - 6));
+  const nlohmann::json snapshot =
+      nlohmann::json::parse(text.substr(data + 6, text.find('\n', data) - data - 6));
   EXPECT_EQ(snapshot["status"]["cameras"][0]["name"], "cam0");
   EXPECT_EQ(snapshot["status"]["mode"], "live");
 
@@ -473,7 +518,8 @@ TEST_F(DaemonTest, EventStreamsStreamPatchesAndStalledOnesStarveNothing) {
     });
   }
   const auto deadline = Clock::now() + std::chrono::seconds(10);
-  while (opened < 16 && Clock::now() < deadline) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  while (opened < 16 && Clock::now() < deadline)
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
   EXPECT_EQ(opened.load(), 16);
   httplib::Client extra("127.0.0.1", port_);
   extra.set_read_timeout(5, 0);
@@ -490,7 +536,9 @@ TEST_F(DaemonTest, EventStreamsStreamPatchesAndStalledOnesStarveNothing) {
   EXPECT_LT(std::chrono::duration<double>(Clock::now() - asked).count(), 1.0);
   ASSERT_FALSE(status.is_null());
   const auto frames = Camera(status, "cam0")["frames_captured"].get<int64_t>();
-  EXPECT_TRUE(WaitStatus([&](const nlohmann::json& s) { return Camera(s, "cam0")["frames_captured"] > frames + 30; }, 10));
+  EXPECT_TRUE(WaitStatus(
+      [&](const nlohmann::json& s) { return Camera(s, "cam0")["frames_captured"] > frames + 30; },
+      10));
   // Writes: a form post, and a JSON post from another site's page, are refused before acting.
   auto r = client_->Post("/api/session/start", "name=x", "application/x-www-form-urlencoded");
   EXPECT_EQ(r->status, 415) << r->body;
@@ -531,7 +579,8 @@ TEST_F(DaemonTest, TheControlApiRefusesBadRequestsByName) {
   // A header of more than 64 KiB (each line within cpp-httplib's 8 KiB): 431 naming the limit.
   {
     std::string big = "GET /api/status HTTP/1.1\r\nHost: 127.0.0.1\r\n";
-    for (int i = 0; i < 10; ++i) big += "X-Big-" + std::to_string(i) + ": " + std::string(7000, 'a') + "\r\n";
+    for (int i = 0; i < 10; ++i)
+      big += "X-Big-" + std::to_string(i) + ": " + std::string(7000, 'a') + "\r\n";
     big += "\r\n";
     const int fd = ConnectFrom("127.0.0.1", port_);
     ASSERT_GE(fd, 0);
@@ -539,11 +588,13 @@ TEST_F(DaemonTest, TheControlApiRefusesBadRequestsByName) {
     const std::string answer = ReadUntilClosed(fd, 5);
     ::close(fd);
     EXPECT_EQ(answer.rfind("HTTP/1.1 431 ", 0), 0u) << answer.substr(0, 300);
-    EXPECT_NE(answer.find("header: larger than 65536 bytes"), std::string::npos) << answer.substr(0, 300);
+    EXPECT_NE(answer.find("header: larger than 65536 bytes"), std::string::npos)
+        << answer.substr(0, 300);
   }
   // 1 MiB of nested brackets (issue 20's fuzzing: the daemon died of a stack overflow when the
   // error quoted the value): refused by its depth, and the daemon answers on.
-  const std::string deep = R"({"name": )" + std::string(524000, '[') + std::string(524000, ']') + "}";
+  const std::string deep =
+      R"({"name": )" + std::string(524000, '[') + std::string(524000, ']') + "}";
   r = post("/api/session/start", deep);
   ASSERT_TRUE(r) << "the daemon did not answer a deeply nested body";
   EXPECT_EQ(r->status, 400) << r->body;
@@ -587,7 +638,8 @@ TEST_F(DaemonTest, SlowClientsDoNotStarveTheApi) {
     // Every slow client sends one more header line, as the attack does every 2 s.
     for (const int fd : slow) ::send(fd, "X-Slow: 1\r\n", 11, MSG_NOSIGNAL);
     const auto r = probe.Get("/api/status");
-    ASSERT_TRUE(r) << "round " << round << ": the API did not answer within 2 s (" << httplib::to_string(r.error()) << ")";
+    ASSERT_TRUE(r) << "round " << round << ": the API did not answer within 2 s ("
+                   << httplib::to_string(r.error()) << ")";
     EXPECT_EQ(r->status, 200);
     std::this_thread::sleep_for(std::chrono::seconds(1));
   }
@@ -624,7 +676,8 @@ TEST_F(DaemonTest, OneAddressHoldsAtMost64ConnectionsAndOthersAreStillServed) {
   // A connection counts once a thread serves it: all 64, and the status request itself.
   const auto until = Clock::now() + std::chrono::seconds(5);
   nlohmann::json c;
-  while (Clock::now() < until && !((c = control()).is_object() && c["connections_open"].get<int>() >= 65)) {
+  while (Clock::now() < until &&
+         !((c = control()).is_object() && c["connections_open"].get<int>() >= 65)) {
     std::this_thread::sleep_for(std::chrono::milliseconds(50));
   }
   ASSERT_TRUE(c.is_object());
@@ -638,8 +691,10 @@ TEST_F(DaemonTest, OneAddressHoldsAtMost64ConnectionsAndOthersAreStillServed) {
   ::close(over);
   EXPECT_TRUE(closed);
   EXPECT_EQ(refused.rfind("HTTP/1.1 503 ", 0), 0u) << refused;
-  EXPECT_NE(refused.find("connections: 64 are open from 127.0.0.1 already (the limit per client address)"),
-            std::string::npos) << refused;
+  EXPECT_NE(refused.find(
+                "connections: 64 are open from 127.0.0.1 already (the limit per client address)"),
+            std::string::npos)
+      << refused;
 
   const auto asked = Clock::now();
   c = control();
@@ -648,7 +703,9 @@ TEST_F(DaemonTest, OneAddressHoldsAtMost64ConnectionsAndOthersAreStillServed) {
   EXPECT_EQ(c["connections_refused"], 1) << c.dump();
   const auto metrics = other.Get("/metrics");
   ASSERT_TRUE(metrics);
-  EXPECT_NE(metrics->body.find("spritestation_http_connections_refused_total 1\n"), std::string::npos) << metrics->body;
+  EXPECT_NE(metrics->body.find("spritestation_http_connections_refused_total 1\n"),
+            std::string::npos)
+      << metrics->body;
 
   for (const int fd : held) ::close(fd);
   EXPECT_TRUE(WaitStatus([](const nlohmann::json& s) { return s["state"] == "running"; }, 5))
@@ -683,7 +740,8 @@ TEST_F(DaemonTest, AClientTricklingItsHeaderIsDroppedAtTheRequestDeadline) {
   ASSERT_GE(slow, 0);
   const std::string line = "GET /api/status HTTP/1.1\r\nHost: 127.0.0.1\r\nX-Slow: ";
   const auto first_byte = Clock::now();
-  ASSERT_EQ(::send(slow, line.data(), line.size(), MSG_NOSIGNAL), static_cast<ssize_t>(line.size()));
+  ASSERT_EQ(::send(slow, line.data(), line.size(), MSG_NOSIGNAL),
+            static_cast<ssize_t>(line.size()));
   const int keep_alive = ConnectFrom("127.0.0.2", port_);
   ASSERT_GE(keep_alive, 0);
 
@@ -694,26 +752,32 @@ TEST_F(DaemonTest, AClientTricklingItsHeaderIsDroppedAtTheRequestDeadline) {
     ::send(slow, "a", 1, MSG_NOSIGNAL);  // one more header byte a second
     const auto asked = Clock::now();
     const int status = KeepAliveGet(keep_alive, "/api/status", 1.0);
-    ASSERT_EQ(status, 200) << "request " << requests << " on the keep-alive connection: no answer within 1 s";
+    ASSERT_EQ(status, 200) << "request " << requests
+                           << " on the keep-alive connection: no answer within 1 s";
     ASSERT_LT(std::chrono::duration<double>(Clock::now() - asked).count(), 1.0);
     ++requests;
     bool closed = false;
-    answer += ReadUntilClosed(slow, std::max(0.0, 1.0 - std::chrono::duration<double>(Clock::now() - asked).count()),
-                              &closed);
+    answer += ReadUntilClosed(
+        slow, std::max(0.0, 1.0 - std::chrono::duration<double>(Clock::now() - asked).count()),
+        &closed);
     if (closed) dropped_s = std::chrono::duration<double>(Clock::now() - first_byte).count();
   }
   ::close(slow);
   ::close(keep_alive);
-  std::printf("trickler dropped after %.2f s; %d requests on one keep-alive connection meanwhile\n", dropped_s, requests);
+  std::printf("trickler dropped after %.2f s; %d requests on one keep-alive connection meanwhile\n",
+              dropped_s, requests);
   EXPECT_GE(dropped_s, 9.9);
   EXPECT_LT(dropped_s, 12.0);
   EXPECT_GE(requests, 10);
   EXPECT_EQ(answer.rfind("HTTP/1.1 408 ", 0), 0u) << answer;
-  EXPECT_NE(answer.find("request: not received whole within 10 s of its first byte"), std::string::npos) << answer;
+  EXPECT_NE(answer.find("request: not received whole within 10 s of its first byte"),
+            std::string::npos)
+      << answer;
   EXPECT_EQ(Status()["control"]["requests_timed_out"], 1) << Status()["control"].dump();
   // The event stream, opened before the trickler's first byte, streams on 11 s later.
   const auto until = Clock::now() + std::chrono::seconds(3);
-  while (last_event_s < 11.0 && Clock::now() < until) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  while (last_event_s < 11.0 && Clock::now() < until)
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
   EXPECT_GE(last_event_s.load(), 11.0);
   stop_events = true;
   events.join();
@@ -737,10 +801,13 @@ TEST_F(DaemonTest, SighupReloadsWhatIsSafeAndKeepsTheConfigWhenTheFileIsBad) {
   const std::string config = Config(ReplayCamera(true));
   auto daemon = Daemon(config);
   // A changed keying section needs a restart; the storage limits apply at once.
-  Config(ReplayCamera(true), "keying:\n  chroma:\n    low: 25\n", "  stop_sprites_below_mib: 1000000000\n");
+  Config(ReplayCamera(true), "keying:\n  chroma:\n    low: 25\n",
+         "  stop_sprites_below_mib: 1000000000\n");
   daemon->Signal(SIGHUP);
-  ASSERT_TRUE(daemon->WaitForOutput("keying: changed; restart the daemon to apply", 10)) << daemon->output();
-  EXPECT_TRUE(WaitStatus([](const nlohmann::json& s) { return s["storage"]["state"] == "sprites_stopped"; }, 10))
+  ASSERT_TRUE(daemon->WaitForOutput("keying: changed; restart the daemon to apply", 10))
+      << daemon->output();
+  EXPECT_TRUE(WaitStatus(
+      [](const nlohmann::json& s) { return s["storage"]["state"] == "sprites_stopped"; }, 10))
       << Status().dump(2);
   // A broken file is refused by name and the running config kept.
   {
@@ -768,19 +835,26 @@ TEST_F(DaemonTest, ABadConfigFieldIsRefusedByName) {
 // GigE path (GVSP frames, RGB8).
 TEST_F(DaemonTest, TheCalibrationWizardPosesALiveGigECameraOnTheFloor) {
   const std::string session = dir_ / "calibration";
-  const CommandResult synth = RunSpritestation("--log-level warn synth --out " + session +
-                                               " --kind calibration --seconds 3 --fps 8 --size 640x480 --cameras 1 --seed 5");
+  const CommandResult synth = RunSpritestation(
+      "--log-level warn synth --out " + session +
+      " --kind calibration --seconds 3 --fps 8 --size 640x480 --cameras 1 --seed 5");
   ASSERT_EQ(synth.exit_code, 0) << synth.output;
   // One pass: the session ends with the board on the floor, so the enclosure comes from that frame.
-  BackgroundCommand cam("fakecam " + session + " --address 127.0.0.1 --serial calib --loop 1 --pixel-format rgb8",
-                        dir_ / "fakecam-calib.log");
+  BackgroundCommand cam(
+      "fakecam " + session + " --address 127.0.0.1 --serial calib --loop 1 --pixel-format rgb8",
+      dir_ / "fakecam-calib.log");
   ASSERT_TRUE(cam.WaitForOutput("fakecam: serving", 20)) << cam.output();
-  const std::string config = Config("  - name: calib\n    source: aravis\n    address: 127.0.0.1\n");
+  const std::string config =
+      Config("  - name: calib\n    source: aravis\n    address: 127.0.0.1\n");
   const std::string out = dir_ / "wizard";
-  const CommandResult r = RunSpritestation(
-      "--log-level warn calibrate wizard --config " + config + " --camera calib --board chessboard:10x7:0.03"
-      " --intrinsics " + session + "/truth/cam0.cameramodel --board-pose -0.15 0.105 0 --board-thickness 0.001"
-      " --floor-still-seconds 0.5 --count 200 --out " + out + " --json");
+  const CommandResult r =
+      RunSpritestation("--log-level warn calibrate wizard --config " + config +
+                       " --camera calib --board chessboard:10x7:0.03"
+                       " --intrinsics " +
+                       session +
+                       "/truth/cam0.cameramodel --board-pose -0.15 0.105 0 --board-thickness 0.001"
+                       " --floor-still-seconds 0.5 --count 200 --out " +
+                       out + " --json");
   ASSERT_EQ(r.exit_code, 0) << r.output << cam.output();
   const nlohmann::json j = JsonInOutput(r.output);
   ASSERT_TRUE(j.is_object()) << r.output;
@@ -789,8 +863,11 @@ TEST_F(DaemonTest, TheCalibrationWizardPosesALiveGigECameraOnTheFloor) {
   const CameraModel posed = CameraModel::Read(out + "/calib.cameramodel");
   const double centre_m = (posed.CentreInGround() - truth.CentreInGround()).norm();
   const double angle = Eigen::AngleAxisd(posed.cam_from_ground().rotation *
-                                         truth.cam_from_ground().rotation.transpose()).angle() * 180 / M_PI;
-  std::printf("live wizard: camera centre %.2f mm, orientation %.3f deg from the truth\n", centre_m * 1000, angle);
+                                         truth.cam_from_ground().rotation.transpose())
+                           .angle() *
+                       180 / M_PI;
+  std::printf("live wizard: camera centre %.2f mm, orientation %.3f deg from the truth\n",
+              centre_m * 1000, angle);
   EXPECT_LT(centre_m, 0.002);
   EXPECT_LT(angle, 0.1);
   ASSERT_TRUE(j.contains("enclosure")) << r.output;

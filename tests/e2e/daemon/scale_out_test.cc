@@ -13,10 +13,10 @@
 #include <vector>
 
 // Eigen before httplib: <resolv.h> (through httplib) defines _res, a name Eigen uses.
-#include <Eigen/Core>
 #include <gtest/gtest.h>
 #include <httplib.h>
 #include <spdlog/fmt/fmt.h>
+#include <Eigen/Core>
 
 #include <nlohmann/json.hpp>
 
@@ -31,14 +31,13 @@ namespace {
 using testing::BackgroundCommand;
 using testing::JsonInOutput;
 using testing::PostgresServer;
-using testing::QueryInt;
 using testing::PrivateNetworkError;
+using testing::QueryInt;
 using testing::RunSpritestation;
 using testing::ScratchDir;
 using Clock = std::chrono::steady_clock;
 
 constexpr int kStations = 3;
-
 
 uint64_t Fnv1a(const cv::Mat& m, uint64_t h) {
   if (m.empty()) return h;
@@ -51,7 +50,8 @@ uint64_t Fnv1a(const cv::Mat& m, uint64_t h) {
 // Every stored sprite of each session (by the session's name, or "" for a bank of one session),
 // as one line of its content: camera, clip, frame, every field to the last bit, its pixels'
 // hash. Ids are left out (they differ between banks); mirrors point at their original's frame.
-std::map<std::string, std::multiset<std::string>> SpritesBySession(const std::string& bank_path, bool by_name) {
+std::map<std::string, std::multiset<std::string>> SpritesBySession(const std::string& bank_path,
+                                                                   bool by_name) {
   Bank bank(bank_path);
   std::map<int64_t, std::string> session_name;
   for (const SessionRecord& s : bank.ListSessions()) session_name[s.id] = by_name ? s.name : "";
@@ -75,13 +75,16 @@ std::map<std::string, std::multiset<std::string>> SpritesBySession(const std::st
     std::string tags;
     for (const std::string& t : s.tags) tags += t + ",";
     out[session_name.at(camera.session_id)].insert(fmt::format(
-        "{} track {} frames {}-{} | frame {} t {} mirror {} of {} | ground {:a} {:a} v {:a} {:a} rgb {:a} {:a} {:a} "
-        "area {:a} ecc {:a} | box {} {} {} {} billboard {}x{} {:a} px/m anchor {:a} {:a} | tags {} | pixels {:x}",
-        camera.name, clip.track_id, clip.first_frame, clip.last_frame, s.frame, s.timestamp_ns, s.mirrored,
-        s.mirrored ? frame_of.at(s.mirror_of) : -1, s.ground_x_m, s.ground_y_m, s.velocity_x_m_s, s.velocity_y_m_s,
-        s.mean_r, s.mean_g, s.mean_b, s.area_px, s.eccentricity, s.bbox_in_image.x, s.bbox_in_image.y,
-        s.bbox_in_image.width, s.bbox_in_image.height, s.billboard_width_px, s.billboard_height_px, s.px_per_m,
-        s.anchor_x_px, s.anchor_y_px, tags, h));
+        "{} track {} frames {}-{} | frame {} t {} mirror {} of {} | ground {:a} {:a} v {:a} {:a} "
+        "rgb {:a} {:a} {:a} "
+        "area {:a} ecc {:a} | box {} {} {} {} billboard {}x{} {:a} px/m anchor {:a} {:a} | tags {} "
+        "| pixels {:x}",
+        camera.name, clip.track_id, clip.first_frame, clip.last_frame, s.frame, s.timestamp_ns,
+        s.mirrored, s.mirrored ? frame_of.at(s.mirror_of) : -1, s.ground_x_m, s.ground_y_m,
+        s.velocity_x_m_s, s.velocity_y_m_s, s.mean_r, s.mean_g, s.mean_b, s.area_px, s.eccentricity,
+        s.bbox_in_image.x, s.bbox_in_image.y, s.bbox_in_image.width, s.bbox_in_image.height,
+        s.billboard_width_px, s.billboard_height_px, s.px_per_m, s.anchor_x_px, s.anchor_y_px, tags,
+        h));
   }
   return out;
 }
@@ -98,7 +101,8 @@ nlohmann::json Status(int port) {
 bool AllReplayed(const nlohmann::json& status) {
   if (status.is_null() || status["cameras"].empty()) return false;
   for (const auto& c : status["cameras"]) {
-    if (c["state"] != "finished" || c["queue_depth"] != 0 || c["frames_processed"] != c["frames_captured"]) {
+    if (c["state"] != "finished" || c["queue_depth"] != 0 ||
+        c["frames_processed"] != c["frames_captured"]) {
       return false;
     }
   }
@@ -113,9 +117,10 @@ TEST(ScaleOut, ThreeDaemonsAndTwoWorkersStoreWhatIngestStores) {
   // Three sessions whose cameras stand in different places (the seed places them): alone, their
   // stations would choose 240, 230 and 230 px/m. The bank must keep one scale.
   for (int k = 0; k < kStations; ++k) {
-    const auto synth = RunSpritestation(fmt::format(
-        "synth --out {} --kind animal --seconds 5 --fps 30 --size 480x360 --cameras 2 --subjects 1 --seed {}",
-        dir / ("session-" + std::to_string(k)), 41 + k));
+    const auto synth =
+        RunSpritestation(fmt::format("synth --out {} --kind animal --seconds 5 --fps 30 --size "
+                                     "480x360 --cameras 2 --subjects 1 --seed {}",
+                                     dir / ("session-" + std::to_string(k)), 41 + k));
     ASSERT_EQ(synth.exit_code, 0) << synth.output;
   }
   const std::string pg = server.CreateDatabase("studio");
@@ -133,9 +138,12 @@ TEST(ScaleOut, ThreeDaemonsAndTwoWorkersStoreWhatIngestStores) {
     const std::string session = dir / ("session-" + std::to_string(k));
     const std::string config = dir / ("station-" + std::to_string(k) + ".yaml");
     std::ofstream(config) << "version: 1\ncameras:\n"
-                          << "  - name: cam0\n    source: replay\n    session: " << session << "\n    realtime: false\n"
-                          << "  - name: cam1\n    source: replay\n    session: " << session << "\n    realtime: false\n"
-                          << "storage:\n  bank: " << pg << "\n  spool_dir: " << (dir / ("spool-" + std::to_string(k)))
+                          << "  - name: cam0\n    source: replay\n    session: " << session
+                          << "\n    realtime: false\n"
+                          << "  - name: cam1\n    source: replay\n    session: " << session
+                          << "\n    realtime: false\n"
+                          << "storage:\n  bank: " << pg
+                          << "\n  spool_dir: " << (dir / ("spool-" + std::to_string(k)))
                           << "\ncontrol:\n  port: 0\n";
     daemons.push_back(std::make_unique<BackgroundCommand>(
         fmt::format("daemon --config {} --session take-{} --json", config, k),
@@ -169,7 +177,8 @@ TEST(ScaleOut, ThreeDaemonsAndTwoWorkersStoreWhatIngestStores) {
   const int64_t clips = QueryInt(pg, "SELECT count(*) FROM clips WHERE complete = 1");
   ASSERT_GE(clips, 2 * kStations);
   const auto deadline = Clock::now() + std::chrono::seconds(240);
-  while (Clock::now() < deadline && QueryInt(pg, "SELECT count(*) FROM transition_work WHERE done = 1") < clips) {
+  while (Clock::now() < deadline &&
+         QueryInt(pg, "SELECT count(*) FROM transition_work WHERE done = 1") < clips) {
     std::this_thread::sleep_for(std::chrono::milliseconds(250));
   }
   EXPECT_EQ(QueryInt(pg, "SELECT count(*) FROM transition_work WHERE done = 1"), clips);
@@ -186,15 +195,17 @@ TEST(ScaleOut, ThreeDaemonsAndTwoWorkersStoreWhatIngestStores) {
   const std::vector<double> scales = Bank(pg).BillboardScales();
   ASSERT_EQ(scales.size(), 1u);
   const std::string ingest_config = dir / "ingest.yaml";
-  std::ofstream(ingest_config) << "version: 1\npipeline:\n  px_per_m: " << fmt::format("{:.17g}", scales[0]) << "\n";
+  std::ofstream(ingest_config) << "version: 1\npipeline:\n  px_per_m: "
+                               << fmt::format("{:.17g}", scales[0]) << "\n";
 
   // The bank holds exactly the union of what ingest stores of each session.
   const auto shared = SpritesBySession(pg, /*by_name=*/true);
   size_t total = 0;
   for (int k = 0; k < kStations; ++k) {
     const std::string bank = dir / ("ingest-" + std::to_string(k) + ".db");
-    const auto ingest = RunSpritestation(fmt::format("--log-level warn ingest {} --bank {} --config {} --no-transitions",
-                                                     dir / ("session-" + std::to_string(k)), bank, ingest_config));
+    const auto ingest = RunSpritestation(
+        fmt::format("--log-level warn ingest {} --bank {} --config {} --no-transitions",
+                    dir / ("session-" + std::to_string(k)), bank, ingest_config));
     ASSERT_EQ(ingest.exit_code, 0) << ingest.output;
     const auto want = SpritesBySession(bank, /*by_name=*/false);
     ASSERT_EQ(want.size(), 1u);
@@ -205,11 +216,15 @@ TEST(ScaleOut, ThreeDaemonsAndTwoWorkersStoreWhatIngestStores) {
     EXPECT_GT(expected.size(), 50u) << name;
     EXPECT_EQ(got.size(), expected.size()) << name;
     std::vector<std::string> missing, extra;
-    std::set_difference(expected.begin(), expected.end(), got.begin(), got.end(), std::back_inserter(missing));
-    std::set_difference(got.begin(), got.end(), expected.begin(), expected.end(), std::back_inserter(extra));
+    std::set_difference(expected.begin(), expected.end(), got.begin(), got.end(),
+                        std::back_inserter(missing));
+    std::set_difference(got.begin(), got.end(), expected.begin(), expected.end(),
+                        std::back_inserter(extra));
     EXPECT_TRUE(missing.empty() && extra.empty())
-        << name << ": " << missing.size() << " sprites of ingest missing, " << extra.size() << " not ingest's\n"
-        << (missing.empty() ? "" : "missing: " + missing.front() + "\n") << (extra.empty() ? "" : "extra: " + extra.front());
+        << name << ": " << missing.size() << " sprites of ingest missing, " << extra.size()
+        << " not ingest's\n"
+        << (missing.empty() ? "" : "missing: " + missing.front() + "\n")
+        << (extra.empty() ? "" : "extra: " + extra.front());
     total += got.size();
   }
   EXPECT_EQ(shared.size(), static_cast<size_t>(kStations));
@@ -226,8 +241,8 @@ TEST(ScaleOut, ThreeDaemonsAndTwoWorkersStoreWhatIngestStores) {
   ASSERT_EQ(got.size(), want.size());
   size_t differ = 0;
   for (size_t k = 0; k < want.size(); ++k) {
-    if (got[k].from_sprite != want[k].from_sprite || got[k].to_sprite != want[k].to_sprite || got[k].d != want[k].d ||
-        got[k].cost != want[k].cost) {
+    if (got[k].from_sprite != want[k].from_sprite || got[k].to_sprite != want[k].to_sprite ||
+        got[k].d != want[k].d || got[k].cost != want[k].cost) {
       ++differ;
     }
   }

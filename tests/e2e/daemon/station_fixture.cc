@@ -39,7 +39,8 @@ std::string EnterPrivateNetwork() {
     const gid_t gid = getgid();
     if (unshare(CLONE_NEWUSER | CLONE_NEWNET) != 0) {
       return std::string("unshare(CLONE_NEWUSER | CLONE_NEWNET): ") + std::strerror(errno) +
-             " (the daemon tests need a private network namespace: run as root or enable user namespaces)";
+             " (the daemon tests need a private network namespace: run as root or enable user "
+             "namespaces)";
     }
     WriteFile("/proc/self/setgroups", "deny");
     if (!WriteFile("/proc/self/uid_map", "0 " + std::to_string(uid) + " 1") ||
@@ -65,7 +66,8 @@ StationSession MakeSession() {
   const char* bin = std::getenv("SPRITESTATION_BIN");
   std::error_code ec;
   const auto built = bin ? fs::last_write_time(bin, ec).time_since_epoch().count() : 0;
-  const fs::path root = fs::temp_directory_path() / ("spritestation-station-fixture-" + std::to_string(built));
+  const fs::path root =
+      fs::temp_directory_path() / ("spritestation-station-fixture-" + std::to_string(built));
   fs::create_directories(root);
   s.dir = (root / "session").string();
   s.ingest_bank = (root / "ingest.bank").string();
@@ -75,9 +77,10 @@ StationSession MakeSession() {
   if (!fs::exists(root / "done")) {
     fs::remove_all(s.dir);
     fs::remove(s.ingest_bank);
-    const CommandResult synth = RunSpritestation("synth --out " + s.dir +
-                                                 " --kind animal --seconds 5 --fps 30 --size 640x480 --cameras 2"
-                                                 " --subjects 1 --seed 11 --empty-lead-in 2");
+    const CommandResult synth =
+        RunSpritestation("synth --out " + s.dir +
+                         " --kind animal --seconds 5 --fps 30 --size 640x480 --cameras 2"
+                         " --subjects 1 --seed 11 --empty-lead-in 2");
     const CommandResult ingest = RunSpritestation("ingest " + s.dir + " --bank " + s.ingest_bank);
     if (synth.exit_code == 0 && ingest.exit_code == 0) {
       WriteFile((root / "done").string(), "ok\n");
@@ -92,8 +95,8 @@ StationSession MakeSession() {
   s.floor_yaml = "[";
   if (floor.is_object() && floor.contains("polygon")) {
     for (const auto& p : floor["polygon"]) {
-      s.floor_yaml += (s.floor_yaml.size() > 1 ? ", [" : "[") + std::to_string(p[0].get<double>()) + ", " +
-                      std::to_string(p[1].get<double>()) + "]";
+      s.floor_yaml += (s.floor_yaml.size() > 1 ? ", [" : "[") + std::to_string(p[0].get<double>()) +
+                      ", " + std::to_string(p[1].get<double>()) + "]";
     }
   }
   s.floor_yaml += "]";

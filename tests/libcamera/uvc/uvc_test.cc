@@ -62,7 +62,6 @@ std::vector<std::string> SharedLibraries(const std::string& binary) {
   return out;
 }
 
-
 // The guest's /init: modules, gadgetfs, the camera in its main layout and the
 // probe, then the camera in its NV12 layout and the probe again.
 std::string InitScript(const std::vector<std::string>& module_files) {
