@@ -17,8 +17,8 @@ namespace ss {
 struct SpriteSpec {
   std::string name;
   Anchor anchor = Anchor::kStart;
-  Eigen::Vector2d anchor_m =
-      Eigen::Vector2d::Zero();        // p_0 (kStart; kFree: first guess) or p_{n-1}
+  // p_0 (kStart; kFree: first guess) or p_{n-1}
+  Eigen::Vector2d anchor_m = Eigen::Vector2d::Zero();
   double smoothness = 1.0;            // α, strength of Cs for this sprite (its SmoothnessTerm)
   int initial_frames = 60;            // length of a random initial sequence
   int max_frames = 0;                 // longer sequences are cut at the end; 0 = no limit

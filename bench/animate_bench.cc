@@ -40,8 +40,8 @@ struct Args {
   bool detail = false;  // per-sprite figures in the JSON
   std::string start;    // replacement's start: random, sequential, beam; "": per scene
   double fly_collision_strength = 100;  // scenes 6 and 7: each pair's anti-collision strength
-  double collision_pick_fraction =
-      -1;  // replacement's picks aimed at a collision; < 0: its default
+  // replacement's picks aimed at a collision; < 0: its default
+  double collision_pick_fraction = -1;
 };
 
 Args Parse(const std::vector<std::string>& argv) {

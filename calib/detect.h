@@ -17,13 +17,13 @@
 namespace ss::calib {
 
 struct DetectOptions {
-  double max_edge_width_px =
-      4.0;               // median 10-90% edge rise of the squares; blurrier views are rejected
-  int min_corners = 12;  // partial (ChArUco) views with fewer corners are rejected
+  // median 10-90% edge rise of the squares; blurrier views are rejected
+  double max_edge_width_px = 4.0;
+  int min_corners = 12;             // partial (ChArUco) views with fewer corners are rejected
   double min_area_fraction = 0.01;  // corners' convex hull must cover this much of the image
   bool check_sharpness = true;
-  bool exhaustive =
-      true;  // chessboard: CALIB_CB_EXHAUSTIVE (harder views; a frame without a board costs ~2x)
+  // chessboard: CALIB_CB_EXHAUSTIVE (harder views; a frame without a board costs ~2x)
+  bool exhaustive = true;
 };
 
 // One image's detection.

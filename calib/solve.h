@@ -35,8 +35,8 @@ struct SolveCamera {
 };
 
 struct SolveOptions {
-  std::string lensmodel =
-      "LENSMODEL_OPENCV8";          // any mrcal model with an fx fy cx cy core, splined included
+  // any mrcal model with an fx fy cx cy core, splined included
+  std::string lensmodel = "LENSMODEL_OPENCV8";
   bool optimize_board_warp = true;  // mrcal's board flex (calobject_warp)
   bool reject_outliers = true;      // mrcal's outlier rejection in the final stage
   bool compute_covariance = true;   // needed for parameter and projection uncertainty

@@ -120,8 +120,8 @@ JobOutcome RunIntrinsics(const std::vector<CameraViews>& cameras, const Intrinsi
     j["summary"] = solution->summary;
     j["pixel_sigma"] = solution->pixel_sigma;
     j["board_warp_m"] = {solution->board_warp[0], solution->board_warp[1]};
-    j["poses"] =
-        nlohmann::json::object();  // cam_from_ref as mrcal rt, reference = the first solved camera
+    // cam_from_ref as mrcal rt, reference = the first solved camera
+    j["poses"] = nlohmann::json::object();
     for (size_t c = 0; c < cameras.size(); ++c) {
       if (solve_index[c] >= 0)
         j["poses"][cameras[c].name] = PoseJson(solution->models[solve_index[c]].cam_from_ground());

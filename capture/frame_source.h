@@ -22,8 +22,8 @@ struct SourceCamera {
 
 struct SourceStats {
   uint64_t frames_delivered = 0;
-  uint64_t frames_dropped =
-      0;                   // lost at the device or in the file (sequence gaps, unreadable frames)
+  // lost at the device or in the file (sequence gaps, unreadable frames)
+  uint64_t frames_dropped = 0;
   uint64_t errors = 0;     // recoverable errors (a corrupt frame, a timeout)
   std::string last_error;  // names the file/device and the frame
 };

@@ -80,8 +80,8 @@ struct KeyingConfig {
   bool despill = true;
   double despill_strength = 1.0;  // 0..1
   bool shadow = true;             // keep the contact-shadow layer
-  double shadow_min_darkening =
-      0.08;                           // fraction of plate brightness below which there is no shadow
+  // fraction of plate brightness below which there is no shadow
+  double shadow_min_darkening = 0.08;
   double shadow_max_darkening = 0.7;  // darkening that counts as full shadow
   double shadow_reach_m = 0.5;        // shadow kept this far around the subject's foot
   bool operator==(const KeyingConfig&) const = default;
@@ -99,8 +99,8 @@ struct PipelineConfig {
   int floor_margin_px = 3;       // floor pixels required around the silhouette
   double wall_margin_m = 0.005;  // contact point distance to keep from the floor polygon's edge
   double still_speed_m_per_s = 0.05;  // slower than this counts as not moving
-  double max_speed_m_per_s =
-      1.0;  // the tracker's speed limit: a subject faster than this starts a new clip
+  // the tracker's speed limit: a subject faster than this starts a new clip
+  double max_speed_m_per_s = 1.0;
   double max_still_s = 2.0;  // still periods longer than this are discarded
   int min_clip_frames = 5;   // shorter clips are discarded
   // Noise (docs/pipeline.md, `noise`): keyed background, not a subject. 0 turns a test off.

@@ -30,8 +30,8 @@ std::string ReadWithinLimit(std::istream& in, const std::string& path, const std
                             uintmax_t max_bytes) {
   const std::string limit = "larger than the " + Amount(max_bytes) + " " + what + " may be";
   std::error_code ec;
-  const uintmax_t size =
-      std::filesystem::file_size(path, ec);  // fails for what is not a regular file
+  // fails for what is not a regular file
+  const uintmax_t size = std::filesystem::file_size(path, ec);
   if (!ec && size > max_bytes) {
     const std::string bytes = std::to_string(size) + " bytes";
     throw InputError(

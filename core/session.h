@@ -23,8 +23,8 @@ struct SessionCamera {
   std::string model;       // e.g. "cam0.cameramodel"; empty when uncalibrated
   int width = 0;
   int height = 0;
-  PixelFormat pixel_format =
-      PixelFormat::kBGR8;      // as the camera delivered it, and as replay returns it
+  // as the camera delivered it, and as replay returns it
+  PixelFormat pixel_format = PixelFormat::kBGR8;
   std::string codec = "ffv1";  // "ffv1" | "mjpeg" | "h264"
   double fps = 30.0;
   // Frames recorded, written when the recording was closed; -1 while it runs or

@@ -75,8 +75,8 @@ struct ImportedCamera {
   int64_t corrupt_frames = 0;  // the decoder reported damaged and that were skipped
   std::string last_problem;
   int64_t first_timestamp_ns = 0, last_timestamp_ns = 0;  // of the imported frames
-  double median_background_share =
-      0;                     // kMedian: share of the sampled values within the spreads kept
+  // kMedian: share of the sampled values within the spreads kept
+  double median_background_share = 0;
   std::string model_source;  // the file, or "rough: ..."
 };
 

@@ -48,11 +48,11 @@ struct CameraStatus {
   uint64_t frames_captured = 0;     // delivered by the source
   uint64_t frames_processed = 0;    // through the pipeline (training frames included)
   uint64_t dropped_queue_full = 0;  // the pipeline queue was full
-  uint64_t dropped_at_source =
-      0;                       // lost before delivery: incomplete frames, sequence gaps, unreadable
+  // lost before delivery: incomplete frames, sequence gaps, unreadable
+  uint64_t dropped_at_source = 0;
   uint64_t source_errors = 0;  // recoverable source problems (timeouts, corrupt frames)
-  uint64_t frames_while_learning =
-      0;  // arrived while the keyer learnt the empty enclosure (preview only)
+  // arrived while the keyer learnt the empty enclosure (preview only)
+  uint64_t frames_while_learning = 0;
   // The frames collected for the keyer to learn the empty enclosure from (set when the set is
   // complete and learning starts): how many, and the first and last one's sequence number and
   // timestamp (-1: none collected yet).
@@ -80,8 +80,8 @@ struct CameraRunnerOptions {
   double offline_after_s = 3.0;  // no frame for this long: offline, closed and reopened
   double backoff_min_s = 0.5;    // first reopen delay, doubled up to backoff_max_s
   double backoff_max_s = 8.0;
-  double preview_interval_s =
-      0.2;  // a preview snapshot this often (set_preview_interval changes it)
+  // a preview snapshot this often (set_preview_interval changes it)
+  double preview_interval_s = 0.2;
   // Opens the camera; unset: OpenCameraSource (benchmarks put frames from memory here).
   std::function<std::unique_ptr<FrameSource>(const CameraConfig&, int camera_index)> open_source;
 };

@@ -49,8 +49,8 @@ constexpr size_t kQueueFrames = 4;  // frames waiting for a camera's wizard; mor
 constexpr int kGrid = 10;           // the coverage map's cells a side
 constexpr double kPublishS = 0.1;   // a camera's state and live view are refreshed this often
 constexpr double kGridStepM = 0.1;  // the floor grid drawn over a posed camera's view
-constexpr double kPlanReachM =
-    8.0;  // a view's rays above the horizon end this far away on the plan
+// a view's rays above the horizon end this far away on the plan
+constexpr double kPlanReachM = 8.0;
 
 std::string UtcStamp(const char* format) {
   const std::time_t now = std::time(nullptr);

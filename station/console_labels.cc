@@ -42,8 +42,8 @@ using api::Route;
 namespace {
 
 constexpr int kFolds = 5;
-constexpr size_t kMaxCandidatesPerRow =
-    1000;  // stage-2 evaluations a row at most (a random subset)
+// stage-2 evaluations a row at most (a random subset)
+constexpr size_t kMaxCandidatesPerRow = 1000;
 
 double Now() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();

@@ -24,8 +24,8 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 constexpr size_t kMaxDrainBytes = 64 << 10;  // read and dropped before a connection is closed
-constexpr auto kStopCheck =
-    std::chrono::milliseconds(100);  // waits notice a stopping server this often
+// waits notice a stopping server this often
+constexpr auto kStopCheck = std::chrono::milliseconds(100);
 
 // The numeric address and port of a socket's peer (`peer`) or its own end; false when unknown.
 bool AddressOf(int sock, bool peer, std::string& ip, int& port) {

@@ -63,8 +63,8 @@ struct ExposureFigures {
   std::vector<uint32_t> histogram_r, histogram_g, histogram_b;  // 32 bins over green-screen pixels
   double clipped_percent = 0;  // pixels of the whole image with a channel at 255
   double dark_percent = 0;     // green-screen pixels with green below 40
-  double green_uniformity =
-      0;                     // 1 - std/mean of the green level over 8x8 cells mostly green screen
+  // 1 - std/mean of the green level over 8x8 cells mostly green screen
+  double green_uniformity = 0;
   double green_min_max = 0;  // darkest cell's green over the brightest's
 };
 ExposureFigures MeasureExposure(const PreviewFrame& frame);

@@ -43,10 +43,10 @@ struct StationStatus {
   double sprites_per_second = 0;  // over the last ~5 s
   uint64_t batches_stored = 0, batches_failed = 0,
            batches_refused = 0;  // refused: storage stopped (disk)
-  uint64_t batches_retried =
-      0;  // appends tried again after the bank stayed locked past its busy timeout
-  uint64_t batches_spooled =
-      0;  // batches kept on disk because the bank could not take them (since start)
+  // appends tried again after the bank stayed locked past its busy timeout
+  uint64_t batches_retried = 0;
+  // batches kept on disk because the bank could not take them (since start)
+  uint64_t batches_spooled = 0;
   uint64_t spool_batches = 0;  // ... of them (and of earlier runs) still waiting in the spool
   int64_t spool_bytes = 0;
   size_t writer_queue = 0;
@@ -73,8 +73,8 @@ struct StationStatus {
   std::string control_url;
   uint64_t control_connections_open = 0;     // being served now
   uint64_t control_connections_refused = 0;  // over the per-client limit, since start
-  uint64_t control_requests_timed_out =
-      0;  // not received whole by the request deadline, since start
+  // not received whole by the request deadline, since start
+  uint64_t control_requests_timed_out = 0;
 };
 
 nlohmann::json StatusToJson(const StationStatus& status);

@@ -14,8 +14,8 @@ namespace {
 constexpr double kDeg = M_PI / 180.0;
 constexpr double kRearPitch = 72.0 * kDeg;  // upright on the hind legs
 constexpr double kLeanPitch = 50.0 * kDeg;  // front paws up on a wall
-constexpr double kBodyHalfWidth =
-    0.060;                            // at scale 1, with the head turned: keeps it off the walls
+// at scale 1, with the head turned: keeps it off the walls
+constexpr double kBodyHalfWidth = 0.060;
 constexpr double kNoseReach = 0.108;  // at scale 1, nose tip ahead of the root
 constexpr double kTailReach = 0.088;  // at scale 1, tail end behind the root
 
@@ -202,8 +202,8 @@ std::vector<Primitive> AnimalPrimitives(const AnimalLook& look, const AnimalStat
         Eigen::Vector3d raised = tucked;
         if (lean > rear) {
           raised = Eigen::Vector3d(0.0, leg.paw_y * 0.8, 0.0);
-          raised.x() =
-              body(Eigen::Vector3d(0.101, 0.0, 0.046)).x() + 0.004;  // just ahead of the nose
+          // just ahead of the nose
+          raised.x() = body(Eigen::Vector3d(0.101, 0.0, 0.046)).x() + 0.004;
           raised.z() = joint.z() + 0.012;
         }
         paw = paw + up * (raised - paw);
@@ -212,8 +212,8 @@ std::vector<Primitive> AnimalPrimitives(const AnimalLook& look, const AnimalStat
     Material leg_mat = limb;
     leg_mat.seed = static_cast<uint32_t>(Mix(look.seed, 20 + i));
     const double leg_r = leg.front ? 0.0072 : 0.0085;
-    const Eigen::Vector3d ankle =
-        paw + Eigen::Vector3d(-0.002, 0.0, leg_r);  // the leg never dips below the floor
+    // the leg never dips below the floor
+    const Eigen::Vector3d ankle = paw + Eigen::Vector3d(-0.002, 0.0, leg_r);
     capsule(joint, ankle, leg_r, leg_mat);
     Eigen::Matrix3d r_paw = Eigen::Matrix3d::Identity();
     if (leg.front && std::max(rear, lean) > 0.0) r_paw = RotY(-0.5 * pitch);

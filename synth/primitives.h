@@ -36,8 +36,8 @@ struct Primitive {
   int slice = 0;    // motion-blur time slice
   Material material;
   Eigen::Vector3d centre = Eigen::Vector3d::Zero();  // ellipsoid
-  Eigen::Matrix3d axes =
-      Eigen::Matrix3d::Identity();  // ellipsoid: columns = semi-axis vectors (ground)
+  // ellipsoid: columns = semi-axis vectors (ground)
+  Eigen::Matrix3d axes = Eigen::Matrix3d::Identity();
   Eigen::Vector3d a = Eigen::Vector3d::Zero(), b = Eigen::Vector3d::Zero();  // capsule end points
   double radius = 0.0;                                                       // capsule
 

@@ -170,8 +170,8 @@ void DescribeMotion(const SkeletonSequence& clip, double fps, const DescriptorOp
   const int n = clip.size();
   const double h = options.motion_window_s;
   auto time = [&](int i) { return static_cast<double>(clip.frames[i].frame) / fps; };
-  const double eps =
-      1e-3 / fps;  // a thousandth of a frame: 0.2f is not 0.2 nor 5 frames at 25 fps exactly
+  // a thousandth of a frame: 0.2f is not 0.2 nor 5 frames at 25 fps exactly
+  const double eps = 1e-3 / fps;
   int a = 0, b = 0;
   for (int i = 0; i < n; ++i) {
     const double t = time(i);

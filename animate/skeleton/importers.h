@@ -18,8 +18,8 @@ struct ImportOptions {
   std::optional<float> min_confidence;
   std::string individual;  // DeepLabCut multi-animal: which individual (empty: the first)
   int person = 0;          // OpenPose: index into people[]; synth truth: the subject
-  int category_id =
-      -1;  // COCO: the category whose annotations are read (-1: the first with keypoints)
+  // COCO: the category whose annotations are read (-1: the first with keypoints)
+  int category_id = -1;
 };
 
 // DeepLabCut's CSV: header rows scorer / [individuals] / bodyparts / coords (x, y,

@@ -610,8 +610,8 @@ void Engine::Step(int t, const float* c, const Row& prev, Row* cur, uint8_t* rec
   const bool local = rules.local_jumps;
   const bool moves = record && MovesRecorded();
   if (local) LocalJumps(rules, prev.m, jump_.data(), moves ? jump_source : nullptr);
-  const float jump_const =
-      local ? kInf : o_.jump_cost + prev.top.front().value;  // J + the row minimum
+  // J + the row minimum
+  const float jump_const = local ? kInf : o_.jump_cost + prev.top.front().value;
   StepArgs a;
   a.cost = c;
   a.m = prev.m;
@@ -797,8 +797,8 @@ bool Engine::SolveWithDecisions(MatchResult* out) {
     mode_ = kArgOnly;
     return false;
   }
-  const auto start =
-      std::chrono::steady_clock::now();  // the forward pass includes the store's pages
+  // the forward pass includes the store's pages
+  const auto start = std::chrono::steady_clock::now();
   // The decisions, then the jump sources, mapped with their pages at once (MAP_POPULATE):
   // a page fault at a time made the forward pass visibly slower (+39 % instead of +7 %
   // over no store at 2,000 x 100,000). Every byte is written by its row's step.

@@ -82,10 +82,10 @@ struct MatchResult {
   double cost_seconds = 0;      // computing cost rows (both passes)
   double forward_seconds = 0;   // the DP rows of the forward pass
   double backward_seconds = 0;  // backtracking (and, without decisions, recomputing blocks)
-  size_t memory_bytes =
-      0;  // what the backtrack keeps: decisions and top lists, or checkpoints and one block
-  bool walked_decisions =
-      false;  // the backtrack walked stored decisions (else recomputed from checkpoints)
+  // what the backtrack keeps: decisions and top lists, or checkpoints and one block
+  size_t memory_bytes = 0;
+  // the backtrack walked stored decisions (else recomputed from checkpoints)
+  bool walked_decisions = false;
   std::string Summary() const;  // one line
 };
 

@@ -19,8 +19,8 @@ struct SkeletonMatchOptions {
   RefineOptions refine;
   bool refine_enabled = true;
   bool compare_without_penalties = true;  // also solve without the penalties (Figure 2a)
-  float min_source_coverage =
-      0.5f;  // source frames with less of the pose terms' weight are never chosen
+  // source frames with less of the pose terms' weight are never chosen
+  float min_source_coverage = 0.5f;
 };
 
 // A source frame as the caller knows it.

@@ -31,8 +31,8 @@ struct AravisOptions {
   double exposure_us = 0.0;  // > 0: set it and turn auto exposure off (a keyer needs it fixed)
   double gain = -1.0;        // >= 0: set it and turn auto gain off
   double fps = 0.0;          // > 0: set the acquisition frame rate
-  WhiteBalanceMode white_balance =
-      WhiteBalanceMode::kDevice;             // device: leave it; once: auto once, then locked
+  // device: leave it; once: auto once, then locked
+  WhiteBalanceMode white_balance = WhiteBalanceMode::kDevice;
   double red_ratio = 1.0, blue_ratio = 1.0;  // manual: BalanceRatio of red and of blue (green = 1)
   bool packet_resend = true;                 // ask the camera to resend lost GVSP packets
   int packet_size = 0;          // GVSP packet bytes; 0 = negotiate the largest that passes

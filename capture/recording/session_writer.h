@@ -18,11 +18,11 @@
 namespace ss {
 
 struct RecordingOptions {
-  std::string codec =
-      "ffv1";  // "ffv1" (lossless), "mjpeg", "h264"; an MJPEG camera is always stored as mjpeg
+  // "ffv1" (lossless), "mjpeg", "h264"; an MJPEG camera is always stored as mjpeg
+  std::string codec = "ffv1";
   bool synthetic = false;  // marks session.json; truth/ is written by the caller
-  int flush_interval_ms =
-      250;  // longest time a written frame waits before it is on disk (0: every frame)
+  // longest time a written frame waits before it is on disk (0: every frame)
+  int flush_interval_ms = 250;
 };
 
 class SessionWriter {

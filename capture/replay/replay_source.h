@@ -26,8 +26,8 @@ struct ReplayOptions {
   bool realtime = false;  // keep the original inter-frame timing (else as fast as possible)
   int loops = 1;          // passes over the session; 0 = until Stop()
   int frames_ahead = 4;   // decoded frames each camera may hold ready
-  int decode_threads =
-      0;               // per camera: 0 = one decoder thread per core, 1 = one decoder (VideoReader)
+  // per camera: 0 = one decoder thread per core, 1 = one decoder (VideoReader)
+  int decode_threads = 0;
   std::string camera;  // replay only this camera of the session ("" = every camera); it is then
                        // Frame::camera 0
   // Later passes shift timestamp_ns by the session's span (plus one frame) and
@@ -42,8 +42,8 @@ struct ReplayCameraStats {
   uint64_t frames_unreadable = 0;   // rows whose frame was corrupt or missing from the video
   uint64_t frames_without_row = 0;  // video frames the CSV does not list (recording interrupted)
   uint64_t recorded_gaps = 0;  // frames the CSV's sequence numbers skip (lost before recording)
-  uint64_t recorded_drops =
-      0;                // sum of the CSV's drops_before (lost at the device or the recorder)
+  // sum of the CSV's drops_before (lost at the device or the recorder)
+  uint64_t recorded_drops = 0;
   uint64_t errors = 0;  // reported problems (one per corrupt frame / truncation / unopenable file)
   std::vector<std::string> problems;  // the first few messages, each naming the file and the frame
 };

@@ -11,8 +11,8 @@
 namespace ss {
 
 struct PlateOptions {
-  int64_t first_frame =
-      0;  // the range of the camera's frames (0-based, as replayed: unreadable ones skipped)
+  // the range of the camera's frames (0-based, as replayed: unreadable ones skipped)
+  int64_t first_frame = 0;
   int64_t last_frame = 29;  // inclusive
   int samples = 30;         // frames taken, spread evenly over the range (all of them when fewer)
 };

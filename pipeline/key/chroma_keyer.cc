@@ -317,8 +317,8 @@ void ChromaKeyer::SampleRow(const uint8_t* row, ChannelOrder /*order*/, int cell
   const int shadow_min = static_cast<int>(std::lround(255 * options_.shadow_min));
   const uint8_t* keyable = &keyable_[static_cast<size_t>(SampleY(cell_row)) * size_.width];
   for (int cx = 0; cx < cols_; ++cx) {
-    const uint8_t* px =
-        row + 3 * SampleX(cx);  // B and R may be swapped: the key is symmetric in them
+    // B and R may be swapped: the key is symmetric in them
+    const uint8_t* px = row + 3 * SampleX(cx);
     const PixelKey k =
         KeyPixel(px[0], px[1], px[2], p.f[kKeyHi][cx], p.f[kGain][cx], p.luma_floor[cx],
                  p.f[kInvLuma][cx], p.f[kShadowBase][cx], shadow_min);

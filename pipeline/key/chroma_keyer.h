@@ -30,10 +30,10 @@ struct ChromaKeyerOptions {
   double coarse_shadow = 0.12;  // a sample darkened more marks its cell as shaded
   double min_key = 0.1;  // training cells with a smaller key k_bg are not green and never keyed
   double max_unkeyable = 0.9;  // training fails when more than this fraction of cells is not green
-  double despill_bias =
-      0.5;  // G <= max(R,B) - bias * (max(R,B) - min(R,B)): 0 keeps yellows, 0.5 = mean(R,B)
-  double despill_strength =
-      1;               // share of the green above that limit removed: 0 = no despill, 1 = all
+  // G <= max(R,B) - bias * (max(R,B) - min(R,B)): 0 keeps yellows, 0.5 = mean(R,B)
+  double despill_bias = 0.5;
+  // share of the green above that limit removed: 0 = no despill, 1 = all
+  double despill_strength = 1;
   bool shadow = true;  // false: no contact-shadow layer (and no shaded cells)
   // When both are >= 0 (the station config's keying.chroma.low/high): the key in 8-bit levels of
   // G - max(R, B) at the floor's brightness, k * Y_bg, where alpha is 1 (<= low) and 0 (>= high);

@@ -29,8 +29,8 @@ inline PixelKey PlatePixel(int b, int g, int r, int mu_b, int mu_g, int mu_r, fl
   const float mu2 = ub * ub + ug * ug + ur * ur + 1.f;
   const float ratio = (pb * ub + pg * ug + pr * ur) / mu2;  // brightness relative to the plate
   const float eb = pb - ratio * ub, eg = pg - ratio * ug, er = pr - ratio * ur;
-  const float chroma =
-      std::sqrt(eb * eb + eg * eg + er * er);  // levels off the plate's colour line
+  // levels off the plate's colour line
+  const float chroma = std::sqrt(eb * eb + eg * eg + er * er);
   const float mu_norm = std::sqrt(mu2);
   // Distance from "the plate, possibly in shadow", in quarter levels.
   const int brighter = static_cast<int>((ratio - 1.f) * mu_norm * 4.f);

@@ -17,16 +17,16 @@ struct KeyingConfig;
 
 struct CleanPlateKeyerOptions {
   GridOptions grid;
-  double noise_z =
-      4.0;  // background tolerance, noise std (the false-positive rate of a 1-D z test)
+  // background tolerance, noise std (the false-positive rate of a 1-D z test)
+  double noise_z = 4.0;
   double min_sigma = 2.0;    // noise std floor, levels of 255 (a single empty frame has no spread)
   double ramp = 30.0;        // alpha goes 0 -> 1 over this many levels beyond the tolerance
   double dark_floor = 0.3;   // darker than this fraction of the plate is subject, not shadow
   double shadow_min = 0.06;  // darkening below this is noise: no shadow
   double coarse_alpha = 0.25;   // a sample with a larger alpha marks its cell as foreground
   double coarse_shadow = 0.12;  // a sample darkened more marks its cell as shaded
-  double ramp_sigma =
-      0;               // > 0: the ramp is this many of the plate's mean noise std instead of `ramp`
+  // > 0: the ramp is this many of the plate's mean noise std instead of `ramp`
+  double ramp_sigma = 0;
   bool shadow = true;  // false: no contact-shadow layer (and no shaded cells)
   // False with "FIELD: reason" in `why` when a value is out of its range.
   bool IsValid(std::string* why) const;

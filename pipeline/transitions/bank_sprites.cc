@@ -67,8 +67,8 @@ void Link(BankSprites* out) {
 
 BankSprites LoadBankSprites(const Bank& bank, SegmentKeys* keys,
                             const std::function<void(size_t, size_t)>& progress) {
-  const std::vector<SpriteFeatures> features =
-      bank.LoadFeatures();  // ordered by (clip, mirrored, frame)
+  // ordered by (clip, mirrored, frame)
+  const std::vector<SpriteFeatures> features = bank.LoadFeatures();
   BankSprites out;
   out.ids.reserve(features.size());
   out.inputs.reserve(features.size());

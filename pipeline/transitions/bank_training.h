@@ -14,8 +14,8 @@ namespace ss {
 struct BankTrainOptions {
   TrainOptions train;
   ComparisonWindow window;  // the pixel features' window (recorded in the weights)
-  double stage1_recall =
-      0.999;  // of stage-2 accepts stage 1 must pass in the sample (0 = keep the label fit)
+  // of stage-2 accepts stage 1 must pass in the sample (0 = keep the label fit)
+  double stage1_recall = 0.999;
   // Share of all sprite pairs that are true transitions; < 0: the labels file's
   // "# positive_rate=" line; none there: stage 2 keeps the label fit's (50/50) bias.
   double positive_rate = -1;

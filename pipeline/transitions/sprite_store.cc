@@ -99,8 +99,8 @@ inline __m128i AbsDifferenceSums(const uint16_t* a, const uint16_t* b, int vecto
   for (int k = 0; k < vectors; ++k) {
     const __m128i x = _mm_load_si128(reinterpret_cast<const __m128i*>(a) + k);
     const __m128i y = _mm_load_si128(reinterpret_cast<const __m128i*>(b) + k);
-    const __m128i d =
-        _mm_or_si128(_mm_subs_epu16(x, y), _mm_subs_epu16(y, x));  // <= 32767: a valid int16
+    // <= 32767: a valid int16
+    const __m128i d = _mm_or_si128(_mm_subs_epu16(x, y), _mm_subs_epu16(y, x));
     sum = _mm_add_epi32(sum, _mm_madd_epi16(d, ones));
   }
   return sum;

@@ -33,8 +33,8 @@ struct SpriteTruth {
 struct TruthLabelOptions {
   double max_heading_difference_rad = 6.0 * M_PI / 180.0;
   double max_phase_difference = 0.04;  // cycles, circular
-  double max_keypoint_displacement_m =
-      0.004;  // when both truths have key points (1 px at 250 px/m)
+  // when both truths have key points (1 px at 250 px/m)
+  double max_keypoint_displacement_m = 0.004;
   // Rejects sampled as near misses (same pose, heading and phase within `near_miss_factor`
   // times the tolerances) rather than uniformly; the rest are uniform random rejects.
   double near_miss_fraction = 0.5;

@@ -38,8 +38,8 @@ struct TransitionWeights {
   double linf_max_alpha = 0;                // linf: max_cells |A_i - A_j| / 255 bound, in (0, 1]
   double colour_blob_max_velocity_mps = 0;  // colour_blob: ||v_i - v_j|| bound (m/s), > 0
   int colour_blob_max_cells = 0;            // colour_blob: LargestColourBlob bound (cells), >= 0
-  std::string training_json =
-      "{}";  // provenance and cross-validation figures (free form JSON object)
+  // provenance and cross-validation figures (free form JSON object)
+  std::string training_json = "{}";
 
   // False (with the field and the reason) unless every field is usable.
   bool IsValid(std::string* why) const;

@@ -178,8 +178,8 @@ TEST(SkeletonDp, StoredDecisionsGiveTheCheckpointPath) {
   std::mt19937 rng(19);
   for (int trial = 0; trial < 24; ++trial) {
     const bool constrained = trial % 2 == 1;
-    const bool grid =
-        trial % 5 == 2;  // 0/1 costs, free skips and stutters: equal candidates everywhere
+    // 0/1 costs, free skips and stutters: equal candidates everywhere
+    const bool grid = trial % 5 == 2;
     const bool wide = trial % 3 == 0;  // move codes above 15: two bytes a cell
     const int T = trial % 4 == 0 ? 160 : 30 + 3 * trial, S = 45 + 5 * trial;
     DenseCostRows costs = RandomCosts(T, S, rng, trial % 4 == 1 ? 0.05f : 0.0f);

@@ -23,11 +23,11 @@ double AngleDeg(const Eigen::Matrix3d& a, const Eigen::Matrix3d& b) {
 struct FloorScene {
   synth::Studio studio = synth::MakeStudio(synth::StudioKind::kEnclosure, 21);
   std::vector<synth::SynthCamera> cams = synth::MakeCameras(studio, 2, 640, 480, 21);
-  synth::BoardSpec spec =
-      synth::ChessboardFor(true);  // 0.7 m x 0.49 m, fits the 1.2 m x 0.8 m floor
+  // 0.7 m x 0.49 m, fits the 1.2 m x 0.8 m floor
+  synth::BoardSpec spec = synth::ChessboardFor(true);
   synth::BoardTexture texture{spec};
-  Rigid3 ground_from_board =
-      FloorBoardPose(-0.33, 0.26, 4.0, 0.001);  // 1 mm thick: off the floor for the renderer
+  // 1 mm thick: off the floor for the renderer
+  Rigid3 ground_from_board = FloorBoardPose(-0.33, 0.26, 4.0, 0.001);
 };
 
 TEST(FloorBoardPose, IsFaceUpOnTheFloor) {

@@ -111,8 +111,8 @@ TEST(CameraModel, Opencv8ProjectsLikeOpencvRationalModel) {
 
 TEST(CameraModel, Opencv8UnprojectThenProjectIsIdentityAcrossTheImage) {
   const CameraModel cam = Opencv8Camera();
-  const std::vector<Vector2d> pixels =
-      PixelGrid(cam.width(), cam.height(), 40);  // corners included
+  // corners included
+  const std::vector<Vector2d> pixels = PixelGrid(cam.width(), cam.height(), 40);
   double worst = 0;
   for (const Vector2d& px : pixels) {
     const Vector3d ray = cam.Unproject(px);
@@ -204,8 +204,8 @@ TEST(CameraModel, EveryLensModelRoundTrips) {
     EXPECT_EQ(cam.lensmodel(), c.name);
     double worst = 0;
     for (const Vector2d& px : PixelGrid(1280, 960, 80)) {
-      const Vector2d inner =
-          Vector2d(640, 480) + 0.8 * (px - Vector2d(640, 480));  // stay inside every model's domain
+      // stay inside every model's domain
+      const Vector2d inner = Vector2d(640, 480) + 0.8 * (px - Vector2d(640, 480));
       const Vector3d ray = cam.Unproject(inner);
       ASSERT_TRUE(ray.allFinite()) << inner.transpose();
       worst = std::max(worst, (cam.Project(ray) - inner).norm());

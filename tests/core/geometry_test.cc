@@ -37,8 +37,8 @@ TEST(Rigid3, FromRtMatchesMrcalRodrigues) {
   for (int i = 0; i < 200; ++i) {
     Vector3d axis(u(rng), u(rng), u(rng));
     axis.normalize();
-    const double angle =
-        (i % 4 == 0) ? 1e-9 * (i + 1) : M_PI * (0.5 + 0.5 * u(rng));  // tiny and large angles
+    // tiny and large angles
+    const double angle = (i % 4 == 0) ? 1e-9 * (i + 1) : M_PI * (0.5 + 0.5 * u(rng));
     const Vector3d r = axis * angle;
     const double rt[6] = {r.x(), r.y(), r.z(), u(rng), u(rng), u(rng)};
     const Rigid3 pose = Rigid3::FromRt(rt);
@@ -408,8 +408,8 @@ std::vector<Vector2d> ProbePoints(const Poly& p, std::mt19937& rng, size_t rando
   const Vector2d pad = 0.1 * (hi - lo) + Vector2d::Constant(1e-300);
   std::uniform_real_distribution<double> ux(lo.x() - pad.x(), hi.x() + pad.x()),
       uy(lo.y() - pad.y(), hi.y() + pad.y());
-  const size_t stride =
-      std::max<size_t>(1, p.size() / 500);  // at most ~500 vertices probed closely
+  // at most ~500 vertices probed closely
+  const size_t stride = std::max<size_t>(1, p.size() / 500);
   for (size_t i = 0; i < p.size(); i += stride) {
     const Vector2d& a = p[i];
     const Vector2d& b = p[(i + 1) % p.size()];

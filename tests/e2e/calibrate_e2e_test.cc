@@ -189,8 +189,8 @@ TEST_F(CalibrateEndToEnd, AgreesWithMrcalCalibrateCameras) {
             out + "/mrcal 'cam0-frame*.png'");
   ASSERT_EQ(m.exit_code, 0) << m.output;
   const CameraModel ours = CameraModel::Read(out + "/cam0.cameramodel");
-  const CameraModel theirs =
-      CameraModel::Read(out + "/mrcal/camera-0.cameramodel");  // through libmrcal
+  // through libmrcal
+  const CameraModel theirs = CameraModel::Read(out + "/mrcal/camera-0.cameramodel");
   const CameraModel truth = CameraModel::Read(session + "/truth/cam0.cameramodel");
   ASSERT_EQ(theirs.lensmodel(), ours.lensmodel());
 

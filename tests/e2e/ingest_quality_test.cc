@@ -60,12 +60,12 @@ constexpr const char* kSynthArgs =
 // One camera-frame of the subject, as the truth has it.
 struct TruthView {
   bool present = false;
-  bool usable =
-      false;  // on the floor, no wall, no border, fully visible, moving, in a long enough run
+  // on the floor, no wall, no border, fully visible, moving, in a long enough run
+  bool usable = false;
   bool touches_wall = false;
   bool leaves_floor = false;
-  bool against_wall =
-      false;  // the true silhouette (grown by 1 px) covers image pixels that are not floor
+  // the true silhouette (grown by 1 px) covers image pixels that are not floor
+  bool against_wall = false;
   double camera_distance_m = 0;  // camera centre to the true contact point, on the floor
   double gx = NAN, gy = NAN;     // the true contact point on the floor
 };

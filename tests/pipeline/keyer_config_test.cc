@@ -53,8 +53,8 @@ class KeyerConfig : public ::testing::Test {
     const SceneFrame f = scene.Render({s}, 7);
     GroundPolygon floor({{-0.6, -0.4}, {0.6, -0.4}, {0.6, 0.4}, {-0.6, 0.4}});
     CameraPipelineOptions options = PipelineOptionsFromConfig(config);
-    options.rectify.px_per_m =
-        800;  // auto is resolved per bank (ChooseBankScale); any scale does here
+    // auto is resolved per bank (ChooseBankScale); any scale does here
+    options.rectify.px_per_m = 800;
     pipelines_.emplace_back(std::make_unique<CameraPipeline>("cam0", 1, Camera(), floor, options));
     CameraPipeline& p = *pipelines_.back();
     p.Train(empty);

@@ -236,17 +236,17 @@ RgbaBillboard Recolour(RgbaBillboard b, const std::vector<Cell>& cells,
 
 TEST(TransitionColourBlob, FeatureOnHandMadePairs) {
   const RgbaBillboard body = Sprite(Rectangle(8, 10, 20, 32, 255));
-  RgbaBillboard two_patches =
-      Recolour(body, Rectangle(9, 12, 12, 14, 255), {90, 100, 50});  // 3 x 2, dR 110
+  // 3 x 2, dR 110
+  RgbaBillboard two_patches = Recolour(body, Rectangle(9, 12, 12, 14, 255), {90, 100, 50});
   two_patches = Recolour(two_patches, Rectangle(15, 20, 17, 21, 255), {200, 40, 20});  // 2 x 1, 90
-  const RgbaBillboard faint =
-      Recolour(body, Rectangle(9, 12, 12, 14, 255), {150, 80, 40});  // dR+dG+dB 80
+  // dR+dG+dB 80
+  const RgbaBillboard faint = Recolour(body, Rectangle(9, 12, 12, 14, 255), {150, 80, 40});
   RgbaBillboard half_transparent = Sprite(Rectangle(8, 10, 20, 32, 255));
   for (const Cell& c : Rectangle(9, 12, 12, 14, 0))
     half_transparent.rgba[(c.y * 32 + c.x) * 4 + 3] = 100;
   half_transparent = Recolour(half_transparent, Rectangle(9, 12, 12, 14, 255), {90, 100, 50});
-  const RgbaBillboard diagonal =
-      Recolour(body, {{9, 12, 255}, {10, 13, 255}}, {0, 0, 0});  // not 4-connected
+  // not 4-connected
+  const RgbaBillboard diagonal = Recolour(body, {{9, 12, 255}, {10, 13, 255}}, {0, 0, 0});
   const std::vector<RgbaBillboard> sprites = {body, two_patches, faint, half_transparent, diagonal};
   std::vector<SpriteInput> inputs;
   for (size_t k = 0; k < sprites.size(); ++k) {
