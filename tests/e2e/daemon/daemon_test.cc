@@ -13,12 +13,13 @@
 #include <thread>
 
 // Eigen before httplib: <resolv.h> (through httplib) defines _res, a name Eigen uses.
+#include <Eigen/Geometry>
+
 #include <arpa/inet.h>
 #include <netinet/in.h>
 #include <poll.h>
 #include <sys/socket.h>
 #include <unistd.h>
-#include <Eigen/Geometry>
 
 #include <gtest/gtest.h>
 #include <httplib.h>

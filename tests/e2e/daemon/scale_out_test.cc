@@ -13,10 +13,11 @@
 #include <vector>
 
 // Eigen before httplib: <resolv.h> (through httplib) defines _res, a name Eigen uses.
+#include <Eigen/Core>
+
 #include <gtest/gtest.h>
 #include <httplib.h>
 #include <spdlog/fmt/fmt.h>
-#include <Eigen/Core>
 
 #include <nlohmann/json.hpp>
 
