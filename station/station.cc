@@ -3,15 +3,10 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
-#include <condition_variable>
 #include <ctime>
-#include <deque>
 #include <filesystem>
-#include <map>
 #include <mutex>
-#include <set>
 #include <thread>
-#include <tuple>
 
 #include <nlohmann/json.hpp>
 #include <opencv2/core/utility.hpp>
@@ -21,19 +16,20 @@
 #include "core/error.h"
 #include "core/error_kinds.h"
 #include "core/log.h"
-#include "core/sql_postgres.h"
 #include "pipeline/run/bank_scale.h"
 #include "pipeline/run/bounded_queue.h"
 #include "pipeline/run/ingest.h"
 #include "pipeline/transitions/worker.h"
 #include "station/bank_spool.h"
 #include "station/recorder.h"
+#include "station/station_impl.h"
 
 namespace ss {
 namespace {
 
 namespace fs = std::filesystem;
-using Clock = std::chrono::steady_clock;
+using station_detail::Clock;
+using station_detail::Seconds;
 
 // SIGTERM must finish within 5 s: from the start of Stop, the transition worker may drain this
 // long.
@@ -42,8 +38,6 @@ constexpr double kTransitionDrainS = 3.0;
 // Preview snapshots a camera takes, idle and while a session stores; each view of a snapshot is
 // encoded once, for every viewer, so these are also the most images a second a view costs.
 constexpr double kPreviewIntervalS = 0.2, kPreviewIntervalSessionS = 0.5;
-
-double Seconds(Clock::duration d) { return std::chrono::duration<double>(d).count(); }
 
 std::string UtcNow(const char* format = "%Y-%m-%dT%H:%M:%SZ") {
   const std::time_t t = std::time(nullptr);
@@ -70,16 +64,6 @@ std::string CheckSessionName(const std::string& name) {
   return name;
 }
 
-// Free MiB on the file system holding `path` (or its nearest existing parent).
-int64_t FreeMib(fs::path path) {
-  std::error_code ec;
-  while (!path.empty() && !fs::exists(path, ec)) path = path.parent_path();
-  if (path.empty()) path = ".";
-  const fs::space_info info = fs::space(path, ec);
-  if (ec) return -1;
-  return static_cast<int64_t>(info.available / (1024 * 1024));
-}
-
 void ApplyLogging(const LoggingConfig& logging) {
   SetLogLevel(logging.level);
   for (const auto& [component, level] : logging.components)
@@ -88,396 +72,55 @@ void ApplyLogging(const LoggingConfig& logging) {
 
 }  // namespace
 
-// One camera's encoded previews, by (view, width): view 0 raw, 1 keyed, 2 the sprites view.
-struct PreviewCache {
-  struct Entry {
-    // The snapshot it was made from, by when it was taken (holding the snapshot itself would
-    // keep the runner from reusing its buffer).
-    std::optional<SteadyTime> frame_taken;
-    Station::PreviewImage image;
-    std::string sprites_json;
-  };
-  std::mutex mutex;  // also makes concurrent callers wait for one encode instead of each doing it
-  std::map<std::pair<int, int>, Entry> entries;
-};
-
-struct Station::Impl {
-  StationOptions options;
-  std::shared_ptr<spdlog::logger> log = Log("station");
-  GroundPolygon floor;
-  std::vector<std::optional<CameraModel>> models;
-  SteadyTime started_at = Clock::now();
-  std::atomic<StationState> state{StationState::kStarting};
-
-  std::mutex bank_mutex;  // BankWriter is one connection: one thread at a time
-  std::unique_ptr<BankWriter> bank;
-  std::unique_ptr<BankSpool> spool;  // the writer thread's
-  std::unique_ptr<TransitionWorker> transitions;
-  std::vector<std::unique_ptr<CameraRunner>> runners;
-
-  BoundedQueue<StationBatch> batches{256};
-  std::thread writer_thread, monitor_thread;
-  std::mutex idle_mutex;
-  std::condition_variable idle_cv;
-  uint64_t batches_in = 0, batches_done = 0;  // under idle_mutex
-
-  // Under stats_mutex.
-  mutable std::mutex stats_mutex;
-  int64_t bank_sprites = 0;
-  uint64_t sprites_stored = 0, batches_stored = 0, batches_failed = 0, batches_refused = 0;
-  uint64_t batches_retried = 0;  // appends tried again after the bank stayed locked (BusyError)
-  uint64_t batches_spooled = 0;  // kept on disk while the bank could not take them
-  uint64_t spool_batches = 0;
-  int64_t spool_bytes = 0;
-  static constexpr int kBusyAttempts = 6;  // with SQLite's 10 s busy timeout: up to a minute
-  std::deque<double> latencies_ms;         // last 10,000
-  uint64_t latency_count = 0;              // every sprite's, since start
-  double latency_sum_ms = 0;
-  std::deque<std::pair<SteadyTime, uint64_t>>
-      stored_log;  // (time, sprites_stored) samples for sprites/s
-  std::string bank_error;
-  bool last_append_failed = false;  // until an append succeeds again
-  StorageState storage_state = StorageState::kOk;
-  int64_t disk_free_mib = -1;
-
-  // The capture session, under session_mutex (held across start/stop).
-  mutable std::mutex session_mutex;
-  SessionStatus session;
-  std::atomic<bool> session_active{false};  // session.active, read without the lock (previews)
-  std::vector<std::unique_ptr<PreviewCache>> preview_caches;  // one per runner
-  SteadyTime session_started{};
-  std::unique_ptr<StationRecorder> recorder;
-  mutable std::mutex recorder_mutex;  // guards `recorder` against the pipeline threads' taps
-  std::mutex control_mutex;           // one session start / stop / rename at a time
-  RecorderStats last_recording;
-
-  std::mutex monitor_mutex;
-  std::condition_variable monitor_wake;
-  bool monitor_stop = false;
-
-  // The cache entry of a camera's view, locked in `lock`; `frame` is set when the entry must be
-  // made (again) from that snapshot, and `runner` to the camera's. nullptr before the camera's
-  // first frame; NotFoundError for no such camera.
-  PreviewCache::Entry* CachedPreview(const std::string& camera, int view, int width,
-                                     std::unique_lock<std::mutex>* lock,
-                                     std::shared_ptr<const PreviewFrame>* frame,
-                                     const CameraRunner** runner) const {
-    for (size_t k = 0; k < runners.size(); ++k) {
-      if (runners[k]->name() != camera) continue;
-      PreviewCache& cache = *preview_caches[k];
-      *lock = std::unique_lock(cache.mutex);
-      *runner = runners[k].get();
-      *frame = runners[k]->preview();
-      if (!*frame) return nullptr;
-      PreviewCache::Entry& entry = cache.entries[{view, width}];
-      if (entry.frame_taken == (*frame)->taken) {
-        *frame = nullptr;  // made from this snapshot already
-      } else {
-        entry.frame_taken = (*frame)->taken;
-      }
-      return &entry;
+PreviewCache::Entry* Station::Impl::CachedPreview(const std::string& camera, int view, int width,
+                                                  std::unique_lock<std::mutex>* lock,
+                                                  std::shared_ptr<const PreviewFrame>* frame,
+                                                  const CameraRunner** runner) const {
+  for (size_t k = 0; k < runners.size(); ++k) {
+    if (runners[k]->name() != camera) continue;
+    PreviewCache& cache = *preview_caches[k];
+    *lock = std::unique_lock(cache.mutex);
+    *runner = runners[k].get();
+    *frame = runners[k]->preview();
+    if (!*frame) return nullptr;
+    PreviewCache::Entry& entry = cache.entries[{view, width}];
+    if (entry.frame_taken == (*frame)->taken) {
+      *frame = nullptr;  // made from this snapshot already
+    } else {
+      entry.frame_taken = (*frame)->taken;
     }
-    throw NotFoundError("camera", "no camera named \"" + camera + "\"");
+    return &entry;
   }
+  throw NotFoundError("camera", "no camera named \"" + camera + "\"");
+}
 
-  void Store(StationBatch sb) {
-    {
-      std::lock_guard lock(idle_mutex);
-      ++batches_in;
-    }
-    if (!batches.Push(std::move(sb))) {
-      std::lock_guard lock(idle_mutex);
-      ++batches_done;
-    }
+void Station::Impl::Tap(int camera, const Frame& frame, uint64_t drops_before, bool usable) {
+  {
+    std::lock_guard lock(watcher_mutex);
+    if (watcher) watcher(camera, frame);
   }
+  std::lock_guard lock(recorder_mutex);
+  if (!recorder) return;
+  const std::optional<SourceCamera> source = runners[static_cast<size_t>(camera)]->source_camera();
+  if (!source) return;
+  const std::optional<CameraModel>& model = models[static_cast<size_t>(camera)];
+  recorder->Offer(camera, *source, model ? &*model : nullptr, frame, drops_before, usable);
+}
 
-  void WriterLoop() {
-    DrainSpool();  // what an earlier run left
-    while (true) {
-      std::optional<StationBatch> sb;
-      if (spool && !spool->empty()) {
-        // Batches wait on disk: try the bank again every second even if no new batch comes.
-        sb = batches.PopFor(std::chrono::seconds(1));
-        if (!sb) {
-          if (batches.closed()) break;
-          DrainSpool();
-          continue;
-        }
-      } else {
-        sb = batches.Pop();
-        if (!sb) break;
-      }
-      WriteBatch(*sb);
-      std::lock_guard lock(idle_mutex);
-      ++batches_done;
-      idle_cv.notify_all();
-    }
-    DrainSpool();  // a last try; what is left waits for the next start
-  }
-
-  // Clips one of whose batches failed (camera, track, first frame): their later batches are
-  // not stored, so the bank never holds a complete clip with a hole (the clip's part stored
-  // before the failure stays an incomplete clip, which readers do not see). Writer thread only.
-  std::set<std::tuple<int64_t, int64_t, int64_t>> broken_clips;
-
-  void WriteBatch(StationBatch& sb) {
-    {
-      std::lock_guard lock(stats_mutex);
-      if (storage_state == StorageState::kSpritesStopped) {
-        ++batches_refused;
-        return;
-      }
-    }
-    const ClipRecord& clip = sb.batch.clip;
-    const auto key = std::make_tuple(clip.camera_id, clip.track_id, clip.first_frame);
-    if (broken_clips.count(key) > 0) {
-      if (clip.complete) broken_clips.erase(key);
-      std::lock_guard lock(stats_mutex);
-      ++batches_failed;
-      return;
-    }
-    if (spool && !spool->empty()) {
-      // Earlier batches wait in the spool: this one goes behind them, so that the bank takes
-      // every clip's batches in order.
-      Spool(sb.batch);
-      DrainSpool();
-      return;
-    }
-    AppendResult result;
-    try {
-      // Another writer of a SQLite bank (the transitions worker, a labelling page, another
-      // process) may hold its write lock past the busy timeout (10 s) on a loaded machine: the
-      // batch is still in hand, so it is tried again before it is spooled. A PostgreSQL bank
-      // that is busy has lost its server: the spool takes the batch at once.
-      const int attempts = bank->is_postgres() ? 1 : kBusyAttempts;
-      for (int attempt = 1;; ++attempt) {
-        try {
-          std::lock_guard lock(bank_mutex);
-          result = bank->AppendClipBatch(sb.batch.clip, sb.batch.sprites);
-          break;
-        } catch (const BusyError& e) {
-          if (attempt == attempts) throw;
-          log->warn("bank: {} (clip {}/{} from frame {}: try {} of {})", e.what(), clip.camera_id,
-                    clip.track_id, clip.first_frame, attempt + 1, attempts);
-          std::lock_guard lock(stats_mutex);
-          ++batches_retried;
-        }
-      }
-    } catch (const BusyError& e) {
-      log->warn("bank: {} (clip {}/{} from frame {}: kept in the spool until the bank answers)",
-                e.what(), clip.camera_id, clip.track_id, clip.first_frame);
-      {
-        std::lock_guard lock(stats_mutex);
-        bank_error = e.what();
-        last_append_failed = true;
-      }
-      Spool(sb.batch);
-      return;
-    } catch (const std::exception& e) {
-      // A failed append is one rolled-back transaction: what was stored stays stored.
-      log->error("bank: {} (the rest of clip {}/{} from frame {} is not stored)", e.what(),
-                 clip.camera_id, clip.track_id, clip.first_frame);
-      if (!clip.complete) broken_clips.insert(key);
-      std::lock_guard lock(stats_mutex);
-      ++batches_failed;
-      bank_error = e.what();
-      last_append_failed = true;
-      return;
-    }
-    Stored(sb.batch, result, &sb.received);
-  }
-
-  // Keeps a batch the bank could not take in the spool; if even that fails, the batch is lost
-  // as a failed append is (counted, its clip's later batches not stored).
-  void Spool(const ClipBatch& batch) {
-    std::string why;
-    try {
-      if (spool && spool->Push(batch)) {
-        std::lock_guard lock(stats_mutex);
-        ++batches_spooled;
-        spool_batches = spool->batches();
-        spool_bytes = spool->bytes();
-        return;
-      }
-      why = spool ? "the spool " + spool->dir() + " is full (storage.spool_max_mib)" : "no spool";
-    } catch (const std::exception& e) {
-      why = e.what();
-    }
-    const ClipRecord& clip = batch.clip;
-    log->error("bank: clip {}/{} from frame {} not stored and not spooled: {}", clip.camera_id,
-               clip.track_id, clip.first_frame, why);
-    if (!clip.complete)
-      broken_clips.insert(std::make_tuple(clip.camera_id, clip.track_id, clip.first_frame));
-    std::lock_guard lock(stats_mutex);
-    ++batches_failed;
-    bank_error = why;
-    last_append_failed = true;
-  }
-
-  // Appends the spooled batches, oldest first, until the spool is empty or the bank is still
-  // away. A batch the bank refuses for what it holds is set aside in the spool's damaged/ folder.
-  void DrainSpool() {
-    size_t drained = 0;
-    while (spool && !spool->empty()) {
-      std::optional<ClipBatch> batch = spool->Front();
-      if (!batch) break;
-      AppendResult result;
-      try {
-        std::lock_guard lock(bank_mutex);
-        result = bank->AppendClipBatch(batch->clip, batch->sprites);
-      } catch (const BusyError&) {
-        break;  // still away: the next batch or the next second tries again
-      } catch (const std::exception& e) {
-        log->error("bank: a spooled batch is refused: {}", e.what());
-        spool->SetAsideFront(e.what());
-        std::lock_guard lock(stats_mutex);
-        ++batches_failed;
-        bank_error = e.what();
-        continue;
-      }
-      spool->PopFront();
-      ++drained;
-      Stored(*batch, result, nullptr);
-    }
-    std::lock_guard lock(stats_mutex);
-    if (spool) {
-      spool_batches = spool->batches();
-      spool_bytes = spool->bytes();
-    }
-    if (drained > 0)
-      log->info("bank: {} spooled batches stored, {} still waiting", drained, spool_batches);
-  }
-
-  // Counts a batch the bank took (`received`: when each sprite's frame arrived, for the latency;
-  // none for a batch from the spool) and hands its new sprites to the transitions worker.
-  void Stored(const ClipBatch& batch, const AppendResult& result,
-              const std::vector<SteadyTime>* received) {
-    const SteadyTime now = Clock::now();
-    uint64_t originals = 0;
-    {
-      std::lock_guard lock(stats_mutex);
-      for (size_t i = 0; i < batch.sprites.size(); ++i) {
-        if (batch.sprites[i].mirrored) continue;
-        ++originals;
-        if (!received) continue;
-        latencies_ms.push_back(Seconds(now - (*received)[i]) * 1e3);
-        ++latency_count;
-        latency_sum_ms += latencies_ms.back();
-        if (latencies_ms.size() > 10000) latencies_ms.pop_front();
-      }
-      sprites_stored += originals;
-      bank_sprites += result.inserted;
-      ++batches_stored;
-      last_append_failed = false;
-      stored_log.emplace_back(now, sprites_stored);
-      while (stored_log.size() > 2 && Seconds(now - stored_log.front().first) > 5.0)
-        stored_log.pop_front();
-    }
-    {
-      std::lock_guard lock(session_mutex);
-      session.sprites_stored += originals;
-    }
-    if (transitions && result.inserted > 0) transitions->Submit(result.sprite_ids);
-  }
-
-  // Waits until every batch handed to the writer so far is stored (or refused).
-  void WaitWriterIdle() {
-    std::unique_lock lock(idle_mutex);
-    idle_cv.wait(lock, [&] { return batches_done >= batches_in; });
-  }
-
-  std::mutex watcher_mutex;
-  Station::FrameWatcher watcher;  // under watcher_mutex
-
-  void Tap(int camera, const Frame& frame, uint64_t drops_before, bool usable) {
-    {
-      std::lock_guard lock(watcher_mutex);
-      if (watcher) watcher(camera, frame);
-    }
+void Station::Impl::StopRecording(const std::string& why) {
+  std::unique_ptr<StationRecorder> done;
+  {
     std::lock_guard lock(recorder_mutex);
-    if (!recorder) return;
-    const std::optional<SourceCamera> source =
-        runners[static_cast<size_t>(camera)]->source_camera();
-    if (!source) return;
-    const std::optional<CameraModel>& model = models[static_cast<size_t>(camera)];
-    recorder->Offer(camera, *source, model ? &*model : nullptr, frame, drops_before, usable);
+    done.swap(recorder);
   }
-
-  void StopRecording(const std::string& why) {
-    std::unique_ptr<StationRecorder> done;
-    {
-      std::lock_guard lock(recorder_mutex);
-      done.swap(recorder);
-    }
-    if (!done) return;
-    done->Close();
-    std::lock_guard lock(recorder_mutex);
-    last_recording = done->stats();
-    log->info("recording {} closed ({} frames, {} dropped){}", last_recording.dir,
-              last_recording.frames_written, last_recording.frames_dropped,
-              why.empty() ? "" : ": " + why);
-  }
-
-  void MonitorLoop() {
-    std::unique_lock lock(monitor_mutex);
-    while (!monitor_stop) {
-      lock.unlock();
-      CheckDisk();
-      lock.lock();
-      monitor_wake.wait_for(lock, std::chrono::seconds(1), [&] { return monitor_stop; });
-    }
-  }
-
-  void CheckDisk() {
-    const StorageConfig storage = StorageSettings();
-    // A PostgreSQL bank's disk is its server's (a full one fails appends: writes_failing).
-    int64_t free_mib =
-        sql::IsPostgresAddress(storage.bank) ? -1 : FreeMib(fs::path(storage.bank).parent_path());
-    if (storage.recording != RecordingMode::kOff) {
-      const int64_t rec = FreeMib(storage.recording_dir);
-      if (rec >= 0 && (free_mib < 0 || rec < free_mib)) free_mib = rec;
-    }
-    StorageState next = StorageState::kOk;
-    if (free_mib >= 0 && free_mib < storage.stop_sprites_below_mib) {
-      next = StorageState::kSpritesStopped;
-    } else if (free_mib >= 0 && free_mib < storage.stop_recording_below_mib) {
-      next = StorageState::kRecordingStopped;
-    }
-    StorageState previous;
-    {
-      std::lock_guard lock(stats_mutex);
-      previous = storage_state;
-      storage_state = next;
-      disk_free_mib = free_mib;
-    }
-    if (next != StorageState::kOk) {
-      bool recording = false;
-      {
-        std::lock_guard lock(recorder_mutex);
-        recording = recorder != nullptr;
-      }
-      if (recording)
-        StopRecording("free disk space " + std::to_string(free_mib) +
-                      " MiB is below storage.stop_recording_below_mib");
-    }
-    if (next != previous) {
-      if (next == StorageState::kOk) {
-        log->info("disk: {} MiB free, storage back to normal", free_mib);
-      } else {
-        log->warn("disk: {} MiB free: {}", free_mib,
-                  next == StorageState::kSpritesStopped
-                      ? "sprite storage stopped (storage.stop_sprites_below_mib)"
-                      : "raw recording stopped (storage.stop_recording_below_mib)");
-      }
-    }
-  }
-
-  mutable std::mutex config_mutex;  // guards options.config.storage / logging for Reload
-  StorageConfig StorageSettings() const {
-    std::lock_guard lock(config_mutex);
-    return options.config.storage;
-  }
-};
+  if (!done) return;
+  done->Close();
+  std::lock_guard lock(recorder_mutex);
+  last_recording = done->stats();
+  log->info("recording {} closed ({} frames, {} dropped){}", last_recording.dir,
+            last_recording.frames_written, last_recording.frames_dropped,
+            why.empty() ? "" : ": " + why);
+}
 
 Station::Station(StationOptions options) : impl_(std::make_unique<Impl>()) {
   Impl& s = *impl_;
