@@ -8,6 +8,7 @@
 // naming the file and the frame, after everything readable has been stored.
 #include <unistd.h>
 
+#include <cmath>
 #include <cstdio>
 #include <string>
 #include <vector>
@@ -26,7 +27,7 @@ namespace {
 void PrintProgress(const IngestProgress& p) {
   const double fraction =
       p.frames_total ? static_cast<double>(p.frames_done) / p.frames_total : 0.0;
-  const int width = 30, filled = static_cast<int>(fraction * width + 0.5);
+  const int width = 30, filled = static_cast<int>(std::lround(fraction * width));
   std::fprintf(stderr, "\r[%s%s] %5.1f%%  %llu/%llu frames  %llu sprites  %.0f frames/s ",
                std::string(filled, '#').c_str(), std::string(width - filled, '.').c_str(),
                100 * fraction, static_cast<unsigned long long>(p.frames_done),

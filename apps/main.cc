@@ -9,7 +9,9 @@
 #include "core/error.h"
 #include "core/log.h"
 
-int main(int argc, char** argv) {
+namespace {
+
+int Run(int argc, char** argv) {
   CLI::App app{"SpriteStation: live capture and recording of video sprites"};
   app.require_subcommand(1);
   std::string log_level = "info";
@@ -51,4 +53,19 @@ int main(int argc, char** argv) {
     return 1;
   }
   return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  // Nothing escapes: what Run's handlers do not name (an exception while the commands are set
+  // up, one that is not a std::exception) still ends with a message and exit 1, not abort().
+  try {
+    return Run(argc, argv);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "spritestation: failed: %s\n", e.what());
+  } catch (...) {
+    std::fprintf(stderr, "spritestation: failed: an unknown error\n");
+  }
+  return 1;
 }

@@ -238,7 +238,8 @@ std::unique_ptr<Problem> MakeScene(int scene, const TransitionGraph& g,
     case 6:
     case 7: {
       for (int k = 0; k < 64; ++k) {
-        const Eigen::Vector2d end(-0.7 + 0.2 * (k % 8), -0.7 + 0.2 * (k / 8));
+        const int column = k % 8, row = k / 8;  // an 8 x 8 grid of ends
+        const Eigen::Vector2d end(-0.7 + 0.2 * column, -0.7 + 0.2 * row);
         const int s = sprite("fly", Anchor::kEnd, end, 110, 200);
         p->AddTerm(std::make_unique<LengthTerm>(s, 100, 5));
         p->AddTerm(std::make_unique<FastFrameTerm>(s, 0.02, 20));

@@ -72,7 +72,7 @@ void BM_SingleProcess(benchmark::State& state) {
 // transitions and no work done.
 const std::string& PostgresBank() {
   static const std::string address = [] {
-    const std::string pg = Env("SPRITESTATION_BENCH_POSTGRES");
+    std::string pg = Env("SPRITESTATION_BENCH_POSTGRES");
     if (BankWriter(pg).Counts().sessions == 0) CopyBank(Env("SPRITESTATION_BENCH_BANK"), pg);
     return pg;
   }();

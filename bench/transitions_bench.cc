@@ -300,7 +300,8 @@ void CompareCascades(const TransitionBuilder& builder, nlohmann::json* out) {
 void SweepStage2(const TransitionBuilder& builder, const TransitionWeights& weights) {
   const auto pairs = SampledCandidates(builder);
   const int32_t n = builder.store().size();
-  const double rows = (n + 9) / 10;
+  const int32_t whole_rows = (n + 9) / 10;  // rows of ten
+  const double rows = whole_rows;
   for (double shift : {0.0, 0.5, 1.0, 1.25, 1.5, 1.75, 2.0, 2.5, 3.0}) {
     TransitionWeights w = weights;
     w.stage2_bias += shift;

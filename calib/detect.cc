@@ -266,7 +266,7 @@ double MeasureEdgeWidth(const BoardSpec& board, const cv::Mat& grey, const std::
     for (int neighbour :
          {id % cx + 1 < cx ? id + 1 : -1, id + cx < board.corner_count() ? id + cx : -1}) {
       if (neighbour < 0 || index[neighbour] < 0) continue;
-      const Eigen::Vector2d a = pixels[index[id]], b = pixels[index[neighbour]];
+      const Eigen::Vector2d &a = pixels[index[id]], &b = pixels[index[neighbour]];
       const Eigen::Vector2d along = b - a;
       const double spacing = along.norm();
       if (spacing < 4) continue;

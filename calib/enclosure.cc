@@ -73,7 +73,7 @@ GroundPolygon FindGreenFloor(const CameraModel& model, const cv::Mat& bgr,
   std::vector<uint8_t> green_levels;
   for (int y = 0; y < bgr.rows; ++y) {
     for (int x = 0; x < bgr.cols; ++x) {
-      const cv::Vec3b p = bgr.at<cv::Vec3b>(y, x);
+      const cv::Vec3b& p = bgr.at<cv::Vec3b>(y, x);
       if (p[1] - std::max(p[0], p[2]) > options.min_green_excess) {
         mask.at<uint8_t>(y, x) = 255;
         green_levels.push_back(p[1]);

@@ -338,7 +338,8 @@ void WriteUncertaintyMap(const std::string& path, const SolveSummary& solution,
   // The scale bar.
   const int bar_w = std::min(200, w / 3), bar_x = w - bar_w - 10, bar_y = h - 24;
   for (int x = 0; x < bar_w; ++x) {
-    cv::Mat one(1, 1, CV_8U, cv::Scalar(255 * x / std::max(1, bar_w - 1))), colour;
+    const int level = 255 * x / std::max(1, bar_w - 1);  // 0..255 along the bar
+    cv::Mat one(1, 1, CV_8U, cv::Scalar(level)), colour;
     cv::applyColorMap(one, colour, cv::COLORMAP_VIRIDIS);
     cv::line(canvas, {bar_x + x, bar_y}, {bar_x + x, bar_y + 10},
              cv::Scalar(colour.at<cv::Vec3b>(0, 0)));

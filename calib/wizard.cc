@@ -390,7 +390,7 @@ WizardFrame CalibrationWizard::Feed(const cv::Mat& image, int frame) {
       now.push_back("move the board to a new place or angle");
     }
     if (step_ == WizardStep::kIntrinsics) {
-      const std::vector<std::string> missing = MissingForIntrinsics();
+      std::vector<std::string> missing = MissingForIntrinsics();
       if (!o_.auto_solve && missing.empty())
         now.insert(now.begin(), "the views meet the criteria: solve");
       for (auto& m : missing) now.push_back(std::move(m));

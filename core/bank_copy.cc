@@ -233,7 +233,7 @@ BankDigest CopyBank(const std::string& from, const std::string& to) {
     copied = Digest(src);
     tx.Commit();
   }
-  const BankDigest written = DigestBank(to);
+  BankDigest written = DigestBank(to);
   if (written.digest != copied.digest) {
     throw WorkError(dst.path(), "the copy's digest " + written.digest +
                                     " differs from the source's " + copied.digest);

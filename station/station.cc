@@ -333,7 +333,7 @@ SessionStatus Station::StartSession(const std::string& requested_name) {
       s.last_recording.error = e.what();
     }
   }
-  const SessionStatus out = s.session;
+  SessionStatus out = s.session;
   lock.unlock();  // the writer updates the session's counts meanwhile
   for (size_t i = 0; i < s.runners.size(); ++i) s.runners[i]->SetBankCamera(camera_ids[i]);
   // Previews back off while a session stores: fewer snapshots for the pipeline threads to copy.

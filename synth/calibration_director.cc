@@ -114,7 +114,7 @@ class CalibrationDirector : public Director {
         std::min(static_cast<int>(seg->poses.size()) - 2, static_cast<int>(std::floor(u)));
     const double s = Smooth((u - p) / 0.6);
     Add(seg->board,
-        Interpolate(seg->poses[static_cast<size_t>(p)], seg->poses[static_cast<size_t>(p + 1)], s),
+        Interpolate(seg->poses[static_cast<size_t>(p)], seg->poses[static_cast<size_t>(p) + 1], s),
         "camera:" + cameras_[static_cast<size_t>(seg->camera)].name, out);
   }
 

@@ -47,7 +47,7 @@ Eigen::Vector2d Lens::Project(const Eigen::Vector3d& p) const {
 }
 
 Eigen::Vector3d Lens::Unproject(const Eigen::Vector2d& pixel) const {
-  const Eigen::Vector2d target = pixel;
+  const Eigen::Vector2d& target = pixel;
   Eigen::Vector2d n((pixel.x() - k_[2]) / k_[0], (pixel.y() - k_[3]) / k_[1]);
   if (distorted_) {
     for (int it = 0; it < 50; ++it) {

@@ -467,7 +467,9 @@ void CameraRenderer::DrawSubjects(const FrameScene& scene, CameraImage* out) con
       std::array<int, 64> seen_count{};
       int covered = 0;
       for (int s = 0; s < kSubsamples; ++s) {
-        const float ox = ((s % 4) + 0.5f) / 4.0f, oy = ((s / 4) + 0.5f) / 4.0f;
+        const int column = s % 4, row = s / 4;  // a 4 x 4 grid
+        const float ox = (static_cast<float>(column) + 0.5f) / 4.0f,
+                    oy = (static_cast<float>(row) + 0.5f) / 4.0f;
         const Eigen::Vector3f d = RayAt(x - 0.5f + ox, y - 0.5f + oy);
         const Sample smp = trace(x, y, d, SliceOf(s, slices));
         for (uint64_t m = smp.seen; m; m &= m - 1) ++seen_count[__builtin_ctzll(m)];

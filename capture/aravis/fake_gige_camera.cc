@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <cstring>
 #include <mutex>
 #include <vector>
@@ -227,7 +228,7 @@ FakeGigECamera::FakeGigECamera(const std::string& session_dir, FakeGigEOptions o
   arv_fake_camera_write_register(fake, ARV_FAKE_CAMERA_REGISTER_PIXEL_FORMAT,
                                  *GenicamPixelFormat(s.format));
   arv_fake_camera_write_register(fake, ARV_FAKE_CAMERA_REGISTER_ACQUISITION_FRAME_PERIOD_US,
-                                 static_cast<guint32>(1e6 / s.fps + 0.5));
+                                 static_cast<guint32>(std::lround(1e6 / s.fps)));
   arv_fake_camera_set_fill_pattern(fake, &Impl::FillPattern, &s);
   Log("capture.fakecam")
       ->info("{} serving {} camera '{}' ({} {}x{} at {:.2f} frames/s) on {}", s.device_id,

@@ -679,11 +679,13 @@ std::optional<Frame> LibcameraSource::Next() {
     auto release = [self, request] { self->Requeue(request); };
     if (s.format == PixelFormat::kMJPEG) {
       f = Frame::Borrowed(s.format, s.width, s.height, data[0], planes[0].bytesused, release);
-    } else if (s.format == PixelFormat::kNV12 && s.stride == static_cast<size_t>(s.width) &&
-               (data.size() == 1 || data[1] == data[0] + static_cast<size_t>(s.width) * s.height)) {
-      f = Frame::Borrowed(s.format, s.width, s.height, data[0], packed, release);
-    } else if (s.format != PixelFormat::kNV12 &&
-               s.stride * static_cast<size_t>(s.height) == packed) {
+    } else if (s.format == PixelFormat::kNV12
+                   // NV12 borrowed when its rows are unpadded and its chroma follows its luma
+                   ? s.stride == static_cast<size_t>(s.width) &&
+                         (data.size() == 1 ||
+                          data[1] == data[0] + static_cast<size_t>(s.width) * s.height)
+                   // any other format when its rows are unpadded
+                   : s.stride * static_cast<size_t>(s.height) == packed) {
       f = Frame::Borrowed(s.format, s.width, s.height, data[0], packed, release);
     } else {
       // Padded rows or separate planes: repack into an owned frame and give the buffer straight

@@ -61,8 +61,8 @@ class PixelRays {
     const double u = static_cast<double>(x - i * step_) / step_;
     const double v = static_cast<double>(y - j * step_) / step_;
     const int i1 = std::min(i + 1, cols_ - 1), j1 = std::min(j + 1, rows_ - 1);
-    const Eigen::Vector3d d = (1 - v) * ((1 - u) * Node(i, j) + u * Node(i1, j)) +
-                              v * ((1 - u) * Node(i, j1) + u * Node(i1, j1));
+    Eigen::Vector3d d = (1 - v) * ((1 - u) * Node(i, j) + u * Node(i1, j)) +
+                        v * ((1 - u) * Node(i, j1) + u * Node(i1, j1));
     if (d.allFinite()) return d;
     return camera_.RayInGround(Eigen::Vector2d(x, y))
         .direction;  // a node outside the lens's valid region

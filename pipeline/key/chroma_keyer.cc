@@ -37,8 +37,12 @@ inline PixelKey KeyPixel(int b, int g, int r, float key_hi, float gain, int32_t 
   const int luma4 = b + 2 * g + r;
   const float key4 =
       static_cast<float>(g - std::max(b, r)) / static_cast<float>(std::max(luma4, luma_floor));
+  // Rounded by + 0.5 and truncation, not std::lround (a call, and no vectorizing): the values
+  // below 0, where truncation rounds the wrong way, all end as 0 (the clamp, the shade test).
+  // NOLINTBEGIN(bugprone-incorrect-roundings)
   const int alpha = std::clamp(static_cast<int>((key_hi - key4) * gain + 0.5f), 0, 255);
   const int dark = static_cast<int>(shadow_base - static_cast<float>(luma4) * inv_luma + 0.5f);
+  // NOLINTEND(bugprone-incorrect-roundings)
   const int shade = dark >= shadow_min ? dark : 0;
   // shade * (255 - alpha) / 255, rounded: the shadow only shows where the subject does not.
   return {alpha, ((shade * (255 - alpha) + 128) * 257) >> 16};
@@ -181,7 +185,8 @@ void ChromaKeyer::Train(const std::vector<cv::Mat>& empty_bgr) {
   band_floor_.assign(static_cast<size_t>(rows) * w, 0);
   for (int cy = 0; cy < rows; ++cy) {
     for (int x = 0; x < size_.width; ++x) {
-      const double fx = std::clamp((x - s / 2) / static_cast<double>(s), 0.0, cols - 1.0);
+      const int from_centre = x - s / 2;  // cell centres lie at s / 2 + k s
+      const double fx = std::clamp(from_centre / static_cast<double>(s), 0.0, cols - 1.0);
       const int c0 = static_cast<int>(fx), c1 = std::min(c0 + 1, cols - 1);
       const double t = fx - c0;
       const size_t i0 = static_cast<size_t>(cy) * cols + c0,

@@ -36,9 +36,13 @@ inline PixelKey PlatePixel(int b, int g, int r, int mu_b, int mu_g, int mu_r, fl
   const int brighter = static_cast<int>((ratio - 1.f) * mu_norm * 4.f);
   const int too_dark = static_cast<int>((dark_floor - ratio) * mu_norm * 4.f);
   const int distance4 = std::max(static_cast<int>(chroma * 4.f), std::max(brighter, too_dark));
+  // Rounded by + 0.5 and truncation, not std::lround (a call, and no vectorizing): the values
+  // below 0, where truncation rounds the wrong way, all end as 0 (the clamp, the shade test).
+  // NOLINTBEGIN(bugprone-incorrect-roundings)
   const int alpha = std::clamp(
       static_cast<int>((static_cast<float>(distance4) * 0.25f - tolerance) * gain + 0.5f), 0, 255);
   const int dark = static_cast<int>(255.f - ratio * 255.f + 0.5f);
+  // NOLINTEND(bugprone-incorrect-roundings)
   const int shade = dark >= shadow_min ? dark : 0;
   return {alpha, ((shade * (255 - alpha) + 128) * 257) >> 16};
 }

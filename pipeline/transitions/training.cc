@@ -304,7 +304,7 @@ TransitionWeights TrainWeights(std::span<const PairFeatures> x, std::span<const 
   const int folds = std::max(2, options.folds);
   size_t accepts = 0;
   for (uint8_t a : accept) accepts += a ? 1 : 0;
-  if (n < static_cast<size_t>(2 * folds)) {
+  if (n < 2 * static_cast<size_t>(folds)) {
     throw InputError("labels", std::to_string(n) + " labelled pairs; at least " +
                                    std::to_string(2 * folds) + " are needed for " +
                                    std::to_string(folds) + "-fold cross-validation");

@@ -28,7 +28,7 @@ Eigen::Vector2d Centroid(const cv::Mat& bgra, const cv::Vec3b& bgr) {
   double weight = 0;
   for (int y = 0; y < bgra.rows; ++y) {
     for (int x = 0; x < bgra.cols; ++x) {
-      const cv::Vec4b p = bgra.at<cv::Vec4b>(y, x);
+      const cv::Vec4b& p = bgra.at<cv::Vec4b>(y, x);
       const bool match = std::abs(p[0] - bgr[0]) < 60 && std::abs(p[1] - bgr[1]) < 60 &&
                          std::abs(p[2] - bgr[2]) < 60;
       if (!match || p[3] == 0) continue;

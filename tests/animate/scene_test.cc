@@ -29,7 +29,7 @@ class SceneTest : public ::testing::Test {
     cv::imwrite(dir_ / "floor.png", cv::Mat(240, 320, CV_8UC3, cv::Scalar(90, 140, 170)));
   }
   std::string WriteSpec(const std::string& body) {
-    const std::string path = dir_ / "scene.yaml";
+    std::string path = dir_ / "scene.yaml";
     std::ofstream out(path);
     out << "camera: virtual.cameramodel\nbackground: floor.png\nbanks: [walker.ssbank]\n" << body;
     return path;

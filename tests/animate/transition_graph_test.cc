@@ -54,8 +54,8 @@ TEST(TransitionGraph, TagsAndBadInput) {
   EXPECT_THROW(TransitionGraph(TwoClips(), {{0, 5, 1.0}}), InputError);
   EXPECT_THROW(TransitionGraph(TwoClips(), {{0, 1, -1.0}}), InputError);
   try {
-    TransitionGraph(TwoClips(), {{0, 1, 1.0}, {0, 1, std::nan("")}});
-    FAIL();
+    const TransitionGraph graph_with_nan(TwoClips(), {{0, 1, 1.0}, {0, 1, std::nan("")}});
+    FAIL() << "a NaN cost was accepted";
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("transitions[1]"), std::string::npos) << e.what();
   }

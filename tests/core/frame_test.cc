@@ -95,7 +95,7 @@ TEST(ToBgr, BayerOfFlatColourDemosaicsToThatColour) {
     }
   }
   const cv::Mat out = ToBgr(FromMat(PixelFormat::kBayerRG8, raw));
-  const cv::Vec3b centre = out.at<cv::Vec3b>(8, 8);
+  const cv::Vec3b& centre = out.at<cv::Vec3b>(8, 8);
   EXPECT_EQ(centre, cv::Vec3b(40, 200, 90));
 }
 

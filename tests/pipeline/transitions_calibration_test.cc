@@ -121,7 +121,7 @@ TEST(TransitionCalibration, StageOneRefittedAsAFilterPassesTheRequestedShare) {
   const auto sprites = MakeSyntheticSprites(so);
   SpriteStore store(ComparisonWindow{}, so.px_per_m);
   store.Append(AsSpriteInputs(sprites), 2);
-  TransitionWeights w = DefaultWeights();
+  const TransitionWeights& w = DefaultWeights();
   const PopulationSample sample = SamplePopulation(store, TransitionClassifier(w), 200, 3, 2);
   ASSERT_EQ(sample.rows.size(), 200u);
   for (const double recall : {0.95, 0.999}) {

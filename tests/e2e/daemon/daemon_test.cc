@@ -125,7 +125,7 @@ class DaemonTest : public ::testing::Test {
   std::string Config(const std::string& cameras, const std::string& extra = "",
                      const std::string& storage = "") {
     // `extra` goes under control: when it starts with two spaces, else it is a top-level section.
-    const std::string path = dir_ / "station.yaml";
+    std::string path = dir_ / "station.yaml";
     std::ofstream out(path);
     out << "version: 1\ncameras:\n"
         << cameras << "enclosure:\n  floor: " << session_->floor_yaml << "\n"

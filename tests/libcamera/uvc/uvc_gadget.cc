@@ -22,6 +22,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cerrno>
 #include <cstdint>
@@ -296,10 +297,8 @@ void StreamingRequest(const usb_ctrlrequest& r) {
     case UVC_GET_CUR:
       c = stream.probe;
       break;
-    case UVC_GET_MIN:
+    case UVC_GET_MIN:  // one format and one frame size: the least, the most and the default
     case UVC_GET_DEF:
-      FillProbe(&c, 1, 1);
-      break;
     case UVC_GET_MAX:
       FillProbe(&c, 1, 1);
       break;
@@ -420,7 +419,9 @@ void FillFrame(const Format& f, FrameSize s, uint32_t number, std::vector<uint8_
                             static_cast<uint8_t>(number >> 8),
                             static_cast<uint8_t>(number)};
     std::memcpy(out.data(), head, sizeof head);
-    std::memcpy(out.data() + sizeof head, jpeg.data() + 2, jpeg.size() - 2);
+    // The JPEG's bytes (a std::string holds them: memcpy of its size - 2 read to
+    // bugprone-not-null-terminated-result as text copied without its terminator).
+    std::copy(jpeg.begin() + 2, jpeg.end(), out.begin() + sizeof head);
     return;
   }
   const int w = s.width, h = s.height;
