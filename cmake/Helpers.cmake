@@ -33,12 +33,14 @@ function(spritestation_add_library name)
   target_link_libraries(${name} PUBLIC ${ARG_DEPS} PRIVATE spritestation_flags)
 endfunction()
 
-# spritestation_add_test(NAME DIR DEPS dep... [LABELS l...] [LOCK resource])
+# spritestation_add_test(NAME DIR DEPS dep... [LABELS l...] [LOCK resource] [RUNS_APP])
 # One GoogleTest executable per tests/<folder>, each TEST registered with CTest.
 # LOCK: tests of this executable never run at the same time as each other
 # (e.g. they all serve an emulated GigE camera on 127.0.0.1:3956).
+# RUNS_APP: the tests run `spritestation` (the e2e suites): it is built first and they find it
+# in $SPRITESTATION_BIN. The unit suites call the libraries only and do not wait for it.
 function(spritestation_add_test name dir)
-  cmake_parse_arguments(ARG "" "LOCK" "DEPS;LABELS" ${ARGN})
+  cmake_parse_arguments(ARG "RUNS_APP" "LOCK" "DEPS;LABELS" ${ARGN})
   file(GLOB sources CONFIGURE_DEPENDS ${dir}/*_test.cc)
   if(NOT sources OR (SPRITESTATION_FUZZ AND NOT name IN_LIST SPRITESTATION_SANITIZE_SUITES))
     return()
@@ -54,7 +56,8 @@ function(spritestation_add_test name dir)
     set(lock_property RESOURCE_LOCK ${ARG_LOCK})
   endif()
   set(bin_property)
-  if(TARGET spritestation)  # the sanitizer build has no app: scripts/fuzz.sh sets SPRITESTATION_BIN
+  if(ARG_RUNS_APP)
+    add_dependencies(${name} spritestation)
     set(bin_property ENVIRONMENT "SPRITESTATION_BIN=$<TARGET_FILE:spritestation>")
   endif()
   gtest_discover_tests(${name} DISCOVERY_TIMEOUT 60

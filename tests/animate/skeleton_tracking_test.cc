@@ -5,87 +5,25 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <cmath>
+#include <string>
+#include <vector>
 
-#include <filesystem>
-#include <fstream>
-
-#include <nlohmann/json.hpp>
-#include <opencv2/imgcodecs.hpp>
-#include <opencv2/imgproc.hpp>
+#include <opencv2/core.hpp>
 
 #include "animate/skeleton/lk_tracker.h"
-#include "animate/skeleton/skeleton_json.h"
-#include "animate/skeleton/synthetic_poses.h"
+#include "animate/skeleton/skeleton.h"
 #include "core/error.h"
-#include "tests/support/test_support.h"
+#include "tests/animate/skeleton_fixtures.h"
 
 namespace ss {
 namespace {
 
-constexpr int kFrames = 40;
-constexpr int kOccludedFrom = 20, kOccludedTo = 24;  // inclusive
-
-// The truth: the walk of synthetic_poses, drifting right by 2 px per frame.
-SkeletonSequence Truth() {
-  GestureScriptOptions o;
-  o.scale_px = 80;
-  o.x_px = 250;
-  o.y_px = 250;
-  SkeletonSequence s =
-      MakeGestureSequence({{Gesture::kWalk, kFrames}}, BodyProportions{}, o).sequence;
-  for (int f = 0; f < s.size(); ++f) {
-    for (auto& j : s.frames[f].joints) j.x_px += 2.0f * f;
-  }
-  return s;
-}
-
-cv::Point Fixed(float x, float y) {  // 4 fractional bits for sub-pixel drawing
-  return {static_cast<int>(std::lround(x * 16)), static_cast<int>(std::lround(y * 16))};
-}
-
-// Limbs as grey lines, joints as dark discs with a bright centre, sensor noise; an
-// occluder (a uniform box over the subject's left arm and leg) when `occluded`.
-cv::Mat Render(const SkeletonFrame& frame, bool occluded) {
-  cv::Mat image(480, 640, CV_8UC1, cv::Scalar(190));
-  const SkeletonDef& def = HumanSkeleton();
-  for (const Limb& l : def.limbs) {
-    const JointSample& a = frame.joints[l.from];
-    const JointSample& b = frame.joints[l.to];
-    cv::line(image, Fixed(a.x_px, a.y_px), Fixed(b.x_px, b.y_px), cv::Scalar(120), 2, cv::LINE_AA,
-             4);
-  }
-  for (const JointSample& j : frame.joints) {
-    cv::circle(image, Fixed(j.x_px, j.y_px), 6 * 16, cv::Scalar(35), cv::FILLED, cv::LINE_AA, 4);
-    cv::circle(image, Fixed(j.x_px, j.y_px), 2 * 16, cv::Scalar(235), cv::FILLED, cv::LINE_AA, 4);
-  }
-  if (occluded) {
-    const JointSample& pelvis = frame.joints[*def.JointIndex("pelvis")];
-    cv::rectangle(image, cv::Rect(static_cast<int>(pelvis.x_px) + 8, 100, 140, 360), cv::Scalar(90),
-                  cv::FILLED);
-  }
-  cv::Mat noise(image.size(), CV_16SC1);
-  cv::randn(noise, 0, 2.0);
-  cv::Mat out;
-  image.convertTo(out, CV_16SC1);
-  out += noise;
-  out.convertTo(out, CV_8UC1);
-  return out;
-}
-
-std::vector<cv::Mat> RenderClip(const SkeletonSequence& truth, bool with_occluder) {
-  cv::setRNGSeed(5);
-  std::vector<cv::Mat> images;
-  for (int f = 0; f < truth.size(); ++f) {
-    images.push_back(
-        Render(truth.frames[f], with_occluder && f >= kOccludedFrom && f <= kOccludedTo));
-  }
-  return images;
-}
-
-float Error(const JointSample& a, const JointSample& b) {
-  return std::hypot(a.x_px - b.x_px, a.y_px - b.y_px);
-}
+using testing::Error;
+using testing::kFrames;
+using testing::kOccludedFrom;
+using testing::kOccludedTo;
+using testing::RenderClip;
+using testing::Truth;
 
 // The joints the occluder hides (the subject's left is the image's right).
 bool UnderOccluder(const std::string& joint) {
@@ -170,60 +108,6 @@ TEST(SkeletonTracking, UnmarkedOcclusionIsReportedPerFrame) {
                    UnderOccluder(HumanSkeleton().joints[j]));
     }
   }
-}
-
-TEST(SkeletonTracking, TrackCommandOnAFolderOfFrames) {
-  // `spritestation skeleton track` on PNG frames, the user's joints for frame 0 and the
-  // occluded frames marked on the command line.
-  const SkeletonSequence truth = Truth();
-  const std::vector<cv::Mat> images = RenderClip(truth, true);
-  testing::ScratchDir dir;
-  std::filesystem::create_directories(dir / "frames");
-  for (size_t f = 0; f < images.size(); ++f) {
-    char name[32];
-    std::snprintf(name, sizeof(name), "frames/%04zu.png", f);
-    ASSERT_TRUE(cv::imwrite(dir / name, images[f]));
-  }
-  nlohmann::json joints = nlohmann::json::object();
-  for (size_t j = 0; j < truth.frames[0].joints.size(); ++j) {
-    joints[HumanSkeleton().joints[j]] = {truth.frames[0].joints[j].x_px,
-                                         truth.frames[0].joints[j].y_px};
-  }
-  std::ofstream(dir / "init.json")
-      << nlohmann::json{{"skeleton", "human14"}, {"joints", joints}}.dump();
-  const auto run = testing::RunSpritestation("skeleton track " + (dir / "frames") + " --init " +
-                                             (dir / "init.json") + " --out " + (dir / "skel.json") +
-                                             " --occluded " + std::to_string(kOccludedFrom) + "-" +
-                                             std::to_string(kOccludedTo) + " --json");
-  ASSERT_EQ(run.exit_code, 0) << run.output;
-  const nlohmann::json report = nlohmann::json::parse(run.output.substr(run.output.find('{')));
-  EXPECT_EQ(report["frames"], kFrames);
-  EXPECT_EQ(report["failures"].size(), 0u);
-  EXPECT_EQ(report["interpolated_joints"], 15 * (kOccludedTo - kOccludedFrom + 1));
-  const SkeletonSequence s = ReadSkeletonSequence(dir / "skel.json");
-  EXPECT_EQ(s.clip, "frames");
-  ASSERT_EQ(s.size(), kFrames);
-  float worst = 0;
-  for (int f = 0; f < kFrames; ++f) {
-    for (size_t j = 0; j < s.frames[f].joints.size(); ++j) {
-      ASSERT_TRUE(s.frames[f].joints[j].present);
-      EXPECT_EQ(s.frames[f].joints[j].interpolated, f >= kOccludedFrom && f <= kOccludedTo);
-      worst = std::max(worst, Error(s.frames[f].joints[j], truth.frames[f].joints[j]));
-    }
-  }
-  EXPECT_LT(worst, 3.0f);
-  // Bad input: an occluded frame past the clip, a missing initial joint.
-  const auto past = testing::RunSpritestation("skeleton track " + (dir / "frames") + " --init " +
-                                              (dir / "init.json") + " --out " + (dir / "x.json") +
-                                              " --occluded 100");
-  EXPECT_EQ(past.exit_code, 2) << past.output;
-  joints.erase("wrist_r");
-  std::ofstream(dir / "bad_init.json") << nlohmann::json{{"joints", joints}}.dump();
-  const auto bad =
-      testing::RunSpritestation("skeleton track " + (dir / "frames") + " --init " +
-                                (dir / "bad_init.json") + " --out " + (dir / "x.json"));
-  EXPECT_EQ(bad.exit_code, 2) << bad.output;
-  EXPECT_NE(bad.output.find("'wrist_r' is missing"), std::string::npos) << bad.output;
 }
 
 TEST(SkeletonTracking, RejectsBadInput) {

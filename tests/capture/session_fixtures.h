@@ -1,6 +1,9 @@
 #pragma once
-// Test frames with known content and small recorded sessions, shared by the capture tests.
+// Test frames with known content and small recorded sessions (some of them damaged), shared by
+// the capture tests and the `spritestation replay` tests in tests/e2e.
 #include <cstdint>
+#include <filesystem>
+#include <fstream>
 #include <string>
 #include <vector>
 
@@ -67,6 +70,25 @@ inline void RecordTestSession(const std::string& dir, PixelFormat format, int wi
                            t0_ns + i * period_ns, smooth));
   }
   writer.Close();
+}
+
+// A recorded session (camera "cam0", BGR8 160x120, 30 frames) whose video is then cut to 60 %
+// of its size; returns the video's path.
+inline std::string RecordTruncatedSession(const std::string& dir) {
+  RecordTestSession(dir, PixelFormat::kBGR8, 160, 120, 30);
+  const std::string video = dir + "/cam0.mkv";
+  std::filesystem::resize_file(video, std::filesystem::file_size(video) * 6 / 10);
+  return video;
+}
+
+// A recorded session (camera "cam0", BGR8 32x32, 5 frames) whose frame CSV is then replaced by
+// one with a garbage timestamp on its line 3; returns the CSV's path.
+inline std::string RecordSessionWithGarbageCsv(const std::string& dir) {
+  RecordTestSession(dir, PixelFormat::kBGR8, 32, 32, 5);
+  const std::string csv = dir + "/cam0.frames.csv";
+  std::ofstream(csv, std::ios::trunc)
+      << "index,timestamp_ns,sequence,drops_before\n0,100,0,0\n1,bogus,1,0\n";
+  return csv;
 }
 
 }  // namespace ss::testing

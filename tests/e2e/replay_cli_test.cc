@@ -1,5 +1,7 @@
 // `spritestation replay`: what it reports about a real recorded session, and
-// how it treats a session whose camera model is missing or broken.
+// how it treats a session whose camera model is missing or broken, whose video is cut
+// short or whose frame CSV holds garbage (what the replay library makes of those two:
+// tests/capture/replay_damage_test.cc).
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -18,6 +20,8 @@
 namespace ss {
 namespace {
 
+using ss::testing::RecordSessionWithGarbageCsv;
+using ss::testing::RecordTruncatedSession;
 using ss::testing::RunSpritestation;
 using ss::testing::ScratchDir;
 using ss::testing::TestCamera;
@@ -209,6 +213,24 @@ TEST(ReplayCli, BadSessionsExitTwoNamingTheFile) {
   ASSERT_TRUE(j.is_object()) << r.output;
   EXPECT_EQ(j["cameras"][1]["frames"], 4);
   EXPECT_EQ(j["cameras"][1]["frames_without_row"], 1);
+}
+
+TEST(ReplayCli, TruncatedVideoExitsTwoNamingTheFile) {
+  ScratchDir dir;
+  const std::string session = dir / "s";
+  const std::string video = RecordTruncatedSession(session);
+  const auto cli = RunSpritestation("replay " + session);
+  EXPECT_EQ(cli.exit_code, 2) << cli.output;
+  EXPECT_TRUE(Contains(cli.output, video)) << cli.output;
+}
+
+TEST(ReplayCli, GarbageCsvExitsTwoNamingTheLine) {
+  ScratchDir dir;
+  const std::string session = dir / "s";
+  const std::string csv = RecordSessionWithGarbageCsv(session);
+  const auto cli = RunSpritestation("replay " + session);
+  EXPECT_EQ(cli.exit_code, 2) << cli.output;
+  EXPECT_TRUE(Contains(cli.output, csv + ":3")) << cli.output;
 }
 
 }  // namespace

@@ -2,7 +2,8 @@
 // what it finds, an unknown id is refused naming it and the ids found, formats
 // map to libcamera's (RGB888 is B,G,R in memory), a station config maps to
 // the controls, and only the controls a camera lists are planned, the rest
-// named as ignored. Streaming from a real driver is tests/libcamera/uvc_test.cc.
+// named as ignored. Streaming from a real driver is tests/libcamera/uvc_test.cc; the
+// `spritestation cameras` command is tested in tests/e2e/cameras_cli_test.cc.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -14,7 +15,6 @@
 #include "capture/libcamera/libcamera_source.h"
 #include "core/config.h"
 #include "core/error.h"
-#include "tests/support/test_support.h"
 
 namespace ss {
 namespace {
@@ -245,30 +245,6 @@ TEST(Libcamera, TheStationOpensLibcameraCamerasByTheirConfig) {
   } catch (const WorkError& e) {  // the station retries a WorkError later
     EXPECT_NE(std::string(e.what()).find("absent-camera-7"), std::string::npos) << e.what();
   }
-}
-
-// The JSON array in a command's output: the first line starting with '[' from which the rest
-// parses.
-nlohmann::json ArrayInOutput(const std::string& output) {
-  for (size_t at = 0; at < output.size(); at = output.find('\n', at) + 1) {
-    if (output[at] == '[') {
-      nlohmann::json j = nlohmann::json::parse(output.substr(at), nullptr, false);
-      if (j.is_array()) return j;
-    }
-    if (output.find('\n', at) == std::string::npos) break;
-  }
-  return {};
-}
-
-TEST(Libcamera, CamerasCommandListsLibcameraCameras) {
-  const auto cameras = ListLibcameraCameras();
-  const auto r = ss::testing::RunSpritestation("cameras --json");
-  ASSERT_EQ(r.exit_code, 0) << r.output;
-  const nlohmann::json list = ArrayInOutput(r.output);
-  ASSERT_TRUE(list.is_array()) << r.output;
-  size_t libcamera = 0;
-  for (const auto& c : list) libcamera += c["backend"] == "libcamera" ? 1 : 0;
-  EXPECT_EQ(libcamera, cameras.size()) << r.output;
 }
 
 }  // namespace

@@ -1,13 +1,12 @@
 // Transitions of a real sprite bank: the bank build equals the in-memory build, the
-// incremental worker equals a from-scratch build, labels from truth, the command line
-// and its error messages.
+// incremental worker equals a from-scratch build, labels from truth. The command line and
+// its error messages are tested in tests/e2e/transitions_cli_test.cc.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
-#include <fstream>
 #include <map>
-
-#include <nlohmann/json.hpp>
+#include <tuple>
 
 #include "core/bank.h"
 #include "core/error.h"
@@ -16,122 +15,22 @@
 #include "pipeline/transitions/builder.h"
 #include "pipeline/transitions/synthetic.h"
 #include "pipeline/transitions/worker.h"
+#include "tests/pipeline/transitions_bank_fixtures.h"
 #include "tests/pipeline/transitions_test_util.h"
 #include "tests/support/test_support.h"
 
 namespace ss {
 namespace {
 
+using testing::BankFiller;
+using testing::Clips;
+using testing::Sprites;
+using testing::WriteTruth;
+
 // Generous weights for the synthetic set so that many pairs and transitions exist.
 TransitionWeights Generous() {
   return testing::UnitWeights({0.03, 30, 0.0006, 0.04, 0.12, 12}, 4.0, 3.0);
 }
-
-constexpr int64_t kFrameNs = 33'333'333;
-
-// A synthetic set whose area survives the bank's round trip bit for bit.
-std::vector<SyntheticSprite> Sprites(int frames, uint64_t seed) {
-  SyntheticSpriteOptions o;
-  o.frames = frames;
-  o.min_clip_frames = 10;
-  o.max_clip_frames = 60;
-  o.seed = seed;
-  auto sprites = MakeSyntheticSprites(o);
-  for (auto& s : sprites) {
-    const double area_px = s.cheap.area_m2 * o.px_per_m * o.px_per_m;
-    s.cheap.area_m2 = area_px / (o.px_per_m * o.px_per_m);
-  }
-  return sprites;
-}
-
-// One synthetic clip (originals and their mirrors) as one bank clip.
-struct ClipOfSprites {
-  int64_t clip = 0;
-  std::vector<const SyntheticSprite*> originals, mirrors;  // by frame
-};
-std::vector<ClipOfSprites> Clips(const std::vector<SyntheticSprite>& sprites) {
-  const size_t half = sprites.size() / 2;
-  std::map<int64_t, ClipOfSprites> by_clip;
-  for (size_t k = 0; k < half; ++k) {
-    auto& c = by_clip[sprites[k].clip];
-    c.clip = sprites[k].clip;
-    c.originals.push_back(&sprites[k]);
-    c.mirrors.push_back(&sprites[half + k]);
-  }
-  std::vector<ClipOfSprites> out;
-  for (auto& [id, c] : by_clip) out.push_back(c);
-  return out;
-}
-
-SpriteRecord Record(const SyntheticSprite& s, int64_t frame, bool mirrored) {
-  const double px_per_m = SyntheticSpriteOptions{}.px_per_m;
-  SpriteRecord r;
-  r.frame = frame;
-  r.timestamp_ns = frame * kFrameNs;
-  r.mirrored = mirrored;
-  r.ground_x_m = 0.001 * frame;
-  r.ground_y_m = 0.5;
-  r.velocity_x_m_s = s.cheap.velocity_x_mps;
-  r.velocity_y_m_s = s.cheap.velocity_y_mps;
-  r.mean_r = s.cheap.colour[0];
-  r.mean_g = s.cheap.colour[1];
-  r.mean_b = s.cheap.colour[2];
-  r.area_px = s.cheap.area_m2 * px_per_m * px_per_m;
-  r.eccentricity = s.cheap.eccentricity;
-  r.billboard_width_px = s.billboard.width;
-  r.billboard_height_px = s.billboard.height;
-  r.px_per_m = px_per_m;
-  r.anchor_x_px = s.billboard.anchor_x_px;
-  r.anchor_y_px = s.billboard.anchor_y_px;
-  r.bbox_in_image = cv::Rect(0, 0, s.billboard.width, s.billboard.height);
-  if (!mirrored) {
-    r.pixels.bgra = cv::Mat(s.billboard.height, s.billboard.width, CV_8UC4,
-                            const_cast<uint8_t*>(s.billboard.rgba.data()))
-                        .clone();
-  }
-  return r;
-}
-
-// Writes clips into a bank, `batch` frames per transaction; `stored` is called with the
-// ids of every batch (as the pipeline would hand them to the worker).
-class BankFiller {
- public:
-  explicit BankFiller(const std::string& path) : writer_(path) {
-    const int64_t session = writer_.AddSession({0, "synthetic@test", "synthetic", "", "test"});
-    camera_ = writer_.AddCamera(session, {0, 0, "cam0", "", 640, 480});
-  }
-  // Stores one clip; fills bank_id for its sprites.
-  void Add(const ClipOfSprites& c, int batch,
-           const std::function<void(const std::vector<int64_t>&)>& stored = {}) {
-    ClipRecord clip;
-    clip.camera_id = camera_;
-    clip.track_id = c.clip;
-    clip.first_frame = next_frame_;
-    for (size_t begin = 0; begin < c.originals.size(); begin += batch) {
-      const size_t end = std::min(c.originals.size(), begin + batch);
-      std::vector<SpriteRecord> records;
-      std::vector<int64_t> synthetic_ids;
-      for (size_t k = begin; k < end; ++k) {
-        records.push_back(Record(*c.originals[k], next_frame_ + static_cast<int64_t>(k), false));
-        synthetic_ids.push_back(c.originals[k]->id);
-        records.push_back(Record(*c.mirrors[k], next_frame_ + static_cast<int64_t>(k), true));
-        synthetic_ids.push_back(c.mirrors[k]->id);
-      }
-      clip.complete = end == c.originals.size();
-      clip.last_frame = next_frame_ + static_cast<int64_t>(end) - 1;
-      const AppendResult r = writer_.AppendClipBatch(clip, records);
-      for (size_t k = 0; k < r.sprite_ids.size(); ++k) bank_id[synthetic_ids[k]] = r.sprite_ids[k];
-      if (stored) stored(r.sprite_ids);
-    }
-    next_frame_ += static_cast<int64_t>(c.originals.size()) + 10;  // a gap between clips
-  }
-  std::map<int64_t, int64_t> bank_id;  // synthetic id -> bank id
-
- private:
-  BankWriter writer_;
-  int64_t camera_ = 0;
-  int64_t next_frame_ = 100;
-};
 
 std::vector<TransitionRecord> Sorted(std::vector<TransitionRecord> t) {
   std::sort(t.begin(), t.end(), [](const auto& a, const auto& b) {
@@ -249,29 +148,6 @@ TEST(TransitionBank, EmptyBankOneClipAndMissingBank) {
       << missing.stats().last_error;
 }
 
-// A session folder whose truth/subjects.csv describes the synthetic sprites as stored by
-// BankFiller.
-void WriteTruth(const std::string& session_dir, const std::vector<SyntheticSprite>& sprites) {
-  std::filesystem::create_directories(std::filesystem::path(session_dir) / "truth");
-  std::ofstream out(std::filesystem::path(session_dir) / "truth" / "subjects.csv");
-  out.precision(17);
-  out << "frame,timestamp_ns,subject,kind,x,y,heading_rad,speed_mps,gait_phase,pose,touches_wall,"
-         "leaves_floor,"
-         "height_m\n";
-  int64_t frame = 100;
-  for (const auto& c : Clips(sprites)) {
-    for (const SyntheticSprite* s : c.originals) {
-      out << frame << ',' << frame * kFrameNs << ",0,animal," << 0.001 * frame << ",0.5,"
-          << s->truth.heading_rad << ',' << s->speed_mps << ',' << s->truth.gait_phase << ','
-          << s->truth.pose << ",0,0,0.1\n";
-      // A second subject far away must not be matched.
-      out << frame << ',' << frame * kFrameNs << ",1,animal,5,5,0,0,0.5,stand,0,0,0.1\n";
-      ++frame;
-    }
-    frame += 10;
-  }
-}
-
 TEST(TransitionBank, LabelsFromSessionTruth) {
   testing::ScratchDir dir;
   const auto sprites = Sprites(300, 6);
@@ -295,64 +171,6 @@ TEST(TransitionBank, LabelsFromSessionTruth) {
   }
   EXPECT_THROW(LabelBankFromTruth(dir / "nosession", dir / "bank.db", 200, TruthLabelOptions{}, 1),
                InputError);
-}
-
-TEST(TransitionBank, CommandLine) {
-  testing::ScratchDir dir;
-  const auto sprites = Sprites(300, 7);
-  BankFiller filler(dir / "bank.db");
-  for (const auto& c : Clips(sprites)) filler.Add(c, 40);
-  WriteTruth(dir / "session", sprites);
-  const std::string bank = dir / "bank.db";
-
-  // label -> train -> build with the trained weights.
-  auto r =
-      testing::RunSpritestation("transitions label --from-truth " + (dir / "session") + " --bank " +
-                                bank + " --out " + (dir / "labels.csv") + " --count 300");
-  ASSERT_EQ(r.exit_code, 0) << r.output;
-  r = testing::RunSpritestation("transitions train " + (dir / "labels.csv") + " --bank " + bank +
-                                " --out " + (dir / "w.json") + " --threads 1");
-  ASSERT_EQ(r.exit_code, 0) << r.output;
-  EXPECT_NE(r.output.find("stage 2 (all 6 features):   precision"), std::string::npos) << r.output;
-  // The labels carry the truth's positive rate, so stage 2 is set for it and stage 1 refitted.
-  double rate = 0;
-  ReadLabelsCsv(dir / "labels.csv", &rate);
-  EXPECT_GT(rate, 0.0);
-  EXPECT_LT(rate, 0.5);
-  EXPECT_NE(r.output.find("stage 2 then set for the positive rate"), std::string::npos) << r.output;
-  EXPECT_NE(r.output.find("stage 1 refitted as its filter"), std::string::npos) << r.output;
-  EXPECT_NO_THROW(LoadWeights(dir / "w.json"));
-  r = testing::RunSpritestation("transitions " + bank + " --weights " + (dir / "w.json") +
-                                " --json");
-  ASSERT_EQ(r.exit_code, 0) << r.output;
-  const auto j = nlohmann::json::parse(r.output.substr(r.output.find('{')));
-  EXPECT_EQ(j["sprites"], 600);
-  EXPECT_EQ(j["transitions"].get<int64_t>(),
-            static_cast<int64_t>(Bank(bank).LoadTransitions().size()));
-  r = testing::RunSpritestation("transitions " + bank);
-  ASSERT_EQ(r.exit_code, 0) << r.output;
-  EXPECT_NE(r.output.find("finding transitions"), std::string::npos)
-      << "progress lines: " << r.output;
-
-  // Clear messages: wrong weights file, empty bank, no bank, labels naming unknown sprites.
-  std::ofstream(dir / "bad.json")
-      << R"({"format": "spritestation-transition-weights", "version": 7})";
-  r = testing::RunSpritestation("transitions " + bank + " --weights " + (dir / "bad.json"));
-  EXPECT_EQ(r.exit_code, 2) << r.output;
-  EXPECT_NE(r.output.find("bad.json"), std::string::npos) << r.output;
-  EXPECT_NE(r.output.find("version"), std::string::npos) << r.output;
-  { BankWriter make(dir / "empty.db"); }
-  r = testing::RunSpritestation("transitions " + (dir / "empty.db"));
-  EXPECT_EQ(r.exit_code, 2) << r.output;
-  EXPECT_NE(r.output.find("no sprites"), std::string::npos) << r.output;
-  r = testing::RunSpritestation("transitions " + (dir / "none.db"));
-  EXPECT_EQ(r.exit_code, 2) << r.output;
-  EXPECT_NE(r.output.find("no such sprite bank"), std::string::npos) << r.output;
-  std::ofstream(dir / "unknown.csv") << "sprite_i,sprite_j,accept\n1,999999,1\n";
-  r = testing::RunSpritestation("transitions train " + (dir / "unknown.csv") + " --bank " + bank +
-                                " --out " + (dir / "w2.json"));
-  EXPECT_EQ(r.exit_code, 2) << r.output;
-  EXPECT_NE(r.output.find("999999"), std::string::npos) << r.output;
 }
 
 }  // namespace
