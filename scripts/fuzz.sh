@@ -9,8 +9,8 @@
 # exit 1 and its input in build-fuzz/findings/<target>/: add it to tests/fuzz/corpus/<target>/
 # once fixed, where the ordinary build's fuzz_corpus.<target> test replays it for good.
 #   scripts/fuzz.sh [SECONDS] [target...]      e.g. scripts/fuzz.sh 600 config spec
-# Naming targets fuzzes only them (no unit suites). The suites that run `spritestation` use the
-# ordinary build's (SPRITESTATION_BIN, default build/apps/spritestation, built when missing).
+# Naming targets fuzzes only them (no unit suites). No unit suite runs `spritestation` (those
+# tests are in tests/e2e/), so this build has no app.
 # SPRITESTATION_FUZZ_SEED=N fixes libFuzzer's seed (default: a new one each run), and
 # SPRITESTATION_FUZZ_FRESH=1 starts from the committed corpus alone: together they make a run
 # repeat the inputs of an earlier one (scripts/test.sh uses both, so CI replays what ran here).
@@ -41,8 +41,6 @@ cmake --build "$build" -j "$(nproc)"
 targets=("$@")
 if [ ${#targets[@]} -eq 0 ]; then
   # The unit suites, built here under ASan + UBSan (clang).
-  export SPRITESTATION_BIN="${SPRITESTATION_BIN:-$top/build/apps/spritestation}"
-  [ -x "$SPRITESTATION_BIN" ] || "$top/scripts/build.sh" >/dev/null
   # Leaks inside Debian's libraries, each explained in the file, are not reported.
   export LSAN_OPTIONS="suppressions=$top/tests/fuzz/lsan.supp:print_suppressions=0${LSAN_OPTIONS:+:$LSAN_OPTIONS}"
   log="$build/unit-tests.log"

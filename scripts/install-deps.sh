@@ -6,6 +6,8 @@ set -euo pipefail
 PACKAGES=(
   # toolchain
   build-essential cmake ninja-build pkgconf ccache git
+  # the style check (scripts/check-style.sh): Debian 12's clang-format and clang-tidy (14)
+  clang-format clang-tidy
   # vision and geometry
   libopencv-dev libopencv-contrib-dev libeigen3-dev
   libmrcal-dev mrcal

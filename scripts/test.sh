@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# The README's test command: installs what is missing, builds, runs the whole suite.
+# The README's test command: installs what is missing, builds, checks the style, runs the whole
+# suite.
 #   scripts/test.sh [ctest args...]     e.g. scripts/test.sh -L e2e (then: those tests alone)
 set -euo pipefail
 top="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -9,6 +10,8 @@ if [ $# -gt 0 ]; then
   (cd "$build" && ctest --output-on-failure --timeout 300 -j "$(nproc)" "$@")
   exit
 fi
+# clang-format on every file, clang-tidy on what changed since it last read all (the script says).
+"$top/scripts/check-style.sh" "$build"
 # The sanitizer build (scripts/fuzz.sh) runs every unit suite under ASan and UBSan, then fuzzes
 # every parser of outside input under libFuzzer for a bounded time (SPRITESTATION_FUZZ_SECONDS
 # each, default 20), from the committed corpus with a fixed seed: the inputs CI tries are the
