@@ -113,6 +113,8 @@ void AddSynthCommand(CLI::App& app) {
   cmd->add_option("--noise", o.noise, "Sensor noise scale (0: none, 1: typical)");
   cmd->add_flag("--motion-blur", o.motion_blur,
                 "Blur moving subjects over half the frame interval");
+  cmd->add_flag("--crossing", o.crossing,
+                "Animals ignore each other: their paths cross and their silhouettes meet in view");
   cmd->add_option("--figure-variant", o.figure_variant,
                   "Figure proportions: 0 reference, 1 the other figure");
   cmd->add_option("--threads", o.threads, "Cameras rendered in parallel");

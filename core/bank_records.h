@@ -47,6 +47,10 @@ struct SpritePixels {
   cv::Mat shadow;  // CV_8UC1; empty means no shadow (stored as zeros)
 };
 
+// The tag of a sprite whose blob held two or more subjects (the pipeline's MergeDetector,
+// docs/pipeline.md): stored with the sprite; transitions leave such sprites out by default.
+inline constexpr const char* kMergedTag = "merged";
+
 struct SpriteRecord {
   int64_t id = 0;            // assigned by the bank
   int64_t clip_id = 0;       // set by the bank from the batch's clip

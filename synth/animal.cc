@@ -351,10 +351,13 @@ void AnimalBehaviour::Choose() {
   look_target_ = rng.Uniform(-0.5, 0.5);
 }
 
-void AnimalBehaviour::Step(double dt_s, const std::vector<Eigen::Vector2d>& others) {
+void AnimalBehaviour::Step(double dt_s, const std::vector<Eigen::Vector2d>& others,
+                           const Eigen::Vector2d* seek) {
   // Sub-steps of at most 1/120 s keep the motion independent of the frame rate.
   const int n = std::max(1, static_cast<int>(std::ceil(dt_s * 120.0 - 1e-9)));
+  seek_ = seek;
   for (int i = 0; i < n; ++i) Integrate(dt_s / n, others);
+  seek_ = nullptr;
 }
 
 void AnimalBehaviour::Integrate(double dt, const std::vector<Eigen::Vector2d>& others) {
@@ -394,6 +397,13 @@ void AnimalBehaviour::Integrate(double dt, const std::vector<Eigen::Vector2d>& o
           const double bearing = Wrap(std::atan2(rel.y(), rel.x()) - s.heading_rad);
           if (std::abs(bearing) < M_PI / 2)
             turn_rate += (bearing > 0 ? -1.0 : 1.0) * 2.5 * (1.0 - d / (0.25 * k));
+        }
+      }
+      if (seek_) {  // --crossing: head for the other animal (and walk on through it)
+        const Eigen::Vector2d rel = *seek_ - s.position;
+        if (rel.norm() > 0.05 * k) {
+          const double bearing = Wrap(std::atan2(rel.y(), rel.x()) - s.heading_rad);
+          turn_rate += std::clamp(2.0 * bearing, -2.0, 2.0);
         }
       }
       turn_rate = std::clamp(turn_rate, -4.0, 4.0);

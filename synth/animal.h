@@ -62,8 +62,10 @@ class AnimalBehaviour {
   AnimalBehaviour(const Studio& studio, const AnimalLook& look, uint64_t seed,
                   const Eigen::Vector2d& start, double heading_rad,
                   std::vector<Eigen::Vector3d> cameras);
-  // Advances by dt seconds; `others` are the other animals' roots (kept apart).
-  void Step(double dt_s, const std::vector<Eigen::Vector2d>& others);
+  // Advances by dt seconds; `others` are the other animals' roots (kept apart). `seek`: while
+  // walking, steer toward this point too (another animal, `--crossing`: their paths cross).
+  void Step(double dt_s, const std::vector<Eigen::Vector2d>& others,
+            const Eigen::Vector2d* seek = nullptr);
   const AnimalState& state() const { return state_; }
   const AnimalLook& look() const { return look_; }
 
@@ -89,6 +91,7 @@ class AnimalBehaviour {
   double stage_s_ = 0.0;      // time in the current sub-stage (lean/stand hold)
   int stage_ = 0;             // sub-stage: 0 approach/turn, 1 up, 2 hold, 3 down
   double look_target_ = 0.0;  // head yaw target
+  const Eigen::Vector2d* seek_ = nullptr;  // during Step only
 };
 
 }  // namespace ss::synth

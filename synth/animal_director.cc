@@ -104,10 +104,13 @@ class AnimalDirector : public Director {
     for (const auto& a : animals_) roots.push_back(a.state().position);
     for (size_t i = 0; i < animals_.size(); ++i) {
       std::vector<Eigen::Vector2d> others;
-      for (size_t j = 0; j < roots.size(); ++j) {
+      for (size_t j = 0; j < roots.size() && !options_.crossing; ++j) {
         if (j != i) others.push_back(roots[j]);
       }
-      animals_[i].Step(dt, others);
+      // --crossing: each heads for the next animal instead of keeping apart.
+      const Eigen::Vector2d* seek =
+          options_.crossing && roots.size() > 1 ? &roots[(i + 1) % roots.size()] : nullptr;
+      animals_[i].Step(dt, others, seek);
     }
     now_ = t;
   }

@@ -17,6 +17,7 @@ struct DirectorOptions {
   double fps = 30.0;
   bool motion_blur = false;  // 4 time slices spread over half a frame interval
   int figure_variant = 0;
+  bool crossing = false;  // animals ignore each other: their paths cross, they pass through
 };
 
 // `subjects` animals with their behaviour models, placed apart on the floor.

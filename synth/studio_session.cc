@@ -128,12 +128,40 @@ LowestPoint SilhouetteLowest(const SynthCamera& cam, const std::vector<Primitive
   return best;
 }
 
+// Pixels of subject b's silhouette (alpha > 0) on or next to (8-neighbours) subject a's: > 0 when
+// the two silhouettes overlap or touch in the image, so that a keyer sees one blob where a
+// perfect one would (docs/synth.md, overlaps.csv).
+int SilhouettesShared(const MatteLayer& a, const MatteLayer& b) {
+  if (a.box.empty() || b.box.empty()) return 0;
+  const cv::Rect grown(a.box.x - 1, a.box.y - 1, a.box.width + 2, a.box.height + 2);
+  const cv::Rect both = grown & b.box;
+  if (both.empty()) return 0;
+  int shared = 0;
+  for (int y = both.y; y < both.y + both.height; ++y) {
+    for (int x = both.x; x < both.x + both.width; ++x) {
+      if (b.values.at<uint8_t>(y - b.box.y, x - b.box.x) == 0) continue;
+      bool near = false;
+      for (int dy = -1; dy <= 1 && !near; ++dy) {
+        const int ay = y + dy - a.box.y;
+        if (ay < 0 || ay >= a.box.height) continue;
+        for (int dx = -1; dx <= 1 && !near; ++dx) {
+          const int ax = x + dx - a.box.x;
+          near = ax >= 0 && ax < a.box.width && a.values.at<uint8_t>(ay, ax) > 0;
+        }
+      }
+      shared += near ? 1 : 0;
+    }
+  }
+  return shared;
+}
+
 struct CameraWork {
   const SynthCamera* camera = nullptr;
   std::unique_ptr<CameraRenderer> renderer;
   std::unique_ptr<Sensor> sensor;
   std::unique_ptr<CsvFile> views;
-  std::unique_ptr<CsvFile> joints;   // figures
+  std::unique_ptr<CsvFile> overlaps;  // several subjects: per pair, whether the silhouettes touch
+  std::unique_ptr<CsvFile> joints;    // figures
   std::unique_ptr<CsvFile> corners;  // calibration
   fs::path truth_dir;
   double render_s = 0, sensor_s = 0, encode_s = 0, truth_s = 0;
@@ -207,6 +235,7 @@ SynthSummary RenderStudioSession(const SynthOptions& o) {
       MakeCameras(studio, o.cameras, o.width, o.height, o.seed);
   DirectorOptions dopt;
   dopt.subjects = o.subjects;
+  dopt.crossing = o.crossing;
   dopt.seed = o.seed;
   dopt.fps = o.fps;
   dopt.motion_blur = o.motion_blur;
@@ -272,6 +301,10 @@ SynthSummary RenderStudioSession(const SynthOptions& o) {
                                         "box_h,lowest_x,lowest_y,lowest_gx,lowest_gy,"
                                         "lowest_gz,lowest_ray_gx,lowest_ray_gy,root_x,root_y,"
                                         "contact_x,contact_y,contact_ray_gx,contact_ray_gy");
+    if (subjects > 1) {
+      w.overlaps = std::make_unique<CsvFile>((w.truth_dir / "overlaps.csv").string(),
+                                             "frame,subject_a,subject_b,touching,shared_px");
+    }
     if (!joint_names.empty()) {
       w.joints = std::make_unique<CsvFile>((w.truth_dir / "joints.csv").string(),
                                            "frame,subject,joint,name,x,y");
@@ -420,6 +453,15 @@ SynthSummary RenderStudioSession(const SynthOptions& o) {
           }
         }
       }
+      if (w.overlaps) {
+        for (int a = 0; a < subjects; ++a) {
+          for (int b = a + 1; b < subjects; ++b) {
+            const int shared = SilhouettesShared(w.image.alpha[static_cast<size_t>(a)],
+                                                 w.image.alpha[static_cast<size_t>(b)]);
+            w.overlaps->Row("%d,%d,%d,%d,%d", frame, a, b, shared > 0 ? 1 : 0, shared);
+          }
+        }
+      }
       if (w.corners) {
         const Eigen::Vector3d eye = cam.CentreInGround();
         for (const BoardTruth& bt : snap.boards) {
@@ -517,6 +559,7 @@ SynthSummary RenderStudioSession(const SynthOptions& o) {
   if (boards_csv) boards_csv->Close();
   for (auto& w : work) {
     w.views->Close();
+    if (w.overlaps) w.overlaps->Close();
     if (w.joints) w.joints->Close();
     if (w.corners) w.corners->Close();
     summary.render_s += w.render_s;
@@ -537,6 +580,7 @@ SynthSummary RenderStudioSession(const SynthOptions& o) {
   t["pixel_format"] = PixelFormatName(o.pixel_format);
   t["noise"] = o.noise;
   t["motion_blur"] = o.motion_blur;
+  t["crossing"] = o.crossing;
   t["timestamp_ns"] = "round(frame * 1e9 / fps), the same on every camera";
   t["floor"] = floor_json;
   t["cameras"] = json::array();
@@ -551,6 +595,7 @@ SynthSummary RenderStudioSession(const SynthOptions& o) {
   if (!joint_names.empty()) t["joint_names"] = joint_names;
   t["files"] = {{"subjects", "subjects.csv"},
                 {"views", "<camera>/views.csv"},
+                {"overlaps", subjects > 1 ? "<camera>/overlaps.csv" : ""},
                 {"alpha", o.write_mattes ? "<camera>/alpha_s<subject>/<frame:06d>.png" : ""},
                 {"shadow", o.write_mattes ? "<camera>/shadow/<frame:06d>.png" : ""}};
   if (!board_specs.empty()) {

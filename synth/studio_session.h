@@ -7,6 +7,7 @@
 //   truth/<cam>.cameramodel          the true camera models
 //   truth/subjects.csv               per frame and subject: position, heading, speed, gait, pose,
 //   ... truth/<cam>/views.csv            per frame, camera and subject: coverage, box, lowest point
+//   truth/<cam>/overlaps.csv         (several subjects) per frame and pair: silhouettes touching
 //   truth/<cam>/alpha_s<K>/<F>.png   per frame: subject K's alpha matte (8-bit, lossless)
 //   truth/<cam>/shadow/<F>.png       per frame: the contact-shadow matte (255 = black)
 //   (figure) truth/joints.csv, truth/<cam>/joints.csv; (calibration) truth/boards.json,
@@ -43,6 +44,10 @@ struct SynthOptions {
   // Subjects stay out of view for this long at the start (truth pose "absent"),
   // as a studio records the empty enclosure first for the keyer to learn.
   double empty_lead_in_s = 0.0;
+  // Animals ignore each other (they no longer keep apart): their paths cross and their
+  // silhouettes meet in the cameras' images (truth/<cam>/overlaps.csv), as two subjects in one
+  // blob. They pass through each other where they meet.
+  bool crossing = false;
 
   // False with the reason when an option is out of range.
   bool IsValid(std::string* why) const;

@@ -118,6 +118,7 @@ void CameraPipeline::Process(const Frame& frame, std::vector<ClipBatch>* out) {
   if (last_sequence_ && frame.sequence != *last_sequence_ + 1) {
     ++stats_.sequence_gaps;
     for (const int64_t clip : cutter_.CloseAll()) batcher_.Close(clip, out);
+    merges_.Reset();
   }
   last_sequence_ = frame.sequence;
 
@@ -152,6 +153,13 @@ void CameraPipeline::Process(const Frame& frame, std::vector<ClipBatch>* out) {
     inputs.push_back({points.back(), c.area});
   }
   const std::vector<int> subjects = tracker_.Update(frame.timestamp_ns, inputs);
+  // Two or more subjects in one blob (MergeDetector's rule, docs/pipeline.md "merged"): their
+  // sprites are stored tagged `merged`.
+  std::vector<MergeDetector::Blob> blobs(subjects.size());
+  for (size_t k = 0; k < subjects.size(); ++k) {
+    blobs[k] = {subjects[k], grounded[k]->bbox, grounded[k]->area};
+  }
+  const std::vector<bool> merged = merges_.Update(blobs);
 
   // Filter and rectify.
   noise_.NextFrame();
@@ -197,16 +205,17 @@ void CameraPipeline::Process(const Frame& frame, std::vector<ClipBatch>* out) {
       }
     }
     usable[k] = reason == Discard::kNone;
-    verdicts_.push_back({&c, subjects[k], points[k], reason});
+    verdicts_.push_back({&c, subjects[k], points[k], reason, merged[k]});
     if (usable[k]) {
       ++usable_total_;
     } else {
       ++stats_.discards[static_cast<size_t>(reason)];
     }
     if (log_->should_log(spdlog::level::trace)) {
-      log_->trace("{} frame {} subject {} at ({:.4f}, {:.4f}) box {}x{}+{}+{}: {}", name_,
-                  frame.sequence, subjects[k], points[k].x(), points[k].y(), c.bbox.width,
-                  c.bbox.height, c.bbox.x, c.bbox.y, DiscardName(reason));
+      log_->trace("{} frame {} subject {} at ({:.4f}, {:.4f}) box {}x{}+{}+{} area {:.0f}: {}{}",
+                  name_, frame.sequence, subjects[k], points[k].x(), points[k].y(), c.bbox.width,
+                  c.bbox.height, c.bbox.x, c.bbox.y, c.area, DiscardName(reason),
+                  merged[k] ? " (merged)" : "");
     }
   }
 
@@ -225,6 +234,7 @@ void CameraPipeline::Process(const Frame& frame, std::vector<ClipBatch>* out) {
     s.bbox_in_image = grounded[k]->bbox;
     s.billboard = std::move(*billboards[k]);
     s.description = DescribeBillboard(s.billboard.bgra);
+    s.merged = merged[k];
     batcher_.Add(e.clip, e.subject, std::move(s), out);
   }
   UpdateClipStats();
@@ -248,6 +258,7 @@ void CameraPipeline::UpdateClipStats() {
   stats_.discards[static_cast<size_t>(Discard::kShortClip)] = short_sprites;
   stats_.discards[static_cast<size_t>(Discard::kNone)] = usable_total_ - short_sprites;
   stats_.stored_sprites = batcher_.stored_originals();
+  stats_.merged_sprites = batcher_.stored_merged_originals();
   stats_.clips = batcher_.clips_completed();
 }
 

@@ -44,6 +44,9 @@ SpriteRecord OriginalRecord(const MadeSprite& s, const Eigen::Vector2d& velocity
   r.anchor_y_px = s.billboard.anchor_px.y();
   r.pixels.bgra = s.billboard.bgra;
   r.pixels.shadow = FitShadow(s.billboard.shadow, s.billboard.bgra.size());
+  // In the sprite's own row batch: the bank stores the tag in the transaction that stores the
+  // sprite, so no sprite is ever stored without its mark (the mirror copies the original's tags).
+  if (s.merged) r.tags.push_back(kMergedTag);
   return r;
 }
 
@@ -123,6 +126,7 @@ void ClipBatcher::Emit(Open& open, size_t count, bool complete, std::vector<Clip
   batch.sprites.reserve(count * (options_.mirrors ? 2 : 1));
   for (size_t k = 0; k < count; ++k) {
     const MadeSprite& s = open.pending[k];
+    stored_merged_originals_ += s.merged ? 1 : 0;
     // Only the emitted frames' velocities: each needs its own +-window, not the whole clip.
     SpriteRecord original = OriginalRecord(
         s, EstimateVelocity(open.timestamps_ns, open.points, static_cast<int>(first_index + k),

@@ -33,6 +33,7 @@ struct MadeSprite {
   cv::Rect bbox_in_image;
   Billboard billboard;
   SpriteDescription description;
+  bool merged = false;  // two or more subjects in one blob: stored with the tag kMergedTag
 };
 
 // One bank transaction: sprites of one clip, originals each followed by its mirror.
@@ -60,6 +61,9 @@ class ClipBatcher {
   uint64_t stored_originals() const {
     return stored_originals_;
   }  // originals handed out in batches
+  uint64_t stored_merged_originals() const {
+    return stored_merged_originals_;
+  }  // of them, tagged kMergedTag
   uint64_t clips_completed() const { return clips_completed_; }
   size_t open_clips() const { return clips_.size(); }
 
@@ -80,6 +84,7 @@ class ClipBatcher {
   std::map<int64_t, Open> clips_;
   uint64_t short_clip_sprites_ = 0;
   uint64_t stored_originals_ = 0;
+  uint64_t stored_merged_originals_ = 0;
   uint64_t clips_completed_ = 0;
 };
 

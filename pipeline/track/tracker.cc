@@ -44,6 +44,96 @@ std::vector<int> Tracker::Update(int64_t timestamp_ns, const std::vector<TrackIn
   return ids;
 }
 
+namespace {
+
+double AreaOf(const cv::Rect& r) { return static_cast<double>(r.width) * r.height; }
+
+// The share of `inner`'s area inside `outer`.
+double ShareInside(const cv::Rect& inner, const cv::Rect& outer) {
+  const double a = AreaOf(inner);
+  return a > 0 ? AreaOf(inner & outer) / a : 0.0;
+}
+
+}  // namespace
+
+std::vector<bool> MergeDetector::Update(const std::vector<Blob>& blobs) {
+  constexpr int kMaxSubjects = 8;
+  // What each blob got from the tracks of the frame before.
+  struct Share {
+    int subjects;
+    int frames;  // the giving track's frames in a row (counted on in this blob)
+    double merged_area;
+    bool swallowed;  // a lost track, not the blob's own
+  };
+  std::vector<std::vector<Share>> shares(blobs.size());
+  // Blobs whose track was not seen in the frame before: new subjects, or ones found again.
+  std::vector<bool> fresh(blobs.size(), true);
+  for (size_t i = 0; i < blobs.size(); ++i) {
+    for (const Seen& p : previous_) fresh[i] = fresh[i] && p.track != blobs[i].track;
+  }
+  for (const Seen& p : previous_) {
+    // This frame's blobs that came out of p: its own (the tracker's) and new ones in its box.
+    std::vector<size_t> children;
+    for (size_t i = 0; i < blobs.size(); ++i) {
+      if (blobs[i].track == p.track ||
+          (fresh[i] && ShareInside(blobs[i].box, p.box) >= options_.split_share)) {
+        children.push_back(i);
+      }
+    }
+    if (children.size() >= 2) {  // a split: one subject each, unless a piece kept most of it
+      for (size_t i : children) {
+        const bool keeps = p.subjects >= 2 && blobs[i].area >= options_.keep_area_share * p.area;
+        // The pieces of a merged blob are subjects: they may merge again at once.
+        const int frames = p.subjects >= 2 ? std::max(p.frames, options_.min_track_frames) : 1;
+        shares[i].push_back({keeps ? p.subjects : 1, frames, keeps ? p.merged_area : 0, false});
+      }
+      continue;
+    }
+    if (children.size() == 1) {
+      shares[children.front()].push_back({p.subjects, p.frames + 1, p.merged_area, false});
+      continue;
+    }
+    // No blob of its own: swallowed by the blob whose box holds most of its box, if any does.
+    size_t best = blobs.size();
+    double best_share = options_.absorb_share;
+    for (size_t i = 0; i < blobs.size(); ++i) {
+      const double share = ShareInside(p.box, blobs[i].box);
+      if (share >= best_share) {
+        best = i;
+        best_share = share;
+      }
+    }
+    if (best < blobs.size()) shares[best].push_back({p.subjects, p.frames + 1, p.merged_area, true});
+  }
+  std::vector<bool> merged(blobs.size(), false);
+  std::vector<Seen> seen;
+  seen.reserve(blobs.size());
+  for (size_t i = 0; i < blobs.size(); ++i) {
+    // A lost track swallowed by a blob that has its own track (or other tracks) counts when it
+    // had been seen long enough; a blob made only of one lost track is its continuation.
+    int n = 0, frames = 1;
+    double at_merge = 0;
+    const bool several = shares[i].size() >= 2;
+    for (const Share& sh : shares[i]) {
+      if (several && sh.swallowed && sh.frames - 1 < options_.min_track_frames) continue;
+      n += sh.subjects;
+      frames = std::max(frames, sh.frames);
+      at_merge = std::max(at_merge, sh.merged_area);
+    }
+    n = std::clamp(n, 1, kMaxSubjects);
+    if (n >= 2 && at_merge <= 0) at_merge = blobs[i].area;  // it merged in this frame
+    if (n >= 2 && blobs[i].area < options_.drop_area_share * at_merge) n = 1;
+    if (n < 2) at_merge = 0;
+    merged[i] = n >= 2;
+    if (blobs[i].track >= 0) {
+      seen.push_back(
+          {blobs[i].track, blobs[i].box, n, at_merge, std::min(frames, 1000), blobs[i].area});
+    }
+  }
+  previous_ = std::move(seen);
+  return merged;
+}
+
 std::vector<ClipCutter::Event> ClipCutter::Update(const std::vector<int>& subjects,
                                                   const std::vector<bool>& usable) {
   std::vector<Event> events;

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include <Eigen/Core>
+#include <opencv2/core.hpp>
 
 namespace ss {
 
@@ -39,6 +40,59 @@ class Tracker {
   TrackerOptions options_;
   std::vector<Subject> subjects_;
   int next_id_ = 0;
+};
+
+// Which blobs hold two or more subjects (issue 19: "two subjects merged into one blob are
+// marked"), from the tracker's evidence frame to frame, not from the blob's looks. Each blob
+// carries a count of the subjects in it, handed on from the tracks of the frame before:
+//   - a track seen in the frame before hands its count to the blob the tracker gave it, unless
+//     it split (below);
+//   - a track of the frame before that got no blob this frame, whose box lies mostly
+//     (>= absorb_share of its area) inside one blob's box, was swallowed by that blob: it adds its
+//     count to that blob (two tracks meeting in one blob: a merge) when it had been seen for at
+//     least min_track_frames frames in a row (a piece of a subject keyed apart for a frame or
+//     two and joined again is no second subject);
+//   - a track of the frame before whose box holds (>= split_share of their area) two or more
+//     blobs of this frame, its own and ones whose track was not seen in the frame before (new or
+//     found again), split: each of them counts one subject, but a
+//     piece keeping most of a merged blob's area (>= keep_area_share) keeps its count (the other
+//     piece was a part keyed apart); the pieces of a merged blob count as seen long enough, so
+//     that they merge again at once;
+//   - a blob without a track of the frame before counts one subject.
+// A blob counting two or more is `merged`. A merged blob whose area falls under
+// drop_area_share of its area when it merged counts one again (the partner left unseen).
+class MergeDetector {
+ public:
+  struct Options {
+    double absorb_share = 0.5;     // of a lost track's box inside the blob's box
+    double split_share = 0.5;      // of a new blob's box inside its parent's box
+    double drop_area_share = 0.5;   // of the area at the merge
+    int min_track_frames = 3;       // frames a swallowed track must have been seen in a row
+    double keep_area_share = 0.75;  // of a merged blob's area, for a piece to keep its count
+  };
+  struct Blob {
+    int track = -1;   // the tracker's subject id
+    cv::Rect box;     // in the image
+    double area = 0;    // matte area, pixels
+  };
+  MergeDetector() = default;
+  explicit MergeDetector(Options options) : options_(options) {}
+  // One frame's blobs (every tracked candidate); true for each that holds two or more subjects.
+  std::vector<bool> Update(const std::vector<Blob>& blobs);
+  // After a frame was lost: nothing carries over.
+  void Reset() { previous_.clear(); }
+
+ private:
+  struct Seen {
+    int track;
+    cv::Rect box;
+    int subjects;        // how many the blob held
+    double merged_area;  // its area when it became merged (subjects >= 2)
+    int frames;          // frames in a row the track was seen
+    double area;
+  };
+  Options options_;
+  std::vector<Seen> previous_;
 };
 
 // Cuts each subject's frames into clips: runs of consecutive usable frames.

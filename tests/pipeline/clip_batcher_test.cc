@@ -25,6 +25,28 @@ MadeSprite Walking(int64_t f) {
   return s;
 }
 
+// A merged sprite (two subjects in one blob) is stored tagged `merged`, its mirror too, in the
+// same batch as the sprite itself; the others carry no tag.
+TEST(ClipBatcher, MergedSpritesCarryTheTagInTheirOwnBatch) {
+  ClipBatcher batcher(7, {.min_clip_frames = 2, .batch_frames = 100});
+  std::vector<ClipBatch> out;
+  for (int f = 0; f < 6; ++f) {
+    MadeSprite s = Walking(f);
+    s.merged = f >= 2 && f < 4;
+    batcher.Add(1, 3, std::move(s), &out);
+  }
+  batcher.Close(1, &out);
+  ASSERT_EQ(out.size(), 1u);
+  ASSERT_EQ(out[0].sprites.size(), 12u);
+  for (const SpriteRecord& r : out[0].sprites) {
+    const bool merged = r.frame >= 2 && r.frame < 4;
+    EXPECT_EQ(r.tags, merged ? std::vector<std::string>{kMergedTag} : std::vector<std::string>{})
+        << "frame " << r.frame << (r.mirrored ? " mirror" : "");
+  }
+  EXPECT_EQ(batcher.stored_originals(), 6u);
+  EXPECT_EQ(batcher.stored_merged_originals(), 2u);
+}
+
 TEST(ClipBatcher, ShortClipsAreDroppedAndCounted) {
   ClipBatcher batcher(7, {.min_clip_frames = 5, .batch_frames = 3});
   std::vector<ClipBatch> out;

@@ -42,6 +42,52 @@ TEST(Tracker, SubjectsUnseenForTooLongAreForgotten) {
   EXPECT_EQ(tracker.live_subjects(), 0);
 }
 
+using Blob = MergeDetector::Blob;
+
+// Two subjects seen apart, then in one blob (the tracker keeps one id, loses the other), then
+// apart again: the blob is merged from the frame they meet to the frame they split.
+TEST(MergeDetector, TwoTracksInOneBlobAreMergedUntilTheySplit) {
+  MergeDetector d;
+  const cv::Rect a(100, 100, 30, 40), b(150, 100, 30, 40), both(100, 100, 80, 40);
+  for (int f = 0; f < 5; ++f)
+    EXPECT_EQ(d.Update({{0, a, 1000}, {1, b, 1000}}), std::vector<bool>({false, false}));
+  for (int f = 0; f < 10; ++f) EXPECT_EQ(d.Update({{0, both, 2000}}), std::vector<bool>({true}));
+  // The tracker gives the blob a new id (its contact point jumped): still both subjects.
+  EXPECT_EQ(d.Update({{2, both, 1900}}), std::vector<bool>({true}));
+  // Apart: the blob's own track and one found again (or new) inside its box.
+  EXPECT_EQ(d.Update({{2, a, 1000}, {1, b, 1000}}), std::vector<bool>({false, false}));
+  EXPECT_EQ(d.Update({{2, a, 1000}, {1, b, 1000}}), std::vector<bool>({false, false}));
+  // And together again at once: the pieces of a merged blob are subjects.
+  EXPECT_EQ(d.Update({{2, both, 2000}}), std::vector<bool>({true}));
+}
+
+// A piece of one subject keyed apart for a frame and joined again is no second subject.
+TEST(MergeDetector, APieceOfOneSubjectIsNoSecondSubject) {
+  MergeDetector d;
+  const cv::Rect body(100, 100, 60, 40), head(100, 100, 20, 20), rest(125, 100, 35, 40);
+  for (int f = 0; f < 5; ++f) EXPECT_EQ(d.Update({{0, body, 1500}}), std::vector<bool>({false}));
+  EXPECT_EQ(d.Update({{0, rest, 1100}, {1, head, 400}}), std::vector<bool>({false, false}));
+  for (int f = 0; f < 5; ++f) EXPECT_EQ(d.Update({{0, body, 1500}}), std::vector<bool>({false}));
+}
+
+// A merged blob that shrinks to less than half its area at the merge holds one subject again
+// (the other left unseen, e.g. behind a wall); a lost frame forgets everything.
+TEST(MergeDetector, AMergedBlobThatShrinksToOneSubjectIsNoLongerMerged) {
+  MergeDetector d;
+  const cv::Rect a(100, 100, 30, 40), b(140, 100, 30, 40), both(100, 100, 70, 40);
+  for (int f = 0; f < 5; ++f) d.Update({{0, a, 1000}, {1, b, 1000}});
+  EXPECT_EQ(d.Update({{0, both, 2000}}), std::vector<bool>({true}));
+  EXPECT_EQ(d.Update({{0, both, 1200}}), std::vector<bool>({true}));
+  EXPECT_EQ(d.Update({{0, a, 950}}), std::vector<bool>({false}));
+  EXPECT_EQ(d.Update({{0, a, 1000}}), std::vector<bool>({false}));
+  d.Update({{0, a, 1000}, {1, b, 1000}});
+  d.Update({{0, a, 1000}, {1, b, 1000}});
+  d.Update({{0, a, 1000}, {1, b, 1000}});
+  EXPECT_EQ(d.Update({{0, both, 2000}}), std::vector<bool>({true}));
+  d.Reset();
+  EXPECT_EQ(d.Update({{0, both, 2000}}), std::vector<bool>({false}));
+}
+
 TEST(ClipCutter, ClipsAreRunsOfConsecutiveUsableFrames) {
   ClipCutter cutter;
   // Subject 7: usable, usable, unusable, usable, then unseen.

@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "capture/replay/replay_source.h"
 #include "core/camera_model.h"
@@ -268,6 +269,45 @@ TEST(SynthSession, ReplaysLikeARecordingInItsPixelFormat) {
   const auto truth = nlohmann::json::parse(ReadFile(fs::path(o.out_dir) / "truth" / "truth.json"));
   EXPECT_EQ(truth["subjects"].size(), 2u);
   EXPECT_EQ(truth["frames"], 10);
+}
+
+// overlaps.csv (two subjects): one row per frame and pair, and `touching` is exactly whether the
+// two true mattes overlap or are 8-neighbours somewhere.
+TEST(SynthSession, OverlapsSayWhereTwoSilhouettesTouch) {
+  ScratchDir dir;
+  SynthOptions o = Small(dir / "s", 11);
+  o.seconds = 3.0;
+  o.cameras = 1;
+  o.subjects = 2;
+  RenderStudioSession(o);
+  const fs::path truth = fs::path(o.out_dir) / "truth";
+  const auto cams = nlohmann::json::parse(ReadFile(truth / "truth.json"))["cameras"];
+  ASSERT_EQ(cams.size(), 1u);
+  const std::string cam = cams[0]["name"];
+  const auto rows = ReadCsv((truth / cam / "overlaps.csv").string());
+  ASSERT_EQ(rows.size(), 30u);  // 30 frames x 1 pair
+  for (const auto& r : rows) {
+    const int frame = std::stoi(r.at("frame"));
+    ASSERT_EQ(r.at("subject_a"), "0");
+    ASSERT_EQ(r.at("subject_b"), "1");
+    const cv::Mat a = cv::imread((truth / cam / "alpha_s0" / Png(frame)).string(),
+                                 cv::IMREAD_UNCHANGED);
+    const cv::Mat b = cv::imread((truth / cam / "alpha_s1" / Png(frame)).string(),
+                                 cv::IMREAD_UNCHANGED);
+    ASSERT_FALSE(a.empty());
+    ASSERT_FALSE(b.empty());
+    cv::Mat a_near;
+    cv::dilate(a > 0, a_near, cv::Mat::ones(3, 3, CV_8U));
+    const int shared = cv::countNonZero(a_near & (b > 0));
+    EXPECT_EQ(std::stoi(r.at("shared_px")), shared) << "frame " << frame;
+    EXPECT_EQ(r.at("touching"), shared > 0 ? "1" : "0") << "frame " << frame;
+  }
+  // One subject: no overlaps.csv.
+  SynthOptions one = Small(dir / "one", 11);
+  one.seconds = 0.5;
+  one.cameras = 1;
+  RenderStudioSession(one);
+  EXPECT_FALSE(fs::exists(fs::path(one.out_dir) / "truth" / cam / "overlaps.csv"));
 }
 
 }  // namespace
