@@ -64,8 +64,8 @@ class Tracker {
 class MergeDetector {
  public:
   struct Options {
-    double absorb_share = 0.5;     // of a lost track's box inside the blob's box
-    double split_share = 0.5;      // of a new blob's box inside its parent's box
+    double absorb_share = 0.5;      // of a lost track's box inside the blob's box
+    double split_share = 0.5;       // of a new blob's box inside its parent's box
     double drop_area_share = 0.5;   // of the area at the merge
     int min_track_frames = 3;       // frames a swallowed track must have been seen in a row
     double keep_area_share = 0.75;  // of a merged blob's area, for a piece to keep its count
@@ -73,7 +73,7 @@ class MergeDetector {
   struct Blob {
     int track = -1;   // the tracker's subject id
     cv::Rect box;     // in the image
-    double area = 0;    // matte area, pixels
+    double area = 0;  // matte area, pixels
   };
   MergeDetector() = default;
   explicit MergeDetector(Options options) : options_(options) {}
