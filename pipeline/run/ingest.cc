@@ -192,7 +192,9 @@ IngestSummary IngestSession(const IngestOptions& options) {
   // writer thread only queues each batch's ids with it.
   std::unique_ptr<TransitionWorker> transitions;
   if (options.transitions)
-    transitions = std::make_unique<TransitionWorker>(options.bank_path, transition_weights, 1);
+    transitions = std::make_unique<TransitionWorker>(
+        options.bank_path, transition_weights, 1,
+        SpriteChoice{.include_merged = config.transitions.include_merged});
 
   std::atomic<uint64_t> frames_done{0}, rows_inserted{0}, batch_count{0}, stored{0};
   std::thread writer([&] {
