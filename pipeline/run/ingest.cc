@@ -298,6 +298,7 @@ IngestSummary IngestSession(const IngestOptions& options) {
         {w.name, w.camera_id, s, c < replay_stats.size() ? replay_stats[c] : ReplayCameraStats{}});
     summary.frames += s.frames;
     summary.sprites_kept += s.stored_sprites;
+    summary.sprites_merged += s.merged_sprites;
     for (size_t r = 0; r < summary.discards.size(); ++r) summary.discards[r] += s.discards[r];
   }
   summary.rows_inserted = rows_inserted;
