@@ -87,10 +87,10 @@ class AnimalBehaviour {
   double activity_left_s_ = 0.0;  // time left in the activity
   double target_speed_ = 0.0;
   double target_heading_ = 0.0;
-  double steer_ = 0.0;        // rad/s of the wander
-  double stage_s_ = 0.0;      // time in the current sub-stage (lean/stand hold)
-  int stage_ = 0;             // sub-stage: 0 approach/turn, 1 up, 2 hold, 3 down
-  double look_target_ = 0.0;  // head yaw target
+  double steer_ = 0.0;                     // rad/s of the wander
+  double stage_s_ = 0.0;                   // time in the current sub-stage (lean/stand hold)
+  int stage_ = 0;                          // sub-stage: 0 approach/turn, 1 up, 2 hold, 3 down
+  double look_target_ = 0.0;               // head yaw target
   const Eigen::Vector2d* seek_ = nullptr;  // during Step only
 };
 

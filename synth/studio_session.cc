@@ -162,7 +162,7 @@ struct CameraWork {
   std::unique_ptr<CsvFile> views;
   std::unique_ptr<CsvFile> overlaps;  // several subjects: per pair, whether the silhouettes touch
   std::unique_ptr<CsvFile> joints;    // figures
-  std::unique_ptr<CsvFile> corners;  // calibration
+  std::unique_ptr<CsvFile> corners;   // calibration
   fs::path truth_dir;
   double render_s = 0, sensor_s = 0, encode_s = 0, truth_s = 0;
   CameraImage image;

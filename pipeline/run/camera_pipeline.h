@@ -54,9 +54,9 @@ struct CameraPipelineStats {
   uint64_t sequence_gaps = 0;    // breaks in the sequence numbers (drops): open clips end there
   DiscardCounts
       discards{};  // by reason; [kNone] counts usable sprites (in clips long enough so far)
-  uint64_t stored_sprites = 0;               // originals handed to the bank (mirrors not counted)
+  uint64_t stored_sprites = 0;  // originals handed to the bank (mirrors not counted)
   uint64_t merged_sprites = 0;  // of them, tagged `merged`: two or more subjects in one blob
-  uint64_t clips = 0;                        // complete clips handed to the bank
+  uint64_t clips = 0;           // complete clips handed to the bank
   double seconds_key = 0, seconds_rest = 0;  // thread time in keying+extracting, in the rest
 };
 
@@ -66,7 +66,7 @@ struct CandidateVerdict {
   int track = -1;  // the tracker's subject id; -1 when its ray missed the floor
   std::optional<Eigen::Vector2d> ground;  // contact point on the floor, metres
   Discard reason = Discard::kNone;        // kNone: usable (it joins a clip)
-  bool merged = false;  // the blob holds two or more subjects (MergeDetector)
+  bool merged = false;                    // the blob holds two or more subjects (MergeDetector)
 };
 
 class CameraPipeline {

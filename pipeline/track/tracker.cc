@@ -103,7 +103,8 @@ std::vector<bool> MergeDetector::Update(const std::vector<Blob>& blobs) {
         best_share = share;
       }
     }
-    if (best < blobs.size()) shares[best].push_back({p.subjects, p.frames + 1, p.merged_area, true});
+    if (best < blobs.size())
+      shares[best].push_back({p.subjects, p.frames + 1, p.merged_area, true});
   }
   std::vector<bool> merged(blobs.size(), false);
   std::vector<Seen> seen;

@@ -51,21 +51,22 @@ class Tracker {
 //     (>= absorb_share of its area) inside one blob's box, was swallowed by that blob: it adds its
 //     count to that blob (two tracks meeting in one blob: a merge) when it had been seen for at
 //     least min_track_frames frames in a row (a piece of a subject keyed apart for a frame or
-//     two and joined again is no second subject);
+//     two and joined again is no second subject); a blob made of one lost track only is that
+//     track going on under a new id, and takes its count whatever its age;
 //   - a track of the frame before whose box holds (>= split_share of their area) two or more
 //     blobs of this frame, its own and ones whose track was not seen in the frame before (new or
-//     found again), split: each of them counts one subject, but a
-//     piece keeping most of a merged blob's area (>= keep_area_share) keeps its count (the other
-//     piece was a part keyed apart); the pieces of a merged blob count as seen long enough, so
-//     that they merge again at once;
+//     found again), split: each of them counts one subject, but a piece keeping most of a
+//     merged blob's area (>= keep_area_share) keeps its count (the other piece was a part keyed
+//     apart); the pieces of a merged blob count as seen long enough, so that they merge again
+//     at once;
 //   - a blob without a track of the frame before counts one subject.
 // A blob counting two or more is `merged`. A merged blob whose area falls under
 // drop_area_share of its area when it merged counts one again (the partner left unseen).
 class MergeDetector {
  public:
   struct Options {
-    double absorb_share = 0.5;     // of a lost track's box inside the blob's box
-    double split_share = 0.5;      // of a new blob's box inside its parent's box
+    double absorb_share = 0.5;      // of a lost track's box inside the blob's box
+    double split_share = 0.5;       // of a new blob's box inside its parent's box
     double drop_area_share = 0.5;   // of the area at the merge
     int min_track_frames = 3;       // frames a swallowed track must have been seen in a row
     double keep_area_share = 0.75;  // of a merged blob's area, for a piece to keep its count
@@ -73,7 +74,7 @@ class MergeDetector {
   struct Blob {
     int track = -1;   // the tracker's subject id
     cv::Rect box;     // in the image
-    double area = 0;    // matte area, pixels
+    double area = 0;  // matte area, pixels
   };
   MergeDetector() = default;
   explicit MergeDetector(Options options) : options_(options) {}

@@ -9,8 +9,8 @@
 namespace ss {
 
 bool SpriteChoice::Takes(const SpriteRecord& sprite) const {
-  return include_merged || std::find(sprite.tags.begin(), sprite.tags.end(), kMergedTag) ==
-                               sprite.tags.end();
+  return include_merged ||
+         std::find(sprite.tags.begin(), sprite.tags.end(), kMergedTag) == sprite.tags.end();
 }
 
 CheapFeatures CheapFromRecord(const SpriteRecord& s) {

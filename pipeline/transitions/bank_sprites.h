@@ -53,8 +53,8 @@ struct BankSprites {
   std::vector<int64_t> ids;
   std::vector<SpriteInput> inputs;  // billboard pointers into `billboards`
   std::vector<RgbaBillboard> billboards;
-  double px_per_m = 0;  // the bank's billboard scale (the same for all)
-  int64_t clips = 0;    // complete clips they came from
+  double px_per_m = 0;            // the bank's billboard scale (the same for all)
+  int64_t clips = 0;              // complete clips they came from
   std::vector<int64_t> left_out;  // sprites loaded but not taken (SpriteChoice), in load order
 };
 

@@ -74,8 +74,7 @@ void UnitWorker::CatchUp() {
   const double scale = builder_ ? builder_->store().px_per_m() : 0.0;
   // The sprites the choice leaves out (merged ones) are never indexed: a clip of them only
   // has no range, and its unit finds nothing.
-  const BankSprites sprites =
-      LoadBankSpritesById(reader_, ids, &keys_, scale, &options_.sprites);
+  const BankSprites sprites = LoadBankSpritesById(reader_, ids, &keys_, scale, &options_.sprites);
   if (sprites.inputs.empty()) return;
   if (!builder_) builder_ = std::make_unique<TransitionBuilder>(options_.weights, sprites.px_per_m);
   const int32_t first = builder_->AppendIndexOnly(sprites.inputs, options_.load_threads);

@@ -8,8 +8,8 @@
 // pairs join the same two clips: TransitionBuilder::AddPairsOf).
 #include <cstdint>
 #include <map>
-#include <set>
 #include <memory>
+#include <set>
 #include <string>
 #include <utility>
 

@@ -112,8 +112,7 @@ void TransitionWorker::Run() {
         stats_.startup_total = static_cast<int64_t>(total);
       };
     };
-    const BankSprites sprites =
-        LoadBankSprites(*s.reader, &s.keys, progress("load"), s.choice);
+    const BankSprites sprites = LoadBankSprites(*s.reader, &s.keys, progress("load"), s.choice);
     if (!sprites.inputs.empty() || !sprites.left_out.empty()) {
       std::vector<Transition> transitions;
       if (!sprites.inputs.empty()) {
@@ -221,11 +220,10 @@ void TransitionWorker::Run() {
 void TransitionWorker::RunUnits() {
   std::unique_ptr<UnitWorker> units;
   try {
-    units = std::make_unique<UnitWorker>(
-        bank_path_,
-        UnitWorkerOptions{.weights = state_->weights,
-                          .load_threads = state_->startup_threads,
-                          .sprites = state_->choice});
+    units = std::make_unique<UnitWorker>(bank_path_,
+                                         UnitWorkerOptions{.weights = state_->weights,
+                                                           .load_threads = state_->startup_threads,
+                                                           .sprites = state_->choice});
   } catch (const std::exception& e) {
     Fail(std::string("start-up: ") + e.what());
   }

@@ -48,8 +48,8 @@ class TransitionWorker {
   // Starts the thread. Invalid weights throw InputError here; a bank that cannot be
   // opened shows up as stats().last_error (the thread then drops what is submitted).
   // `sprites`: which sprites take part (merged ones not, by default), at start and in rounds.
-  TransitionWorker(std::string bank_path, const TransitionWeights& weights,
-                   int startup_threads = 1, SpriteChoice sprites = {});
+  TransitionWorker(std::string bank_path, const TransitionWeights& weights, int startup_threads = 1,
+                   SpriteChoice sprites = {});
   ~TransitionWorker();  // Stop()
   TransitionWorker(const TransitionWorker&) = delete;
   TransitionWorker& operator=(const TransitionWorker&) = delete;

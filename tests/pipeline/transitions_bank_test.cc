@@ -131,7 +131,7 @@ class BankFiller {
     next_frame_ += static_cast<int64_t>(c.originals.size()) + 10;  // a gap between clips
   }
   std::map<int64_t, int64_t> bank_id;  // synthetic id -> bank id
-  std::set<int64_t> merged;             // synthetic ids of originals stored tagged merged
+  std::set<int64_t> merged;            // synthetic ids of originals stored tagged merged
 
  private:
   BankWriter writer_;

@@ -290,10 +290,10 @@ TEST(SynthSession, OverlapsSayWhereTwoSilhouettesTouch) {
     const int frame = std::stoi(r.at("frame"));
     ASSERT_EQ(r.at("subject_a"), "0");
     ASSERT_EQ(r.at("subject_b"), "1");
-    const cv::Mat a = cv::imread((truth / cam / "alpha_s0" / Png(frame)).string(),
-                                 cv::IMREAD_UNCHANGED);
-    const cv::Mat b = cv::imread((truth / cam / "alpha_s1" / Png(frame)).string(),
-                                 cv::IMREAD_UNCHANGED);
+    const cv::Mat a =
+        cv::imread((truth / cam / "alpha_s0" / Png(frame)).string(), cv::IMREAD_UNCHANGED);
+    const cv::Mat b =
+        cv::imread((truth / cam / "alpha_s1" / Png(frame)).string(), cv::IMREAD_UNCHANGED);
     ASSERT_FALSE(a.empty());
     ASSERT_FALSE(b.empty());
     cv::Mat a_near;
