@@ -94,6 +94,7 @@ void RunIngest(const std::string& session, const std::string& bank, const std::s
     out["session_id"] = s.session_id;
     out["frames"] = s.frames;
     out["sprites_kept"] = s.sprites_kept;
+    out["sprites_merged"] = s.sprites_merged;
     out["rows_inserted"] = s.rows_inserted;
     out["batches"] = s.batches;
     out["px_per_m"] = s.px_per_m;
@@ -117,6 +118,7 @@ void RunIngest(const std::string& session, const std::string& bank, const std::s
                                 {"training_frames", c.stats.training_frames},
                                 {"candidates", c.stats.candidates},
                                 {"sprites_kept", c.stats.stored_sprites},
+                                {"sprites_merged", c.stats.merged_sprites},
                                 {"clips", c.stats.clips},
                                 {"sequence_gaps", c.stats.sequence_gaps},
                                 {"discards", DiscardsJson(c.stats.discards)},
@@ -139,6 +141,12 @@ void RunIngest(const std::string& session, const std::string& bank, const std::s
       static_cast<unsigned long long>(s.sprites_kept),
       static_cast<unsigned long long>(s.rows_inserted), static_cast<unsigned long long>(s.batches),
       s.rows_inserted == 0 && s.sprites_kept > 0 ? " (already in the bank)" : "");
+  if (s.sprites_merged > 0) {
+    std::printf(
+        "  %llu of them tagged merged (two subjects in one blob; no transitions unless "
+        "transitions.include_merged)\n",
+        static_cast<unsigned long long>(s.sprites_merged));
+  }
   std::printf("  billboard scale %g px/m: %s\n", s.px_per_m, s.px_per_m_why.c_str());
   std::printf("  discarded:");
   for (size_t r = 1; r < s.discards.size(); ++r) {

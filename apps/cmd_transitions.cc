@@ -30,6 +30,7 @@ struct Args {
   double stage1_recall = 0.999;
   double positive_rate = -1;
   bool json = false, quiet = false;
+  bool include_merged = false;
 };
 
 TransitionWeights WeightsOf(const Args& a) {
@@ -65,6 +66,7 @@ void Build(const Args& a) {
   BankUpdateOptions options;
   options.weights = WeightsOf(a);
   options.threads = a.threads;
+  options.sprites.include_merged = a.include_merged;
   auto progress = std::make_shared<Progress>(a.quiet || a.json);
   options.progress = [progress](const std::string& stage, size_t done, size_t total) {
     (*progress)(stage, done, total);
@@ -164,6 +166,7 @@ void Worker(const Args& a) {
   options.name = a.name;
   options.lease_s = a.lease_s;
   options.load_threads = a.threads;
+  options.sprites.include_merged = a.include_merged;
   UnitWorker worker(a.bank, options);
   const auto t0 = std::chrono::steady_clock::now();
   while (!g_worker_stop) {
@@ -215,6 +218,8 @@ void AddTransitionsCommand(CLI::App& app) {
                   "Classifier weights file (default: the shipped weights)");
   cmd->add_option("--threads", args->threads, "Worker threads")->check(CLI::Range(1, 64));
   cmd->add_flag("--quiet", args->quiet, "No progress lines");
+  cmd->add_flag("--include-merged", args->include_merged,
+                "Sprites tagged merged (two subjects in one blob) take part too");
   cmd->add_flag("--json", args->json, "Print JSON");
   cmd->callback([cmd, args] {
     if (cmd->get_subcommands().empty()) Build(*args);
@@ -268,6 +273,8 @@ void AddTransitionsCommand(CLI::App& app) {
       ->check(CLI::Range(1.0, 86400.0));
   worker->add_option("--threads", args->threads, "Threads for the comparison images of new sprites")
       ->check(CLI::Range(1, 64));
+  worker->add_flag("--include-merged", args->include_merged,
+                   "Sprites tagged merged take part too (every worker of a bank alike)");
   worker->add_flag("--exit-when-idle", args->exit_when_idle,
                    "Exit when no unit is pending or leased");
   worker->add_flag("--json", args->json, "Print JSON");

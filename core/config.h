@@ -118,6 +118,14 @@ struct PipelineConfig {
   bool operator==(const PipelineConfig&) const = default;
 };
 
+// The transition table kept by the station (and ingest): which sprites take part.
+struct TransitionsConfig {
+  // Sprites tagged `merged` (two or more subjects in one blob, docs/pipeline.md) are left out
+  // of transitions unless this is true.
+  bool include_merged = false;
+  bool operator==(const TransitionsConfig&) const = default;
+};
+
 struct StorageConfig {
   std::string bank;           // the sprite bank (absolute)
   std::string recording_dir;  // where recorded sessions go (absolute)
@@ -152,6 +160,7 @@ struct StationConfig {
   KeyingConfig keying;
   EnclosureConfig enclosure;
   PipelineConfig pipeline;
+  TransitionsConfig transitions;
   StorageConfig storage;
   ControlConfig control;
   LoggingConfig logging;

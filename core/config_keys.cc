@@ -259,6 +259,13 @@ OptionsBinder PipelineKeys(PipelineConfig& p) {
   return b;
 }
 
+OptionsBinder TransitionsKeys(TransitionsConfig& t) {
+  OptionsBinder b;
+  b.Add("include_merged", &t.include_merged,
+        "sprites tagged merged (two subjects in one blob) take part in transitions");
+  return b;
+}
+
 OptionsBinder StorageKeys(StorageConfig& s) {
   OptionsBinder b;
   b.AddRead("bank", Quoted(s.bank), "the sprite bank: a file, or a PostgreSQL server's address",
@@ -367,6 +374,7 @@ OptionsBinder StationKeys(StationConfig& cfg) {
       .AddRead("keying", "", "keying.*", Section(KeyingKeys, cfg.keying))
       .AddRead("enclosure", "", "enclosure.*", Section(EnclosureKeys, cfg.enclosure))
       .AddRead("pipeline", "", "pipeline.*", Section(PipelineKeys, cfg.pipeline))
+      .AddRead("transitions", "", "transitions.*", Section(TransitionsKeys, cfg.transitions))
       .AddRead("storage", "", "storage.*", Section(StorageKeys, cfg.storage))
       .AddRead("control", "", "control.*", Section(ControlKeys, cfg.control))
       .AddRead("logging", "", "logging.*", Section(LoggingKeys, cfg.logging));

@@ -185,7 +185,8 @@ void Station::Start() {
   }
   if (s.options.transitions) {
     s.transitions = std::make_unique<TransitionWorker>(
-        config.storage.bank, s.options.weights ? *s.options.weights : DefaultWeights());
+        config.storage.bank, s.options.weights ? *s.options.weights : DefaultWeights(), 1,
+        SpriteChoice{.include_merged = config.transitions.include_merged});
   }
   s.writer_thread = std::thread([&s] { s.WriterLoop(); });
 

@@ -128,6 +128,7 @@ nlohmann::json StatusToJson(const StationStatus& st) {
                        {"has_model", c.has_model},
                        {"usable_sprites", c.pipeline.discards[static_cast<size_t>(Discard::kNone)]},
                        {"sprites_stored", c.pipeline.stored_sprites},
+                       {"sprites_merged", c.pipeline.merged_sprites},
                        {"clips", c.pipeline.clips},
                        {"sequence_gaps", c.pipeline.sequence_gaps},
                        {"batches_unstored", c.batches_unstored},
@@ -230,6 +231,9 @@ std::string StatusToPrometheus(const StationStatus& st) {
                    "\"");
     }
   }
+  per_camera("sprites_merged_total", "counter",
+             "original sprites stored tagged merged (two or more subjects in one blob)",
+             [](const CameraStatus& c) { return c.pipeline.merged_sprites; });
   m.Family("sprites_stored_total", "counter", "original sprites stored in the bank since start");
   m.Sample(static_cast<double>(st.sprites_stored));
   m.Family("sprites_per_second", "gauge", "sprites stored per second over the last 5 s");

@@ -192,7 +192,9 @@ IngestSummary IngestSession(const IngestOptions& options) {
   // writer thread only queues each batch's ids with it.
   std::unique_ptr<TransitionWorker> transitions;
   if (options.transitions)
-    transitions = std::make_unique<TransitionWorker>(options.bank_path, transition_weights, 1);
+    transitions = std::make_unique<TransitionWorker>(
+        options.bank_path, transition_weights, 1,
+        SpriteChoice{.include_merged = config.transitions.include_merged});
 
   std::atomic<uint64_t> frames_done{0}, rows_inserted{0}, batch_count{0}, stored{0};
   std::thread writer([&] {
@@ -296,6 +298,7 @@ IngestSummary IngestSession(const IngestOptions& options) {
         {w.name, w.camera_id, s, c < replay_stats.size() ? replay_stats[c] : ReplayCameraStats{}});
     summary.frames += s.frames;
     summary.sprites_kept += s.stored_sprites;
+    summary.sprites_merged += s.merged_sprites;
     for (size_t r = 0; r < summary.discards.size(); ++r) summary.discards[r] += s.discards[r];
   }
   summary.rows_inserted = rows_inserted;

@@ -54,9 +54,10 @@ struct IngestSummary {
   std::string session_name;
   int64_t session_id = 0;
   std::vector<IngestCamera> cameras;
-  uint64_t frames = 0;         // frames through the pipelines (training frames included)
-  uint64_t sprites_kept = 0;   // usable originals handed to the bank
-  uint64_t rows_inserted = 0;  // new sprite rows (originals + mirrors); 0 on a re-ingest
+  uint64_t frames = 0;          // frames through the pipelines (training frames included)
+  uint64_t sprites_kept = 0;    // usable originals handed to the bank
+  uint64_t sprites_merged = 0;  // of them, tagged merged (two or more subjects in one blob)
+  uint64_t rows_inserted = 0;   // new sprite rows (originals + mirrors); 0 on a re-ingest
   uint64_t batches = 0;
   double px_per_m = 0;       // the bank's billboard scale the sprites were made at
   std::string px_per_m_why;  // how it was chosen (ChooseBankScale)

@@ -51,13 +51,14 @@ class Tracker {
 //     (>= absorb_share of its area) inside one blob's box, was swallowed by that blob: it adds its
 //     count to that blob (two tracks meeting in one blob: a merge) when it had been seen for at
 //     least min_track_frames frames in a row (a piece of a subject keyed apart for a frame or
-//     two and joined again is no second subject);
+//     two and joined again is no second subject); a blob made of one lost track only is that
+//     track going on under a new id, and takes its count whatever its age;
 //   - a track of the frame before whose box holds (>= split_share of their area) two or more
 //     blobs of this frame, its own and ones whose track was not seen in the frame before (new or
-//     found again), split: each of them counts one subject, but a
-//     piece keeping most of a merged blob's area (>= keep_area_share) keeps its count (the other
-//     piece was a part keyed apart); the pieces of a merged blob count as seen long enough, so
-//     that they merge again at once;
+//     found again), split: each of them counts one subject, but a piece keeping most of a
+//     merged blob's area (>= keep_area_share) keeps its count (the other piece was a part keyed
+//     apart); the pieces of a merged blob count as seen long enough, so that they merge again
+//     at once;
 //   - a blob without a track of the frame before counts one subject.
 // A blob counting two or more is `merged`. A merged blob whose area falls under
 // drop_area_share of its area when it merged counts one again (the partner left unseen).

@@ -1,11 +1,17 @@
 #include "pipeline/transitions/bank_sprites.h"
 
+#include <algorithm>
 #include <cstring>
 #include <set>
 
 #include "core/error.h"
 
 namespace ss {
+
+bool SpriteChoice::Takes(const SpriteRecord& sprite) const {
+  return include_merged ||
+         std::find(sprite.tags.begin(), sprite.tags.end(), kMergedTag) == sprite.tags.end();
+}
 
 CheapFeatures CheapFromRecord(const SpriteRecord& s) {
   CheapFeatures f;
@@ -66,7 +72,8 @@ void Link(BankSprites* out) {
 }  // namespace
 
 BankSprites LoadBankSprites(const Bank& bank, SegmentKeys* keys,
-                            const std::function<void(size_t, size_t)>& progress) {
+                            const std::function<void(size_t, size_t)>& progress,
+                            const SpriteChoice& choice) {
   // ordered by (clip, mirrored, frame)
   const std::vector<SpriteFeatures> features = bank.LoadFeatures();
   BankSprites out;
@@ -75,8 +82,13 @@ BankSprites LoadBankSprites(const Bank& bank, SegmentKeys* keys,
   out.billboards.reserve(features.size());
   std::set<int64_t> clips;
   for (size_t k = 0; k < features.size(); ++k) {
-    AddSprite(bank, bank.LoadSprite(features[k].id), keys, &out);
-    clips.insert(features[k].clip_id);
+    const SpriteRecord r = bank.LoadSprite(features[k].id);  // with its tags
+    if (choice.Takes(r)) {
+      AddSprite(bank, r, keys, &out);
+      clips.insert(features[k].clip_id);
+    } else {
+      out.left_out.push_back(r.id);
+    }
     if (progress && (k % 512 == 511 || k + 1 == features.size())) progress(k + 1, features.size());
   }
   out.clips = static_cast<int64_t>(clips.size());
@@ -85,7 +97,7 @@ BankSprites LoadBankSprites(const Bank& bank, SegmentKeys* keys,
 }
 
 BankSprites LoadBankSpritesById(const Bank& bank, std::span<const int64_t> ids, SegmentKeys* keys,
-                                double px_per_m) {
+                                double px_per_m, const SpriteChoice* choice) {
   BankSprites out;
   out.px_per_m = px_per_m;
   out.ids.reserve(ids.size());
@@ -94,6 +106,10 @@ BankSprites LoadBankSpritesById(const Bank& bank, std::span<const int64_t> ids, 
   std::set<int64_t> clips;
   for (int64_t id : ids) {
     const SpriteRecord r = bank.LoadSprite(id);  // InputError naming the bank for an unknown id
+    if (choice && !choice->Takes(r)) {
+      out.left_out.push_back(id);
+      continue;
+    }
     AddSprite(bank, r, keys, &out);
     clips.insert(r.clip_id);
   }

@@ -16,6 +16,16 @@
 
 namespace ss {
 
+// Which stored sprites take part in transitions (docs/transitions.md): by default not those
+// tagged kMergedTag (two or more subjects in one blob: a sprite that is neither of them).
+struct SpriteChoice {
+  bool include_merged = false;  // the config's transitions.include_merged, --include-merged
+  bool Takes(const SpriteRecord& sprite) const;
+  // The bank's meta key recording the choice its transition table was made with.
+  static constexpr const char* kMetaKey = "transitions.include_merged";
+  std::string MetaValue() const { return include_merged ? "true" : "false"; }
+};
+
 // The cheap features of a stored sprite: velocity, mean colour, eccentricity as stored;
 // area_m2 = area_px / px_per_m^2.
 CheapFeatures CheapFromRecord(const SpriteRecord& sprite);
@@ -43,20 +53,24 @@ struct BankSprites {
   std::vector<int64_t> ids;
   std::vector<SpriteInput> inputs;  // billboard pointers into `billboards`
   std::vector<RgbaBillboard> billboards;
-  double px_per_m = 0;  // the bank's billboard scale (the same for all)
-  int64_t clips = 0;    // complete clips they came from
+  double px_per_m = 0;            // the bank's billboard scale (the same for all)
+  int64_t clips = 0;              // complete clips they came from
+  std::vector<int64_t> left_out;  // sprites loaded but not taken (SpriteChoice), in load order
 };
 
-// Loads the sprites of every complete clip, ordered by (clip, mirrored, frame), their
-// segments from `keys`. InputError naming the bank when sprites disagree on px_per_m.
-// `progress(done, total)` is called every few hundred sprites when given.
+// Loads the sprites of every complete clip that `choice` takes, ordered by (clip, mirrored,
+// frame), their segments from `keys` (a sprite left out breaks its clip's segment there).
+// InputError naming the bank when sprites disagree on px_per_m. `progress(done, total)` is
+// called every few hundred sprites when given.
 BankSprites LoadBankSprites(const Bank& bank, SegmentKeys* keys,
-                            const std::function<void(size_t, size_t)>& progress = {});
+                            const std::function<void(size_t, size_t)>& progress = {},
+                            const SpriteChoice& choice = {});
 
 // Loads the named sprites (in that order) with `keys` giving their segments.
 // InputError naming the bank and the sprite for an unknown id or another px_per_m
-// (`px_per_m` 0 = take the first sprite's).
+// (`px_per_m` 0 = take the first sprite's). With `choice`, only the sprites it takes (the rest
+// go to left_out); without, every named sprite (labels name the sprites they judge).
 BankSprites LoadBankSpritesById(const Bank& bank, std::span<const int64_t> ids, SegmentKeys* keys,
-                                double px_per_m = 0);
+                                double px_per_m = 0, const SpriteChoice* choice = nullptr);
 
 }  // namespace ss

@@ -113,41 +113,57 @@ BankUpdateSummary UpdateBankTransitions(const std::string& bank_path,
   BankWriter bank(bank_path);
   auto t = std::chrono::steady_clock::now();
   SegmentKeys keys;
-  const BankSprites sprites = LoadBankSprites(bank, &keys, [&](size_t done, size_t total) {
-    if (options.progress) options.progress("load", done, total);
-  });
+  const BankSprites sprites = LoadBankSprites(
+      bank, &keys,
+      [&](size_t done, size_t total) {
+        if (options.progress) options.progress("load", done, total);
+      },
+      options.sprites);
   s.seconds_load = SecondsSince(t);
   s.sprites = static_cast<int64_t>(sprites.inputs.size());
   s.clips = sprites.clips;
-  if (sprites.inputs.empty()) {
+  s.left_out = static_cast<int64_t>(sprites.left_out.size());
+  if (sprites.inputs.empty() && sprites.left_out.empty()) {
     throw InputError(
         bank_path,
         "the bank holds no sprites in complete clips: there is nothing to find transitions "
         "between (ingest a session first)");
   }
   t = std::chrono::steady_clock::now();
-  TransitionBuilder real(options.weights, sprites.px_per_m);
-  BuildOptions build;
-  build.threads = options.threads;
-  build.progress = [&](size_t done, size_t total) {
-    if (options.progress) options.progress("pairs", done, total);
-  };
-  real.BuildFromScratch(sprites.inputs, build);
-  const std::vector<Transition> transitions = real.Transitions();
+  std::vector<Transition> transitions;
+  if (!sprites.inputs.empty()) {
+    TransitionBuilder real(options.weights, sprites.px_per_m);
+    BuildOptions build;
+    build.threads = options.threads;
+    build.progress = [&](size_t done, size_t total) {
+      if (options.progress) options.progress("pairs", done, total);
+    };
+    real.BuildFromScratch(sprites.inputs, build);
+    transitions = real.Transitions();
+    s.build = real.stats();
+  }
   s.seconds_build = SecondsSince(t);
-  s.build = real.stats();
   s.transitions = static_cast<int64_t>(transitions.size());
   if (s.clips == 1) {
     s.notes.push_back(
         "the bank has one clip: its transitions only jump within it (and its mirror)");
+  }
+  if (s.left_out > 0) {
+    s.notes.push_back(std::to_string(s.left_out) +
+                      " sprites tagged merged (two subjects in one blob) left out: "
+                      "transitions.include_merged / --include-merged takes them");
   }
   if (s.transitions == 0) {
     s.notes.push_back(
         "no transitions found: the clips share no similar frames under these weights");
   }
   t = std::chrono::steady_clock::now();
-  const std::unordered_set<int64_t> universe(sprites.ids.begin(), sprites.ids.end());
+  // The sprites left out belong to the table's universe: their old transitions (a table made
+  // with include_merged) go.
+  std::unordered_set<int64_t> universe(sprites.ids.begin(), sprites.ids.end());
+  universe.insert(sprites.left_out.begin(), sprites.left_out.end());
   s.store = StoreTransitionTable(bank, transitions, WeightsFingerprint(options.weights), universe);
+  bank.SetMeta(SpriteChoice::kMetaKey, options.sprites.MetaValue());
   s.seconds_store = SecondsSince(t);
   log->info("{}: {} sprites, {} transitions ({} added, {} changed, {} removed{})", bank_path,
             s.sprites, s.transitions, s.store.added, s.store.changed, s.store.removed,
@@ -159,6 +175,7 @@ std::string BankUpdateSummary::ToJson() const {
   nlohmann::json j{{"bank", bank},
                    {"sprites", sprites},
                    {"clips", clips},
+                   {"left_out_merged", left_out},
                    {"stage1_candidates", build.stage1_candidates},
                    {"stage2_evaluations", build.stage2_evaluations},
                    {"kept_pairs", build.kept_pairs},

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "core/bank.h"
+#include "pipeline/transitions/bank_sprites.h"
 #include "pipeline/transitions/builder.h"
 #include "pipeline/transitions/weights.h"
 
@@ -40,6 +41,7 @@ std::vector<TransitionRecord> ToRecords(const std::vector<Transition>& transitio
 struct BankUpdateOptions {
   TransitionWeights weights = DefaultWeights();
   int threads = 2;
+  SpriteChoice sprites;  // which sprites take part (merged ones not, by default)
   // stage: "load" (sprites read and decoded) or "pairs" (sprites searched); from any thread.
   std::function<void(const std::string& stage, size_t done, size_t total)> progress;
 };
@@ -47,6 +49,7 @@ struct BankUpdateOptions {
 struct BankUpdateSummary {
   std::string bank;
   int64_t sprites = 0, clips = 0;
+  int64_t left_out = 0;  // sprites of complete clips the choice left out (tagged merged)
   BuildStats build;
   int64_t transitions = 0;
   StoreResult store;

@@ -41,6 +41,17 @@ UnitWorker::UnitWorker(const std::string& bank, UnitWorkerOptions options)
                          "); rebuild them with `spritestation transitions BANK` first");
   }
   if (!made_with) writer_.SetMeta(kTransitionWeightsMetaKey, fingerprint);
+  // Workers taking merged sprites and workers leaving them out would make a table of neither.
+  const std::string choice = options_.sprites.MetaValue();
+  const std::string table_choice = writer_.KeepMeta(SpriteChoice::kMetaKey, choice);
+  if (table_choice != choice && reader_.Counts().transitions > 0) {
+    throw InputError(reader_.path(), std::string("its transitions were made with ") +
+                                         SpriteChoice::kMetaKey + " " + table_choice +
+                                         ", this worker has " + choice +
+                                         "; rebuild them with `spritestation transitions BANK` "
+                                         "first, or run every worker alike");
+  }
+  if (table_choice != choice) writer_.SetMeta(SpriteChoice::kMetaKey, choice);
 }
 
 void UnitWorker::CatchUp() {
@@ -51,26 +62,30 @@ void UnitWorker::CatchUp() {
   for (const ClipRecord& c : reader_.ListClips(loaded_seq_)) upto = std::max(upto, c.complete_seq);
   if (upto == loaded_seq_) return;
   std::vector<int64_t> ids;
-  std::vector<int64_t> clips;  // per id
+  std::map<int64_t, int64_t> clip_of;  // sprite id -> clip id
   for (const SpriteFeatures& f : reader_.LoadFeatures(loaded_seq_)) {
-    if (clip_range_.count(f.clip_id)) continue;
+    if (clip_range_.count(f.clip_id) || seen_clips_.count(f.clip_id)) continue;
     ids.push_back(f.id);
-    clips.push_back(f.clip_id);
+    clip_of[f.id] = f.clip_id;
   }
   loaded_seq_ = upto;
   if (ids.empty()) return;
+  for (const auto& [id, clip] : clip_of) seen_clips_.insert(clip);
   const double scale = builder_ ? builder_->store().px_per_m() : 0.0;
-  const BankSprites sprites = LoadBankSpritesById(reader_, ids, &keys_, scale);
+  // The sprites the choice leaves out (merged ones) are never indexed: a clip of them only
+  // has no range, and its unit finds nothing.
+  const BankSprites sprites = LoadBankSpritesById(reader_, ids, &keys_, scale, &options_.sprites);
+  if (sprites.inputs.empty()) return;
   if (!builder_) builder_ = std::make_unique<TransitionBuilder>(options_.weights, sprites.px_per_m);
   const int32_t first = builder_->AppendIndexOnly(sprites.inputs, options_.load_threads);
-  for (size_t k = 0; k < clips.size(); ++k) {
+  for (size_t k = 0; k < sprites.ids.size(); ++k) {
     const int32_t index = first + static_cast<int32_t>(k);
-    auto [it, fresh] = clip_range_.try_emplace(clips[k], index, index + 1);
+    auto [it, fresh] = clip_range_.try_emplace(clip_of.at(sprites.ids[k]), index, index + 1);
     if (!fresh)
       it->second.second = index + 1;  // a clip's sprites are one run (LoadFeatures' order)
     if (fresh) ++stats_.clips_indexed;
   }
-  stats_.sprites_indexed += static_cast<int64_t>(ids.size());
+  stats_.sprites_indexed += static_cast<int64_t>(sprites.ids.size());
   stats_.seconds_index += SecondsSince(t0);
 }
 

@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <map>
 #include <memory>
+#include <set>
 #include <string>
 #include <utility>
 
@@ -25,6 +26,7 @@ struct UnitWorkerOptions {
   std::string name;      // in the work table (host:pid when empty)
   double lease_s = 60;   // a unit not done by then may be taken by another worker
   int load_threads = 1;  // comparison images of newly indexed sprites
+  SpriteChoice sprites;  // which sprites take part: every worker of a bank must agree
 };
 
 struct UnitWorkerStats {
@@ -37,7 +39,7 @@ struct UnitWorkerStats {
 class UnitWorker {
  public:
   // InputError for a bank that is not PostgreSQL, or whose transitions were made with other
-  // weights (rebuild them with `transitions BANK` first).
+  // weights or another sprite choice (rebuild them with `transitions BANK` first).
   UnitWorker(const std::string& bank, UnitWorkerOptions options);
 
   // Registers new complete clips as units, claims one and does it. False when none was free.
@@ -57,6 +59,7 @@ class UnitWorker {
   SegmentKeys keys_;
   std::unique_ptr<TransitionBuilder> builder_;
   std::map<int64_t, std::pair<int32_t, int32_t>> clip_range_;  // bank clip -> store [first, end)
+  std::set<int64_t> seen_clips_;  // clips read (some may have no sprite taken: no range)
   int64_t loaded_seq_ = 0;
   UnitWorkerStats stats_;
 };

@@ -25,6 +25,7 @@ constexpr size_t kRowsPerTransaction = 2000;  // transitions stored per bank tra
 struct TransitionWorker::State {
   TransitionWeights weights;
   int startup_threads = 1;
+  SpriteChoice choice;
   std::optional<Bank> reader;
   std::optional<BankWriter> writer;
   std::unique_ptr<TransitionBuilder> builder;  // made when the bank scale is known
@@ -32,12 +33,13 @@ struct TransitionWorker::State {
 };
 
 TransitionWorker::TransitionWorker(std::string bank_path, const TransitionWeights& weights,
-                                   int startup_threads)
+                                   int startup_threads, SpriteChoice sprites)
     : bank_path_(std::move(bank_path)), state_(std::make_unique<State>()) {
   const TransitionClassifier check(
       weights);  // InputError for invalid weights, in the caller's thread
   state_->weights = weights;
   state_->startup_threads = std::max(1, startup_threads);
+  state_->choice = sprites;
   thread_ = std::thread([this] { Run(); });
 }
 
@@ -110,13 +112,18 @@ void TransitionWorker::Run() {
         stats_.startup_total = static_cast<int64_t>(total);
       };
     };
-    const BankSprites sprites = LoadBankSprites(*s.reader, &s.keys, progress("load"));
-    if (!sprites.inputs.empty()) {
-      s.builder = std::make_unique<TransitionBuilder>(s.weights, sprites.px_per_m);
-      s.builder->BuildFromScratch(sprites.inputs, BuildOptions{.threads = s.startup_threads,
-                                                               .progress = progress("pairs")});
-      const auto transitions = s.builder->Transitions();
-      const std::unordered_set<int64_t> universe(sprites.ids.begin(), sprites.ids.end());
+    const BankSprites sprites = LoadBankSprites(*s.reader, &s.keys, progress("load"), s.choice);
+    if (!sprites.inputs.empty() || !sprites.left_out.empty()) {
+      std::vector<Transition> transitions;
+      if (!sprites.inputs.empty()) {
+        s.builder = std::make_unique<TransitionBuilder>(s.weights, sprites.px_per_m);
+        s.builder->BuildFromScratch(sprites.inputs, BuildOptions{.threads = s.startup_threads,
+                                                                 .progress = progress("pairs")});
+        transitions = s.builder->Transitions();
+      }
+      // Sprites left out are in the universe: transitions of theirs from before go.
+      std::unordered_set<int64_t> universe(sprites.ids.begin(), sprites.ids.end());
+      universe.insert(sprites.left_out.begin(), sprites.left_out.end());
       const StoreResult r =
           StoreTransitionTable(*s.writer, transitions, WeightsFingerprint(s.weights), universe);
       stored = r.replaced_all ? static_cast<int64_t>(transitions.size()) : r.added + r.changed;
@@ -124,6 +131,7 @@ void TransitionWorker::Run() {
     } else {
       s.writer->SetMeta(kTransitionWeightsMetaKey, WeightsFingerprint(s.weights));
     }
+    s.writer->SetMeta(SpriteChoice::kMetaKey, s.choice.MetaValue());
     log->info("transition worker: {} sprites at start, {} transitions written", known, stored);
   } catch (const std::exception& e) {
     fail(std::string("start-up: ") + e.what());
@@ -163,10 +171,13 @@ void TransitionWorker::Run() {
       }
       if (!fresh.empty()) {
         const double scale = s.builder ? s.builder->store().px_per_m() : 0.0;
-        const BankSprites sprites = LoadBankSpritesById(*s.reader, fresh, &s.keys, scale);
-        if (!s.builder)
+        // Merged sprites (unless the choice takes them) are left out here, never indexed.
+        const BankSprites sprites =
+            LoadBankSpritesById(*s.reader, fresh, &s.keys, scale, &s.choice);
+        if (!s.builder && !sprites.inputs.empty())
           s.builder = std::make_unique<TransitionBuilder>(s.weights, sprites.px_per_m);
-        const TransitionDelta delta = s.builder->Add(sprites.inputs);
+        const TransitionDelta delta =
+            sprites.inputs.empty() ? TransitionDelta{} : s.builder->Add(sprites.inputs);
         if (!delta.transitions.empty()) {
           // A few thousand rows a transaction: a round of a large bank holds tens of thousands,
           // and one transaction for all of them held the bank's write lock past the station
@@ -180,7 +191,7 @@ void TransitionWorker::Run() {
                 records.begin() + static_cast<std::ptrdiff_t>(i), end));
           }
         }
-        added_sprites = static_cast<int64_t>(fresh.size());
+        added_sprites = static_cast<int64_t>(sprites.inputs.size());  // those taken
         added_transitions = static_cast<int64_t>(delta.transitions.size());
       }
     } catch (const std::exception& e) {
@@ -209,9 +220,10 @@ void TransitionWorker::Run() {
 void TransitionWorker::RunUnits() {
   std::unique_ptr<UnitWorker> units;
   try {
-    units = std::make_unique<UnitWorker>(
-        bank_path_,
-        UnitWorkerOptions{.weights = state_->weights, .load_threads = state_->startup_threads});
+    units = std::make_unique<UnitWorker>(bank_path_,
+                                         UnitWorkerOptions{.weights = state_->weights,
+                                                           .load_threads = state_->startup_threads,
+                                                           .sprites = state_->choice});
   } catch (const std::exception& e) {
     Fail(std::string("start-up: ") + e.what());
   }

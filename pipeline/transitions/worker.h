@@ -23,13 +23,14 @@
 #include <thread>
 #include <vector>
 
+#include "pipeline/transitions/bank_sprites.h"
 #include "pipeline/transitions/weights.h"
 
 namespace ss {
 
 struct TransitionWorkerStats {
   bool ready = false;              // the start-up build is done
-  int64_t sprites = 0;             // sprites the worker knows (start-up + submitted)
+  int64_t sprites = 0;             // sprites the worker knows (start-up + submitted, not left out)
   int64_t queued = 0;              // submitted, not yet processed
   int64_t rounds = 0;              // rounds of submitted sprites processed
   int64_t transitions_stored = 0;  // written since start (start-up table included)
@@ -46,8 +47,9 @@ class TransitionWorker {
  public:
   // Starts the thread. Invalid weights throw InputError here; a bank that cannot be
   // opened shows up as stats().last_error (the thread then drops what is submitted).
-  TransitionWorker(std::string bank_path, const TransitionWeights& weights,
-                   int startup_threads = 1);
+  // `sprites`: which sprites take part (merged ones not, by default), at start and in rounds.
+  TransitionWorker(std::string bank_path, const TransitionWeights& weights, int startup_threads = 1,
+                   SpriteChoice sprites = {});
   ~TransitionWorker();  // Stop()
   TransitionWorker(const TransitionWorker&) = delete;
   TransitionWorker& operator=(const TransitionWorker&) = delete;

@@ -346,6 +346,16 @@ TEST(StationConfig, NoiseThresholds) {
             std::string::npos);
 }
 
+// transitions.include_merged: off by default (merged sprites take no part), a boolean.
+TEST(StationConfig, TransitionsIncludeMerged) {
+  EXPECT_FALSE(Parse("version: 1\n").transitions.include_merged);
+  EXPECT_TRUE(Parse("transitions:\n  include_merged: true\n").transitions.include_merged);
+  const std::string wrong = ErrorOf("transitions:\n  include_merged: sometimes\n");
+  EXPECT_NE(wrong.find("transitions.include_merged"), std::string::npos) << wrong;
+  const std::string unknown = ErrorOf("transitions:\n  include_merge: true\n");
+  EXPECT_NE(unknown.find("transitions.include_merge"), std::string::npos) << unknown;
+}
+
 TEST(StationConfig, SyntaxErrorsAndBadFiles) {
   const std::string msg = ErrorOf("cameras:\n  - name: [unclosed\n");
   EXPECT_EQ(msg.rfind("station.yaml:", 0), 0u) << msg;

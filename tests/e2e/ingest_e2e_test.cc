@@ -45,6 +45,9 @@ TEST_F(IngestEndToEnd, KeepsUsableSpritesAndCountsEveryDiscard) {
     EXPECT_TRUE(j["discards"].contains(reason)) << reason;
   }
   ASSERT_EQ(j["cameras"].size(), 2u);
+  // One subject: no sprite holds two (docs/pipeline.md, "Merged subjects").
+  EXPECT_EQ(j["sprites_merged"].get<int>(), 0) << r.output;
+  for (const auto& c : j["cameras"]) EXPECT_EQ(c["sprites_merged"].get<int>(), 0) << r.output;
 
   const auto info = RunSpritestation("--log-level warn bank info " + bank + " --json");
   ASSERT_EQ(info.exit_code, 0) << info.output;

@@ -91,6 +91,10 @@ void BankFiller::Add(const ClipOfSprites& c, int batch,
       synthetic_ids.push_back(c.originals[k]->id);
       records.push_back(Record(*c.mirrors[k], next_frame_ + static_cast<int64_t>(k), true));
       synthetic_ids.push_back(c.mirrors[k]->id);
+      if (merged.count(c.originals[k]->id)) {  // tagged in the sprite's own batch
+        records[records.size() - 2].tags = {kMergedTag};
+        records.back().tags = {kMergedTag};
+      }
     }
     clip.complete = end == c.originals.size();
     clip.last_frame = next_frame_ + static_cast<int64_t>(end) - 1;

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <functional>
 #include <map>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -33,6 +34,8 @@ class BankFiller {
   void Add(const ClipOfSprites& c, int batch,
            const std::function<void(const std::vector<int64_t>&)>& stored = {});
   std::map<int64_t, int64_t> bank_id;  // synthetic id -> bank id
+  // Synthetic ids of originals stored tagged merged (with their mirrors).
+  std::set<int64_t> merged;
 
  private:
   BankWriter writer_;

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <filesystem>
 #include <map>
+#include <set>
 #include <tuple>
 
 #include "core/bank.h"
@@ -111,6 +112,72 @@ TEST(TransitionBank, WorkerEqualsFromScratch) {
   EXPECT_EQ(s.store.changed, 0);
   EXPECT_EQ(s.store.removed, 0);
   EXPECT_FALSE(s.store.replaced_all);
+}
+
+// Sprites tagged merged (two subjects in one blob) take part in no transition, on the worker
+// path (start-up and rounds) and in a single-process build alike, unless included.
+TEST(TransitionBank, MergedSpritesTakePartOnlyWhenIncluded) {
+  testing::ScratchDir dir;
+  const std::string bank = dir / "bank.db";
+  const auto sprites = Sprites(400, 5);
+  const auto clips = Clips(sprites);
+  ASSERT_GT(clips.size(), 6u);
+  BankFiller filler(bank);
+  // In every clip, 3 frames a third of the way in (the clip's segment is cut there).
+  for (const auto& c : clips) {
+    const size_t at = c.originals.size() / 3;
+    for (size_t k = at; k < at + 3 && k < c.originals.size(); ++k)
+      filler.merged.insert(c.originals[k]->id);
+  }
+  const auto touches_merged = [&](const std::vector<TransitionRecord>& table) {
+    const std::vector<int64_t> tagged = Bank(bank).SpritesTagged(kMergedTag);
+    const std::set<int64_t> m(tagged.begin(), tagged.end());
+    int64_t n = 0;
+    for (const TransitionRecord& t : table) n += m.count(t.from_sprite) || m.count(t.to_sprite);
+    return n;
+  };
+  const size_t before = clips.size() / 3;
+  for (size_t k = 0; k < before; ++k) filler.Add(clips[k], 50);
+  {
+    TransitionWorker worker(bank, Generous());
+    for (size_t k = before; k < clips.size(); ++k)
+      filler.Add(clips[k], 7, [&](const std::vector<int64_t>& ids) { worker.Submit(ids); });
+    worker.WaitIdle();
+    EXPECT_EQ(worker.stats().failed_rounds, 0) << worker.stats().last_error;
+    EXPECT_EQ(worker.stats().sprites, 800 - 2 * static_cast<int64_t>(filler.merged.size()));
+  }
+  EXPECT_EQ(Bank(bank).SpritesTagged(kMergedTag).size(), 2 * filler.merged.size());
+  const auto incremental = Bank(bank).LoadTransitions();
+  ASSERT_GT(incremental.size(), 100u);
+  EXPECT_EQ(touches_merged(incremental), 0);
+  EXPECT_EQ(Bank(bank).GetMeta(SpriteChoice::kMetaKey).value_or(""), "false");
+
+  // The single-process build leaves them out too, and finds the worker's table.
+  BankUpdateOptions options;
+  options.weights = Generous();
+  const BankUpdateSummary s = UpdateBankTransitions(bank, options);
+  EXPECT_EQ(s.left_out, 2 * static_cast<int64_t>(filler.merged.size()));
+  EXPECT_EQ(s.transitions, static_cast<int64_t>(incremental.size()));
+  EXPECT_EQ(s.store.added + s.store.changed + s.store.removed, 0);
+
+  // Included, they have transitions; left out again, those go.
+  options.sprites.include_merged = true;
+  const BankUpdateSummary with = UpdateBankTransitions(bank, options);
+  EXPECT_EQ(with.left_out, 0);
+  EXPECT_GT(touches_merged(Bank(bank).LoadTransitions()), 0);
+  EXPECT_EQ(Bank(bank).GetMeta(SpriteChoice::kMetaKey).value_or(""), "true");
+  options.sprites.include_merged = false;
+  const BankUpdateSummary without = UpdateBankTransitions(bank, options);
+  EXPECT_GT(without.store.removed, 0);
+  EXPECT_EQ(touches_merged(Bank(bank).LoadTransitions()), 0);
+  // A worker starting on a table made with them drops their transitions at start.
+  options.sprites.include_merged = true;
+  UpdateBankTransitions(bank, options);
+  {
+    TransitionWorker worker(bank, Generous());
+    worker.WaitIdle();
+  }
+  EXPECT_EQ(touches_merged(Bank(bank).LoadTransitions()), 0);
 }
 
 TEST(TransitionBank, EmptyBankOneClipAndMissingBank) {

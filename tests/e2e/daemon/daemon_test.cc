@@ -255,6 +255,15 @@ TEST_F(DaemonTest, TwoEmulatedGigECamerasStoreWhatIngestFinds) {
                                std::to_string(status["bank"]["sprites_stored"].get<int64_t>())),
             std::string::npos)
       << metrics->body;
+  // Sprites stored tagged merged (two subjects in one blob), per camera, as the status says.
+  for (const std::string name : {"cam0", "cam1"}) {
+    const nlohmann::json& merged = Camera(status, name)["sprites_merged"];
+    ASSERT_TRUE(merged.is_number_integer()) << status.dump(2);
+    EXPECT_NE(metrics->body.find("spritestation_sprites_merged_total{camera=\"" + name + "\"} " +
+                                 std::to_string(merged.get<int64_t>())),
+              std::string::npos)
+        << metrics->body;
+  }
   // What Prometheus's own checker makes of it (promtool, from Debian's prometheus package).
   {
     const std::string file = dir_ / "metrics.txt";
