@@ -333,6 +333,15 @@ struct CameraRunner::Impl {
         ++status.batches_unstored;
         continue;
       }
+      {
+        std::lock_guard lock(status_mutex);
+        for (const SpriteRecord& s : b.sprites) {
+          if (s.mirrored) continue;
+          ++status.sprites_to_bank;
+          if (std::find(s.tags.begin(), s.tags.end(), kMergedTag) != s.tags.end())
+            ++status.merged_to_bank;
+        }
+      }
       StationBatch sb;
       sb.camera = index;
       sb.received.reserve(b.sprites.size());

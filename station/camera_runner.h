@@ -63,6 +63,10 @@ struct CameraStatus {
   } learnt_from;
   uint64_t frames_rejected = 0;  // frames the pipeline refused (corrupt, another size); see message
   uint64_t batches_unstored = 0;  // batches made with no capture session (not stored)
+  // Original sprites of the batches handed to the bank writer (a session ran; mirrors not
+  // counted), and of them those tagged `merged`. The pipeline's own counts include the batches
+  // made with no session, which are not stored.
+  uint64_t sprites_to_bank = 0, merged_to_bank = 0;
   size_t queue_depth = 0, queue_capacity = 0;
   uint64_t reopens = 0;    // times the camera was opened again after going offline
   bool has_model = false;  // without one no sprite is stored (preview and recording only)

@@ -127,8 +127,8 @@ nlohmann::json StatusToJson(const StationStatus& st) {
                        {"reopens", c.reopens},
                        {"has_model", c.has_model},
                        {"usable_sprites", c.pipeline.discards[static_cast<size_t>(Discard::kNone)]},
-                       {"sprites_stored", c.pipeline.stored_sprites},
-                       {"sprites_merged", c.pipeline.merged_sprites},
+                       {"sprites_stored", c.sprites_to_bank},
+                       {"sprites_merged", c.merged_to_bank},
                        {"clips", c.pipeline.clips},
                        {"sequence_gaps", c.pipeline.sequence_gaps},
                        {"batches_unstored", c.batches_unstored},
@@ -233,7 +233,7 @@ std::string StatusToPrometheus(const StationStatus& st) {
   }
   per_camera("sprites_merged_total", "counter",
              "original sprites stored tagged merged (two or more subjects in one blob)",
-             [](const CameraStatus& c) { return c.pipeline.merged_sprites; });
+             [](const CameraStatus& c) { return c.merged_to_bank; });
   m.Family("sprites_stored_total", "counter", "original sprites stored in the bank since start");
   m.Sample(static_cast<double>(st.sprites_stored));
   m.Family("sprites_per_second", "gauge", "sprites stored per second over the last 5 s");
