@@ -23,6 +23,7 @@ std::vector<PreviewCandidate> PreviewCandidates(const std::vector<CandidateVerdi
     p.track = v.track;
     p.ground = v.ground;
     p.reason = v.reason;
+    p.merged = v.merged;
     if (!c.alpha.empty()) {
       cv::compare(c.alpha, 127, mask, cv::CMP_GT);
       contours.clear();
@@ -120,6 +121,7 @@ nlohmann::json SpritesViewJson(const PreviewFrame& frame, bool storing,
          {"contact", {c.contact.x, c.contact.y}},
          {"track", c.track},
          {"verdict", verdict},
+         {"merged", c.merged},
          {"ground", c.ground ? nlohmann::json{c.ground->x(), c.ground->y()} : nlohmann::json()}});
   }
   return {{"sequence", frame.sequence}, {"timestamp_ns", frame.timestamp_ns},

@@ -27,6 +27,7 @@ struct PreviewCandidate {
   int track = -1;                         // -1: its ray missed the floor
   std::optional<Eigen::Vector2d> ground;  // metres
   Discard reason = Discard::kNone;
+  bool merged = false;  // two or more subjects in one blob: stored tagged `merged`
 };
 
 struct PreviewFrame {

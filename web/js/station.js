@@ -67,6 +67,8 @@ class Tile {
         <dt title="incomplete frames, sequence gaps, unreadable frames">drops source</dt><dd class="num" data-testid="tile-drops-source">–</dd>
         <dt>queue</dt><dd class="num"><span data-testid="tile-queue">–</span><i class="meter"><i data-testid="tile-queue-meter"></i></i></dd>
         <dt title="empty-enclosure frames the keyer learnt from">learnt</dt><dd class="num" data-testid="tile-learnt">–</dd>
+        <dt title="sprites this camera stored since the station started">stored</dt><dd class="num" data-testid="tile-stored">–</dd>
+        <dt title="of them, two or more subjects in one blob: tagged merged, left out of transitions">merged</dt><dd class="num" data-testid="tile-merged">–</dd>
       </dl>
       <div class="exposure">
         <canvas class="hist" data-testid="tile-histogram" title="green-screen histogram (r, g, b); shaded: green below 40"></canvas>
@@ -81,7 +83,7 @@ class Tile {
       name: q('tile-name'), state: q('tile-state'), fps: q('tile-fps'), canvas: q('tile-canvas'),
       msg: q('tile-message'), frame: q('tile-frame'), cands: q('tile-candidates'), error: q('tile-error'),
       dq: q('tile-drops-queue'), ds: q('tile-drops-source'), queue: q('tile-queue'), meter: q('tile-queue-meter'),
-      learnt: q('tile-learnt'), hist: q('tile-histogram'), clipped: q('tile-clipped'), dark: q('tile-dark'),
+      learnt: q('tile-learnt'), stored: q('tile-stored'), merged: q('tile-merged'), hist: q('tile-histogram'), clipped: q('tile-clipped'), dark: q('tile-dark'),
       uniformity: q('tile-uniformity'), green: q('tile-green'),
     };
     this.els.name.textContent = name;
@@ -132,6 +134,8 @@ class Tile {
     e.meter.style.width = `${Math.round(Math.min(1, fill) * 100)}%`;
     e.meter.classList.toggle('hot', fill > 0.75);
     e.learnt.textContent = cam.learnt_from?.frames ? `${fmt(cam.learnt_from.frames)} fr` : 'not yet';
+    e.stored.textContent = fmt(cam.sprites_stored);
+    e.merged.textContent = fmt(cam.sprites_merged);
     const x = cam.exposure;
     e.clipped.textContent = x ? `${fmt(x.clipped_percent, 1)}%` : '–';
     e.dark.textContent = x ? `${fmt(x.dark_percent, 1)}%` : '–';
@@ -226,6 +230,8 @@ class Tile {
       ctx.strokeStyle = colour;
       ctx.fillStyle = colour;
       ctx.lineWidth = 2 * px;
+      // Two or more subjects in one blob: stored tagged merged, drawn dashed.
+      ctx.setLineDash(c.merged ? [6 * px, 4 * px] : []);
       if (c.outline && c.outline.length > 1) {
         ctx.beginPath();
         c.outline.forEach(([x, y], i) => (i ? ctx.lineTo(x * s, y * s) : ctx.moveTo(x * s, y * s)));
@@ -234,6 +240,11 @@ class Tile {
       } else if (c.bbox) {
         ctx.strokeRect(c.bbox[0] * s, c.bbox[1] * s, c.bbox[2] * s, c.bbox[3] * s);
       }
+      // The outline is the blob's largest part; a merged blob's box holds all of its subjects.
+      if (c.merged && c.bbox && c.outline?.length > 1) {
+        ctx.strokeRect(c.bbox[0] * s, c.bbox[1] * s, c.bbox[2] * s, c.bbox[3] * s);
+      }
+      ctx.setLineDash([]);
       if (c.contact) {
         ctx.beginPath();
         ctx.arc(c.contact[0] * s, c.contact[1] * s, 3.5 * px, 0, Math.PI * 2);
@@ -243,7 +254,7 @@ class Tile {
         ctx.stroke();
       }
       if (c.bbox) {
-        const label = c.track >= 0 ? `#${c.track}` : '–';
+        const label = (c.track >= 0 ? `#${c.track}` : '–') + (c.merged ? ' ×2' : '');
         const tx = c.bbox[0] * s;
         const ty = Math.max(12 * px, c.bbox[1] * s - 2 * px);
         const tw = ctx.measureText(label).width;
@@ -254,6 +265,7 @@ class Tile {
       }
     }
     this.root.dataset.candidates = String(cands.length);
+    this.root.dataset.merged = String(cands.filter((c) => c.merged).length);
     this.root.dataset.verdicts = [...new Set(cands.map((c) => c.verdict))].join(',');
     this.els.cands.textContent = data.training ? 'training' : `${cands.length} candidate${cands.length === 1 ? '' : 's'}`;
     this.#showFrame(data.sequence);
@@ -465,6 +477,7 @@ $('legend').querySelector('ul').append(
     el('li', { 'data-verdict': v }, el('i', { style: { background: c } }), el('span', { text: VERDICT_LABELS[v] || v })),
   ),
   el('li', {}, el('i', { class: 'dot' }), el('span', { text: 'contact point, #track id' })),
+  el('li', {}, el('i', { class: 'dashed' }), el('span', { text: 'dashed, #id ×2: two subjects in one blob (merged)' })),
 );
 
 // ---- wiring ----------------------------------------------------------------
