@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <optional>
+#include <vector>
 
 #include <spdlog/fmt/fmt.h>
 
@@ -55,6 +56,34 @@ double FloorPixelsPerMetre(const CameraModel& model, const GroundPolygon& floor)
   if (!Sees(model, {centre.x(), centre.y(), 0.0})) return 0;
   const double s = ((px - p).norm() + (py - p).norm()) / (2 * step);
   return std::isfinite(s) ? s : 0.0;
+}
+
+double SeenFloorPixelsPerMetre(const CameraModel& model, const GroundPolygon& floor) {
+  if (floor.empty() || model.width() <= 0 || model.height() <= 0) return 0;
+  // A 32x24 grid of pixel centres over the image; each one whose ray meets the floor inside the
+  // polygon (in front of the camera) gives the image's resolution of the floor there.
+  constexpr int kCols = 32, kRows = 24;
+  constexpr double kStep = 0.01;
+  std::vector<double> seen;
+  seen.reserve(kCols * kRows);
+  for (int r = 0; r < kRows; ++r) {
+    for (int c = 0; c < kCols; ++c) {
+      const Eigen::Vector2d px((c + 0.5) * model.width() / kCols,
+                               (r + 0.5) * model.height() / kRows);
+      const std::optional<Eigen::Vector3d> hit = IntersectGround(model.RayInGround(px));
+      if (!hit || !floor.Contains(hit->head<2>()) || !Sees(model, *hit)) continue;
+      const Eigen::Vector3d& g = *hit;
+      const Eigen::Vector2d p = model.ProjectGround(g);
+      const Eigen::Vector2d dx = model.ProjectGround(g + Eigen::Vector3d(kStep, 0, 0));
+      const Eigen::Vector2d dy = model.ProjectGround(g + Eigen::Vector3d(0, kStep, 0));
+      const double s = ((dx - p).norm() + (dy - p).norm()) / (2 * kStep);
+      if (std::isfinite(s) && s > 0) seen.push_back(s);
+    }
+  }
+  if (seen.empty()) return 0;
+  auto mid = seen.begin() + static_cast<std::ptrdiff_t>(seen.size() / 2);
+  std::nth_element(seen.begin(), mid, seen.end());
+  return *mid;
 }
 
 double TallestVisibleM(const CameraModel& model, const GroundPolygon& floor) {
@@ -109,22 +138,23 @@ BankScale ChooseBankScale(const BankScaleInputs& in) {
   if (in.configured > 0)
     return {in.configured, "pipeline.px_per_m " + Num(in.configured) + " (configured)"};
 
-  // auto, empty bank: the finest camera's ground resolution, capped by what fits.
+  // auto, empty bank: the finest camera's resolution of the floor it sees, capped by what fits.
   double finest = 0, tallest = 0;
   for (const CameraModel* m : in.models) {
-    finest = std::max(finest, FloorPixelsPerMetre(*m, in.floor));
+    finest = std::max(finest, SeenFloorPixelsPerMetre(*m, in.floor));
     tallest = std::max(tallest, TallestVisibleM(*m, in.floor));
   }
   if (!(finest > 0)) {
     throw InputError("pipeline.px_per_m",
-                     "auto: no camera sees the floor's centre, so the billboard scale cannot "
-                     "be chosen from the cameras; give pipeline.px_per_m a number");
+                     "auto: no camera sees the floor, so the billboard scale cannot be chosen "
+                     "from the cameras; give pipeline.px_per_m a number");
   }
   // The billboard of a subject `tallest` high: ceil((tallest + margin) * s) + 1 <= max_side_px.
   const double fit = tallest > 0 ? (in.max_side_px - 2) / (tallest + in.margin_m) : finest;
   const double chosen = RoundDown(std::min(finest, fit));
   std::string why = fmt::format(
-      "auto: the finest camera sees {:.0f} px/m at the floor's centre; the tallest thing a camera "
+      "auto: the finest camera sees the floor at {:.0f} px/m (the median over its view of the "
+      "floor); the tallest thing a camera "
       "sees whole on the "
       "floor is {:.2f} m, which fits {} px up to {:.0f} px/m; {} px/m (two digits, rounded down)",
       finest, tallest, in.max_side_px, fit, Num(chosen));

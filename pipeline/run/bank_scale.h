@@ -2,8 +2,8 @@
 // The bank's billboard scale (px_per_m), chosen once for a bank (docs/pipeline.md, "The
 // bank's scale"): a bank that holds sprites keeps its own scale; a configured number
 // (pipeline.px_per_m) overrides for an empty bank; `auto` (0) picks it from the cameras:
-// the finest camera's ground resolution at the floor's centre, capped so that anything a
-// camera can see whole standing on the floor fits the billboard size limit.
+// the finest camera's typical resolution of the floor it sees (SeenFloorPixelsPerMetre), capped
+// so that anything a camera can see whole standing on the floor fits the billboard size limit.
 #include <string>
 #include <vector>
 
@@ -15,6 +15,13 @@ namespace ss {
 
 // Image pixels per metre on the floor at the polygon's centre (0 when the camera does not see it).
 double FloorPixelsPerMetre(const CameraModel& model, const GroundPolygon& floor);
+
+// The camera's typical resolution of the floor: the median, over the image pixels that see the
+// floor (a 32x24 grid), of the image pixels per metre of floor there (0 when it sees none). A
+// subject near the camera covers more of the image than one far away, and the floor's centre
+// can be far off (a wide view over a square): the centre alone would store near subjects below
+// the resolution they were seen at.
+double SeenFloorPixelsPerMetre(const CameraModel& model, const GroundPolygon& floor);
 
 // The height (metres) of the tallest upright thing the camera sees whole, standing anywhere on
 // the floor that the camera sees (0 when it sees none of it). A usable sprite never touches the
