@@ -135,8 +135,9 @@ export async function fakecam(s, camera, address) {
   return cam;
 }
 
-// Writes a station config: `cameras` a list of {name, source, ...} objects.
-export function config(name, s, cameras, { control = {}, storage = {} } = {}) {
+// Writes a station config: `cameras` a list of {name, source, ...} objects; `control`,
+// `storage` and `pipeline` add keys to those sections.
+export function config(name, s, cameras, { control = {}, storage = {}, pipeline = {} } = {}) {
   const dir = path.join(WORK, name);
   fs.mkdirSync(dir, { recursive: true });
   const y = (v) => JSON.stringify(v); // JSON is YAML
@@ -149,6 +150,7 @@ export function config(name, s, cameras, { control = {}, storage = {} } = {}) {
   lines.push('enclosure:', `  floor: ${y(s.floor)}`);
   const st = { bank: path.join(dir, 'station.bank'), recording_dir: path.join(dir, 'recordings'), ...storage };
   lines.push('storage:', ...Object.entries(st).map(([k, v]) => `  ${k}: ${y(v)}`));
+  if (Object.keys(pipeline).length) lines.push('pipeline:', ...Object.entries(pipeline).map(([k, v]) => `  ${k}: ${y(v)}`));
   const ctl = { port: 0, ...control };
   lines.push('control:', ...Object.entries(ctl).map(([k, v]) => `  ${k}: ${y(v)}`));
   const file = path.join(dir, 'station.yaml');
