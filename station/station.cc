@@ -1,14 +1,14 @@
+// The station: start and stop, its status, reloading the config. Sessions and the recorder
+// taps are in station_sessions.cc, previews in station_previews.cc, the bank writer in
+// bank_writer_thread.cc, the disk guard in disk_guard.cc (shared state: station_impl.h).
 #include "station/station.h"
 
 #include <algorithm>
 #include <atomic>
 #include <chrono>
-#include <ctime>
-#include <filesystem>
 #include <mutex>
 #include <thread>
 
-#include <nlohmann/json.hpp>
 #include <opencv2/core/utility.hpp>
 
 #include "capture/camera_source.h"
@@ -27,42 +27,13 @@
 namespace ss {
 namespace {
 
-namespace fs = std::filesystem;
 using station_detail::Clock;
+using station_detail::kPreviewIntervalS;
 using station_detail::Seconds;
 
 // SIGTERM must finish within 5 s: from the start of Stop, the transition worker may drain this
 // long.
 constexpr double kTransitionDrainS = 3.0;
-
-// Preview snapshots a camera takes, idle and while a session stores; each view of a snapshot is
-// encoded once, for every viewer, so these are also the most images a second a view costs.
-constexpr double kPreviewIntervalS = 0.2, kPreviewIntervalSessionS = 0.5;
-
-std::string UtcNow(const char* format = "%Y-%m-%dT%H:%M:%SZ") {
-  const std::time_t t = std::time(nullptr);
-  std::tm tm{};
-  gmtime_r(&t, &tm);
-  char text[64];
-  std::strftime(text, sizeof text, format, &tm);
-  return text;
-}
-
-// A session name: what a studio user types, kept usable as a folder name.
-std::string CheckSessionName(const std::string& name) {
-  if (name.empty() || name.size() > 100)
-    throw InputError("name", "a session name needs 1 to 100 characters");
-  for (const char c : name) {
-    if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_' || c == '.' ||
-          c == ' ')) {
-      throw InputError(
-          "name", "\"" + name + "\": only letters, digits, space, '-', '_' and '.' are allowed");
-    }
-  }
-  if (name == "." || name == "..")
-    throw InputError("name", "\"" + name + "\" is not a session name");
-  return name;
-}
 
 void ApplyLogging(const LoggingConfig& logging) {
   SetLogLevel(logging.level);
@@ -71,56 +42,6 @@ void ApplyLogging(const LoggingConfig& logging) {
 }
 
 }  // namespace
-
-PreviewCache::Entry* Station::Impl::CachedPreview(const std::string& camera, int view, int width,
-                                                  std::unique_lock<std::mutex>* lock,
-                                                  std::shared_ptr<const PreviewFrame>* frame,
-                                                  const CameraRunner** runner) const {
-  for (size_t k = 0; k < runners.size(); ++k) {
-    if (runners[k]->name() != camera) continue;
-    PreviewCache& cache = *preview_caches[k];
-    *lock = std::unique_lock(cache.mutex);
-    *runner = runners[k].get();
-    *frame = runners[k]->preview();
-    if (!*frame) return nullptr;
-    PreviewCache::Entry& entry = cache.entries[{view, width}];
-    if (entry.frame_taken == (*frame)->taken) {
-      *frame = nullptr;  // made from this snapshot already
-    } else {
-      entry.frame_taken = (*frame)->taken;
-    }
-    return &entry;
-  }
-  throw NotFoundError("camera", "no camera named \"" + camera + "\"");
-}
-
-void Station::Impl::Tap(int camera, const Frame& frame, uint64_t drops_before, bool usable) {
-  {
-    std::lock_guard lock(watcher_mutex);
-    if (watcher) watcher(camera, frame);
-  }
-  std::lock_guard lock(recorder_mutex);
-  if (!recorder) return;
-  const std::optional<SourceCamera> source = runners[static_cast<size_t>(camera)]->source_camera();
-  if (!source) return;
-  const std::optional<CameraModel>& model = models[static_cast<size_t>(camera)];
-  recorder->Offer(camera, *source, model ? &*model : nullptr, frame, drops_before, usable);
-}
-
-void Station::Impl::StopRecording(const std::string& why) {
-  std::unique_ptr<StationRecorder> done;
-  {
-    std::lock_guard lock(recorder_mutex);
-    done.swap(recorder);
-  }
-  if (!done) return;
-  done->Close();
-  std::lock_guard lock(recorder_mutex);
-  last_recording = done->stats();
-  log->info("recording {} closed ({} frames, {} dropped){}", last_recording.dir,
-            last_recording.frames_written, last_recording.frames_dropped,
-            why.empty() ? "" : ": " + why);
-}
 
 Station::Station(StationOptions options) : impl_(std::make_unique<Impl>()) {
   Impl& s = *impl_;
@@ -275,111 +196,6 @@ void Station::Stop() {
   s.log->info("station stopped: {} sprites stored", s.sprites_stored);
 }
 
-SessionStatus Station::StartSession(const std::string& requested_name) {
-  Impl& s = *impl_;
-  const std::string name = CheckSessionName(requested_name);
-  std::lock_guard control(s.control_mutex);
-  std::unique_lock lock(s.session_mutex);
-  if (s.state != StationState::kRunning)
-    throw ConflictError("session", "the station is not running");
-  if (s.session.active)
-    throw ConflictError("session", "session \"" + s.session.name + "\" is running; stop it first");
-  const std::string created = UtcNow();
-  SessionRecord record;
-  record.uid = name + "@" + created;
-  record.name = name;
-  record.created = created;
-  record.source = "station";
-  std::vector<int64_t> camera_ids(s.runners.size(), 0);
-  {
-    std::lock_guard bank_lock(s.bank_mutex);
-    const int64_t session_id = s.bank->AddSession(record);
-    s.session = SessionStatus{};
-    s.session.bank_session_id = session_id;
-    for (size_t i = 0; i < s.runners.size(); ++i) {
-      if (!s.models[i]) continue;
-      CameraRecord camera;
-      camera.name = s.runners[i]->name();
-      camera.cameramodel = s.models[i]->ToText();
-      camera.width = s.models[i]->width();
-      camera.height = s.models[i]->height();
-      camera_ids[i] = s.bank->AddCamera(session_id, camera);
-    }
-  }
-  s.session.active = true;
-  s.session_active = true;
-  s.session.name = name;
-  s.session.started = created;
-  s.session_started = Clock::now();
-  const StorageConfig storage = s.StorageSettings();
-  StorageState storage_state;
-  {
-    std::lock_guard stats_lock(s.stats_mutex);
-    storage_state = s.storage_state;
-  }
-  if (storage.recording != RecordingMode::kOff && storage_state == StorageState::kOk) {
-    const fs::path dir = fs::path(storage.recording_dir) / (name + "-" + UtcNow("%Y%m%dT%H%M%SZ"));
-    RecordingOptions recording;
-    recording.codec = storage.recording_codec;
-    try {
-      auto recorder = std::make_unique<StationRecorder>(dir.string(), name, recording,
-                                                        storage.recording == RecordingMode::kUsable,
-                                                        static_cast<int>(s.runners.size()));
-      std::lock_guard rec_lock(s.recorder_mutex);
-      s.recorder = std::move(recorder);
-      s.session.recording_dir = dir.string();
-    } catch (const std::exception& e) {
-      s.log->error("recording: {}", e.what());
-      std::lock_guard rec_lock(s.recorder_mutex);
-      s.last_recording.error = e.what();
-    }
-  }
-  SessionStatus out = s.session;
-  lock.unlock();  // the writer updates the session's counts meanwhile
-  for (size_t i = 0; i < s.runners.size(); ++i) s.runners[i]->SetBankCamera(camera_ids[i]);
-  // Previews back off while a session stores: fewer snapshots for the pipeline threads to copy.
-  for (auto& r : s.runners) r->set_preview_interval(kPreviewIntervalSessionS);
-  s.log->info("session \"{}\" started (bank session {})", name, out.bank_session_id);
-  return out;
-}
-
-SessionStatus Station::StopSession() {
-  Impl& s = *impl_;
-  std::lock_guard control(s.control_mutex);
-  {
-    std::lock_guard lock(s.session_mutex);
-    if (!s.session.active) throw ConflictError("session", "no session is running");
-  }
-  // Every open clip closes into the writer queue under the session's cameras; then
-  // the writer stores them all before the session is reported stopped.
-  for (auto& r : s.runners) r->SetBankCamera(0);
-  s.WaitWriterIdle();
-  s.StopRecording("the session stopped");
-  std::lock_guard lock(s.session_mutex);
-  s.session.active = false;
-  s.session_active = false;
-  for (auto& r : s.runners) r->set_preview_interval(kPreviewIntervalS);
-  s.session.seconds = Seconds(Clock::now() - s.session_started);
-  s.log->info("session \"{}\" stopped: {} sprites stored", s.session.name,
-              s.session.sprites_stored);
-  return s.session;
-}
-
-SessionStatus Station::RenameSession(const std::string& requested_name) {
-  Impl& s = *impl_;
-  const std::string name = CheckSessionName(requested_name);
-  std::lock_guard control(s.control_mutex);
-  std::lock_guard lock(s.session_mutex);
-  if (!s.session.active) throw ConflictError("session", "no session is running");
-  {
-    std::lock_guard bank_lock(s.bank_mutex);
-    s.bank->RenameSession(s.session.bank_session_id, name);
-  }
-  s.log->info("session \"{}\" renamed \"{}\"", s.session.name, name);
-  s.session.name = name;
-  return s.session;
-}
-
 StationStatus Station::Status() const {
   const Impl& s = *impl_;
   StationStatus out;
@@ -453,41 +269,6 @@ StationStatus Station::Status() const {
     if (!r.error.empty()) out.recording_error = r.error;
   }
   return out;
-}
-
-std::optional<Station::PreviewImage> Station::Preview(const std::string& camera, PreviewView view,
-                                                      int max_width) const {
-  const int width = std::clamp(max_width, 16, 4096);
-  std::unique_lock<std::mutex> lock;
-  std::shared_ptr<const PreviewFrame> frame;
-  const CameraRunner* runner = nullptr;
-  PreviewCache::Entry* entry = impl_->CachedPreview(camera, view == PreviewView::kKeyed ? 1 : 0,
-                                                    width, &lock, &frame, &runner);
-  if (entry == nullptr) return std::nullopt;
-  if (frame) {
-    entry->image = {EncodeJpeg(RenderPreview(*frame, view, width)), frame->sequence,
-                    frame->timestamp_ns, frame->bgr.cols, frame->bgr.rows};
-  }
-  return entry->image;
-}
-
-std::optional<std::string> Station::SpritesView(const std::string& camera, int max_width) const {
-  const int width = std::clamp(max_width, 16, 4096);
-  std::unique_lock<std::mutex> lock;
-  std::shared_ptr<const PreviewFrame> frame;
-  const CameraRunner* runner = nullptr;
-  PreviewCache::Entry* entry = impl_->CachedPreview(camera, 2, width, &lock, &frame, &runner);
-  if (entry == nullptr) return std::nullopt;
-  if (frame) {
-    const cv::Mat image = RenderPreview(*frame, PreviewView::kRaw, width);
-    const double scale = frame->bgr.cols > 0 ? double(image.cols) / frame->bgr.cols : 1.0;
-    const bool storing = SessionActive() && runner->model().has_value();
-    entry->sprites_json =
-        SpritesViewJson(*frame, storing, "data:image/jpeg;base64," + Base64(EncodeJpeg(image)),
-                        scale)
-            .dump();
-  }
-  return entry->sprites_json;
 }
 
 const std::string& Station::bank_path() const { return impl_->options.config.storage.bank; }

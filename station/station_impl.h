@@ -38,6 +38,10 @@ using Clock = std::chrono::steady_clock;
 
 inline double Seconds(Clock::duration d) { return std::chrono::duration<double>(d).count(); }
 
+// Preview snapshots a camera takes, idle and while a session stores; each view of a snapshot is
+// encoded once, for every viewer, so these are also the most images a second a view costs.
+constexpr double kPreviewIntervalS = 0.2, kPreviewIntervalSessionS = 0.5;
+
 }  // namespace station_detail
 
 // One camera's encoded previews, by (view, width): view 0 raw, 1 keyed, 2 the sprites view.
