@@ -7,7 +7,6 @@
 #include <chrono>
 #include <cmath>
 #include <condition_variable>
-#include <ctime>
 #include <deque>
 #include <filesystem>
 #include <fstream>
@@ -31,6 +30,7 @@
 #include "core/error_kinds.h"
 #include "core/frame.h"
 #include "core/log.h"
+#include "core/utc_time.h"
 #include "station/preview.h"
 #include "station/station.h"
 #include "station/station_host.h"
@@ -51,15 +51,6 @@ constexpr double kPublishS = 0.1;   // a camera's state and live view are refres
 constexpr double kGridStepM = 0.1;  // the floor grid drawn over a posed camera's view
 // a view's rays above the horizon end this far away on the plan
 constexpr double kPlanReachM = 8.0;
-
-std::string UtcStamp(const char* format) {
-  const std::time_t now = std::time(nullptr);
-  std::tm tm{};
-  gmtime_r(&now, &tm);
-  char buf[64];
-  std::strftime(buf, sizeof buf, format, &tm);
-  return buf;
-}
 
 nlohmann::json Num(double v) {
   return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr);
@@ -845,7 +836,7 @@ struct ConsoleCalibration::Impl {
                                                : fs::path(context.config_path).parent_path();
     request.config_path = context.config_path;
     request.calibration_dir = (dir / "calibration").string();
-    request.stamp = UtcStamp("%Y%m%dT%H%M%SZ");
+    request.stamp = UtcNowStamp();
     calib::StationSaveResult result;
     try {
       result = calib::SaveStationCalibration(config, request);
@@ -855,7 +846,7 @@ struct ConsoleCalibration::Impl {
       throw;
     }
     nlohmann::json j = {
-        {"at", UtcStamp("%Y-%m-%dT%H:%M:%SZ")},
+        {"at", UtcNowIso()},
         {"files", result.files},
         {"previous", result.previous},
         {"config", context.config_path.empty() ? nlohmann::json(nullptr)

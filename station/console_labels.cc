@@ -5,7 +5,6 @@
 #include <cmath>
 #include <condition_variable>
 #include <cstdio>
-#include <ctime>
 #include <filesystem>
 #include <fstream>
 #include <random>
@@ -19,6 +18,7 @@
 #include "core/error.h"
 #include "core/error_kinds.h"
 #include "core/log.h"
+#include "core/utc_time.h"
 #include "pipeline/transitions/bank_sprites.h"
 #include "pipeline/transitions/bank_training.h"
 #include "pipeline/transitions/bank_transitions.h"
@@ -47,16 +47,6 @@ constexpr size_t kMaxCandidatesPerRow = 1000;
 
 double Now() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
-}
-
-// UTC time as "2026-12-01T06:35:12Z" (iso) or "20261201T063512Z" (a file name's stamp).
-std::string UtcText(bool iso) {
-  const std::time_t t = std::time(nullptr);
-  std::tm tm{};
-  gmtime_r(&t, &tm);
-  char text[32];
-  std::strftime(text, sizeof(text), iso ? "%Y-%m-%dT%H:%M:%SZ" : "%Y%m%dT%H%M%SZ", &tm);
-  return text;
 }
 
 // NotFoundError naming the sprite when the bank has no such sprite.
@@ -400,7 +390,7 @@ nlohmann::json ConsoleLabels::Store(const nlohmann::json& body) {
     CheckSprite(reader, from);
     CheckSprite(reader, to);
   }
-  TransitionLabelRecord record{from, to, label, UtcText(true), "console"};
+  TransitionLabelRecord record{from, to, label, UtcNowIso(), "console"};
   BankWriter(bank).SetTransitionLabel(record);
   {
     std::lock_guard lock(shared_->mutex);
@@ -473,7 +463,7 @@ nlohmann::json ConsoleLabels::StartRetrain() {
                         {"stage", "exporting the labels"},
                         {"labels", yes + no},
                         {"accepts", yes},
-                        {"started", UtcText(true)},
+                        {"started", UtcNowIso()},
                         {"previous_weights", path.empty() ? "shipped defaults" : path}};
   }
   std::thread(RunRetrain, shared_, context_, options_, bank, std::move(weights)).detach();
@@ -514,7 +504,7 @@ void ConsoleLabels::RunRetrain(std::shared_ptr<Shared> shared, api::Context cont
     std::error_code ec;
     fs::create_directories(dir, ec);
     if (ec) throw WorkError(dir.string(), "cannot create the weights folder: " + ec.message());
-    const std::string stamp = UtcText(false);
+    const std::string stamp = UtcNowStamp();
     const fs::path labels_path = FreshName(dir, "labels-", stamp, ".csv");
     const double positive_rate = CalibratedPositiveRate(current);
     WriteText(labels_path, TransitionLabelsCsv(Bank(bank).LoadTransitionLabels(), positive_rate));
@@ -641,14 +631,14 @@ void ConsoleLabels::RunRetrain(std::shared_ptr<Shared> shared, api::Context cont
       r["transitions"] = transitions;
       r["seconds_rebuild"] = rebuild_s;
       r["seconds"] = seconds(t0);
-      r["finished"] = UtcText(true);
+      r["finished"] = UtcNowIso();
     });
   } catch (const std::exception& e) {
     log->error("retrain failed: {}", e.what());
     SetRetrain([&](nlohmann::json& r) {
       r["state"] = "failed";
       r["error"] = e.what();
-      r["finished"] = UtcText(true);
+      r["finished"] = UtcNowIso();
     });
   }
   {

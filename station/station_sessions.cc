@@ -1,12 +1,12 @@
 // The station's capture sessions (start, stop, rename) and what taps the frames while one runs:
 // the recorder and the frame watcher.
-#include <ctime>
 #include <filesystem>
 #include <mutex>
 
 #include "core/bank.h"
 #include "core/error.h"
 #include "core/error_kinds.h"
+#include "core/utc_time.h"
 #include "station/recorder.h"
 #include "station/station.h"
 #include "station/station_impl.h"
@@ -19,15 +19,6 @@ using station_detail::Clock;
 using station_detail::kPreviewIntervalS;
 using station_detail::kPreviewIntervalSessionS;
 using station_detail::Seconds;
-
-std::string UtcNow(const char* format = "%Y-%m-%dT%H:%M:%SZ") {
-  const std::time_t t = std::time(nullptr);
-  std::tm tm{};
-  gmtime_r(&t, &tm);
-  char text[64];
-  std::strftime(text, sizeof text, format, &tm);
-  return text;
-}
 
 // A session name: what a studio user types, kept usable as a folder name.
 std::string CheckSessionName(const std::string& name) {
@@ -84,7 +75,7 @@ SessionStatus Station::StartSession(const std::string& requested_name) {
     throw ConflictError("session", "the station is not running");
   if (s.session.active)
     throw ConflictError("session", "session \"" + s.session.name + "\" is running; stop it first");
-  const std::string created = UtcNow();
+  const std::string created = UtcNowIso();
   SessionRecord record;
   record.uid = name + "@" + created;
   record.name = name;
@@ -118,7 +109,7 @@ SessionStatus Station::StartSession(const std::string& requested_name) {
     storage_state = s.storage_state;
   }
   if (storage.recording != RecordingMode::kOff && storage_state == StorageState::kOk) {
-    const fs::path dir = fs::path(storage.recording_dir) / (name + "-" + UtcNow("%Y%m%dT%H%M%SZ"));
+    const fs::path dir = fs::path(storage.recording_dir) / (name + "-" + UtcNowStamp());
     RecordingOptions recording;
     recording.codec = storage.recording_codec;
     try {

@@ -2,7 +2,6 @@
 
 #include <chrono>
 #include <condition_variable>
-#include <ctime>
 #include <deque>
 #include <filesystem>
 #include <mutex>
@@ -14,21 +13,13 @@
 #include "core/error.h"
 #include "core/log.h"
 #include "core/recording_codecs.h"
+#include "core/utc_time.h"
 
 namespace ss {
 namespace {
 
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
-
-std::string NowIso8601Utc() {
-  const std::time_t now = std::time(nullptr);
-  std::tm utc{};
-  gmtime_r(&now, &utc);
-  char text[32];
-  std::strftime(text, sizeof(text), "%Y-%m-%dT%H:%M:%SZ", &utc);
-  return text;
-}
 
 // A file stem from a device name: "/dev/video0" -> "dev_video0"; "" -> fallback.
 std::string SafeStem(const std::string& name, const std::string& fallback) {
@@ -137,7 +128,7 @@ SessionWriter::SessionWriter(const std::string& dir, const std::string& name,
   impl_->dir = dir;
   impl_->options = options;
   impl_->info.name = name;
-  impl_->info.created = NowIso8601Utc();
+  impl_->info.created = UtcNowIso();
   impl_->info.synthetic = options.synthetic;
   WriteSessionInfo(dir, impl_->info);
   impl_->flusher = std::thread([impl = impl_.get()] { impl->FlusherLoop(); });
