@@ -17,53 +17,16 @@
 #include "pipeline/transitions/classifier.h"
 #include "pipeline/transitions/sprite_store.h"
 #include "pipeline/transitions/synthetic.h"
+#include "tests/pipeline/hand_made_sprites.h"
 #include "tests/pipeline/transitions_test_util.h"
 
 namespace ss {
 namespace {
 
-// 32 x 32 cells at 100 px/m on a 32 x 32 px billboard anchored at (15.5, 31.5): cell (u, v)
-// is exactly pixel (u, v).
-ComparisonWindow CellPerPixel() {
-  ComparisonWindow w;
-  w.width_m = 0.32;
-  w.height_m = 0.32;
-  w.cells_x = 32;
-  w.cells_y = 32;
-  w.align = HorizontalAlignment::kContactPoint;
-  return w;
-}
-
-struct Cell {
-  int x, y;
-  uint8_t alpha;
-};
-
-RgbaBillboard Sprite(const std::vector<Cell>& cells,
-                     const std::array<uint8_t, 3>& rgb = {200, 100, 50}) {
-  RgbaBillboard b;
-  b.width = 32;
-  b.height = 32;
-  b.anchor_x_px = 15.5;
-  b.anchor_y_px = 31.5;
-  b.rgba.assign(32 * 32 * 4, 0);
-  for (const Cell& c : cells) {
-    uint8_t* p = b.rgba.data() + (static_cast<size_t>(c.y) * 32 + c.x) * 4;
-    p[0] = rgb[0];
-    p[1] = rgb[1];
-    p[2] = rgb[2];
-    p[3] = c.alpha;
-  }
-  return b;
-}
-
-std::vector<Cell> Rectangle(int x0, int y0, int x1, int y1, uint8_t alpha) {
-  std::vector<Cell> out;
-  for (int y = y0; y < y1; ++y) {
-    for (int x = x0; x < x1; ++x) out.push_back({x, y, alpha});
-  }
-  return out;
-}
+using testing::Cell;
+using testing::CellPerPixel;
+using testing::Rectangle;
+using testing::Sprite;
 
 // Linf weights: stage 1 = the velocity bound alone (so it passes every pair stage 2 can keep).
 TransitionWeights LinfWeights(const ComparisonWindow& window, double max_velocity,
