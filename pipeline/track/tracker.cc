@@ -2,7 +2,10 @@
 
 #include <algorithm>
 #include <limits>
+#include <string>
 #include <tuple>
+
+#include "core/log.h"
 
 namespace ss {
 
@@ -64,7 +67,11 @@ std::vector<bool> MergeDetector::Update(const std::vector<Blob>& blobs) {
     int frames;  // the giving track's frames in a row (counted on in this blob)
     double merged_area;
     bool swallowed;  // a lost track, not the blob's own
+    int from;        // the giving track
   };
+  const auto log = Log("pipeline.track");
+  const bool debug = log->should_log(spdlog::level::debug);
+  ++updates_;
   std::vector<std::vector<Share>> shares(blobs.size());
   // Blobs whose track was not seen in the frame before: new subjects, or ones found again.
   std::vector<bool> fresh(blobs.size(), true);
@@ -85,12 +92,19 @@ std::vector<bool> MergeDetector::Update(const std::vector<Blob>& blobs) {
         const bool keeps = p.subjects >= 2 && blobs[i].area >= options_.keep_area_share * p.area;
         // The pieces of a merged blob are subjects: they may merge again at once.
         const int frames = p.subjects >= 2 ? std::max(p.frames, options_.min_track_frames) : 1;
-        shares[i].push_back({keeps ? p.subjects : 1, frames, keeps ? p.merged_area : 0, false});
+        shares[i].push_back(
+            {keeps ? p.subjects : 1, frames, keeps ? p.merged_area : 0, false, p.track});
+        if (debug) {
+          log->debug(
+              "merge update {}: track {} ({} subjects, area {:.0f}) split: track {} area {:.0f}{}",
+              updates_, p.track, p.subjects, p.area, blobs[i].track, blobs[i].area,
+              keeps ? " keeps its count" : "");
+        }
       }
       continue;
     }
     if (children.size() == 1) {
-      shares[children.front()].push_back({p.subjects, p.frames + 1, p.merged_area, false});
+      shares[children.front()].push_back({p.subjects, p.frames + 1, p.merged_area, false, p.track});
       continue;
     }
     // No blob of its own: swallowed by the blob whose box holds most of its box, if any does.
@@ -104,7 +118,7 @@ std::vector<bool> MergeDetector::Update(const std::vector<Blob>& blobs) {
       }
     }
     if (best < blobs.size())
-      shares[best].push_back({p.subjects, p.frames + 1, p.merged_area, true});
+      shares[best].push_back({p.subjects, p.frames + 1, p.merged_area, true, p.track});
   }
   std::vector<bool> merged(blobs.size(), false);
   std::vector<Seen> seen;
@@ -115,7 +129,12 @@ std::vector<bool> MergeDetector::Update(const std::vector<Blob>& blobs) {
     int n = 0, frames = 1;
     double at_merge = 0;
     const bool several = shares[i].size() >= 2;
+    std::string from;  // for the debug log
     for (const Share& sh : shares[i]) {
+      if (debug) {
+        from += fmt::format(" {}{}:{}x{}f", sh.swallowed ? "swallowed " : "", sh.from, sh.subjects,
+                            sh.frames);
+      }
       if (several && sh.swallowed && sh.frames - 1 < options_.min_track_frames) continue;
       n += sh.subjects;
       frames = std::max(frames, sh.frames);
@@ -123,7 +142,14 @@ std::vector<bool> MergeDetector::Update(const std::vector<Blob>& blobs) {
     }
     n = std::clamp(n, 1, kMaxSubjects);
     if (n >= 2 && at_merge <= 0) at_merge = blobs[i].area;  // it merged in this frame
-    if (n >= 2 && blobs[i].area < options_.drop_area_share * at_merge) n = 1;
+    const bool dropped = n >= 2 && blobs[i].area < options_.drop_area_share * at_merge;
+    if (dropped) n = 1;
+    if (debug && (several || n >= 2 || dropped)) {
+      const cv::Rect& b = blobs[i].box;
+      log->debug("merge update {}: track {} box {}x{}+{}+{} area {:.0f} counts {}{} from{}",
+                 updates_, blobs[i].track, b.width, b.height, b.x, b.y, blobs[i].area, n,
+                 dropped ? " (area under drop_area_share of the merge's)" : "", from);
+    }
     if (n < 2) at_merge = 0;
     merged[i] = n >= 2;
     if (blobs[i].track >= 0) {

@@ -94,6 +94,7 @@ class MergeDetector {
   };
   Options options_;
   std::vector<Seen> previous_;
+  int64_t updates_ = 0;  // frames seen, for the debug log
 };
 
 // Cuts each subject's frames into clips: runs of consecutive usable frames.
