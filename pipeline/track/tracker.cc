@@ -78,12 +78,24 @@ std::vector<bool> MergeDetector::Update(const std::vector<Blob>& blobs) {
   for (size_t i = 0; i < blobs.size(); ++i) {
     for (const Seen& p : previous_) fresh[i] = fresh[i] && p.track != blobs[i].track;
   }
+  // A fresh blob came out of one track of the frame before at most: of those whose box holds it,
+  // the one with the smallest box. A blob of several subjects can have a box that holds another
+  // track's box whole; a piece in both is that track's, not one subject of each.
+  std::vector<const Seen*> parent(blobs.size(), nullptr);
+  for (size_t i = 0; i < blobs.size(); ++i) {
+    if (!fresh[i]) continue;
+    for (const Seen& p : previous_) {
+      if (ShareInside(blobs[i].box, p.box) >= options_.split_share &&
+          (parent[i] == nullptr || AreaOf(p.box) < AreaOf(parent[i]->box))) {
+        parent[i] = &p;
+      }
+    }
+  }
   for (const Seen& p : previous_) {
     // This frame's blobs that came out of p: its own (the tracker's) and new ones in its box.
     std::vector<size_t> children;
     for (size_t i = 0; i < blobs.size(); ++i) {
-      if (blobs[i].track == p.track ||
-          (fresh[i] && ShareInside(blobs[i].box, p.box) >= options_.split_share)) {
+      if (blobs[i].track == p.track || parent[i] == &p) {
         children.push_back(i);
       }
     }

@@ -88,6 +88,24 @@ TEST(MergeDetector, AMergedBlobThatShrinksToOneSubjectIsNoLongerMerged) {
   EXPECT_EQ(d.Update({{0, both, 2000}}), std::vector<bool>({false}));
 }
 
+// A subject lost for a frame and found again under a new id, whose box lies inside both its own
+// track's box and a big blob's box (a crowd at the frame's edge): it came out of its own track,
+// not of both (vtest.avi frame 152: one person tagged merged).
+TEST(MergeDetector, APieceInsideTwoTracksBoxesCameOutOfTheTighterOne) {
+  MergeDetector d;
+  const cv::Rect crowd(100, 0, 600, 300), person(400, 200, 60, 100);
+  for (int f = 0; f < 5; ++f) {
+    d.Update({{0, cv::Rect(100, 0, 200, 150), 3000}, {1, cv::Rect(400, 0, 200, 150), 3000}});
+  }
+  // The two meet in one blob whose box grows over the person's.
+  EXPECT_EQ(d.Update({{0, crowd, 6000}, {2, person, 1300}}), std::vector<bool>({true, false}));
+  // The person, under a new id (its contact point jumped), and the crowd under a new id too.
+  EXPECT_EQ(d.Update({{3, crowd, 6000}, {4, cv::Rect(404, 202, 56, 100), 1300}}),
+            std::vector<bool>({true, false}));
+  EXPECT_EQ(d.Update({{3, crowd, 6000}, {4, cv::Rect(410, 202, 56, 100), 1300}}),
+            std::vector<bool>({true, false}));
+}
+
 TEST(ClipCutter, ClipsAreRunsOfConsecutiveUsableFrames) {
   ClipCutter cutter;
   // Subject 7: usable, usable, unusable, usable, then unseen.
