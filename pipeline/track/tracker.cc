@@ -1,6 +1,7 @@
 #include "pipeline/track/tracker.h"
 
 #include <algorithm>
+#include <iterator>
 #include <limits>
 #include <string>
 #include <tuple>
@@ -66,8 +67,9 @@ std::vector<bool> MergeDetector::Update(const std::vector<Blob>& blobs) {
     int subjects;
     int frames;  // the giving track's frames in a row (counted on in this blob)
     double merged_area;
-    bool swallowed;  // a lost track, not the blob's own
-    int from;        // the giving track
+    bool swallowed;            // a lost track, not the blob's own
+    int from;                  // the giving track
+    std::vector<int> members;  // the tracks swallowed into the giving blob, counted in it
   };
   const auto log = Log("pipeline.track");
   const bool debug = log->should_log(spdlog::level::debug);
@@ -100,12 +102,25 @@ std::vector<bool> MergeDetector::Update(const std::vector<Blob>& blobs) {
       }
     }
     if (children.size() >= 2) {  // a split: one subject each, unless a piece kept most of it
+      // Pieces that are tracks swallowed into p, come out again under their own ids: partners
+      // that left. The piece keeping most of p's area keeps its count less theirs.
+      std::vector<int> left;
+      for (size_t i : children) {
+        if (std::find(p.members.begin(), p.members.end(), blobs[i].track) != p.members.end())
+          left.push_back(blobs[i].track);
+      }
       for (size_t i : children) {
         const bool keeps = p.subjects >= 2 && blobs[i].area >= options_.keep_area_share * p.area;
         // The pieces of a merged blob are subjects: they may merge again at once.
         const int frames = p.subjects >= 2 ? std::max(p.frames, options_.min_track_frames) : 1;
+        std::vector<int> members;
+        if (keeps) {
+          std::copy_if(p.members.begin(), p.members.end(), std::back_inserter(members),
+                       [&](int t) { return std::find(left.begin(), left.end(), t) == left.end(); });
+        }
+        const int count = keeps ? std::max(p.subjects - static_cast<int>(left.size()), 1) : 1;
         shares[i].push_back(
-            {keeps ? p.subjects : 1, frames, keeps ? p.merged_area : 0, false, p.track});
+            {count, frames, count >= 2 ? p.merged_area : 0, false, p.track, std::move(members)});
         if (debug) {
           log->debug(
               "merge update {}: track {} ({} subjects, area {:.0f}) split: track {} area {:.0f}{}",
@@ -116,7 +131,8 @@ std::vector<bool> MergeDetector::Update(const std::vector<Blob>& blobs) {
       continue;
     }
     if (children.size() == 1) {
-      shares[children.front()].push_back({p.subjects, p.frames + 1, p.merged_area, false, p.track});
+      shares[children.front()].push_back(
+          {p.subjects, p.frames + 1, p.merged_area, false, p.track, p.members});
       continue;
     }
     // No blob of its own: swallowed by the blob whose box holds most of its box, if any does.
@@ -130,7 +146,7 @@ std::vector<bool> MergeDetector::Update(const std::vector<Blob>& blobs) {
       }
     }
     if (best < blobs.size())
-      shares[best].push_back({p.subjects, p.frames + 1, p.merged_area, true, p.track});
+      shares[best].push_back({p.subjects, p.frames + 1, p.merged_area, true, p.track, p.members});
   }
   std::vector<bool> merged(blobs.size(), false);
   std::vector<Seen> seen;
@@ -140,6 +156,7 @@ std::vector<bool> MergeDetector::Update(const std::vector<Blob>& blobs) {
     // had been seen long enough; a blob made only of one lost track is its continuation.
     int n = 0, frames = 1;
     double at_merge = 0;
+    std::vector<int> members;
     const bool several = shares[i].size() >= 2;
     std::string from;  // for the debug log
     for (const Share& sh : shares[i]) {
@@ -151,6 +168,8 @@ std::vector<bool> MergeDetector::Update(const std::vector<Blob>& blobs) {
       n += sh.subjects;
       frames = std::max(frames, sh.frames);
       at_merge = std::max(at_merge, sh.merged_area);
+      members.insert(members.end(), sh.members.begin(), sh.members.end());
+      if (several && sh.swallowed) members.push_back(sh.from);
     }
     n = std::clamp(n, 1, kMaxSubjects);
     if (n >= 2 && at_merge <= 0) at_merge = blobs[i].area;  // it merged in this frame
@@ -162,11 +181,14 @@ std::vector<bool> MergeDetector::Update(const std::vector<Blob>& blobs) {
                  updates_, blobs[i].track, b.width, b.height, b.x, b.y, blobs[i].area, n,
                  dropped ? " (area under drop_area_share of the merge's)" : "", from);
     }
-    if (n < 2) at_merge = 0;
+    if (n < 2) {
+      at_merge = 0;
+      members.clear();
+    }
     merged[i] = n >= 2;
     if (blobs[i].track >= 0) {
-      seen.push_back(
-          {blobs[i].track, blobs[i].box, n, at_merge, std::min(frames, 1000), blobs[i].area});
+      seen.push_back({blobs[i].track, blobs[i].box, n, at_merge, std::min(frames, 1000),
+                      blobs[i].area, std::move(members)});
     }
   }
   previous_ = std::move(seen);

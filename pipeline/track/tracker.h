@@ -57,7 +57,8 @@ class Tracker {
 //     blobs of this frame, its own and ones whose track was not seen in the frame before (new or
 //     found again; such a blob is a piece of the smallest box holding it only), split: each of them
 //     counts one subject, but a piece keeping most of a merged blob's area (>= keep_area_share)
-//     keeps its count (the other piece was a part keyed apart); the pieces of a merged blob count
+//     keeps its count (the other piece was a part keyed apart), less the counts of pieces that are
+//     tracks it swallowed, come out under their own ids again; the pieces of a merged blob count
 //     as seen long enough, so that they merge again at once;
 //   - a blob without a track of the frame before counts one subject.
 // A blob counting two or more is `merged`. A merged blob whose area falls under
@@ -91,6 +92,7 @@ class MergeDetector {
     double merged_area;  // its area when it became merged (subjects >= 2)
     int frames;          // frames in a row the track was seen
     double area;
+    std::vector<int> members;  // tracks swallowed into it and counted (subjects >= 2)
   };
   Options options_;
   std::vector<Seen> previous_;

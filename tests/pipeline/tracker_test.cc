@@ -106,6 +106,20 @@ TEST(MergeDetector, APieceInsideTwoTracksBoxesCameOutOfTheTighterOne) {
             std::vector<bool>({true, false}));
 }
 
+// A small subject swallowed by a big one's blob comes out again under its own id: the big one's
+// piece keeps most of the area but holds one subject again (vtest.avi frame 212: a person
+// tagged merged for 20 frames after the other had left).
+TEST(MergeDetector, ASwallowedTrackComingOutAgainTakesItsCountAlong) {
+  MergeDetector d;
+  const cv::Rect big(100, 100, 40, 100), small(150, 60, 20, 40), both(100, 60, 70, 140);
+  for (int f = 0; f < 5; ++f) d.Update({{0, big, 1500}, {1, small, 500}});
+  EXPECT_EQ(d.Update({{0, both, 2000}}), std::vector<bool>({true}));
+  EXPECT_EQ(d.Update({{0, both, 2000}}), std::vector<bool>({true}));
+  // Apart again; the big one keeps 3/4 of the merged area.
+  EXPECT_EQ(d.Update({{0, big, 1550}, {1, small, 500}}), std::vector<bool>({false, false}));
+  EXPECT_EQ(d.Update({{0, big, 1550}, {1, small, 500}}), std::vector<bool>({false, false}));
+}
+
 TEST(ClipCutter, ClipsAreRunsOfConsecutiveUsableFrames) {
   ClipCutter cutter;
   // Subject 7: usable, usable, unusable, usable, then unseen.
