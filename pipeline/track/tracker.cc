@@ -1,8 +1,12 @@
 #include "pipeline/track/tracker.h"
 
 #include <algorithm>
+#include <iterator>
 #include <limits>
+#include <string>
 #include <tuple>
+
+#include "core/log.h"
 
 namespace ss {
 
@@ -63,34 +67,72 @@ std::vector<bool> MergeDetector::Update(const std::vector<Blob>& blobs) {
     int subjects;
     int frames;  // the giving track's frames in a row (counted on in this blob)
     double merged_area;
-    bool swallowed;  // a lost track, not the blob's own
+    bool swallowed;            // a lost track, not the blob's own
+    int from;                  // the giving track
+    std::vector<int> members;  // the tracks swallowed into the giving blob, counted in it
   };
+  const auto log = Log("pipeline.track");
+  const bool debug = log->should_log(spdlog::level::debug);
+  ++updates_;
   std::vector<std::vector<Share>> shares(blobs.size());
   // Blobs whose track was not seen in the frame before: new subjects, or ones found again.
   std::vector<bool> fresh(blobs.size(), true);
   for (size_t i = 0; i < blobs.size(); ++i) {
     for (const Seen& p : previous_) fresh[i] = fresh[i] && p.track != blobs[i].track;
   }
+  // A fresh blob came out of one track of the frame before at most: of those whose box holds it,
+  // the one with the smallest box. A blob of several subjects can have a box that holds another
+  // track's box whole; a piece in both is that track's, not one subject of each.
+  std::vector<const Seen*> parent(blobs.size(), nullptr);
+  for (size_t i = 0; i < blobs.size(); ++i) {
+    if (!fresh[i]) continue;
+    for (const Seen& p : previous_) {
+      if (ShareInside(blobs[i].box, p.box) >= options_.split_share &&
+          (parent[i] == nullptr || AreaOf(p.box) < AreaOf(parent[i]->box))) {
+        parent[i] = &p;
+      }
+    }
+  }
   for (const Seen& p : previous_) {
     // This frame's blobs that came out of p: its own (the tracker's) and new ones in its box.
     std::vector<size_t> children;
     for (size_t i = 0; i < blobs.size(); ++i) {
-      if (blobs[i].track == p.track ||
-          (fresh[i] && ShareInside(blobs[i].box, p.box) >= options_.split_share)) {
+      if (blobs[i].track == p.track || parent[i] == &p) {
         children.push_back(i);
       }
     }
     if (children.size() >= 2) {  // a split: one subject each, unless a piece kept most of it
+      // Pieces that are tracks swallowed into p, come out again under their own ids: partners
+      // that left. The piece keeping most of p's area keeps its count less theirs.
+      std::vector<int> left;
+      for (size_t i : children) {
+        if (std::find(p.members.begin(), p.members.end(), blobs[i].track) != p.members.end())
+          left.push_back(blobs[i].track);
+      }
       for (size_t i : children) {
         const bool keeps = p.subjects >= 2 && blobs[i].area >= options_.keep_area_share * p.area;
         // The pieces of a merged blob are subjects: they may merge again at once.
         const int frames = p.subjects >= 2 ? std::max(p.frames, options_.min_track_frames) : 1;
-        shares[i].push_back({keeps ? p.subjects : 1, frames, keeps ? p.merged_area : 0, false});
+        std::vector<int> members;
+        if (keeps) {
+          std::copy_if(p.members.begin(), p.members.end(), std::back_inserter(members),
+                       [&](int t) { return std::find(left.begin(), left.end(), t) == left.end(); });
+        }
+        const int count = keeps ? std::max(p.subjects - static_cast<int>(left.size()), 1) : 1;
+        shares[i].push_back(
+            {count, frames, count >= 2 ? p.merged_area : 0, false, p.track, std::move(members)});
+        if (debug) {
+          log->debug(
+              "merge update {}: track {} ({} subjects, area {:.0f}) split: track {} area {:.0f}{}",
+              updates_, p.track, p.subjects, p.area, blobs[i].track, blobs[i].area,
+              keeps ? " keeps its count" : "");
+        }
       }
       continue;
     }
     if (children.size() == 1) {
-      shares[children.front()].push_back({p.subjects, p.frames + 1, p.merged_area, false});
+      shares[children.front()].push_back(
+          {p.subjects, p.frames + 1, p.merged_area, false, p.track, p.members});
       continue;
     }
     // No blob of its own: swallowed by the blob whose box holds most of its box, if any does.
@@ -104,7 +146,7 @@ std::vector<bool> MergeDetector::Update(const std::vector<Blob>& blobs) {
       }
     }
     if (best < blobs.size())
-      shares[best].push_back({p.subjects, p.frames + 1, p.merged_area, true});
+      shares[best].push_back({p.subjects, p.frames + 1, p.merged_area, true, p.track, p.members});
   }
   std::vector<bool> merged(blobs.size(), false);
   std::vector<Seen> seen;
@@ -114,21 +156,39 @@ std::vector<bool> MergeDetector::Update(const std::vector<Blob>& blobs) {
     // had been seen long enough; a blob made only of one lost track is its continuation.
     int n = 0, frames = 1;
     double at_merge = 0;
+    std::vector<int> members;
     const bool several = shares[i].size() >= 2;
+    std::string from;  // for the debug log
     for (const Share& sh : shares[i]) {
+      if (debug) {
+        from += fmt::format(" {}{}:{}x{}f", sh.swallowed ? "swallowed " : "", sh.from, sh.subjects,
+                            sh.frames);
+      }
       if (several && sh.swallowed && sh.frames - 1 < options_.min_track_frames) continue;
       n += sh.subjects;
       frames = std::max(frames, sh.frames);
       at_merge = std::max(at_merge, sh.merged_area);
+      members.insert(members.end(), sh.members.begin(), sh.members.end());
+      if (several && sh.swallowed) members.push_back(sh.from);
     }
     n = std::clamp(n, 1, kMaxSubjects);
     if (n >= 2 && at_merge <= 0) at_merge = blobs[i].area;  // it merged in this frame
-    if (n >= 2 && blobs[i].area < options_.drop_area_share * at_merge) n = 1;
-    if (n < 2) at_merge = 0;
+    const bool dropped = n >= 2 && blobs[i].area < options_.drop_area_share * at_merge;
+    if (dropped) n = 1;
+    if (debug && (several || n >= 2 || dropped)) {
+      const cv::Rect& b = blobs[i].box;
+      log->debug("merge update {}: track {} box {}x{}+{}+{} area {:.0f} counts {}{} from{}",
+                 updates_, blobs[i].track, b.width, b.height, b.x, b.y, blobs[i].area, n,
+                 dropped ? " (area under drop_area_share of the merge's)" : "", from);
+    }
+    if (n < 2) {
+      at_merge = 0;
+      members.clear();
+    }
     merged[i] = n >= 2;
     if (blobs[i].track >= 0) {
-      seen.push_back(
-          {blobs[i].track, blobs[i].box, n, at_merge, std::min(frames, 1000), blobs[i].area});
+      seen.push_back({blobs[i].track, blobs[i].box, n, at_merge, std::min(frames, 1000),
+                      blobs[i].area, std::move(members)});
     }
   }
   previous_ = std::move(seen);

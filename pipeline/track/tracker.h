@@ -55,10 +55,11 @@ class Tracker {
 //     track going on under a new id, and takes its count whatever its age;
 //   - a track of the frame before whose box holds (>= split_share of their area) two or more
 //     blobs of this frame, its own and ones whose track was not seen in the frame before (new or
-//     found again), split: each of them counts one subject, but a piece keeping most of a
-//     merged blob's area (>= keep_area_share) keeps its count (the other piece was a part keyed
-//     apart); the pieces of a merged blob count as seen long enough, so that they merge again
-//     at once;
+//     found again; such a blob is a piece of the smallest box holding it only), split: each of them
+//     counts one subject, but a piece keeping most of a merged blob's area (>= keep_area_share)
+//     keeps its count (the other piece was a part keyed apart), less the counts of pieces that are
+//     tracks it swallowed, come out under their own ids again; the pieces of a merged blob count
+//     as seen long enough, so that they merge again at once;
 //   - a blob without a track of the frame before counts one subject.
 // A blob counting two or more is `merged`. A merged blob whose area falls under
 // drop_area_share of its area when it merged counts one again (the partner left unseen).
@@ -91,9 +92,11 @@ class MergeDetector {
     double merged_area;  // its area when it became merged (subjects >= 2)
     int frames;          // frames in a row the track was seen
     double area;
+    std::vector<int> members;  // tracks swallowed into it and counted (subjects >= 2)
   };
   Options options_;
   std::vector<Seen> previous_;
+  int64_t updates_ = 0;  // frames seen, for the debug log
 };
 
 // Cuts each subject's frames into clips: runs of consecutive usable frames.

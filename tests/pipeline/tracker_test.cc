@@ -88,6 +88,38 @@ TEST(MergeDetector, AMergedBlobThatShrinksToOneSubjectIsNoLongerMerged) {
   EXPECT_EQ(d.Update({{0, both, 2000}}), std::vector<bool>({false}));
 }
 
+// A subject lost for a frame and found again under a new id, whose box lies inside both its own
+// track's box and a big blob's box (a crowd at the frame's edge): it came out of its own track,
+// not of both (vtest.avi frame 152: one person tagged merged).
+TEST(MergeDetector, APieceInsideTwoTracksBoxesCameOutOfTheTighterOne) {
+  MergeDetector d;
+  const cv::Rect crowd(100, 0, 600, 300), person(400, 200, 60, 100);
+  for (int f = 0; f < 5; ++f) {
+    d.Update({{0, cv::Rect(100, 0, 200, 150), 3000}, {1, cv::Rect(400, 0, 200, 150), 3000}});
+  }
+  // The two meet in one blob whose box grows over the person's.
+  EXPECT_EQ(d.Update({{0, crowd, 6000}, {2, person, 1300}}), std::vector<bool>({true, false}));
+  // The person, under a new id (its contact point jumped), and the crowd under a new id too.
+  EXPECT_EQ(d.Update({{3, crowd, 6000}, {4, cv::Rect(404, 202, 56, 100), 1300}}),
+            std::vector<bool>({true, false}));
+  EXPECT_EQ(d.Update({{3, crowd, 6000}, {4, cv::Rect(410, 202, 56, 100), 1300}}),
+            std::vector<bool>({true, false}));
+}
+
+// A small subject swallowed by a big one's blob comes out again under its own id: the big one's
+// piece keeps most of the area but holds one subject again (vtest.avi frame 212: a person
+// tagged merged for 20 frames after the other had left).
+TEST(MergeDetector, ASwallowedTrackComingOutAgainTakesItsCountAlong) {
+  MergeDetector d;
+  const cv::Rect big(100, 100, 40, 100), small(150, 60, 20, 40), both(100, 60, 70, 140);
+  for (int f = 0; f < 5; ++f) d.Update({{0, big, 1500}, {1, small, 500}});
+  EXPECT_EQ(d.Update({{0, both, 2000}}), std::vector<bool>({true}));
+  EXPECT_EQ(d.Update({{0, both, 2000}}), std::vector<bool>({true}));
+  // Apart again; the big one keeps 3/4 of the merged area.
+  EXPECT_EQ(d.Update({{0, big, 1550}, {1, small, 500}}), std::vector<bool>({false, false}));
+  EXPECT_EQ(d.Update({{0, big, 1550}, {1, small, 500}}), std::vector<bool>({false, false}));
+}
+
 TEST(ClipCutter, ClipsAreRunsOfConsecutiveUsableFrames) {
   ClipCutter cutter;
   // Subject 7: usable, usable, unusable, usable, then unseen.
