@@ -135,7 +135,7 @@ Station::Station(StationOptions options) : impl_(std::make_unique<Impl>()) {
     }
     if (replay == nullptr)
       throw InputError("enclosure.floor", "the station needs the floor polygon");
-    s.floor = FloorForSession(replay->session, config);
+    s.floor = FloorForSession(replay->session, config.enclosure.floor);
   } else {
     s.floor = config.enclosure.floor;
   }

@@ -4,10 +4,10 @@
 #include <cmath>
 #include <string>
 
-#include "core/config.h"
 #include "core/error.h"
 #include "core/log.h"
 #include "pipeline/key/keyer_registry.h"
+#include "pipeline/key/keying_config.h"
 
 namespace ss {
 namespace {

@@ -15,12 +15,12 @@
 #include <opencv2/core.hpp>
 
 #include "core/camera_model.h"
-#include "core/config.h"
 #include "core/frame.h"
 #include "core/geometry.h"
 #include "pipeline/extract/extractor.h"
 #include "pipeline/filter/usability.h"
 #include "pipeline/key/keyer.h"
+#include "pipeline/key/keying_config.h"
 #include "pipeline/key/matte.h"
 #include "pipeline/rectify/rectifier.h"
 #include "pipeline/run/clip_batcher.h"
@@ -28,7 +28,9 @@
 
 namespace ss {
 
-// Everything a camera pipeline is tuned by, from the station config.
+// Everything a camera pipeline is tuned by. The station config makes them from its sections
+// (PipelineOptionsFromConfig, config/station_config.h); rectify.px_per_m 0 is `auto`: the
+// caller sets the bank's scale (ChooseBankScale, bank_scale.h) before making a CameraPipeline.
 struct CameraPipelineOptions {
   // The config's keying section: keying.method picks the keyer, which reads its own block
   // (pipeline/key/keyer_registry.h); keying.shadow.reach_m (> 0) becomes its grid's
@@ -43,9 +45,6 @@ struct CameraPipelineOptions {
   RectifierOptions rectify;
   ClipBatcherOptions batch;
 };
-// rectify.px_per_m is the config's pipeline.px_per_m, 0 for auto: the caller sets the bank's
-// scale (ChooseBankScale, bank_scale.h) before making a CameraPipeline.
-CameraPipelineOptions PipelineOptionsFromConfig(const StationConfig& config);
 
 struct CameraPipelineStats {
   uint64_t frames = 0;           // frames processed (training frames included)
@@ -103,7 +102,7 @@ class CameraPipeline {
   // ones).
   uint64_t usable_sprites() const { return usable_total_; }
   const FloorMask& floor_mask() const { return floor_mask_; }
-  const Keyer& keyer() const { return *keyer_; }  // as configured (PipelineOptionsFromConfig)
+  const Keyer& keyer() const { return *keyer_; }  // as configured (options.keying)
 
  private:
   std::string name_;

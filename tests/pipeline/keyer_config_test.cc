@@ -6,7 +6,7 @@
 #include <gtest/gtest.h>
 #include <opencv2/core.hpp>
 
-#include "core/config.h"
+#include "config/station_config.h"
 #include "pipeline/run/camera_pipeline.h"
 #include "tests/pipeline/key_scene.h"
 

@@ -1,5 +1,5 @@
 // The station config's values and cross-field rules: Valid / Adjusted / Invalid with the reason
-// (core/config.h, ValidateStationConfig).
+// (config/station_config.h, ValidateStationConfig).
 #include <arpa/inet.h>
 
 #include <algorithm>
@@ -7,7 +7,7 @@
 #include <cmath>
 #include <filesystem>
 
-#include "core/config_detail.h"
+#include "config/config_detail.h"
 #include "core/frame.h"
 #include "core/recording_codecs.h"
 

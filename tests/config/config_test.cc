@@ -1,6 +1,6 @@
 // The station config: a complete file parses into every field, defaults are
 // filled, and each kind of mistake is refused naming the field and its line.
-#include "core/config.h"
+#include "config/station_config.h"
 
 #include <cstdlib>
 #include <filesystem>

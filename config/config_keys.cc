@@ -1,12 +1,12 @@
 // The station config's keys, each bound to its field (core/options_binder.h). The defaults are
-// the fields' initial values in core/config.h; docs/config.md is the contract.
+// the fields' initial values in config/station_config.h; docs/config.md is the contract.
 #include <algorithm>
 #include <cctype>
 #include <cerrno>
 #include <cstring>
 #include <fstream>
 
-#include "core/config_detail.h"
+#include "config/config_detail.h"
 #include "core/sql_postgres.h"
 
 namespace ss::config_detail {

@@ -1,91 +1,35 @@
 #pragma once
-// The station config: one YAML file (docs/config.md, docs/station.example.yaml).
-// Loading answers Valid / Adjusted (with what was adjusted) / Invalid (with
-// every reason, each naming the field path and YAML line, e.g.
-// `station.yaml:14: cameras[1].fps: expected a positive number, got "fast"`).
-// Unknown keys are refused by name. Relative paths are resolved against the
-// config file's folder.
+// The station config (the `config/` layer, above the pipeline and below the station, so that
+// it can name the components it configures): one YAML file (docs/config.md,
+// docs/station.example.yaml). Loading answers Valid / Adjusted (with what was adjusted) / Invalid
+// (with every reason, each naming the field path and YAML line, e.g. `station.yaml:14:
+// cameras[1].fps: expected a positive number, got "fast"`). Unknown keys are refused by name.
+// Relative paths are resolved against the config file's folder.
 #include <cstdint>
 #include <map>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "capture/camera_config.h"
 #include "core/enum_text.h"
 #include "core/geometry.h"
+#include "pipeline/key/keying_config.h"
+#include "pipeline/run/camera_pipeline.h"
 
 namespace ss {
 
 inline constexpr int kConfigVersion = 1;
 
-// Closed sets are enums in the program and text only in the config file and the API.
-enum class WhiteBalanceMode {
-  kDevice,
-  kOnce,
-  kManual
-};  // device: leave as is; once: auto, then lock
-enum class KeyingMethod { kChroma, kCleanPlate };
+// Closed sets are enums in the program and text only in the config file and the API. The
+// camera's (capture/camera_config.h) and the keyers' (pipeline/key/keying_config.h) are their
+// owners'.
 enum class RecordingMode { kOff, kAll, kUsable };  // all frames, or those that gave a usable sprite
 
-inline constexpr EnumText<WhiteBalanceMode> kWhiteBalanceModeTexts[] = {
-    {WhiteBalanceMode::kDevice, "device"},
-    {WhiteBalanceMode::kOnce, "once"},
-    {WhiteBalanceMode::kManual, "manual"}};
-inline constexpr EnumText<KeyingMethod> kKeyingMethodTexts[] = {
-    {KeyingMethod::kChroma, "chroma"}, {KeyingMethod::kCleanPlate, "clean_plate"}};
 inline constexpr EnumText<RecordingMode> kRecordingModeTexts[] = {
     {RecordingMode::kOff, "off"}, {RecordingMode::kAll, "all"}, {RecordingMode::kUsable, "usable"}};
 
-const char* ToText(WhiteBalanceMode mode);
-const char* ToText(KeyingMethod method);
 const char* ToText(RecordingMode mode);
-
-struct WhiteBalanceConfig {
-  WhiteBalanceMode mode = WhiteBalanceMode::kDevice;
-  double red_gain = 1.0;  // manual: red/green and blue/green balance ratios
-  double blue_gain = 1.0;
-  double temperature_k = 0;  // manual: colour temperature instead of ratios (V4L2); 0 = unset
-  bool operator==(const WhiteBalanceConfig&) const = default;
-};
-
-struct CameraConfig {
-  std::string name;            // unique; the stem of its recorded files
-  std::string source;          // "replay" | "v4l2" | "aravis" | "libcamera"
-  std::string session;         // replay: session folder (absolute)
-  std::string session_camera;  // replay: camera within the session (default: name)
-  bool loop = false;           // replay: start over at the end
-  bool realtime = true;        // replay: paced by the device timestamps
-  std::string device;          // v4l2: "/dev/video0"
-  std::string camera_id;       // aravis / libcamera: the device id
-  std::string address;         // aravis: IP address of a GigE Vision camera
-  bool packet_resend = true;   // aravis
-  int packet_size = 0;         // aravis: GigE packet size in bytes, 0 = negotiate
-  std::string pixel_format;    // core/frame.h names ("yuyv", "bayer_rg8"...); "" = device default
-  int width = 0, height = 0;   // 0 = device default
-  double fps = 0;              // 0 = device default
-  std::optional<double> exposure_us;  // unset = keep the device's current value, locked
-  std::optional<double> gain_db;      // unset = keep the device's current value, locked
-  WhiteBalanceConfig white_balance;
-  std::string model;  // .cameramodel (absolute); "" = the session's, or none
-  bool operator==(const CameraConfig&) const = default;
-};
-
-struct KeyingConfig {
-  KeyingMethod method = KeyingMethod::kChroma;
-  int training_frames = 30;    // empty-enclosure frames to learn from
-  double chroma_low = 20;      // chroma: key difference (8-bit levels) where alpha starts to fall
-  double chroma_high = 60;     // chroma: ... and where it reaches 0 (fully background)
-  double plate_low_sigma = 3;  // clean_plate: difference in noise sigmas where alpha starts to rise
-  double plate_high_sigma = 6;  // clean_plate: ... and where it reaches 1
-  bool despill = true;
-  double despill_strength = 1.0;  // 0..1
-  bool shadow = true;             // keep the contact-shadow layer
-  // fraction of plate brightness below which there is no shadow
-  double shadow_min_darkening = 0.08;
-  double shadow_max_darkening = 0.7;  // darkening that counts as full shadow
-  double shadow_reach_m = 0.5;        // shadow kept this far around the subject's foot
-  bool operator==(const KeyingConfig&) const = default;
-};
 
 struct EnclosureConfig {
   GroundPolygon floor;         // ground metres, vertices in order
@@ -194,6 +138,11 @@ StationConfig ParseStationConfig(const std::string& yaml, const std::string& ori
 ConfigReport ValidateStationConfig(StationConfig& config, const std::string& origin = "config",
                                    const std::map<std::string, int>& lines = {},
                                    const ConfigOptions& options = {});
+
+// The camera pipeline's options from the config's keying, enclosure and pipeline sections.
+// rectify.px_per_m is the config's pipeline.px_per_m, 0 for auto: the caller sets the bank's
+// scale (ChooseBankScale, pipeline/run/bank_scale.h) before making a CameraPipeline.
+CameraPipelineOptions PipelineOptionsFromConfig(const StationConfig& config);
 
 // True for 127.0.0.0/8, ::1 and "localhost".
 bool IsLoopbackAddress(const std::string& address);
