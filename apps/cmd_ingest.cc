@@ -58,8 +58,7 @@ void RunIngest(const std::string& session, const std::string& bank, const std::s
     config_options.check_files = false;  // ingest uses keying, enclosure and pipeline only
     config = LoadStationConfig(config_path, nullptr, config_options);
   }
-  options.pipeline = PipelineOptionsFromConfig(config);
-  options.workers = config.pipeline.workers;
+  options.pipeline = config.pipeline;
   options.floor = config.enclosure.floor;
   options.transition_sprites.include_merged = config.transitions.include_merged;
   const bool bar = !json && isatty(STDERR_FILENO);

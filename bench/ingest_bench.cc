@@ -131,7 +131,7 @@ void BM_Ingest(benchmark::State& state, const std::string& codec, int decode_thr
     options.bank_path = (ScratchFolder() / ("run" + std::to_string(run++) + ".bank")).string();
     options.transitions = false;
     options.decode_threads = decode_threads;
-    options.pipeline = PipelineOptionsFromConfig(StationConfig{});  // the config's defaults
+    options.pipeline = DefaultPipelineOptions();  // the config's defaults
     const double cpu_start = ProcessCpuSeconds();
     const IngestSummary summary = IngestSession(options);
     cpu_s += ProcessCpuSeconds() - cpu_start;

@@ -81,24 +81,4 @@ StationConfig LoadStationConfig(const std::string& path, ConfigReport* report,
 
 const char* ToText(RecordingMode mode) { return TextOf(mode, kRecordingModeTexts); }
 
-CameraPipelineOptions PipelineOptionsFromConfig(const StationConfig& config) {
-  const PipelineConfig& p = config.pipeline;
-  CameraPipelineOptions o;
-  // Each keyer reads its own block (docs/keying.md, "From the station config").
-  o.keying = config.keying;
-  o.extract.min_area = p.min_area_px;
-  o.usability.border_margin_px = p.border_margin_px;
-  o.usability.floor_margin_px = p.floor_margin_px;
-  o.usability.wall_margin_m = p.wall_margin_m;
-  o.usability.wall_height_m = config.enclosure.wall_height_m;
-  o.noise = {p.noise_thick_px,          p.noise_min_solidity,   p.noise_min_thick_share,
-             p.noise_min_largest_share, p.noise_min_mean_alpha, p.noise_recover_solidity};
-  o.still_speed_m_per_s = p.still_speed_m_per_s;
-  o.track.max_speed_m_per_s = p.max_speed_m_per_s;
-  o.max_still_s = p.max_still_s;
-  o.rectify.px_per_m = p.px_per_m;
-  o.batch.min_clip_frames = p.min_clip_frames;
-  return o;
-}
-
 }  // namespace ss

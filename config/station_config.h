@@ -31,36 +31,24 @@ inline constexpr EnumText<RecordingMode> kRecordingModeTexts[] = {
 
 const char* ToText(RecordingMode mode);
 
+// The enclosure section's floor; its wall_height_m is the pipeline's
+// (CameraPipelineOptions::usability.wall_height_m, which it tunes).
 struct EnclosureConfig {
-  GroundPolygon floor;         // ground metres, vertices in order
-  double wall_height_m = 0.0;  // walls occlude the floor behind them up to this height
+  GroundPolygon floor;  // ground metres, vertices in order
   bool operator==(const EnclosureConfig&) const = default;
 };
 
-struct PipelineConfig {
-  int min_area_px = 400;         // smaller blobs are noise
-  int border_margin_px = 2;      // distance to keep from the image border
-  int floor_margin_px = 3;       // floor pixels required around the silhouette
-  double wall_margin_m = 0.005;  // contact point distance to keep from the floor polygon's edge
-  double still_speed_m_per_s = 0.05;  // slower than this counts as not moving
-  // the tracker's speed limit: a subject faster than this starts a new clip
-  double max_speed_m_per_s = 1.0;
-  double max_still_s = 2.0;  // still periods longer than this are discarded
-  int min_clip_frames = 5;   // shorter clips are discarded
-  // Noise (docs/pipeline.md, `noise`): keyed background, not a subject. 0 turns a test off.
-  double noise_min_solidity = 0.25;      // noise when the matte fills less of its convex hull
-  double noise_recover_solidity = 0.30;  // a subject noise the frame before stays noise below this
-  double noise_thick_px = 2.0;           // interior: more than this from the matte's edge (pixels)
-  double noise_min_thick_share = 0.0;    // ... or when less of the matte is interior
-  double noise_min_largest_share = 0.0;  // ... or its largest part holds less of it
-  double noise_min_mean_alpha = 0.0;     // ... or its mean alpha (of 1) is lower
-  // Billboard scale in pixels per metre, the same for the whole bank; 0 = `auto` (chosen from
-  // the cameras, or the bank's own scale when it holds sprites: pipeline/run/bank_scale.h).
-  double px_per_m = 0;
-  int workers = 0;       // OpenCV threads inside a frame's work; 0 = OpenCV's default
-  int queue_frames = 8;  // per-camera queue between capture and pipeline
-  bool operator==(const PipelineConfig&) const = default;
-};
+// The camera pipeline's options as the config's defaults make them, where these differ from the
+// stages' own (docs/config.md is the contract): the keying section is always there (unset, a
+// pipeline keys with the chroma keyer's own defaults), pipeline.min_area_px is 400 (the
+// extractor's own 40 suits small test frames) and pipeline.px_per_m is `auto` (0).
+inline CameraPipelineOptions DefaultPipelineOptions() {
+  CameraPipelineOptions o;
+  o.keying = KeyingConfig{};
+  o.extract.min_area = 400;
+  o.rectify.px_per_m = 0;
+  return o;
+}
 
 // The transition table kept by the station (and ingest): which sprites take part.
 struct TransitionsConfig {
@@ -101,9 +89,10 @@ struct LoggingConfig {
 struct StationConfig {
   int version = kConfigVersion;
   std::vector<CameraConfig> cameras;
-  KeyingConfig keying;
   EnclosureConfig enclosure;
-  PipelineConfig pipeline;
+  // The keying and pipeline sections and enclosure.wall_height_m: the camera pipeline's own
+  // options, bound key by key (config/config_keys.cc); `keying` is always set.
+  CameraPipelineOptions pipeline = DefaultPipelineOptions();
   TransitionsConfig transitions;
   StorageConfig storage;
   ControlConfig control;
@@ -138,11 +127,6 @@ StationConfig ParseStationConfig(const std::string& yaml, const std::string& ori
 ConfigReport ValidateStationConfig(StationConfig& config, const std::string& origin = "config",
                                    const std::map<std::string, int>& lines = {},
                                    const ConfigOptions& options = {});
-
-// The camera pipeline's options from the config's keying, enclosure and pipeline sections.
-// rectify.px_per_m is the config's pipeline.px_per_m, 0 for auto: the caller sets the bank's
-// scale (ChooseBankScale, pipeline/run/bank_scale.h) before making a CameraPipeline.
-CameraPipelineOptions PipelineOptionsFromConfig(const StationConfig& config);
 
 // True for 127.0.0.0/8, ::1 and "localhost".
 bool IsLoopbackAddress(const std::string& address);

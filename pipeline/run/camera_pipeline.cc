@@ -6,6 +6,7 @@
 
 #include "core/error.h"
 #include "core/log.h"
+#include "core/option_checks.h"
 #include "pipeline/describe/sprite_description.h"
 #include "pipeline/key/chroma_keyer.h"
 #include "pipeline/key/keyer_registry.h"
@@ -35,6 +36,26 @@ std::unique_ptr<Keyer> KeyerFor(const CameraPipelineOptions& o, const CameraMode
 }
 
 }  // namespace
+
+bool CameraPipelineOptions::IsValid(std::string* why) const {
+  OptionProblems check(why);
+  std::string part;
+  check.Nested(extract.IsValid(&part), "extract.", part);
+  check.Nested(track.IsValid(&part), "track.", part);
+  check.Nested(usability.IsValid(&part), "usability.", part);
+  check.Nested(noise.IsValid(&part), "noise.", part);
+  for (const auto& [v, field] : {std::pair{still_speed_m_per_s, "still_speed_m_per_s"},
+                                 std::pair{max_still_s, "max_still_s"}}) {
+    check(std::isfinite(v) && v > 0, field,
+          "expected a positive number, got " + OptionProblems::Num(v));
+  }
+  check.Nested(batch.IsValid(&part), "batch.", part);
+  check(workers >= 0, "workers",
+        "expected 0 (one per core) or more, got " + std::to_string(workers));
+  check(queue_frames >= 1, "queue_frames",
+        "expected at least 1 frame, got " + std::to_string(queue_frames));
+  return check.ok();
+}
 
 CameraPipeline::CameraPipeline(std::string name, int64_t camera_id, CameraModel model,
                                GroundPolygon floor, CameraPipelineOptions options)

@@ -92,7 +92,7 @@ GroundPolygon FloorForSession(const std::string& session_dir, const GroundPolygo
 
 IngestSummary IngestSession(const IngestOptions& options) {
   const auto start = Clock::now();
-  if (options.workers > 0) cv::setNumThreads(options.workers);  // process-wide
+  if (options.pipeline.workers > 0) cv::setNumThreads(options.pipeline.workers);  // process-wide
   ReplayOptions replay_options;
   replay_options.realtime = false;
   replay_options.frames_ahead = 6;

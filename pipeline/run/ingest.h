@@ -32,11 +32,10 @@ struct IngestProgress {
 struct IngestOptions {
   std::string session_dir;
   std::string bank_path;
-  // What the station config sets (config/station_config.h: PipelineOptionsFromConfig and the
-  // sections named). The defaults are the stages' own, not the config's: without a config file
-  // a caller passes a default StationConfig's.
-  CameraPipelineOptions pipeline;   // keying.training_frames frames train the keyer (30 unset)
-  int workers = 0;                  // pipeline.workers: OpenCV threads, 0 = OpenCV's default
+  // What the station config sets (config/station_config.h: the sections named). The defaults
+  // are the stages' own, not the config's: without a config file a caller passes a default
+  // StationConfig's (DefaultPipelineOptions).
+  CameraPipelineOptions pipeline;   // keying, pipeline; keying.training_frames train (30 unset)
   GroundPolygon floor;              // enclosure.floor; empty: the session's (FloorForSession)
   SpriteChoice transition_sprites;  // transitions.include_merged
   std::function<void(const IngestProgress&)>

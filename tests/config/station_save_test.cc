@@ -198,8 +198,8 @@ TEST(FloorPolygon, ReplacesTheConfigsFloorKeepingTheRest) {
   const StationConfig c = ParseStationConfig(updated, "station.yaml", ".", nullptr, o);
   ASSERT_EQ(c.enclosure.floor.vertices().size(), 4u);
   EXPECT_NEAR(c.enclosure.floor.Area(), 0.6, 1e-9);
-  EXPECT_DOUBLE_EQ(c.enclosure.wall_height_m, 0.6);
-  EXPECT_EQ(c.pipeline.min_area_px, 500);
+  EXPECT_DOUBLE_EQ(c.pipeline.usability.wall_height_m, 0.6);
+  EXPECT_EQ(c.pipeline.extract.min_area, 500);
   EXPECT_NE(updated.find("# keep me"), std::string::npos);
   // A config without an enclosure gets one.
   const StationConfig added = ParseStationConfig(
