@@ -148,9 +148,9 @@ OptionsBinder KeyingKeys(KeyingConfig& k) {
             "chroma (a green screen) or clean_plate (any background)")
       .Add("training_frames", &k.training_frames, "a number of frames",
            "empty-enclosure frames to learn from")
-      .Add("chroma.low", &k.chroma_low, "a level 0..255",
+      .Add("chroma.low", &k.chroma.key_low_levels, "a level 0..255",
            "key difference where alpha starts to fall")
-      .Add("chroma.high", &k.chroma_high, "a level 0..255", "... and where it reaches 0")
+      .Add("chroma.high", &k.chroma.key_high_levels, "a level 0..255", "... and where it reaches 0")
       .Add("clean_plate.low_sigma", &k.plate_low_sigma, "a number of noise sigmas",
            "difference where alpha starts to rise")
       .Add("clean_plate.high_sigma", &k.plate_high_sigma, "a number of noise sigmas",

@@ -146,10 +146,12 @@ class Validator {
   void Keying(KeyingConfig& k) {
     Check(k.training_frames >= 1, "keying.training_frames",
           "expected at least 1 frame, got " + std::to_string(k.training_frames));
-    Range(k.chroma_low, 0, 255, "keying.chroma.low");
-    Range(k.chroma_high, 0, 255, "keying.chroma.high");
-    Check(!(k.chroma_low >= k.chroma_high), "keying.chroma.high",
-          "must be above keying.chroma.low (" + Num(k.chroma_low) + "), got " + Num(k.chroma_high));
+    // The config's range; the keyer itself also takes < 0 (off: min_margin and ramp instead).
+    const double low = k.chroma.key_low_levels, high = k.chroma.key_high_levels;
+    Range(low, 0, 255, "keying.chroma.low");
+    Range(high, 0, 255, "keying.chroma.high");
+    Check(!(low >= high), "keying.chroma.high",
+          "must be above keying.chroma.low (" + Num(low) + "), got " + Num(high));
     NonNegative(k.plate_low_sigma, "keying.clean_plate.low_sigma");
     NonNegative(k.plate_high_sigma, "keying.clean_plate.high_sigma");
     Check(!(k.plate_low_sigma >= k.plate_high_sigma), "keying.clean_plate.high_sigma",

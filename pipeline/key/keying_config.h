@@ -3,6 +3,7 @@
 // each keyer makes its options from (pipeline/key/keyer_registry.h). The station config
 // (config/station_config.h) reads it; the keyers own it.
 #include "core/enum_text.h"
+#include "pipeline/key/chroma_keyer.h"
 
 namespace ss {
 
@@ -16,9 +17,18 @@ inline const char* ToText(KeyingMethod method) { return TextOf(method, kKeyingMe
 
 struct KeyingConfig {
   KeyingMethod method = KeyingMethod::kChroma;
-  int training_frames = 30;    // empty-enclosure frames to learn from
-  double chroma_low = 20;      // chroma: key difference (8-bit levels) where alpha starts to fall
-  double chroma_high = 60;     // chroma: ... and where it reaches 0 (fully background)
+  int training_frames = 30;  // empty-enclosure frames to learn from
+  // The chroma keyer's own options: keying.chroma.low and .high are bound to key_low_levels and
+  // key_high_levels (the key difference in 8-bit levels where alpha starts to fall, and where it
+  // reaches 0), whose defaults here are the config's, 20 and 60 (the keyer's own, -1, keys by
+  // min_margin and ramp); despill and shadow come from the shared blocks below
+  // (ChromaKeyerOptionsFrom).
+  ChromaKeyerOptions chroma = [] {
+    ChromaKeyerOptions o;
+    o.key_low_levels = 20;
+    o.key_high_levels = 60;
+    return o;
+  }();
   double plate_low_sigma = 3;  // clean_plate: difference in noise sigmas where alpha starts to rise
   double plate_high_sigma = 6;  // clean_plate: ... and where it reaches 1
   bool despill = true;

@@ -112,8 +112,8 @@ TEST(StationConfig, ExampleParsesIntoEveryField) {
 
   EXPECT_EQ(cfg.pipeline.keying->method, KeyingMethod::kChroma);
   EXPECT_EQ(cfg.pipeline.keying->training_frames, 30);
-  EXPECT_EQ(cfg.pipeline.keying->chroma_low, 20);
-  EXPECT_EQ(cfg.pipeline.keying->chroma_high, 60);
+  EXPECT_EQ(cfg.pipeline.keying->chroma.key_low_levels, 20);
+  EXPECT_EQ(cfg.pipeline.keying->chroma.key_high_levels, 60);
   EXPECT_EQ(cfg.pipeline.keying->plate_low_sigma, 3);
   EXPECT_EQ(cfg.pipeline.keying->plate_high_sigma, 6);
   EXPECT_TRUE(cfg.pipeline.keying->despill);
@@ -367,6 +367,21 @@ TEST(StationConfig, PipelineSectionsAreTheStagesOptionsWithTheConfigsDefaults) {
   EXPECT_EQ(set.pipeline.track.max_speed_m_per_s, 2);
   EXPECT_EQ(set.pipeline.batch.min_clip_frames, 7);
   EXPECT_EQ(set.pipeline.rectify.px_per_m, 600);
+}
+
+// keying.chroma.* are the chroma keyer's own options (KeyingConfig::chroma); the shared despill
+// and shadow blocks are applied to them when the keyer is made.
+TEST(StationConfig, ChromaBlockIsTheChromaKeyersOptions) {
+  const StationConfig cfg =
+      Parse("keying:\n  chroma: {low: 10, high: 50}\n  shadow: {max_darkening: 0.6}\n");
+  EXPECT_EQ(cfg.pipeline.keying->chroma.key_low_levels, 10);
+  EXPECT_EQ(cfg.pipeline.keying->chroma.key_high_levels, 50);
+  const ChromaKeyerOptions o = ChromaKeyerOptionsFrom(*cfg.pipeline.keying);
+  EXPECT_EQ(o.key_low_levels, 10);
+  EXPECT_EQ(o.key_high_levels, 50);
+  EXPECT_NEAR(o.dark_floor, 0.4, 1e-12);
+  EXPECT_EQ(o.shadow_min, 0.08);
+  EXPECT_EQ(o.noise_z, ChromaKeyerOptions{}.noise_z);  // not in the config: the keyer's own
 }
 
 // The stages' own rules (their options' IsValid), each error naming the config key, all of them.

@@ -115,8 +115,8 @@ TEST_F(KeyerConfig, ChromaThresholdsFollowTheConfig) {
   ASSERT_GT(defaults.alpha_sum, 0);
   // A key threshold far below the green's own (~105 levels): the soft, greenish edge falls to
   // background (about 2.5% of the subject's alpha).
-  config.pipeline.keying->chroma_low = 0;
-  config.pipeline.keying->chroma_high = 15;
+  config.pipeline.keying->chroma.key_low_levels = 0;
+  config.pipeline.keying->chroma.key_high_levels = 15;
   const Keyed tight = Key(config);
   EXPECT_LT(tight.alpha_sum, 0.99 * defaults.alpha_sum);
   EXPECT_GT(tight.alpha_sum, 0.9 * defaults.alpha_sum);
