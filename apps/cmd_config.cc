@@ -8,7 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "apps/commands.h"
-#include "core/config.h"
+#include "config/station_config.h"
 #include "core/error.h"
 
 namespace ss::apps {

@@ -19,7 +19,7 @@
 #include <nlohmann/json.hpp>
 
 #include "apps/commands.h"
-#include "core/config.h"
+#include "config/station_config.h"
 #include "core/error.h"
 #include "core/log.h"
 #include "pipeline/transitions/weights.h"

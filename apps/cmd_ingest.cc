@@ -16,7 +16,7 @@
 #include <nlohmann/json.hpp>
 
 #include "apps/commands.h"
-#include "core/config.h"
+#include "config/station_config.h"
 #include "core/error.h"
 #include "pipeline/filter/usability.h"
 #include "pipeline/run/ingest.h"
@@ -52,11 +52,15 @@ void RunIngest(const std::string& session, const std::string& bank, const std::s
   options.bank_path = bank;
   options.transitions = transitions;
   options.transition_weights = transition_weights;
+  StationConfig config;  // without a file: the config's defaults
   if (!config_path.empty()) {
     ConfigOptions config_options;
     config_options.check_files = false;  // ingest uses keying, enclosure and pipeline only
-    options.config = LoadStationConfig(config_path, nullptr, config_options);
+    config = LoadStationConfig(config_path, nullptr, config_options);
   }
+  options.pipeline = config.pipeline;
+  options.floor = config.enclosure.floor;
+  options.transition_sprites.include_merged = config.transitions.include_merged;
   const bool bar = !json && isatty(STDERR_FILENO);
   if (bar) options.progress = PrintProgress;
   const IngestSummary s = IngestSession(options);

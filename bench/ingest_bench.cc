@@ -30,6 +30,7 @@
 
 #include "bench/bench_registry.h"
 #include "capture/recording/video_reader.h"
+#include "config/station_config.h"
 #include "core/log.h"
 #include "pipeline/run/ingest.h"
 #include "synth/studio_session.h"
@@ -130,6 +131,7 @@ void BM_Ingest(benchmark::State& state, const std::string& codec, int decode_thr
     options.bank_path = (ScratchFolder() / ("run" + std::to_string(run++) + ".bank")).string();
     options.transitions = false;
     options.decode_threads = decode_threads;
+    options.pipeline = DefaultPipelineOptions();  // the config's defaults
     const double cpu_start = ProcessCpuSeconds();
     const IngestSummary summary = IngestSession(options);
     cpu_s += ProcessCpuSeconds() - cpu_start;

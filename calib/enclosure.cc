@@ -6,7 +6,6 @@
 
 #include <opencv2/imgproc.hpp>
 
-#include "core/config.h"
 #include "core/error.h"
 
 namespace ss::calib {
@@ -165,71 +164,6 @@ std::string EnclosureYaml(const GroundPolygon& floor, double wall_height_m) {
     o << "    - [" << Number(v.x()) << ", " << Number(v.y()) << "]\n";
   o << "  wall_height_m: " << Number(wall_height_m) << "\n";
   return o.str();
-}
-
-std::string ReplaceEnclosureFloor(const std::string& config_yaml, const GroundPolygon& floor,
-                                  const std::string& origin) {
-  std::vector<std::string> lines;
-  {
-    std::istringstream in(config_yaml);
-    std::string line;
-    while (std::getline(in, line)) lines.push_back(line);
-  }
-  auto indent = [](const std::string& l) { return l.find_first_not_of(' '); };
-  auto blank = [&](const std::string& l) {
-    const size_t i = indent(l);
-    return i == std::string::npos || l[i] == '#';
-  };
-  std::ostringstream floor_text;
-  for (const auto& v : floor.vertices())
-    floor_text << "    - [" << Number(v.x()) << ", " << Number(v.y()) << "]\n";
-  std::vector<std::string> out;
-  size_t i = 0;
-  bool done = false;
-  for (; i < lines.size(); ++i) {
-    if (!done && lines[i].rfind("enclosure:", 0) == 0) {
-      out.push_back(lines[i]);
-      size_t end = i + 1;
-      while (end < lines.size() && (blank(lines[end]) || indent(lines[end]) > 0)) ++end;
-      bool replaced = false;
-      for (size_t k = i + 1; k < end; ++k) {
-        const size_t in = indent(lines[k]);
-        if (!blank(lines[k]) && lines[k].compare(in, 6, "floor:") == 0) {
-          out.push_back(lines[k].substr(0, in) + "floor:");
-          size_t j = k + 1;
-          while (j < end && (blank(lines[j]) || indent(lines[j]) > in ||
-                             (indent(lines[j]) == in && lines[j][in] == '-'))) {
-            ++j;
-          }
-          std::istringstream f(floor_text.str());
-          std::string fl;
-          while (std::getline(f, fl))
-            out.push_back(std::string(in + 2, ' ') + fl.substr(fl.find('-')));
-          k = j - 1;
-          replaced = true;
-        } else {
-          out.push_back(lines[k]);
-        }
-      }
-      if (!replaced) {
-        out.push_back("  floor:");
-        std::istringstream f(floor_text.str());
-        std::string fl;
-        while (std::getline(f, fl)) out.push_back(fl);
-      }
-      i = end - 1;
-      done = true;
-    } else {
-      out.push_back(lines[i]);
-    }
-  }
-  std::string result;
-  for (const auto& l : out) result += l + "\n";
-  if (!done) result += EnclosureYaml(floor, 0.0);
-  ConfigOptions check;
-  check.check_files = false;
-  ParseStationConfig(result, origin, ".", nullptr, check);  // throws InputError naming the line
-  return result;
 }
 
 }  // namespace ss::calib

@@ -3,7 +3,8 @@
 // points given in ground coordinates, from points picked in a calibrated
 // camera's image (rays meet the floor), or found as the largest green floor
 // region in a camera's view of the empty enclosure. The result goes into the
-// station config's `enclosure.floor` (core/config.h), which the pipeline reads.
+// station config's `enclosure.floor` (config/station_config.h; ReplaceEnclosureFloor in
+// config/station_save.h edits it), which the pipeline reads.
 #include <string>
 #include <vector>
 
@@ -41,11 +42,5 @@ std::vector<Eigen::Vector2d> ParsePointList(const std::string& text, const std::
 
 // The config's enclosure section for this floor (YAML, docs/config.md).
 std::string EnclosureYaml(const GroundPolygon& floor, double wall_height_m);
-
-// Replaces (or adds) `enclosure.floor` in a station config's YAML text, keeping
-// everything else as written. The result is checked by ParseStationConfig
-// (InputError naming `origin` when it does not hold).
-std::string ReplaceEnclosureFloor(const std::string& config_yaml, const GroundPolygon& floor,
-                                  const std::string& origin);
 
 }  // namespace ss::calib

@@ -11,8 +11,8 @@
 #include <string>
 #include <vector>
 
+#include "capture/camera_config.h"
 #include "capture/frame_source.h"
-#include "core/config.h"
 
 namespace ss {
 

@@ -4,9 +4,9 @@
 #include <memory>
 #include <optional>
 
+#include "capture/camera_config.h"
 #include "capture/frame_source.h"
 #include "core/camera_model.h"
-#include "core/config.h"
 
 namespace ss {
 

@@ -18,6 +18,7 @@ namespace ss {
 struct ContactPointOptions {
   double band_fraction = 0.1;  // of the silhouette's height (top row to the lowest point)
   double min_band_px = 3.0;    // the band is never thinner than this
+  bool operator==(const ContactPointOptions&) const = default;
 };
 
 // The contact point of the silhouette in `alpha` (CV_8U, 255 = subject), in

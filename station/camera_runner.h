@@ -15,9 +15,9 @@
 #include <utility>
 #include <vector>
 
+#include "capture/camera_config.h"
 #include "capture/frame_source.h"
 #include "core/camera_model.h"
-#include "core/config.h"
 #include "core/frame.h"
 #include "core/geometry.h"
 #include "pipeline/run/camera_pipeline.h"

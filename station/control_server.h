@@ -13,7 +13,7 @@
 #include <string>
 #include <string_view>
 
-#include "core/config.h"
+#include "config/station_config.h"
 
 namespace ss {
 

@@ -56,7 +56,7 @@ Station::Station(StationOptions options) : impl_(std::make_unique<Impl>()) {
     }
     if (replay == nullptr)
       throw InputError("enclosure.floor", "the station needs the floor polygon");
-    s.floor = FloorForSession(replay->session, config);
+    s.floor = FloorForSession(replay->session, config.enclosure.floor);
   } else {
     s.floor = config.enclosure.floor;
   }
@@ -88,10 +88,10 @@ void Station::Start() {
     s.spool_batches = s.spool->batches();
     s.spool_bytes = s.spool->bytes();
   }
-  CameraPipelineOptions pipeline = PipelineOptionsFromConfig(config);
+  CameraPipelineOptions pipeline = config.pipeline;
   // The bank's one billboard scale, shared by every camera (pipeline/run/bank_scale.h).
   BankScaleInputs scale_inputs;
-  scale_inputs.configured = config.pipeline.px_per_m;
+  scale_inputs.configured = config.pipeline.rectify.px_per_m;
   scale_inputs.bank_path = config.storage.bank;
   for (const std::optional<CameraModel>& m : s.models) {
     if (m) scale_inputs.models.push_back(&*m);
@@ -124,7 +124,8 @@ void Station::Start() {
     o.model = s.models[i];
     o.floor = s.floor;
     o.pipeline = camera_pipeline;
-    o.training_frames = std::max(1, config.keying.training_frames);
+    o.training_frames = std::max(
+        1, (config.pipeline.keying ? *config.pipeline.keying : KeyingConfig{}).training_frames);
     o.queue_frames = config.pipeline.queue_frames;
     o.offline_after_s = s.options.offline_after_s;
     o.preview_interval_s = kPreviewIntervalS;
@@ -286,11 +287,20 @@ std::vector<std::string> Station::Reload(const StationConfig& config) {
   const StationConfig& old = s.options.config;
   if (config.cameras != old.cameras)
     needs_restart.push_back("cameras: changed; restart the daemon to apply");
-  if (config.keying != old.keying)
+  // The pipeline's options hold the keying section and enclosure.wall_height_m too: each
+  // section is named for what it sets.
+  const auto pipeline_section = [](const StationConfig& c) {
+    CameraPipelineOptions p = c.pipeline;
+    p.keying.reset();
+    p.usability.wall_height_m = 0;
+    return p;
+  };
+  if (config.pipeline.keying != old.pipeline.keying)
     needs_restart.push_back("keying: changed; restart the daemon to apply");
-  if (config.enclosure != old.enclosure)
+  if (config.enclosure != old.enclosure ||
+      config.pipeline.usability.wall_height_m != old.pipeline.usability.wall_height_m)
     needs_restart.push_back("enclosure: changed; restart the daemon to apply");
-  if (config.pipeline != old.pipeline)
+  if (pipeline_section(config) != pipeline_section(old))
     needs_restart.push_back("pipeline: changed; restart the daemon to apply");
   if (config.control != old.control)
     needs_restart.push_back("control: changed; restart the daemon to apply");

@@ -14,7 +14,7 @@
 #include <vector>
 
 #include "capture/frame_source.h"
-#include "core/config.h"
+#include "config/station_config.h"
 #include "pipeline/transitions/weights.h"
 #include "station/preview.h"
 #include "station/station_status.h"

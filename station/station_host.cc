@@ -87,10 +87,8 @@ StationConfig ReplayStationConfig(const StationConfig& live, const SessionInfo& 
     c.cameras.push_back(std::move(cam));
   }
   // The session's own floor when it has one (read as ingest reads it), else the config's.
-  StationConfig without_floor = c;
-  without_floor.enclosure.floor = GroundPolygon();
   try {
-    c.enclosure.floor = FloorForSession(dir, without_floor);
+    c.enclosure.floor = FloorForSession(dir, GroundPolygon());
   } catch (const InputError&) {
     // none in the session: the config's floor stays
   }

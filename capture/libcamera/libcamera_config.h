@@ -1,7 +1,7 @@
 #pragma once
 // A station camera's config (`source: libcamera`) as LibcameraOptions.
+#include "capture/camera_config.h"
 #include "capture/libcamera/libcamera_source.h"
-#include "core/config.h"
 
 namespace ss {
 

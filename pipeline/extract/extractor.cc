@@ -5,6 +5,7 @@
 
 #include "core/contact_point.h"
 #include "core/error.h"
+#include "core/option_checks.h"
 
 namespace ss {
 namespace {
@@ -68,6 +69,15 @@ cv::Mat View(std::vector<uint8_t>& bytes, cv::Size size, int type) {
 }
 
 }  // namespace
+
+bool ExtractorOptions::IsValid(std::string* why) const {
+  OptionProblems check(why);
+  check(min_area >= 1, "min_area", "expected at least 1 pixel, got " + std::to_string(min_area));
+  check(margin_px >= 0, "margin_px", "must not be negative");
+  check(alpha_min >= 1 && alpha_min <= 255, "alpha_min", "must be within 1..255");
+  check(shadow_min >= 1 && shadow_min <= 255, "shadow_min", "must be within 1..255");
+  return check.ok();
+}
 
 Extractor::Extractor(ExtractorOptions options) : options_(options) {
   if (options_.min_area < 0) throw InputError("extract.min_area", "must not be negative");

@@ -4,6 +4,7 @@
 // by the keyer), cut to the subject's box. Blobs smaller than `min_area` are
 // noise: dropped and counted.
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -26,11 +27,16 @@ struct Candidate {
 };
 
 struct ExtractorOptions {
-  double min_area = 40;  // pixels of alpha; smaller blobs are noise
-  int margin_px = 4;     // added around the subject's alpha box
-  int alpha_min = 16;    // alpha (of 255) that counts as subject for the box and the border test
-  int shadow_min = 16;   // shadow (of 255) that counts for the box
+  // Pixels of alpha; smaller blobs are noise (the station config's pipeline.min_area_px, whose
+  // default is 400: config/station_config.h, DefaultPipelineOptions).
+  int min_area = 40;
+  int margin_px = 4;    // added around the subject's alpha box
+  int alpha_min = 16;   // alpha (of 255) that counts as subject for the box and the border test
+  int shadow_min = 16;  // shadow (of 255) that counts for the box
   ContactPointOptions contact;  // the contact point's bottom band
+  // False with "FIELD: reason" lines in `why` (core/option_checks.h) for values out of range.
+  bool IsValid(std::string* why) const;
+  bool operator==(const ExtractorOptions&) const = default;
 };
 
 struct ExtractTotals {

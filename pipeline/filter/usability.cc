@@ -1,10 +1,47 @@
 #include "pipeline/filter/usability.h"
 
+#include <cmath>
+
 #include <opencv2/imgproc.hpp>
 
 #include "core/error.h"
+#include "core/option_checks.h"
 
 namespace ss {
+namespace {
+
+bool NonNegative(double v) { return std::isfinite(v) && v >= 0; }
+
+}  // namespace
+
+bool UsabilityOptions::IsValid(std::string* why) const {
+  OptionProblems check(why);
+  check(border_margin_px >= 0, "border_margin_px",
+        "expected a number >= 0, got " + std::to_string(border_margin_px));
+  check(floor_margin_px >= 0, "floor_margin_px",
+        "expected a number >= 0, got " + std::to_string(floor_margin_px));
+  for (const auto& [v, field] :
+       {std::pair{wall_margin_m, "wall_margin_m"}, std::pair{wall_height_m, "wall_height_m"},
+        std::pair{wall_check_height_m, "wall_check_height_m"}}) {
+    check(NonNegative(v), field, "expected a number >= 0, got " + OptionProblems::Num(v));
+  }
+  return check.ok();
+}
+
+bool NoiseOptions::IsValid(std::string* why) const {
+  OptionProblems check(why);
+  check(NonNegative(thick_px), "thick_px",
+        "expected a number >= 0, got " + OptionProblems::Num(thick_px));
+  for (const auto& [v, field] :
+       {std::pair{recover_solidity, "recover_solidity"},
+        std::pair{min_thick_share, "min_thick_share"}, std::pair{min_solidity, "min_solidity"},
+        std::pair{min_largest_share, "min_largest_share"},
+        std::pair{min_mean_alpha, "min_mean_alpha"}}) {
+    check(std::isfinite(v) && v >= 0 && v <= 1, field,
+          "expected a share from 0 to 1 (0 turns the test off), got " + OptionProblems::Num(v));
+  }
+  return check.ok();
+}
 
 const char* DiscardName(Discard reason) {
   switch (reason) {

@@ -47,6 +47,9 @@ struct UsabilityOptions {
   // something in front of it (what stands on the floor in front of a subject hides its lowest part
   // first).
   double wall_check_height_m = 0.3;
+  // False with "FIELD: reason" lines in `why` (core/option_checks.h) for values out of range.
+  bool IsValid(std::string* why) const;
+  bool operator==(const UsabilityOptions&) const = default;
 };
 
 // The shape of a candidate's matte (its alpha crop at full resolution), for telling a subject from
@@ -74,6 +77,9 @@ struct NoiseOptions {
   // A subject whose previous frame was noise stays noise until its solidity reaches this
   // (keyed background flickers about the threshold; 0: no memory).
   double recover_solidity = 0.30;
+  // False with "FIELD: reason" lines in `why` (core/option_checks.h) for values out of range.
+  bool IsValid(std::string* why) const;
+  bool operator==(const NoiseOptions&) const = default;
 };
 // The features those tests need, no more (the per-frame path): thick_share and largest_share,
 // the costly ones, are measured only when their tests are on, and read 1 (pass) otherwise.

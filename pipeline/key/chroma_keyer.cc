@@ -4,10 +4,10 @@
 #include <cmath>
 #include <string>
 
-#include "core/config.h"
 #include "core/error.h"
 #include "core/log.h"
 #include "pipeline/key/keyer_registry.h"
+#include "pipeline/key/keying_config.h"
 
 namespace ss {
 namespace {
@@ -352,9 +352,7 @@ void ChromaKeyer::FineRow(const uint8_t* row, ChannelOrder order, int y, int x0,
 }
 
 ChromaKeyerOptions ChromaKeyerOptionsFrom(const KeyingConfig& k) {
-  ChromaKeyerOptions o;
-  o.key_low_levels = k.chroma_low;
-  o.key_high_levels = k.chroma_high;
+  ChromaKeyerOptions o = k.chroma;
   o.despill_strength = k.despill ? k.despill_strength : 0.0;
   o.shadow = k.shadow;
   o.shadow_min = k.shadow_min_darkening;

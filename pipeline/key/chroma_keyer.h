@@ -44,10 +44,12 @@ struct ChromaKeyerOptions {
   bool global_model = false;  // one reference for the whole frame: the naive keyer, for comparison
   // False with "FIELD: reason" in `why` when a value is out of its range.
   bool IsValid(std::string* why) const;
+  bool operator==(const ChromaKeyerOptions&) const = default;
 };
 
 // The options the station config's keying section sets (docs/keying.md, "From the station
-// config"): keying.chroma.*, keying.despill.*, keying.shadow.*; the others keep their defaults.
+// config"): its `chroma` block (keying.chroma.* bound to its fields) with the shared
+// keying.despill.* and keying.shadow.* applied.
 ChromaKeyerOptions ChromaKeyerOptionsFrom(const KeyingConfig& keying);
 
 class ChromaKeyer : public Keyer {

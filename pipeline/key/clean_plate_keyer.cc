@@ -6,10 +6,10 @@
 
 #include <opencv2/imgproc.hpp>
 
-#include "core/config.h"
 #include "core/error.h"
 #include "core/log.h"
 #include "pipeline/key/keyer_registry.h"
+#include "pipeline/key/keying_config.h"
 
 namespace ss {
 namespace {

@@ -41,6 +41,7 @@ struct GridOptions {
   int step = 8;       // coarse sampling step, px; anything >= step + 2 px across is sampled
   int margin_px = 6;  // added around each region's cell box
   int shadow_reach_cells = 6;  // shaded cells join a region up to this many cells away from it
+  bool operator==(const GridOptions&) const = default;
 };
 
 class Keyer {

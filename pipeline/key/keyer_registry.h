@@ -8,8 +8,8 @@
 #include <memory>
 #include <string>
 
-#include "core/config.h"
 #include "pipeline/key/keyer.h"
+#include "pipeline/key/keying_config.h"
 
 namespace ss {
 

@@ -20,6 +20,7 @@ struct RectifierOptions {
   double margin_m = 0.01;         // billboard border around the sprite's extent
   double shadow_radius_m = 0.08;  // half-size of the square ground patch for the shadow
   int max_side_px = 512;          // refuse absurd billboards (a sprite far above the floor)
+  bool operator==(const RectifierOptions&) const = default;
 };
 
 // What the camera saw, cropped: pixels of the crop at (offset) in the full image.

@@ -6,6 +6,7 @@
 
 #include "core/error.h"
 #include "core/log.h"
+#include "core/option_checks.h"
 #include "pipeline/describe/sprite_description.h"
 #include "pipeline/key/chroma_keyer.h"
 #include "pipeline/key/keyer_registry.h"
@@ -36,24 +37,24 @@ std::unique_ptr<Keyer> KeyerFor(const CameraPipelineOptions& o, const CameraMode
 
 }  // namespace
 
-CameraPipelineOptions PipelineOptionsFromConfig(const StationConfig& config) {
-  const PipelineConfig& p = config.pipeline;
-  CameraPipelineOptions o;
-  // Each keyer reads its own block (docs/keying.md, "From the station config").
-  o.keying = config.keying;
-  o.extract.min_area = p.min_area_px;
-  o.usability.border_margin_px = p.border_margin_px;
-  o.usability.floor_margin_px = p.floor_margin_px;
-  o.usability.wall_margin_m = p.wall_margin_m;
-  o.usability.wall_height_m = config.enclosure.wall_height_m;
-  o.noise = {p.noise_thick_px,          p.noise_min_solidity,   p.noise_min_thick_share,
-             p.noise_min_largest_share, p.noise_min_mean_alpha, p.noise_recover_solidity};
-  o.still_speed_m_per_s = p.still_speed_m_per_s;
-  o.track.max_speed_m_per_s = p.max_speed_m_per_s;
-  o.max_still_s = p.max_still_s;
-  o.rectify.px_per_m = p.px_per_m;
-  o.batch.min_clip_frames = p.min_clip_frames;
-  return o;
+bool CameraPipelineOptions::IsValid(std::string* why) const {
+  OptionProblems check(why);
+  std::string part;
+  check.Nested(extract.IsValid(&part), "extract.", part);
+  check.Nested(track.IsValid(&part), "track.", part);
+  check.Nested(usability.IsValid(&part), "usability.", part);
+  check.Nested(noise.IsValid(&part), "noise.", part);
+  for (const auto& [v, field] : {std::pair{still_speed_m_per_s, "still_speed_m_per_s"},
+                                 std::pair{max_still_s, "max_still_s"}}) {
+    check(std::isfinite(v) && v > 0, field,
+          "expected a positive number, got " + OptionProblems::Num(v));
+  }
+  check.Nested(batch.IsValid(&part), "batch.", part);
+  check(workers >= 0, "workers",
+        "expected 0 (one per core) or more, got " + std::to_string(workers));
+  check(queue_frames >= 1, "queue_frames",
+        "expected at least 1 frame, got " + std::to_string(queue_frames));
+  return check.ok();
 }
 
 CameraPipeline::CameraPipeline(std::string name, int64_t camera_id, CameraModel model,

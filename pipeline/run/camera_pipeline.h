@@ -15,12 +15,12 @@
 #include <opencv2/core.hpp>
 
 #include "core/camera_model.h"
-#include "core/config.h"
 #include "core/frame.h"
 #include "core/geometry.h"
 #include "pipeline/extract/extractor.h"
 #include "pipeline/filter/usability.h"
 #include "pipeline/key/keyer.h"
+#include "pipeline/key/keying_config.h"
 #include "pipeline/key/matte.h"
 #include "pipeline/rectify/rectifier.h"
 #include "pipeline/run/clip_batcher.h"
@@ -28,24 +28,34 @@
 
 namespace ss {
 
-// Everything a camera pipeline is tuned by, from the station config.
+// Everything a camera pipeline is tuned by: each stage's own options. The station config's
+// keying and pipeline sections (and enclosure.wall_height_m) are these fields, bound key by key
+// (config/config_keys.cc; its defaults where they differ: DefaultPipelineOptions in
+// config/station_config.h). rectify.px_per_m 0 is `auto`: the caller sets the bank's scale
+// (ChooseBankScale, bank_scale.h) before making a CameraPipeline.
 struct CameraPipelineOptions {
   // The config's keying section: keying.method picks the keyer, which reads its own block
   // (pipeline/key/keyer_registry.h); keying.shadow.reach_m (> 0) becomes its grid's
   // shadow_reach_cells at the floor's centre. Unset: a chroma keyer with its own defaults.
   std::optional<KeyingConfig> keying;
-  ExtractorOptions extract;
-  TrackerOptions track;
-  UsabilityOptions usability;
-  NoiseOptions noise;
-  double still_speed_m_per_s = 0.05;
-  double max_still_s = 2.0;
-  RectifierOptions rectify;
-  ClipBatcherOptions batch;
+  ExtractorOptions extract;           // blobs of the matte into candidates
+  TrackerOptions track;               // candidates into subjects across frames
+  UsabilityOptions usability;         // border, floor and wall tests
+  NoiseOptions noise;                 // keyed background that is not a subject
+  double still_speed_m_per_s = 0.05;  // slower than this counts as not moving (StillnessFilter)
+  double max_still_s = 2.0;           // still periods longer than this are discarded
+  RectifierOptions rectify;           // billboards and their scale
+  ClipBatcherOptions batch;           // clips into the bank's batches
+  // How the pipelines run, read by whoever runs them (the station, ingest), not by
+  // CameraPipeline: OpenCV threads inside a frame's work (process-wide; 0 = OpenCV's
+  // default), and frames queued between a camera's capture and its pipeline (the station).
+  int workers = 0;
+  int queue_frames = 8;
+  // False with "FIELD: reason" lines in `why` (FIELD as "extract.min_area") for values out of
+  // range; the keying block is the keyers' to check (they refuse what they cannot use).
+  bool IsValid(std::string* why) const;
+  bool operator==(const CameraPipelineOptions&) const = default;
 };
-// rectify.px_per_m is the config's pipeline.px_per_m, 0 for auto: the caller sets the bank's
-// scale (ChooseBankScale, bank_scale.h) before making a CameraPipeline.
-CameraPipelineOptions PipelineOptionsFromConfig(const StationConfig& config);
 
 struct CameraPipelineStats {
   uint64_t frames = 0;           // frames processed (training frames included)
@@ -103,7 +113,7 @@ class CameraPipeline {
   // ones).
   uint64_t usable_sprites() const { return usable_total_; }
   const FloorMask& floor_mask() const { return floor_mask_; }
-  const Keyer& keyer() const { return *keyer_; }  // as configured (PipelineOptionsFromConfig)
+  const Keyer& keyer() const { return *keyer_; }  // as configured (options.keying)
 
  private:
   std::string name_;

@@ -3,8 +3,20 @@
 #include <algorithm>
 
 #include "core/error.h"
+#include "core/option_checks.h"
 
 namespace ss {
+
+bool ClipBatcherOptions::IsValid(std::string* why) const {
+  OptionProblems check(why);
+  check(min_clip_frames >= 1, "min_clip_frames",
+        "expected at least 1 frame, got " + std::to_string(min_clip_frames));
+  check(batch_frames >= 1, "batch_frames",
+        "expected at least 1 frame, got " + std::to_string(batch_frames));
+  check(velocity_half_window >= 0, "velocity_half_window",
+        "expected a number >= 0, got " + std::to_string(velocity_half_window));
+  return check.ok();
+}
 namespace {
 
 // The bank keeps the shadow billboard-sized: the rectifier's square ground

@@ -8,6 +8,7 @@
 // followed by its horizontally mirrored copy.
 #include <cstdint>
 #include <map>
+#include <string>
 #include <vector>
 
 #include <Eigen/Core>
@@ -20,10 +21,13 @@
 namespace ss {
 
 struct ClipBatcherOptions {
-  int min_clip_frames = 5;
+  int min_clip_frames = 5;       // shorter clips are discarded
   int batch_frames = 60;         // sprites per batch once a clip is long enough
   int velocity_half_window = 2;  // frames each side for the velocity slope
   bool mirrors = true;           // store the mirrored copy of every sprite
+  // False with "FIELD: reason" lines in `why` (core/option_checks.h) for values out of range.
+  bool IsValid(std::string* why) const;
+  bool operator==(const ClipBatcherOptions&) const = default;
 };
 
 // One usable sprite of a clip, as the pipeline made it.

@@ -79,8 +79,8 @@ struct CameraWork {
 
 }  // namespace
 
-GroundPolygon FloorForSession(const std::string& session_dir, const StationConfig& config) {
-  if (!config.enclosure.floor.empty()) return config.enclosure.floor;
+GroundPolygon FloorForSession(const std::string& session_dir, const GroundPolygon& configured) {
+  if (!configured.empty()) return configured;
   const fs::path dir(session_dir);
   for (const fs::path& candidate : {dir / "enclosure.json", dir / "truth" / "floor.json"}) {
     if (auto polygon = ReadFloorJson(candidate)) return *polygon;
@@ -92,15 +92,14 @@ GroundPolygon FloorForSession(const std::string& session_dir, const StationConfi
 
 IngestSummary IngestSession(const IngestOptions& options) {
   const auto start = Clock::now();
-  const StationConfig& config = options.config;
-  if (config.pipeline.workers > 0) cv::setNumThreads(config.pipeline.workers);  // process-wide
+  if (options.pipeline.workers > 0) cv::setNumThreads(options.pipeline.workers);  // process-wide
   ReplayOptions replay_options;
   replay_options.realtime = false;
   replay_options.frames_ahead = 6;
   replay_options.decode_threads = options.decode_threads;
   ReplaySource source(options.session_dir, replay_options);
   const SessionInfo& info = source.session();
-  const GroundPolygon floor = FloorForSession(options.session_dir, config);
+  const GroundPolygon floor = FloorForSession(options.session_dir, options.floor);
 
   // Everything that can be refused is checked before the bank is touched.
   std::vector<CameraModel> models;
@@ -119,7 +118,7 @@ IngestSummary IngestSession(const IngestOptions& options) {
                            std::to_string(cam.height));
     }
   }
-  CameraPipelineOptions pipeline_options = PipelineOptionsFromConfig(config);
+  CameraPipelineOptions pipeline_options = options.pipeline;
   const TransitionWeights transition_weights = options.transition_weights.empty()
                                                    ? DefaultWeights()
                                                    : LoadWeights(options.transition_weights);
@@ -138,7 +137,7 @@ IngestSummary IngestSession(const IngestOptions& options) {
   IngestSummary summary;
   // The bank's one billboard scale: its own when it holds sprites, else the config's or auto.
   BankScaleInputs scale_inputs;
-  scale_inputs.configured = config.pipeline.px_per_m;
+  scale_inputs.configured = options.pipeline.rectify.px_per_m;
   scale_inputs.bank_path = options.bank_path;
   for (const CameraModel& m : models) scale_inputs.models.push_back(&m);
   scale_inputs.floor = floor;
@@ -192,9 +191,8 @@ IngestSummary IngestSession(const IngestOptions& options) {
   // writer thread only queues each batch's ids with it.
   std::unique_ptr<TransitionWorker> transitions;
   if (options.transitions)
-    transitions = std::make_unique<TransitionWorker>(
-        options.bank_path, transition_weights, 1,
-        SpriteChoice{.include_merged = config.transitions.include_merged});
+    transitions = std::make_unique<TransitionWorker>(options.bank_path, transition_weights, 1,
+                                                     options.transition_sprites);
 
   std::atomic<uint64_t> frames_done{0}, rows_inserted{0}, batch_count{0}, stored{0};
   std::thread writer([&] {
@@ -212,7 +210,8 @@ IngestSummary IngestSession(const IngestOptions& options) {
     }
   });
 
-  const int training_frames = std::max(1, config.keying.training_frames);
+  const int training_frames = std::max(
+      1, (options.pipeline.keying ? *options.pipeline.keying : KeyingConfig{}).training_frames);
   for (CameraWork& w : cameras) {
     w.thread = std::thread([&, &w = w] {
       try {

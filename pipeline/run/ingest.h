@@ -16,9 +16,9 @@
 
 #include "capture/frame_source.h"
 #include "capture/replay/replay_source.h"
-#include "core/config.h"
 #include "core/geometry.h"
 #include "pipeline/run/camera_pipeline.h"
+#include "pipeline/transitions/bank_sprites.h"
 
 namespace ss {
 
@@ -32,7 +32,12 @@ struct IngestProgress {
 struct IngestOptions {
   std::string session_dir;
   std::string bank_path;
-  StationConfig config;  // keying, enclosure and pipeline sections are used
+  // What the station config sets (config/station_config.h: the sections named). The defaults
+  // are the stages' own, not the config's: without a config file a caller passes a default
+  // StationConfig's (DefaultPipelineOptions).
+  CameraPipelineOptions pipeline;   // keying, pipeline; keying.training_frames train (30 unset)
+  GroundPolygon floor;              // enclosure.floor; empty: the session's (FloorForSession)
+  SpriteChoice transition_sprites;  // transitions.include_merged
   std::function<void(const IngestProgress&)>
       progress;                    // a few times a second, from the calling thread
   bool transitions = true;         // keep the transition table current (TransitionWorker)
@@ -72,10 +77,10 @@ struct IngestSummary {
   std::string transitions_error;  // its last error ("" when none): the table may be incomplete
 };
 
-// The floor polygon for a session: the config's `enclosure.floor` when given,
-// else the session's own `enclosure.json` or (synthetic sessions) `truth/floor.json`.
+// The floor polygon for a session: `configured` (the config's `enclosure.floor`) when not
+// empty, else the session's own `enclosure.json` or (synthetic sessions) `truth/floor.json`.
 // InputError naming what was looked at when there is none.
-GroundPolygon FloorForSession(const std::string& session_dir, const StationConfig& config);
+GroundPolygon FloorForSession(const std::string& session_dir, const GroundPolygon& configured);
 
 // Runs the whole ingest. InputError for bad input (session, models, config),
 // WorkError when the work fails; batches stored before a failure stay stored.

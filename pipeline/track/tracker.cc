@@ -1,14 +1,29 @@
 #include "pipeline/track/tracker.h"
 
 #include <algorithm>
+#include <cmath>
 #include <iterator>
 #include <limits>
 #include <string>
 #include <tuple>
 
 #include "core/log.h"
+#include "core/option_checks.h"
 
 namespace ss {
+
+bool TrackerOptions::IsValid(std::string* why) const {
+  OptionProblems check(why);
+  check(std::isfinite(max_speed_m_per_s) && max_speed_m_per_s > 0, "max_speed_m_per_s",
+        "expected a positive number, got " + OptionProblems::Num(max_speed_m_per_s));
+  check(std::isfinite(reach_slack_m) && reach_slack_m >= 0, "reach_slack_m",
+        "expected a number >= 0, got " + OptionProblems::Num(reach_slack_m));
+  check(max_area_ratio >= 1, "max_area_ratio",
+        "expected a ratio >= 1, got " + OptionProblems::Num(max_area_ratio));
+  check(forget_after_ns >= 0, "forget_after_ns",
+        "expected a duration >= 0, got " + std::to_string(forget_after_ns));
+  return check.ok();
+}
 
 std::vector<int> Tracker::Update(int64_t timestamp_ns, const std::vector<TrackInput>& inputs) {
   std::erase_if(subjects_, [&](const Subject& s) {

@@ -4,6 +4,7 @@
 // subject within reach (speed limit x elapsed time), greedily by distance;
 // unmatched candidates start new subjects; subjects unseen for a while end.
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include <Eigen/Core>
@@ -15,7 +16,10 @@ struct TrackerOptions {
   double max_speed_m_per_s = 1.0;  // a subject cannot move faster than this
   double reach_slack_m = 0.02;     // plus this, for keying jitter of the contact point
   double max_area_ratio = 2.5;     // a blob that grows or shrinks more is not the same sprite
-  int64_t forget_after_ns = 500'000'000;
+  int64_t forget_after_ns = 500'000'000;  // a subject unseen this long has ended
+  // False with "FIELD: reason" lines in `why` (core/option_checks.h) for values out of range.
+  bool IsValid(std::string* why) const;
+  bool operator==(const TrackerOptions&) const = default;
 };
 
 struct TrackInput {

@@ -2,7 +2,6 @@
 
 #include <gtest/gtest.h>
 
-#include "core/config.h"
 #include "core/error.h"
 #include "synth/renderer.h"
 #include "synth/scene.h"
@@ -59,34 +58,6 @@ TEST(FloorPolygon, LargestGreenFloorRegionMatchesTheStudioFloor) {
   // The wrong image size is refused.
   cv::Mat small(10, 10, CV_8UC3, cv::Scalar(0, 255, 0));
   EXPECT_THROW(FindGreenFloor(TrueModel(cam), small), InputError);
-}
-
-TEST(FloorPolygon, ReplacesTheConfigsFloorKeepingTheRest) {
-  const std::string config =
-      "version: 1\n"
-      "# the enclosure\n"
-      "enclosure:\n"
-      "  floor:\n"
-      "    - [-1.2, -0.8]\n"
-      "    - [ 1.2, -0.8]\n"
-      "    - [ 1.2,  0.8]\n"
-      "  wall_height_m: 0.6   # keep me\n"
-      "pipeline:\n"
-      "  min_area_px: 500\n";
-  const GroundPolygon floor({{-0.5, -0.3}, {0.5, -0.3}, {0.5, 0.3}, {-0.5, 0.3}});
-  const std::string updated = ReplaceEnclosureFloor(config, floor, "station.yaml");
-  ConfigOptions o;
-  o.check_files = false;
-  const StationConfig c = ParseStationConfig(updated, "station.yaml", ".", nullptr, o);
-  ASSERT_EQ(c.enclosure.floor.vertices().size(), 4u);
-  EXPECT_NEAR(c.enclosure.floor.Area(), 0.6, 1e-9);
-  EXPECT_DOUBLE_EQ(c.enclosure.wall_height_m, 0.6);
-  EXPECT_EQ(c.pipeline.min_area_px, 500);
-  EXPECT_NE(updated.find("# keep me"), std::string::npos);
-  // A config without an enclosure gets one.
-  const StationConfig added = ParseStationConfig(
-      ReplaceEnclosureFloor("version: 1\n", floor, "s.yaml"), "s.yaml", ".", nullptr, o);
-  EXPECT_NEAR(added.enclosure.floor.Area(), 0.6, 1e-9);
 }
 
 }  // namespace

@@ -7,7 +7,6 @@
 
 #include <gtest/gtest.h>
 
-#include "core/config.h"
 #include "core/error.h"
 #include "tests/support/test_support.h"
 
@@ -46,20 +45,6 @@ TEST(ReadWithinLimit, CountsWhatHasNoSizeWhileReading) {
             "(a pipe): more than 1 MiB read: larger than the 1 MiB an animation spec may be");
   std::istringstream small("cameras: []\n");
   EXPECT_EQ(ReadWithinLimit(small, "(a pipe)", "a config file", 1u << 20), "cameras: []\n");
-}
-
-// Issue 20: yaml-cpp parses a whole file first (a 250 MB config took seconds and GBs). The file is
-// sparse: refused from its size, before a byte of it is read.
-TEST(StationConfig, AFileOverTheLimitIsRefusedBeforeItIsRead) {
-  ScratchDir dir;
-  const std::string path = dir / "station.yaml";
-  std::ofstream(path) << "cameras:\n";
-  fs::resize_file(path, 250'000'000);
-  EXPECT_EQ(ErrorOf([&] { LoadStationConfig(path); }),
-            path + ": 238.4 MiB (250000000 bytes): larger than the 16 MiB a config file may be");
-  fs::resize_file(path, kMaxInputFileBytes + 1);
-  EXPECT_EQ(ErrorOf([&] { LoadStationConfig(path); }),
-            path + ": 16.0 MiB (16777217 bytes): larger than the 16 MiB a config file may be");
 }
 
 }  // namespace

@@ -38,7 +38,7 @@ using testing::ReadCsv;
 using testing::RunSpritestation;
 using testing::ScratchDir;
 
-// The station config's defaults (core/config.h PipelineConfig, ExtractorOptions).
+// The station config's defaults (config/station_config.h, pipeline/run/camera_pipeline.h).
 constexpr int kBorderMarginPx = 2;       // pipeline.border_margin_px
 constexpr int kExtractMarginPx = 4;      // the extractor's margin around the subject's box
 constexpr double kStillSpeed = 0.05;     // pipeline.still_speed_m_per_s

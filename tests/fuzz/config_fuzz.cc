@@ -1,5 +1,5 @@
-// The station config (core/config.h): YAML with every section, field and polygon.
-#include "core/config.h"
+// The station config (config/station_config.h): YAML with every section, field and polygon.
+#include "config/station_config.h"
 #include "tests/fuzz/fuzz_support.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {

@@ -13,7 +13,7 @@
 #include "capture/camera_source.h"
 #include "capture/libcamera/libcamera_config.h"
 #include "capture/libcamera/libcamera_source.h"
-#include "core/config.h"
+#include "config/station_config.h"
 #include "core/error.h"
 
 namespace ss {

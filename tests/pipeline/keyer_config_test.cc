@@ -1,4 +1,4 @@
-// The station config's keying section reaches the keyers (PipelineOptionsFromConfig ->
+// The station config's keying section reaches the keyers (StationConfig::pipeline ->
 // CameraPipeline): a changed config value changes what the pipeline's keyer makes of the same
 // frame (docs/keying.md, "From the station config").
 #include <vector>
@@ -6,7 +6,7 @@
 #include <gtest/gtest.h>
 #include <opencv2/core.hpp>
 
-#include "core/config.h"
+#include "config/station_config.h"
 #include "pipeline/run/camera_pipeline.h"
 #include "tests/pipeline/key_scene.h"
 
@@ -52,7 +52,7 @@ class KeyerConfig : public ::testing::Test {
     for (int i = 0; i < 4; ++i) empty.push_back(scene.Empty(100 + i));
     const SceneFrame f = scene.Render({s}, 7);
     GroundPolygon floor({{-0.6, -0.4}, {0.6, -0.4}, {0.6, 0.4}, {-0.6, 0.4}});
-    CameraPipelineOptions options = PipelineOptionsFromConfig(config);
+    CameraPipelineOptions options = config.pipeline;
     // auto is resolved per bank (ChooseBankScale); any scale does here
     options.rectify.px_per_m = 800;
     pipelines_.emplace_back(std::make_unique<CameraPipeline>("cam0", 1, Camera(), floor, options));
@@ -76,9 +76,9 @@ TEST_F(KeyerConfig, DespillFollowsTheConfig) {
   StationConfig config;
   const Keyed on = Key(config);
   ASSERT_GT(on.alpha_sum, 0);
-  config.keying.despill_strength = 0.5;
+  config.pipeline.keying->despill_strength = 0.5;
   const Keyed half = Key(config);
-  config.keying.despill = false;
+  config.pipeline.keying->despill = false;
   const Keyed off = Key(config);
   // The rim's green spill above the despill limit (~16 levels on average): all of it removed,
   // half of it, none.
@@ -91,19 +91,19 @@ TEST_F(KeyerConfig, ShadowFollowsTheConfig) {
   StationConfig config;
   const Keyed on = Key(config);
   ASSERT_GT(on.shadow_sum, 255 * 200.0) << "the scene's subject casts a contact shadow";
-  config.keying.shadow_min_darkening = 0.3;
+  config.pipeline.keying->shadow_min_darkening = 0.3;
   const Keyed faint_dropped = Key(config);
   EXPECT_LT(faint_dropped.shadow_sum, 0.9 * on.shadow_sum);
-  config.keying = {};
-  config.keying.shadow = false;
+  config.pipeline.keying = KeyingConfig{};
+  config.pipeline.keying->shadow = false;
   const Keyed off = Key(config);
   EXPECT_EQ(off.shadow_sum, 0);
   EXPECT_GT(off.alpha_sum, 0);
   // The reach in metres becomes grid cells at the camera's scale (~300 px per metre at the floor).
-  config.keying = {};
-  config.keying.shadow_reach_m = 0.05;
+  config.pipeline.keying = KeyingConfig{};
+  config.pipeline.keying->shadow_reach_m = 0.05;
   const int near = Key(config).pipeline->keyer().grid().shadow_reach_cells;
-  config.keying.shadow_reach_m = 0.5;
+  config.pipeline.keying->shadow_reach_m = 0.5;
   const int far = Key(config).pipeline->keyer().grid().shadow_reach_cells;
   EXPECT_GE(near, 1);
   EXPECT_GT(far, 5 * near);
@@ -115,8 +115,8 @@ TEST_F(KeyerConfig, ChromaThresholdsFollowTheConfig) {
   ASSERT_GT(defaults.alpha_sum, 0);
   // A key threshold far below the green's own (~105 levels): the soft, greenish edge falls to
   // background (about 2.5% of the subject's alpha).
-  config.keying.chroma_low = 0;
-  config.keying.chroma_high = 15;
+  config.pipeline.keying->chroma.key_low_levels = 0;
+  config.pipeline.keying->chroma.key_high_levels = 15;
   const Keyed tight = Key(config);
   EXPECT_LT(tight.alpha_sum, 0.99 * defaults.alpha_sum);
   EXPECT_GT(tight.alpha_sum, 0.9 * defaults.alpha_sum);
@@ -124,12 +124,12 @@ TEST_F(KeyerConfig, ChromaThresholdsFollowTheConfig) {
 
 TEST_F(KeyerConfig, CleanPlateThresholdsFollowTheConfig) {
   StationConfig config;
-  config.keying.method = KeyingMethod::kCleanPlate;
+  config.pipeline.keying->method = KeyingMethod::kCleanPlate;
   const Keyed defaults = Key(config, /*green=*/false);
   ASSERT_GT(defaults.alpha_sum, 0);
   // A wider tolerance and ramp (in noise sigmas) key less of the frame as subject.
-  config.keying.plate_low_sigma = 12;
-  config.keying.plate_high_sigma = 40;
+  config.pipeline.keying->plate_low_sigma = 12;
+  config.pipeline.keying->plate_high_sigma = 40;
   const Keyed loose = Key(config, false);
   EXPECT_LT(loose.alpha_sum, 0.97 * defaults.alpha_sum);
 }

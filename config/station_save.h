@@ -5,14 +5,16 @@
 // replaced atomically (written beside it, then renamed over it) and the file
 // it replaces kept beside it as NAME.previous-<UTC>.EXT. Every new file is
 // written before any is renamed: a folder that cannot be written fails the
-// save with nothing changed.
+// save with nothing changed. Also the edits of a config's YAML text that keep the rest as
+// written. In config/ (namespace calib, as its users know it), above the config it edits and
+// the calibration it saves.
 #include <optional>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "config/station_config.h"
 #include "core/camera_model.h"
-#include "core/config.h"
 #include "core/geometry.h"
 
 namespace ss::calib {
@@ -43,5 +45,11 @@ std::string SetCameraModelPath(const std::string& config_yaml, const std::string
 
 // "DIR/NAME.previous-STAMP.EXT" for "DIR/NAME.EXT".
 std::string PreviousFileName(const std::string& path, const std::string& stamp);
+
+// Replaces (or adds) `enclosure.floor` in a station config's YAML text, keeping
+// everything else as written. The result is checked by ParseStationConfig
+// (InputError naming `origin` when it does not hold).
+std::string ReplaceEnclosureFloor(const std::string& config_yaml, const GroundPolygon& floor,
+                                  const std::string& origin);
 
 }  // namespace ss::calib

@@ -1,6 +1,6 @@
 // The station config: a complete file parses into every field, defaults are
 // filled, and each kind of mistake is refused naming the field and its line.
-#include "core/config.h"
+#include "config/station_config.h"
 
 #include <cstdlib>
 #include <filesystem>
@@ -110,38 +110,38 @@ TEST(StationConfig, ExampleParsesIntoEveryField) {
   EXPECT_EQ(gige.white_balance.red_gain, 1.42);
   EXPECT_EQ(gige.white_balance.blue_gain, 1.87);
 
-  EXPECT_EQ(cfg.keying.method, KeyingMethod::kChroma);
-  EXPECT_EQ(cfg.keying.training_frames, 30);
-  EXPECT_EQ(cfg.keying.chroma_low, 20);
-  EXPECT_EQ(cfg.keying.chroma_high, 60);
-  EXPECT_EQ(cfg.keying.plate_low_sigma, 3);
-  EXPECT_EQ(cfg.keying.plate_high_sigma, 6);
-  EXPECT_TRUE(cfg.keying.despill);
-  EXPECT_EQ(cfg.keying.despill_strength, 1.0);
-  EXPECT_TRUE(cfg.keying.shadow);
-  EXPECT_EQ(cfg.keying.shadow_min_darkening, 0.08);
-  EXPECT_EQ(cfg.keying.shadow_max_darkening, 0.7);
-  EXPECT_EQ(cfg.keying.shadow_reach_m, 0.5);
+  EXPECT_EQ(cfg.pipeline.keying->method, KeyingMethod::kChroma);
+  EXPECT_EQ(cfg.pipeline.keying->training_frames, 30);
+  EXPECT_EQ(cfg.pipeline.keying->chroma.key_low_levels, 20);
+  EXPECT_EQ(cfg.pipeline.keying->chroma.key_high_levels, 60);
+  EXPECT_EQ(cfg.pipeline.keying->plate_low_sigma, 3);
+  EXPECT_EQ(cfg.pipeline.keying->plate_high_sigma, 6);
+  EXPECT_TRUE(cfg.pipeline.keying->despill);
+  EXPECT_EQ(cfg.pipeline.keying->despill_strength, 1.0);
+  EXPECT_TRUE(cfg.pipeline.keying->shadow);
+  EXPECT_EQ(cfg.pipeline.keying->shadow_min_darkening, 0.08);
+  EXPECT_EQ(cfg.pipeline.keying->shadow_max_darkening, 0.7);
+  EXPECT_EQ(cfg.pipeline.keying->shadow_reach_m, 0.5);
 
   ASSERT_EQ(cfg.enclosure.floor.vertices().size(), 4u);
   EXPECT_EQ(cfg.enclosure.floor.vertices()[2], Eigen::Vector2d(1.2, 0.8));
   EXPECT_NEAR(cfg.enclosure.floor.Area(), 2.4 * 1.6, 1e-12);
-  EXPECT_EQ(cfg.enclosure.wall_height_m, 0.6);
+  EXPECT_EQ(cfg.pipeline.usability.wall_height_m, 0.6);
 
-  EXPECT_EQ(cfg.pipeline.min_area_px, 400);
-  EXPECT_EQ(cfg.pipeline.border_margin_px, 2);
-  EXPECT_EQ(cfg.pipeline.floor_margin_px, 3);
-  EXPECT_EQ(cfg.pipeline.wall_margin_m, 0.005);
+  EXPECT_EQ(cfg.pipeline.extract.min_area, 400);
+  EXPECT_EQ(cfg.pipeline.usability.border_margin_px, 2);
+  EXPECT_EQ(cfg.pipeline.usability.floor_margin_px, 3);
+  EXPECT_EQ(cfg.pipeline.usability.wall_margin_m, 0.005);
   EXPECT_EQ(cfg.pipeline.still_speed_m_per_s, 0.05);
-  EXPECT_EQ(cfg.pipeline.max_speed_m_per_s, 1.5);
+  EXPECT_EQ(cfg.pipeline.track.max_speed_m_per_s, 1.5);
   EXPECT_EQ(cfg.pipeline.max_still_s, 2.0);
-  EXPECT_EQ(cfg.pipeline.min_clip_frames, 5);
-  EXPECT_EQ(cfg.pipeline.px_per_m, 0);  // auto
+  EXPECT_EQ(cfg.pipeline.batch.min_clip_frames, 5);
+  EXPECT_EQ(cfg.pipeline.rectify.px_per_m, 0);  // auto
   EXPECT_EQ(cfg.pipeline.workers, 0);
   EXPECT_EQ(cfg.pipeline.queue_frames, 8);
-  EXPECT_EQ(cfg.pipeline.noise_min_solidity, 0.25);
-  EXPECT_EQ(cfg.pipeline.noise_recover_solidity, 0.30);
-  EXPECT_EQ(cfg.pipeline.noise_min_thick_share, 0);  // off
+  EXPECT_EQ(cfg.pipeline.noise.min_solidity, 0.25);
+  EXPECT_EQ(cfg.pipeline.noise.recover_solidity, 0.30);
+  EXPECT_EQ(cfg.pipeline.noise.min_thick_share, 0);  // off
 
   EXPECT_EQ(cfg.storage.bank, dir + "/station.bank");
   EXPECT_EQ(cfg.storage.recording_dir, dir + "/recordings");
@@ -173,13 +173,13 @@ TEST(StationConfig, DefaultsAreFilled) {
   EXPECT_EQ(cfg, expected);
   EXPECT_FALSE(cfg.cameras[0].exposure_us.has_value());  // unset: the device's value, locked
   EXPECT_EQ(cfg.control.address, "127.0.0.1");
-  EXPECT_EQ(cfg.keying.method, KeyingMethod::kChroma);
+  EXPECT_EQ(cfg.pipeline.keying->method, KeyingMethod::kChroma);
   EXPECT_TRUE(cfg.enclosure.floor.empty());
 }
 
 TEST(StationConfig, PxPerMIsAutoOrANumber) {
-  EXPECT_EQ(Parse(kOneCamera + "pipeline:\n  px_per_m: auto\n").pipeline.px_per_m, 0);
-  EXPECT_EQ(Parse(kOneCamera + "pipeline:\n  px_per_m: 500\n").pipeline.px_per_m, 500);
+  EXPECT_EQ(Parse(kOneCamera + "pipeline:\n  px_per_m: auto\n").pipeline.rectify.px_per_m, 0);
+  EXPECT_EQ(Parse(kOneCamera + "pipeline:\n  px_per_m: 500\n").pipeline.rectify.px_per_m, 500);
 }
 
 TEST(StationConfig, ReplayCameraDefaultsToItsOwnNameInTheSession) {
@@ -326,18 +326,89 @@ TEST(StationConfig, EveryErrorIsReportedAtOnce) {
             "station.yaml:7: pipeline.px_per_m: expected auto or a positive number, got -1");
 }
 
+// The keying and pipeline sections (and enclosure.wall_height_m) are the camera pipeline's own
+// options (issue 17); the config's defaults are as they were where they differ from the
+// stages' own (DefaultPipelineOptions).
+TEST(StationConfig, PipelineSectionsAreTheStagesOptionsWithTheConfigsDefaults) {
+  const CameraPipelineOptions p = Parse(kOneCamera).pipeline;
+  ASSERT_TRUE(p.keying.has_value());
+  EXPECT_EQ(*p.keying, KeyingConfig{});
+  EXPECT_EQ(p.extract.min_area, 400);  // the extractor's own is 40
+  EXPECT_EQ(p.usability.border_margin_px, 2);
+  EXPECT_EQ(p.usability.floor_margin_px, 3);
+  EXPECT_EQ(p.usability.wall_margin_m, 0.005);
+  EXPECT_EQ(p.usability.wall_height_m, 0.0);
+  EXPECT_EQ(p.still_speed_m_per_s, 0.05);
+  EXPECT_EQ(p.track.max_speed_m_per_s, 1.0);
+  EXPECT_EQ(p.max_still_s, 2.0);
+  EXPECT_EQ(p.batch.min_clip_frames, 5);
+  EXPECT_EQ(p.noise.thick_px, 2.0);
+  EXPECT_EQ(p.noise.min_solidity, 0.25);
+  EXPECT_EQ(p.noise.recover_solidity, 0.30);
+  EXPECT_EQ(p.noise.min_thick_share, 0);
+  EXPECT_EQ(p.noise.min_largest_share, 0);
+  EXPECT_EQ(p.noise.min_mean_alpha, 0);
+  EXPECT_EQ(p.rectify.px_per_m, 0);  // auto; the rectifier's own is 800
+  EXPECT_EQ(p.workers, 0);
+  EXPECT_EQ(p.queue_frames, 8);
+  // What the config does not set is the stages' own.
+  CameraPipelineOptions stages = p;
+  stages.keying.reset();
+  stages.extract.min_area = ExtractorOptions{}.min_area;
+  stages.rectify.px_per_m = RectifierOptions{}.px_per_m;
+  EXPECT_EQ(stages, CameraPipelineOptions{});
+
+  const StationConfig set = Parse(
+      "enclosure:\n  wall_height_m: 0.4\n"
+      "pipeline:\n  min_area_px: 90\n  max_speed_m_per_s: 2\n  min_clip_frames: 7\n"
+      "  px_per_m: 600\n");
+  EXPECT_EQ(set.pipeline.usability.wall_height_m, 0.4);
+  EXPECT_EQ(set.pipeline.extract.min_area, 90);
+  EXPECT_EQ(set.pipeline.track.max_speed_m_per_s, 2);
+  EXPECT_EQ(set.pipeline.batch.min_clip_frames, 7);
+  EXPECT_EQ(set.pipeline.rectify.px_per_m, 600);
+}
+
+// keying.chroma.* are the chroma keyer's own options (KeyingConfig::chroma); the shared despill
+// and shadow blocks are applied to them when the keyer is made.
+TEST(StationConfig, ChromaBlockIsTheChromaKeyersOptions) {
+  const StationConfig cfg =
+      Parse("keying:\n  chroma: {low: 10, high: 50}\n  shadow: {max_darkening: 0.6}\n");
+  EXPECT_EQ(cfg.pipeline.keying->chroma.key_low_levels, 10);
+  EXPECT_EQ(cfg.pipeline.keying->chroma.key_high_levels, 50);
+  const ChromaKeyerOptions o = ChromaKeyerOptionsFrom(*cfg.pipeline.keying);
+  EXPECT_EQ(o.key_low_levels, 10);
+  EXPECT_EQ(o.key_high_levels, 50);
+  EXPECT_NEAR(o.dark_floor, 0.4, 1e-12);
+  EXPECT_EQ(o.shadow_min, 0.08);
+  EXPECT_EQ(o.noise_z, ChromaKeyerOptions{}.noise_z);  // not in the config: the keyer's own
+}
+
+// The stages' own rules (their options' IsValid), each error naming the config key, all of them.
+TEST(StationConfig, PipelineValuesAreCheckedByTheStagesNamingTheKey) {
+  EXPECT_EQ(ErrorOf("enclosure:\n  wall_height_m: -0.5\n"
+                    "pipeline:\n  min_clip_frames: 0\n  max_speed_m_per_s: -1\n"
+                    "  noise_min_mean_alpha: 2\n  queue_frames: 0\n"),
+            "station.yaml:2: enclosure.wall_height_m: expected a number >= 0, got -0.5\n"
+            "station.yaml:5: pipeline.max_speed_m_per_s: expected a positive number, got -1\n"
+            "station.yaml:4: pipeline.min_clip_frames: expected at least 1 frame, got 0\n"
+            "station.yaml:6: pipeline.noise_min_mean_alpha: expected a share from 0 to 1 (0 turns "
+            "the test off), got 2\n"
+            "station.yaml:7: pipeline.queue_frames: expected at least 1 frame, got 0");
+}
+
 // The noise rule's thresholds (issue 19): shares from 0 to 1, 0 turning a test off.
 TEST(StationConfig, NoiseThresholds) {
   const StationConfig cfg = Parse(
       "pipeline:\n  noise_min_solidity: 0\n  noise_recover_solidity: 0.4\n  noise_thick_px: 3\n"
       "  noise_min_thick_share: 0.2\n  noise_min_largest_share: 0.5\n  noise_min_mean_alpha: "
       "0.6\n");
-  EXPECT_EQ(cfg.pipeline.noise_min_solidity, 0);
-  EXPECT_EQ(cfg.pipeline.noise_recover_solidity, 0.4);
-  EXPECT_EQ(cfg.pipeline.noise_thick_px, 3);
-  EXPECT_EQ(cfg.pipeline.noise_min_thick_share, 0.2);
-  EXPECT_EQ(cfg.pipeline.noise_min_largest_share, 0.5);
-  EXPECT_EQ(cfg.pipeline.noise_min_mean_alpha, 0.6);
+  EXPECT_EQ(cfg.pipeline.noise.min_solidity, 0);
+  EXPECT_EQ(cfg.pipeline.noise.recover_solidity, 0.4);
+  EXPECT_EQ(cfg.pipeline.noise.thick_px, 3);
+  EXPECT_EQ(cfg.pipeline.noise.min_thick_share, 0.2);
+  EXPECT_EQ(cfg.pipeline.noise.min_largest_share, 0.5);
+  EXPECT_EQ(cfg.pipeline.noise.min_mean_alpha, 0.6);
   const std::string share = ErrorOf("pipeline:\n  noise_min_solidity: 1.5\n");
   EXPECT_NE(share.find("pipeline.noise_min_solidity: expected a share from 0 to 1"),
             std::string::npos)
@@ -411,7 +482,7 @@ TEST(StationConfig, AdjustmentsAreReported) {
   EXPECT_EQ(report.status, ConfigStatus::kAdjusted);
   EXPECT_EQ(cfg.cameras[0].width, 1280);
   EXPECT_EQ(cfg.cameras[0].height, 720);
-  EXPECT_EQ(cfg.keying.despill_strength, 1.0);
+  EXPECT_EQ(cfg.pipeline.keying->despill_strength, 1.0);
   EXPECT_EQ(cfg.storage.stop_recording_below_mib, 500);
   EXPECT_EQ(cfg.storage.stop_sprites_below_mib, 500);
   ASSERT_EQ(report.adjustments.size(), 4u) << report.Summary();
@@ -472,7 +543,7 @@ TEST(StationConfig, ValidatesConfigsBuiltInCode) {
   cfg.storage.bank = "/b";
   cfg.storage.recording_dir = "/r";
   EXPECT_EQ(ValidateStationConfig(cfg, "code", {}, NoFileChecks()).status, ConfigStatus::kValid);
-  cfg.pipeline.px_per_m = -5;
+  cfg.pipeline.rectify.px_per_m = -5;
   cfg.control.address = "0.0.0.0";
   const ConfigReport report = ValidateStationConfig(cfg, "code", {}, NoFileChecks());
   EXPECT_EQ(report.status, ConfigStatus::kInvalid);

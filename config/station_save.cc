@@ -1,9 +1,10 @@
-#include "calib/station_save.h"
+#include "config/station_save.h"
 
 #include <fcntl.h>
 #include <unistd.h>
 
 #include <cerrno>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -20,6 +21,12 @@ namespace ss::calib {
 namespace {
 
 namespace fs = std::filesystem;
+
+std::string Number(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.4f", v);
+  return buf;
+}
 
 // Writes `bytes` to `path` and flushes them to the disk; WorkError naming the file.
 void WriteDurably(const std::string& path, const std::string& bytes) {
@@ -195,6 +202,71 @@ StationSaveResult SaveStationCalibration(const StationConfig& config,
   Log("calib.save")
       ->info("calibration saved: {} file(s), {} previous kept", result.files.size(),
              result.previous.size());
+  return result;
+}
+
+std::string ReplaceEnclosureFloor(const std::string& config_yaml, const GroundPolygon& floor,
+                                  const std::string& origin) {
+  std::vector<std::string> lines;
+  {
+    std::istringstream in(config_yaml);
+    std::string line;
+    while (std::getline(in, line)) lines.push_back(line);
+  }
+  auto indent = [](const std::string& l) { return l.find_first_not_of(' '); };
+  auto blank = [&](const std::string& l) {
+    const size_t i = indent(l);
+    return i == std::string::npos || l[i] == '#';
+  };
+  std::ostringstream floor_text;
+  for (const auto& v : floor.vertices())
+    floor_text << "    - [" << Number(v.x()) << ", " << Number(v.y()) << "]\n";
+  std::vector<std::string> out;
+  size_t i = 0;
+  bool done = false;
+  for (; i < lines.size(); ++i) {
+    if (!done && lines[i].rfind("enclosure:", 0) == 0) {
+      out.push_back(lines[i]);
+      size_t end = i + 1;
+      while (end < lines.size() && (blank(lines[end]) || indent(lines[end]) > 0)) ++end;
+      bool replaced = false;
+      for (size_t k = i + 1; k < end; ++k) {
+        const size_t in = indent(lines[k]);
+        if (!blank(lines[k]) && lines[k].compare(in, 6, "floor:") == 0) {
+          out.push_back(lines[k].substr(0, in) + "floor:");
+          size_t j = k + 1;
+          while (j < end && (blank(lines[j]) || indent(lines[j]) > in ||
+                             (indent(lines[j]) == in && lines[j][in] == '-'))) {
+            ++j;
+          }
+          std::istringstream f(floor_text.str());
+          std::string fl;
+          while (std::getline(f, fl))
+            out.push_back(std::string(in + 2, ' ') + fl.substr(fl.find('-')));
+          k = j - 1;
+          replaced = true;
+        } else {
+          out.push_back(lines[k]);
+        }
+      }
+      if (!replaced) {
+        out.push_back("  floor:");
+        std::istringstream f(floor_text.str());
+        std::string fl;
+        while (std::getline(f, fl)) out.push_back(fl);
+      }
+      i = end - 1;
+      done = true;
+    } else {
+      out.push_back(lines[i]);
+    }
+  }
+  std::string result;
+  for (const auto& l : out) result += l + "\n";
+  if (!done) result += EnclosureYaml(floor, 0.0);
+  ConfigOptions check;
+  check.check_files = false;
+  ParseStationConfig(result, origin, ".", nullptr, check);  // throws InputError naming the line
   return result;
 }
 

@@ -1,7 +1,7 @@
 // Saving a calibration into a station's files: the config edited as text
 // (comments kept), every file replaced atomically with the old one kept, and
 // a folder that cannot be written changing nothing.
-#include "calib/station_save.h"
+#include "config/station_save.h"
 
 #include <sys/resource.h>
 #include <unistd.h>
@@ -14,7 +14,7 @@
 #include <fstream>
 #include <sstream>
 
-#include "core/config.h"
+#include "config/station_config.h"
 #include "core/error.h"
 #include "synth/scene.h"
 #include "tests/calib/calib_fixtures.h"
@@ -177,6 +177,34 @@ TEST(SaveStationCalibration, AFolderThatCannotBeWrittenChangesNothing) {
   // An unknown camera is named.
   request.models = {{"middle", Model(1)}};
   EXPECT_THROW(SaveStationCalibration(LoadStationConfig(config_path), request), InputError);
+}
+
+TEST(FloorPolygon, ReplacesTheConfigsFloorKeepingTheRest) {
+  const std::string config =
+      "version: 1\n"
+      "# the enclosure\n"
+      "enclosure:\n"
+      "  floor:\n"
+      "    - [-1.2, -0.8]\n"
+      "    - [ 1.2, -0.8]\n"
+      "    - [ 1.2,  0.8]\n"
+      "  wall_height_m: 0.6   # keep me\n"
+      "pipeline:\n"
+      "  min_area_px: 500\n";
+  const GroundPolygon floor({{-0.5, -0.3}, {0.5, -0.3}, {0.5, 0.3}, {-0.5, 0.3}});
+  const std::string updated = ReplaceEnclosureFloor(config, floor, "station.yaml");
+  ConfigOptions o;
+  o.check_files = false;
+  const StationConfig c = ParseStationConfig(updated, "station.yaml", ".", nullptr, o);
+  ASSERT_EQ(c.enclosure.floor.vertices().size(), 4u);
+  EXPECT_NEAR(c.enclosure.floor.Area(), 0.6, 1e-9);
+  EXPECT_DOUBLE_EQ(c.pipeline.usability.wall_height_m, 0.6);
+  EXPECT_EQ(c.pipeline.extract.min_area, 500);
+  EXPECT_NE(updated.find("# keep me"), std::string::npos);
+  // A config without an enclosure gets one.
+  const StationConfig added = ParseStationConfig(
+      ReplaceEnclosureFloor("version: 1\n", floor, "s.yaml"), "s.yaml", ".", nullptr, o);
+  EXPECT_NEAR(added.enclosure.floor.Area(), 0.6, 1e-9);
 }
 
 }  // namespace

@@ -1,4 +1,4 @@
-#include "core/config.h"
+#include "config/station_config.h"
 
 #include <cerrno>
 #include <cstring>
@@ -8,7 +8,7 @@
 
 #include <yaml-cpp/yaml.h>
 
-#include "core/config_detail.h"
+#include "config/config_detail.h"
 #include "core/error.h"
 #include "core/input_file.h"
 #include "core/log.h"
@@ -79,8 +79,6 @@ StationConfig LoadStationConfig(const std::string& path, ConfigReport* report,
   return ParseStationConfig(text, path, base.string(), report, options);
 }
 
-const char* ToText(WhiteBalanceMode mode) { return TextOf(mode, kWhiteBalanceModeTexts); }
-const char* ToText(KeyingMethod method) { return TextOf(method, kKeyingMethodTexts); }
 const char* ToText(RecordingMode mode) { return TextOf(mode, kRecordingModeTexts); }
 
 }  // namespace ss

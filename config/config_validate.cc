@@ -1,13 +1,14 @@
 // The station config's values and cross-field rules: Valid / Adjusted / Invalid with the reason
-// (core/config.h, ValidateStationConfig).
+// (config/station_config.h, ValidateStationConfig).
 #include <arpa/inet.h>
 
 #include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <filesystem>
+#include <sstream>
 
-#include "core/config_detail.h"
+#include "config/config_detail.h"
 #include "core/frame.h"
 #include "core/recording_codecs.h"
 
@@ -142,6 +143,35 @@ class Validator {
     Exists(c.model, Child(path, "model"), "camera model");
   }
 
+  void Keying(KeyingConfig& k) {
+    Check(k.training_frames >= 1, "keying.training_frames",
+          "expected at least 1 frame, got " + std::to_string(k.training_frames));
+    // The config's range; the keyer itself also takes < 0 (off: min_margin and ramp instead).
+    const double low = k.chroma.key_low_levels, high = k.chroma.key_high_levels;
+    Range(low, 0, 255, "keying.chroma.low");
+    Range(high, 0, 255, "keying.chroma.high");
+    Check(!(low >= high), "keying.chroma.high",
+          "must be above keying.chroma.low (" + Num(low) + "), got " + Num(high));
+    NonNegative(k.plate_low_sigma, "keying.clean_plate.low_sigma");
+    NonNegative(k.plate_high_sigma, "keying.clean_plate.high_sigma");
+    Check(!(k.plate_low_sigma >= k.plate_high_sigma), "keying.clean_plate.high_sigma",
+          "must be above keying.clean_plate.low_sigma (" + Num(k.plate_low_sigma) + "), got " +
+              Num(k.plate_high_sigma));
+    Finite(k.despill_strength, "keying.despill.strength");
+    if (std::isfinite(k.despill_strength) && (k.despill_strength < 0 || k.despill_strength > 1)) {
+      const double clamped = std::clamp(k.despill_strength, 0.0, 1.0);
+      msg_.Adjust("keying.despill.strength",
+                  Num(k.despill_strength) + " is outside 0..1; clamped to " + Num(clamped));
+      k.despill_strength = clamped;
+    }
+    Range(k.shadow_min_darkening, 0, 1, "keying.shadow.min_darkening");
+    Range(k.shadow_max_darkening, 0, 1, "keying.shadow.max_darkening");
+    Check(!(k.shadow_min_darkening >= k.shadow_max_darkening), "keying.shadow.max_darkening",
+          "must be above keying.shadow.min_darkening (" + Num(k.shadow_min_darkening) + "), got " +
+              Num(k.shadow_max_darkening));
+    Positive(k.shadow_reach_m, "keying.shadow.reach_m");
+  }
+
   void Run(StationConfig& cfg) {
     Check(cfg.version == kConfigVersion, "version",
           cfg.version > kConfigVersion
@@ -161,31 +191,23 @@ class Validator {
       }
     }
 
-    KeyingConfig& k = cfg.keying;
-    Check(k.training_frames >= 1, "keying.training_frames",
-          "expected at least 1 frame, got " + std::to_string(k.training_frames));
-    Range(k.chroma_low, 0, 255, "keying.chroma.low");
-    Range(k.chroma_high, 0, 255, "keying.chroma.high");
-    Check(!(k.chroma_low >= k.chroma_high), "keying.chroma.high",
-          "must be above keying.chroma.low (" + Num(k.chroma_low) + "), got " + Num(k.chroma_high));
-    NonNegative(k.plate_low_sigma, "keying.clean_plate.low_sigma");
-    NonNegative(k.plate_high_sigma, "keying.clean_plate.high_sigma");
-    Check(!(k.plate_low_sigma >= k.plate_high_sigma), "keying.clean_plate.high_sigma",
-          "must be above keying.clean_plate.low_sigma (" + Num(k.plate_low_sigma) + "), got " +
-              Num(k.plate_high_sigma));
-    Finite(k.despill_strength, "keying.despill.strength");
-    if (std::isfinite(k.despill_strength) && (k.despill_strength < 0 || k.despill_strength > 1)) {
-      const double clamped = std::clamp(k.despill_strength, 0.0, 1.0);
-      msg_.Adjust("keying.despill.strength",
-                  Num(k.despill_strength) + " is outside 0..1; clamped to " + Num(clamped));
-      k.despill_strength = clamped;
+    // The pipeline's own rules (CameraPipelineOptions::IsValid), each problem by its field.
+    std::map<std::string, std::string> pipeline_problems;
+    if (std::string why; !cfg.pipeline.IsValid(&why)) {
+      std::istringstream lines(why);
+      for (std::string line; std::getline(lines, line);) {
+        const size_t colon = line.find(": ");
+        if (colon != std::string::npos)
+          pipeline_problems[line.substr(0, colon)] = line.substr(colon + 2);
+      }
     }
-    Range(k.shadow_min_darkening, 0, 1, "keying.shadow.min_darkening");
-    Range(k.shadow_max_darkening, 0, 1, "keying.shadow.max_darkening");
-    Check(!(k.shadow_min_darkening >= k.shadow_max_darkening), "keying.shadow.max_darkening",
-          "must be above keying.shadow.min_darkening (" + Num(k.shadow_min_darkening) + "), got " +
-              Num(k.shadow_max_darkening));
-    Positive(k.shadow_reach_m, "keying.shadow.reach_m");
+    // Reports the problem of pipeline option `field` (if any) at config key `path`.
+    const auto pipeline_rule = [&](const std::string& field, const std::string& path) {
+      const auto it = pipeline_problems.find(field);
+      if (it != pipeline_problems.end()) Check(false, path, it->second);
+    };
+
+    if (cfg.pipeline.keying) Keying(*cfg.pipeline.keying);
 
     const auto& floor = cfg.enclosure.floor.vertices();
     if (!floor.empty() && !msg_.Failed("enclosure.floor")) {
@@ -203,36 +225,31 @@ class Validator {
         }
       }
     }
-    NonNegative(cfg.enclosure.wall_height_m, "enclosure.wall_height_m");
+    pipeline_rule("usability.wall_height_m", "enclosure.wall_height_m");
 
-    PipelineConfig& p = cfg.pipeline;
-    Check(p.min_area_px >= 1, "pipeline.min_area_px",
-          "expected at least 1 pixel, got " + std::to_string(p.min_area_px));
-    Check(p.border_margin_px >= 0, "pipeline.border_margin_px",
-          "expected a number >= 0, got " + std::to_string(p.border_margin_px));
-    Check(p.floor_margin_px >= 0, "pipeline.floor_margin_px",
-          "expected a number >= 0, got " + std::to_string(p.floor_margin_px));
-    NonNegative(p.wall_margin_m, "pipeline.wall_margin_m");
-    Positive(p.still_speed_m_per_s, "pipeline.still_speed_m_per_s");
-    Positive(p.max_speed_m_per_s, "pipeline.max_speed_m_per_s");
-    Positive(p.max_still_s, "pipeline.max_still_s");
-    Check(p.min_clip_frames >= 1, "pipeline.min_clip_frames",
-          "expected at least 1 frame, got " + std::to_string(p.min_clip_frames));
-    NonNegative(p.noise_thick_px, "pipeline.noise_thick_px");
-    for (const auto& [v, key] : {std::pair{p.noise_recover_solidity, "noise_recover_solidity"},
-                                 std::pair{p.noise_min_thick_share, "noise_min_thick_share"},
-                                 std::pair{p.noise_min_solidity, "noise_min_solidity"},
-                                 std::pair{p.noise_min_largest_share, "noise_min_largest_share"},
-                                 std::pair{p.noise_min_mean_alpha, "noise_min_mean_alpha"}}) {
-      Check(std::isfinite(v) && v >= 0 && v <= 1, std::string("pipeline.") + key,
-            "expected a share from 0 to 1 (0 turns the test off), got " + Num(v));
+    CameraPipelineOptions& p = cfg.pipeline;
+    for (const auto& [field, key] : {std::pair{"extract.min_area", "min_area_px"},
+                                     {"usability.border_margin_px", "border_margin_px"},
+                                     {"usability.floor_margin_px", "floor_margin_px"},
+                                     {"usability.wall_margin_m", "wall_margin_m"},
+                                     {"still_speed_m_per_s", "still_speed_m_per_s"},
+                                     {"track.max_speed_m_per_s", "max_speed_m_per_s"},
+                                     {"max_still_s", "max_still_s"},
+                                     {"batch.min_clip_frames", "min_clip_frames"},
+                                     {"noise.thick_px", "noise_thick_px"},
+                                     {"noise.recover_solidity", "noise_recover_solidity"},
+                                     {"noise.min_thick_share", "noise_min_thick_share"},
+                                     {"noise.min_solidity", "noise_min_solidity"},
+                                     {"noise.min_largest_share", "noise_min_largest_share"},
+                                     {"noise.min_mean_alpha", "noise_min_mean_alpha"}}) {
+      pipeline_rule(field, std::string("pipeline.") + key);
     }
-    Check(p.px_per_m == 0 || (std::isfinite(p.px_per_m) && p.px_per_m > 0), "pipeline.px_per_m",
-          "expected auto or a positive number, got " + Num(p.px_per_m));
-    Check(p.workers >= 0, "pipeline.workers",
-          "expected 0 (one per core) or more, got " + std::to_string(p.workers));
-    Check(p.queue_frames >= 1, "pipeline.queue_frames",
-          "expected at least 1 frame, got " + std::to_string(p.queue_frames));
+    // `auto` (0) is the config's own: the rectifier needs the scale chosen.
+    const double px_per_m = p.rectify.px_per_m;
+    Check(px_per_m == 0 || (std::isfinite(px_per_m) && px_per_m > 0), "pipeline.px_per_m",
+          "expected auto or a positive number, got " + Num(px_per_m));
+    pipeline_rule("workers", "pipeline.workers");
+    pipeline_rule("queue_frames", "pipeline.queue_frames");
     constexpr int kMaxQueue = 1024;
     if (p.queue_frames > kMaxQueue) {
       msg_.Adjust("pipeline.queue_frames", std::to_string(p.queue_frames) +

@@ -1,11 +1,11 @@
 #pragma once
-// Inside the station config's reader (core/config.cc), for its own files only:
+// Inside the station config's reader (config/station_config.cc), for its own files only:
 // config_keys.cc binds every key to its field, config_validate.cc checks values.
 #include <string>
 #include <utility>
 #include <vector>
 
-#include "core/config.h"
+#include "config/station_config.h"
 #include "core/options_binder.h"
 #include "core/yaml_reader.h"
 

@@ -1,12 +1,12 @@
 // The station config's keys, each bound to its field (core/options_binder.h). The defaults are
-// the fields' initial values in core/config.h; docs/config.md is the contract.
+// the fields' initial values in config/station_config.h; docs/config.md is the contract.
 #include <algorithm>
 #include <cctype>
 #include <cerrno>
 #include <cstring>
 #include <fstream>
 
-#include "core/config_detail.h"
+#include "config/config_detail.h"
 #include "core/sql_postgres.h"
 
 namespace ss::config_detail {
@@ -148,9 +148,9 @@ OptionsBinder KeyingKeys(KeyingConfig& k) {
             "chroma (a green screen) or clean_plate (any background)")
       .Add("training_frames", &k.training_frames, "a number of frames",
            "empty-enclosure frames to learn from")
-      .Add("chroma.low", &k.chroma_low, "a level 0..255",
+      .Add("chroma.low", &k.chroma.key_low_levels, "a level 0..255",
            "key difference where alpha starts to fall")
-      .Add("chroma.high", &k.chroma_high, "a level 0..255", "... and where it reaches 0")
+      .Add("chroma.high", &k.chroma.key_high_levels, "a level 0..255", "... and where it reaches 0")
       .Add("clean_plate.low_sigma", &k.plate_low_sigma, "a number of noise sigmas",
            "difference where alpha starts to rise")
       .Add("clean_plate.high_sigma", &k.plate_high_sigma, "a number of noise sigmas",
@@ -167,9 +167,11 @@ OptionsBinder KeyingKeys(KeyingConfig& k) {
   return b;
 }
 
-OptionsBinder EnclosureKeys(EnclosureConfig& e) {
+// wall_height_m tunes the pipeline's usability tests: bound to their field.
+OptionsBinder EnclosureKeys(StationConfig& cfg) {
+  EnclosureConfig& e = cfg.enclosure;
   OptionsBinder b;
-  b.Add("wall_height_m", &e.wall_height_m, "a height in metres",
+  b.Add("wall_height_m", &cfg.pipeline.usability.wall_height_m, "a height in metres",
         "walls occlude the floor behind them up to this")
       .AddRead(
           "floor", "[]", "the floor polygon, [x, y] ground metres in order",
@@ -208,46 +210,48 @@ OptionsBinder EnclosureKeys(EnclosureConfig& e) {
   return b;
 }
 
-OptionsBinder PipelineKeys(PipelineConfig& p) {
+// Each key bound straight to the stage option it sets (pipeline/run/camera_pipeline.h).
+OptionsBinder PipelineKeys(CameraPipelineOptions& p) {
   OptionsBinder b;
-  b.Add("min_area_px", &p.min_area_px, "an area in pixels", "smaller blobs are noise")
-      .Add("border_margin_px", &p.border_margin_px, "a number of pixels",
+  b.Add("min_area_px", &p.extract.min_area, "an area in pixels", "smaller blobs are noise")
+      .Add("border_margin_px", &p.usability.border_margin_px, "a number of pixels",
            "distance to keep from the image border")
-      .Add("floor_margin_px", &p.floor_margin_px, "a number of pixels",
+      .Add("floor_margin_px", &p.usability.floor_margin_px, "a number of pixels",
            "floor pixels required around the silhouette")
-      .Add("wall_margin_m", &p.wall_margin_m, "a distance in metres",
+      .Add("wall_margin_m", &p.usability.wall_margin_m, "a distance in metres",
            "contact point distance to keep from the walls")
       .Add("still_speed_m_per_s", &p.still_speed_m_per_s, "a speed in m/s",
            "slower counts as not moving")
-      .Add("max_speed_m_per_s", &p.max_speed_m_per_s, "a speed in m/s", "faster starts a new clip")
+      .Add("max_speed_m_per_s", &p.track.max_speed_m_per_s, "a speed in m/s",
+           "faster starts a new clip")
       .Add("max_still_s", &p.max_still_s, "a duration in seconds",
            "longer still periods are discarded")
-      .Add("min_clip_frames", &p.min_clip_frames, "a number of frames",
+      .Add("min_clip_frames", &p.batch.min_clip_frames, "a number of frames",
            "shorter clips are discarded")
-      .Add("noise_recover_solidity", &p.noise_recover_solidity, "a share from 0 to 1",
+      .Add("noise_recover_solidity", &p.noise.recover_solidity, "a share from 0 to 1",
            "a subject noise the frame before stays noise below this")
-      .Add("noise_thick_px", &p.noise_thick_px, "a distance in pixels",
+      .Add("noise_thick_px", &p.noise.thick_px, "a distance in pixels",
            "interior: this far from the matte's edge")
-      .Add("noise_min_thick_share", &p.noise_min_thick_share, "a share from 0 to 1",
+      .Add("noise_min_thick_share", &p.noise.min_thick_share, "a share from 0 to 1",
            "noise below this interior share")
-      .Add("noise_min_solidity", &p.noise_min_solidity, "a share from 0 to 1",
+      .Add("noise_min_solidity", &p.noise.min_solidity, "a share from 0 to 1",
            "noise below this solidity")
-      .Add("noise_min_largest_share", &p.noise_min_largest_share, "a share from 0 to 1",
+      .Add("noise_min_largest_share", &p.noise.min_largest_share, "a share from 0 to 1",
            "noise when its largest part holds less")
-      .Add("noise_min_mean_alpha", &p.noise_min_mean_alpha, "a share from 0 to 1",
+      .Add("noise_min_mean_alpha", &p.noise.min_mean_alpha, "a share from 0 to 1",
            "noise below this mean alpha")
       .AddRead("px_per_m", "auto", "billboard scale in pixels per metre, or auto",
                [&p](Reader& r, const MapView& view, const std::string& key) {
                  // `auto` (stored as 0) or a positive number of pixels per metre.
                  if (const YAML::Node* n = view.Find(key);
                      n && n->IsScalar() && n->Scalar() == "auto") {
-                   p.px_per_m = 0;
+                   p.rectify.px_per_m = 0;
                    return true;
                  }
                  double v = 0;
                  if (!r.Number(view, key, v, "auto or a positive number of pixels per metre"))
                    return false;
-                 p.px_per_m = v;
+                 p.rectify.px_per_m = v;
                  if (v == 0)
                    r.msg().Error("pipeline.px_per_m", "expected auto or a positive number, got 0");
                  return true;
@@ -353,6 +357,7 @@ OptionsBinder::ReadFn Section(OptionsBinder (*keys)(Config&), Config& config) {
 
 // The whole file.
 OptionsBinder StationKeys(StationConfig& cfg) {
+  if (!cfg.pipeline.keying) cfg.pipeline.keying.emplace();  // the keying section's home
   OptionsBinder b;
   b.Add("version", &cfg.version, "a config version number", "the config format's version")
       .AddRead("cameras", "[]", "the cameras, each a mapping",
@@ -371,8 +376,8 @@ OptionsBinder StationKeys(StationConfig& cfg) {
                  }
                  return true;
                })
-      .AddRead("keying", "", "keying.*", Section(KeyingKeys, cfg.keying))
-      .AddRead("enclosure", "", "enclosure.*", Section(EnclosureKeys, cfg.enclosure))
+      .AddRead("keying", "", "keying.*", Section(KeyingKeys, *cfg.pipeline.keying))
+      .AddRead("enclosure", "", "enclosure.*", Section(EnclosureKeys, cfg))
       .AddRead("pipeline", "", "pipeline.*", Section(PipelineKeys, cfg.pipeline))
       .AddRead("transitions", "", "transitions.*", Section(TransitionsKeys, cfg.transitions))
       .AddRead("storage", "", "storage.*", Section(StorageKeys, cfg.storage))

@@ -1,0 +1,44 @@
+#pragma once
+// IsValid(std::string* why) of a component's options struct: every value out of its range, one
+// line "FIELD: reason" each in `why` (FIELD as the struct names it; the station config names
+// it by its key: config/config_validate.cc).
+#include <sstream>
+#include <string>
+
+namespace ss {
+
+class OptionProblems {
+ public:
+  explicit OptionProblems(std::string* why) : why_(why) {
+    if (why_) why_->clear();
+  }
+  // Adds "field: reason" unless `good`.
+  void operator()(bool good, const std::string& field, const std::string& reason) {
+    if (good) return;
+    ok_ = false;
+    if (why_) *why_ += (why_->empty() ? "" : "\n") + field + ": " + reason;
+  }
+  // Another struct's problems (its IsValid's `why`), each field under `prefix` ("extract.").
+  void Nested(bool good, const std::string& prefix, const std::string& why) {
+    if (good) return;
+    ok_ = false;
+    if (!why_) return;
+    std::istringstream lines(why);
+    for (std::string line; std::getline(lines, line);)
+      *why_ += (why_->empty() ? "" : "\n") + prefix + line;
+  }
+  bool ok() const { return ok_; }
+
+  // A number as the messages write it ("25", "0.5").
+  static std::string Num(double v) {
+    std::ostringstream s;
+    s << v;
+    return s.str();
+  }
+
+ private:
+  std::string* why_;
+  bool ok_ = true;
+};
+
+}  // namespace ss
