@@ -12,6 +12,8 @@ namespace {
 
 constexpr int64_t kFrameNs = 33'333'333;
 
+}  // namespace
+
 SpriteRecord Record(const SyntheticSprite& s, int64_t frame, bool mirrored) {
   const double px_per_m = SyntheticSpriteOptions{}.px_per_m;
   SpriteRecord r;
@@ -40,8 +42,6 @@ SpriteRecord Record(const SyntheticSprite& s, int64_t frame, bool mirrored) {
   }
   return r;
 }
-
-}  // namespace
 
 std::vector<SyntheticSprite> Sprites(int frames, uint64_t seed) {
   SyntheticSpriteOptions o;

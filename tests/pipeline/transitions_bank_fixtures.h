@@ -15,6 +15,10 @@
 
 namespace ss::testing {
 
+// The bank record of a synthetic sprite at `frame` (33.3 ms apart, 1 mm further along x each),
+// at the synthetic set's scale; a mirror carries no pixels of its own.
+SpriteRecord Record(const SyntheticSprite& s, int64_t frame, bool mirrored);
+
 // A synthetic set whose area survives the bank's round trip bit for bit.
 std::vector<SyntheticSprite> Sprites(int frames, uint64_t seed);
 

@@ -21,6 +21,7 @@
 #include "pipeline/transitions/synthetic.h"
 #include "pipeline/transitions/truth_labels.h"
 #include "station/console_labels.h"
+#include "tests/pipeline/transitions_bank_fixtures.h"
 #include "tests/support/test_support.h"
 
 namespace ss {
@@ -49,33 +50,6 @@ SyntheticBank MakeBank(const std::string& path, int frames) {
   BankWriter w(path);
   const int64_t session = w.AddSession({0, "synthetic@labels", "synthetic", "", "test"});
   const int64_t camera = w.AddCamera(session, {0, 0, "cam0", "", 640, 480});
-  auto record = [&](const SyntheticSprite& s, int64_t frame, bool mirrored) {
-    SpriteRecord r;
-    r.frame = frame;
-    r.timestamp_ns = frame * 33'333'333;
-    r.mirrored = mirrored;
-    r.ground_x_m = 0.001 * static_cast<double>(frame);
-    r.ground_y_m = 0.5;
-    r.velocity_x_m_s = s.cheap.velocity_x_mps;
-    r.velocity_y_m_s = s.cheap.velocity_y_mps;
-    r.mean_r = s.cheap.colour[0];
-    r.mean_g = s.cheap.colour[1];
-    r.mean_b = s.cheap.colour[2];
-    r.area_px = s.cheap.area_m2 * o.px_per_m * o.px_per_m;
-    r.eccentricity = s.cheap.eccentricity;
-    r.billboard_width_px = s.billboard.width;
-    r.billboard_height_px = s.billboard.height;
-    r.px_per_m = o.px_per_m;
-    r.anchor_x_px = s.billboard.anchor_x_px;
-    r.anchor_y_px = s.billboard.anchor_y_px;
-    r.bbox_in_image = cv::Rect(0, 0, s.billboard.width, s.billboard.height);
-    if (!mirrored) {
-      r.pixels.bgra = cv::Mat(s.billboard.height, s.billboard.width, CV_8UC4,
-                              const_cast<uint8_t*>(s.billboard.rgba.data()))
-                          .clone();
-    }
-    return r;
-  };
   int64_t frame = 100;
   for (size_t begin = 0; begin < half;) {
     size_t end = begin;
@@ -89,8 +63,8 @@ SyntheticBank MakeBank(const std::string& path, int frames) {
     std::vector<SpriteRecord> records;
     for (size_t k = begin; k < end; ++k) {
       const int64_t f = frame + static_cast<int64_t>(k - begin);
-      records.push_back(record(sprites[k], f, false));
-      records.push_back(record(sprites[half + k], f, true));
+      records.push_back(testing::Record(sprites[k], f, false));
+      records.push_back(testing::Record(sprites[half + k], f, true));
     }
     const AppendResult r = w.AppendClipBatch(clip, records);
     for (size_t k = begin; k < end; ++k) {
