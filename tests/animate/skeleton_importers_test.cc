@@ -15,6 +15,7 @@
 #include "animate/skeleton/joint_mapping.h"
 #include "animate/skeleton/skeleton_json.h"
 #include "core/error.h"
+#include "tests/support/error_text.h"
 #include "tests/support/test_support.h"
 
 namespace ss {
@@ -148,15 +149,6 @@ TEST(SkeletonImporters, ImportedSequenceRoundTripsThroughJson) {
   }
 }
 
-std::string ErrorOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "";
-}
-
 TEST(SkeletonImporters, ErrorsNameTheFileAndTheReason) {
   testing::ScratchDir dir;
   // A mapping onto a keypoint the file does not have.
@@ -164,7 +156,8 @@ TEST(SkeletonImporters, ErrorsNameTheFileAndTheReason) {
   bad["joints"]["forepaw"] = "forepawR";
   std::ofstream(dir / "bad_mapping.json") << bad.dump();
   const JointMapping bad_mapping = LoadJointMapping(dir / "bad_mapping.json");
-  const std::string e = ErrorOf([&] { ImportDeepLabCutCsv(Data("dlc_mouse.csv"), bad_mapping); });
+  const std::string e =
+      testing::InputErrorOf([&] { ImportDeepLabCutCsv(Data("dlc_mouse.csv"), bad_mapping); });
   EXPECT_NE(e.find("bad_mapping.json"), std::string::npos) << e;
   EXPECT_NE(e.find("'forepaw'"), std::string::npos) << e;
   EXPECT_NE(e.find("'forepawR'"), std::string::npos) << e;
@@ -172,7 +165,7 @@ TEST(SkeletonImporters, ErrorsNameTheFileAndTheReason) {
   bad = nlohmann::json::parse(std::ifstream(Data("mouse_mapping.json")));
   bad["joints"]["tail_tip"] = "tailbase";
   std::ofstream(dir / "unknown_joint.json") << bad.dump();
-  EXPECT_NE(ErrorOf([&] {
+  EXPECT_NE(testing::InputErrorOf([&] {
               LoadJointMapping(dir / "unknown_joint.json");
             }).find("no joint named 'tail_tip'"),
             std::string::npos);
@@ -181,21 +174,21 @@ TEST(SkeletonImporters, ErrorsNameTheFileAndTheReason) {
   std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   text.erase(text.rfind(','));
   std::ofstream(dir / "short.csv") << text << "\n";
-  const std::string s = ErrorOf([&] {
+  const std::string s = testing::InputErrorOf([&] {
     ImportDeepLabCutCsv(dir / "short.csv", LoadJointMapping(Data("mouse_mapping.json")));
   });
   EXPECT_NE(s.find("short.csv: line 7"), std::string::npos) << s;
   // Not the expected format at all.
-  EXPECT_NE(ErrorOf([&] {
+  EXPECT_NE(testing::InputErrorOf([&] {
               ImportDeepLabCutCsv(Data("coco_person_keypoints.json"), Body25ToHuman14());
             }).find("not a DeepLabCut CSV"),
             std::string::npos);
-  EXPECT_NE(ErrorOf([&] {
+  EXPECT_NE(testing::InputErrorOf([&] {
               ImportCocoKeypoints(Data("openpose_ymca/ymca_000000000000_keypoints.json"),
                                   Coco17ToHuman14());
             }).find("no 'annotations' array"),
             std::string::npos);
-  EXPECT_NE(ErrorOf([&] {
+  EXPECT_NE(testing::InputErrorOf([&] {
               ImportOpenPoseJson(Data("coco_person_keypoints.json"), Body25ToHuman14());
             }).find("no 'people' array"),
             std::string::npos);
