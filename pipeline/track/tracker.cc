@@ -86,7 +86,8 @@ std::vector<bool> MergeDetector::Update(const std::vector<Blob>& blobs) {
     int from;                  // the giving track
     std::vector<int> members;  // the tracks swallowed into the giving blob, counted in it
   };
-  const auto log = Log("pipeline.track");
+  // Looked up once: Log() takes two global locks, and this runs every frame of every camera.
+  static const std::shared_ptr<spdlog::logger> log = Log("pipeline.track");
   const bool debug = log->should_log(spdlog::level::debug);
   ++updates_;
   std::vector<std::vector<Share>> shares(blobs.size());
