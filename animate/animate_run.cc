@@ -53,29 +53,22 @@ ConstraintFigures MeasureConstraints(const Problem& problem, const std::vector<T
 }
 
 AnimateResult RunAnimation(const Scene& scene, const AnimateRunOptions& options) {
-  if (options.method != "replace" && options.method != "beam") {
-    throw InputError("--method", "expected replace or beam, got " + options.method);
-  }
-  if (!(options.time_budget_s > 0)) throw InputError("--time-budget", "must be > 0");
+  const OptimizerSpec& o = options.optimizer;
+  if (!(o.replacement.time_budget_seconds > 0)) throw InputError("--time-budget", "must be > 0");
   AnimateResult result;
   const Problem& problem = scene.problem();
   const std::vector<std::string> names = SpriteNames(scene);
-  if (options.method == "beam") {
-    BeamOptions beam = scene.MakeBeamOptions();
-    beam.time_budget_seconds = options.time_budget_s;
-    result.tracks = BeamSearch(problem, beam, &result.summary);
+  if (o.method == OptimizerMethod::kBeam) {
+    result.tracks = BeamSearch(problem, o.Beam(), &result.summary);
   } else {
-    ReplacementOptions replace = scene.MakeReplacementOptions();
-    replace.time_budget_seconds = options.time_budget_s;
-    replace.seed = options.seed;
+    ReplacementOptions replace = scene.MakeReplacementOptions(o.replacement);
     replace.progress_seconds = options.progress_every_s;
     if (options.max_turns > 0) replace.max_turns = options.max_turns;
-    if (options.threads > 0) replace.reach.num_threads = options.threads;
-    double next_snapshot = options.snapshot_every_s;
-    if (options.snapshot_every_s > 0) {
+    double next_snapshot = o.snapshot_every_s;
+    if (o.snapshot_every_s > 0) {
       replace.on_improvement = [&](const std::vector<Track>& tracks, const TracePoint& point) {
         if (point.seconds < next_snapshot) return;
-        while (next_snapshot <= point.seconds) next_snapshot += options.snapshot_every_s;
+        while (next_snapshot <= point.seconds) next_snapshot += o.snapshot_every_s;
         result.stages.push_back(
             {point.seconds, point.cost, ToSpriteSequences(scene.bank(), names, tracks)});
       };

@@ -15,12 +15,9 @@
 namespace ss {
 
 struct AnimateRunOptions {
-  std::string method = "replace";  // "replace" | "beam"
-  double time_budget_s = 30.0;
-  uint64_t seed = 1;
+  // The spec's optimizer block (method, budget, seed, threads, snapshots), as a caller changed it.
+  OptimizerSpec optimizer;
   double progress_every_s = 0.0;  // log the progress this often; 0: never
-  double snapshot_every_s = 0.0;  // keep the current sequences this often; 0: never
-  int threads = 0;                // F/B set threads; 0: the spec's
   // Replacement: stop after this many sprite turns (0: the time budget alone). With a budget
   // that is never reached, the same work on any machine, loaded or not (tests).
   int max_turns = 0;

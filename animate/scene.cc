@@ -106,19 +106,7 @@ void Scene::AddTerms() {
   }
 }
 
-ReplacementOptions Scene::MakeReplacementOptions() const {
-  const OptimizerSpec& o = spec_.optimizer;
-  ReplacementOptions options;
-  options.reach.set_size = o.set_size;
-  options.reach.num_threads = o.threads;
-  options.time_budget_seconds = o.time_budget_s;
-  options.seed = o.seed;
-  options.changes_per_turn = o.changes_per_turn;
-  options.collision_pick_fraction = o.collision_pick_fraction;
-  options.beam.width = o.beam_width;
-  options.start = o.start == "random" ? StartMethod::kRandom
-                  : o.start == "beam" ? StartMethod::kBeam
-                                      : StartMethod::kSequential;
+ReplacementOptions Scene::MakeReplacementOptions(ReplacementOptions options) const {
   // Ĉ favours fast frames when the spec does (seed 000 §6.2, the fly).
   std::optional<FastFrameSpec> fast = spec_.fast;
   for (const SpriteSpecEntry& s : spec_.sprites) {
@@ -128,13 +116,6 @@ ReplacementOptions Scene::MakeReplacementOptions() const {
     options.reference_speed_m = fast->reference_speed_m_s * IntervalS();
     options.slow_frame_cost = fast->strength / IntervalS();
   }
-  return options;
-}
-
-BeamOptions Scene::MakeBeamOptions() const {
-  BeamOptions options;
-  options.width = spec_.optimizer.beam_width;
-  options.time_budget_seconds = spec_.optimizer.time_budget_s;
   return options;
 }
 

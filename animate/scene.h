@@ -27,9 +27,12 @@ class Scene {
   const TransitionGraph& graph() const { return bank_.graph; }
   const Problem& problem() const { return *problem_; }
 
-  // Options from the spec's optimizer section (callers may override them).
-  ReplacementOptions MakeReplacementOptions() const;
-  BeamOptions MakeBeamOptions() const;
+  // `options` (by default the spec's optimizer block) with what the scene derives from the
+  // spec: Ĉ's fast-frame terms.
+  ReplacementOptions MakeReplacementOptions(ReplacementOptions options) const;
+  ReplacementOptions MakeReplacementOptions() const {
+    return MakeReplacementOptions(spec_.optimizer.replacement);
+  }
 
  private:
   void AddTerms();

@@ -371,19 +371,22 @@ void ReadBound(const Reader& r, const OptionsBinder& keys, const YAML::Node& nod
 
 void ReadOptimizer(const Reader& r, const YAML::Node& node, OptimizerSpec& o) {
   const std::string f = "optimizer";
-  int64_t seed = static_cast<int64_t>(o.seed);
+  ReplacementOptions& rep = o.replacement;
+  int64_t seed = static_cast<int64_t>(rep.seed);
   OptionsBinder keys;
-  keys.Add("method", &o.method, "a string", "replace or beam")
-      .Add("start", &o.start, "a string", "replacement's start: sequential, random or beam")
-      .Add("time_budget_s", &o.time_budget_s, "a number", "seconds the optimizer may run")
+  keys.AddEnum("method", &o.method, kOptimizerMethodTexts, "replace or beam")
+      .AddEnum("start", &rep.start, kSpecStartTexts,
+               "replacement's start: sequential, random or beam")
+      .Add("time_budget_s", &rep.time_budget_seconds, "a number", "seconds the optimizer may run")
       .Add("seed", &seed, "a whole number >= 0", "the random generator's seed")
-      .Add("set_size", &o.set_size, "a whole number >= 2", "N of the F/B sets")
-      .Add("threads", &o.threads, "a whole number >= 1", "worker threads")
-      .Add("changes_per_turn", &o.changes_per_turn, "a whole number >= 1", "picks per sprite turn")
-      .Add("beam_width", &o.beam_width, "a whole number >= 1", "the beam search's width")
+      .Add("set_size", &rep.reach.set_size, "a whole number >= 2", "N of the F/B sets")
+      .Add("threads", &rep.reach.num_threads, "a whole number >= 1", "worker threads")
+      .Add("changes_per_turn", &rep.changes_per_turn, "a whole number >= 1",
+           "picks per sprite turn")
+      .Add("beam_width", &rep.beam.width, "a whole number >= 1", "the beam search's width")
       .Add("snapshot_every_s", &o.snapshot_every_s, "a number",
            "> 0: keep the sequences every so many seconds")
-      .Add("collision_pick_fraction", &o.collision_pick_fraction, "a number",
+      .Add("collision_pick_fraction", &rep.collision_pick_fraction, "a number",
            "replacement's picks aimed at a collision, 0 to 1");
   ReadBound(r, keys, node, f);
   // The bounds; those of the optimizer (ReplacementOptions::IsValid, beam search) are checked
@@ -402,23 +405,18 @@ void ReadOptimizer(const Reader& r, const YAML::Node& node, OptimizerSpec& o) {
     if (!std::isfinite(value)) fail(key, "expected a finite number");
     if (value <= 0) fail(key, "must be > 0");
   };
-  if (node["start"] && o.start != "sequential" && o.start != "random" && o.start != "beam") {
-    fail("start", "expected sequential, random or beam");
-  }
-  if (node["method"] && o.method != "replace" && o.method != "beam")
-    fail("method", "expected replace or beam");
-  positive("time_budget_s", o.time_budget_s);
+  positive("time_budget_s", rep.time_budget_seconds);
   if (node["seed"] && (seed < 0 || seed > 1000000000)) fail("seed", "expected a whole number >= 0");
-  o.seed = static_cast<uint64_t>(seed);
-  whole("set_size", o.set_size, 2, 65535);
-  whole("threads", o.threads, 1, 256);
-  whole("changes_per_turn", o.changes_per_turn, 1, 1000000000);
-  whole("beam_width", o.beam_width, 1, 65535);
+  rep.seed = static_cast<uint64_t>(seed);
+  whole("set_size", rep.reach.set_size, 2, 65535);
+  whole("threads", rep.reach.num_threads, 1, 256);
+  whole("changes_per_turn", rep.changes_per_turn, 1, 1000000000);
+  whole("beam_width", rep.beam.width, 1, 65535);
   if (node["collision_pick_fraction"]) {
-    if (!std::isfinite(o.collision_pick_fraction))
-      fail("collision_pick_fraction", "expected a finite number");
-    if (o.collision_pick_fraction < 0) fail("collision_pick_fraction", "must be >= 0");
-    if (o.collision_pick_fraction > 1) fail("collision_pick_fraction", "expected 0 to 1");
+    const double fraction = rep.collision_pick_fraction;
+    if (!std::isfinite(fraction)) fail("collision_pick_fraction", "expected a finite number");
+    if (fraction < 0) fail("collision_pick_fraction", "must be >= 0");
+    if (fraction > 1) fail("collision_pick_fraction", "expected 0 to 1");
   }
   positive("snapshot_every_s", o.snapshot_every_s);
 }

@@ -11,9 +11,12 @@
 
 #include <Eigen/Core>
 
+#include "animate/beam_search.h"
 #include "animate/cost_term.h"
 #include "animate/path_cost.h"
+#include "animate/replacement.h"
 #include "animate/track.h"
+#include "core/enum_text.h"
 
 namespace ss {
 
@@ -80,17 +83,30 @@ struct CollisionSpec {  // eq. 9, between every pair of the listed sprites
   double strength = 1.0;  // µ
 };
 
+enum class OptimizerMethod { kReplace, kBeam };
+inline constexpr EnumText<OptimizerMethod> kOptimizerMethodTexts[] = {
+    {OptimizerMethod::kReplace, "replace"}, {OptimizerMethod::kBeam, "beam"}};
+// A replacement start the spec may ask for (kGiven is for callers with sequences of their own).
+inline constexpr EnumText<StartMethod> kSpecStartTexts[] = {
+    {StartMethod::kSequential, "sequential"},
+    {StartMethod::kRandom, "random"},
+    {StartMethod::kBeam, "beam"}};
+
+// The spec's `optimizer:` block, bound key by key to the optimizers' own options (no copies):
+// set_size and threads are replacement.reach's, beam_width replacement.beam's (the beam method
+// and the beam start alike), time_budget_s bounds either method.
 struct OptimizerSpec {
-  std::string method = "replace";    // "replace" | "beam"
-  std::string start = "sequential";  // replacement's start: "sequential" | "random" | "beam"
-  double time_budget_s = 30.0;
-  uint64_t seed = 1;
-  int set_size = 200;  // N of the F/B sets
-  int threads = 2;
-  int changes_per_turn = 100;  // picks per sprite turn
-  int beam_width = 32;
-  double collision_pick_fraction = 0.25;  // replacement's picks aimed at a collision
+  OptimizerSpec() { replacement.time_budget_seconds = 30.0; }  // a spec's default budget
+  OptimizerMethod method = OptimizerMethod::kReplace;
+  ReplacementOptions replacement;
   double snapshot_every_s = 0.0;  // > 0: keep the sequences every so many seconds (stages video)
+
+  // Beam search as this block sets it: replacement.beam with the whole time budget.
+  BeamOptions Beam() const {
+    BeamOptions beam = replacement.beam;
+    beam.time_budget_seconds = replacement.time_budget_seconds;
+    return beam;
+  }
 };
 
 struct AnimationSpec {

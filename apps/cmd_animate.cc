@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -21,8 +22,8 @@ namespace {
 struct AnimateArgs {
   std::string spec;
   std::string out;
-  std::string plot;  // "" = next to --out
-  std::string method;
+  std::string plot;    // "" = next to --out
+  std::string method;  // "": the spec's
   double time_budget_s = 0;
   int64_t seed = -1;
   int threads = 0;
@@ -32,27 +33,30 @@ struct AnimateArgs {
 
 void Run(const AnimateArgs& args) {
   AnimationSpec spec = LoadAnimationSpec(args.spec);
-  AnimateRunOptions options;
-  options.method = args.method.empty() ? spec.optimizer.method : args.method;
-  options.time_budget_s =
-      args.time_budget_s > 0 ? args.time_budget_s : spec.optimizer.time_budget_s;
-  options.seed = args.seed >= 0 ? static_cast<uint64_t>(args.seed) : spec.optimizer.seed;
-  options.threads = args.threads;
-  options.snapshot_every_s =
-      args.snapshot_every_s >= 0 ? args.snapshot_every_s : spec.optimizer.snapshot_every_s;
+  // The spec's optimizer block with the command line's changes.
+  AnimateRunOptions options{spec.optimizer};
+  OptimizerSpec& o = options.optimizer;
+  for (const auto& [value, text] : kOptimizerMethodTexts) {
+    if (args.method == text) o.method = value;
+  }
+  if (args.time_budget_s > 0) o.replacement.time_budget_seconds = args.time_budget_s;
+  if (args.seed >= 0) o.replacement.seed = static_cast<uint64_t>(args.seed);
+  if (args.threads > 0) o.replacement.reach.num_threads = args.threads;
+  if (args.snapshot_every_s >= 0) o.snapshot_every_s = args.snapshot_every_s;
   options.progress_every_s = 1.0;
+  const std::string method = TextOf(o.method, kOptimizerMethodTexts);
 
   const auto scene = Scene::Load(std::move(spec));
   Log("animate")->info("{} sprites, {} frames, {} edges, {} cost terms; {} for {:.1f} s",
                        scene->problem().num_sprites(), scene->graph().num_frames(),
-                       scene->graph().num_edges(), scene->problem().num_terms(), options.method,
-                       options.time_budget_s);
+                       scene->graph().num_edges(), scene->problem().num_terms(), method,
+                       o.replacement.time_budget_seconds);
   const AnimateResult result = RunAnimation(*scene, options);
   WriteSequenceFile(args.out, MakeSequenceFile(*scene, result));
 
   std::string plot = args.plot;
   if (plot.empty()) plot = std::filesystem::path(args.out).replace_extension(".cost.png").string();
-  WriteCostPlot(plot, {{options.method, result.summary.trace, cv::Scalar(200, 80, 0)}},
+  WriteCostPlot(plot, {{method, result.summary.trace, cv::Scalar(200, 80, 0)}},
                 std::filesystem::path(args.spec).filename().string());
 
   if (args.json) {
@@ -83,8 +87,10 @@ void AddAnimateCommand(CLI::App& app) {
   auto* cmd = app.add_subcommand("animate", "Optimize sprite sequences for an animation spec");
   cmd->add_option("spec", args->spec, "Animation spec (YAML, docs/animation.md)")->required();
   cmd->add_option("--out", args->out, "Sequences file to write (JSON)")->required();
-  cmd->add_option("--method", args->method, "replace (default) or beam")
-      ->check(CLI::IsMember({"replace", "beam"}));
+  std::vector<std::string> methods;
+  for (const auto& method : kOptimizerMethodTexts) methods.emplace_back(method.text);
+  cmd->add_option("--method", args->method, "replace or beam (default: the spec's)")
+      ->check(CLI::IsMember(methods));
   cmd->add_option("--time-budget", args->time_budget_s,
                   "Seconds for the whole run (default: the spec's)")
       ->check(CLI::PositiveNumber);

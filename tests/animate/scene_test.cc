@@ -26,8 +26,8 @@ sprites:
     constraints:
       - path: {points: [[0, 0], [1, 0], [1, 1]], direction_strength: 0.2, distance_strength: 20, unreached_strength: 5}
 )")));
-  AnimateRunOptions options;
-  options.time_budget_s = 60;
+  AnimateRunOptions options{scene->spec().optimizer};
+  options.optimizer.replacement.time_budget_seconds = 60;
   options.max_turns = 300;  // the same work on any machine (a budget never reached)
   const AnimateResult result = RunAnimation(*scene, options);
   ASSERT_EQ(result.tracks.size(), 1u);
@@ -56,8 +56,8 @@ sprites:
 )")));
   // The same work on any machine: 300 sprite turns (~2.3 s idle), a budget never reached.
   // (With a 4 s budget a loaded CI machine stopped it short: 3 steps off the tag.)
-  AnimateRunOptions options;
-  options.time_budget_s = 60;
+  AnimateRunOptions options{scene->spec().optimizer};
+  options.optimizer.replacement.time_budget_seconds = 60;
   options.max_turns = 300;
   const AnimateResult result = RunAnimation(*scene, options);
   EXPECT_EQ(result.figures.paths_unfinished, 0);

@@ -70,10 +70,12 @@ TEST_F(SpecTest, ReadsEveryField) {
   EXPECT_EQ(spec.length->strength, 2);
   EXPECT_EQ(spec.camera_path, dir_ / "virtual.cameramodel");
   ASSERT_EQ(spec.bank_paths.size(), 1u);
-  EXPECT_EQ(spec.optimizer.seed, 7u);
-  EXPECT_EQ(spec.optimizer.start, "random");
-  EXPECT_EQ(spec.optimizer.set_size, 50);
-  EXPECT_EQ(spec.optimizer.collision_pick_fraction, 0.25);  // the default
+  EXPECT_EQ(spec.optimizer.replacement.seed, 7u);
+  EXPECT_EQ(spec.optimizer.replacement.start, StartMethod::kRandom);
+  EXPECT_EQ(spec.optimizer.replacement.reach.set_size, 50);
+  EXPECT_EQ(spec.optimizer.replacement.collision_pick_fraction, 0.25);  // the default
+  EXPECT_EQ(spec.optimizer.replacement.time_budget_seconds, 5);
+  EXPECT_EQ(OptimizerSpec().replacement.time_budget_seconds, 30);  // a spec's default
   ASSERT_EQ(spec.sprites.size(), 2u);
   const SpriteSpecEntry& lead = spec.sprites[0];
   EXPECT_EQ(lead.anchor, Anchor::kStart);
@@ -174,7 +176,7 @@ TEST_F(SpecTest, BadSpecsNameTheLineAndTheField) {
   EXPECT_EQ(ErrorOf(Edit("name: follower", "name: lead")),
             o + ":15: sprites[1].name: another sprite is named lead");
   EXPECT_EQ(ErrorOf(Edit("start: random", "start: later")),
-            o + ":7: optimizer.start: expected sequential, random or beam");
+            o + ":7: optimizer.start: expected one of sequential, random, beam, got \"later\"");
   EXPECT_EQ(ErrorOf(Edit("start: random,", "start: random, collision_pick_fraction: 1.5,")),
             o + ":7: optimizer.collision_pick_fraction: expected 0 to 1");
   // The optimizer's own limits, named as the spec's fields (it said "reach.set_size", no file).
