@@ -1,6 +1,6 @@
 // The bank page: sessions, clips as filmstrips of billboards, a sprite's detail,
 // tagging a run of frames, export.
-import { Events, Limiter, chrome, el, fmt, getJson, getBlob, postJson, saveBlob } from './api.js';
+import { ApiError, Events, Limiter, chrome, el, fmt, getJson, getBlob, postJson, saveBlob } from './api.js';
 import { showMessage } from './message.js';
 
 const events = new Events().start();
@@ -40,17 +40,28 @@ const clipObserver = new IntersectionObserver(
   { rootMargin: '300px' },
 );
 
-async function loadBillboard(cell) {
+// A billboard whose request failed for a passing reason (a station too busy to answer, 5xx;
+// a connection dropped) is asked for again after 0.5, 1, 2 and 4 s; one the bank does not have
+// (4xx) shows its error at once.
+const BILLBOARD_RETRIES = 4;
+
+async function loadBillboard(cell, attempt = 0) {
   const img = cell.querySelector('img');
   try {
     const { blob } = await billboards.run(() => getBlob(`/api/bank/sprites/${cell.dataset.sprite}/billboard.png?height=96`));
     img.src = URL.createObjectURL(blob);
     await img.decode().catch(() => {});
     cell.dataset.loaded = '1';
+    img.alt = '';
+    img.title = '';
   } catch (err) {
     cell.dataset.loaded = 'error';
     img.alt = `billboard: ${err.message}`;
     img.title = img.alt;
+    const passing = !(err instanceof ApiError) || err.status >= 500;
+    if (passing && attempt < BILLBOARD_RETRIES && cell.isConnected) {
+      setTimeout(() => loadBillboard(cell, attempt + 1), 500 * 2 ** attempt);
+    }
   }
 }
 
