@@ -226,6 +226,19 @@ test('start then stop stores sprites, and the page shows what the bank holds', a
   assert.equal(stoppedCount, inSession);
 });
 
+// True once every billboard cell under `scope` that is in view has loaded its image; else
+// throws naming those that have not (not requested yet, or the error the page shows).
+async function billboardsInView(page, scope) {
+  const missing = await page.$$eval(`${scope} [data-testid="sprite-cell"]`, (cells) => cells.filter((c) => {
+    const r = c.getBoundingClientRect();
+    const strip = c.parentElement.getBoundingClientRect();
+    const inView = r.right > strip.left && r.left < strip.right && r.bottom > 0 && r.top < innerHeight;
+    return inView && c.dataset.loaded !== '1';
+  }).map((c) => `sprite ${c.dataset.sprite}: ${c.dataset.loaded ?? 'not requested'} ${c.querySelector('img').alt}`));
+  if (missing.length) throw new Error(`${missing.length} in view not loaded: ${missing.slice(0, 5).join('; ')}`);
+  return true;
+}
+
 test("the bank page shows the session's clips as filmstrips, and a tag set there is in the bank", async () => {
   const id = Number(h.sql(cfg.bank, `SELECT max(id) FROM sessions WHERE name = '${SESSION_NAME}'`));
   const bp = await h.page(b);
@@ -241,15 +254,25 @@ test("the bank page shows the session's clips as filmstrips, and a tag set there
     const sel = `[data-testid="clip"][data-clip="${clip}"]`;
     await bp.$eval(sel, (e) => e.scrollIntoView());
     await h.waitFor(`clip ${clip}'s ${n} sprites`, async () => (await bp.$$(`${sel} [data-testid="sprite-cell"]`)).length === n);
-    // scroll the filmstrip through: every billboard loads as an image
-    await bp.$eval(`${sel} [data-testid="filmstrip"]`, async (strip) => {
-      for (let x = 0; x <= strip.scrollWidth; x += strip.clientWidth / 2) {
-        strip.scrollLeft = x;
-        await new Promise((r) => setTimeout(r, 60));
-      }
-    });
-    await h.waitFor(`clip ${clip}'s ${n} billboards`, async () => bp.$$eval(`${sel} [data-testid="billboard"]`,
-      (imgs) => imgs.length && imgs.every((i) => i.complete && i.naturalWidth > 0) && imgs.length), { timeout: 15000 });
+    // scroll the filmstrip through as a person does, half a view at a time, each view
+    // looked at until its billboards are in: every billboard loads as an image
+    const strip = `${sel} [data-testid="filmstrip"]`;
+    for (let x = 0; ; ) {
+      const view = await bp.$eval(strip, (e, left) => {
+        e.scrollLeft = left;
+        return { width: e.clientWidth, end: e.scrollWidth };
+      }, x);
+      await h.waitFor(`clip ${clip}'s billboards in view at ${x} px`, () => billboardsInView(bp, sel), { timeout: 20000 });
+      if (x + view.width >= view.end) break;
+      x += Math.max(1, Math.floor(view.width / 2));
+    }
+    await h.waitFor(`clip ${clip}'s ${n} billboards`, async () => {
+      const missing = await bp.$$eval(`${sel} [data-testid="sprite-cell"]`, (cells) => cells
+        .filter((c) => !(c.querySelector('img').complete && c.querySelector('img').naturalWidth > 0))
+        .map((c) => `sprite ${c.dataset.sprite}: ${c.dataset.loaded ?? 'not requested'} ${c.querySelector('img').alt}`));
+      if (missing.length) throw new Error(`${missing.length} not shown: ${missing.slice(0, 5).join('; ')}`);
+      return true;
+    }, { timeout: 20000 });
   }
 
   // tag a run of frames (the 2nd to the 6th) of the longest clip as "stand"
@@ -323,11 +346,7 @@ test("a sprite's detail lists its transitions; clicking one shows that sprite", 
   await h.waitFor('its cell marked', async () => bp.$eval(`[data-testid="sprite-cell"][data-sprite="${rows[0]}"]`, (e) => e.classList.contains('current')).catch(() => false));
   const frame = h.sql(cfg.bank, `SELECT frame FROM sprites WHERE id = ${rows[0]}`);
   assert.equal(await h.text(bp, 'detail-frame'), frame);
-  await h.waitFor('the billboards in view', () => bp.$$eval('[data-testid="sprite-cell"]', (cells) => cells.every((c) => {
-    const r = c.getBoundingClientRect();
-    const strip = c.parentElement.getBoundingClientRect();
-    return r.right <= strip.left || r.left >= strip.right || r.bottom <= 0 || r.top >= innerHeight || c.dataset.loaded === '1';
-  })), { timeout: 10000 });
+  await h.waitFor('the billboards in view', () => billboardsInView(bp, '[data-testid="bank-clips"]'), { timeout: 20000 });
   await h.sleep(300);
   await h.screenshot(bp, 'console-bank.png');
   assert.deepEqual(bp.errors, []);
