@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "apps/commands.h"
+#include "core/enum_text.h"
 #include "core/error.h"
 #include "synth/studio_session.h"
 
@@ -18,6 +19,7 @@ namespace {
 struct SynthArgs {
   synth::SynthOptions options;
   std::string kind = "animal";
+  std::string studio;  // "": the kind's
   std::string size = "640x480";
   std::string pixel_format = "rgb8";
   bool json = false;
@@ -26,17 +28,20 @@ struct SynthArgs {
 
 void RunSynth(SynthArgs args) {
   synth::SynthOptions& o = args.options;
-  if (args.kind == "animal") {
-    o.kind = synth::SynthKind::kAnimal;
-  } else if (args.kind == "figure") {
-    o.kind = synth::SynthKind::kFigure;
-  } else if (args.kind == "calibration") {
-    o.kind = synth::SynthKind::kCalibration;
-  } else {
-    throw InputError("--kind", "expected animal, figure or calibration, got '" + args.kind + "'");
+  if (!FromText(args.kind, synth::kSynthKindTexts, o.kind)) {
+    throw InputError("--kind",
+                     "expected " + TextsOf(synth::kSynthKindTexts) + ", got '" + args.kind + "'");
   }
-  o.empty_lead_in_s =
-      args.empty_lead_in_s >= 0 ? args.empty_lead_in_s : (args.kind == "animal" ? 1.0 : 0.0);
+  synth::StudioKind studio{};
+  if (!args.studio.empty()) {
+    if (!FromText(args.studio, synth::kStudioKindTexts, studio)) {
+      throw InputError("--studio", "expected " + TextsOf(synth::kStudioKindTexts) + ", got '" +
+                                       args.studio + "'");
+    }
+    o.studio = studio;
+  }
+  o.empty_lead_in_s = args.empty_lead_in_s >= 0 ? args.empty_lead_in_s
+                                                : (o.kind == synth::SynthKind::kAnimal ? 1.0 : 0.0);
   int w = 0, h = 0;
   char tail = 0;
   if (std::sscanf(args.size.c_str(), "%dx%d%c", &w, &h, &tail) != 2) {
@@ -98,11 +103,10 @@ void AddSynthCommand(CLI::App& app) {
   synth::SynthOptions& o = args->options;
   cmd->add_option("--out", o.out_dir, "Session folder to create (must not exist or be empty)")
       ->required();
-  cmd->add_option("--kind", args->kind, "animal, figure or calibration")
-      ->check(CLI::IsMember({"animal", "figure", "calibration"}));
-  cmd->add_option("--studio", o.studio,
-                  "enclosure or stage (default: stage for figures, else enclosure)")
-      ->check(CLI::IsMember({"enclosure", "stage"}));
+  cmd->add_option("--kind", args->kind, TextsOf(synth::kSynthKindTexts));
+  cmd->add_option(
+      "--studio", args->studio,
+      TextsOf(synth::kStudioKindTexts) + " (default: stage for figures, else enclosure)");
   cmd->add_option("--seconds", o.seconds, "Length of the session");
   cmd->add_option("--fps", o.fps, "Frames per second");
   cmd->add_option("--size", args->size, "Image size WIDTHxHEIGHT");

@@ -3,6 +3,8 @@
 // StringToLinearSolverType): each enum has one table of its values' texts, read by the
 // YAML reader (core/yaml_reader.h) and written by ToText.
 #include <cstddef>
+#include <string>
+#include <string_view>
 
 namespace ss {
 
@@ -19,6 +21,29 @@ const char* TextOf(E value, const EnumText<E> (&texts)[N]) {
     if (t.value == value) return t.text;
   }
   return "unknown";
+}
+
+// The value whose text is `text`: false, and `out` untouched, when `texts` has none.
+template <typename E, size_t N>
+bool FromText(std::string_view text, const EnumText<E> (&texts)[N], E& out) {
+  for (const EnumText<E>& t : texts) {
+    if (text == t.text) {
+      out = t.value;
+      return true;
+    }
+  }
+  return false;
+}
+
+// The texts for a message or a help line: "a, b or c".
+template <typename E, size_t N>
+std::string TextsOf(const EnumText<E> (&texts)[N]) {
+  std::string out;
+  for (size_t i = 0; i < N; ++i) {
+    if (i > 0) out += i + 1 == N ? " or " : ", ";
+    out += texts[i].text;
+  }
+  return out;
 }
 
 }  // namespace ss

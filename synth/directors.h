@@ -16,8 +16,11 @@ struct DirectorOptions {
   uint64_t seed = 1;
   double fps = 30.0;
   bool motion_blur = false;  // 4 time slices spread over half a frame interval
-  int figure_variant = 0;
-  bool crossing = false;  // animals ignore each other: their paths cross, they pass through
+  int figure_variant = 0;    // 0: the reference figure; 1: differently proportioned
+  // Animals ignore each other (they no longer keep apart): their paths cross and their
+  // silhouettes meet in the cameras' images (truth/<cam>/overlaps.csv), as two subjects in one
+  // blob. They pass through each other where they meet.
+  bool crossing = false;
 };
 
 // `subjects` animals with their behaviour models, placed apart on the floor.

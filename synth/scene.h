@@ -8,6 +8,7 @@
 
 #include <Eigen/Core>
 
+#include "core/enum_text.h"
 #include "core/geometry.h"
 #include "synth/lens.h"
 
@@ -16,6 +17,8 @@ namespace ss::synth {
 // enclosure: 1.2 m x 0.8 m floor, 0.25 m walls on all four sides (animals).
 // stage: 4 m x 3 m floor, 2.5 m walls at the back and the sides (figures).
 enum class StudioKind { kEnclosure, kStage };
+inline constexpr EnumText<StudioKind> kStudioKindTexts[] = {{StudioKind::kEnclosure, "enclosure"},
+                                                            {StudioKind::kStage, "stage"}};
 
 enum class Surface : int { kGreenFloor, kGreenWall, kWallOutside, kRoomFloor, kRoomWall, kCeiling };
 

@@ -171,18 +171,6 @@ struct CameraWork {
 
 }  // namespace
 
-std::string SynthKindName(SynthKind kind) {
-  switch (kind) {
-    case SynthKind::kAnimal:
-      return "animal";
-    case SynthKind::kFigure:
-      return "figure";
-    case SynthKind::kCalibration:
-      return "calibration";
-  }
-  return "?";
-}
-
 int SynthOptions::frames() const {
   return std::max(1, static_cast<int>(std::lround(seconds * fps)));
 }
@@ -208,12 +196,9 @@ bool SynthOptions::IsValid(std::string* why) const {
   }
   if (!(noise >= 0) || noise > 10) return fail("--noise: expected 0..10");
   if (threads < 1 || threads > 64) return fail("--threads: expected 1..64");
-  if (!studio.empty() && studio != "enclosure" && studio != "stage") {
-    return fail("--studio: expected enclosure or stage");
-  }
-  if (kind == SynthKind::kAnimal && studio == "stage")
+  if (kind == SynthKind::kAnimal && studio == StudioKind::kStage)
     return fail("--studio: animals live in the enclosure");
-  if (kind == SynthKind::kFigure && studio == "enclosure")
+  if (kind == SynthKind::kFigure && studio == StudioKind::kEnclosure)
     return fail("--studio: figures perform on the stage");
   if (figure_variant < 0 || figure_variant > 1) return fail("--figure-variant: expected 0 or 1");
   return true;
@@ -227,29 +212,20 @@ SynthSummary RenderStudioSession(const SynthOptions& o) {
   auto log = Log("synth");
 
   const StudioKind studio_kind =
-      o.studio == "stage" || (o.studio.empty() && o.kind == SynthKind::kFigure)
-          ? StudioKind::kStage
-          : StudioKind::kEnclosure;
+      o.studio.value_or(o.kind == SynthKind::kFigure ? StudioKind::kStage : StudioKind::kEnclosure);
   const Studio studio = MakeStudio(studio_kind, o.seed);
   const std::vector<SynthCamera> cameras =
       MakeCameras(studio, o.cameras, o.width, o.height, o.seed);
-  DirectorOptions dopt;
-  dopt.subjects = o.subjects;
-  dopt.crossing = o.crossing;
-  dopt.seed = o.seed;
-  dopt.fps = o.fps;
-  dopt.motion_blur = o.motion_blur;
-  dopt.figure_variant = o.figure_variant;
   std::unique_ptr<Director> director;
   switch (o.kind) {
     case SynthKind::kAnimal:
-      director = MakeAnimalDirector(studio, cameras, dopt);
+      director = MakeAnimalDirector(studio, cameras, o);
       break;
     case SynthKind::kCalibration:
-      director = MakeCalibrationDirector(studio, cameras, dopt, o.frames() / o.fps);
+      director = MakeCalibrationDirector(studio, cameras, o, o.frames() / o.fps);
       break;
     case SynthKind::kFigure:
-      director = MakeFigureDirector(studio, cameras, dopt);
+      director = MakeFigureDirector(studio, cameras, o);
       break;
   }
 
@@ -258,8 +234,10 @@ SynthSummary RenderStudioSession(const SynthOptions& o) {
   rec.synthetic = true;
   rec.codec = o.codec;
   rec.flush_interval_ms = 1000;
-  SessionWriter writer(o.out_dir,
-                       "synth-" + SynthKindName(o.kind) + "-seed" + std::to_string(o.seed), rec);
+  SessionWriter writer(
+      o.out_dir,
+      "synth-" + std::string(TextOf(o.kind, kSynthKindTexts)) + "-seed" + std::to_string(o.seed),
+      rec);
   const fs::path truth = fs::path(o.out_dir) / "truth";
   std::error_code ec;
   fs::create_directories(truth, ec);
@@ -570,7 +548,7 @@ SynthSummary RenderStudioSession(const SynthOptions& o) {
 
   json t;
   t["format_version"] = kTruthVersion;
-  t["kind"] = SynthKindName(o.kind);
+  t["kind"] = TextOf(o.kind, kSynthKindTexts);
   t["studio"] = StudioKindName(studio.kind);
   t["seed"] = o.seed;
   t["fps"] = o.fps;
@@ -615,7 +593,7 @@ SynthSummary RenderStudioSession(const SynthOptions& o) {
       "{}: {} frames x {} camera(s) of a {} session in {:.2f} s wall, {:.2f} s CPU ({:.2f} "
       "camera-seconds "
       "per CPU-second)",
-      o.out_dir, summary.frames, summary.cameras, SynthKindName(o.kind), summary.wall_s,
+      o.out_dir, summary.frames, summary.cameras, TextOf(o.kind, kSynthKindTexts), summary.wall_s,
       summary.cpu_s, summary.CpuRealTimeFactor());
   return summary;
 }

@@ -14,40 +14,39 @@
 //   truth/board_poses.csv, truth/<cam>/corners.csv
 #include <cstdint>
 #include <map>
+#include <optional>
 #include <string>
 
+#include "core/enum_text.h"
 #include "core/frame.h"
+#include "synth/directors.h"
+#include "synth/scene.h"
 
 namespace ss::synth {
 
 enum class SynthKind { kAnimal, kFigure, kCalibration };
-std::string SynthKindName(SynthKind kind);
+inline constexpr EnumText<SynthKind> kSynthKindTexts[] = {{SynthKind::kAnimal, "animal"},
+                                                          {SynthKind::kFigure, "figure"},
+                                                          {SynthKind::kCalibration, "calibration"}};
 
-struct SynthOptions {
+// The director's options (subjects, seed, fps, motion blur, figure variant, crossing: handed to
+// it as they are) and the session's.
+struct SynthOptions : DirectorOptions {
   std::string out_dir;
   SynthKind kind = SynthKind::kAnimal;
-  std::string studio;  // "enclosure" | "stage"; empty: stage for figures, else enclosure
+  std::optional<StudioKind> studio;  // unset: the stage for figures, else the enclosure
   double seconds = 10.0;
-  double fps = 30.0;
   int width = 640;
   int height = 480;
   int cameras = 2;
-  int subjects = 1;
-  uint64_t seed = 1;
   PixelFormat pixel_format = PixelFormat::kRGB8;
   double noise = 1.0;          // sensor noise scale (0: none)
-  bool motion_blur = false;    // 4 time slices over half the frame interval
-  int figure_variant = 0;      // 0: the reference figure; 1: differently proportioned
   int threads = 1;             // cameras rendered in parallel
   bool write_mattes = true;    // the per-frame PNG mattes in truth/
   std::string codec = "ffv1";  // the videos' codec (core/recording_codecs.h)
   // Subjects stay out of view for this long at the start (truth pose "absent"),
   // as a studio records the empty enclosure first for the keyer to learn.
   double empty_lead_in_s = 0.0;
-  // Animals ignore each other (they no longer keep apart): their paths cross and their
-  // silhouettes meet in the cameras' images (truth/<cam>/overlaps.csv), as two subjects in one
-  // blob. They pass through each other where they meet.
-  bool crossing = false;
 
   // False with the reason when an option is out of range.
   bool IsValid(std::string* why) const;
