@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "apps/commands.h"
+#include "capture/aravis/fake_gige_options.h"
 #include "core/error.h"
 #include "core/frame.h"
 #ifdef SPRITESTATION_HAVE_ARAVIS
@@ -27,26 +28,15 @@ void OnSignal(int) { g_stop.store(true); }
 
 struct FakecamArgs {
   std::string session;
-  std::string address = "127.0.0.1";
-  std::string serial = "SS0001";
-  std::string camera;
-  std::string pixel_format;
-  double fps = 0.0;
-  int loops = 0;
-  double lost_packets = 0.0;
+  FakeGigEOptions options;   // the flags bound to its fields
+  std::string pixel_format;  // "": the session's
   double duration_s = 0.0;
   bool json = false;
 };
 
 void RunFakecam(const FakecamArgs& a) {
 #ifdef SPRITESTATION_HAVE_ARAVIS
-  FakeGigEOptions options;
-  options.address = a.address;
-  options.serial = a.serial;
-  options.camera = a.camera;
-  options.fps = a.fps;
-  options.loops = a.loops;
-  options.lost_packet_ratio = a.lost_packets;
+  FakeGigEOptions options = a.options;
   if (!a.pixel_format.empty()) {
     options.pixel_format = ParsePixelFormat(a.pixel_format);
     if (!options.pixel_format)
@@ -57,8 +47,8 @@ void RunFakecam(const FakecamArgs& a) {
   std::signal(SIGTERM, OnSignal);
   // The ready line: scripts and tests wait for it before opening the camera.
   std::printf("fakecam: serving %s on %s: %s %dx%d at %.2f frames/s\n", camera.device_id().c_str(),
-              a.address.c_str(), PixelFormatName(camera.pixel_format()).c_str(), camera.width(),
-              camera.height(), camera.fps());
+              options.address.c_str(), PixelFormatName(camera.pixel_format()).c_str(),
+              camera.width(), camera.height(), camera.fps());
   std::fflush(stdout);
   const auto start = std::chrono::steady_clock::now();
   while (!g_stop.load() && !camera.finished()) {
@@ -73,7 +63,7 @@ void RunFakecam(const FakecamArgs& a) {
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (a.json) {
     nlohmann::json out = {{"device_id", camera.device_id()},
-                          {"address", a.address},
+                          {"address", options.address},
                           {"pixel_format", PixelFormatName(camera.pixel_format())},
                           {"width", camera.width()},
                           {"height", camera.height()},
@@ -100,20 +90,22 @@ void AddFakecamCommand(CLI::App& app) {
       app.add_subcommand("fakecam", "Serve a recorded session as an emulated GigE Vision camera");
   auto a = std::make_shared<FakecamArgs>();
   cmd->add_option("session", a->session, "Session folder (holds session.json)")->required();
-  cmd->add_option("--address", a->address, "IPv4 address or interface to serve on (GVCP port 3956)")
+  cmd->add_option("--address", a->options.address,
+                  "IPv4 address or interface to serve on (GVCP port 3956)")
       ->capture_default_str();
-  cmd->add_option("--serial", a->serial, "Serial number; the device id is Aravis-Fake-SERIAL")
+  cmd->add_option("--serial", a->options.serial,
+                  "Serial number; the device id is Aravis-Fake-SERIAL")
       ->capture_default_str();
-  cmd->add_option("--camera", a->camera, "Session camera to serve (default: the first)");
+  cmd->add_option("--camera", a->options.camera, "Session camera to serve (default: the first)");
   cmd->add_option("--pixel-format", a->pixel_format,
                   "mono8, bayer_rg8, bayer_gr8, bayer_gb8, bayer_bg8 or rgb8 (default: the "
                   "session's, else rgb8)");
-  cmd->add_option("--fps", a->fps, "Frame rate (default: the session camera's)")
+  cmd->add_option("--fps", a->options.fps, "Frame rate (default: the session camera's)")
       ->check(CLI::NonNegativeNumber);
-  cmd->add_option("--loop", a->loops, "Passes over the session (0: forever)")
+  cmd->add_option("--loop", a->options.loops, "Passes over the session (0: forever)")
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
-  cmd->add_option("--lost-packets", a->lost_packets,
+  cmd->add_option("--lost-packets", a->options.lost_packet_ratio,
                   "Share of GVSP packets dropped on purpose (0..1)")
       ->check(CLI::Range(0.0, 1.0));
   cmd->add_option("--duration", a->duration_s,
