@@ -449,7 +449,8 @@ struct CameraRunner::Impl {
           if (collect) {
             // Straight into the next pre-faulted slot of the training set: no allocation here.
             if (training_set.empty())
-              training_set = PrefaultedImages(options.training_frames, frame.width, frame.height);
+              training_set =
+                  PrefaultedImages(options.pipeline.TrainingFrames(), frame.width, frame.height);
             // A camera that reopened mid-collection numbers and times its frames from its own
             // start again: the frames before belong to another stream, so the set starts over
             // (else learnt_from's first frame came after its last).
@@ -545,7 +546,7 @@ CameraRunner::CameraRunner(int index, CameraRunnerOptions options, BatchSink sin
   s.sink = std::move(sink);
   s.tap = std::move(tap);
   s.queue = std::make_unique<BoundedQueue<Captured>>(
-      static_cast<size_t>(std::max(1, s.options.queue_frames)));
+      static_cast<size_t>(std::max(1, s.options.pipeline.queue_frames)));
   s.status.name = s.options.camera.name;
   s.status.source = s.options.camera.source;
   s.status.has_model = s.options.model.has_value();
@@ -554,8 +555,8 @@ CameraRunner::CameraRunner(int index, CameraRunnerOptions options, BatchSink sin
     try {
       s.pipeline = std::make_unique<CameraPipeline>(s.options.camera.name, 0, *s.options.model,
                                                     s.options.floor, s.options.pipeline);
-      s.training_set = PrefaultedImages(s.options.training_frames, s.options.model->width(),
-                                        s.options.model->height());
+      s.training_set = PrefaultedImages(s.options.pipeline.TrainingFrames(),
+                                        s.options.model->width(), s.options.model->height());
     } catch (const std::exception& e) {
       s.SetKeyerPhase(Impl::KeyerPhase::kFailed, e.what());
     }

@@ -78,9 +78,9 @@ struct CameraRunnerOptions {
   CameraConfig camera;
   std::optional<CameraModel> model;
   GroundPolygon floor;
+  // The pipeline's options; its TrainingFrames() and queue_frames also say how many frames the
+  // keyer learns from and how many wait between capture and the pipeline.
   CameraPipelineOptions pipeline;
-  int training_frames = 30;
-  int queue_frames = 8;
   double offline_after_s = 3.0;  // no frame for this long: offline, closed and reopened
   double backoff_min_s = 0.5;    // first reopen delay, doubled up to backoff_max_s
   double backoff_max_s = 8.0;

@@ -124,9 +124,6 @@ void Station::Start() {
     o.model = s.models[i];
     o.floor = s.floor;
     o.pipeline = camera_pipeline;
-    o.training_frames = std::max(
-        1, (config.pipeline.keying ? *config.pipeline.keying : KeyingConfig{}).training_frames);
-    o.queue_frames = config.pipeline.queue_frames;
     o.offline_after_s = s.options.offline_after_s;
     o.preview_interval_s = kPreviewIntervalS;
     o.open_source = s.options.open_source;

@@ -3,6 +3,7 @@
 //   key -> extract -> track -> filter -> rectify -> describe -> clip batches
 // and what comes out are the batches the bank stores. One CameraPipeline
 // belongs to one thread; several cameras run side by side, each its own.
+#include <algorithm>
 #include <array>
 #include <chrono>
 #include <cstdint>
@@ -51,6 +52,12 @@ struct CameraPipelineOptions {
   // default), and frames queued between a camera's capture and its pipeline (the station).
   int workers = 0;
   int queue_frames = 8;
+
+  // Empty-enclosure frames the keyer learns from before the first frame is keyed
+  // (keying.training_frames; 30 when the keying block is unset), at least 1.
+  int TrainingFrames() const {
+    return std::max(1, keying ? keying->training_frames : KeyingConfig{}.training_frames);
+  }
   // False with "FIELD: reason" lines in `why` (FIELD as "extract.min_area") for values out of
   // range; the keying block is the keyers' to check (they refuse what they cannot use).
   bool IsValid(std::string* why) const;

@@ -210,8 +210,7 @@ IngestSummary IngestSession(const IngestOptions& options) {
     }
   });
 
-  const int training_frames = std::max(
-      1, (options.pipeline.keying ? *options.pipeline.keying : KeyingConfig{}).training_frames);
+  const int training_frames = options.pipeline.TrainingFrames();
   for (CameraWork& w : cameras) {
     w.thread = std::thread([&, &w = w] {
       try {

@@ -56,7 +56,6 @@ TEST(CameraRunner, AReopenedCameraLearnsFromItsNewStreamOnly) {
   o.camera.source = "test";
   o.model = CameraModel("LENSMODEL_PINHOLE", {300, 300, 160, 120}, 320, 240, cam_from_ground);
   o.floor = GroundPolygon({{-0.4, -0.3}, {0.4, -0.3}, {0.4, 0.3}, {-0.4, 0.3}});
-  o.training_frames = 30;
   o.offline_after_s = 1.0;
   o.backoff_min_s = 0.05;
   std::atomic<int> opens{0};
