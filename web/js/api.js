@@ -289,7 +289,36 @@ export class Events extends EventTarget {
 // ---- page chrome -----------------------------------------------------------
 
 // Marks the current page in the top nav and shows the stream's connection.
+// The console's pages, in the order the top bar lists them: adding a page is one line here.
+const PAGES = [
+  { href: '/', id: 'station', title: 'Station' },
+  { href: 'replay.html', id: 'replay', title: 'Replay' },
+  { href: 'bank.html', id: 'bank', title: 'Bank' },
+  { href: 'calibrate.html', id: 'calibrate', title: 'Calibrate' },
+  { href: 'label.html', id: 'label', title: 'Label' },
+];
+
+// The top bar (the pages, the mode, the connection, sign out) and the message area, the same
+// on every page, put in front of the page's own content.
+function addChrome() {
+  const message = el('div', { class: 'message', testid: 'message', role: 'alert', hidden: true });
+  document.body.prepend(
+    el(
+      'header',
+      { class: 'topbar' },
+      el('span', { class: 'brand' }, 'Sprite', el('b', { text: 'Station' })),
+      el('nav', { class: 'top', testid: 'nav' }, PAGES.map((p) => el('a', { href: p.href, testid: `nav-${p.id}`, text: p.title }))),
+      el('span', { class: 'spacer' }),
+      el('span', { class: 'mode', testid: 'nav-mode' }),
+      el('span', { class: 'connection', testid: 'connection', 'data-state': 'connecting', text: 'connecting' }),
+      el('button', { class: 'link', testid: 'signout', hidden: true, text: 'Sign out' }),
+    ),
+    message,
+  );
+}
+
 export function chrome(events) {
+  addChrome();
   const here = location.pathname.replace(/^\/$/, '/index.html');
   for (const a of document.querySelectorAll('nav.top a[href]')) {
     const target = new URL(a.href, location.href).pathname.replace(/^\/$/, '/index.html');
