@@ -4,6 +4,7 @@
 //   bandwidth) key/ffmpeg_chromakey_1080p      FFmpeg's chromakey filter (libavfilter), one thread,
 //   the same frames
 //                                   pre-converted (untimed) to its own pixel format, yuva444p
+//   key/train_1080p                 ChromaKeyer::Train on the empty frames (frames learnt a second)
 // Content: tests/pipeline/key_scene.h at 1080p: uneven, vignetted, tinted green with sensor
 // noise; one brown textured subject with legs, spill and a contact shadow, moving across.
 // Figures: frames/s, and key + extract as ratios to the read and to FFmpeg of the same run.
@@ -208,8 +209,27 @@ void BM_FfmpegChromakey(benchmark::State& state) {
   state.SetItemsProcessed(n);
 }
 
+// Learning the empty enclosure: a one-time cost a camera pays before its first sprite (the
+// recording waits for it), per frame learnt.
+void BM_Train(benchmark::State& state) {
+  const Footage& f = Frames();
+  int64_t n = 0;
+  for (auto _ : state) {
+    ChromaKeyer keyer;
+    keyer.Train(f.empty_bgr);
+    benchmark::DoNotOptimize(keyer.unkeyable_fraction());
+    n += static_cast<int64_t>(f.empty_bgr.size());
+  }
+  state.SetItemsProcessed(n);
+}
+
 BENCHMARK(BM_KeyExtract)
     ->Name("key/key_extract_1080p_rgb8")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->MinTime(2.0);
+BENCHMARK(BM_Train)
+    ->Name("key/train_1080p")
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->MinTime(2.0);
@@ -262,24 +282,29 @@ int Run(const std::vector<std::string>& args) {
 
   auto& fps = collector.frames_per_second;
   const std::string key = "key/key_extract_1080p_rgb8", read = "key/baseline/read_1080p_rgb8",
-                    ffmpeg = "key/ffmpeg_chromakey_1080p";
+                    ffmpeg = "key/ffmpeg_chromakey_1080p", train = "key/train_1080p";
   nlohmann::json figures = {{"frame", "1920x1080 rgb8, one subject"}, {"threads", 1}};
   for (const auto& [name, value] : fps) figures["frames_per_second"][name] = value;
   if (fps.count(key) && fps.count(read)) figures["key_over_read"] = fps[key] / fps[read];
   if (fps.count(key) && fps.count(ffmpeg))
     figures["key_over_ffmpeg_chromakey"] = fps[key] / fps[ffmpeg];
+  if (fps.count(train) && fps.count(read)) figures["train_over_read"] = fps[train] / fps[read];
   if (json) {
     std::printf("%s\n", figures.dump(2).c_str());
     return 0;
   }
   std::printf("\nkey figures (1920x1080 RGB8, one subject, one thread of %ld cores):\n",
               sysconf(_SC_NPROCESSORS_ONLN));
-  for (const std::string& name : {key, read, ffmpeg}) {
+  for (const std::string& name : {key, train, read, ffmpeg}) {
     if (fps.count(name)) std::printf("  %-32s %10.1f frames/s\n", name.c_str(), fps[name]);
   }
   if (figures.contains("key_over_read")) {
     std::printf("  key + extract = %.3f x the read limit (goal >= 0.25)\n",
                 figures["key_over_read"].get<double>());
+  }
+  if (figures.contains("train_over_read")) {
+    std::printf("  training = %.3f x the read limit, per frame learnt\n",
+                figures["train_over_read"].get<double>());
   }
   if (figures.contains("key_over_ffmpeg_chromakey")) {
     std::printf("  key + extract = %.1f x FFmpeg chromakey (goal >> 50)\n",

@@ -1,8 +1,11 @@
 #include "pipeline/key/chroma_keyer.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <string>
+
+#include <opencv2/core/utility.hpp>
 
 #include "core/error.h"
 #include "core/log.h"
@@ -48,6 +51,46 @@ inline PixelKey KeyPixel(int b, int g, int r, float key_hi, float gain, int32_t 
   return {alpha, ((shade * (255 - alpha) + 128) * 257) >> 16};
 }
 
+// One row of an empty-enclosure frame, for the training statistics. Per pixel: its key added to
+// `pixel_key`, and when it is green (key >= min_key, luma4 >= min_luma4) its luma4, key, key^2
+// and a count added to the column accumulators (summed into cells per cell row, later). Written
+// for the vectorizer: element-wise only, no reductions, no branches; cloned per instruction set
+// as the keying rows are (the 3-byte de-interleave needs SSSE3).
+__attribute__((target_clones("avx2", "ssse3", "default"))) void TrainRow(
+    const uint8_t* __restrict in, int width, float min_key, int min_luma4,
+    float* __restrict pixel_key, int32_t* __restrict luma4_sum, float* __restrict key_sum,
+    float* __restrict key2_sum, int32_t* __restrict count) {
+  for (int x = 0; x < width; ++x) {
+    const int b = in[3 * x], g = in[3 * x + 1], r = in[3 * x + 2];
+    const int luma4 = b + 2 * g + r;
+    // (G - max(R,B)) / max(luma, kMinTrainingLuma), luma = luma4 / 4
+    const float key = 4.f * static_cast<float>(g - std::max(b, r)) /
+                      static_cast<float>(std::max(luma4, min_luma4));
+    pixel_key[x] += key;
+    const bool green = (key >= min_key) & (luma4 >= min_luma4);  // & : no branch
+    const int take = green ? 1 : 0;
+    const auto weight = static_cast<float>(take);  // multiplied, not selected: no branch
+    luma4_sum[x] += luma4 * take;
+    key_sum[x] += key * weight;
+    key2_sum[x] += key * key * weight;
+    count[x] += take;
+  }
+}
+
+// One row of an empty-enclosure frame keyed by the trained model: each pixel's alpha added to
+// `alpha_sum` (a pixel the model keys on the empty enclosure is not green).
+__attribute__((target_clones("avx2", "ssse3", "default"))) void AlphaSumRow(
+    const uint8_t* __restrict in, int width, const float* __restrict key_hi,
+    const float* __restrict gain, const int32_t* __restrict luma_floor,
+    const float* __restrict inv_luma, const float* __restrict shadow_base, int shadow_min,
+    uint32_t* __restrict alpha_sum) {
+  for (int x = 0; x < width; ++x) {
+    const PixelKey k = KeyPixel(in[3 * x], in[3 * x + 1], in[3 * x + 2], key_hi[x], gain[x],
+                                luma_floor[x], inv_luma[x], shadow_base[x], shadow_min);
+    alpha_sum[x] += static_cast<uint32_t>(k.alpha);
+  }
+}
+
 }  // namespace
 
 bool ChromaKeyerOptions::IsValid(std::string* why) const {
@@ -86,25 +129,39 @@ void ChromaKeyer::Train(const std::vector<cv::Mat>& empty_bgr) {
   std::vector<double> sum_y(cells, 0), sum_k(cells, 0), sum_kk(cells, 0), count(cells, 0),
       all(cells, 0);
   std::vector<float> pixel_key(static_cast<size_t>(size_.width) * size_.height, 0.f);
-  for (const cv::Mat& frame : empty_bgr) {
-    for (int y = 0; y < size_.height; ++y) {
-      const uint8_t* p = frame.ptr<uint8_t>(y);
-      const size_t row = static_cast<size_t>(y / s) * cols;
-      float* pk = &pixel_key[static_cast<size_t>(y) * size_.width];
-      for (int x = 0; x < size_.width; ++x, p += 3) {
-        const double luma = (p[0] + 2.0 * p[1] + p[2]) / 4.0;
-        const double key = (p[1] - std::max(p[0], p[2])) / std::max(luma, kMinTrainingLuma);
-        pk[x] += static_cast<float>(key);
-        const size_t c = row + x / s;
-        all[c] += 1;
-        if (key < options_.min_key || luma < kMinTrainingLuma) continue;
-        sum_y[c] += luma;
-        sum_k[c] += key;
-        sum_kk[c] += key * key;
-        count[c] += 1;
+  const int min_luma4 = static_cast<int>(std::ceil(4 * kMinTrainingLuma));
+  const auto min_key = static_cast<float>(options_.min_key);
+  // Cell rows are independent (their cells, their pixel rows): one task each, all frames inside;
+  // per column, sums over the cell row's pixel rows of every frame, then summed into its cells.
+  cv::parallel_for_(cv::Range(0, rows), [&](const cv::Range& range) {
+    const size_t w = static_cast<size_t>(size_.width);
+    std::vector<int32_t> luma4_sum(w), n(w);
+    std::vector<float> key_sum(w), key2_sum(w);
+    for (int cy = range.start; cy < range.end; ++cy) {
+      std::fill(luma4_sum.begin(), luma4_sum.end(), 0);
+      std::fill(n.begin(), n.end(), 0);
+      std::fill(key_sum.begin(), key_sum.end(), 0.f);
+      std::fill(key2_sum.begin(), key2_sum.end(), 0.f);
+      const int y0 = cy * s, y1 = std::min(y0 + s, size_.height);
+      for (const cv::Mat& frame : empty_bgr) {
+        for (int y = y0; y < y1; ++y) {
+          TrainRow(frame.ptr<uint8_t>(y), size_.width, min_key, min_luma4, &pixel_key[y * w],
+                   luma4_sum.data(), key_sum.data(), key2_sum.data(), n.data());
+        }
+      }
+      for (int cx = 0; cx < cols; ++cx) {
+        const size_t c = static_cast<size_t>(cy) * cols + cx;
+        const int x0 = cx * s, x1 = std::min(x0 + s, size_.width);
+        all[c] = static_cast<double>(x1 - x0) * (y1 - y0) * static_cast<double>(empty_bgr.size());
+        for (int x = x0; x < x1; ++x) {
+          sum_y[c] += luma4_sum[x] / 4.0;
+          sum_k[c] += key_sum[x];
+          sum_kk[c] += key2_sum[x];
+          count[c] += n[x];
+        }
       }
     }
-  }
+  });
   std::vector<double> luma(cells), key(cells), spread(cells);
   std::vector<uint8_t> green(cells);
   size_t n_green = 0;
@@ -202,28 +259,30 @@ void ChromaKeyer::Train(const std::vector<cv::Mat>& empty_bgr) {
   // global model, kept naive for comparison, skips this).
   std::vector<uint32_t> alpha_sum(static_cast<size_t>(size_.width) * size_.height, 0);
   const int shadow_min = static_cast<int>(std::lround(255 * o.shadow_min));
-  for (const cv::Mat& frame : empty_bgr) {
-    if (o.global_model) break;
-    for (int y = 0; y < size_.height; ++y) {
-      const Params p = BandParams(y / s);
-      const uint8_t* px = frame.ptr<uint8_t>(y);
-      uint32_t* sum = &alpha_sum[static_cast<size_t>(y) * w];
-      for (int x = 0; x < size_.width; ++x, px += 3) {
-        const PixelKey k =
-            KeyPixel(px[0], px[1], px[2], p.f[kKeyHi][x], p.f[kGain][x], p.luma_floor[x],
-                     p.f[kInvLuma][x], p.f[kShadowBase][x], shadow_min);
-        sum[x] += static_cast<uint32_t>(k.alpha);
+  if (!o.global_model) {
+    cv::parallel_for_(cv::Range(0, rows), [&](const cv::Range& range) {
+      for (int cy = range.start; cy < range.end; ++cy) {
+        const Params p = BandParams(cy);
+        for (const cv::Mat& frame : empty_bgr) {
+          for (int y = cy * s; y < std::min((cy + 1) * s, size_.height); ++y) {
+            AlphaSumRow(frame.ptr<uint8_t>(y), size_.width, p.f[kKeyHi], p.f[kGain], p.luma_floor,
+                        p.f[kInvLuma], p.f[kShadowBase], shadow_min, &alpha_sum[y * w]);
+          }
+        }
       }
-    }
+    });
   }
   keyable_.resize(alpha_sum.size());
   green_px_.resize(alpha_sum.size());
   size_t masked = 0;
-  const double n_frames = static_cast<double>(empty_bgr.size());
+  // Mean alpha <= kUnkeyableAlpha and mean key >= min_key, without a division per pixel.
+  const auto n_frames = static_cast<uint32_t>(empty_bgr.size());
+  const uint32_t max_alpha_sum = kUnkeyableAlpha * n_frames;
+  const auto min_key_sum = static_cast<float>(o.min_key * n_frames);
   for (size_t i = 0; i < alpha_sum.size(); ++i) {
-    const bool keyable = alpha_sum[i] / n_frames <= kUnkeyableAlpha;
+    const bool keyable = alpha_sum[i] <= max_alpha_sum;
     keyable_[i] = keyable ? 0xFF : 0;
-    green_px_[i] = keyable && pixel_key[i] / n_frames >= o.min_key ? 0xFF : 0;
+    green_px_[i] = keyable && pixel_key[i] >= min_key_sum ? 0xFF : 0;
     masked += !keyable;
   }
   if (masked > 0) {
