@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include <opencv2/core/utility.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "core/error.h"
@@ -122,20 +123,23 @@ cv::Mat FloorPixels(const CameraModel& camera, const PixelRays& rays, double wal
                     const std::function<bool(const Eigen::Vector2d&)>& contains) {
   cv::Mat mask = cv::Mat::zeros(camera.height(), camera.width(), CV_8U);
   const Eigen::Vector3d centre = camera.CentreInGround();
-  for (int y = 0; y < camera.height(); ++y) {
-    auto* row = mask.ptr<uint8_t>(y);
-    for (int x = 0; x < camera.width(); ++x) {
-      const auto g = IntersectGround(Ray{centre, rays.Direction(x, y)});
-      if (!g || !contains(g->head<2>())) continue;
-      // Seen over the walls: where the ray passes wall height it must be inside too.
-      if (wall_height_m > 0 && centre.z() > wall_height_m) {
-        const double s = (centre.z() - wall_height_m) / centre.z();
-        const Eigen::Vector3d top = centre + s * (*g - centre);
-        if (!contains(top.head<2>())) continue;
+  // Rows are independent: spread over the cores (a camera's pipeline waits for its mask).
+  cv::parallel_for_(cv::Range(0, camera.height()), [&](const cv::Range& rows) {
+    for (int y = rows.start; y < rows.end; ++y) {
+      auto* row = mask.ptr<uint8_t>(y);
+      for (int x = 0; x < camera.width(); ++x) {
+        const auto g = IntersectGround(Ray{centre, rays.Direction(x, y)});
+        if (!g || !contains(g->head<2>())) continue;
+        // Seen over the walls: where the ray passes wall height it must be inside too.
+        if (wall_height_m > 0 && centre.z() > wall_height_m) {
+          const double s = (centre.z() - wall_height_m) / centre.z();
+          const Eigen::Vector3d top = centre + s * (*g - centre);
+          if (!contains(top.head<2>())) continue;
+        }
+        row[x] = 255;
       }
-      row[x] = 255;
     }
-  }
+  });
   return mask;
 }
 

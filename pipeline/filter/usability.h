@@ -106,6 +106,7 @@ class NoiseFilter {
 // wall_height_m > 0, passes that height inside it too: FloorMask's mask before Restrict.
 // `contains` decides a ground point: FloorMask gives it a GroundPolygonIndex (the edges near the
 // point only); GroundPolygon::Contains (every edge, the way before issue 20) gives the same mask.
+// Rows are computed in parallel (cv::parallel_for_): `contains` is called from several threads.
 cv::Mat FloorPixels(const CameraModel& camera, double wall_height_m,
                     const std::function<bool(const Eigen::Vector2d&)>& contains);
 
