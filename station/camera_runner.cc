@@ -498,7 +498,10 @@ struct CameraRunner::Impl {
           const uint64_t usable_before = pipeline->usable_sprites();
           pipeline->Process(frame, &out);
           usable = pipeline->usable_sprites() > usable_before;
-          if (preview) UpdatePreview(pipeline->last_bgr(), pipeline.get(), frame, item->received);
+          if (preview) {
+            ToBgr(frame, bgr);  // the pipeline keys the camera's bytes as they are
+            UpdatePreview(bgr, pipeline.get(), frame, item->received);
+          }
           Sink(out, arrivals);
         }
       } catch (const std::exception& e) {

@@ -125,11 +125,11 @@ void CameraPipeline::Process(const Frame& frame, std::vector<ClipBatch>* out) {
 
   const auto key_start = Clock::now();
   try {
-    ToBgr(frame, bgr_);
+    // RGB8 and BGR8 frames are keyed in place; other formats go through bgr_scratch_.
+    keyer_->Key(frame, bgr_scratch_, matte_);
   } catch (const InputError& e) {  // a corrupt frame: say which camera's
     throw InputError(name_ + " frame " + std::to_string(frame.sequence), e.what());
   }
-  keyer_->Key(bgr_, matte_);
   const std::vector<Candidate>& candidates = extractor_.Extract(matte_);
   stats_.seconds_key += SecondsSince(key_start);
   const auto rest_start = Clock::now();

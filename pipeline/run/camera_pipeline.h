@@ -107,8 +107,7 @@ class CameraPipeline {
   // stores the clips to come under bank camera `camera_id`. The keyer stays trained.
   void Retarget(int64_t camera_id, std::vector<ClipBatch>* out);
 
-  // The last processed frame in BGR and its matte (previews; valid until the next Process).
-  const cv::Mat& last_bgr() const { return bgr_; }
+  // The last processed frame's matte (previews; valid until the next Process).
   const Matte& last_matte() const { return matte_; }
   // Every candidate of the last processed frame with its verdict (valid until the next Process).
   const std::vector<CandidateVerdict>& last_verdicts() const { return verdicts_; }
@@ -137,7 +136,7 @@ class CameraPipeline {
   ClipCutter cutter_;
   Rectifier rectifier_;
   ClipBatcher batcher_;
-  cv::Mat bgr_;
+  cv::Mat bgr_scratch_;  // a frame converted for the keyer (formats it cannot key in place)
   Matte matte_;
   std::vector<CandidateVerdict> verdicts_;
   void UpdateClipStats();
