@@ -151,16 +151,16 @@ OptionsBinder KeyingKeys(KeyingConfig& k) {
       .Add("chroma.low", &k.chroma.key_low_levels, "a level 0..255",
            "key difference where alpha starts to fall")
       .Add("chroma.high", &k.chroma.key_high_levels, "a level 0..255", "... and where it reaches 0")
-      .Add("clean_plate.low_sigma", &k.plate_low_sigma, "a number of noise sigmas",
+      .Add("clean_plate.low_sigma", &k.clean_plate.low_sigma, "a number of noise sigmas",
            "difference where alpha starts to rise")
-      .Add("clean_plate.high_sigma", &k.plate_high_sigma, "a number of noise sigmas",
+      .Add("clean_plate.high_sigma", &k.clean_plate.high_sigma, "a number of noise sigmas",
            "... and where it reaches 1")
-      .Add("despill.enabled", &k.despill, "remove the green cast from the subject's edges")
-      .Add("despill.strength", &k.despill_strength, "a number 0..1", "share of the cast removed")
-      .Add("shadow.enabled", &k.shadow, "keep the contact-shadow layer")
-      .Add("shadow.min_darkening", &k.shadow_min_darkening, "a fraction 0..1",
+      .Add("despill.enabled", &k.despill.enabled, "remove the green cast from the subject's edges")
+      .Add("despill.strength", &k.despill.strength, "a number 0..1", "share of the cast removed")
+      .Add("shadow.enabled", &k.shadow.enabled, "keep the contact-shadow layer")
+      .Add("shadow.min_darkening", &k.shadow.min_darkening, "a fraction 0..1",
            "darkening below which there is no shadow")
-      .Add("shadow.max_darkening", &k.shadow_max_darkening, "a fraction 0..1",
+      .Add("shadow.max_darkening", &k.shadow.max_darkening, "a fraction 0..1",
            "darkening that counts as full shadow")
       .Add("shadow.reach_m", &k.shadow_reach_m, "a distance in metres",
            "shadow kept this far around the foot");

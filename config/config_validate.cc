@@ -152,23 +152,23 @@ class Validator {
     Range(high, 0, 255, "keying.chroma.high");
     Check(!(low >= high), "keying.chroma.high",
           "must be above keying.chroma.low (" + Num(low) + "), got " + Num(high));
-    NonNegative(k.plate_low_sigma, "keying.clean_plate.low_sigma");
-    NonNegative(k.plate_high_sigma, "keying.clean_plate.high_sigma");
-    Check(!(k.plate_low_sigma >= k.plate_high_sigma), "keying.clean_plate.high_sigma",
-          "must be above keying.clean_plate.low_sigma (" + Num(k.plate_low_sigma) + "), got " +
-              Num(k.plate_high_sigma));
-    Finite(k.despill_strength, "keying.despill.strength");
-    if (std::isfinite(k.despill_strength) && (k.despill_strength < 0 || k.despill_strength > 1)) {
-      const double clamped = std::clamp(k.despill_strength, 0.0, 1.0);
+    NonNegative(k.clean_plate.low_sigma, "keying.clean_plate.low_sigma");
+    NonNegative(k.clean_plate.high_sigma, "keying.clean_plate.high_sigma");
+    Check(!(k.clean_plate.low_sigma >= k.clean_plate.high_sigma), "keying.clean_plate.high_sigma",
+          "must be above keying.clean_plate.low_sigma (" + Num(k.clean_plate.low_sigma) +
+              "), got " + Num(k.clean_plate.high_sigma));
+    Finite(k.despill.strength, "keying.despill.strength");
+    if (std::isfinite(k.despill.strength) && (k.despill.strength < 0 || k.despill.strength > 1)) {
+      const double clamped = std::clamp(k.despill.strength, 0.0, 1.0);
       msg_.Adjust("keying.despill.strength",
-                  Num(k.despill_strength) + " is outside 0..1; clamped to " + Num(clamped));
-      k.despill_strength = clamped;
+                  Num(k.despill.strength) + " is outside 0..1; clamped to " + Num(clamped));
+      k.despill.strength = clamped;
     }
-    Range(k.shadow_min_darkening, 0, 1, "keying.shadow.min_darkening");
-    Range(k.shadow_max_darkening, 0, 1, "keying.shadow.max_darkening");
-    Check(!(k.shadow_min_darkening >= k.shadow_max_darkening), "keying.shadow.max_darkening",
-          "must be above keying.shadow.min_darkening (" + Num(k.shadow_min_darkening) + "), got " +
-              Num(k.shadow_max_darkening));
+    Range(k.shadow.min_darkening, 0, 1, "keying.shadow.min_darkening");
+    Range(k.shadow.max_darkening, 0, 1, "keying.shadow.max_darkening");
+    Check(!(k.shadow.min_darkening >= k.shadow.max_darkening), "keying.shadow.max_darkening",
+          "must be above keying.shadow.min_darkening (" + Num(k.shadow.min_darkening) + "), got " +
+              Num(k.shadow.max_darkening));
     Positive(k.shadow_reach_m, "keying.shadow.reach_m");
   }
 

@@ -95,26 +95,24 @@ __attribute__((target_clones("avx2", "ssse3", "default"))) void AlphaSumRow(
 
 bool ChromaKeyerOptions::IsValid(std::string* why) const {
   const ChromaKeyerOptions& o = *this;
-  OptionChecks check(why);
+  OptionProblems check(why);
   check(o.noise_z >= 0, "noise_z", "must not be negative");
   check(o.min_margin >= 0 && o.min_margin < 1, "min_margin", "must be within [0, 1)");
   check(o.ramp > 0 && o.ramp <= 2, "ramp", "must be within (0, 2]");
-  check(o.dark_floor >= 0 && o.dark_floor < 1, "dark_floor", "must be within [0, 1)");
-  check(o.shadow_min >= 0 && o.shadow_min < 1, "shadow_min", "must be within [0, 1)");
+  std::string part;
+  check.Nested(o.shadow.IsValid(&part), "shadow.", part);
+  check.Nested(o.despill.IsValid(&part), "despill.", part);
   check(o.coarse_alpha > 0 && o.coarse_alpha < 1, "coarse_alpha", "must be within (0, 1)");
   check(o.coarse_shadow > 0 && o.coarse_shadow < 1, "coarse_shadow", "must be within (0, 1)");
   check(o.min_key > 0, "min_key", "must be positive");
   check(o.max_unkeyable >= 0 && o.max_unkeyable <= 1, "max_unkeyable", "must be within [0, 1]");
-  check(o.despill_bias >= 0 && o.despill_bias <= 1, "despill_bias", "must be within [0, 1]");
-  check(o.despill_strength >= 0 && o.despill_strength <= 1, "despill_strength",
-        "must be within [0, 1]");
-  check(o.key_low_levels < 0 || o.key_high_levels > o.key_low_levels, "high",
-        "must be above keying.chroma.low");
+  check(o.key_low_levels < 0 || o.key_high_levels > o.key_low_levels, "key_high_levels",
+        "must be above key_low_levels (" + OptionProblems::Num(o.key_low_levels) + ")");
   return check.ok();
 }
 
 ChromaKeyer::ChromaKeyer(ChromaKeyerOptions options) : Keyer(options.grid), options_(options) {
-  if (std::string why; !options_.IsValid(&why)) throw InputError("keying.chroma." + why);
+  if (std::string why; !options_.IsValid(&why)) throw InputError("chroma keyer options", why);
 }
 
 void ChromaKeyer::Train(const std::vector<cv::Mat>& empty_bgr) {
@@ -218,8 +216,9 @@ void ChromaKeyer::Train(const std::vector<cv::Mat>& empty_bgr) {
     f[kKeyHi] = is_green ? static_cast<float>(key_hi / 4) : kNeverKey;
     f[kGain] = static_cast<float>(4 * 255 / ramp);
     f[kInvLuma] = is_green ? static_cast<float>(255 / (4 * l)) : 0.f;
-    f[kShadowBase] = is_green && o.shadow ? 255.f : kNoShadow;
-    *luma_floor = static_cast<int32_t>(std::lround(std::max(4 * o.dark_floor * l, 4.0)));
+    f[kShadowBase] = is_green && o.shadow.enabled ? 255.f : kNoShadow;
+    const double dark_floor = 1 - o.shadow.max_darkening;  // darker than this: the subject
+    *luma_floor = static_cast<int32_t>(std::lround(std::max(4 * dark_floor * l, 4.0)));
   };
   float f[kFloatParams];
   int32_t floor4 = 0;
@@ -258,7 +257,7 @@ void ChromaKeyer::Train(const std::vector<cv::Mat>& empty_bgr) {
   // Pixels the model itself keys on the empty enclosure are not green (the
   // global model, kept naive for comparison, skips this).
   std::vector<uint32_t> alpha_sum(static_cast<size_t>(size_.width) * size_.height, 0);
-  const int shadow_min = static_cast<int>(std::lround(255 * o.shadow_min));
+  const int shadow_min = static_cast<int>(std::lround(255 * o.shadow.min_darkening));
   if (!o.global_model) {
     cv::parallel_for_(cv::Range(0, rows), [&](const cv::Range& range) {
       for (int cy = range.start; cy < range.end; ++cy) {
@@ -378,7 +377,7 @@ void ChromaKeyer::SampleRow(const uint8_t* row, ChannelOrder /*order*/, int cell
   const Params p = CellParams(cell_row);
   const int coarse_alpha = static_cast<int>(std::lround(255 * options_.coarse_alpha));
   const int coarse_shadow = static_cast<int>(std::lround(255 * options_.coarse_shadow));
-  const int shadow_min = static_cast<int>(std::lround(255 * options_.shadow_min));
+  const int shadow_min = static_cast<int>(std::lround(255 * options_.shadow.min_darkening));
   const uint8_t* keyable = &keyable_[static_cast<size_t>(SampleY(cell_row)) * size_.width];
   for (int cx = 0; cx < cols_; ++cx) {
     // B and R may be swapped: the key is symmetric in them
@@ -395,9 +394,11 @@ void ChromaKeyer::SampleRow(const uint8_t* row, ChannelOrder /*order*/, int cell
 void ChromaKeyer::FineRow(const uint8_t* row, ChannelOrder order, int y, int x0, int x1,
                           uint8_t* alpha, uint8_t* shadow, uint8_t* colour) const {
   const Params p = BandParams(std::min(y / grid_.step, rows_ - 1));
-  const int shadow_min = static_cast<int>(std::lround(255 * options_.shadow_min));
-  const int despill256 = static_cast<int>(std::lround(256 * options_.despill_bias));
-  const int strength256 = static_cast<int>(std::lround(256 * options_.despill_strength));
+  const int shadow_min = static_cast<int>(std::lround(255 * options_.shadow.min_darkening));
+  const DespillOptions& despill = options_.despill;
+  const int despill256 = static_cast<int>(std::lround(256 * despill.bias));
+  const int strength256 =
+      despill.enabled ? static_cast<int>(std::lround(256 * despill.strength)) : 0;
   const uint8_t* keyable = &keyable_[static_cast<size_t>(y) * size_.width];
   if (order == ChannelOrder::kRgb) {
     ChromaRowRgb(row, x0, x1, p.f[kKeyHi], p.f[kGain], p.luma_floor, p.f[kInvLuma],
@@ -412,10 +413,8 @@ void ChromaKeyer::FineRow(const uint8_t* row, ChannelOrder order, int y, int x0,
 
 ChromaKeyerOptions ChromaKeyerOptionsFrom(const KeyingConfig& k) {
   ChromaKeyerOptions o = k.chroma;
-  o.despill_strength = k.despill ? k.despill_strength : 0.0;
   o.shadow = k.shadow;
-  o.shadow_min = k.shadow_min_darkening;
-  o.dark_floor = 1.0 - k.shadow_max_darkening;
+  o.despill = k.despill;
   return o;
 }
 

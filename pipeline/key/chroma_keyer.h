@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "pipeline/key/keyer.h"
+#include "pipeline/key/shared_options.h"
 
 namespace ss {
 
@@ -21,20 +22,16 @@ struct KeyingConfig;
 
 struct ChromaKeyerOptions {
   GridOptions grid;
-  double noise_z = 5.0;     // background tolerance in noise std of the learned key...
-  double min_margin = 0.2;  // ...and at least this fraction of the learned key
-  double ramp = 0.6;        // alpha goes 0 -> 1 over this fraction of the learned key
-  double dark_floor = 0.2;  // luma below this fraction of the floor's counts as subject, not shadow
-  double shadow_min = 0.06;     // darkening below this is noise: no shadow
+  double noise_z = 5.0;         // background tolerance in noise std of the learned key...
+  double min_margin = 0.2;      // ...and at least this fraction of the learned key
+  double ramp = 0.6;            // alpha goes 0 -> 1 over this fraction of the learned key
   double coarse_alpha = 0.25;   // a sample with a larger alpha marks its cell as foreground
   double coarse_shadow = 0.12;  // a sample darkened more marks its cell as shaded
   double min_key = 0.1;  // training cells with a smaller key k_bg are not green and never keyed
   double max_unkeyable = 0.9;  // training fails when more than this fraction of cells is not green
-  // G <= max(R,B) - bias * (max(R,B) - min(R,B)): 0 keeps yellows, 0.5 = mean(R,B)
-  double despill_bias = 0.5;
-  // share of the green above that limit removed: 0 = no despill, 1 = all
-  double despill_strength = 1;
-  bool shadow = true;  // false: no contact-shadow layer (and no shaded cells)
+  // The contact shadow: luma below (1 - max_darkening) of the floor's is subject, not shadow.
+  ShadowOptions shadow;
+  DespillOptions despill;  // the green cast removed from the subject's colour
   // When both are >= 0 (the station config's keying.chroma.low/high): the key in 8-bit levels of
   // G - max(R, B) at the floor's brightness, k * Y_bg, where alpha is 1 (<= low) and 0 (>= high);
   // `high` never reaches into the floor's own noise (min_margin, noise_z). Else min_margin and
@@ -48,8 +45,8 @@ struct ChromaKeyerOptions {
 };
 
 // The options the station config's keying section sets (docs/keying.md, "From the station
-// config"): its `chroma` block (keying.chroma.* bound to its fields) with the shared
-// keying.despill.* and keying.shadow.* applied.
+// config"): its `chroma` block (keying.chroma.* bound to its fields) with the shared blocks
+// keying.despill and keying.shadow as they are.
 ChromaKeyerOptions ChromaKeyerOptionsFrom(const KeyingConfig& keying);
 
 class ChromaKeyer : public Keyer {

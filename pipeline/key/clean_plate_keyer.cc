@@ -84,25 +84,27 @@ SS_PLATE_ROW(PlateRowRgb, true)
 
 bool CleanPlateKeyerOptions::IsValid(std::string* why) const {
   const CleanPlateKeyerOptions& o = *this;
-  OptionChecks check(why);
-  check(o.noise_z >= 0, "noise_z", "must not be negative");
+  OptionProblems check(why);
+  check(o.low_sigma >= 0, "low_sigma", "must not be negative");
   check(o.min_sigma > 0, "min_sigma", "must be positive");
   check(o.ramp > 0, "ramp", "must be positive");
-  check(o.dark_floor >= 0 && o.dark_floor < 1, "dark_floor", "must be within [0, 1)");
-  check(o.shadow_min >= 0 && o.shadow_min < 1, "shadow_min", "must be within [0, 1)");
+  std::string part;
+  check.Nested(o.shadow.IsValid(&part), "shadow.", part);
   check(o.coarse_alpha > 0 && o.coarse_alpha < 1, "coarse_alpha", "must be within (0, 1)");
   check(o.coarse_shadow > 0 && o.coarse_shadow < 1, "coarse_shadow", "must be within (0, 1)");
-  check(o.ramp_sigma >= 0, "ramp_sigma", "must not be negative");
+  check(o.high_sigma == 0 || o.high_sigma > o.low_sigma, "high_sigma",
+        "must be 0 (ramp by levels) or above low_sigma (" + OptionProblems::Num(o.low_sigma) + ")");
   return check.ok();
 }
 
 CleanPlateKeyer::CleanPlateKeyer(CleanPlateKeyerOptions options)
     : Keyer(options.grid), options_(options) {
-  if (std::string why; !options_.IsValid(&why)) throw InputError("keying.clean_plate." + why);
+  if (std::string why; !options_.IsValid(&why)) throw InputError("clean-plate keyer options", why);
 }
 
 int CleanPlateKeyer::ShadowMin() const {
-  return options_.shadow ? static_cast<int>(std::lround(255 * options_.shadow_min)) : 256;
+  const ShadowOptions& shadow = options_.shadow;
+  return shadow.enabled ? static_cast<int>(std::lround(255 * shadow.min_darkening)) : 256;
 }
 
 void CleanPlateKeyer::Train(const std::vector<cv::Mat>& empty_bgr) {
@@ -130,16 +132,17 @@ void CleanPlateKeyer::Train(const std::vector<cv::Mat>& empty_bgr) {
   // The distance a pixel is tested on is mostly the chromaticity distortion,
   // the length of a residual in the 2-D plane across the plate's colour line,
   // and the plate carries the noise of its own n frames: a tolerance of
-  // noise_z std in one dimension would let through exp(-z^2/2) of the pixels
+  // low_sigma std in one dimension would let through exp(-z^2/2) of the pixels
   // instead of erfc(z/sqrt 2) (e.g. z = 4: 3e-4 instead of 6e-5, a speck per
   // frame). Match the one-dimensional rate: z2 = sqrt(-2 ln erfc(z/sqrt 2)),
   // on the std of (frame - plate), sigma * sqrt(1 + 1/n).
-  const double tail = std::erfc(options_.noise_z / std::sqrt(2.0));
-  const double z2 = tail > 0 && tail < 1 ? std::sqrt(-2.0 * std::log(tail)) : options_.noise_z;
+  const double tail = std::erfc(options_.low_sigma / std::sqrt(2.0));
+  const double z2 = tail > 0 && tail < 1 ? std::sqrt(-2.0 * std::log(tail)) : options_.low_sigma;
   sigma.convertTo(tolerance_, CV_32F, z2 * std::sqrt(1.0 + 1.0 / n));
   ramp_ = options_.ramp;
-  if (options_.ramp_sigma > 0) {
-    ramp_ = std::max(1.0, options_.ramp_sigma * cv::mean(sigma)[0] * std::sqrt(1.0 + 1.0 / n));
+  if (options_.high_sigma > 0) {
+    const double ramp_sigma = options_.high_sigma - options_.low_sigma;
+    ramp_ = std::max(1.0, ramp_sigma * cv::mean(sigma)[0] * std::sqrt(1.0 + 1.0 / n));
   }
   if (empty_bgr.size() < 2) {
     Log("pipeline.key")
@@ -158,7 +161,7 @@ void CleanPlateKeyer::SampleRow(const uint8_t* row, ChannelOrder order, int cell
   const uint8_t* plate = plate_.ptr<uint8_t>(y);
   const float* tolerance = tolerance_.ptr<float>(y);
   const float gain = static_cast<float>(255 / ramp_);
-  const float dark_floor = static_cast<float>(options_.dark_floor);
+  const auto dark_floor = static_cast<float>(1 - options_.shadow.max_darkening);
   const int shadow_min = ShadowMin();
   const int coarse_alpha = static_cast<int>(std::lround(255 * options_.coarse_alpha));
   const int coarse_shadow = static_cast<int>(std::lround(255 * options_.coarse_shadow));
@@ -176,7 +179,7 @@ void CleanPlateKeyer::SampleRow(const uint8_t* row, ChannelOrder order, int cell
 void CleanPlateKeyer::FineRow(const uint8_t* row, ChannelOrder order, int y, int x0, int x1,
                               uint8_t* alpha, uint8_t* shadow, uint8_t* colour) const {
   const float gain = static_cast<float>(255 / ramp_);
-  const float dark_floor = static_cast<float>(options_.dark_floor);
+  const auto dark_floor = static_cast<float>(1 - options_.shadow.max_darkening);
   const int shadow_min = ShadowMin();
   if (order == ChannelOrder::kRgb) {
     PlateRowRgb(row, plate_.ptr<uint8_t>(y), tolerance_.ptr<float>(y), x0, x1, gain, dark_floor,
@@ -188,12 +191,8 @@ void CleanPlateKeyer::FineRow(const uint8_t* row, ChannelOrder order, int y, int
 }
 
 CleanPlateKeyerOptions CleanPlateKeyerOptionsFrom(const KeyingConfig& k) {
-  CleanPlateKeyerOptions o;
-  o.noise_z = k.plate_low_sigma;
-  o.ramp_sigma = k.plate_high_sigma - k.plate_low_sigma;
+  CleanPlateKeyerOptions o = k.clean_plate;
   o.shadow = k.shadow;
-  o.shadow_min = k.shadow_min_darkening;
-  o.dark_floor = 1.0 - k.shadow_max_darkening;
   return o;
 }
 

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "pipeline/key/keyer.h"
+#include "pipeline/key/shared_options.h"
 
 namespace ss {
 
@@ -17,23 +18,26 @@ struct KeyingConfig;
 
 struct CleanPlateKeyerOptions {
   GridOptions grid;
-  // background tolerance, noise std (the false-positive rate of a 1-D z test)
-  double noise_z = 4.0;
-  double min_sigma = 2.0;    // noise std floor, levels of 255 (a single empty frame has no spread)
-  double ramp = 30.0;        // alpha goes 0 -> 1 over this many levels beyond the tolerance
-  double dark_floor = 0.3;   // darker than this fraction of the plate is subject, not shadow
-  double shadow_min = 0.06;  // darkening below this is noise: no shadow
+  // Background tolerance in noise sigmas (the false-positive rate of a 1-D z test): the
+  // difference where alpha starts to rise.
+  double low_sigma = 4.0;
+  double min_sigma = 2.0;  // noise std floor, levels of 255 (a single empty frame has no spread)
+  double ramp = 30.0;      // alpha goes 0 -> 1 over this many levels beyond the tolerance
   double coarse_alpha = 0.25;   // a sample with a larger alpha marks its cell as foreground
   double coarse_shadow = 0.12;  // a sample darkened more marks its cell as shaded
-  // > 0: the ramp is this many of the plate's mean noise std instead of `ramp`
-  double ramp_sigma = 0;
-  bool shadow = true;  // false: no contact-shadow layer (and no shaded cells)
+  // > 0: alpha reaches 1 at this many of the plate's noise sigmas (the ramp is high_sigma -
+  // low_sigma of the mean sigma) instead of `ramp` levels beyond the tolerance.
+  double high_sigma = 0;
+  // The contact shadow: darker than (1 - max_darkening) of the plate is subject, not shadow.
+  ShadowOptions shadow = {true, 0.06, 0.7};
   // False with "FIELD: reason" in `why` when a value is out of its range.
   bool IsValid(std::string* why) const;
+  bool operator==(const CleanPlateKeyerOptions&) const = default;
 };
 
 // The options the station config's keying section sets (docs/keying.md, "From the station
-// config"): keying.clean_plate.*, keying.shadow.*; the others keep their defaults.
+// config"): its `clean_plate` block (keying.clean_plate.* bound to its fields) with the shared
+// block keying.shadow as it is.
 CleanPlateKeyerOptions CleanPlateKeyerOptionsFrom(const KeyingConfig& keying);
 
 class CleanPlateKeyer : public Keyer {

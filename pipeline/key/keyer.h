@@ -20,23 +20,6 @@ namespace ss {
 // matte's colour layer is BGR (OpenCV's order) either way.
 enum class ChannelOrder { kBgr, kRgb };
 
-// The checks of a keyer's options' IsValid: the first that fails gives `why` "FIELD: reason".
-class OptionChecks {
- public:
-  explicit OptionChecks(std::string* why) : why_(why) {}
-  void operator()(bool good, const char* field, const char* reason) {
-    if (ok_ && !good) {
-      ok_ = false;
-      if (why_) *why_ = std::string(field) + ": " + reason;
-    }
-  }
-  bool ok() const { return ok_; }
-
- private:
-  std::string* why_;
-  bool ok_ = true;
-};
-
 struct GridOptions {
   int step = 8;       // coarse sampling step, px; anything >= step + 2 px across is sampled
   int margin_px = 6;  // added around each region's cell box

@@ -4,6 +4,8 @@
 // (config/station_config.h) reads it; the keyers own it.
 #include "core/enum_text.h"
 #include "pipeline/key/chroma_keyer.h"
+#include "pipeline/key/clean_plate_keyer.h"
+#include "pipeline/key/shared_options.h"
 
 namespace ss {
 
@@ -22,22 +24,26 @@ struct KeyingConfig {
   // key_high_levels (the key difference in 8-bit levels where alpha starts to fall, and where it
   // reaches 0), whose defaults here are the config's, 20 and 60 (the keyer's own, -1, keys by
   // min_margin and ramp); despill and shadow come from the shared blocks below
-  // (ChromaKeyerOptionsFrom).
+  // (ChromaKeyerOptionsFrom copies them in whole).
   ChromaKeyerOptions chroma = [] {
     ChromaKeyerOptions o;
     o.key_low_levels = 20;
     o.key_high_levels = 60;
     return o;
   }();
-  double plate_low_sigma = 3;  // clean_plate: difference in noise sigmas where alpha starts to rise
-  double plate_high_sigma = 6;  // clean_plate: ... and where it reaches 1
-  bool despill = true;
-  double despill_strength = 1.0;  // 0..1
-  bool shadow = true;             // keep the contact-shadow layer
-  // fraction of plate brightness below which there is no shadow
-  double shadow_min_darkening = 0.08;
-  double shadow_max_darkening = 0.7;  // darkening that counts as full shadow
-  double shadow_reach_m = 0.5;        // shadow kept this far around the subject's foot
+  // The clean-plate keyer's own options: keying.clean_plate.low_sigma and .high_sigma are bound
+  // to its fields, whose defaults here are the config's, 3 and 6 (the keyer's own, 4 and 0,
+  // ramps by levels); shadow comes from the shared block below.
+  CleanPlateKeyerOptions clean_plate = [] {
+    CleanPlateKeyerOptions o;
+    o.low_sigma = 3;
+    o.high_sigma = 6;
+    return o;
+  }();
+  DespillOptions despill;  // keying.despill.*, every keyer that removes spill
+  // keying.shadow.*, every keyer's contact-shadow layer (the config's defaults)
+  ShadowOptions shadow = {true, 0.08, 0.7};
+  double shadow_reach_m = 0.5;  // keying.shadow.reach_m: shadow kept this far around the foot
   bool operator==(const KeyingConfig&) const = default;
 };
 

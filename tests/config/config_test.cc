@@ -114,13 +114,13 @@ TEST(StationConfig, ExampleParsesIntoEveryField) {
   EXPECT_EQ(cfg.pipeline.keying->training_frames, 30);
   EXPECT_EQ(cfg.pipeline.keying->chroma.key_low_levels, 20);
   EXPECT_EQ(cfg.pipeline.keying->chroma.key_high_levels, 60);
-  EXPECT_EQ(cfg.pipeline.keying->plate_low_sigma, 3);
-  EXPECT_EQ(cfg.pipeline.keying->plate_high_sigma, 6);
-  EXPECT_TRUE(cfg.pipeline.keying->despill);
-  EXPECT_EQ(cfg.pipeline.keying->despill_strength, 1.0);
-  EXPECT_TRUE(cfg.pipeline.keying->shadow);
-  EXPECT_EQ(cfg.pipeline.keying->shadow_min_darkening, 0.08);
-  EXPECT_EQ(cfg.pipeline.keying->shadow_max_darkening, 0.7);
+  EXPECT_EQ(cfg.pipeline.keying->clean_plate.low_sigma, 3);
+  EXPECT_EQ(cfg.pipeline.keying->clean_plate.high_sigma, 6);
+  EXPECT_TRUE(cfg.pipeline.keying->despill.enabled);
+  EXPECT_EQ(cfg.pipeline.keying->despill.strength, 1.0);
+  EXPECT_TRUE(cfg.pipeline.keying->shadow.enabled);
+  EXPECT_EQ(cfg.pipeline.keying->shadow.min_darkening, 0.08);
+  EXPECT_EQ(cfg.pipeline.keying->shadow.max_darkening, 0.7);
   EXPECT_EQ(cfg.pipeline.keying->shadow_reach_m, 0.5);
 
   ASSERT_EQ(cfg.enclosure.floor.vertices().size(), 4u);
@@ -369,19 +369,44 @@ TEST(StationConfig, PipelineSectionsAreTheStagesOptionsWithTheConfigsDefaults) {
   EXPECT_EQ(set.pipeline.rectify.px_per_m, 600);
 }
 
-// keying.chroma.* are the chroma keyer's own options (KeyingConfig::chroma); the shared despill
-// and shadow blocks are applied to them when the keyer is made.
-TEST(StationConfig, ChromaBlockIsTheChromaKeyersOptions) {
-  const StationConfig cfg =
-      Parse("keying:\n  chroma: {low: 10, high: 50}\n  shadow: {max_darkening: 0.6}\n");
+// keying.chroma.* and keying.clean_plate.* are the keyers' own options (KeyingConfig::chroma,
+// ::clean_plate); the shared despill and shadow blocks are copied in whole when a keyer is made.
+TEST(StationConfig, KeyerBlocksAreTheKeyersOptions) {
+  const StationConfig cfg = Parse(
+      "keying:\n  chroma: {low: 10, high: 50}\n  clean_plate: {low_sigma: 2, high_sigma: 9}\n"
+      "  shadow: {max_darkening: 0.6}\n  despill: {strength: 0.25}\n");
   EXPECT_EQ(cfg.pipeline.keying->chroma.key_low_levels, 10);
   EXPECT_EQ(cfg.pipeline.keying->chroma.key_high_levels, 50);
   const ChromaKeyerOptions o = ChromaKeyerOptionsFrom(*cfg.pipeline.keying);
   EXPECT_EQ(o.key_low_levels, 10);
   EXPECT_EQ(o.key_high_levels, 50);
-  EXPECT_NEAR(o.dark_floor, 0.4, 1e-12);
-  EXPECT_EQ(o.shadow_min, 0.08);
+  EXPECT_EQ(o.shadow, (ShadowOptions{true, 0.08, 0.6}));
+  EXPECT_EQ(o.despill, (DespillOptions{true, 0.25, 0.5}));
   EXPECT_EQ(o.noise_z, ChromaKeyerOptions{}.noise_z);  // not in the config: the keyer's own
+  const CleanPlateKeyerOptions p = CleanPlateKeyerOptionsFrom(*cfg.pipeline.keying);
+  EXPECT_EQ(p.low_sigma, 2);
+  EXPECT_EQ(p.high_sigma, 9);
+  EXPECT_EQ(p.shadow, o.shadow);
+  EXPECT_EQ(p.ramp, CleanPlateKeyerOptions{}.ramp);
+}
+
+// A keyer made with values out of range says which field of which block, every one.
+TEST(StationConfig, KeyerOptionsNameTheirBadFields) {
+  ChromaKeyerOptions o;
+  o.shadow.max_darkening = 0.01;  // below min_darkening
+  o.despill.strength = 2;
+  std::string why;
+  EXPECT_FALSE(o.IsValid(&why));
+  EXPECT_EQ(why,
+            "shadow.max_darkening: must be above min_darkening (0.06)\n"
+            "despill.strength: must be within [0, 1]");
+  EXPECT_THROW(ChromaKeyer{o}, InputError);
+  CleanPlateKeyerOptions p;
+  p.high_sigma = 3;  // at or below low_sigma (4): neither 0 nor a ramp
+  EXPECT_FALSE(p.IsValid(&why));
+  EXPECT_EQ(why, "high_sigma: must be 0 (ramp by levels) or above low_sigma (4)");
+  EXPECT_TRUE(CleanPlateKeyerOptions{}.IsValid(&why)) << why;
+  EXPECT_TRUE(ChromaKeyerOptions{}.IsValid(&why)) << why;
 }
 
 // The stages' own rules (their options' IsValid), each error naming the config key, all of them.
@@ -482,7 +507,7 @@ TEST(StationConfig, AdjustmentsAreReported) {
   EXPECT_EQ(report.status, ConfigStatus::kAdjusted);
   EXPECT_EQ(cfg.cameras[0].width, 1280);
   EXPECT_EQ(cfg.cameras[0].height, 720);
-  EXPECT_EQ(cfg.pipeline.keying->despill_strength, 1.0);
+  EXPECT_EQ(cfg.pipeline.keying->despill.strength, 1.0);
   EXPECT_EQ(cfg.storage.stop_recording_below_mib, 500);
   EXPECT_EQ(cfg.storage.stop_sprites_below_mib, 500);
   ASSERT_EQ(report.adjustments.size(), 4u) << report.Summary();

@@ -180,7 +180,7 @@ TEST(ChromaKeyer, DespillRemovesGreenFromTheRim) {
 
   // Bias 0 (G <= max(R, B)) keeps yellows but leaves a brown rim's spill alone.
   ChromaKeyerOptions keep_yellow;
-  keep_yellow.despill_bias = 0;
+  keep_yellow.despill.bias = 0;
   ChromaKeyer conservative(keep_yellow);
   conservative.Train(EmptyFrames(scene, 6));
   conservative.Key(f.bgr, m);

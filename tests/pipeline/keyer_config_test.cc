@@ -76,9 +76,9 @@ TEST_F(KeyerConfig, DespillFollowsTheConfig) {
   StationConfig config;
   const Keyed on = Key(config);
   ASSERT_GT(on.alpha_sum, 0);
-  config.pipeline.keying->despill_strength = 0.5;
+  config.pipeline.keying->despill.strength = 0.5;
   const Keyed half = Key(config);
-  config.pipeline.keying->despill = false;
+  config.pipeline.keying->despill.enabled = false;
   const Keyed off = Key(config);
   // The rim's green spill above the despill limit (~16 levels on average): all of it removed,
   // half of it, none.
@@ -91,11 +91,11 @@ TEST_F(KeyerConfig, ShadowFollowsTheConfig) {
   StationConfig config;
   const Keyed on = Key(config);
   ASSERT_GT(on.shadow_sum, 255 * 200.0) << "the scene's subject casts a contact shadow";
-  config.pipeline.keying->shadow_min_darkening = 0.3;
+  config.pipeline.keying->shadow.min_darkening = 0.3;
   const Keyed faint_dropped = Key(config);
   EXPECT_LT(faint_dropped.shadow_sum, 0.9 * on.shadow_sum);
   config.pipeline.keying = KeyingConfig{};
-  config.pipeline.keying->shadow = false;
+  config.pipeline.keying->shadow.enabled = false;
   const Keyed off = Key(config);
   EXPECT_EQ(off.shadow_sum, 0);
   EXPECT_GT(off.alpha_sum, 0);
@@ -128,8 +128,8 @@ TEST_F(KeyerConfig, CleanPlateThresholdsFollowTheConfig) {
   const Keyed defaults = Key(config, /*green=*/false);
   ASSERT_GT(defaults.alpha_sum, 0);
   // A wider tolerance and ramp (in noise sigmas) key less of the frame as subject.
-  config.pipeline.keying->plate_low_sigma = 12;
-  config.pipeline.keying->plate_high_sigma = 40;
+  config.pipeline.keying->clean_plate.low_sigma = 12;
+  config.pipeline.keying->clean_plate.high_sigma = 40;
   const Keyed loose = Key(config, false);
   EXPECT_LT(loose.alpha_sum, 0.97 * defaults.alpha_sum);
 }
