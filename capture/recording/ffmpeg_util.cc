@@ -56,26 +56,4 @@ void InstallLogBridge() {
   std::call_once(once, [] { av_log_set_callback(LogCallback); });
 }
 
-AVPixelFormat RawPixelFormat(PixelFormat format) {
-  switch (format) {
-    case PixelFormat::kMono8:
-    case PixelFormat::kBayerRG8:
-    case PixelFormat::kBayerGR8:
-    case PixelFormat::kBayerGB8:
-    case PixelFormat::kBayerBG8:
-      return AV_PIX_FMT_GRAY8;
-    case PixelFormat::kRGB8:
-      return AV_PIX_FMT_RGB24;
-    case PixelFormat::kBGR8:
-      return AV_PIX_FMT_BGR24;
-    case PixelFormat::kYUYV:
-      return AV_PIX_FMT_YUYV422;
-    case PixelFormat::kNV12:
-      return AV_PIX_FMT_NV12;
-    case PixelFormat::kMJPEG:
-      return AV_PIX_FMT_NONE;
-  }
-  return AV_PIX_FMT_NONE;
-}
-
 }  // namespace ss::av

@@ -57,8 +57,4 @@ std::string ErrorText(int code);
 // Routes libav* log lines (warnings and errors) to spdlog's [capture.ffmpeg]; idempotent.
 void InstallLogBridge();
 
-// The FFmpeg pixel format that holds a camera format's bytes as they are
-// (bgr24, rgb24, gray, yuyv422, nv12); AV_PIX_FMT_NONE for MJPEG.
-AVPixelFormat RawPixelFormat(PixelFormat format);
-
 }  // namespace ss::av

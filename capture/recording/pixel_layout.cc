@@ -43,25 +43,44 @@ __attribute__((target_clones("avx2", "ssse3", "default"))) void DeinterleaveRow(
 
 }  // namespace
 
+namespace {
+
+// Per camera format, in one table: its bytes as FFmpeg names them, and the format FFV1 stores
+// them in (the top of this file's header says how each is repacked).
+struct AvLayout {
+  PixelFormat format;
+  AVPixelFormat raw;
+  AVPixelFormat lossless;
+};
+constexpr AvLayout kAvLayouts[] = {
+    {PixelFormat::kMono8, AV_PIX_FMT_GRAY8, AV_PIX_FMT_GRAY8},
+    {PixelFormat::kBayerRG8, AV_PIX_FMT_GRAY8, AV_PIX_FMT_GRAY8},
+    {PixelFormat::kBayerGR8, AV_PIX_FMT_GRAY8, AV_PIX_FMT_GRAY8},
+    {PixelFormat::kBayerGB8, AV_PIX_FMT_GRAY8, AV_PIX_FMT_GRAY8},
+    {PixelFormat::kBayerBG8, AV_PIX_FMT_GRAY8, AV_PIX_FMT_GRAY8},
+    {PixelFormat::kRGB8, AV_PIX_FMT_RGB24, AV_PIX_FMT_BGR0},
+    {PixelFormat::kBGR8, AV_PIX_FMT_BGR24, AV_PIX_FMT_BGR0},
+    {PixelFormat::kYUYV, AV_PIX_FMT_YUYV422, AV_PIX_FMT_YUV422P},
+    {PixelFormat::kNV12, AV_PIX_FMT_NV12, AV_PIX_FMT_YUV420P},
+    {PixelFormat::kMJPEG, AV_PIX_FMT_NONE, AV_PIX_FMT_NONE},
+};
+
+const AvLayout* LayoutOf(PixelFormat format) {
+  for (const AvLayout& layout : kAvLayouts)
+    if (layout.format == format) return &layout;
+  return nullptr;
+}
+
+}  // namespace
+
+AVPixelFormat RawPixelFormat(PixelFormat format) {
+  const AvLayout* layout = LayoutOf(format);
+  return layout ? layout->raw : AV_PIX_FMT_NONE;
+}
+
 AVPixelFormat LosslessStorageFormat(PixelFormat format) {
-  switch (format) {
-    case PixelFormat::kBGR8:
-    case PixelFormat::kRGB8:
-      return AV_PIX_FMT_BGR0;
-    case PixelFormat::kMono8:
-    case PixelFormat::kBayerRG8:
-    case PixelFormat::kBayerGR8:
-    case PixelFormat::kBayerGB8:
-    case PixelFormat::kBayerBG8:
-      return AV_PIX_FMT_GRAY8;
-    case PixelFormat::kYUYV:
-      return AV_PIX_FMT_YUV422P;
-    case PixelFormat::kNV12:
-      return AV_PIX_FMT_YUV420P;
-    case PixelFormat::kMJPEG:
-      return AV_PIX_FMT_NONE;
-  }
-  return AV_PIX_FMT_NONE;
+  const AvLayout* layout = LayoutOf(format);
+  return layout ? layout->lossless : AV_PIX_FMT_NONE;
 }
 
 bool IsLosslessStorage(int av_format, PixelFormat format) {

@@ -18,6 +18,9 @@ extern "C" {
 
 namespace ss::av {
 
+// The FFmpeg pixel format that holds a camera format's bytes as they are
+// (bgr24, rgb24, gray, yuyv422, nv12); AV_PIX_FMT_NONE for MJPEG.
+AVPixelFormat RawPixelFormat(PixelFormat format);
 // The FFV1 storage format for a raw camera format; AV_PIX_FMT_NONE for MJPEG.
 AVPixelFormat LosslessStorageFormat(PixelFormat format);
 // Whether a decoded frame of `av_format` holds `format`'s bytes exactly (StorageToRaw takes it).
