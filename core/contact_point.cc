@@ -1,8 +1,10 @@
 #include "core/contact_point.h"
 
 #include <algorithm>
+#include <cmath>
 
 #include "core/error.h"
+#include "core/option_checks.h"
 
 namespace ss {
 namespace {
@@ -17,7 +19,18 @@ bool RowHasSubject(const uint8_t* a, int n) {
 
 }  // namespace
 
+bool ContactPointOptions::IsValid(std::string* why) const {
+  OptionProblems check(why);
+  check(std::isfinite(band_fraction) && band_fraction >= 0 && band_fraction <= 1, "band_fraction",
+        "expected a fraction from 0 to 1, got " + OptionProblems::Num(band_fraction));
+  // The band's height divides the ramp: it must not be 0.
+  check(std::isfinite(min_band_px) && min_band_px > 0, "min_band_px",
+        "expected a positive number of pixels, got " + OptionProblems::Num(min_band_px));
+  return check.ok();
+}
+
 bool ContactPoint(const cv::Mat& alpha, cv::Point2d* point, const ContactPointOptions& options) {
+  if (std::string why; !options.IsValid(&why)) throw InputError("contact point options", why);
   if (alpha.type() != CV_8U) throw InputError("contact point", "alpha must be 8-bit, one channel");
   const int w = alpha.cols;
   int top = 0, bottom = alpha.rows - 1;

@@ -11,19 +11,25 @@
 // and 0 at the band's top. A paw that becomes the lowest, or a second paw that
 // reaches the band, moves the point continuously instead of making it jump
 // from one paw to the other.
+#include <string>
+
 #include <opencv2/core.hpp>
 
 namespace ss {
 
 struct ContactPointOptions {
-  double band_fraction = 0.1;  // of the silhouette's height (top row to the lowest point)
-  double min_band_px = 3.0;    // the band is never thinner than this
+  // the bottom band's height, as a fraction (0..1) of the silhouette's height (top row to the
+  // lowest point)
+  double band_fraction = 0.1;
+  double min_band_px = 3.0;  // the band is never thinner than this, px (> 0)
+  // False with "FIELD: reason" lines in `why` (core/option_checks.h) for values out of range.
+  bool IsValid(std::string* why) const;
   bool operator==(const ContactPointOptions&) const = default;
 };
 
 // The contact point of the silhouette in `alpha` (CV_8U, 255 = subject), in
 // `alpha`'s pixel coordinates (pixel centres at integers). False when no
-// pixel has alpha > 1/2.
+// pixel has alpha > 1/2. InputError ("contact point options") for options out of range.
 bool ContactPoint(const cv::Mat& alpha, cv::Point2d* point,
                   const ContactPointOptions& options = {});
 

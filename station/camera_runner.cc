@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <condition_variable>
 #include <cstdio>
 #include <deque>
@@ -9,6 +10,7 @@
 #include <future>
 #include <mutex>
 #include <thread>
+#include <utility>
 
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -16,6 +18,7 @@
 #include "capture/camera_source.h"
 #include "core/error.h"
 #include "core/log.h"
+#include "core/option_checks.h"
 #include "pipeline/run/bounded_queue.h"
 
 namespace ss {
@@ -540,11 +543,31 @@ struct CameraRunner::Impl {
   bool pipeline_done = false;             // under target_mutex
 };
 
+bool CameraRunnerOptions::IsValid(std::string* why) const {
+  OptionProblems check(why);
+  std::string part;
+  check.Nested(pipeline.IsValid(&part), "pipeline.", part);
+  for (const auto& [v, field] :
+       {std::pair{offline_after_s, "offline_after_s"}, std::pair{backoff_min_s, "backoff_min_s"}}) {
+    check(std::isfinite(v) && v > 0, field,
+          "expected a positive number of seconds, got " + OptionProblems::Num(v));
+  }
+  check(std::isfinite(backoff_max_s) && !(backoff_max_s < backoff_min_s), "backoff_max_s",
+        "expected at least backoff_min_s (" + OptionProblems::Num(backoff_min_s) + " s), got " +
+            OptionProblems::Num(backoff_max_s));
+  check(std::isfinite(preview_interval_s) && preview_interval_s >= 0, "preview_interval_s",
+        "expected a number of seconds >= 0, got " + OptionProblems::Num(preview_interval_s));
+  return check.ok();
+}
+
 CameraRunner::CameraRunner(int index, CameraRunnerOptions options, BatchSink sink, FrameTap tap)
     : impl_(std::make_unique<Impl>()) {
   Impl& s = *impl_;
   s.index = index;
   s.options = std::move(options);
+  if (std::string why; !s.options.IsValid(&why)) {
+    throw InputError("camera " + s.options.camera.name + " runner options", why);
+  }
   s.preview_interval_s = s.options.preview_interval_s;
   s.sink = std::move(sink);
   s.tap = std::move(tap);

@@ -75,19 +75,23 @@ struct CameraStatus {
 };
 
 struct CameraRunnerOptions {
-  CameraConfig camera;
-  std::optional<CameraModel> model;
-  GroundPolygon floor;
+  CameraConfig camera;               // the config's camera (validated with the config)
+  std::optional<CameraModel> model;  // unset: no sprites, only previews and recording
+  GroundPolygon floor;               // the enclosure's floor, metres
   // The pipeline's options; its TrainingFrames() and queue_frames also say how many frames the
   // keyer learns from and how many wait between capture and the pipeline.
   CameraPipelineOptions pipeline;
-  double offline_after_s = 3.0;  // no frame for this long: offline, closed and reopened
-  double backoff_min_s = 0.5;    // first reopen delay, doubled up to backoff_max_s
-  double backoff_max_s = 8.0;
-  // a preview snapshot this often (set_preview_interval changes it)
+  // no frame for this long, seconds (> 0): offline, closed and reopened
+  double offline_after_s = 3.0;
+  double backoff_min_s = 0.5;  // first reopen delay, seconds (> 0), doubled up to backoff_max_s
+  double backoff_max_s = 8.0;  // longest reopen delay, seconds (>= backoff_min_s)
+  // a preview snapshot this often, seconds (>= 0; set_preview_interval changes it)
   double preview_interval_s = 0.2;
   // Opens the camera; unset: OpenCameraSource (benchmarks put frames from memory here).
   std::function<std::unique_ptr<FrameSource>(const CameraConfig&, int camera_index)> open_source;
+  // False with "FIELD: reason" lines in `why` (core/option_checks.h) for values out of range
+  // (the pipeline's as "pipeline.extract.min_area").
+  bool IsValid(std::string* why) const;
 };
 
 // Sources are closed on threads of their own (a dead device takes seconds to close):

@@ -18,6 +18,7 @@
 #include "core/error.h"
 #include "core/error_kinds.h"
 #include "core/log.h"
+#include "core/option_checks.h"
 #include "core/utc_time.h"
 #include "pipeline/transitions/bank_sprites.h"
 #include "pipeline/transitions/bank_training.h"
@@ -212,10 +213,21 @@ struct ConsoleLabels::Pool {
   }
 };
 
+bool ConsoleLabelsOptions::IsValid(std::string* why) const {
+  OptionProblems check(why);
+  check(threads >= 1, "threads", "expected at least 1 thread, got " + std::to_string(threads));
+  check(candidate_rows >= 1, "candidate_rows",
+        "expected at least 1 sprite, got " + std::to_string(candidate_rows));
+  check(min_labels >= 2, "min_labels",
+        "expected at least 2 (a yes and a no), got " + std::to_string(min_labels));
+  return check.ok();
+}
+
 ConsoleLabels::ConsoleLabels(api::Context context, ConsoleLabelsOptions options)
     : context_(std::move(context)),
       options_(std::move(options)),
       shared_(std::make_shared<Shared>()) {
+  if (std::string why; !options_.IsValid(&why)) throw InputError("labels options", why);
   shared_->retrain = {{"state", "idle"}, {"progress", 0}, {"stage", ""}};
 }
 

@@ -27,11 +27,14 @@
 namespace ss {
 
 struct ConsoleLabelsOptions {
-  std::string bank;          // "" : the running station's bank (tests name one)
-  int threads = 2;           // training and, without a station, the rebuild
-  int candidate_rows = 400;  // sprites whose stage-1 candidates are searched for uncertain pairs
-  uint64_t seed = 1;         // of the row sample
-  int min_labels = 10;       // yes + no labels a retrain needs (and both kinds)
+  std::string bank;  // "" : the running station's bank (tests name one)
+  int threads = 2;   // threads for training and, without a station, the rebuild (>= 1)
+  // sprites whose stage-1 candidates are searched for uncertain pairs (>= 1)
+  int candidate_rows = 400;
+  uint64_t seed = 1;    // of the row sample
+  int min_labels = 10;  // yes + no labels a retrain needs (>= 2: both kinds are needed)
+  // False with "FIELD: reason" lines in `why` (core/option_checks.h) for values out of range.
+  bool IsValid(std::string* why) const;
 };
 
 // The labels CSV of `transitions train` (training.h ReadLabelsCsv): the header, then one

@@ -17,6 +17,7 @@
 #include "core/error.h"
 #include "core/error_kinds.h"
 #include "core/log.h"
+#include "core/option_checks.h"
 #include "station/api_part.h"
 #include "station/console_bank.h"
 #include "station/console_calibration.h"
@@ -459,8 +460,18 @@ struct ControlServer::Impl {
   }
 };
 
+bool ControlServerOptions::IsValid(std::string* why) const {
+  OptionProblems check(why);
+  check(config.port >= 0 && config.port <= 65535, "config.port",
+        "expected a port number 0..65535, got " + std::to_string(config.port));
+  check(max_event_streams >= 0, "max_event_streams",
+        "expected a number >= 0, got " + std::to_string(max_event_streams));
+  return check.ok();
+}
+
 ControlServer::ControlServer(StationHost& host, ControlServerOptions options)
     : impl_(std::make_unique<Impl>()) {
+  if (std::string why; !options.IsValid(&why)) throw InputError("control server options", why);
   impl_->host = &host;
   impl_->options = std::move(options);
   impl_->events = std::make_unique<ConsoleEvents>([s = impl_.get()] { return s->StatusJson(); });

@@ -20,15 +20,17 @@ namespace ss {
 class StationHost;
 
 struct ControlServerOptions {
-  ControlConfig config;
+  ControlConfig config;  // the config's control section: address, port (0..65535), token
   // The console's pages: served from `web_dir` when set (a source tree's web/, edited live),
   // else by `embedded` (a file's bytes in the copy built into the executable, by its path
   // below web/); neither: no pages. The content type follows the file's extension.
   std::string web_dir;
   std::function<std::optional<std::string_view>(std::string_view path)> embedded;
-  int max_event_streams = 16;  // open /api/events connections; more get 503
+  int max_event_streams = 16;  // open /api/events connections (>= 0); more get 503
   std::string
       config_path;  // the daemon's config file (the calibration wizard saves into it); "": none
+  // False with "FIELD: reason" lines in `why` (core/option_checks.h) for values out of range.
+  bool IsValid(std::string* why) const;
 };
 
 class ControlServer {

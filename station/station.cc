@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <mutex>
 #include <thread>
 
@@ -16,6 +17,7 @@
 #include "core/error.h"
 #include "core/error_kinds.h"
 #include "core/log.h"
+#include "core/option_checks.h"
 #include "pipeline/run/bank_scale.h"
 #include "pipeline/run/bounded_queue.h"
 #include "pipeline/run/ingest.h"
@@ -43,9 +45,19 @@ void ApplyLogging(const LoggingConfig& logging) {
 
 }  // namespace
 
+bool StationOptions::IsValid(std::string* why) const {
+  OptionProblems check(why);
+  std::string part;
+  if (weights) check(weights->IsValid(&part), "weights", part);
+  check(std::isfinite(offline_after_s) && offline_after_s > 0, "offline_after_s",
+        "expected a positive number of seconds, got " + OptionProblems::Num(offline_after_s));
+  return check.ok();
+}
+
 Station::Station(StationOptions options) : impl_(std::make_unique<Impl>()) {
   Impl& s = *impl_;
   s.options = std::move(options);
+  if (std::string why; !s.options.IsValid(&why)) throw InputError("station options", why);
   const StationConfig& config = s.options.config;
   if (config.cameras.empty()) throw InputError("cameras", "the station needs at least one camera");
   if (config.enclosure.floor.empty()) {

@@ -22,13 +22,16 @@
 namespace ss {
 
 struct StationOptions {
-  StationConfig config;                      // validated
-  std::optional<TransitionWeights> weights;  // unset: the shipped defaults
+  // the station config, validated by the caller (ValidateStationConfig): not checked again here
+  StationConfig config;
+  std::optional<TransitionWeights> weights;  // unset: the shipped defaults; set: valid ones
   std::string weights_path;                  // the file `weights` came from (named in the status)
   bool transitions = true;                   // keep the bank's transitions current
-  double offline_after_s = 3.0;              // a camera silent this long is reopened
+  double offline_after_s = 3.0;  // a camera silent this long, seconds (> 0), is reopened
   // Opens each camera; unset: its configured backend (benchmarks replay from memory).
   std::function<std::unique_ptr<FrameSource>(const CameraConfig&, int camera_index)> open_source;
+  // False with "FIELD: reason" lines in `why` (core/option_checks.h) for values out of range.
+  bool IsValid(std::string* why) const;
 };
 
 class Station {

@@ -3,12 +3,15 @@
 #include <arv.h>
 
 #include <atomic>
+#include <cmath>
 #include <mutex>
+#include <utility>
 
 #include "capture/aravis/gobject_ptr.h"
 #include "capture/aravis/pixel_formats.h"
 #include "core/error.h"
 #include "core/log.h"
+#include "core/option_checks.h"
 
 namespace ss {
 namespace {
@@ -141,17 +144,40 @@ struct AravisSource::Impl {
   }
 };
 
+bool AravisOptions::IsValid(std::string* why) const {
+  OptionProblems check(why);
+  check(camera_index >= 0, "camera_index",
+        "expected a number >= 0, got " + std::to_string(camera_index));
+  check(!pixel_format || GenicamPixelFormat(*pixel_format).has_value(), "pixel_format",
+        (pixel_format ? PixelFormatName(*pixel_format) : std::string()) +
+            " is not a GigE/USB3 Vision format (use mono8, bayer_*8, rgb8, bgr8, yuyv)");
+  check(width >= 0 && height >= 0 && (width > 0) == (height > 0), "width/height",
+        "give both or neither (got " + std::to_string(width) + "x" + std::to_string(height) + ")");
+  check(std::isfinite(exposure_us) && exposure_us >= 0, "exposure_us",
+        "expected 0 (leave it) or a positive number of microseconds, got " +
+            OptionProblems::Num(exposure_us));
+  check(std::isfinite(gain), "gain",
+        "expected a number (< 0: leave it), got " + OptionProblems::Num(gain));
+  check(std::isfinite(fps) && fps >= 0, "fps",
+        "expected 0 (leave it) or a positive frame rate, got " + OptionProblems::Num(fps));
+  for (const auto& [v, field] : {std::pair{red_ratio, "red_ratio"}, {blue_ratio, "blue_ratio"}}) {
+    check(std::isfinite(v) && v > 0, field,
+          "expected a positive ratio, got " + OptionProblems::Num(v));
+  }
+  check(packet_size >= 0, "packet_size",
+        "expected 0 (negotiate) or a number of bytes, got " + std::to_string(packet_size));
+  check(buffers >= 2, "buffers", "expected 2 or more, got " + std::to_string(buffers));
+  check(frame_timeout_ms >= 1, "frame_timeout_ms",
+        "expected at least 1 ms, got " + std::to_string(frame_timeout_ms));
+  return check.ok();
+}
+
 AravisSource::AravisSource(AravisOptions options) : impl_(std::make_unique<Impl>()) {
   Impl& s = *impl_;
   s.options = options;
   s.label = "aravis camera '" +
             (options.camera.empty() ? std::string("(first found)") : options.camera) + "'";
-  if (options.buffers < 2)
-    throw InputError("buffers", "expected 2 or more, got " + std::to_string(options.buffers));
-  if ((options.width > 0) != (options.height > 0)) {
-    throw InputError("width/height", "give both or neither (got " + std::to_string(options.width) +
-                                         "x" + std::to_string(options.height) + ")");
-  }
+  if (std::string why; !options.IsValid(&why)) throw InputError("aravis options", why);
 
   GErrorHolder error;
   auto holder = std::make_shared<StreamHolder>();
@@ -185,13 +211,7 @@ AravisSource::AravisSource(AravisOptions options) : impl_(std::make_unique<Impl>
   error.Clear();
 
   if (options.pixel_format) {
-    const auto code = GenicamPixelFormat(*options.pixel_format);
-    if (!code) {
-      throw InputError(
-          "pixel_format",
-          PixelFormatName(*options.pixel_format) +
-              " is not a GigE/USB3 Vision format (use mono8, bayer_*8, rgb8, bgr8, yuyv)");
-    }
+    const auto code = GenicamPixelFormat(*options.pixel_format);  // IsValid: a GigE format
     arv_camera_set_pixel_format(cam, static_cast<ArvPixelFormat>(*code), error.out());
     s.Check(error, "pixel_format", GenicamPixelFormatName(*code));
   }

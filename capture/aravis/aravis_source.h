@@ -24,20 +24,27 @@ namespace ss {
 struct AravisOptions {
   std::string camera;    // device id, serial number or IP address ("" = the first camera found)
   std::string name;      // SourceCamera::name ("" = the device id)
-  int camera_index = 0;  // Frame::camera of every frame
-  std::optional<PixelFormat> pixel_format;  // unset = keep the camera's
-  int width = 0;                            // region size; 0 = keep the camera's
-  int height = 0;
-  double exposure_us = 0.0;  // > 0: set it and turn auto exposure off (a keyer needs it fixed)
-  double gain = -1.0;        // >= 0: set it and turn auto gain off
-  double fps = 0.0;          // > 0: set the acquisition frame rate
+  int camera_index = 0;  // Frame::camera of every frame (>= 0)
+  // unset = keep the camera's; else a GigE/USB3 Vision format (mono8, bayer_*8, rgb8, bgr8, yuyv)
+  std::optional<PixelFormat> pixel_format;
+  int width = 0;   // region width, px; 0 = keep the camera's (with height: both or neither)
+  int height = 0;  // region height, px; 0 = keep the camera's
+  // exposure time, microseconds; > 0: set it and turn auto exposure off (a keyer needs it
+  // fixed), 0 = leave it
+  double exposure_us = 0.0;
+  double gain = -1.0;  // gain, dB; >= 0: set it and turn auto gain off, < 0 = leave it
+  double fps = 0.0;    // frames per second; > 0: set the acquisition frame rate, 0 = leave it
   // device: leave it; once: auto once, then locked
   WhiteBalanceMode white_balance = WhiteBalanceMode::kDevice;
-  double red_ratio = 1.0, blue_ratio = 1.0;  // manual: BalanceRatio of red and of blue (green = 1)
-  bool packet_resend = true;                 // ask the camera to resend lost GVSP packets
-  int packet_size = 0;          // GVSP packet bytes; 0 = negotiate the largest that passes
-  int buffers = 16;             // stream buffers (frames held by consumers count against them)
-  int frame_timeout_ms = 2000;  // no frame for this long counts as one error (the stream goes on)
+  // manual: BalanceRatio of red and of blue (green = 1), unitless (> 0)
+  double red_ratio = 1.0, blue_ratio = 1.0;
+  bool packet_resend = true;  // ask the camera to resend lost GVSP packets
+  int packet_size = 0;        // GVSP packet bytes; 0 = negotiate the largest that passes
+  int buffers = 16;           // stream buffers (>= 2; frames held by consumers count against them)
+  // no frame for this long, milliseconds (>= 1), counts as one error (the stream goes on)
+  int frame_timeout_ms = 2000;
+  // False with "FIELD: reason" lines in `why` (core/option_checks.h) for values out of range.
+  bool IsValid(std::string* why) const;
 };
 
 // The stream's own counters (Aravis's ArvStream infos).

@@ -16,6 +16,7 @@
 #include "capture/replay/replay_source.h"
 #include "core/error.h"
 #include "core/log.h"
+#include "core/option_checks.h"
 
 namespace ss {
 namespace {
@@ -165,17 +166,28 @@ struct FakeGigECamera::Impl {
   }
 };
 
+bool FakeGigEOptions::IsValid(std::string* why) const {
+  OptionProblems check(why);
+  // The GVCP bootstrap register holds 16 bytes with the terminating NUL.
+  check(!serial.empty() && serial.size() < 16, "serial",
+        "expected 1 to 15 characters, got '" + serial + "'");
+  check(!pixel_format || GigECarries(*pixel_format), "pixel_format",
+        (pixel_format ? PixelFormatName(*pixel_format) : std::string()) +
+            " is not offered by the emulated camera (mono8, bayer_rg8, bayer_gr8, bayer_gb8, "
+            "bayer_bg8, rgb8)");
+  check(std::isfinite(fps) && fps >= 0, "fps",
+        "expected 0 (the session's) or a positive frame rate, got " + OptionProblems::Num(fps));
+  check(loops >= 0, "loops", "expected 0 (forever) or more, got " + std::to_string(loops));
+  check(std::isfinite(lost_packet_ratio) && lost_packet_ratio >= 0 && lost_packet_ratio <= 1,
+        "lost_packet_ratio", "expected 0..1, got " + OptionProblems::Num(lost_packet_ratio));
+  return check.ok();
+}
+
 FakeGigECamera::FakeGigECamera(const std::string& session_dir, FakeGigEOptions options)
     : impl_(std::make_unique<Impl>()) {
   Impl& s = *impl_;
   s.options = options;
-  if (options.lost_packet_ratio < 0 || options.lost_packet_ratio > 1) {
-    throw InputError("lost_packet_ratio",
-                     "expected 0..1, got " + std::to_string(options.lost_packet_ratio));
-  }
-  if (options.serial.empty() || options.serial.size() >= 16) {
-    throw InputError("serial", "expected 1 to 15 characters, got '" + options.serial + "'");
-  }
+  if (std::string why; !options.IsValid(&why)) throw InputError("fake camera options", why);
   ReplayOptions replay_options;
   replay_options.loops = options.loops;
   s.replay = std::make_unique<ReplaySource>(session_dir, replay_options);

@@ -15,9 +15,11 @@
 #include <mutex>
 #include <ostream>
 #include <streambuf>
+#include <utility>
 
 #include "core/error.h"
 #include "core/log.h"
+#include "core/option_checks.h"
 
 namespace ss {
 namespace {
@@ -401,19 +403,35 @@ struct LibcameraSource::Impl : std::enable_shared_from_this<Impl> {
   }
 };
 
+bool LibcameraOptions::IsValid(std::string* why) const {
+  OptionProblems check(why);
+  check(camera_index >= 0, "camera_index",
+        "expected a number >= 0, got " + std::to_string(camera_index));
+  check(!pixel_format || ToLibcamera(*pixel_format).has_value(), "pixel_format",
+        "the libcamera backend reads yuyv, nv12, mjpeg, rgb8 and bgr8, not " +
+            (pixel_format ? PixelFormatName(*pixel_format) : std::string()));
+  check(width >= 0 && height >= 0 && (width > 0) == (height > 0), "width/height",
+        "give both or neither (got " + std::to_string(width) + "x" + std::to_string(height) + ")");
+  for (const auto& [v, field] :
+       {std::pair{fps, "fps"}, {exposure_us, "exposure_us"}, {analogue_gain, "analogue_gain"}}) {
+    check(std::isfinite(v) && v >= 0, field,
+          "expected 0 (leave it) or a positive number, got " + OptionProblems::Num(v));
+  }
+  for (const auto& [v, field] : {std::pair{red_gain, "red_gain"}, {blue_gain, "blue_gain"}}) {
+    check(std::isfinite(v) && v > 0, field,
+          "expected a positive gain, got " + OptionProblems::Num(v));
+  }
+  check(awb_settle_frames >= 1, "awb_settle_frames",
+        "expected at least 1 frame, got " + std::to_string(awb_settle_frames));
+  check(buffers >= 2, "buffers", "expected 2 or more, got " + std::to_string(buffers));
+  check(frame_timeout_ms >= 1, "frame_timeout_ms",
+        "expected at least 1 ms, got " + std::to_string(frame_timeout_ms));
+  return check.ok();
+}
+
 LibcameraSource::LibcameraSource(LibcameraOptions options) : impl_(std::make_shared<Impl>()) {
   Impl& s = *impl_;
-  if (options.buffers < 2)
-    throw InputError("buffers", "expected 2 or more, got " + std::to_string(options.buffers));
-  if ((options.width > 0) != (options.height > 0)) {
-    throw InputError("width/height", "give both or neither (got " + std::to_string(options.width) +
-                                         "x" + std::to_string(options.height) + ")");
-  }
-  if (options.pixel_format && !ToLibcamera(*options.pixel_format)) {
-    throw InputError("pixel_format",
-                     "the libcamera backend reads yuyv, nv12, mjpeg, rgb8 and bgr8, not " +
-                         PixelFormatName(*options.pixel_format));
-  }
+  if (std::string why; !options.IsValid(&why)) throw InputError("libcamera options", why);
   s.manager = SharedManager();
 
   // The camera.

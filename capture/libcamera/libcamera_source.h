@@ -29,20 +29,23 @@ enum class LibcameraWhiteBalance {
 struct LibcameraOptions {
   std::string camera_id;  // libcamera's camera id; "" = the first camera found
   std::string name;       // SourceCamera::name ("" = the camera id)
-  int camera_index = 0;   // Frame::camera of every frame
+  int camera_index = 0;   // Frame::camera of every frame (>= 0)
   // yuyv, nv12, mjpeg, rgb8, bgr8; unset = the camera's default.
   std::optional<PixelFormat> pixel_format;
-  int width = 0;  // 0 = the camera's default size
-  int height = 0;
-  double fps = 0.0;            // > 0: FrameDurationLimits fixed at 1/fps
-  double exposure_us = 0.0;    // > 0: ExposureTime (AeEnable = false in any case: locked)
-  double analogue_gain = 0.0;  // > 0: AnalogueGain (linear, 1 = unity)
-  LibcameraWhiteBalance white_balance = LibcameraWhiteBalance::kDevice;
-  double red_gain = 1.0;  // kManual: ColourGains
-  double blue_gain = 1.0;
-  int awb_settle_frames = 30;   // kOnce
-  int buffers = 4;              // requested; libcamera may adjust
-  int frame_timeout_ms = 2000;  // no frame for this long counts as one error
+  int width = 0;     // px; 0 = the camera's default size (with height: both or neither)
+  int height = 0;    // px; 0 = the camera's default size
+  double fps = 0.0;  // frames per second; > 0: FrameDurationLimits fixed at 1/fps, 0 = leave it
+  // microseconds; > 0: ExposureTime (AeEnable = false in any case: locked), 0 = leave it
+  double exposure_us = 0.0;
+  double analogue_gain = 0.0;  // > 0: AnalogueGain (linear, 1 = unity), 0 = leave it
+  LibcameraWhiteBalance white_balance = LibcameraWhiteBalance::kDevice;  // device, once, manual
+  double red_gain = 1.0;        // kManual: ColourGains red, linear (> 0)
+  double blue_gain = 1.0;       // kManual: ColourGains blue, linear (> 0)
+  int awb_settle_frames = 30;   // kOnce: frames auto white balance runs before it is locked (>= 1)
+  int buffers = 4;              // requested (>= 2); libcamera may adjust
+  int frame_timeout_ms = 2000;  // no frame for this long, milliseconds (>= 1), counts as one error
+  // False with "FIELD: reason" lines in `why` (core/option_checks.h) for values out of range.
+  bool IsValid(std::string* why) const;
 };
 
 // A camera libcamera can open.

@@ -12,6 +12,7 @@
 #include "capture/recording/video_writer.h"
 #include "core/error.h"
 #include "core/log.h"
+#include "core/option_checks.h"
 #include "core/recording_codecs.h"
 #include "core/utc_time.h"
 
@@ -107,17 +108,19 @@ struct SessionWriter::Impl {
   }
 };
 
+bool RecordingOptions::IsValid(std::string* why) const {
+  OptionProblems check(why);
+  check(FindRecordingCodec(codec) != nullptr, "codec",
+        "unknown codec '" + codec + "' (expected " + RecordingCodecNames() + ")");
+  check(flush_interval_ms >= 0, "flush_interval_ms",
+        "expected 0 or more, got " + std::to_string(flush_interval_ms));
+  return check.ok();
+}
+
 SessionWriter::SessionWriter(const std::string& dir, const std::string& name,
                              RecordingOptions options)
     : impl_(std::make_unique<Impl>()) {
-  if (FindRecordingCodec(options.codec) == nullptr) {
-    throw InputError(
-        "codec", "unknown codec '" + options.codec + "' (expected " + RecordingCodecNames() + ")");
-  }
-  if (options.flush_interval_ms < 0) {
-    throw InputError("flush_interval_ms",
-                     "expected 0 or more, got " + std::to_string(options.flush_interval_ms));
-  }
+  if (std::string why; !options.IsValid(&why)) throw InputError("recording options", why);
   std::error_code ec;
   if (fs::exists(dir, ec) && !(fs::is_directory(dir, ec) && fs::is_empty(dir, ec))) {
     throw WorkError(dir,

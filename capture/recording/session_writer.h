@@ -18,11 +18,14 @@
 namespace ss {
 
 struct RecordingOptions {
-  // "ffv1" (lossless), "mjpeg", "h264"; an MJPEG camera is always stored as mjpeg
+  // "ffv1" (lossless), "mjpeg", "h264" (core/recording_codecs.h); an MJPEG camera is always
+  // stored as mjpeg
   std::string codec = "ffv1";
   bool synthetic = false;  // marks session.json; truth/ is written by the caller
-  // longest time a written frame waits before it is on disk (0: every frame)
+  // longest time a written frame waits before it is on disk, milliseconds (>= 0; 0: every frame)
   int flush_interval_ms = 250;
+  // False with "FIELD: reason" lines in `why` (core/option_checks.h) for values out of range.
+  bool IsValid(std::string* why) const;
 };
 
 class SessionWriter {

@@ -13,6 +13,7 @@
 #include "core/camera_model.h"
 #include "core/error.h"
 #include "core/log.h"
+#include "core/option_checks.h"
 
 namespace ss {
 namespace {
@@ -235,11 +236,19 @@ struct ReplaySource::Impl {
   }
 };
 
+bool ReplayOptions::IsValid(std::string* why) const {
+  OptionProblems check(why);
+  check(loops >= 0, "loops", "expected 0 (forever) or more, got " + std::to_string(loops));
+  check(frames_ahead >= 1, "frames_ahead",
+        "expected at least 1 frame, got " + std::to_string(frames_ahead));
+  check(decode_threads >= 0, "decode_threads",
+        "expected 0 (one per core) or more, got " + std::to_string(decode_threads));
+  return check.ok();
+}
+
 ReplaySource::ReplaySource(const std::string& dir, ReplayOptions options)
     : impl_(std::make_unique<Impl>()) {
-  if (options.loops < 0)
-    throw InputError("loops", "expected 0 (forever) or more, got " + std::to_string(options.loops));
-  if (options.frames_ahead < 1) options.frames_ahead = 1;
+  if (std::string why; !options.IsValid(&why)) throw InputError("replay options", why);
   Impl& s = *impl_;
   s.dir = dir;
   s.options = options;

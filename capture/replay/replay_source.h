@@ -24,14 +24,17 @@ namespace ss {
 
 struct ReplayOptions {
   bool realtime = false;  // keep the original inter-frame timing (else as fast as possible)
-  int loops = 1;          // passes over the session; 0 = until Stop()
-  int frames_ahead = 4;   // decoded frames each camera may hold ready
-  // per camera: 0 = one decoder thread per core, 1 = one decoder (VideoReader)
+  int loops = 1;          // passes over the session (>= 0); 0 = until Stop()
+  int frames_ahead = 4;   // decoded frames each camera may hold ready (>= 1)
+  // decoder threads per camera (>= 0): 0 = one decoder thread per core, 1 = one decoder
+  // (VideoReader)
   int decode_threads = 0;
   std::string camera;  // replay only this camera of the session ("" = every camera); it is then
                        // Frame::camera 0
   // Later passes shift timestamp_ns by the session's span (plus one frame) and
   // sequence by the camera's sequence span, so time never runs backwards.
+  // False with "FIELD: reason" lines in `why` (core/option_checks.h) for values out of range.
+  bool IsValid(std::string* why) const;
 };
 
 // What one camera's replay came to so far.

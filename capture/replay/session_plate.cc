@@ -8,20 +8,24 @@
 #include "core/error.h"
 #include "core/frame.h"
 #include "core/image_median.h"
+#include "core/option_checks.h"
 
 namespace ss {
 
+bool PlateOptions::IsValid(std::string* why) const {
+  OptionProblems check(why);
+  check(first_frame >= 0, "first_frame", "must be >= 0, got " + std::to_string(first_frame));
+  check(last_frame >= first_frame, "last_frame",
+        std::to_string(last_frame) + " is before the first frame " + std::to_string(first_frame));
+  // Each sample is a full frame held in memory for the median.
+  check(samples >= 1 && samples <= 1000, "samples",
+        "expected 1..1000 frames, got " + std::to_string(samples));
+  return check.ok();
+}
+
 SessionPlate ReadSessionPlate(const std::string& session_dir, const std::string& camera,
                               const PlateOptions& o) {
-  if (o.first_frame < 0)
-    throw InputError("first_frame", "must be >= 0, got " + std::to_string(o.first_frame));
-  if (o.last_frame < o.first_frame) {
-    throw InputError("last_frame", std::to_string(o.last_frame) + " is before the first frame " +
-                                       std::to_string(o.first_frame));
-  }
-  if (o.samples < 1 || o.samples > 1000) {
-    throw InputError("samples", "expected 1..1000 frames, got " + std::to_string(o.samples));
-  }
+  if (std::string why; !o.IsValid(&why)) throw InputError("plate options", why);
   ReplayOptions replay;
   replay.camera = camera;
   ReplaySource source(session_dir, replay);  // InputError naming the session or the camera

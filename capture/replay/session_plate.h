@@ -11,10 +11,13 @@
 namespace ss {
 
 struct PlateOptions {
-  // the range of the camera's frames (0-based, as replayed: unreadable ones skipped)
+  // the range of the camera's frames (0-based, as replayed: unreadable ones skipped), >= 0
   int64_t first_frame = 0;
-  int64_t last_frame = 29;  // inclusive
-  int samples = 30;         // frames taken, spread evenly over the range (all of them when fewer)
+  int64_t last_frame = 29;  // inclusive (>= first_frame)
+  // frames taken (1..1000), spread evenly over the range (all of them when fewer)
+  int samples = 30;
+  // False with "FIELD: reason" lines in `why` (core/option_checks.h) for values out of range.
+  bool IsValid(std::string* why) const;
 };
 
 struct SessionPlate {

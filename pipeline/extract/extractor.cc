@@ -76,17 +76,13 @@ bool ExtractorOptions::IsValid(std::string* why) const {
   check(margin_px >= 0, "margin_px", "must not be negative");
   check(alpha_min >= 1 && alpha_min <= 255, "alpha_min", "must be within 1..255");
   check(shadow_min >= 1 && shadow_min <= 255, "shadow_min", "must be within 1..255");
+  std::string part;
+  check.Nested(contact.IsValid(&part), "contact.", part);
   return check.ok();
 }
 
 Extractor::Extractor(ExtractorOptions options) : options_(options) {
-  if (options_.min_area < 0) throw InputError("extract.min_area", "must not be negative");
-  if (options_.margin_px < 0) throw InputError("extract.margin_px", "must not be negative");
-  if (options_.alpha_min < 1 || options_.alpha_min > 255)
-    throw InputError("extract.alpha_min", "must be within 1..255");
-  if (options_.shadow_min < 1 || options_.shadow_min > 255) {
-    throw InputError("extract.shadow_min", "must be within 1..255");
-  }
+  if (std::string why; !options_.IsValid(&why)) throw InputError("extract options", why);
 }
 
 const std::vector<Candidate>& Extractor::Extract(const Matte& matte) {

@@ -3,6 +3,7 @@
 #include <string>
 
 #include "core/error.h"
+#include "core/option_checks.h"
 
 namespace ss {
 namespace {
@@ -19,13 +20,17 @@ std::string SizeText(cv::Size s) {
 
 }  // namespace
 
+bool GridOptions::IsValid(std::string* why) const {
+  OptionProblems check(why);
+  check(step >= 2 && step <= 64, "step", "expected 2 to 64 px, got " + std::to_string(step));
+  check(margin_px >= 0, "margin_px", "expected a number >= 0, got " + std::to_string(margin_px));
+  check(shadow_reach_cells >= 0, "shadow_reach_cells",
+        "expected a number >= 0, got " + std::to_string(shadow_reach_cells));
+  return check.ok();
+}
+
 Keyer::Keyer(GridOptions grid) : grid_(grid) {
-  if (grid_.step < 2 || grid_.step > 64) {
-    throw InputError("keying.step", "must be within 2..64 px, got " + std::to_string(grid_.step));
-  }
-  if (grid_.margin_px < 0) throw InputError("keying.margin_px", "must not be negative");
-  if (grid_.shadow_reach_cells < 0)
-    throw InputError("keying.shadow_reach_cells", "must not be negative");
+  if (std::string why; !grid_.IsValid(&why)) throw InputError("keyer grid options", why);
 }
 
 void Keyer::StartTraining(const std::vector<cv::Mat>& empty_bgr, const std::string& keyer) {

@@ -21,9 +21,12 @@ namespace ss {
 enum class ChannelOrder { kBgr, kRgb };
 
 struct GridOptions {
-  int step = 8;       // coarse sampling step, px; anything >= step + 2 px across is sampled
-  int margin_px = 6;  // added around each region's cell box
-  int shadow_reach_cells = 6;  // shaded cells join a region up to this many cells away from it
+  int step = 8;       // coarse sampling step, px (2..64); anything >= step + 2 px across is sampled
+  int margin_px = 6;  // added around each region's cell box, px (>= 0)
+  // shaded cells join a region up to this many cells away from it (>= 0)
+  int shadow_reach_cells = 6;
+  // False with "FIELD: reason" lines in `why` (core/option_checks.h) for values out of range.
+  bool IsValid(std::string* why) const;
   bool operator==(const GridOptions&) const = default;
 };
 

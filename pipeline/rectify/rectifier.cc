@@ -2,10 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 #include <opencv2/imgproc.hpp>
 
+#include "core/error.h"
 #include "core/log.h"
+#include "core/option_checks.h"
 
 namespace ss {
 namespace {
@@ -64,6 +67,25 @@ std::optional<Eigen::Vector3d> IntersectVerticalPlane(const CameraModel& camera,
 }
 
 }  // namespace
+
+bool RectifierOptions::IsValid(std::string* why) const {
+  OptionProblems check(why);
+  check(std::isfinite(px_per_m) && px_per_m > 0, "px_per_m",
+        "expected a positive number of pixels per metre, got " + OptionProblems::Num(px_per_m));
+  for (const auto& [v, field] :
+       {std::pair{margin_m, "margin_m"}, std::pair{shadow_radius_m, "shadow_radius_m"}}) {
+    check(std::isfinite(v) && v >= 0, field,
+          "expected a number of metres >= 0, got " + OptionProblems::Num(v));
+  }
+  // A billboard is at least 3 px on each side.
+  check(max_side_px >= 3, "max_side_px",
+        "expected at least 3 pixels, got " + std::to_string(max_side_px));
+  return check.ok();
+}
+
+Rectifier::Rectifier(RectifierOptions options) : options_(options) {
+  if (std::string why; !options_.IsValid(&why)) throw InputError("rectifier options", why);
+}
 
 std::optional<Billboard> Rectifier::Rectify(const CameraModel& camera, const SpriteView& view,
                                             Refusal* why) const {

@@ -7,6 +7,7 @@
 // alike. The contact shadow is resampled onto a horizontal ground patch around
 // the same point, so rendering can lay it on the virtual floor.
 #include <optional>
+#include <string>
 
 #include <Eigen/Core>
 #include <opencv2/core.hpp>
@@ -16,10 +17,13 @@
 namespace ss {
 
 struct RectifierOptions {
-  double px_per_m = 800.0;        // billboard and shadow-patch scale (1.25 mm per pixel)
-  double margin_m = 0.01;         // billboard border around the sprite's extent
-  double shadow_radius_m = 0.08;  // half-size of the square ground patch for the shadow
-  int max_side_px = 512;          // refuse absurd billboards (a sprite far above the floor)
+  double px_per_m = 800.0;  // billboard and shadow-patch scale, px per metre (1.25 mm per pixel)
+  double margin_m = 0.01;   // billboard border around the sprite's extent, metres
+  double shadow_radius_m = 0.08;  // half-size of the square ground patch for the shadow, metres
+  // largest billboard side, px (>= 3): refuses absurd billboards (a sprite far above the floor)
+  int max_side_px = 512;
+  // False with "FIELD: reason" lines in `why` (core/option_checks.h) for values out of range.
+  bool IsValid(std::string* why) const;
   bool operator==(const RectifierOptions&) const = default;
 };
 
@@ -44,7 +48,8 @@ struct Billboard {
 
 class Rectifier {
  public:
-  explicit Rectifier(RectifierOptions options = {}) : options_(options) {}
+  // InputError ("rectifier options") for options out of range.
+  explicit Rectifier(RectifierOptions options = {});
   // Why Rectify made no billboard.
   struct Refusal {
     bool too_large = false;  // else: the contact point's ray misses the floor, or degenerate

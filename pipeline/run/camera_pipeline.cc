@@ -35,6 +35,18 @@ std::unique_ptr<Keyer> KeyerFor(const CameraPipelineOptions& o, const CameraMode
   return MakeKeyer(*o.keying, shadow_reach_cells);
 }
 
+// `o`, when its values are in range (else InputError naming the field) and the bank's scale is
+// chosen (rectify.px_per_m `auto` resolved).
+const CameraPipelineOptions& Checked(const std::string& camera, const CameraPipelineOptions& o) {
+  if (!(o.rectify.px_per_m > 0)) {
+    throw InputError("pipeline.px_per_m", "camera " + camera +
+                                              ": the bank's billboard scale was not chosen "
+                                              "(ChooseBankScale resolves auto)");
+  }
+  if (std::string why; !o.IsValid(&why)) throw InputError("pipeline options", why);
+  return o;
+}
+
 }  // namespace
 
 bool CameraPipelineOptions::IsValid(std::string* why) const {
@@ -49,6 +61,10 @@ bool CameraPipelineOptions::IsValid(std::string* why) const {
     check(std::isfinite(v) && v > 0, field,
           "expected a positive number, got " + OptionProblems::Num(v));
   }
+  // rectify.px_per_m 0 is `auto`, resolved by the caller before a CameraPipeline is made.
+  RectifierOptions scaled = rectify;
+  if (scaled.px_per_m == 0) scaled.px_per_m = RectifierOptions{}.px_per_m;
+  check.Nested(scaled.IsValid(&part), "rectify.", part);
   check.Nested(batch.IsValid(&part), "batch.", part);
   check(workers >= 0, "workers",
         "expected 0 (one per core) or more, got " + std::to_string(workers));
@@ -65,7 +81,7 @@ CameraPipeline::CameraPipeline(std::string name, int64_t camera_id, CameraModel 
                            : throw InputError(name_,
                                               "the camera has no model: calibrate it first "
                                               "(spritestation calibrate)")),
-      options_(options),
+      options_(Checked(name_, options)),
       keyer_(KeyerFor(options, model_, floor)),
       floor_mask_(model_, floor, options.usability),
       extractor_(options.extract),
@@ -74,13 +90,7 @@ CameraPipeline::CameraPipeline(std::string name, int64_t camera_id, CameraModel 
       noise_(options.noise),
       rectifier_(options.rectify),
       batcher_(camera_id, options.batch),
-      log_(Log("pipeline.run")) {
-  if (!(options_.rectify.px_per_m > 0)) {
-    throw InputError("pipeline.px_per_m", "camera " + name_ +
-                                              ": the bank's billboard scale was not chosen "
-                                              "(ChooseBankScale resolves auto)");
-  }
-}
+      log_(Log("pipeline.run")) {}
 
 CameraPipeline::~CameraPipeline() = default;
 CameraPipeline::CameraPipeline(CameraPipeline&&) noexcept = default;

@@ -17,6 +17,7 @@
 #include "core/bank_verify.h"
 #include "core/error.h"
 #include "core/log.h"
+#include "core/option_checks.h"
 #include "pipeline/run/bank_scale.h"
 #include "pipeline/run/bounded_queue.h"
 #include "pipeline/transitions/worker.h"
@@ -90,8 +91,18 @@ GroundPolygon FloorForSession(const std::string& session_dir, const GroundPolygo
                    "enclosure.json in the session");
 }
 
+bool IngestOptions::IsValid(std::string* why) const {
+  OptionProblems check(why);
+  std::string part;
+  check.Nested(pipeline.IsValid(&part), "pipeline.", part);
+  check(decode_threads >= 0, "decode_threads",
+        "expected 0 (one per core) or more, got " + std::to_string(decode_threads));
+  return check.ok();
+}
+
 IngestSummary IngestSession(const IngestOptions& options) {
   const auto start = Clock::now();
+  if (std::string why; !options.IsValid(&why)) throw InputError("ingest options", why);
   if (options.pipeline.workers > 0) cv::setNumThreads(options.pipeline.workers);  // process-wide
   ReplayOptions replay_options;
   replay_options.realtime = false;

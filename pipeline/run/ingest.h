@@ -30,8 +30,8 @@ struct IngestProgress {
 };
 
 struct IngestOptions {
-  std::string session_dir;
-  std::string bank_path;
+  std::string session_dir;  // the recorded session to ingest (a folder with session.json)
+  std::string bank_path;    // the bank the sprites go into (made when missing)
   // What the station config sets (config/station_config.h: the sections named). The defaults
   // are the stages' own, not the config's: without a config file a caller passes a default
   // StationConfig's (DefaultPipelineOptions).
@@ -45,6 +45,9 @@ struct IngestOptions {
   // Decoder threads per camera (ReplayOptions::decode_threads): 0 = one per core, 1 = frames
   // decoded one after another on the replay thread. The bank is the same either way.
   int decode_threads = 0;
+  // False with "FIELD: reason" lines in `why` (core/option_checks.h) for values out of range
+  // (the pipeline's as "pipeline.extract.min_area").
+  bool IsValid(std::string* why) const;
 };
 
 struct IngestCamera {

@@ -13,14 +13,33 @@
 #include "core/bank.h"
 #include "core/error.h"
 #include "core/log.h"
+#include "core/option_checks.h"
 #include "pipeline/transitions/bank_sprites.h"
 
 namespace ss {
 
 namespace fs = std::filesystem;
 
+bool BankTrainOptions::IsValid(std::string* why) const {
+  OptionProblems check(why);
+  std::string part;
+  check.Nested(train.IsValid(&part), "train.", part);
+  check(window.IsValid(&part), "window", part);
+  check(std::isfinite(stage1_recall) && stage1_recall >= 0 && stage1_recall <= 1, "stage1_recall",
+        "expected a share from 0 to 1, got " + OptionProblems::Num(stage1_recall));
+  // Negative (any) reads the labels file's rate.
+  check(!std::isnan(positive_rate) && positive_rate <= 1, "positive_rate",
+        "expected a share from 0 to 1 (< 0: the labels file's), got " +
+            OptionProblems::Num(positive_rate));
+  check(calibration_rows >= 1, "calibration_rows",
+        "expected at least 1 sprite, got " + std::to_string(calibration_rows));
+  check(threads >= 1, "threads", "expected at least 1 thread, got " + std::to_string(threads));
+  return check.ok();
+}
+
 BankTrainResult TrainOnBank(const std::string& labels_path, const std::string& bank_path,
                             const BankTrainOptions& options) {
+  if (std::string why; !options.IsValid(&why)) throw InputError("training options", why);
   double file_rate = -1;
   const std::vector<Label> labels = ReadLabelsCsv(labels_path, &file_rate);
   const double positive_rate = options.positive_rate >= 0 ? options.positive_rate : file_rate;

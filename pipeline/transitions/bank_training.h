@@ -12,15 +12,17 @@
 namespace ss {
 
 struct BankTrainOptions {
-  TrainOptions train;
+  TrainOptions train;       // the label fit: folds, seed, logistic regression
   ComparisonWindow window;  // the pixel features' window (recorded in the weights)
-  // of stage-2 accepts stage 1 must pass in the sample (0 = keep the label fit)
+  // share (0..1) of stage-2 accepts stage 1 must pass in the sample (0 = keep the label fit)
   double stage1_recall = 0.999;
-  // Share of all sprite pairs that are true transitions; < 0: the labels file's
+  // Share (0..1) of all sprite pairs that are true transitions; < 0: the labels file's
   // "# positive_rate=" line; none there: stage 2 keeps the label fit's (50/50) bias.
   double positive_rate = -1;
-  int calibration_rows = 300;  // sprites whose every pair stage 2 judges for the calibration
-  int threads = 2;
+  int calibration_rows = 300;  // sprites whose every pair stage 2 judges for the calibration (>= 1)
+  int threads = 2;             // worker threads (>= 1)
+  // False with "FIELD: reason" lines in `why` (core/option_checks.h) for values out of range.
+  bool IsValid(std::string* why) const;
 };
 
 struct BankTrainResult {

@@ -10,6 +10,7 @@
 
 #include "core/error.h"
 #include "core/log.h"
+#include "core/option_checks.h"
 #include "pipeline/transitions/bank_sprites.h"
 
 namespace ss {
@@ -98,13 +99,21 @@ StoreResult StoreTransitionTable(BankWriter& bank, const std::vector<Transition>
   return r;
 }
 
+bool BankUpdateOptions::IsValid(std::string* why) const {
+  OptionProblems check(why);
+  std::string part;
+  check(weights.IsValid(&part), "weights", part);
+  check(threads >= 1, "threads", "expected at least 1 thread, got " + std::to_string(threads));
+  return check.ok();
+}
+
 BankUpdateSummary UpdateBankTransitions(const std::string& bank_path,
                                         const BankUpdateOptions& options) {
   auto log = Log("pipeline.transitions");
   BankUpdateSummary s;
   s.bank = bank_path;
-  const TransitionClassifier check(
-      options.weights);  // InputError for invalid weights, before any work
+  // Before any work.
+  if (std::string why; !options.IsValid(&why)) throw InputError("transition update options", why);
   {
     // Read-only first: a missing file or a non-bank is an InputError, never a new bank.
     const Bank probe(bank_path);

@@ -39,11 +39,13 @@ StoreResult StoreTransitionTable(BankWriter& bank, const std::vector<Transition>
 std::vector<TransitionRecord> ToRecords(const std::vector<Transition>& transitions);
 
 struct BankUpdateOptions {
-  TransitionWeights weights = DefaultWeights();
-  int threads = 2;
+  TransitionWeights weights = DefaultWeights();  // the classifier (valid: weights.h IsValid)
+  int threads = 2;                               // worker threads (>= 1)
   SpriteChoice sprites;  // which sprites take part (merged ones not, by default)
   // stage: "load" (sprites read and decoded) or "pairs" (sprites searched); from any thread.
   std::function<void(const std::string& stage, size_t done, size_t total)> progress;
+  // False with "FIELD: reason" lines in `why` (core/option_checks.h) for values out of range.
+  bool IsValid(std::string* why) const;
 };
 
 struct BankUpdateSummary {

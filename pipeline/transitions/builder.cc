@@ -8,6 +8,7 @@
 
 #include "core/error.h"
 #include "core/log.h"
+#include "core/option_checks.h"
 
 namespace ss {
 
@@ -18,6 +19,12 @@ double SecondsSince(std::chrono::steady_clock::time_point start) {
 }
 
 }  // namespace
+
+bool BuildOptions::IsValid(std::string* why) const {
+  OptionProblems check(why);
+  check(threads >= 1, "threads", "expected at least 1 thread, got " + std::to_string(threads));
+  return check.ok();
+}
 
 TransitionBuilder::TransitionBuilder(const TransitionWeights& weights, double px_per_m)
     : classifier_(weights), store_(weights.window, px_per_m), index_(classifier_) {}
@@ -43,6 +50,7 @@ double TransitionBuilder::KeptDistance(int32_t i, int32_t j) const {
 
 void TransitionBuilder::BuildFromScratch(std::span<const SpriteInput> sprites,
                                          const BuildOptions& options) {
+  if (std::string why; !options.IsValid(&why)) throw InputError("build options", why);
   if (sprites.empty())
     throw InputError("sprites",
                      "the set is empty: there are no sprites to find transitions between");
@@ -50,7 +58,7 @@ void TransitionBuilder::BuildFromScratch(std::span<const SpriteInput> sprites,
   store_.Clear();
   neighbours_.clear();
   stats_ = BuildStats{};
-  const int threads = std::max(1, options.threads);
+  const int threads = options.threads;
 
   auto start = std::chrono::steady_clock::now();
   store_.Append(sprites, threads);

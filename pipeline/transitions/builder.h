@@ -41,9 +41,11 @@ struct TransitionDelta {
 };
 
 struct BuildOptions {
-  int threads = 2;
+  int threads = 2;  // worker threads (>= 1)
   std::function<void(size_t done, size_t total)>
       progress;  // called from worker threads, serialized
+  // False with "FIELD: reason" lines in `why` (core/option_checks.h) for values out of range.
+  bool IsValid(std::string* why) const;
 };
 
 struct BuildStats {

@@ -6,6 +6,9 @@
 #include <functional>
 #include <random>
 
+#include "core/error.h"
+#include "core/option_checks.h"
+
 namespace ss {
 
 namespace {
@@ -362,7 +365,28 @@ double PoseSpeed(const std::string& pose) {
 
 }  // namespace
 
+bool SyntheticSpriteOptions::IsValid(std::string* why) const {
+  OptionProblems check(why);
+  check(frames >= 0, "frames", "expected a number >= 0, got " + std::to_string(frames));
+  for (const auto& [v, field] : {std::pair{px_per_m, "px_per_m"}, std::pair{fps, "fps"}}) {
+    check(std::isfinite(v) && v > 0, field,
+          "expected a positive number, got " + OptionProblems::Num(v));
+  }
+  // A clip of 0 frames would never end the clip loop.
+  check(min_clip_frames >= 1, "min_clip_frames",
+        "expected at least 1 frame, got " + std::to_string(min_clip_frames));
+  check(max_clip_frames >= min_clip_frames, "max_clip_frames",
+        "expected at least min_clip_frames (" + std::to_string(min_clip_frames) + "), got " +
+            std::to_string(max_clip_frames));
+  check(std::isfinite(velocity_noise_mps) && velocity_noise_mps >= 0, "velocity_noise_mps",
+        "expected a number >= 0, got " + OptionProblems::Num(velocity_noise_mps));
+  check(pixel_noise >= 0 && pixel_noise <= 255, "pixel_noise",
+        "expected 0 to 255 levels, got " + std::to_string(pixel_noise));
+  return check.ok();
+}
+
 std::vector<SyntheticSprite> MakeSyntheticSprites(const SyntheticSpriteOptions& o) {
+  if (std::string why; !o.IsValid(&why)) throw InputError("synthetic sprite options", why);
   std::mt19937_64 rng(o.seed);
   std::normal_distribution<double> normal(0.0, 1.0);
   std::uniform_real_distribution<double> uniform(0.0, 1.0);

@@ -14,6 +14,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/error.h"
+#include "core/option_checks.h"
 
 namespace ss {
 
@@ -169,9 +170,21 @@ struct Problem {
 
 }  // namespace
 
+bool LogisticOptions::IsValid(std::string* why) const {
+  OptionProblems check(why);
+  check(std::isfinite(l2) && l2 >= 0, "l2",
+        "expected a number >= 0, got " + OptionProblems::Num(l2));
+  check(max_iterations >= 1, "max_iterations",
+        "expected at least 1, got " + std::to_string(max_iterations));
+  check(std::isfinite(tolerance) && tolerance >= 0, "tolerance",
+        "expected a number >= 0, got " + OptionProblems::Num(tolerance));
+  return check.ok();
+}
+
 LinearModel FitLogistic(std::span<const double> z, int dims, std::span<const uint8_t> accept,
                         const LogisticOptions& options) {
   const size_t n = accept.size();
+  if (std::string why; !options.IsValid(&why)) throw InputError("logistic options", why);
   if (z.size() != n * dims) throw WorkError("FitLogistic: feature rows and labels disagree");
   Problem p{z, dims, std::vector<double>(n), std::vector<double>(n), options.l2};
   size_t accepts = 0;
@@ -296,12 +309,21 @@ void Count(Confusion* c, bool predicted, bool truth) {
 
 }  // namespace
 
+bool TrainOptions::IsValid(std::string* why) const {
+  OptionProblems check(why);
+  check(folds >= 2, "folds", "expected at least 2 folds, got " + std::to_string(folds));
+  std::string part;
+  check.Nested(logistic.IsValid(&part), "logistic.", part);
+  return check.ok();
+}
+
 TransitionWeights TrainWeights(std::span<const PairFeatures> x, std::span<const uint8_t> accept,
                                const ComparisonWindow& window, const TrainOptions& options,
                                TrainReport* report) {
   const size_t n = x.size();
+  if (std::string why; !options.IsValid(&why)) throw InputError("training options", why);
   if (accept.size() != n) throw WorkError("TrainWeights: features and labels disagree");
-  const int folds = std::max(2, options.folds);
+  const int folds = options.folds;
   size_t accepts = 0;
   for (uint8_t a : accept) accepts += a ? 1 : 0;
   if (n < 2 * static_cast<size_t>(folds)) {

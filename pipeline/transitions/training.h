@@ -28,11 +28,14 @@ void WriteLabelsCsv(const std::vector<Label>& labels, const std::string& path,
                     double positive_rate = -1);
 
 struct LogisticOptions {
-  double l2 = 1e-4;  // ridge on the weights (not the bias)
-  int max_iterations = 20000;
-  double tolerance = 1e-9;      // stop when the relative change of the loss stays below this
+  double l2 = 1e-4;            // ridge on the weights (not the bias), unitless (>= 0)
+  int max_iterations = 20000;  // FISTA steps at most (>= 1)
+  // stop when the relative change of the loss stays below this, unitless (>= 0)
+  double tolerance = 1e-9;
   bool balance_classes = true;  // weight both classes equally, as the paper's ~50/50 labels
   bool non_negative = true;     // project the weights onto w >= 0 after every step
+  // False with "FIELD: reason" lines in `why` (core/option_checks.h) for values out of range.
+  bool IsValid(std::string* why) const;
 };
 
 // s = w.z + b, "reject" when s > 0; z are rows of `dims` standardized features.
@@ -52,9 +55,11 @@ struct Confusion {
 };
 
 struct TrainOptions {
-  int folds = 5;
-  uint64_t seed = 1;
-  LogisticOptions logistic;
+  int folds = 5;             // cross-validation folds (>= 2)
+  uint64_t seed = 1;         // of the fold split
+  LogisticOptions logistic;  // each fit's
+  // False with "FIELD: reason" lines in `why` (core/option_checks.h) for values out of range.
+  bool IsValid(std::string* why) const;
 };
 struct TrainReport {
   int64_t samples = 0, accepts = 0;

@@ -1,12 +1,14 @@
 #include "pipeline/transitions/truth_labels.h"
 
 #include <algorithm>
+#include <cmath>
 #include <numeric>
 #include <random>
 #include <set>
 #include <unordered_map>
 
 #include "core/error.h"
+#include "core/option_checks.h"
 
 namespace ss {
 
@@ -54,12 +56,31 @@ bool Within(const SpriteTruth& a, const SpriteTruth& b, const TruthLabelOptions&
 
 }  // namespace
 
+bool TruthLabelOptions::IsValid(std::string* why) const {
+  OptionProblems check(why);
+  for (const auto& [v, field] :
+       {std::pair{max_heading_difference_rad, "max_heading_difference_rad"},
+        std::pair{max_phase_difference, "max_phase_difference"},
+        std::pair{max_keypoint_displacement_m, "max_keypoint_displacement_m"}}) {
+    check(std::isfinite(v) && v >= 0, field,
+          "expected a number >= 0, got " + OptionProblems::Num(v));
+  }
+  check(std::isfinite(near_miss_fraction) && near_miss_fraction >= 0 && near_miss_fraction <= 1,
+        "near_miss_fraction",
+        "expected a share from 0 to 1, got " + OptionProblems::Num(near_miss_fraction));
+  // Below 1 a near miss would have to be nearer than an accept.
+  check(std::isfinite(near_miss_factor) && near_miss_factor >= 1, "near_miss_factor",
+        "expected a factor >= 1, got " + OptionProblems::Num(near_miss_factor));
+  return check.ok();
+}
+
 bool TruthAccepts(const SpriteTruth& a, const SpriteTruth& b, const TruthLabelOptions& options) {
   return Within(a, b, options, 1.0);
 }
 
 double TruthPositiveRate(std::span<const SpriteTruth> truth, const TruthLabelOptions& options,
                          int rows, uint64_t seed) {
+  if (std::string why; !options.IsValid(&why)) throw InputError("truth label options", why);
   const size_t n = truth.size();
   if (n < 2) return 0.0;
   std::vector<size_t> sample(n);
@@ -78,6 +99,7 @@ double TruthPositiveRate(std::span<const SpriteTruth> truth, const TruthLabelOpt
 
 std::vector<Label> LabelsFromTruth(std::span<const int64_t> ids, std::span<const SpriteTruth> truth,
                                    size_t count, const TruthLabelOptions& options, uint64_t seed) {
+  if (std::string why; !options.IsValid(&why)) throw InputError("truth label options", why);
   const size_t n = truth.size();
   if (ids.size() != n) throw WorkError("LabelsFromTruth: ids and truth disagree");
   if (n < 2) throw InputError("truth", "at least two sprites are needed to make labels");

@@ -31,14 +31,19 @@ struct SpriteTruth {
 };
 
 struct TruthLabelOptions {
+  // headings further apart than this are not alike, radians (>= 0)
   double max_heading_difference_rad = 6.0 * M_PI / 180.0;
-  double max_phase_difference = 0.04;  // cycles, circular
-  // when both truths have key points (1 px at 250 px/m)
+  double max_phase_difference = 0.04;  // gait phases further apart are not, cycles (>= 0)
+  // when both truths have key points: the most a key point may move, metres (>= 0; 0.004 is
+  // 1 px at 250 px/m)
   double max_keypoint_displacement_m = 0.004;
-  // Rejects sampled as near misses (same pose, heading and phase within `near_miss_factor`
-  // times the tolerances) rather than uniformly; the rest are uniform random rejects.
+  // Share (0..1) of the rejects sampled as near misses (same pose, heading and phase within
+  // `near_miss_factor` times the tolerances) rather than uniformly; the rest are uniform random
+  // rejects.
   double near_miss_fraction = 0.5;
-  double near_miss_factor = 3.0;
+  double near_miss_factor = 3.0;  // how many tolerances a near miss may be off, unitless (>= 1)
+  // False with "FIELD: reason" lines in `why` (core/option_checks.h) for values out of range.
+  bool IsValid(std::string* why) const;
 };
 
 // The largest displacement (metres) among the key points visible in a or in b (a point

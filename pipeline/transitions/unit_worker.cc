@@ -4,12 +4,14 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdlib>
 #include <thread>
 #include <vector>
 
 #include "core/error.h"
 #include "core/log.h"
+#include "core/option_checks.h"
 #include "pipeline/transitions/bank_transitions.h"
 
 namespace ss {
@@ -29,10 +31,21 @@ std::string DefaultName() {
 
 }  // namespace
 
+bool UnitWorkerOptions::IsValid(std::string* why) const {
+  OptionProblems check(why);
+  std::string part;
+  check(weights.IsValid(&part), "weights", part);
+  check(std::isfinite(lease_s) && lease_s > 0, "lease_s",
+        "expected a positive number of seconds, got " + OptionProblems::Num(lease_s));
+  check(load_threads >= 1, "load_threads",
+        "expected at least 1 thread, got " + std::to_string(load_threads));
+  return check.ok();
+}
+
 UnitWorker::UnitWorker(const std::string& bank, UnitWorkerOptions options)
     : options_(std::move(options)), queue_(bank), writer_(bank), reader_(bank) {
+  if (std::string why; !options_.IsValid(&why)) throw InputError("unit worker options", why);
   if (options_.name.empty()) options_.name = DefaultName();
-  const TransitionClassifier check(options_.weights);  // InputError for invalid weights
   const std::string fingerprint = WeightsFingerprint(options_.weights);
   const std::optional<std::string> made_with = reader_.GetMeta(kTransitionWeightsMetaKey);
   if (made_with && *made_with != fingerprint && reader_.Counts().transitions > 0) {

@@ -22,11 +22,14 @@
 namespace ss {
 
 struct UnitWorkerOptions {
-  TransitionWeights weights = DefaultWeights();
-  std::string name;      // in the work table (host:pid when empty)
-  double lease_s = 60;   // a unit not done by then may be taken by another worker
-  int load_threads = 1;  // comparison images of newly indexed sprites
+  TransitionWeights weights = DefaultWeights();  // the classifier (valid: weights.h IsValid)
+  std::string name;                              // in the work table (host:pid when empty)
+  // a unit not done by then may be taken by another worker, seconds (> 0)
+  double lease_s = 60;
+  int load_threads = 1;  // threads for the comparison images of newly indexed sprites (>= 1)
   SpriteChoice sprites;  // which sprites take part: every worker of a bank must agree
+  // False with "FIELD: reason" lines in `why` (core/option_checks.h) for values out of range.
+  bool IsValid(std::string* why) const;
 };
 
 struct UnitWorkerStats {

@@ -65,6 +65,30 @@ TEST(Libcamera, FormatsLibcameraCannotCarryAreRefusedBeforeOpening) {
   EXPECT_THROW(LibcameraSource{o}, InputError);
 }
 
+TEST(Libcamera, OptionsOutOfRangeAreRefusedNamingTheField) {
+  std::string why = "stale";
+  EXPECT_TRUE(LibcameraOptions{}.IsValid(&why)) << why;
+  EXPECT_EQ(why, "");
+  LibcameraOptions o;
+  o.height = 480;  // without a width
+  o.awb_settle_frames = 0;
+  o.red_gain = -1;
+  EXPECT_FALSE(o.IsValid(&why));
+  EXPECT_EQ(why.rfind("width/height: ", 0), 0u) << why;
+  EXPECT_NE(why.find("\nred_gain: "), std::string::npos) << why;
+  EXPECT_NE(why.find("\nawb_settle_frames: "), std::string::npos) << why;
+  o = {};
+  o.camera_id = "no-such-camera";
+  o.frame_timeout_ms = 0;
+  try {
+    LibcameraSource source(o);
+    FAIL() << "a frame timeout of 0 was accepted";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()),
+              "libcamera options: frame_timeout_ms: expected at least 1 ms, got 0");
+  }
+}
+
 TEST(Libcamera, FormatNamesFollowLibcamerasDrmConvention) {
   EXPECT_EQ(LibcameraFormatName(PixelFormat::kYUYV), "YUYV");
   EXPECT_EQ(LibcameraFormatName(PixelFormat::kNV12), "NV12");

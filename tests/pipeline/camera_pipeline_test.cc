@@ -58,6 +58,21 @@ TEST(CameraPipelineInput, AMissingModelIsRefusedNamingTheCamera) {
   EXPECT_NE(message.find("no model"), std::string::npos) << message;
 }
 
+TEST(CameraPipelineInput, OptionsOutOfRangeAreRefusedNamingTheField) {
+  CameraPipelineOptions o;
+  o.rectify.margin_m = -0.5;
+  const std::string message =
+      MessageOf([&] { CameraPipeline p("side", 1, DownCamera(), Floor(), o); });
+  EXPECT_EQ(message,
+            "pipeline options: rectify.margin_m: expected a number of metres >= 0, got -0.5");
+  o = {};
+  o.rectify.px_per_m = 0;  // auto, not resolved
+  EXPECT_NE(MessageOf([&] {
+              CameraPipeline p("side", 1, DownCamera(), Floor(), o);
+            }).find("pipeline.px_per_m"),
+            std::string::npos);
+}
+
 TEST(CameraPipelineInput, AFrameSizeChangingMidStreamIsRefusedNamingCameraAndFrame) {
   CameraPipeline p = Trained();
   std::vector<ClipBatch> out;

@@ -1,0 +1,226 @@
+// Each pipeline component's options: the defaults are valid, a value out of range is refused
+// naming its field, and the component's entry point refuses it with an InputError.
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "core/error.h"
+#include "pipeline/extract/extractor.h"
+#include "pipeline/key/chroma_keyer.h"
+#include "pipeline/rectify/rectifier.h"
+#include "pipeline/run/ingest.h"
+#include "pipeline/transitions/bank_training.h"
+#include "pipeline/transitions/bank_transitions.h"
+#include "pipeline/transitions/builder.h"
+#include "pipeline/transitions/synthetic.h"
+#include "pipeline/transitions/training.h"
+#include "pipeline/transitions/truth_labels.h"
+#include "pipeline/transitions/unit_worker.h"
+#include "tests/support/error_text.h"
+
+namespace ss {
+namespace {
+
+using testing::InputErrorOf;
+
+// The problems `options` has (its IsValid's `why`), "" when it is valid.
+template <typename Options>
+std::string Problems(const Options& options) {
+  std::string why = "stale";
+  const bool ok = options.IsValid(&why);
+  EXPECT_EQ(ok, why.empty()) << why;
+  return why;
+}
+
+// True when `why` has a line starting "FIELD: ".
+bool Names(const std::string& why, const std::string& field) {
+  return why.rfind(field + ": ", 0) == 0 || why.find("\n" + field + ": ") != std::string::npos;
+}
+
+TEST(PipelineOptions, DefaultsAreValid) {
+  EXPECT_EQ(Problems(GridOptions{}), "");
+  EXPECT_EQ(Problems(ExtractorOptions{}), "");
+  EXPECT_EQ(Problems(RectifierOptions{}), "");
+  EXPECT_EQ(Problems(SyntheticSpriteOptions{}), "");
+  EXPECT_EQ(Problems(LogisticOptions{}), "");
+  EXPECT_EQ(Problems(TrainOptions{}), "");
+  EXPECT_EQ(Problems(BankUpdateOptions{}), "");
+  EXPECT_EQ(Problems(TruthLabelOptions{}), "");
+  EXPECT_EQ(Problems(BankTrainOptions{}), "");
+  EXPECT_EQ(Problems(BuildOptions{}), "");
+  EXPECT_EQ(Problems(UnitWorkerOptions{}), "");
+  EXPECT_EQ(Problems(IngestOptions{}), "");
+}
+
+TEST(PipelineOptions, GridAndKeyer) {
+  GridOptions g;
+  g.step = 65;
+  EXPECT_TRUE(Names(Problems(g), "step"));
+  g = {};
+  g.margin_px = -1;
+  g.shadow_reach_cells = -1;
+  const std::string why = Problems(g);
+  EXPECT_TRUE(Names(why, "margin_px")) << why;
+  EXPECT_TRUE(Names(why, "shadow_reach_cells")) << why;
+  ChromaKeyerOptions bad;
+  bad.grid.step = 1;
+  const std::string what = InputErrorOf([&] { ChromaKeyer keyer(bad); });
+  EXPECT_EQ(what.rfind("keyer grid options: step: ", 0), 0u) << what;
+}
+
+TEST(PipelineOptions, ExtractorNestsTheContactPoint) {
+  ExtractorOptions o;
+  o.contact.min_band_px = 0;
+  EXPECT_TRUE(Names(Problems(o), "contact.min_band_px"));
+  const std::string what = InputErrorOf([&] { Extractor extractor(o); });
+  EXPECT_EQ(what, "extract options: " + Problems(o)) << what;
+  o = {};
+  o.min_area = -1;
+  EXPECT_NE(InputErrorOf([&] { Extractor extractor(o); }).find("min_area: "), std::string::npos);
+}
+
+TEST(PipelineOptions, Rectifier) {
+  RectifierOptions o;
+  o.px_per_m = 0;
+  EXPECT_TRUE(Names(Problems(o), "px_per_m"));
+  o = {};
+  o.margin_m = -0.01;
+  o.max_side_px = 2;
+  const std::string why = Problems(o);
+  EXPECT_TRUE(Names(why, "margin_m")) << why;
+  EXPECT_TRUE(Names(why, "max_side_px")) << why;
+  o = {};
+  o.shadow_radius_m = std::nan("");
+  const std::string what = InputErrorOf([&] { Rectifier rectifier(o); });
+  EXPECT_EQ(what.rfind("rectifier options: shadow_radius_m: ", 0), 0u) << what;
+}
+
+TEST(PipelineOptions, CameraPipelineNestsTheRectifierButLeavesAutoScale) {
+  CameraPipelineOptions o;
+  o.rectify.px_per_m = 0;  // auto: the caller resolves it
+  EXPECT_EQ(Problems(o), "");
+  o.rectify.max_side_px = 0;
+  EXPECT_TRUE(Names(Problems(o), "rectify.max_side_px"));
+}
+
+TEST(PipelineOptions, SyntheticSprites) {
+  SyntheticSpriteOptions o;
+  o.min_clip_frames = 0;
+  EXPECT_TRUE(Names(Problems(o), "min_clip_frames"));
+  o = {};
+  o.max_clip_frames = o.min_clip_frames - 1;
+  o.pixel_noise = -1;
+  const std::string why = Problems(o);
+  EXPECT_TRUE(Names(why, "max_clip_frames")) << why;
+  EXPECT_TRUE(Names(why, "pixel_noise")) << why;
+  o = {};
+  o.frames = 10;
+  o.fps = 0;
+  const std::string what = InputErrorOf([&] { MakeSyntheticSprites(o); });
+  EXPECT_EQ(what.rfind("synthetic sprite options: fps: ", 0), 0u) << what;
+}
+
+TEST(PipelineOptions, Training) {
+  LogisticOptions l;
+  l.l2 = -1;
+  EXPECT_TRUE(Names(Problems(l), "l2"));
+  l = {};
+  l.max_iterations = 0;
+  EXPECT_TRUE(Names(Problems(l), "max_iterations"));
+  TrainOptions t;
+  t.folds = 1;
+  t.logistic.tolerance = -1;
+  const std::string why = Problems(t);
+  EXPECT_TRUE(Names(why, "folds")) << why;
+  EXPECT_TRUE(Names(why, "logistic.tolerance")) << why;
+  // Refused before the features are looked at.
+  const std::string what =
+      InputErrorOf([&] { TrainWeights({}, {}, ComparisonWindow{}, t, nullptr); });
+  EXPECT_EQ(what.rfind("training options: folds: ", 0), 0u) << what;
+  const std::string fit = InputErrorOf([&] { FitLogistic({}, 1, {}, l); });
+  EXPECT_EQ(fit.rfind("logistic options: max_iterations: ", 0), 0u) << fit;
+}
+
+TEST(PipelineOptions, TruthLabels) {
+  TruthLabelOptions o;
+  o.near_miss_fraction = 1.5;
+  EXPECT_TRUE(Names(Problems(o), "near_miss_fraction"));
+  o = {};
+  o.max_phase_difference = -0.1;
+  o.near_miss_factor = 0.5;
+  const std::string why = Problems(o);
+  EXPECT_TRUE(Names(why, "max_phase_difference")) << why;
+  EXPECT_TRUE(Names(why, "near_miss_factor")) << why;
+  const std::vector<int64_t> ids = {1, 2};
+  const std::vector<SpriteTruth> truth(2);
+  const std::string what = InputErrorOf([&] { LabelsFromTruth(ids, truth, 2, o, 1); });
+  EXPECT_EQ(what.rfind("truth label options: max_phase_difference: ", 0), 0u) << what;
+}
+
+TEST(PipelineOptions, BankTraining) {
+  BankTrainOptions o;
+  o.stage1_recall = 1.5;
+  o.train.folds = 0;
+  std::string why = Problems(o);
+  EXPECT_TRUE(Names(why, "stage1_recall")) << why;
+  EXPECT_TRUE(Names(why, "train.folds")) << why;
+  o = {};
+  o.positive_rate = -1;  // the labels file's
+  EXPECT_EQ(Problems(o), "");
+  o.positive_rate = 2;
+  o.calibration_rows = 0;
+  o.window.cells_x = 0;
+  why = Problems(o);
+  EXPECT_TRUE(Names(why, "positive_rate")) << why;
+  EXPECT_TRUE(Names(why, "calibration_rows")) << why;
+  EXPECT_TRUE(Names(why, "window")) << why;
+  // Refused before the files are read.
+  o = {};
+  o.threads = 0;
+  const std::string what = InputErrorOf([&] { TrainOnBank("/no/labels.csv", "/no/bank", o); });
+  EXPECT_EQ(what.rfind("training options: threads: ", 0), 0u) << what;
+}
+
+TEST(PipelineOptions, TransitionBuildersAndWorkers) {
+  BuildOptions b;
+  b.threads = 0;
+  EXPECT_TRUE(Names(Problems(b), "threads"));
+  TransitionBuilder builder(DefaultWeights(), 250);
+  const std::string built = InputErrorOf([&] { builder.BuildFromScratch({}, b); });
+  EXPECT_EQ(built.rfind("build options: threads: ", 0), 0u) << built;
+
+  BankUpdateOptions u;
+  u.weights.feature_scale[0] = 0;
+  u.threads = 0;
+  const std::string why = Problems(u);
+  EXPECT_TRUE(Names(why, "weights")) << why;
+  EXPECT_TRUE(Names(why, "threads")) << why;
+  // Refused before the bank is opened.
+  const std::string what = InputErrorOf([&] { UpdateBankTransitions("/no/bank", u); });
+  EXPECT_EQ(what.rfind("transition update options: weights: ", 0), 0u) << what;
+
+  UnitWorkerOptions w;
+  w.lease_s = 0;
+  w.load_threads = 0;
+  const std::string worker = Problems(w);
+  EXPECT_TRUE(Names(worker, "lease_s")) << worker;
+  EXPECT_TRUE(Names(worker, "load_threads")) << worker;
+}
+
+TEST(PipelineOptions, IngestNestsThePipeline) {
+  IngestOptions o;
+  o.decode_threads = -1;
+  o.pipeline.rectify.margin_m = -1;
+  const std::string why = Problems(o);
+  EXPECT_TRUE(Names(why, "decode_threads")) << why;
+  EXPECT_TRUE(Names(why, "pipeline.rectify.margin_m")) << why;
+  // Refused before the session is opened.
+  o.session_dir = "/no/session";
+  const std::string what = InputErrorOf([&] { IngestSession(o); });
+  EXPECT_EQ(what.rfind("ingest options: ", 0), 0u) << what;
+  EXPECT_NE(what.find("decode_threads: "), std::string::npos) << what;
+}
+
+}  // namespace
+}  // namespace ss
