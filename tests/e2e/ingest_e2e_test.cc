@@ -117,7 +117,8 @@ TEST_F(IngestEndToEnd, ACameraThatCannotBeReadIsAFailureNamedAfterTheRest) {
     std::ofstream video(damaged / "cam1.mkv", std::ios::trunc | std::ios::binary);
     video << "this is not a Matroska file";
   }
-  const std::string bank = *dir_ / "damaged.bank";
+  // Not damaged.bank: the damaged-bank test leaves its corrupt bank there in this suite's folder.
+  const std::string bank = *dir_ / "unreadable_camera.bank";
   const auto r = RunSpritestation("--log-level warn ingest " + damaged.string() + " --bank " +
                                   bank + " --json");
   EXPECT_EQ(r.exit_code, 1) << r.output;
