@@ -81,10 +81,7 @@ SpriteRecord MirrorRecord(const SpriteRecord& original, const MadeSprite& s) {
 
 ClipBatcher::ClipBatcher(int64_t camera_id, ClipBatcherOptions options)
     : camera_id_(camera_id), options_(options) {
-  if (options_.min_clip_frames < 1)
-    throw InputError("pipeline.min_clip_frames", "must be at least 1");
-  if (options_.batch_frames < 1) throw InputError("clip batch size", "must be at least 1");
-  options_.velocity_half_window = std::max(0, options_.velocity_half_window);
+  if (std::string why; !options_.IsValid(&why)) throw InputError("clip batcher options", why);
 }
 
 void ClipBatcher::Add(int64_t clip, int subject, MadeSprite sprite, std::vector<ClipBatch>* out) {

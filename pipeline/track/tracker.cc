@@ -7,6 +7,7 @@
 #include <string>
 #include <tuple>
 
+#include "core/error.h"
 #include "core/log.h"
 #include "core/option_checks.h"
 
@@ -23,6 +24,10 @@ bool TrackerOptions::IsValid(std::string* why) const {
   check(forget_after_ns >= 0, "forget_after_ns",
         "expected a duration >= 0, got " + std::to_string(forget_after_ns));
   return check.ok();
+}
+
+Tracker::Tracker(TrackerOptions options) : options_(options) {
+  if (std::string why; !options_.IsValid(&why)) throw InputError("tracker options", why);
 }
 
 std::vector<int> Tracker::Update(int64_t timestamp_ns, const std::vector<TrackInput>& inputs) {

@@ -29,7 +29,8 @@ struct TrackInput {
 
 class Tracker {
  public:
-  explicit Tracker(TrackerOptions options = {}) : options_(options) {}
+  // InputError naming the field when `options` are out of range (TrackerOptions::IsValid).
+  explicit Tracker(TrackerOptions options = {});
   // Subject id for each input of the frame at `timestamp_ns` (same order).
   std::vector<int> Update(int64_t timestamp_ns, const std::vector<TrackInput>& inputs);
   int live_subjects() const { return static_cast<int>(subjects_.size()); }

@@ -9,7 +9,9 @@
 #include "pipeline/extract/extractor.h"
 #include "pipeline/key/chroma_keyer.h"
 #include "pipeline/rectify/rectifier.h"
+#include "pipeline/run/clip_batcher.h"
 #include "pipeline/run/ingest.h"
+#include "pipeline/track/tracker.h"
 #include "pipeline/transitions/bank_training.h"
 #include "pipeline/transitions/bank_transitions.h"
 #include "pipeline/transitions/builder.h"
@@ -67,6 +69,22 @@ TEST(PipelineOptions, GridAndKeyer) {
   bad.grid.step = 1;
   const std::string what = InputErrorOf([&] { ChromaKeyer keyer(bad); });
   EXPECT_EQ(what.rfind("keyer grid options: step: ", 0), 0u) << what;
+}
+
+// The tracker and the clip batcher check their options themselves, not only inside a
+// CameraPipeline (the batcher used to raise a negative velocity window to 0 without a word).
+TEST(PipelineOptions, TrackerAndClipBatcherRefuseBadOptions) {
+  TrackerOptions t;
+  t.max_speed_m_per_s = 0;
+  EXPECT_EQ(
+      InputErrorOf([&] { Tracker tracker(t); }).rfind("tracker options: max_speed_m_per_s: ", 0),
+      0u);
+  ClipBatcherOptions b;
+  b.velocity_half_window = -1;
+  const std::string what = InputErrorOf([&] { ClipBatcher batcher(1, b); });
+  EXPECT_EQ(what.rfind("clip batcher options: velocity_half_window: ", 0), 0u) << what;
+  EXPECT_NO_THROW(Tracker{});
+  EXPECT_NO_THROW(ClipBatcher(1, ClipBatcherOptions{}));
 }
 
 TEST(PipelineOptions, ExtractorNestsTheContactPoint) {
