@@ -9,6 +9,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "core/error.h"
+#include "core/option_checks.h"
 
 namespace ss::calib {
 namespace {
@@ -280,8 +281,20 @@ double MeasureEdgeWidth(const BoardSpec& board, const cv::Mat& grey, const std::
   return widths[widths.size() / 2];
 }
 
+bool DetectOptions::IsValid(std::string* why) const {
+  OptionProblems check(why);
+  check(std::isfinite(max_edge_width_px) && max_edge_width_px > 0, "max_edge_width_px",
+        "expected a positive number of pixels, got " + OptionProblems::Num(max_edge_width_px));
+  check(min_corners >= 4, "min_corners",
+        "expected at least 4 (a board pose needs 4 corners), got " + std::to_string(min_corners));
+  check(min_area_fraction >= 0 && min_area_fraction <= 1, "min_area_fraction",
+        "expected a fraction 0..1, got " + OptionProblems::Num(min_area_fraction));
+  return check.ok();
+}
+
 BoardView DetectBoard(const BoardSpec& board, const cv::Mat& image, const DetectOptions& options,
                       const std::string& source) {
+  if (std::string why; !options.IsValid(&why)) throw InputError("board detection options", why);
   BoardView view;
   view.source = source;
   const cv::Mat grey = ToGrey(image);

@@ -24,6 +24,8 @@ struct DetectOptions {
   bool check_sharpness = true;
   // chessboard: CALIB_CB_EXHAUSTIVE (harder views; a frame without a board costs ~2x)
   bool exhaustive = true;
+  // False with "FIELD: reason" lines in `why` (core/option_checks.h) for values out of range.
+  bool IsValid(std::string* why) const;
 };
 
 // One image's detection.

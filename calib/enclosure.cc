@@ -7,6 +7,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "core/error.h"
+#include "core/option_checks.h"
 
 namespace ss::calib {
 namespace {
@@ -58,8 +59,18 @@ GroundPolygon FloorPolygonFromPixels(const CameraModel& model,
   return Checked(points, field);
 }
 
+bool GreenFloorOptions::IsValid(std::string* why) const {
+  OptionProblems check(why);
+  check(min_green_excess >= 0 && min_green_excess <= 255, "min_green_excess",
+        "expected 8-bit levels 0..255, got " + OptionProblems::Num(min_green_excess));
+  check(std::isfinite(simplify_m) && simplify_m >= 0, "simplify_m",
+        "expected a distance in metres >= 0, got " + OptionProblems::Num(simplify_m));
+  return check.ok();
+}
+
 GroundPolygon FindGreenFloor(const CameraModel& model, const cv::Mat& bgr,
                              const GreenFloorOptions& options) {
+  if (std::string why; !options.IsValid(&why)) throw InputError("green floor options", why);
   if (bgr.empty() || bgr.type() != CV_8UC3)
     throw InputError("image", "expected an 8-bit colour image");
   if (bgr.cols != model.width() || bgr.rows != model.height()) {

@@ -30,6 +30,8 @@ struct GreenFloorOptions {
   double min_green_excess = 30;  // G - max(R, B), 8-bit levels, for a pixel to count as green
   bool split_walls = true;   // green walls are darker than the lit floor: keep the brighter green
   double simplify_m = 0.01;  // polygon simplification tolerance on the floor
+  // False with "FIELD: reason" lines in `why` (core/option_checks.h) for values out of range.
+  bool IsValid(std::string* why) const;
 };
 
 // The largest connected green floor region in `bgr`, carried onto the floor.

@@ -10,6 +10,7 @@
 #include "core/error.h"
 #include "core/frame.h"
 #include "core/log.h"
+#include "core/option_checks.h"
 #include "core/session.h"
 
 namespace ss::calib {
@@ -21,8 +22,21 @@ bool IsSessionDir(const std::string& path) {
   return fs::is_directory(path, ec) && fs::exists(fs::path(path) / "session.json", ec);
 }
 
+bool SampleOptions::IsValid(std::string* why) const {
+  OptionProblems check(why);
+  check(every >= 0, "every",
+        "expected 0 (spread max_views) or a step >= 1, got " + std::to_string(every));
+  check(max_views >= 1, "max_views", "expected at least 1 view, got " + std::to_string(max_views));
+  check(first >= 0, "first", "expected a frame index >= 0, got " + std::to_string(first));
+  check(count >= 0, "count",
+        "expected 0 (to the end) or a number of frames, got " + std::to_string(count));
+  return check.ok();
+}
+
 std::vector<CameraViews> DetectInSession(const std::string& dir, const BoardSpec& board,
                                          const DetectOptions& detect, const SampleOptions& sample) {
+  if (std::string why; !sample.IsValid(&why)) throw InputError("frame sampling options", why);
+  if (std::string why; !detect.IsValid(&why)) throw InputError("board detection options", why);
   const SessionInfo info = ReadSessionInfo(dir);
   std::vector<CameraViews> out;
   std::vector<int> wanted(info.cameras.size(), -1), every(info.cameras.size(), 1);
@@ -87,6 +101,7 @@ std::vector<CameraViews> DetectInSession(const std::string& dir, const BoardSpec
 
 CameraViews DetectInImages(const std::vector<std::string>& paths, const BoardSpec& board,
                            const DetectOptions& detect, const std::string& name) {
+  if (std::string why; !detect.IsValid(&why)) throw InputError("board detection options", why);
   static const std::set<std::string> kImageExt = {".png", ".jpg",  ".jpeg", ".bmp",
                                                   ".tif", ".tiff", ".pgm",  ".ppm"};
   std::vector<std::string> files;

@@ -26,6 +26,8 @@ struct SampleOptions {
   int first = 0;       // skip frames before this index
   int count = 0;       // 0 = to the end; else this many frames from `first`
   std::vector<std::string> cameras;  // only these session cameras ("" = all)
+  // False with "FIELD: reason" lines in `why` (core/option_checks.h) for values out of range.
+  bool IsValid(std::string* why) const;
 };
 
 // True when `path` is a folder holding session.json.

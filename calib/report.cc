@@ -9,6 +9,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "core/error.h"
+#include "core/option_checks.h"
 
 namespace ss::calib {
 namespace {
@@ -74,8 +75,27 @@ std::vector<std::string> EmptyRegions(const cv::Mat& counts) {
   return out;
 }
 
+bool VerdictOptions::IsValid(std::string* why) const {
+  OptionProblems check(why);
+  check(min_views >= 1, "min_views", "expected at least 1 view, got " + std::to_string(min_views));
+  check(max_rms_px > 0, "max_rms_px",
+        "expected a positive error in pixels, got " + OptionProblems::Num(max_rms_px));
+  check(max_worst_px > 0, "max_worst_px",
+        "expected a positive error in pixels, got " + OptionProblems::Num(max_worst_px));
+  check(min_coverage >= 0 && min_coverage <= 1, "min_coverage",
+        "expected a fraction 0..1, got " + OptionProblems::Num(min_coverage));
+  check(min_tilt_deg >= 0 && min_tilt_deg < 90, "min_tilt_deg",
+        "expected degrees within [0, 90), got " + OptionProblems::Num(min_tilt_deg));
+  check(grid_x >= 1, "grid_x", "expected at least 1 cell, got " + std::to_string(grid_x));
+  check(grid_y >= 1, "grid_y", "expected at least 1 cell, got " + std::to_string(grid_y));
+  check(max_stdev_percent >= 0, "max_stdev_percent",
+        "expected 0 (not checked) or a percentage, got " + OptionProblems::Num(max_stdev_percent));
+  return check.ok();
+}
+
 CameraReport MakeCameraReport(const BoardSpec& board, const SolveSummary& solution, int camera,
                               const std::vector<BoardView>& views, const VerdictOptions& options) {
+  if (std::string why; !options.IsValid(&why)) throw InputError("verdict options", why);
   (void)board;
   CameraReport r;
   const CameraModel& m = solution.models.at(camera);

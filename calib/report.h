@@ -25,6 +25,8 @@ struct VerdictOptions {
   int grid_x = 12, grid_y = 9;  // coverage cells
   // fx, fy, cx, cy each known to this percent of its value (1.96 sigma); 0: not checked.
   double max_stdev_percent = 0;
+  // False with "FIELD: reason" lines in `why` (core/option_checks.h) for values out of range.
+  bool IsValid(std::string* why) const;
 };
 
 struct CameraReport {

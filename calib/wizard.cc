@@ -12,6 +12,7 @@
 #include "calib/enclosure.h"
 #include "core/error.h"
 #include "core/log.h"
+#include "core/option_checks.h"
 
 namespace ss::calib {
 namespace {
@@ -47,9 +48,33 @@ const char* WizardStepName(WizardStep step) {
   return "?";
 }
 
+bool WizardOptions::IsValid(std::string* why) const {
+  OptionProblems check(why);
+  std::string part;
+  check.Nested(detect.IsValid(&part), "detect.", part);
+  check.Nested(verdict.IsValid(&part), "verdict.", part);
+  check(still_px > 0, "still_px",
+        "expected a positive motion in pixels, got " + OptionProblems::Num(still_px));
+  check(still_frames >= 1, "still_frames",
+        "expected at least 1 frame, got " + std::to_string(still_frames));
+  check(min_shift >= 0, "min_shift",
+        "expected a fraction >= 0, got " + OptionProblems::Num(min_shift));
+  check(min_tilt_change_deg >= 0, "min_tilt_change_deg",
+        "expected degrees >= 0, got " + OptionProblems::Num(min_tilt_change_deg));
+  check(min_scale_change >= 0, "min_scale_change",
+        "expected a fraction >= 0, got " + OptionProblems::Num(min_scale_change));
+  check(min_new_cells >= 0, "min_new_cells",
+        "expected a number >= 0, got " + std::to_string(min_new_cells));
+  check(max_views >= 1, "max_views", "expected at least 1 view, got " + std::to_string(max_views));
+  check(floor_still_frames >= 1, "floor_still_frames",
+        "expected at least 1 frame, got " + std::to_string(floor_still_frames));
+  return check.ok();
+}
+
 CalibrationWizard::CalibrationWizard(std::string camera, int width, int height,
                                      WizardOptions options)
     : camera_(std::move(camera)), width_(width), height_(height), o_(std::move(options)) {
+  if (std::string why; !o_.IsValid(&why)) throw InputError("calibration wizard options", why);
   coverage_ = cv::Mat(o_.verdict.grid_y, o_.verdict.grid_x, CV_32F, cv::Scalar(0));
   if (o_.intrinsics) {
     if (o_.intrinsics->width() != width_ || o_.intrinsics->height() != height_) {

@@ -47,6 +47,9 @@ struct WizardOptions {
   // false: the intrinsics are solved only when Solve() is called (the console's Solve button);
   // capturing stops at max_views.
   bool auto_solve = true;
+  // False with "FIELD: reason" lines in `why` for values out of range (detect. and verdict.
+  // name the nested blocks' fields).
+  bool IsValid(std::string* why) const;
 };
 
 // How varied the captured views are, as ROS's camera_calibration shows it: each 0..1, the

@@ -2,17 +2,30 @@
 
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <thread>
 
 #include <opencv2/core.hpp>
 
+#include "core/error.h"
 #include "core/frame.h"
+#include "core/option_checks.h"
 
 namespace ss::calib {
+
+bool WizardRunOptions::IsValid(std::string* why) const {
+  OptionProblems check(why);
+  check(max_frames >= 0, "max_frames",
+        "expected 0 (until done) or a number of frames, got " + std::to_string(max_frames));
+  check(std::isfinite(silent_s) && silent_s > 0, "silent_s",
+        "expected a positive number of seconds, got " + OptionProblems::Num(silent_s));
+  return check.ok();
+}
 
 WizardRunResult RunWizardOnSource(FrameSource& source, CalibrationWizard& wizard,
                                   const WizardRunOptions& options,
                                   const std::function<void()>& after_frame) {
+  if (std::string why; !options.IsValid(&why)) throw InputError("wizard run options", why);
   // A live camera that stops delivering (unplugged, its stream ended) ends the run with what
   // it has; Next() itself waits for frames as long as the source lives. (The station's
   // CameraRunner does the same, then reopens the camera.)

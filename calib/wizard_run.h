@@ -14,6 +14,8 @@ namespace ss::calib {
 struct WizardRunOptions {
   int max_frames = 0;     // stop after this many frames; 0: until done or the stream ends
   double silent_s = 5.0;  // a camera without a frame this long ends the run
+  // False with "FIELD: reason" lines in `why` (core/option_checks.h) for values out of range.
+  bool IsValid(std::string* why) const;
 };
 
 struct WizardRunResult {
