@@ -1,6 +1,7 @@
 #include "animate/animate_run.h"
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 
 #include "animate/basic_costs.h"
@@ -10,6 +11,7 @@
 #include "animate/replacement.h"
 #include "core/error.h"
 #include "core/log.h"
+#include "core/option_checks.h"
 
 namespace ss {
 
@@ -52,7 +54,17 @@ ConstraintFigures MeasureConstraints(const Problem& problem, const std::vector<T
   return f;
 }
 
+bool AnimateRunOptions::IsValid(std::string* why) const {
+  OptionProblems check(why);
+  check(progress_every_s >= 0 && std::isfinite(progress_every_s), "progress_every_s",
+        "must be seconds >= 0 (0: never), got " + OptionProblems::Num(progress_every_s));
+  check(max_turns >= 0, "max_turns",
+        "must be >= 0 (0: the time budget alone), got " + std::to_string(max_turns));
+  return check.ok();
+}
+
 AnimateResult RunAnimation(const Scene& scene, const AnimateRunOptions& options) {
+  if (std::string why; !options.IsValid(&why)) throw InputError("animate options", why);
   const OptimizerSpec& o = options.optimizer;
   if (!(o.replacement.time_budget_seconds > 0)) throw InputError("--time-budget", "must be > 0");
   AnimateResult result;

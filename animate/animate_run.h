@@ -21,6 +21,8 @@ struct AnimateRunOptions {
   // Replacement: stop after this many sprite turns (0: the time budget alone). With a budget
   // that is never reached, the same work on any machine, loaded or not (tests).
   int max_turns = 0;
+  // False with "FIELD: reason" lines in `why` (core/option_checks.h) for values out of range.
+  bool IsValid(std::string* why) const;
 };
 
 // How well the result meets its constraints (the scenes' figures).

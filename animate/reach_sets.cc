@@ -10,6 +10,7 @@
 #include <thread>
 
 #include "core/error.h"
+#include "core/option_checks.h"
 
 namespace ss {
 namespace {
@@ -75,15 +76,19 @@ class DijkstraWorkspace {
 
 }  // namespace
 
+bool ReachOptions::IsValid(std::string* why) const {
+  OptionProblems check(why);
+  check(set_size >= 1 && set_size <= 65535, "set_size",
+        "must be in 1..65535, got " + std::to_string(set_size));
+  check(num_threads >= 1, "num_threads", "must be >= 1, got " + std::to_string(num_threads));
+  check(step_cost >= 0 && std::isfinite(step_cost), "step_cost",
+        "must be finite and >= 0, got " + OptionProblems::Num(step_cost));
+  return check.ok();
+}
+
 ReachSets ReachSets::Build(const TransitionGraph& graph, ReachDirection direction,
                            const ReachOptions& options, std::span<const double> entry_cost) {
-  if (options.set_size < 1 || options.set_size > 65535) {
-    throw InputError("reach.set_size",
-                     "must be in 1..65535, got " + std::to_string(options.set_size));
-  }
-  if (!(options.step_cost >= 0) || !std::isfinite(options.step_cost)) {
-    throw InputError("reach.step_cost", "must be finite and >= 0");
-  }
+  if (std::string why; !options.IsValid(&why)) throw InputError("reach options", why);
   if (!entry_cost.empty() && static_cast<int>(entry_cost.size()) != graph.num_frames()) {
     throw InputError("reach.entry_cost", "needs one value per frame");
   }

@@ -7,6 +7,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "core/error.h"
+#include "core/option_checks.h"
 
 namespace ss {
 namespace {
@@ -40,10 +41,18 @@ cv::Mat ShadowLayer(const cv::Mat& shadow, double opacity) {
 
 }  // namespace
 
+bool RenderOptions::IsValid(std::string* why) const {
+  OptionProblems check(why);
+  check(shadow_opacity >= 0 && shadow_opacity <= 1, "shadow_opacity",
+        "must be within [0, 1], got " + OptionProblems::Num(shadow_opacity));
+  check(grid_step_px >= 1, "grid_step_px", "must be >= 1, got " + std::to_string(grid_step_px));
+  return check.ok();
+}
+
 SpriteRenderer::SpriteRenderer(CameraModel camera, cv::Mat background, RenderOptions options)
     : camera_(std::move(camera)), options_(options) {
   if (!camera_.valid()) throw InputError("camera", "no camera model");
-  if (options_.grid_step_px < 1) throw InputError("render.grid_step_px", "must be >= 1");
+  if (std::string why; !options_.IsValid(&why)) throw InputError("render options", why);
   centre_in_ground_ = camera_.CentreInGround();
   if (!background.empty()) {
     if (background.cols != camera_.width() || background.rows != camera_.height()) {

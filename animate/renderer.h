@@ -29,6 +29,8 @@ struct RenderOptions {
   bool shadows = true;
   double shadow_opacity = 1.0;  // darkening at a full (255) shadow pixel
   int grid_step_px = 8;         // the lens model is evaluated on this grid, interpolated between
+  // False with "FIELD: reason" lines in `why` (core/option_checks.h) for values out of range.
+  bool IsValid(std::string* why) const;
 };
 
 class SpriteRenderer {

@@ -7,6 +7,7 @@
 #include "animate/basic_costs.h"
 #include "core/error.h"
 #include "core/log.h"
+#include "core/option_checks.h"
 
 namespace ss {
 namespace {
@@ -582,11 +583,11 @@ bool ReplacementOptions::IsValid(std::string* why) const {
     if (why) *why = reason;
     return false;
   };
-  if (reach.set_size < 1 || reach.set_size > 65535)
-    return fail("reach.set_size must be in 1..65535");
-  if (reach.num_threads < 1) return fail("reach.num_threads must be >= 1");
-  if (!(reach.step_cost >= 0) || !std::isfinite(reach.step_cost))
-    return fail("reach.step_cost must be >= 0");
+  if (std::string part; !reach.IsValid(&part)) {
+    OptionProblems nested(why);
+    nested.Nested(false, "reach.", part);
+    return false;
+  }
   if (!(step_cost_fraction >= 0) || !std::isfinite(step_cost_fraction)) {
     return fail("step_cost_fraction must be >= 0");
   }

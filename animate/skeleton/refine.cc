@@ -5,8 +5,35 @@
 #include <string>
 
 #include "core/error.h"
+#include "core/option_checks.h"
 
 namespace ss {
+
+bool MovementOptions::IsValid(std::string* why) const {
+  OptionProblems check(why);
+  check(lag_s > 0 && std::isfinite(lag_s), "lag_s",
+        "must be a positive number of seconds, got " + OptionProblems::Num(lag_s));
+  check(smoothing_s >= 0 && std::isfinite(smoothing_s), "smoothing_s",
+        "must be seconds >= 0, got " + OptionProblems::Num(smoothing_s));
+  check(min_length_s >= 0 && std::isfinite(min_length_s), "min_length_s",
+        "must be seconds >= 0, got " + OptionProblems::Num(min_length_s));
+  check(min_prominence >= 0, "min_prominence",
+        "must be >= 0, got " + OptionProblems::Num(min_prominence));
+  check(noise_factor >= 0, "noise_factor",
+        "must be >= 0, got " + OptionProblems::Num(noise_factor));
+  return check.ok();
+}
+
+bool RefineOptions::IsValid(std::string* why) const {
+  OptionProblems check(why);
+  std::string part;
+  check.Nested(movements.IsValid(&part), "movements.", part);
+  check(jump_cost_per_frame >= 0, "jump_cost_per_frame",
+        "must be >= 0, got " + OptionProblems::Num(jump_cost_per_frame));
+  check(averaging_window >= 1, "averaging_window",
+        "must be >= 1, got " + std::to_string(averaging_window));
+  return check.ok();
+}
 
 MovementFrames MovementWindows(const MovementOptions& options, double fps) {
   if (!(fps > 0)) throw InputError("refine", "the frame rate must be > 0");
@@ -152,7 +179,7 @@ RefineResult RefineMatch(const CostRows& costs, const PoseDescriptors& targets,
   if (targets.count != costs.targets() || sources.count != costs.sources()) {
     throw InputError("refine", "the descriptors do not match the cost rows");
   }
-  if (refine.averaging_window < 1) throw InputError("refine", "averaging_window must be >= 1");
+  if (std::string why; !refine.IsValid(&why)) throw InputError("refine options", why);
   RefineResult result;
   result.target_movements = FindMovements(targets, {0}, refine.movements);
   result.source_movements = FindMovements(sources, clip_starts, refine.movements);

@@ -28,6 +28,8 @@ struct MovementOptions {
   // tracked or imported joints, whose jitter alone makes peaks.
   float min_prominence = 0.02f;
   float noise_factor = 2.5f;
+  // False with "FIELD: reason" lines in `why` (core/option_checks.h) for values out of range.
+  bool IsValid(std::string* why) const;
 };
 
 // The windows above in frames at `fps` (rounded, at least 1).
@@ -52,6 +54,8 @@ struct RefineOptions {
   MovementOptions movements;
   float jump_cost_per_frame = 0.01f;  // λ: a jump of d frames inside a movement costs λ|d| more
   int averaging_window = 5;           // frames, centred, clipped to the movement; 1 = none
+  // As MovementOptions::IsValid; the movements' fields come out under "movements.".
+  bool IsValid(std::string* why) const;
 };
 
 struct RefineResult {

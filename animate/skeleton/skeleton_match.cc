@@ -5,12 +5,25 @@
 #include "animate/skeleton/cost_rows.h"
 #include "core/error.h"
 #include "core/log.h"
+#include "core/option_checks.h"
 
 namespace ss {
+
+bool SkeletonMatchOptions::IsValid(std::string* why) const {
+  OptionProblems check(why);
+  std::string part;
+  check.Nested(descriptor.IsValid(&part), "descriptor.", part);
+  check.Nested(match.IsValid(&part), "match.", part);
+  check.Nested(refine.IsValid(&part), "refine.", part);
+  check(min_source_coverage >= 0 && min_source_coverage <= 1, "min_source_coverage",
+        "must be within [0, 1], got " + OptionProblems::Num(min_source_coverage));
+  return check.ok();
+}
 
 SkeletonMatchResult MatchSkeletons(const SkeletonSequence& target,
                                    const std::vector<const SkeletonSequence*>& clips,
                                    const SkeletonMatchOptions& options) {
+  if (std::string why; !options.IsValid(&why)) throw InputError("skeleton match options", why);
   if (clips.empty()) throw InputError("sources", "no source clip");
   SkeletonMatchResult result;
   int flat = 0;

@@ -21,6 +21,9 @@ struct SkeletonMatchOptions {
   bool compare_without_penalties = true;  // also solve without the penalties (Figure 2a)
   // source frames with less of the pose terms' weight are never chosen
   float min_source_coverage = 0.5f;
+  // False with "FIELD: reason" lines in `why` for values out of range; the parts' fields come out
+  // under "descriptor.", "match.", "refine.".
+  bool IsValid(std::string* why) const;
 };
 
 // A source frame as the caller knows it.
