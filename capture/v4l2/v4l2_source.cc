@@ -17,6 +17,7 @@
 
 #include "core/error.h"
 #include "core/log.h"
+#include "core/option_checks.h"
 
 namespace ss {
 namespace {
@@ -244,15 +245,28 @@ struct V4l2Source::Impl {
   }
 };
 
+bool V4l2Options::IsValid(std::string* why) const {
+  OptionProblems check(why);
+  check(!device.empty(), "device", "expected a device path such as /dev/video0");
+  check(width >= 0 && height >= 0 && (width > 0) == (height > 0), "width/height",
+        "give both or neither (got " + std::to_string(width) + "x" + std::to_string(height) + ")");
+  check(std::isfinite(fps) && fps >= 0, "fps",
+        "expected 0 (the driver's) or frames per second, got " + OptionProblems::Num(fps));
+  check(std::isfinite(exposure_us) && exposure_us >= 0, "exposure_us",
+        "expected 0 (auto) or microseconds, got " + OptionProblems::Num(exposure_us));
+  check(gain >= -1, "gain", "expected -1 (auto) or a gain >= 0, got " + std::to_string(gain));
+  check(white_balance_k >= 0, "white_balance_k",
+        "expected 0 (auto) or kelvin, got " + std::to_string(white_balance_k));
+  check(buffers >= 2, "buffers", "expected 2 or more, got " + std::to_string(buffers));
+  check(frame_timeout_ms >= 1, "frame_timeout_ms",
+        "expected at least 1 ms, got " + std::to_string(frame_timeout_ms));
+  return check.ok();
+}
+
 V4l2Source::V4l2Source(V4l2Options options) : impl_(std::make_unique<Impl>()) {
   Impl& s = *impl_;
   s.options = options;
-  if (options.buffers < 2)
-    throw InputError("buffers", "expected 2 or more, got " + std::to_string(options.buffers));
-  if ((options.width > 0) != (options.height > 0)) {
-    throw InputError("width/height", "give both or neither (got " + std::to_string(options.width) +
-                                         "x" + std::to_string(options.height) + ")");
-  }
+  if (std::string why; !options.IsValid(&why)) throw InputError("v4l2 options", why);
   auto device = std::make_shared<Device>();
   device->path = options.device;
   device->fd = OpenDevice(options.device);

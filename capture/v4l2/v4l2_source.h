@@ -30,6 +30,8 @@ struct V4l2Options {
   bool white_balance_once = false;  // balance once (V4L2_CID_DO_WHITE_BALANCE), then hold it
   int buffers = 4;                  // mmap buffers requested
   int frame_timeout_ms = 2000;      // no frame for this long counts as one error
+  // False with "FIELD: reason" lines in `why` (core/option_checks.h) for values out of range.
+  bool IsValid(std::string* why) const;
 };
 
 // A capture device found under /dev.

@@ -11,6 +11,9 @@
 #include "core/error.h"
 #include "tests/support/error_text.h"
 #include "tests/support/test_support.h"
+#ifdef SPRITESTATION_HAVE_V4L2
+#include "capture/v4l2/v4l2_source.h"
+#endif
 #ifdef SPRITESTATION_HAVE_ARAVIS
 #include "capture/aravis/aravis_source.h"
 #include "capture/aravis/fake_gige_camera.h"
@@ -91,6 +94,26 @@ TEST(CaptureOptions, Plate) {
 }
 
 #ifdef SPRITESTATION_HAVE_ARAVIS
+#ifdef SPRITESTATION_HAVE_V4L2
+TEST(CaptureOptions, V4l2) {
+  EXPECT_EQ(Problems(V4l2Options{}), "");
+  V4l2Options o;
+  o.height = 480;  // without a width
+  o.gain = -2;
+  o.fps = std::nan("");
+  const std::string why = Problems(o);
+  EXPECT_TRUE(Names(why, "width/height")) << why;
+  EXPECT_TRUE(Names(why, "gain")) << why;
+  EXPECT_TRUE(Names(why, "fps")) << why;
+  // Refused before the device is opened (there is none here).
+  o = {};
+  o.device = "/dev/no-such-video-device";
+  o.buffers = 1;
+  EXPECT_EQ(InputErrorOf([&] { V4l2Source source(o); }),
+            "v4l2 options: buffers: expected 2 or more, got 1");
+}
+#endif
+
 TEST(CaptureOptions, Aravis) {
   AravisOptions o;
   o.width = 640;  // without a height
