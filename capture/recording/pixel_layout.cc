@@ -41,10 +41,6 @@ __attribute__((target_clones("avx2", "ssse3", "default"))) void DeinterleaveRow(
   }
 }
 
-}  // namespace
-
-namespace {
-
 // Per camera format, in one table: its bytes as FFmpeg names them, and the format FFV1 stores
 // them in (the top of this file's header says how each is repacked).
 struct AvLayout {

@@ -1,7 +1,6 @@
 #include "pipeline/key/chroma_keyer.h"
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <string>
 
