@@ -11,19 +11,13 @@
 #include "animate/skeleton/refine.h"
 #include "animate/skeleton/skeleton_match.h"
 #include "tests/support/error_text.h"
+#include "tests/support/option_problems.h"
 
 namespace ss {
 namespace {
 
 using testing::InputErrorOf;
-
-template <typename Options>
-std::string Problems(const Options& options) {
-  std::string why = "stale";
-  const bool ok = options.IsValid(&why);
-  EXPECT_EQ(ok, why.empty()) << why;
-  return why;
-}
+using testing::Problems;
 
 TEST(AnimateOptions, DefaultsAreValid) {
   EXPECT_EQ(Problems(ReachOptions{}), "");

@@ -13,19 +13,13 @@
 #include "calib/wizard.h"
 #include "calib/wizard_run.h"
 #include "tests/support/error_text.h"
+#include "tests/support/option_problems.h"
 
 namespace ss::calib {
 namespace {
 
 using ss::testing::InputErrorOf;
-
-template <typename Options>
-std::string Problems(const Options& options) {
-  std::string why = "stale";
-  const bool ok = options.IsValid(&why);
-  EXPECT_EQ(ok, why.empty()) << why;
-  return why;
-}
+using ss::testing::Problems;
 
 TEST(CalibOptions, DefaultsAreValid) {
   EXPECT_EQ(Problems(DetectOptions{}), "");

@@ -10,6 +10,7 @@
 #include "capture/replay/session_plate.h"
 #include "core/error.h"
 #include "tests/support/error_text.h"
+#include "tests/support/option_problems.h"
 #include "tests/support/test_support.h"
 #ifdef SPRITESTATION_HAVE_V4L2
 #include "capture/v4l2/v4l2_source.h"
@@ -23,21 +24,9 @@ namespace ss {
 namespace {
 
 using testing::InputErrorOf;
+using testing::Names;
+using testing::Problems;
 using testing::ScratchDir;
-
-// The problems `options` has (its IsValid's `why`), "" when it is valid.
-template <typename Options>
-std::string Problems(const Options& options) {
-  std::string why = "stale";
-  const bool ok = options.IsValid(&why);
-  EXPECT_EQ(ok, why.empty()) << why;
-  return why;
-}
-
-// True when `why` has a line starting "FIELD: ".
-bool Names(const std::string& why, const std::string& field) {
-  return why.rfind(field + ": ", 0) == 0 || why.find("\n" + field + ": ") != std::string::npos;
-}
 
 TEST(CaptureOptions, DefaultsAreValid) {
   EXPECT_EQ(Problems(RecordingOptions{}), "");

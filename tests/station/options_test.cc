@@ -11,25 +11,14 @@
 #include "station/control_server.h"
 #include "station/station.h"
 #include "tests/support/error_text.h"
+#include "tests/support/option_problems.h"
 
 namespace ss {
 namespace {
 
 using testing::InputErrorOf;
-
-// The problems `options` has (its IsValid's `why`), "" when it is valid.
-template <typename Options>
-std::string Problems(const Options& options) {
-  std::string why = "stale";
-  const bool ok = options.IsValid(&why);
-  EXPECT_EQ(ok, why.empty()) << why;
-  return why;
-}
-
-// True when `why` has a line starting "FIELD: ".
-bool Names(const std::string& why, const std::string& field) {
-  return why.rfind(field + ": ", 0) == 0 || why.find("\n" + field + ": ") != std::string::npos;
-}
+using testing::Names;
+using testing::Problems;
 
 TEST(StationOptions, DefaultsAreValid) {
   EXPECT_EQ(Problems(StationOptions{}), "");
