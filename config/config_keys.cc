@@ -240,6 +240,8 @@ OptionsBinder PipelineKeys(CameraPipelineOptions& p) {
            "noise when its largest part holds less")
       .Add("noise_min_mean_alpha", &p.noise.min_mean_alpha, "a share from 0 to 1",
            "noise below this mean alpha")
+      .Add("merged_min_width_ratio", &p.side_by_side.min_width_ratio, "0 or a ratio of at least 1",
+           "two side by side when split and this many times one subject's width")
       .AddRead("px_per_m", "auto", "billboard scale in pixels per metre, or auto",
                [&p](Reader& r, const MapView& view, const std::string& key) {
                  // `auto` (stored as 0) or a positive number of pixels per metre.

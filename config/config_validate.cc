@@ -241,7 +241,8 @@ class Validator {
                                      {"noise.min_thick_share", "noise_min_thick_share"},
                                      {"noise.min_solidity", "noise_min_solidity"},
                                      {"noise.min_largest_share", "noise_min_largest_share"},
-                                     {"noise.min_mean_alpha", "noise_min_mean_alpha"}}) {
+                                     {"noise.min_mean_alpha", "noise_min_mean_alpha"},
+                                     {"side_by_side.min_width_ratio", "merged_min_width_ratio"}}) {
       pipeline_rule(field, std::string("pipeline.") + key);
     }
     // `auto` (0) is the config's own: the rectifier needs the scale chosen.

@@ -66,6 +66,7 @@ bool CameraPipelineOptions::IsValid(std::string* why) const {
   if (scaled.px_per_m == 0) scaled.px_per_m = RectifierOptions{}.px_per_m;
   check.Nested(scaled.IsValid(&part), "rectify.", part);
   check.Nested(batch.IsValid(&part), "batch.", part);
+  check.Nested(side_by_side.IsValid(&part), "side_by_side.", part);
   check(workers >= 0, "workers",
         "expected 0 (one per core) or more, got " + std::to_string(workers));
   check(queue_frames >= 1, "queue_frames",
@@ -86,6 +87,7 @@ CameraPipeline::CameraPipeline(std::string name, int64_t camera_id, CameraModel 
       floor_mask_(model_, floor, options.usability),
       extractor_(options.extract),
       tracker_(options.track),
+      side_by_side_(options.side_by_side),
       stillness_(options.still_speed_m_per_s, options.max_still_s),
       noise_(options.noise),
       rectifier_(options.rectify),
@@ -129,6 +131,7 @@ void CameraPipeline::Process(const Frame& frame, std::vector<ClipBatch>* out) {
   if (last_sequence_ && frame.sequence != *last_sequence_ + 1) {
     ++stats_.sequence_gaps;
     for (const int64_t clip : cutter_.CloseAll()) batcher_.Close(clip, out);
+    two_clips_.clear();
     merges_.Reset();
   }
   last_sequence_ = frame.sequence;
@@ -165,12 +168,15 @@ void CameraPipeline::Process(const Frame& frame, std::vector<ClipBatch>* out) {
   }
   const std::vector<int> subjects = tracker_.Update(frame.timestamp_ns, inputs);
   // Two or more subjects in one blob (MergeDetector's rule, docs/pipeline.md "merged"): their
-  // sprites are stored tagged `merged`.
+  // sprites are stored tagged `merged`. A pair side by side that the tracks never saw apart is
+  // found below, by its looks.
   std::vector<MergeDetector::Blob> blobs(subjects.size());
   for (size_t k = 0; k < subjects.size(); ++k) {
     blobs[k] = {subjects[k], grounded[k]->bbox, grounded[k]->area};
   }
-  const std::vector<bool> merged = merges_.Update(blobs);
+  std::vector<bool> merged = merges_.Update(blobs);
+  std::vector<MatteLook> looks(subjects.size());  // of the usable sprites' billboards
+  std::vector<size_t> verdict_of(subjects.size());
 
   // Filter and rectify.
   noise_.NextFrame();
@@ -201,7 +207,10 @@ void CameraPipeline::Process(const Frame& frame, std::vector<ClipBatch>* out) {
                             Eigen::Vector2d(c.contact_point.x, c.contact_point.y)};
       Rectifier::Refusal why;
       billboards[k] = rectifier_.Rectify(model_, view, &why);
-      if (!billboards[k]) {
+      if (billboards[k]) {
+        looks[k] =
+            MeasureMatteLook(billboards[k]->bgra, billboards[k]->px_per_m, side_by_side_.options());
+      } else {
         reason = why.too_large ? Discard::kTooLarge : Discard::kNoGroundHit;
         if (why.too_large && (!last_too_large_log_ ||
                               Clock::now() - *last_too_large_log_ > std::chrono::seconds(10))) {
@@ -216,6 +225,7 @@ void CameraPipeline::Process(const Frame& frame, std::vector<ClipBatch>* out) {
       }
     }
     usable[k] = reason == Discard::kNone;
+    verdict_of[k] = verdicts_.size();
     verdicts_.push_back({&c, subjects[k], points[k], reason, merged[k]});
     if (usable[k]) {
       ++usable_total_;
@@ -233,7 +243,9 @@ void CameraPipeline::Process(const Frame& frame, std::vector<ClipBatch>* out) {
   // Clips: runs of consecutive usable frames per subject.
   const std::vector<ClipCutter::Event> events = cutter_.Update(subjects, usable);
   for (const ClipCutter::Event& e : events) {
-    if (e.closes) batcher_.Close(e.closed_clip, out);
+    if (!e.closes) continue;
+    batcher_.Close(e.closed_clip, out);
+    two_clips_.erase(e.closed_clip);
   }
   const size_t first_input_event = events.size() - subjects.size();
   for (size_t k = 0; k < subjects.size(); ++k) {
@@ -245,8 +257,25 @@ void CameraPipeline::Process(const Frame& frame, std::vector<ClipBatch>* out) {
     s.bbox_in_image = grounded[k]->bbox;
     s.billboard = std::move(*billboards[k]);
     s.description = DescribeBillboard(s.billboard.bgra);
+    // Two side by side (SideBySide): split and wide, or wide in a clip once seen split.
+    const bool wide = side_by_side_.IsWide(looks[k].width_m);
+    const bool first_split = !merged[k] && wide && looks[k].split && !two_clips_.contains(e.clip);
+    if (!merged[k] && wide && (looks[k].split || two_clips_.contains(e.clip))) {
+      merged[k] = true;
+      verdicts_[verdict_of[k]].merged = true;
+    }
+    if (!merged[k]) side_by_side_.AddOne(looks[k].width_m);
     s.merged = merged[k];
+    s.matte_width_m = looks[k].width_m;
     batcher_.Add(e.clip, e.subject, std::move(s), out);
+    if (first_split) {
+      // The clip's wide sprites still held were the pair too, before a gap showed it.
+      two_clips_.insert(e.clip);
+      batcher_.MarkMerged(e.clip, side_by_side_.min_wide_m());
+      log_->debug("{} frame {} subject {}: two side by side ({:.2f} m wide, one is {:.2f} m)",
+                  name_, frame.sequence, subjects[k], looks[k].width_m,
+                  side_by_side_.median_width_m());
+    }
   }
   UpdateClipStats();
   stats_.seconds_rest += SecondsSince(rest_start);
@@ -255,6 +284,7 @@ void CameraPipeline::Process(const Frame& frame, std::vector<ClipBatch>* out) {
 void CameraPipeline::Finish(std::vector<ClipBatch>* out) {
   for (const int64_t clip : cutter_.CloseAll()) batcher_.Close(clip, out);
   batcher_.CloseAll(out);
+  two_clips_.clear();
   UpdateClipStats();
 }
 

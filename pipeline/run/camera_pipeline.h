@@ -10,6 +10,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <unordered_set>
 #include <vector>
 
 #include <spdlog/logger.h>
@@ -25,6 +26,7 @@
 #include "pipeline/key/matte.h"
 #include "pipeline/rectify/rectifier.h"
 #include "pipeline/run/clip_batcher.h"
+#include "pipeline/track/side_by_side.h"
 #include "pipeline/track/tracker.h"
 
 namespace ss {
@@ -43,6 +45,7 @@ struct CameraPipelineOptions {
   TrackerOptions track;               // candidates into subjects across frames
   UsabilityOptions usability;         // border, floor and wall tests
   NoiseOptions noise;                 // keyed background that is not a subject
+  SideBySideOptions side_by_side;     // a pair in one blob by its looks (tagged merged)
   double still_speed_m_per_s = 0.05;  // slower than this counts as not moving (StillnessFilter)
   double max_still_s = 2.0;           // still periods longer than this are discarded
   RectifierOptions rectify;           // billboards and their scale
@@ -83,7 +86,7 @@ struct CandidateVerdict {
   int track = -1;  // the tracker's subject id; -1 when its ray missed the floor
   std::optional<Eigen::Vector2d> ground;  // contact point on the floor, metres
   Discard reason = Discard::kNone;        // kNone: usable (it joins a clip)
-  bool merged = false;                    // the blob holds two or more subjects (MergeDetector)
+  bool merged = false;  // the blob holds two or more subjects (MergeDetector, SideBySide)
 };
 
 class CameraPipeline {
@@ -131,6 +134,8 @@ class CameraPipeline {
   Extractor extractor_;
   Tracker tracker_;
   MergeDetector merges_;
+  SideBySide side_by_side_;
+  std::unordered_set<int64_t> two_clips_;  // open clips seen split side by side (SideBySide)
   StillnessFilter stillness_;
   NoiseFilter noise_;
   ClipCutter cutter_;

@@ -107,6 +107,12 @@ void ClipBatcher::Add(int64_t clip, int subject, MadeSprite sprite, std::vector<
   }
 }
 
+void ClipBatcher::MarkMerged(int64_t clip, double min_width_m) {
+  const auto it = clips_.find(clip);
+  if (it == clips_.end()) return;
+  for (MadeSprite& s : it->second.pending) s.merged = s.merged || s.matte_width_m >= min_width_m;
+}
+
 void ClipBatcher::Close(int64_t clip, std::vector<ClipBatch>* out) {
   const auto it = clips_.find(clip);
   if (it == clips_.end()) return;

@@ -37,7 +37,8 @@ struct MadeSprite {
   cv::Rect bbox_in_image;
   Billboard billboard;
   SpriteDescription description;
-  bool merged = false;  // two or more subjects in one blob: stored with the tag kMergedTag
+  bool merged = false;       // two or more subjects in one blob: stored with the tag kMergedTag
+  double matte_width_m = 0;  // the billboard matte's width (MatteLook), for MarkMerged
 };
 
 // One bank transaction: sprites of one clip, originals each followed by its mirror.
@@ -51,6 +52,11 @@ class ClipBatcher {
   ClipBatcher(int64_t camera_id, ClipBatcherOptions options);
   // Adds the next frame of clip `clip` (ClipCutter's id) of tracker subject `subject`.
   void Add(int64_t clip, int subject, MadeSprite sprite, std::vector<ClipBatch>* out);
+  // The clip's subject is two subjects side by side, seen only now (SideBySide): each sprite of
+  // the clip not yet handed out whose matte is at least `min_width_m` wide is tagged merged.
+  // Those handed out stay as stored: a clip goes out batch_frames at a time, so a pair seen
+  // split within its first batch is tagged whole.
+  void MarkMerged(int64_t clip, double min_width_m);
   // The clip ended: its rest goes out as the complete batch, or it is dropped when short.
   void Close(int64_t clip, std::vector<ClipBatch>* out);
   // Closes every open clip.

@@ -42,6 +42,7 @@ TEST(PipelineOptions, DefaultsAreValid) {
   EXPECT_EQ(Problems(BuildOptions{}), "");
   EXPECT_EQ(Problems(UnitWorkerOptions{}), "");
   EXPECT_EQ(Problems(IngestOptions{}), "");
+  EXPECT_EQ(Problems(SideBySideOptions{}), "");
 }
 
 TEST(PipelineOptions, GridAndKeyer) {
@@ -109,6 +110,8 @@ TEST(PipelineOptions, CameraPipelineNestsTheRectifierButLeavesAutoScale) {
   EXPECT_EQ(Problems(o), "");
   o.rectify.max_side_px = 0;
   EXPECT_TRUE(Names(Problems(o), "rectify.max_side_px"));
+  o.side_by_side.min_part_share = 0.7;
+  EXPECT_TRUE(Names(Problems(o), "side_by_side.min_part_share"));
 }
 
 TEST(PipelineOptions, SyntheticSprites) {
