@@ -21,11 +21,14 @@ bool RowHasSubject(const uint8_t* a, int n) {
 
 bool ContactPointOptions::IsValid(std::string* why) const {
   OptionProblems check(why);
-  check(std::isfinite(band_fraction) && band_fraction >= 0 && band_fraction <= 1, "band_fraction",
-        "expected a fraction from 0 to 1, got " + OptionProblems::Num(band_fraction));
+  // Checked on every call of ContactPoint: the reasons are written only when needed.
+  check(
+      std::isfinite(band_fraction) && band_fraction >= 0 && band_fraction <= 1, "band_fraction",
+      [&] { return "expected a fraction from 0 to 1, got " + OptionProblems::Num(band_fraction); });
   // The band's height divides the ramp: it must not be 0.
-  check(std::isfinite(min_band_px) && min_band_px > 0, "min_band_px",
-        "expected a positive number of pixels, got " + OptionProblems::Num(min_band_px));
+  check(std::isfinite(min_band_px) && min_band_px > 0, "min_band_px", [&] {
+    return "expected a positive number of pixels, got " + OptionProblems::Num(min_band_px);
+  });
   return check.ok();
 }
 

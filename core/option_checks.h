@@ -4,6 +4,8 @@
 // it by its key: config/config_validate.cc).
 #include <sstream>
 #include <string>
+#include <type_traits>
+#include <utility>
 
 namespace ss {
 
@@ -17,6 +19,14 @@ class OptionProblems {
     if (good) return;
     ok_ = false;
     if (why_) *why_ += (why_->empty() ? "" : "\n") + field + ": " + reason;
+  }
+  // The same with the reason written only when needed: for options checked on a hot path (each
+  // call of ContactPoint), where building every reason would cost more than the check.
+  template <class Reason>
+  requires std::is_invocable_r_v<std::string, Reason>
+  void operator()(bool good, const char* field, Reason&& reason) {
+    if (good) return;
+    (*this)(false, field, std::forward<Reason>(reason)());
   }
   // Another struct's problems (its IsValid's `why`), each field under `prefix` ("extract.").
   void Nested(bool good, const std::string& prefix, const std::string& why) {
