@@ -7,10 +7,15 @@
 //                                             GroundPolygonIndex (the edges near each point)
 //   geometry/floor_mask/every_edge/{comb,star}/N  the same mask through GroundPolygon::Contains
 //                                             (every edge for every pixel: FloorMask before)
+//   geometry/contact_point                    ContactPoint of a person-sized matte (48x120), its
+//                                             options checked on each call as they are now
+//   geometry/contact_point/eager_check        the same after a check that writes every reason
+//                                             whether or not it fails (OptionProblems before)
 // Shapes (tests/core/polygon_fixtures.h): a comb, half of whose edges cross the sweep line at
 // once, and a star of random radii; both simple, so that every check runs to the end. For the
 // floor mask they are scaled to fill the camera's view of the floor.
 // Figures: ms a check or a mask, and the old way's time as a multiple of the new, in this run.
+#include <cmath>
 #include <cstdio>
 #include <map>
 #include <random>
@@ -21,7 +26,9 @@
 
 #include "bench/bench_registry.h"
 #include "core/camera_model.h"
+#include "core/contact_point.h"
 #include "core/geometry.h"
+#include "core/option_checks.h"
 #include "pipeline/filter/usability.h"
 #include "tests/core/polygon_fixtures.h"
 
@@ -132,6 +139,52 @@ BENCHMARK_CAPTURE(BM_FloorMaskEveryEdge, star, std::string("star"))
     ->Range(1000, 10000)
     ->Unit(benchmark::kMillisecond);
 
+// A person's matte: a body 30 px wide and 100 tall, two legs apart below it.
+cv::Mat PersonMatte() {
+  cv::Mat alpha(120, 48, CV_8U, cv::Scalar(0));
+  alpha(cv::Rect(9, 4, 30, 100)).setTo(255);
+  alpha(cv::Rect(9, 100, 10, 18)).setTo(255);
+  alpha(cv::Rect(29, 100, 10, 18)).setTo(255);
+  return alpha;
+}
+
+void BM_ContactPoint(benchmark::State& state) {
+  const cv::Mat alpha = PersonMatte();
+  const ContactPointOptions options;
+  cv::Point2d point;
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(ContactPoint(alpha, &point, options));
+    benchmark::DoNotOptimize(point);
+  }
+}
+BENCHMARK(BM_ContactPoint)->Name("geometry/contact_point")->Unit(benchmark::kMicrosecond);
+
+// The options check as ContactPointOptions::IsValid wrote it before: every reason built.
+bool EagerCheck(const ContactPointOptions& o, std::string* why) {
+  OptionProblems check(why);
+  check(std::isfinite(o.band_fraction) && o.band_fraction >= 0 && o.band_fraction <= 1,
+        "band_fraction",
+        "expected a fraction from 0 to 1, got " + OptionProblems::Num(o.band_fraction));
+  check(std::isfinite(o.min_band_px) && o.min_band_px > 0, "min_band_px",
+        "expected a positive number of pixels, got " + OptionProblems::Num(o.min_band_px));
+  return check.ok();
+}
+
+void BM_ContactPointEagerCheck(benchmark::State& state) {
+  const cv::Mat alpha = PersonMatte();
+  const ContactPointOptions options;
+  cv::Point2d point;
+  for (auto _ : state) {
+    std::string why;
+    benchmark::DoNotOptimize(EagerCheck(options, &why));
+    benchmark::DoNotOptimize(ContactPoint(alpha, &point, options));
+    benchmark::DoNotOptimize(point);
+  }
+}
+BENCHMARK(BM_ContactPointEagerCheck)
+    ->Name("geometry/contact_point/eager_check")
+    ->Unit(benchmark::kMicrosecond);
+
 int Run(const std::vector<std::string>& args) {
   RealTimes collector;  // by "geometry/is_simple/sweep/comb/1000", in ms
   if (const int status = RunGoogleBenchmarks("geometry/", args, &collector)) return status;
@@ -172,12 +225,20 @@ int Run(const std::vector<std::string>& args) {
       std::printf("\n");
     }
   }
+  const std::string lazy = "geometry/contact_point", eager = "geometry/contact_point/eager_check";
+  if (collector.time.count(lazy) && collector.time.count(eager)) {
+    std::printf(
+        "\ncontact point (48x120 matte, one thread): %.3f us a call; with the eager check %.3f us "
+        "= %.2f x\n",
+        collector.time[lazy], collector.time[eager], collector.time[eager] / collector.time[lazy]);
+  }
   return 0;
 }
 
 const bool kRegistered = RegisterSuite(
     {"geometry",
-     "floor polygon: simplicity check (sweep vs brute force), floor mask (index vs every edge)",
+     "floor polygon: simplicity check (sweep vs brute force), floor mask (index vs every edge); "
+     "the contact point",
      &Run});
 
 }  // namespace
