@@ -95,46 +95,44 @@ void AddIntrinsics(CLI::App& parent) {
   auto* cmd = parent.add_subcommand(
       "intrinsics", "Solve lens intrinsics (mrcal) from board views; several cameras jointly");
   auto in = std::make_shared<InputOptions>();
-  auto out = std::make_shared<std::string>();
-  auto lensmodel = std::make_shared<std::string>("LENSMODEL_OPENCV8");
+  // The flags are the job's own fields: its defaults are the solver's and the verdict's.
+  auto job = std::make_shared<calib::IntrinsicsJob>();
   auto json = std::make_shared<bool>(false);
-  auto force = std::make_shared<bool>(false);
-  auto min_views = std::make_shared<int>(10);
-  auto max_rms = std::make_shared<double>(0.5);
   auto keep_outliers = std::make_shared<bool>(false);
-  auto min_coverage = std::make_shared<double>(calib::VerdictOptions{}.min_coverage);
   AddInputOptions(cmd, in.get(), 40);
-  cmd->add_option("--out", *out, "Output folder: CAMERA.cameramodel, plots, intrinsics.json")
+  cmd->add_option("--out", job->out_dir,
+                  "Output folder: CAMERA.cameramodel, plots, intrinsics.json")
       ->required();
-  cmd->add_option("--lensmodel", *lensmodel,
+  cmd->add_option("--lensmodel", job->solve.lensmodel,
                   "mrcal lens model, e.g. LENSMODEL_OPENCV8, "
-                  "LENSMODEL_SPLINED_STEREOGRAPHIC_order=3_Nx=16_Ny=12_fov_x_deg=100");
-  cmd->add_option("--min-views", *min_views, "Accepted views needed for a trusted model");
-  cmd->add_option("--max-rms", *max_rms, "Largest trusted RMS reprojection error, px");
-  cmd->add_option("--min-coverage", *min_coverage,
-                  "Fraction of the image's coverage cells that need corners");
-  cmd->add_flag("--write-rejected", *force, "Write models even when the verdict is 'rejected'");
+                  "LENSMODEL_SPLINED_STEREOGRAPHIC_order=3_Nx=16_Ny=12_fov_x_deg=100")
+      ->capture_default_str();
+  cmd->add_option("--min-views", job->verdict.min_views,
+                  "Accepted views needed for a trusted model")
+      ->capture_default_str();
+  cmd->add_option("--max-rms", job->verdict.max_rms_px,
+                  "Largest trusted RMS reprojection error, px")
+      ->capture_default_str();
+  cmd->add_option("--min-coverage", job->verdict.min_coverage,
+                  "Fraction of the image's coverage cells that need corners")
+      ->capture_default_str();
+  cmd->add_flag("--write-rejected", job->write_rejected,
+                "Write models even when the verdict is 'rejected'");
   cmd->add_flag("--no-outlier-rejection", *keep_outliers,
                 "Keep every corner (mrcal's outlier rejection off)");
   cmd->add_flag("--json", *json, "Print the report as JSON");
   cmd->callback([=] {
-    calib::IntrinsicsJob job;
-    job.board = calib::ParseBoardSpec(in->board);
-    job.solve.lensmodel = *lensmodel;
-    job.solve.reject_outliers = !*keep_outliers;
-    job.verdict.min_views = *min_views;
-    job.verdict.max_rms_px = *max_rms;
-    job.verdict.min_coverage = *min_coverage;
-    job.out_dir = *out;
-    job.write_rejected = *force;
-    const auto views = LoadViews(*in, job.board);
-    const calib::JobOutcome outcome = calib::RunIntrinsics(views, job);
+    job->board = calib::ParseBoardSpec(in->board);
+    job->solve.reject_outliers = !*keep_outliers;
+    const auto views = LoadViews(*in, job->board);
+    const calib::JobOutcome outcome = calib::RunIntrinsics(views, *job);
     Print(outcome, *json);
     if (!outcome.any_board) {
       throw InputError(in->inputs.front(),
-                       "no board " + job.board.ToString() + " found in any view (wrong --board?)");
+                       "no board " + job->board.ToString() + " found in any view (wrong --board?)");
     }
-    if (!outcome.all_good) throw WorkError(*out, "calibration not trusted (see the reasons above)");
+    if (!outcome.all_good)
+      throw WorkError(job->out_dir, "calibration not trusted (see the reasons above)");
   });
 }
 
@@ -274,14 +272,16 @@ void AddEnclosure(CLI::App& parent) {
 void AddWizard(CLI::App& parent) {
   auto* cmd = parent.add_subcommand(
       "wizard", "Guided calibration of one camera: intrinsics, ground, enclosure");
+  // What the wizard's and its run's options do not hold: where the frames come from, the
+  // outputs, and what becomes a field only once known (the board, its pose, frames from seconds).
+  // The other flags are those options' own fields, with their defaults.
   struct Options {
     std::string session, config, camera, board, out, intrinsics, floor_points;
     std::vector<double> pose{0, 0, 0};
-    double thickness = 0, still_px = 0.5, still_s = 0.2, floor_still_s = 1.0, min_coverage = 0.5,
-           max_rms = 0.5;
-    double silent_s = 5;
-    int min_views = 10, max_views = 30, count = 0;
+    double thickness = 0, still_s = 0.2, floor_still_s = 1.0;
     bool json = false;
+    calib::WizardOptions wizard;
+    calib::WizardRunOptions run;
   };
   auto o = std::make_shared<Options>();
   cmd->add_option("--session", o->session,
@@ -306,22 +306,27 @@ void AddWizard(CLI::App& parent) {
                   "Height of the printed surface above the floor, m");
   cmd->add_option("--floor-points", o->floor_points,
                   "Enclosure floor \"x,y x,y ...\" in ground metres (default: the green floor)");
-  cmd->add_option("--min-views", o->min_views, "Intrinsics: views needed");
-  cmd->add_option("--max-views", o->max_views,
-                  "Intrinsics: solve what there is at this many views");
-  cmd->add_option("--min-coverage", o->min_coverage,
-                  "Intrinsics: fraction of the image's coverage cells needed");
-  cmd->add_option("--max-rms", o->max_rms,
-                  "Intrinsics: largest trusted RMS reprojection error, px");
-  cmd->add_option("--still-px", o->still_px,
-                  "Largest corner motion between frames of a still board, px");
+  cmd->add_option("--min-views", o->wizard.verdict.min_views, "Intrinsics: views needed")
+      ->capture_default_str();
+  cmd->add_option("--max-views", o->wizard.max_views,
+                  "Intrinsics: solve what there is at this many views")
+      ->capture_default_str();
+  cmd->add_option("--min-coverage", o->wizard.verdict.min_coverage,
+                  "Intrinsics: fraction of the image's coverage cells needed")
+      ->capture_default_str();
+  cmd->add_option("--max-rms", o->wizard.verdict.max_rms_px,
+                  "Intrinsics: largest trusted RMS reprojection error, px")
+      ->capture_default_str();
+  cmd->add_option("--still-px", o->wizard.still_px,
+                  "Largest corner motion between frames of a still board, px")
+      ->capture_default_str();
   cmd->add_option("--still-seconds", o->still_s,
                   "Intrinsics: the board is still this long before a capture");
   cmd->add_option("--floor-still-seconds", o->floor_still_s,
                   "Ground: still this long = lying on the floor");
-  cmd->add_option("--count", o->count,
+  cmd->add_option("--count", o->run.max_frames,
                   "Stop after this many frames (0: the whole session / until done)");
-  cmd->add_option("--silent-seconds", o->silent_s,
+  cmd->add_option("--silent-seconds", o->run.silent_s,
                   "A live camera without a frame this long ends the wizard")
       ->check(CLI::PositiveNumber);
   cmd->add_flag("--json", o->json, "Print the result and the step log as JSON");
@@ -351,13 +356,9 @@ void AddWizard(CLI::App& parent) {
       if (!found)
         throw InputError("--camera", "no camera named \"" + o->camera + "\" in " + o->config);
     }
-    calib::WizardOptions w;
+    calib::WizardOptions w = o->wizard;
     w.board = calib::ParseBoardSpec(o->board);
-    w.verdict.min_views = o->min_views;
-    w.verdict.min_coverage = o->min_coverage;
-    w.verdict.max_rms_px = o->max_rms;
-    w.max_views = std::max(o->max_views, o->min_views);
-    w.still_px = o->still_px;
+    w.max_views = std::max(w.max_views, w.verdict.min_views);
     w.detect.exhaustive = false;  // a live camera's frames without a board must stay cheap
     w.ground_from_board = calib::FloorBoardPose(o->pose[0], o->pose[1], o->pose[2], o->thickness);
     if (!o->floor_points.empty())
@@ -390,15 +391,12 @@ void AddWizard(CLI::App& parent) {
       }
       std::fflush(stdout);
     };
-    calib::WizardRunOptions run;
-    run.max_frames = o->count;
-    run.silent_s = o->silent_s;
-    const calib::WizardRunResult ran = calib::RunWizardOnSource(*source, wizard, run, print_log);
+    const calib::WizardRunResult ran = calib::RunWizardOnSource(*source, wizard, o->run, print_log);
     const int frames = ran.frames;
     if (ran.silent) {
       std::fprintf(
           stderr, "calibrate wizard: %s delivered no frame for %.1f s; ending with what was seen\n",
-          camera.name.c_str(), o->silent_s);
+          camera.name.c_str(), o->run.silent_s);
     }
     wizard.Finish();
     print_log();
