@@ -30,6 +30,7 @@
 #include "bench/bench_registry.h"
 #include "core/bank.h"
 #include "core/bank_pixels.h"
+#include "core/posix.h"
 
 namespace ss::bench {
 namespace {
@@ -245,8 +246,8 @@ void BM_LoadPixels(benchmark::State& state) {
 // Four stations storing into one PostgreSQL bank at once: each thread its own writer, session
 // and camera (so their clips never collide), the same batches as bank/append/with_mirrors.
 void BM_PostgresFourWriters(benchmark::State& state) {
-  const char* address = std::getenv("SPRITESTATION_BENCH_POSTGRES");
-  if (!address || !*address) {
+  const std::string address = Environment("SPRITESTATION_BENCH_POSTGRES").value_or("");
+  if (address.empty()) {
     state.SkipWithError(
         "SPRITESTATION_BENCH_POSTGRES is not set (scripts/bench-postgres.sh sets it)");
     return;

@@ -20,6 +20,7 @@
 #include "core/bank.h"
 #include "core/bank_copy.h"
 #include "core/bank_work.h"
+#include "core/posix.h"
 #include "core/sql.h"
 #include "core/sql_postgres.h"
 #include "pipeline/transitions/bank_transitions.h"
@@ -30,13 +31,11 @@ namespace {
 
 namespace fs = std::filesystem;
 
-const char* Env(const char* name) {
-  const char* v = std::getenv(name);
-  return v && *v ? v : nullptr;
-}
+// The variable's value; empty when it is not set.
+std::string Env(const char* name) { return Environment(name).value_or(""); }
 
 bool Inputs(benchmark::State& state) {
-  if (!Env("SPRITESTATION_BENCH_POSTGRES") || !Env("SPRITESTATION_BENCH_BANK")) {
+  if (Env("SPRITESTATION_BENCH_POSTGRES").empty() || Env("SPRITESTATION_BENCH_BANK").empty()) {
     state.SkipWithError(
         "SPRITESTATION_BENCH_POSTGRES and SPRITESTATION_BENCH_BANK are needed "
         "(scripts/bench-postgres.sh BUILD transitions sets both)");

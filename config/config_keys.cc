@@ -7,6 +7,7 @@
 #include <fstream>
 
 #include "config/config_detail.h"
+#include "core/posix.h"
 #include "core/sql_postgres.h"
 
 namespace ss::config_detail {
@@ -314,7 +315,7 @@ OptionsBinder ControlKeys(ControlConfig& c) {
             std::ifstream in(token_file);
             if (!in) {
               r.msg().Error("control.token_file",
-                            token_file + ": cannot read the token: " + std::strerror(errno));
+                            token_file + ": cannot read the token: " + ErrnoText(errno));
               return false;
             }
             std::getline(in, c.token);

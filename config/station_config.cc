@@ -12,6 +12,7 @@
 #include "core/error.h"
 #include "core/input_file.h"
 #include "core/log.h"
+#include "core/posix.h"
 #include "core/yaml_reader.h"
 
 // Reading a config: the text (here), its keys (config_keys.cc), its values (config_validate.cc).
@@ -73,7 +74,7 @@ StationConfig LoadStationConfig(const std::string& path, ConfigReport* report,
   std::error_code ec;
   if (fs::is_directory(path, ec)) throw InputError(path, "is a directory, not a config file");
   std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path, std::string("cannot open the config: ") + std::strerror(errno));
+  if (!in) throw InputError(path, std::string("cannot open the config: ") + ErrnoText(errno));
   const std::string text = ReadWithinLimit(in, path, "a config file");
   const fs::path base = fs::absolute(fs::path(path), ec).parent_path();
   return ParseStationConfig(text, path, base.string(), report, options);

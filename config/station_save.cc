@@ -16,6 +16,7 @@
 #include "calib/enclosure.h"
 #include "core/error.h"
 #include "core/log.h"
+#include "core/posix.h"
 
 namespace ss::calib {
 namespace {
@@ -33,7 +34,7 @@ void WriteDurably(const std::string& path, const std::string& bytes) {
   const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
   if (fd < 0)
     throw WorkError(fs::path(path).parent_path().string(),
-                    std::string("cannot write there: ") + std::strerror(errno));
+                    std::string("cannot write there: ") + ErrnoText(errno));
   size_t done = 0;
   while (done < bytes.size()) {
     const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
@@ -42,14 +43,14 @@ void WriteDurably(const std::string& path, const std::string& bytes) {
       const int err = errno;
       ::close(fd);
       ::unlink(path.c_str());
-      throw WorkError(path, std::string("cannot write: ") + std::strerror(err));
+      throw WorkError(path, std::string("cannot write: ") + ErrnoText(err));
     }
     done += static_cast<size_t>(n);
   }
   if (::fsync(fd) != 0 || ::close(fd) != 0) {
     const int err = errno;
     ::unlink(path.c_str());
-    throw WorkError(path, std::string("cannot write: ") + std::strerror(err));
+    throw WorkError(path, std::string("cannot write: ") + ErrnoText(err));
   }
 }
 
@@ -195,7 +196,7 @@ StationSaveResult SaveStationCalibration(const StationConfig& config,
     if (::rename(p.temp.c_str(), p.target.c_str()) != 0) {
       const int err = errno;
       for (size_t k = i; k < pending.size(); ++k) ::unlink(pending[k].temp.c_str());
-      throw WorkError(p.target, std::string("cannot replace: ") + std::strerror(err));
+      throw WorkError(p.target, std::string("cannot replace: ") + ErrnoText(err));
     }
     result.files.push_back(p.target);
   }

@@ -17,6 +17,7 @@
 #include <system_error>
 
 #include "core/error.h"
+#include "core/posix.h"
 
 // libmrcal's headers are plain C without extern "C" guards.
 extern "C" {
@@ -265,7 +266,7 @@ CameraModel CameraModel::Read(const std::string& path) {
   if (std::filesystem::is_directory(path, ec))
     throw InputError(path, "is a directory, not a camera model");
   std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path, std::string("cannot open camera model: ") + std::strerror(errno));
+  if (!in) throw InputError(path, std::string("cannot open camera model: ") + ErrnoText(errno));
   std::ostringstream text;
   text << in.rdbuf();
   if (in.bad()) throw InputError(path, "cannot read camera model");
@@ -303,8 +304,7 @@ void CameraModel::Write(const std::string& path) const {
   const std::string tmp = path + ".tmp." + std::to_string(::getpid());
   {
     std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    if (!out)
-      throw WorkError(path, std::string("cannot write camera model: ") + std::strerror(errno));
+    if (!out) throw WorkError(path, std::string("cannot write camera model: ") + ErrnoText(errno));
     out << text;
     out.flush();
     if (!out) {

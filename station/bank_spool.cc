@@ -16,6 +16,7 @@
 #include "core/bank_pixels.h"
 #include "core/error.h"
 #include "core/log.h"
+#include "core/posix.h"
 
 namespace ss {
 namespace {
@@ -36,7 +37,7 @@ void WriteAll(int fd, const std::vector<uint8_t>& bytes, const std::string& path
   while (done < bytes.size()) {
     const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
     if (n < 0 && errno == EINTR) continue;
-    if (n < 0) throw WorkError(path, std::string("cannot write: ") + std::strerror(errno));
+    if (n < 0) throw WorkError(path, std::string("cannot write: ") + ErrnoText(errno));
     done += static_cast<size_t>(n);
   }
 }
@@ -170,11 +171,10 @@ bool BankSpool::Push(const ClipBatch& batch) {
   const std::string path = (fs::path(dir_) / name).string();
   const std::string temp = (fs::path(dir_) / (".writing-" + name)).string();
   const int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-  if (fd < 0) throw WorkError(temp, std::string("cannot write: ") + std::strerror(errno));
+  if (fd < 0) throw WorkError(temp, std::string("cannot write: ") + ErrnoText(errno));
   try {
     WriteAll(fd, bytes, temp);
-    if (::fsync(fd) != 0)
-      throw WorkError(temp, std::string("cannot write: ") + std::strerror(errno));
+    if (::fsync(fd) != 0) throw WorkError(temp, std::string("cannot write: ") + ErrnoText(errno));
   } catch (...) {
     ::close(fd);
     ::unlink(temp.c_str());
@@ -183,7 +183,7 @@ bool BankSpool::Push(const ClipBatch& batch) {
   ::close(fd);
   if (::rename(temp.c_str(), path.c_str()) != 0) {
     ::unlink(temp.c_str());
-    throw WorkError(path, std::string("cannot write: ") + std::strerror(errno));
+    throw WorkError(path, std::string("cannot write: ") + ErrnoText(errno));
   }
   SyncDir(dir_);
   ++next_;

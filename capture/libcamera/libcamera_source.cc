@@ -20,6 +20,7 @@
 #include "core/error.h"
 #include "core/log.h"
 #include "core/option_checks.h"
+#include "core/posix.h"
 
 namespace ss {
 namespace {
@@ -107,7 +108,7 @@ class LogLines : public std::streambuf {
 void RouteLibcameraLog() {
   static std::once_flag once;
   std::call_once(once, [] {
-    if (std::getenv("LIBCAMERA_LOG_FILE") != nullptr) return;
+    if (Environment("LIBCAMERA_LOG_FILE")) return;
     static auto* buffer = new LogLines();  // libcamera logs until the process ends
     static auto* stream = new std::ostream(buffer);
     lc::logSetStream(stream, false);
@@ -134,7 +135,7 @@ std::shared_ptr<lc::CameraManager> SharedManager() {
   if (r < 0) {
     delete raw;
     throw WorkError("libcamera",
-                    std::string("the camera manager does not start: ") + std::strerror(-r));
+                    std::string("the camera manager does not start: ") + ErrnoText(-r));
   }
   std::shared_ptr<lc::CameraManager> m(raw, [](lc::CameraManager* cm) {
     cm->stop();
@@ -394,7 +395,7 @@ struct LibcameraSource::Impl : std::enable_shared_from_this<Impl> {
       pending.clear();
     }
     const int r = camera->queueRequest(request);
-    if (r < 0) Problem(id() + ": cannot queue a request back: " + std::strerror(-r));
+    if (r < 0) Problem(id() + ": cannot queue a request back: " + ErrnoText(-r));
   }
 
   void Requeue(lc::Request* request) {
@@ -455,7 +456,7 @@ LibcameraSource::LibcameraSource(LibcameraOptions options) : impl_(std::make_sha
   if (const int r = s.camera->acquire(); r < 0) {
     if (r == -EBUSY)
       throw WorkError(id, "busy: another program or camera of this station holds it");
-    throw WorkError(id, std::string("cannot acquire: ") + std::strerror(-r));
+    throw WorkError(id, std::string("cannot acquire: ") + ErrnoText(-r));
   }
   s.acquired = true;
   for (const auto& [control, info] : s.camera->controls()) s.listed.push_back(control->name());
@@ -512,7 +513,7 @@ LibcameraSource::LibcameraSource(LibcameraOptions options) : impl_(std::make_sha
                                          "; sizes: " + sizes + ")");
   }
   if (const int r = s.camera->configure(s.config.get()); r < 0) {
-    throw WorkError(id, "cannot configure " + sc.toString() + ": " + std::strerror(-r));
+    throw WorkError(id, "cannot configure " + sc.toString() + ": " + ErrnoText(-r));
   }
   s.format = *format;
   s.width = static_cast<int>(sc.size.width);
@@ -545,7 +546,7 @@ LibcameraSource::LibcameraSource(LibcameraOptions options) : impl_(std::make_sha
   // Buffers, mapped once, and one request per buffer.
   s.allocator = std::make_unique<lc::FrameBufferAllocator>(s.camera);
   if (const int r = s.allocator->allocate(s.stream); r < 0) {
-    throw WorkError(id, std::string("cannot allocate buffers: ") + std::strerror(-r));
+    throw WorkError(id, std::string("cannot allocate buffers: ") + ErrnoText(-r));
   }
   const auto& buffers = s.allocator->buffers(s.stream);
   if (buffers.size() < 2)
@@ -563,7 +564,7 @@ LibcameraSource::LibcameraSource(LibcameraOptions options) : impl_(std::make_sha
       m.length = length;
       m.start = mmap(nullptr, length, PROT_READ, MAP_SHARED, fd, 0);
       if (m.start == MAP_FAILED)
-        throw WorkError(id, std::string("cannot map a buffer: ") + std::strerror(errno));
+        throw WorkError(id, std::string("cannot map a buffer: ") + ErrnoText(errno));
       s.maps.push_back(m);
       base[fd] = static_cast<const uint8_t*>(m.start);
     }
@@ -576,7 +577,7 @@ LibcameraSource::LibcameraSource(LibcameraOptions options) : impl_(std::make_sha
     std::unique_ptr<lc::Request> request = s.camera->createRequest();
     if (!request) throw WorkError(id, "cannot create a request");
     if (const int r = request->addBuffer(s.stream, buffer.get()); r < 0) {
-      throw WorkError(id, std::string("cannot attach a buffer to a request: ") + std::strerror(-r));
+      throw WorkError(id, std::string("cannot attach a buffer to a request: ") + ErrnoText(-r));
     }
     // Some pipelines (UVC) take controls only with requests: the first carries them too.
     if (s.requests.empty()) request->controls().merge(controls);
@@ -587,7 +588,7 @@ LibcameraSource::LibcameraSource(LibcameraOptions options) : impl_(std::make_sha
   s.camera->disconnected.connect(impl_.get(), &Impl::OnDisconnected);
   if (const int r = s.camera->start(&controls); r < 0) {
     if (r == -EBUSY) throw WorkError(id, "busy: another program is streaming from it");
-    throw WorkError(id, std::string("cannot start: ") + std::strerror(-r));
+    throw WorkError(id, std::string("cannot start: ") + ErrnoText(-r));
   }
   s.started = true;
   {
@@ -595,7 +596,7 @@ LibcameraSource::LibcameraSource(LibcameraOptions options) : impl_(std::make_sha
     s.running = true;
     for (auto& request : s.requests) {
       if (const int r = s.camera->queueRequest(request.get()); r < 0) {
-        throw WorkError(id, std::string("cannot queue a request: ") + std::strerror(-r));
+        throw WorkError(id, std::string("cannot queue a request: ") + ErrnoText(-r));
       }
     }
   }

@@ -18,6 +18,7 @@
 #include "core/error.h"
 #include "core/log.h"
 #include "core/option_checks.h"
+#include "core/posix.h"
 
 namespace ss {
 namespace {
@@ -69,7 +70,7 @@ std::string FourccName(uint32_t fourcc) {
   return s;
 }
 
-std::string Errno() { return std::strerror(errno); }
+std::string Errno() { return ErrnoText(errno); }
 
 // The open file and the mmap'ed buffers, kept alive by the source and by every
 // lent frame; a frame's buffer is queued back to the driver when it dies.

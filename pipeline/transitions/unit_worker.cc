@@ -12,6 +12,7 @@
 #include "core/error.h"
 #include "core/log.h"
 #include "core/option_checks.h"
+#include "core/posix.h"
 #include "pipeline/transitions/bank_transitions.h"
 
 namespace ss {
@@ -106,9 +107,9 @@ bool UnitWorker::RunOne() {
   queue_.Register();
   const std::optional<WorkUnit> unit = queue_.Claim(options_.name, options_.lease_s);
   if (!unit) return false;
-  if (const char* pause = std::getenv("SPRITESTATION_WORKER_TEST_PAUSE_S")) {
+  if (const auto pause = Environment("SPRITESTATION_WORKER_TEST_PAUSE_S")) {
     // Tests: hold the claimed unit a while, so that the worker can be killed in the middle of it.
-    std::this_thread::sleep_for(std::chrono::duration<double>(std::atof(pause)));
+    std::this_thread::sleep_for(std::chrono::duration<double>(std::atof(pause->c_str())));
   }
   CatchUp();
   const auto range = clip_range_.find(unit->clip_id);

@@ -19,6 +19,7 @@
 #include "capture/recording/session_writer.h"
 #include "capture/replay/replay_source.h"
 #include "core/error.h"
+#include "core/posix.h"
 #include "core/session.h"
 #include "tests/capture/session_fixtures.h"
 #include "tests/support/test_support.h"
@@ -68,25 +69,26 @@ void ExpectFramesIntact(const std::vector<Frame>& frames, PixelFormat format, in
 // Started by StartRecorder as a fresh exec of this test binary, so the child
 // inherits no threads (OpenCV's pool, sanitizer runtimes) from the parent.
 TEST(KilledRecorder, RecorderProcess) {
-  const char* session = std::getenv("SS_TEST_RECORDER_DIR");
-  if (session == nullptr)
-    GTEST_SKIP() << "runs only as the child process of the other KilledRecorder tests";
-  const int stop_after = std::atoi(std::getenv("SS_TEST_RECORDER_FRAMES"));
-  SessionWriter writer(session, "killed");
+  const std::optional<std::string> session = Environment("SS_TEST_RECORDER_DIR");
+  if (!session) GTEST_SKIP() << "runs only as the child process of the other KilledRecorder tests";
+  const int stop_after = std::stoi(Environment("SS_TEST_RECORDER_FRAMES").value_or("0"));
+  SessionWriter writer(*session, "killed");
   const int cam = writer.AddCamera(TestCamera("cam0", PixelFormat::kBGR8, 320, 240, 60), nullptr);
   for (uint64_t seq = 0; stop_after == 0 || seq < static_cast<uint64_t>(stop_after); ++seq) {
     writer.Write(TestFrame(PixelFormat::kBGR8, 320, 240, cam, seq, MonotonicNs()));
     std::this_thread::sleep_for(std::chrono::milliseconds(16));
   }
-  std::ofstream(std::string(session) + ".written") << "done";  // tells the parent it is idle now
+  std::ofstream(*session + ".written") << "done";  // tells the parent it is idle now
   while (true) pause();
 }
 
 pid_t StartRecorder(const std::string& session, int stop_after) {
   const pid_t pid = fork();
   if (pid != 0) return pid;
-  setenv("SS_TEST_RECORDER_DIR", session.c_str(), 1);
-  setenv("SS_TEST_RECORDER_FRAMES", std::to_string(stop_after).c_str(), 1);
+  // The forked child has one thread: nothing reads the environment while it is written.
+  setenv("SS_TEST_RECORDER_DIR", session.c_str(), 1);  // NOLINT(concurrency-mt-unsafe)
+  setenv("SS_TEST_RECORDER_FRAMES", std::to_string(stop_after).c_str(),
+         1);  // NOLINT(concurrency-mt-unsafe)
   execl("/proc/self/exe", "capture_tests", "--gtest_filter=KilledRecorder.RecorderProcess",
         nullptr);
   _exit(127);

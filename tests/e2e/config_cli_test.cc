@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include "core/posix.h"
 #include "tests/support/test_support.h"
 
 namespace ss {
@@ -19,7 +20,7 @@ const std::string kOneCamera =
 
 // `spritestation config check`: exit codes and messages of the real executable.
 TEST(StationConfig, CheckCommand) {
-  if (std::getenv("SPRITESTATION_BIN") == nullptr)
+  if (!Environment("SPRITESTATION_BIN"))
     GTEST_SKIP() << "SPRITESTATION_BIN not set (run through ctest)";
   ScratchDir dir;
   auto r = ss::testing::RunSpritestation("config check --no-file-checks " + kExample);
@@ -45,7 +46,7 @@ TEST(StationConfig, CheckCommand) {
 
 // Issue 20: a config or a spec over 16 MiB is bad input (exit 2), refused before it is parsed.
 TEST(StationConfig, OversizedFilesAreRefusedWithExitCode2) {
-  if (std::getenv("SPRITESTATION_BIN") == nullptr)
+  if (!Environment("SPRITESTATION_BIN"))
     GTEST_SKIP() << "SPRITESTATION_BIN not set (run through ctest)";
   ScratchDir dir;
   const std::string config = dir / "big.yaml", spec = dir / "big-spec.yaml";

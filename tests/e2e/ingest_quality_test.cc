@@ -25,6 +25,7 @@
 #include "core/bank.h"
 #include "core/camera_model.h"
 #include "core/geometry.h"
+#include "core/posix.h"
 #include "tests/support/test_support.h"
 #include "tests/synth/synth_csv.h"
 
@@ -211,9 +212,8 @@ class IngestQuality : public ::testing::Test {
     const std::string session = *dir_ / "session";
     // SPRITESTATION_QUALITY_SYNTH replaces the session's options (2 cameras, 1 subject, 30 fps
     // kept) to measure longer sessions (bench/RESULTS.md, "pipeline quality").
-    const char* args = std::getenv("SPRITESTATION_QUALITY_SYNTH");
-    const auto synth =
-        RunSpritestation("--log-level warn synth --out " + session + (args ? args : kSynthArgs));
+    const std::string args = Environment("SPRITESTATION_QUALITY_SYNTH").value_or(kSynthArgs);
+    const auto synth = RunSpritestation("--log-level warn synth --out " + session + args);
     ASSERT_EQ(synth.exit_code, 0) << synth.output;
     const std::string bank_path = *dir_ / "q.bank";
     const auto ingest = RunSpritestation("--log-level warn ingest " + session + " --bank " +

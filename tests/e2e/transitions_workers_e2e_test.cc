@@ -61,11 +61,12 @@ TEST(TransitionWorkers, TwoWorkersAndAKilledOneMakeTheSingleProcessTable) {
   ASSERT_GE(clips, 4) << "several units are needed to share";
 
   // A worker that claims a unit and is killed before it stores anything: its lease (2 s) runs out.
-  setenv("SPRITESTATION_WORKER_TEST_PAUSE_S", "60", 1);
+  // Set for the child only, on gtest's one thread: no thread reads the environment meanwhile.
+  setenv("SPRITESTATION_WORKER_TEST_PAUSE_S", "60", 1);  // NOLINT(concurrency-mt-unsafe)
   BackgroundCommand victim(
       "--log-level warn transitions worker --bank " + pg + " --name victim --lease 2",
       dir / "victim.log");
-  unsetenv("SPRITESTATION_WORKER_TEST_PAUSE_S");
+  unsetenv("SPRITESTATION_WORKER_TEST_PAUSE_S");  // NOLINT(concurrency-mt-unsafe)
   int64_t claimed = 0;
   for (int i = 0; i < 300 && claimed == 0; ++i) {
     std::this_thread::sleep_for(std::chrono::milliseconds(100));

@@ -1,4 +1,5 @@
 #include "tests/support/test_support.h"
+#include "core/posix.h"
 
 #include <sys/wait.h>
 #include <unistd.h>
@@ -31,7 +32,7 @@ ScratchDir::ScratchDir() {
 
 ScratchDir::~ScratchDir() {
   std::error_code ec;
-  if (std::getenv("SPRITESTATION_KEEP_SCRATCH") == nullptr) std::filesystem::remove_all(path_, ec);
+  if (!Environment("SPRITESTATION_KEEP_SCRATCH")) std::filesystem::remove_all(path_, ec);
 }
 
 std::string SourcePath(const std::string& relative) {
@@ -39,8 +40,7 @@ std::string SourcePath(const std::string& relative) {
 }
 
 CommandResult RunSpritestation(const std::string& args) {
-  const char* bin = std::getenv("SPRITESTATION_BIN");
-  return RunCommand(std::string(bin ? bin : "spritestation") + " " + args);
+  return RunCommand(Environment("SPRITESTATION_BIN").value_or("spritestation") + " " + args);
 }
 
 CommandResult RunCommand(const std::string& shell_command) {
@@ -59,9 +59,8 @@ CommandResult RunCommand(const std::string& shell_command) {
 
 BackgroundCommand::BackgroundCommand(const std::string& args, const std::string& log_path)
     : log_path_(log_path) {
-  const char* bin = std::getenv("SPRITESTATION_BIN");
-  const std::string command = "exec " + std::string(bin ? bin : "spritestation") + " " + args +
-                              " > '" + log_path + "' 2>&1";
+  const std::string command = "exec " + Environment("SPRITESTATION_BIN").value_or("spritestation") +
+                              " " + args + " > '" + log_path + "' 2>&1";
   pid_ = fork();
   if (pid_ == 0) {
     execl("/bin/sh", "sh", "-c", command.c_str(), static_cast<char*>(nullptr));

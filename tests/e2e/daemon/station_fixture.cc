@@ -13,6 +13,7 @@
 #include <gtest/gtest.h>
 
 #include "core/bank.h"
+#include "core/posix.h"
 #include "tests/support/test_support.h"
 
 namespace ss::testing {
@@ -38,7 +39,7 @@ std::string EnterPrivateNetwork() {
     const uid_t uid = getuid();
     const gid_t gid = getgid();
     if (unshare(CLONE_NEWUSER | CLONE_NEWNET) != 0) {
-      return std::string("unshare(CLONE_NEWUSER | CLONE_NEWNET): ") + std::strerror(errno) +
+      return std::string("unshare(CLONE_NEWUSER | CLONE_NEWNET): ") + ErrnoText(errno) +
              " (the daemon tests need a private network namespace: run as root or enable user "
              "namespaces)";
     }
@@ -63,9 +64,9 @@ const auto* const kEnvironment = ::testing::AddGlobalTestEnvironment(new Private
 StationSession MakeSession() {
   StationSession s;
   // Keyed by the executable's build time: a rebuilt pipeline makes its own reference bank.
-  const char* bin = std::getenv("SPRITESTATION_BIN");
+  const std::optional<std::string> bin = Environment("SPRITESTATION_BIN");
   std::error_code ec;
-  const auto built = bin ? fs::last_write_time(bin, ec).time_since_epoch().count() : 0;
+  const auto built = bin ? fs::last_write_time(*bin, ec).time_since_epoch().count() : 0;
   const fs::path root =
       fs::temp_directory_path() / ("spritestation-station-fixture-" + std::to_string(built));
   fs::create_directories(root);

@@ -35,6 +35,12 @@
 
 namespace {
 
+// errno's text, thread-safe (the gadget's threads fail independently); GNU strerror_r.
+std::string ErrnoText(int err) {
+  char buffer[256];
+  return strerror_r(err, buffer, sizeof(buffer));
+}
+
 constexpr uint8_t kEndpoint = 0x81;      // dummy_udc's ep1in-bulk
 constexpr uint32_t kMaxPayload = 16384;  // dwMaxPayloadTransferSize: 32 high-speed packets
 constexpr uint32_t kInterval = 333333;   // 30 frames/s in 100 ns units
@@ -233,7 +239,7 @@ bool EnableStreamingEndpoint() {
   if (ep.load() >= 0) return true;
   const int fd = open("/dev/gadget/ep1in-bulk", O_RDWR);
   if (fd < 0) {
-    std::printf("GADGET cannot open ep1in-bulk: %s\n", std::strerror(errno));
+    std::printf("GADGET cannot open ep1in-bulk: %s\n", ErrnoText(errno).c_str());
     return false;
   }
   Bytes config;
@@ -241,7 +247,7 @@ bool EnableStreamingEndpoint() {
   config.u8(7).u8(USB_DT_ENDPOINT).u8(kEndpoint).u8(USB_ENDPOINT_XFER_BULK).u16(64).u8(0);
   config.u8(7).u8(USB_DT_ENDPOINT).u8(kEndpoint).u8(USB_ENDPOINT_XFER_BULK).u16(512).u8(0);
   if (write(fd, config.b.data(), config.b.size()) < 0) {
-    std::printf("GADGET cannot configure ep1in-bulk: %s\n", std::strerror(errno));
+    std::printf("GADGET cannot configure ep1in-bulk: %s\n", ErrnoText(errno).c_str());
     close(fd);
     return false;
   }
@@ -261,7 +267,7 @@ void Stall(const usb_ctrlrequest& r) {
 
 void Reply(const usb_ctrlrequest& r, const void* data, size_t n) {
   const size_t len = n < r.wLength ? n : r.wLength;
-  if (write(ep0, data, len) < 0) std::printf("GADGET reply failed: %s\n", std::strerror(errno));
+  if (write(ep0, data, len) < 0) std::printf("GADGET reply failed: %s\n", ErrnoText(errno).c_str());
 }
 
 void Ack() {
@@ -491,7 +497,7 @@ void StreamLoop() {
                                         (at + n == frame.size() ? UVC_STREAM_EOF : 0));
       std::memcpy(&payload[2], &frame[at], n);
       if (write(ep.load(), payload.data(), n + 2) < 0) {
-        std::printf("GADGET write failed: %s\n", std::strerror(errno));
+        std::printf("GADGET write failed: %s\n", ErrnoText(errno).c_str());
         std::fflush(stdout);
         usleep(100000);
         break;
@@ -529,14 +535,14 @@ int main(int argc, char** argv) {
   FillProbe(&stream.probe, 1, 1);
   ep0 = open("/dev/gadget/dummy_udc", O_RDWR);
   if (ep0 < 0) {
-    std::printf("GADGET cannot open /dev/gadget/dummy_udc: %s\n", std::strerror(errno));
+    std::printf("GADGET cannot open /dev/gadget/dummy_udc: %s\n", ErrnoText(errno).c_str());
     return 1;
   }
   Bytes all;
   all.u32(0).add(ConfigDescriptor(64)).add(ConfigDescriptor(512)).add(DeviceDescriptor());
   std::printf("GADGET configuration descriptor: %zu bytes\n", ConfigDescriptor(512).b.size());
   if (write(ep0, all.b.data(), all.b.size()) < 0) {
-    std::printf("GADGET descriptors refused: %s\n", std::strerror(errno));
+    std::printf("GADGET descriptors refused: %s\n", ErrnoText(errno).c_str());
     return 1;
   }
   std::printf("GADGET bound\n");
@@ -558,7 +564,7 @@ int main(int argc, char** argv) {
       // A host that gave up on a slow answer (a loaded machine slows the guest)
       // leaves a request pending: the read stalls it and the host retries.
       if (errno == EINTR || errno == EAGAIN) continue;
-      std::printf("GADGET ep0 read: %s (continuing)\n", std::strerror(errno));
+      std::printf("GADGET ep0 read: %s (continuing)\n", ErrnoText(errno).c_str());
       if (++read_errors > 1000) return 1;
       usleep(10000);
       continue;

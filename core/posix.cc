@@ -1,0 +1,21 @@
+#include "core/posix.h"
+
+#include <cstdlib>
+#include <cstring>
+
+namespace ss {
+
+std::string ErrnoText(int err) {
+  char buffer[256];
+  // GNU strerror_r: returns the text, in `buffer` or a static string of its own.
+  return strerror_r(err, buffer, sizeof(buffer));
+}
+
+std::optional<std::string> Environment(const char* name) {
+  // Read only, and never while another thread could write it (core/posix.h).
+  const char* value = std::getenv(name);  // NOLINT(concurrency-mt-unsafe)
+  if (value == nullptr) return std::nullopt;
+  return std::string(value);
+}
+
+}  // namespace ss
