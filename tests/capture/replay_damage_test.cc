@@ -86,9 +86,9 @@ pid_t StartRecorder(const std::string& session, int stop_after) {
   const pid_t pid = fork();
   if (pid != 0) return pid;
   // The forked child has one thread: nothing reads the environment while it is written.
-  setenv("SS_TEST_RECORDER_DIR", session.c_str(), 1);  // NOLINT(concurrency-mt-unsafe)
-  setenv("SS_TEST_RECORDER_FRAMES", std::to_string(stop_after).c_str(),
-         1);  // NOLINT(concurrency-mt-unsafe)
+  const std::string frames = std::to_string(stop_after);
+  setenv("SS_TEST_RECORDER_DIR", session.c_str(), 1);    // NOLINT(concurrency-mt-unsafe)
+  setenv("SS_TEST_RECORDER_FRAMES", frames.c_str(), 1);  // NOLINT(concurrency-mt-unsafe)
   execl("/proc/self/exe", "capture_tests", "--gtest_filter=KilledRecorder.RecorderProcess",
         nullptr);
   _exit(127);

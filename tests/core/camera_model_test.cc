@@ -349,7 +349,7 @@ TEST(CameraModel, ReadsACalibrationToolFile) {
 std::string PythonWithMrcal() {
   for (const char* python : {"/usr/bin/python3", "python3"}) {
     const std::string probe = std::string(python) + " -c 'import mrcal' >/dev/null 2>&1";
-    if (std::system(probe.c_str()) == 0) return python;
+    if (testing::RunCommand(probe).exit_code == 0) return python;
   }
   return {};
 }
@@ -377,7 +377,7 @@ print(' '.join(repr(float(v)) for v in mrcal.project(p, lens, intrinsics)))
   const std::string out_path = dir / "out.txt";
   const std::string command =
       python + " " + (dir / "check.py") + " " + model + " > " + out_path + " 2>&1";
-  ASSERT_EQ(std::system(command.c_str()), 0) << ReadText(out_path);
+  ASSERT_EQ(testing::RunCommand(command).exit_code, 0) << ReadText(out_path);
   std::istringstream out(ReadText(out_path));
   std::string lens, line;
   std::getline(out, lens);

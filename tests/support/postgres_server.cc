@@ -11,6 +11,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <array>
 #include <chrono>
 #include <cstdlib>
 #include <filesystem>
@@ -23,6 +24,24 @@ namespace ss::testing {
 namespace {
 
 namespace fs = std::filesystem;
+
+// The user "nobody" (postgres refuses to run as root), looked up once with getpwnam_r (getpwnam's
+// entry is shared by every thread); nullptr when there is none.
+const passwd* NobodyUser() {
+  struct Entry {
+    passwd user{};
+    std::array<char, 4096> text{};
+    bool found = false;
+  };
+  static const Entry* const entry = [] {
+    auto* e = new Entry;  // lives as long as the process, like getpwnam's own
+    passwd* result = nullptr;
+    e->found = ::getpwnam_r("nobody", &e->user, e->text.data(), e->text.size(), &result) == 0 &&
+               result != nullptr;
+    return e;
+  }();
+  return entry->found ? &entry->user : nullptr;
+}
 
 // The newest installed server's bin folder ("" when none).
 std::string FindBin() {
@@ -54,7 +73,7 @@ int FreePort() {
 
 // Runs `argv` as the server's user with stdout and stderr appended to `log`; returns the pid.
 int Spawn(const std::vector<std::string>& argv, const std::string& log) {
-  const passwd* nobody = ::geteuid() == 0 ? ::getpwnam("nobody") : nullptr;
+  const passwd* nobody = ::geteuid() == 0 ? NobodyUser() : nullptr;
   const pid_t pid = ::fork();
   if (pid != 0) return pid;
   if (nobody) {
@@ -93,7 +112,7 @@ PostgresServer::PostgresServer() {
   }
   dir_ = tmpl;
   if (::geteuid() == 0) {
-    const passwd* nobody = ::getpwnam("nobody");
+    const passwd* nobody = NobodyUser();
     if (!nobody || ::chown(dir_.c_str(), nobody->pw_uid, nobody->pw_gid) != 0) {
       ADD_FAILURE() << "cannot hand " << dir_ << " to user nobody";
       return;

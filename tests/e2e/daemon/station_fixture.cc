@@ -49,7 +49,7 @@ std::string EnterPrivateNetwork() {
       return "cannot map this user to root in the new user namespace";
     }
   }
-  if (std::system("ip link set lo up && ip addr add 127.0.0.2/8 dev lo") != 0) {
+  if (testing::RunCommand("ip link set lo up && ip addr add 127.0.0.2/8 dev lo").exit_code != 0) {
     return "`ip link set lo up && ip addr add 127.0.0.2/8 dev lo` failed (is iproute2 installed?)";
   }
   return "";

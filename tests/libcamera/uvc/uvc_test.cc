@@ -181,7 +181,7 @@ TEST(Uvc, LibcameraBackendStreamsFromAUsbCameraUnderQemu) {
       " -append 'console=ttyS0 panic=-1 loglevel=3 no_timer_check mitigations=off "
       "rdinit=/init' < /dev/null > " +
       log.string() + " 2>&1";
-  const int rc = std::system(command.c_str());
+  const int rc = ss::testing::RunCommand(command).exit_code;
   const std::string console = ReadFile(log);
   ASSERT_NE(console.find("PROBE_DONE_NV12"), std::string::npos)
       << "the probe did not finish (qemu exit " << rc << "); console:\n"
