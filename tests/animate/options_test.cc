@@ -1,10 +1,13 @@
 // The animation stages' options (issue 17): defaults valid, values out of range refused by
 // IsValid naming the field (nested blocks under their prefix), and entry points refusing them.
+#include <limits>
 #include <string>
 
 #include <gtest/gtest.h>
 
 #include "animate/animate_run.h"
+#include "animate/beam_search.h"
+#include "animate/problem.h"
 #include "animate/reach_sets.h"
 #include "animate/renderer.h"
 #include "animate/replacement.h"
@@ -17,6 +20,7 @@ namespace ss {
 namespace {
 
 using testing::InputErrorOf;
+using testing::Names;
 using testing::Problems;
 
 TEST(AnimateOptions, DefaultsAreValid) {
@@ -26,6 +30,8 @@ TEST(AnimateOptions, DefaultsAreValid) {
   EXPECT_EQ(Problems(RefineOptions{}), "");
   EXPECT_EQ(Problems(SkeletonMatchOptions{}), "");
   EXPECT_EQ(Problems(AnimateRunOptions{}), "");
+  EXPECT_EQ(Problems(ReplacementOptions{}), "");
+  EXPECT_EQ(Problems(BeamOptions{}), "");
 }
 
 TEST(AnimateOptions, EachProblemNamesItsField) {
@@ -44,6 +50,89 @@ TEST(AnimateOptions, EachProblemNamesItsField) {
   ReplacementOptions replace;
   replace.reach.step_cost = -1;
   EXPECT_EQ(Problems(replace), "reach.step_cost: must be finite and >= 0, got -1");
+}
+
+// The replacement optimizer reports every problem, not the first; the beam block counts only when
+// the replacement starts with a beam search, and comes out under "beam.".
+TEST(AnimateOptions, ReplacementNamesEveryField) {
+  ReplacementOptions o;
+  o.reach.set_size = 0;
+  o.step_cost_fraction = -0.1;
+  o.slow_frame_cost = -1;
+  o.reference_speed_m = -1;
+  o.time_budget_seconds = 0;
+  o.max_tries = 0;
+  o.changes_per_turn = 0;
+  o.max_turns = -1;
+  o.sequential_fraction = 1.5;
+  o.middle_fraction = -0.5;
+  o.begin_fraction = -0.5;
+  o.max_span = -1;
+  o.collision_pick_fraction = 2;
+  o.max_candidates = -1;
+  o.progress_seconds = -1;
+  EXPECT_EQ(Problems(o),
+            "reach.set_size: must be in 1..65535, got 0\n"
+            "step_cost_fraction: must be finite and >= 0, got -0.1\n"
+            "slow_frame_cost: must be >= 0, got -1\n"
+            "reference_speed_m: must be metres >= 0, got -1\n"
+            "time_budget_seconds: must be a positive number of seconds, got 0\n"
+            "max_tries: must be >= 1, got 0\n"
+            "changes_per_turn: must be >= 1, got 0\n"
+            "max_turns: must be >= 0 (0: no limit), got -1\n"
+            "sequential_fraction: must be within [0, 1], got 1.5\n"
+            "middle_fraction: must be >= 0, got -0.5\n"
+            "begin_fraction: must be >= 0, got -0.5\n"
+            "max_span: must be >= 0 (0: the whole sequence), got -1\n"
+            "collision_pick_fraction: must be within [0, 1], got 2\n"
+            "max_candidates: must be >= 0 (0: all of them), got -1\n"
+            "progress_seconds: must be seconds >= 0 (0: never), got -1");
+  ReplacementOptions split;
+  split.middle_fraction = 0.7;
+  split.begin_fraction = 0.4;
+  EXPECT_EQ(Problems(split),
+            "begin_fraction: must leave middle_fraction + begin_fraction <= 1, got 1.1");
+  ReplacementOptions beam;
+  beam.beam.width = 0;
+  EXPECT_EQ(Problems(beam), "");  // a sequential start never reads the beam block
+  beam.start = StartMethod::kBeam;
+  EXPECT_EQ(Problems(beam), "beam.width: must be >= 1, got 0");
+}
+
+TEST(AnimateOptions, BeamNamesEveryField) {
+  BeamOptions o;
+  o.width = 0;
+  o.length = -1;
+  o.start_frames = -1;
+  o.time_budget_seconds = -1;
+  EXPECT_EQ(Problems(o),
+            "width: must be >= 1, got 0\n"
+            "length: must be >= 0 (0: the sprite's own), got -1\n"
+            "start_frames: must be >= 0 (0: every frame), got -1\n"
+            "time_budget_seconds: must be seconds >= 0 (0: one pass), got -1");
+  o = {};
+  o.time_budget_seconds = std::numeric_limits<double>::infinity();
+  EXPECT_TRUE(Names(Problems(o), "time_budget_seconds"));
+}
+
+TEST(AnimateOptions, OptimizersRefuseBadOptions) {
+  const TransitionGraph graph;
+  Problem problem(graph);
+  Summary summary;
+  BeamOptions beam;
+  beam.width = 0;
+  beam.length = -2;
+  EXPECT_EQ(InputErrorOf([&] { BeamSearch(problem, beam, &summary); }),
+            "beam options: width: must be >= 1, got 0\n"
+            "length: must be >= 0 (0: the sprite's own), got -2");
+  ReplacementOptions replace;
+  replace.max_tries = 0;
+  replace.time_budget_seconds = -1;
+  const std::string what = InputErrorOf([&] { OptimizeSequences(problem, replace, &summary); });
+  EXPECT_EQ(what,
+            "replacement options: time_budget_seconds: must be a positive number of seconds, got "
+            "-1\nmax_tries: must be >= 1, got 0");
+  EXPECT_EQ(InputErrorOf([&] { ReplacementSets::Build(problem, replace); }), what);
 }
 
 TEST(AnimateOptions, SkeletonMatchNamesItsNestedBlocks) {
