@@ -1,7 +1,9 @@
 // The animation stages' options (issue 17): defaults valid, values out of range refused by
 // IsValid naming the field (nested blocks under their prefix), and entry points refusing them.
+#include <functional>
 #include <limits>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -11,8 +13,11 @@
 #include "animate/reach_sets.h"
 #include "animate/renderer.h"
 #include "animate/replacement.h"
+#include "animate/skeleton/importers.h"
+#include "animate/skeleton/match_plot.h"
 #include "animate/skeleton/refine.h"
 #include "animate/skeleton/skeleton_match.h"
+#include "animate/skeleton/synthetic_poses.h"
 #include "tests/support/error_text.h"
 #include "tests/support/option_problems.h"
 
@@ -32,6 +37,9 @@ TEST(AnimateOptions, DefaultsAreValid) {
   EXPECT_EQ(Problems(AnimateRunOptions{}), "");
   EXPECT_EQ(Problems(ReplacementOptions{}), "");
   EXPECT_EQ(Problems(BeamOptions{}), "");
+  EXPECT_EQ(Problems(SkeletonImportOptions{}), "");
+  EXPECT_EQ(Problems(GestureScriptOptions{}), "");
+  EXPECT_EQ(Problems(PlotOptions{}), "");
 }
 
 TEST(AnimateOptions, EachProblemNamesItsField) {
@@ -155,6 +163,70 @@ TEST(AnimateOptions, ReachSetsRefuseBadOptions) {
   const std::string what =
       InputErrorOf([&] { ReachSets::Build(TransitionGraph{}, ReachDirection::kForward, reach); });
   EXPECT_EQ(what.rfind("reach options: set_size: must be in 1..65535, got 70000", 0), 0u) << what;
+}
+
+TEST(AnimateOptions, SkeletonImportNamesEveryField) {
+  SkeletonImportOptions o;
+  o.min_confidence = 1.5f;
+  o.person = -1;
+  o.category_id = -2;
+  EXPECT_EQ(Problems(o),
+            "min_confidence: must be within [0, 1] (or unset: the mapping's or the format's), "
+            "got 1.5\n"
+            "person: must be an index >= 0, got -1\n"
+            "category_id: must be a category id >= 0 (or -1: the first with keypoints), got -2");
+  o = {};
+  o.min_confidence = 0;
+  o.category_id = 3;
+  EXPECT_EQ(Problems(o), "");
+  // Each importer refuses bad options before it opens the file.
+  o.person = -1;
+  const JointMapping mapping = IdentityMapping(HumanSkeleton());
+  for (const auto& import : std::vector<std::function<void()>>{
+           [&] { ImportDeepLabCutCsv("/nonexistent.csv", mapping, o); },
+           [&] { ImportOpenPoseJson("/nonexistent", mapping, o); },
+           [&] { ImportCocoKeypoints("/nonexistent.json", mapping, o); },
+           [&] { ImportSynthTruth("/nonexistent", "", mapping, o); }}) {
+    EXPECT_EQ(InputErrorOf(import),
+              "skeleton import options: person: must be an index >= 0, got -1");
+  }
+}
+
+TEST(AnimateOptions, GestureScriptNamesEveryField) {
+  GestureScriptOptions o;
+  o.transition_frames = -1;
+  o.speed = 0;
+  o.noise_px = -1;
+  o.scale_px = 0;
+  o.x_px = std::numeric_limits<float>::quiet_NaN();
+  o.y_px = std::numeric_limits<float>::infinity();
+  EXPECT_EQ(Problems(o),
+            "transition_frames: must be frames >= 0, got -1\n"
+            "speed: must be a positive factor, got 0\n"
+            "noise_px: must be pixels >= 0, got -1\n"
+            "scale_px: must be a positive number of pixels per body unit, got 0\n"
+            "x_px: must be a finite pixel position, got nan\n"
+            "y_px: must be a finite pixel position, got inf");
+  GestureScriptOptions slow;
+  slow.speed = -2;
+  EXPECT_EQ(InputErrorOf([&] {
+              MakeGestureSequence({{Gesture::kY, 5}}, BodyProportions{}, slow);
+            }),
+            "gesture script options: speed: must be a positive factor, got -2");
+}
+
+TEST(AnimateOptions, PlotNamesEveryField) {
+  PlotOptions o;
+  o.panel_size = {100, 480};
+  o.stutter_window = -1;
+  EXPECT_EQ(Problems(o),
+            "panel_size: must be at least 120 x 100 pixels, got 100 x 480\n"
+            "stutter_window: must be frames >= 0, got -1");
+  const std::vector<PlotPanel> panels = {{"a", {0, 1, 1, 0}}};
+  EXPECT_EQ(InputErrorOf([&] { PlotMatch(panels, 2, o); }).rfind("plot options: panel_size: ", 0),
+            0u);
+  EXPECT_EQ(InputErrorOf([&] { PlotMatch({}, 2); }), "plot: needs at least one panel");
+  EXPECT_EQ(PlotMatch(panels, 2).cols, 640);
 }
 
 }  // namespace
