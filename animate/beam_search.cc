@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "core/error.h"
+#include "core/option_checks.h"
 
 namespace ss {
 namespace {
@@ -166,23 +167,19 @@ class BeamPlanner {
 }  // namespace
 
 bool BeamOptions::IsValid(std::string* why) const {
-  auto fail = [why](const std::string& reason) {
-    if (why) *why = reason;
-    return false;
-  };
-  if (width < 1) return fail("width must be >= 1");
-  if (length < 0) return fail("length must be >= 0");
-  if (start_frames < 0) return fail("start_frames must be >= 0");
-  if (!(time_budget_seconds >= 0) || !std::isfinite(time_budget_seconds)) {
-    return fail("time_budget_seconds must be >= 0");
-  }
-  return true;
+  OptionProblems check(why);
+  check(width >= 1, "width", "must be >= 1, got " + std::to_string(width));
+  check(length >= 0, "length", "must be >= 0 (0: the sprite's own), got " + std::to_string(length));
+  check(start_frames >= 0, "start_frames",
+        "must be >= 0 (0: every frame), got " + std::to_string(start_frames));
+  check(time_budget_seconds >= 0 && std::isfinite(time_budget_seconds), "time_budget_seconds",
+        "must be seconds >= 0 (0: one pass), got " + OptionProblems::Num(time_budget_seconds));
+  return check.ok();
 }
 
 std::vector<Track> BeamSearch(const Problem& problem, const BeamOptions& options,
                               Summary* summary) {
-  std::string why;
-  if (!options.IsValid(&why)) throw InputError("beam options", why);
+  if (std::string why; !options.IsValid(&why)) throw InputError("beam options", why);
   const double run_start = MonotonicSeconds();
   const bool budgeted = options.time_budget_seconds > 0;
   const double deadline = budgeted ? run_start + options.time_budget_seconds : kInf;

@@ -20,10 +20,11 @@ struct BeamOptions {
   // > 0: after a pass, rerun with twice the width while time remains and keep the best
   // result; a pass cut by the budget returns the best sequences found so far.
   double time_budget_seconds = 0.0;
+  // False with "FIELD: reason" lines in `why` (core/option_checks.h) for values out of range.
   bool IsValid(std::string* why) const;
 };
 
-// Throws InputError when the options are not valid.
+// Throws InputError("beam options", ...) when the options are not valid.
 std::vector<Track> BeamSearch(const Problem& problem, const BeamOptions& options, Summary* summary);
 
 }  // namespace ss

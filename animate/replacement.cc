@@ -579,43 +579,43 @@ std::vector<Track> Improve(const Problem& problem, const ReplacementOptions& opt
 }  // namespace
 
 bool ReplacementOptions::IsValid(std::string* why) const {
-  auto fail = [why](const std::string& reason) {
-    if (why) *why = reason;
-    return false;
-  };
-  if (std::string part; !reach.IsValid(&part)) {
-    OptionProblems nested(why);
-    nested.Nested(false, "reach.", part);
-    return false;
-  }
-  if (!(step_cost_fraction >= 0) || !std::isfinite(step_cost_fraction)) {
-    return fail("step_cost_fraction must be >= 0");
-  }
-  if (!(slow_frame_cost >= 0) || !(reference_speed_m >= 0)) {
-    return fail("slow_frame_cost and reference_speed_m must be >= 0");
-  }
-  if (!(time_budget_seconds > 0) || !std::isfinite(time_budget_seconds)) {
-    return fail("time_budget_seconds must be > 0");
-  }
-  if (max_tries < 1) return fail("max_tries must be >= 1");
-  if (!(sequential_fraction >= 0 && sequential_fraction <= 1)) {
-    return fail("sequential_fraction must be in [0, 1]");
-  }
-  if (changes_per_turn < 1) return fail("changes_per_turn must be >= 1");
-  if (max_turns < 0) return fail("max_turns must be >= 0");
-  if (!(middle_fraction >= 0) || !(begin_fraction >= 0) || middle_fraction + begin_fraction > 1) {
-    return fail("middle_fraction and begin_fraction must be >= 0 with a sum <= 1");
-  }
-  if (max_span < 0 || max_candidates < 0) return fail("max_span and max_candidates must be >= 0");
-  if (!(collision_pick_fraction >= 0 && collision_pick_fraction <= 1)) {
-    return fail("collision_pick_fraction must be in [0, 1]");
-  }
-  if (!(progress_seconds >= 0)) return fail("progress_seconds must be >= 0");
-  if (start == StartMethod::kBeam) {
-    std::string beam_why;
-    if (!beam.IsValid(&beam_why)) return fail("beam: " + beam_why);
-  }
-  return true;
+  OptionProblems check(why);
+  std::string part;
+  check.Nested(reach.IsValid(&part), "reach.", part);
+  check(step_cost_fraction >= 0 && std::isfinite(step_cost_fraction), "step_cost_fraction",
+        "must be finite and >= 0, got " + OptionProblems::Num(step_cost_fraction));
+  check(slow_frame_cost >= 0, "slow_frame_cost",
+        "must be >= 0, got " + OptionProblems::Num(slow_frame_cost));
+  check(reference_speed_m >= 0, "reference_speed_m",
+        "must be metres >= 0, got " + OptionProblems::Num(reference_speed_m));
+  check(time_budget_seconds > 0 && std::isfinite(time_budget_seconds), "time_budget_seconds",
+        "must be a positive number of seconds, got " + OptionProblems::Num(time_budget_seconds));
+  check(max_tries >= 1, "max_tries", "must be >= 1, got " + std::to_string(max_tries));
+  check(changes_per_turn >= 1, "changes_per_turn",
+        "must be >= 1, got " + std::to_string(changes_per_turn));
+  check(max_turns >= 0, "max_turns",
+        "must be >= 0 (0: no limit), got " + std::to_string(max_turns));
+  check(sequential_fraction >= 0 && sequential_fraction <= 1, "sequential_fraction",
+        "must be within [0, 1], got " + OptionProblems::Num(sequential_fraction));
+  // The beam block is used only to start with a beam search.
+  if (start == StartMethod::kBeam) check.Nested(beam.IsValid(&part), "beam.", part);
+  check(middle_fraction >= 0, "middle_fraction",
+        "must be >= 0, got " + OptionProblems::Num(middle_fraction));
+  check(begin_fraction >= 0, "begin_fraction",
+        "must be >= 0, got " + OptionProblems::Num(begin_fraction));
+  check(!(middle_fraction >= 0 && begin_fraction >= 0) || middle_fraction + begin_fraction <= 1,
+        "begin_fraction",
+        "must leave middle_fraction + begin_fraction <= 1, got " +
+            OptionProblems::Num(middle_fraction + begin_fraction));
+  check(max_span >= 0, "max_span",
+        "must be >= 0 (0: the whole sequence), got " + std::to_string(max_span));
+  check(collision_pick_fraction >= 0 && collision_pick_fraction <= 1, "collision_pick_fraction",
+        "must be within [0, 1], got " + OptionProblems::Num(collision_pick_fraction));
+  check(max_candidates >= 0, "max_candidates",
+        "must be >= 0 (0: all of them), got " + std::to_string(max_candidates));
+  check(progress_seconds >= 0, "progress_seconds",
+        "must be seconds >= 0 (0: never), got " + OptionProblems::Num(progress_seconds));
+  return check.ok();
 }
 
 ReplacementSets ReplacementSets::Build(const Problem& problem, const ReplacementOptions& options) {

@@ -62,6 +62,9 @@ struct ReplacementOptions {
   // Called after every accepted move with the current tracks (tests, live plots).
   std::function<void(const std::vector<Track>&, const TracePoint&)> on_improvement;
 
+  // False with "FIELD: reason" lines in `why` (core/option_checks.h) for values out of range;
+  // the reach block's fields come out under "reach.", the beam block's (checked only for
+  // start = kBeam) under "beam.".
   bool IsValid(std::string* why) const;
 };
 

@@ -302,7 +302,7 @@ void Import(const ImportArgs& a) {
                      "DeepLabCut body parts are named by the project: give a joint mapping file "
                      "(docs/skeletons.md)");
   }
-  ImportOptions options;
+  SkeletonImportOptions options;
   if (a.min_confidence >= 0) options.min_confidence = a.min_confidence;
   options.individual = a.individual;
   options.person = a.person;

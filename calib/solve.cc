@@ -17,6 +17,7 @@ extern "C" {
 
 #include "core/error.h"
 #include "core/log.h"
+#include "core/option_checks.h"
 
 namespace ss::calib {
 namespace {
@@ -145,18 +146,24 @@ std::vector<cv::Point2f> ImagePoints(const BoardObservation& o) {
 
 }  // namespace
 
+bool SolveOptions::IsValid(std::string* why) const {
+  OptionProblems check(why);
+  mrcal_lensmodel_t lens{};
+  const bool known = mrcal_lensmodel_from_name(&lens, lensmodel.c_str());
+  check(known, "lensmodel",
+        "unknown mrcal lens model \"" + lensmodel + "\" (e.g. LENSMODEL_OPENCV8)");
+  check(!known || mrcal_lensmodel_metadata(&lens).has_core, "lensmodel",
+        lensmodel + " has no fx fy cx cy core; pick another model");
+  return check.ok();
+}
+
 SolveSummary SolveBoards(const BoardSpec& board, const std::vector<SolveCamera>& cameras,
                          const std::vector<BoardObservation>& observations,
                          const SolveOptions& options) {
+  if (std::string why; !options.IsValid(&why)) throw InputError("calibration solve options", why);
   auto log = Log("calib.solve");
   Problem p;
-  if (!mrcal_lensmodel_from_name(&p.lens, options.lensmodel.c_str())) {
-    throw InputError("--lensmodel", "unknown mrcal lens model \"" + options.lensmodel + "\"");
-  }
-  if (!mrcal_lensmodel_metadata(&p.lens).has_core) {
-    throw InputError("--lensmodel",
-                     options.lensmodel + " has no fx fy cx cy core; pick another model");
-  }
+  mrcal_lensmodel_from_name(&p.lens, options.lensmodel.c_str());  // known: IsValid
   p.nparams = mrcal_lensmodel_num_params(&p.lens);
   p.ncam = static_cast<int>(cameras.size());
   p.w = board.corners_x();

@@ -43,6 +43,9 @@ struct SolveOptions {
   // Called between the solve's stages ("stage 2 of 3: ...", fraction of the work done): the
   // console shows it while a solve runs.
   std::function<void(const std::string& stage, double fraction)> progress;
+  // False with "FIELD: reason" lines in `why` (core/option_checks.h): a lens model mrcal does not
+  // know, or one without the fx fy cx cy core the seed needs.
+  bool IsValid(std::string* why) const;
 };
 
 // The residual of one observed corner after the solve.
@@ -76,9 +79,9 @@ struct SolveSummary {
   std::string summary;  // one line
 };
 
-// Solves. InputError (naming the camera or view) when a camera has no
-// observation, a camera shares no board view with the others, or an
-// observation has fewer than 4 corners; WorkError when mrcal fails.
+// Solves. InputError for options that are not valid (SolveOptions::IsValid), and (naming the
+// camera or view) when a camera has no observation, a camera shares no board view with the others,
+// or an observation has fewer than 4 corners; WorkError when mrcal fails.
 SolveSummary SolveBoards(const BoardSpec& board, const std::vector<SolveCamera>& cameras,
                          const std::vector<BoardObservation>& observations,
                          const SolveOptions& options = {});

@@ -53,6 +53,7 @@ bool WizardOptions::IsValid(std::string* why) const {
   std::string part;
   check.Nested(detect.IsValid(&part), "detect.", part);
   check.Nested(verdict.IsValid(&part), "verdict.", part);
+  check.Nested(solve.IsValid(&part), "solve.", part);
   check(still_px > 0, "still_px",
         "expected a positive motion in pixels, got " + OptionProblems::Num(still_px));
   check(still_frames >= 1, "still_frames",

@@ -47,8 +47,8 @@ struct WizardOptions {
   // false: the intrinsics are solved only when Solve() is called (the console's Solve button);
   // capturing stops at max_views.
   bool auto_solve = true;
-  // False with "FIELD: reason" lines in `why` for values out of range (detect. and verdict.
-  // name the nested blocks' fields).
+  // False with "FIELD: reason" lines in `why` for values out of range (detect., verdict. and
+  // solve. name the nested blocks' fields).
   bool IsValid(std::string* why) const;
 };
 

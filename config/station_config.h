@@ -109,6 +109,7 @@ struct ConfigReport {
   std::string Summary() const;           // one line per adjustment or error
 };
 
+// No IsValid (core/option_checks.h): its one field is a switch, so no value is out of range.
 struct ConfigOptions {
   bool check_files = true;  // the model, session and token files must exist
 };

@@ -7,6 +7,8 @@
 
 namespace ss {
 
+// No IsValid (core/option_checks.h): any tag is a name a sprite may carry (an unknown one
+// exports nothing) and the other field is a switch, so no value is out of range.
 struct BankExportOptions {
   std::string tag;              // only sprites with this tag; empty = all
   bool include_mirrors = true;  // mirrored copies too (their flipped pixels)

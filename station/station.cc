@@ -48,7 +48,7 @@ void ApplyLogging(const LoggingConfig& logging) {
 bool StationOptions::IsValid(std::string* why) const {
   OptionProblems check(why);
   std::string part;
-  if (weights) check(weights->IsValid(&part), "weights", part);
+  if (weights) check.Nested(weights->IsValid(&part), "weights.", part);
   check(std::isfinite(offline_after_s) && offline_after_s > 0, "offline_after_s",
         "expected a positive number of seconds, got " + OptionProblems::Num(offline_after_s));
   return check.ok();

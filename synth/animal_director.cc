@@ -126,6 +126,7 @@ class AnimalDirector : public Director {
 std::unique_ptr<Director> MakeAnimalDirector(const Studio& studio,
                                              const std::vector<SynthCamera>& cameras,
                                              const DirectorOptions& options) {
+  if (std::string why; !options.IsValid(&why)) throw InputError("director options", why);
   if (studio.kind != StudioKind::kEnclosure)
     throw InputError("kind", "animals live in the enclosure studio");
   return std::make_unique<AnimalDirector>(studio, cameras, options);

@@ -8,6 +8,7 @@
 #include <Eigen/Geometry>
 #include <nlohmann/json.hpp>
 
+#include "core/error.h"
 #include "synth/directors.h"
 #include "synth/random.h"
 
@@ -167,6 +168,7 @@ class CalibrationDirector : public Director {
 std::unique_ptr<Director> MakeCalibrationDirector(const Studio& studio,
                                                   const std::vector<SynthCamera>& cameras,
                                                   const DirectorOptions& options, double seconds) {
+  if (std::string why; !options.IsValid(&why)) throw InputError("director options", why);
   return std::make_unique<CalibrationDirector>(studio, cameras, options, seconds);
 }
 

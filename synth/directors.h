@@ -1,8 +1,10 @@
 #pragma once
 // The directors of the three kinds of session (snapshot.h): animals in the
-// enclosure, articulated figures on the stage, calibration boards.
+// enclosure, articulated figures on the stage, calibration boards. Each refuses options that are
+// not valid (DirectorOptions::IsValid) with an InputError.
 #include <cstdint>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "synth/lens.h"
@@ -21,6 +23,8 @@ struct DirectorOptions {
   // silhouettes meet in the cameras' images (truth/<cam>/overlaps.csv), as two subjects in one
   // blob. They pass through each other where they meet.
   bool crossing = false;
+  // False with "FIELD: reason" lines in `why` (core/option_checks.h) for values out of range.
+  bool IsValid(std::string* why) const;
 };
 
 // `subjects` animals with their behaviour models, placed apart on the floor.

@@ -247,6 +247,7 @@ class FigureDirector : public Director {
 std::unique_ptr<Director> MakeFigureDirector(const Studio& studio,
                                              const std::vector<SynthCamera>& cameras,
                                              const DirectorOptions& options) {
+  if (std::string why; !options.IsValid(&why)) throw InputError("director options", why);
   if (studio.kind != StudioKind::kStage)
     throw InputError("kind", "figures perform on the stage studio");
   return std::make_unique<FigureDirector>(studio, cameras, options);

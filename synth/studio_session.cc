@@ -21,6 +21,8 @@
 #include "core/contact_point.h"
 #include "core/error.h"
 #include "core/log.h"
+#include "core/option_checks.h"
+#include "core/recording_codecs.h"
 #include "synth/directors.h"
 #include "synth/renderer.h"
 #include "synth/scene.h"
@@ -176,37 +178,50 @@ int SynthOptions::frames() const {
 }
 
 bool SynthOptions::IsValid(std::string* why) const {
-  auto fail = [&](const std::string& reason) {
-    if (why) *why = reason;
-    return false;
-  };
-  if (out_dir.empty()) return fail("--out: a session folder is needed");
-  if (!(seconds > 0) || seconds > 3600) return fail("--seconds: expected 0 < S <= 3600");
-  if (!(fps >= 1) || fps > 240) return fail("--fps: expected 1..240");
-  if (width < 64 || height < 48 || width > 4096 || height > 4096)
-    return fail("--size: expected 64x48 .. 4096x4096");
-  if (pixel_format == PixelFormat::kBayerRG8 && (width % 2 || height % 2)) {
-    return fail("--size: bayer_rg8 needs an even width and height");
+  OptionProblems check(why);
+  // The director's fields by the director's ranges; then, for values it takes, the session's
+  // narrower ones (each field named once).
+  std::string part;
+  check.Nested(DirectorOptions::IsValid(&part), "", part);
+  if (subjects >= 0 && subjects <= 64) {
+    check(subjects <= 8, "subjects",
+          "a session renders at most 8 subjects, got " + std::to_string(subjects));
   }
-  if (cameras < 1 || cameras > 8) return fail("--cameras: expected 1..8");
-  if (subjects < 0 || subjects > 8) return fail("--subjects: expected 0..8");
-  if (pixel_format != PixelFormat::kRGB8 && pixel_format != PixelFormat::kBGR8 &&
-      pixel_format != PixelFormat::kBayerRG8 && pixel_format != PixelFormat::kMono8) {
-    return fail("--pixel-format: expected rgb8, bgr8, bayer_rg8 or mono8");
+  if (std::isfinite(fps) && fps > 0) {
+    check(fps >= 1 && fps <= 240, "fps",
+          "a session runs at 1..240 frames per second, got " + OptionProblems::Num(fps));
   }
-  if (!(noise >= 0) || noise > 10) return fail("--noise: expected 0..10");
-  if (threads < 1 || threads > 64) return fail("--threads: expected 1..64");
-  if (kind == SynthKind::kAnimal && studio == StudioKind::kStage)
-    return fail("--studio: animals live in the enclosure");
-  if (kind == SynthKind::kFigure && studio == StudioKind::kEnclosure)
-    return fail("--studio: figures perform on the stage");
-  if (figure_variant < 0 || figure_variant > 1) return fail("--figure-variant: expected 0 or 1");
-  return true;
+  check(!out_dir.empty(), "out_dir", "a session folder is needed");
+  check(seconds > 0 && seconds <= 3600, "seconds",
+        "expected 0 < seconds <= 3600, got " + OptionProblems::Num(seconds));
+  const bool bayer = pixel_format == PixelFormat::kBayerRG8;
+  const bool width_ok = width >= 64 && width <= 4096, height_ok = height >= 48 && height <= 4096;
+  check(width_ok, "width", "expected 64..4096 pixels, got " + std::to_string(width));
+  check(!width_ok || !bayer || width % 2 == 0, "width",
+        "bayer_rg8 needs an even width, got " + std::to_string(width));
+  check(height_ok, "height", "expected 48..4096 pixels, got " + std::to_string(height));
+  check(!height_ok || !bayer || height % 2 == 0, "height",
+        "bayer_rg8 needs an even height, got " + std::to_string(height));
+  check(cameras >= 1 && cameras <= 8, "cameras", "expected 1..8, got " + std::to_string(cameras));
+  check(pixel_format == PixelFormat::kRGB8 || pixel_format == PixelFormat::kBGR8 || bayer ||
+            pixel_format == PixelFormat::kMono8,
+        "pixel_format",
+        "expected rgb8, bgr8, bayer_rg8 or mono8, got " + PixelFormatName(pixel_format));
+  check(noise >= 0 && noise <= 10, "noise", "expected 0..10, got " + OptionProblems::Num(noise));
+  check(threads >= 1 && threads <= 64, "threads", "expected 1..64, got " + std::to_string(threads));
+  check(!(kind == SynthKind::kAnimal && studio == StudioKind::kStage), "studio",
+        "animals live in the enclosure");
+  check(!(kind == SynthKind::kFigure && studio == StudioKind::kEnclosure), "studio",
+        "figures perform on the stage");
+  check(FindRecordingCodec(codec) != nullptr, "codec",
+        "unknown codec '" + codec + "' (expected " + RecordingCodecNames() + ")");
+  check(std::isfinite(empty_lead_in_s) && empty_lead_in_s >= 0, "empty_lead_in_s",
+        "expected seconds >= 0, got " + OptionProblems::Num(empty_lead_in_s));
+  return check.ok();
 }
 
 SynthSummary RenderStudioSession(const SynthOptions& o) {
-  std::string why;
-  if (!o.IsValid(&why)) throw InputError(why);
+  if (std::string why; !o.IsValid(&why)) throw InputError("synth options", why);
   const auto t_start = Clock::now();
   const double cpu_start = ProcessCpuS();
   auto log = Log("synth");

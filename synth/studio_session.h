@@ -48,7 +48,8 @@ struct SynthOptions : DirectorOptions {
   // as a studio records the empty enclosure first for the keyer to learn.
   double empty_lead_in_s = 0.0;
 
-  // False with the reason when an option is out of range.
+  // False with "FIELD: reason" lines in `why` (core/option_checks.h) for values out of range:
+  // the director's fields by DirectorOptions::IsValid, narrowed to what a session renders.
   bool IsValid(std::string* why) const;
   int frames() const;
 };
@@ -78,7 +79,7 @@ struct SynthSummary {
 };
 
 // Renders the session into options.out_dir (which must not exist or be empty).
-// InputError for bad options, WorkError when writing fails.
+// InputError("synth options", ...) for bad options, WorkError when writing fails.
 SynthSummary RenderStudioSession(const SynthOptions& options);
 
 }  // namespace ss::synth

@@ -12,6 +12,7 @@
 
 #include "core/error.h"
 #include "core/log.h"
+#include "core/option_checks.h"
 
 namespace ss {
 namespace {
@@ -86,10 +87,27 @@ struct DlcPart {
   int x = -1, y = -1, likelihood = -1;
 };
 
+void RefuseBadOptions(const SkeletonImportOptions& options) {
+  if (std::string why; !options.IsValid(&why)) throw InputError("skeleton import options", why);
+}
+
 }  // namespace
 
+bool SkeletonImportOptions::IsValid(std::string* why) const {
+  OptionProblems check(why);
+  check(!min_confidence || (*min_confidence >= 0 && *min_confidence <= 1), "min_confidence",
+        "must be within [0, 1] (or unset: the mapping's or the format's), got " +
+            OptionProblems::Num(min_confidence.value_or(0)));
+  check(person >= 0, "person", "must be an index >= 0, got " + std::to_string(person));
+  check(category_id >= -1, "category_id",
+        "must be a category id >= 0 (or -1: the first with keypoints), got " +
+            std::to_string(category_id));
+  return check.ok();
+}
+
 SkeletonSequence ImportDeepLabCutCsv(const std::string& path, const JointMapping& mapping,
-                                     const ImportOptions& options) {
+                                     const SkeletonImportOptions& options) {
+  RefuseBadOptions(options);
   std::ifstream in(path);
   if (!in) throw InputError(path, "cannot open the DeepLabCut CSV");
   std::vector<std::vector<std::string>> header;
@@ -203,7 +221,7 @@ SkeletonSequence ImportDeepLabCutCsv(const std::string& path, const JointMapping
 
 namespace {
 SkeletonSequence ImportOpenPoseJsonUnchecked(const std::string& path, const JointMapping& mapping,
-                                             const ImportOptions& options) {
+                                             const SkeletonImportOptions& options) {
   std::vector<std::string> files;
   std::error_code ec;
   if (fs::is_directory(path, ec)) {
@@ -289,7 +307,8 @@ SkeletonSequence ImportOpenPoseJsonUnchecked(const std::string& path, const Join
 }  // namespace
 
 SkeletonSequence ImportOpenPoseJson(const std::string& path, const JointMapping& mapping,
-                                    const ImportOptions& options) {
+                                    const SkeletonImportOptions& options) {
+  RefuseBadOptions(options);
   // A field of the wrong JSON type (an array where a name belongs) is the file's fault.
   try {
     return ImportOpenPoseJsonUnchecked(path, mapping, options);
@@ -300,7 +319,7 @@ SkeletonSequence ImportOpenPoseJson(const std::string& path, const JointMapping&
 
 namespace {
 SkeletonSequence ImportCocoKeypointsUnchecked(const std::string& path, const JointMapping& mapping,
-                                              const ImportOptions& options) {
+                                              const SkeletonImportOptions& options) {
   const nlohmann::json json = ReadJsonFile(path);
   const auto annotations = json.find("annotations");
   if (!json.is_object() || annotations == json.end() || !annotations->is_array()) {
@@ -376,7 +395,8 @@ SkeletonSequence ImportCocoKeypointsUnchecked(const std::string& path, const Joi
 }  // namespace
 
 SkeletonSequence ImportCocoKeypoints(const std::string& path, const JointMapping& mapping,
-                                     const ImportOptions& options) {
+                                     const SkeletonImportOptions& options) {
+  RefuseBadOptions(options);
   // A field of the wrong JSON type (an array where a name belongs) is the file's fault.
   try {
     return ImportCocoKeypointsUnchecked(path, mapping, options);
@@ -400,7 +420,7 @@ JointMapping IdentityMapping(const SkeletonDef& def) {
 namespace {
 SkeletonSequence ImportSynthTruthUnchecked(const std::string& path, const std::string& camera,
                                            const JointMapping& mapping,
-                                           const ImportOptions& options) {
+                                           const SkeletonImportOptions& options) {
   // Find the truth folder and the CSV.
   fs::path truth_dir, csv;
   if (fs::is_regular_file(path)) {
@@ -491,7 +511,9 @@ SkeletonSequence ImportSynthTruthUnchecked(const std::string& path, const std::s
 }  // namespace
 
 SkeletonSequence ImportSynthTruth(const std::string& path, const std::string& camera,
-                                  const JointMapping& mapping, const ImportOptions& options) {
+                                  const JointMapping& mapping,
+                                  const SkeletonImportOptions& options) {
+  RefuseBadOptions(options);
   // A field of the wrong JSON type (an array where a name belongs) is the file's fault.
   try {
     return ImportSynthTruthUnchecked(path, camera, mapping, options);

@@ -7,6 +7,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "core/error.h"
+#include "core/option_checks.h"
 
 namespace ss {
 namespace {
@@ -66,12 +67,21 @@ void DrawPanel(cv::Mat& canvas, const PlotPanel& panel, int source_count, const 
 
 }  // namespace
 
+bool PlotOptions::IsValid(std::string* why) const {
+  OptionProblems check(why);
+  check(panel_size.width >= 120 && panel_size.height >= 100, "panel_size",
+        "must be at least 120 x 100 pixels, got " + std::to_string(panel_size.width) + " x " +
+            std::to_string(panel_size.height));
+  check(stutter_window >= 0, "stutter_window",
+        "must be frames >= 0, got " + std::to_string(stutter_window));
+  return check.ok();
+}
+
 cv::Mat PlotMatch(const std::vector<PlotPanel>& panels, int source_count,
                   const PlotOptions& options) {
+  if (std::string why; !options.IsValid(&why)) throw InputError("plot options", why);
+  if (panels.empty()) throw InputError("plot", "needs at least one panel");
   const cv::Size size = options.panel_size;
-  if (panels.empty() || size.width < 120 || size.height < 100) {
-    throw InputError("plot", "needs at least one panel of at least 120 x 100 pixels");
-  }
   cv::Mat canvas(size.height, size.width * static_cast<int>(panels.size()), CV_8UC3,
                  cv::Scalar(255, 255, 255));
   for (size_t i = 0; i < panels.size(); ++i) {

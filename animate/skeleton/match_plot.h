@@ -20,9 +20,12 @@ struct PlotOptions {
   int stutter_window = 8;             // a backward step of up to this many frames is a stutter
   std::vector<int> clip_starts;       // drawn as faint horizontal lines
   std::vector<int> target_movements;  // drawn as faint vertical lines
+  // False with "FIELD: reason" lines in `why` (core/option_checks.h) for values out of range.
+  bool IsValid(std::string* why) const;
 };
 
-// The panels side by side, BGR. `source_count` sets the vertical range.
+// The panels side by side, BGR. `source_count` sets the vertical range. InputError for options
+// that are not valid ("plot options") and for no panel.
 cv::Mat PlotMatch(const std::vector<PlotPanel>& panels, int source_count,
                   const PlotOptions& options = {});
 

@@ -3,6 +3,9 @@
 #include <cmath>
 #include <random>
 
+#include "core/error.h"
+#include "core/option_checks.h"
+
 namespace ss {
 namespace {
 
@@ -157,9 +160,27 @@ BodyProportions OtherBody() {
   return b;
 }
 
+bool GestureScriptOptions::IsValid(std::string* why) const {
+  OptionProblems check(why);
+  check(transition_frames >= 0, "transition_frames",
+        "must be frames >= 0, got " + std::to_string(transition_frames));
+  check(speed > 0 && std::isfinite(speed), "speed",
+        "must be a positive factor, got " + OptionProblems::Num(speed));
+  check(noise_px >= 0 && std::isfinite(noise_px), "noise_px",
+        "must be pixels >= 0, got " + OptionProblems::Num(noise_px));
+  check(scale_px > 0 && std::isfinite(scale_px), "scale_px",
+        "must be a positive number of pixels per body unit, got " + OptionProblems::Num(scale_px));
+  check(std::isfinite(x_px), "x_px",
+        "must be a finite pixel position, got " + OptionProblems::Num(x_px));
+  check(std::isfinite(y_px), "y_px",
+        "must be a finite pixel position, got " + OptionProblems::Num(y_px));
+  return check.ok();
+}
+
 LabelledSkeletons MakeGestureSequence(const std::vector<std::pair<Gesture, int>>& script,
                                       const BodyProportions& body,
                                       const GestureScriptOptions& options) {
+  if (std::string why; !options.IsValid(&why)) throw InputError("gesture script options", why);
   LabelledSkeletons out;
   out.sequence.skeleton = HumanSkeleton();
   out.sequence.fps = 25;

@@ -38,6 +38,8 @@ struct GestureScriptOptions {
   float scale_px = 100.0f;       // pixels per body unit
   float x_px = 320, y_px = 300;  // pelvis position
   uint32_t seed = 1;
+  // False with "FIELD: reason" lines in `why` (core/option_checks.h) for values out of range.
+  bool IsValid(std::string* why) const;
 };
 
 struct LabelledSkeletons {
@@ -45,7 +47,8 @@ struct LabelledSkeletons {
   std::vector<Gesture> labels;  // per frame; a transition's first half keeps the old label
 };
 
-// Plays `script` (gesture, frames held) with `body`.
+// Plays `script` (gesture, frames held) with `body`. InputError("gesture script options", ...)
+// for options that are not valid.
 LabelledSkeletons MakeGestureSequence(const std::vector<std::pair<Gesture, int>>& script,
                                       const BodyProportions& body,
                                       const GestureScriptOptions& options = {});

@@ -24,7 +24,7 @@ bool BankTrainOptions::IsValid(std::string* why) const {
   OptionProblems check(why);
   std::string part;
   check.Nested(train.IsValid(&part), "train.", part);
-  check(window.IsValid(&part), "window", part);
+  check.Nested(window.IsValid(&part), "window.", part);
   check(std::isfinite(stage1_recall) && stage1_recall >= 0 && stage1_recall <= 1, "stage1_recall",
         "expected a share from 0 to 1, got " + OptionProblems::Num(stage1_recall));
   // Negative (any) reads the labels file's rate.

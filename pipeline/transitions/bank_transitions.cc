@@ -102,7 +102,7 @@ StoreResult StoreTransitionTable(BankWriter& bank, const std::vector<Transition>
 bool BankUpdateOptions::IsValid(std::string* why) const {
   OptionProblems check(why);
   std::string part;
-  check(weights.IsValid(&part), "weights", part);
+  check.Nested(weights.IsValid(&part), "weights.", part);
   check(threads >= 1, "threads", "expected at least 1 thread, got " + std::to_string(threads));
   return check.ok();
 }

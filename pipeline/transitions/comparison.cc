@@ -9,21 +9,24 @@
 #include <vector>
 
 #include "core/error.h"
+#include "core/option_checks.h"
 
 namespace ss {
 
 bool ComparisonWindow::IsValid(std::string* why) const {
-  auto fail = [&](const std::string& reason) {
-    if (why) *why = reason;
-    return false;
-  };
-  if (!(width_m > 0) || !std::isfinite(width_m))
-    return fail("width_m must be a positive number of metres");
-  if (!(height_m > 0) || !std::isfinite(height_m))
-    return fail("height_m must be a positive number of metres");
-  if (cells_x < 1 || cells_y < 1) return fail("cells_x and cells_y must be at least 1");
-  if (Cells() > 4096) return fail("cells_x * cells_y must be at most 4096");
-  return true;
+  OptionProblems check(why);
+  check(std::isfinite(width_m) && width_m > 0, "width_m",
+        "expected a positive number of metres, got " + OptionProblems::Num(width_m));
+  check(std::isfinite(height_m) && height_m > 0, "height_m",
+        "expected a positive number of metres, got " + OptionProblems::Num(height_m));
+  check(cells_x >= 1, "cells_x", "expected at least 1 cell, got " + std::to_string(cells_x));
+  check(cells_y >= 1, "cells_y", "expected at least 1 cell, got " + std::to_string(cells_y));
+  // A plane holds at most 4096 cells; the product is reported under cells_y.
+  const int64_t cells = int64_t{cells_x} * cells_y;
+  check(cells_x < 1 || cells_y < 1 || cells <= 4096, "cells_y",
+        "expected cells_x * cells_y <= 4096 cells, got " + std::to_string(cells_x) + " x " +
+            std::to_string(cells_y));
+  return check.ok();
 }
 
 CellBox UnionBox(const CellBox& a, const CellBox& b) {

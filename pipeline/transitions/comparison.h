@@ -31,7 +31,8 @@ struct ComparisonWindow {
   int PlaneStride() const { return (Cells() + 63) / 64 * 64; }
   // Bytes of one comparison image (four planes).
   int ImageBytes() const { return 4 * PlaneStride(); }
-  // False (with the reason) for non-positive sizes or more than 4096 cells.
+  // False with "FIELD: reason" lines in `why` (core/option_checks.h) for non-positive sizes or
+  // more than 4096 cells.
   bool IsValid(std::string* why) const;
 };
 

@@ -35,7 +35,7 @@ std::string DefaultName() {
 bool UnitWorkerOptions::IsValid(std::string* why) const {
   OptionProblems check(why);
   std::string part;
-  check(weights.IsValid(&part), "weights", part);
+  check.Nested(weights.IsValid(&part), "weights.", part);
   check(std::isfinite(lease_s) && lease_s > 0, "lease_s",
         "expected a positive number of seconds, got " + OptionProblems::Num(lease_s));
   check(load_threads >= 1, "load_threads",

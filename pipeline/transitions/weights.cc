@@ -1,12 +1,15 @@
 #include "pipeline/transitions/weights.h"
 
+#include <array>
 #include <cmath>
 #include <fstream>
 #include <sstream>
+#include <string>
 
 #include <nlohmann/json.hpp>
 
 #include "core/error.h"
+#include "core/option_checks.h"
 
 namespace ss {
 
@@ -20,7 +23,7 @@ class FieldReader {
   FieldReader(const json& root, std::string source) : root_(root), source_(std::move(source)) {}
 
   [[noreturn]] void Fail(const std::string& field, const std::string& reason) const {
-    throw InputError(source_, "field '" + field + "': " + reason);
+    throw InputError(source_, field + ": " + reason);
   }
   const json& Get(const std::string& field) const {
     const json* node = &root_;
@@ -68,49 +71,53 @@ class FieldReader {
   std::string source_;
 };
 
+// The elements of `values` that `good` refuses, "element K is V" each, joined by ", ".
+template <size_t N, class Good>
+std::string BadElements(const std::array<double, N>& values, Good good) {
+  std::string out;
+  for (size_t k = 0; k < N; ++k) {
+    if (good(values[k])) continue;
+    out += (out.empty() ? "" : ", ") + std::string("element ") + std::to_string(k) + " is " +
+           OptionProblems::Num(values[k]);
+  }
+  return out;
+}
+
 }  // namespace
 
 bool TransitionWeights::IsValid(std::string* why) const {
-  auto fail = [&](const std::string& field, const std::string& reason) {
-    if (why) *why = "field '" + field + "': " + reason;
-    return false;
-  };
-  std::string window_why;
-  if (!window.IsValid(&window_why)) return fail("comparison_window", window_why);
-  for (int k = 0; k < kPairFeatureCount; ++k) {
-    if (!std::isfinite(feature_mean[k])) return fail("feature_mean", "not finite");
-    if (!(feature_scale[k] > 0) || !std::isfinite(feature_scale[k])) {
-      return fail("feature_scale", "element " + std::to_string(k) + " must be positive");
-    }
-    if (!(stage2_weights[k] >= 0) || !std::isfinite(stage2_weights[k])) {
-      return fail("stage2.weights",
-                  "element " + std::to_string(k) + " must be a non-negative number");
-    }
-  }
-  for (int k = 0; k < kCheapFeatureCount; ++k) {
-    if (!(stage1_weights[k] >= 0) || !std::isfinite(stage1_weights[k])) {
-      return fail("stage1.weights",
-                  "element " + std::to_string(k) +
-                      " must be non-negative (stage 1 must accept a weighted-L1 ball)");
-    }
-  }
-  if (!std::isfinite(stage1_bias)) return fail("stage1.bias", "not finite");
-  if (!std::isfinite(stage2_bias)) return fail("stage2.bias", "not finite");
+  OptionProblems check(why);
+  std::string part;
+  check.Nested(window.IsValid(&part), "comparison_window.", part);
+  const auto positive = [](double v) { return std::isfinite(v) && v > 0; };
+  const auto non_negative = [](double v) { return std::isfinite(v) && v >= 0; };
+  const auto finite = [](double v) { return std::isfinite(v); };
+  std::string bad = BadElements(feature_mean, finite);
+  check(bad.empty(), "feature_mean", "expected finite numbers, but " + bad);
+  bad = BadElements(feature_scale, positive);
+  check(bad.empty(), "feature_scale", "expected positive numbers, but " + bad);
+  bad = BadElements(stage1_weights, non_negative);
+  check(bad.empty(), "stage1.weights",
+        "expected numbers >= 0 (stage 1 must accept a weighted-L1 ball), but " + bad);
+  check(std::isfinite(stage1_bias), "stage1.bias",
+        "expected a finite number, got " + OptionProblems::Num(stage1_bias));
+  bad = BadElements(stage2_weights, non_negative);
+  check(bad.empty(), "stage2.weights", "expected numbers >= 0, but " + bad);
+  check(std::isfinite(stage2_bias), "stage2.bias",
+        "expected a finite number, got " + OptionProblems::Num(stage2_bias));
   if (stage2_variant == Stage2Variant::kLinf) {
-    if (!(linf_max_velocity_mps > 0) || !std::isfinite(linf_max_velocity_mps)) {
-      return fail("stage2.linf.max_velocity_mps", "must be a positive number");
-    }
-    if (!(linf_max_alpha > 0 && linf_max_alpha <= 1)) {
-      return fail("stage2.linf.max_alpha_linf", "must be in (0, 1]");
-    }
+    check(positive(linf_max_velocity_mps), "stage2.linf.max_velocity_mps",
+          "expected a positive number, got " + OptionProblems::Num(linf_max_velocity_mps));
+    check(linf_max_alpha > 0 && linf_max_alpha <= 1, "stage2.linf.max_alpha_linf",
+          "expected a number in (0, 1], got " + OptionProblems::Num(linf_max_alpha));
   }
   if (stage2_variant == Stage2Variant::kColourBlob) {
-    if (!(colour_blob_max_velocity_mps > 0) || !std::isfinite(colour_blob_max_velocity_mps)) {
-      return fail("stage2.colour_blob.max_velocity_mps", "must be a positive number");
-    }
-    if (colour_blob_max_cells < 0) return fail("stage2.colour_blob.max_blob_cells", "must be >= 0");
+    check(positive(colour_blob_max_velocity_mps), "stage2.colour_blob.max_velocity_mps",
+          "expected a positive number, got " + OptionProblems::Num(colour_blob_max_velocity_mps));
+    check(colour_blob_max_cells >= 0, "stage2.colour_blob.max_blob_cells",
+          "expected a number >= 0, got " + std::to_string(colour_blob_max_cells));
   }
-  return true;
+  return check.ok();
 }
 
 TransitionWeights ParseWeights(const std::string& text, const std::string& source) {

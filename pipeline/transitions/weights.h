@@ -41,12 +41,15 @@ struct TransitionWeights {
   // provenance and cross-validation figures (free form JSON object)
   std::string training_json = "{}";
 
-  // False (with the field and the reason) unless every field is usable.
+  // False with "FIELD: reason" lines in `why` (core/option_checks.h) for every field that is not
+  // usable, each named by its key in the weights file ("stage1.weights",
+  // "comparison_window.cells_x").
   bool IsValid(std::string* why) const;
 };
 
 // Parses a weights file's text; `source` names it in errors. Throws
-// InputError(source, "field 'stage1.weights': ...") on any wrong, missing or garbled field.
+// InputError(source, "stage1.weights: ...") on a wrong, missing or garbled field (every value
+// out of range, one line each, once the file's fields have been read).
 TransitionWeights ParseWeights(const std::string& text, const std::string& source);
 // Reads and parses a file; InputError(path, ...) when it cannot be read or parsed.
 TransitionWeights LoadWeights(const std::string& path);

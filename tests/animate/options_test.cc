@@ -1,15 +1,23 @@
 // The animation stages' options (issue 17): defaults valid, values out of range refused by
 // IsValid naming the field (nested blocks under their prefix), and entry points refusing them.
+#include <functional>
+#include <limits>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
 #include "animate/animate_run.h"
+#include "animate/beam_search.h"
+#include "animate/problem.h"
 #include "animate/reach_sets.h"
 #include "animate/renderer.h"
 #include "animate/replacement.h"
+#include "animate/skeleton/importers.h"
+#include "animate/skeleton/match_plot.h"
 #include "animate/skeleton/refine.h"
 #include "animate/skeleton/skeleton_match.h"
+#include "animate/skeleton/synthetic_poses.h"
 #include "tests/support/error_text.h"
 #include "tests/support/option_problems.h"
 
@@ -17,6 +25,7 @@ namespace ss {
 namespace {
 
 using testing::InputErrorOf;
+using testing::Names;
 using testing::Problems;
 
 TEST(AnimateOptions, DefaultsAreValid) {
@@ -26,6 +35,11 @@ TEST(AnimateOptions, DefaultsAreValid) {
   EXPECT_EQ(Problems(RefineOptions{}), "");
   EXPECT_EQ(Problems(SkeletonMatchOptions{}), "");
   EXPECT_EQ(Problems(AnimateRunOptions{}), "");
+  EXPECT_EQ(Problems(ReplacementOptions{}), "");
+  EXPECT_EQ(Problems(BeamOptions{}), "");
+  EXPECT_EQ(Problems(SkeletonImportOptions{}), "");
+  EXPECT_EQ(Problems(GestureScriptOptions{}), "");
+  EXPECT_EQ(Problems(PlotOptions{}), "");
 }
 
 TEST(AnimateOptions, EachProblemNamesItsField) {
@@ -44,6 +58,89 @@ TEST(AnimateOptions, EachProblemNamesItsField) {
   ReplacementOptions replace;
   replace.reach.step_cost = -1;
   EXPECT_EQ(Problems(replace), "reach.step_cost: must be finite and >= 0, got -1");
+}
+
+// The replacement optimizer reports every problem, not the first; the beam block counts only when
+// the replacement starts with a beam search, and comes out under "beam.".
+TEST(AnimateOptions, ReplacementNamesEveryField) {
+  ReplacementOptions o;
+  o.reach.set_size = 0;
+  o.step_cost_fraction = -0.1;
+  o.slow_frame_cost = -1;
+  o.reference_speed_m = -1;
+  o.time_budget_seconds = 0;
+  o.max_tries = 0;
+  o.changes_per_turn = 0;
+  o.max_turns = -1;
+  o.sequential_fraction = 1.5;
+  o.middle_fraction = -0.5;
+  o.begin_fraction = -0.5;
+  o.max_span = -1;
+  o.collision_pick_fraction = 2;
+  o.max_candidates = -1;
+  o.progress_seconds = -1;
+  EXPECT_EQ(Problems(o),
+            "reach.set_size: must be in 1..65535, got 0\n"
+            "step_cost_fraction: must be finite and >= 0, got -0.1\n"
+            "slow_frame_cost: must be >= 0, got -1\n"
+            "reference_speed_m: must be metres >= 0, got -1\n"
+            "time_budget_seconds: must be a positive number of seconds, got 0\n"
+            "max_tries: must be >= 1, got 0\n"
+            "changes_per_turn: must be >= 1, got 0\n"
+            "max_turns: must be >= 0 (0: no limit), got -1\n"
+            "sequential_fraction: must be within [0, 1], got 1.5\n"
+            "middle_fraction: must be >= 0, got -0.5\n"
+            "begin_fraction: must be >= 0, got -0.5\n"
+            "max_span: must be >= 0 (0: the whole sequence), got -1\n"
+            "collision_pick_fraction: must be within [0, 1], got 2\n"
+            "max_candidates: must be >= 0 (0: all of them), got -1\n"
+            "progress_seconds: must be seconds >= 0 (0: never), got -1");
+  ReplacementOptions split;
+  split.middle_fraction = 0.7;
+  split.begin_fraction = 0.4;
+  EXPECT_EQ(Problems(split),
+            "begin_fraction: must leave middle_fraction + begin_fraction <= 1, got 1.1");
+  ReplacementOptions beam;
+  beam.beam.width = 0;
+  EXPECT_EQ(Problems(beam), "");  // a sequential start never reads the beam block
+  beam.start = StartMethod::kBeam;
+  EXPECT_EQ(Problems(beam), "beam.width: must be >= 1, got 0");
+}
+
+TEST(AnimateOptions, BeamNamesEveryField) {
+  BeamOptions o;
+  o.width = 0;
+  o.length = -1;
+  o.start_frames = -1;
+  o.time_budget_seconds = -1;
+  EXPECT_EQ(Problems(o),
+            "width: must be >= 1, got 0\n"
+            "length: must be >= 0 (0: the sprite's own), got -1\n"
+            "start_frames: must be >= 0 (0: every frame), got -1\n"
+            "time_budget_seconds: must be seconds >= 0 (0: one pass), got -1");
+  o = {};
+  o.time_budget_seconds = std::numeric_limits<double>::infinity();
+  EXPECT_TRUE(Names(Problems(o), "time_budget_seconds"));
+}
+
+TEST(AnimateOptions, OptimizersRefuseBadOptions) {
+  const TransitionGraph graph;
+  Problem problem(graph);
+  Summary summary;
+  BeamOptions beam;
+  beam.width = 0;
+  beam.length = -2;
+  EXPECT_EQ(InputErrorOf([&] { BeamSearch(problem, beam, &summary); }),
+            "beam options: width: must be >= 1, got 0\n"
+            "length: must be >= 0 (0: the sprite's own), got -2");
+  ReplacementOptions replace;
+  replace.max_tries = 0;
+  replace.time_budget_seconds = -1;
+  const std::string what = InputErrorOf([&] { OptimizeSequences(problem, replace, &summary); });
+  EXPECT_EQ(what,
+            "replacement options: time_budget_seconds: must be a positive number of seconds, got "
+            "-1\nmax_tries: must be >= 1, got 0");
+  EXPECT_EQ(InputErrorOf([&] { ReplacementSets::Build(problem, replace); }), what);
 }
 
 TEST(AnimateOptions, SkeletonMatchNamesItsNestedBlocks) {
@@ -66,6 +163,70 @@ TEST(AnimateOptions, ReachSetsRefuseBadOptions) {
   const std::string what =
       InputErrorOf([&] { ReachSets::Build(TransitionGraph{}, ReachDirection::kForward, reach); });
   EXPECT_EQ(what.rfind("reach options: set_size: must be in 1..65535, got 70000", 0), 0u) << what;
+}
+
+TEST(AnimateOptions, SkeletonImportNamesEveryField) {
+  SkeletonImportOptions o;
+  o.min_confidence = 1.5f;
+  o.person = -1;
+  o.category_id = -2;
+  EXPECT_EQ(Problems(o),
+            "min_confidence: must be within [0, 1] (or unset: the mapping's or the format's), "
+            "got 1.5\n"
+            "person: must be an index >= 0, got -1\n"
+            "category_id: must be a category id >= 0 (or -1: the first with keypoints), got -2");
+  o = {};
+  o.min_confidence = 0;
+  o.category_id = 3;
+  EXPECT_EQ(Problems(o), "");
+  // Each importer refuses bad options before it opens the file.
+  o.person = -1;
+  const JointMapping mapping = IdentityMapping(HumanSkeleton());
+  for (const auto& import : std::vector<std::function<void()>>{
+           [&] { ImportDeepLabCutCsv("/nonexistent.csv", mapping, o); },
+           [&] { ImportOpenPoseJson("/nonexistent", mapping, o); },
+           [&] { ImportCocoKeypoints("/nonexistent.json", mapping, o); },
+           [&] { ImportSynthTruth("/nonexistent", "", mapping, o); }}) {
+    EXPECT_EQ(InputErrorOf(import),
+              "skeleton import options: person: must be an index >= 0, got -1");
+  }
+}
+
+TEST(AnimateOptions, GestureScriptNamesEveryField) {
+  GestureScriptOptions o;
+  o.transition_frames = -1;
+  o.speed = 0;
+  o.noise_px = -1;
+  o.scale_px = 0;
+  o.x_px = std::numeric_limits<float>::quiet_NaN();
+  o.y_px = std::numeric_limits<float>::infinity();
+  EXPECT_EQ(Problems(o),
+            "transition_frames: must be frames >= 0, got -1\n"
+            "speed: must be a positive factor, got 0\n"
+            "noise_px: must be pixels >= 0, got -1\n"
+            "scale_px: must be a positive number of pixels per body unit, got 0\n"
+            "x_px: must be a finite pixel position, got nan\n"
+            "y_px: must be a finite pixel position, got inf");
+  GestureScriptOptions slow;
+  slow.speed = -2;
+  EXPECT_EQ(InputErrorOf([&] {
+              MakeGestureSequence({{Gesture::kY, 5}}, BodyProportions{}, slow);
+            }),
+            "gesture script options: speed: must be a positive factor, got -2");
+}
+
+TEST(AnimateOptions, PlotNamesEveryField) {
+  PlotOptions o;
+  o.panel_size = {100, 480};
+  o.stutter_window = -1;
+  EXPECT_EQ(Problems(o),
+            "panel_size: must be at least 120 x 100 pixels, got 100 x 480\n"
+            "stutter_window: must be frames >= 0, got -1");
+  const std::vector<PlotPanel> panels = {{"a", {0, 1, 1, 0}}};
+  EXPECT_EQ(InputErrorOf([&] { PlotMatch(panels, 2, o); }).rfind("plot options: panel_size: ", 0),
+            0u);
+  EXPECT_EQ(InputErrorOf([&] { PlotMatch({}, 2); }), "plot: needs at least one panel");
+  EXPECT_EQ(PlotMatch(panels, 2).cols, 640);
 }
 
 }  // namespace

@@ -54,7 +54,7 @@ TEST(SkeletonImporters, DeepLabCutAnalysisCsv) {
   EXPECT_TRUE(Present(s, 2, "snout"));
   EXPECT_FALSE(Present(s, 3, "snout"));  // 0.45
   // An explicit threshold wins.
-  ImportOptions loose;
+  SkeletonImportOptions loose;
   loose.min_confidence = 0.3f;
   const SkeletonSequence l = ImportDeepLabCutCsv(Data("dlc_mouse.csv"), mapping, loose);
   ExpectJoint(l, 2, "hindpaw", 224.0f, 154.0f);
@@ -66,7 +66,7 @@ TEST(SkeletonImporters, DeepLabCutMultiAnimalCsv) {
   const SkeletonSequence first = ImportDeepLabCutCsv(Data("madlc_mice.csv"), mapping);
   ASSERT_EQ(first.size(), 2);
   ExpectJoint(first, 0, "snout", 100.0f, 50.0f);
-  ImportOptions second;
+  SkeletonImportOptions second;
   second.individual = "mus2";
   const SkeletonSequence s = ImportDeepLabCutCsv(Data("madlc_mice.csv"), mapping, second);
   ExpectJoint(s, 0, "snout", 400.0f, 300.0f);
@@ -98,7 +98,7 @@ TEST(SkeletonImporters, OpenPoseBody25Folder) {
   for (const auto& j : s.frames[1].joints) EXPECT_FALSE(j.present);  // nobody detected
   ExpectJoint(s, 2, "neck", 324, 140);                               // person 0, not person 1
   EXPECT_FALSE(Present(s, 2, "wrist_l"));                            // c = 0.1 < 0.2
-  ImportOptions other;
+  SkeletonImportOptions other;
   other.person = 1;
   const SkeletonSequence p1 = ImportOpenPoseJson(Data("openpose_ymca"), Body25ToHuman14(), other);
   ExpectJoint(p1, 2, "neck", 520, 150);
@@ -124,7 +124,7 @@ TEST(SkeletonImporters, CocoPersonKeypoints) {
   EXPECT_NEAR(s.frames[1].joints[*s.skeleton.JointIndex("wrist_l")].confidence, 0.5f, 1e-6);
   EXPECT_FALSE(Present(s, 1, "ankle_r"));                            // v = 0
   for (const auto& j : s.frames[2].joints) EXPECT_FALSE(j.present);  // image 9: no annotation
-  ImportOptions visible_only;
+  SkeletonImportOptions visible_only;
   visible_only.min_confidence = 0.9f;
   EXPECT_FALSE(Present(
       ImportCocoKeypoints(Data("coco_person_keypoints.json"), Coco17ToHuman14(), visible_only), 1,
@@ -216,7 +216,7 @@ TEST(SkeletonImporters, SynthJointTruth) {
       }
     }
   }
-  ImportOptions options;
+  SkeletonImportOptions options;
   options.person = 1;
   const SkeletonSequence s =
       ImportSynthTruth(session.string(), "", IdentityMapping(HumanSkeleton()), options);

@@ -10,6 +10,7 @@
 #include "calib/enclosure.h"
 #include "calib/inputs.h"
 #include "calib/report.h"
+#include "calib/solve.h"
 #include "calib/wizard.h"
 #include "calib/wizard_run.h"
 #include "tests/support/error_text.h"
@@ -19,6 +20,7 @@ namespace ss::calib {
 namespace {
 
 using ss::testing::InputErrorOf;
+using ss::testing::Names;
 using ss::testing::Problems;
 
 TEST(CalibOptions, DefaultsAreValid) {
@@ -28,6 +30,7 @@ TEST(CalibOptions, DefaultsAreValid) {
   EXPECT_EQ(Problems(VerdictOptions{}), "");
   EXPECT_EQ(Problems(WizardOptions{}), "");
   EXPECT_EQ(Problems(WizardRunOptions{}), "");
+  EXPECT_EQ(Problems(SolveOptions{}), "");
 }
 
 TEST(CalibOptions, EachProblemNamesItsField) {
@@ -49,19 +52,31 @@ TEST(CalibOptions, EachProblemNamesItsField) {
   WizardRunOptions r;
   r.silent_s = 0;
   EXPECT_EQ(Problems(r), "silent_s: expected a positive number of seconds, got 0");
+  SolveOptions solve;
+  solve.lensmodel = "LENSMODEL_NOPE";
+  EXPECT_EQ(Problems(solve),
+            "lensmodel: unknown mrcal lens model \"LENSMODEL_NOPE\" (e.g. LENSMODEL_OPENCV8)");
+  solve.lensmodel = "";
+  EXPECT_TRUE(Names(Problems(solve), "lensmodel"));
+  // Any model mrcal knows with an fx fy cx cy core will do.
+  solve.lensmodel = "LENSMODEL_PINHOLE";
+  EXPECT_EQ(Problems(solve), "");
 }
 
-// The wizard's options hold the detector's and the verdict's: their fields come out under
-// detect. and verdict.
+// The wizard's options hold the detector's, the verdict's and the solve's: their fields come out
+// under detect., verdict. and solve.
 TEST(CalibOptions, TheWizardNamesItsNestedBlocks) {
   WizardOptions w;
   w.detect.max_edge_width_px = -1;
   w.verdict.min_coverage = 2;
+  w.solve.lensmodel = "LENSMODEL_NOPE";
   w.still_frames = 0;
-  EXPECT_EQ(Problems(w),
-            "detect.max_edge_width_px: expected a positive number of pixels, got -1\n"
-            "verdict.min_coverage: expected a fraction 0..1, got 2\n"
-            "still_frames: expected at least 1 frame, got 0");
+  EXPECT_EQ(
+      Problems(w),
+      "detect.max_edge_width_px: expected a positive number of pixels, got -1\n"
+      "verdict.min_coverage: expected a fraction 0..1, got 2\n"
+      "solve.lensmodel: unknown mrcal lens model \"LENSMODEL_NOPE\" (e.g. LENSMODEL_OPENCV8)\n"
+      "still_frames: expected at least 1 frame, got 0");
   const std::string what = InputErrorOf([&] { CalibrationWizard wizard("cam0", 640, 480, w); });
   EXPECT_EQ(what.rfind("calibration wizard options: detect.max_edge_width_px: ", 0), 0u) << what;
 }
@@ -82,6 +97,13 @@ TEST(CalibOptions, EntryPointsRefuseBadOptions) {
   EXPECT_EQ(InputErrorOf([&] {
               FindGreenFloor(CameraModel{}, green, g);
             }).rfind("green floor options: simplify_m: ", 0),
+            0u);
+  // The solve refuses a lens model it does not know before it looks at the views.
+  SolveOptions solve;
+  solve.lensmodel = "LENSMODEL_NOPE";
+  EXPECT_EQ(InputErrorOf([&] {
+              SolveBoards(BoardSpec{}, {{"cam0", 640, 480}}, {}, solve);
+            }).rfind("calibration solve options: lensmodel: unknown mrcal lens model", 0),
             0u);
 }
 

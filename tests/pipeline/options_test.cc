@@ -1,5 +1,6 @@
 // Each pipeline component's options: the defaults are valid, a value out of range is refused
 // naming its field, and the component's entry point refuses it with an InputError.
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -15,10 +16,13 @@
 #include "pipeline/transitions/bank_training.h"
 #include "pipeline/transitions/bank_transitions.h"
 #include "pipeline/transitions/builder.h"
+#include "pipeline/transitions/classifier.h"
+#include "pipeline/transitions/comparison.h"
 #include "pipeline/transitions/synthetic.h"
 #include "pipeline/transitions/training.h"
 #include "pipeline/transitions/truth_labels.h"
 #include "pipeline/transitions/unit_worker.h"
+#include "pipeline/transitions/weights.h"
 #include "tests/support/error_text.h"
 #include "tests/support/option_problems.h"
 
@@ -43,6 +47,9 @@ TEST(PipelineOptions, DefaultsAreValid) {
   EXPECT_EQ(Problems(UnitWorkerOptions{}), "");
   EXPECT_EQ(Problems(IngestOptions{}), "");
   EXPECT_EQ(Problems(SideBySideOptions{}), "");
+  EXPECT_EQ(Problems(ComparisonWindow{}), "");
+  EXPECT_EQ(Problems(TransitionWeights{}), "");
+  EXPECT_EQ(Problems(DefaultWeights()), "");
 }
 
 TEST(PipelineOptions, GridAndKeyer) {
@@ -184,7 +191,7 @@ TEST(PipelineOptions, BankTraining) {
   why = Problems(o);
   EXPECT_TRUE(Names(why, "positive_rate")) << why;
   EXPECT_TRUE(Names(why, "calibration_rows")) << why;
-  EXPECT_TRUE(Names(why, "window")) << why;
+  EXPECT_TRUE(Names(why, "window.cells_x")) << why;
   // Refused before the files are read.
   o = {};
   o.threads = 0;
@@ -204,11 +211,11 @@ TEST(PipelineOptions, TransitionBuildersAndWorkers) {
   u.weights.feature_scale[0] = 0;
   u.threads = 0;
   const std::string why = Problems(u);
-  EXPECT_TRUE(Names(why, "weights")) << why;
+  EXPECT_TRUE(Names(why, "weights.feature_scale")) << why;
   EXPECT_TRUE(Names(why, "threads")) << why;
   // Refused before the bank is opened.
   const std::string what = InputErrorOf([&] { UpdateBankTransitions("/no/bank", u); });
-  EXPECT_EQ(what.rfind("transition update options: weights: ", 0), 0u) << what;
+  EXPECT_EQ(what.rfind("transition update options: weights.feature_scale: ", 0), 0u) << what;
 
   UnitWorkerOptions w;
   w.lease_s = 0;
@@ -230,6 +237,80 @@ TEST(PipelineOptions, IngestNestsThePipeline) {
   const std::string what = InputErrorOf([&] { IngestSession(o); });
   EXPECT_EQ(what.rfind("ingest options: ", 0), 0u) << what;
   EXPECT_NE(what.find("decode_threads: "), std::string::npos) << what;
+}
+
+TEST(PipelineOptions, ComparisonWindow) {
+  ComparisonWindow w;
+  w.width_m = 0;
+  w.height_m = std::nan("");
+  w.cells_x = 0;
+  w.cells_y = -1;
+  EXPECT_EQ(Problems(w),
+            "width_m: expected a positive number of metres, got 0\n"
+            "height_m: expected a positive number of metres, got nan\n"
+            "cells_x: expected at least 1 cell, got 0\n"
+            "cells_y: expected at least 1 cell, got -1");
+  w = {};
+  w.cells_x = 128;
+  w.cells_y = 64;
+  EXPECT_EQ(Problems(w), "cells_y: expected cells_x * cells_y <= 4096 cells, got 128 x 64");
+  w.cells_x = 1 << 20;  // the product is counted without overflowing
+  w.cells_y = 1 << 12;
+  EXPECT_TRUE(Names(Problems(w), "cells_y"));
+  // Refused before the billboard is resampled.
+  w = {};
+  w.cells_x = 0;
+  RgbaBillboard billboard;  // a good one, 2 x 2 opaque pixels
+  billboard.width = billboard.height = 2;
+  billboard.rgba.assign(16, 255);
+  std::vector<uint8_t> image(ComparisonWindow{}.ImageBytes());
+  const std::string what =
+      InputErrorOf([&] { MakeComparisonImage(billboard, 100, w, image.data()); });
+  EXPECT_EQ(what, "comparison_window: cells_x: expected at least 1 cell, got 0") << what;
+}
+
+// Every problem of the weights, each named by its key in the weights file; the window's under
+// "comparison_window.".
+TEST(PipelineOptions, TransitionWeights) {
+  TransitionWeights w;
+  w.window.width_m = -1;
+  w.feature_mean[1] = std::nan("");
+  w.feature_scale[0] = 0;
+  w.feature_scale[3] = -2;
+  w.stage1_weights[2] = -0.5;
+  w.stage1_bias = INFINITY;
+  w.stage2_weights[5] = -1;
+  w.stage2_bias = std::nan("");
+  EXPECT_EQ(Problems(w),
+            "comparison_window.width_m: expected a positive number of metres, got -1\n"
+            "feature_mean: expected finite numbers, but element 1 is nan\n"
+            "feature_scale: expected positive numbers, but element 0 is 0, element 3 is -2\n"
+            "stage1.weights: expected numbers >= 0 (stage 1 must accept a weighted-L1 ball), "
+            "but element 2 is -0.5\n"
+            "stage1.bias: expected a finite number, got inf\n"
+            "stage2.weights: expected numbers >= 0, but element 5 is -1\n"
+            "stage2.bias: expected a finite number, got nan");
+  // The variants' bounds count only for their variant.
+  TransitionWeights linf;
+  EXPECT_EQ(Problems(linf), "");
+  linf.stage2_variant = Stage2Variant::kLinf;
+  linf.linf_max_alpha = 1.5;
+  EXPECT_EQ(Problems(linf),
+            "stage2.linf.max_velocity_mps: expected a positive number, got 0\n"
+            "stage2.linf.max_alpha_linf: expected a number in (0, 1], got 1.5");
+  TransitionWeights blob;
+  blob.stage2_variant = Stage2Variant::kColourBlob;
+  blob.colour_blob_max_velocity_mps = 1;
+  blob.colour_blob_max_cells = -1;
+  EXPECT_EQ(Problems(blob), "stage2.colour_blob.max_blob_cells: expected a number >= 0, got -1");
+  // The classifier refuses them, and a weights file holding them names the file.
+  const std::string what = InputErrorOf([&] { TransitionClassifier classifier(blob); });
+  EXPECT_EQ(what, "weights: stage2.colour_blob.max_blob_cells: expected a number >= 0, got -1");
+  TransitionWeights bad = DefaultWeights();
+  bad.feature_scale[0] = 0;
+  bad.stage2_bias = INFINITY;
+  const std::string file = InputErrorOf([&] { ParseWeights(WeightsToJson(bad), "w.json"); });
+  EXPECT_EQ(file.rfind("w.json: ", 0), 0u) << file;
 }
 
 }  // namespace

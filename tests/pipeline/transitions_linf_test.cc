@@ -323,26 +323,26 @@ TEST(TransitionLinf, WeightsFileCarriesTheVariant) {
   };
   EXPECT_EQ(with([](auto&) {}), "");
   EXPECT_EQ(with([](auto& j) { j["stage2"]["variant"] = "paper"; }), "");
-  EXPECT_NE(with([](auto& j) { j["stage2"]["variant"] = "max"; }).find("field 'stage2.variant'"),
+  EXPECT_NE(with([](auto& j) { j["stage2"]["variant"] = "max"; }).find("w.json: stage2.variant:"),
             std::string::npos);
   EXPECT_NE(
-      with([](auto& j) { j["stage2"].erase("variant"); }).find("field 'stage2.variant': missing"),
+      with([](auto& j) { j["stage2"].erase("variant"); }).find("w.json: stage2.variant: missing"),
       std::string::npos);
   EXPECT_NE(with([](auto& j) {
               j["stage2"]["linf"].erase("max_alpha_linf");
-            }).find("field 'stage2.linf.max_alpha_linf': missing"),
+            }).find("w.json: stage2.linf.max_alpha_linf: missing"),
             std::string::npos);
   EXPECT_NE(with([](auto& j) {
               j["stage2"]["linf"]["max_alpha_linf"] = 1.5;
-            }).find("field 'stage2.linf.max_alpha_linf'"),
+            }).find("w.json: stage2.linf.max_alpha_linf:"),
             std::string::npos);
   EXPECT_NE(with([](auto& j) {
               j["stage2"]["linf"]["max_velocity_mps"] = -0.1;
-            }).find("field 'stage2.linf.max_velocity_mps'"),
+            }).find("w.json: stage2.linf.max_velocity_mps:"),
             std::string::npos);
   EXPECT_NE(with([](auto& j) {
               j["stage2"]["linf"]["max_velocity_mps"] = "fast";
-            }).find("field 'stage2.linf.max_velocity_mps'"),
+            }).find("w.json: stage2.linf.max_velocity_mps:"),
             std::string::npos);
   // The colour_blob variant's fields.
   TransitionWeights b = w;
@@ -363,18 +363,18 @@ TEST(TransitionLinf, WeightsFileCarriesTheVariant) {
   };
   EXPECT_NE(bwith([](auto& j) {
               j["stage2"]["colour_blob"]["max_blob_cells"] = -1;
-            }).find("field 'stage2.colour_blob.max_blob_cells'"),
+            }).find("w.json: stage2.colour_blob.max_blob_cells:"),
             std::string::npos);
   EXPECT_NE(bwith([](auto& j) {
               j["stage2"]["colour_blob"]["max_blob_cells"] = 2.5;
-            }).find("field 'stage2.colour_blob.max_blob_cells'"),
+            }).find("w.json: stage2.colour_blob.max_blob_cells:"),
             std::string::npos);
   EXPECT_NE(bwith([](auto& j) {
               j["stage2"]["colour_blob"].erase("max_velocity_mps");
-            }).find("field 'stage2.colour_blob.max_velocity_mps': missing"),
+            }).find("w.json: stage2.colour_blob.max_velocity_mps: missing"),
             std::string::npos);
   // A version-1 file has no variant: one that names one is refused rather than misread.
-  EXPECT_NE(with([](auto& j) { j["version"] = 1; }).find("field 'stage2.variant'"),
+  EXPECT_NE(with([](auto& j) { j["version"] = 1; }).find("w.json: stage2.variant:"),
             std::string::npos);
 }
 

@@ -406,24 +406,27 @@ TEST(TransitionWeightsFile, WrongFilesNameTheFileAndField) {
     edit(j);
     return ErrorOf(j.dump());
   };
-  EXPECT_NE(with([](auto& j) { j["version"] = 3; }).find("field 'version'"),
+  EXPECT_NE(with([](auto& j) { j["version"] = 3; }).find("w.json: version:"),
             std::string::npos);  // 2 exists now
-  EXPECT_NE(with([](auto& j) { j["format"] = "other"; }).find("field 'format'"), std::string::npos);
-  EXPECT_NE(with([](auto& j) { j["stage1"]["weights"][2] = -0.5; }).find("field 'stage1.weights'"),
+  EXPECT_NE(with([](auto& j) { j["format"] = "other"; }).find("w.json: format:"),
+            std::string::npos);
+  EXPECT_NE(with([](auto& j) { j["stage1"]["weights"][2] = -0.5; }).find("w.json: stage1.weights:"),
             std::string::npos);
   EXPECT_NE(with([](auto& j) {
               j["stage1"]["weights"] = {1, 2};
-            }).find("field 'stage1.weights'"),
+            }).find("w.json: stage1.weights:"),
             std::string::npos);
-  EXPECT_NE(with([](auto& j) { j["stage2"].erase("bias"); }).find("field 'stage2.bias': missing"),
+  EXPECT_NE(with([](auto& j) { j["stage2"].erase("bias"); }).find("w.json: stage2.bias: missing"),
             std::string::npos);
-  EXPECT_NE(with([](auto& j) { j["stage2"]["bias"] = "x"; }).find("field 'stage2.bias'"),
+  EXPECT_NE(with([](auto& j) { j["stage2"]["bias"] = "x"; }).find("w.json: stage2.bias:"),
             std::string::npos);
-  EXPECT_NE(with([](auto& j) { j["feature_scale"][0] = 0; }).find("field 'feature_scale'"),
+  EXPECT_NE(with([](auto& j) { j["feature_scale"][0] = 0; }).find("w.json: feature_scale:"),
             std::string::npos);
-  EXPECT_NE(with([](auto& j) { j["features"][0] = "speed"; }).find("field 'features'"),
+  EXPECT_NE(with([](auto& j) { j["features"][0] = "speed"; }).find("w.json: features:"),
             std::string::npos);
-  EXPECT_NE(with([](auto& j) { j["comparison_window"]["cells_x"] = 0; }).find("comparison_window"),
+  EXPECT_NE(with([](auto& j) {
+              j["comparison_window"]["cells_x"] = 0;
+            }).find("w.json: comparison_window.cells_x: expected at least 1 cell, got 0"),
             std::string::npos);
   EXPECT_NE(with([](auto& j) {
               j["comparison_window"]["align"] = "left";
@@ -431,7 +434,7 @@ TEST(TransitionWeightsFile, WrongFilesNameTheFileAndField) {
             std::string::npos);
   EXPECT_NE(with([](auto& j) {
               j.erase("comparison_window");
-            }).find("field 'comparison_window.width_m': missing"),
+            }).find("w.json: comparison_window.width_m: missing"),
             std::string::npos);
   // A builder refuses invalid weights the same way.
   TransitionWeights bad = testing::UnitWeights({1, 1, 1, 1, 1, 1}, 1, 1);

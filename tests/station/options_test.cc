@@ -34,7 +34,7 @@ TEST(StationOptions, Station) {
   o = {};
   o.weights = DefaultWeights();
   o.weights->feature_scale[0] = -1;
-  EXPECT_TRUE(Names(Problems(o), "weights"));
+  EXPECT_TRUE(Names(Problems(o), "weights.feature_scale"));
   // Refused before the config is looked at (it has no camera either).
   o = {};
   o.offline_after_s = std::nan("");
