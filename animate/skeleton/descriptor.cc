@@ -4,36 +4,36 @@
 #include <cmath>
 
 #include "core/error.h"
+#include "core/option_checks.h"
 
 namespace ss {
 
 bool DescriptorOptions::IsValid(std::string* why) const {
-  auto fail = [&](const char* reason) {
-    if (why) *why = reason;
-    return false;
+  OptionProblems check(why);
+  const auto at_least_0 = [&](double v, const char* field) {
+    check(std::isfinite(v) && v >= 0, field,
+          "must be a finite number >= 0, got " + OptionProblems::Num(v));
   };
-  if (!(angle_weight >= 0) || !(ratio_weight >= 0) || !(orientation_weight >= 0)) {
-    return fail("weights must be >= 0");
+  const auto positive = [&](double v, const char* field, const char* what) {
+    check(std::isfinite(v) && v > 0, field,
+          std::string("must be a positive ") + what + ", got " + OptionProblems::Num(v));
+  };
+  at_least_0(angle_weight, "angle_weight");
+  at_least_0(ratio_weight, "ratio_weight");
+  at_least_0(orientation_weight, "orientation_weight");
+  check(!(angle_weight >= 0 && ratio_weight >= 0) || angle_weight + ratio_weight > 0,
+        "angle_weight", "angle_weight + ratio_weight must be > 0 (the descriptor would be empty)");
+  at_least_0(min_limb_px, "min_limb_px");
+  at_least_0(no_overlap_cost, "no_overlap_cost");
+  at_least_0(motion_weight, "motion_weight");
+  if (motion_weight > 0) {
+    positive(motion_window_s, "motion_window_s", "number of seconds");
+    positive(motion_scale, "motion_scale", "number");
   }
-  if (angle_weight + ratio_weight <= 0) return fail("angle_weight + ratio_weight must be > 0");
-  if (!(min_limb_px >= 0)) return fail("min_limb_px must be >= 0");
-  if (!(no_overlap_cost >= 0) || !std::isfinite(no_overlap_cost))
-    return fail("no_overlap_cost must be finite, >= 0");
-  if (!(motion_weight >= 0) || !std::isfinite(motion_weight))
-    return fail("motion_weight must be finite, >= 0");
-  if (motion_weight > 0 && !(motion_window_s > 0 && std::isfinite(motion_window_s))) {
-    return fail("motion_window_s must be > 0 seconds");
-  }
-  if (motion_weight > 0 && !(motion_scale > 0 && std::isfinite(motion_scale)))
-    return fail("motion_scale must be > 0");
-  if (!(root_motion_weight >= 0) || !std::isfinite(root_motion_weight)) {
-    return fail("root_motion_weight must be finite, >= 0");
-  }
-  if (root_motion_weight > 0 && !(root_motion_scale > 0 && std::isfinite(root_motion_scale))) {
-    return fail("root_motion_scale must be > 0");
-  }
-  if (!(default_fps > 0) || !std::isfinite(default_fps)) return fail("default_fps must be > 0");
-  return true;
+  at_least_0(root_motion_weight, "root_motion_weight");
+  if (root_motion_weight > 0) positive(root_motion_scale, "root_motion_scale", "number");
+  positive(default_fps, "default_fps", "frame rate");
+  return check.ok();
 }
 
 DescriptorLayout MakeDescriptorLayout(const SkeletonDef& def, const DescriptorOptions& options) {

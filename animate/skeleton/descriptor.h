@@ -50,6 +50,7 @@ struct DescriptorOptions {
   float root_motion_weight = 2.0f;   // on (Δν)^2; 0 = none (only with motion_weight > 0)
   float root_motion_scale = 0.15f;   // root speed (root lengths per second) at which ν = 1/2
   double default_fps = 30;           // for sequences that do not give theirs
+  // False with "FIELD: reason" lines in `why` (core/option_checks.h) for values out of range.
   bool IsValid(std::string* why) const;
 };
 

@@ -7,21 +7,23 @@
 #include <opencv2/video/tracking.hpp>
 
 #include "core/error.h"
+#include "core/option_checks.h"
 
 namespace ss {
 
 bool LkOptions::IsValid(std::string* why) const {
-  auto fail = [&](const char* reason) {
-    if (why) *why = reason;
-    return false;
-  };
-  if (window_px < 5) return fail("window_px must be >= 5");
-  if (pyramid_levels < 0 || pyramid_levels > 8) return fail("pyramid_levels must be within 0..8");
-  if (max_iterations < 1) return fail("max_iterations must be >= 1");
-  if (!(epsilon > 0)) return fail("epsilon must be > 0");
-  if (!(max_forward_backward_px > 0)) return fail("max_forward_backward_px must be > 0");
-  if (interpolation_context < 1) return fail("interpolation_context must be >= 1");
-  return true;
+  OptionProblems check(why);
+  check(window_px >= 5, "window_px", "must be >= 5 pixels, got " + std::to_string(window_px));
+  check(pyramid_levels >= 0 && pyramid_levels <= 8, "pyramid_levels",
+        "must be within 0..8, got " + std::to_string(pyramid_levels));
+  check(max_iterations >= 1, "max_iterations",
+        "must be >= 1, got " + std::to_string(max_iterations));
+  check(epsilon > 0, "epsilon", "must be > 0, got " + OptionProblems::Num(epsilon));
+  check(max_forward_backward_px > 0, "max_forward_backward_px",
+        "must be > 0 pixels, got " + OptionProblems::Num(max_forward_backward_px));
+  check(interpolation_context >= 1, "interpolation_context",
+        "must be >= 1, got " + std::to_string(interpolation_context));
+  return check.ok();
 }
 
 LkJointTracker::LkJointTracker(SkeletonDef skeleton, LkOptions options)

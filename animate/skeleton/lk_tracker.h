@@ -22,6 +22,7 @@ struct LkOptions {
   double epsilon = 0.01;                 // pixels: the iteration stops below this update
   float max_forward_backward_px = 1.0f;  // tracking back must land this close to the start
   int interpolation_context = 2;         // frames each side whose motion shapes the interpolation
+  // False with "FIELD: reason" lines in `why` (core/option_checks.h) for values out of range.
   bool IsValid(std::string* why) const;
 };
 

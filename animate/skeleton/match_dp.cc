@@ -8,6 +8,7 @@
 #include "animate/skeleton/match_dp_detail.h"
 #include "core/error.h"
 #include "core/log.h"
+#include "core/option_checks.h"
 
 // The driver: the options, the row rules and the Engine's set-up; the row step is in
 // match_dp_kernels.cc, the two backtracks in match_dp_decisions.cc and
@@ -16,29 +17,30 @@
 namespace ss {
 
 bool MatchOptions::IsValid(std::string* why) const {
-  auto fail = [&](const std::string& reason) {
-    if (why) *why = reason;
-    return false;
-  };
-  for (float v : {skip_cost, jump_cost, freeze_cost, stutter_cost}) {
-    if (!(v >= 0) || !std::isfinite(v))
-      return fail("skip, jump, freeze and stutter costs must be finite and >= 0");
+  OptionProblems check(why);
+  for (const auto& [v, field] :
+       {std::pair{skip_cost, "skip_cost"}, std::pair{jump_cost, "jump_cost"},
+        std::pair{freeze_cost, "freeze_cost"}, std::pair{stutter_cost, "stutter_cost"}}) {
+    check(std::isfinite(v) && v >= 0, field,
+          "must be a finite cost >= 0, got " + OptionProblems::Num(v));
   }
-  if (max_forward_step < 1 || max_forward_step > 64)
-    return fail("max_forward_step must be within 1..64");
-  if (stutter_window < 0 || stutter_window > 64) return fail("stutter_window must be within 0..64");
-  if (freeze_levels < 1 || freeze_levels > 7) return fail("freeze_levels must be within 1..7");
-  if (skip_cost * static_cast<float>(max_forward_step - 1) > jump_cost) {
-    return fail(
+  const auto within = [&](int v, int low, int high, const char* field) {
+    check(v >= low && v <= high, field,
+          "must be within " + std::to_string(low) + ".." + std::to_string(high) + ", got " +
+              std::to_string(v));
+  };
+  within(max_forward_step, 1, 64, "max_forward_step");
+  within(stutter_window, 0, 64, "stutter_window");
+  within(freeze_levels, 1, 7, "freeze_levels");
+  check(!(skip_cost * static_cast<float>(max_forward_step - 1) > jump_cost), "skip_cost",
         "a forward skip may not cost more than a jump: skip_cost * (max_forward_step - 1) <= "
         "jump_cost");
-  }
   for (size_t i = 0; i < transitions.size(); ++i) {
-    if (!(transitions[i].cost >= 0) || !std::isfinite(transitions[i].cost)) {
-      return fail("transitions[" + std::to_string(i) + "].cost must be finite and >= 0");
-    }
+    const float cost = transitions[i].cost;
+    check(std::isfinite(cost) && cost >= 0, "transitions[" + std::to_string(i) + "].cost",
+          "must be a finite cost >= 0, got " + OptionProblems::Num(cost));
   }
-  return true;
+  return check.ok();
 }
 
 MatchOptions MatchOptions::WithoutPenalties() const {

@@ -48,7 +48,8 @@ struct MatchOptions {
   size_t max_decision_bytes = size_t{3} << 30;
 
   // Valid when the costs are finite and >= 0, Kf >= 1, W >= 0, 1 <= R <= 7 and a forward
-  // skip never costs more than a jump (skip_cost * (Kf - 1) <= J).
+  // skip never costs more than a jump (skip_cost * (Kf - 1) <= J); otherwise false with
+  // "FIELD: reason" lines in `why` (core/option_checks.h).
   bool IsValid(std::string* why) const;
   // The same smoothness without the freeze and stutter penalties (Figure 2a).
   MatchOptions WithoutPenalties() const;

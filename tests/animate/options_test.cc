@@ -13,7 +13,10 @@
 #include "animate/reach_sets.h"
 #include "animate/renderer.h"
 #include "animate/replacement.h"
+#include "animate/skeleton/descriptor.h"
 #include "animate/skeleton/importers.h"
+#include "animate/skeleton/lk_tracker.h"
+#include "animate/skeleton/match_dp.h"
 #include "animate/skeleton/match_plot.h"
 #include "animate/skeleton/refine.h"
 #include "animate/skeleton/skeleton_match.h"
@@ -38,6 +41,9 @@ TEST(AnimateOptions, DefaultsAreValid) {
   EXPECT_EQ(Problems(ReplacementOptions{}), "");
   EXPECT_EQ(Problems(BeamOptions{}), "");
   EXPECT_EQ(Problems(SkeletonImportOptions{}), "");
+  EXPECT_EQ(Problems(DescriptorOptions{}), "");
+  EXPECT_EQ(Problems(MatchOptions{}), "");
+  EXPECT_EQ(Problems(LkOptions{}), "");
   EXPECT_EQ(Problems(GestureScriptOptions{}), "");
   EXPECT_EQ(Problems(PlotOptions{}), "");
 }
@@ -227,6 +233,38 @@ TEST(AnimateOptions, PlotNamesEveryField) {
             0u);
   EXPECT_EQ(InputErrorOf([&] { PlotMatch({}, 2); }), "plot: needs at least one panel");
   EXPECT_EQ(PlotMatch(panels, 2).cols, 640);
+}
+
+// The skeleton matcher's inner blocks report every bad field, not the first only.
+TEST(AnimateOptions, SkeletonBlocksNameEveryField) {
+  DescriptorOptions d;
+  d.ratio_weight = -1;
+  d.motion_weight = 1;
+  d.motion_window_s = 0;
+  d.default_fps = 0;
+  std::string why = Problems(d);
+  for (const char* field : {"ratio_weight", "motion_window_s", "default_fps"})
+    EXPECT_TRUE(Names(why, field)) << field << " in " << why;
+  MatchOptions m;
+  m.jump_cost = -1;
+  m.freeze_levels = 9;
+  m.transitions.push_back({});
+  m.transitions.back().cost = std::numeric_limits<float>::infinity();
+  why = Problems(m);
+  for (const char* field : {"jump_cost", "freeze_levels", "transitions[0].cost"})
+    EXPECT_TRUE(Names(why, field)) << field << " in " << why;
+  LkOptions lk;
+  lk.window_px = 3;
+  lk.epsilon = 0;
+  why = Problems(lk);
+  EXPECT_TRUE(Names(why, "window_px")) << why;
+  EXPECT_TRUE(Names(why, "epsilon")) << why;
+  SkeletonMatchOptions o;
+  o.descriptor.default_fps = 0;
+  o.match.stutter_window = -1;
+  why = Problems(o);
+  EXPECT_TRUE(Names(why, "descriptor.default_fps")) << why;
+  EXPECT_TRUE(Names(why, "match.stutter_window")) << why;
 }
 
 }  // namespace
