@@ -60,13 +60,16 @@ bool AnimateRunOptions::IsValid(std::string* why) const {
         "must be seconds >= 0 (0: never), got " + OptionProblems::Num(progress_every_s));
   check(max_turns >= 0, "max_turns",
         "must be >= 0 (0: the time budget alone), got " + std::to_string(max_turns));
+  // Either optimizer stops at the replacement's budget (the spec's optimizer.time_budget_s).
+  const double budget = optimizer.replacement.time_budget_seconds;
+  check(budget > 0 && std::isfinite(budget), "optimizer.replacement.time_budget_seconds",
+        "must be a positive number of seconds, got " + OptionProblems::Num(budget));
   return check.ok();
 }
 
 AnimateResult RunAnimation(const Scene& scene, const AnimateRunOptions& options) {
   if (std::string why; !options.IsValid(&why)) throw InputError("animate options", why);
   const OptimizerSpec& o = options.optimizer;
-  if (!(o.replacement.time_budget_seconds > 0)) throw InputError("--time-budget", "must be > 0");
   AnimateResult result;
   const Problem& problem = scene.problem();
   const std::vector<std::string> names = SpriteNames(scene);

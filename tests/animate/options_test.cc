@@ -60,6 +60,11 @@ TEST(AnimateOptions, EachProblemNamesItsField) {
   AnimateRunOptions run;
   run.max_turns = -1;
   EXPECT_EQ(Problems(run), "max_turns: must be >= 0 (0: the time budget alone), got -1");
+  run.max_turns = 0;
+  run.optimizer.replacement.time_budget_seconds = 0;
+  EXPECT_EQ(Problems(run),
+            "optimizer.replacement.time_budget_seconds: must be a positive number of seconds, "
+            "got 0");
   // The replacement optimizer's reach block comes out under "reach.".
   ReplacementOptions replace;
   replace.reach.step_cost = -1;
