@@ -9,7 +9,7 @@ namespace ss {
 
 TransitionClassifier::TransitionClassifier(const TransitionWeights& weights) : weights_(weights) {
   std::string why;
-  if (!weights.IsValid(&why)) throw InputError("weights", why);
+  if (!weights.IsValid(&why)) throw InputError("transition weights", why);
   t1_ = -weights.stage1_bias;
   for (int k = 0; k < kCheapFeatureCount; ++k) {
     u1_[k] = weights.stage1_weights[k] / weights.feature_scale[k];

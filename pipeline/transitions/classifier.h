@@ -13,7 +13,7 @@ namespace ss {
 
 class TransitionClassifier {
  public:
-  // Throws InputError("weights", reason) for invalid weights.
+  // Throws InputError("transition weights", "field: reason...") for invalid weights.
   explicit TransitionClassifier(const TransitionWeights& weights);
 
   // The stage-1 sum; the linear scan and the index both decide with exactly this.

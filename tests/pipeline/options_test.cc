@@ -305,7 +305,9 @@ TEST(PipelineOptions, TransitionWeights) {
   EXPECT_EQ(Problems(blob), "stage2.colour_blob.max_blob_cells: expected a number >= 0, got -1");
   // The classifier refuses them, and a weights file holding them names the file.
   const std::string what = InputErrorOf([&] { TransitionClassifier classifier(blob); });
-  EXPECT_EQ(what, "weights: stage2.colour_blob.max_blob_cells: expected a number >= 0, got -1");
+  EXPECT_EQ(what,
+            "transition weights: stage2.colour_blob.max_blob_cells: expected a number >= 0, got "
+            "-1");
   TransitionWeights bad = DefaultWeights();
   bad.feature_scale[0] = 0;
   bad.stage2_bias = INFINITY;
