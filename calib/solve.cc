@@ -400,7 +400,7 @@ SolveSummary SolveBoards(const BoardSpec& board, const std::vector<SolveCamera>&
     if (out.covariance.size() == 0)
       log->warn("no covariance: the problem is singular or mrcal's callback failed");
   }
-  char line[256];
+  char line[512];  // the model name alone may take 255
   std::snprintf(line, sizeof line, "%d camera(s), %d views, %s: RMS %.3f px, %d outlier corners",
                 p.ncam, p.Nobs(), name, all_n ? std::sqrt(all2 / all_n) : NAN, stats.Noutliers);
   out.summary = line;

@@ -143,8 +143,9 @@ TEST(SkeletonImporters, ImportedSequenceRoundTripsThroughJson) {
   for (int f = 0; f < s.size(); ++f) {
     for (size_t j = 0; j < s.skeleton.joints.size(); ++j) {
       EXPECT_EQ(back.frames[f].joints[j].present, s.frames[f].joints[j].present);
-      if (s.frames[f].joints[j].present)
+      if (s.frames[f].joints[j].present) {
         EXPECT_NEAR(back.frames[f].joints[j].x_px, s.frames[f].joints[j].x_px, 1e-3);
+      }
     }
   }
 }

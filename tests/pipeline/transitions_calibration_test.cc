@@ -51,7 +51,9 @@ TEST(TransitionCalibration, EarlyExitStageTwoDecidesAsTheFullEvaluation) {
         double d = -1;
         const bool early = c.Stage2(store, i, j, &d);
         ASSERT_EQ(early, c.Stage2Accepts(full)) << i << " " << j << " shift " << shift;
-        if (early) EXPECT_EQ(d, full);
+        if (early) {
+          EXPECT_EQ(d, full);
+        }
         (early ? accepted : rejected) += 1;
       }
     }

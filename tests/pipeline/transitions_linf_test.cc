@@ -130,8 +130,9 @@ TEST(TransitionLinf, BoundNeverRejectsWhatTheFullEvaluationAccepts) {
         exceeding += exceeds;
       }
     }
-    if (limit <= 60)
+    if (limit <= 60) {
       EXPECT_GT(proven, exceeding / 10) << "limit " << limit << ": the bound must prove something";
+    }
   }
 }
 
