@@ -23,7 +23,7 @@ Eigen::Vector2d RedCentroid(const cv::Mat& bgr) {
   int count = 0;
   for (int y = 0; y < bgr.rows; ++y) {
     for (int x = 0; x < bgr.cols; ++x) {
-      const cv::Vec3b p = bgr.at<cv::Vec3b>(y, x);
+      const cv::Vec3b& p = bgr.at<cv::Vec3b>(y, x);
       if (p[2] > 150 && p[1] < 100 && p[0] < 100) {
         sum += Eigen::Vector2d(x, y);
         ++count;
