@@ -131,7 +131,6 @@ void CameraPipeline::Process(const Frame& frame, std::vector<ClipBatch>* out) {
   if (last_sequence_ && frame.sequence != *last_sequence_ + 1) {
     ++stats_.sequence_gaps;
     for (const int64_t clip : cutter_.CloseAll()) batcher_.Close(clip, out);
-    two_clips_.clear();
     merges_.Reset();
   }
   last_sequence_ = frame.sequence;
@@ -207,7 +206,7 @@ void CameraPipeline::Process(const Frame& frame, std::vector<ClipBatch>* out) {
                             Eigen::Vector2d(c.contact_point.x, c.contact_point.y)};
       Rectifier::Refusal why;
       billboards[k] = rectifier_.Rectify(model_, view, &why);
-      if (billboards[k]) {
+      if (billboards[k] && side_by_side_.options().min_width_ratio > 0) {  // the rule is on
         looks[k] =
             MeasureMatteLook(billboards[k]->bgra, billboards[k]->px_per_m, side_by_side_.options());
       } else {
@@ -243,9 +242,7 @@ void CameraPipeline::Process(const Frame& frame, std::vector<ClipBatch>* out) {
   // Clips: runs of consecutive usable frames per subject.
   const std::vector<ClipCutter::Event> events = cutter_.Update(subjects, usable);
   for (const ClipCutter::Event& e : events) {
-    if (!e.closes) continue;
-    batcher_.Close(e.closed_clip, out);
-    two_clips_.erase(e.closed_clip);
+    if (e.closes) batcher_.Close(e.closed_clip, out);
   }
   const size_t first_input_event = events.size() - subjects.size();
   for (size_t k = 0; k < subjects.size(); ++k) {
@@ -258,9 +255,10 @@ void CameraPipeline::Process(const Frame& frame, std::vector<ClipBatch>* out) {
     s.billboard = std::move(*billboards[k]);
     s.description = DescribeBillboard(s.billboard.bgra);
     // Two side by side (SideBySide): split and wide, or wide in a clip once seen split.
-    const bool wide = side_by_side_.IsWide(looks[k].width_m);
-    const bool first_split = !merged[k] && wide && looks[k].split && !two_clips_.contains(e.clip);
-    if (!merged[k] && wide && (looks[k].split || two_clips_.contains(e.clip))) {
+    const bool wide = !merged[k] && side_by_side_.IsWide(looks[k].width_m);
+    const bool seen_split = batcher_.MarkedMerged(e.clip);
+    const bool first_split = wide && looks[k].split && !seen_split;
+    if (wide && (looks[k].split || seen_split)) {
       merged[k] = true;
       verdicts_[verdict_of[k]].merged = true;
     }
@@ -270,7 +268,6 @@ void CameraPipeline::Process(const Frame& frame, std::vector<ClipBatch>* out) {
     batcher_.Add(e.clip, e.subject, std::move(s), out);
     if (first_split) {
       // The clip's wide sprites still held were the pair too, before a gap showed it.
-      two_clips_.insert(e.clip);
       batcher_.MarkMerged(e.clip, side_by_side_.min_wide_m());
       log_->debug("{} frame {} subject {}: two side by side ({:.2f} m wide, one is {:.2f} m)",
                   name_, frame.sequence, subjects[k], looks[k].width_m,
@@ -284,7 +281,6 @@ void CameraPipeline::Process(const Frame& frame, std::vector<ClipBatch>* out) {
 void CameraPipeline::Finish(std::vector<ClipBatch>* out) {
   for (const int64_t clip : cutter_.CloseAll()) batcher_.Close(clip, out);
   batcher_.CloseAll(out);
-  two_clips_.clear();
   UpdateClipStats();
 }
 

@@ -10,7 +10,6 @@
 #include <memory>
 #include <optional>
 #include <string>
-#include <unordered_set>
 #include <vector>
 
 #include <spdlog/logger.h>
@@ -135,7 +134,6 @@ class CameraPipeline {
   Tracker tracker_;
   MergeDetector merges_;
   SideBySide side_by_side_;
-  std::unordered_set<int64_t> two_clips_;  // open clips seen split side by side (SideBySide)
   StillnessFilter stillness_;
   NoiseFilter noise_;
   ClipCutter cutter_;

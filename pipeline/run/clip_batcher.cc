@@ -110,7 +110,13 @@ void ClipBatcher::Add(int64_t clip, int subject, MadeSprite sprite, std::vector<
 void ClipBatcher::MarkMerged(int64_t clip, double min_width_m) {
   const auto it = clips_.find(clip);
   if (it == clips_.end()) return;
+  it->second.marked_merged = true;
   for (MadeSprite& s : it->second.pending) s.merged = s.merged || s.matte_width_m >= min_width_m;
+}
+
+bool ClipBatcher::MarkedMerged(int64_t clip) const {
+  const auto it = clips_.find(clip);
+  return it != clips_.end() && it->second.marked_merged;
 }
 
 void ClipBatcher::Close(int64_t clip, std::vector<ClipBatch>* out) {

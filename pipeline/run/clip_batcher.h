@@ -55,8 +55,10 @@ class ClipBatcher {
   // The clip's subject is two subjects side by side, seen only now (SideBySide): each sprite of
   // the clip not yet handed out whose matte is at least `min_width_m` wide is tagged merged.
   // Those handed out stay as stored: a clip goes out batch_frames at a time, so a pair seen
-  // split within its first batch is tagged whole.
+  // split within its first batch is tagged whole. The clip stays marked until it closes.
   void MarkMerged(int64_t clip, double min_width_m);
+  // Whether MarkMerged was called for the open clip `clip`.
+  bool MarkedMerged(int64_t clip) const;
   // The clip ended: its rest goes out as the complete batch, or it is dropped when short.
   void Close(int64_t clip, std::vector<ClipBatch>* out);
   // Closes every open clip.
@@ -85,6 +87,7 @@ class ClipBatcher {
     std::vector<Eigen::Vector2d> points;  // their contact points
     std::vector<MadeSprite> pending;      // not yet handed out: the last pending.size() frames
     bool started = false;                 // a first batch went out
+    bool marked_merged = false;           // MarkMerged: two side by side
   };
   // Hands out the first `count` pending sprites of `open`.
   void Emit(Open& open, size_t count, bool complete, std::vector<ClipBatch>* out);

@@ -47,6 +47,36 @@ TEST(ClipBatcher, MergedSpritesCarryTheTagInTheirOwnBatch) {
   EXPECT_EQ(batcher.stored_merged_originals(), 2u);
 }
 
+// A pair walked in together: frames 0-3 went out in a first batch, 4-6 are held back when frame 6
+// shows the split. MarkMerged tags the wide ones still held; the narrow one (the pair one behind
+// the other) and the sprites already handed out stay as they are.
+TEST(ClipBatcher, MarkMergedTagsTheWideSpritesStillHeld) {
+  ClipBatcher batcher(
+      1, {.min_clip_frames = 2, .batch_frames = 4, .velocity_half_window = 1, .mirrors = false});
+  std::vector<ClipBatch> out;
+  const std::vector<double> widths = {1.0, 1.1, 1.0, 1.2, 0.5, 1.1, 1.0};  // one is 0.5 m
+  for (int f = 0; f < 7; ++f) {
+    MadeSprite s = Walking(f);
+    s.matte_width_m = widths[f];
+    batcher.Add(4, 2, std::move(s), &out);
+  }
+  EXPECT_FALSE(batcher.MarkedMerged(4));
+  const size_t handed_out = out.empty() ? 0 : out[0].sprites.size();
+  ASSERT_EQ(handed_out, 4u);  // frames 0-3 (batch_frames 4, one held for the velocity)
+  batcher.MarkMerged(4, 0.75);
+  batcher.MarkMerged(99, 0.75);  // no such clip: nothing
+  EXPECT_TRUE(batcher.MarkedMerged(4));
+  EXPECT_FALSE(batcher.MarkedMerged(99));
+  batcher.Close(4, &out);
+  std::vector<int64_t> tagged;
+  for (const ClipBatch& b : out) {
+    for (const SpriteRecord& r : b.sprites)
+      if (!r.tags.empty()) tagged.push_back(r.frame);
+  }
+  EXPECT_EQ(tagged, (std::vector<int64_t>{5, 6}));
+  EXPECT_EQ(batcher.stored_merged_originals(), 2u);
+}
+
 TEST(ClipBatcher, ShortClipsAreDroppedAndCounted) {
   ClipBatcher batcher(7, {.min_clip_frames = 5, .batch_frames = 3});
   std::vector<ClipBatch> out;

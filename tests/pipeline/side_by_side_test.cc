@@ -1,6 +1,6 @@
 // SideBySide (issue 19): a billboard matte of two subjects side by side, told from one subject
-// by a split into two tall parts and a width above one subject's; and ClipBatcher::MarkMerged,
-// which tags the clip's sprites held back from before the split showed.
+// by a split into two tall parts and a width above one subject's (ClipBatcher::MarkMerged, which
+// tags the clip's sprites held back from before the split showed: clip_batcher_test.cc).
 #include "pipeline/track/side_by_side.h"
 
 #include <gtest/gtest.h>
@@ -8,7 +8,6 @@
 #include <opencv2/imgproc.hpp>
 
 #include "core/error.h"
-#include "pipeline/run/clip_batcher.h"
 
 namespace ss {
 namespace {
@@ -87,44 +86,6 @@ TEST(SideBySide, OptionsNameTheirFields) {
   for (const char* field : {"min_width_ratio: ", "max_neck_share: ", "min_widths: "})
     EXPECT_NE(why.find(field), std::string::npos) << field << " in " << why;
   EXPECT_THROW(SideBySide{o}, InputError);
-}
-
-MadeSprite Sprite(int64_t f, double width_m) {
-  MadeSprite s;
-  s.frame = f;
-  s.timestamp_ns = f * 100'000'000;
-  s.billboard.bgra = cv::Mat(20, 11, CV_8UC4, cv::Scalar(1, 2, 3, 255));
-  s.billboard.shadow = cv::Mat::zeros(9, 9, CV_8U);
-  s.billboard.anchor_px = Eigen::Vector2d(5, 19);
-  s.billboard.point_in_ground = Eigen::Vector3d(0.1 * f, 0, 0);
-  s.billboard.right_in_ground = Eigen::Vector2d(1, 0);
-  s.billboard.toward_camera = Eigen::Vector2d(0, -1);
-  s.billboard.px_per_m = 40;
-  s.matte_width_m = width_m;
-  return s;
-}
-
-// A pair walked in together: frames 0-3 went out in a first batch, 4-6 are held back when frame 6
-// shows the split. MarkMerged tags the wide ones still held; the narrow one (the pair one behind
-// the other) and the sprites already handed out stay as they are.
-TEST(ClipBatcher, MarkMergedTagsTheWideSpritesStillHeld) {
-  ClipBatcher batcher(
-      1, {.min_clip_frames = 2, .batch_frames = 4, .velocity_half_window = 1, .mirrors = false});
-  std::vector<ClipBatch> out;
-  const std::vector<double> widths = {1.0, 1.1, 1.0, 1.2, 0.5, 1.1, 1.0};  // one is 0.5 m
-  for (int f = 0; f < 7; ++f) batcher.Add(4, 2, Sprite(f, widths[f]), &out);
-  const size_t handed_out = out.empty() ? 0 : out[0].sprites.size();
-  ASSERT_EQ(handed_out, 4u);  // frames 0-3 (batch_frames 4, one held for the velocity)
-  batcher.MarkMerged(4, 0.75);
-  batcher.MarkMerged(99, 0.75);  // no such clip: nothing
-  batcher.Close(4, &out);
-  std::vector<int64_t> tagged;
-  for (const ClipBatch& b : out) {
-    for (const SpriteRecord& r : b.sprites)
-      if (!r.tags.empty()) tagged.push_back(r.frame);
-  }
-  EXPECT_EQ(tagged, (std::vector<int64_t>{5, 6}));
-  EXPECT_EQ(batcher.stored_merged_originals(), 2u);
 }
 
 }  // namespace
