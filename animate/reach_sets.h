@@ -18,7 +18,7 @@ enum class ReachDirection { kForward, kBackward };
 
 struct ReachOptions {
   int set_size = 200;      // N: frames kept per set, the root included
-  int num_threads = 2;     // Dijkstra runs are independent; split over this many threads
+  int num_threads = 2;     // Dijkstra runs are independent; split over this many threads (1..256)
   double step_cost = 0.0;  // added to every edge of Ĉ
   // False with "FIELD: reason" lines in `why` (core/option_checks.h) for values out of range.
   bool IsValid(std::string* why) const;

@@ -53,7 +53,7 @@ TEST(AnimateOptions, EachProblemNamesItsField) {
   reach.set_size = 0;
   reach.num_threads = 0;
   EXPECT_EQ(Problems(reach),
-            "set_size: must be in 1..65535, got 0\nnum_threads: must be >= 1, got 0");
+            "set_size: must be in 1..65535, got 0\nnum_threads: must be in 1..256, got 0");
   RenderOptions render;
   render.shadow_opacity = 1.5;
   EXPECT_EQ(Problems(render), "shadow_opacity: must be within [0, 1], got 1.5");
