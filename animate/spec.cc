@@ -4,7 +4,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
-#include <initializer_list>
+#include <functional>
 #include <map>
 #include <optional>
 #include <sstream>
@@ -15,458 +15,9 @@
 #include "core/error.h"
 #include "core/input_file.h"
 #include "core/options_binder.h"
+#include "core/yaml_reader.h"
 
 namespace ss {
-namespace {
-
-namespace fs = std::filesystem;
-
-int LineOf(const YAML::Node& node) {
-  const YAML::Mark mark = node.Mark();
-  return mark.line >= 0 ? mark.line + 1 : 0;
-}
-
-// Reads nodes of one spec, naming the file, line and field in every error.
-class Reader {
- public:
-  explicit Reader(std::string origin) : origin_(std::move(origin)) {}
-
-  [[noreturn]] void Fail(const YAML::Node& node, const std::string& field,
-                         const std::string& why) const {
-    throw InputError(origin_ + ":" + std::to_string(LineOf(node)) + ": " + field, why);
-  }
-  SpecPlace Place(const YAML::Node& node, const std::string& field) const {
-    return {LineOf(node), field};
-  }
-
-  // `node` must be a map holding only `known` keys.
-  void Map(const YAML::Node& node, const std::string& field,
-           std::initializer_list<const char*> known) const {
-    if (!node.IsMap()) Fail(node, field, "expected a map");
-    for (const auto& item : node) {
-      if (!item.first.IsScalar()) Fail(item.first, field, "a key that is not a plain name");
-      const std::string key = item.first.as<std::string>();
-      bool ok = false;
-      std::string list;
-      for (const char* k : known) {
-        ok = ok || key == k;
-        list += (list.empty() ? "" : ", ") + std::string(k);
-      }
-      if (!ok) Fail(item.first, Join(field, key), "unknown field (expected one of: " + list + ")");
-    }
-  }
-  static std::string Join(const std::string& field, const std::string& key) {
-    return field.empty() ? key : field + "." + key;
-  }
-  static std::string Index(const std::string& field, size_t i) {
-    return field + "[" + std::to_string(i) + "]";
-  }
-
-  std::string Text(const YAML::Node& node, const std::string& field) const {
-    if (!node.IsScalar()) Fail(node, field, "expected a string");
-    return node.Scalar();
-  }
-  double Number(const YAML::Node& node, const std::string& field) const {
-    if (!node.IsScalar()) Fail(node, field, "expected a number");
-    try {
-      const double value = node.as<double>();
-      if (!std::isfinite(value)) Fail(node, field, "expected a finite number");
-      return value;
-    } catch (const YAML::Exception&) {
-      Fail(node, field, "expected a number, got \"" + node.Scalar() + "\"");
-    }
-  }
-  double AtLeast(const YAML::Node& node, const std::string& field, double low) const {
-    const double value = Number(node, field);
-    if (value < low) Fail(node, field, "must be >= " + Num(low));
-    return value;
-  }
-  double Positive(const YAML::Node& node, const std::string& field) const {
-    const double value = Number(node, field);
-    if (value <= 0) Fail(node, field, "must be > 0");
-    return value;
-  }
-  int Integer(const YAML::Node& node, const std::string& field, int low) const {
-    const double value = Number(node, field);
-    if (value != std::floor(value) || value < low || value > 1e9) {
-      Fail(node, field, "expected a whole number >= " + std::to_string(low));
-    }
-    return static_cast<int>(value);
-  }
-  // A whole number in [low, high]; `high` is a limit of the optimizer, named in the message.
-  int IntegerIn(const YAML::Node& node, const std::string& field, int low, int high) const {
-    const int value = Integer(node, field, low);
-    if (value > high)
-      Fail(node, field,
-           "expected at most " + std::to_string(high) + ", got " + std::to_string(value));
-    return value;
-  }
-  Eigen::Vector2d Point(const YAML::Node& node, const std::string& field) const {
-    if (!node.IsSequence() || node.size() != 2) Fail(node, field, "expected [x, y] in metres");
-    return {Number(node[0], Index(field, 0)), Number(node[1], Index(field, 1))};
-  }
-  std::string Path(const YAML::Node& node, const std::string& field, bool must_exist) const {
-    std::string text = Text(node, field);
-    if (text.empty()) Fail(node, field, "expected a file name");
-    fs::path p(text);
-    if (p.is_relative()) p = fs::path(origin_).parent_path() / p;
-    p = p.lexically_normal();
-    std::error_code ec;  // a name the file system refuses (too long, ...) is no such file either
-    if (must_exist && !fs::exists(p, ec)) {
-      Fail(node, field, "no such file: " + p.string() + (ec ? " (" + ec.message() + ")" : ""));
-    }
-    return p.string();
-  }
-  const std::string& origin() const { return origin_; }
-
- private:
-  static std::string Num(double v) {
-    std::ostringstream s;
-    s << v;
-    return s.str();
-  }
-  std::string origin_;
-};
-
-// A time in seconds or "end": (step, counts back from the end).
-std::pair<int, bool> ReadTime(const Reader& r, const AnimationSpec& spec, const YAML::Node& node,
-                              const std::string& field) {
-  if (node.IsScalar() && node.Scalar() == "end") return {0, true};
-  return {spec.Steps(r.AtLeast(node, field, 0.0)), false};
-}
-
-// `at: T | end` or `from: T` / `to: T | end`; `fallback` when none is given.
-StepWindow ReadWindow(const Reader& r, const AnimationSpec& spec, const YAML::Node& node,
-                      const std::string& field, StepWindow fallback) {
-  if (node["at"]) {
-    if (node["from"] || node["to"]) r.Fail(node, field + ".at", "give either at or from/to");
-    const auto [step, from_end] = ReadTime(r, spec, node["at"], field + ".at");
-    return {step, from_end, step, from_end};
-  }
-  if (!node["from"] && !node["to"]) return fallback;
-  StepWindow window = StepWindow::All();
-  if (node["from"]) {
-    const auto [step, from_end] = ReadTime(r, spec, node["from"], field + ".from");
-    window.first = step;
-    window.first_from_end = from_end;
-  }
-  if (node["to"]) {
-    const auto [step, from_end] = ReadTime(r, spec, node["to"], field + ".to");
-    window.last = step;
-    window.last_from_end = from_end;
-  }
-  if (!window.first_from_end && !window.last_from_end && window.last < window.first) {
-    r.Fail(node["to"], field + ".to", "ends before it starts");
-  }
-  return window;
-}
-
-double ReadStrength(const Reader& r, const YAML::Node& node, const std::string& field,
-                    double fallback) {
-  return node["strength"] ? r.AtLeast(node["strength"], field + ".strength", 0.0) : fallback;
-}
-
-LengthSpec ReadLength(const Reader& r, const YAML::Node& node, const std::string& field) {
-  r.Map(node, field, {"min_frames", "strength"});
-  if (!node["min_frames"]) r.Fail(node, field + ".min_frames", "required");
-  return {r.Integer(node["min_frames"], field + ".min_frames", 1),
-          ReadStrength(r, node, field, 1.0)};
-}
-
-FastFrameSpec ReadFast(const Reader& r, const YAML::Node& node, const std::string& field) {
-  r.Map(node, field, {"reference_speed_m_s", "strength"});
-  if (!node["reference_speed_m_s"]) r.Fail(node, field + ".reference_speed_m_s", "required");
-  return {r.Positive(node["reference_speed_m_s"], field + ".reference_speed_m_s"),
-          ReadStrength(r, node, field, 1.0)};
-}
-
-LocationSpec ReadLocation(const Reader& r, const AnimationSpec& spec, const YAML::Node& node,
-                          const std::string& field) {
-  r.Map(node, field, {"target", "follow", "offset", "offset_axes", "at", "from", "to", "strength"});
-  LocationSpec out;
-  out.place = r.Place(node, field);
-  if (node["follow"]) {
-    if (node["target"]) r.Fail(node["target"], field + ".target", "give either target or follow");
-    out.follow = r.Text(node["follow"], field + ".follow");
-    out.target_m =
-        node["offset"] ? r.Point(node["offset"], field + ".offset") : Eigen::Vector2d::Zero();
-    if (node["offset_axes"]) {
-      const std::string axes = r.Text(node["offset_axes"], field + ".offset_axes");
-      if (axes != "heading" && axes != "ground") {
-        r.Fail(node["offset_axes"], field + ".offset_axes", "expected heading or ground");
-      }
-      out.offset_in_heading = axes == "heading";
-    }
-  } else {
-    if (!node["target"]) r.Fail(node, field + ".target", "required (or follow: SPRITE)");
-    if (node["offset"]) r.Fail(node["offset"], field + ".offset", "only with follow");
-    out.target_m = r.Point(node["target"], field + ".target");
-  }
-  out.window = ReadWindow(r, spec, node, field, StepWindow::All());
-  out.strength = ReadStrength(r, node, field, 1.0);
-  return out;
-}
-
-PathSpec ReadPath(const Reader& r, const YAML::Node& node, const std::string& field) {
-  r.Map(node, field, {"points", "direction_strength", "distance_strength", "unreached_strength"});
-  PathSpec out;
-  out.place = r.Place(node, field);
-  const YAML::Node points = node["points"];
-  if (!points) r.Fail(node, field + ".points", "required");
-  if (!points.IsSequence() || points.size() < 2) {
-    r.Fail(points, field + ".points", "expected a list of at least two [x, y] points");
-  }
-  for (size_t i = 0; i < points.size(); ++i) {
-    out.points_m.push_back(r.Point(points[i], Reader::Index(field + ".points", i)));
-  }
-  try {
-    Polyline check(out.points_m, field + ".points");
-  } catch (const InputError&) {
-    r.Fail(points, field + ".points", "needs two distinct points");
-  }
-  if (node["direction_strength"]) {
-    out.strengths.direction =
-        r.AtLeast(node["direction_strength"], field + ".direction_strength", 0);
-  }
-  if (node["distance_strength"]) {
-    out.strengths.distance = r.AtLeast(node["distance_strength"], field + ".distance_strength", 0);
-  }
-  if (node["unreached_strength"]) {
-    out.strengths.unreached =
-        r.AtLeast(node["unreached_strength"], field + ".unreached_strength", 0);
-  }
-  return out;
-}
-
-FrameSpec ReadFrames(const Reader& r, const AnimationSpec& spec, const YAML::Node& node,
-                     const std::string& field) {
-  r.Map(node, field, {"tag", "sprites", "at", "from", "to", "after_path", "duration", "strength"});
-  FrameSpec out;
-  out.place = r.Place(node, field);
-  if (node["tag"] && node["sprites"]) r.Fail(node, field, "give either tag or sprites");
-  if (node["tag"]) {
-    out.tag = r.Text(node["tag"], field + ".tag");
-    if (out.tag.empty()) r.Fail(node["tag"], field + ".tag", "must not be empty");
-  } else if (node["sprites"]) {
-    const YAML::Node ids = node["sprites"];
-    if (!ids.IsSequence() || ids.size() == 0) {
-      r.Fail(ids, field + ".sprites", "expected a list of bank sprite ids");
-    }
-    for (size_t i = 0; i < ids.size(); ++i) {
-      out.sprite_ids.push_back(r.Integer(ids[i], Reader::Index(field + ".sprites", i), 1));
-    }
-  } else {
-    r.Fail(node, field + ".tag", "required (or sprites: [ids])");
-  }
-  if (node["after_path"]) {
-    if (node["at"] || node["from"] || node["to"]) {
-      r.Fail(node["after_path"], field + ".after_path", "give either after_path or at/from/to");
-    }
-    out.after_path_of = r.Text(node["after_path"], field + ".after_path");
-    if (!node["duration"]) r.Fail(node, field + ".duration", "required with after_path");
-    out.duration_steps = std::max(1, spec.Steps(r.Positive(node["duration"], field + ".duration")));
-  } else {
-    if (node["duration"]) r.Fail(node["duration"], field + ".duration", "only with after_path");
-    out.window = ReadWindow(r, spec, node, field, StepWindow::All());
-  }
-  out.strength = ReadStrength(r, node, field, 1.0);
-  return out;
-}
-
-SpriteSpecEntry ReadSprite(const Reader& r, const AnimationSpec& spec, const YAML::Node& node,
-                           const std::string& field) {
-  r.Map(node, field,
-        {"name", "start", "end", "smoothness", "constraints", "length", "fast_frames"});
-  SpriteSpecEntry out;
-  out.place = r.Place(node, field);
-  if (!node["name"]) r.Fail(node, field + ".name", "required");
-  out.name = r.Text(node["name"], field + ".name");
-  if (out.name.empty()) r.Fail(node["name"], field + ".name", "must not be empty");
-  if (node["start"] && node["end"]) r.Fail(node["end"], field + ".end", "give either start or end");
-  if (node["end"]) {
-    out.anchor = Anchor::kEnd;
-    out.anchor_m = r.Point(node["end"], field + ".end");
-  } else if (node["start"]) {
-    const YAML::Node start = node["start"];
-    if (start.IsScalar() && start.Scalar() == "free") {
-      out.anchor = Anchor::kFree;
-    } else if (start.IsMap()) {
-      r.Map(start, field + ".start", {"free", "guess"});
-      out.anchor = Anchor::kFree;
-      if (start["guess"]) out.anchor_m = r.Point(start["guess"], field + ".start.guess");
-    } else {
-      out.anchor_m = r.Point(start, field + ".start");
-    }
-  } else {
-    r.Fail(node, field + ".start", "required: [x, y], free, or end: [x, y] instead");
-  }
-  if (node["smoothness"]) out.smoothness = r.AtLeast(node["smoothness"], field + ".smoothness", 0);
-  if (node["length"]) out.length = ReadLength(r, node["length"], field + ".length");
-  if (node["fast_frames"]) out.fast = ReadFast(r, node["fast_frames"], field + ".fast_frames");
-  if (const YAML::Node list = node["constraints"]) {
-    const std::string lfield = field + ".constraints";
-    if (!list.IsSequence()) r.Fail(list, lfield, "expected a list");
-    for (size_t i = 0; i < list.size(); ++i) {
-      const std::string cfield = Reader::Index(lfield, i);
-      const YAML::Node item = list[i];
-      if (!item.IsMap() || item.size() != 1) {
-        r.Fail(item, cfield, "expected one of location:, path:, frames:");
-      }
-      if (!item.begin()->first.IsScalar())
-        r.Fail(item, cfield, "expected one of location:, path:, frames:");
-      const std::string kind = item.begin()->first.as<std::string>();
-      const YAML::Node body = item.begin()->second;
-      if (kind == "location") {
-        out.locations.push_back(ReadLocation(r, spec, body, cfield + ".location"));
-      } else if (kind == "path") {
-        if (out.path) r.Fail(item, cfield + ".path", "a sprite has at most one path");
-        out.path = ReadPath(r, body, cfield + ".path");
-      } else if (kind == "frames") {
-        out.frames.push_back(ReadFrames(r, spec, body, cfield + ".frames"));
-      } else {
-        r.Fail(item, cfield + "." + kind, "unknown constraint (expected location, path or frames)");
-      }
-    }
-  }
-  return out;
-}
-
-CollisionSpec ReadCollision(const Reader& r, const AnimationSpec& spec, const YAML::Node& node,
-                            const std::string& field) {
-  r.Map(node, field, {"sprites", "min_distance_m", "strength"});
-  CollisionSpec out;
-  out.place = r.Place(node, field);
-  const YAML::Node sprites = node["sprites"];
-  if (!sprites) r.Fail(node, field + ".sprites", "required: a list of names, or all");
-  if (sprites.IsScalar() && sprites.Scalar() == "all") {
-    if (spec.sprites.size() < 2) r.Fail(sprites, field + ".sprites", "needs two sprites or more");
-  } else {
-    if (!sprites.IsSequence() || sprites.size() < 2) {
-      r.Fail(sprites, field + ".sprites", "expected all or a list of two sprite names or more");
-    }
-    for (size_t i = 0; i < sprites.size(); ++i) {
-      const std::string f = Reader::Index(field + ".sprites", i);
-      const std::string name = r.Text(sprites[i], f);
-      if (spec.SpriteIndex(name) < 0) r.Fail(sprites[i], f, "no sprite named " + name);
-      out.sprites.push_back(name);
-    }
-  }
-  if (!node["min_distance_m"]) r.Fail(node, field + ".min_distance_m", "required");
-  out.min_distance_m = r.Positive(node["min_distance_m"], field + ".min_distance_m");
-  out.strength = ReadStrength(r, node, field, 1.0);
-  return out;
-}
-
-// Reads `node` as the block `field` with `keys` (the station config's reader,
-// core/options_binder.h: types, unknown keys) and throws its first mistake: a spec stops there.
-void ReadBound(const Reader& r, const OptionsBinder& keys, const YAML::Node& node,
-               const std::string& field) {
-  std::map<std::string, int> lines;
-  YamlMessages msg(r.origin(), lines);
-  YamlReader reader(msg, lines, fs::path(r.origin()).parent_path().string());
-  if (!node.IsMap()) r.Fail(node, field, "expected a map");
-  keys.Read(reader, node, field);
-  if (!msg.errors.empty()) throw InputError(msg.errors.front());
-}
-
-void ReadOptimizer(const Reader& r, const YAML::Node& node, OptimizerSpec& o) {
-  const std::string f = "optimizer";
-  ReplacementOptions& rep = o.replacement;
-  int64_t seed = static_cast<int64_t>(rep.seed);
-  OptionsBinder keys;
-  keys.AddEnum("method", &o.method, kOptimizerMethodTexts, "replace or beam")
-      .AddEnum("start", &rep.start, kSpecStartTexts,
-               "replacement's start: sequential, random or beam")
-      .Add("time_budget_s", &rep.time_budget_seconds, "a number", "seconds the optimizer may run")
-      .Add("seed", &seed, "a whole number >= 0", "the random generator's seed")
-      .Add("set_size", &rep.reach.set_size, "a whole number >= 2", "N of the F/B sets")
-      .Add("threads", &rep.reach.num_threads, "a whole number >= 1", "worker threads")
-      .Add("changes_per_turn", &rep.changes_per_turn, "a whole number >= 1",
-           "picks per sprite turn")
-      .Add("beam_width", &rep.beam.width, "a whole number >= 1", "the beam search's width")
-      .Add("snapshot_every_s", &o.snapshot_every_s, "a number",
-           "> 0: keep the sequences every so many seconds")
-      .Add("collision_pick_fraction", &rep.collision_pick_fraction, "a number",
-           "replacement's picks aimed at a collision, 0 to 1");
-  ReadBound(r, keys, node, f);
-  // The bounds; those of the optimizer (ReplacementOptions::IsValid, beam search) are checked
-  // here so that the message names the spec's file, line and field rather than the optimizer's.
-  const auto fail = [&](const char* key, const std::string& why) {
-    r.Fail(node[key], f + "." + key, why);
-  };
-  const auto whole = [&](const char* key, int value, int low, int high) {
-    if (!node[key]) return;
-    if (value < low) fail(key, "expected a whole number >= " + std::to_string(low));
-    if (value > high)
-      fail(key, "expected at most " + std::to_string(high) + ", got " + std::to_string(value));
-  };
-  const auto positive = [&](const char* key, double value) {
-    if (!node[key]) return;
-    if (!std::isfinite(value)) fail(key, "expected a finite number");
-    if (value <= 0) fail(key, "must be > 0");
-  };
-  positive("time_budget_s", rep.time_budget_seconds);
-  if (node["seed"] && (seed < 0 || seed > 1000000000)) fail("seed", "expected a whole number >= 0");
-  rep.seed = static_cast<uint64_t>(seed);
-  whole("set_size", rep.reach.set_size, 2, 65535);
-  whole("threads", rep.reach.num_threads, 1, 256);
-  whole("changes_per_turn", rep.changes_per_turn, 1, 1000000000);
-  whole("beam_width", rep.beam.width, 1, 65535);
-  if (node["collision_pick_fraction"]) {
-    const double fraction = rep.collision_pick_fraction;
-    if (!std::isfinite(fraction)) fail("collision_pick_fraction", "expected a finite number");
-    if (fraction < 0) fail("collision_pick_fraction", "must be >= 0");
-    if (fraction > 1) fail("collision_pick_fraction", "expected 0 to 1");
-  }
-  positive("snapshot_every_s", o.snapshot_every_s);
-}
-
-void ReadLengthTop(const Reader& r, const YAML::Node& node, AnimationSpec& spec) {
-  int fixed = 0, min_frames = 0, max_frames = 0, initial_frames = 0;
-  std::optional<double> strength;
-  if (node.IsScalar()) {
-    fixed = r.Integer(node, "length", 1);
-  } else {
-    OptionsBinder keys;
-    keys.Add("frames", &fixed, "a whole number >= 1", "every sequence is this long")
-        .Add("min_frames", &min_frames, "a whole number >= 1", "sequences shorter are penalized")
-        .Add("max_frames", &max_frames, "a whole number >= 1", "the longest sequence")
-        .Add("initial_frames", &initial_frames, "a whole number >= 1",
-             "length of random initial sequences")
-        .Add("strength", &strength, "a number", "weight of the length term");
-    ReadBound(r, keys, node, "length");
-    for (const auto& [key, value] :
-         {std::pair{"frames", fixed}, std::pair{"min_frames", min_frames},
-          std::pair{"max_frames", max_frames}, std::pair{"initial_frames", initial_frames}}) {
-      if (node[key] && value < 1)
-        r.Fail(node[key], std::string("length.") + key, "expected a whole number >= 1");
-    }
-    if (strength && (!std::isfinite(*strength) || *strength < 0)) {
-      r.Fail(node["strength"], "length.strength",
-             std::isfinite(*strength) ? "must be >= 0" : "expected a finite number");
-    }
-    if (node["frames"] && (node["min_frames"] || node["max_frames"])) {
-      r.Fail(node["frames"], "length.frames", "give either frames (fixed) or min/max_frames");
-    }
-    spec.max_frames = max_frames;
-    if (initial_frames > 0) spec.initial_frames = initial_frames;
-    if (min_frames > 0) {
-      spec.length = LengthSpec{min_frames, strength.value_or(1.0)};
-      if (spec.max_frames > 0 && spec.max_frames < min_frames) {
-        r.Fail(node["max_frames"], "length.max_frames", "is below length.min_frames");
-      }
-    }
-  }
-  if (fixed > 0) {
-    // A fixed length: sequences are cut at N and strongly held to N.
-    spec.fixed_frames = fixed;
-    spec.max_frames = fixed;
-    spec.initial_frames = fixed;
-    spec.length = LengthSpec{fixed, strength.value_or(100.0)};
-  }
-}
-
-}  // namespace
 
 int AnimationSpec::Steps(double seconds) const {
   return static_cast<int>(std::lround(seconds * frame_rate));
@@ -485,85 +36,727 @@ std::string AnimationSpec::Where(const SpecPlace& place) const {
 
 namespace {
 
-AnimationSpec ParseSpecRoot(const YAML::Node& root, const std::string& origin) {
-  const Reader r(origin);
-  AnimationSpec spec;
-  spec.path = origin;
-  r.Map(root, "",
-        {"version", "frame_rate", "length", "camera", "background", "banks", "sprites",
-         "collisions", "fast_frames", "optimizer"});
-  if (root["version"]) {
-    spec.version = r.Integer(root["version"], "version", 1);
-    if (spec.version != kAnimationSpecVersion) {
-      r.Fail(root["version"], "version",
-             "this build reads version " + std::to_string(kAnimationSpecVersion));
-    }
-  }
-  if (root["frame_rate"]) spec.frame_rate = r.Positive(root["frame_rate"], "frame_rate");
-  if (!root["length"]) r.Fail(root, "length", "required: N frames, or {min_frames, max_frames}");
-  ReadLengthTop(r, root["length"], spec);
-  if (!root["camera"]) r.Fail(root, "camera", "required: the virtual camera's .cameramodel");
-  spec.camera_path = r.Path(root["camera"], "camera", true);
-  if (root["background"]) spec.background_path = r.Path(root["background"], "background", true);
-  const YAML::Node banks = root["banks"];
-  if (!banks) r.Fail(root, "banks", "required: a list of sprite banks");
-  if (banks.IsScalar()) {
-    spec.bank_paths.push_back(r.Path(banks, "banks", true));
-  } else {
-    if (!banks.IsSequence() || banks.size() == 0)
-      r.Fail(banks, "banks", "expected a list of banks");
-    for (size_t i = 0; i < banks.size(); ++i) {
-      spec.bank_paths.push_back(r.Path(banks[i], Reader::Index("banks", i), true));
-    }
-  }
-  if (root["fast_frames"]) spec.fast = ReadFast(r, root["fast_frames"], "fast_frames");
-  if (root["optimizer"]) ReadOptimizer(r, root["optimizer"], spec.optimizer);
+namespace fs = std::filesystem;
+using namespace yaml_text;
 
-  const YAML::Node sprites = root["sprites"];
-  if (!sprites) r.Fail(root, "sprites", "required: a list of sprites");
-  if (!sprites.IsSequence() || sprites.size() == 0) r.Fail(sprites, "sprites", "expected a list");
-  for (size_t i = 0; i < sprites.size(); ++i) {
-    const std::string field = Reader::Index("sprites", i);
-    SpriteSpecEntry entry = ReadSprite(r, spec, sprites[i], field);
-    if (spec.SpriteIndex(entry.name) >= 0) {
-      r.Fail(sprites[i]["name"], field + ".name", "another sprite is named " + entry.name);
-    }
-    spec.sprites.push_back(std::move(entry));
+// A time as written: seconds, or `end`.
+struct SpecTime {
+  double seconds = 0;
+  bool end = false;
+};
+
+// The `at`, `from` and `to` keys of a block with a window, as read.
+struct WindowKeys {
+  std::optional<SpecTime> at, from, to;
+};
+
+enum class OffsetAxes { kHeading, kGround };
+constexpr EnumText<OffsetAxes> kOffsetAxesTexts[] = {{OffsetAxes::kHeading, "heading"},
+                                                     {OffsetAxes::kGround, "ground"}};
+
+// The optimizer's option fields (ReplacementOptions, BeamOptions) by the spec key that sets them,
+// so that the optimizer's own limits are checked by the optimizer and named as the spec's keys.
+const std::map<std::string, std::string> kReplacementKeys = {
+    {"reach.set_size", "set_size"},
+    {"reach.num_threads", "threads"},
+    {"time_budget_seconds", "time_budget_s"},
+    {"changes_per_turn", "changes_per_turn"},
+    {"collision_pick_fraction", "collision_pick_fraction"},
+    {"beam.width", "beam_width"},
+};
+const std::map<std::string, std::string> kBeamKeys = {
+    {"width", "beam_width"},
+    {"time_budget_seconds", "time_budget_s"},
+};
+
+// Reads one spec with the station config's reader (core/yaml_reader.h): each block's keys are
+// bound to the spec's fields (core/options_binder.h), values with a shape of their own (points,
+// times, `free`, `all`) are read by this class, and every mistake of the file is collected with
+// its line and field before the spec is refused.
+class SpecReader {
+ public:
+  explicit SpecReader(const std::string& origin)
+      : msg_(origin, lines_), r_(msg_, lines_, fs::path(origin).parent_path().string()) {
+    spec_.path = origin;
   }
-  // References between sprites, now that every name is known.
-  for (size_t i = 0; i < sprites.size(); ++i) {
-    const SpriteSpecEntry& s = spec.sprites[i];
+
+  AnimationSpec Read(const YAML::Node& root);
+
+ private:
+  using NodeRead = std::function<bool(const YAML::Node& node, const std::string& path)>;
+
+  // --- values of one node at `path` (list items, and the values of shaped keys)
+  bool Number(const YAML::Node& node, const std::string& path, double& out);
+  bool WholeNumber(const YAML::Node& node, const std::string& path, int low, int64_t& out);
+  bool Text(const YAML::Node& node, const std::string& path, std::string& out);
+  bool Point(const YAML::Node& node, const std::string& path, Eigen::Vector2d& out);
+  bool Time(const YAML::Node& node, const std::string& path, SpecTime& out);
+  bool ExistingFile(const YAML::Node& node, const std::string& path, std::string& out);
+
+  // A key whose value `read` takes from its node, once the key is there with a value.
+  static OptionsBinder::ReadFn Shaped(NodeRead read) {
+    return [read = std::move(read)](YamlReader& r, const YamlMap& view, const std::string& key) {
+      const YAML::Node* node = r.Value(view, key);
+      return node != nullptr && read(*node, Child(view.path(), key));
+    };
+  }
+  // A key holding a block that `read` takes whole, reporting its own errors.
+  static OptionsBinder::ReadFn BlockOf(
+      std::function<void(const YAML::Node& node, const std::string& path)> read) {
+    return Shaped([read = std::move(read)](const YAML::Node& n, const std::string& p) {
+      read(n, p);
+      return true;
+    });
+  }
+  OptionsBinder::ReadFn PointInto(Eigen::Vector2d* out) {
+    return Shaped(
+        [this, out](const YAML::Node& n, const std::string& p) { return Point(n, p, *out); });
+  }
+  OptionsBinder::ReadFn FileInto(std::string* out) {
+    return Shaped([this, out](const YAML::Node& n, const std::string& p) {
+      return ExistingFile(n, p, *out);
+    });
+  }
+  void BindWindow(OptionsBinder& keys, WindowKeys& window);
+
+  // Reads the mapping `node` as the block at `path` with `keys` into `view`; false when it is
+  // not a mapping (reported).
+  bool Block(const OptionsBinder& keys, const YAML::Node& node, const std::string& path,
+             YamlMap& view);
+
+  // --- rules on what a block's keys hold, each reported on the key
+  void Error(const YamlMap& view, const std::string& key, const std::string& reason) {
+    msg_.Error(Child(view.path(), key), reason);
+  }
+  // Reports `reason` on `key` unless `good`, when the key was given and read without an error.
+  void Check(const YamlMap& view, const std::string& key, bool good, const std::string& reason) {
+    if (!good && view.Find(key) != nullptr && !msg_.Failed(Child(view.path(), key)))
+      Error(view, key, reason);
+  }
+  void AtLeast(const YamlMap& view, const std::string& key, double value, double low) {
+    Check(view, key, std::isfinite(value) && value >= low,
+          std::isfinite(value) ? "must be >= " + Num(low) : "expected a finite number");
+  }
+  void Positive(const YamlMap& view, const std::string& key, double value) {
+    Check(view, key, std::isfinite(value) && value > 0,
+          std::isfinite(value) ? "must be > 0" : "expected a finite number");
+  }
+  void Required(const YamlMap& view, const std::string& key, const std::string& reason) {
+    if (view.Find(key) == nullptr) Error(view, key, reason);
+  }
+  // The window the keys give; `fallback` when none is given.
+  StepWindow Window(const YamlMap& view, const WindowKeys& keys, StepWindow fallback);
+  // An options struct's problems ("field: reason" lines), each on the spec key that sets it.
+  void Report(const YamlMap& view, const std::string& why,
+              const std::map<std::string, std::string>& keys);
+
+  // --- the blocks
+  void LengthTop(const YAML::Node& node);
+  void Banks(const YAML::Node& node);
+  void Optimizer(const YAML::Node& node);
+  void Sprites(const YAML::Node& node);
+  void Collisions(const YAML::Node& node);
+  SpriteSpecEntry Sprite(const YAML::Node& node, const std::string& path);
+  void Start(const YAML::Node& node, const std::string& path, SpriteSpecEntry& out);
+  void Constraints(const YAML::Node& node, const std::string& path, SpriteSpecEntry& out);
+  LengthSpec Length(const YAML::Node& node, const std::string& path);
+  FastFrameSpec Fast(const YAML::Node& node, const std::string& path);
+  LocationSpec Location(const YAML::Node& node, const std::string& path);
+  PathSpec Path(const YAML::Node& node, const std::string& path);
+  FrameSpec Frames(const YAML::Node& node, const std::string& path);
+  CollisionSpec Collision(const YAML::Node& node, const std::string& path);
+  // The references between sprites, once every name is known.
+  void CheckReferences();
+
+  std::map<std::string, int> lines_;  // before msg_ and r_, which keep references to it
+  YamlMessages msg_;
+  YamlReader r_;
+  AnimationSpec spec_;
+};
+
+bool SpecReader::Number(const YAML::Node& node, const std::string& path, double& out) {
+  double value = 0;
+  if (!node.IsScalar() || !YAML::convert<double>::decode(node, value)) {
+    msg_.Error(path, "expected a number, got " + ShapeOf(node));
+    return false;
+  }
+  if (!std::isfinite(value)) {
+    msg_.Error(path, "expected a finite number");
+    return false;
+  }
+  out = value;
+  return true;
+}
+
+bool SpecReader::WholeNumber(const YAML::Node& node, const std::string& path, int low,
+                             int64_t& out) {
+  double value = 0;
+  const bool number = node.IsScalar() && YAML::convert<double>::decode(node, value);
+  if (!number || value != std::floor(value) || value < low || value > 1e9) {
+    msg_.Error(path,
+               "expected a whole number >= " + std::to_string(low) + ", got " + ShapeOf(node));
+    return false;
+  }
+  out = static_cast<int64_t>(value);
+  return true;
+}
+
+bool SpecReader::Text(const YAML::Node& node, const std::string& path, std::string& out) {
+  if (!node.IsScalar()) {
+    msg_.Error(path, "expected a name, got " + ShapeOf(node));
+    return false;
+  }
+  out = node.Scalar();
+  return true;
+}
+
+bool SpecReader::Point(const YAML::Node& node, const std::string& path, Eigen::Vector2d& out) {
+  if (!node.IsSequence() || node.size() != 2) {
+    msg_.Error(path, "expected [x, y] in metres");
+    return false;
+  }
+  Eigen::Vector2d p;
+  const bool x = Number(node[0], Index(path, 0), p.x());
+  const bool y = Number(node[1], Index(path, 1), p.y());
+  if (!x || !y) return false;
+  out = p;
+  return true;
+}
+
+bool SpecReader::Time(const YAML::Node& node, const std::string& path, SpecTime& out) {
+  if (node.IsScalar() && node.Scalar() == "end") {
+    out = {0, true};
+    return true;
+  }
+  double seconds = 0;
+  if (!Number(node, path, seconds)) return false;
+  if (seconds < 0) {
+    msg_.Error(path, "must be >= 0 (seconds) or end");
+    return false;
+  }
+  out = {seconds, false};
+  return true;
+}
+
+bool SpecReader::ExistingFile(const YAML::Node& node, const std::string& path, std::string& out) {
+  if (!node.IsScalar() || node.Scalar().empty()) {
+    msg_.Error(path, "expected a file name, got " + ShapeOf(node));
+    return false;
+  }
+  const std::string file = r_.Resolve(node.Scalar());
+  std::error_code ec;  // a name the file system refuses (too long, ...) is no such file either
+  if (!fs::exists(file, ec)) {
+    msg_.Error(path, "no such file: " + file + (ec ? " (" + ec.message() + ")" : ""));
+    return false;
+  }
+  out = file;
+  return true;
+}
+
+void SpecReader::BindWindow(OptionsBinder& keys, WindowKeys& window) {
+  for (auto [key, field] : {std::pair{"at", &window.at}, std::pair{"from", &window.from},
+                            std::pair{"to", &window.to}}) {
+    keys.AddRead(key, "", "seconds or end",
+                 Shaped([this, field](const YAML::Node& n, const std::string& p) {
+                   SpecTime time;
+                   if (!Time(n, p, time)) return false;
+                   *field = time;
+                   return true;
+                 }));
+  }
+}
+
+bool SpecReader::Block(const OptionsBinder& keys, const YAML::Node& node, const std::string& path,
+                       YamlMap& view) {
+  view = r_.Map(node, path);
+  if (!node.IsMap()) {
+    if (node.IsNull() && !path.empty()) msg_.Error(path, "expected a mapping of keys, got nothing");
+    return false;
+  }
+  r_.Known(view, keys.Keys());
+  keys.ReadKeys(r_, view);
+  return true;
+}
+
+StepWindow SpecReader::Window(const YamlMap& view, const WindowKeys& keys, StepWindow fallback) {
+  const auto step = [&](const SpecTime& t) { return t.end ? 0 : spec_.Steps(t.seconds); };
+  if (view.Find("at") != nullptr) {
+    if (view.Find("from") != nullptr || view.Find("to") != nullptr)
+      Error(view, "at", "give either at or from/to");
+    if (!keys.at) return fallback;
+    return {step(*keys.at), keys.at->end, step(*keys.at), keys.at->end};
+  }
+  if (!keys.from && !keys.to) return fallback;
+  StepWindow window = StepWindow::All();
+  if (keys.from) {
+    window.first = step(*keys.from);
+    window.first_from_end = keys.from->end;
+  }
+  if (keys.to) {
+    window.last = step(*keys.to);
+    window.last_from_end = keys.to->end;
+  }
+  Check(view, "to", window.first_from_end || window.last_from_end || window.last >= window.first,
+        "ends before it starts");
+  return window;
+}
+
+void SpecReader::Report(const YamlMap& view, const std::string& why,
+                        const std::map<std::string, std::string>& keys) {
+  std::istringstream lines(why);
+  for (std::string line; std::getline(lines, line);) {
+    const size_t colon = line.find(": ");
+    const auto key = keys.find(line.substr(0, colon));
+    if (key == keys.end() || colon == std::string::npos) {
+      msg_.Error(view.path(), line);  // a field the spec does not set: cannot happen from a spec
+    } else if (!msg_.Failed(Child(view.path(), key->second))) {
+      Error(view, key->second, line.substr(colon + 2));
+    }
+  }
+}
+
+AnimationSpec SpecReader::Read(const YAML::Node& root) {
+  OptionsBinder keys;
+  keys.Add("version", &spec_.version, "a whole number", "the spec's version")
+      .AddRead("frame_rate", "30", "playback frames per second",
+               [this](YamlReader& r, const YamlMap& view, const std::string& key) {
+                 double rate = 0;
+                 if (!r.Number(view, key, rate)) return false;
+                 if (!std::isfinite(rate) || rate <= 0) {
+                   Error(view, key, "must be > 0");  // before any time is turned into steps
+                   return false;
+                 }
+                 spec_.frame_rate = rate;
+                 return true;
+               })
+      .AddRead("length", "", "N, or {min_frames, max_frames, ...}",
+               BlockOf([this](const YAML::Node& n, const std::string&) { LengthTop(n); }))
+      .AddRead("camera", "", "the virtual camera's .cameramodel", FileInto(&spec_.camera_path))
+      .AddRead("background", "", "an image of the camera's size", FileInto(&spec_.background_path))
+      .AddRead("banks", "", "a list of sprite banks",
+               BlockOf([this](const YAML::Node& n, const std::string&) { Banks(n); }))
+      .AddRead(
+          "fast_frames", "", "{reference_speed_m_s, strength}",
+          BlockOf([this](const YAML::Node& n, const std::string& p) { spec_.fast = Fast(n, p); }))
+      .AddRead("optimizer", "", "the optimizer's block",
+               BlockOf([this](const YAML::Node& n, const std::string&) { Optimizer(n); }))
+      .AddRead("sprites", "", "the list of sprites",
+               BlockOf([this](const YAML::Node& n, const std::string&) { Sprites(n); }))
+      .AddRead("collisions", "", "collision constraints",
+               BlockOf([this](const YAML::Node& n, const std::string&) { Collisions(n); }));
+  YamlMap view;
+  if (!Block(keys, root, "", view)) {
+    if (root.IsNull()) msg_.Error("(top level)", "the spec is empty");
+    throw InputError(Join(msg_.errors, "\n"));
+  }
+  Check(view, "version", spec_.version == kAnimationSpecVersion,
+        "this build reads version " + std::to_string(kAnimationSpecVersion));
+  Required(view, "length", "required: N frames, or {min_frames, max_frames}");
+  Required(view, "camera", "required: the virtual camera's .cameramodel");
+  Required(view, "banks", "required: a list of sprite banks");
+  Required(view, "sprites", "required: a list of sprites");
+  CheckReferences();
+  if (!msg_.errors.empty()) throw InputError(Join(msg_.errors, "\n"));
+  if (spec_.initial_frames == 0) {
+    spec_.initial_frames = spec_.length ? spec_.length->min_frames : spec_.Steps(4.0);
+    if (spec_.max_frames > 0)
+      spec_.initial_frames = std::min(spec_.initial_frames, spec_.max_frames);
+  }
+  return std::move(spec_);
+}
+
+void SpecReader::LengthTop(const YAML::Node& node) {
+  int fixed = 0, min_frames = 0, max_frames = 0, initial_frames = 0;
+  std::optional<double> strength;
+  if (node.IsScalar()) {
+    int64_t frames = 0;
+    if (!WholeNumber(node, "length", 1, frames)) return;
+    fixed = static_cast<int>(frames);
+  } else {
+    OptionsBinder keys;
+    keys.Add("frames", &fixed, "a whole number >= 1", "every sequence is this long")
+        .Add("min_frames", &min_frames, "a whole number >= 1", "sequences shorter are penalized")
+        .Add("max_frames", &max_frames, "a whole number >= 1", "the longest sequence")
+        .Add("initial_frames", &initial_frames, "a whole number >= 1",
+             "length of random initial sequences")
+        .Add("strength", &strength, "a number", "weight of the length term");
+    YamlMap view;
+    if (!Block(keys, node, "length", view)) return;
+    for (const auto& [key, value] :
+         {std::pair{"frames", fixed}, std::pair{"min_frames", min_frames},
+          std::pair{"max_frames", max_frames}, std::pair{"initial_frames", initial_frames}}) {
+      Check(view, key, value >= 1, "expected a whole number >= 1");
+    }
+    if (strength) AtLeast(view, "strength", *strength, 0);
+    if (view.Find("frames") != nullptr &&
+        (view.Find("min_frames") != nullptr || view.Find("max_frames") != nullptr)) {
+      Error(view, "frames", "give either frames (fixed) or min/max_frames");
+    }
+    spec_.max_frames = std::max(0, max_frames);
+    if (initial_frames > 0) spec_.initial_frames = initial_frames;
+    if (min_frames > 0) {
+      spec_.length = LengthSpec{min_frames, strength.value_or(1.0)};
+      Check(view, "max_frames", spec_.max_frames == 0 || spec_.max_frames >= min_frames,
+            "is below length.min_frames");
+    }
+  }
+  if (fixed > 0) {
+    // A fixed length: sequences are cut at N and strongly held to N.
+    spec_.fixed_frames = fixed;
+    spec_.max_frames = fixed;
+    spec_.initial_frames = fixed;
+    spec_.length = LengthSpec{fixed, strength.value_or(100.0)};
+  }
+}
+
+void SpecReader::Banks(const YAML::Node& node) {
+  if (node.IsScalar()) {
+    std::string file;
+    if (ExistingFile(node, "banks", file)) spec_.bank_paths.push_back(file);
+    return;
+  }
+  if (!node.IsSequence() || node.size() == 0) {
+    msg_.Error("banks", "expected a list of banks, got " + ShapeOf(node));
+    return;
+  }
+  for (size_t i = 0; i < node.size(); ++i) {
+    const std::string path = Index("banks", i);
+    r_.Mark(path, node[i]);
+    std::string file;
+    if (ExistingFile(node[i], path, file)) spec_.bank_paths.push_back(file);
+  }
+}
+
+void SpecReader::Optimizer(const YAML::Node& node) {
+  OptimizerSpec& o = spec_.optimizer;
+  ReplacementOptions& rep = o.replacement;
+  int64_t seed = static_cast<int64_t>(rep.seed);
+  OptionsBinder keys;
+  keys.AddEnum("method", &o.method, kOptimizerMethodTexts, "replace or beam")
+      .AddEnum("start", &rep.start, kSpecStartTexts,
+               "replacement's start: sequential, random or beam")
+      .Add("time_budget_s", &rep.time_budget_seconds, "a number", "seconds the optimizer may run")
+      .Add("seed", &seed, "a whole number >= 0", "the random generator's seed")
+      .Add("set_size", &rep.reach.set_size, "a whole number", "N of the F/B sets")
+      .Add("threads", &rep.reach.num_threads, "a whole number", "worker threads")
+      .Add("changes_per_turn", &rep.changes_per_turn, "a whole number", "picks per sprite turn")
+      .Add("beam_width", &rep.beam.width, "a whole number", "the beam search's width")
+      .Add("snapshot_every_s", &o.snapshot_every_s, "a number",
+           "> 0: keep the sequences every so many seconds")
+      .Add("collision_pick_fraction", &rep.collision_pick_fraction, "a number",
+           "replacement's picks aimed at a collision, 0 to 1");
+  YamlMap view;
+  if (!Block(keys, node, "optimizer", view)) return;
+  Check(view, "seed", seed >= 0 && seed <= 1000000000, "expected a whole number >= 0");
+  rep.seed = static_cast<uint64_t>(std::max<int64_t>(seed, 0));
+  AtLeast(view, "snapshot_every_s", o.snapshot_every_s, 0);
+  // The optimizer's own limits, checked by the optimizer and named as the spec's keys.
+  std::string why;
+  if (!rep.IsValid(&why)) Report(view, why, kReplacementKeys);
+  if (o.method == OptimizerMethod::kBeam && !o.Beam().IsValid(&why)) Report(view, why, kBeamKeys);
+}
+
+void SpecReader::Sprites(const YAML::Node& node) {
+  if (!node.IsSequence() || node.size() == 0) {
+    msg_.Error("sprites", "expected a list of sprites, got " + ShapeOf(node));
+    return;
+  }
+  for (size_t i = 0; i < node.size(); ++i) {
+    const std::string path = Index("sprites", i);
+    r_.Mark(path, node[i]);
+    SpriteSpecEntry entry = Sprite(node[i], path);
+    if (!entry.name.empty() && spec_.SpriteIndex(entry.name) >= 0)
+      msg_.Error(Child(path, "name"), "another sprite is named " + entry.name);
+    spec_.sprites.push_back(std::move(entry));
+  }
+}
+
+void SpecReader::Collisions(const YAML::Node& node) {
+  if (!node.IsSequence()) {
+    msg_.Error("collisions", "expected a list, got " + ShapeOf(node));
+    return;
+  }
+  for (size_t i = 0; i < node.size(); ++i) {
+    const std::string path = Index("collisions", i);
+    r_.Mark(path, node[i]);
+    spec_.collisions.push_back(Collision(node[i], path));
+  }
+}
+
+SpriteSpecEntry SpecReader::Sprite(const YAML::Node& node, const std::string& path) {
+  SpriteSpecEntry out;
+  out.place = {LineOf(node), path};
+  Eigen::Vector2d end = Eigen::Vector2d::Zero();
+  OptionsBinder keys;
+  keys.Add("name", &out.name, "a name", "unique")
+      .AddRead(
+          "start", "", "[x, y], free or {guess: [x, y]}",
+          BlockOf([this, &out](const YAML::Node& n, const std::string& p) { Start(n, p, out); }))
+      .AddRead("end", "", "[x, y]: the last position is fixed", PointInto(&end))
+      .Add("smoothness", &out.smoothness, "a number", "α")
+      .AddRead("constraints", "", "location:, path:, frames:",
+               BlockOf([this, &out](const YAML::Node& n, const std::string& p) {
+                 Constraints(n, p, out);
+               }))
+      .AddRead("length", "", "{min_frames, strength}",
+               BlockOf([this, &out](const YAML::Node& n, const std::string& p) {
+                 out.length = Length(n, p);
+               }))
+      .AddRead("fast_frames", "", "{reference_speed_m_s, strength}",
+               BlockOf([this, &out](const YAML::Node& n, const std::string& p) {
+                 out.fast = Fast(n, p);
+               }));
+  YamlMap view;
+  if (!Block(keys, node, path, view)) return out;
+  Required(view, "name", "required");
+  Check(view, "name", !out.name.empty(), "must not be empty");
+  if (view.Find("end") != nullptr) {
+    if (view.Find("start") != nullptr) Error(view, "end", "give either start or end");
+    out.anchor = Anchor::kEnd;
+    out.anchor_m = end;
+  } else if (view.Find("start") == nullptr) {
+    Error(view, "start", "required: [x, y], free, or end: [x, y] instead");
+  }
+  AtLeast(view, "smoothness", out.smoothness, 0);
+  return out;
+}
+
+void SpecReader::Start(const YAML::Node& node, const std::string& path, SpriteSpecEntry& out) {
+  if (node.IsScalar() && node.Scalar() == "free") {
+    out.anchor = Anchor::kFree;
+  } else if (node.IsMap()) {
+    out.anchor = Anchor::kFree;
+    OptionsBinder keys;
+    keys.AddRead("free", "", "(any value)",
+                 [](YamlReader&, const YamlMap&, const std::string&) { return true; })
+        .AddRead("guess", "", "[x, y]: the first guess", PointInto(&out.anchor_m));
+    YamlMap view;
+    Block(keys, node, path, view);
+  } else {
+    Point(node, path, out.anchor_m);
+  }
+}
+
+void SpecReader::Constraints(const YAML::Node& node, const std::string& path,
+                             SpriteSpecEntry& out) {
+  if (!node.IsSequence()) {
+    msg_.Error(path, "expected a list, got " + ShapeOf(node));
+    return;
+  }
+  for (size_t i = 0; i < node.size(); ++i) {
+    const std::string item_path = Index(path, i);
+    const YAML::Node item = node[i];
+    r_.Mark(item_path, item);
+    if (!item.IsMap() || item.size() != 1 || !item.begin()->first.IsScalar()) {
+      msg_.Error(item_path, "expected one of location:, path:, frames:");
+      continue;
+    }
+    const std::string kind = item.begin()->first.Scalar();
+    const YAML::Node body = item.begin()->second;
+    const std::string body_path = Child(item_path, kind);
+    if (kind == "location") {
+      out.locations.push_back(Location(body, body_path));
+    } else if (kind == "path") {
+      if (out.path) {
+        msg_.Error(body_path, "a sprite has at most one path");
+        continue;
+      }
+      out.path = Path(body, body_path);
+    } else if (kind == "frames") {
+      out.frames.push_back(Frames(body, body_path));
+    } else {
+      msg_.Error(body_path, "unknown constraint (expected location, path or frames)");
+    }
+  }
+}
+
+LengthSpec SpecReader::Length(const YAML::Node& node, const std::string& path) {
+  LengthSpec out{0, 1.0};
+  OptionsBinder keys;
+  keys.Add("min_frames", &out.min_frames, "a whole number >= 1", "sequences shorter pay")
+      .Add("strength", &out.strength, "a number", "per missing frame");
+  YamlMap view;
+  if (!Block(keys, node, path, view)) return out;
+  Required(view, "min_frames", "required");
+  Check(view, "min_frames", out.min_frames >= 1, "expected a whole number >= 1");
+  AtLeast(view, "strength", out.strength, 0);
+  return out;
+}
+
+FastFrameSpec SpecReader::Fast(const YAML::Node& node, const std::string& path) {
+  FastFrameSpec out{0.0, 1.0};
+  OptionsBinder keys;
+  keys.Add("reference_speed_m_s", &out.reference_speed_m_s, "a number", "v_ref")
+      .Add("strength", &out.strength, "a number", "per (m/s) below v_ref, per step");
+  YamlMap view;
+  if (!Block(keys, node, path, view)) return out;
+  Required(view, "reference_speed_m_s", "required");
+  Positive(view, "reference_speed_m_s", out.reference_speed_m_s);
+  AtLeast(view, "strength", out.strength, 0);
+  return out;
+}
+
+LocationSpec SpecReader::Location(const YAML::Node& node, const std::string& path) {
+  LocationSpec out;
+  out.place = {LineOf(node), path};
+  OffsetAxes axes = OffsetAxes::kHeading;
+  WindowKeys window;
+  OptionsBinder keys;
+  keys.AddRead("target", "", "[x, y] in metres", PointInto(&out.target_m))
+      .Add("follow", &out.follow, "a sprite's name", "the leader")
+      .AddRead("offset", "", "[along, left] in metres", PointInto(&out.target_m))
+      .AddEnum("offset_axes", &axes, kOffsetAxesTexts, "the offset's axes");
+  BindWindow(keys, window);
+  keys.Add("strength", &out.strength, "a number", "γ");
+  YamlMap view;
+  if (!Block(keys, node, path, view)) return out;
+  if (view.Find("follow") != nullptr) {
+    if (view.Find("target") != nullptr) Error(view, "target", "give either target or follow");
+  } else {
+    Required(view, "target", "required (or follow: SPRITE)");
+    if (view.Find("offset") != nullptr) Error(view, "offset", "only with follow");
+  }
+  out.offset_in_heading = axes == OffsetAxes::kHeading;
+  out.window = Window(view, window, StepWindow::All());
+  AtLeast(view, "strength", out.strength, 0);
+  return out;
+}
+
+PathSpec SpecReader::Path(const YAML::Node& node, const std::string& path) {
+  PathSpec out;
+  out.place = {LineOf(node), path};
+  OptionsBinder keys;
+  keys.AddRead("points", "", "[[x, y], ...]",
+               Shaped([this, &out](const YAML::Node& n, const std::string& p) {
+                 if (!n.IsSequence() || n.size() < 2) {
+                   msg_.Error(p, "expected a list of at least two [x, y] points");
+                   return false;
+                 }
+                 bool all = true;
+                 for (size_t i = 0; i < n.size(); ++i) {
+                   Eigen::Vector2d point;
+                   all = Point(n[i], Index(p, i), point) && all;
+                   out.points_m.push_back(point);
+                 }
+                 if (!all) return false;
+                 try {
+                   Polyline check(out.points_m, p);
+                 } catch (const InputError&) {
+                   msg_.Error(p, "needs two distinct points");
+                   return false;
+                 }
+                 return true;
+               }))
+      .Add("direction_strength", &out.strengths.direction, "a number", "δ")
+      .Add("distance_strength", &out.strengths.distance, "a number", "φ")
+      .Add("unreached_strength", &out.strengths.unreached, "a number", "η");
+  YamlMap view;
+  if (!Block(keys, node, path, view)) return out;
+  Required(view, "points", "required");
+  AtLeast(view, "direction_strength", out.strengths.direction, 0);
+  AtLeast(view, "distance_strength", out.strengths.distance, 0);
+  AtLeast(view, "unreached_strength", out.strengths.unreached, 0);
+  return out;
+}
+
+FrameSpec SpecReader::Frames(const YAML::Node& node, const std::string& path) {
+  FrameSpec out;
+  out.place = {LineOf(node), path};
+  double duration_s = 0;
+  WindowKeys window;
+  OptionsBinder keys;
+  keys.Add("tag", &out.tag, "a tag", "G: the frames with this tag")
+      .AddRead("sprites", "", "[ids]: G, these bank sprites",
+               Shaped([this, &out](const YAML::Node& n, const std::string& p) {
+                 if (!n.IsSequence() || n.size() == 0) {
+                   msg_.Error(p, "expected a list of bank sprite ids");
+                   return false;
+                 }
+                 for (size_t i = 0; i < n.size(); ++i) {
+                   int64_t id = 0;
+                   if (WholeNumber(n[i], Index(p, i), 1, id)) out.sprite_ids.push_back(id);
+                 }
+                 return true;
+               }));
+  BindWindow(keys, window);
+  keys.Add("after_path", &out.after_path_of, "a sprite's name", "the window starts at its end")
+      .Add("duration", &duration_s, "a number", "seconds, with after_path")
+      .Add("strength", &out.strength, "a number", "λ");
+  YamlMap view;
+  if (!Block(keys, node, path, view)) return out;
+  const bool tag = view.Find("tag") != nullptr, ids = view.Find("sprites") != nullptr;
+  if (tag && ids) msg_.Error(path, "give either tag or sprites");
+  if (!tag && !ids) Error(view, "tag", "required (or sprites: [ids])");
+  Check(view, "tag", !out.tag.empty(), "must not be empty");
+  if (view.Find("after_path") != nullptr) {
+    if (view.Find("at") != nullptr || view.Find("from") != nullptr || view.Find("to") != nullptr)
+      Error(view, "after_path", "give either after_path or at/from/to");
+    Required(view, "duration", "required with after_path");
+    Positive(view, "duration", duration_s);
+    if (std::isfinite(duration_s)) out.duration_steps = std::max(1, spec_.Steps(duration_s));
+  } else {
+    if (view.Find("duration") != nullptr) Error(view, "duration", "only with after_path");
+    out.window = Window(view, window, StepWindow::All());
+  }
+  AtLeast(view, "strength", out.strength, 0);
+  return out;
+}
+
+CollisionSpec SpecReader::Collision(const YAML::Node& node, const std::string& path) {
+  CollisionSpec out;
+  out.place = {LineOf(node), path};
+  OptionsBinder keys;
+  keys.AddRead("sprites", "", "all, or a list of names",
+               Shaped([this, &out](const YAML::Node& n, const std::string& p) {
+                 if (n.IsScalar() && n.Scalar() == "all") {
+                   if (spec_.sprites.size() < 2) msg_.Error(p, "needs two sprites or more");
+                   return true;
+                 }
+                 if (!n.IsSequence() || n.size() < 2) {
+                   msg_.Error(p, "expected all or a list of two sprite names or more");
+                   return false;
+                 }
+                 for (size_t i = 0; i < n.size(); ++i) {
+                   std::string name;
+                   if (!Text(n[i], Index(p, i), name)) continue;
+                   if (spec_.SpriteIndex(name) < 0)
+                     msg_.Error(Index(p, i), "no sprite named " + name);
+                   out.sprites.push_back(name);
+                 }
+                 return true;
+               }))
+      .Add("min_distance_m", &out.min_distance_m, "a number", "d_min")
+      .Add("strength", &out.strength, "a number", "µ");
+  YamlMap view;
+  if (!Block(keys, node, path, view)) return out;
+  Required(view, "sprites", "required: a list of names, or all");
+  Required(view, "min_distance_m", "required");
+  Positive(view, "min_distance_m", out.min_distance_m);
+  AtLeast(view, "strength", out.strength, 0);
+  return out;
+}
+
+void SpecReader::CheckReferences() {
+  for (size_t i = 0; i < spec_.sprites.size(); ++i) {
+    const SpriteSpecEntry& s = spec_.sprites[i];
     for (const LocationSpec& l : s.locations) {
       if (l.follow.empty()) continue;
-      const int leader = spec.SpriteIndex(l.follow);
+      const int leader = spec_.SpriteIndex(l.follow);
       if (leader < 0 || leader == static_cast<int>(i)) {
-        throw InputError(spec.Where(l.place) + ".follow", leader < 0
-                                                              ? "no sprite named " + l.follow
-                                                              : "a sprite cannot follow itself");
+        msg_.Error(Child(l.place.field, "follow"),
+                   leader < 0 ? "no sprite named " + l.follow : "a sprite cannot follow itself");
       }
     }
     for (const FrameSpec& f : s.frames) {
       if (f.after_path_of.empty()) continue;
-      const int owner = spec.SpriteIndex(f.after_path_of);
-      if (owner < 0)
-        throw InputError(spec.Where(f.place) + ".after_path", "no sprite named " + f.after_path_of);
-      if (!spec.sprites[owner].path) {
-        throw InputError(spec.Where(f.place) + ".after_path",
-                         f.after_path_of + " has no path constraint");
+      const int owner = spec_.SpriteIndex(f.after_path_of);
+      if (owner < 0) {
+        msg_.Error(Child(f.place.field, "after_path"), "no sprite named " + f.after_path_of);
+      } else if (!spec_.sprites[owner].path) {
+        msg_.Error(Child(f.place.field, "after_path"), f.after_path_of + " has no path constraint");
       }
     }
   }
-  if (const YAML::Node list = root["collisions"]) {
-    if (!list.IsSequence()) r.Fail(list, "collisions", "expected a list");
-    for (size_t i = 0; i < list.size(); ++i) {
-      spec.collisions.push_back(ReadCollision(r, spec, list[i], Reader::Index("collisions", i)));
-    }
-  }
-  if (spec.initial_frames == 0) {
-    spec.initial_frames = spec.length ? spec.length->min_frames : spec.Steps(4.0);
-    if (spec.max_frames > 0) spec.initial_frames = std::min(spec.initial_frames, spec.max_frames);
-  }
-  return spec;
 }
 
 }  // namespace
@@ -576,7 +769,7 @@ AnimationSpec ParseAnimationSpec(const std::string& yaml, const std::string& ori
     throw InputError(origin + ":" + std::to_string(e.mark.line + 1), "not valid YAML: " + e.msg);
   }
   try {
-    return ParseSpecRoot(root, origin);
+    return SpecReader(origin).Read(root);
   } catch (const YAML::Exception& e) {
     // A shape the reader did not check for (found by tests/fuzz): still an error naming the line.
     throw InputError(origin + ":" + std::to_string(e.mark.line + 1),
