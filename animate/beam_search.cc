@@ -71,6 +71,7 @@ class BeamPlanner {
       children.push_back({Cost(s, scratch, 0, nullptr, 1), -1, f});
     }
     KeepBest(width, &children);
+    beam.reserve(children.size());
     for (const Child& c : children)
       beam.push_back(MakeTrack(graph_, {c.frame}, anchor, spec.anchor_m));
 

@@ -16,7 +16,8 @@ Eigen::Vector2d HeadingAt(const Track& track, int t, int steps) {
   return sum.squaredNorm() > 1e-18 ? Eigen::Vector2d(sum.normalized()) : Eigen::Vector2d::UnitX();
 }
 
-LocationTerm::LocationTerm(int sprite, StepWindow window, LocationTarget target, double strength)
+LocationTerm::LocationTerm(int sprite, StepWindow window, const LocationTarget& target,
+                           double strength)
     : StepSumTerm("location",
                   target.follow_sprite >= 0 ? std::vector<int>{sprite, target.follow_sprite}
                                             : std::vector<int>{sprite},

@@ -29,7 +29,7 @@ struct LocationTarget {
 class LocationTerm : public StepSumTerm {
  public:
   // Throws InputError for a sprite following itself or heading_steps < 1.
-  LocationTerm(int sprite, StepWindow window, LocationTarget target, double strength);
+  LocationTerm(int sprite, StepWindow window, const LocationTarget& target, double strength);
   // q_t for these tracks.
   Eigen::Vector2d TargetAt(Tracks tracks, int t) const;
   void AddStartNormalEquations(Tracks tracks, int sprite, double* weight,

@@ -26,7 +26,7 @@ double PointSegmentDistance(const Eigen::Vector2d& p, const Eigen::Vector2d& a,
 
 }  // namespace
 
-Polyline::Polyline(std::vector<Eigen::Vector2d> points_m, const std::string& field) {
+Polyline::Polyline(const std::vector<Eigen::Vector2d>& points_m, const std::string& field) {
   for (const Eigen::Vector2d& p : points_m) {
     if (!p.allFinite()) throw InputError(field, "points must be finite");
     if (points_.empty() || (p - points_.back()).norm() > 1e-12) points_.push_back(p);

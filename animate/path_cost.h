@@ -18,7 +18,7 @@ namespace ss {
 class Polyline {
  public:
   // Drops repeated points; throws InputError(field) with fewer than two distinct points.
-  Polyline(std::vector<Eigen::Vector2d> points_m, const std::string& field = "path.points");
+  Polyline(const std::vector<Eigen::Vector2d>& points_m, const std::string& field = "path.points");
   int num_segments() const { return static_cast<int>(directions_.size()); }
   const Eigen::Vector2d& end(int i) const { return points_[i + 1]; }
   const Eigen::Vector2d& direction(int i) const { return directions_[i]; }  // unit

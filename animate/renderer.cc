@@ -49,7 +49,7 @@ bool RenderOptions::IsValid(std::string* why) const {
   return check.ok();
 }
 
-SpriteRenderer::SpriteRenderer(CameraModel camera, cv::Mat background, RenderOptions options)
+SpriteRenderer::SpriteRenderer(CameraModel camera, const cv::Mat& background, RenderOptions options)
     : camera_(std::move(camera)), options_(options) {
   if (!camera_.valid()) throw InputError("camera", "no camera model");
   if (std::string why; !options_.IsValid(&why)) throw InputError("render options", why);

@@ -37,7 +37,7 @@ class SpriteRenderer {
  public:
   // `background` BGR or BGRA of the camera's size, or empty for a transparent background.
   // InputError when the camera is invalid or the background's size differs from it.
-  SpriteRenderer(CameraModel camera, cv::Mat background, RenderOptions options = {});
+  SpriteRenderer(CameraModel camera, const cv::Mat& background, RenderOptions options = {});
 
   // One frame, CV_8UC4 BGRA (straight alpha; opaque where the background is).
   cv::Mat Render(const std::vector<PlacedSprite>& sprites) const;

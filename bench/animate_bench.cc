@@ -12,6 +12,7 @@
 #include <numbers>
 #include <random>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -184,7 +185,7 @@ std::unique_ptr<Problem> MakeScene(int scene, const TransitionGraph& g,
     SpriteSpec s;
     s.name = name;
     s.anchor = anchor;
-    s.anchor_m = at;
+    s.anchor_m = std::move(at);
     s.initial_frames = initial;
     s.max_frames = max;
     return p->AddSprite(std::move(s));

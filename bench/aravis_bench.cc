@@ -96,6 +96,7 @@ Result Measure(const std::string& session, PixelFormat format, int packet_size, 
                                    session,   "--address",   "127.0.0.1", "--serial",
                                    "SSBENCH", "--fps",       "1000"};
   std::vector<char*> argv;
+  argv.reserve(args.size() + 1);  // and the nullptr
   for (auto& a : args) argv.push_back(a.data());
   argv.push_back(nullptr);
   pid_t pid = 0;

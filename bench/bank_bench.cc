@@ -118,6 +118,7 @@ SpriteRecord Mirror(const SpriteRecord& o) {
 const std::vector<SpritePixels>& Billboards() {
   static const std::vector<SpritePixels> all = [] {
     std::vector<SpritePixels> v;
+    v.reserve(kBatch);
     for (int i = 0; i < kBatch; ++i) v.push_back(RealisticBillboard(static_cast<uint32_t>(i)));
     return v;
   }();

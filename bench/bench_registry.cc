@@ -21,6 +21,7 @@ int RunGoogleBenchmarks(const std::string& prefix, const std::vector<std::string
   std::vector<std::string> storage = {"spritestation-bench", "--benchmark_filter=^" + prefix};
   storage.insert(storage.end(), args.begin(), args.end());
   std::vector<char*> argv;
+  argv.reserve(storage.size());
   for (auto& s : storage) argv.push_back(s.data());
   int argc = static_cast<int>(argv.size());
   benchmark::Initialize(&argc, argv.data());

@@ -41,14 +41,14 @@ std::vector<Eigen::Vector2d> Shape(const std::string& shape, size_t n) {
   return testing::Star(n, rng, 0.9);
 }
 
-void BM_Sweep(benchmark::State& state, std::string shape) {
+void BM_Sweep(benchmark::State& state, const std::string& shape) {
   const GroundPolygon polygon(Shape(shape, static_cast<size_t>(state.range(0))));
   for (auto _ : state) {
     if (!polygon.IsSimple()) state.SkipWithError("not simple");
   }
 }
 
-void BM_BruteForce(benchmark::State& state, std::string shape) {
+void BM_BruteForce(benchmark::State& state, const std::string& shape) {
   const std::vector<Eigen::Vector2d> vertices = Shape(shape, static_cast<size_t>(state.range(0)));
   for (auto _ : state) {
     if (!testing::BruteForceIsSimple(vertices)) state.SkipWithError("not simple");
@@ -97,7 +97,7 @@ GroundPolygon MaskFloor(const std::string& shape, size_t n) {
   return GroundPolygon(std::move(v));
 }
 
-void BM_FloorMaskIndex(benchmark::State& state, std::string shape) {
+void BM_FloorMaskIndex(benchmark::State& state, const std::string& shape) {
   const CameraModel camera = MaskCamera();
   const GroundPolygon floor = MaskFloor(shape, static_cast<size_t>(state.range(0)));
   for (auto _ : state) {
@@ -108,7 +108,7 @@ void BM_FloorMaskIndex(benchmark::State& state, std::string shape) {
   }
 }
 
-void BM_FloorMaskEveryEdge(benchmark::State& state, std::string shape) {
+void BM_FloorMaskEveryEdge(benchmark::State& state, const std::string& shape) {
   const CameraModel camera = MaskCamera();
   const GroundPolygon floor = MaskFloor(shape, static_cast<size_t>(state.range(0)));
   for (auto _ : state) {

@@ -223,6 +223,7 @@ int Run(const std::vector<std::string>& args) {
   std::vector<std::string> storage = {"spritestation-bench", "--benchmark_filter=^ingest/"};
   storage.insert(storage.end(), args.begin(), args.end());
   std::vector<char*> argv;
+  argv.reserve(storage.size());
   for (auto& s : storage) argv.push_back(s.data());
   int argc = static_cast<int>(argv.size());
   benchmark::Initialize(&argc, argv.data());

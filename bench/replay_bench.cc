@@ -80,6 +80,7 @@ const std::vector<cv::Mat>& Frames() {
   static const std::vector<cv::Mat> frames = [] {
     std::vector<cv::Mat> v;
     cv::setRNGSeed(7);
+    v.reserve(kFrames);
     for (int i = 0; i < kFrames; ++i) v.push_back(StudioFrame(i));
     return v;
   }();

@@ -96,6 +96,7 @@ void BM_Workers(benchmark::State& state) {
     Reset(pg);
     state.ResumeTiming();
     std::vector<std::thread> threads;
+    threads.reserve(n);
     for (int k = 0; k < n; ++k) {
       threads.emplace_back([&, k] {
         UnitWorker worker(pg, UnitWorkerOptions{.name = "bench-" + std::to_string(k)});

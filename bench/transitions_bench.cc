@@ -146,11 +146,13 @@ std::vector<SyntheticSprite> LiveSet(int sprites, uint64_t seed) {
 
 std::vector<int64_t> Ids(const std::vector<SyntheticSprite>& s) {
   std::vector<int64_t> ids;
+  ids.reserve(s.size());
   for (const auto& x : s) ids.push_back(x.id);
   return ids;
 }
 std::vector<SpriteTruth> Truths(const std::vector<SyntheticSprite>& s) {
   std::vector<SpriteTruth> t;
+  t.reserve(s.size());
   for (const auto& x : s) t.push_back(x.truth);
   return t;
 }

@@ -135,6 +135,7 @@ GroundPolygon FindGreenFloor(const CameraModel& model, const cv::Mat& bgr,
   std::vector<cv::Point2f> simple;
   cv::approxPolyDP(on_floor_mm, simple, options.simplify_m * 1000, true);
   std::vector<Eigen::Vector2d> vertices;
+  vertices.reserve(simple.size());
   for (const auto& p : simple) vertices.emplace_back(p.x / 1000.0, p.y / 1000.0);
   GroundPolygon polygon(vertices);
   if (!polygon.IsSimple())

@@ -428,6 +428,7 @@ double ProjectionStdev(const SolveSummary& solution, const BoardSpec& board, int
   const Rigid3 cam_from_ref = camera == 0 ? Rigid3{} : pose_at(s0, ext0 + 6 * (camera - 1));
   const Eigen::Vector3d p_ref = cam_from_ref.Inverse() * p_cam;
   std::vector<Eigen::Vector3d> p_frame;
+  p_frame.reserve(nframes);
   for (int f = 0; f < nframes; ++f)
     p_frame.push_back(pose_at(s0, frame0 + 6 * f).Inverse() * p_ref);
   // q(state): mean over frames of the point carried back to the reference, then projected.
@@ -443,6 +444,7 @@ double ProjectionStdev(const SolveSummary& solution, const BoardSpec& board, int
     return Eigen::Vector2d(q.x, q.y);
   };
   std::vector<int> vars;
+  vars.reserve(np + 6);
   for (int i = 0; i < np; ++i) vars.push_back(camera * np + i);
   if (camera > 0)
     for (int i = 0; i < 6; ++i) vars.push_back(ext0 + 6 * (camera - 1) + i);

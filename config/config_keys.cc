@@ -126,6 +126,7 @@ void ReadCamera(Reader& r, const YAML::Node& node, const std::string& path, Came
   identity.ReadKeys(r, view);
   // Keys that belong to another source are named as such; others are unknown.
   std::vector<std::string> all;
+  all.reserve(kCameraKeys.size());
   for (const auto& [key, sources] : kCameraKeys) all.push_back(key);
   for (const auto& item : view.entries()) {
     // (a structured binding cannot be captured before clang 16)

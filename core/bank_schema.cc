@@ -380,7 +380,7 @@ int PreparePostgres(sql::Db& db, bool writable) {
   return kBankSchemaVersion;
 }
 
-std::string Normalize(std::string sql) {
+std::string Normalize(const std::string& sql) {
   std::string out;
   bool space = false;
   for (char c : sql) {

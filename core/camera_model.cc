@@ -15,6 +15,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <system_error>
+#include <utility>
 
 #include "core/error.h"
 #include "core/posix.h"
@@ -154,12 +155,12 @@ std::string DiagnoseRefusal(const std::string& text) {
 
 }  // namespace
 
-CameraModel::CameraModel(std::string lensmodel, std::vector<double> intrinsics, int width,
+CameraModel::CameraModel(const std::string& lensmodel, std::vector<double> intrinsics, int width,
                          int height, Rigid3 cam_from_ground)
     : intrinsics_(std::move(intrinsics)),
       width_(width),
       height_(height),
-      cam_from_ground_(cam_from_ground) {
+      cam_from_ground_(std::move(cam_from_ground)) {
   lens_ = ParseLens(lensmodel);
   if (!lens_) throw InputError("camera model", "unknown lens model '" + lensmodel + "'");
   lensmodel_ = LensName(lens_->model);

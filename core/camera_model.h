@@ -28,7 +28,7 @@ class CameraModel {
   // `lensmodel` is mrcal's name, e.g. "LENSMODEL_OPENCV8" or "LENSMODEL_PINHOLE".
   // Throws InputError when the name is unknown, the intrinsics count is wrong,
   // a value is not finite or the imager size is not positive.
-  CameraModel(std::string lensmodel, std::vector<double> intrinsics, int width, int height,
+  CameraModel(const std::string& lensmodel, std::vector<double> intrinsics, int width, int height,
               Rigid3 cam_from_ground);
 
   // Reads a .cameramodel file; InputError naming the file on any problem.

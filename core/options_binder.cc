@@ -25,7 +25,8 @@ OptionsBinder& OptionsBinder::AddRead(std::string key, std::string default_text,
 OptionsBinder& OptionsBinder::Add(std::string key, int* field, std::string expected,
                                   std::string doc) {
   return AddRead(std::move(key), std::to_string(*field), std::move(doc),
-                 [field, expected](YamlReader& r, const YamlMap& view, const std::string& k) {
+                 [field, expected = std::move(expected)](YamlReader& r, const YamlMap& view,
+                                                         const std::string& k) {
                    return r.Int(view, k, *field, expected);
                  });
 }
@@ -33,7 +34,8 @@ OptionsBinder& OptionsBinder::Add(std::string key, int* field, std::string expec
 OptionsBinder& OptionsBinder::Add(std::string key, int64_t* field, std::string expected,
                                   std::string doc) {
   return AddRead(std::move(key), std::to_string(*field), std::move(doc),
-                 [field, expected](YamlReader& r, const YamlMap& view, const std::string& k) {
+                 [field, expected = std::move(expected)](YamlReader& r, const YamlMap& view,
+                                                         const std::string& k) {
                    return r.Int64(view, k, *field, expected);
                  });
 }
@@ -41,7 +43,8 @@ OptionsBinder& OptionsBinder::Add(std::string key, int64_t* field, std::string e
 OptionsBinder& OptionsBinder::Add(std::string key, double* field, std::string expected,
                                   std::string doc) {
   return AddRead(std::move(key), Num(*field), std::move(doc),
-                 [field, expected](YamlReader& r, const YamlMap& view, const std::string& k) {
+                 [field, expected = std::move(expected)](YamlReader& r, const YamlMap& view,
+                                                         const std::string& k) {
                    return r.Number(view, k, *field, expected);
                  });
 }
@@ -49,7 +52,8 @@ OptionsBinder& OptionsBinder::Add(std::string key, double* field, std::string ex
 OptionsBinder& OptionsBinder::Add(std::string key, std::optional<double>* field,
                                   std::string expected, std::string doc) {
   return AddRead(std::move(key), *field ? Num(**field) : "unset", std::move(doc),
-                 [field, expected](YamlReader& r, const YamlMap& view, const std::string& k) {
+                 [field, expected = std::move(expected)](YamlReader& r, const YamlMap& view,
+                                                         const std::string& k) {
                    double v = 0;
                    if (!r.Number(view, k, v, expected)) return false;
                    *field = v;
@@ -67,7 +71,8 @@ OptionsBinder& OptionsBinder::Add(std::string key, bool* field, std::string doc)
 OptionsBinder& OptionsBinder::Add(std::string key, std::string* field, std::string expected,
                                   std::string doc) {
   return AddRead(std::move(key), Quoted(*field), std::move(doc),
-                 [field, expected](YamlReader& r, const YamlMap& view, const std::string& k) {
+                 [field, expected = std::move(expected)](YamlReader& r, const YamlMap& view,
+                                                         const std::string& k) {
                    return r.String(view, k, *field, expected);
                  });
 }

@@ -108,6 +108,7 @@ std::vector<Eigen::Vector2d> FloorOfView(const CameraModel& posed) {
   std::vector<Eigen::Vector2d> border;
   const double w = posed.width() - 1, h = posed.height() - 1;
   constexpr int kPerEdge = 12;
+  border.reserve(kPerEdge);
   for (int i = 0; i < kPerEdge; ++i) border.emplace_back(w * i / kPerEdge, 0);
   for (int i = 0; i < kPerEdge; ++i) border.emplace_back(w, h * i / kPerEdge);
   for (int i = 0; i < kPerEdge; ++i) border.emplace_back(w - w * i / kPerEdge, h);

@@ -105,6 +105,7 @@ std::string TransitionLabelsCsv(const std::vector<TransitionLabelRecord>& labels
   // In pair order, not labelling order: training's fold split follows the file's order, so
   // the same labels give the same cross-validated figures however they were asked.
   std::vector<const TransitionLabelRecord*> sorted;
+  sorted.reserve(labels.size());
   for (const TransitionLabelRecord& l : labels) sorted.push_back(&l);
   std::stable_sort(sorted.begin(), sorted.end(), [](const auto* x, const auto* y) {
     return std::make_tuple(std::min(x->from_sprite, x->to_sprite),
@@ -488,8 +489,8 @@ void ConsoleLabels::WaitRetrain() {
 }
 
 void ConsoleLabels::RunRetrain(std::shared_ptr<Shared> shared, api::Context context,
-                               ConsoleLabelsOptions options, std::string bank,
-                               TransitionWeights current) {
+                               const ConsoleLabelsOptions& options, const std::string& bank,
+                               const TransitionWeights& current) {
   auto log = Log("station.labels");
   auto SetRetrain = [&](const std::function<void(nlohmann::json&)>& change) {
     std::lock_guard lock(shared->mutex);

@@ -102,7 +102,8 @@ class ConsoleLabels : public api::Part {
   // The weights in use: the host's (its stations run them), else this part's own.
   std::pair<TransitionWeights, std::string> WeightsInUse() const;
   static void RunRetrain(std::shared_ptr<Shared> shared, api::Context context,
-                         ConsoleLabelsOptions options, std::string bank, TransitionWeights current);
+                         const ConsoleLabelsOptions& options, const std::string& bank,
+                         const TransitionWeights& current);
   void RefreshStatus() const;  // labels and weights from the bank (at most every 2 s)
 
   api::Context context_;

@@ -50,8 +50,9 @@ struct StationRecorder::Impl {
   }
 };
 
-StationRecorder::StationRecorder(std::string dir, std::string name, RecordingOptions options,
-                                 bool usable_only, int cameras, int queue_frames)
+StationRecorder::StationRecorder(const std::string& dir, const std::string& name,
+                                 const RecordingOptions& options, bool usable_only, int cameras,
+                                 int queue_frames)
     : impl_(std::make_unique<Impl>()) {
   impl_->writer = std::make_unique<SessionWriter>(dir, name, options);
   impl_->usable_only = usable_only;

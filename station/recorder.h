@@ -26,8 +26,8 @@ struct RecorderStats {
 class StationRecorder {
  public:
   // Creates the session folder DIR (WorkError naming it when it exists or cannot be made).
-  StationRecorder(std::string dir, std::string name, RecordingOptions options, bool usable_only,
-                  int cameras, int queue_frames = 16);
+  StationRecorder(const std::string& dir, const std::string& name, const RecordingOptions& options,
+                  bool usable_only, int cameras, int queue_frames = 16);
   ~StationRecorder();  // Close()
   StationRecorder(const StationRecorder&) = delete;
   StationRecorder& operator=(const StationRecorder&) = delete;

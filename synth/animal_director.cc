@@ -21,6 +21,7 @@ class AnimalDirector : public Director {
                  const DirectorOptions& options)
       : studio_(studio), options_(options) {
     std::vector<Eigen::Vector3d> centres;
+    centres.reserve(cameras.size());
     for (const auto& c : cameras) centres.push_back(c.CentreInGround());
     Rng rng(StreamSeed(options.seed, "animal-placement"));
     std::vector<Eigen::Vector2d> placed;

@@ -526,6 +526,7 @@ SynthSummary RenderStudioSession(const SynthOptions& o) {
       for (size_t c = 0; c < cameras.size(); ++c) render_camera(c, first, count);
     } else {
       std::vector<std::thread> pool;
+      pool.reserve(n_threads);
       for (int t = 0; t < n_threads; ++t) {
         pool.emplace_back([&, t] {
           try {

@@ -17,7 +17,7 @@ std::optional<int> SkeletonDef::JointIndex(std::string_view joint) const {
 }
 
 SkeletonDef MakeSkeletonDef(std::string name, std::vector<std::string> joints,
-                            std::vector<std::pair<std::string, std::string>> limbs,
+                            const std::vector<std::pair<std::string, std::string>>& limbs,
                             const std::string& context, int root_limb) {
   SkeletonDef def;
   def.name = std::move(name);

@@ -41,7 +41,7 @@ struct SkeletonDef {
 
 // Checks names and limbs and fills `pairs`. Throws InputError(context, reason).
 SkeletonDef MakeSkeletonDef(std::string name, std::vector<std::string> joints,
-                            std::vector<std::pair<std::string, std::string>> limbs,
+                            const std::vector<std::pair<std::string, std::string>>& limbs,
                             const std::string& context, int root_limb = 0);
 
 // The paper's human: 15 joints, 14 limbs (docs/skeletons.md lists them).

@@ -118,7 +118,7 @@ bool RecordingOptions::IsValid(std::string* why) const {
 }
 
 SessionWriter::SessionWriter(const std::string& dir, const std::string& name,
-                             RecordingOptions options)
+                             const RecordingOptions& options)
     : impl_(std::make_unique<Impl>()) {
   if (std::string why; !options.IsValid(&why)) throw InputError("recording options", why);
   std::error_code ec;

@@ -32,7 +32,8 @@ class SessionWriter {
  public:
   // Creates DIR (which must not exist or be empty) and writes session.json;
   // WorkError naming DIR otherwise, InputError for a bad option.
-  SessionWriter(const std::string& dir, const std::string& name, RecordingOptions options = {});
+  SessionWriter(const std::string& dir, const std::string& name,
+                const RecordingOptions& options = {});
   ~SessionWriter();  // Close()s; never throws
   SessionWriter(const SessionWriter&) = delete;
   SessionWriter& operator=(const SessionWriter&) = delete;

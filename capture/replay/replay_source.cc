@@ -246,7 +246,7 @@ bool ReplayOptions::IsValid(std::string* why) const {
   return check.ok();
 }
 
-ReplaySource::ReplaySource(const std::string& dir, ReplayOptions options)
+ReplaySource::ReplaySource(const std::string& dir, const ReplayOptions& options)
     : impl_(std::make_unique<Impl>()) {
   if (std::string why; !options.IsValid(&why)) throw InputError("replay options", why);
   Impl& s = *impl_;

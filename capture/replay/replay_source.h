@@ -55,7 +55,7 @@ class ReplaySource : public FrameSource {
  public:
   // Reads DIR/session.json and every camera's CSV (InputError naming the file
   // on any problem) and starts decoding.
-  explicit ReplaySource(const std::string& dir, ReplayOptions options = {});
+  explicit ReplaySource(const std::string& dir, const ReplayOptions& options = {});
   ~ReplaySource() override;
   ReplaySource(const ReplaySource&) = delete;
   ReplaySource& operator=(const ReplaySource&) = delete;

@@ -92,7 +92,7 @@ class CameraPipeline {
  public:
   // `camera_id` is the bank's id of the camera. Throws InputError when the model
   // is missing or the options are invalid (rectify.px_per_m not chosen: <= 0).
-  CameraPipeline(std::string name, int64_t camera_id, CameraModel model, GroundPolygon floor,
+  CameraPipeline(std::string name, int64_t camera_id, CameraModel model, const GroundPolygon& floor,
                  CameraPipelineOptions options);
   ~CameraPipeline();
   CameraPipeline(CameraPipeline&&) noexcept;

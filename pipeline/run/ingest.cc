@@ -11,6 +11,7 @@
 
 #include <nlohmann/json.hpp>
 #include <opencv2/core/utility.hpp>
+#include <utility>
 
 #include "capture/replay/replay_source.h"
 #include "core/bank.h"
@@ -190,7 +191,7 @@ IngestSummary IngestSession(const IngestOptions& options) {
   const auto fail = [&](std::exception_ptr e) {
     {
       std::lock_guard lock(failure_mutex);
-      if (!failure) failure = e;
+      if (!failure) failure = std::move(e);
     }
     failed = true;
     source.Stop();

@@ -249,12 +249,14 @@ std::vector<std::pair<HeadPiece, EllipseShape>> HeadShapes(const Geometry& g, co
 std::vector<int> PaintOrder(const Geometry& g) {
   const int legs = static_cast<int>(g.legs.size());
   std::vector<std::pair<double, int>> parts;
+  parts.reserve(legs + 2);  // the legs, the body and the head
   for (int l = 0; l < legs; ++l) parts.push_back({g.legs[l].depth, l});
   parts.push_back({0.0, legs});
   parts.push_back({g.head_depth, legs + 1});
   std::stable_sort(parts.begin(), parts.end(),
                    [](const auto& a, const auto& b) { return a.first > b.first; });
   std::vector<int> order;
+  order.reserve(parts.size());
   for (const auto& p : parts) order.push_back(p.second);
   return order;
 }

@@ -184,6 +184,7 @@ TEST(Replacement, AFollowerCopiesItsLeadersStandUp) {
   // A follower one frame long, its leader walking 1.6 m on along +x: held, it is out of
   // formation by ~1 m at step 20 and more later.
   std::vector<int> straight;
+  straight.reserve(32);
   for (int m = 0; m < 32; ++m)
     straight.push_back(WalkingGraph::Straight(0, m % WalkingGraph::kStraight));
   const std::vector<Track> short_follower{

@@ -88,6 +88,7 @@ SkeletonSequence Truth() {
 std::vector<cv::Mat> RenderClip(const SkeletonSequence& truth, bool with_occluder) {
   cv::setRNGSeed(5);
   std::vector<cv::Mat> images;
+  images.reserve(truth.size());
   for (int f = 0; f < truth.size(); ++f) {
     images.push_back(
         Render(truth.frames[f], with_occluder && f >= kOccludedFrom && f <= kOccludedTo));

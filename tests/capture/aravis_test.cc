@@ -11,6 +11,7 @@
 #include <thread>
 
 #include <opencv2/imgproc.hpp>
+#include <utility>
 
 #include "capture/aravis/aravis_source.h"
 #include "capture/aravis/fake_gige_camera.h"
@@ -33,7 +34,8 @@ constexpr int64_t kPeriod = 33'000'000;
 
 // UDP port 3956 on 127.0.0.1 takes one camera at a time; another test process
 // may hold it for a moment, so binding is retried for a while.
-std::unique_ptr<FakeGigECamera> StartFakecam(const std::string& dir, FakeGigEOptions options) {
+std::unique_ptr<FakeGigECamera> StartFakecam(const std::string& dir,
+                                             const FakeGigEOptions& options) {
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(20);
   while (true) {
     try {
@@ -63,7 +65,7 @@ struct Received {
 // Opens the fake camera, takes `count` frames, and checks each against `expected(index)`.
 template <typename Expected>
 Received Receive(AravisOptions options, int count, PixelFormat format, Expected expected) {
-  AravisSource source(options);
+  AravisSource source(std::move(options));
   EXPECT_EQ(source.cameras().size(), 1u);
   EXPECT_EQ(source.cameras()[0].width, kW);
   EXPECT_EQ(source.cameras()[0].height, kH);

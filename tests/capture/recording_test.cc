@@ -9,6 +9,7 @@
 
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <utility>
 
 #include "capture/recording/session_writer.h"
 #include "capture/recording/video_reader.h"
@@ -29,7 +30,7 @@ using ss::testing::TestFrame;
 using ss::testing::TestPixels;
 
 std::vector<Frame> ReplayAll(const std::string& dir, ReplayOptions options = {}) {
-  ReplaySource source(dir, options);
+  ReplaySource source(dir, std::move(options));
   std::vector<Frame> frames;
   while (auto f = source.Next()) frames.push_back(std::move(*f));
   return frames;

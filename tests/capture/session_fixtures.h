@@ -60,7 +60,7 @@ inline SourceCamera TestCamera(const std::string& name, PixelFormat format, int 
 // Records one camera: frames 0..count-1, sequence = frame number + first_sequence,
 // timestamps every `period_ns` from `t0_ns`.
 inline void RecordTestSession(const std::string& dir, PixelFormat format, int width, int height,
-                              int count, RecordingOptions options = {},
+                              int count, const RecordingOptions& options = {},
                               int64_t period_ns = 33'000'000, int64_t t0_ns = 1'000'000'000,
                               bool smooth = false) {
   SessionWriter writer(dir, "test", options);

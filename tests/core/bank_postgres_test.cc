@@ -188,6 +188,7 @@ TEST(BankPostgres, ManyWritersAtOnceAndAReaderThatMissesNoClip) {
   constexpr int kWriters = 4, kClips = 12;
   std::atomic<int> done{0};
   std::vector<std::thread> writers;
+  writers.reserve(kWriters);
   for (int k = 0; k < kWriters; ++k) {
     writers.emplace_back([&, k] {
       BankWriter w(pg);

@@ -22,6 +22,7 @@ cv::Mat Frame(cv::RNG& rng, int walker_x, double noise) {
 TEST(MedianAndSpread, SeesThroughAWalkerAndMeasuresTheNoise) {
   cv::RNG rng(7);
   std::vector<cv::Mat> frames;
+  frames.reserve(31);
   for (int i = 0; i < 31; ++i)
     frames.push_back(Frame(rng, (i % 3) * 10, 4.0));  // each column covered 1/3 of the time
   const RobustBackground b = MedianAndSpread(frames);
@@ -41,6 +42,7 @@ TEST(MedianAndSpread, SeesThroughAWalkerAndMeasuresTheNoise) {
 TEST(Winsorized, RemovesTheWalkerAndKeepsTheBackgroundsOwnNoise) {
   cv::RNG rng(11);
   std::vector<cv::Mat> frames;
+  frames.reserve(31);
   for (int i = 0; i < 31; ++i) frames.push_back(Frame(rng, -1, 4.0));
   const RobustBackground b = MedianAndSpread(frames);
   const cv::Mat with_walker = Frame(rng, 15, 4.0);

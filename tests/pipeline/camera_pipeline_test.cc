@@ -37,6 +37,7 @@ Frame Green(int width, int height, uint64_t sequence) {
 CameraPipeline Trained() {
   CameraPipeline p("cam0", 1, DownCamera(), Floor(), CameraPipelineOptions{});
   std::vector<cv::Mat> empty;
+  empty.reserve(5);
   for (int i = 0; i < 5; ++i) empty.push_back(ToBgr(Green(640, 480, i)));
   p.Train(empty);
   return p;

@@ -85,7 +85,7 @@ std::vector<KeyedFrame> KeySynthSession(uint64_t seed, PixelFormat format, int f
   return out;
 }
 
-double MedianIoU(std::vector<KeyedFrame> frames, double min_visible_px) {
+double MedianIoU(const std::vector<KeyedFrame>& frames, double min_visible_px) {
   std::vector<double> v;
   for (const KeyedFrame& f : frames) {
     if (f.visible_px >= min_visible_px) v.push_back(f.soft_iou);

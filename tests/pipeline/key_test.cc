@@ -24,6 +24,7 @@ using testing::SoftIoU;
 
 std::vector<cv::Mat> EmptyFrames(const KeyScene& scene, int n) {
   std::vector<cv::Mat> frames;
+  frames.reserve(n);
   for (int i = 0; i < n; ++i) frames.push_back(scene.Empty(1000 + i));
   return frames;
 }
@@ -288,6 +289,7 @@ TEST(ChromaKeyer, BayerAndYuvFramesKeyCloseToTruth) {
   const SceneFrame f = scene.Render({Hamster({300.5, 220.5})}, 1);
   for (PixelFormat format : {PixelFormat::kBayerRG8, PixelFormat::kNV12, PixelFormat::kYUYV}) {
     std::vector<cv::Mat> empty;
+    empty.reserve(4);
     for (int i = 0; i < 4; ++i) empty.push_back(ToBgr(AsFormat(scene.Empty(1000 + i), format)));
     ChromaKeyer keyer;
     keyer.Train(empty);

@@ -49,6 +49,7 @@ class KeyerConfig : public ::testing::Test {
     SceneSubject s;
     s.centre = {320.5, 250.5};
     std::vector<cv::Mat> empty;
+    empty.reserve(4);
     for (int i = 0; i < 4; ++i) empty.push_back(scene.Empty(100 + i));
     const SceneFrame f = scene.Render({s}, 7);
     GroundPolygon floor({{-0.6, -0.4}, {0.6, -0.4}, {0.6, 0.4}, {-0.6, 0.4}});

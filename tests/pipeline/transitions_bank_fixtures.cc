@@ -67,6 +67,7 @@ std::vector<ClipOfSprites> Clips(const std::vector<SyntheticSprite>& sprites) {
     c.mirrors.push_back(&sprites[half + k]);
   }
   std::vector<ClipOfSprites> out;
+  out.reserve(by_clip.size());
   for (auto& [id, c] : by_clip) out.push_back(c);
   return out;
 }

@@ -80,6 +80,7 @@ TEST(TransitionCalibration, StageTwoThresholdFollowsTheRarePositiveRate) {
     sample.distance[j] = static_cast<float>(truth[j] ? unit(rng) : wide(rng));
   }
   std::vector<double> labels;
+  labels.reserve(500);
   for (int k = 0; k < 500; ++k) labels.push_back(unit(rng));
   TransitionWeights w = DefaultWeights();
   const Stage2Calibration c =
@@ -158,6 +159,7 @@ TEST(TransitionCalibration, PositiveRateOfTheTruthAndInTheLabelsFile) {
   so.frames = 300;
   const auto sprites = MakeSyntheticSprites(so);
   std::vector<SpriteTruth> truth;
+  truth.reserve(sprites.size());
   for (const auto& s : sprites) truth.push_back(s.truth);
   const TruthLabelOptions o;
   int64_t positives = 0;

@@ -64,7 +64,7 @@ TEST(CameraRunner, AReopenedCameraLearnsFromItsNewStreamOnly) {
     return std::make_unique<GreenSource>(opens++ == 0 ? 12 : -1);
   };
   CameraRunner runner(
-      0, o, [](StationBatch) {}, nullptr);
+      0, o, [](const StationBatch&) {}, nullptr);
   runner.Start();
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(20);
   CameraStatus status = runner.status();

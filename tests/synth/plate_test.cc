@@ -21,7 +21,7 @@ namespace {
 
 using ss::testing::ScratchDir;
 
-cv::Mat Filled(int rows, int cols, int type, cv::Scalar value) {
+cv::Mat Filled(int rows, int cols, int type, const cv::Scalar& value) {
   return cv::Mat(rows, cols, type, value);
 }
 
@@ -29,6 +29,7 @@ TEST(PerPixelMedian, TakesEachBytesMedianAndIgnoresAPassingSubject) {
   // Five frames of a grey floor; a bright "subject" crosses pixel (1, 2) in two of them and
   // pixel (0, 0) in one: the median keeps the floor everywhere.
   std::vector<cv::Mat> stack;
+  stack.reserve(5);
   for (int i = 0; i < 5; ++i) stack.push_back(Filled(3, 4, CV_8UC3, cv::Scalar(100 + i, 50, 10)));
   stack[1].at<cv::Vec3b>(1, 2) = {255, 255, 255};
   stack[3].at<cv::Vec3b>(1, 2) = {250, 0, 255};
