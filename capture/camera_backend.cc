@@ -27,6 +27,8 @@ const CameraBackend* FindCameraBackend(const std::string& name) { return Backend
 
 std::vector<const CameraBackend*> CameraBackends() { return Backends().All(); }
 
+std::vector<std::string> CameraBackendNames() { return Backends().Names(); }
+
 std::optional<PixelFormat> PixelFormatOf(const CameraConfig& camera) {
   if (camera.pixel_format.empty()) return std::nullopt;
   const std::optional<PixelFormat> format = ParsePixelFormat(camera.pixel_format);

@@ -4,7 +4,8 @@
 // Each backend lives in its own folder with one file that defines
 // `void RegisterNAMECameraBackend()` (calling RegisterCameraBackend), and one
 // line in capture/CMakeLists.txt (spritestation_camera_backend) builds it in and
-// calls it; nothing else in the project names a backend.
+// calls it; nothing else in the project names a backend. A backend also owns its
+// keys of a station camera's config block: it binds them and checks their values.
 #include <functional>
 #include <memory>
 #include <optional>
@@ -13,6 +14,7 @@
 
 #include "capture/camera_config.h"
 #include "capture/frame_source.h"
+#include "core/options_binder.h"
 
 namespace ss {
 
@@ -32,6 +34,16 @@ struct CameraBackend {
   std::function<std::unique_ptr<FrameSource>(const CameraConfig& camera, int camera_index)> open;
   // The devices present now; unset for a backend that has none to list (replay).
   std::function<std::vector<FoundCamera>()> list;
+  // Binds the camera keys of its own (beyond name, source, model and the device settings) to
+  // their fields of `camera` (core/options_binder.h); the config reads them for its cameras.
+  std::function<void(OptionsBinder& keys, CameraConfig& camera)> keys;
+  // Its rules on a camera's values beyond their types: one "KEY: reason" line per problem in
+  // `why` (core/option_checks.h), KEY the config's. It may fill a key whose default is another
+  // key's value (replay's session_camera). Unset: no rules.
+  std::function<bool(CameraConfig& camera, std::string* why)> check;
+  // Takes the device settings, which the config binds for it (pixel_format, width, height, fps,
+  // exposure_us, gain_db, white_balance; SetLiveOptions): every backend of a device, not replay.
+  bool device_settings = true;
 };
 
 // Called by each backend's registration function; a second backend of the same name is an error.
@@ -40,6 +52,7 @@ void RegisterCameraBackend(CameraBackend backend);
 const CameraBackend* FindCameraBackend(const std::string& name);
 // Every backend built in, by name.
 std::vector<const CameraBackend*> CameraBackends();
+std::vector<std::string> CameraBackendNames();
 
 // The config's pixel format; nullopt when unset. InputError naming cameras.NAME.pixel_format when
 // unknown.

@@ -11,10 +11,7 @@
 
 namespace ss::config_detail {
 
-extern const std::vector<std::string> kSources;    // a camera's `source`
 extern const std::vector<std::string> kLogLevels;  // logging.level and per component
-// Camera keys and the sources they apply to (empty: every source).
-extern const std::vector<std::pair<std::string, std::vector<std::string>>> kCameraKeys;
 
 // The whole file's keys, bound to `cfg`'s fields.
 OptionsBinder StationKeys(StationConfig& cfg);

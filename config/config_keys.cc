@@ -5,39 +5,17 @@
 #include <cerrno>
 #include <cstring>
 #include <fstream>
+#include <map>
 
+#include "capture/camera_backend.h"
 #include "config/config_detail.h"
 #include "core/posix.h"
 #include "core/sql_postgres.h"
 
 namespace ss::config_detail {
 
-const std::vector<std::string> kSources = {"replay", "v4l2", "aravis", "libcamera"};
 const std::vector<std::string> kLogLevels = {"trace", "debug",    "info", "warn",
                                              "error", "critical", "off"};
-
-// Camera keys and the sources they apply to (empty: every source).
-const std::vector<std::pair<std::string, std::vector<std::string>>> kCameraKeys = {
-    {"name", {}},
-    {"source", {}},
-    {"model", {}},
-    {"session", {"replay"}},
-    {"session_camera", {"replay"}},
-    {"loop", {"replay"}},
-    {"realtime", {"replay"}},
-    {"device", {"v4l2"}},
-    {"camera_id", {"aravis", "libcamera"}},
-    {"address", {"aravis"}},
-    {"packet_resend", {"aravis"}},
-    {"packet_size", {"aravis"}},
-    {"pixel_format", {"v4l2", "aravis", "libcamera"}},
-    {"width", {"v4l2", "aravis", "libcamera"}},
-    {"height", {"v4l2", "aravis", "libcamera"}},
-    {"fps", {"v4l2", "aravis", "libcamera"}},
-    {"exposure_us", {"v4l2", "aravis", "libcamera"}},
-    {"gain_db", {"v4l2", "aravis", "libcamera"}},
-    {"white_balance", {"v4l2", "aravis", "libcamera"}},
-};
 
 namespace {
 
@@ -86,23 +64,9 @@ void ReadWhiteBalance(Reader& r, const YAML::Node& node, const std::string& path
   }
 }
 
-// A camera's keys after name and source; which sources take each is kCameraKeys.
-OptionsBinder CameraSettingKeys(CameraConfig& cam) {
-  OptionsBinder b;
-  b.AddPath("model", &cam.model, ".cameramodel; unset: the session's, or none")
-      .AddPath("session", &cam.session, "replay: the recorded session's folder")
-      .Add("session_camera", &cam.session_camera, "a string",
-           "replay: the camera within the session")
-      .Add("loop", &cam.loop, "replay: start over at the end")
-      .Add("realtime", &cam.realtime, "replay: paced by the device timestamps")
-      .Add("device", &cam.device, "a string", "v4l2: the device, e.g. /dev/video0")
-      .Add("camera_id", &cam.camera_id, "a string", "aravis / libcamera: the device id")
-      .Add("address", &cam.address, "a string", "aravis: IP address of a GigE Vision camera")
-      .Add("packet_resend", &cam.packet_resend, "aravis")
-      .Add("packet_size", &cam.packet_size, "a packet size in bytes",
-           "aravis: GigE packet size, 0 = negotiate")
-      .Add("pixel_format", &cam.pixel_format, "a string",
-           "yuyv, bayer_rg8...; unset = device default")
+// The settings of a device, which every backend of one takes (CameraBackend::device_settings).
+void DeviceSettingKeys(OptionsBinder& b, CameraConfig& cam) {
+  b.Add("pixel_format", &cam.pixel_format, "a string", "yuyv, bayer_rg8...; unset = device default")
       .Add("width", &cam.width, "a width in pixels", "0 = device default")
       .Add("height", &cam.height, "a height in pixels", "0 = device default")
       .Add("fps", &cam.fps, "a positive number", "0 = device default")
@@ -115,28 +79,52 @@ OptionsBinder CameraSettingKeys(CameraConfig& cam) {
                  if (wb) ReadWhiteBalance(r, *wb, Child(view.path(), key), cam.white_balance);
                  return wb != nullptr;
                });
+}
+
+// A camera's keys after name and source: its model, and what its backend takes (the device
+// settings, and the keys the backend binds itself, capture/camera_backend.h).
+OptionsBinder CameraSettingKeys(CameraConfig& cam) {
+  OptionsBinder b;
+  b.AddPath("model", &cam.model, ".cameramodel; unset: the session's, or none");
+  const CameraBackend* backend = FindCameraBackend(cam.source);
+  if (backend == nullptr) return b;
+  if (backend->device_settings) DeviceSettingKeys(b, cam);
+  if (backend->keys) backend->keys(b, cam);
   return b;
+}
+
+// Every camera key after name and source, with the backends that take it (none: every one).
+std::map<std::string, std::vector<std::string>> CameraKeySources() {
+  std::map<std::string, std::vector<std::string>> sources;
+  CameraConfig scratch;
+  for (const CameraBackend* backend : CameraBackends()) {
+    scratch.source = backend->name;
+    for (const std::string& key : CameraSettingKeys(scratch).Keys())
+      sources[key].push_back(backend->name);
+  }
+  sources["model"].clear();
+  return sources;
 }
 
 void ReadCamera(Reader& r, const YAML::Node& node, const std::string& path, CameraConfig& cam) {
   const MapView view = r.Map(node, path);
   OptionsBinder identity;
   identity.Add("name", &cam.name, "a string", "unique; the stem of its recorded files")
-      .Add("source", &cam.source, "a string", Join(kSources, " | "));
+      .Add("source", &cam.source, "a string",
+           "the camera backend: " + Join(CameraBackendNames(), " | "));
   identity.ReadKeys(r, view);
   // Keys that belong to another source are named as such; others are unknown.
-  std::vector<std::string> all;
-  all.reserve(kCameraKeys.size());
-  for (const auto& [key, sources] : kCameraKeys) all.push_back(key);
+  const auto sources = CameraKeySources();
+  std::vector<std::string> all = {"name", "source"};
+  for (const auto& [key, backends] : sources) all.push_back(key);
+  const bool known_source = FindCameraBackend(cam.source) != nullptr;
   for (const auto& item : view.entries()) {
-    // (a structured binding cannot be captured before clang 16)
     const std::string& key = item.first;
-    const auto it = std::find_if(kCameraKeys.begin(), kCameraKeys.end(),
-                                 [&](const auto& k) { return k.first == key; });
-    if (it == kCameraKeys.end()) {
-      r.msg().Error(Child(path, key), "unknown key" + Suggest(key, all));
-    } else if (OneOf(cam.source, kSources) && !it->second.empty() &&
-               !OneOf(cam.source, it->second)) {
+    const auto it = sources.find(key);
+    if (it == sources.end()) {
+      if (!OneOf(key, {"name", "source"}))
+        r.msg().Error(Child(path, key), "unknown key" + Suggest(key, all));
+    } else if (known_source && !it->second.empty() && !OneOf(cam.source, it->second)) {
       r.msg().Error(Child(path, key), "only for source " + Join(it->second, " or ") +
                                           " (this camera's source is " + cam.source + ")");
     }

@@ -1,15 +1,15 @@
 // The station config's values and cross-field rules: Valid / Adjusted / Invalid with the reason
 // (config/station_config.h, ValidateStationConfig).
-#include <arpa/inet.h>
-
 #include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <filesystem>
 #include <sstream>
 
+#include "capture/camera_backend.h"
 #include "config/config_detail.h"
 #include "core/frame.h"
+#include "core/ip_address.h"
 #include "core/recording_codecs.h"
 
 namespace ss {
@@ -19,11 +19,6 @@ namespace {
 namespace fs = std::filesystem;
 using namespace yaml_text;
 using Messages = YamlMessages;
-
-bool IsIpAddress(const std::string& a) {
-  unsigned char buf[16];
-  return inet_pton(AF_INET, a.c_str(), buf) == 1 || inet_pton(AF_INET6, a.c_str(), buf) == 1;
-}
 
 bool ValidName(const std::string& name) {
   return !name.empty() && std::all_of(name.begin(), name.end(), [](char c) {
@@ -68,32 +63,25 @@ class Validator {
                          : "expected letters, digits, '_', '-' or '.', got " + Quoted(c.name));
     if (c.source.empty()) {
       Check(false, Child(path, "source"),
-            "every camera needs a source (one of " + Join(kSources) + ")");
+            "every camera needs a source (one of " + Join(CameraBackendNames()) + ")");
       return;
     }
-    Enum(c.source, kSources, Child(path, "source"));
-    if (c.source == "replay") {
-      Check(!c.session.empty(), Child(path, "session"),
-            "a replay camera needs the session folder it replays");
-      Exists(c.session.empty() ? "" : (fs::path(c.session) / "session.json").string(),
-             Child(path, "session"), "recorded session (session.json)");
-      if (c.session_camera.empty()) c.session_camera = c.name;
-    } else if (c.source == "v4l2") {
-      Check(!c.device.empty(), Child(path, "device"),
-            "a v4l2 camera needs its device, e.g. /dev/video0");
-    } else if (c.source == "aravis") {
-      Check(!c.camera_id.empty() || !c.address.empty(), Child(path, "camera_id"),
-            "an aravis camera needs camera_id or address");
-      Check(c.camera_id.empty() || c.address.empty(), Child(path, "address"),
-            "give camera_id or address, not both");
-      if (!c.address.empty()) {
-        Check(IsIpAddress(c.address), Child(path, "address"),
-              "expected an IP address, got " + Quoted(c.address));
+    // The backend's own rules on its keys (capture/camera_backend.h), each at its key.
+    const CameraBackend* backend = FindCameraBackend(c.source);
+    Enum(c.source, CameraBackendNames(), Child(path, "source"));
+    if (std::string why; backend != nullptr && backend->check && !backend->check(c, &why)) {
+      std::istringstream lines(why);
+      for (std::string line; std::getline(lines, line);) {
+        const size_t colon = line.find(": ");
+        if (colon == std::string::npos) {
+          Check(false, path, line);
+        } else {
+          Check(false, Child(path, line.substr(0, colon)), line.substr(colon + 2));
+        }
       }
-      Check(c.packet_size == 0 || (c.packet_size >= 576 && c.packet_size <= 16384),
-            Child(path, "packet_size"),
-            "expected 0 (negotiate) or 576..16384 bytes, got " + std::to_string(c.packet_size));
     }
+    Exists(c.session.empty() ? "" : (fs::path(c.session) / "session.json").string(),
+           Child(path, "session"), "recorded session (session.json)");
     if (!c.pixel_format.empty()) {
       Check(ParsePixelFormat(c.pixel_format).has_value(), Child(path, "pixel_format"),
             "expected one of mono8, bayer_rg8, bayer_gr8, bayer_gb8, bayer_bg8, rgb8, bgr8, yuyv, "
@@ -130,16 +118,6 @@ class Validator {
             (c.white_balance.temperature_k >= 1500 && c.white_balance.temperature_k <= 15000),
         Child(path, "white_balance.temperature_k"),
         "expected a colour temperature of 1500-15000 K, got " + Num(c.white_balance.temperature_k));
-    // How each backend fixes white balance: V4L2 as a colour temperature, GenICam as ratios.
-    if (c.white_balance.mode == WhiteBalanceMode::kManual && c.source == "v4l2") {
-      Check(c.white_balance.temperature_k > 0, Child(path, "white_balance.temperature_k"),
-            "V4L2 devices fix white balance as a colour temperature: give temperature_k");
-    }
-    if (c.source == "aravis") {
-      Check(
-          c.white_balance.temperature_k == 0, Child(path, "white_balance.temperature_k"),
-          "GigE Vision cameras fix white balance as red/blue ratios: give red_gain and blue_gain");
-    }
     Exists(c.model, Child(path, "model"), "camera model");
   }
 

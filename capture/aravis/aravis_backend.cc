@@ -1,6 +1,8 @@
 // The Aravis backend: GigE Vision and USB3 Vision cameras.
 #include "capture/aravis/aravis_source.h"
 #include "capture/camera_backend.h"
+#include "core/ip_address.h"
+#include "core/option_checks.h"
 
 namespace ss {
 
@@ -27,6 +29,32 @@ void RegisterAravisCameraBackend() {
                {"aravis", d.id, d.vendor + " " + d.model, d.protocol, d.address, d.serial});
          }
          return out;
+       },
+       [](OptionsBinder& keys, CameraConfig& camera) {
+         keys.Add("camera_id", &camera.camera_id, "a string", "the device id")
+             .Add("address", &camera.address, "a string", "IP address of a GigE Vision camera")
+             .Add("packet_resend", &camera.packet_resend, "ask for lost GVSP packets again")
+             .Add("packet_size", &camera.packet_size, "a packet size in bytes",
+                  "GigE packet size, 0 = negotiate");
+       },
+       [](CameraConfig& camera, std::string* why) {
+         OptionProblems check(why);
+         check(!camera.camera_id.empty() || !camera.address.empty(), "camera_id",
+               "an aravis camera needs camera_id or address");
+         check(camera.camera_id.empty() || camera.address.empty(), "address",
+               "give camera_id or address, not both");
+         check(camera.address.empty() || IsIpAddress(camera.address), "address",
+               "expected an IP address, got \"" + camera.address + "\"");
+         check(
+             camera.packet_size == 0 || (camera.packet_size >= 576 && camera.packet_size <= 16384),
+             "packet_size",
+             "expected 0 (negotiate) or 576..16384 bytes, got " +
+                 std::to_string(camera.packet_size));
+         // GenICam fixes white balance as ratios (BalanceRatio), not as a colour temperature.
+         check(camera.white_balance.temperature_k == 0, "white_balance.temperature_k",
+               "GigE Vision cameras fix white balance as red/blue ratios: give red_gain and "
+               "blue_gain");
+         return check.ok();
        }});
 }
 

@@ -17,7 +17,11 @@ void RegisterLibcameraCameraBackend() {
            out.push_back({"libcamera", d.id, d.model, "libcamera", d.location, ""});
          }
          return out;
-       }});
+       },
+       [](OptionsBinder& keys, CameraConfig& camera) {
+         keys.Add("camera_id", &camera.camera_id, "a string", "the device id");
+       },
+       nullptr});
 }
 
 }  // namespace ss

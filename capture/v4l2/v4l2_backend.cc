@@ -3,6 +3,7 @@
 
 #include "capture/camera_backend.h"
 #include "capture/v4l2/v4l2_source.h"
+#include "core/option_checks.h"
 
 namespace ss {
 
@@ -25,6 +26,20 @@ void RegisterV4l2CameraBackend() {
          for (const auto& d : ListV4l2Devices())
            out.push_back({"v4l2", d.path, d.card, d.driver, d.bus, ""});
          return out;
+       },
+       [](OptionsBinder& keys, CameraConfig& camera) {
+         keys.Add("device", &camera.device, "a string", "the device, e.g. /dev/video0");
+       },
+       [](CameraConfig& camera, std::string* why) {
+         OptionProblems check(why);
+         check(!camera.device.empty(), "device",
+               "a v4l2 camera needs its device, e.g. /dev/video0");
+         // V4L2 fixes white balance as a colour temperature (V4L2_CID_WHITE_BALANCE_TEMPERATURE).
+         check(camera.white_balance.mode != WhiteBalanceMode::kManual ||
+                   camera.white_balance.temperature_k > 0,
+               "white_balance.temperature_k",
+               "V4L2 devices fix white balance as a colour temperature: give temperature_k");
+         return check.ok();
        }});
 }
 

@@ -2,6 +2,7 @@
 // filled, and each kind of mistake is refused naming the field and its line.
 #include "config/station_config.h"
 
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -10,7 +11,9 @@
 
 #include <cmath>
 
+#include "capture/camera_backend.h"
 #include "core/error.h"
+#include "core/option_checks.h"
 #include "tests/support/test_support.h"
 
 namespace ss {
@@ -224,9 +227,8 @@ TEST(StationConfig, UnknownKeysAreRefusedByName) {
               "/dev/video0\n"),
       "station.yaml:5: cameras[0].device: only for source v4l2 (this camera's source is aravis)");
   EXPECT_EQ(ErrorOf("cameras:\n  - name: c\n    source: replay\n    session: s\n    fps: 30\n"),
-            "station.yaml:5: cameras[0].fps: only for source v4l2 or aravis or libcamera (this "
-            "camera's source is "
-            "replay)");
+            "station.yaml:5: cameras[0].fps: only for source aravis or libcamera or v4l2 (this "
+            "camera's source is replay)");
 }
 
 TEST(StationConfig, ValueErrorsNameFieldAndLine) {
@@ -235,7 +237,7 @@ TEST(StationConfig, ValueErrorsNameFieldAndLine) {
   };
   const std::vector<Case> cases = {
       {"cameras:\n  - name: c\n    source: usb\n",
-       "station.yaml:3: cameras[0].source: expected one of replay, v4l2, aravis, libcamera, got "
+       "station.yaml:3: cameras[0].source: expected one of aravis, libcamera, replay, v4l2, got "
        "\"usb\""},
       {"cameras:\n  - name: c\n    source: v4l2\n",
        "station.yaml:2: cameras[0].device: a v4l2 camera needs its device, e.g. /dev/video0"},
@@ -576,6 +578,49 @@ TEST(StationConfig, ValidatesConfigsBuiltInCode) {
   EXPECT_EQ(report.errors[0],
             "code: pipeline.px_per_m: expected auto or a positive number, got -5");
   EXPECT_EQ(report.errors[1].rfind("code: control.token: required", 0), 0u) << report.errors[1];
+}
+
+// Registers a backend of its own, as a backend's file does, and reads configs naming it; the
+// number of answers that were not as wanted (each printed).
+int ReadConfigsOfARegisteredBackend() {
+  RegisterCameraBackend({"testcam", "a backend of this test", nullptr, nullptr,
+                         [](OptionsBinder& keys, CameraConfig& camera) {
+                           keys.Add("device", &camera.device, "a string", "the test device");
+                         },
+                         [](CameraConfig& camera, std::string* why) {
+                           OptionProblems check(why);
+                           check(camera.device.rfind("/dev/", 0) == 0, "device",
+                                 "expected a /dev path, got " + camera.device);
+                           return check.ok();
+                         },
+                         false});
+  const std::string head = "cameras:\n  - name: t\n    source: testcam\n";
+  const std::vector<std::pair<std::string, std::string>> errors = {
+      {head + "    device: /dev/x\n", ""},
+      {head + "    device: x\n", "station.yaml:4: cameras[0].device: expected a /dev path, got x"},
+      {head + "    device: /dev/x\n    fps: 30\n",
+       "station.yaml:5: cameras[0].fps: only for source aravis or libcamera or v4l2 (this "
+       "camera's source is testcam)"},
+      {"cameras:\n  - name: c\n    source: replay\n    session: s\n    device: /dev/x\n",
+       "station.yaml:5: cameras[0].device: only for source testcam or v4l2 (this camera's "
+       "source is replay)"}};
+  int failed = 0;
+  for (const auto& [yaml, error] : errors) {
+    const std::string got = ErrorOf(yaml);
+    if (got == error) continue;
+    std::fprintf(stderr, "for\n%sgot    \"%s\"\nwanted \"%s\"\n", yaml.c_str(), got.c_str(),
+                 error.c_str());
+    ++failed;
+  }
+  if (Parse(head + "    device: /dev/x\n").cameras.at(0).device != "/dev/x") ++failed;
+  return failed;
+}
+
+// A backend owns its keys and their rules (capture/camera_backend.h): one registered as a
+// backend's own file does is read and checked by the config without a line of config/. It is
+// registered in a child process, so that the other tests see only the backends built in.
+TEST(StationConfigDeathTest, ABackendBindsAndChecksItsOwnKeys) {
+  EXPECT_EXIT(std::exit(ReadConfigsOfARegisteredBackend()), ::testing::ExitedWithCode(0), "");
 }
 
 }  // namespace
