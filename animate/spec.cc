@@ -7,13 +7,13 @@
 #include <functional>
 #include <map>
 #include <optional>
-#include <sstream>
 #include <utility>
 
 #include <yaml-cpp/yaml.h>
 
 #include "core/error.h"
 #include "core/input_file.h"
+#include "core/option_checks.h"
 #include "core/options_binder.h"
 #include "core/yaml_reader.h"
 
@@ -303,14 +303,13 @@ StepWindow SpecReader::Window(const YamlMap& view, const WindowKeys& keys, StepW
 
 void SpecReader::Report(const YamlMap& view, const std::string& why,
                         const std::map<std::string, std::string>& keys) {
-  std::istringstream lines(why);
-  for (std::string line; std::getline(lines, line);) {
-    const size_t colon = line.find(": ");
-    const auto key = keys.find(line.substr(0, colon));
-    if (key == keys.end() || colon == std::string::npos) {
-      msg_.Error(view.path(), line);  // a field the spec does not set: cannot happen from a spec
+  for (const auto& [field, reason] : OptionProblems::Split(why)) {
+    const auto key = keys.find(field);
+    if (key == keys.end()) {
+      // A field the spec does not set: cannot happen from a spec.
+      msg_.Error(view.path(), field.empty() ? reason : field + ": " + reason);
     } else if (!msg_.Failed(Child(view.path(), key->second))) {
-      Error(view, key->second, line.substr(colon + 2));
+      Error(view, key->second, reason);
     }
   }
 }

@@ -4,12 +4,12 @@
 #include <cctype>
 #include <cmath>
 #include <filesystem>
-#include <sstream>
 
 #include "capture/camera_backend.h"
 #include "config/config_detail.h"
 #include "core/frame.h"
 #include "core/ip_address.h"
+#include "core/option_checks.h"
 #include "core/recording_codecs.h"
 
 namespace ss {
@@ -70,15 +70,8 @@ class Validator {
     const CameraBackend* backend = FindCameraBackend(c.source);
     Enum(c.source, CameraBackendNames(), Child(path, "source"));
     if (std::string why; backend != nullptr && backend->check && !backend->check(c, &why)) {
-      std::istringstream lines(why);
-      for (std::string line; std::getline(lines, line);) {
-        const size_t colon = line.find(": ");
-        if (colon == std::string::npos) {
-          Check(false, path, line);
-        } else {
-          Check(false, Child(path, line.substr(0, colon)), line.substr(colon + 2));
-        }
-      }
+      for (const auto& [field, reason] : OptionProblems::Split(why))
+        Check(false, field.empty() ? path : Child(path, field), reason);
     }
     Exists(c.session.empty() ? "" : (fs::path(c.session) / "session.json").string(),
            Child(path, "session"), "recorded session (session.json)");
@@ -172,12 +165,8 @@ class Validator {
     // The pipeline's own rules (CameraPipelineOptions::IsValid), each problem by its field.
     std::map<std::string, std::string> pipeline_problems;
     if (std::string why; !cfg.pipeline.IsValid(&why)) {
-      std::istringstream lines(why);
-      for (std::string line; std::getline(lines, line);) {
-        const size_t colon = line.find(": ");
-        if (colon != std::string::npos)
-          pipeline_problems[line.substr(0, colon)] = line.substr(colon + 2);
-      }
+      for (const auto& [field, reason] : OptionProblems::Split(why))
+        pipeline_problems[field] = reason;
     }
     // Reports the problem of pipeline option `field` (if any) at config key `path`.
     const auto pipeline_rule = [&](const std::string& field, const std::string& path) {

@@ -6,6 +6,7 @@
 #include <string>
 #include <type_traits>
 #include <utility>
+#include <vector>
 
 namespace ss {
 
@@ -38,6 +39,26 @@ class OptionProblems {
       *why_ += (why_->empty() ? "" : "\n") + prefix + line;
   }
   bool ok() const { return ok_; }
+
+  // The problems an IsValid wrote into `why`, back as fields and reasons, for a reader that names
+  // each at its own key (the station config, the animation spec). A line without "field: " has
+  // the field "".
+  struct Problem {
+    std::string field, reason;
+  };
+  static std::vector<Problem> Split(const std::string& why) {
+    std::vector<Problem> problems;
+    std::istringstream lines(why);
+    for (std::string line; std::getline(lines, line);) {
+      const size_t colon = line.find(": ");
+      if (colon == std::string::npos) {
+        problems.push_back({"", line});
+      } else {
+        problems.push_back({line.substr(0, colon), line.substr(colon + 2)});
+      }
+    }
+    return problems;
+  }
 
   // A number as the messages write it ("25", "0.5").
   static std::string Num(double v) {
