@@ -254,9 +254,10 @@ bool SpecReader::ExistingFile(const YAML::Node& node, const std::string& path, s
 }
 
 void SpecReader::BindWindow(OptionsBinder& keys, WindowKeys& window) {
-  for (auto [key, field] : {std::pair{"at", &window.at}, std::pair{"from", &window.from},
+  for (const auto& bound : {std::pair{"at", &window.at}, std::pair{"from", &window.from},
                             std::pair{"to", &window.to}}) {
-    keys.AddRead(key, "", "seconds or end",
+    std::optional<SpecTime>* field = bound.second;
+    keys.AddRead(bound.first, "", "seconds or end",
                  Shaped([this, field](const YAML::Node& n, const std::string& p) {
                    SpecTime time;
                    if (!Time(n, p, time)) return false;

@@ -269,6 +269,7 @@ int Run(const std::vector<std::string>& args) {
     }
   }
   std::vector<char*> argv;
+  argv.reserve(storage.size());
   for (auto& s : storage) argv.push_back(s.data());
   int argc = static_cast<int>(argv.size());
   benchmark::Initialize(&argc, argv.data());

@@ -136,7 +136,7 @@ SkeletonDef SkeletonDefFromJson(const nlohmann::json& json, const std::string& c
     if (root < 0) throw InputError(context, "root_limb " + it->dump() + " is not one of the limbs");
   }
   const std::string name = json.value("name", std::string("custom"));
-  return MakeSkeletonDef(name, std::move(joints), std::move(limbs), context, root);
+  return MakeSkeletonDef(name, std::move(joints), limbs, context, root);
 }
 
 nlohmann::json SkeletonDefToJson(const SkeletonDef& def) {

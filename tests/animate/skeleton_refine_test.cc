@@ -169,6 +169,7 @@ TEST(SkeletonRefine, TargetMovementsAreCutWhereTheFirstPassChangesSourceMovement
   // Source movements [0, 10), [10, 30), [30, ...). Target movements [0, 20), [20, 26).
   const std::vector<int> source_starts{0, 10, 30};
   std::vector<int> first_pass;
+  first_pass.reserve(26);
   for (int t = 0; t < 10; ++t) first_pass.push_back(12 + t);  // movement 1
   first_pass.push_back(5);                                    // movement 0 for 2 frames: too short
   first_pass.push_back(6);

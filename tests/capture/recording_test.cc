@@ -29,8 +29,8 @@ using ss::testing::TestCamera;
 using ss::testing::TestFrame;
 using ss::testing::TestPixels;
 
-std::vector<Frame> ReplayAll(const std::string& dir, ReplayOptions options = {}) {
-  ReplaySource source(dir, std::move(options));
+std::vector<Frame> ReplayAll(const std::string& dir, const ReplayOptions& options = {}) {
+  ReplaySource source(dir, options);
   std::vector<Frame> frames;
   while (auto f = source.Next()) frames.push_back(std::move(*f));
   return frames;

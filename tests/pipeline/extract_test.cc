@@ -34,6 +34,7 @@ class ExtractorTest : public ::testing::Test {
  protected:
   ExtractorTest() : scene_(SceneOptions{}) {
     std::vector<cv::Mat> empty;
+    empty.reserve(4);
     for (int i = 0; i < 4; ++i) empty.push_back(scene_.Empty(1000 + i));
     keyer_.Train(empty);
   }
