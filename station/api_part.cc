@@ -14,7 +14,18 @@ void Reply(httplib::Response& res, int status, const nlohmann::json& body) {
 }
 
 void ReplyError(httplib::Response& res, int status, const std::string& message) {
-  Reply(res, status, {{"error", message}});
+  // An error may quote what was sent (a path, a JSON parser's "last read" token): never more
+  // than a short excerpt of it.
+  constexpr size_t kMostBytes = 1024;
+  if (message.size() <= kMostBytes) {
+    Reply(res, status, {{"error", message}});
+    return;
+  }
+  size_t cut = kMostBytes - 64;
+  while (cut > 0 && (static_cast<unsigned char>(message[cut]) & 0xC0) == 0x80) --cut;
+  Reply(res, status,
+        {{"error", message.substr(0, cut) + "... (cut: " + std::to_string(message.size()) +
+                       " bytes in all)"}});
 }
 
 Handler Json(std::function<nlohmann::json(const httplib::Request&)> f) {

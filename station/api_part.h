@@ -43,6 +43,7 @@ struct Route {
 };
 
 void Reply(httplib::Response& res, int status, const nlohmann::json& body);
+// {"error": message}; a message over 1 KiB (one that quotes what was sent) is cut to 960 bytes.
 void ReplyError(httplib::Response& res, int status, const std::string& message);
 // A handler that answers 200 with what `f(req)` returns.
 Handler Json(std::function<nlohmann::json(const httplib::Request&)> f);

@@ -31,9 +31,17 @@ ConsoleEvents::~ConsoleEvents() { Stop(); }
 
 void ConsoleEvents::Start() {
   if (thread_.joinable()) return;
+  // The first snapshot; a status that cannot be read yet (no station runs) is an object that
+  // says so, replaced by the first one the loop reads.
+  nlohmann::json first;
+  try {
+    first = status_();
+  } catch (const std::exception& e) {
+    first = {{"error", e.what()}};
+  }
   {
     std::lock_guard lock(mutex_);
-    current_ = status_();
+    current_ = std::move(first);
     version_ = 1;
   }
   thread_ = std::thread([this] { Loop(); });

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <regex>
 #include <sstream>
 #include <thread>
 #include <vector>
@@ -41,12 +42,6 @@ using api::Route;
 using httplib::Request;
 using httplib::Response;
 
-constexpr size_t kMaxBodyBytes = 1 << 20;  // every JSON body the API takes is far smaller
-// Each open connection holds an HTTP thread while it waits for its request (cpp-httplib 0.11
-// reads a request on the thread that serves it). Enough threads that 500 slow or idle clients
-// leave the API answering: idle, they cost ~10 MB. A slow client keeps its thread for at most
-// the request deadline, and one address holds at most 64 of them (HttpLimits).
-constexpr int kHttpThreads = 600;
 constexpr int kHttpNice = 10;  // HTTP threads yield the cores to capture and the pipeline
 
 // HTTP worker threads run at a lower priority than every other thread of the daemon:
@@ -89,6 +84,54 @@ std::string HostName(const std::string& host_port) {
   return colon == std::string::npos ? host : host.substr(0, colon);
 }
 
+// The page a request's (decoded) path names, relative to web/ ("/" is "index.html"): "." and
+// empty segments dropped, ".." taking the one before. Nullopt for a path that climbs out of
+// the pages or holds anything but letters, digits and "_-./" (a backslash, a NUL, a byte of
+// an overlong UTF-8 sequence): such a path names no page, whatever the folder holds.
+std::optional<std::string> PagePath(std::string_view request_path) {
+  if (request_path.empty() || request_path[0] != '/') return std::nullopt;
+  std::vector<std::string_view> segments;
+  size_t at = 1;
+  while (at <= request_path.size()) {
+    size_t end = request_path.find('/', at);
+    if (end == std::string_view::npos) end = request_path.size();
+    const std::string_view segment = request_path.substr(at, end - at);
+    at = end + 1;
+    for (const char c : segment) {
+      if (!std::isalnum(static_cast<unsigned char>(c)) && c != '_' && c != '-' && c != '.')
+        return std::nullopt;
+    }
+    if (segment.empty() || segment == ".") continue;
+    if (segment == "..") {
+      if (segments.empty()) return std::nullopt;
+      segments.pop_back();
+      continue;
+    }
+    segments.push_back(segment);
+  }
+  if (segments.empty()) return "index.html";
+  std::string path;
+  for (const std::string_view segment : segments) {
+    if (!path.empty()) path += '/';
+    path += segment;
+  }
+  return path;
+}
+
+// Whether the Authorization header carries `token`, in a time that does not depend on where
+// the two first differ (nor on the token's content: only its length).
+bool CarriesToken(const std::string& authorization, const std::string& token) {
+  static constexpr std::string_view kScheme = "Bearer ";
+  const std::string_view given = authorization;
+  if (given.size() != kScheme.size() + token.size()) return false;
+  unsigned char diff = 0;
+  for (size_t i = 0; i < given.size(); ++i) {
+    const char want = i < kScheme.size() ? kScheme[i] : token[i - kScheme.size()];
+    diff |= static_cast<unsigned char>(given[i] ^ want);
+  }
+  return diff == 0;
+}
+
 const char* ContentTypeOf(const fs::path& path) {
   const std::string ext = path.extension().string();
   if (ext == ".html") return "text/html; charset=utf-8";
@@ -111,6 +154,7 @@ struct ControlServer::Impl {
   int port = 0;
   std::unique_ptr<ConsoleEvents> events;
   std::vector<Route> routes;
+  std::vector<std::regex> route_patterns;         // routes[i]'s pattern, compiled
   std::vector<std::unique_ptr<api::Part>> parts;  // the API's parts in files of their own
 
   // Every part of the API that lives in a file of its own: one line each.
@@ -169,6 +213,11 @@ struct ControlServer::Impl {
   // it (another site's page may not act) and the token. (The body is read after this: a POST's
   // JSON type is checked by its handler's wrapper.)
   httplib::Server::HandlerResponse Admit(const Request& req, Response& res) {
+    // A body whose end is ambiguous is refused before anything else (http_server.h).
+    if (const std::string why = HttpServer::AmbiguousFraming(req); !why.empty()) {
+      ReplyError(res, 400, why + " (where the body ends is ambiguous)");
+      return httplib::Server::HandlerResponse::Handled;
+    }
     const bool api =
         req.path == "/metrics" || req.path == "/api" || req.path.rfind("/api/", 0) == 0;
     if (!api) return httplib::Server::HandlerResponse::Unhandled;
@@ -192,7 +241,7 @@ struct ControlServer::Impl {
       }
     }
     if (!config.token.empty() &&
-        req.get_header_value("Authorization") != "Bearer " + config.token) {
+        !CarriesToken(req.get_header_value("Authorization"), config.token)) {
       res.set_header("WWW-Authenticate", "Bearer");
       ReplyError(
           res, 401,
@@ -202,23 +251,23 @@ struct ControlServer::Impl {
     return httplib::Server::HandlerResponse::Unhandled;
   }
 
-  // The console's static files: `path` below the web folder, or the embedded copy.
+  // The console's static files: only the pages' own set (the files the build embeds), read
+  // from the web folder when one is given, else from the embedded copy. A path that names
+  // anything else, however spelled, is not served.
   bool ServeWebFile(const std::string& request_path, Response& res) {
-    std::string path = request_path == "/" ? "/index.html" : request_path;
-    if (path.find("..") != std::string::npos || path.find('\0') != std::string::npos) return false;
-    path = path.substr(1);
+    if (!options.embedded) return false;
+    const std::optional<std::string> path = PagePath(request_path);
+    if (!path) return false;
+    const std::optional<std::string_view> embedded = options.embedded(*path);
+    if (!embedded) return false;
     if (!options.web_dir.empty()) {
-      const fs::path file = fs::path(options.web_dir) / path;
-      std::ifstream in(file, std::ios::binary);
+      std::ifstream in(fs::path(options.web_dir) / *path, std::ios::binary);
       if (!in) return false;
       std::ostringstream bytes;
       bytes << in.rdbuf();
-      res.set_content(bytes.str(), ContentTypeOf(file));
+      res.set_content(bytes.str(), ContentTypeOf(*path));
     } else {
-      if (!options.embedded) return false;
-      const std::optional<std::string_view> bytes = options.embedded(path);
-      if (!bytes) return false;
-      res.set_content(std::string(*bytes), ContentTypeOf(path));
+      res.set_content(std::string(*embedded), ContentTypeOf(*path));
     }
     res.set_header("Cache-Control", "no-cache");
     res.set_header("X-Content-Type-Options", "nosniff");
@@ -391,8 +440,7 @@ struct ControlServer::Impl {
     for (const auto& part : parts) {
       for (Route& r : part->Routes()) routes.push_back(std::move(r));
     }
-    server.new_task_queue = [] { return new NiceThreadPool(kHttpThreads); };
-    server.set_payload_max_length(kMaxBodyBytes);
+    server.new_task_queue = [n = options.http_threads] { return new NiceThreadPool(n); };
     server.set_keep_alive_max_count(1000);
     server.set_read_timeout(10, 0);
     server.set_write_timeout(5,
@@ -400,6 +448,7 @@ struct ControlServer::Impl {
     server.set_pre_routing_handler(
         [this](const Request& req, Response& res) { return Admit(req, res); });
     for (const Route& r : routes) {
+      route_patterns.emplace_back(r.pattern);
       auto handler = [h = r.handler](const Request& req, Response& res) {
         // A body must be JSON: a form or text/plain post from another site's page is refused
         // before anything acts (such a post needs no CORS preflight; a JSON one does).
@@ -422,35 +471,64 @@ struct ControlServer::Impl {
     }
     // The console's pages: everything else that GET asks for.
     server.Get(R"(/(|[A-Za-z0-9_\-./]+))", [this](const Request& req, Response& res) {
-      if (req.path.rfind("/api/", 0) == 0 || !ServeWebFile(req.path, res)) {
-        ReplyError(res, 404,
-                   "no such endpoint or page: GET " + req.path + " (GET /api lists the endpoints)");
-      }
+      if (req.path.rfind("/api/", 0) == 0 || !ServeWebFile(req.path, res)) NoRoute(req, res);
     });
     server.set_error_handler([this](const Request& req, Response& res) {
       if (!res.body.empty()) return;
       // A request the HTTP server could not read whole (cpp-httplib's bare 400): the limit it
       // broke.
-      const HttpLimits& limits = server.limits();
-      if (HttpServer::CurrentFault() == HttpServer::RequestFault::kTimedOut) {
-        const int64_t ms = limits.request_deadline.count();
-        ReplyError(
-            res, 408,
-            "request: not received whole within " +
-                (ms % 1000 == 0 ? std::to_string(ms / 1000) + " s" : std::to_string(ms) + " ms") +
-                " of its first byte");
-      } else if (HttpServer::CurrentFault() == HttpServer::RequestFault::kHeaderTooLarge) {
-        ReplyError(res, 431,
-                   "header: larger than " + std::to_string(limits.max_header_bytes) + " bytes");
-      } else if (res.status == 404) {
-        ReplyError(res, 404,
-                   "no such endpoint: " + req.method + " " + req.path + " (GET /api lists them)");
+      if (const auto fault = HttpServer::CurrentFault(); fault != HttpServer::RequestFault::kNone) {
+        const auto [status, message] = HttpServer::FaultAnswer(fault, server.limits());
+        ReplyError(res, status, message);
+      } else if (res.status == 404 || res.status == 400) {
+        NoRoute(req, res);
       } else if (res.status == 413) {
-        ReplyError(res, 413, "body: larger than " + std::to_string(kMaxBodyBytes) + " bytes");
-      } else if (res.status == 405 || res.status == 400) {
+        ReplyError(
+            res, 413,
+            "body: larger than " + std::to_string(server.limits().max_body_bytes) + " bytes");
+      } else if (res.status == 414) {
+        ReplyError(res, 414,
+                   "request line: longer than " +
+                       std::to_string(server.limits().max_request_line_bytes) + " bytes");
+      } else if (res.status >= 400) {
         ReplyError(res, res.status, "malformed request: " + req.method + " " + req.path);
       }
     });
+  }
+
+  // No route takes the request: 405 with the methods its path does take (cpp-httplib answers
+  // 404 for those, or 400 for a method it does not know), else 404 (400: unknown method).
+  void NoRoute(const Request& req, Response& res) const {
+    const bool known_method = req.method == "GET" || req.method == "HEAD" || req.method == "POST" ||
+                              req.method == "PUT" || req.method == "DELETE" ||
+                              req.method == "PATCH" || req.method == "OPTIONS";
+    const std::string allowed = MethodsOf(req.path);
+    if (!allowed.empty()) {
+      res.set_header("Allow", allowed);
+      ReplyError(res, 405, "method: " + req.method + " " + req.path + " takes " + allowed);
+    } else if (known_method) {
+      ReplyError(res, 404,
+                 "no such endpoint or page: " + req.method + " " + req.path +
+                     " (GET /api lists the endpoints)");
+    } else {
+      ReplyError(res, 400, "malformed request: " + req.method + " " + req.path);
+    }
+  }
+
+  // The methods that routes take at `path`, "GET, HEAD" style; "" when none matches it.
+  std::string MethodsOf(const std::string& path) const {
+    bool get = false, post = false;
+    for (size_t i = 0; i < routes.size(); ++i) {
+      if (!std::regex_match(path, route_patterns[i])) continue;
+      (routes[i].method == "GET" ? get : post) = true;
+    }
+    if (!get && !post && path.rfind("/api/", 0) != 0 && options.embedded) {
+      const std::optional<std::string> page = PagePath(path);
+      get = page && options.embedded(*page);
+    }
+    std::string allowed = get ? "GET, HEAD" : "";
+    if (post) allowed += allowed.empty() ? "POST" : ", POST";
+    return allowed;
   }
 
   std::string Url() const {
@@ -466,6 +544,8 @@ bool ControlServerOptions::IsValid(std::string* why) const {
         "expected a port number 0..65535, got " + std::to_string(config.port));
   check(max_event_streams >= 0, "max_event_streams",
         "expected a number >= 0, got " + std::to_string(max_event_streams));
+  check(http_threads >= 1 && http_threads <= 4096, "http_threads",
+        "expected 1..4096 threads, got " + std::to_string(http_threads));
   return check.ok();
 }
 

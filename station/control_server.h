@@ -27,6 +27,11 @@ struct ControlServerOptions {
   std::string web_dir;
   std::function<std::optional<std::string_view>(std::string_view path)> embedded;
   int max_event_streams = 16;  // open /api/events connections (>= 0); more get 503
+  // Threads serving connections (1..4096): each open connection holds one while it waits for
+  // its request (cpp-httplib 0.11). Enough that 500 slow or idle clients leave the API
+  // answering: idle, they cost ~10 MB. A slow client keeps its thread for at most the request
+  // deadline, and one address holds at most 64 of them (HttpLimits).
+  int http_threads = 600;
   std::string
       config_path;  // the daemon's config file (the calibration wizard saves into it); "": none
   // False with "FIELD: reason" lines in `why` (core/option_checks.h) for values out of range.

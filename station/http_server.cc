@@ -24,6 +24,8 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 constexpr size_t kMaxDrainBytes = 64 << 10;  // read and dropped before a connection is closed
+constexpr size_t kMaxLingerBytes = 4 << 20;  // ... after a refused request, within kLinger
+constexpr auto kLinger = std::chrono::milliseconds(250);
 // waits notice a stopping server this often
 constexpr auto kStopCheck = std::chrono::milliseconds(100);
 
@@ -61,12 +63,12 @@ bool ExpectsBody(const std::string& method) {
 class ConnectionStream final : public httplib::Stream {
  public:
   ConnectionStream(int sock, const std::atomic<socket_t>& listener, Clock::duration read_timeout,
-                   Clock::duration write_timeout, size_t max_header_bytes)
+                   Clock::duration write_timeout, const HttpLimits& limits)
       : sock_(sock),
         listener_(listener),
         read_timeout_(read_timeout),
         write_timeout_(write_timeout),
-        max_header_bytes_(max_header_bytes) {}
+        limits_(limits) {}
 
   // Waits up to `idle` for the next request's first byte; false when none came.
   bool WaitForRequest(Clock::duration idle) {
@@ -79,27 +81,46 @@ class ConnectionStream final : public httplib::Stream {
     deadline_ = deadline;
     fault_ = HttpServer::RequestFault::kNone;
     header_in_ = false;
+    line_in_ = false;
     header_bytes_ = 0;
+    header_lines_ = 0;
+    body_expected_ = false;
+    body_bytes_ = 0;
     body_left_ = 0;
+    written_ = 0;
   }
 
   // Its header is in (cpp-httplib's setup_request hook). A request without a body is whole
   // now; one with a Content-Length once that many more bytes are read. A chunked body, or one
   // without a length (read until the client closes), stays under the deadline to the end.
+  // A declared length over the limit, or a framing that cannot be trusted, fails the body's
+  // first read.
   void HeaderIn(const httplib::Request& req) {
     header_in_ = true;
+    if (!HttpServer::AmbiguousFraming(req).empty()) {
+      fault_ = HttpServer::RequestFault::kAmbiguousFraming;
+      return;
+    }
     if (!ExpectsBody(req.method)) {
       deadline_.reset();
       return;
     }
-    if (strcasecmp(req.get_header_value("Transfer-Encoding").c_str(), "chunked") == 0) return;
+    body_expected_ = true;
+    if (req.has_header("Transfer-Encoding")) return;  // chunked (AmbiguousFraming)
     const std::string length = req.get_header_value("Content-Length");
     uint64_t n = 0;
     const auto [end, error] = std::from_chars(length.data(), length.data() + length.size(), n);
     if (length.empty() || error != std::errc() || end != length.data() + length.size()) return;
+    if (n > limits_.max_body_bytes) {
+      fault_ = HttpServer::RequestFault::kBodyTooLarge;
+      return;
+    }
     body_left_ = n;
     if (n == 0) deadline_.reset();
   }
+
+  // Bytes written since the request began: 0 when it got no answer.
+  uint64_t written() const { return written_; }
 
   HttpServer::RequestFault fault() const { return fault_; }
 
@@ -107,6 +128,8 @@ class ConnectionStream final : public httplib::Stream {
   bool is_writable() const override { return Wait(POLLOUT, write_timeout_); }
 
   ssize_t read(char* ptr, size_t size) override {
+    // A fault ends the request's reading: what is still to come is never read.
+    if (fault_ != HttpServer::RequestFault::kNone) return -1;
     if (off_ == len_) {
       if (!Wait(POLLIN, read_timeout_)) return -1;
       ssize_t n = 0;
@@ -117,13 +140,20 @@ class ConnectionStream final : public httplib::Stream {
       off_ = 0;
       len_ = static_cast<size_t>(n);
     }
-    const size_t n = std::min(size, len_ - off_);
+    // What this read may hand out: at most what the limits leave (the byte that passes one
+    // is never read, so a body over the limit costs no more memory than the limit).
+    size_t n = std::min(size, len_ - off_);
+    if (!header_in_) {
+      if (!CountHeader(buffer_.data() + off_, n)) return -1;
+    } else if (body_expected_) {
+      if (body_bytes_ + n > limits_.max_body_bytes) {
+        fault_ = HttpServer::RequestFault::kBodyTooLarge;
+        return -1;
+      }
+      body_bytes_ += n;
+    }
     std::memcpy(ptr, buffer_.data() + off_, n);
     off_ += n;
-    if (!header_in_ && (header_bytes_ += n) > max_header_bytes_) {
-      fault_ = HttpServer::RequestFault::kHeaderTooLarge;
-      return -1;
-    }
     if (header_in_ && body_left_ > 0) {
       body_left_ -= std::min<uint64_t>(body_left_, n);
       if (body_left_ == 0) deadline_.reset();
@@ -137,6 +167,7 @@ class ConnectionStream final : public httplib::Stream {
     do {
       n = ::send(sock_, ptr, size, MSG_NOSIGNAL);
     } while (n < 0 && errno == EINTR);
+    if (n > 0) written_ += static_cast<uint64_t>(n);
     return n;
   }
 
@@ -149,6 +180,28 @@ class ConnectionStream final : public httplib::Stream {
   socket_t socket() const override { return sock_; }
 
  private:
+  // Counts `n` header bytes at `p` against the limits; false (the fault set) when one is passed.
+  bool CountHeader(const char* p, size_t n) {
+    header_bytes_ += n;
+    for (size_t i = 0; i < n; ++i) {
+      if (p[i] != '\n') continue;
+      if (!line_in_) {
+        line_in_ = true;
+      } else {
+        ++header_lines_;  // the empty line that ends the header counts too: one spare
+      }
+    }
+    using Fault = HttpServer::RequestFault;
+    if (!line_in_ && header_bytes_ > limits_.max_request_line_bytes) {
+      fault_ = Fault::kRequestLineTooLong;
+    } else if (header_bytes_ > limits_.max_header_bytes) {
+      fault_ = Fault::kHeaderTooLarge;
+    } else if (header_lines_ > limits_.max_header_lines + 1) {
+      fault_ = Fault::kTooManyHeaderLines;
+    }
+    return fault_ == Fault::kNone;
+  }
+
   // Waits for `events` up to `timeout` (reads: no later than the deadline, which then counts
   // as the request's fault); false on timeout, a poll error or the server stopping.
   bool Wait(short events, Clock::duration timeout) const {
@@ -174,25 +227,39 @@ class ConnectionStream final : public httplib::Stream {
   const int sock_;
   const std::atomic<socket_t>& listener_;  // INVALID_SOCKET once the server stops
   const Clock::duration read_timeout_, write_timeout_;
-  const size_t max_header_bytes_;
+  const HttpLimits& limits_;
   std::array<char, 4096> buffer_{};
   size_t off_ = 0, len_ = 0;                   // the unread bytes of buffer_
   std::optional<Clock::time_point> deadline_;  // while a request is being read
   bool header_in_ = false;
-  size_t header_bytes_ = 0;  // of the request line and header read so far
-  uint64_t body_left_ = 0;   // Content-Length bytes still to read
+  bool line_in_ = false;        // the request line's end has been read
+  size_t header_bytes_ = 0;     // of the request line and header read so far
+  int header_lines_ = 0;        // header lines read so far
+  bool body_expected_ = false;  // the method takes a body: what is read after the header is one
+  uint64_t body_bytes_ = 0;     // body bytes read so far, as sent
+  uint64_t body_left_ = 0;      // Content-Length bytes still to read
+  uint64_t written_ = 0;        // bytes written since the request began
   mutable HttpServer::RequestFault fault_ = HttpServer::RequestFault::kNone;
 };
 
 thread_local const ConnectionStream* t_stream = nullptr;  // the connection this thread serves
 
 // Closes a connection after its last answer. What the client sent and the server did not read
-// (the rest of a refused request) is read and dropped first, up to 64 KiB, so that the close
-// sends FIN rather than a reset, which could discard the answer at the client.
-void Close(int sock) {
+// (the rest of a refused request) is read and dropped first, so that the close sends FIN rather
+// than a reset, which could discard the answer at the client: what is there already, up to
+// 64 KiB, or, after a refused request (`linger`), what comes within 250 ms, up to 4 MiB (a
+// client still streaming a body over the limit then reads its 413 before the reset).
+void Close(int sock, bool linger = false) {
   ::shutdown(sock, SHUT_WR);
   std::array<char, 4096> sink;
-  for (size_t drained = 0; drained < kMaxDrainBytes;) {
+  const size_t most = linger ? kMaxLingerBytes : kMaxDrainBytes;
+  const Clock::time_point until = Clock::now() + (linger ? kLinger : Clock::duration::zero());
+  for (size_t drained = 0; drained < most;) {
+    if (linger) {
+      const auto left = std::chrono::ceil<std::chrono::milliseconds>(until - Clock::now());
+      pollfd p{sock, POLLIN, 0};
+      if (left.count() <= 0 || ::poll(&p, 1, static_cast<int>(left.count())) <= 0) break;
+    }
     const ssize_t n = ::recv(sock, sink.data(), sink.size(), MSG_DONTWAIT);
     if (n <= 0) break;
     drained += static_cast<size_t>(n);
@@ -200,23 +267,56 @@ void Close(int sock) {
   ::close(sock);
 }
 
+// The reason phrase of the statuses this file sends itself.
+const char* ReasonPhrase(int status) {
+  switch (status) {
+    case 400:
+      return "Bad Request";
+    case 408:
+      return "Request Timeout";
+    case 413:
+      return "Payload Too Large";
+    case 414:
+      return "URI Too Long";
+    case 431:
+      return "Request Header Fields Too Large";
+    case 503:
+      return "Service Unavailable";
+    default:
+      return "Error";
+  }
+}
+
+// A whole answer written straight to the socket: `status` with {"error": message}, closing.
+void SendError(int sock, int status, const char* reason, const std::string& message,
+               const std::string& extra_headers = "") {
+  const std::string body = nlohmann::json{{"error", message}}.dump() + "\n";
+  const std::string reply =
+      "HTTP/1.1 " + std::to_string(status) + " " + reason +
+      "\r\nContent-Type: application/json\r\nContent-Length: " + std::to_string(body.size()) +
+      "\r\nConnection: close\r\n" + extra_headers + "\r\n" + body;
+  (void)::send(sock, reply.data(), reply.size(), MSG_NOSIGNAL | MSG_DONTWAIT);
+}
+
 // The 503 for a connection over the per-client limit, then closed.
 void Refuse(int sock, const std::string& address, int limit) {
-  const std::string body =
-      nlohmann::json{{"error", "connections: " + std::to_string(limit) + " are open from " +
-                                   address + " already (the limit per client address)"}}
-          .dump() +
-      "\n";
-  const std::string reply =
-      "HTTP/1.1 503 Service Unavailable\r\nContent-Type: application/json\r\nContent-Length: " +
-      std::to_string(body.size()) + "\r\nConnection: close\r\nRetry-After: 5\r\n\r\n" + body;
-  (void)::send(sock, reply.data(), reply.size(), MSG_NOSIGNAL | MSG_DONTWAIT);
+  SendError(sock, 503, ReasonPhrase(503),
+            "connections: " + std::to_string(limit) + " are open from " + address +
+                " already (the limit per client address)",
+            "Retry-After: 5\r\n");
   Close(sock);
+}
+
+std::string Seconds(std::chrono::milliseconds ms) {
+  return ms.count() % 1000 == 0 ? std::to_string(ms.count() / 1000) + " s"
+                                : std::to_string(ms.count()) + " ms";
 }
 
 }  // namespace
 
-HttpServer::HttpServer(HttpLimits limits) : limits_(limits) {}
+HttpServer::HttpServer(HttpLimits limits) : limits_(limits) {
+  set_payload_max_length(limits_.max_body_bytes);  // a Content-Length over it: 413 at once
+}
 
 HttpCounters HttpServer::counters() const {
   return {open_.load(), refused_.load(), timed_out_.load()};
@@ -224,6 +324,41 @@ HttpCounters HttpServer::counters() const {
 
 HttpServer::RequestFault HttpServer::CurrentFault() {
   return t_stream ? t_stream->fault() : RequestFault::kNone;
+}
+
+std::pair<int, std::string> HttpServer::FaultAnswer(RequestFault fault, const HttpLimits& limits) {
+  switch (fault) {
+    case RequestFault::kNone:
+      break;
+    case RequestFault::kTimedOut:
+      return {408, "request: not received whole within " + Seconds(limits.request_deadline) +
+                       " of its first byte"};
+    case RequestFault::kRequestLineTooLong:
+      return {414, "request line: longer than " + std::to_string(limits.max_request_line_bytes) +
+                       " bytes"};
+    case RequestFault::kHeaderTooLarge:
+      return {431, "header: larger than " + std::to_string(limits.max_header_bytes) + " bytes"};
+    case RequestFault::kTooManyHeaderLines:
+      return {431, "header: more than " + std::to_string(limits.max_header_lines) + " fields"};
+    case RequestFault::kBodyTooLarge:
+      return {413, "body: larger than " + std::to_string(limits.max_body_bytes) + " bytes"};
+    case RequestFault::kAmbiguousFraming:
+      return {400, "header: where the body ends is ambiguous"};
+  }
+  return {500, "request: no fault"};
+}
+
+std::string HttpServer::AmbiguousFraming(const httplib::Request& req) {
+  const size_t lengths = req.get_header_value_count("Content-Length");
+  const size_t encodings = req.get_header_value_count("Transfer-Encoding");
+  if (lengths > 1) return "Content-Length: given " + std::to_string(lengths) + " times";
+  if (encodings > 1) return "Transfer-Encoding: given " + std::to_string(encodings) + " times";
+  if (encodings == 1) {
+    if (strcasecmp(req.get_header_value("Transfer-Encoding").c_str(), "chunked") != 0)
+      return "Transfer-Encoding: only chunked is taken";
+    if (lengths == 1) return "Content-Length: given with Transfer-Encoding";
+  }
+  return "";
 }
 
 bool HttpServer::Admit(const std::string& address) {
@@ -261,9 +396,10 @@ bool HttpServer::process_and_close_socket(socket_t sock) {
       sock, svr_sock_,
       std::chrono::seconds(read_timeout_sec_) + std::chrono::microseconds(read_timeout_usec_),
       std::chrono::seconds(write_timeout_sec_) + std::chrono::microseconds(write_timeout_usec_),
-      limits_.max_header_bytes);
+      limits_);
   t_stream = &stream;
   bool ret = false;
+  bool refused = false;  // the last request broke a limit: the connection closes after its answer
   // cpp-httplib's keep-alive loop (detail::process_server_socket_core), with the deadline.
   for (size_t left = keep_alive_max_count_; left > 0 && svr_sock_ != INVALID_SOCKET; --left) {
     if (!stream.WaitForRequest(std::chrono::seconds(keep_alive_timeout_sec_))) break;
@@ -272,17 +408,19 @@ bool HttpServer::process_and_close_socket(socket_t sock) {
     ret = process_request(stream, left == 1, connection_closed,
                           [&stream](httplib::Request& req) { stream.HeaderIn(req); });
     if (stream.fault() != RequestFault::kNone) {
+      refused = true;
       if (stream.fault() == RequestFault::kTimedOut) ++timed_out_;
-      Log("station.control")
-          ->debug("{}:{}: closed, its request {}", address, port,
-                  stream.fault() == RequestFault::kTimedOut ? "was not in whole by the deadline"
-                                                            : "header was too large");
+      const auto [status, message] = FaultAnswer(stream.fault(), limits_);
+      // Refused before its request line was read whole, the request got no answer from
+      // cpp-httplib: it gets its own here.
+      if (stream.written() == 0) SendError(sock, status, ReasonPhrase(status), message);
+      Log("station.control")->debug("{}:{}: closed, {} ({})", address, port, message, status);
       break;
     }
     if (!ret || connection_closed) break;
   }
   t_stream = nullptr;
-  Close(sock);
+  Close(sock, refused);
   Release(address);
   return ret;
 }

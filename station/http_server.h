@@ -11,8 +11,19 @@
 //    request is in, the deadline no longer applies: an event stream or a download takes as long
 //    as it needs (the write timeout still drops a reader that stalls). Between requests of a
 //    keep-alive connection the keep-alive timeout applies, as before;
-//  - the request line and header together at most `max_header_bytes` (cpp-httplib limits each
-//    line, not their number), else 431 and the connection is closed.
+//  - the request line at most `max_request_line_bytes` (else 414), the request line and header
+//    together at most `max_header_bytes` in at most `max_header_lines` lines (cpp-httplib
+//    limits each line, not their number; else 431); either way the connection is closed;
+//  - a body at most `max_body_bytes` as sent, however it is framed (Content-Length, chunked,
+//    multipart, or read until the client closes): counted while it is read, and the read
+//    fails the byte it passes the limit (a declared Content-Length over it at once), so the
+//    answer is a 413 and the connection is closed; cpp-httplib 0.11 checks a Content-Length
+//    only, and reads a chunked body whole into memory, however large;
+//  - a request whose framing is ambiguous (Content-Length twice, or with Transfer-Encoding; a
+//    Transfer-Encoding other than chunked) is answered 400 and the connection closed, since
+//    where its body ends cannot be known (request smuggling).
+// A request refused before cpp-httplib could read its request line (too long, or not in by
+// the deadline) gets its answer here, as a JSON error; cpp-httplib would send none.
 // It replaces the server's connection loop (Server::process_and_close_socket, the one virtual
 // step between accept and the request; the base's is private, so it cannot be wrapped): its
 // own keep-alive loop over its own Stream, which reads under the deadline, and cpp-httplib's
@@ -26,6 +37,7 @@
 #include <mutex>
 #include <string>
 #include <unordered_map>
+#include <utility>
 
 #include <httplib.h>
 
@@ -34,7 +46,10 @@ namespace ss {
 struct HttpLimits {
   int max_connections_per_client = 64;                 // open at once from one address
   std::chrono::milliseconds request_deadline{10'000};  // first byte of a request -> all of it read
-  size_t max_header_bytes = 64 << 10;                  // request line and header together
+  size_t max_request_line_bytes = 8 << 10;  // "GET /path?query HTTP/1.1" (cpp-httplib's URI limit)
+  size_t max_header_bytes = 64 << 10;       // request line and header together
+  int max_header_lines = 100;               // header fields, the request line aside
+  size_t max_body_bytes = 1 << 20;          // as sent: chunk framing counts
 };
 
 struct HttpCounters {
@@ -52,8 +67,21 @@ class HttpServer : public httplib::Server {
 
   // Why the request served on the calling thread could not be read whole, for the error
   // handler to name the limit (cpp-httplib answers any header cut short with a bare 400).
-  enum class RequestFault { kNone, kTimedOut, kHeaderTooLarge };
+  enum class RequestFault {
+    kNone,
+    kTimedOut,
+    kRequestLineTooLong,
+    kHeaderTooLarge,
+    kTooManyHeaderLines,
+    kBodyTooLarge,
+    kAmbiguousFraming,
+  };
   static RequestFault CurrentFault();
+  // The answer to a request with `fault`: its status and the error's text, naming the limit.
+  static std::pair<int, std::string> FaultAnswer(RequestFault fault, const HttpLimits& limits);
+  // Why the framing of `req`'s body cannot be trusted ("" when it can): Content-Length given
+  // twice or beside Transfer-Encoding, or a Transfer-Encoding other than chunked.
+  static std::string AmbiguousFraming(const httplib::Request& req);
 
  private:
   bool process_and_close_socket(socket_t sock) override;

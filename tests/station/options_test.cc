@@ -63,9 +63,11 @@ TEST(StationOptions, ControlServerAndLabels) {
   ControlServerOptions c;
   c.config.port = 70000;
   c.max_event_streams = -1;
+  c.http_threads = 0;
   const std::string why = Problems(c);
   EXPECT_TRUE(Names(why, "config.port")) << why;
   EXPECT_TRUE(Names(why, "max_event_streams")) << why;
+  EXPECT_TRUE(Names(why, "http_threads")) << why;
 
   ConsoleLabelsOptions l;
   l.candidate_rows = 0;
