@@ -1,0 +1,94 @@
+// The control server's HTTP surface (station/http_server.h, station/control_server.h): the bytes
+// are what one client sends on one connection (request lines, headers, bodies, more requests
+// behind them), sent over loopback to a ControlServer of this process with every route of the
+// API and the console behind it (no station runs: a route that needs one answers 500 after
+// every check before it). The connection must end within its deadline, and every answer must
+// be an HTTP/1.1 status line with a JSON error or a page, never a file outside the pages.
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <poll.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdlib>
+#include <memory>
+#include <string>
+
+#include "core/log.h"
+#include "station/control_server.h"
+#include "station/station_host.h"
+#include "tests/fuzz/fuzz_support.h"
+#include "web/web_files.h"
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// The server, started once per process and never stopped (its threads outlive the inputs).
+int Port() {
+  static const int port = [] {
+    ss::SetLogLevel("off");
+    auto* host = new ss::StationHost(ss::StationOptions{}, {});
+    ss::ControlServerOptions options;
+    options.config.address = "127.0.0.1";
+    options.config.port = 0;
+    options.embedded = ss::FindEmbeddedWebFile;
+    options.http_threads = 4;
+    auto* server = new ss::ControlServer(*host, options);
+    return server->Start();
+  }();
+  return port;
+}
+
+}  // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+  const int port = Port();
+  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in server{};
+  server.sin_family = AF_INET;
+  server.sin_port = htons(static_cast<uint16_t>(port));
+  server.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  if (fd < 0 || ::connect(fd, reinterpret_cast<sockaddr*>(&server), sizeof server) != 0) {
+    std::fprintf(stderr, "http_request: cannot connect to the server\n");
+    std::abort();
+  }
+  // Send it all (the server may close early: a refused request), then say that is all.
+  for (size_t sent = 0; sent < size;) {
+    const ssize_t n = ::send(fd, data + sent, size - sent, MSG_NOSIGNAL);
+    if (n <= 0) break;
+    sent += static_cast<size_t>(n);
+  }
+  ::shutdown(fd, SHUT_WR);
+  // Everything the server answers, until it closes: within the request deadline (10 s) and
+  // then some; never a connection left open.
+  std::string answer;
+  const auto deadline = Clock::now() + std::chrono::seconds(12);
+  bool closed = false;
+  while (!closed && Clock::now() < deadline) {
+    pollfd p{fd, POLLIN, 0};
+    if (::poll(&p, 1, 100) <= 0) continue;
+    char buf[16384];
+    const ssize_t n = ::recv(fd, buf, sizeof buf, 0);
+    if (n <= 0) {
+      closed = true;
+    } else if (answer.size() < (4u << 20)) {
+      answer.append(buf, static_cast<size_t>(n));
+    }
+  }
+  ::close(fd);
+  if (!closed) {
+    std::fprintf(stderr, "http_request: the server kept the connection open past 12 s\n");
+    std::abort();
+  }
+  if (!answer.empty() && answer.rfind("HTTP/1.1 ", 0) != 0) {
+    std::fprintf(stderr, "http_request: an answer that is not HTTP/1.1: %.80s\n", answer.c_str());
+    std::abort();
+  }
+  if (answer.find("root:x:0:0") != std::string::npos) {
+    std::fprintf(stderr, "http_request: /etc/passwd was served\n");
+    std::abort();
+  }
+  return 0;
+}
