@@ -51,6 +51,7 @@ class BackgroundCommand {
   // Waits for the exit: the exit code, 128 + signal when killed, -1 on timeout.
   int Wait(double timeout_s);
   bool running();
+  int pid() const { return pid_; }
 
  private:
   int pid_ = -1;
