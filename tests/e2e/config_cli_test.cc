@@ -18,6 +18,29 @@ const std::string kExample = fs::path(ss::testing::SourcePath("docs/station.exam
 const std::string kOneCamera =
     "cameras:\n  - name: cam0\n    source: v4l2\n    device: /dev/video0\n";
 
+// docs/station.replay.yaml, the config `scripts/demo.sh --station` runs, is valid as written, and
+// with its files there (a copy of it beside a sample session, as in the repository: the paths
+// are relative to the file) its cameras and session check out.
+TEST(StationConfig, TheDemoStationConfigIsValid) {
+  if (!Environment("SPRITESTATION_BIN"))
+    GTEST_SKIP() << "SPRITESTATION_BIN not set (run through ctest)";
+  const std::string config = ss::testing::SourcePath("docs/station.replay.yaml");
+  auto r = ss::testing::RunSpritestation("config check --no-file-checks " + config);
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find(": valid (2 cameras)"), std::string::npos) << r.output;
+
+  ScratchDir dir;
+  fs::create_directories(dir.path() / "docs");
+  fs::copy_file(config, dir / "docs/station.replay.yaml");
+  r = ss::testing::RunSpritestation("synth --out " + (dir / "recordings/sample") +
+                                    " --kind animal --seconds 1 --fps 10 --size 160x120 "
+                                    "--cameras 2 --subjects 1 --seed 7");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  r = ss::testing::RunSpritestation("config check " + (dir / "docs/station.replay.yaml"));
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find(": valid (2 cameras)"), std::string::npos) << r.output;
+}
+
 // `spritestation config check`: exit codes and messages of the real executable.
 TEST(StationConfig, CheckCommand) {
   if (!Environment("SPRITESTATION_BIN"))
