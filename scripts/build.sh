@@ -1,5 +1,7 @@
 #!/usr/bin/env bash
-# Configures and builds SpriteStation into build/ (or $SPRITESTATION_BUILD_DIR).
+# Configures and builds SpriteStation into build/ (or $SPRITESTATION_BUILD_DIR); prints the build
+# folder on stdout, last, and everything else (ninja's [n/N] progress) on stderr.
+#   scripts/build.sh [TARGET...]       only those targets (the demo: spritestation), else all
 #   SPRITESTATION_SANITIZE=asan|tsan   build with sanitizers into build-asan/ or build-tsan/
 set -euo pipefail
 top="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -26,7 +28,11 @@ debug="-g1"
 if [ ! -f "$build/CMakeCache.txt" ]; then
   cmake -S "$top" -B "$build" "${generator[@]}" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
     "-DCMAKE_C_FLAGS_RELWITHDEBINFO=-O2 $debug -DNDEBUG" "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O2 $debug -DNDEBUG" \
-    "${extra[@]}"
+    "${extra[@]}" >&2
 fi
-cmake --build "$build" -j "$(nproc)"
+targets=()
+for t in "$@"; do targets+=(--target "$t"); done
+start=$SECONDS
+cmake --build "$build" -j "$(nproc)" "${targets[@]}" >&2
+echo "build.sh: built ${*:-everything} in $((SECONDS - start)) s" >&2
 echo "$build"

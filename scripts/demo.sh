@@ -1,36 +1,103 @@
 #!/usr/bin/env bash
-# The README's main command: installs what is missing, builds, and runs the main
-# job on the sample session (recordings/sample, rendered by `spritestation synth`
-# the first time), printing what each stage did.
+# The README's main command: installs what building and running need, builds the executable,
+# and runs the main job on the sample session (recordings/sample, rendered by `spritestation
+# synth` the first time), printing each stage and how long it took.
+#   scripts/demo.sh             the offline job: ingest, transitions, animate, render
+#   scripts/demo.sh --station   the live station instead: the daemon in test mode on the sample
+#                               (docs/station.replay.yaml), its console in the browser; Ctrl-C stops
 set -euo pipefail
 top="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-"$top/scripts/install-deps.sh"
-build="$("$top/scripts/build.sh" | tail -n 1)"
+mode=offline
+case "${1:-}" in
+  --station) mode=station ;;
+  "") ;;
+  *) echo "demo.sh: usage: scripts/demo.sh [--station]" >&2; exit 2 ;;
+esac
+
+t0=$SECONDS
+stage_start=$SECONDS
+stage_name=""
+# Ends the stage in progress (its time) and starts the next: `stage NAME "what it does"`.
+stage() {
+  if [ -n "$stage_name" ]; then
+    echo "   ($stage_name took $((SECONDS - stage_start)) s)"
+  fi
+  stage_name="$1"
+  stage_start=$SECONDS
+  echo "== [$((SECONDS - t0)) s] $2"
+}
+
+stage install "installing what building and running need (scripts/install-deps.sh --run)"
+"$top/scripts/install-deps.sh" --run
+stage build "building the executable (scripts/build.sh spritestation)"
+build="$("$top/scripts/build.sh" spritestation)"
 ss="$build/apps/spritestation"
 sample="$top/recordings/sample"
 out="$top/recordings/demo-output"
 mkdir -p "$out"
 
 if [ ! -f "$sample/session.json" ]; then
-  echo "== no recorded sample: rendering a synthetic one into $sample"
+  stage synth "rendering a synthetic sample session into $sample (no camera needed)"
   rm -rf "$sample"
   "$ss" synth --out "$sample" --kind animal --seconds 10 --fps 30 --size 640x480 --cameras 2 --subjects 1 --seed 7
 fi
 
-echo "== replaying $sample"
+if [ "$mode" = station ]; then
+  config="$top/docs/station.replay.yaml"
+  stage station "starting the station on the sample session ($config)"
+  log="$out/station.log"
+  "$ss" daemon --config "$config" >"$log" 2>&1 &
+  daemon=$!
+  stop() {
+    trap - INT TERM
+    echo
+    stage stop "stopping the station (any running session is stored)"
+    kill -INT "$daemon" 2>/dev/null || true
+    wait "$daemon" || true
+    if [ -f "$out/station.bank" ]; then
+      "$ss" bank verify "$out/station.bank" && "$ss" bank info "$out/station.bank"
+    fi
+    stage done "done (log: $log)"
+    exit 0
+  }
+  trap stop INT TERM
+  for _ in $(seq 1 300); do
+    grep -q "daemon: control API on" "$log" 2>/dev/null && break
+    kill -0 "$daemon" 2>/dev/null || { cat "$log" >&2; echo "demo.sh: the station did not start" >&2; exit 1; }
+    sleep 0.1
+  done
+  url="$(grep -o 'http://[^ ]*' "$log" | head -1)/"
+  cat <<EOF
+
+   The station runs, its two sample cameras replayed as if live. Open the console:
+
+       $url
+
+   Try: Start a session (the station page), watch sprites arrive in the bank;
+        the Bank page (${url}bank.html) to browse clips and tag frames;
+        the Labelling page (${url}label.html) and Calibration (${url}calibrate.html).
+   Scripts use the same port: curl -s ${url}api/status
+   Ctrl-C stops the station: a running session is stored and the bank verified.
+
+EOF
+  wait "$daemon"
+  exit $?
+fi
+
+stage replay "replaying $sample"
 "$ss" replay "$sample"
 
-echo "== ingesting $sample into $out/sample.bank (the live pipeline, as fast as it runs)"
+stage ingest "ingesting $sample into $out/sample.bank (the live pipeline, as fast as it runs)"
 "$ss" ingest "$sample" --bank "$out/sample.bank"
 "$ss" bank info "$out/sample.bank"
 
-echo "== finding the bank's transitions (seed 000 §3)"
+stage transitions "finding the bank's transitions (seed 000 §3)"
 "$ss" transitions "$out/sample.bank"
 
-echo "== the empty enclosure cam0 saw before the animal came in: the render's background"
+stage plate "the empty enclosure cam0 saw before the animal came in: the render's background"
 "$ss" plate "$sample" --camera cam0 --out "$out/plate.png"
 
-echo "== animating: one sprite walks a straight path across the floor (seed 000 §4-5)"
+stage animate "animating: one sprite walks a straight path across the floor (seed 000 §4-5)"
 cat > "$out/walk.yaml" <<EOF
 version: 1
 frame_rate: 30
@@ -49,6 +116,6 @@ sprites:
 EOF
 "$ss" animate "$out/walk.yaml" --out "$out/walk.json"
 
-echo "== rendering the animation into the enclosure, with its contact shadow"
+stage render "rendering the animation into the enclosure, with its contact shadow"
 "$ss" render "$out/walk.json" --out "$out/walk.mkv"
-echo "== done: the animation is $out/walk.mkv (cost plot: $out/walk.cost.png)"
+stage done "done: the animation is $out/walk.mkv (cost plot: $out/walk.cost.png); $((SECONDS - t0)) s in all"

@@ -5,5 +5,5 @@
 #   scripts/soak.sh [MINUTES]
 set -euo pipefail
 top="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-build="$("$top/scripts/build.sh" | tail -n 1)"
+build="$("$top/scripts/build.sh")"
 SPRITESTATION="$build/apps/spritestation" exec node "$top/bench/soak/soak.mjs" "${1:-30}"

@@ -5,7 +5,7 @@
 set -euo pipefail
 top="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 "$top/scripts/install-deps.sh"
-build="$("$top/scripts/build.sh" | tail -n 1)"
+build="$("$top/scripts/build.sh")"
 if [ $# -gt 0 ]; then
   (cd "$build" && ctest --output-on-failure --timeout 300 -j "$(nproc)" "$@")
   exit
