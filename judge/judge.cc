@@ -288,6 +288,7 @@ Judgement JudgeSequences(const SequenceFile& file, const std::vector<std::string
     }
   }
   std::vector<std::unique_ptr<Bank>> banks;
+  banks.reserve(bank_paths.size());
   for (const std::string& path : bank_paths) banks.push_back(std::make_unique<Bank>(path));
 
   Judgement out;

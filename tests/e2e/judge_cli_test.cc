@@ -1,13 +1,13 @@
 // `spritestation judge` end to end: sequences `animate` made over the walker bank
 // (tests/animate/scene_fixture.h) judged with and without their spec, the same figures as the
 // ones `animate` printed, and bad input refused with exit code 2.
-#include <cstdlib>
 #include <string>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
 #include "animate/sequence_io.h"
+#include "core/posix.h"
 #include "tests/animate/scene_fixture.h"
 #include "tests/support/test_support.h"
 
@@ -29,9 +29,9 @@ sprites:
   // Animated from the spec's folder with relative names: the file names its bank absolute,
   // so the judge finds it from anywhere.
   const std::string seq = dir_ / "seq.json";
-  const char* bin = std::getenv("SPRITESTATION_BIN");
   const auto animate = testing::RunCommand(
-      "cd " + dir_.path().string() + " && " + (bin ? bin : "spritestation") +
+      "cd " + dir_.path().string() + " && " +
+      Environment("SPRITESTATION_BIN").value_or("spritestation") +
       " --log-level off animate scene.yaml --out seq.json --json --time-budget 1");
   ASSERT_EQ(animate.exit_code, 0) << animate.output;
   const nlohmann::json from_animate = nlohmann::json::parse(animate.output)["judge"];

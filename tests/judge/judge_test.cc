@@ -144,8 +144,8 @@ AnimationSpec ColumnSpec(const std::string& bank) {
 
 TEST_F(JudgeTest, ConstraintOutcomesOfAPathSweptHalfway) {
   // "a" walks A0..A9 from x = 0 to 0.45 m, 2 cm off the line: half the 0.9 m path.
-  std::vector<double> x;
-  for (int t = 0; t < 10; ++t) x.push_back(0.05 * t);
+  std::vector<double> x(10);
+  for (int t = 0; t < 10; ++t) x[t] = 0.05 * t;
   file_.sprites = {
       Sequence("a", A({0, 1, 2, 3, 4, 5, 6, 7, 8, 9}), x, 0.02),
       Sequence("b", C({0, 1, 2, 3, 4, 5, 6, 7, 8, 9}), std::vector<double>(10, 0.25), 0.1)};
