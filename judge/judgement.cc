@@ -1,5 +1,7 @@
 #include "judge/judgement.h"
 
+#include <algorithm>
+#include <cstddef>
 #include <cstdio>
 
 namespace ss {
@@ -145,6 +147,21 @@ std::string JudgementReport(const Judgement& j) {
         "max %s x an ordinary frame step\n",
         v.transitions, v.unmeasured, Figure(v.median).c_str(), Figure(v.p95).c_str(),
         Figure(v.max).c_str());
+    // The most visible ones, to look at first.
+    std::vector<const TransitionJump*> worst;
+    for (const TransitionJump& t : v.each) {
+      if (t.jump) worst.push_back(&t);
+    }
+    const size_t shown = std::min<size_t>(3, worst.size());
+    std::partial_sort(
+        worst.begin(), worst.begin() + static_cast<std::ptrdiff_t>(shown), worst.end(),
+        [](const TransitionJump* a, const TransitionJump* b) { return *a->jump > *b->jump; });
+    for (size_t k = 0; k < shown; ++k) {
+      const TransitionJump& t = *worst[k];
+      add("              %.2f: %s step %d shows sprite %lld for %lld (after %lld)\n", *t.jump,
+          t.sprite.c_str(), t.step, static_cast<long long>(t.to.sprite_id),
+          static_cast<long long>(*t.natural), static_cast<long long>(t.from.sprite_id));
+    }
   }
   return out;
 }
