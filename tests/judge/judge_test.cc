@@ -101,6 +101,12 @@ TEST_F(JudgeTest, JumpsAreMeasuredAgainstTheNaturalSuccessor) {
   EXPECT_DOUBLE_EQ(*j.jumps.p95, 9.5);
   EXPECT_DOUBLE_EQ(*j.jumps.max, 10.0);
   EXPECT_EQ(j.jumps.median_step_px, std::vector<double>{30.0});
+  // The report names the most visible first.
+  const std::string report = JudgementReport(j);
+  EXPECT_NE(report.find("10.00: a step 7 shows sprite " + std::to_string(ids_.b[5]) + " for " +
+                        std::to_string(ids_.c[5])),
+            std::string::npos)
+      << report;
 }
 
 TEST_F(JudgeTest, ASequenceOfOneClipHasNoTransitions) {
