@@ -35,6 +35,10 @@ class LocationTerm : public StepSumTerm {
   void AddStartNormalEquations(Tracks tracks, int sprite, double* weight,
                                Eigen::Vector2d* weighted_target) const override;
   const StepWindow& window() const { return window_; }
+  const LocationTarget& target() const { return target_; }
+  // The steps [begin, end) of the window for these tracks (a formation's counts from the
+  // longer sequence's end).
+  std::pair<int, int> Window(Tracks tracks) const { return Steps(tracks, EvalRequest{}); }
 
  protected:
   std::pair<int, int> Steps(Tracks tracks, const EvalRequest& request) const override;

@@ -249,7 +249,9 @@ bool SpecReader::ExistingFile(const YAML::Node& node, const std::string& path, s
     msg_.Error(path, "no such file: " + file + (ec ? " (" + ec.message() + ")" : ""));
     return false;
   }
-  out = file;
+  // Absolute: the sequences file names these, and is read from anywhere (render, judge).
+  out = fs::absolute(file, ec).lexically_normal().string();
+  if (ec) out = file;
   return true;
 }
 

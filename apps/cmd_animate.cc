@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -15,6 +16,7 @@
 #include "animate/spec.h"
 #include "apps/commands.h"
 #include "core/log.h"
+#include "judge/judge.h"
 
 namespace ss::apps {
 namespace {
@@ -29,6 +31,7 @@ struct AnimateArgs {
   int threads = 0;
   double snapshot_every_s = -1;
   bool json = false;
+  bool no_judge = false;
 };
 
 void Run(const AnimateArgs& args) {
@@ -52,7 +55,16 @@ void Run(const AnimateArgs& args) {
                        scene->graph().num_edges(), scene->problem().num_terms(), method,
                        o.replacement.time_budget_seconds);
   const AnimateResult result = RunAnimation(*scene, options);
-  WriteSequenceFile(args.out, MakeSequenceFile(*scene, result));
+  SequenceFile file = MakeSequenceFile(*scene, result);
+  // What a viewer sees (judge/judge.h), kept in the file's summary beside the costs.
+  std::optional<Judgement> judgement;
+  if (!args.no_judge) {
+    judgement = JudgeSequences(file, file.bank_paths, scene.get());
+    nlohmann::json j = JudgementJson(*judgement);
+    j["jumps"].erase("each");
+    file.summary["judge"] = std::move(j);
+  }
+  WriteSequenceFile(args.out, file);
 
   std::string plot = args.plot;
   if (plot.empty()) plot = std::filesystem::path(args.out).replace_extension(".cost.png").string();
@@ -64,6 +76,7 @@ void Run(const AnimateArgs& args) {
     j["sequences"] = args.out;
     j["plot"] = plot;
     j.erase("trace");
+    if (judgement) j["judge"] = file.summary["judge"];
     std::printf("%s\n", j.dump(2).c_str());
     return;
   }
@@ -78,6 +91,7 @@ void Run(const AnimateArgs& args) {
               f.colliding_pairs, f.min_distance_m);
   std::printf("  frames off tag     %d of %d steps\n", f.frame_steps_off, f.frame_steps);
   std::printf("  sequences          %s\n  cost plot          %s\n", args.out.c_str(), plot.c_str());
+  if (judgement) std::printf("%s", JudgementReport(*judgement).c_str());
 }
 
 }  // namespace
@@ -103,6 +117,8 @@ void AddAnimateCommand(CLI::App& app) {
       ->check(CLI::NonNegativeNumber);
   cmd->add_option("--plot", args->plot, "Cost-versus-time PNG (default: OUT with .cost.png)");
   cmd->add_flag("--json", args->json, "Print the summary as JSON");
+  cmd->add_flag("--no-judge", args->no_judge,
+                "Leave out the judge's figures (stutter, visible jumps: reads billboards)");
   cmd->callback([args] { Run(*args); });
 }
 

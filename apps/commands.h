@@ -15,6 +15,7 @@ void AddIngestCommand(CLI::App& app);
 void AddConfigCommand(CLI::App& app);
 void AddAnimateCommand(CLI::App& app);
 void AddRenderCommand(CLI::App& app);
+void AddJudgeCommand(CLI::App& app);
 void AddFakecamCommand(CLI::App& app);
 void AddCamerasCommand(CLI::App& app);
 void AddSkeletonCommand(CLI::App& app);

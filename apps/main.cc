@@ -29,6 +29,7 @@ int Run(int argc, char** argv) {
   ss::apps::AddConfigCommand(app);
   ss::apps::AddAnimateCommand(app);
   ss::apps::AddRenderCommand(app);
+  ss::apps::AddJudgeCommand(app);
   ss::apps::AddFakecamCommand(app);
   ss::apps::AddCamerasCommand(app);
   ss::apps::AddSkeletonCommand(app);

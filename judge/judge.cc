@@ -1,0 +1,314 @@
+#include "judge/judge.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <map>
+#include <memory>
+#include <set>
+#include <utility>
+
+#include "animate/basic_costs.h"
+#include "animate/collision_cost.h"
+#include "animate/location_cost.h"
+#include "animate/path_cost.h"
+#include "core/bank.h"
+#include "core/error.h"
+#include "core/option_checks.h"
+
+namespace ss {
+namespace {
+
+double PointSegmentDistance(const Eigen::Vector2d& p, const Eigen::Vector2d& a,
+                            const Eigen::Vector2d& b) {
+  const Eigen::Vector2d ab = b - a;
+  const double s = std::clamp((p - a).dot(ab) / ab.squaredNorm(), 0.0, 1.0);
+  return (a + s * ab - p).norm();
+}
+
+double PolylineDistance(const Polyline& path, const Eigen::Vector2d& p) {
+  double best = std::numeric_limits<double>::infinity();
+  for (size_t i = 0; i + 1 < path.points().size(); ++i) {
+    best = std::min(best, PointSegmentDistance(p, path.points()[i], path.points()[i + 1]));
+  }
+  return best;
+}
+
+std::string Point(const Eigen::Vector2d& p) {
+  char text[64];
+  std::snprintf(text, sizeof text, "[%.3f, %.3f]", p.x(), p.y());
+  return text;
+}
+
+// The file's sequences as tracks of the scene's graph, at the file's positions.
+std::vector<Track> FileTracks(const SequenceFile& file, const Scene& scene) {
+  const BankGraph& bank = scene.bank();
+  std::map<std::pair<int, int64_t>, int> frame_of;
+  for (size_t i = 0; i < bank.frames.size(); ++i) {
+    frame_of[{bank.frames[i].bank, bank.frames[i].sprite_id}] = static_cast<int>(i);
+  }
+  std::vector<Track> tracks;
+  for (size_t s = 0; s < file.sprites.size(); ++s) {
+    const SpriteSequence& seq = file.sprites[s];
+    Track track;
+    for (size_t t = 0; t < seq.frames.size(); ++t) {
+      const auto it = frame_of.find({seq.frames[t].bank, seq.frames[t].sprite_id});
+      if (it == frame_of.end()) {
+        throw InputError("sequences",
+                         "sprites[" + std::to_string(s) + "].steps[" + std::to_string(t) +
+                             "]: bank " + std::to_string(seq.frames[t].bank) + " has no sprite " +
+                             std::to_string(seq.frames[t].sprite_id) + " in a complete clip");
+      }
+      track.frames.push_back(it->second);
+      track.positions_m.push_back(seq.positions_m[t]);
+      track.velocities_m.push_back(scene.graph().velocity_m(it->second));
+    }
+    UpdateChunkBoxes(&track);
+    tracks.push_back(std::move(track));
+  }
+  return tracks;
+}
+
+PathOutcome JudgePath(const PathTerm& term, const Track& track) {
+  const Polyline& path = term.path();
+  PathOutcome out;
+  out.length_m = path.length();
+  int segment = 0;
+  double reached = 0.0;
+  std::vector<double> deviations;
+  for (int t = 0; t < track.size(); ++t) {
+    const Eigen::Vector2d& p = track.positions_m[t];
+    segment = path.Advance(segment, p);
+    reached = std::max(reached, out.length_m - path.Remaining(segment, p));
+    deviations.push_back(PolylineDistance(path, p));
+    if (segment == path.num_segments()) {
+      out.finished_step = t;
+      break;
+    }
+  }
+  out.swept_share = out.length_m > 0 ? std::clamp(reached / out.length_m, 0.0, 1.0) : 1.0;
+  if (!deviations.empty()) {
+    out.max_deviation_m = *std::max_element(deviations.begin(), deviations.end());
+    out.median_deviation_m = *Quantile(deviations, 0.5);
+  }
+  return out;
+}
+
+LocationOutcome JudgeLocation(const LocationTerm& term, Tracks view, const Track& track) {
+  LocationOutcome out;
+  std::tie(out.first_step, out.end_step) = term.Window(view);
+  std::vector<double> distances;
+  for (int t = out.first_step; t < out.end_step; ++t) {
+    distances.push_back((track.PositionAt(t) - term.TargetAt(view, t)).norm());
+  }
+  if (!distances.empty()) {
+    out.first_m = distances.front();
+    out.last_m = distances.back();
+    out.min_m = *std::min_element(distances.begin(), distances.end());
+    out.max_m = *std::max_element(distances.begin(), distances.end());
+    out.median_m = *Quantile(distances, 0.5);
+  }
+  return out;
+}
+
+CollisionOutcome JudgeCollision(const CollisionTerm& term, Tracks view) {
+  CollisionOutcome out;
+  out.min_distance_m = term.min_distance_m();
+  const Track& a = *view[term.sprites()[0]];
+  const Track& b = *view[term.sprites()[1]];
+  out.closest_m = std::numeric_limits<double>::infinity();
+  for (int t = 0; t < std::max(a.size(), b.size()); ++t) {
+    const double d = (a.PositionAt(t) - b.PositionAt(t)).norm();
+    if (d < out.closest_m) {
+      out.closest_m = d;
+      out.closest_step = t;
+    }
+  }
+  out.steps_closer = term.CountViolations(view);
+  return out;
+}
+
+void JudgeConstraints(const SequenceFile& file, const Scene& scene, Judgement* out) {
+  const AnimationSpec& spec = scene.spec();
+  if (spec.sprites.size() != file.sprites.size()) {
+    throw InputError(spec.path, "sprites: the spec names " + std::to_string(spec.sprites.size()) +
+                                    " sprites, the sequences hold " +
+                                    std::to_string(file.sprites.size()));
+  }
+  for (size_t s = 0; s < spec.sprites.size(); ++s) {
+    if (spec.sprites[s].name != file.sprites[s].name) {
+      throw InputError(spec.path, "sprites[" + std::to_string(s) + "].name: '" +
+                                      spec.sprites[s].name + "', the sequences' is '" +
+                                      file.sprites[s].name + "'");
+    }
+    const std::optional<LengthSpec>& length =
+        spec.sprites[s].length ? spec.sprites[s].length : spec.length;
+    if (length) out->lengths[s].min_frames = length->min_frames;
+    if (spec.fixed_frames > 0) out->lengths[s].min_frames = spec.fixed_frames;
+  }
+  const std::vector<Track> tracks = FileTracks(file, scene);
+  const std::vector<const Track*> view = TrackPointers(tracks);
+  const Problem& problem = scene.problem();
+  std::vector<size_t> locations_seen(tracks.size(), 0), frames_seen(tracks.size(), 0);
+  for (int k = 0; k < problem.num_terms(); ++k) {
+    const CostTerm& term = problem.term(k);
+    const int s = term.sprites()[0];
+    const SpriteSpecEntry& entry = spec.sprites[s];
+    if (const auto* path = dynamic_cast<const PathTerm*>(&term)) {
+      PathOutcome o = JudgePath(*path, tracks[s]);
+      o.sprite = entry.name;
+      o.field = entry.path->place.field;
+      out->paths.push_back(std::move(o));
+    } else if (const auto* location = dynamic_cast<const LocationTerm*>(&term)) {
+      LocationOutcome o = JudgeLocation(*location, view, tracks[s]);
+      const LocationSpec& l = entry.locations.at(locations_seen[s]++);
+      o.sprite = entry.name;
+      o.field = l.place.field;
+      o.target =
+          l.follow.empty() ? Point(l.target_m) : "follow " + l.follow + " + " + Point(l.target_m);
+      out->locations.push_back(std::move(o));
+    } else if (const auto* collision = dynamic_cast<const CollisionTerm*>(&term)) {
+      CollisionOutcome o = JudgeCollision(*collision, view);
+      o.a = entry.name;
+      o.b = spec.sprites[collision->sprites()[1]].name;
+      out->collisions.push_back(std::move(o));
+    } else if (const auto* frame = dynamic_cast<const FrameTerm*>(&term)) {
+      FrameOutcome o;
+      const FrameSpec& f = entry.frames.at(frames_seen[s]++);
+      o.sprite = entry.name;
+      o.field = f.place.field;
+      o.set = f.tag.empty() ? std::to_string(f.sprite_ids.size()) + " sprites" : "tag " + f.tag;
+      std::tie(o.first_step, o.end_step) = frame->Window(view);
+      const int steps = std::max(0, o.end_step - o.first_step);
+      o.steps_on = steps - frame->CountViolations(view);
+      o.on_share = steps > 0 ? static_cast<double>(o.steps_on) / steps : 1.0;
+      out->frames.push_back(std::move(o));
+    }
+  }
+  out->constraints_judged = true;
+}
+
+JumpFigures JudgeJumps(const SequenceFile& file, const std::vector<std::unique_ptr<Bank>>& banks,
+                       const VisibleJumpOptions& options) {
+  JumpFigures out;
+  out.measured = true;
+  std::vector<std::unique_ptr<VisibleJumpMeter>> meters(banks.size());
+  auto meter = [&](int b) -> VisibleJumpMeter& {
+    if (!meters[b]) meters[b] = std::make_unique<VisibleJumpMeter>(*banks[b], options);
+    return *meters[b];
+  };
+  std::vector<double> jumps;
+  for (const SpriteSequence& s : file.sprites) {
+    for (size_t t = 1; t < s.frames.size(); ++t) {
+      const BankFrameRef& from = s.frames[t - 1];
+      const BankFrameRef& to = s.frames[t];
+      TransitionJump j{s.name, static_cast<int>(t), from, to, std::nullopt, std::nullopt};
+      if (from.bank == to.bank) {
+        j.natural = meter(from.bank).NaturalSuccessor(from.sprite_id);
+        if (j.natural && *j.natural == to.sprite_id) continue;  // the clip goes on
+        if (j.natural) j.jump = meter(to.bank).JumpBetween(to.sprite_id, *j.natural);
+      }
+      ++out.transitions;
+      if (j.jump) {
+        jumps.push_back(*j.jump);
+      } else {
+        ++out.unmeasured;
+      }
+      out.each.push_back(std::move(j));
+    }
+  }
+  out.median = Quantile(jumps, 0.5);
+  out.p95 = Quantile(jumps, 0.95);
+  out.max = Quantile(jumps, 1.0);
+  for (size_t b = 0; b < banks.size(); ++b) {
+    out.median_step_px.push_back(meters[b] ? meters[b]->MedianStep_px() : 0.0);
+  }
+  return out;
+}
+
+}  // namespace
+
+bool JudgeOptions::IsValid(std::string* why) const {
+  OptionProblems check(why);
+  check(stutter_window_steps >= 1, "stutter_window_steps",
+        "must be >= 1, got " + std::to_string(stutter_window_steps));
+  std::string jump_why;
+  check.Nested(jump.IsValid(&jump_why), "jump.", jump_why);
+  return check.ok();
+}
+
+std::optional<double> Quantile(std::vector<double> values, double q) {
+  if (values.empty()) return std::nullopt;
+  std::sort(values.begin(), values.end());
+  const double at = std::clamp(q, 0.0, 1.0) * static_cast<double>(values.size() - 1);
+  const size_t below = static_cast<size_t>(std::floor(at));
+  const size_t above = std::min(values.size() - 1, below + 1);
+  return values[below] + (at - static_cast<double>(below)) * (values[above] - values[below]);
+}
+
+StutterFigures MeasureStutter(const std::vector<SpriteSequence>& sprites, int window_steps,
+                              const std::function<bool(const BankFrameRef&)>& is_still) {
+  StutterFigures out;
+  out.window_steps = window_steps;
+  for (const SpriteSequence& s : sprites) {
+    const int n = static_cast<int>(s.frames.size());
+    for (int t = 0; t < n; ++t) {
+      const BankFrameRef& f = s.frames[t];
+      ++out.steps;
+      if (is_still(f)) {
+        ++out.still_steps;
+        continue;
+      }
+      for (int u = std::max(0, t - window_steps); u < t; ++u) {
+        if (s.frames[u].bank == f.bank && s.frames[u].sprite_id == f.sprite_id) {
+          ++out.repeats;
+          break;
+        }
+      }
+    }
+  }
+  const int counted = out.steps - out.still_steps;
+  out.share = counted > 0 ? static_cast<double>(out.repeats) / counted : 0.0;
+  return out;
+}
+
+Judgement JudgeSequences(const SequenceFile& file, const std::vector<std::string>& bank_paths,
+                         const Scene* scene, const JudgeOptions& options) {
+  if (std::string why; !options.IsValid(&why)) throw InputError("judge options", why);
+  for (size_t s = 0; s < file.sprites.size(); ++s) {
+    for (size_t t = 0; t < file.sprites[s].frames.size(); ++t) {
+      const int b = file.sprites[s].frames[t].bank;
+      if (b < 0 || b >= static_cast<int>(bank_paths.size())) {
+        throw InputError("sequences", "sprites[" + std::to_string(s) + "].steps[" +
+                                          std::to_string(t) + "][0]: no bank " + std::to_string(b) +
+                                          " among the " + std::to_string(bank_paths.size()) +
+                                          " given");
+      }
+    }
+  }
+  std::vector<std::unique_ptr<Bank>> banks;
+  banks.reserve(bank_paths.size());
+  for (const std::string& path : bank_paths) banks.push_back(std::make_unique<Bank>(path));
+
+  Judgement out;
+  for (const SpriteSequence& s : file.sprites) {
+    out.lengths.push_back({s.name, static_cast<int>(s.frames.size()), 0});
+  }
+  if (scene != nullptr) JudgeConstraints(file, *scene, &out);
+
+  std::set<std::pair<int, int64_t>> still;
+  for (size_t b = 0; b < banks.size(); ++b) {
+    for (const std::string& tag : options.still_tags) {
+      for (int64_t id : banks[b]->SpritesTagged(tag)) still.insert({static_cast<int>(b), id});
+    }
+  }
+  out.stutter =
+      MeasureStutter(file.sprites, options.stutter_window_steps, [&](const BankFrameRef& f) {
+        return still.count({f.bank, f.sprite_id}) > 0;
+      });
+  if (options.jumps) out.jumps = JudgeJumps(file, banks, options.jump);
+  return out;
+}
+
+}  // namespace ss

@@ -1,0 +1,43 @@
+#pragma once
+// The judge of what a viewer sees (issue 33, docs/animation.md "Judging an animation"): for a
+// sequences file (what `animate` writes) and its banks, each constraint's outcome (given the
+// spec), the stutter, and the visible jump at each transition
+// (pipeline/transitions/visible_jump.h). Reads the banks; optimizes nothing.
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "animate/scene.h"
+#include "animate/sequence_io.h"
+#include "judge/judgement.h"
+#include "pipeline/transitions/visible_jump.h"
+
+namespace ss {
+
+struct JudgeOptions {
+  // A step stutters when it shows a frame already shown in this many steps before it.
+  int stutter_window_steps = 15;
+  // Steps showing a frame with one of these bank tags hold still on purpose: not counted.
+  std::vector<std::string> still_tags = {"still"};
+  bool jumps = true;  // measure the visible jumps (reads billboards); false: skip them
+  VisibleJumpOptions jump;
+  // False with "FIELD: reason" lines in `why` (core/option_checks.h) for values out of range.
+  bool IsValid(std::string* why) const;
+};
+
+// Judges `file`'s final sequences. Banks are opened from `bank_paths` (the file's, or where they
+// are now), index for index. `scene`: the spec the sequences were made for, built over the same
+// banks, for the constraints' outcomes; null: lengths, stutter and jumps only. InputError naming
+// the file's field for a sprite the banks do not hold or sprites the spec does not name.
+Judgement JudgeSequences(const SequenceFile& file, const std::vector<std::string>& bank_paths,
+                         const Scene* scene, const JudgeOptions& options = {});
+
+// The stutter of some sprites' frames alone; `is_still` exempts a step showing that frame.
+StutterFigures MeasureStutter(const std::vector<SpriteSequence>& sprites, int window_steps,
+                              const std::function<bool(const BankFrameRef&)>& is_still);
+
+// Linear-interpolated quantile q in [0, 1] of `values` (nullopt when empty).
+std::optional<double> Quantile(std::vector<double> values, double q);
+
+}  // namespace ss
