@@ -30,7 +30,7 @@ flags="-O1 -gline-tables-only"
 # The unit suites built and run here (SPRITESTATION_SANITIZE_SUITES, CMake's names, or `all`,
 # the default: CI runs every unit suite here and not in the ordinary build; tests/fuzz/README.md,
 # Cost).
-all="core_tests capture_tests synth_tests calib_tests pipeline_tests config_tests station_tests animate_tests import_tests libcamera_tests"
+all="core_tests capture_tests synth_tests calib_tests pipeline_tests config_tests station_tests animate_tests import_tests libcamera_tests judge_tests"
 suites="${SPRITESTATION_SANITIZE_SUITES:-all}"
 [ "$suites" = all ] && suites="$all"
 CC=clang CXX=clang++ cmake -S "$top" -B "$build" "${generator[@]}" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
