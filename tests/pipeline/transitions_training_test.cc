@@ -414,6 +414,16 @@ TEST(TransitionWeightsFile, RoundTripAndDefault) {
   ASSERT_TRUE(in) << shipped;
   EXPECT_EQ(nlohmann::json::parse(in), nlohmann::json::parse(DefaultWeightsText()))
       << "default_weights.cc is stale: run pipeline/transitions/embed_default_weights.sh";
+  // So is the paper's six, kept beside it; a version-1 file of the paper variant.
+  const TransitionWeights& paper = PaperWeights();
+  EXPECT_TRUE(paper.IsValid(&why)) << why;
+  EXPECT_EQ(paper.stage2_variant, Stage2Variant::kPaper);
+  std::ifstream paper_in(ss::testing::SourcePath("pipeline/transitions/paper_weights.json"));
+  ASSERT_TRUE(paper_in);
+  const nlohmann::json paper_file = nlohmann::json::parse(paper_in);
+  EXPECT_EQ(paper_file, nlohmann::json::parse(PaperWeightsText()))
+      << "default_weights.cc is stale: run pipeline/transitions/embed_default_weights.sh";
+  EXPECT_EQ(paper_file["version"], 1);
 }
 
 TEST(TransitionWeightsFile, WrongFilesNameTheFileAndField) {
