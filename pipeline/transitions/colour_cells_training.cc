@@ -236,7 +236,7 @@ ColourCellsFit FitColourCellsOnLabels(std::span<const ColourCellsMeasure> positi
   const double rate = static_cast<double>(positives.size()) / total;
   ColourCellsFit fit = Choose(std::move(pos), static_cast<int64_t>(positives.size()),
                               std::move(all), total, rate, options, total, weights);
-  fit.accepts_per_sprite = 0;  // not a population: no per-sprite figure
+  fit.accepts_per_sprite = -1;  // not a population: no per-sprite figure
   return fit;
 }
 
@@ -260,7 +260,7 @@ ColourCellsFit FitColourCellsOnTruth(std::span<const ColourCellsMeasure> units,
   ColourCellsFit fit =
       Choose(std::move(pos), true_total, std::move(all), pairs,
              static_cast<double>(true_total) / pairs, options, 1.0, weights, min_precision);
-  fit.accepts_per_sprite = 0;  // the caller knows its rows
+  fit.accepts_per_sprite = -1;  // no population of sprites: the caller knows its rows
   return fit;
 }
 

@@ -41,7 +41,7 @@ struct ColourCellsFit {
   int max_colour_cells = 0;
   // estimated on the sample, for the positive rate (see the header comment)
   double precision = 0, recall = 0, f1 = 0;
-  double accepts_per_sprite = 0;
+  double accepts_per_sprite = 0;  // in the sample; -1 when the fit had no sample of sprites
   double positive_rate = 0;
   int64_t sampled_pairs = 0, positives = 0;
 };
