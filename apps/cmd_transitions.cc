@@ -111,7 +111,9 @@ void Train(const Args& a) {
         "or make "
         "labels with 'label --from-truth')\n");
   }
-  if (a.stage1_recall > 0 && r.stage2_calibrated) {
+  if (r.colour_cells) {
+    // stage 1 is the colour_cells variant's velocity ball (below)
+  } else if (a.stage1_recall > 0 && r.stage2_calibrated) {
     std::printf(
         "  stage 1 refitted as its filter to pass %.3f of %lld stage-2 accepts on the bank: %.1f "
         "candidates "
@@ -123,6 +125,15 @@ void Train(const Args& a) {
         "  stage 1 then set to pass %.3f of %lld stage-2 accepts on the bank (bias %.4f -> %.4f)\n",
         a.stage1_recall, static_cast<long long>(r.calibration_accepts), r.stage1_bias_from_labels,
         r.weights.stage1_bias);
+  }
+  if (r.colour_cells) {
+    std::printf(
+        "  the shipped classifier (colour_cells) fitted on %s: velocity <= %.4g m/s AND alpha "
+        "difference <= %.4g cells AND <= %d colour-different cells; estimated precision %.3f, "
+        "recall %.3f (stage 1: the velocity ball)\n",
+        r.stage2_calibrated ? "the bank for the positive rate" : "the labels alone (50/50)",
+        r.cells.max_velocity_mps, r.cells.max_alpha_cells, r.cells.max_colour_cells,
+        r.cells.precision, r.cells.recall);
   }
   std::printf("weights written to %s\n", a.out.c_str());
 }

@@ -1,9 +1,15 @@
 // spritestation bench transitions: the two-stage transition search on a synthetic
-// hamster bank (seed 000 §3), against brute force measured in the same run.
-//   full build of N sprites on T threads; stage-2 evaluations vs all N(N-1)/2 pairs;
-//   recall of the pairs brute force accepts (exact on sampled rows); quality against
-//   the synthetic truth; the candidate cascade with and without the level-2 silhouette
-//   signature (one core, same candidates); incremental add of one sprite to a 60,000-sprite set.
+// hamster bank (seed 000 §3), against brute force measured in the same run, for the default
+// classifier (colour_cells) and the paper's six side by side.
+//   weights fitted on seed 1 only (--train-out refits both); every figure on other seeds:
+//   full build of N sprites of seed 2 on T threads; stage-2 evaluations (pixel reads) vs all
+//   N(N-1)/2 pairs; recall of the pairs brute force accepts (exact on sampled rows); quality
+//   against the synthetic truth (visible key points, feet unordered); for the paper's six the
+//   candidate cascade with and without the level-2 silhouette signature (one core, same
+//   candidates); incremental add of one sprite to a 60,000-sprite set of seed 3 (default).
+// The JSON's "seeds" says which seeds were which. The visible-jump judge
+// (pipeline/transitions/visible_jump.h, another branch) plugs into FullBuild: its
+// full_build.jump_ratio_median / _p95 are not printed here yet.
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
@@ -12,6 +18,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <ctime>
+#include <mutex>
 #include <numeric>
 #include <random>
 #include <stdexcept>
@@ -25,6 +32,7 @@
 #include "core/error.h"
 #include "core/log.h"
 #include "pipeline/transitions/builder.h"
+#include "pipeline/transitions/colour_cells_training.h"
 #include "pipeline/transitions/synthetic.h"
 #include "pipeline/transitions/training.h"
 #include "pipeline/transitions/truth_labels.h"
@@ -61,9 +69,15 @@ struct Args {
   int threads = 2;
   int labels = 3000;
   double stage1_recall = 0.999;
-  double stage2_bias_shift = 0;  // added to the stage-2 bias (> 0 lowers the threshold T2)
+  double stage2_bias_shift = 0;
+  // --train-out: the least transitions precision (on the training set) the default is fitted
+  // for; 0.85 is the lower bar (F1 >= 0.80 at P >= 0.85).
+  double min_precision = 0.85;
+  // The seed the weights are fitted on. Anything but 1 is for measuring a family's ceiling
+  // (--train-seed=2 fits on the test set itself: an upper bound, not a held-out figure).
+  uint64_t train_seed = 1;  // added to the stage-2 bias (> 0 lowers the threshold T2)
   double near_miss = TruthLabelOptions{}.near_miss_fraction;
-  std::string weights_path, train_out;
+  std::string weights_path, train_out, paper_weights_path, paper_train_out;
   bool incremental = true, micro = false, json = false, sweep = false;
 };
 
@@ -110,6 +124,14 @@ Args Parse(const std::vector<std::string>& argv) {
       a.weights_path = value();
     else if (s == "--train-out")
       a.train_out = value();
+    else if (s == "--train-seed")
+      a.train_seed = std::stoull(value());
+    else if (s == "--min-precision")
+      a.min_precision = std::stod(value());
+    else if (s == "--paper-weights")
+      a.paper_weights_path = value();
+    else if (s == "--paper-train-out")
+      a.paper_train_out = value();
     else if (s == "--skip-incremental")
       a.incremental = false;
     else if (s == "--micro")
@@ -157,11 +179,22 @@ std::vector<SpriteTruth> Truths(const std::vector<SyntheticSprite>& s) {
   return t;
 }
 
-// Trains weights on a separate synthetic set (truth labels, then stage 1 calibrated as a
-// filter for stage 2) and writes them.
-TransitionWeights Train(const Args& a, nlohmann::json* out) {
+// The seeds of the synthetic sets: weights and thresholds are fitted on the training set only,
+// every figure is reported on the others.
+constexpr uint64_t kTestSeed = 2, kIncrementalSeed = 3;
+
+struct Trained {
+  TransitionWeights paper, cells;
+};
+
+// Trains on a separate synthetic set (seed kTrainSeed): labels from truth, then (1) the paper's
+// six as shipped before (label fit on the 32 x 32 window, stage 2 set for the real positive
+// rate, stage 1 refitted as its filter) and (2) the colour_cells default (the paper fit on the
+// default's 1 px window for the labelling page's ordering, then the three thresholds by
+// FitColourCells: what `transitions train` does). Writes them when asked.
+Trained Train(const Args& a, nlohmann::json* out) {
   const auto t0 = Clock::now();
-  const auto sprites = LiveSet(a.sprites, 1);
+  const auto sprites = LiveSet(a.sprites, a.train_seed);
   SpriteStore store(ComparisonWindow{}, SyntheticSpriteOptions{}.px_per_m);
   store.Append(AsSpriteInputs(sprites), a.threads);
   const auto ids = Ids(sprites);
@@ -191,10 +224,12 @@ TransitionWeights Train(const Args& a, nlohmann::json* out) {
       SamplePopulation(store, TransitionClassifier(w), a.rows, 7, a.threads);
   const Stage2Calibration s2 = CalibrateStage2(positive_distances, sample, positive_rate, &w);
   const Stage1Calibration s1 = FitStage1Filter(store, sample, a.stage1_recall, 7, &w);
+  const std::string source =
+      "spritestation bench transitions --train-out: synthetic hamster set, seed " +
+      std::to_string(a.train_seed) + ", " + std::to_string(a.sprites) +
+      " sprites (pipeline/transitions/synthetic.cc), labels from truth";
   nlohmann::json training = nlohmann::json::parse(w.training_json);
-  training["source"] =
-      "spritestation bench transitions --train-out: synthetic hamster set, seed 1, " +
-      std::to_string(a.sprites) + " sprites (pipeline/transitions/synthetic.cc), labels from truth";
+  training["source"] = source;
   training["stage2_calibration"] = {{"positive_rate", positive_rate},
                                     {"sampled_rows", sample.rows.size()},
                                     {"threshold", s2.threshold},
@@ -210,24 +245,163 @@ TransitionWeights Train(const Args& a, nlohmann::json* out) {
                                     {"bias_from_labels", label_stage1_bias},
                                     {"bias", w.stage1_bias}};
   w.training_json = training.dump();
-  SaveWeights(w, a.train_out);
-  (*out)["training"] = training;
+  Trained trained;
+  trained.paper = w;
+  (*out)["training"]["paper_six"] = training;
+  std::printf(
+      "trained on %zu labels of seed %llu (%lld accepts): paper six stage 1 CV precision %.3f "
+      "recall %.3f, stage 2 CV precision %.3f recall %.3f\n",
+      labels.size(), static_cast<unsigned long long>(a.train_seed),
+      static_cast<long long>(report.accepts), report.stage1.precision(), report.stage1.recall(),
+      report.stage2.precision(), report.stage2.recall());
+  std::printf(
+      "  paper six: stage 2 set for the truth's positive rate %.3g (%.1f true partners per "
+      "sprite): %.1f accepts per sprite, estimated precision %.3f recall %.3f; stage 1 refitted "
+      "to pass %.3f of them: %.1f candidates per sprite\n",
+      positive_rate, positive_rate * (a.sprites - 1), s2.accepts_per_sprite, s2.precision,
+      s2.recall, a.stage1_recall, s1.candidates_per_sprite);
+
+  // The colour_cells default, on its own window.
+  const ComparisonWindow window = DefaultWeights().window;
+  SpriteStore fine(window, SyntheticSpriteOptions{}.px_per_m);
+  fine.Append(AsSpriteInputs(sprites), a.threads);
+  std::vector<PairFeatures> xf;
+  for (const Label& l : labels) {
+    const int32_t i = *fine.IndexOf(l.sprite_i), j = *fine.IndexOf(l.sprite_j);
+    xf.push_back(fine.Features(i, j));
+  }
+  TrainReport fine_report;
+  TransitionWeights c = TrainWeights(xf, y, window, TrainOptions{}, &fine_report);
+  // The three thresholds, fitted on the training set's truth for what the goal counts:
+  // transitions i -> j (all of {i, j}, {i+1, j}, {i, j-1} kept) of a.rows random sprites
+  // against every sprite, each measured as the componentwise largest of its three pairs'.
+  const TruthLabelOptions truth_options;
+  std::vector<int32_t> order(fine.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::mt19937_64 row_rng(7);
+  std::shuffle(order.begin(), order.end(), row_rng);
+  std::vector<int32_t> fit_rows;
+  for (int32_t i : order) {
+    if (static_cast<int>(fit_rows.size()) >= a.rows) break;
+    if (fine.next(i) >= 0) fit_rows.push_back(i);
+  }
+  constexpr double kFar = 0.12;  // the fit's largest velocity bound
+  std::vector<ColourCellsMeasure> units;
+  std::vector<uint8_t> unit_truth;
+  std::atomic<int64_t> true_total{0}, true_far{0}, true_colourful{0};
+  {
+    std::mutex merge;
+    std::atomic<size_t> cursor{0};
+    const int32_t m = fine.size();
+    auto work = [&] {
+      std::vector<ColourCellsMeasure> mi(m), ms(m), local_units;
+      std::vector<uint8_t> ti(m), ts(m), near_i(m), near_s(m), local_truth;
+      int64_t local_true = 0, local_true_far = 0, local_true_colourful = 0;
+      for (size_t r; (r = cursor.fetch_add(1)) < fit_rows.size();) {
+        const int32_t i = fit_rows[r], s = fine.next(i);
+        for (int32_t j = 0; j < m; ++j) {
+          ti[j] = TruthAccepts(sprites[i].truth, sprites[j].truth, truth_options);
+          ts[j] = TruthAccepts(sprites[s].truth, sprites[j].truth, truth_options);
+          near_i[j] = CheapDiff(fine.cheap(i), fine.cheap(j))[0] <= kFar;
+          near_s[j] = CheapDiff(fine.cheap(s), fine.cheap(j))[0] <= kFar;
+          if (near_i[j]) mi[j] = MeasureColourCells(fine, i, j);
+          if (near_s[j]) ms[j] = MeasureColourCells(fine, s, j);
+        }
+        for (int32_t j = 0; j < m; ++j) {
+          const int32_t q = fine.prev(j);
+          if (q < 0 || j == i || j == s) continue;
+          const bool truth = ti[j] && ts[j] && ti[q];
+          local_true += truth;
+          if (!near_i[j] || !near_s[j] || !near_i[q]) {
+            local_true_far += truth;
+            continue;
+          }
+          ColourCellsMeasure u;
+          u.velocity_mps = std::max({mi[j].velocity_mps, ms[j].velocity_mps, mi[q].velocity_mps});
+          u.alpha_cells = std::max({mi[j].alpha_cells, ms[j].alpha_cells, mi[q].alpha_cells});
+          u.colour_cells = std::max({mi[j].colour_cells, ms[j].colour_cells, mi[q].colour_cells});
+          if (u.colour_cells > 40) {  // beyond the grid: never accepted
+            local_true_colourful += truth;
+            continue;
+          }
+          local_units.push_back(u);
+          local_truth.push_back(truth);
+        }
+      }
+      std::lock_guard<std::mutex> lock(merge);
+      units.insert(units.end(), local_units.begin(), local_units.end());
+      unit_truth.insert(unit_truth.end(), local_truth.begin(), local_truth.end());
+      true_total += local_true;
+      true_far += local_true_far;
+      true_colourful += local_true_colourful;
+    };
+    std::vector<std::thread> pool;
+    for (int t = 1; t < a.threads; ++t) pool.emplace_back(work);
+    work();
+    for (auto& th : pool) th.join();
+  }
+  ColourCellsFitOptions fit_options;
+  fit_options.threads = a.threads;
+  const ColourCellsFit fit =
+      FitColourCellsOnTruth(units, unit_truth, true_total.load(), a.min_precision, fit_options, &c);
+  // What the chosen point loses of the true transitions, bound by bound (a transition fails a
+  // bound when the largest of its three pairs' measurements exceeds it; beyond 0.12 m/s or 40
+  // colour cells it was not measured).
+  int64_t lose_velocity = 0, lose_alpha = 0, lose_cells = 0, lose_only_cells = 0;
+  for (size_t k = 0; k < units.size(); ++k) {
+    if (!unit_truth[k]) continue;
+    const bool v = units[k].velocity_mps > fit.max_velocity_mps;
+    const bool al = units[k].alpha_cells > fit.max_alpha_cells;
+    const bool ce = units[k].colour_cells > fit.max_colour_cells;
+    lose_velocity += v;
+    lose_alpha += al;
+    lose_cells += ce;
+    lose_only_cells += ce && !v && !al;
+  }
+  std::printf(
+      "  default on the training set: of %lld true transitions, %lld beyond 0.12 m/s and %lld "
+      "beyond 40 colour cells (no grid point keeps them); over the chosen velocity bound %lld, "
+      "alpha bound %lld, colour bound %lld (only it %lld)\n",
+      static_cast<long long>(true_total.load()), static_cast<long long>(true_far.load()),
+      static_cast<long long>(true_colourful.load()), static_cast<long long>(lose_velocity),
+      static_cast<long long>(lose_alpha), static_cast<long long>(lose_cells),
+      static_cast<long long>(lose_only_cells));
+  nlohmann::json cells_training = nlohmann::json::parse(c.training_json);
+  cells_training["source"] = source;
+  // The labelling page reads the positive rate the weights were calibrated for here.
+  cells_training["stage2_calibration"] = {{"positive_rate", positive_rate}};
+  cells_training["colour_cells_fit"] = {{"population",
+                                         "transitions of sampled sprites against every sprite, "
+                                         "truth known (bench transitions --train-out)"},
+                                        {"min_precision", a.min_precision},
+                                        {"true_transitions_sampled", true_total.load()},
+                                        {"true_beyond_velocity_grid", true_far.load()},
+                                        {"true_beyond_colour_grid", true_colourful.load()},
+                                        {"true_over_velocity_bound", lose_velocity},
+                                        {"true_over_alpha_bound", lose_alpha},
+                                        {"true_over_colour_bound", lose_cells},
+                                        {"positive_rate", positive_rate},
+                                        {"sampled_rows", a.rows},
+                                        {"max_velocity_mps", fit.max_velocity_mps},
+                                        {"max_alpha_cells", fit.max_alpha_cells},
+                                        {"max_colour_cells", fit.max_colour_cells},
+                                        {"estimated_precision", fit.precision},
+                                        {"estimated_recall", fit.recall},
+                                        {"estimated_f1", fit.f1},
+                                        {"accepts_per_sprite", fit.accepts_per_sprite}};
+  c.training_json = cells_training.dump();
+  trained.cells = c;
+  (*out)["training"]["default"] = cells_training;
   (*out)["training"]["seconds"] = Since(t0);
   std::printf(
-      "trained on %zu labels (%lld accepts): stage 1 CV precision %.3f recall %.3f, stage 2 CV "
-      "precision %.3f "
-      "recall %.3f\n",
-      labels.size(), static_cast<long long>(report.accepts), report.stage1.precision(),
-      report.stage1.recall(), report.stage2.precision(), report.stage2.recall());
-  std::printf(
-      "stage 2 set for the truth's positive rate %.3g (%.1f true partners per sprite): %.1f "
-      "accepts per sprite, "
-      "estimated precision %.3f recall %.3f; stage 1 refitted to pass %.3f of them: %.1f "
-      "candidates per sprite "
-      "-> %s\n",
-      positive_rate, positive_rate * (a.sprites - 1), s2.accepts_per_sprite, s2.precision,
-      s2.recall, a.stage1_recall, s1.candidates_per_sprite, a.train_out.c_str());
-  return w;
+      "  default (colour_cells): velocity <= %.4g m/s AND alpha difference <= %.4g cells AND "
+      "colour-different cells <= %d; estimated on the training set: precision %.3f recall %.3f "
+      "F1 %.3f (transitions of %zu rows, chosen at precision >= %.2f)\n",
+      fit.max_velocity_mps, fit.max_alpha_cells, fit.max_colour_cells, fit.precision, fit.recall,
+      fit.f1, fit_rows.size(), a.min_precision);
+  if (!a.train_out.empty()) SaveWeights(trained.cells, a.train_out);
+  if (!a.paper_train_out.empty()) SaveWeights(trained.paper, a.paper_train_out);
+  return trained;
 }
 
 // The candidates of every 10th sprite (j > i), from the built index.
@@ -325,28 +499,13 @@ void SweepStage2(const TransitionBuilder& builder, const TransitionWeights& weig
   }
 }
 
-int Run(const std::vector<std::string>& argv) {
-  const Args a = Parse(argv);
-  SetLogLevel("warn");
-  nlohmann::json result;
-  TransitionWeights weights =
-      a.weights_path.empty() ? DefaultWeights() : LoadWeights(a.weights_path);
-  if (!a.train_out.empty()) weights = Train(a, &result);
-  if (a.stage2_bias_shift != 0) {
-    weights.stage2_bias += a.stage2_bias_shift;
-    std::printf(
-        "stage-2 bias shifted by %+g (threshold T2 %.4f -> %.4f): NOT the shipped operating "
-        "point\n",
-        a.stage2_bias_shift, TransitionClassifier(weights).stage2_threshold() + a.stage2_bias_shift,
-        TransitionClassifier(weights).stage2_threshold());
-    result["stage2_bias_shift"] = a.stage2_bias_shift;
-  }
+// One classifier's full build of the test set, brute force on sampled rows in the same run,
+// and its agreement with the truth. Returns the "full_build" object.
+nlohmann::json FullBuild(const Args& a, const TransitionWeights& weights, const std::string& name,
+                         const std::vector<SyntheticSprite>& sprites, double seconds_generate,
+                         bool paper_extras, nlohmann::json* result) {
   const double px_per_m = SyntheticSpriteOptions{}.px_per_m;
-
-  // ---- full build ----
   auto t = Clock::now();
-  const auto sprites = LiveSet(a.sprites, 2);
-  const double seconds_generate = Since(t);
   const auto inputs = AsSpriteInputs(sprites);
   TransitionBuilder builder(weights, px_per_m);
   const double load_before = LoadAverage();
@@ -382,7 +541,8 @@ int Run(const std::vector<std::string>& argv) {
       const int32_t i = rows[r];
       for (int32_t j = 0; j < n; ++j) {
         if (j == i) continue;
-        const bool brute = classifier.Stage2Accepts(classifier.Distance(store.Features(i, j)));
+        double d;
+        const bool brute = classifier.Stage2(store, i, j, &d);  // the full evaluation
         const bool kept = builder.KeptDistance(i, j) >= 0;
         const bool truth = TruthAccepts(sprites[i].truth, sprites[j].truth, truth_options);
         ba += brute;
@@ -413,8 +573,8 @@ int Run(const std::vector<std::string>& argv) {
   const double plain_cpu0 = ThreadCpuSeconds();
   for (size_t r = 0; r < plain_rows; ++r) {
     for (int32_t j = 0; j < n; ++j) {
-      if (j != rows[r])
-        sink += classifier.Stage2Accepts(classifier.Distance(store.Features(rows[r], j)));
+      double d;
+      if (j != rows[r]) sink += classifier.Stage2(store, rows[r], j, &d);
     }
   }
   benchmark::DoNotOptimize(sink);
@@ -455,9 +615,10 @@ int Run(const std::vector<std::string>& argv) {
   }
 
   std::printf(
-      "\n== transitions: full build, %d synthetic sprites (%lld clips, mirrors included), %d "
-      "threads ==\n",
-      n, static_cast<long long>(stats.clips), a.threads);
+      "\n== transitions, %s: full build, %d synthetic sprites of seed %llu (%lld clips, mirrors "
+      "included), %d threads ==\n",
+      name.c_str(), n, static_cast<unsigned long long>(kTestSeed),
+      static_cast<long long>(stats.clips), a.threads);
   std::printf(
       "  build: %.2f s (images %.2f s, index %.3f s, stage 1 + stage 2 %.2f s, transitions %.2f s)"
       "   goal <= 60 s: %s\n",
@@ -473,19 +634,18 @@ int Run(const std::vector<std::string>& argv) {
       static_cast<long long>(stats.stage1_candidates), all_pairs, ratio_stage1,
       static_cast<long long>(stats.signature_rejected));
   std::printf(
-      "  stage-2 evaluations: %lld of %.0f pairs -> %.0fx fewer than brute force   goal >= 1000x: "
-      "%s\n",
+      "  stage-2 evaluations (pairs whose pixels are read): %lld of %.0f pairs -> %.0fx fewer "
+      "than brute force   goal >= 600x: %s\n",
       static_cast<long long>(stats.stage2_evaluations), all_pairs, ratio,
-      ratio >= 1000 ? "met" : "MISSED");
+      ratio >= 600 ? "met" : "MISSED");
   std::printf(
-      "  accepts per sprite (kept pairs x 2 / sprites): %.1f; at most all_pairs / 1000 = %.0f "
-      "evaluations for "
-      "1000x\n",
-      2.0 * stats.kept_pairs / n, all_pairs / 1000);
+      "  accepts per sprite (kept pairs x 2 / sprites): %.1f; at most all_pairs / 600 = %.0f "
+      "evaluations for 600x\n",
+      2.0 * stats.kept_pairs / n, all_pairs / 600);
   std::printf(
-      "  brute force (extrapolated: stage 2 alone timed on %zu rows x %d pairs, %.0f ns each, CPU "
-      "time of one "
-      "core): %.0f s on one core, %.0f s on %d; the two-stage build (%.2f s CPU) needs %.0fx less "
+      "  brute force (extrapolated: the full stage 2 timed on %zu rows x %d pairs, %.0f ns each, "
+      "CPU time of one core): %.0f s on one core, %.0f s on %d; the two-stage build (%.2f s CPU) "
+      "needs %.0fx less "
       "CPU\n",
       plain_rows, n - 1, seconds_per_eval_core * 1e9, brute_seconds_core,
       brute_seconds_core / a.threads, a.threads, cpu_build, brute_seconds_core / cpu_build);
@@ -501,46 +661,109 @@ int Run(const std::vector<std::string>& argv) {
       static_cast<long long>(brute_accepted.load()), recall_vs_brute,
       recall_vs_brute >= 0.99 ? "met" : "MISSED");
   std::printf(
-      "  against synthetic truth (sampled rows; same pose, every key point within %.1f mm; "
-      "%.1f true partners per sprite): pairs precision %.3f recall %.3f; transitions precision "
+      "  against synthetic truth (sampled rows; same pose, every visible key point within %.1f "
+      "mm, feet unordered; %.1f true partners per sprite): pairs precision %.3f recall %.3f; "
+      "transitions precision "
       "%.3f recall %.3f\n",
       truth_options.max_keypoint_displacement_m * 1e3, static_cast<double>(truth_pos) / rows.size(),
       precision_truth, recall_truth, t_found ? static_cast<double>(t_true) / t_found : 0.0,
       t_truth_total ? static_cast<double>(t_true) / t_truth_total : 0.0);
-  CompareCascades(builder, &result);
-  if (a.sweep) SweepStage2(builder, weights);
-  result["full_build"] = {
-      {"sprites", n},
-      {"clips", stats.clips},
-      {"threads", a.threads},
-      {"seconds", seconds_build},
-      {"cpu_seconds", cpu_build},
-      {"load_average_before", load_before},
-      {"seconds_generate_synthetic", seconds_generate},
-      {"stage1_candidates", stats.stage1_candidates},
-      {"signature_rejected", stats.signature_rejected},
-      {"stage2_evaluations", stats.stage2_evaluations},
-      {"fewer_stage1_candidates_ratio", ratio_stage1},
-      {"all_pairs", all_pairs},
-      {"fewer_evaluations_ratio", ratio},
-      {"kept_pairs", stats.kept_pairs},
-      {"transitions", transitions.size()},
-      {"brute_force_sampled_rows", rows.size()},
-      {"brute_force_ns_per_evaluation_one_core", seconds_per_eval_core * 1e9},
-      {"brute_force_timed_rows", plain_rows},
-      {"cpu_ratio_brute_force_vs_build", brute_seconds_core / cpu_build},
-      {"brute_force_seconds_extrapolated_one_core", brute_seconds_core},
-      {"recall_of_brute_force_accepts", recall_vs_brute},
-      {"brute_force_accepts_sampled", brute_accepted.load()},
-      {"truth_pair_precision", precision_truth},
-      {"truth_pair_recall", recall_truth},
-      {"truth_transition_precision", t_found ? static_cast<double>(t_true) / t_found : 0.0},
-      {"truth_transition_recall",
-       t_truth_total ? static_cast<double>(t_true) / t_truth_total : 0.0}};
+  if (paper_extras) {
+    CompareCascades(builder, result);
+    if (a.sweep) SweepStage2(builder, weights);
+  }
+  const double precision_transitions = t_found ? static_cast<double>(t_true) / t_found : 0.0;
+  const double recall_transitions =
+      t_truth_total ? static_cast<double>(t_true) / t_truth_total : 0.0;
+  const double f1_transitions = precision_transitions + recall_transitions > 0
+                                    ? 2 * precision_transitions * recall_transitions /
+                                          (precision_transitions + recall_transitions)
+                                    : 0.0;
+  std::printf("  transitions F1 %.3f at precision %.3f   goal >= 0.85 at P >= 0.90: %s\n",
+              f1_transitions, precision_transitions,
+              f1_transitions >= 0.85 && precision_transitions >= 0.9 ? "met" : "MISSED");
+  return {{"sprites", n},
+          {"clips", stats.clips},
+          {"threads", a.threads},
+          {"seconds", seconds_build},
+          {"cpu_seconds", cpu_build},
+          {"load_average_before", load_before},
+          {"seconds_generate_synthetic", seconds_generate},
+          {"stage1_candidates", stats.stage1_candidates},
+          {"signature_rejected", stats.signature_rejected},
+          {"stage2_evaluations", stats.stage2_evaluations},
+          {"fewer_stage1_candidates_ratio", ratio_stage1},
+          {"all_pairs", all_pairs},
+          {"fewer_evaluations_ratio", ratio},
+          {"kept_pairs", stats.kept_pairs},
+          {"transitions", transitions.size()},
+          {"brute_force_sampled_rows", rows.size()},
+          {"brute_force_ns_per_evaluation_one_core", seconds_per_eval_core * 1e9},
+          {"brute_force_timed_rows", plain_rows},
+          {"cpu_ratio_brute_force_vs_build", brute_seconds_core / cpu_build},
+          {"brute_force_seconds_extrapolated_one_core", brute_seconds_core},
+          {"recall_of_brute_force_accepts", recall_vs_brute},
+          {"brute_force_accepts_sampled", brute_accepted.load()},
+          {"truth_pair_precision", precision_truth},
+          {"truth_pair_recall", recall_truth},
+          {"truth_transition_precision", t_found ? static_cast<double>(t_true) / t_found : 0.0},
+          {"truth_transition_recall", recall_transitions},
+          {"truth_transition_f1", f1_transitions},
+          {"truth_partners_per_sprite", static_cast<double>(truth_pos) / rows.size()},
+          {"classifier", name}};
+}
+
+int Run(const std::vector<std::string>& argv) {
+  const Args a = Parse(argv);
+  SetLogLevel("warn");
+  nlohmann::json result;
+  TransitionWeights weights =
+      a.weights_path.empty() ? DefaultWeights() : LoadWeights(a.weights_path);
+  TransitionWeights paper =
+      a.paper_weights_path.empty() ? PaperWeights() : LoadWeights(a.paper_weights_path);
+  if (!a.train_out.empty() || !a.paper_train_out.empty()) {
+    const Trained trained = Train(a, &result);
+    weights = trained.cells;
+    paper = trained.paper;
+  }
+  if (a.stage2_bias_shift != 0) {
+    paper.stage2_bias += a.stage2_bias_shift;
+    std::printf(
+        "paper six: stage-2 bias shifted by %+g (threshold T2 %.4f): NOT the shipped operating "
+        "point\n",
+        a.stage2_bias_shift, TransitionClassifier(paper).stage2_threshold());
+    result["stage2_bias_shift"] = a.stage2_bias_shift;
+  }
+  result["seeds"] = {
+      {"train", a.train_seed}, {"test", kTestSeed}, {"incremental", kIncrementalSeed}};
+  std::printf(
+      "seeds: weights and thresholds fitted on seed %llu (--train-out, or the shipped files, "
+      "trained the same way on seed 1); every figure below on seed %llu (full build) and %llu "
+      "(incremental)\n",
+      static_cast<unsigned long long>(a.train_seed), static_cast<unsigned long long>(kTestSeed),
+      static_cast<unsigned long long>(kIncrementalSeed));
+  if (a.train_seed == kTestSeed || a.train_seed == kIncrementalSeed) {
+    std::printf(
+        "WARNING: fitted on a seed the figures are reported on: an upper bound of the "
+        "classifiers' family, not a held-out figure\n");
+  }
+  const double px_per_m = SyntheticSpriteOptions{}.px_per_m;
+
+  // ---- full builds of the test set: the default, then the paper's six ----
+  auto t = Clock::now();
+  const auto sprites = LiveSet(a.sprites, kTestSeed);
+  const double seconds_generate = Since(t);
+  result["full_build"] = FullBuild(a, weights, "default", sprites, seconds_generate,
+                                   !TransitionClassifier(weights).colour_cells(), &result);
+  nlohmann::json paper_result;
+  result["paper_six"]["full_build"] =
+      FullBuild(a, paper, "paper six", sprites, seconds_generate, true, &paper_result);
+  if (paper_result.contains("cascade_ab"))
+    result["paper_six"]["cascade_ab"] = paper_result["cascade_ab"];
 
   // ---- incremental ----
   if (a.incremental) {
-    auto live = LiveSet(a.incremental_base + a.adds, 3);
+    auto live = LiveSet(a.incremental_base + a.adds, kIncrementalSeed);
     const auto live_inputs = AsSpriteInputs(live);
     TransitionBuilder inc(weights, px_per_m);
     t = Clock::now();
@@ -645,9 +868,10 @@ int RunOrWorkers(const std::vector<std::string>& args) {
 
 const bool registered = RegisterSuite(
     {"transitions",
-     "two-stage transition search on a synthetic 30k-sprite bank vs brute force; incremental add "
-     "at 60k "
-     "[--sprites N --threads T --rows R --weights F --train-out F --stage2-bias-shift X "
+     "two-stage transition search on a synthetic 30k-sprite bank vs brute force, default and "
+     "paper six; incremental add at 60k "
+     "[--sprites N --threads T --rows R --weights F --paper-weights F --train-out F "
+     "--paper-train-out F --min-precision P --train-seed S --stage2-bias-shift X "
      "--sweep-stage2 --skip-incremental --micro --json]; --workers: PostgreSQL transition workers "
      "(scripts/bench-postgres.sh BUILD transitions)",
      &RunOrWorkers});

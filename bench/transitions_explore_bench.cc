@@ -446,7 +446,7 @@ int Run(const std::vector<std::string>& argv) {
   configs.back().window.align = HorizontalAlignment::kContactPoint;
   configs.push_back({"1px_bodyframe(oracle)", window(1, 1, 0.24, 0.18), true});
   const int nc = static_cast<int>(configs.size());
-  const TransitionClassifier paper(DefaultWeights());
+  const TransitionClassifier paper(PaperWeights());  // the paper six as shipped before
   const TruthLabelOptions truth_options;
 
   auto collect = [&](const Set& s, uint64_t seed) {

@@ -531,9 +531,10 @@ void ConsoleLabels::RunRetrain(std::shared_ptr<Shared> shared, api::Context cont
       r["positive_rate"] =
           positive_rate > 0 ? nlohmann::json(positive_rate) : nlohmann::json(nullptr);
     });
+    // The shipped classifier (BankTrainOptions' defaults: DefaultWeights()' variant and window),
+    // whatever the weights in use are.
     BankTrainOptions train;
     train.train.folds = kFolds;
-    train.window = current.window;
     train.threads = options.threads;
     const BankTrainResult result = TrainOnBank(labels_path.string(), bank, train);
     const double train_s = seconds(t0);

@@ -34,6 +34,9 @@ bool BankTrainOptions::IsValid(std::string* why) const {
   check(calibration_rows >= 1, "calibration_rows",
         "expected at least 1 sprite, got " + std::to_string(calibration_rows));
   check(threads >= 1, "threads", "expected at least 1 thread, got " + std::to_string(threads));
+  check(variant == Stage2Variant::kPaper || variant == Stage2Variant::kColourCells, "variant",
+        "only \"paper\" and \"colour_cells\" are trained (linf and colour_blob files are "
+        "written by hand)");
   return check.ok();
 }
 
@@ -77,6 +80,34 @@ BankTrainResult TrainOnBank(const std::string& labels_path, const std::string& b
   nlohmann::json training = nlohmann::json::parse(result.weights.training_json);
   training["source"] = "spritestation transitions train " + labels_path + " --bank " + bank_path;
   const bool calibrate_stage2 = positive_rate > 0;
+  const bool cells = options.variant == Stage2Variant::kColourCells;
+  // The colour_cells measurements of the labelled pairs.
+  std::vector<ColourCellsMeasure> cells_positive, cells_negative;
+  if (cells) {
+    for (const Label& l : labels) {
+      (l.accept ? cells_positive : cells_negative)
+          .push_back(
+              MeasureColourCells(store, *store.IndexOf(l.sprite_i), *store.IndexOf(l.sprite_j)));
+    }
+  }
+  ColourCellsFitOptions cells_options;
+  cells_options.rows = options.calibration_rows;
+  cells_options.seed = options.train.seed;
+  cells_options.threads = options.threads;
+  auto record_cells = [&](const char* population) {
+    const ColourCellsFit& f = result.cells;
+    training["colour_cells_fit"] = {{"population", population},
+                                    {"positive_rate", f.positive_rate},
+                                    {"max_velocity_mps", f.max_velocity_mps},
+                                    {"max_alpha_cells", f.max_alpha_cells},
+                                    {"max_colour_cells", f.max_colour_cells},
+                                    {"estimated_precision", f.precision},
+                                    {"estimated_recall", f.recall},
+                                    {"estimated_f1", f.f1},
+                                    {"accepts_per_sprite", f.accepts_per_sprite},
+                                    {"sampled_pairs", f.sampled_pairs},
+                                    {"accept_labels", f.positives}};
+  };
   if (calibrate_stage2 || options.stage1_recall > 0) {
     // Judge every pair of some sprites with stage 2 (brute force): the population.
     SegmentKeys all_keys;
@@ -101,7 +132,17 @@ BankTrainResult TrainOnBank(const std::string& labels_path, const std::string& b
                                           {"estimated_precision", result.stage2.precision},
                                           {"estimated_recall", result.stage2.recall},
                                           {"bias", result.weights.stage2_bias}};
-        if (options.stage1_recall > 0) {
+        if (cells) {
+          // Stage 1 becomes the velocity ball of the variant (FitColourCells sets it).
+          try {
+            result.cells =
+                FitColourCells(all, cells_positive, positive_rate, cells_options, &result.weights);
+          } catch (const InputError& e) {
+            throw InputError(labels_path, e.what());
+          }
+          result.colour_cells = true;
+          record_cells("every pair of sampled sprites of the bank");
+        } else if (options.stage1_recall > 0) {
           result.stage1 = FitStage1Filter(all, sample, options.stage1_recall, options.train.seed,
                                           &result.weights);
           result.calibration_accepts = result.stage1.stage2_accepts;
@@ -114,7 +155,7 @@ BankTrainResult TrainOnBank(const std::string& labels_path, const std::string& b
         result.calibration_accepts = static_cast<int64_t>(accepted.size());
       }
     }
-    if (options.stage1_recall > 0) {
+    if (options.stage1_recall > 0 && !cells) {
       training["stage1_calibration"] = {
           {"target_recall_of_stage2", options.stage1_recall},
           {"refitted_as_filter", result.stage2_calibrated},
@@ -124,6 +165,16 @@ BankTrainResult TrainOnBank(const std::string& labels_path, const std::string& b
           {"bias_from_labels", result.stage1_bias_from_labels},
           {"bias", result.weights.stage1_bias}};
     }
+  }
+  if (cells && !result.colour_cells) {
+    try {
+      result.cells =
+          FitColourCellsOnLabels(cells_positive, cells_negative, cells_options, &result.weights);
+    } catch (const InputError& e) {
+      throw InputError(labels_path, e.what());
+    }
+    result.colour_cells = true;
+    record_cells("the labelled pairs (no positive rate: a 50/50 world)");
   }
   result.weights.training_json = training.dump();
   return result;

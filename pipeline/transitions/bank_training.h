@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "pipeline/transitions/colour_cells_training.h"
 #include "pipeline/transitions/training.h"
 #include "pipeline/transitions/truth_labels.h"
 #include "pipeline/transitions/weights.h"
@@ -12,8 +13,14 @@
 namespace ss {
 
 struct BankTrainOptions {
-  TrainOptions train;       // the label fit: folds, seed, logistic regression
-  ComparisonWindow window;  // the pixel features' window (recorded in the weights)
+  TrainOptions train;  // the label fit: folds, seed, logistic regression
+  // The pixel features' window (recorded in the weights): the shipped weights' (a 1 px window
+  // on the contact point for the colour_cells default).
+  ComparisonWindow window = DefaultWeights().window;
+  // Which stage 2 to fit: kPaper (the paper's six, linear) or kColourCells (the default: the
+  // paper fit is made as well, for the labelling page's ordering, then the three thresholds
+  // are fitted: FitColourCells with a positive rate, FitColourCellsOnLabels without).
+  Stage2Variant variant = DefaultWeights().stage2_variant;
   // share (0..1) of stage-2 accepts stage 1 must pass in the sample (0 = keep the label fit)
   double stage1_recall = 0.999;
   // Share (0..1) of all sprite pairs that are true transitions; < 0: the labels file's
@@ -32,7 +39,9 @@ struct BankTrainResult {
   double stage1_bias_from_labels = 0;
   bool stage2_calibrated = false;  // a positive rate was known
   Stage2Calibration stage2;
-  Stage1Calibration stage1;  // when stage2_calibrated and stage1_recall > 0
+  Stage1Calibration stage1;   // when stage2_calibrated and stage1_recall > 0
+  bool colour_cells = false;  // the colour_cells variant was fitted (`cells`)
+  ColourCellsFit cells;
 };
 
 // Trains both stages on the labelled pairs of `bank_path`'s sprites. With a positive rate

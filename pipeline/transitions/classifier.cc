@@ -21,6 +21,17 @@ TransitionClassifier::TransitionClassifier(const TransitionWeights& weights) : w
     t2_ += u2_[k] * weights.feature_mean[k];
   }
   linf_alpha_limit_ = static_cast<int>(std::floor(255.0 * weights.linf_max_alpha + 1e-9));
+  colour_cells_alpha_limit_ =
+      static_cast<uint64_t>(std::floor(255.0 * weights.colour_cells_max_alpha_cells + 1e-9));
+}
+
+double TransitionClassifier::ColourCellsDistance(double velocity_mps, uint64_t alpha_abs_diff,
+                                                 int cells) const {
+  const double v = velocity_mps / weights_.colour_cells_max_velocity_mps;
+  const double a = static_cast<double>(alpha_abs_diff) /
+                   static_cast<double>(std::max<uint64_t>(1, colour_cells_alpha_limit_));
+  const double c = static_cast<double>(cells) / std::max(1, weights_.colour_cells_max_cells);
+  return std::max({v, a, c});
 }
 
 namespace {
@@ -42,6 +53,11 @@ bool TransitionClassifier::SignatureRejects(const SpriteStore& store, int32_t i,
            store.SignatureLinfExceeds(i, j, linf_alpha_limit_);
   }
   if (colour_blob()) return cheap[0] > weights_.colour_blob_max_velocity_mps;
+  if (colour_cells()) {
+    return cheap[0] > weights_.colour_cells_max_velocity_mps ||
+           store.CoarseAlphaBound(i, j) > colour_cells_alpha_limit_ ||
+           store.SignatureAlphaBound(i, j) > colour_cells_alpha_limit_;
+  }
   // d is Distance()'s prefix, and the alpha feature is monotone in its numerator, so
   // d + u4 * bound <= the full sum.
   const double d = CheapPart(cheap);
@@ -70,6 +86,16 @@ bool TransitionClassifier::Stage2(const SpriteStore& store, int32_t i, int32_t j
     if (blob > weights_.colour_blob_max_cells) return false;
     *distance = std::max(cheap[0] / weights_.colour_blob_max_velocity_mps,
                          static_cast<double>(blob) / std::max(1, weights_.colour_blob_max_cells));
+    return true;
+  }
+  if (colour_cells()) {
+    if (cheap[0] > weights_.colour_cells_max_velocity_mps) return false;
+    const int stride = store.window().PlaneStride();
+    const uint64_t alpha = SumAlphaDifference(store.image(i), store.image(j), stride);
+    if (alpha > colour_cells_alpha_limit_) return false;
+    const int cells = ColourCellCount(store.image(i), store.image(j), stride);
+    if (cells > weights_.colour_cells_max_cells) return false;
+    *distance = ColourCellsDistance(cheap[0], alpha, cells);
     return true;
   }
   // The partial sums are Distance()'s prefixes.

@@ -44,6 +44,10 @@ class TransitionClassifier {
   // SpriteStore::SignatureLinfExceeds proves the largest cell difference exceeds its bound.
   // With the colour_blob variant: true when the velocity difference exceeds its bound (the
   // colour blob has no per-sprite bound: every other pair is evaluated).
+  // With the colour_cells variant: true when the velocity difference exceeds its bound or
+  // a silhouette-signature bound (CoarseAlphaBound, then SignatureAlphaBound) of
+  // sum |A_i - A_j| exceeds colour_cells_alpha_limit() (the bounds are <= the sum, so the
+  // full evaluation rejects such a pair too).
   bool SignatureRejects(const SpriteStore& store, int32_t i, int32_t j) const;
   // Stage 2 on store indices (i, j) with early exits: the sum of Distance() is built in
   // its own order (the cheap terms, then alpha from the alpha plane, then colour) and every
@@ -56,11 +60,19 @@ class TransitionClassifier {
   // ratios to their bounds (0..1). With the colour_blob variant: kept when velocity <=
   // max_velocity_mps and LargestColourBlob <= max_blob_cells; *distance = the larger of
   // velocity / max_velocity_mps and blob / max(1, max_blob_cells) (0..1). Distance() and
-  // Stage2Accepts() stay the linear D (training
-  // and the labelling page use them).
+  // With the colour_cells variant: kept when velocity <= max_velocity_mps, sum |A_i - A_j| <=
+  // colour_cells_alpha_limit() (the alpha plane, read first) and ColourCellCount <=
+  // max_colour_cells (then the colour planes); *distance = the largest of the three ratios to
+  // their bounds (0..1; a bound of 0 counts as 1). Stage2Accepts() stay the linear D (the
+  // paper variant's training and the labelling page's ordering use them).
   bool Stage2(const SpriteStore& store, int32_t i, int32_t j, double* distance) const;
   bool linf() const { return weights_.stage2_variant == Stage2Variant::kLinf; }
   bool colour_blob() const { return weights_.stage2_variant == Stage2Variant::kColourBlob; }
+  bool colour_cells() const { return weights_.stage2_variant == Stage2Variant::kColourCells; }
+  // colour_cells: the largest accepted sum_cells |A_i - A_j| (floor(255 * max_alpha_cells)).
+  uint64_t colour_cells_alpha_limit() const { return colour_cells_alpha_limit_; }
+  // colour_cells: the stored d of a kept pair from its three measurements.
+  double ColourCellsDistance(double velocity_mps, uint64_t alpha_abs_diff, int cells) const;
   // linf: the largest accepted MaxAlphaDifference (0..255).
   int linf_alpha_limit() const { return linf_alpha_limit_; }
 
@@ -83,6 +95,7 @@ class TransitionClassifier {
   PairFeatures u2_{};
   double t2_ = 0;
   int linf_alpha_limit_ = 0;
+  uint64_t colour_cells_alpha_limit_ = 0;
 };
 
 }  // namespace ss

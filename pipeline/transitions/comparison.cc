@@ -310,6 +310,43 @@ int LargestColourBlob(const uint8_t* a, const uint8_t* b, const ComparisonWindow
   return best;
 }
 
+int ColourCellCountScalar(const uint8_t* a, const uint8_t* b, int stride) {
+  int count = 0;
+  for (int k = 0; k < stride; ++k) {
+    if (a[k] < kOpaqueAlpha || b[k] < kOpaqueAlpha) continue;
+    int d = 0;
+    for (int c = 1; c <= 3; ++c) d += std::abs(int{a[c * stride + k]} - int{b[c * stride + k]});
+    count += d >= kColourStep;
+  }
+  return count;
+}
+
+int ColourCellCount(const uint8_t* a, const uint8_t* b, int stride) {
+  // 16 cells a step: opaque in both <=> the top bit of min(A_a, A_b) (kOpaqueAlpha = 128);
+  // the three channel differences summed in 16-bit lanes (<= 765) and compared with 89.
+  static_assert(kOpaqueAlpha == 128, "the opacity test is the top bit of the smaller alpha");
+  const __m128i zero = _mm_setzero_si128();
+  const __m128i step = _mm_set1_epi16(kColourStep - 1);
+  int count = 0;
+  for (int k = 0; k < stride; k += 16) {
+    const __m128i aa = _mm_loadu_si128(reinterpret_cast<const __m128i*>(a + k));
+    const __m128i ab = _mm_loadu_si128(reinterpret_cast<const __m128i*>(b + k));
+    const int opaque = _mm_movemask_epi8(_mm_min_epu8(aa, ab));
+    if (opaque == 0) continue;
+    __m128i lo = zero, hi = zero;
+    for (int c = 1; c <= 3; ++c) {
+      const __m128i x = _mm_loadu_si128(reinterpret_cast<const __m128i*>(a + c * stride + k));
+      const __m128i y = _mm_loadu_si128(reinterpret_cast<const __m128i*>(b + c * stride + k));
+      const __m128i d = _mm_or_si128(_mm_subs_epu8(x, y), _mm_subs_epu8(y, x));
+      lo = _mm_add_epi16(lo, _mm_unpacklo_epi8(d, zero));
+      hi = _mm_add_epi16(hi, _mm_unpackhi_epi8(d, zero));
+    }
+    const __m128i differ = _mm_packs_epi16(_mm_cmpgt_epi16(lo, step), _mm_cmpgt_epi16(hi, step));
+    count += __builtin_popcount(static_cast<unsigned>(_mm_movemask_epi8(differ) & opaque));
+  }
+  return count;
+}
+
 PixelSums SumPixelDifferences(const uint8_t* a, const uint8_t* b, int stride) {
   static const Kernel kernel = ChooseKernel();
   return kernel(a, b, stride);

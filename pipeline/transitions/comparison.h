@@ -77,6 +77,13 @@ int MaxAlphaDifference(const uint8_t* image_a, const uint8_t* image_b, int strid
 // opaque in both (A >= 128) whose colours differ by |dR| + |dG| + |dB| >= 90. Symmetric.
 int LargestColourBlob(const uint8_t* image_a, const uint8_t* image_b,
                       const ComparisonWindow& window);
+// The colour_cells stage 2's pixel feature: how many cells are opaque in both (A >= 128) and
+// differ in colour by |dR| + |dG| + |dB| >= 90 (kColourStep). Symmetric; padding counts 0.
+// SSE2; ColourCellCountScalar is the plain loop it is tested against.
+inline constexpr int kColourStep = 90;
+inline constexpr int kOpaqueAlpha = 128;
+int ColourCellCount(const uint8_t* image_a, const uint8_t* image_b, int stride);
+int ColourCellCountScalar(const uint8_t* image_a, const uint8_t* image_b, int stride);
 // Plain loop, the reference the SIMD kernels are tested against.
 PixelSums SumPixelDifferencesScalar(const uint8_t* image_a, const uint8_t* image_b, int stride);
 // The features from the sums and the two alpha boxes.

@@ -440,6 +440,7 @@ std::vector<SyntheticSprite> MakeSyntheticSprites(const SyntheticSpriteOptions& 
       sprite.truth.heading_rad = s.heading;
       sprite.truth.gait_phase = s.phase;
       sprite.truth.keypoints_m = Keypoints(s, &sprite.truth.keypoint_visible);
+      sprite.truth.unordered_from = 4;  // the feet: which leg is which does not show
       states.push_back(s);
       out.push_back(std::move(sprite));
     }

@@ -1,6 +1,7 @@
 #include "pipeline/transitions/truth_labels.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numeric>
 #include <random>
@@ -24,20 +25,44 @@ double PhaseDifference(double a, double b) {
 
 double KeypointDisplacement(const SpriteTruth& a, const SpriteTruth& b) {
   if (a.keypoints_m.empty() || a.keypoints_m.size() != b.keypoints_m.size() ||
-      a.keypoints_m.size() % 2 != 0) {
+      a.keypoints_m.size() % 2 != 0 || a.unordered_from != b.unordered_from) {
     return INFINITY;
   }
   const size_t points = a.keypoints_m.size() / 2;
   const auto& va = a.keypoint_visible;
   const auto& vb = b.keypoint_visible;
   if ((!va.empty() && va.size() != points) || (!vb.empty() && vb.size() != points)) return INFINITY;
+  const bool flags = !va.empty() && !vb.empty();
+  // Point k of a against point l of b: compared when visible in at least one.
+  const auto seen = [&](size_t k, size_t l) { return !flags || va[k] || vb[l]; };
+  const auto distance = [&](size_t k, size_t l) {
+    return std::hypot(a.keypoints_m[2 * k] - b.keypoints_m[2 * l],
+                      a.keypoints_m[2 * k + 1] - b.keypoints_m[2 * l + 1]);
+  };
+  const size_t fixed =
+      a.unordered_from < 0 ? points : std::min(points, static_cast<size_t>(a.unordered_from));
   double worst = 0;
-  for (size_t k = 0; k < a.keypoints_m.size(); k += 2) {
-    if (!va.empty() && !vb.empty() && !va[k / 2] && !vb[k / 2]) continue;
-    worst = std::max(worst, std::hypot(a.keypoints_m[k] - b.keypoints_m[k],
-                                       a.keypoints_m[k + 1] - b.keypoints_m[k + 1]));
+  for (size_t k = 0; k < fixed; ++k) {
+    if (seen(k, k)) worst = std::max(worst, distance(k, k));
   }
-  return worst;
+  const size_t feet = points - fixed;
+  if (feet == 0) return worst;
+  if (feet > 8) return INFINITY;  // 8! matchings at most; no truth has more feet
+  // Bottleneck matching by enumeration (4 feet: 24 matchings) on the pairwise distances.
+  std::array<double, 64> cost{};
+  for (size_t k = 0; k < feet; ++k) {
+    for (size_t l = 0; l < feet; ++l)
+      cost[k * feet + l] = seen(fixed + k, fixed + l) ? distance(fixed + k, fixed + l) : 0.0;
+  }
+  std::array<int, 8> perm{};
+  std::iota(perm.begin(), perm.begin() + feet, 0);
+  double best = INFINITY;
+  do {
+    double w = 0;
+    for (size_t k = 0; k < feet && w < best; ++k) w = std::max(w, cost[k * feet + perm[k]]);
+    best = std::min(best, w);
+  } while (best > 0 && std::next_permutation(perm.begin(), perm.begin() + feet));
+  return std::max(worst, best);
 }
 
 namespace {

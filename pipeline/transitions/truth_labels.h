@@ -4,7 +4,8 @@
 // "accept" when both sprites have the same pose label and look alike:
 //  - when both truths carry key points (the synthetic sets of synthetic.h do): every
 //    key point visible in either sprite moved at most max_keypoint_displacement_m in the
-//    billboard plane (a point hidden in both is not seen to move);
+//    billboard plane (a point hidden in both is not seen to move), the feet matched as an
+//    unordered set (a picture does not show which leg is which);
 //  - otherwise (e.g. a studio session's subjects.csv): headings and gait phases are close.
 // Key points measure closeness the way an eye does: a phase tolerance alone would call a
 // barely moving sniff "different" and a fast trot "alike" (docs/transitions.md).
@@ -28,6 +29,11 @@ struct SpriteTruth {
   // Per key point: 1 when the picture shows it, 0 when a nearer part hides it. Empty: all
   // visible. Only points visible in at least one sprite of a pair are compared.
   std::vector<uint8_t> keypoint_visible;
+  // Key points from this index on (the feet) form an unordered set: a pair is compared under
+  // the matching of one sprite's feet to the other's that moves them least (a side view at
+  // gait phase p and p + 0.5 draws the same picture with the legs swapped). -1: every point
+  // keeps its identity.
+  int unordered_from = -1;
 };
 
 struct TruthLabelOptions {
@@ -47,7 +53,10 @@ struct TruthLabelOptions {
 };
 
 // The largest displacement (metres) among the key points visible in a or in b (a point
-// hidden in both is not seen to move); infinity when the sets do not correspond.
+// hidden in both is not seen to move), the points from unordered_from on matched to each
+// other as the set that minimizes that largest displacement (bottleneck matching; a matched
+// pair hidden in both is not compared); infinity when the sets do not correspond (counts,
+// flags, or unordered_from differ).
 double KeypointDisplacement(const SpriteTruth& a, const SpriteTruth& b);
 
 // Circular differences: headings in radians (0..pi), phases in cycles (0..0.5).

@@ -117,6 +117,17 @@ bool TransitionWeights::IsValid(std::string* why) const {
     check(colour_blob_max_cells >= 0, "stage2.colour_blob.max_blob_cells",
           "expected a number >= 0, got " + std::to_string(colour_blob_max_cells));
   }
+  if (stage2_variant == Stage2Variant::kColourCells) {
+    check(positive(colour_cells_max_velocity_mps), "stage2.colour_cells.max_velocity_mps",
+          "expected a positive number, got " + OptionProblems::Num(colour_cells_max_velocity_mps));
+    // 255 * the bound must fit the integer sums it is compared with.
+    check(non_negative(colour_cells_max_alpha_cells) && colour_cells_max_alpha_cells <= 1e12,
+          "stage2.colour_cells.max_alpha_cells",
+          "expected a number from 0 to 1e12, got " +
+              OptionProblems::Num(colour_cells_max_alpha_cells));
+    check(colour_cells_max_cells >= 0, "stage2.colour_cells.max_colour_cells",
+          "expected a number >= 0, got " + std::to_string(colour_cells_max_cells));
+  }
   return check.ok();
 }
 
@@ -179,9 +190,15 @@ TransitionWeights ParseWeights(const std::string& text, const std::string& sourc
       w.stage2_variant = Stage2Variant::kColourBlob;
       w.colour_blob_max_velocity_mps = r.Number("stage2.colour_blob.max_velocity_mps");
       w.colour_blob_max_cells = r.Integer("stage2.colour_blob.max_blob_cells");
+    } else if (variant == "colour_cells") {
+      w.stage2_variant = Stage2Variant::kColourCells;
+      w.colour_cells_max_velocity_mps = r.Number("stage2.colour_cells.max_velocity_mps");
+      w.colour_cells_max_alpha_cells = r.Number("stage2.colour_cells.max_alpha_cells");
+      w.colour_cells_max_cells = r.Integer("stage2.colour_cells.max_colour_cells");
     } else {
       r.Fail("stage2.variant",
-             "expected \"paper\", \"linf\" or \"colour_blob\", got " + variant.dump());
+             "expected \"paper\", \"linf\", \"colour_blob\" or \"colour_cells\", got " +
+                 variant.dump());
     }
   }
   if (root.contains("training")) {
@@ -207,7 +224,8 @@ std::string WeightsToJson(const TransitionWeights& w) {
   root["format"] = kWeightsFileFormat;
   const bool linf = w.stage2_variant == Stage2Variant::kLinf;
   const bool blob = w.stage2_variant == Stage2Variant::kColourBlob;
-  root["version"] = linf || blob ? 2 : 1;  // the paper variant is written as version 1 was
+  const bool cells = w.stage2_variant == Stage2Variant::kColourCells;
+  root["version"] = linf || blob || cells ? 2 : 1;  // the paper variant is written as version 1 was
   root["features"] = FeatureNames();
   root["comparison_window"] = {
       {"width_m", w.window.width_m},
@@ -230,6 +248,12 @@ std::string WeightsToJson(const TransitionWeights& w) {
     root["stage2"]["colour_blob"] = {{"max_velocity_mps", w.colour_blob_max_velocity_mps},
                                      {"max_blob_cells", w.colour_blob_max_cells}};
   }
+  if (cells) {
+    root["stage2"]["variant"] = "colour_cells";
+    root["stage2"]["colour_cells"] = {{"max_velocity_mps", w.colour_cells_max_velocity_mps},
+                                      {"max_alpha_cells", w.colour_cells_max_alpha_cells},
+                                      {"max_colour_cells", w.colour_cells_max_cells}};
+  }
   json training = json::parse(w.training_json, nullptr, false);
   root["training"] = training.is_object() ? training : json::object();
   return root.dump(2) + "\n";
@@ -246,6 +270,12 @@ void SaveWeights(const TransitionWeights& w, const std::string& path) {
 const TransitionWeights& DefaultWeights() {
   static const TransitionWeights weights =
       ParseWeights(DefaultWeightsText(), "pipeline/transitions/default_weights.json (built in)");
+  return weights;
+}
+
+const TransitionWeights& PaperWeights() {
+  static const TransitionWeights weights =
+      ParseWeights(PaperWeightsText(), "pipeline/transitions/paper_weights.json (built in)");
   return weights;
 }
 

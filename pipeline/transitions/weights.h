@@ -12,8 +12,9 @@
 
 namespace ss {
 
-// Version 1: the paper's linear stage 2. Version 2 adds `stage2.variant` ("paper" or
-// "linf"); files with the paper variant are still written as version 1, byte for byte.
+// Version 1: the paper's linear stage 2. Version 2 adds `stage2.variant` ("paper", "linf",
+// "colour_blob" or "colour_cells"); files with the paper variant are still written as
+// version 1, byte for byte.
 inline constexpr int kWeightsFileVersion = 2;
 
 // Which stage 2 the builder runs (docs/transitions.md "Stage-2 variants").
@@ -22,6 +23,9 @@ enum class Stage2Variant {
   kLinf,   // velocity <= max_velocity_mps AND the largest cell alpha difference <= max_alpha_linf
   kColourBlob,  // velocity <= max_velocity_mps AND the largest colour-difference blob <=
                 // max_blob_cells
+  // the default: velocity <= max_velocity_mps AND alpha difference <= max_alpha_cells AND
+  // colour-different cells <= max_colour_cells
+  kColourCells,
 };
 inline constexpr const char* kWeightsFileFormat = "spritestation-transition-weights";
 
@@ -34,10 +38,14 @@ struct TransitionWeights {
   PairFeatures stage2_weights{};
   double stage2_bias = 0;
   Stage2Variant stage2_variant = Stage2Variant::kPaper;
-  double linf_max_velocity_mps = 0;         // linf: ||v_i - v_j|| bound (m/s), > 0
-  double linf_max_alpha = 0;                // linf: max_cells |A_i - A_j| / 255 bound, in (0, 1]
-  double colour_blob_max_velocity_mps = 0;  // colour_blob: ||v_i - v_j|| bound (m/s), > 0
-  int colour_blob_max_cells = 0;            // colour_blob: LargestColourBlob bound (cells), >= 0
+  double linf_max_velocity_mps = 0;          // linf: ||v_i - v_j|| bound (m/s), > 0
+  double linf_max_alpha = 0;                 // linf: max_cells |A_i - A_j| / 255 bound, in (0, 1]
+  double colour_blob_max_velocity_mps = 0;   // colour_blob: ||v_i - v_j|| bound (m/s), > 0
+  int colour_blob_max_cells = 0;             // colour_blob: LargestColourBlob bound (cells), >= 0
+  double colour_cells_max_velocity_mps = 0;  // colour_cells: ||v_i - v_j|| bound (m/s), > 0
+  // colour_cells: sum_cells |A_i - A_j| / 255 bound (cells; px^2 in a 1 px window), >= 0
+  double colour_cells_max_alpha_cells = 0;
+  int colour_cells_max_cells = 0;  // colour_cells: ColourCellCount bound (cells), >= 0
   // provenance and cross-validation figures (free form JSON object)
   std::string training_json = "{}";
 
@@ -58,9 +66,14 @@ std::string WeightsToJson(const TransitionWeights& weights);
 void SaveWeights(const TransitionWeights& weights, const std::string& path);
 
 // The weights shipped with the project (pipeline/transitions/default_weights.json,
-// compiled into the binary).
+// compiled into the binary): the colour_cells variant.
 const TransitionWeights& DefaultWeights();
 // Their text as embedded.
 const char* DefaultWeightsText();
+// The paper's six (linear stage 2) trained on the same synthetic set, as shipped before the
+// colour_cells default (pipeline/transitions/paper_weights.json, compiled in): what the benches
+// compare the default with.
+const TransitionWeights& PaperWeights();
+const char* PaperWeightsText();
 
 }  // namespace ss

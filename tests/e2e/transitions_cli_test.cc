@@ -47,8 +47,12 @@ TEST(TransitionBank, CommandLine) {
   EXPECT_GT(rate, 0.0);
   EXPECT_LT(rate, 0.5);
   EXPECT_NE(r.output.find("stage 2 then set for the positive rate"), std::string::npos) << r.output;
-  EXPECT_NE(r.output.find("stage 1 refitted as its filter"), std::string::npos) << r.output;
-  EXPECT_NO_THROW(LoadWeights(dir / "w.json"));
+  // It fits the shipped classifier (colour_cells: three thresholds, stage 1 the velocity ball).
+  EXPECT_NE(r.output.find("the shipped classifier (colour_cells) fitted on the bank for the "
+                          "positive rate"),
+            std::string::npos)
+      << r.output;
+  EXPECT_EQ(LoadWeights(dir / "w.json").stage2_variant, Stage2Variant::kColourCells);
   r = testing::RunSpritestation("transitions " + bank + " --weights " + (dir / "w.json") +
                                 " --json");
   ASSERT_EQ(r.exit_code, 0) << r.output;

@@ -36,7 +36,7 @@ TEST(TransitionCalibration, EarlyExitStageTwoDecidesAsTheFullEvaluation) {
   const auto sprites = MakeSyntheticSprites(so);
   SpriteStore store(ComparisonWindow{}, so.px_per_m);
   store.Append(AsSpriteInputs(sprites), 2);
-  TransitionWeights w = DefaultWeights();
+  TransitionWeights w = PaperWeights();
   for (const double shift : {-3.0, 0.0, 3.0}) {  // tight, shipped, loose
     TransitionWeights v = w;
     v.stage2_bias = w.stage2_bias + shift;
@@ -82,7 +82,7 @@ TEST(TransitionCalibration, StageTwoThresholdFollowsTheRarePositiveRate) {
   std::vector<double> labels;
   labels.reserve(500);
   for (int k = 0; k < 500; ++k) labels.push_back(unit(rng));
-  TransitionWeights w = DefaultWeights();
+  TransitionWeights w = PaperWeights();
   const Stage2Calibration c =
       CalibrateStage2(labels, sample, static_cast<double>(positives) / (n - 1), &w);
   // The true F1 at the chosen threshold vs the best possible.
@@ -109,7 +109,7 @@ TEST(TransitionCalibration, StageTwoThresholdFollowsTheRarePositiveRate) {
   const TransitionClassifier classifier(w);
   EXPECT_NEAR(classifier.stage2_threshold(), c.threshold, 1e-6 * (1 + c.threshold));
   // A prior ten times too high would accept far more.
-  TransitionWeights naive = DefaultWeights();
+  TransitionWeights naive = PaperWeights();
   const Stage2Calibration wrong =
       CalibrateStage2(labels, sample, 10.0 * positives / (n - 1), &naive);
   EXPECT_GT(wrong.threshold, c.threshold + 0.2);
@@ -124,7 +124,7 @@ TEST(TransitionCalibration, StageOneRefittedAsAFilterPassesTheRequestedShare) {
   const auto sprites = MakeSyntheticSprites(so);
   SpriteStore store(ComparisonWindow{}, so.px_per_m);
   store.Append(AsSpriteInputs(sprites), 2);
-  const TransitionWeights& w = DefaultWeights();
+  const TransitionWeights& w = PaperWeights();
   const PopulationSample sample = SamplePopulation(store, TransitionClassifier(w), 200, 3, 2);
   ASSERT_EQ(sample.rows.size(), 200u);
   for (const double recall : {0.95, 0.999}) {

@@ -108,7 +108,7 @@ TEST(TransitionSignature, NeverRejectsAPairStageTwoAccepts) {
   const auto sprites = MakeSyntheticSprites(so);
   SpriteStore store(ComparisonWindow{}, so.px_per_m);
   store.Append(AsSpriteInputs(sprites), 2);
-  const TransitionWeights& shipped = DefaultWeights();
+  const TransitionWeights& shipped = PaperWeights();
   for (const double shift : {1.5, 0.0, -3.0}) {
     TransitionWeights w = shipped;
     w.stage2_bias += shift;

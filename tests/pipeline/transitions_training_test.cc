@@ -215,6 +215,32 @@ TEST(TransitionTraining, KeypointTruth) {
   f.keypoint_visible = {1};  // flags that do not match the points
   EXPECT_EQ(KeypointDisplacement(e, f), INFINITY);
 
+  // The feet (points from unordered_from on) are an unordered set: the picture does not show
+  // which leg is which, so two sprites whose feet swapped places are alike.
+  SpriteTruth g{"walk", 0.0, 0.1, {0.0, 0.05, 0.02, 0.0, -0.02, 0.0}};
+  g.unordered_from = 1;
+  SpriteTruth h = g;
+  std::swap(h.keypoints_m[2], h.keypoints_m[4]);
+  EXPECT_NEAR(KeypointDisplacement(g, h), 0.0, 1e-12);
+  EXPECT_TRUE(TruthAccepts(g, h, o));
+  h.keypoints_m[3] += 0.003;  // after the best matching one foot moved 3 mm
+  EXPECT_NEAR(KeypointDisplacement(g, h), 0.003, 1e-12);
+  h.keypoints_m[1] += 0.005;  // the fixed points keep their identity
+  EXPECT_NEAR(KeypointDisplacement(g, h), 0.005, 1e-12);
+  h.keypoints_m[1] -= 0.005;
+  SpriteTruth g_ordered = g, h_ordered = h;  // ordered, each foot moved 4 cm
+  g_ordered.unordered_from = h_ordered.unordered_from = -1;
+  EXPECT_NEAR(KeypointDisplacement(g_ordered, h_ordered), std::hypot(0.04, 0.003), 1e-12);
+  EXPECT_EQ(KeypointDisplacement(g, h_ordered), INFINITY);  // sets that do not correspond
+  // Visibility under the matching: a matched pair hidden in both is not compared. Foot 1 of g
+  // is hidden; h's foot 2 (g's foot 1 swapped over) is hidden and moved 5 cm: unseen.
+  g.keypoint_visible = {1, 0, 1};
+  h.keypoint_visible = {1, 1, 0};
+  h.keypoints_m[4] += 0.05;
+  EXPECT_NEAR(KeypointDisplacement(g, h), 0.003, 1e-12);
+  h.keypoint_visible = {1, 1, 1};  // now seen
+  EXPECT_NEAR(KeypointDisplacement(g, h), 0.05, 1e-9);
+
   // A synthetic mirror's key points are its original's mirrored (x -> -x), legs permuted.
   SyntheticSpriteOptions so;
   so.frames = 300;
@@ -317,7 +343,9 @@ TEST(TransitionTraining, TrainsOnSyntheticTruth) {
   }
   TrainReport report;
   TrainWeights(x, y, ComparisonWindow{}, TrainOptions{}, &report);
-  EXPECT_GT(report.stage2.precision(), 0.8);
+  // Precision measured 0.757 since the truth matches the feet unordered (above 0.8 before): the
+  // leg-swapped pairs it now accepts are harder for the paper's six than for a person.
+  EXPECT_GT(report.stage2.precision(), 0.72);
   EXPECT_GT(report.stage2.recall(), 0.8);
   EXPECT_GE(report.stage2.precision() + report.stage2.recall(),
             report.stage1.precision() + report.stage1.recall() - 0.02)
@@ -386,6 +414,16 @@ TEST(TransitionWeightsFile, RoundTripAndDefault) {
   ASSERT_TRUE(in) << shipped;
   EXPECT_EQ(nlohmann::json::parse(in), nlohmann::json::parse(DefaultWeightsText()))
       << "default_weights.cc is stale: run pipeline/transitions/embed_default_weights.sh";
+  // So is the paper's six, kept beside it; a version-1 file of the paper variant.
+  const TransitionWeights& paper = PaperWeights();
+  EXPECT_TRUE(paper.IsValid(&why)) << why;
+  EXPECT_EQ(paper.stage2_variant, Stage2Variant::kPaper);
+  std::ifstream paper_in(ss::testing::SourcePath("pipeline/transitions/paper_weights.json"));
+  ASSERT_TRUE(paper_in);
+  const nlohmann::json paper_file = nlohmann::json::parse(paper_in);
+  EXPECT_EQ(paper_file, nlohmann::json::parse(PaperWeightsText()))
+      << "default_weights.cc is stale: run pipeline/transitions/embed_default_weights.sh";
+  EXPECT_EQ(paper_file["version"], 1);
 }
 
 TEST(TransitionWeightsFile, WrongFilesNameTheFileAndField) {

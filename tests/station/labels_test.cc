@@ -277,6 +277,9 @@ TEST(ConsoleLabels, TheExportTrainsAndARetrainRebuildsTheTable) {
   const std::string weights_path = r["weights"];
   EXPECT_EQ(fs::path(weights_path).parent_path(), fs::path(dir / "weights"));
   const TransitionWeights written = LoadWeights(weights_path);
+  // It fits the shipped classifier, as `transitions train` does.
+  EXPECT_EQ(written.stage2_variant, DefaultWeights().stage2_variant);
+  EXPECT_EQ(written.stage2_variant, trained.weights.stage2_variant);
   EXPECT_EQ(r["fingerprint"], WeightsFingerprint(written));
   EXPECT_EQ(Bank(bank.path).GetMeta(kTransitionWeightsMetaKey), WeightsFingerprint(written));
   EXPECT_EQ(r["transitions"], Bank(bank.path).Counts().transitions);
