@@ -16,7 +16,7 @@
 # OUT/hamster links to the longest hamster set of this run (what docs/examples name).
 #
 # Cached by its inputs: each stage keeps a hash of what it was made from (the content of the
-# sources it runs, its arguments, this script and the stage before's hash) and
+# sources it runs, its arguments and config, the recipe's version and the stage before's) and
 # is skipped when that has not changed, so a second run is instant. The rendered session is
 # deleted once the bank and the plate are made unless --keep-sessions (a 30 min session is
 # ~21 GB); a later stage that needs it again renders it again (synth is deterministic).
@@ -55,16 +55,17 @@ pipeline_sources=(pipeline core capture config apps/cmd_ingest.cc apps/cmd_trans
 # they hold keeps the cache.
 sources_hash() {
   if git -C "$top" rev-parse --git-dir >/dev/null 2>&1; then
-    (cd "$top" && git ls-files -co --exclude-standard -- "$@" | sort | while read -r f; do
-      echo "$f $(git hash-object "$f")"
-    done) | sha256sum | cut -c1-16
+    (cd "$top" && files="$(git ls-files -co --exclude-standard -- "$@" | sort)" &&
+      paste -d' ' <(echo "$files") <(echo "$files" | git hash-object --stdin-paths)) |
+      sha256sum | cut -c1-16
   else  # not a checkout: the binary stands for its sources
     sha256sum "$ss" | cut -c1-16
   fi
 }
 synth_src="$(sources_hash "${synth_sources[@]}")"
 pipeline_src="$(sources_hash "${pipeline_sources[@]}")"
-script_hash="$(sha256sum "$0" | cut -c1-16)"
+# Bump when a stage's recipe below changes in a way its arguments do not show.
+recipe=1
 
 stage_order="synth ingest transitions plate tag"
 now() { date +%s.%N; }
@@ -152,7 +153,9 @@ for name in "${names[@]}"; do
     ingest_args=(--config "$dir/ingest.yaml")
   fi
   synth_key="$(echo "$synth_src ${synth_args[*]}" | sha256sum | cut -c1-16)"
-  ingest_key="$(echo "$synth_key $pipeline_src ${ingest_args[*]} $script_hash" | sha256sum | cut -c1-16)"
+  config=""
+  [ ${#ingest_args[@]} -gt 0 ] && config="$(cat "$dir/ingest.yaml")"
+  ingest_key="$(echo "$synth_key $pipeline_src ${ingest_args[*]} $config $recipe" | sha256sum | cut -c1-16)"
   printf 'synth: %s (sources %s: %s)\ningest: %s (sources %s: %s)\nkeys: synth %s, later stages %s\n' \
     "${synth_args[*]}" "$synth_src" "${synth_sources[*]}" "--no-transitions ${ingest_args[*]}" \
     "$pipeline_src" "${pipeline_sources[*]}" "$synth_key" "$ingest_key" > "$dir/inputs.txt"
