@@ -70,6 +70,13 @@ recipe=1
 stage_order="synth ingest transitions plate tag"
 now() { date +%s.%N; }
 elapsed() { awk -v a="$1" -v b="$(now)" 'BEGIN { printf "%.1f", b - a }'; }
+# CPU seconds (user + system) of the finished child processes so far: the wall clock of this
+# shared machine measures the other jobs too.
+# Sets cpu_now. (`times` must run in this shell: in a pipe or $(...) it counts a subshell's.)
+children_cpu() {
+  times > "$out/.times"
+  cpu_now="$(tail -n 1 "$out/.times" | awk '{ t = 0; for (i = 1; i <= 2; ++i) { split($i, p, "m"); t += p[1] * 60 + p[2] } printf "%.1f", t }')"
+}
 
 # stage NAME KEY COMMAND...: runs COMMAND unless DIR/.NAME.key holds KEY; records its time.
 stage() {
@@ -87,17 +94,21 @@ stage() {
   done
   rm -f "$dir/.$name.key"
   echo "   $name: $*"
-  local t0
+  local t0 c0
   t0="$(now)"
+  children_cpu
+  c0="$cpu_now"
   "$@"
-  local took
+  local took cpu
   took="$(elapsed "$t0")"
+  children_cpu
+  cpu="$(awk -v a="$c0" -v b="$cpu_now" 'BEGIN { printf "%.1f", b - a }')"
   touch "$dir/timings.txt"
   grep -v "^$name " "$dir/timings.txt" > "$dir/timings.tmp" || true
-  echo "$name ${took} s wall ($(date -u +%FT%TZ), $(nproc) cores, load $(cut -d' ' -f1-3 /proc/loadavg))" >> "$dir/timings.tmp"
+  echo "$name ${took} s wall, ${cpu} s CPU ($(date -u +%FT%TZ), $(nproc) cores, load $(cut -d' ' -f1-3 /proc/loadavg))" >> "$dir/timings.tmp"
   mv "$dir/timings.tmp" "$dir/timings.txt"
   echo "$key" > "$dir/.$name.key"
-  echo "   $name: done in ${took} s"
+  echo "   $name: done in ${took} s (${cpu} s CPU)"
 }
 
 run_synth() { rm -rf "$dir/session"; nice -n 10 "$ss" synth --out "$dir/session" "${synth_args[@]}"; }
