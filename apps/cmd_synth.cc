@@ -40,8 +40,10 @@ void RunSynth(SynthArgs args) {
     }
     o.studio = studio;
   }
-  o.empty_lead_in_s = args.empty_lead_in_s >= 0 ? args.empty_lead_in_s
-                                                : (o.kind == synth::SynthKind::kAnimal ? 1.0 : 0.0);
+  o.empty_lead_in_s =
+      args.empty_lead_in_s >= 0
+          ? args.empty_lead_in_s
+          : (o.kind == synth::SynthKind::kAnimal || o.kind == synth::SynthKind::kFly ? 1.0 : 0.0);
   int w = 0, h = 0;
   char tail = 0;
   if (std::sscanf(args.size.c_str(), "%dx%d%c", &w, &h, &tail) != 2) {
@@ -111,7 +113,7 @@ void AddSynthCommand(CLI::App& app) {
   cmd->add_option("--fps", o.fps, "Frames per second");
   cmd->add_option("--size", args->size, "Image size WIDTHxHEIGHT");
   cmd->add_option("--cameras", o.cameras, "Number of cameras (1..8)");
-  cmd->add_option("--subjects", o.subjects, "Animals or figures (0..8)");
+  cmd->add_option("--subjects", o.subjects, "Animals, flies or figures (0..8)");
   cmd->add_option("--seed", o.seed, "Seed: the same seed gives the same session");
   cmd->add_option("--pixel-format", args->pixel_format, "rgb8, bgr8, bayer_rg8 or mono8");
   cmd->add_option("--noise", o.noise, "Sensor noise scale (0: none, 1: typical)");
@@ -125,7 +127,7 @@ void AddSynthCommand(CLI::App& app) {
   cmd->add_option(
       "--empty-lead-in", args->empty_lead_in_s,
       "Seconds of empty enclosure before the subjects appear (keyer training; default 1 for animal "
-      "sessions, 0 otherwise)");
+      "and fly sessions, 0 otherwise)");
   cmd->add_option(
       "--codec", o.codec,
       "Video codec: ffv1 (lossless, the default), ffvhuff (lossless, faster to decode), "

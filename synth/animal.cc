@@ -247,9 +247,13 @@ AnimalBehaviour::AnimalBehaviour(const Studio& studio, const AnimalLook& look, u
   Rng& rng = rng_;
   state_.gait_phase = rng.Uniform();
   // Sessions start with the animal on the move or resting, never mid-stand.
-  activity_ = rng.Chance(0.5) ? Activity::kWalk : Activity::kIdle;
-  activity_left_s_ = activity_ == Activity::kWalk ? rng.Uniform(1.5, 4.0) : rng.Uniform(0.5, 2.5);
-  target_speed_ = activity_ == Activity::kWalk ? rng.Uniform(0.06, 0.11) * look.scale : 0.0;
+  if (rng.Chance(0.5)) {
+    StartWalk(false);
+  } else {
+    activity_ = Activity::kIdle;
+    activity_left_s_ = rng.Uniform(0.5, 2.5);
+    target_speed_ = 0.0;
+  }
 }
 
 double AnimalBehaviour::RoomAhead(const Eigen::Vector2d& position, double heading_rad) const {
@@ -275,13 +279,45 @@ bool AnimalBehaviour::TurnToward(double target_rad, double rate, double dt_s) {
   return std::abs(diff - step) < 1e-3;
 }
 
+Eigen::Vector2d AnimalBehaviour::PickGoal() {
+  // The open floor: 0.17 m from the end walls and 0.15 m from the side walls (the body is
+  // 0.19 m long), so that walks cross the floor rather than follow the walls.
+  const double gx = std::max(0.05, studio_->half_x - 0.17);
+  const double gy = std::max(0.05, studio_->half_y - 0.15);
+  Eigen::Vector2d best = state_.position;
+  for (int attempt = 0; attempt < 8; ++attempt) {
+    const Eigen::Vector2d g(rng_.Uniform(-gx, gx), rng_.Uniform(-gy, gy));
+    if ((g - state_.position).norm() > (best - state_.position).norm()) best = g;
+    if ((g - state_.position).norm() > 0.3) break;
+  }
+  return best;
+}
+
+void AnimalBehaviour::StartWalk(bool run) {
+  const double k = look_.scale;
+  stage_ = 0;
+  stage_s_ = 0.0;
+  goal_ = PickGoal();
+  if (run) {
+    activity_ = Activity::kTrot;
+    activity_left_s_ = rng_.Uniform(0.5, 1.6);
+    target_speed_ = rng_.Uniform(0.30, 0.45) * k;
+  } else {
+    activity_ = Activity::kWalk;
+    activity_left_s_ = rng_.Uniform(2.0, 6.0);
+    target_speed_ = rng_.Uniform(0.10, 0.19) * k;
+  }
+}
+
 void AnimalBehaviour::Choose() {
   Rng& rng = rng_;
   const bool moving =
       activity_ == Activity::kWalk || activity_ == Activity::kTrot || activity_ == Activity::kTurn;
-  // Weights: idle, pause, walk, trot, turn, to-wall, to-camera (rare).
-  const double w_moving[7] = {0.10, 0.33, 0.22, 0.08, 0.14, 0.09, 0.04};
-  const double w_still[7] = {0.08, 0.04, 0.42, 0.12, 0.18, 0.11, 0.05};
+  // Weights: idle, pause, walk, run (trot), turn, to-wall, to-camera (very rare: seed 000 §6.1).
+  // Mostly on the move, as a hamster exploring an enclosure: a walk or run follows most
+  // things, rests are short, leaning on a wall is rare.
+  const double w_moving[7] = {0.06, 0.12, 0.50, 0.17, 0.11, 0.02, 0.02};
+  const double w_still[7] = {0.03, 0.02, 0.60, 0.18, 0.13, 0.02, 0.02};
   const double* w = moving ? w_moving : w_still;
   double u = rng.Uniform(), acc = 0.0;
   int pick = 0;
@@ -289,29 +325,24 @@ void AnimalBehaviour::Choose() {
     acc += w[pick];
     if (u < acc) break;
   }
-  const double k = look_.scale;
   stage_ = 0;
   stage_s_ = 0.0;
   switch (pick) {
     case 0:
       activity_ = Activity::kIdle;
-      activity_left_s_ = rng.Uniform(3.0, 10.0);
+      activity_left_s_ = rng.Uniform(1.0, 5.0);
       target_speed_ = 0.0;
       break;
     case 1:
       activity_ = Activity::kPause;
-      activity_left_s_ = rng.Uniform(0.3, 1.5);
+      activity_left_s_ = rng.Uniform(0.3, 1.2);
       target_speed_ = 0.0;
       break;
     case 2:
-      activity_ = Activity::kWalk;
-      activity_left_s_ = rng.Uniform(1.5, 5.0);
-      target_speed_ = rng.Uniform(0.06, 0.11) * k;
+      StartWalk(false);
       break;
     case 3:
-      activity_ = Activity::kTrot;
-      activity_left_s_ = rng.Uniform(0.6, 2.0);
-      target_speed_ = rng.Uniform(0.22, 0.30) * k;
+      StartWalk(true);
       break;
     case 4:
       activity_ = Activity::kTurn;
@@ -337,9 +368,10 @@ void AnimalBehaviour::Choose() {
       break;
     }
     default: {
+      // Walks on, curving round to face a camera, and rears up as soon as it does.
       activity_ = Activity::kToCamera;
       activity_left_s_ = 4.0;
-      target_speed_ = 0.0;
+      target_speed_ = 0.08 * look_.scale;
       const Eigen::Vector3d cam = cameras_.empty()
                                       ? Eigen::Vector3d(0, -1, 1)
                                       : cameras_[static_cast<size_t>(rng.UniformInt(
@@ -380,8 +412,12 @@ void AnimalBehaviour::Integrate(double dt, const std::vector<Eigen::Vector2d>& o
     case Activity::kWalk:
     case Activity::kTrot: {
       pose = activity_ == Activity::kWalk ? "walk" : "trot";
-      steer_ = steer_ * std::exp(-1.5 * dt) + rng.Normal() * 2.2 * std::sqrt(dt);
-      turn_rate = steer_;
+      // A wander on top of heading for the goal; a new goal once there.
+      steer_ = steer_ * std::exp(-2.0 * dt) + rng.Normal() * 1.6 * std::sqrt(dt);
+      if ((goal_ - s.position).norm() < 0.06 * k) goal_ = PickGoal();
+      const Eigen::Vector2d to_goal = goal_ - s.position;
+      const double bearing = Wrap(std::atan2(to_goal.y(), to_goal.x()) - s.heading_rad);
+      turn_rate = steer_ + std::clamp(2.5 * bearing, -2.5, 2.5);
       // Steer away from walls ahead and from other animals.
       const double look_ahead = 0.08 * k + 0.5 * s.speed_mps;
       const double room = RoomAhead(s.position, s.heading_rad) - kNoseReach * k;
@@ -481,34 +517,41 @@ void AnimalBehaviour::Integrate(double dt, const std::vector<Eigen::Vector2d>& o
       }
       break;
     }
-    case Activity::kToCamera:
-      pose = "turn";
-      target_speed_ = 0.0;
+    case Activity::kToCamera: {
+      // Walks on while curving round to face the camera, then rears up at once: turning on
+      // the spot first would make the turn and the stand-up one still period, which the
+      // pipeline discards when it lasts over 2 s (docs/pipeline.md, rule 5).
+      const double room = RoomAhead(s.position, s.heading_rad) - kNoseReach * k;
+      target_speed_ = room > 0.05 ? 0.08 * k : 0.0;
+      pose = target_speed_ > 0 ? "walk" : "turn";
       look_target_ = 0.0;
-      if (TurnToward(target_heading_, 2.6, dt) || activity_left_s_ <= 0) {
+      if (TurnToward(target_heading_, 2.0, dt) || activity_left_s_ <= 0) {
         activity_ = Activity::kStand;
         stage_ = 1;
         stage_s_ = 0;
-        activity_left_s_ = rng.Uniform(1.0, 2.5);
+        s.speed_mps = 0.0;
+        target_speed_ = 0.0;
+        activity_left_s_ = rng.Uniform(0.7, 1.3);  // counts the 0.4 s of rising: held 0.3-0.9 s
       }
       break;
+    }
     case Activity::kStand:
       look_target_ = 0.0;
       if (stage_ == 1) {
-        s.rear = std::min(1.0, s.rear + dt / 0.5);
+        s.rear = std::min(1.0, s.rear + dt / 0.4);
         if (s.rear >= 1.0) stage_ = 2, stage_s_ = 0;
       } else if (stage_ == 2) {
         if (activity_left_s_ <= 0) stage_ = 3, stage_s_ = 0;
       } else {
-        s.rear = std::max(0.0, s.rear - dt / 0.5);
-        if (s.rear <= 0.0) Choose();
+        s.rear = std::max(0.0, s.rear - dt / 0.4);
+        if (s.rear <= 0.0) StartWalk(false);
       }
       pose = s.rear > 0.5 ? "stand" : "idle";
       break;
   }
 
   // Speed and heading.
-  const double accel = target_speed_ > s.speed_mps ? 0.8 : 1.6;
+  const double accel = target_speed_ > s.speed_mps ? 1.5 : 2.5;
   s.speed_mps += std::clamp(target_speed_ - s.speed_mps, -accel * dt, accel * dt);
   if (activity_ == Activity::kWalk || activity_ == Activity::kTrot) {
     s.heading_rad = Wrap(s.heading_rad + turn_rate * dt);

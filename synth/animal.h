@@ -2,8 +2,10 @@
 // The studio's animal: a hamster-like articulated body (torso, rump, head,
 // ears, eyes, nose, four legs with paws, tail) built from primitives, posed from
 // an AnimalState (ground position, heading, gait phase, rearing and leaning),
-// and a behaviour model that walks, trots, turns, pauses, idles for long
-// stretches, leans on the walls and now and then rears up facing a camera.
+// and a behaviour model that walks across the open floor (0.1-0.2 m/s) toward
+// places it picks, runs in short bursts (up to ~0.5 m/s), turns both ways,
+// pauses and idles, now and then leans on a wall and, very rarely, rears up
+// facing a camera.
 //
 // Animal frame: x forward, y left, z up; origin on the floor under the body
 // centre (the "root"; it stays put while the animal rears on its hind legs).
@@ -72,6 +74,10 @@ class AnimalBehaviour {
  private:
   enum class Activity { kIdle, kPause, kWalk, kTrot, kTurn, kToWall, kLean, kToCamera, kStand };
   void Choose();
+  // Starts walking (or, `run`, a burst of running) toward a new goal on the open floor.
+  void StartWalk(bool run);
+  // A place on the open floor, away from the walls, preferably some way off.
+  Eigen::Vector2d PickGoal();
   void Integrate(double dt_s, const std::vector<Eigen::Vector2d>& others);
   // Turns the heading toward `target_rad` at up to `rate` rad/s; true when there.
   bool TurnToward(double target_rad, double rate, double dt_s);
@@ -87,11 +93,12 @@ class AnimalBehaviour {
   double activity_left_s_ = 0.0;  // time left in the activity
   double target_speed_ = 0.0;
   double target_heading_ = 0.0;
-  double steer_ = 0.0;                     // rad/s of the wander
-  double stage_s_ = 0.0;                   // time in the current sub-stage (lean/stand hold)
-  int stage_ = 0;                          // sub-stage: 0 approach/turn, 1 up, 2 hold, 3 down
-  double look_target_ = 0.0;               // head yaw target
-  const Eigen::Vector2d* seek_ = nullptr;  // during Step only
+  double steer_ = 0.0;        // rad/s of the wander
+  double stage_s_ = 0.0;      // time in the current sub-stage (lean/stand hold)
+  int stage_ = 0;             // sub-stage: 0 approach/turn, 1 up, 2 hold, 3 down
+  double look_target_ = 0.0;  // head yaw target
+  Eigen::Vector2d goal_ = Eigen::Vector2d::Zero();  // where a walk or run heads
+  const Eigen::Vector2d* seek_ = nullptr;           // during Step only
 };
 
 }  // namespace ss::synth

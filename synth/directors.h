@@ -32,6 +32,9 @@ std::unique_ptr<Director> MakeAnimalDirector(const Studio& studio,
                                              const std::vector<SynthCamera>& cameras,
                                              const DirectorOptions& options);
 
+// `subjects` flies (synth/fly.h): still most of the time, grooming, walking and darting.
+std::unique_ptr<Director> MakeFlyDirector(const Studio& studio, const DirectorOptions& options);
+
 // Calibration boards (a chessboard and a ChArUco board) held in many poses
 // before each camera in turn, then lying flat on the floor. No subjects.
 std::unique_ptr<Director> MakeCalibrationDirector(const Studio& studio,

@@ -211,6 +211,8 @@ bool SynthOptions::IsValid(std::string* why) const {
   check(threads >= 1 && threads <= 64, "threads", "expected 1..64, got " + std::to_string(threads));
   check(!(kind == SynthKind::kAnimal && studio == StudioKind::kStage), "studio",
         "animals live in the enclosure");
+  check(!(kind == SynthKind::kFly && studio == StudioKind::kStage), "studio",
+        "flies live in the enclosure");
   check(!(kind == SynthKind::kFigure && studio == StudioKind::kEnclosure), "studio",
         "figures perform on the stage");
   check(FindRecordingCodec(codec) != nullptr, "codec",
@@ -241,6 +243,9 @@ SynthSummary RenderStudioSession(const SynthOptions& o) {
       break;
     case SynthKind::kFigure:
       director = MakeFigureDirector(studio, cameras, o);
+      break;
+    case SynthKind::kFly:
+      director = MakeFlyDirector(studio, o);
       break;
   }
 

@@ -24,10 +24,11 @@
 
 namespace ss::synth {
 
-enum class SynthKind { kAnimal, kFigure, kCalibration };
+enum class SynthKind { kAnimal, kFigure, kCalibration, kFly };
 inline constexpr EnumText<SynthKind> kSynthKindTexts[] = {{SynthKind::kAnimal, "animal"},
                                                           {SynthKind::kFigure, "figure"},
-                                                          {SynthKind::kCalibration, "calibration"}};
+                                                          {SynthKind::kCalibration, "calibration"},
+                                                          {SynthKind::kFly, "fly"}};
 
 // The director's options (subjects, seed, fps, motion blur, figure variant, crossing: handed to
 // it as they are) and the session's.

@@ -275,16 +275,23 @@ TEST_F(SpecTest, AFileOverTheLimitIsRefusedBeforeItIsRead) {
   }
 }
 
-// Every example in docs/examples parses (with stand-ins for its bank, camera and image).
+// Every example in docs/examples parses, with stand-ins for the bank, plate and camera it names
+// where scripts/reference-banks.sh makes them (recordings/reference/, relative to the spec).
 TEST_F(SpecTest, TheDocumentedExamplesAreValid) {
   namespace fs = std::filesystem;
   const fs::path examples = fs::path(ss::testing::SourcePath("docs/examples"));
-  for (const char* name : {"hamster.ssbank", "fly.ssbank", "floor.png"})
-    std::ofstream(dir_ / name) << "x";
+  const fs::path copies = fs::path(dir_.path()) / "docs" / "examples";
+  fs::create_directories(copies);
+  for (const char* set : {"hamster", "flies"}) {
+    const fs::path reference = fs::path(dir_.path()) / "recordings" / "reference" / set;
+    fs::create_directories(reference);
+    for (const char* name : {"hamster.ssbank", "fly.ssbank", "floor.png", "virtual.cameramodel"})
+      std::ofstream(reference / name) << "x";
+  }
   int count = 0;
   for (const auto& entry : fs::directory_iterator(examples)) {
     if (entry.path().extension() != ".yaml") continue;
-    const fs::path copy = fs::path(dir_.path()) / entry.path().filename();
+    const fs::path copy = copies / entry.path().filename();
     fs::copy_file(entry.path(), copy, fs::copy_options::overwrite_existing);
     EXPECT_NO_THROW(LoadAnimationSpec(copy.string())) << entry.path();
     ++count;

@@ -87,9 +87,9 @@ TEST(AnimalBehaviour, ShowsEveryBehaviourAndStaysOnTheFloor) {
     const SimRun run = Simulate(seed, 200.0);
     for (const auto& [pose, n] : run.poses) seen.insert(pose);
     EXPECT_EQ(run.left_floor, 0);
-    EXPECT_LT(run.max_speed, 0.4);
-    // Long idles: a good share of the time is spent resting.
-    EXPECT_GT(run.poses.count("idle") ? run.poses.at("idle") : 0, 200 * 30 / 10) << "seed " << seed;
+    EXPECT_LT(run.max_speed, 0.55);  // runs in bursts up to ~0.5 m/s (scale up to 1.12)
+    // Rests: some of the time is spent idle (mostly it explores, tests/synth/motion_test.cc).
+    EXPECT_GT(run.poses.count("idle") ? run.poses.at("idle") : 0, 200 * 30 / 20) << "seed " << seed;
     lean_frames += run.lean_frames;
     lean_touching += run.lean_touching;
   }
