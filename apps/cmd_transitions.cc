@@ -29,6 +29,7 @@ struct Args {
   uint64_t seed = 1;
   double stage1_recall = 0.999;
   double positive_rate = -1;
+  std::string variant;  // train: "paper" | "colour_cells"; "": the default weights' variant
   bool json = false, quiet = false;
   bool include_merged = false;
 };
@@ -80,6 +81,13 @@ void Train(const Args& a) {
   options.train.folds = a.folds;
   options.train.seed = a.seed;
   options.window = DefaultWeights().window;
+  if (a.variant == "colour_cells") {
+    options.variant = Stage2Variant::kColourCells;
+    options.window = ColourCellsWeights().window;  // its 1 px window on the contact point
+  } else if (a.variant == "paper") {
+    options.variant = Stage2Variant::kPaper;
+    options.window = PaperWeights().window;
+  }
   options.stage1_recall = a.stage1_recall;
   options.positive_rate = a.positive_rate;
   options.threads = a.threads;
@@ -128,7 +136,7 @@ void Train(const Args& a) {
   }
   if (r.colour_cells) {
     std::printf(
-        "  the shipped classifier (colour_cells) fitted on %s: velocity <= %.4g m/s AND alpha "
+        "  stage 2 (colour_cells) fitted on %s: velocity <= %.4g m/s AND alpha "
         "difference <= %.4g cells AND <= %d colour-different cells; estimated precision %.3f, "
         "recall %.3f (stage 1: the velocity ball)\n",
         r.stage2_calibrated ? "the bank for the positive rate" : "the labels alone (50/50)",
@@ -256,6 +264,10 @@ void AddTransitionsCommand(CLI::App& app) {
           "(default: the labels file's '# positive_rate=' line)")
       ->check(CLI::Range(0.0, 1.0));
   train->add_option("--threads", args->threads, "Worker threads")->check(CLI::Range(1, 64));
+  train
+      ->add_option("--variant", args->variant,
+                   "Stage 2 to fit: paper (the default's) or colour_cells (docs/transitions.md)")
+      ->check(CLI::IsMember({"paper", "colour_cells"}));
   train->add_flag("--json", args->json, "Print JSON");
   train->callback([args] { Train(*args); });
 

@@ -279,4 +279,10 @@ const TransitionWeights& PaperWeights() {
   return weights;
 }
 
+const TransitionWeights& ColourCellsWeights() {
+  static const TransitionWeights weights = ParseWeights(
+      ColourCellsWeightsText(), "pipeline/transitions/colour_cells_weights.json (built in)");
+  return weights;
+}
+
 }  // namespace ss

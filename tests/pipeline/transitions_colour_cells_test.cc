@@ -1,4 +1,4 @@
-// The colour_cells stage-2 variant, the shipped default (velocity AND alpha difference AND the
+// The colour_cells stage-2 variant, shipped as an option (velocity AND alpha difference AND the
 // count of colour-different cells): the feature is right on hand-made pairs and its SIMD kernel
 // agrees with the plain loop, the filter never rejects a pair the full evaluation keeps, the
 // weights file carries the variant, and its fit picks the thresholds the counts call for.
@@ -221,10 +221,10 @@ TEST(TransitionColourCells, WeightsFileCarriesTheVariant) {
             }).find("w.json: stage2.colour_cells.max_velocity_mps: missing"),
             std::string::npos);
   // The shipped default is this variant, and its stage 1 is the velocity ball of its bound.
-  const TransitionClassifier shipped(DefaultWeights());
+  const TransitionClassifier shipped(ColourCellsWeights());
   ASSERT_TRUE(shipped.colour_cells());
   CheapFeatures a, b;
-  b.velocity_x_mps = DefaultWeights().colour_cells_max_velocity_mps;
+  b.velocity_x_mps = ColourCellsWeights().colour_cells_max_velocity_mps;
   b.colour[0] = b.colour[1] = b.colour[2] = 250;  // other cheap features do not count
   b.area_m2 = 1;
   EXPECT_TRUE(shipped.Stage1Accepts(a, b));

@@ -295,12 +295,14 @@ std::string ErrorOf(const std::string& text) {
 
 TEST(TransitionLinf, WeightsFileCarriesTheVariant) {
   // The shipped paper file (version 1) loads as the paper's variant and is written back as
-  // version 1; the default is the colour_cells variant, a version-2 file.
+  // version 1; so is the default (the paper's six); the colour_cells option is a version-2 file.
   EXPECT_EQ(PaperWeights().stage2_variant, Stage2Variant::kPaper);
   EXPECT_EQ(nlohmann::json::parse(WeightsToJson(PaperWeights()))["version"], 1);
   EXPECT_FALSE(TransitionClassifier(PaperWeights()).linf());
-  EXPECT_EQ(DefaultWeights().stage2_variant, Stage2Variant::kColourCells);
-  EXPECT_EQ(nlohmann::json::parse(WeightsToJson(DefaultWeights()))["version"], 2);
+  EXPECT_EQ(DefaultWeights().stage2_variant, Stage2Variant::kPaper);
+  EXPECT_EQ(nlohmann::json::parse(WeightsToJson(DefaultWeights()))["version"], 1);
+  EXPECT_EQ(ColourCellsWeights().stage2_variant, Stage2Variant::kColourCells);
+  EXPECT_EQ(nlohmann::json::parse(WeightsToJson(ColourCellsWeights()))["version"], 2);
 
   ComparisonWindow window;
   window.cells_x = 60;

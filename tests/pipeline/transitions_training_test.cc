@@ -424,6 +424,14 @@ TEST(TransitionWeightsFile, RoundTripAndDefault) {
   EXPECT_EQ(paper_file, nlohmann::json::parse(PaperWeightsText()))
       << "default_weights.cc is stale: run pipeline/transitions/embed_default_weights.sh";
   EXPECT_EQ(paper_file["version"], 1);
+  // And the colour_cells option, a version-2 file of its variant.
+  const TransitionWeights& cells = ColourCellsWeights();
+  EXPECT_TRUE(cells.IsValid(&why)) << why;
+  EXPECT_EQ(cells.stage2_variant, Stage2Variant::kColourCells);
+  std::ifstream cells_in(ss::testing::SourcePath("pipeline/transitions/colour_cells_weights.json"));
+  ASSERT_TRUE(cells_in);
+  EXPECT_EQ(nlohmann::json::parse(cells_in), nlohmann::json::parse(ColourCellsWeightsText()))
+      << "default_weights.cc is stale: run pipeline/transitions/embed_default_weights.sh";
 }
 
 TEST(TransitionWeightsFile, WrongFilesNameTheFileAndField) {
