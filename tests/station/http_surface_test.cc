@@ -380,7 +380,8 @@ TEST_F(HttpSurface, EveryBodyFramingIsHeldToOneLimitWhileItIsRead) {
       },
       "multipart, chunked");
   stream(
-      post + "Connection: close\r\n\r\n", [&](size_t) { return mib; }, "no length");
+      post + "Connection: close\r\n\r\n", [&](size_t) -> const std::string& { return mib; },
+      "no length");
   // Each refused client's connection is closed; the server answers on.
   EXPECT_EQ(Exchange(port_, Get("/")).status, 200);
 }

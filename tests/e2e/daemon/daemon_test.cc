@@ -822,6 +822,7 @@ TEST_F(DaemonTest, ChunkedBodiesOverTheLimitAre413AndCostNoMemory) {
   std::atomic<int> refused{0};
   std::atomic<uint64_t> sent_most{0};
   std::vector<std::thread> clients;
+  clients.reserve(kClients);
   const auto t0 = Clock::now();
   for (int c = 0; c < kClients; ++c) {
     clients.emplace_back([&, c] {
