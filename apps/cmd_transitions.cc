@@ -7,15 +7,20 @@
 #include <cstdio>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <thread>
+#include <utility>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
 #include "apps/commands.h"
+#include "core/bank.h"
 #include "core/error.h"
 #include "pipeline/transitions/bank_training.h"
 #include "pipeline/transitions/bank_transitions.h"
+#include "pipeline/transitions/transition_jumps.h"
 #include "pipeline/transitions/unit_worker.h"
 
 namespace ss::apps {
@@ -32,6 +37,7 @@ struct Args {
   std::string variant;  // train: "paper" | "colour_cells"; "": the default weights' variant
   bool json = false, quiet = false;
   bool include_merged = false;
+  int jump_sample = TransitionJumpOptions{}.max_transitions;
 };
 
 TransitionWeights WeightsOf(const Args& a) {
@@ -73,7 +79,27 @@ void Build(const Args& a) {
     (*progress)(stage, done, total);
   };
   const BankUpdateSummary s = UpdateBankTransitions(a.bank, options);
-  std::printf("%s", a.json ? (s.ToJson() + "\n").c_str() : s.ToText().c_str());
+  // The judge without a truth: how visible the kept transitions are (issue 34).
+  std::optional<TransitionJumpSummary> jumps;
+  if (a.jump_sample > 0) {
+    const Bank bank(a.bank);
+    std::vector<std::pair<int64_t, int64_t>> pairs;
+    for (const TransitionRecord& t : bank.LoadTransitions())
+      pairs.emplace_back(t.from_sprite, t.to_sprite);
+    VisibleJumpMeter meter(bank);
+    jumps = MeasureTransitionJumps(meter, pairs, {.max_transitions = a.jump_sample});
+  }
+  if (!a.json) {
+    std::printf("%s%s", s.ToText().c_str(), jumps ? jumps->ToText().c_str() : "");
+    return;
+  }
+  nlohmann::json j = nlohmann::json::parse(s.ToJson());
+  if (jumps) {
+    j["jumps"] = jumps->ToJson();
+    j["transitions_per_sprite"] =
+        s.sprites > 0 ? static_cast<double>(s.transitions) / static_cast<double>(s.sprites) : 0.0;
+  }
+  std::printf("%s\n", j.dump(2).c_str());
 }
 
 void Train(const Args& a) {
@@ -239,6 +265,9 @@ void AddTransitionsCommand(CLI::App& app) {
   cmd->add_flag("--quiet", args->quiet, "No progress lines");
   cmd->add_flag("--include-merged", args->include_merged,
                 "Sprites tagged merged (two subjects in one blob) take part too");
+  cmd->add_option("--jump-sample", args->jump_sample,
+                  "Judge at most this many kept transitions by their visible jump (0: none)")
+      ->check(CLI::Range(0, 10000000));
   cmd->add_flag("--json", args->json, "Print JSON");
   cmd->callback([cmd, args] {
     if (cmd->get_subcommands().empty()) Build(*args);

@@ -238,15 +238,6 @@ bool JudgeOptions::IsValid(std::string* why) const {
   return check.ok();
 }
 
-std::optional<double> Quantile(std::vector<double> values, double q) {
-  if (values.empty()) return std::nullopt;
-  std::sort(values.begin(), values.end());
-  const double at = std::clamp(q, 0.0, 1.0) * static_cast<double>(values.size() - 1);
-  const size_t below = static_cast<size_t>(std::floor(at));
-  const size_t above = std::min(values.size() - 1, below + 1);
-  return values[below] + (at - static_cast<double>(below)) * (values[above] - values[below]);
-}
-
 StutterFigures MeasureStutter(const std::vector<SpriteSequence>& sprites, int window_steps,
                               const std::function<bool(const BankFrameRef&)>& is_still) {
   StutterFigures out;

@@ -11,6 +11,7 @@
 #include "animate/scene.h"
 #include "animate/sequence_io.h"
 #include "judge/judgement.h"
+#include "pipeline/transitions/transition_jumps.h"  // Quantile
 #include "pipeline/transitions/visible_jump.h"
 
 namespace ss {
@@ -36,8 +37,5 @@ Judgement JudgeSequences(const SequenceFile& file, const std::vector<std::string
 // The stutter of some sprites' frames alone; `is_still` exempts a step showing that frame.
 StutterFigures MeasureStutter(const std::vector<SpriteSequence>& sprites, int window_steps,
                               const std::function<bool(const BankFrameRef&)>& is_still);
-
-// Linear-interpolated quantile q in [0, 1] of `values` (nullopt when empty).
-std::optional<double> Quantile(std::vector<double> values, double q);
 
 }  // namespace ss

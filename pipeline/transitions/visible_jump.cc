@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <mutex>
+#include <utility>
 
 #include "core/error.h"
 #include "core/option_checks.h"
@@ -69,16 +70,43 @@ bool VisibleJumpOptions::IsValid(std::string* why) const {
 }
 
 VisibleJumpMeter::VisibleJumpMeter(const Bank& bank, VisibleJumpOptions options)
-    : bank_(bank), options_(options) {
+    : options_(options) {
   if (std::string why; !options_.IsValid(&why)) throw InputError("visible jump options", why);
-  const std::vector<SpriteFeatures> features = bank_.LoadFeatures();
+  const std::vector<SpriteFeatures> features = bank.LoadFeatures();
+  std::vector<JumpFrame> frames;
+  frames.reserve(features.size());
   for (const SpriteFeatures& f : features) {
-    if (f.next < 0) continue;
-    next_[f.id] = features[f.next].id;
+    JumpFrame frame{f.id, f.clip_id, f.mirrored, std::nullopt};
+    if (f.next >= 0) frame.next = features[f.next].id;
+    frames.push_back(frame);
+  }
+  Index(frames);
+  load_ = [&bank](int64_t id) {
+    const SpriteRecord record = bank.LoadSprite(id);
+    return BillboardFromPixels(bank.LoadPixels(id), record.anchor_x_px, record.anchor_y_px);
+  };
+  cache_key_ = bank.path() + "\n" + std::to_string(features.size()) + "\n" +
+               std::to_string(options_.max_pairs) + "\n" + std::to_string(options_.min_step_px);
+}
+
+VisibleJumpMeter::VisibleJumpMeter(const std::vector<JumpFrame>& frames, BillboardLoader load,
+                                   const std::string& cache_key, VisibleJumpOptions options)
+    : load_(std::move(load)), options_(options) {
+  if (std::string why; !options_.IsValid(&why)) throw InputError("visible jump options", why);
+  Index(frames);
+  if (!cache_key.empty()) {
+    cache_key_ = cache_key + "\n" + std::to_string(frames.size()) + "\n" +
+                 std::to_string(options_.max_pairs) + "\n" + std::to_string(options_.min_step_px);
+  }
+}
+
+void VisibleJumpMeter::Index(const std::vector<JumpFrame>& frames) {
+  for (const JumpFrame& f : frames) {
+    clip_of_[f.id] = {f.clip, f.mirrored};
+    if (!f.next) continue;
+    next_[f.id] = *f.next;
     if (!f.mirrored) originals_with_next_.push_back(f.id);
   }
-  cache_key_ = bank_.path() + "\n" + std::to_string(features.size()) + "\n" +
-               std::to_string(options_.max_pairs) + "\n" + std::to_string(options_.min_step_px);
 }
 
 std::optional<int64_t> VisibleJumpMeter::NaturalSuccessor(int64_t id) const {
@@ -87,13 +115,17 @@ std::optional<int64_t> VisibleJumpMeter::NaturalSuccessor(int64_t id) const {
   return it->second;
 }
 
+std::optional<TransitionKind> VisibleJumpMeter::KindOf(int64_t from, int64_t to) const {
+  const auto a = clip_of_.find(from), b = clip_of_.find(to);
+  if (a == clip_of_.end() || b == clip_of_.end()) return std::nullopt;
+  if (a->second.second != b->second.second) return TransitionKind::kOriginalMirror;
+  return a->second.first == b->second.first ? TransitionKind::kWithinClip
+                                            : TransitionKind::kJoiningClips;
+}
+
 const RgbaBillboard& VisibleJumpMeter::Billboard(int64_t id) {
   if (const auto it = billboards_.find(id); it != billboards_.end()) return it->second;
-  const SpriteRecord record = bank_.LoadSprite(id);
-  return billboards_
-      .emplace(id,
-               BillboardFromPixels(bank_.LoadPixels(id), record.anchor_x_px, record.anchor_y_px))
-      .first->second;
+  return billboards_.emplace(id, load_(id)).first->second;
 }
 
 double VisibleJumpMeter::Difference_px(int64_t a, int64_t b) {
@@ -105,10 +137,11 @@ double VisibleJumpMeter::Difference_px(int64_t a, int64_t b) {
 }
 
 double VisibleJumpMeter::MedianStep_px() {
-  {
+  if (median_step_px_) return *median_step_px_;
+  if (!cache_key_.empty()) {
     const std::lock_guard<std::mutex> lock(CacheMutex());
     const auto it = MedianCache().find(cache_key_);
-    if (it != MedianCache().end()) return it->second;
+    if (it != MedianCache().end()) return *(median_step_px_ = it->second);
   }
   const size_t n = originals_with_next_.size();
   const size_t pairs = std::min(n, static_cast<size_t>(options_.max_pairs));
@@ -126,6 +159,8 @@ double VisibleJumpMeter::MedianStep_px() {
     median = steps.size() % 2 == 1 ? steps[m] : 0.5 * (steps[m - 1] + steps[m]);
   }
   median = std::max(median, options_.min_step_px);
+  median_step_px_ = median;
+  if (cache_key_.empty()) return median;
   const std::lock_guard<std::mutex> lock(CacheMutex());
   MedianCache()[cache_key_] = median;
   return median;

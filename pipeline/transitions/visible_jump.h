@@ -14,6 +14,7 @@
 //   Jump(from -> to) = Difference_px(to, n) / MedianStep_px: 1.0 is no more visible than an
 //     ordinary frame step, 0 the natural successor itself.
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <optional>
 #include <string>
@@ -39,16 +40,38 @@ struct VisibleJumpOptions {
   bool IsValid(std::string* why) const;
 };
 
-// The visible jumps of one bank. Reads the bank's clip structure (no pixels) on construction
-// and billboards on demand (a few hundred kept). Borrows `bank` for its lifetime; one thread.
+// One sprite of the clip structure a meter reads.
+struct JumpFrame {
+  int64_t id = 0;
+  int64_t clip = 0;
+  bool mirrored = false;
+  std::optional<int64_t> next;  // the next frame's id (same mirrored flag); none at a clip's end
+};
+
+// A sprite's billboard at full resolution (straight colour), by id; InputError if unknown.
+using BillboardLoader = std::function<RgbaBillboard(int64_t id)>;
+
+// How a transition from -> to leaves its clip: to another frame of the same clip, to another
+// clip, or between an original and a mirrored copy.
+enum class TransitionKind { kWithinClip, kJoiningClips, kOriginalMirror };
+
+// The visible jumps of one bank, or of any set of sprites with clips. Reads the clip structure
+// (no pixels) on construction and billboards on demand (a few hundred kept). One thread.
 class VisibleJumpMeter {
  public:
-  // InputError for invalid options or a bank that cannot be read.
+  // Borrows `bank` for the meter's lifetime. InputError for invalid options or a bank that
+  // cannot be read.
   explicit VisibleJumpMeter(const Bank& bank, VisibleJumpOptions options = {});
+  // Sprites held elsewhere (the bench's synthetic sets). `cache_key` names the set for
+  // MedianStep_px's process-wide cache ("": not cached). InputError for invalid options.
+  VisibleJumpMeter(const std::vector<JumpFrame>& frames, BillboardLoader load,
+                   const std::string& cache_key, VisibleJumpOptions options = {});
 
   // The next frame of `id`'s clip with the same mirrored flag; nullopt at the clip's end or
   // for a sprite outside the bank's complete clips.
   std::optional<int64_t> NaturalSuccessor(int64_t id) const;
+  // The kind of the transition from -> to; nullopt when either is not one of the sprites.
+  std::optional<TransitionKind> KindOf(int64_t from, int64_t to) const;
   // Contact-aligned difference of two of the bank's sprites, px. InputError for an unknown id.
   double Difference_px(int64_t a, int64_t b);
   // The median consecutive-frame difference of the bank's clips, px (>= min_step_px).
@@ -62,11 +85,15 @@ class VisibleJumpMeter {
  private:
   const RgbaBillboard& Billboard(int64_t id);
 
-  const Bank& bank_;
+  void Index(const std::vector<JumpFrame>& frames);
+
+  BillboardLoader load_;
   VisibleJumpOptions options_;
   std::unordered_map<int64_t, int64_t> next_;  // sprite id -> its natural successor's id
-  std::vector<int64_t> originals_with_next_;   // in (clip, frame) order
-  std::string cache_key_;
+  std::unordered_map<int64_t, std::pair<int64_t, bool>> clip_of_;  // id -> (clip, mirrored)
+  std::vector<int64_t> originals_with_next_;                       // in (clip, frame) order
+  std::string cache_key_;                 // "": MedianStep_px is not cached process-wide
+  std::optional<double> median_step_px_;  // once computed or read from the cache
   std::map<int64_t, RgbaBillboard> billboards_;
 };
 
