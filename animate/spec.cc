@@ -764,12 +764,7 @@ void SpecReader::CheckReferences() {
 }  // namespace
 
 AnimationSpec ParseAnimationSpec(const std::string& yaml, const std::string& origin) {
-  YAML::Node root;
-  try {
-    root = YAML::Load(yaml);
-  } catch (const YAML::Exception& e) {
-    throw InputError(origin + ":" + std::to_string(e.mark.line + 1), "not valid YAML: " + e.msg);
-  }
+  const YAML::Node root = LoadOneDocument(yaml, origin);
   try {
     return SpecReader(origin).Read(root);
   } catch (const YAML::Exception& e) {

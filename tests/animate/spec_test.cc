@@ -201,6 +201,17 @@ TEST_F(SpecTest, BadSpecsNameTheLineAndTheField) {
   EXPECT_NE(ErrorOf("sprites: [\n").find(o + ":"), std::string::npos);  // YAML syntax: a line too
 }
 
+// Issue 39: one YAML document, nested no deeper than yaml-cpp reads, each said so (a second
+// document was dropped without a word; deep nesting was "bad file").
+TEST_F(SpecTest, OneDocumentOfBoundedDepth) {
+  const std::string o = Origin();
+  EXPECT_EQ(ErrorOf(std::string(kGood) + "---\nversion: 2\n"),
+            o + ":23: a second YAML document (---) starts here; the file must hold one document");
+  EXPECT_EQ(ErrorOf(Edit("smoothness: 0.5",
+                         "smoothness: " + std::string(600, '[') + std::string(600, ']'))),
+            o + ":17: nested deeper than 499 levels");
+}
+
 // The whole file is read before it is refused: every mistake, each with its line and field, in
 // the order of the file (the station config's reader, core/yaml_reader.h).
 TEST_F(SpecTest, EveryMistakeOfTheFileIsReported) {

@@ -474,6 +474,20 @@ TEST(StationConfig, SyntaxErrorsAndBadFiles) {
   }
 }
 
+// Issue 39: one YAML document, nested no deeper than yaml-cpp reads, each said so (a second
+// document was dropped without a word; deep nesting was "bad file").
+TEST(StationConfig, OneDocumentOfBoundedDepth) {
+  EXPECT_EQ(ErrorOf("version: 1\n---\ncameras: 3\n"),
+            "station.yaml:2: a second YAML document (---) starts here; the file must hold one "
+            "document");
+  EXPECT_EQ(ErrorOf("---\nversion: 1\n---\n"),
+            "station.yaml:3: a second YAML document (---) starts here; the file must hold one "
+            "document");
+  EXPECT_EQ(ErrorOf("version: 1\nlogging:\n  level: " + std::string(600, '[') +
+                    std::string(600, ']') + "\n"),
+            "station.yaml:3: nested deeper than 499 levels");
+}
+
 TEST(StationConfig, FilesAreCheckedWhenAsked) {
   ScratchDir dir;
   const std::string yaml =
