@@ -503,6 +503,10 @@ TEST(StationConfig, ValuesTheDaemonCannotHoldAreRefused) {
   EXPECT_EQ(ErrorOf("cameras:\n  - name: a/b\n    source: v4l2\n    device: x\n"),
             "station.yaml:2: cameras[0].name: expected letters, digits, '_', '-' or '.', got "
             "\"a/b\"");
+  // Any long value is quoted in part, with its length (core/yaml_reader.h, Quoted).
+  EXPECT_EQ(ErrorOf(cam + "    fps: " + std::string(100, 'f') + "\n"),
+            "station.yaml:5: cameras[0].fps: expected a positive number, got \"" +
+                std::string(64, 'f') + "...\" (100 characters)");
   // No cameras at all: replay and ingest did nothing and exited 0.
   EXPECT_EQ(ErrorOf("cameras: []\n"), "station.yaml:1: cameras: expected at least one camera");
   // The bank: a folder or a device, in the words the daemon refuses it with.
