@@ -64,6 +64,17 @@ bool AnimateRunOptions::IsValid(std::string* why) const {
   const double budget = optimizer.replacement.time_budget_seconds;
   check(budget > 0 && std::isfinite(budget), "optimizer.replacement.time_budget_seconds",
         "must be a positive number of seconds, got " + OptionProblems::Num(budget));
+  check(!(budget > kMaxTimeBudgetSeconds) || !std::isfinite(budget),
+        "optimizer.replacement.time_budget_seconds",
+        "must be at most " + OptionProblems::Num(kMaxTimeBudgetSeconds) + " seconds (a day), got " +
+            OptionProblems::Num(budget));
+  // Each snapshot keeps every sequence: at most kMaxSpecSnapshots of them over the budget.
+  const double every = optimizer.snapshot_every_s;
+  check(every == 0 || (every > 0 && every * kMaxSpecSnapshots >= budget),
+        "optimizer.snapshot_every_s",
+        "must be 0 or >= " + OptionProblems::Num(budget / kMaxSpecSnapshots) +
+            " s (the time budget / " + std::to_string(kMaxSpecSnapshots) + "), got " +
+            OptionProblems::Num(every));
   return check.ok();
 }
 

@@ -175,6 +175,10 @@ bool BeamOptions::IsValid(std::string* why) const {
         "must be >= 0 (0: every frame), got " + std::to_string(start_frames));
   check(time_budget_seconds >= 0 && std::isfinite(time_budget_seconds), "time_budget_seconds",
         "must be seconds >= 0 (0: one pass), got " + OptionProblems::Num(time_budget_seconds));
+  check(!(time_budget_seconds > kMaxTimeBudgetSeconds) || !std::isfinite(time_budget_seconds),
+        "time_budget_seconds",
+        "must be at most " + OptionProblems::Num(kMaxTimeBudgetSeconds) + " seconds (a day), got " +
+            OptionProblems::Num(time_budget_seconds));
   return check.ok();
 }
 

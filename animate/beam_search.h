@@ -13,6 +13,9 @@
 
 namespace ss {
 
+// The longest time budget an optimizer takes (a spec's time_budget_s, `--time-budget`): a day.
+inline constexpr double kMaxTimeBudgetSeconds = 86400;
+
 struct BeamOptions {
   int width = 32;        // partial sequences kept per step
   int length = 0;        // steps to extend to; 0: the sprite's max_frames, else initial_frames

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstdio>
 #include <functional>
 #include <limits>
 #include <queue>
@@ -87,9 +88,29 @@ bool ReachOptions::IsValid(std::string* why) const {
   return check.ok();
 }
 
+int64_t ReachSetBytes(int num_frames, int set_size) {
+  const int64_t n = std::max(num_frames, 0);
+  const int64_t stride = std::min<int64_t>(std::max(set_size, 0), std::max<int64_t>(n, 1));
+  return n * stride * static_cast<int64_t>(sizeof(ReachSets::Entry) + sizeof(uint16_t));
+}
+
+std::string ReachSetTooLarge(int num_frames, int set_size) {
+  const int64_t bytes = ReachSetBytes(num_frames, set_size);
+  if (bytes <= kMaxReachSetBytes) return "";
+  const int64_t per_root = ReachSetBytes(num_frames, 1);  // one entry per root
+  const int64_t most = per_root > 0 ? kMaxReachSetBytes / per_root : 0;
+  char gib[32];
+  std::snprintf(gib, sizeof gib, "%.1f", static_cast<double>(bytes) / (int64_t{1} << 30));
+  return "set_size: " + std::to_string(set_size) + " for a bank of " + std::to_string(num_frames) +
+         " frames takes " + gib + " GiB per F/B set, over the 1 GiB a set may take (at most " +
+         std::to_string(most) + " for this bank)";
+}
+
 ReachSets ReachSets::Build(const TransitionGraph& graph, ReachDirection direction,
                            const ReachOptions& options, std::span<const double> entry_cost) {
   if (std::string why; !options.IsValid(&why)) throw InputError("reach options", why);
+  if (const std::string why = ReachSetTooLarge(graph.num_frames(), options.set_size); !why.empty())
+    throw InputError("reach options", why);
   if (!entry_cost.empty() && static_cast<int>(entry_cost.size()) != graph.num_frames()) {
     throw InputError("reach.entry_cost", "needs one value per frame");
   }

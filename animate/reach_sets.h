@@ -8,6 +8,7 @@
 // required tag, slow frames) and per step (so long zero-cost runs are not free).
 #include <cstdint>
 #include <span>
+#include <string>
 #include <vector>
 
 #include "animate/transition_graph.h"
@@ -23,6 +24,14 @@ struct ReachOptions {
   // False with "FIELD: reason" lines in `why` (core/option_checks.h) for values out of range.
   bool IsValid(std::string* why) const;
 };
+
+// The memory one F or B set of `num_frames` roots takes at `set_size` (entries and depths), and
+// the most a set may take: a bank of 50,000 frames at set_size 65535 would take 33 GiB.
+inline constexpr int64_t kMaxReachSetBytes = int64_t{1} << 30;  // 1 GiB per set
+int64_t ReachSetBytes(int num_frames, int set_size);
+// Why `set_size` is too large for a bank of `num_frames` frames (with the largest that fits), or
+// "".
+std::string ReachSetTooLarge(int num_frames, int set_size);
 
 class ReachSets {
  public:

@@ -590,6 +590,10 @@ bool ReplacementOptions::IsValid(std::string* why) const {
         "must be metres >= 0, got " + OptionProblems::Num(reference_speed_m));
   check(time_budget_seconds > 0 && std::isfinite(time_budget_seconds), "time_budget_seconds",
         "must be a positive number of seconds, got " + OptionProblems::Num(time_budget_seconds));
+  check(!(time_budget_seconds > kMaxTimeBudgetSeconds) || !std::isfinite(time_budget_seconds),
+        "time_budget_seconds",
+        "must be at most " + OptionProblems::Num(kMaxTimeBudgetSeconds) + " seconds (a day), got " +
+            OptionProblems::Num(time_budget_seconds));
   check(max_tries >= 1, "max_tries", "must be >= 1, got " + std::to_string(max_tries));
   check(changes_per_turn >= 1, "changes_per_turn",
         "must be >= 1, got " + std::to_string(changes_per_turn));

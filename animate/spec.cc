@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -50,6 +51,13 @@ struct WindowKeys {
   std::optional<SpecTime> at, from, to;
 };
 
+// A number as written, without rounding to 6 digits ("10000000", not "1e+07").
+std::string Exact(double v) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.15g", v);
+  return text;
+}
+
 enum class OffsetAxes { kHeading, kGround };
 constexpr EnumText<OffsetAxes> kOffsetAxesTexts[] = {{OffsetAxes::kHeading, "heading"},
                                                      {OffsetAxes::kGround, "ground"}};
@@ -87,10 +95,13 @@ class SpecReader {
 
   // --- values of one node at `path` (list items, and the values of shaped keys)
   bool Number(const YAML::Node& node, const std::string& path, double& out);
-  bool WholeNumber(const YAML::Node& node, const std::string& path, int low, int64_t& out);
+  bool WholeNumber(const YAML::Node& node, const std::string& path, int low, int64_t& out,
+                   int64_t high = 1000000000);
   bool Text(const YAML::Node& node, const std::string& path, std::string& out);
   bool Point(const YAML::Node& node, const std::string& path, Eigen::Vector2d& out);
   bool Time(const YAML::Node& node, const std::string& path, SpecTime& out);
+  // Why `seconds` lies past the animation's end (its steps beyond its longest sequence), or "".
+  std::string PastTheEnd(double seconds) const;
   bool ExistingFile(const YAML::Node& node, const std::string& path, std::string& out);
 
   // A key whose value `read` takes from its node, once the key is there with a value.
@@ -188,13 +199,17 @@ bool SpecReader::Number(const YAML::Node& node, const std::string& path, double&
   return true;
 }
 
-bool SpecReader::WholeNumber(const YAML::Node& node, const std::string& path, int low,
-                             int64_t& out) {
+bool SpecReader::WholeNumber(const YAML::Node& node, const std::string& path, int low, int64_t& out,
+                             int64_t high) {
   double value = 0;
   const bool number = node.IsScalar() && YAML::convert<double>::decode(node, value);
-  if (!number || value != std::floor(value) || value < low || value > 1e9) {
+  if (!number || value != std::floor(value) || value < low) {
     msg_.Error(path,
                "expected a whole number >= " + std::to_string(low) + ", got " + ShapeOf(node));
+    return false;
+  }
+  if (value > static_cast<double>(high)) {
+    msg_.Error(path, "must be at most " + std::to_string(high) + ", got " + ShapeOf(node));
     return false;
   }
   out = static_cast<int64_t>(value);
@@ -234,8 +249,27 @@ bool SpecReader::Time(const YAML::Node& node, const std::string& path, SpecTime&
     msg_.Error(path, "must be >= 0 (seconds) or end");
     return false;
   }
+  if (const std::string past = PastTheEnd(seconds); !past.empty()) {
+    msg_.Error(path, past);
+    return false;
+  }
   out = {seconds, false};
   return true;
+}
+
+std::string SpecReader::PastTheEnd(double seconds) const {
+  // The animation's own extent: its longest sequence, or a spec's longest when it sets none.
+  // A window may end one step past the last frame (at the end of a fixed length's time).
+  const double steps = seconds * spec_.frame_rate;
+  const int extent = spec_.max_frames > 0 ? spec_.max_frames : kMaxSpecFrames;
+  if (!(steps <= extent + 0.5)) {
+    return "past the animation's end: " + Exact(seconds) + " s is step " +
+           Exact(std::round(steps)) + " at " + Exact(spec_.frame_rate) + " fps, and " +
+           (spec_.max_frames > 0 ? "its sequences are at most "
+                                 : "a spec's sequences are at most ") +
+           std::to_string(extent) + " frames";
+  }
+  return "";
 }
 
 bool SpecReader::ExistingFile(const YAML::Node& node, const std::string& path, std::string& out) {
@@ -328,12 +362,22 @@ AnimationSpec SpecReader::Read(const YAML::Node& root) {
                    Error(view, key, "must be > 0");  // before any time is turned into steps
                    return false;
                  }
+                 if (rate < kMinFrameRate || rate > kMaxFrameRate) {
+                   Error(view, key,
+                         "must be from " + Num(kMinFrameRate) + " to " + Num(kMaxFrameRate) +
+                             " frames per second, got " + Num(rate));
+                   return false;
+                 }
                  spec_.frame_rate = rate;
                  return true;
                })
       .AddRead("length", "", "N, or {min_frames, max_frames, ...}",
                BlockOf([this](const YAML::Node& n, const std::string&) { LengthTop(n); }))
-      .AddRead("camera", "", "the virtual camera's .cameramodel", FileInto(&spec_.camera_path))
+      .AddRead("camera", "", "the virtual camera's .cameramodel",
+               Shaped([this](const YAML::Node& n, const std::string& p) {
+                 spec_.camera_place = {LineOf(n), p};
+                 return ExistingFile(n, p, spec_.camera_path);
+               }))
       .AddRead("background", "", "an image of the camera's size", FileInto(&spec_.background_path))
       .AddRead("banks", "", "a list of sprite banks",
                BlockOf([this](const YAML::Node& n, const std::string&) { Banks(n); }))
@@ -372,7 +416,7 @@ void SpecReader::LengthTop(const YAML::Node& node) {
   std::optional<double> strength;
   if (node.IsScalar()) {
     int64_t frames = 0;
-    if (!WholeNumber(node, "length", 1, frames)) return;
+    if (!WholeNumber(node, "length", 1, frames, kMaxSpecFrames)) return;
     fixed = static_cast<int>(frames);
   } else {
     OptionsBinder keys;
@@ -388,6 +432,9 @@ void SpecReader::LengthTop(const YAML::Node& node) {
          {std::pair{"frames", fixed}, std::pair{"min_frames", min_frames},
           std::pair{"max_frames", max_frames}, std::pair{"initial_frames", initial_frames}}) {
       Check(view, key, value >= 1, "expected a whole number >= 1");
+      Check(view, key, value <= kMaxSpecFrames,
+            "must be at most " + std::to_string(kMaxSpecFrames) + " frames, got " +
+                std::to_string(value));
     }
     if (strength) AtLeast(view, "strength", *strength, 0);
     if (view.Find("frames") != nullptr &&
@@ -417,8 +464,12 @@ void SpecReader::Banks(const YAML::Node& node) {
     if (ExistingFile(node, "banks", file)) spec_.bank_paths.push_back(file);
     return;
   }
-  if (!node.IsSequence() || node.size() == 0) {
+  if (!node.IsSequence()) {
     msg_.Error("banks", "expected a list of banks, got " + ShapeOf(node));
+    return;
+  }
+  if (node.size() == 0) {
+    msg_.Error("banks", "expected at least one bank");
     return;
   }
   for (size_t i = 0; i < node.size(); ++i) {
@@ -452,6 +503,12 @@ void SpecReader::Optimizer(const YAML::Node& node) {
   Check(view, "seed", seed >= 0 && seed <= 1000000000, "expected a whole number >= 0");
   rep.seed = static_cast<uint64_t>(std::max<int64_t>(seed, 0));
   AtLeast(view, "snapshot_every_s", o.snapshot_every_s, 0);
+  const double budget = rep.time_budget_seconds, every = o.snapshot_every_s;
+  Check(view, "snapshot_every_s",
+        !(every > 0) || !std::isfinite(budget) || every * kMaxSpecSnapshots >= budget,
+        "keeps at most " + std::to_string(kMaxSpecSnapshots) +
+            " snapshots: must be 0 or >= " + Num(budget / kMaxSpecSnapshots) +
+            " (time_budget_s / " + std::to_string(kMaxSpecSnapshots) + "), got " + Num(every));
   // The optimizer's own limits, checked by the optimizer and named as the spec's keys.
   std::string why;
   if (!rep.IsValid(&why)) Report(view, why, kReplacementKeys);
@@ -459,8 +516,17 @@ void SpecReader::Optimizer(const YAML::Node& node) {
 }
 
 void SpecReader::Sprites(const YAML::Node& node) {
-  if (!node.IsSequence() || node.size() == 0) {
+  if (!node.IsSequence()) {
     msg_.Error("sprites", "expected a list of sprites, got " + ShapeOf(node));
+    return;
+  }
+  if (node.size() == 0) {
+    msg_.Error("sprites", "expected at least one sprite");
+    return;
+  }
+  if (node.size() > static_cast<size_t>(kMaxSpecSprites)) {
+    msg_.Error("sprites", "expected at most " + std::to_string(kMaxSpecSprites) + " sprites, got " +
+                              std::to_string(node.size()));
     return;
   }
   for (size_t i = 0; i < node.size(); ++i) {
@@ -581,6 +647,9 @@ LengthSpec SpecReader::Length(const YAML::Node& node, const std::string& path) {
   if (!Block(keys, node, path, view)) return out;
   Required(view, "min_frames", "required");
   Check(view, "min_frames", out.min_frames >= 1, "expected a whole number >= 1");
+  Check(view, "min_frames", out.min_frames <= kMaxSpecFrames,
+        "must be at most " + std::to_string(kMaxSpecFrames) + " frames, got " +
+            std::to_string(out.min_frames));
   AtLeast(view, "strength", out.strength, 0);
   return out;
 }
@@ -695,7 +764,10 @@ FrameSpec SpecReader::Frames(const YAML::Node& node, const std::string& path) {
       Error(view, "after_path", "give either after_path or at/from/to");
     Required(view, "duration", "required with after_path");
     Positive(view, "duration", duration_s);
-    if (std::isfinite(duration_s)) out.duration_steps = std::max(1, spec_.Steps(duration_s));
+    const std::string past = std::isfinite(duration_s) ? PastTheEnd(duration_s) : "";
+    Check(view, "duration", past.empty(), past);
+    if (std::isfinite(duration_s) && past.empty())
+      out.duration_steps = std::max(1, spec_.Steps(duration_s));
   } else {
     if (view.Find("duration") != nullptr) Error(view, "duration", "only with after_path");
     out.window = Window(view, window, StepWindow::All());
@@ -764,18 +836,21 @@ void SpecReader::CheckReferences() {
 }  // namespace
 
 AnimationSpec ParseAnimationSpec(const std::string& yaml, const std::string& origin) {
-  YAML::Node root;
-  try {
-    root = YAML::Load(yaml);
-  } catch (const YAML::Exception& e) {
-    throw InputError(origin + ":" + std::to_string(e.mark.line + 1), "not valid YAML: " + e.msg);
-  }
+  const YAML::Node root = LoadOneDocument(yaml, origin);
   try {
     return SpecReader(origin).Read(root);
   } catch (const YAML::Exception& e) {
     // A shape the reader did not check for (found by tests/fuzz): still an error naming the line.
     throw InputError(origin + ":" + std::to_string(e.mark.line + 1),
                      "cannot read this (" + e.msg + ")");
+  }
+}
+
+CameraModel ReadSpecCamera(const AnimationSpec& spec) {
+  try {
+    return CameraModel::Read(spec.camera_path);
+  } catch (const InputError& e) {
+    throw InputError(spec.Where(spec.camera_place), e.what());
   }
 }
 

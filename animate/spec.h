@@ -16,11 +16,20 @@
 #include "animate/path_cost.h"
 #include "animate/replacement.h"
 #include "animate/track.h"
+#include "core/camera_model.h"
 #include "core/enum_text.h"
 
 namespace ss {
 
 inline constexpr int kAnimationSpecVersion = 1;
+
+// Bounds on the numbers of a spec that size work (docs/animation.md, "Bounds"), each refused
+// with its line and field when exceeded. The optimizers' own (set_size, threads, time_budget_s)
+// are theirs (ReplacementOptions, BeamOptions).
+inline constexpr int kMaxSpecFrames = 10000;  // a sequence's length: 5.5 min at 30 fps
+inline constexpr double kMinFrameRate = 1, kMaxFrameRate = 1000;  // frames per second
+inline constexpr int kMaxSpecSprites = 256;
+inline constexpr int kMaxSpecSnapshots = 1000;  // snapshot_every_s >= time_budget_s / this
 
 // Where a spec item was written, for errors raised after parsing (unknown tag, sprite).
 struct SpecPlace {
@@ -119,6 +128,7 @@ struct AnimationSpec {
   std::optional<LengthSpec> length;  // free length: penalize sequences under N frames
   std::optional<FastFrameSpec> fast;
   std::string camera_path;              // .cameramodel (absolute)
+  SpecPlace camera_place;               // where the spec names it
   std::string background_path;          // image (absolute) or ""
   std::vector<std::string> bank_paths;  // absolute
   std::vector<SpriteSpecEntry> sprites;
@@ -134,5 +144,8 @@ struct AnimationSpec {
 AnimationSpec ParseAnimationSpec(const std::string& yaml, const std::string& origin);
 // Reads and parses a spec file; InputError naming the file, line and field.
 AnimationSpec LoadAnimationSpec(const std::string& path);
+// The spec's camera, read as `render` reads it: InputError naming the spec's line and field
+// (`camera`) and why the file is not a camera model. `animate` checks it before it optimizes.
+CameraModel ReadSpecCamera(const AnimationSpec& spec);
 
 }  // namespace ss

@@ -15,6 +15,7 @@
 #include "animate/sequence_io.h"
 #include "animate/spec.h"
 #include "apps/commands.h"
+#include "core/error.h"
 #include "core/log.h"
 #include "judge/judge.h"
 
@@ -48,6 +49,10 @@ void Run(const AnimateArgs& args) {
   if (args.snapshot_every_s >= 0) o.snapshot_every_s = args.snapshot_every_s;
   options.progress_every_s = 1.0;
   const std::string method = TextOf(o.method, kOptimizerMethodTexts);
+  // Refused before the banks are read: the options with the command line's changes, and the
+  // camera, which `render` reads (a YAML file named as the camera was accepted here).
+  if (std::string why; !options.IsValid(&why)) throw InputError("animate options", why);
+  ReadSpecCamera(spec);
 
   const auto scene = Scene::Load(std::move(spec));
   Log("animate")->info("{} sprites, {} frames, {} edges, {} cost terms; {} for {:.1f} s",

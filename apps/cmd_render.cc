@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include <nlohmann/json.hpp>
@@ -73,14 +74,14 @@ class FrameSink {
 
 void Run(const RenderArgs& args) {
   const SequenceFile file = ReadSequenceFile(args.sequences);
-  std::string camera_path = file.camera_path;
   std::string background_path = file.background_path;
+  std::optional<CameraModel> from_spec;
   if (!args.spec.empty()) {
     const AnimationSpec spec = LoadAnimationSpec(args.spec);
-    camera_path = spec.camera_path;
+    from_spec = ReadSpecCamera(spec);  // as `animate` reads it
     background_path = spec.background_path;
   }
-  const CameraModel camera = CameraModel::Read(camera_path);
+  const CameraModel camera = from_spec ? *from_spec : CameraModel::Read(file.camera_path);
   cv::Mat background;
   if (!background_path.empty()) {
     background = cv::imread(background_path, cv::IMREAD_UNCHANGED);

@@ -360,6 +360,10 @@ OptionsBinder StationKeys(StationConfig& cfg) {
                    r.msg().Error("cameras", "expected a list of cameras, got " + ShapeOf(*cams));
                    return false;
                  }
+                 if (cams->size() == 0) {  // replay and ingest would do nothing and exit 0
+                   r.msg().Error("cameras", "expected at least one camera");
+                   return false;
+                 }
                  for (size_t i = 0; i < cams->size(); ++i) {
                    const std::string path = Index("cameras", i);
                    r.Mark(path, (*cams)[i]);

@@ -3,10 +3,14 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
+#include <tuple>
+#include <utility>
 
 #include "capture/camera_backend.h"
 #include "config/config_detail.h"
+#include "core/bank_schema.h"
 #include "core/frame.h"
 #include "core/ip_address.h"
 #include "core/option_checks.h"
@@ -20,10 +24,22 @@ namespace fs = std::filesystem;
 using namespace yaml_text;
 using Messages = YamlMessages;
 
+// A camera's name: it names folders, files and URLs, and is shown in every message about it.
+constexpr size_t kMaxNameLength = 64;
+// The frames of the empty enclosure a camera holds while it learns (BGR, its full size): each
+// camera's set is held at once, in memory, before the keyer is made.
+constexpr int64_t kTrainingSetBytes = int64_t{1} << 30;  // 1 GiB per camera
+constexpr int kMaxTrainingFrames = 1000;                 // whatever the size
+constexpr int kUnsetWidth = 1920, kUnsetHeight = 1080;   // a camera of the device's default size
+
 bool ValidName(const std::string& name) {
-  return !name.empty() && std::all_of(name.begin(), name.end(), [](char c) {
-    return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' || c == '.';
-  }) && name[0] != '.';
+  return !name.empty() && name.size() <= kMaxNameLength &&
+         std::all_of(name.begin(), name.end(),
+                     [](char c) {
+                       return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' ||
+                              c == '.';
+                     }) &&
+         name[0] != '.';
 }
 
 class Validator {
@@ -60,7 +76,10 @@ class Validator {
   void Camera(CameraConfig& c, const std::string& path) {
     Check(ValidName(c.name), Child(path, "name"),
           c.name.empty() ? "every camera needs a name"
-                         : "expected letters, digits, '_', '-' or '.', got " + Quoted(c.name));
+          : c.name.size() > kMaxNameLength
+              ? "expected a name of at most " + std::to_string(kMaxNameLength) +
+                    " characters, got " + std::to_string(c.name.size())
+              : "expected letters, digits, '_', '-' or '.', got " + Quoted(c.name));
     if (c.source.empty()) {
       Check(false, Child(path, "source"),
             "every camera needs a source (one of " + Join(CameraBackendNames()) + ")");
@@ -114,9 +133,31 @@ class Validator {
     Exists(c.model, Child(path, "model"), "camera model");
   }
 
-  void Keying(KeyingConfig& k) {
+  void Keying(KeyingConfig& k, const std::vector<CameraConfig>& cameras) {
     Check(k.training_frames >= 1, "keying.training_frames",
           "expected at least 1 frame, got " + std::to_string(k.training_frames));
+    // The training set must fit in memory (the daemon failed every frame with bad_alloc): the
+    // largest camera's frames against the budget; a camera of unset size counts as 1920x1080.
+    int width = cameras.empty() ? kUnsetWidth : 0, height = cameras.empty() ? kUnsetHeight : 0;
+    for (const CameraConfig& c : cameras) {
+      const int w = c.width > 0 ? c.width : kUnsetWidth, h = c.height > 0 ? c.height : kUnsetHeight;
+      if (int64_t{w} * h > int64_t{width} * height) std::tie(width, height) = std::pair{w, h};
+    }
+    const int64_t frame_bytes = int64_t{width} * height * 3;
+    const int64_t most =
+        std::clamp<int64_t>(kTrainingSetBytes / frame_bytes, 1, kMaxTrainingFrames);
+    if (k.training_frames > most) {
+      char gib[32];
+      std::snprintf(gib, sizeof gib, "%.1f",
+                    static_cast<double>(k.training_frames) * static_cast<double>(frame_bytes) /
+                        static_cast<double>(int64_t{1} << 30));
+      Check(false, "keying.training_frames",
+            "expected at most " + std::to_string(most) +
+                " frames: " + std::to_string(k.training_frames) + " frames of " +
+                std::to_string(width) + "x" + std::to_string(height) + " take " + gib +
+                " GiB, and a camera's training set may hold 1 GiB (" +
+                std::to_string(kMaxTrainingFrames) + " frames at most)");
+    }
     // The config's range; the keyer itself also takes < 0 (off: min_margin and ramp instead).
     const double low = k.chroma.key_low_levels, high = k.chroma.key_high_levels;
     Range(low, 0, 255, "keying.chroma.low");
@@ -174,7 +215,7 @@ class Validator {
       if (it != pipeline_problems.end()) Check(false, path, it->second);
     };
 
-    if (cfg.pipeline.keying) Keying(*cfg.pipeline.keying);
+    if (cfg.pipeline.keying) Keying(*cfg.pipeline.keying, cfg.cameras);
 
     const auto& floor = cfg.enclosure.floor.vertices();
     if (!floor.empty() && !msg_.Failed("enclosure.floor")) {
@@ -229,6 +270,11 @@ class Validator {
 
     StorageConfig& s = cfg.storage;
     Check(!s.bank.empty(), "storage.bank", "expected a path");
+    // A folder or a device: the daemon would refuse to start, with these words.
+    if (options_.check_files && !s.bank.empty()) {
+      const std::string problem = BankPathProblem(s.bank);
+      Check(problem.empty(), "storage.bank", s.bank + ": " + problem);
+    }
     Check(!s.recording_dir.empty(), "storage.recording_dir", "expected a path");
     {
       std::vector<std::string> codecs;

@@ -42,14 +42,7 @@ std::string ConfigReport::Summary() const {
 StationConfig ParseStationConfig(const std::string& yaml, const std::string& origin,
                                  const std::string& base_dir, ConfigReport* report,
                                  const ConfigOptions& options) {
-  YAML::Node root;
-  try {
-    root = YAML::Load(yaml);
-  } catch (const YAML::Exception& e) {
-    const std::string where =
-        e.mark.is_null() ? origin : origin + ":" + std::to_string(e.mark.line + 1);
-    throw InputError(where, "not valid YAML: " + e.msg);
-  }
+  const YAML::Node root = LoadOneDocument(yaml, origin);
   if (root.IsNull()) {
     throw InputError(origin,
                      "the config is empty (expected sections such as cameras, enclosure, storage)");

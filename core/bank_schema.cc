@@ -415,6 +415,16 @@ int PrepareBankSchema(sql::Db& db, bool writable) {
                                                  : PrepareSqlite(db, writable);
 }
 
+std::string BankPathProblem(const std::string& path) {
+  if (sql::IsPostgresAddress(path)) return "";
+  std::error_code ec;
+  const auto status = std::filesystem::status(path, ec);
+  if (!std::filesystem::exists(status)) return "";  // a new bank: SQLite makes it
+  if (std::filesystem::is_directory(status)) return "not a sprite bank (a folder)";
+  if (!std::filesystem::is_regular_file(status)) return "not a sprite bank (not a regular file)";
+  return "";
+}
+
 sql::Db OpenBankDatabase(const std::string& path, bool writable) {
   if (sql::IsPostgresAddress(path)) {
     sql::Db db = sql::OpenPostgres(path, !writable);
@@ -422,11 +432,10 @@ sql::Db OpenBankDatabase(const std::string& path, bool writable) {
     return db;
   }
   std::error_code ec;
-  if (!writable) {
-    if (!std::filesystem::exists(path, ec)) throw InputError(path, "no such sprite bank");
-    if (!std::filesystem::is_regular_file(path, ec))
-      throw InputError(path, "not a sprite bank (not a regular file)");
-  }
+  if (!writable && !std::filesystem::exists(path, ec))
+    throw InputError(path, "no such sprite bank");
+  if (const std::string problem = BankPathProblem(path); !problem.empty())
+    throw InputError(path, problem);
   const int flags = (writable ? SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE : SQLITE_OPEN_READONLY) |
                     SQLITE_OPEN_NOMUTEX;
   sql::Db db = sql::OpenSqlite(path, flags);

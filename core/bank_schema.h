@@ -39,6 +39,9 @@ int PrepareBankSchema(sql::Db& db, bool writable);
 // and prepares it as PrepareBankSchema does. Read-only, a missing file or one that is not a
 // regular file is an InputError naming it (SQLite would make an empty one).
 sql::Db OpenBankDatabase(const std::string& path, bool writable);
+// Why a SQLite bank cannot be at `path` (a folder, a device), or "" (a regular file, none yet, or
+// a PostgreSQL address): the words OpenBankDatabase refuses it with, for `config check` to say.
+std::string BankPathProblem(const std::string& path);
 int ReadSchemaVersion(const sql::Db& db);
 
 // Called inside the transaction that completes a clip, before it takes the next complete_seq:

@@ -4,6 +4,10 @@
 #include <filesystem>
 #include <sstream>
 
+#include <yaml-cpp/depthguard.h>
+
+#include "core/error.h"
+
 namespace ss {
 
 namespace yaml_text {
@@ -36,7 +40,12 @@ bool OneOf(const std::string& value, const std::vector<std::string>& options) {
   return std::find(options.begin(), options.end(), value) != options.end();
 }
 
-std::string Quoted(const std::string& s) { return "\"" + s + "\""; }
+std::string Quoted(const std::string& s) {
+  // A message names a value, it does not repeat it: a 10 MiB name made a 20 MB error.
+  constexpr size_t kShown = 64;
+  if (s.size() <= kShown) return "\"" + s + "\"";
+  return "\"" + s.substr(0, kShown) + "...\" (" + std::to_string(s.size()) + " characters)";
+}
 
 std::string Num(double v) {
   std::ostringstream s;
@@ -63,6 +72,40 @@ std::string Child(const std::string& path, const std::string& key) {
 
 std::string Index(const std::string& path, size_t i) {
   return path + "[" + std::to_string(i) + "]";
+}
+
+YAML::Node LoadOneDocument(const std::string& text, const std::string& origin) {
+  const auto at = [&origin](const YAML::Mark& mark) {
+    return mark.is_null() ? origin : origin + ":" + std::to_string(mark.line + 1);
+  };
+  std::vector<YAML::Node> documents;
+  try {
+    documents = YAML::LoadAll(text);
+  } catch (const YAML::DeepRecursion& e) {
+    // yaml-cpp's own limit, which it reports as "bad file".
+    throw InputError(at(e.mark), "nested deeper than " + std::to_string(e.depth() - 1) + " levels");
+  } catch (const YAML::Exception& e) {
+    throw InputError(at(e.mark), "not valid YAML: " + e.msg);
+  }
+  if (documents.size() > 1) {
+    // The line of the `---` that starts the second document (the one after the first
+    // document's content, or a second one), else where yaml-cpp put its node.
+    YAML::Mark mark = documents[1].Mark();
+    std::istringstream lines(text);
+    std::string line;
+    int markers = 0;
+    bool content = false;  // the first document has begun
+    for (int number = 0; std::getline(lines, line); ++number) {
+      if (line.rfind("---", 0) == 0 && (markers++ > 0 || content)) {
+        mark.line = number;
+        break;
+      }
+      if (!line.empty() && line[0] != '#' && line[0] != '%') content = true;
+    }
+    throw InputError(at(mark),
+                     "a second YAML document (---) starts here; the file must hold one document");
+  }
+  return documents.empty() ? YAML::Node() : documents.front();
 }
 
 int LineOf(const YAML::Node& node) {

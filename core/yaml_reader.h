@@ -25,7 +25,11 @@ std::string Num(double v);  // short form of a number for messages ("25", "0.5")
 std::string Suggest(const std::string& key, const std::vector<std::string>& known);
 std::string Child(const std::string& path, const std::string& key);  // "a.b"
 std::string Index(const std::string& path, size_t i);                // "a[3]"
-int LineOf(const YAML::Node& node);                                  // 1-based; 0 when unknown
+// Parses `text` as one YAML document; InputError naming `origin` and the line when it is not
+// valid YAML, is nested deeper than yaml-cpp reads, or holds a second document (which yaml-cpp's
+// Load would drop without a word). An empty text is a null node.
+YAML::Node LoadOneDocument(const std::string& text, const std::string& origin);
+int LineOf(const YAML::Node& node);           // 1-based; 0 when unknown
 std::string ShapeOf(const YAML::Node& node);  // "\"text\"", "a list", "a mapping", "nothing"
 }  // namespace yaml_text
 

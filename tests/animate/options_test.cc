@@ -65,6 +65,17 @@ TEST(AnimateOptions, EachProblemNamesItsField) {
   EXPECT_EQ(Problems(run),
             "optimizer.replacement.time_budget_seconds: must be a positive number of seconds, "
             "got 0");
+  // Issue 39: a day at most (1e300 ran until killed), and at most 1000 snapshots.
+  run.optimizer.replacement.time_budget_seconds = 1e300;
+  EXPECT_EQ(Problems(run),
+            "optimizer.replacement.time_budget_seconds: must be at most 86400 seconds (a day), "
+            "got 1e+300");
+  run.optimizer.replacement.time_budget_seconds = 60;
+  run.optimizer.snapshot_every_s = 0.01;
+  EXPECT_EQ(Problems(run),
+            "optimizer.snapshot_every_s: must be 0 or >= 0.06 s (the time budget / 1000), got "
+            "0.01");
+  run.optimizer.snapshot_every_s = 0;
   // The replacement optimizer's reach block comes out under "reach.".
   ReplacementOptions replace;
   replace.reach.step_cost = -1;
@@ -132,6 +143,8 @@ TEST(AnimateOptions, BeamNamesEveryField) {
   o = {};
   o.time_budget_seconds = std::numeric_limits<double>::infinity();
   EXPECT_TRUE(Names(Problems(o), "time_budget_seconds"));
+  o.time_budget_seconds = 86401;  // issue 39: a day at most
+  EXPECT_EQ(Problems(o), "time_budget_seconds: must be at most 86400 seconds (a day), got 86401");
 }
 
 TEST(AnimateOptions, OptimizersRefuseBadOptions) {

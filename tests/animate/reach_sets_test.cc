@@ -116,5 +116,18 @@ TEST(ReachSets, RejectsBadOptions) {
   EXPECT_ANY_THROW(ReachSets::Build(graph, ReachDirection::kForward, {5, 1, 0.0}, short_entry));
 }
 
+// Issue 39: set_size sizes the F/B sets (frames x set_size entries): bounded by memory, so that a
+// spec's set_size: 65535 over a large bank is refused before it is allocated.
+TEST(ReachSets, SetSizeIsBoundedByMemory) {
+  EXPECT_EQ(ReachSetBytes(1000, 200), int64_t{1000} * 200 * 14);
+  EXPECT_EQ(ReachSetBytes(100, 200), int64_t{100} * 100 * 14);  // a set holds at most every frame
+  EXPECT_EQ(ReachSetTooLarge(50000, 200), "");
+  EXPECT_EQ(ReachSetTooLarge(50000, 65535),
+            "set_size: 65535 for a bank of 50000 frames takes 32.6 GiB per F/B set, over the 1 GiB "
+            "a set may take (at most 1533 for this bank)");
+  EXPECT_EQ(ReachSetTooLarge(50000, 1533), "");
+  EXPECT_NE(ReachSetTooLarge(50000, 1534), "");
+}
+
 }  // namespace
 }  // namespace ss

@@ -127,13 +127,13 @@ TEST_F(SpecTest, FixedLengthHoldsEverySequenceToIt) {
   std::string yaml = kGood;
   yaml.replace(yaml.find("length: {min_frames: 100, max_frames: 300, strength: 2}"),
                std::string("length: {min_frames: 100, max_frames: 300, strength: 2}").size(),
-               "length: 90");
+               "length: 150");  // 6 s at 25 fps: every window of kGood lies within
   const AnimationSpec spec = ParseAnimationSpec(yaml, Origin());
-  EXPECT_EQ(spec.fixed_frames, 90);
-  EXPECT_EQ(spec.max_frames, 90);
-  EXPECT_EQ(spec.initial_frames, 90);
+  EXPECT_EQ(spec.fixed_frames, 150);
+  EXPECT_EQ(spec.max_frames, 150);
+  EXPECT_EQ(spec.initial_frames, 150);
   ASSERT_TRUE(spec.length);
-  EXPECT_EQ(spec.length->min_frames, 90);
+  EXPECT_EQ(spec.length->min_frames, 150);
 }
 
 // Replaces the first occurrence of `from` in the good spec.
@@ -190,7 +190,7 @@ TEST_F(SpecTest, BadSpecsNameTheLineAndTheField) {
   // The optimizer's and length's keys are read as the station config's are (core/options_binder.h).
   EXPECT_EQ(ErrorOf(Edit("max_frames: 300", "max_frame: 300")),
             o + ":3: length.max_frame: unknown key (did you mean \"max_frames\"?)");
-  EXPECT_EQ(ErrorOf(Edit("max_frames: 300", "max_frames: 50")),
+  EXPECT_EQ(ErrorOf(Edit("min_frames: 100, max_frames: 300", "min_frames: 200, max_frames: 150")),
             o + ":3: length.max_frames: is below length.min_frames");
   EXPECT_EQ(ErrorOf(Edit("min_frames: 100", "min_frames: 0")),
             o + ":3: length.min_frames: expected a whole number >= 1");
@@ -199,6 +199,80 @@ TEST_F(SpecTest, BadSpecsNameTheLineAndTheField) {
   EXPECT_EQ(ErrorOf(Edit("set_size: 50", "set_size: 2.5")),
             o + ":7: optimizer.set_size: expected a whole number, got \"2.5\"");
   EXPECT_NE(ErrorOf("sprites: [\n").find(o + ":"), std::string::npos);  // YAML syntax: a line too
+}
+
+// Issue 39: every number of a spec that sizes work is bounded, by the animation's own extent (its
+// longest sequence) or a stated bound (docs/animation.md, "Bounds"), and refused with its line
+// (`from: 10000000` took 2.4 GB and 9 s, `time_budget_s: 1e300` ran until killed).
+TEST_F(SpecTest, NumbersThatSizeWorkAreBounded) {
+  const std::string o = Origin();
+  // kGood: 25 fps, sequences of at most 300 frames: its end is 12 s.
+  const std::string past = "past the animation's end: ";
+  EXPECT_EQ(ErrorOf(Edit("from: 1, to: end", "from: 10000000, to: end")),
+            o + ":19: sprites[1].constraints[0].location.from: " + past +
+                "10000000 s is step 250000000 at 25 fps, and its sequences are at most 300 "
+                "frames");
+  EXPECT_EQ(ErrorOf(Edit("from: 1, to: end", "from: 1e15, to: end")),
+            o + ":19: sprites[1].constraints[0].location.from: " + past +
+                "1e+15 s is step 2.5e+16 at 25 fps, and its sequences are at most 300 frames");
+  EXPECT_EQ(ErrorOf(Edit("from: 2, to: 3", "from: 2, to: 12.1")),
+            o + ":20: sprites[1].constraints[1].frames.to: " + past +
+                "12.1 s is step 303 at 25 fps, and its sequences are at most 300 frames");
+  EXPECT_EQ(ErrorOf(Edit("at: 4,", "at: 12,")), "");  // step 300: the end of the longest
+  EXPECT_EQ(ErrorOf(Edit("duration: 2", "duration: 1e9")),
+            o + ":13: sprites[0].constraints[1].frames.duration: " + past +
+                "1000000000 s is step 25000000000 at 25 fps, and its sequences are at most 300 "
+                "frames");
+  // Without max_frames, a spec's own bound.
+  std::string free_length = Edit("max_frames: 300, ", "");
+  EXPECT_EQ(ErrorOf(free_length), "");
+  free_length.replace(free_length.find("at: 4,"), 6, "at: 401,");
+  EXPECT_EQ(ErrorOf(free_length),
+            o + ":14: sprites[0].constraints[2].location.at: " + past +
+                "401 s is step 10025 at 25 fps, and a spec's sequences are at most 10000 frames");
+  // Lengths.
+  EXPECT_EQ(ErrorOf(Edit("max_frames: 300", "max_frames: 20000")),
+            o + ":3: length.max_frames: must be at most 10000 frames, got 20000");
+  EXPECT_EQ(ErrorOf(Edit("max_frames: 300", "max_frames: 300, initial_frames: 10001")),
+            o + ":3: length.initial_frames: must be at most 10000 frames, got 10001");
+  EXPECT_EQ(
+      ErrorOf(Edit("length: {min_frames: 100, max_frames: 300, strength: 2}", "length: 20000")),
+      o + ":3: length: must be at most 10000, got \"20000\"");
+  // The frame rate, 1..1000 frames per second.
+  EXPECT_EQ(ErrorOf(Edit("frame_rate: 25", "frame_rate: 1e300")),
+            o + ":2: frame_rate: must be from 1 to 1000 frames per second, got 1e+300");
+  EXPECT_EQ(ErrorOf(Edit("frame_rate: 25", "frame_rate: 1e-300")),
+            o + ":2: frame_rate: must be from 1 to 1000 frames per second, got 1e-300");
+  // The time budget: a day at most; snapshots: a thousand at most.
+  EXPECT_EQ(ErrorOf(Edit("time_budget_s: 5", "time_budget_s: 1e300")),
+            o + ":7: optimizer.time_budget_s: must be at most 86400 seconds (a day), got 1e+300");
+  EXPECT_EQ(ErrorOf(Edit("method: replace, start: random, time_budget_s: 5",
+                         "method: beam, time_budget_s: 86401")),
+            o + ":7: optimizer.time_budget_s: must be at most 86400 seconds (a day), got 86401");
+  EXPECT_EQ(ErrorOf(Edit("time_budget_s: 5", "time_budget_s: 5, snapshot_every_s: 0.001")),
+            o + ":7: optimizer.snapshot_every_s: keeps at most 1000 snapshots: must be 0 or >= "
+                "0.005 (time_budget_s / 1000), got 0.001");
+  // Lists that must not be empty, or too long.
+  EXPECT_EQ(ErrorOf(Edit("banks: [walker.ssbank]", "banks: []")),
+            o + ":5: banks: expected at least one bank");
+  std::string no_sprites = kGood;
+  no_sprites = no_sprites.substr(0, no_sprites.find("sprites:\n")) + "sprites: []\n";
+  EXPECT_EQ(ErrorOf(no_sprites), o + ":8: sprites: expected at least one sprite");
+  std::string many = kGood;
+  many = many.substr(0, many.find("sprites:\n")) + "sprites:\n";
+  for (int i = 0; i < 257; ++i) many += "  - {name: s" + std::to_string(i) + ", start: free}\n";
+  EXPECT_EQ(ErrorOf(many), o + ":8: sprites: expected at most 256 sprites, got 257");
+}
+
+// Issue 39: one YAML document, nested no deeper than yaml-cpp reads, each said so (a second
+// document was dropped without a word; deep nesting was "bad file").
+TEST_F(SpecTest, OneDocumentOfBoundedDepth) {
+  const std::string o = Origin();
+  EXPECT_EQ(ErrorOf(std::string(kGood) + "---\nversion: 2\n"),
+            o + ":23: a second YAML document (---) starts here; the file must hold one document");
+  EXPECT_EQ(ErrorOf(Edit("smoothness: 0.5",
+                         "smoothness: " + std::string(600, '[') + std::string(600, ']'))),
+            o + ":17: nested deeper than 499 levels");
 }
 
 // The whole file is read before it is refused: every mistake, each with its line and field, in

@@ -12,8 +12,10 @@
 #include <cmath>
 
 #include "capture/camera_backend.h"
+#include "core/bank_schema.h"
 #include "core/error.h"
 #include "core/option_checks.h"
+#include "core/sql.h"
 #include "tests/support/test_support.h"
 
 namespace ss {
@@ -472,6 +474,70 @@ TEST(StationConfig, SyntaxErrorsAndBadFiles) {
     EXPECT_EQ(std::string(e.what()).rfind(dir / "missing.yaml" + ": cannot open the config", 0), 0u)
         << e.what();
   }
+}
+
+// Issue 39: `config check` says what the daemon will do. Each of these was valid, and the
+// daemon then failed (bad_alloc on every frame, a refusal to start, a 20 MB message).
+TEST(StationConfig, ValuesTheDaemonCannotHoldAreRefused) {
+  const std::string cam = "cameras:\n  - name: c\n    source: v4l2\n    device: /dev/video0\n";
+  // The training set against its memory budget (a camera of unset size counts as 1920x1080).
+  EXPECT_EQ(
+      ErrorOf(cam + "keying:\n  training_frames: 2000000000\n"),
+      "station.yaml:6: keying.training_frames: expected at most 172 frames: 2000000000 frames "
+      "of 1920x1080 take 11587142.9 GiB, and a camera's training set may hold 1 GiB (1000 frames "
+      "at most)");
+  EXPECT_EQ(ErrorOf(cam + "    width: 3840\n    height: 2160\nkeying:\n  training_frames: 44\n"),
+            "station.yaml:8: keying.training_frames: expected at most 43 frames: 44 frames of "
+            "3840x2160 take 1.0 GiB, and a camera's training set may hold 1 GiB (1000 frames at "
+            "most)");
+  EXPECT_EQ(Parse(cam + "keying:\n  training_frames: 172\n").pipeline.keying->training_frames, 172);
+  // A camera's name: at most 64 characters, and the message does not repeat a long one.
+  const std::string long_name(1 << 20, 'a');  // the e2e test has the 10 MiB one
+  EXPECT_EQ(ErrorOf("cameras:\n  - name: " + long_name + "\n    source: v4l2\n    device: x\n"),
+            "station.yaml:2: cameras[0].name: expected a name of at most 64 characters, got "
+            "1048576");
+  EXPECT_EQ(ErrorOf("cameras:\n  - name: " + std::string(100, '/') +
+                    "\n    source: v4l2\n"
+                    "    device: x\n"),
+            "station.yaml:2: cameras[0].name: expected a name of at most 64 characters, got 100");
+  EXPECT_EQ(ErrorOf("cameras:\n  - name: a/b\n    source: v4l2\n    device: x\n"),
+            "station.yaml:2: cameras[0].name: expected letters, digits, '_', '-' or '.', got "
+            "\"a/b\"");
+  // Any long value is quoted in part, with its length (core/yaml_reader.h, Quoted).
+  EXPECT_EQ(ErrorOf(cam + "    fps: " + std::string(100, 'f') + "\n"),
+            "station.yaml:5: cameras[0].fps: expected a positive number, got \"" +
+                std::string(64, 'f') + "...\" (100 characters)");
+  // No cameras at all: replay and ingest did nothing and exited 0.
+  EXPECT_EQ(ErrorOf("cameras: []\n"), "station.yaml:1: cameras: expected at least one camera");
+  // The bank: a folder or a device, in the words the daemon refuses it with.
+  ScratchDir dir;
+  ConfigOptions files;
+  files.check_files = true;
+  EXPECT_EQ(ErrorOf("storage:\n  bank: /dev/null\n", files),
+            "station.yaml:2: storage.bank: /dev/null: not a sprite bank (not a regular file)");
+  fs::create_directories(dir / "banks");
+  EXPECT_EQ(ErrorOf("storage:\n  bank: " + (dir / "banks") + "\n", files),
+            "station.yaml:2: storage.bank: " + (dir / "banks") + ": not a sprite bank (a folder)");
+  try {
+    OpenBankDatabase("/dev/null", true);
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()), "/dev/null: not a sprite bank (not a regular file)");
+  }
+}
+
+// Issue 39: one YAML document, nested no deeper than yaml-cpp reads, each said so (a second
+// document was dropped without a word; deep nesting was "bad file").
+TEST(StationConfig, OneDocumentOfBoundedDepth) {
+  EXPECT_EQ(ErrorOf("version: 1\n---\ncameras: 3\n"),
+            "station.yaml:2: a second YAML document (---) starts here; the file must hold one "
+            "document");
+  EXPECT_EQ(ErrorOf("---\nversion: 1\n---\n"),
+            "station.yaml:3: a second YAML document (---) starts here; the file must hold one "
+            "document");
+  EXPECT_EQ(ErrorOf("version: 1\nlogging:\n  level: " + std::string(600, '[') +
+                    std::string(600, ']') + "\n"),
+            "station.yaml:3: nested deeper than 499 levels");
 }
 
 TEST(StationConfig, FilesAreCheckedWhenAsked) {

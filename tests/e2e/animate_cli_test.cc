@@ -2,6 +2,7 @@
 // synthetic walker bank (tests/animate/scene_fixture.h) animated into a sequence file,
 // rendered to PNG frames and to video files, and a spec error named by file and line.
 #include <filesystem>
+#include <fstream>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -74,6 +75,47 @@ collisions:
   EXPECT_NE(refused.output.find("scene.yaml:8: sprites[0].start[1]: expected a number"),
             std::string::npos)
       << refused.output;
+}
+
+// Issue 39: `animate` reads the spec's camera as `render` does (a YAML file was accepted as the
+// camera), and a window past the animation's end is refused at once with its line (`from:
+// 10000000` took 2.4 GB and 9 s, and exited 0).
+TEST_F(SceneTest, AnimateRefusesABadCameraAndAWindowPastTheEnd) {
+  const std::string seq = dir_ / "seq.json";
+  const std::string past = WriteSpec(R"(frame_rate: 30
+length: {min_frames: 60, max_frames: 120}
+sprites:
+  - name: a
+    start: [0, 0]
+    constraints:
+      - location: {target: [1, 0], from: 10000000}
+)");
+  auto r = testing::RunSpritestation("animate " + past + " --out " + seq);
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find(past + ":10: sprites[0].constraints[0].location.from: past the "
+                                 "animation's end: 10000000 s is step 300000000 at 30 fps, and "
+                                 "its sequences are at most 120 frames"),
+            std::string::npos)
+      << r.output;
+  EXPECT_FALSE(fs::exists(seq));
+
+  const std::string spec = WriteSpec(
+      "frame_rate: 30\nlength: 40\nsprites:\n"
+      "  - name: a\n    start: [0, 0]\n");
+  std::ofstream(dir_ / "virtual.cameramodel") << "cameras:\n  - name: cam0\n";  // a station config
+  r = testing::RunSpritestation("animate " + spec + " --out " + seq);
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find(spec + ":1: camera: " + (dir_ / "virtual.cameramodel") + ": "),
+            std::string::npos)
+      << r.output;
+  EXPECT_FALSE(fs::exists(seq));
+
+  // The command line's budget is bounded as the spec's is, before the camera is read.
+  r = testing::RunSpritestation("animate " + spec + " --out " + seq + " --time-budget 1e300");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("time_budget_seconds: must be at most 86400 seconds (a day), got 1e+300"),
+            std::string::npos)
+      << r.output;
 }
 
 }  // namespace

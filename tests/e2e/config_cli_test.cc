@@ -67,6 +67,55 @@ TEST(StationConfig, CheckCommand) {
   EXPECT_NE(r.output.find(dir / "missing.yaml"), std::string::npos) << r.output;
 }
 
+// Issue 39: `config check` says what the daemon will do: a bank that is a device or a folder, a
+// training set that cannot fit in memory, a 10 MiB name were "valid", and the daemon then
+// refused to start or failed every frame. Refused now, each with its line, with exit code 2.
+TEST(StationConfig, CheckRefusesWhatTheDaemonCannotRun) {
+  if (!Environment("SPRITESTATION_BIN"))
+    GTEST_SKIP() << "SPRITESTATION_BIN not set (run through ctest)";
+  ScratchDir dir;
+  fs::create_directories(dir / "banks");
+  const std::string config = dir / "station.yaml";
+  const auto check = [&](const std::string& yaml) {
+    std::ofstream(config) << yaml;
+    return ss::testing::RunSpritestation("config check " + config);
+  };
+  auto r = check(kOneCamera + "storage:\n  bank: /dev/null\n");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find(config + ":6: storage.bank: /dev/null: not a sprite bank (not a regular "
+                                   "file)"),
+            std::string::npos)
+      << r.output;
+  r = check(kOneCamera + "storage:\n  bank: banks\n");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find(config + ":6: storage.bank: " + (dir / "banks") +
+                          ": not a sprite bank (a folder)"),
+            std::string::npos)
+      << r.output;
+  r = check(kOneCamera + "keying:\n  training_frames: 2000000000\n");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find(config + ":6: keying.training_frames: expected at most 172 frames"),
+            std::string::npos)
+      << r.output;
+  r = check("cameras:\n  - name: " + std::string(10 << 20, 'c') +
+            "\n    source: v4l2\n    device: /dev/video0\n");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find(config + ":2: cameras[0].name: expected a name of at most 64 characters, "
+                                   "got 10485760"),
+            std::string::npos)
+      << r.output;
+  EXPECT_LT(r.output.size(), 1000u);  // the name is not repeated (it made a 20 MB message)
+  r = check("cameras: []\n");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find(config + ":1: cameras: expected at least one camera"), std::string::npos)
+      << r.output;
+  r = check(kOneCamera + "---\nversion: 1\n");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find(config + ":5: a second YAML document (---) starts here"),
+            std::string::npos)
+      << r.output;
+}
+
 // Issue 20: a config or a spec over 16 MiB is bad input (exit 2), refused before it is parsed.
 TEST(StationConfig, OversizedFilesAreRefusedWithExitCode2) {
   if (!Environment("SPRITESTATION_BIN"))
