@@ -114,15 +114,20 @@ export class Child {
   }
 }
 
-// The synthetic session every test streams: made once a run.
-export function session() {
-  const dir = path.join(WORK, 'sessions', 'studio');
-  if (!fs.existsSync(path.join(WORK, 'sessions', 'done'))) {
+// The synthetic session every test streams: made once a run. `seed` 11 is the one the tests
+// share; the labelling test asks for 12, whose animal stays on the open floor long enough for
+// its 6 s to hold transitions (seed 11's walks into the walls since the subjects explore).
+export function session(seed = 11) {
+  // Another seed's session in a folder of its own: the replay tests list the shared one's.
+  const root = path.join(WORK, seed === 11 ? 'sessions' : `sessions-${seed}`);
+  const dir = path.join(root, 'studio');
+  const done = path.join(root, 'done');
+  if (!fs.existsSync(done)) {
     fs.rmSync(dir, { recursive: true, force: true });
     fs.mkdirSync(path.dirname(dir), { recursive: true });
     run(['synth', '--out', dir, '--kind', 'animal', '--seconds', '6', '--fps', '30', '--size', '640x480',
-      '--cameras', '2', '--subjects', '1', '--seed', '11', '--empty-lead-in', '2', '--no-mattes']);
-    fs.writeFileSync(path.join(WORK, 'sessions', 'done'), 'ok\n');
+      '--cameras', '2', '--subjects', '1', '--seed', String(seed), '--empty-lead-in', '2', '--no-mattes']);
+    fs.writeFileSync(done, 'ok\n');
   }
   const floor = JSON.parse(fs.readFileSync(path.join(dir, 'truth', 'floor.json'), 'utf8'));
   return { dir, root: path.dirname(dir), floor: floor.polygon };

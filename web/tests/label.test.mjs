@@ -19,7 +19,7 @@ let s, cfg, station, b, p;
 let answers = []; // [{from, to, label}] as pressed
 
 before(async () => {
-  s = h.session();
+  s = h.session(12);
   // The billboard scale is pinned: the pairs the classifier is least sure of, and so the
   // cross-validated figures of a retrain on 30 of them, move with any change to the sprites (the
   // auto scale going from 240 to 250 px/m took the precision below under 0.7, to 0.667). What is

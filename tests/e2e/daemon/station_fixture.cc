@@ -81,7 +81,7 @@ StationSession MakeSession() {
     const CommandResult synth =
         RunSpritestation("synth --out " + s.dir +
                          " --kind animal --seconds 5 --fps 30 --size 640x480 --cameras 2"
-                         " --subjects 1 --seed 11 --empty-lead-in 2");
+                         " --subjects 1 --seed 12 --empty-lead-in 2");
     const CommandResult ingest = RunSpritestation("ingest " + s.dir + " --bank " + s.ingest_bank);
     if (synth.exit_code == 0 && ingest.exit_code == 0) {
       WriteFile((root / "done").string(), "ok\n");
