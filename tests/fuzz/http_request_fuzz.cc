@@ -97,7 +97,11 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     std::fprintf(stderr, "http_request: an answer that is not HTTP/1.1: %.80s\n", answer.c_str());
     std::abort();
   }
-  if (answer.find("root:x:0:0") != std::string::npos) {
+  // /etc/passwd's first line in the answer, not quoted from the request (an error may quote a
+  // path the request named).
+  const std::string sent(reinterpret_cast<const char*>(data), size);
+  if (answer.find("root:x:0:0") != std::string::npos &&
+      sent.find("root:x:0:0") == std::string::npos) {
     std::fprintf(stderr, "http_request: /etc/passwd was served\n");
     std::abort();
   }
