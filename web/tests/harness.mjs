@@ -117,15 +117,16 @@ export class Child {
 // The synthetic session every test streams: made once a run. `seed` 11 is the one the tests
 // share; the labelling test asks for 12, whose animal stays on the open floor long enough for
 // its 6 s to hold transitions (seed 11's walks into the walls since the subjects explore).
-export function session(seed = 11) {
-  // Another seed's session in a folder of its own: the replay tests list the shared one's.
-  const root = path.join(WORK, seed === 11 ? 'sessions' : `sessions-${seed}`);
+export function session(seed = 11, { size = '640x480', fps = 30 } = {}) {
+  // Another seed's (or size's) session in a folder of its own: the replay tests list the shared one's.
+  const usual = seed === 11 && size === '640x480' && fps === 30;
+  const root = path.join(WORK, usual ? 'sessions' : `sessions-${seed}-${size}-${fps}`);
   const dir = path.join(root, 'studio');
   const done = path.join(root, 'done');
   if (!fs.existsSync(done)) {
     fs.rmSync(dir, { recursive: true, force: true });
     fs.mkdirSync(path.dirname(dir), { recursive: true });
-    run(['synth', '--out', dir, '--kind', 'animal', '--seconds', '6', '--fps', '30', '--size', '640x480',
+    run(['synth', '--out', dir, '--kind', 'animal', '--seconds', '6', '--fps', String(fps), '--size', size,
       '--cameras', '2', '--subjects', '1', '--seed', String(seed), '--empty-lead-in', '2', '--no-mattes']);
     fs.writeFileSync(done, 'ok\n');
   }
