@@ -4,12 +4,14 @@
 #include <cstdio>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
 #include "apps/commands.h"
 #include "config/station_config.h"
 #include "core/error.h"
+#include "station/station.h"
 
 namespace ss::apps {
 namespace {
@@ -45,11 +47,15 @@ void Check(const std::string& path, bool json, bool check_files) {
     }
     throw;
   }
+  // What the daemon would lack to store sprites (it starts all the same; station/station.h).
+  const std::vector<std::string> gaps =
+      check_files ? CalibrationGaps(config) : std::vector<std::string>{};
   if (json) {
     nlohmann::json j = {{"config", path},
                         {"status", StatusName(report.status)},
                         {"adjustments", report.adjustments},
                         {"errors", report.errors},
+                        {"to_calibrate", gaps},
                         {"cameras", config.cameras.size()}};
     std::printf("%s\n", j.dump(2).c_str());
     return;
@@ -57,6 +63,12 @@ void Check(const std::string& path, bool json, bool check_files) {
   std::printf("%s: %s (%zu camera%s)\n", path.c_str(), StatusName(report.status),
               config.cameras.size(), config.cameras.size() == 1 ? "" : "s");
   for (const auto& a : report.adjustments) std::printf("  adjusted: %s\n", a.c_str());
+  for (const auto& g : gaps) std::printf("  to calibrate: %s\n", g.c_str());
+  if (!gaps.empty()) {
+    std::printf(
+        "  (the station starts and streams; what lacks these stores no sprites until the "
+        "console's calibration page saves them)\n");
+  }
 }
 
 }  // namespace

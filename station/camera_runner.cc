@@ -576,8 +576,13 @@ CameraRunner::CameraRunner(int index, CameraRunnerOptions options, BatchSink sin
   s.status.name = s.options.camera.name;
   s.status.source = s.options.camera.source;
   s.status.has_model = s.options.model.has_value();
+  s.status.has_floor = !s.options.floor.empty();
   s.status.queue_capacity = s.queue->capacity();
-  if (s.options.model) {
+  if (s.options.model && s.options.floor.empty()) {
+    s.SetKeyerPhase(Impl::KeyerPhase::kNoModel,
+                    "no floor: calibrate (enclosure step); streams for preview and recording, "
+                    "stores no sprites");
+  } else if (s.options.model) {
     try {
       s.pipeline = std::make_unique<CameraPipeline>(s.options.camera.name, 0, *s.options.model,
                                                     s.options.floor, s.options.pipeline);
@@ -588,7 +593,8 @@ CameraRunner::CameraRunner(int index, CameraRunnerOptions options, BatchSink sin
     }
   } else {
     s.SetKeyerPhase(Impl::KeyerPhase::kNoModel,
-                    "no camera model: streams for preview and recording, stores no sprites");
+                    "no camera model: calibrate; streams for preview and recording, stores no "
+                    "sprites");
   }
 }
 

@@ -70,6 +70,7 @@ struct CameraStatus {
   size_t queue_depth = 0, queue_capacity = 0;
   uint64_t reopens = 0;    // times the camera was opened again after going offline
   bool has_model = false;  // without one no sprite is stored (preview and recording only)
+  bool has_floor = false;  // the same without the enclosure's floor
   CameraPipelineStats pipeline;
   ExposureFigures exposure;  // how the green screen is lit (latest preview, measured once a second)
 };
@@ -77,7 +78,7 @@ struct CameraStatus {
 struct CameraRunnerOptions {
   CameraConfig camera;               // the config's camera (validated with the config)
   std::optional<CameraModel> model;  // unset: no sprites, only previews and recording
-  GroundPolygon floor;               // the enclosure's floor, metres
+  GroundPolygon floor;               // the enclosure's floor, metres (empty: as without a model)
   // The pipeline's options; its TrainingFrames() and queue_frames also say how many frames the
   // keyer learns from and how many wait between capture and the pipeline.
   CameraPipelineOptions pipeline;

@@ -45,6 +45,35 @@ void ApplyLogging(const LoggingConfig& logging) {
 
 }  // namespace
 
+GroundPolygon StationFloor(const StationConfig& config) {
+  if (!config.enclosure.floor.empty()) return config.enclosure.floor;
+  for (const CameraConfig& c : config.cameras) {
+    if (c.source != "replay") continue;
+    try {
+      return FloorForSession(c.session, GroundPolygon());
+    } catch (const InputError&) {
+      // that session has none: the next replay's, or none
+    }
+  }
+  return {};
+}
+
+std::vector<std::string> CalibrationGaps(const StationConfig& config) {
+  std::vector<std::string> gaps;
+  for (const CameraConfig& c : config.cameras) {
+    std::optional<CameraModel> model;
+    try {
+      model = ModelForCamera(c);
+    } catch (const std::exception& e) {
+      gaps.push_back(c.name + ": no camera model (" + e.what() + ")");
+      continue;
+    }
+    if (!model) gaps.push_back(c.name + ": no camera model");
+  }
+  if (StationFloor(config).empty()) gaps.push_back("enclosure.floor: no floor polygon");
+  return gaps;
+}
+
 bool StationOptions::IsValid(std::string* why) const {
   OptionProblems check(why);
   std::string part;
@@ -60,17 +89,13 @@ Station::Station(StationOptions options) : impl_(std::make_unique<Impl>()) {
   if (std::string why; !s.options.IsValid(&why)) throw InputError("station options", why);
   const StationConfig& config = s.options.config;
   if (config.cameras.empty()) throw InputError("cameras", "the station needs at least one camera");
-  if (config.enclosure.floor.empty()) {
-    // A replay station may take the floor from its session, as ingest does.
-    const CameraConfig* replay = nullptr;
-    for (const CameraConfig& c : config.cameras) {
-      if (c.source == "replay") replay = &c;
-    }
-    if (replay == nullptr)
-      throw InputError("enclosure.floor", "the station needs the floor polygon");
-    s.floor = FloorForSession(replay->session, config.enclosure.floor);
-  } else {
-    s.floor = config.enclosure.floor;
+  s.floor = StationFloor(config);
+  // Without a floor the station still runs, so that the calibration wizard can find it: every
+  // camera streams for preview and recording and stores no sprite until it is calibrated.
+  if (s.floor.empty()) {
+    s.log->warn(
+        "enclosure.floor: no floor polygon: every camera streams for preview and recording but "
+        "stores no sprites (find the floor: the console's calibration page, enclosure step)");
   }
   for (size_t i = 0; i < config.cameras.size(); ++i) {
     const CameraConfig& c = config.cameras[i];
@@ -111,7 +136,7 @@ void Station::Start() {
   scale_inputs.floor = s.floor;
   scale_inputs.max_side_px = pipeline.rectify.max_side_px;
   scale_inputs.margin_m = pipeline.rectify.margin_m;
-  if (!scale_inputs.models.empty()) {
+  if (!scale_inputs.models.empty() && !s.floor.empty()) {
     const BankScale scale = ChooseAndKeepBankScale(*s.bank, scale_inputs);
     pipeline.rectify.px_per_m = scale.px_per_m;
     s.log->info("billboard scale {} px/m: {}", scale.px_per_m, scale.why);

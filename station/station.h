@@ -34,6 +34,16 @@ struct StationOptions {
   bool IsValid(std::string* why) const;
 };
 
+// The enclosure's floor a station on `config` uses: enclosure.floor, else the floor of the first
+// replayed session that has one (as ingest takes it), else empty.
+GroundPolygon StationFloor(const StationConfig& config);
+
+// What a station on `config` lacks to store sprites, one line each ("cam0: no camera model",
+// "enclosure.floor: no floor polygon"): without it the camera (or every camera) streams for
+// preview and recording and stores none. The daemon logs these at start; `config check` lists
+// them. Camera model files that cannot be read count as missing.
+std::vector<std::string> CalibrationGaps(const StationConfig& config);
+
 class Station {
  public:
   // Checks what can be checked before anything starts (models, floor, bank):

@@ -126,6 +126,7 @@ nlohmann::json StatusToJson(const StationStatus& st) {
                        {"queue_capacity", c.queue_capacity},
                        {"reopens", c.reopens},
                        {"has_model", c.has_model},
+                       {"has_floor", c.has_floor},
                        {"usable_sprites", c.pipeline.discards[static_cast<size_t>(Discard::kNone)]},
                        {"sprites_stored", c.sprites_to_bank},
                        {"sprites_merged", c.merged_to_bank},

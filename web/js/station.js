@@ -61,6 +61,7 @@ class Tile {
           ${VIEWS.map((v) => `<button type="button" data-view="${v}" data-testid="view-${v}">${v}</button>`).join('')}
         </div>
         <span class="error-text" data-testid="tile-error"></span>
+        <a class="needs" data-testid="tile-needs" href="calibrate.html" hidden></a>
       </div>
       <dl class="stats">
         <dt title="dropped because the pipeline fell behind">drops queue</dt><dd class="num" data-testid="tile-drops-queue">–</dd>
@@ -81,7 +82,7 @@ class Tile {
       </div>`;
     this.els = {
       name: q('tile-name'), state: q('tile-state'), fps: q('tile-fps'), canvas: q('tile-canvas'),
-      msg: q('tile-message'), frame: q('tile-frame'), cands: q('tile-candidates'), error: q('tile-error'),
+      msg: q('tile-message'), frame: q('tile-frame'), cands: q('tile-candidates'), error: q('tile-error'), needs: q('tile-needs'),
       dq: q('tile-drops-queue'), ds: q('tile-drops-source'), queue: q('tile-queue'), meter: q('tile-queue-meter'),
       learnt: q('tile-learnt'), stored: q('tile-stored'), merged: q('tile-merged'), hist: q('tile-histogram'), clipped: q('tile-clipped'), dark: q('tile-dark'),
       uniformity: q('tile-uniformity'), green: q('tile-green'),
@@ -124,6 +125,11 @@ class Tile {
     e.state.dataset.state = cam.state;
     e.error.textContent = cam.state === 'error' || cam.state === 'offline' ? cam.message || '' : '';
     e.error.title = cam.message || '';
+    // A camera without its model or without the floor streams but stores no sprite: say which.
+    const needs = !cam.has_model ? 'no camera model: calibrate' : cam.has_floor === false ? 'no floor: calibrate' : '';
+    e.needs.textContent = needs;
+    e.needs.title = needs ? `${cam.message || needs} (the calibration page)` : '';
+    e.needs.hidden = !needs || cam.state === 'error' || cam.state === 'offline';
     e.fps.textContent = `${fmt(cam.fps, 1)} fps`;
     e.dq.textContent = fmt(cam.dropped?.queue_full);
     e.ds.textContent = fmt(cam.dropped?.at_source);
