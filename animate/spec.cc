@@ -444,7 +444,7 @@ void SpecReader::LengthTop(const YAML::Node& node) {
     spec_.max_frames = std::max(0, max_frames);
     if (initial_frames > 0) spec_.initial_frames = initial_frames;
     if (min_frames > 0) {
-      spec_.length = LengthSpec{min_frames, strength.value_or(1.0)};
+      spec_.length = LengthSpec{min_frames, strength.value_or(LengthSpec{}.strength)};
       Check(view, "max_frames", spec_.max_frames == 0 || spec_.max_frames >= min_frames,
             "is below length.min_frames");
     }
@@ -454,7 +454,7 @@ void SpecReader::LengthTop(const YAML::Node& node) {
     spec_.fixed_frames = fixed;
     spec_.max_frames = fixed;
     spec_.initial_frames = fixed;
-    spec_.length = LengthSpec{fixed, strength.value_or(100.0)};
+    spec_.length = LengthSpec{fixed, strength.value_or(LengthSpec{}.strength)};
   }
 }
 
@@ -639,7 +639,7 @@ void SpecReader::Constraints(const YAML::Node& node, const std::string& path,
 }
 
 LengthSpec SpecReader::Length(const YAML::Node& node, const std::string& path) {
-  LengthSpec out{0, 1.0};
+  LengthSpec out;
   OptionsBinder keys;
   keys.Add("min_frames", &out.min_frames, "a whole number >= 1", "sequences shorter pay")
       .Add("strength", &out.strength, "a number", "per missing frame");

@@ -29,6 +29,8 @@ RUN_PACKAGES=(
   libspdlog-dev libfmt-dev libcpp-httplib-dev libsystemd-dev libpng-dev libzstd-dev
   # the configure step's test and benchmark libraries
   libgtest-dev libgmock-dev libbenchmark-dev
+  # the demo's reference bank: scripts/reference-banks.sh tags its standing frames with SQL
+  sqlite3
 )
 # What the tests add.
 TEST_PACKAGES=(
@@ -37,8 +39,8 @@ TEST_PACKAGES=(
   # clang and its runtimes for the sanitizer build and the libFuzzer targets (scripts/fuzz.sh)
   clang libclang-rt-14-dev
   # mrcal's tools (the calibration tests compare against mrcal-calibrate-cameras), aravis's
-  # emulated camera tools, the ffmpeg and sqlite3 CLIs that check what we write
-  mrcal aravis-tools ffmpeg sqlite3
+  # emulated camera tools, the ffmpeg CLI that checks what we write (sqlite3: in the run set)
+  mrcal aravis-tools ffmpeg
   # real footage for the import tests (tests/e2e/import_*): OpenCV's sample videos,
   # vtest.avi (a fixed camera over people walking), Apache-2.0 / BSD-3-Clause
   opencv-doc

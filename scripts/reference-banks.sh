@@ -13,7 +13,7 @@
 # OUT/NAME/ holds BANK.ssbank (hamster.ssbank or fly.ssbank), floor.png (the clean plate),
 # virtual.cameramodel, subjects.csv and truth.json (the session's truth), bank-info.txt,
 # timings.txt (each stage's wall time) and inputs.txt (what the stages were made from);
-# OUT/hamster links to the longest hamster set of this run (what docs/examples name).
+# OUT/hamster links to the longest hamster set OUT holds (what docs/examples name).
 #
 # Cached by its inputs: each stage keeps a hash of what it was made from (the content of the
 # sources it runs, its arguments and config, the recipe's version and the stage before's) and
@@ -134,7 +134,6 @@ run_tag() {
   "$ss" bank tag "$dir/$bank" --sprites "$ids" --tag standing
 }
 
-longest_hamster=""
 IFS=',' read -r -a names <<< "$sets"
 for name in "${names[@]}"; do
   ingest_args=()
@@ -147,7 +146,6 @@ for name in "${names[@]}"; do
       esac
       bank=hamster.ssbank
       synth_args=(--kind animal --seconds "$seconds" --fps 30 --size 640x480 --cameras 1 --subjects 1 --seed 53 --no-mattes)
-      longest_hamster="$name"
       ;;
     flies)
       bank=fly.ssbank
@@ -191,8 +189,13 @@ for name in "${names[@]}"; do
   echo "   $(head -n 3 "$dir/bank-info.txt" | paste -sd' ' -)"
   echo "== $name: $(elapsed "$t_set") s"
 done
-if [ -n "$longest_hamster" ]; then
-  ln -sfn "$longest_hamster" "$out/hamster"
-  echo "== $out/hamster -> $longest_hamster"
-fi
+# The longest hamster set OUT holds (made in this run or before): the demo's 60 s set made
+# after a 5 min one must not take the examples' bank from them.
+for longest_hamster in hamster-30min hamster-5min hamster-60s; do
+  if [ -f "$out/$longest_hamster/hamster.ssbank" ]; then
+    ln -sfn "$longest_hamster" "$out/hamster"
+    echo "== $out/hamster -> $longest_hamster"
+    break
+  fi
+done
 if [[ ",$sets," == *",flies,"* ]]; then ln -sfn flies "$out/fly"; fi
