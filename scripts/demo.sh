@@ -89,33 +89,11 @@ fi
 # transition between them, and the walk stopped after 0.12 m; the reference hamster's first
 # minute (one camera, 1,618 sprites in 7 clips, 13,713 transitions) finishes it.
 ref_root="$top/recordings/reference"
-ref="$ref_root/hamster-60s"
 stage reference "the reference hamster's first 60 s: rendered (no camera needed), ingested through the live pipeline, its transitions and clean plate (scripts/reference-banks.sh; cached: instant the second time)"
 "$top/scripts/reference-banks.sh" "$ref_root" --sets hamster-60s --build "$build"
 
-stage animate "animating: the hamster walks a straight path 0.6 m across the floor (seed 000 §4-5)"
-cat > "$out/walk.yaml" <<EOF
-version: 1
-frame_rate: 30
-# Free length: the hamster walks ~0.12 m/s, so 0.6 m takes ~5 s; min_frames keeps it from
-# standing still at the start.
-length: {min_frames: 60, max_frames: 300}
-camera: $ref/virtual.cameramodel
-background: $ref/floor.png
-banks: [$ref/hamster.ssbank]
-optimizer: {method: replace, time_budget_s: 10}
-sprites:
-  - name: walker
-    start: [-0.3, 0.0]
-    constraints:
-      - path:
-          points: [[-0.3, 0.0], [0.3, 0.0]]
-          distance_strength: 200
-          # The unreached rest of the path must outweigh what each further step costs, or the
-          # walk stops short: 200 a metre left it at 77 % of the path, 1000 and 3000 finish it.
-          unreached_strength: 3000
-EOF
-"$ss" animate "$out/walk.yaml" --out "$out/walk.json"
+stage animate "animating: the hamster walks a straight path 0.6 m across the floor (docs/examples/walk.yaml; seed 000 §4-5)"
+"$ss" animate "$top/docs/examples/walk.yaml" --out "$out/walk.json"
 
 stage render "rendering the animation into the enclosure, with its contact shadow"
 "$ss" render "$out/walk.json" --out "$out/walk.mkv"

@@ -356,7 +356,7 @@ TEST_F(SpecTest, TheDocumentedExamplesAreValid) {
   const fs::path examples = fs::path(ss::testing::SourcePath("docs/examples"));
   const fs::path copies = fs::path(dir_.path()) / "docs" / "examples";
   fs::create_directories(copies);
-  for (const char* set : {"hamster", "flies"}) {
+  for (const char* set : {"hamster", "hamster-60s", "flies"}) {
     const fs::path reference = fs::path(dir_.path()) / "recordings" / "reference" / set;
     fs::create_directories(reference);
     for (const char* name : {"hamster.ssbank", "fly.ssbank", "floor.png", "virtual.cameramodel"})
