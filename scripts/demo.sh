@@ -40,9 +40,8 @@ mkdir -p "$out"
 
 if [ "$mode" = station ]; then
   if [ ! -f "$sample/session.json" ]; then
-    stage synth "rendering a synthetic sample session into $sample (no camera needed)"
-    rm -rf "$sample"
-    "$ss" synth --out "$sample" --kind animal --seconds 10 --fps 30 --size 640x480 --cameras 2 --subjects 1 --seed 7
+    stage synth "rendering a synthetic sample session into $sample (scripts/sample.sh; no camera needed)"
+    SPRITESTATION="$ss" "$top/scripts/sample.sh" "$sample"
   fi
   config="$top/docs/station.replay.yaml"
   stage station "starting the station on the sample session ($config)"

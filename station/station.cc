@@ -7,6 +7,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <filesystem>
 #include <mutex>
 #include <thread>
 
@@ -18,6 +19,7 @@
 #include "core/error_kinds.h"
 #include "core/log.h"
 #include "core/option_checks.h"
+#include "core/sql_postgres.h"
 #include "pipeline/run/bank_scale.h"
 #include "pipeline/run/bounded_queue.h"
 #include "pipeline/run/ingest.h"
@@ -32,6 +34,7 @@ namespace {
 using station_detail::Clock;
 using station_detail::kPreviewIntervalS;
 using station_detail::Seconds;
+namespace fs = std::filesystem;
 
 // SIGTERM must finish within 5 s: from the start of Stop, the transition worker may drain this
 // long.
@@ -115,6 +118,17 @@ Station::~Station() { Stop(); }
 void Station::Start() {
   Impl& s = *impl_;
   const StationConfig& config = s.options.config;
+  if (!sql::IsPostgresAddress(config.storage.bank)) {
+    // A first run's bank folder (docs/station.replay.yaml names recordings/demo-output/): made,
+    // as the recordings' folder is.
+    const fs::path folder = fs::path(config.storage.bank).parent_path();
+    std::error_code ec;
+    if (!folder.empty()) fs::create_directories(folder, ec);
+    if (ec) {
+      throw InputError("storage.bank",
+                       "cannot make the bank's folder " + folder.string() + ": " + ec.message());
+    }
+  }
   s.bank = std::make_unique<BankWriter>(config.storage.bank);
   s.bank_sprites = s.bank->Counts().sprites;
   {
