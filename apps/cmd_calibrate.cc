@@ -322,8 +322,9 @@ void AddWizard(CLI::App& parent) {
       ->capture_default_str();
   cmd->add_option("--still-seconds", o->still_s,
                   "Intrinsics: the board is still this long before a capture");
-  cmd->add_option("--floor-still-seconds", o->floor_still_s,
-                  "Ground: still this long = lying on the floor");
+  cmd->add_option(
+      "--floor-still-seconds", o->floor_still_s,
+      "Ground: the floor board still this long (frames' timestamps), then its pose is checked");
   cmd->add_option("--count", o->run.max_frames,
                   "Stop after this many frames (0: the whole session / until done)");
   cmd->add_option("--silent-seconds", o->run.silent_s,
@@ -368,7 +369,8 @@ void AddWizard(CLI::App& parent) {
     const SourceCamera& sc = source->cameras().at(0);
     const double fps = sc.fps > 0 ? sc.fps : 30.0;
     w.still_frames = std::max(2, static_cast<int>(std::lround(o->still_s * fps)));
-    w.floor_still_frames = std::max(3, static_cast<int>(std::lround(o->floor_still_s * fps)));
+    // By the frames' timestamps: a recording replayed as fast as it decodes keeps its own time.
+    w.floor_still_s = o->floor_still_s;
     calib::CalibrationWizard wizard(camera.name, sc.width, sc.height, w);
     size_t printed = 0;
     auto print_log = [&] {

@@ -68,17 +68,10 @@ bool GreenFloorOptions::IsValid(std::string* why) const {
   return check.ok();
 }
 
-GroundPolygon FindGreenFloor(const CameraModel& model, const cv::Mat& bgr,
-                             const GreenFloorOptions& options) {
+cv::Mat GreenFloorMask(const cv::Mat& bgr, const GreenFloorOptions& options) {
   if (std::string why; !options.IsValid(&why)) throw InputError("green floor options", why);
   if (bgr.empty() || bgr.type() != CV_8UC3)
     throw InputError("image", "expected an 8-bit colour image");
-  if (bgr.cols != model.width() || bgr.rows != model.height()) {
-    throw InputError("image", "the image is " + std::to_string(bgr.cols) + "x" +
-                                  std::to_string(bgr.rows) + " but the camera model's imager is " +
-                                  std::to_string(model.width()) + "x" +
-                                  std::to_string(model.height()));
-  }
   cv::Mat mask(bgr.size(), CV_8U, cv::Scalar(0));
   std::vector<uint8_t> green_levels;
   for (int y = 0; y < bgr.rows; ++y) {
@@ -90,8 +83,7 @@ GroundPolygon FindGreenFloor(const CameraModel& model, const cv::Mat& bgr,
       }
     }
   }
-  if (green_levels.size() < 100) throw InputError("image", "no green floor region in view");
-  if (options.split_walls) {
+  if (options.split_walls && green_levels.size() >= 2) {
     // Lit from above, the floor is brighter than the green walls: Otsu on the green level.
     cv::Mat levels(1, static_cast<int>(green_levels.size()), CV_8U, green_levels.data()), unused;
     const double t = cv::threshold(levels, unused, 0, 255, cv::THRESH_BINARY | cv::THRESH_OTSU);
@@ -107,6 +99,22 @@ GroundPolygon FindGreenFloor(const CameraModel& model, const cv::Mat& bgr,
     }
   }
   cv::morphologyEx(mask, mask, cv::MORPH_OPEN, cv::getStructuringElement(cv::MORPH_RECT, {3, 3}));
+  return mask;
+}
+
+GroundPolygon FindGreenFloor(const CameraModel& model, const cv::Mat& bgr,
+                             const GreenFloorOptions& options) {
+  if (std::string why; !options.IsValid(&why)) throw InputError("green floor options", why);
+  if (bgr.empty() || bgr.type() != CV_8UC3)
+    throw InputError("image", "expected an 8-bit colour image");
+  if (bgr.cols != model.width() || bgr.rows != model.height()) {
+    throw InputError("image", "the image is " + std::to_string(bgr.cols) + "x" +
+                                  std::to_string(bgr.rows) + " but the camera model's imager is " +
+                                  std::to_string(model.width()) + "x" +
+                                  std::to_string(model.height()));
+  }
+  cv::Mat mask = GreenFloorMask(bgr, options);
+  if (cv::countNonZero(mask) < 100) throw InputError("image", "no green floor region in view");
   cv::Mat labels, stats, centroids;
   const int n = cv::connectedComponentsWithStats(mask, labels, stats, centroids, 8);
   int best = -1;

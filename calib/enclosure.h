@@ -34,6 +34,10 @@ struct GreenFloorOptions {
   bool IsValid(std::string* why) const;
 };
 
+// The pixels of `bgr` (8-bit BGR) that pass the green floor test (255, else 0): green
+// enough, and with split_walls the brighter of the floor's and the walls' greens.
+cv::Mat GreenFloorMask(const cv::Mat& bgr, const GreenFloorOptions& options = {});
+
 // The largest connected green floor region in `bgr`, carried onto the floor.
 // InputError when the image holds no green region or its size does not match the model.
 GroundPolygon FindGreenFloor(const CameraModel& model, const cv::Mat& bgr,

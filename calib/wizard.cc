@@ -69,6 +69,29 @@ bool WizardOptions::IsValid(std::string* why) const {
   check(max_views >= 1, "max_views", "expected at least 1 view, got " + std::to_string(max_views));
   check(floor_still_frames >= 1, "floor_still_frames",
         "expected at least 1 frame, got " + std::to_string(floor_still_frames));
+  check(std::isfinite(floor_still_s) && floor_still_s >= 0, "floor_still_s",
+        "expected seconds >= 0, got " + OptionProblems::Num(floor_still_s));
+  check.Nested(ground_checks.IsValid(&part), "ground_checks.", part);
+  return check.ok();
+}
+
+bool GroundChecks::IsValid(std::string* why) const {
+  OptionProblems check(why);
+  check(ring_from_squares >= 0 && ring_to_squares > ring_from_squares, "ring_to_squares",
+        "expected 0 <= ring_from_squares < ring_to_squares, got " +
+            OptionProblems::Num(ring_from_squares) + " and " +
+            OptionProblems::Num(ring_to_squares));
+  check(min_ring_green >= 0 && min_ring_green <= 1, "min_ring_green",
+        "expected a fraction 0..1, got " + OptionProblems::Num(min_ring_green));
+  check(min_height_m >= 0 && max_height_m > min_height_m, "max_height_m",
+        "expected 0 <= min_height_m < max_height_m, got " + OptionProblems::Num(min_height_m) +
+            " and " + OptionProblems::Num(max_height_m));
+  check(min_axis_down_deg >= -90 && min_axis_down_deg <= 90, "min_axis_down_deg",
+        "expected degrees -90..90, got " + OptionProblems::Num(min_axis_down_deg));
+  check(max_spread_mm > 0, "max_spread_mm",
+        "expected a positive distance, got " + OptionProblems::Num(max_spread_mm));
+  check(max_spread_deg > 0, "max_spread_deg",
+        "expected a positive angle, got " + OptionProblems::Num(max_spread_deg));
   return check.ok();
 }
 
@@ -273,6 +296,8 @@ void CalibrationWizard::EnterGround(int frame) {
   step_ = WizardStep::kGround;
   run_.clear();
   run_used_ = false;
+  word_ = false;
+  ground_check_.reset();
   Event(frame, "step");
 }
 
@@ -331,6 +356,125 @@ void CalibrationWizard::TryEmptyFloor(const cv::Mat& image, int frame) {
   }
 }
 
+GroundCheck CalibrationWizard::CheckGround(const GroundResult& g, const cv::Mat& image,
+                                           int frame) const {
+  const GroundChecks& k = o_.ground_checks;
+  GroundCheck c;
+  c.frame = frame;
+  c.frames = static_cast<int>(run_.size());
+  c.height_m = g.height_m;
+  c.axis_down_deg = g.optical_axis_down_deg;
+  std::vector<std::string> doubts;
+  // (a) A board lying on the floor is surrounded by it: the ring around the board (past the
+  // paper's margin) is floor green; a board held up in front of the camera has a room behind it.
+  cv::Mat bgr = image;
+  if (image.channels() == 1) cv::cvtColor(image, bgr, cv::COLOR_GRAY2BGR);
+  const cv::Mat green = GreenFloorMask(bgr);
+  const Rigid3 cam_from_board = g.cam_from_ground * o_.ground_from_board;
+  const double sq = o_.board.square_m, w = o_.board.squares_x * sq, h = o_.board.squares_y * sq;
+  // The checkered area grown by `grow` squares, in pixels; empty when part of it is behind the
+  // camera.
+  auto outline = [&](double grow) {
+    const double m = grow * sq;
+    const Eigen::Vector3d rect[4] = {
+        {-m, -m, 0}, {w + m, -m, 0}, {w + m, h + m, 0}, {-m, h + m, 0}};
+    std::vector<cv::Point> px;
+    constexpr int kPerSide = 16;
+    for (int side = 0; side < 4; ++side) {
+      for (int i = 0; i < kPerSide; ++i) {
+        const Eigen::Vector3d p =
+            rect[side] + (rect[(side + 1) % 4] - rect[side]) * (static_cast<double>(i) / kPerSide);
+        const Eigen::Vector3d in_cam = cam_from_board * p;
+        if (in_cam.z() < 1e-3) return std::vector<cv::Point>{};
+        const Eigen::Vector2d q = intrinsics_model_->Project(in_cam);
+        if (!q.allFinite()) return std::vector<cv::Point>{};
+        // (far outside the image only the side it leaves by matters)
+        px.emplace_back(
+            static_cast<int>(std::lround(std::clamp(q.x(), -2.0 * width_, 3.0 * width_))),
+            static_cast<int>(std::lround(std::clamp(q.y(), -2.0 * height_, 3.0 * height_))));
+      }
+    }
+    return px;
+  };
+  const std::vector<cv::Point> outer = outline(k.ring_to_squares),
+                               inner = outline(k.ring_from_squares);
+  if (outer.empty() || inner.empty()) {
+    doubts.push_back("the floor around the board would be behind the camera");
+  } else {
+    cv::Mat ring(bgr.size(), CV_8U, cv::Scalar(0));
+    cv::fillPoly(ring, std::vector<std::vector<cv::Point>>{outer}, cv::Scalar(255));
+    cv::fillPoly(ring, std::vector<std::vector<cv::Point>>{inner}, cv::Scalar(0));
+    const double ring_area = cv::contourArea(outer) - cv::contourArea(inner);
+    const int in_view = cv::countNonZero(ring);
+    cv::Mat green_ring;
+    cv::bitwise_and(ring, green, green_ring);
+    // Less than a third of the ring in the image: too little to tell.
+    if (in_view < 0.33 * ring_area || in_view == 0) {
+      doubts.push_back(
+          Fmt("too little of the floor around the board is in view (%.0f%% of it): "
+              "lay the board further from the image's edges",
+              100.0 * in_view / std::max(1.0, ring_area)));
+    } else {
+      c.ring_green = cv::countNonZero(green_ring) / static_cast<double>(in_view);
+      if (c.ring_green < k.min_ring_green) {
+        doubts.push_back(
+            Fmt("the board is not surrounded by green floor (%.0f%% of the ring "
+                "around it is floor green, need %.0f%%): is it lying on the floor?",
+                100 * c.ring_green, 100 * k.min_ring_green));
+      }
+    }
+  }
+  // (b) A camera that watches a floor stands above it and looks down at it.
+  if (!(g.height_m >= k.min_height_m && g.height_m <= k.max_height_m)) {
+    doubts.push_back(Fmt("the camera would be %.2f m above the floor (expected %.2f", g.height_m,
+                         k.min_height_m) +
+                     Fmt(" to %.1f m)", k.max_height_m));
+  }
+  if (!(g.optical_axis_down_deg >= k.min_axis_down_deg)) {
+    doubts.push_back(
+        Fmt("the camera's optical axis would be %.1f deg below the horizon "
+            "(expected at least %.0f: a camera watching a floor looks down at it)",
+            g.optical_axis_down_deg, k.min_axis_down_deg));
+  }
+  // (c) Each still frame on its own gives the same pose as their mean.
+  const size_t n = run_.size(), samples = std::min<size_t>(5, n);
+  double spread_m = 0, spread_deg = 0;
+  for (size_t s = 0; s < samples; ++s) {
+    const size_t i = samples == 1 ? 0 : s * (n - 1) / (samples - 1);
+    try {
+      const GroundResult one =
+          SolveGroundPose(*intrinsics_model_, o_.board, run_[i], o_.ground_from_board, camera_);
+      spread_m = std::max(spread_m, (one.centre_in_ground - g.centre_in_ground).norm());
+      const Eigen::Matrix3d d =
+          one.cam_from_ground.rotation * g.cam_from_ground.rotation.transpose();
+      spread_deg =
+          std::max(spread_deg, std::acos(std::clamp((d.trace() - 1) / 2, -1.0, 1.0)) * 180 / M_PI);
+    } catch (const std::runtime_error& e) {
+      doubts.push_back(std::string("a still frame gives no pose: ") + e.what());
+      break;
+    }
+  }
+  c.spread_mm = spread_m * 1000;
+  c.spread_deg = spread_deg;
+  if (c.spread_mm > k.max_spread_mm || c.spread_deg > k.max_spread_deg) {
+    doubts.push_back(Fmt("the still frames' poses disagree by %.1f mm", c.spread_mm) +
+                     Fmt(" and %.2f deg: the board moved", c.spread_deg));
+  }
+  for (const auto& d : doubts) c.doubt += (c.doubt.empty() ? "" : "; ") + d;
+  return c;
+}
+
+void CalibrationWizard::BoardOnFloor(int frame) {
+  if (step_ != WizardStep::kGround) {
+    throw InputError("board on floor", std::string("the camera is not in the ground step (now: ") +
+                                           WizardStepName(step_) + ")");
+  }
+  word_ = true;
+  run_.clear();  // the still span starts now
+  run_used_ = false;
+  Event(frame, "board_on_floor");
+}
+
 std::optional<CameraModel> CalibrationWizard::posed_model() const {
   if (!intrinsics_model_ || !ground_) return std::nullopt;
   CameraModel m = *intrinsics_model_;
@@ -338,7 +482,7 @@ std::optional<CameraModel> CalibrationWizard::posed_model() const {
   return m;
 }
 
-WizardFrame CalibrationWizard::Feed(const cv::Mat& image, int frame) {
+WizardFrame CalibrationWizard::Feed(const cv::Mat& image, int frame, double time_s) {
   WizardFrame out;
   out.step = step_;
   if (step_ == WizardStep::kDone) return out;
@@ -372,6 +516,7 @@ WizardFrame CalibrationWizard::Feed(const cv::Mat& image, int frame) {
   } else {
     run_ = {view};
     run_used_ = false;
+    run_start_s_ = time_s;
   }
   out.still = run_.size() >= 2;
 
@@ -423,24 +568,61 @@ WizardFrame CalibrationWizard::Feed(const cv::Mat& image, int frame) {
     }
   }
   if (step_ == WizardStep::kGround) {
-    if (!view.accepted) {
-      now.push_back("lay the board flat on the floor, in view");
-    } else if (static_cast<int>(run_.size()) < o_.floor_still_frames) {
-      now.push_back("lay the board flat on the floor and leave it still");
-    } else {
+    // The still span by the timestamps (frames without one: by the count alone).
+    const double still_s = run_.empty() ? 0.0 : time_s - run_start_s_;
+    const bool long_enough = static_cast<int>(run_.size()) >= o_.floor_still_frames &&
+                             !(still_s < o_.floor_still_s);  // NaN: no timestamps
+    const bool may_take = !o_.floor_needs_word || word_;
+    std::string failed;
+    if (may_take && view.accepted && long_enough) {
       try {
         floor_view_ = AverageStillViews(run_, 2 * o_.still_px);
-        ground_ = SolveGroundPose(*intrinsics_model_, o_.board, floor_view_, o_.ground_from_board,
-                                  camera_);
-        Event(frame, "ground",
-              {{"height_m", ground_->height_m},
-               {"rms_px", ground_->rms_px},
-               {"from", floor_view_.source}});
-        EnterEnclosure(frame, image);
+        GroundResult g = SolveGroundPose(*intrinsics_model_, o_.board, floor_view_,
+                                         o_.ground_from_board, camera_);
+        GroundCheck c = CheckGround(g, image, frame);
+        c.still_s = still_s;
+        auto num = [](double v) {
+          return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr);
+        };
+        nlohmann::json detail = {{"height_m", g.height_m},
+                                 {"axis_down_deg", g.optical_axis_down_deg},
+                                 {"rms_px", g.rms_px},
+                                 {"from", floor_view_.source},
+                                 {"frames", c.frames},
+                                 {"still_s", num(c.still_s)},
+                                 {"ring_green", num(c.ring_green)},
+                                 {"spread_mm", num(c.spread_mm)},
+                                 {"spread_deg", num(c.spread_deg)}};
+        word_ = false;  // one word, one board checked
+        ground_check_ = c;
+        if (c.doubt.empty()) {
+          ground_ = std::move(g);
+          Event(frame, "ground", std::move(detail));
+          EnterEnclosure(frame, image);
+        } else {
+          detail["doubt"] = c.doubt;
+          Event(frame, "ground_doubtful", std::move(detail));
+          run_.clear();
+        }
       } catch (const std::runtime_error& e) {
         Event(frame, "ground_failed", {{"reason", e.what()}});
         run_.clear();
-        now.push_back(std::string("the floor board could not be used: ") + e.what());
+        word_ = false;
+        failed = e.what();
+      }
+    }
+    if (step_ == WizardStep::kGround) {
+      if (ground_check_ && !ground_check_->doubt.empty())
+        now.push_back("the floor board's pose is doubtful, not taken: " + ground_check_->doubt);
+      if (!failed.empty()) {
+        now.push_back("the floor board could not be used: " + failed);
+      } else if (!may_take || (o_.floor_needs_word && !word_)) {
+        now.push_back(
+            "lay the board flat on the green floor, in view, then say so (\"board on floor\")");
+      } else if (!view.accepted) {
+        now.push_back("lay the board flat on the floor, in view");
+      } else {
+        now.push_back("lay the board flat on the floor and leave it still");
       }
     }
   }
@@ -578,6 +760,10 @@ void CalibrationWizard::Redo(WizardStep step) {
     case WizardStep::kDone:
       throw InputError("step", "expected intrinsics, ground or enclosure");
   }
+  if (step != WizardStep::kEnclosure) {
+    word_ = false;
+    ground_check_.reset();
+  }
   verdicts_.clear();
   run_.clear();
   run_used_ = false;
@@ -680,8 +866,13 @@ void CalibrationWizard::Finish() {
     }
   }
   if (step_ == WizardStep::kGround) {
-    verdicts_.push_back(
-        "ground: no board lying still on the floor was seen; lay the board flat on the floor");
+    if (ground_check_ && !ground_check_->doubt.empty()) {
+      verdicts_.push_back("ground: the floor board's pose was doubtful, not taken: " +
+                          ground_check_->doubt);
+    } else {
+      verdicts_.push_back(
+          "ground: no board lying still on the floor was seen; lay the board flat on the floor");
+    }
     step_ = WizardStep::kDone;
     Event(-1, "verdict", {{"reason", verdicts_.back()}});
     return;

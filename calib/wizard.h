@@ -6,6 +6,7 @@
 // says what is missing ("cover the left edge", "tilt the board more", "lay
 // the board flat on the floor"), and ends each step when its criteria are met.
 // Every decision goes into a step log (JSON).
+#include <cmath>
 #include <optional>
 #include <string>
 #include <vector>
@@ -25,6 +26,47 @@
 
 namespace ss::calib {
 
+// When a floor board's pose is doubtful (not taken): see GroundCheck. The values come from
+// the synthetic calibration sessions (`synth --kind calibration`, 640x480, seeds 1 and 3-6, the
+// chessboard held in 5 poses per session, then lying on the floor beside the ChArUco board) and
+// from tests/calib/wizard_ground_test.cc.
+struct GroundChecks {
+  // (a) The ring around the board, between its checkered area grown by ring_from_squares and by
+  // ring_to_squares squares (from 1.5: past the paper's white margin, 1 square on the synthetic
+  // board), must be at least min_ring_green floor green (GreenFloorMask, the enclosure step's
+  // test). Measured: lying on the floor 0.76-0.86 (the ChArUco board beside it covers part of
+  // the ring), 0.90-1.00 alone; held up before the camera 0.00-0.49 (the room, the walls' darker
+  // green and the floor's edge behind it), 0.00 in a room without green.
+  double ring_from_squares = 1.5, ring_to_squares = 3.0;
+  double min_ring_green = 0.6;
+  // (b) The camera above the floor: the synthetic enclosure's cameras stand 0.77-1.5 m high
+  // (1.08-1.24 m measured), the stage's 1.1-1.8 m; a board held at arm's length before the
+  // camera poses it 0.24-0.64 m high (issue 41's hand-held recording: 0.31 m). 0.5 m is below
+  // every camera the studios place; 6 m above any room's ceiling. Its optical axis looks down at
+  // the floor: 43-58 deg below the horizon in the enclosure, 2-10 deg on the stage; above the
+  // horizon the board could not be the floor it watches.
+  double min_height_m = 0.5, max_height_m = 6.0;
+  double min_axis_down_deg = 0.0;
+  // (c) The pose from each still frame (up to 5 of them) against the averaged one: a board lying
+  // still differs by the corner noise only, 0.15-0.51 mm and 0.005-0.017 deg measured; 10 times
+  // that means it moved (or the corners jump between two readings).
+  double max_spread_mm = 5.0, max_spread_deg = 0.2;
+  // False with "FIELD: reason" lines in `why` for values out of range.
+  bool IsValid(std::string* why) const;
+};
+
+// What the ground step made of the last still floor board: its measurements and, when the
+// pose is not taken, why.
+struct GroundCheck {
+  int frame = -1;
+  std::string doubt;        // empty: taken
+  double ring_green = NAN;  // fraction of the ring around the board that is floor green
+  double height_m = NAN, axis_down_deg = NAN;
+  double spread_mm = NAN, spread_deg = NAN;  // the still frames' poses against the averaged one
+  int frames = 0;                            // still frames averaged
+  double still_s = NAN;                      // their span by the timestamps
+};
+
 struct WizardOptions {
   BoardSpec board;
   DetectOptions detect;
@@ -39,7 +81,17 @@ struct WizardOptions {
   double min_scale_change = 0.25;   // ... or its size in the image this fraction, ...
   int min_new_cells = 3;            // ... or it puts corners in this many empty coverage cells
   int max_views = 30;               // intrinsics: solve what there is at this many views
-  int floor_still_frames = 5;  // ground: still this long = lying on the floor (a held board is not)
+  // Ground: the board must lie still this long, by the frames' timestamps (a count of frames
+  // would depend on how many the machine gets to process), and for at least this many frames
+  // (the pose is averaged over them and checked for agreement). Frames fed without a timestamp
+  // are counted only. Enclosure: frames in a row without a board before the floor is taken.
+  double floor_still_s = 1.0;
+  int floor_still_frames = 3;
+  // Ground: a board lying still is taken only after the operator said it lies on the floor
+  // (BoardOnFloor(): the console's button). False (the command line on a recording): at once,
+  // trusted only by the checks below.
+  bool floor_needs_word = false;
+  GroundChecks ground_checks;
   Rigid3 ground_from_board = FloorBoardPose();
   std::vector<Eigen::Vector2d>
       floor_points;  // enclosure in ground metres; empty: the largest green floor region
@@ -69,8 +121,9 @@ class CalibrationWizard {
  public:
   CalibrationWizard(std::string camera, int width, int height, WizardOptions options);
 
-  // One frame (8-bit BGR or grey, the camera's size); `frame` is its index.
-  WizardFrame Feed(const cv::Mat& image, int frame);
+  // One frame (8-bit BGR or grey, the camera's size); `frame` is its index, `time_s` its
+  // timestamp in seconds (NaN: none; the still spans are then counted in frames).
+  WizardFrame Feed(const cv::Mat& image, int frame, double time_s = NAN);
   // The input ended: solves a step that has enough to solve, gives every
   // unfinished step its verdict with the reason.
   void Finish();
@@ -103,6 +156,14 @@ class CalibrationWizard {
   // intrinsics step is over.
   void DropLast();
   void DropWorst();
+  // The operator's word that the board lies on the floor now: the ground step takes the next
+  // still span of it (floor_needs_word). InputError outside the ground step.
+  void BoardOnFloor(int frame = -1);
+  bool waiting_for_word() const {
+    return step_ == WizardStep::kGround && o_.floor_needs_word && !word_;
+  }
+  // The last floor board checked (nullopt: none yet in this ground step).
+  const std::optional<GroundCheck>& ground_check() const { return ground_check_; }
   // Back to the start of `step`: intrinsics (every view and result goes), ground (the pose and
   // the enclosure), enclosure (the enclosure). InputError when the step cannot be reached.
   void Redo(WizardStep step);
@@ -143,13 +204,18 @@ class CalibrationWizard {
   // A frame without the board: its green floor becomes the enclosure if nothing hides it.
   void TryEmptyFloor(const cv::Mat& image, int frame);
   double Focal() const;
+  // The floor board's pose checked (GroundChecks) against the frame and the still run.
+  GroundCheck CheckGround(const GroundResult& ground, const cv::Mat& image, int frame) const;
 
   std::string camera_;
   int width_, height_;
   WizardOptions o_;
   WizardStep step_ = WizardStep::kIntrinsics;
-  std::vector<BoardView> run_;    // consecutive still detections ending at the last frame
-  bool run_used_ = false;         // the current still run was captured already
+  std::vector<BoardView> run_;  // consecutive still detections ending at the last frame
+  bool run_used_ = false;       // the current still run was captured already
+  double run_start_s_ = NAN;    // the timestamp of the still run's first frame
+  bool word_ = false;           // the operator said the board lies on the floor
+  std::optional<GroundCheck> ground_check_;
   int empty_frames_ = 0;          // enclosure: frames in a row without a board
   int fed_ = 0;                   // frames fed
   bool last_detected_ = false;    // the board was found in the last frame

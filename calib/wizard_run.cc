@@ -56,7 +56,8 @@ WizardRunResult RunWizardOnSource(FrameSource& source, CalibrationWizard& wizard
       if (!frame) break;
       last_frame_ns.store(Clock::now().time_since_epoch().count());
       ToBgr(*frame, bgr);
-      wizard.Feed(bgr, static_cast<int>(frame->sequence));
+      wizard.Feed(bgr, static_cast<int>(frame->sequence),
+                  frame->timestamp_ns > 0 ? static_cast<double>(frame->timestamp_ns) * 1e-9 : NAN);
       ++result.frames;
       if (after_frame) after_frame();
     }

@@ -293,11 +293,15 @@ class CameraWork {
         calib::WizardOptions o = settings_.options;
         const double fps = fps_hint_ > 0 ? fps_hint_ : 30.0;
         o.still_frames = std::max(2, static_cast<int>(std::lround(settings_.still_s * fps)));
-        o.floor_still_frames =
-            std::max(3, static_cast<int>(std::lround(settings_.floor_still_s * fps)));
+        // The floor board's still span by the frames' timestamps (frames dropped under load
+        // do not make it longer), after the operator's word that it lies on the floor.
+        o.floor_still_s = settings_.floor_still_s;
+        o.floor_needs_word = true;
         wizard_ = std::make_unique<calib::CalibrationWizard>(name_, bgr_.cols, bgr_.rows, o);
       }
-      const calib::WizardFrame out = wizard_->Feed(bgr_, static_cast<int>(frame.sequence));
+      const calib::WizardFrame out = wizard_->Feed(
+          bgr_, static_cast<int>(frame.sequence),
+          frame.timestamp_ns > 0 ? static_cast<double>(frame.timestamp_ns) * 1e-9 : NAN);
       guidance_ = out.guidance;
       ++frames_fed_;
       message_.clear();
@@ -438,6 +442,8 @@ class CameraWork {
                 {"checklist", nlohmann::json::array()},
                 {"solve", nullptr},
                 {"ground", nullptr},
+                {"ground_word_needed", settings_.options.intrinsics.has_value()},
+                {"ground_check", nullptr},
                 {"enclosure", nullptr},
                 {"plan", nullptr}});
       std::lock_guard lock(state_mutex_);
@@ -485,6 +491,23 @@ class CameraWork {
       grid_.clear();
       j["ground"] = nullptr;
       j["plan"] = nullptr;
+    }
+    // The ground step: waiting for the operator's word, and what the last floor board's checks
+    // found (a doubtful pose is not taken; `doubt` says why).
+    j["ground_word_needed"] = w.waiting_for_word();
+    if (const auto& c = w.ground_check()) {
+      j["ground_check"] = {
+          {"doubt", c->doubt.empty() ? nlohmann::json(nullptr) : nlohmann::json(c->doubt)},
+          {"frame", c->frame},
+          {"ring_green", Num(c->ring_green)},
+          {"height_m", Num(c->height_m)},
+          {"axis_down_deg", Num(c->axis_down_deg)},
+          {"spread_mm", Num(c->spread_mm)},
+          {"spread_deg", Num(c->spread_deg)},
+          {"frames", c->frames},
+          {"still_s", Num(c->still_s)}};
+    } else {
+      j["ground_check"] = nullptr;
     }
     std::vector<Eigen::Vector2d> floor_px;
     if (w.floor()) {
@@ -1057,6 +1080,33 @@ std::vector<api::Route> ConsoleCalibration::Routes() {
          for (const auto& w : chosen) w->StartSolve();
          api::Reply(res, 202, StateWithCameras());
        }},
+      {"POST", "/api/calibration/ground",
+       "POST /api/calibration/ground {\"camera\"} (the board lies on the floor now)",
+       state_after([s](const Request& req) {
+         const nlohmann::json body = api::ObjectBody(req, api::kCalibrationGroundFields);
+         s->RequireActive();
+         const std::optional<std::string> camera = api::ParseCameraName(body, false);
+         std::vector<std::shared_ptr<CameraWork>> chosen = s->Chosen(camera);
+         if (!camera) {
+           // Every camera in the ground step.
+           std::vector<std::shared_ptr<CameraWork>> in_step;
+           for (const auto& w : chosen) {
+             if (w->Snapshot().value("step", "") == "ground") in_step.push_back(w);
+           }
+           if (in_step.empty()) throw ConflictError("ground", "no camera is in the ground step");
+           chosen = in_step;
+         }
+         for (const auto& w : chosen) {
+           w->Run([&](calib::CalibrationWizard& wiz) {
+             try {
+               wiz.BoardOnFloor(-1);
+             } catch (const InputError& e) {
+               throw ConflictError(w->name(), e.what());
+             }
+             return 0;
+           });
+         }
+       })},
       {"POST", "/api/calibration/redo",
        "POST /api/calibration/redo {\"camera\", \"step\": \"intrinsics\" | \"ground\" | "
        "\"enclosure\"}",

@@ -108,6 +108,10 @@ CalibrationDropRequest ParseCalibrationDrop(const nlohmann::json& body);
 // POST /api/calibration/solve {"camera"} (every camera in the intrinsics step when none).
 inline constexpr std::initializer_list<const char*> kCalibrationSolveFields = {"camera"};
 
+// POST /api/calibration/ground {"camera"}: the operator's word that the board lies on the floor
+// now (every camera in the ground step when none names one); parsed with ParseCameraName.
+inline constexpr std::initializer_list<const char*> kCalibrationGroundFields = {"camera"};
+
 // POST /api/calibration/redo {"camera", "step": "intrinsics" | "ground" | "enclosure"}.
 inline constexpr std::initializer_list<const char*> kCalibrationRedoFields = {"camera", "step"};
 struct CalibrationRedoRequest {

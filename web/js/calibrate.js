@@ -128,6 +128,10 @@ form.addEventListener('submit', (ev) => {
   });
 });
 
+$('calib-board-on-floor').addEventListener('click', (e) => {
+  act(e.currentTarget, () => postJson('/api/calibration/ground'));
+});
+
 $('calib-cancel').addEventListener('click', (e) => {
   act(e.currentTarget, () => postJson('/api/calibration/cancel'));
 });
@@ -181,6 +185,7 @@ function renderRun() {
   badge.dataset.state = active ? 'live' : 'idle';
   $('calib-start').textContent = active ? 'Restart' : 'Start';
   $('calib-cancel').disabled = !active;
+  $('calib-board-on-floor').disabled = !active || !(c?.cameras || []).some((k) => k.step === 'ground' && k.ground_word_needed);
   $('calib-run-no').textContent = c?.run ? `run ${c.run}${c.board ? ' · ' + c.board : ''}` : '';
 
   // the steps, as far as the least advanced camera got
@@ -316,9 +321,16 @@ class Card {
           </section>
           <section class="step-ground" data-testid="cam-ground">
             <h3>Ground</h3>
-            <p class="instructions" data-testid="cam-ground-instructions">Lay the board flat on the floor, face up, where
-              the start form says, and leave it still: the camera is posed against it. The 10 cm floor grid is then drawn
-              over the live image: check it sits on the floor.</p>
+            <p class="instructions" data-testid="cam-ground-instructions">Lay the board flat on the green floor, face up,
+              where the start form says, then press <b>Board on floor</b> and leave it still: the camera is posed
+              against it, if the pose is plausible (green floor all round the board, the camera above the floor looking
+              down). The 10 cm floor grid is then drawn over the live image: check it sits on the floor.</p>
+            <div class="buttons">
+              <button type="button" class="primary" data-testid="cam-board-on-floor"
+                title="the board lies flat on the floor now: pose the camera once it is still">Board on floor</button>
+              <span class="muted" data-testid="cam-ground-word"></span>
+            </div>
+            <p class="ground-doubt" data-testid="cam-ground-doubt" role="status" hidden></p>
             <dl class="facts" data-testid="cam-pose">
               <dt>height</dt><dd class="num" data-testid="cam-height">–</dd>
               <dt>tilt (axis below horizon)</dt><dd class="num" data-testid="cam-tilt">–</dd>
@@ -386,6 +398,8 @@ class Card {
       act(e.currentTarget, () => postJson('/api/calibration/drop', { camera: name, which: 'worst' })));
     q('cam-solve').addEventListener('click', (e) =>
       act(e.currentTarget, () => postJson('/api/calibration/solve', { camera: name })));
+    q('cam-board-on-floor').addEventListener('click', (e) =>
+      act(e.currentTarget, () => postJson('/api/calibration/ground', { camera: name })));
     q('cam-detect-floor').addEventListener('click', (e) =>
       act(e.currentTarget, () => postJson('/api/calibration/floor', { camera: name, detect: true })));
     q('cam-use-picks').addEventListener('click', (e) =>
@@ -486,6 +500,20 @@ class Card {
     e['cam-centre'].textContent = g?.centre_m ? g.centre_m.map((v) => fmt(v, 3)).join(', ') + ' m' : '–';
     e['cam-ground-rms'].textContent = g && g.rms_px !== undefined ? `${fmt(g.rms_px, 2)} px` : '–';
     e['cam-pose'].dataset.posed = String(Boolean(g));
+    // the operator's word, and a floor board whose pose was doubtful (not taken), with why
+    const inGround = cam.step === 'ground';
+    e['cam-board-on-floor'].disabled = !inGround || !cam.ground_word_needed || Boolean(busy);
+    e['cam-ground-word'].textContent = !inGround ? ''
+      : cam.ground_word_needed ? 'waiting for your word' : 'checking the board once it is still';
+    e['cam-ground-word'].dataset.state = !inGround ? '' : cam.ground_word_needed ? 'waiting' : 'given';
+    const gc = cam.ground_check;
+    const doubt = inGround && gc?.doubt ? gc.doubt : '';
+    e['cam-ground-doubt'].hidden = !doubt;
+    e['cam-ground-doubt'].dataset.doubt = doubt;
+    e['cam-ground-doubt'].textContent = doubt
+      ? `Doubtful pose, not taken: ${doubt} (green round the board ${gc.ring_green === null ? '–' : fmt(gc.ring_green * 100, 0) + ' %'}, ` +
+        `height ${fmt(gc.height_m, 2)} m, axis ${fmt(gc.axis_down_deg, 1)}° down)`
+      : '';
 
     // enclosure
     const en = cam.enclosure;

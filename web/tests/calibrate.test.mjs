@@ -162,7 +162,9 @@ async function startWizard(board) {
   await p.fill('[data-testid="calib-thickness"]', '1');
   if (!(await p.$eval('details.criteria', (d) => d.open))) await p.click('details.criteria summary');
   await p.fill('[data-testid="calib-min-coverage"]', '40');
-  await p.fill('[data-testid="calib-floor-still"]', String(4 / FPS)); // 4 frames averaged, as the command line's 0.5 s at 8 fps
+  // still 0.5 s by the frames' timestamps, which fakecam serves as recorded (8 fps): 5 frames, as
+  // the command line's; a held pose stands still 2 or 3 frames, never that long
+  await p.fill('[data-testid="calib-floor-still"]', '0.5');
   const run = (await api('/api/calibration')).run || 0;
   await p.click('[data-testid="calib-start"]');
   await h.waitFor(`wizard run ${run + 1} with ${board}`, async () => {
@@ -360,8 +362,42 @@ test('intrinsics: views captured while the board stands still; a vanished camera
   cli = runCli(path.join(h.WORK, 'calib-cli'));
 });
 
-test('ground: the board lying on the floor poses the camera; height, tilt, grid; the green floor detected', async () => {
-  const c = await cardWait('the camera posed', (k) => k.posed && k.grid > 0, 60000);
+test('ground: the board lying on the floor poses the camera only after the word; height, tilt, grid; the green floor detected', async () => {
+  // The boards lie on the floor (the chessboard seen again after the ChArUco segment, still):
+  // without the operator's word nothing is posed and the step is not ticked, however long it lies.
+  const lying = await cardWait('the board lying still on the floor', (k) => k.step === 'ground' && k.boardState === 'still', 90000);
+  const waiting = () => p.$eval(`${CARD} [data-testid="cam-ground-word"]`, (x) => x.dataset.state);
+  assert.equal(await waiting(), 'waiting');
+  assert.equal(await p.isDisabled(`${CARD} [data-testid="cam-board-on-floor"]`), false, 'the word can be given');
+  assert.ok(lying.guidance.some((g) => /say so/.test(g)), `the guidance asks for the word: ${JSON.stringify(lying.guidance)}`);
+  // lying still longer than floor_still_s (0.5 s of the session's time: 5 frames, 2.5 s at 2 fps),
+  // then the word: the boards lie on the floor for 16 frames of the loop, the pose needs 5 more
+  // after the word
+  const t0 = Date.now();
+  const fed0 = (await api('/api/calibration')).cameras[0].frames;
+  const violations = [];
+  await h.waitFor('the board lying still for 6 frames without the word', async () => {
+    const k = await card();
+    const tick = await p.getAttribute('[data-testid="calib-steps"] li[data-step="ground"]', 'data-state');
+    if (k.posed || k.step !== 'ground' || tick !== 'current') violations.push({ ...k, tick });
+    return Date.now() - t0 > 6000 / FPS && k;
+  }, { timeout: 10000, interval: 100 });
+  assert.deepEqual(violations, [], 'posed or ticked without the word');
+  measured.frames_fed_without_word = (await api('/api/calibration')).cameras[0].frames - fed0;
+  assert.ok((await api('/api/calibration')).cameras[0].ground === null, 'the API has no pose either');
+  await h.screenshot(p, 'console-calibrate-ground-waiting.png');
+  const [req] = await Promise.all([
+    p.waitForRequest((r) => r.url().endsWith('/api/calibration/ground') && r.method() === 'POST'),
+    p.click(`${CARD} [data-testid="cam-board-on-floor"]`),
+  ]);
+  assert.deepEqual(JSON.parse(req.postData()), { camera: 'cam0' });
+  // (missed, the word waits for the boards' next time on the floor, 80 s on: a held pose is
+  // never still for 1.5 s)
+  const c = await cardWait('the camera posed', (k) => k.posed && k.grid > 0, 120000);
+  const check = (await api('/api/calibration')).cameras[0].ground_check;
+  assert.equal(check.doubt, null);
+  measured.ground_check = round(check);
+  assert.ok(check.ring_green > 0.6, `green round the board: ${check.ring_green}`);
   // The floor is clear of held boards only while the boards lie on it (the session's
   // last 2 s): detect at once, and again until a whole floor is seen.
   let area = 0;
