@@ -222,9 +222,11 @@ before(async () => {
       '--size', '640x480', '--cameras', '1', '--seed', '5']);
   }
   truth = readModel(path.join(dir, 'truth', 'cam0.cameramodel'));
+  // the true floor, where the enclosure step clicks (the config has none)
   floor = JSON.parse(fs.readFileSync(path.join(dir, 'truth', 'floor.json'), 'utf8')).polygon;
   cam = await fakecam();
-  cfg = h.config('calib', { floor }, [{ name: 'cam0', source: 'aravis', address: '127.0.0.2' }]);
+  // A first-time user's config: the camera alone, no model and no floor (issue 41).
+  cfg = h.config('calib', {}, [{ name: 'cam0', source: 'aravis', address: '127.0.0.2' }]);
   // As root, a read-only folder stops nobody: the daemon runs without CAP_DAC_OVERRIDE.
   const prefix = process.getuid?.() === 0 ? ['setpriv', '--bounding-set', '-dac_override,-dac_read_search'] : [];
   station = await h.daemon('calib', cfg, ['--offline-after', '1.5', '--no-transitions'], { prefix });
@@ -244,6 +246,10 @@ after(async () => {
 });
 
 test('the start form lists the cameras; a board that does not match is named on the page', async () => {
+  // the station runs without a floor: the camera streams, and says what it lacks
+  const cam0 = (await api('/api/status')).cameras.find((c) => c.name === 'cam0');
+  assert.equal(cam0.has_model, false);
+  assert.equal(cam0.has_floor, false);
   await p.waitForSelector('[data-testid="calib-camera-choice"][value="cam0"]', { timeout: 20000 });
   assert.equal(await p.isChecked('[data-testid="calib-camera-choice"][value="cam0"]'), true);
   assert.equal(await p.getAttribute('[data-testid="calib"]', 'data-active'), 'false');
@@ -479,6 +485,9 @@ test('save: the model is written, the station uses it, and its pose meets the tr
   assert.ok(fs.readdirSync(cfg.dir).some((f) => /^station\.previous-.*\.yaml$/.test(f)), 'the previous config kept');
   await h.waitFor('cam0 has a model', async () => (await api('/api/status')).cameras.find((c) => c.name === 'cam0')?.has_model === true,
     { timeout: 30000, interval: 250 });
+  // the floor the wizard found is the config's now (it had none), and the station's
+  assert.match(yaml, /^enclosure:\n\s+floor:/m, `the config's enclosure:\n${yaml}`);
+  assert.equal((await api('/api/status')).cameras.find((c) => c.name === 'cam0')?.has_floor, true);
 
   const model = readModel(savedFile);
   const err = against(model);

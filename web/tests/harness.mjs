@@ -142,7 +142,8 @@ export async function fakecam(s, camera, address) {
 }
 
 // Writes a station config: `cameras` a list of {name, source, ...} objects; `control`,
-// `storage` and `pipeline` add keys to those sections.
+// `storage` and `pipeline` add keys to those sections; `s.floor` the enclosure's (none: no
+// enclosure section, as a first-time user's config).
 export function config(name, s, cameras, { control = {}, storage = {}, pipeline = {} } = {}) {
   const dir = path.join(WORK, name);
   fs.mkdirSync(dir, { recursive: true });
@@ -153,7 +154,7 @@ export function config(name, s, cameras, { control = {}, storage = {}, pipeline 
     lines.push(`  - ${first[0]}: ${y(first[1])}`);
     for (const [k, v] of rest) lines.push(`    ${k}: ${y(v)}`);
   }
-  lines.push('enclosure:', `  floor: ${y(s.floor)}`);
+  if (s.floor) lines.push('enclosure:', `  floor: ${y(s.floor)}`); // none: the wizard finds it
   const st = { bank: path.join(dir, 'station.bank'), recording_dir: path.join(dir, 'recordings'), ...storage };
   lines.push('storage:', ...Object.entries(st).map(([k, v]) => `  ${k}: ${y(v)}`));
   if (Object.keys(pipeline).length) lines.push('pipeline:', ...Object.entries(pipeline).map(([k, v]) => `  ${k}: ${y(v)}`));
