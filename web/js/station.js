@@ -394,6 +394,12 @@ function defaultName() {
   return `take ${d.getFullYear()}-${two(d.getMonth() + 1)}-${two(d.getDate())} ${two(d.getHours())}${two(d.getMinutes())}`;
 }
 
+// The session as a start, stop or rename answered it (the same fields as the status's), shown at
+// once rather than when the next status event brings it.
+function applySession(session) {
+  if (status && session && typeof session.active === 'boolean') status = { ...status, session };
+}
+
 async function act(button, fn) {
   button.disabled = true;
   button.classList.add('busy');
@@ -411,7 +417,7 @@ async function act(button, fn) {
 $('session-start').addEventListener('click', (e) =>
   act(e.currentTarget, async () => {
     const name = nameInput.value.trim() || defaultName();
-    await postJson('/api/session/start', { name });
+    applySession(await postJson('/api/session/start', { name }));
     showMessage(`Session “${name}” started.`, 'info');
   }),
 );
@@ -420,6 +426,7 @@ $('session-stop').addEventListener('click', (e) =>
     $('session-stop').textContent = 'Stopping…';
     try {
       const r = await postJson('/api/session/stop');
+      applySession(r);
       const n = r.sprites_stored ?? r.session?.sprites_stored;
       showMessage(`Session stopped${n !== undefined ? `: ${fmt(n)} sprites stored` : ''}.`, 'info');
     } finally {
@@ -431,7 +438,7 @@ $('session-rename').addEventListener('click', (e) =>
   act(e.currentTarget, async () => {
     const name = nameInput.value.trim();
     if (!name) throw new Error('name: type the new name first');
-    await postJson('/api/session/rename', { name });
+    applySession(await postJson('/api/session/rename', { name }));
     showMessage(`Session renamed to “${name}”.`, 'info');
   }),
 );
