@@ -259,6 +259,9 @@ test("the bank page shows the session's clips as filmstrips, and a tag set there
     const strip = `${sel} [data-testid="filmstrip"]`;
     for (let x = 0; ; ) {
       const view = await bp.$eval(strip, (e, left) => {
+        // the strip kept in the window: clips above it that load their images push it down
+        // (a cell below the window is neither requested by the page nor looked at here)
+        e.scrollIntoView({ block: 'nearest' });
         e.scrollLeft = left;
         return { width: e.clientWidth, end: e.scrollWidth };
       }, x);
