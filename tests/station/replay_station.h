@@ -31,7 +31,8 @@ inline StationOptions OneReplayCamera(const ScratchDir& dir) {
   so.width = 640;
   so.height = 480;
   so.cameras = 1;
-  so.seed = 11;
+  // Its animal stays on the open floor (seed 11's walks into the walls: fewer batches).
+  so.seed = 12;
   so.empty_lead_in_s = 1.5;
   so.write_mattes = false;
   synth::RenderStudioSession(so);
