@@ -5,18 +5,7 @@
 set -euo pipefail
 top="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 "$top/scripts/install-deps.sh"
-fuzz_seconds="${SPRITESTATION_FUZZ_SECONDS:-20}"
-if [ $# -eq 0 ] && [ "$fuzz_seconds" != 0 ] && [ -z "${SPRITESTATION_SANITIZE:-}" ]; then
-  # The unit suites run in the sanitizer build (below): this build makes only what the rest of
-  # the suite runs, the executable and the suites ctest lists outside the `unit` label (35 % of
-  # the compile time of a whole build; bench/RESULTS.md, "build").
-  build="$("$top/scripts/build.sh" spritestation)"
-  mapfile -t suites < <(cd "$build" && ctest -N -V -LE '^unit$' |
-    sed -n "s|.*Test command: $build/\([^ ]*\).*|\1|p" | xargs -rn1 basename | sort -u)
-  build="$("$top/scripts/build.sh" spritestation "${suites[@]}")"
-else
-  build="$("$top/scripts/build.sh")"
-fi
+build="$("$top/scripts/build.sh")"
 if [ $# -gt 0 ]; then
   (cd "$build" && ctest --output-on-failure --timeout 300 -j "$(nproc)" "$@")
   exit
@@ -31,6 +20,7 @@ fi
 # (end-to-end, browser, vivid, ...). SPRITESTATION_FUZZ_SECONDS=0 skips the sanitizer build and
 # runs the unit suites here instead, as does a whole-tree sanitizer build (SPRITESTATION_SANITIZE,
 # scripts/build.sh).
+fuzz_seconds="${SPRITESTATION_FUZZ_SECONDS:-20}"
 if [ "$fuzz_seconds" = 0 ] || [ -n "${SPRITESTATION_SANITIZE:-}" ]; then
   (cd "$build" && ctest --output-on-failure --timeout 300 -j "$(nproc)")
   exit
