@@ -78,34 +78,39 @@ YAML::Node LoadOneDocument(const std::string& text, const std::string& origin) {
   const auto at = [&origin](const YAML::Mark& mark) {
     return mark.is_null() ? origin : origin + ":" + std::to_string(mark.line + 1);
   };
-  std::vector<YAML::Node> documents;
+  // A second document is found in the text, not with YAML::LoadAll: yaml-cpp 0.7's LoadAll
+  // never returns on some malformed input (a 425-byte config with a run of 0xFF bytes grew
+  // without end; the config fuzz target's timeout), where Load stops at its error.
+  // The line of the `---` that starts a second document: a marker after the first document's
+  // content, or a second marker; a `...` end followed by more content starts one too.
+  std::istringstream lines(text);
+  std::string line;
+  int markers = 0;
+  bool content = false;  // the first document has begun
+  bool ended = false;    // a `...` closed it
+  for (int number = 0; std::getline(lines, line); ++number) {
+    const auto marker = [&line](const char* m) {
+      return line.rfind(m, 0) == 0 &&
+             (line.size() == 3 || line[3] == ' ' || line[3] == '\t' || line[3] == '\r');
+    };
+    const bool start = marker("---");
+    const bool blank_or_comment =
+        line.find_first_not_of(" \t\r") == std::string::npos || line[0] == '#' || line[0] == '%';
+    if ((start && (markers++ > 0 || content)) || (ended && !blank_or_comment)) {
+      throw InputError(origin + ":" + std::to_string(number + 1),
+                       "a second YAML document (---) starts here; the file must hold one document");
+    }
+    if (marker("...") && content) ended = true;
+    if (!start && !blank_or_comment) content = true;
+  }
   try {
-    documents = YAML::LoadAll(text);
+    return YAML::Load(text);
   } catch (const YAML::DeepRecursion& e) {
     // yaml-cpp's own limit, which it reports as "bad file".
     throw InputError(at(e.mark), "nested deeper than " + std::to_string(e.depth() - 1) + " levels");
   } catch (const YAML::Exception& e) {
     throw InputError(at(e.mark), "not valid YAML: " + e.msg);
   }
-  if (documents.size() > 1) {
-    // The line of the `---` that starts the second document (the one after the first
-    // document's content, or a second one), else where yaml-cpp put its node.
-    YAML::Mark mark = documents[1].Mark();
-    std::istringstream lines(text);
-    std::string line;
-    int markers = 0;
-    bool content = false;  // the first document has begun
-    for (int number = 0; std::getline(lines, line); ++number) {
-      if (line.rfind("---", 0) == 0 && (markers++ > 0 || content)) {
-        mark.line = number;
-        break;
-      }
-      if (!line.empty() && line[0] != '#' && line[0] != '%') content = true;
-    }
-    throw InputError(at(mark),
-                     "a second YAML document (---) starts here; the file must hold one document");
-  }
-  return documents.empty() ? YAML::Node() : documents.front();
 }
 
 int LineOf(const YAML::Node& node) {
