@@ -14,21 +14,18 @@
 #include "calib/wizard.h"
 #include "core/error.h"
 #include "tests/calib/calib_fixtures.h"
+#include "tests/support/test_support.h"
 
 namespace ss::calib {
 namespace {
 
+using ss::testing::AnyContains;
 using ss::testing::CamFromBoardInView;
 using ss::testing::RenderBoards;
 using ss::testing::ToCalibBoard;
 using ss::testing::TrueModel;
 
 constexpr double kFps = 8;
-
-bool Has(const std::vector<std::string>& lines, const std::string& text) {
-  return std::any_of(lines.begin(), lines.end(),
-                     [&](const std::string& l) { return l.find(text) != std::string::npos; });
-}
 
 double AngleDeg(const Eigen::Matrix3d& a, const Eigen::Matrix3d& b) {
   return Eigen::AngleAxisd(a * b.transpose()).angle() * 180 / M_PI;
@@ -147,7 +144,7 @@ TEST(WizardGround, TheConsoleWaitsForTheOperatorsWord) {
   int n = 0;
   EXPECT_TRUE(w.waiting_for_word());
   const std::vector<std::string> guidance = FeedStill(w, image, 12, &n);  // 1.5 s
-  EXPECT_TRUE(Has(guidance, "then say so")) << ::testing::PrintToString(guidance);
+  EXPECT_TRUE(AnyContains(guidance, "then say so")) << ::testing::PrintToString(guidance);
   EXPECT_FALSE(w.ground_good());
   EXPECT_EQ(w.step(), WizardStep::kGround);
   w.BoardOnFloor();
@@ -209,7 +206,8 @@ TEST(WizardGround, ABoardNotOnTheFloorIsNeverTaken) {
     EXPECT_FALSE(w.ground_good()) << k.what << ": " << Describe(c);
     EXPECT_EQ(w.step(), WizardStep::kGround) << k.what;
     EXPECT_FALSE(c.doubt.empty()) << k.what;
-    EXPECT_TRUE(Has(guidance, "doubtful")) << k.what << ": " << ::testing::PrintToString(guidance);
+    EXPECT_TRUE(AnyContains(guidance, "doubtful"))
+        << k.what << ": " << ::testing::PrintToString(guidance);
     if (k.grey) {
       EXPECT_NE(c.doubt.find("not surrounded by green floor"), std::string::npos) << c.doubt;
     }

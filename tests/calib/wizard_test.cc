@@ -8,19 +8,16 @@
 
 #include "core/error.h"
 #include "tests/calib/calib_fixtures.h"
+#include "tests/support/test_support.h"
 
 namespace ss::calib {
 namespace {
 
+using ss::testing::AnyContains;
 using ss::testing::CamFromBoardInView;
 using ss::testing::RenderBoards;
 using ss::testing::ToCalibBoard;
 using ss::testing::TrueModel;
-
-bool Has(const std::vector<std::string>& lines, const std::string& text) {
-  return std::any_of(lines.begin(), lines.end(),
-                     [&](const std::string& l) { return l.find(text) != std::string::npos; });
-}
 
 WizardOptions Options(const BoardSpec& board) {
   WizardOptions o;
@@ -47,16 +44,16 @@ struct BoardStudio {
 TEST(CalibrationWizard, NamesWhatIsMissingAndRefusesToSolveWithoutViews) {
   CalibrationWizard w("cam0", 320, 240, Options(ParseBoardSpec("chessboard:10x7:0.03")));
   const auto missing = w.MissingForIntrinsics();
-  EXPECT_TRUE(Has(missing, "cover the left edge"));
-  EXPECT_TRUE(Has(missing, "cover the top-right corner"));
-  EXPECT_TRUE(Has(missing, "tilt the board more"));
-  EXPECT_TRUE(Has(missing, "capture more views (0 of 10)"));
+  EXPECT_TRUE(AnyContains(missing, "cover the left edge"));
+  EXPECT_TRUE(AnyContains(missing, "cover the top-right corner"));
+  EXPECT_TRUE(AnyContains(missing, "tilt the board more"));
+  EXPECT_TRUE(AnyContains(missing, "capture more views (0 of 10)"));
   // A grey frame: no board, and the wizard says so.
   const cv::Mat grey(240, 320, CV_8UC3, cv::Scalar(128, 128, 128));
   const WizardFrame f = w.Feed(grey, 0);
   EXPECT_FALSE(f.detected);
   EXPECT_FALSE(f.captured);
-  EXPECT_TRUE(Has(f.guidance, "show the board to the camera"));
+  EXPECT_TRUE(AnyContains(f.guidance, "show the board to the camera"));
   EXPECT_THROW(w.Feed(cv::Mat(100, 100, CV_8UC3, cv::Scalar(0)), 1), InputError);
   w.Finish();
   EXPECT_TRUE(w.done());
@@ -88,7 +85,7 @@ TEST(CalibrationWizard, CapturesAStillBoardOnceAndOnlyANewViewAgain) {
       EXPECT_TRUE(f.detected) << n;
       captured += f.captured;
       if (pose == &a && i == 0 && n == 1) {
-        EXPECT_TRUE(Has(f.guidance, "hold the board still"));
+        EXPECT_TRUE(AnyContains(f.guidance, "hold the board still"));
       }
     }
   }

@@ -2,6 +2,7 @@
 // Helpers shared by the test suites: scratch folders and running the executable.
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -25,6 +26,14 @@ struct CommandResult {
   int exit_code = -1;
   std::string output;  // stdout and stderr together
 };
+
+// True when one of `lines` contains `text` (guidance, problem lists, gap lists).
+inline bool AnyContains(const std::vector<std::string>& lines, const std::string& text) {
+  for (const std::string& line : lines) {
+    if (line.find(text) != std::string::npos) return true;
+  }
+  return false;
+}
 
 // A file of the source tree, by its path from the top ("docs/station.example.yaml"):
 // absolute, whatever the working directory or the compiler's idea of __FILE__.
