@@ -636,6 +636,21 @@ struct ConsoleCalibration::Impl {
     return {Work(*camera)};
   }
 
+  // `camera`, or without one every camera in `step` ("intrinsics", "ground"): ConflictError
+  // naming `what` when none is.
+  std::vector<std::shared_ptr<CameraWork>> ChosenInStep(const std::optional<std::string>& camera,
+                                                        const std::string& step,
+                                                        const std::string& what) const {
+    std::vector<std::shared_ptr<CameraWork>> chosen = Chosen(camera);
+    if (camera) return chosen;
+    std::vector<std::shared_ptr<CameraWork>> in_step;
+    for (const auto& w : chosen) {
+      if (w->Snapshot().value("step", "") == step) in_step.push_back(w);
+    }
+    if (in_step.empty()) throw ConflictError(what, "no camera is in the " + step + " step");
+    return in_step;
+  }
+
   void RequireActive() const {
     std::lock_guard lock(mutex);
     if (!active) throw ConflictError("calibration", "no wizard is running: start one");
@@ -1067,16 +1082,8 @@ std::vector<api::Route> ConsoleCalibration::Routes() {
          const nlohmann::json body = api::ObjectBody(req, api::kCalibrationSolveFields);
          s->RequireActive();
          const std::optional<std::string> camera = api::ParseCameraName(body, false);
-         std::vector<std::shared_ptr<CameraWork>> chosen = s->Chosen(camera);
-         if (!camera) {
-           // Every camera still in the intrinsics step.
-           std::vector<std::shared_ptr<CameraWork>> in_step;
-           for (const auto& w : chosen) {
-             if (w->Snapshot().value("step", "") == "intrinsics") in_step.push_back(w);
-           }
-           if (in_step.empty()) throw ConflictError("solve", "no camera is in the intrinsics step");
-           chosen = in_step;
-         }
+         const std::vector<std::shared_ptr<CameraWork>> chosen =
+             s->ChosenInStep(camera, "intrinsics", "solve");
          for (const auto& w : chosen) w->StartSolve();
          api::Reply(res, 202, StateWithCameras());
        }},
@@ -1086,16 +1093,8 @@ std::vector<api::Route> ConsoleCalibration::Routes() {
          const nlohmann::json body = api::ObjectBody(req, api::kCalibrationGroundFields);
          s->RequireActive();
          const std::optional<std::string> camera = api::ParseCameraName(body, false);
-         std::vector<std::shared_ptr<CameraWork>> chosen = s->Chosen(camera);
-         if (!camera) {
-           // Every camera in the ground step.
-           std::vector<std::shared_ptr<CameraWork>> in_step;
-           for (const auto& w : chosen) {
-             if (w->Snapshot().value("step", "") == "ground") in_step.push_back(w);
-           }
-           if (in_step.empty()) throw ConflictError("ground", "no camera is in the ground step");
-           chosen = in_step;
-         }
+         const std::vector<std::shared_ptr<CameraWork>> chosen =
+             s->ChosenInStep(camera, "ground", "ground");
          for (const auto& w : chosen) {
            w->Run([&](calib::CalibrationWizard& wiz) {
              try {
