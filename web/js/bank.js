@@ -47,6 +47,7 @@ const BILLBOARD_RETRIES = 4;
 
 async function loadBillboard(cell, attempt = 0) {
   const img = cell.querySelector('img');
+  cell.dataset.loaded = 'requested';
   try {
     const { blob } = await billboards.run(() => getBlob(`/api/bank/sprites/${cell.dataset.sprite}/billboard.png?height=96`));
     img.src = URL.createObjectURL(blob);

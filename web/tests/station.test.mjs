@@ -208,6 +208,13 @@ test('start then stop stores sprites, and the page shows what the bank holds', a
   const rate = await previewRate(2000);
   for (const n of CAMERAS) assert.ok(rate[n] >= 1 && rate[n] <= 5, `${n}: ${rate[n]} previews in 2 s while a session runs`);
   await h.waitFor('sprites stored', async () => (await h.num(p, 'session-sprites')) > 20, { timeout: 20000, interval: 250 });
+  // the station keeps the transitions current while the session runs: the session goes on
+  // until one joins two of its sprites (a later test opens it); the footage loops every 6 s
+  const own = `SELECT s.id FROM sprites s JOIN cameras c ON c.id = s.camera_id
+    WHERE c.session_id = (SELECT max(id) FROM sessions) AND s.mirrored = 0`;
+  await h.waitFor('a transition between two sprites of the session', () => Number(h.sql(cfg.bank,
+    `SELECT count(*) FROM transitions WHERE from_sprite IN (${own}) AND to_sprite IN (${own})`)) > 0,
+  { timeout: 40000, interval: 500 });
   await h.sleep(1000);
   await p.click('[data-testid="session-stop"]');
   await h.waitFor('session idle', async () => (await p.getAttribute('[data-testid="session-state"]', 'data-state')) === 'idle', { timeout: 20000 });
@@ -230,9 +237,19 @@ test('start then stop stores sprites, and the page shows what the bank holds', a
 // throws naming those that have not (not requested yet, or the error the page shows).
 async function billboardsInView(page, scope) {
   const missing = await page.$$eval(`${scope} [data-testid="sprite-cell"]`, (cells) => cells.filter((c) => {
+    // seen: inside the window and inside every box that scrolls it (the filmstrip and the
+    // clips panel): a cell scrolled above the panel but still below the window's top is hidden
     const r = c.getBoundingClientRect();
-    const strip = c.parentElement.getBoundingClientRect();
-    const inView = r.right > strip.left && r.left < strip.right && r.bottom > 0 && r.top < innerHeight;
+    let box = { left: r.left, right: r.right, top: r.top, bottom: r.bottom };
+    const clip = (o) => {
+      box = { left: Math.max(box.left, o.left), right: Math.min(box.right, o.right),
+        top: Math.max(box.top, o.top), bottom: Math.min(box.bottom, o.bottom) };
+    };
+    for (let e = c.parentElement; e && e !== document.body; e = e.parentElement) {
+      if (getComputedStyle(e).overflow !== 'visible') clip(e.getBoundingClientRect());
+    }
+    clip({ left: 0, right: innerWidth, top: 0, bottom: innerHeight });
+    const inView = box.right > box.left && box.bottom > box.top;
     return inView && c.dataset.loaded !== '1';
   }).map((c) => `sprite ${c.dataset.sprite}: ${c.dataset.loaded ?? 'not requested'} ${c.querySelector('img').alt}`));
   if (missing.length) throw new Error(`${missing.length} in view not loaded: ${missing.slice(0, 5).join('; ')}`);
