@@ -141,6 +141,7 @@ void AddBankCommand(CLI::App& app) {
     // Opened read-only first: the writer would turn an empty file into a new bank
     // and upgrade an older one in place; tagging does neither.
     { const Bank check(args->path); }
+    RefuseDamagedBank(args->path);
     BankWriter writer(args->path);
     if (args->remove) {
       writer.Untag(args->sprites, args->tag);
@@ -186,6 +187,7 @@ void AddBankCommand(CLI::App& app) {
     if (!sql::IsPostgresAddress(args->path) && !std::filesystem::exists(args->path)) {
       throw InputError(args->path, "no such sprite bank");
     }
+    RefuseDamagedBank(args->path);
     const BankWriter writer(args->path);
     if (args->json) {
       std::printf("%s\n", nlohmann::json({{"bank", writer.path()},

@@ -292,4 +292,14 @@ std::vector<std::string> QuickCheckBank(const std::string& path) {
   return problems;
 }
 
+void RefuseDamagedBank(const std::string& path) {
+  const std::vector<std::string> damage = QuickCheckBank(path);
+  if (damage.empty()) return;
+  throw InputError(
+      path, "the bank does not pass SQLite's quick check (" + damage.front() +
+                (damage.size() > 1 ? ", and " + std::to_string(damage.size() - 1) + " more" : "") +
+                "); nothing was written. Run `spritestation bank verify " + path +
+                "` to see the damage");
+}
+
 }  // namespace ss

@@ -23,7 +23,13 @@ BankVerifyReport VerifyBank(const std::string& path);
 
 // SQLite's quick check of an existing bank file (pages and indexes well formed; seconds for a
 // large bank, much less than VerifyBank): the problems it reports, empty when it passes or the
-// file does not exist. What writes into a bank (ingest) runs it first and refuses a damaged one.
+// file does not exist.
 std::vector<std::string> QuickCheckBank(const std::string& path);
+
+// What writes into an existing bank (ingest, `bank tag` and `upgrade`, `transitions`, the
+// station) calls this first: throws InputError naming the file and its first damage when the
+// quick check fails, so nothing is written. A damaged bank stays readable by `bank export`, and
+// `bank verify` says where it is damaged; appending could only spread the damage.
+void RefuseDamagedBank(const std::string& path);
 
 }  // namespace ss

@@ -15,6 +15,7 @@
 
 #include "capture/camera_source.h"
 #include "core/bank.h"
+#include "core/bank_verify.h"
 #include "core/error.h"
 #include "core/error_kinds.h"
 #include "core/log.h"
@@ -129,6 +130,7 @@ void Station::Start() {
                        "cannot make the bank's folder " + folder.string() + ": " + ec.message());
     }
   }
+  RefuseDamagedBank(config.storage.bank);
   s.bank = std::make_unique<BankWriter>(config.storage.bank);
   s.bank_sprites = s.bank->Counts().sprites;
   {

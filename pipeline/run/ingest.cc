@@ -135,16 +135,7 @@ IngestSummary IngestSession(const IngestOptions& options) {
                                                    ? DefaultWeights()
                                                    : LoadWeights(options.transition_weights);
 
-  // A damaged bank is not written into: what it holds is still readable by `bank export` and
-  // `bank verify` says where it is damaged; appending could only spread the damage.
-  if (const std::vector<std::string> damage = QuickCheckBank(options.bank_path); !damage.empty()) {
-    throw InputError(
-        options.bank_path,
-        "the bank does not pass SQLite's quick check (" + damage.front() +
-            (damage.size() > 1 ? ", and " + std::to_string(damage.size() - 1) + " more" : "") +
-            "); nothing was written. Run `spritestation bank verify " + options.bank_path +
-            "` to see the damage");
-  }
+  RefuseDamagedBank(options.bank_path);  // before anything is written
   BankWriter bank(options.bank_path);
   IngestSummary summary;
   // The bank's one billboard scale: its own when it holds sprites, else the config's or auto.

@@ -8,6 +8,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "core/bank_verify.h"
 #include "core/error.h"
 #include "core/log.h"
 #include "core/option_checks.h"
@@ -119,6 +120,7 @@ BankUpdateSummary UpdateBankTransitions(const std::string& bank_path,
     const Bank probe(bank_path);
     (void)probe;
   }
+  RefuseDamagedBank(bank_path);
   BankWriter bank(bank_path);
   auto t = std::chrono::steady_clock::now();
   SegmentKeys keys;

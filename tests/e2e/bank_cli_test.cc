@@ -167,6 +167,36 @@ TEST(BankCli, DamagedPagesAreReportedNotHidden) {
   EXPECT_NE(r.output.find(path + ": the database is damaged"), std::string::npos) << r.output;
 }
 
+// A bank that opens but fails SQLite's quick check (a damaged page of its first tables) is
+// written into by nothing: each writing command refuses it as ingest does, names the file and
+// the way to see the damage, and leaves every byte as it was (issue 39: `bank tag` wrote).
+TEST(BankCli, WritingCommandsRefuseABankThatFailsItsQuickCheck) {
+  ScratchDir dir;
+  const std::string path = dir / "bank.db";
+  SmallBank(path);
+  ASSERT_TRUE(QuickCheckBank(path).empty());
+  ASSERT_GT(std::filesystem::file_size(path), 3 * 4096u);
+  {
+    std::fstream f(path, std::ios::in | std::ios::out | std::ios::binary);
+    f.seekp(2 * 4096);  // page 3: a b-tree page of the schema's first tables
+    const std::string garbage(4096, '\xa5');
+    f.write(garbage.data(), static_cast<std::streamsize>(garbage.size()));
+  }
+  ASSERT_FALSE(QuickCheckBank(path).empty());
+  const auto before = RunCommand("md5sum < " + path).output;
+  for (const std::string& command : {"bank tag " + path + " --sprites 1 --tag stand",
+                                     "bank upgrade " + path, "transitions " + path + " --quiet"}) {
+    SCOPED_TRACE(command);
+    const auto r = RunSpritestation(command);
+    EXPECT_EQ(r.exit_code, 2) << r.output;
+    EXPECT_NE(r.output.find(path + ": the bank does not pass SQLite's quick check"),
+              std::string::npos)
+        << r.output;
+    EXPECT_NE(r.output.find("spritestation bank verify " + path), std::string::npos) << r.output;
+    EXPECT_EQ(RunCommand("md5sum < " + path).output, before);
+  }
+}
+
 TEST(BankCli, TagRemoveAndJson) {
   ScratchDir dir;
   const std::string path = dir / "bank.db";
