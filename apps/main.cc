@@ -1,6 +1,9 @@
 // spritestation: the one executable. Exit codes: 0 success, 1 the work failed,
 // 2 bad usage or bad input. Errors name the file or field and the reason.
+#include <cerrno>
+#include <csignal>
 #include <cstdio>
+#include <cstring>
 #include <string>
 
 #include <CLI/CLI.hpp>
@@ -56,13 +59,28 @@ int Run(int argc, char** argv) {
   return 0;
 }
 
+// What was printed reached standard output, or the command fails saying why (a closed pipe,
+// a full disk): a reader must not take a cut-off listing for the whole.
+int CheckStdout(int code) {
+  if (std::fflush(stdout) == 0 && !std::ferror(stdout)) return code;
+  const int err = errno;
+  std::fprintf(stderr, "spritestation: failed: standard output: %s\n",
+               err != 0 ? std::strerror(err) : "write error");
+  return code == 0 ? 1 : code;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
+  // A file grown past its size limit (ulimit -f, a quota) and a closed pipe are errors that name
+  // their file, not signals that kill the process without a word: write() then fails with EFBIG
+  // or EPIPE, and the writer that called it (SQLite, FFmpeg, our own) reports the file.
+  std::signal(SIGXFSZ, SIG_IGN);
+  std::signal(SIGPIPE, SIG_IGN);
   // Nothing escapes: what Run's handlers do not name (an exception while the commands are set
   // up, one that is not a std::exception) still ends with a message and exit 1, not abort().
   try {
-    return Run(argc, argv);
+    return CheckStdout(Run(argc, argv));
   } catch (const std::exception& e) {
     std::fprintf(stderr, "spritestation: failed: %s\n", e.what());
   } catch (...) {

@@ -1,5 +1,7 @@
 #include "core/sql_sqlite.h"
 
+#include <cerrno>
+#include <cstring>
 #include <memory>
 #include <utility>
 
@@ -8,7 +10,16 @@
 namespace ss::sql {
 
 void Fail(sqlite3* db, int rc, const std::string& path, std::string_view what) {
-  const std::string message = db ? sqlite3_errmsg(db) : sqlite3_errstr(rc);
+  const int thread_errno = errno;  // the failed write's, before anything here makes calls
+  std::string message = db ? sqlite3_errmsg(db) : sqlite3_errstr(rc);
+  // A failed write says why: "disk I/O error" alone hides a full disk (ENOSPC) or a file past
+  // its size limit (EFBIG). SQLite's own record of the call's errno is often 0 by the time the
+  // statement returns (a rollback ran after it); the thread's errno still holds it.
+  if ((rc & 0xff) == SQLITE_IOERR || (rc & 0xff) == SQLITE_FULL) {
+    int err = db ? sqlite3_system_errno(db) : 0;
+    if (err == 0) err = thread_errno;
+    if (err != 0) message += " (" + std::string(std::strerror(err)) + ")";
+  }
   const std::string reason = std::string(what) + ": " + message;
   switch (rc & 0xff) {
     case SQLITE_NOTADB:

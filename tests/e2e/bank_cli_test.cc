@@ -2,6 +2,7 @@
 // files that are not banks (the executable, so in tests/e2e).
 #include <gtest/gtest.h>
 
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 
@@ -195,6 +196,21 @@ TEST(BankCli, WritingCommandsRefuseABankThatFailsItsQuickCheck) {
     EXPECT_NE(r.output.find("spritestation bank verify " + path), std::string::npos) << r.output;
     EXPECT_EQ(RunCommand("md5sum < " + path).output, before);
   }
+}
+
+// Issue 39: what a command prints must arrive, or it fails saying so (exit 1), not exit 0 with
+// a reader left holding a cut-off listing.
+TEST(BankCli, AStandardOutputThatCannotBeWrittenIsAFailure) {
+  ScratchDir dir;
+  const std::string path = dir / "bank.db";
+  SmallBank(path);
+  const char* bin = std::getenv("SPRITESTATION_BIN");
+  const auto r =
+      RunCommand("{ " + std::string(bin ? bin : "spritestation") + " bank info " + path +
+                 " > /dev/full; }");  // (RunCommand sends the group's stderr to the pipe)
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.output.find("standard output: No space left on device"), std::string::npos)
+      << r.output;
 }
 
 TEST(BankCli, TagRemoveAndJson) {

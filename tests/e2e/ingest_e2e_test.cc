@@ -1,6 +1,7 @@
 // End to end: a synthetic session through `spritestation ingest` into a bank.
 #include <gtest/gtest.h>
 
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 
@@ -105,6 +106,27 @@ TEST_F(IngestEndToEnd, ADamagedBankIsRefusedAndLeftAsItWas) {
       << r.output;
   EXPECT_NE(r.output.find("bank verify"), std::string::npos) << r.output;
   EXPECT_EQ(testing::RunCommand("md5sum < " + bank).output, before.output);
+}
+
+// Issue 39: a bank that reaches its file-size limit (ulimit -f, a quota) killed ingest with
+// SIGXFSZ and no word. Now the write fails by name and cause, exit 1; what was committed
+// verifies, and the same ingest without the limit completes into the same bank.
+TEST_F(IngestEndToEnd, AFileSizeLimitIsAnErrorNamingTheBankAndLosesNothing) {
+  const std::string bank = *dir_ / "limited.bank";
+  const char* bin = std::getenv("SPRITESTATION_BIN");
+  const std::string ingest = std::string(bin ? bin : "spritestation") +
+                             " --log-level warn ingest " + *dir_ / "session" + " --bank " + bank +
+                             " --no-transitions";
+  auto r = testing::RunCommand("prlimit --fsize=300000 " + ingest);
+  EXPECT_EQ(r.exit_code, 1) << r.output;  // not 128 + SIGXFSZ
+  EXPECT_NE(r.output.find(bank + ": "), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("File too large"), std::string::npos) << r.output;
+  r = RunSpritestation("bank verify " + bank);
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  r = testing::RunCommand(ingest);
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  r = RunSpritestation("bank verify " + bank);
+  EXPECT_EQ(r.exit_code, 0) << r.output;
 }
 
 // A camera whose video cannot be read at all: ingest stores the other camera's sprites, then
