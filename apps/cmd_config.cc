@@ -35,6 +35,11 @@ void Check(const std::string& path, bool json, bool check_files) {
   StationConfig config;
   try {
     config = LoadStationConfig(path, &report, options);
+    try {
+      CheckStationConfig(config);  // what the daemon refuses at start, in its words
+    } catch (const InputError& e) {
+      throw InputError(path, e.what());
+    }
   } catch (const InputError& e) {
     if (json) {
       // The report is filled for invalid values; file and syntax errors come as the message alone.

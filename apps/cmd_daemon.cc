@@ -83,6 +83,11 @@ void RunDaemon(const DaemonArgs& a) {
   ConfigReport report;
   StationOptions options;
   options.config = LoadStationConfig(a.config, &report);
+  try {
+    CheckStationConfig(options.config);  // as `config check` says it
+  } catch (const InputError& e) {
+    throw InputError(a.config, e.what());
+  }
   if (!a.weights.empty()) {
     options.weights = LoadWeights(a.weights);
     options.weights_path = a.weights;

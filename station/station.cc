@@ -87,12 +87,20 @@ bool StationOptions::IsValid(std::string* why) const {
   return check.ok();
 }
 
+void CheckStationConfig(const StationConfig& config) {
+  if (config.cameras.empty()) {
+    throw InputError("cameras",
+                     "the station needs at least one camera (only `ingest --config` may leave "
+                     "them out: it takes the session's)");
+  }
+}
+
 Station::Station(StationOptions options) : impl_(std::make_unique<Impl>()) {
   Impl& s = *impl_;
   s.options = std::move(options);
   if (std::string why; !s.options.IsValid(&why)) throw InputError("station options", why);
   const StationConfig& config = s.options.config;
-  if (config.cameras.empty()) throw InputError("cameras", "the station needs at least one camera");
+  CheckStationConfig(config);
   s.floor = StationFloor(config);
   // Without a floor the station still runs, so that the calibration wizard can find it: every
   // camera streams for preview and recording and stores no sprite until it is calibrated.

@@ -44,6 +44,12 @@ GroundPolygon StationFloor(const StationConfig& config);
 // them. Camera model files that cannot be read count as missing.
 std::vector<std::string> CalibrationGaps(const StationConfig& config);
 
+// What the station refuses to start on although the file is well formed (no camera at all):
+// throws InputError naming the field. The daemon calls it at start and `config check` before
+// it says valid, so both say the same words. (`ingest --config` may leave the cameras out: it
+// takes the session's.)
+void CheckStationConfig(const StationConfig& config);
+
 class Station {
  public:
   // Checks what can be checked before anything starts (models, floor, bank):

@@ -105,6 +105,17 @@ TEST(StationConfig, CheckRefusesWhatTheDaemonCannotRun) {
             std::string::npos)
       << r.output;
   EXPECT_LT(r.output.size(), 1000u);  // the name is not repeated (it made a 20 MB message)
+  // no cameras key at all: a file `ingest --config` may use, which the daemon refuses
+  r = check("storage:\n  bank: station.bank\n");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find(config + ": cameras: the station needs at least one camera"),
+            std::string::npos)
+      << r.output;
+  auto daemon = ss::testing::RunSpritestation("daemon --config " + config + " --duration 1");
+  EXPECT_EQ(daemon.exit_code, 2) << daemon.output;
+  EXPECT_NE(daemon.output.find(config + ": cameras: the station needs at least one camera"),
+            std::string::npos)
+      << daemon.output;
   r = check("cameras: []\n");
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_NE(r.output.find(config + ":1: cameras: expected at least one camera"), std::string::npos)
