@@ -77,6 +77,11 @@ SpritePixels PixelCodec::Decode(const void* data, size_t size, int width, int he
   const size_t n = static_cast<size_t>(width) * static_cast<size_t>(height);
   const unsigned long long stated = ZSTD_getFrameContentSize(data, size);
   if (stated == ZSTD_CONTENTSIZE_ERROR) throw WorkError("billboard pixels", "not a zstd frame");
+  if (stated == ZSTD_CONTENTSIZE_UNKNOWN) {  // every blob we write states it: a damaged header
+    throw WorkError("billboard pixels",
+                    "its zstd frame states no size (a damaged header), expected " +
+                        std::to_string(n * kPlanes) + " bytes");
+  }
   if (stated != n * kPlanes) {
     throw WorkError("billboard pixels", "holds " + std::to_string(stated) + " bytes, expected " +
                                             std::to_string(n * kPlanes) + " (" +

@@ -510,8 +510,9 @@ TEST(Bank, VerifyFindsEachKindOfDamage) {
     const char* expect;  // a word the problem report must contain
   };
   const Damage damages[] = {
+      // a frame header that states no size (it was reported as 18446744073709551615 bytes)
       {"pixel blob", "UPDATE sprite_pixels SET data = x'28b52ffd0000' WHERE sprite_id = 1",
-       "pixels"},
+       "states no size"},
       {"pixel size", "UPDATE sprite_pixels SET width_px = 8 WHERE sprite_id = 1", "pixels"},
       {"mirror speed", "UPDATE sprites SET velocity_x_m_s = 5 WHERE mirrored = 1 AND frame = 2",
        "mirror"},
