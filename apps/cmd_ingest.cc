@@ -78,6 +78,12 @@ void RunIngest(const std::string& session, const std::string& bank, const std::s
                        " of " + std::to_string(c.replay.frames_in_csv) +
                        " frames could not be read" +
                        (c.replay.problems.empty() ? "" : " (" + c.replay.problems.front() + ")"));
+    } else if (c.replay.errors > 0) {
+      // Every frame read, yet the recording is not whole (a truncated frames CSV, a session.json
+      // that lists more frames than there are): logged as an error, so not a success.
+      failed.push_back("camera " + c.name + ": " +
+                       (c.replay.problems.empty() ? std::to_string(c.replay.errors) + " problems"
+                                                  : c.replay.problems.front()));
     }
   }
   if (s.transitions && !s.transitions_error.empty()) {

@@ -94,6 +94,28 @@ struct ReplaySource::Impl {
            std::to_string(cam.records[row].timestamp_ns) + ")";
   }
 
+  // Rows [first, end) of the CSV that no frame of the video matches. A row whose timestamp goes
+  // back is named as such: the CSV was not written with this video (a recorder forces the
+  // video's times forward and the replay does the same, so a real camera's backward step
+  // matches).
+  std::string MissingRows(const Camera& cam, size_t first, size_t end) const {
+    std::string what =
+        end - first == 1
+            ? "frame " + std::to_string(first) + " listed in " + cam.csv_path + " (timestamp_ns " +
+                  std::to_string(cam.records[first].timestamp_ns) + ") is missing from the video"
+            : "frames " + std::to_string(first) + ".." + std::to_string(end - 1) + " listed in " +
+                  cam.csv_path + " are missing from the video";
+    for (size_t i = std::max<size_t>(first, 1); i < end; ++i) {
+      if (cam.records[i].timestamp_ns < cam.records[i - 1].timestamp_ns) {
+        what += "; row " + std::to_string(i) + "'s timestamp_ns goes back from " +
+                std::to_string(cam.records[i - 1].timestamp_ns) + " to " +
+                std::to_string(cam.records[i].timestamp_ns) + ": the CSV does not match the video";
+        break;
+      }
+    }
+    return cam.video_path + ": " + what;
+  }
+
   // Waits for room in the camera's queue and hands it a frame; false when stopped.
   bool Push(Camera& cam, Frame frame) {
     std::unique_lock<std::mutex> lock(mutex);
@@ -158,11 +180,7 @@ struct ReplaySource::Impl {
         continue;
       }
       if (at > row) {
-        if (pass == 0) {
-          Problem(cam, cam.video_path + ": frames " + std::to_string(row) + ".." +
-                           std::to_string(at - 1) + " listed in " + cam.csv_path +
-                           " are missing from the video");
-        }
+        if (pass == 0) Problem(cam, MissingRows(cam, row, at));
         std::lock_guard<std::mutex> lock(mutex);
         cam.stats.frames_unreadable += at - row;
       }

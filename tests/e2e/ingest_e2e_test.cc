@@ -4,6 +4,8 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -127,6 +129,58 @@ TEST_F(IngestEndToEnd, AFileSizeLimitIsAnErrorNamingTheBankAndLosesNothing) {
   EXPECT_EQ(r.exit_code, 0) << r.output;
   r = RunSpritestation("bank verify " + bank);
   EXPECT_EQ(r.exit_code, 0) << r.output;
+}
+
+// Issue 39: a frames CSV cut short (fewer rows than session.json says were recorded) was logged
+// as an error while ingest exited 0; a row whose timestamp goes back was reported as "frames
+// 10..10 missing from the video". Now the first is a failure named after what was stored, and
+// the second names the row and its timestamps.
+TEST_F(IngestEndToEnd, ACutOrDisorderedFramesCsvIsAFailureThatSaysWhich) {
+  namespace fs = std::filesystem;
+  const auto rows = [](const std::string& path) {
+    std::ifstream in(path);
+    std::vector<std::string> lines;
+    for (std::string l; std::getline(in, l);) lines.push_back(l);
+    return lines;
+  };
+  const auto write = [](const std::string& path, const std::vector<std::string>& lines) {
+    std::ofstream out(path, std::ios::trunc);
+    for (const auto& l : lines) out << l << "\n";
+  };
+  const std::string cut = *dir_ / "cut";
+  fs::copy(*dir_ / "session", cut, fs::copy_options::recursive);
+  auto lines = rows(cut + "/cam0.frames.csv");
+  ASSERT_GT(lines.size(), 101u);
+  lines.resize(101);  // the header and 100 rows of 180
+  write(cut + "/cam0.frames.csv", lines);
+  auto r = RunSpritestation("--log-level warn ingest " + cut + " --bank " + *dir_ / "cut.bank" +
+                            " --no-transitions");
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.output.find("ingest stored what it could, but camera cam0: " + cut +
+                          "/cam0.frames.csv: lists 100 frames, but the recording was closed "
+                          "with 180"),
+            std::string::npos)
+      << r.output;
+
+  const std::string back = *dir_ / "back";
+  fs::copy(*dir_ / "session", back, fs::copy_options::recursive);
+  lines = rows(back + "/cam0.frames.csv");
+  // row 10 (line 12) takes the time of row 5
+  const auto field = [](const std::string& line, int k) {
+    size_t a = 0;
+    for (int i = 0; i < k; ++i) a = line.find(',', a) + 1;
+    return line.substr(a, line.find(',', a) - a);
+  };
+  const std::string earlier = field(lines[6], 1);
+  lines[11] = "10," + earlier + "," + field(lines[11], 2) + "," + field(lines[11], 3);
+  write(back + "/cam0.frames.csv", lines);
+  r = RunSpritestation("--log-level warn ingest " + back + " --bank " + *dir_ / "back.bank" +
+                       " --no-transitions");
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.output.find("frame 10 listed in " + back + "/cam0.frames.csv (timestamp_ns " +
+                          earlier + ") is missing from the video; row 10's timestamp_ns goes back"),
+            std::string::npos)
+      << r.output;
 }
 
 // A camera whose video cannot be read at all: ingest stores the other camera's sprites, then
