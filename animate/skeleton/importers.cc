@@ -64,7 +64,32 @@ std::optional<int64_t> ParseInteger(const std::string& text) {
   }
 }
 
+// A skeleton file is read whole (JSON) or into frames (CSV), so its size sizes the work: 64 MiB
+// holds some 150,000 frames of 17 key points (83 minutes at 30 frames/s) and parses within about
+// 400 MB; a larger file is refused before it is read.
+constexpr uintmax_t kMaxSkeletonFileBytes = uintmax_t{64} << 20;
+// Frame numbers (an image id, a row index) fit a clip's frames: at most 2^31 - 1.
+constexpr int64_t kMaxFrameNumber = 2147483647;
+
+void RefuseOversizedFile(const std::string& path) {
+  std::error_code ec;
+  const uintmax_t bytes = fs::file_size(path, ec);
+  if (ec || bytes <= kMaxSkeletonFileBytes) return;  // (one that cannot be opened says so later)
+  throw InputError(path, "holds " + std::to_string(bytes >> 20) +
+                             " MiB; a skeleton file is at most 64 MiB (about 150,000 frames)");
+}
+
+int64_t CheckedFrame(const std::string& where, const char* field, int64_t frame) {
+  if (frame < 0 || frame > kMaxFrameNumber) {
+    throw InputError(where, std::string(field) + " " + std::to_string(frame) +
+                                " is not a frame number (0.." + std::to_string(kMaxFrameNumber) +
+                                ")");
+  }
+  return frame;
+}
+
 nlohmann::json ReadJsonFile(const std::string& path) {
+  RefuseOversizedFile(path);
   std::ifstream in(path);
   if (!in) throw InputError(path, "cannot open");
   try {
@@ -108,6 +133,7 @@ bool SkeletonImportOptions::IsValid(std::string* why) const {
 SkeletonSequence ImportDeepLabCutCsv(const std::string& path, const JointMapping& mapping,
                                      const SkeletonImportOptions& options) {
   RefuseBadOptions(options);
+  RefuseOversizedFile(path);
   std::ifstream in(path);
   if (!in) throw InputError(path, "cannot open the DeepLabCut CSV");
   std::vector<std::vector<std::string>> header;
@@ -195,7 +221,7 @@ SkeletonSequence ImportDeepLabCutCsv(const std::string& path, const JointMapping
                                   std::to_string(width));
     }
     const auto index = leading == 1 ? ParseInteger(cells[0]) : std::nullopt;
-    const int64_t frame = index.value_or(ordinal);
+    const int64_t frame = CheckedFrame(where, "frame index", index.value_or(ordinal));
     ++ordinal;
     std::vector<Keypoint> keypoints(parts.size());
     for (size_t k = 0; k < parts.size(); ++k) {
@@ -356,15 +382,29 @@ SkeletonSequence ImportCocoKeypointsUnchecked(const std::string& path, const Joi
     }
     int labelled = 0;
     for (size_t i = 2; i < kp->size(); i += 3) labelled += (*kp)[i].get<double>() > 0 ? 1 : 0;
-    const int64_t image = ann["image_id"].get<int64_t>();
+    if (ann["image_id"].is_number_unsigned() &&
+        ann["image_id"].get<uint64_t>() > static_cast<uint64_t>(kMaxFrameNumber)) {
+      throw InputError(where, "image_id " + std::to_string(ann["image_id"].get<uint64_t>()) +
+                                  " is not a frame number (0.." + std::to_string(kMaxFrameNumber) +
+                                  ")");
+    }
+    const int64_t image = CheckedFrame(where, "image_id", ann["image_id"].get<int64_t>());
     auto it = best.find(image);
     if (it == best.end() || labelled > it->second.first) best[image] = {labelled, &ann};
   }
   std::vector<int64_t> images;
   if (const auto imgs = json.find("images"); imgs != json.end() && imgs->is_array()) {
-    for (const auto& img : *imgs) {
-      if (img.contains("id") && img["id"].is_number_integer())
-        images.push_back(img["id"].get<int64_t>());
+    for (size_t i = 0; i < imgs->size(); ++i) {
+      const auto& img = (*imgs)[i];
+      if (!img.contains("id") || !img["id"].is_number_integer()) continue;
+      const std::string where = path + ": images[" + std::to_string(i) + "]";
+      if (img["id"].is_number_unsigned() &&
+          img["id"].get<uint64_t>() > static_cast<uint64_t>(kMaxFrameNumber)) {
+        throw InputError(where, "id " + std::to_string(img["id"].get<uint64_t>()) +
+                                    " is not a frame number (0.." +
+                                    std::to_string(kMaxFrameNumber) + ")");
+      }
+      images.push_back(CheckedFrame(where, "id", img["id"].get<int64_t>()));
     }
   }
   for (const auto& [image, unused] : best) images.push_back(image);
@@ -449,6 +489,7 @@ SkeletonSequence ImportSynthTruthUnchecked(const std::string& path, const std::s
   } else if (cam.empty()) {
     cam = csv.parent_path().filename().string();
   }
+  RefuseOversizedFile(csv.string());
   std::ifstream in(csv);
   if (!in) throw InputError(csv.string(), "cannot open (a figure session's projected joint truth)");
   std::string line;
@@ -478,6 +519,7 @@ SkeletonSequence ImportSynthTruthUnchecked(const std::string& path, const std::s
     const auto frame = ParseInteger(cells[c_frame]);
     const auto subject = ParseInteger(cells[c_subject]);
     if (!frame || !subject) throw InputError(where, "frame and subject must be integers");
+    CheckedFrame(where, "frame", *frame);
     if (*subject != options.person) continue;
     auto [it, added] = index_of.emplace(cells[c_name], static_cast<int>(names.size()));
     if (added) names.push_back(cells[c_name]);

@@ -195,6 +195,37 @@ TEST(SkeletonImporters, ErrorsNameTheFileAndTheReason) {
             std::string::npos);
 }
 
+// Issue 39: what sizes the work is bounded. An image id of 2^63 became frame
+// -9223372036854775808, and a COCO file of 1.5 M images took 3.4 GB; now an id that is not a
+// frame number and a file over 64 MiB are refused by name before the work.
+TEST(SkeletonImporters, FrameNumbersAndFileSizesAreBounded) {
+  testing::ScratchDir dir;
+  nlohmann::json coco = nlohmann::json::parse(std::ifstream(Data("coco_person_keypoints.json")));
+  coco["annotations"][0]["image_id"] = uint64_t{1} << 63;
+  std::ofstream(dir / "huge_id.json") << coco.dump();
+  std::string e =
+      testing::InputErrorOf([&] { ImportCocoKeypoints(dir / "huge_id.json", Coco17ToHuman14()); });
+  EXPECT_NE(e.find("huge_id.json: annotations[0]: image_id 9223372036854775808 is not a frame "
+                   "number (0..2147483647)"),
+            std::string::npos)
+      << e;
+  coco = nlohmann::json::parse(std::ifstream(Data("coco_person_keypoints.json")));
+  coco["images"] = nlohmann::json::array({{{"id", -4}}});
+  std::ofstream(dir / "negative_id.json") << coco.dump();
+  e = testing::InputErrorOf(
+      [&] { ImportCocoKeypoints(dir / "negative_id.json", Coco17ToHuman14()); });
+  EXPECT_NE(e.find("images[0]: id -4 is not a frame number"), std::string::npos) << e;
+  // 65 MiB of JSON whitespace around the small file: refused before it is parsed
+  {
+    std::ofstream big(dir / "big.json");
+    big << std::string(65 << 20, ' ')
+        << nlohmann::json::parse(std::ifstream(Data("coco_person_keypoints.json"))).dump();
+  }
+  e = testing::InputErrorOf([&] { ImportCocoKeypoints(dir / "big.json", Coco17ToHuman14()); });
+  EXPECT_NE(e.find("big.json: holds 65 MiB; a skeleton file is at most 64 MiB"), std::string::npos)
+      << e;
+}
+
 // The synthetic studio's joint truth (docs/synth.md layout), written by hand: two subjects,
 // two frames, an extra column the importer must ignore, rows out of joint order.
 TEST(SkeletonImporters, SynthJointTruth) {
