@@ -3,8 +3,8 @@
 #include <cerrno>
 #include <csignal>
 #include <cstdio>
-#include <cstring>
 #include <string>
+#include <system_error>
 
 #include <CLI/CLI.hpp>
 
@@ -64,8 +64,9 @@ int Run(int argc, char** argv) {
 int CheckStdout(int code) {
   if (std::fflush(stdout) == 0 && !std::ferror(stdout)) return code;
   const int err = errno;
-  std::fprintf(stderr, "spritestation: failed: standard output: %s\n",
-               err != 0 ? std::strerror(err) : "write error");
+  std::fprintf(
+      stderr, "spritestation: failed: standard output: %s\n",
+      err != 0 ? std::error_code(err, std::generic_category()).message().c_str() : "write error");
   return code == 0 ? 1 : code;
 }
 

@@ -1,8 +1,8 @@
 #include "core/sql_sqlite.h"
 
 #include <cerrno>
-#include <cstring>
 #include <memory>
+#include <system_error>
 #include <utility>
 
 #include "core/error.h"
@@ -18,7 +18,7 @@ void Fail(sqlite3* db, int rc, const std::string& path, std::string_view what) {
   if ((rc & 0xff) == SQLITE_IOERR || (rc & 0xff) == SQLITE_FULL) {
     int err = db ? sqlite3_system_errno(db) : 0;
     if (err == 0) err = thread_errno;
-    if (err != 0) message += " (" + std::string(std::strerror(err)) + ")";
+    if (err != 0) message += " (" + std::error_code(err, std::generic_category()).message() + ")";
   }
   const std::string reason = std::string(what) + ": " + message;
   switch (rc & 0xff) {

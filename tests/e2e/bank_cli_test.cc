@@ -2,7 +2,6 @@
 // files that are not banks (the executable, so in tests/e2e).
 #include <gtest/gtest.h>
 
-#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 
@@ -12,6 +11,7 @@
 #include "core/bank.h"
 #include "core/bank_schema.h"
 #include "core/bank_verify.h"
+#include "core/posix.h"
 #include "tests/support/bank_fixtures.h"
 #include "tests/support/test_support.h"
 
@@ -204,9 +204,9 @@ TEST(BankCli, AStandardOutputThatCannotBeWrittenIsAFailure) {
   ScratchDir dir;
   const std::string path = dir / "bank.db";
   SmallBank(path);
-  const char* bin = std::getenv("SPRITESTATION_BIN");
+  const std::string bin = Environment("SPRITESTATION_BIN").value_or("spritestation");
   const auto r =
-      RunCommand("{ " + std::string(bin ? bin : "spritestation") + " bank info " + path +
+      RunCommand("{ " + bin + " bank info " + path +
                  " > /dev/full; }");  // (RunCommand sends the group's stderr to the pipe)
   EXPECT_EQ(r.exit_code, 1) << r.output;
   EXPECT_NE(r.output.find("standard output: No space left on device"), std::string::npos)

@@ -1,7 +1,6 @@
 // End to end: a synthetic session through `spritestation ingest` into a bank.
 #include <gtest/gtest.h>
 
-#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -9,6 +8,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "core/posix.h"
 #include "tests/support/test_support.h"
 
 namespace ss {
@@ -115,10 +115,9 @@ TEST_F(IngestEndToEnd, ADamagedBankIsRefusedAndLeftAsItWas) {
 // verifies, and the same ingest without the limit completes into the same bank.
 TEST_F(IngestEndToEnd, AFileSizeLimitIsAnErrorNamingTheBankAndLosesNothing) {
   const std::string bank = *dir_ / "limited.bank";
-  const char* bin = std::getenv("SPRITESTATION_BIN");
-  const std::string ingest = std::string(bin ? bin : "spritestation") +
-                             " --log-level warn ingest " + *dir_ / "session" + " --bank " + bank +
-                             " --no-transitions";
+  const std::string bin = Environment("SPRITESTATION_BIN").value_or("spritestation");
+  const std::string ingest = bin + " --log-level warn ingest " + *dir_ / "session" + " --bank " +
+                             bank + " --no-transitions";
   auto r = testing::RunCommand("prlimit --fsize=300000 " + ingest);
   EXPECT_EQ(r.exit_code, 1) << r.output;  // not 128 + SIGXFSZ
   EXPECT_NE(r.output.find(bank + ": "), std::string::npos) << r.output;
