@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "core/error.h"
+#include "core/target_clones.h"
 
 // GCC notes that 32-byte vector arguments change the ABI without AVX; these helpers are
 // inline and never cross a library boundary.
@@ -97,9 +98,9 @@ __attribute__((always_inline)) inline void DenseRows(const float* b, int dim, co
 
 // Complete targets against every source: see DenseChunk. `b` is the packed block of the
 // first source (a multiple of kChunk). 1 <= tb <= kTile.
-__attribute__((target_clones("arch=x86-64-v3", "default"))) void DenseKernel(
-    const float* b, int dim, const float* nb, const float* a, const float* na, int tb,
-    float* const* rows, int count) {
+SS_TARGET_CLONES("arch=x86-64-v3", "default")
+void DenseKernel(const float* b, int dim, const float* nb, const float* a, const float* na, int tb,
+                 float* const* rows, int count) {
   switch (tb) {
     case 1:
       DenseRows<1>(b, dim, nb, a, na, rows, count);
@@ -149,9 +150,9 @@ __attribute__((always_inline)) inline void SparseRow(const float* b, int dim, co
   }
 }
 
-__attribute__((target_clones("arch=x86-64-v3", "default"))) void SparseKernel(
-    const float* b, int dim, const int* features, int nfeatures, const float* w, const float* a,
-    float* row, int count) {
+SS_TARGET_CLONES("arch=x86-64-v3", "default")
+void SparseKernel(const float* b, int dim, const int* features, int nfeatures, const float* w,
+                  const float* a, float* row, int count) {
   SparseRow(b, dim, features, nfeatures, w, a, row, count);
 }
 

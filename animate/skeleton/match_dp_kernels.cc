@@ -5,6 +5,7 @@
 
 #include "animate/skeleton/match_dp_detail.h"
 #include "core/error.h"
+#include "core/target_clones.h"
 
 // GCC notes that 32-byte vector arguments change the ABI without AVX; these helpers are
 // inline and never cross a library boundary.
@@ -160,8 +161,8 @@ __attribute__((always_inline)) inline void StepModes(const StepArgs& args) {
   }
 }
 
-__attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default"))) void StepKernel(
-    const StepArgs& args) {
+SS_TARGET_CLONES("arch=x86-64-v4", "arch=x86-64-v3", "default")
+void StepKernel(const StepArgs& args) {
   if (args.masked) {
     StepModes<true>(args);
   } else {

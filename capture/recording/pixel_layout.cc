@@ -5,6 +5,8 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "core/target_clones.h"
+
 namespace ss::av {
 namespace {
 
@@ -20,9 +22,9 @@ void CopyPlane(const uint8_t* src, int src_stride, uint8_t* dst, int dst_stride,
 // set (the interleave vectorizes with SSSE3 shuffles; this file is built at -O3, see
 // capture/CMakeLists.txt): a 1080p frame in 0.29 ms against cv::mixChannels' 2.0-2.4 ms (one
 // core, measured 2026-12-03).
-__attribute__((target_clones("avx2", "ssse3", "default"))) void InterleaveRow(
-    const uint8_t* __restrict a, const uint8_t* __restrict b, const uint8_t* __restrict c,
-    uint8_t* __restrict out, int width) {
+SS_TARGET_CLONES("avx2", "ssse3", "default")
+void InterleaveRow(const uint8_t* __restrict a, const uint8_t* __restrict b,
+                   const uint8_t* __restrict c, uint8_t* __restrict out, int width) {
   for (int x = 0; x < width; ++x) {
     out[3 * x] = a[x];
     out[3 * x + 1] = b[x];
@@ -31,9 +33,9 @@ __attribute__((target_clones("avx2", "ssse3", "default"))) void InterleaveRow(
 }
 
 // Packed 3-byte pixels into three planes, one row (the inverse of InterleaveRow).
-__attribute__((target_clones("avx2", "ssse3", "default"))) void DeinterleaveRow(
-    const uint8_t* __restrict in, uint8_t* __restrict a, uint8_t* __restrict b,
-    uint8_t* __restrict c, int width) {
+SS_TARGET_CLONES("avx2", "ssse3", "default")
+void DeinterleaveRow(const uint8_t* __restrict in, uint8_t* __restrict a, uint8_t* __restrict b,
+                     uint8_t* __restrict c, int width) {
   for (int x = 0; x < width; ++x) {
     a[x] = in[3 * x];
     b[x] = in[3 * x + 1];

@@ -8,6 +8,7 @@
 
 #include "core/error.h"
 #include "core/log.h"
+#include "core/target_clones.h"
 #include "pipeline/key/keyer_registry.h"
 #include "pipeline/key/keying_config.h"
 
@@ -55,10 +56,10 @@ inline PixelKey KeyPixel(int b, int g, int r, float key_hi, float gain, int32_t 
 // and a count added to the column accumulators (summed into cells per cell row, later). Written
 // for the vectorizer: element-wise only, no reductions, no branches; cloned per instruction set
 // as the keying rows are (the 3-byte de-interleave needs SSSE3).
-__attribute__((target_clones("avx2", "ssse3", "default"))) void TrainRow(
-    const uint8_t* __restrict in, int width, float min_key, int min_luma4,
-    float* __restrict pixel_key, int32_t* __restrict luma4_sum, float* __restrict key_sum,
-    float* __restrict key2_sum, int32_t* __restrict count) {
+SS_TARGET_CLONES("avx2", "ssse3", "default")
+void TrainRow(const uint8_t* __restrict in, int width, float min_key, int min_luma4,
+              float* __restrict pixel_key, int32_t* __restrict luma4_sum, float* __restrict key_sum,
+              float* __restrict key2_sum, int32_t* __restrict count) {
   for (int x = 0; x < width; ++x) {
     const int b = in[3 * x], g = in[3 * x + 1], r = in[3 * x + 2];
     const int luma4 = b + 2 * g + r;
@@ -78,11 +79,11 @@ __attribute__((target_clones("avx2", "ssse3", "default"))) void TrainRow(
 
 // One row of an empty-enclosure frame keyed by the trained model: each pixel's alpha added to
 // `alpha_sum` (a pixel the model keys on the empty enclosure is not green).
-__attribute__((target_clones("avx2", "ssse3", "default"))) void AlphaSumRow(
-    const uint8_t* __restrict in, int width, const float* __restrict key_hi,
-    const float* __restrict gain, const int32_t* __restrict luma_floor,
-    const float* __restrict inv_luma, const float* __restrict shadow_base, int shadow_min,
-    uint32_t* __restrict alpha_sum) {
+SS_TARGET_CLONES("avx2", "ssse3", "default")
+void AlphaSumRow(const uint8_t* __restrict in, int width, const float* __restrict key_hi,
+                 const float* __restrict gain, const int32_t* __restrict luma_floor,
+                 const float* __restrict inv_luma, const float* __restrict shadow_base,
+                 int shadow_min, uint32_t* __restrict alpha_sum) {
   for (int x = 0; x < width; ++x) {
     const PixelKey k = KeyPixel(in[3 * x], in[3 * x + 1], in[3 * x + 2], key_hi[x], gain[x],
                                 luma_floor[x], inv_luma[x], shadow_base[x], shadow_min);
@@ -355,15 +356,15 @@ __attribute__((always_inline)) inline void ChromaRowImpl(
 
 // Cloned per instruction set: the de-interleave of 3-byte pixels needs SSSE3
 // shuffles to vectorize; plain SSE2 runs it scalar.
-#define SS_CHROMA_ROW(NAME, RGB)                                                                \
-  __attribute__((target_clones("avx2", "ssse3", "default"))) void NAME(                         \
-      const uint8_t* __restrict in, int x0, int x1, const float* __restrict key_hi,             \
-      const float* __restrict gain, const int32_t* __restrict luma_floor,                       \
-      const float* __restrict inv_luma, const float* __restrict shadow_base, int shadow_min,    \
-      int despill256, int strength256, const uint8_t* __restrict keyable,                       \
-      uint8_t* __restrict alpha, uint8_t* __restrict shadow, uint8_t* __restrict colour) {      \
-    ChromaRowImpl<RGB>(in, x0, x1, key_hi, gain, luma_floor, inv_luma, shadow_base, shadow_min, \
-                       despill256, strength256, keyable, alpha, shadow, colour);                \
+#define SS_CHROMA_ROW(NAME, RGB)                                                                   \
+  SS_TARGET_CLONES("avx2", "ssse3", "default")                                                     \
+  void NAME(const uint8_t* __restrict in, int x0, int x1, const float* __restrict key_hi,          \
+            const float* __restrict gain, const int32_t* __restrict luma_floor,                    \
+            const float* __restrict inv_luma, const float* __restrict shadow_base, int shadow_min, \
+            int despill256, int strength256, const uint8_t* __restrict keyable,                    \
+            uint8_t* __restrict alpha, uint8_t* __restrict shadow, uint8_t* __restrict colour) {   \
+    ChromaRowImpl<RGB>(in, x0, x1, key_hi, gain, luma_floor, inv_luma, shadow_base, shadow_min,    \
+                       despill256, strength256, keyable, alpha, shadow, colour);                   \
   }
 SS_CHROMA_ROW(ChromaRowBgr, false)
 SS_CHROMA_ROW(ChromaRowRgb, true)

@@ -8,6 +8,7 @@
 
 #include "core/error.h"
 #include "core/log.h"
+#include "core/target_clones.h"
 #include "pipeline/key/keyer_registry.h"
 #include "pipeline/key/keying_config.h"
 
@@ -68,11 +69,11 @@ __attribute__((always_inline)) inline void PlateRowImpl(
 }
 
 #define SS_PLATE_ROW(NAME, RGB)                                                                  \
-  __attribute__((target_clones("avx2", "ssse3", "default"))) void NAME(                          \
-      const uint8_t* __restrict in, const uint8_t* __restrict plate,                             \
-      const float* __restrict tolerance, int x0, int x1, float gain, float dark_floor,           \
-      int shadow_min, uint8_t* __restrict alpha, uint8_t* __restrict shadow,                     \
-      uint8_t* __restrict colour) {                                                              \
+  SS_TARGET_CLONES("avx2", "ssse3", "default")                                                   \
+  void NAME(const uint8_t* __restrict in, const uint8_t* __restrict plate,                       \
+            const float* __restrict tolerance, int x0, int x1, float gain, float dark_floor,     \
+            int shadow_min, uint8_t* __restrict alpha, uint8_t* __restrict shadow,               \
+            uint8_t* __restrict colour) {                                                        \
     PlateRowImpl<RGB>(in, plate, tolerance, x0, x1, gain, dark_floor, shadow_min, alpha, shadow, \
                       colour);                                                                   \
   }
