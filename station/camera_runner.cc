@@ -521,7 +521,9 @@ struct CameraRunner::Impl {
       {
         std::lock_guard lock(status_mutex);
         ++status.frames_processed;
-        if (pipeline) status.pipeline = pipeline->stats();
+        // Not while the keyer learns on its own thread: Train counts its frames into the stats
+        // (a data race ThreadSanitizer found); they are read once the training is collected.
+        if (pipeline && !training.valid()) status.pipeline = pipeline->stats();
       }
       if (tap) tap(index, frame, item->drops_before, usable);
     }
