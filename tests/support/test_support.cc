@@ -15,6 +15,21 @@
 #include <thread>
 
 #include <gtest/gtest.h>
+#if defined(__SANITIZE_THREAD__)
+#include <opencv2/core/utility.hpp>
+#endif
+
+#if defined(__SANITIZE_THREAD__)
+namespace {
+// Under ThreadSanitizer (scripts/tsan.sh) OpenCV runs parallel_for_ bodies on the calling thread:
+// its TBB pool synchronises in code TSan does not see, so every body run on a pool thread was
+// reported as racing with its caller. The run is about our own threads.
+const bool kOpenCvSerial = [] {
+  cv::setNumThreads(0);
+  return true;
+}();
+}  // namespace
+#endif
 
 namespace ss::testing {
 
