@@ -35,11 +35,6 @@ void Check(const std::string& path, bool json, bool check_files) {
   StationConfig config;
   try {
     config = LoadStationConfig(path, &report, options);
-    try {
-      CheckStationConfig(config);  // what the daemon refuses at start, in its words
-    } catch (const InputError& e) {
-      throw InputError(path, e.what());
-    }
   } catch (const InputError& e) {
     if (json) {
       // The report is filled for invalid values; file and syntax errors come as the message alone.
@@ -55,12 +50,21 @@ void Check(const std::string& path, bool json, bool check_files) {
   // What the daemon would lack to store sprites (it starts all the same; station/station.h).
   const std::vector<std::string> gaps =
       check_files ? CalibrationGaps(config) : std::vector<std::string>{};
+  // What the daemon refuses at start although the file is valid (no cameras: a file for
+  // `ingest --config`, which takes the session's), in the daemon's words.
+  std::vector<std::string> daemon_refuses;
+  try {
+    CheckStationConfig(config);
+  } catch (const InputError& e) {
+    daemon_refuses.emplace_back(e.what());
+  }
   if (json) {
     nlohmann::json j = {{"config", path},
                         {"status", StatusName(report.status)},
                         {"adjustments", report.adjustments},
                         {"errors", report.errors},
                         {"to_calibrate", gaps},
+                        {"daemon_refuses", daemon_refuses},
                         {"cameras", config.cameras.size()}};
     std::printf("%s\n", j.dump(2).c_str());
     return;
@@ -68,6 +72,7 @@ void Check(const std::string& path, bool json, bool check_files) {
   std::printf("%s: %s (%zu camera%s)\n", path.c_str(), StatusName(report.status),
               config.cameras.size(), config.cameras.size() == 1 ? "" : "s");
   for (const auto& a : report.adjustments) std::printf("  adjusted: %s\n", a.c_str());
+  for (const auto& d : daemon_refuses) std::printf("  the daemon refuses it: %s\n", d.c_str());
   for (const auto& g : gaps) std::printf("  to calibrate: %s\n", g.c_str());
   if (!gaps.empty()) {
     std::printf(
