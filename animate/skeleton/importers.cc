@@ -88,6 +88,17 @@ int64_t CheckedFrame(const std::string& where, const char* field, int64_t frame)
   return frame;
 }
 
+// A JSON integer as a frame number; one past int64_t (parsed as unsigned) is refused as such.
+int64_t FrameFromJson(const std::string& where, const char* field, const nlohmann::json& value) {
+  if (value.is_number_unsigned() &&
+      value.get<uint64_t>() > static_cast<uint64_t>(kMaxFrameNumber)) {
+    throw InputError(where, std::string(field) + " " + std::to_string(value.get<uint64_t>()) +
+                                " is not a frame number (0.." + std::to_string(kMaxFrameNumber) +
+                                ")");
+  }
+  return CheckedFrame(where, field, value.get<int64_t>());
+}
+
 nlohmann::json ReadJsonFile(const std::string& path) {
   RefuseOversizedFile(path);
   std::ifstream in(path);
@@ -382,13 +393,7 @@ SkeletonSequence ImportCocoKeypointsUnchecked(const std::string& path, const Joi
     }
     int labelled = 0;
     for (size_t i = 2; i < kp->size(); i += 3) labelled += (*kp)[i].get<double>() > 0 ? 1 : 0;
-    if (ann["image_id"].is_number_unsigned() &&
-        ann["image_id"].get<uint64_t>() > static_cast<uint64_t>(kMaxFrameNumber)) {
-      throw InputError(where, "image_id " + std::to_string(ann["image_id"].get<uint64_t>()) +
-                                  " is not a frame number (0.." + std::to_string(kMaxFrameNumber) +
-                                  ")");
-    }
-    const int64_t image = CheckedFrame(where, "image_id", ann["image_id"].get<int64_t>());
+    const int64_t image = FrameFromJson(where, "image_id", ann["image_id"]);
     auto it = best.find(image);
     if (it == best.end() || labelled > it->second.first) best[image] = {labelled, &ann};
   }
@@ -397,14 +402,8 @@ SkeletonSequence ImportCocoKeypointsUnchecked(const std::string& path, const Joi
     for (size_t i = 0; i < imgs->size(); ++i) {
       const auto& img = (*imgs)[i];
       if (!img.contains("id") || !img["id"].is_number_integer()) continue;
-      const std::string where = path + ": images[" + std::to_string(i) + "]";
-      if (img["id"].is_number_unsigned() &&
-          img["id"].get<uint64_t>() > static_cast<uint64_t>(kMaxFrameNumber)) {
-        throw InputError(where, "id " + std::to_string(img["id"].get<uint64_t>()) +
-                                    " is not a frame number (0.." +
-                                    std::to_string(kMaxFrameNumber) + ")");
-      }
-      images.push_back(CheckedFrame(where, "id", img["id"].get<int64_t>()));
+      images.push_back(
+          FrameFromJson(path + ": images[" + std::to_string(i) + "]", "id", img["id"]));
     }
   }
   for (const auto& [image, unused] : best) images.push_back(image);
