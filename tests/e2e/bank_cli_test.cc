@@ -11,7 +11,6 @@
 #include "core/bank.h"
 #include "core/bank_schema.h"
 #include "core/bank_verify.h"
-#include "core/posix.h"
 #include "tests/support/bank_fixtures.h"
 #include "tests/support/test_support.h"
 
@@ -204,9 +203,8 @@ TEST(BankCli, AStandardOutputThatCannotBeWrittenIsAFailure) {
   ScratchDir dir;
   const std::string path = dir / "bank.db";
   SmallBank(path);
-  const std::string bin = Environment("SPRITESTATION_BIN").value_or("spritestation");
   const auto r =
-      RunCommand("{ " + bin + " bank info " + path +
+      RunCommand("{ " + SpritestationCommand("bank info " + path) +
                  " > /dev/full; }");  // (RunCommand sends the group's stderr to the pipe)
   EXPECT_EQ(r.exit_code, 1) << r.output;
   EXPECT_NE(r.output.find("standard output: No space left on device"), std::string::npos)

@@ -8,7 +8,6 @@
 
 #include <nlohmann/json.hpp>
 
-#include "core/posix.h"
 #include "tests/support/test_support.h"
 
 namespace ss {
@@ -115,9 +114,8 @@ TEST_F(IngestEndToEnd, ADamagedBankIsRefusedAndLeftAsItWas) {
 // verifies, and the same ingest without the limit completes into the same bank.
 TEST_F(IngestEndToEnd, AFileSizeLimitIsAnErrorNamingTheBankAndLosesNothing) {
   const std::string bank = *dir_ / "limited.bank";
-  const std::string bin = Environment("SPRITESTATION_BIN").value_or("spritestation");
-  const std::string ingest = bin + " --log-level warn ingest " + *dir_ / "session" + " --bank " +
-                             bank + " --no-transitions";
+  const std::string ingest = testing::SpritestationCommand(
+      "--log-level warn ingest " + *dir_ / "session" + " --bank " + bank + " --no-transitions");
   auto r = testing::RunCommand("prlimit --fsize=300000 " + ingest);
   EXPECT_EQ(r.exit_code, 1) << r.output;  // not 128 + SIGXFSZ
   EXPECT_NE(r.output.find(bank + ": "), std::string::npos) << r.output;

@@ -54,8 +54,12 @@ std::string SourcePath(const std::string& relative) {
   return (std::filesystem::path(SPRITESTATION_SOURCE_DIR) / relative).string();
 }
 
+std::string SpritestationCommand(const std::string& args) {
+  return Environment("SPRITESTATION_BIN").value_or("spritestation") + " " + args;
+}
+
 CommandResult RunSpritestation(const std::string& args) {
-  return RunCommand(Environment("SPRITESTATION_BIN").value_or("spritestation") + " " + args);
+  return RunCommand(SpritestationCommand(args));
 }
 
 CommandResult RunCommand(const std::string& shell_command) {

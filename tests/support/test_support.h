@@ -41,6 +41,9 @@ std::string SourcePath(const std::string& relative);
 
 // Runs `spritestation ARGS` (the binary named by $SPRITESTATION_BIN) through the shell.
 CommandResult RunSpritestation(const std::string& args);
+// The shell command RunSpritestation runs (the executable, $SPRITESTATION_BIN, and `args`), for a
+// test that runs it under another command (prlimit, a redirection).
+std::string SpritestationCommand(const std::string& args);
 // Runs a shell command (sqlite3, ffprobe ...): its exit code and output (stdout, then stderr).
 CommandResult RunCommand(const std::string& command);
 
