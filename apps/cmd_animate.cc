@@ -30,6 +30,7 @@ struct AnimateArgs {
   double time_budget_s = 0;
   int64_t seed = -1;
   int threads = 0;
+  int max_turns = 0;  // 0: the time budget alone
   double snapshot_every_s = -1;
   bool json = false;
   bool no_judge = false;
@@ -47,6 +48,7 @@ void Run(const AnimateArgs& args) {
   if (args.seed >= 0) o.replacement.seed = static_cast<uint64_t>(args.seed);
   if (args.threads > 0) o.replacement.reach.num_threads = args.threads;
   if (args.snapshot_every_s >= 0) o.snapshot_every_s = args.snapshot_every_s;
+  options.max_turns = args.max_turns;
   options.progress_every_s = 1.0;
   const std::string method = TextOf(o.method, kOptimizerMethodTexts);
   // Refused before the banks are read: the options with the command line's changes, and the
@@ -116,6 +118,10 @@ void AddAnimateCommand(CLI::App& app) {
   cmd->add_option("--seed", args->seed, "Random seed (default: the spec's)")
       ->check(CLI::NonNegativeNumber);
   cmd->add_option("--threads", args->threads, "Threads for the F/B sets (default: the spec's)")
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--max-turns", args->max_turns,
+                  "replace: stop after this many sprite turns, whichever comes first with the "
+                  "budget (with a long budget: the same result on any machine)")
       ->check(CLI::PositiveNumber);
   cmd->add_option("--snapshot-every", args->snapshot_every_s,
                   "Keep the sequences every S seconds (for `render --stages`)")

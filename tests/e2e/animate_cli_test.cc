@@ -116,6 +116,9 @@ sprites:
   EXPECT_NE(r.output.find("time_budget_seconds: must be at most 86400 seconds (a day), got 1e+300"),
             std::string::npos)
       << r.output;
+  r = testing::RunSpritestation("animate " + spec + " --out " + seq + " --max-turns 0");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("--max-turns"), std::string::npos) << r.output;
 }
 
 }  // namespace
