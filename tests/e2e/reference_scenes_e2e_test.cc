@@ -2,9 +2,10 @@
 // cut of the reference hamster (the same animal, seed 53, one camera, as
 // scripts/reference-banks.sh renders) is rendered, ingested through the live pipeline, given its
 // transitions and its clean plate, once for the file. The examples scripts/demo.sh and
-// scripts/examples.sh run (docs/examples/walk.yaml, crossing.yaml) animate it unchanged but for
-// their paths, and what a viewer would see must hold (issue 33: the demo's walk covered 0.12 m
-// and replayed four frames; the crossing ended 0.16-0.28 m from its targets).
+// scripts/examples.sh run (docs/examples/walk.yaml, crossing.yaml, circle.yaml) animate it
+// unchanged but for their paths, and what a viewer would see must hold (issue 33: the demo's
+// walk covered 0.12 m and replayed four frames; the crossing ended 0.16-0.28 m from its targets;
+// the circle swept 60 of 360 degrees).
 #include <filesystem>
 #include <fstream>
 #include <memory>
@@ -85,7 +86,7 @@ std::unique_ptr<testing::ScratchDir> ReferenceCut::dir_;
 bool ReferenceCut::made_ = false;
 
 // One test, so that the cut is made once (ctest runs each test in a process of its own).
-TEST_F(ReferenceCut, TheWalkAndTheCrossingMeetTheirConstraintsWithoutStutterOrJumps) {
+TEST_F(ReferenceCut, TheWalkCrossingAndCircleMeetTheirConstraintsWithoutStutterOrJumps) {
   // In turns, not seconds (a budget never reached): the same work on a loaded machine. 100
   // turns give what the spec's 10 s give here (674 turns), in 2.3 s.
   const nlohmann::json judge = Animate("walk", "../../recordings/reference/hamster-60s/", 3,
@@ -132,6 +133,24 @@ TEST_F(ReferenceCut, TheWalkAndTheCrossingMeetTheirConstraintsWithoutStutterOrJu
     EXPECT_LE(crossing["stutter"]["share"].get<double>(), 0.01);
     if (crossing["jumps"]["transitions"].get<int>() > 0)
       EXPECT_LE(crossing["jumps"]["max"].get<double>(), 2.0);
+  }
+
+  // Seed 000 figure 7a on the cut, 100 turns (6 s here): the hamster goes the whole way round
+  // without stutter. On this cut's 907 sprites it strays up to 14 cm (median 7 cm); on the
+  // 5-minute set 5.7-6.6 cm (the goal of 3 cm is unmet).
+  {
+    const nlohmann::json circle = Animate("circle", "../../recordings/reference/hamster/", 3,
+                                          "--time-budget 600 --max-turns 100");
+    SCOPED_TRACE(circle.dump(2));
+    ASSERT_EQ(circle["paths"].size(), 1u);
+    const nlohmann::json& round = circle["paths"][0];
+    EXPECT_GE(round["swept_share"].get<double>(), 0.98) << "the circle stops short";
+    EXPECT_GE(round["finished_step"].get<int>(), 0) << "the circle never closes";
+    EXPECT_LE(round["max_deviation_m"].get<double>(), 0.20);
+    EXPECT_LE(round["median_deviation_m"].get<double>(), 0.10);
+    EXPECT_LE(circle["stutter"]["share"].get<double>(), 0.01);
+    if (circle["jumps"]["transitions"].get<int>() > 0)
+      EXPECT_LE(circle["jumps"]["max"].get<double>(), 2.0);
   }
 }
 
