@@ -287,6 +287,7 @@ struct ControlServer::Impl {
       return;
     }
     auto stream = std::make_shared<ConsoleEvents::Stream>(*events);
+    HttpServer::CountApart();  // limited by max_event_streams, not the connection limits
     res.set_header("Cache-Control", "no-store");
     res.set_header("X-Accel-Buffering", "no");
     res.set_chunked_content_provider("text/event-stream",
@@ -554,6 +555,13 @@ ControlServer::ControlServer(StationHost& host, ControlServerOptions options)
   if (std::string why; !options.IsValid(&why)) throw InputError("control server options", why);
   impl_->host = &host;
   impl_->options = std::move(options);
+  // Fewer connections in all than threads, so that a thread is free to refuse the next at once
+  // (a connection waits for a thread before anything is read of it).
+  HttpLimits limits;
+  const int threads = impl_->options.http_threads;
+  limits.max_connections_total =
+      std::min(limits.max_connections_total, std::max(1, threads - std::max(1, threads / 8)));
+  impl_->server.set_limits(limits);
   impl_->events = std::make_unique<ConsoleEvents>([s = impl_.get()] { return s->StatusJson(); });
   impl_->Routes();
 }

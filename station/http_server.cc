@@ -243,6 +243,9 @@ class ConnectionStream final : public httplib::Stream {
 };
 
 thread_local const ConnectionStream* t_stream = nullptr;  // the connection this thread serves
+// Set by CountApart on the thread serving a connection: its slot is released already.
+thread_local bool t_counted_apart = false;
+thread_local std::function<void()> t_release;  // releases the served connection's slot
 
 // Closes a connection after its last answer. What the client sent and the server did not read
 // (the rest of a refused request) is read and dropped first, so that the close sends FIN rather
@@ -298,12 +301,9 @@ void SendError(int sock, int status, const char* reason, const std::string& mess
   (void)::send(sock, reply.data(), reply.size(), MSG_NOSIGNAL | MSG_DONTWAIT);
 }
 
-// The 503 for a connection over the per-client limit, then closed.
-void Refuse(int sock, const std::string& address, int limit) {
-  SendError(sock, 503, ReasonPhrase(503),
-            "connections: " + std::to_string(limit) + " are open from " + address +
-                " already (the limit per client address)",
-            "Retry-After: 5\r\n");
+// The 503 for a connection over a connection limit, then closed.
+void Refuse(int sock, const std::string& message) {
+  SendError(sock, 503, ReasonPhrase(503), message, "Retry-After: 5\r\n");
   Close(sock);
 }
 
@@ -316,6 +316,11 @@ std::string Seconds(std::chrono::milliseconds ms) {
 
 HttpServer::HttpServer(HttpLimits limits) : limits_(limits) {
   set_payload_max_length(limits_.max_body_bytes);  // a Content-Length over it: 413 at once
+}
+
+void HttpServer::set_limits(const HttpLimits& limits) {
+  limits_ = limits;
+  set_payload_max_length(limits_.max_body_bytes);
 }
 
 HttpCounters HttpServer::counters() const {
@@ -361,17 +366,29 @@ std::string HttpServer::AmbiguousFraming(const httplib::Request& req) {
   return "";
 }
 
-bool HttpServer::Admit(const std::string& address) {
+std::string HttpServer::Admit(const std::string& address) {
   std::lock_guard lock(mutex_);
+  if (open_ >= static_cast<uint64_t>(limits_.max_connections_total)) {
+    ++refused_;
+    return "connections: " + std::to_string(limits_.max_connections_total) +
+           " are open already (the limit in total)";
+  }
   int& open = open_by_address_[address];
   if (open >= limits_.max_connections_per_client) {
     if (open == 0) open_by_address_.erase(address);
     ++refused_;
-    return false;
+    return "connections: " + std::to_string(limits_.max_connections_per_client) +
+           " are open from " + address + " already (the limit per client address)";
   }
   ++open;
   ++open_;
-  return true;
+  return "";
+}
+
+void HttpServer::CountApart() {
+  if (!t_release || t_counted_apart) return;
+  t_release();
+  t_counted_apart = true;
 }
 
 void HttpServer::Release(const std::string& address) {
@@ -385,13 +402,13 @@ bool HttpServer::process_and_close_socket(socket_t sock) {
   std::string address;  // "" when unknown: such connections share one count
   int port = 0;
   AddressOf(sock, true, address, port);
-  if (!Admit(address)) {
-    Log("station.control")
-        ->debug("{}:{}: refused, {} connections are open from there", address, port,
-                limits_.max_connections_per_client);
-    Refuse(sock, address, limits_.max_connections_per_client);
+  if (const std::string refused = Admit(address); !refused.empty()) {
+    Log("station.control")->debug("{}:{}: refused, {}", address, port, refused);
+    Refuse(sock, refused);
     return false;
   }
+  t_counted_apart = false;
+  t_release = [this, &address] { Release(address); };
   ConnectionStream stream(
       sock, svr_sock_,
       std::chrono::seconds(read_timeout_sec_) + std::chrono::microseconds(read_timeout_usec_),
@@ -417,11 +434,14 @@ bool HttpServer::process_and_close_socket(socket_t sock) {
       Log("station.control")->debug("{}:{}: closed, {} ({})", address, port, message, status);
       break;
     }
-    if (!ret || connection_closed) break;
+    // A stream counted apart ends its connection: a next request would be counted nowhere.
+    if (!ret || connection_closed || t_counted_apart) break;
   }
   t_stream = nullptr;
   Close(sock, refused);
-  Release(address);
+  if (!t_counted_apart) Release(address);
+  t_release = nullptr;
+  t_counted_apart = false;
   return ret;
 }
 

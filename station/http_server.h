@@ -1,9 +1,12 @@
 #pragma once
 // The station's HTTP server: cpp-httplib's, with two limits its 0.11 (Debian 12's) lacks
 // (docs/daemon.md, "Limits of the HTTP server"):
-//  - connections per client address: a connection beyond `max_connections_per_client` open
-//    from the same address is answered 503 and closed at once, so that one client cannot hold
-//    every HTTP thread;
+//  - connections per client address and in total: a connection beyond
+//    `max_connections_per_client` open from the same address, or beyond `max_connections_total`
+//    open in all, is answered 503 and closed at once, so that one client cannot hold every
+//    HTTP thread, and many (an IPv6 client's many addresses) get an answer rather than a wait
+//    for a thread. A long stream (the console's event stream) is counted apart once its route
+//    says so (CountApart), under that route's own limit: an open console costs no request slot;
 //  - a deadline for each request: its request line, header and body must have arrived within
 //    `request_deadline` of its first byte, else the connection is closed (with a 408 when the
 //    request line was in). cpp-httplib restarts its read timeout with every byte, so without
@@ -34,6 +37,7 @@
 #include <chrono>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <mutex>
 #include <string>
 #include <unordered_map>
@@ -44,7 +48,8 @@
 namespace ss {
 
 struct HttpLimits {
-  int max_connections_per_client = 64;                 // open at once from one address
+  int max_connections_per_client = 64;  // open at once from one address
+  int max_connections_total = 512;  // open at once in all: fewer than the threads, so some refuse
   std::chrono::milliseconds request_deadline{10'000};  // first byte of a request -> all of it read
   size_t max_request_line_bytes = 8 << 10;  // "GET /path?query HTTP/1.1" (cpp-httplib's URI limit)
   size_t max_header_bytes = 64 << 10;       // request line and header together
@@ -54,7 +59,7 @@ struct HttpLimits {
 
 struct HttpCounters {
   uint64_t connections_open = 0;     // served now (a connection waiting for a thread is not)
-  uint64_t connections_refused = 0;  // over the per-client limit, since start
+  uint64_t connections_refused = 0;  // over the per-client or total limit, since start
   uint64_t requests_timed_out = 0;   // not in whole by the deadline, since start
 };
 
@@ -63,6 +68,8 @@ class HttpServer : public httplib::Server {
   explicit HttpServer(HttpLimits limits = {});
 
   const HttpLimits& limits() const { return limits_; }
+  // Before listening only.
+  void set_limits(const HttpLimits& limits);
   HttpCounters counters() const;
 
   // Why the request served on the calling thread could not be read whole, for the error
@@ -82,11 +89,16 @@ class HttpServer : public httplib::Server {
   // Why the framing of `req`'s body cannot be trusted ("" when it can): Content-Length given
   // twice or beside Transfer-Encoding, or a Transfer-Encoding other than chunked.
   static std::string AmbiguousFraming(const httplib::Request& req);
+  // Called by a route on the thread serving its request: this connection is a long stream
+  // limited by the route itself (the event stream), no longer counted in the connection
+  // limits; it is closed once the request ends. No effect outside a request.
+  static void CountApart();
 
  private:
   bool process_and_close_socket(socket_t sock) override;
-  // Counts a connection from `address` in; false (and counted as refused) over the limit.
-  bool Admit(const std::string& address);
+  // Counts a connection from `address` in; "" when admitted, else the 503's text (and the
+  // connection counted as refused).
+  std::string Admit(const std::string& address);
   void Release(const std::string& address);
 
   HttpLimits limits_;

@@ -18,6 +18,7 @@
 #include <functional>
 #include <set>
 #include <thread>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -124,7 +125,7 @@ std::string ErrorOf(const Answer& a) {
 // folder (with `web_dir`), or from the embedded set only.
 class HttpSurface : public ::testing::Test {
  protected:
-  void Start(bool web_dir, const std::string& token) {
+  void Start(bool web_dir, const std::string& token, int http_threads = 16) {
     SetLogLevel("off");  // with no station, the status and the routes behind it log errors
     const fs::path web = scratch_.path() / "web";
     fs::copy(SourcePath("web"), web, fs::copy_options::recursive | fs::copy_options::skip_symlinks);
@@ -139,7 +140,7 @@ class HttpSurface : public ::testing::Test {
     options.config.token = token;
     if (web_dir) options.web_dir = web.string();
     options.embedded = FindEmbeddedWebFile;
-    options.http_threads = 16;
+    options.http_threads = http_threads;
     server_ = std::make_unique<ControlServer>(*host_, options);
     port_ = server_->Start();
     ASSERT_GT(port_, 0);
@@ -407,6 +408,53 @@ TEST_F(HttpSurface, TheRequestLineAndHeadersAreBounded) {
   a = Exchange(port_, Get("/", big));
   EXPECT_EQ(a.status, 431);
   EXPECT_EQ(ErrorOf(a), "header: larger than 65536 bytes");
+}
+
+// Issue 39: connections are capped in total as well as per address, below the thread count so
+// that a free thread answers the next one 503 at once; the console's event streams are counted
+// apart (under their own limit of 16), so open consoles take no request's place.
+TEST_F(HttpSurface, ConnectionsAreCappedInTotalWithEventStreamsCountedApart) {
+  Start(false, "", 24);  // 24 threads: at most 21 connections (24 less an eighth)
+  std::vector<int> fds;
+  for (int i = 0; i < 2; ++i) {  // two consoles' event streams
+    fds.push_back(Connect(port_));
+    const std::string events = Get("/api/events");
+    ASSERT_GT(::send(fds.back(), events.data(), events.size(), MSG_NOSIGNAL), 0);
+    const Answer a = ReadAnswer(fds.back(), 5, 0);
+    ASSERT_EQ(a.status, 200) << a.head;
+    ASSERT_NE(a.head.find("text/event-stream"), std::string::npos) << a.head;
+  }
+  // 21 requests begun and never finished, each holding a connection and its thread.
+  const std::string begun = "GET /api/status HTTP/1.1\r\nHost: 127.0.0.1\r\n";
+  for (int i = 0; i < 21; ++i) {
+    fds.push_back(Connect(port_));
+    ASSERT_GE(fds.back(), 0);
+    ASSERT_GT(::send(fds.back(), begun.data(), begun.size(), MSG_NOSIGNAL), 0);
+  }
+  // None of them is refused: the streams do not count.
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  for (size_t i = 2; i < fds.size(); ++i) {
+    pollfd p{fds[i], POLLIN, 0};
+    EXPECT_EQ(::poll(&p, 1, 0), 0) << "connection " << i - 2 << " was answered";
+  }
+  // The next is refused at once by the one thread left, naming the limit.
+  const auto asked = Clock::now();
+  const Answer over = Exchange(port_, Get("/api/status"), 5, 1);
+  EXPECT_LT(std::chrono::duration<double>(Clock::now() - asked).count(), 1.0);
+  EXPECT_EQ(over.status, 503) << over.head;
+  EXPECT_EQ(ErrorOf(over), "connections: 21 are open already (the limit in total)");
+  EXPECT_NE(over.head.find("Retry-After: 5"), std::string::npos) << over.head;
+  EXPECT_TRUE(over.closed);
+  // One closes: the next is served.
+  ::close(fds.back());
+  fds.pop_back();
+  Answer served;
+  for (int tries = 0; tries < 50 && served.status != 200; ++tries) {
+    served = Exchange(port_, Get("/"));
+    if (served.status != 200) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  EXPECT_EQ(served.status, 200) << served.head;
+  for (const int fd : fds) ::close(fd);
 }
 
 TEST_F(HttpSurface, AmbiguousFramingIsRefusedAndNothingAfterItIsServed) {
