@@ -47,25 +47,29 @@ UnitWorker::UnitWorker(const std::string& bank, UnitWorkerOptions options)
     : options_(std::move(options)), queue_(bank), writer_(bank), reader_(bank) {
   if (std::string why; !options_.IsValid(&why)) throw InputError("unit worker options", why);
   if (options_.name.empty()) options_.name = DefaultName();
+  // The bank's weights and sprite choice are decided by the first to set them, in one
+  // statement each (KeepMeta: two workers starting at once are ordered by the key, and the
+  // second reads the first's). A worker with other settings refuses whether or not a
+  // transition is stored yet: the one that set them may be making transitions now, and the
+  // table would be of neither (issue 39: on an empty table both used to proceed).
   const std::string fingerprint = WeightsFingerprint(options_.weights);
-  const std::optional<std::string> made_with = reader_.GetMeta(kTransitionWeightsMetaKey);
-  if (made_with && *made_with != fingerprint && reader_.Counts().transitions > 0) {
+  const std::string table_weights = writer_.KeepMeta(kTransitionWeightsMetaKey, fingerprint);
+  if (table_weights != fingerprint) {
     throw InputError(reader_.path(),
-                     "its transitions were made with other weights (" + *made_with +
-                         "); rebuild them with `spritestation transitions BANK` first");
+                     "its transitions are made with other weights (" + table_weights +
+                         ", this worker's are " + fingerprint +
+                         "); run every worker alike, or rebuild them with `spritestation "
+                         "transitions BANK` with this worker's weights first");
   }
-  if (!made_with) writer_.SetMeta(kTransitionWeightsMetaKey, fingerprint);
-  // Workers taking merged sprites and workers leaving them out would make a table of neither.
   const std::string choice = options_.sprites.MetaValue();
   const std::string table_choice = writer_.KeepMeta(SpriteChoice::kMetaKey, choice);
-  if (table_choice != choice && reader_.Counts().transitions > 0) {
-    throw InputError(reader_.path(), std::string("its transitions were made with ") +
+  if (table_choice != choice) {
+    throw InputError(reader_.path(), std::string("its transitions are made with ") +
                                          SpriteChoice::kMetaKey + " " + table_choice +
                                          ", this worker has " + choice +
-                                         "; rebuild them with `spritestation transitions BANK` "
-                                         "first, or run every worker alike");
+                                         "; run every worker alike, or rebuild them with "
+                                         "`spritestation transitions BANK` first");
   }
-  if (table_choice != choice) writer_.SetMeta(SpriteChoice::kMetaKey, choice);
 }
 
 void UnitWorker::CatchUp() {

@@ -41,8 +41,9 @@ struct UnitWorkerStats {
 
 class UnitWorker {
  public:
-  // InputError for a bank that is not PostgreSQL, or whose transitions were made with other
-  // weights or another sprite choice (rebuild them with `transitions BANK` first).
+  // InputError for a bank that is not PostgreSQL, or whose transitions are made with other
+  // weights or another sprite choice (decided by the first worker, station or `transitions
+  // BANK` to set them, on an empty table too; rebuild them with `transitions BANK` first).
   UnitWorker(const std::string& bank, UnitWorkerOptions options);
 
   // Registers new complete clips as units, claims one and does it. False when none was free.
