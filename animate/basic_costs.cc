@@ -39,6 +39,39 @@ double FastFrameTerm::StepCost(Tracks tracks, int t) const {
          std::max(0.0, reference_speed_m_ - tracks[sprites()[0]]->VelocityAt(t).norm());
 }
 
+RepeatTerm::RepeatTerm(int sprite, int window_steps, double strength,
+                       std::shared_ptr<const std::vector<bool>> exempt)
+    : StepSumTerm("repeat", {sprite}, strength),
+      window_steps_(window_steps),
+      exempt_(std::move(exempt)) {
+  if (window_steps < 1) throw InputError("repeat.window_steps", "must be >= 1");
+}
+
+std::pair<int, int> RepeatTerm::Steps(Tracks tracks, const EvalRequest& /*request*/) const {
+  return {1, std::max(1, tracks[sprites()[0]]->size())};
+}
+
+bool RepeatTerm::Repeats(const Track& track, int t) const {
+  if (t < 1 || t >= track.size()) return false;
+  const int frame = track.frames[t];
+  if (exempt_ && (*exempt_)[frame]) return false;
+  for (int u = std::max(0, t - window_steps_); u < t; ++u) {
+    if (track.frames[u] == frame) return true;
+  }
+  return false;
+}
+
+double RepeatTerm::StepCost(Tracks tracks, int t) const {
+  return Repeats(*tracks[sprites()[0]], t) ? strength() : 0.0;
+}
+
+int RepeatTerm::CountViolations(Tracks tracks) const {
+  const Track& track = *tracks[sprites()[0]];
+  int n = 0;
+  for (int t = 1; t < track.size(); ++t) n += Repeats(track, t);
+  return n;
+}
+
 LengthTerm::LengthTerm(int sprite, int min_frames, double strength)
     : StepSumTerm("length", {sprite}, strength), min_frames_(min_frames) {
   if (min_frames < 1) throw InputError("length.min_frames", "must be >= 1");

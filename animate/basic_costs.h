@@ -3,6 +3,9 @@
 //   smoothness (seed 000 eq. 2)  c_t = α C(s_{t-1} -> s_t)
 //   frame/pose (eq. 10)          c_t = λ if s_t ∉ G (or the sequence has ended), else 0
 //   fast frames (§6.2)           c_t = ρ max(0, v_ref - |v(s_t)|)
+//   repeats (ours)               c_t = κ if s_t ∈ {s_{t-W}, ..., s_{t-1}} and s_t is not
+//                                still-tagged: a frame shown again within W steps is what a
+//                                viewer sees as stutter (judge/judge.h counts the same)
 //   length (§6.2)                end cost λ max(0, N - n)
 #include <memory>
 #include <optional>
@@ -40,6 +43,28 @@ class FastFrameTerm : public StepSumTerm {
 
  private:
   double reference_speed_m_;
+};
+
+class RepeatTerm : public StepSumTerm {
+ public:
+  // `exempt`: per frame, true for frames that hold still on purpose (may be null: none).
+  RepeatTerm(int sprite, int window_steps, double strength,
+             std::shared_ptr<const std::vector<bool>> exempt = nullptr);
+  // Steps showing a frame already shown within the window.
+  int CountViolations(Tracks tracks) const override;
+
+ protected:
+  std::pair<int, int> Steps(Tracks tracks, const EvalRequest& request) const override;
+  double StepCost(Tracks tracks, int t) const override;
+  bool FramesOnly() const override { return true; }
+  bool TimeInvariant() const override { return true; }
+  int LookBack() const override { return window_steps_; }
+
+ private:
+  bool Repeats(const Track& track, int t) const;
+
+  int window_steps_;
+  std::shared_ptr<const std::vector<bool>> exempt_;
 };
 
 class LengthTerm : public StepSumTerm {

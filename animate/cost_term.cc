@@ -46,8 +46,10 @@ double StepSumTerm::Evaluate(Tracks tracks, const EvalRequest& request) const {
       from = cached_end;
     }
     if (TimeInvariant() && request.shifted_from < end) {
-      // Steps t >= shifted_from + 1 have both frames of their edge in the shifted part.
-      const int shifted_begin = std::max(from, request.shifted_from + 1);
+      // Steps t >= shifted_from + LookBack() read frames of the shifted part only (both of
+      // their edge's), as their old steps t - shift did (frame shifted_from was old frame
+      // shifted_from - shift >= 0, so no old window was cut by step 0).
+      const int shifted_begin = std::max(from, request.shifted_from + LookBack());
       const int old_begin = shifted_begin - request.shift;
       const int old_end = end - request.shift;
       if (old_begin >= 0 && old_end <= cached_size && old_begin <= old_end) {

@@ -99,6 +99,8 @@ class StepSumTerm : public CostTerm {
   // c_t also ignores t itself (frames at t and t - 1 only) and the window is [w, n): the
   // part after a replaced piece is summed from the cache with its time shift.
   virtual bool TimeInvariant() const { return false; }
+  // With TimeInvariant: c_t reads the frames at steps [t - LookBack(), t] (the edge: 1).
+  virtual int LookBack() const { return 1; }
   // Longest sequence among the sprites read.
   int MaxLength(Tracks tracks) const;
 };

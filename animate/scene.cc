@@ -22,6 +22,8 @@ std::unique_ptr<Scene> Scene::Load(AnimationSpec spec) {
       if (!f.tag.empty()) tags.push_back(f.tag);
     }
   }
+  if (spec.repeats.strength > 0 && !spec.repeats.still_tag.empty())
+    tags.push_back(spec.repeats.still_tag);
   BankGraph bank = LoadBankGraph(spec.bank_paths, tags);
   return std::make_unique<Scene>(std::move(spec), std::move(bank));
 }
@@ -39,6 +41,9 @@ void Scene::AddTerms() {
     s.max_frames = spec_.max_frames;
     problem_->AddSprite(std::move(s));
   }
+  std::shared_ptr<const std::vector<bool>> still;  // frames a RepeatTerm lets repeat
+  if (spec_.repeats.strength > 0 && !spec_.repeats.still_tag.empty())
+    still = std::make_shared<std::vector<bool>>(graph.FramesWithTag(spec_.repeats.still_tag));
   for (int id = 0; id < static_cast<int>(spec_.sprites.size()); ++id) {
     const SpriteSpecEntry& entry = spec_.sprites[id];
     for (const LocationSpec& l : entry.locations) {
@@ -80,6 +85,10 @@ void Scene::AddTerms() {
     const std::optional<LengthSpec>& length = entry.length ? entry.length : spec_.length;
     if (length) {
       problem_->AddTerm(std::make_unique<LengthTerm>(id, length->min_frames, length->strength));
+    }
+    if (spec_.repeats.strength > 0) {
+      problem_->AddTerm(std::make_unique<RepeatTerm>(id, spec_.repeats.window_steps,
+                                                     spec_.repeats.strength, still));
     }
     const std::optional<FastFrameSpec>& fast = entry.fast ? entry.fast : spec_.fast;
     if (fast && fast->strength > 0) {

@@ -172,6 +172,7 @@ class SpecReader {
   void Constraints(const YAML::Node& node, const std::string& path, SpriteSpecEntry& out);
   LengthSpec Length(const YAML::Node& node, const std::string& path);
   FastFrameSpec Fast(const YAML::Node& node, const std::string& path);
+  RepeatSpec Repeats(const YAML::Node& node, const std::string& path);
   LocationSpec Location(const YAML::Node& node, const std::string& path);
   PathSpec Path(const YAML::Node& node, const std::string& path);
   FrameSpec Frames(const YAML::Node& node, const std::string& path);
@@ -384,6 +385,10 @@ AnimationSpec SpecReader::Read(const YAML::Node& root) {
       .AddRead(
           "fast_frames", "", "{reference_speed_m_s, strength}",
           BlockOf([this](const YAML::Node& n, const std::string& p) { spec_.fast = Fast(n, p); }))
+      .AddRead("repeats", "", "{strength, window_steps, still_tag}",
+               BlockOf([this](const YAML::Node& n, const std::string& p) {
+                 spec_.repeats = Repeats(n, p);
+               }))
       .AddRead("optimizer", "", "the optimizer's block",
                BlockOf([this](const YAML::Node& n, const std::string&) { Optimizer(n); }))
       .AddRead("sprites", "", "the list of sprites",
@@ -664,6 +669,21 @@ FastFrameSpec SpecReader::Fast(const YAML::Node& node, const std::string& path) 
   Required(view, "reference_speed_m_s", "required");
   Positive(view, "reference_speed_m_s", out.reference_speed_m_s);
   AtLeast(view, "strength", out.strength, 0);
+  return out;
+}
+
+RepeatSpec SpecReader::Repeats(const YAML::Node& node, const std::string& path) {
+  RepeatSpec out;
+  OptionsBinder keys;
+  keys.Add("strength", &out.strength, "a number", "per step showing a frame shown just before")
+      .Add("window_steps", &out.window_steps, "a number of steps", "how far back")
+      .Add("still_tag", &out.still_tag, "a tag", "frames that may repeat");
+  YamlMap view;
+  if (!Block(keys, node, path, view)) return out;
+  Required(view, "strength", "required");
+  AtLeast(view, "strength", out.strength, 0);
+  Check(view, "window_steps", out.window_steps >= 1 && out.window_steps <= 1000,
+        "must be 1..1000 steps, got " + std::to_string(out.window_steps));
   return out;
 }
 

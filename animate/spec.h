@@ -75,6 +75,14 @@ struct FastFrameSpec {  // §6.2: prefer fast-moving frames
   double strength = 0.0;  // per (m/s) below the reference, per step
 };
 
+// Ours (not the paper's): a frame shown again within `window_steps` costs `strength` a step,
+// as the judge counts stutter (judge/judge.h); frames tagged `still_tag` hold still on purpose.
+struct RepeatSpec {
+  int window_steps = 15;
+  double strength = 0.0;  // off unless the spec sets it
+  std::string still_tag = "still";
+};
+
 struct SpriteSpecEntry {
   SpecPlace place;
   std::string name;
@@ -130,6 +138,7 @@ struct AnimationSpec {
   int initial_frames = 0;            // length of random initial sequences (default: derived)
   std::optional<LengthSpec> length;  // free length: penalize sequences under N frames
   std::optional<FastFrameSpec> fast;
+  RepeatSpec repeats;
   std::string camera_path;              // .cameramodel (absolute)
   SpecPlace camera_place;               // where the spec names it
   std::string background_path;          // image (absolute) or ""

@@ -175,6 +175,19 @@ TEST_F(CostTermsTest, LengthAndFastFrames) {
   EXPECT_THROW(LengthTerm(0, 3, -1.0), InputError);
 }
 
+// Frames 0 1 2 1 3 0: frame 1 comes back after 2 steps, frame 0 after 5.
+TEST_F(CostTermsTest, RepeatsWithinTheWindowUnlessStill) {
+  tracks_ = {MakeTrack(graph_, {0, 1, 2, 1, 3, 0}, Anchor::kStart, Vector2d(0, 0))};
+  const RepeatTerm three(0, 3, 2.0);
+  EXPECT_DOUBLE_EQ(Eval(three), 2.0);
+  EXPECT_EQ(three.CountViolations(TrackPointers(tracks_)), 1);
+  EXPECT_DOUBLE_EQ(Eval(RepeatTerm(0, 5, 2.0)), 4.0);
+  auto still = std::make_shared<std::vector<bool>>(
+      std::vector<bool>{false, true, false, false, false, false});
+  EXPECT_DOUBLE_EQ(Eval(RepeatTerm(0, 5, 2.0, still)), 2.0);  // frame 1 may hold still
+  EXPECT_THROW(RepeatTerm(0, 0, 1.0), InputError);
+}
+
 TEST_F(CostTermsTest, ProblemSumsAndBreaksDownByKind) {
   Problem problem(graph_);
   SpriteSpec spec;
@@ -286,6 +299,47 @@ TEST(CostTermCache, IncrementalEqualsFullEvaluation) {
       EXPECT_NEAR(term->Evaluate(after_view, partial), term->Evaluate(after_view, partial_full),
                   1e-9 * (1 + term->Evaluate(after_view)))
           << term->kind() << " (partial) trial " << trial;
+    }
+  }
+}
+
+// The replacement's use: a piece replaced in the middle, the tail after it moved in time.
+// Terms reading the frames alone sum the moved tail from the cache, shifted; for the repeat
+// term only the steps whose whole window lies in the moved tail.
+TEST(CostTermCache, AMovedTailEqualsFullEvaluation) {
+  const TransitionGraph graph = testing::RandomGraph(8, 40, 5);
+  std::vector<std::unique_ptr<CostTerm>> terms;
+  terms.push_back(std::make_unique<RepeatTerm>(0, 4, 1.5));
+  terms.push_back(std::make_unique<RepeatTerm>(0, 15, 1.0));
+  terms.push_back(std::make_unique<FastFrameTerm>(0, 0.08, 1.0));
+  std::mt19937_64 rng(5);
+  auto random_frames = [&](int n) {
+    std::vector<int> frames;
+    for (int i = 0; i < n; ++i) frames.push_back(static_cast<int>(rng() % graph.num_frames()));
+    return frames;
+  };
+  for (int trial = 0; trial < 300; ++trial) {
+    const std::vector<int> old_frames = random_frames(30 + trial % 20);
+    const int n = static_cast<int>(old_frames.size());
+    const int k = 1 + static_cast<int>(rng() % (n / 2));      // first changed step
+    const int l = k + static_cast<int>(rng() % (n - k - 1));  // old tail from here
+    const std::vector<int> piece = random_frames(static_cast<int>(rng() % 12));
+    std::vector<int> frames(old_frames.begin(), old_frames.begin() + k);
+    frames.insert(frames.end(), piece.begin(), piece.end());
+    frames.insert(frames.end(), old_frames.begin() + l, old_frames.end());
+    const std::vector<Track> before{MakeTrack(graph, old_frames, Anchor::kStart, {0, 0})};
+    const std::vector<Track> after{MakeTrack(graph, frames, Anchor::kStart, {0, 0})};
+    for (const auto& term : terms) {
+      TermCache cache;
+      term->BuildCache(TrackPointers(before), &cache);
+      EvalRequest request;
+      request.first_changed = k;
+      request.cache = &cache;
+      request.shifted_from = k + static_cast<int>(piece.size());
+      request.shift = request.shifted_from - l;
+      const double full = term->Evaluate(TrackPointers(after));
+      EXPECT_NEAR(term->Evaluate(TrackPointers(after), request), full, 1e-9 * (1 + full))
+          << term->kind() << " trial " << trial;
     }
   }
 }

@@ -144,6 +144,29 @@ std::string Edit(const std::string& from, const std::string& to) {
   return yaml.replace(at, from.size(), to);
 }
 
+// Issue 33: the loiter's hamster replayed a few frames to hold its place (stutter 6-7 %).
+TEST_F(SpecTest, RepeatsCostAFrameShownAgainWithinTheWindow) {
+  const std::string fast = "fast_frames: {reference_speed_m_s: 1.0, strength: 0.5}";
+  const AnimationSpec spec =
+      ParseAnimationSpec(Edit(fast, "repeats: {strength: 3, window_steps: 10}"), Origin());
+  EXPECT_EQ(spec.repeats.strength, 3);
+  EXPECT_EQ(spec.repeats.window_steps, 10);
+  EXPECT_EQ(spec.repeats.still_tag, "still");
+  EXPECT_EQ(ParseAnimationSpec(kGood, Origin()).repeats.strength, 0);  // off unless set
+  const auto scene = Scene::Load(spec);
+  int repeats = 0;
+  for (int k = 0; k < scene->problem().num_terms(); ++k)
+    repeats += scene->problem().term(k).kind() == "repeat";
+  EXPECT_EQ(repeats, 2);  // one a sprite
+  const std::string o = Origin();
+  EXPECT_EQ(ErrorOf(Edit(fast, "repeats: {strength: -1}")),
+            o + ":6: repeats.strength: must be >= 0");
+  EXPECT_EQ(ErrorOf(Edit(fast, "repeats: {strength: 1, window_steps: 0}")),
+            o + ":6: repeats.window_steps: must be 1..1000 steps, got 0");
+  EXPECT_EQ(ErrorOf(Edit(fast, "repeats: {window_steps: 5}")),
+            o + ":6: repeats.strength: required");
+}
+
 TEST_F(SpecTest, BadSpecsNameTheLineAndTheField) {
   const std::string o = Origin();
   EXPECT_EQ(ErrorOf(Edit("frame_rate: 25", "frame_rate: fast")),
