@@ -233,6 +233,8 @@ bool JudgeOptions::IsValid(std::string* why) const {
   OptionProblems check(why);
   check(stutter_window_steps >= 1, "stutter_window_steps",
         "must be >= 1, got " + std::to_string(stutter_window_steps));
+  check(clone_lag_steps >= 0, "clone_lag_steps",
+        "must be >= 0, got " + std::to_string(clone_lag_steps));
   std::string jump_why;
   check.Nested(jump.IsValid(&jump_why), "jump.", jump_why);
   return check.ok();
@@ -261,6 +263,37 @@ StutterFigures MeasureStutter(const std::vector<SpriteSequence>& sprites, int wi
   }
   const int counted = out.steps - out.still_steps;
   out.share = counted > 0 ? static_cast<double>(out.repeats) / counted : 0.0;
+  return out;
+}
+
+CloneFigures MeasureClones(const std::vector<SpriteSequence>& sprites, int lag_steps) {
+  CloneFigures out;
+  out.lag_steps = lag_steps;
+  // Every (sprite, step) showing each frame.
+  std::map<std::pair<int, int64_t>, std::vector<std::pair<int, int>>> shown;
+  for (size_t s = 0; s < sprites.size(); ++s) {
+    for (size_t t = 0; t < sprites[s].frames.size(); ++t) {
+      const BankFrameRef& f = sprites[s].frames[t];
+      shown[{f.bank, f.sprite_id}].emplace_back(static_cast<int>(s), static_cast<int>(t));
+    }
+  }
+  for (size_t s = 0; s < sprites.size(); ++s) {
+    const int n = static_cast<int>(sprites[s].frames.size());
+    int cloned = 0;
+    for (int t = 0; t < n; ++t) {
+      const BankFrameRef& f = sprites[s].frames[t];
+      for (const auto& [other, u] : shown.at({f.bank, f.sprite_id})) {
+        if (other != static_cast<int>(s) && std::abs(u - t) <= lag_steps) {
+          ++cloned;
+          break;
+        }
+      }
+    }
+    out.steps += n;
+    out.cloned_steps += cloned;
+    if (n > 0 && 2 * cloned >= n) ++out.sprites_cloned;
+  }
+  out.share = out.steps > 0 ? static_cast<double>(out.cloned_steps) / out.steps : 0.0;
   return out;
 }
 
@@ -298,6 +331,7 @@ Judgement JudgeSequences(const SequenceFile& file, const std::vector<std::string
       MeasureStutter(file.sprites, options.stutter_window_steps, [&](const BankFrameRef& f) {
         return still.count({f.bank, f.sprite_id}) > 0;
       });
+  out.clones = MeasureClones(file.sprites, options.clone_lag_steps);
   if (options.jumps) out.jumps = JudgeJumps(file, banks, options.jump);
   return out;
 }

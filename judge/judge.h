@@ -21,6 +21,8 @@ struct JudgeOptions {
   int stutter_window_steps = 15;
   // Steps showing a frame with one of these bank tags hold still on purpose: not counted.
   std::vector<std::string> still_tags = {"still"};
+  // Two sprites showing the same frame this many steps apart or closer are copies.
+  int clone_lag_steps = 2;
   bool jumps = true;  // measure the visible jumps (reads billboards); false: skip them
   VisibleJumpOptions jump;
   // False with "FIELD: reason" lines in `why` (core/option_checks.h) for values out of range.
@@ -37,5 +39,8 @@ Judgement JudgeSequences(const SequenceFile& file, const std::vector<std::string
 // The stutter of some sprites' frames alone; `is_still` exempts a step showing that frame.
 StutterFigures MeasureStutter(const std::vector<SpriteSequence>& sprites, int window_steps,
                               const std::function<bool(const BankFrameRef&)>& is_still);
+
+// Which steps of `sprites` show a frame another sprite shows within `lag_steps`.
+CloneFigures MeasureClones(const std::vector<SpriteSequence>& sprites, int lag_steps);
 
 }  // namespace ss

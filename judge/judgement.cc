@@ -78,6 +78,12 @@ json JudgementJson(const Judgement& j) {
                     {"still_steps", s.still_steps},
                     {"repeats", s.repeats},
                     {"share", s.share}};
+  const CloneFigures& c = j.clones;
+  out["clones"] = {{"lag_steps", c.lag_steps},
+                   {"steps", c.steps},
+                   {"cloned_steps", c.cloned_steps},
+                   {"share", c.share},
+                   {"sprites_cloned", c.sprites_cloned}};
   const JumpFigures& v = j.jumps;
   json each = json::array();
   for (const TransitionJump& t : v.each) {
@@ -139,6 +145,12 @@ std::string JudgementReport(const Judgement& j) {
   add("  stutter     %.1f %% (%d of %d steps show a frame of the %d before; %d still steps not "
       "counted)\n",
       100 * s.share, s.repeats, s.steps - s.still_steps, s.window_steps, s.still_steps);
+  if (j.clones.steps > 0 && j.clones.cloned_steps > 0) {
+    add("  clones      %.1f %% (%d of %d steps show a frame another sprite shows within %d "
+        "steps; %d sprites mostly copies)\n",
+        100 * j.clones.share, j.clones.cloned_steps, j.clones.steps, j.clones.lag_steps,
+        j.clones.sprites_cloned);
+  }
   const JumpFigures& v = j.jumps;
   if (!v.measured) {
     add("  jumps       not measured\n");

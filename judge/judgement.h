@@ -59,6 +59,16 @@ struct StutterFigures {
   double share = 0;     // repeats / (steps - still_steps)
 };
 
+// Sprites that move as one: a step is a clone step when another sprite shows the same bank
+// frame within `lag_steps` of it (what a viewer sees as copies: 64 flies in lockstep).
+struct CloneFigures {
+  int lag_steps = 2;
+  int steps = 0;           // all sprites' steps
+  int cloned_steps = 0;    // of them, with another sprite showing the same frame within the lag
+  double share = 0;        // cloned_steps / steps
+  int sprites_cloned = 0;  // sprites with at least half of their steps cloned
+};
+
 struct TransitionJump {
   std::string sprite;
   int step = 0;  // the step showing `to`
@@ -84,6 +94,7 @@ struct Judgement {
   std::vector<FrameOutcome> frames;
   bool constraints_judged = false;  // false: no spec given
   StutterFigures stutter;
+  CloneFigures clones;
   JumpFigures jumps;
 };
 

@@ -79,6 +79,28 @@ TEST_F(JudgeTest, StutterLeavesOutFramesTaggedStill) {
   EXPECT_DOUBLE_EQ(j.stutter.share, 3.0 / 7);
 }
 
+TEST_F(JudgeTest, ClonesAreSpritesShowingTheSameFramesTogether) {
+  // a and b show A0-A3 one step apart (copies); c shows B0-B9, then A0-A4 ten steps after a
+  // (not copies).
+  file_.sprites = {Sequence("a", A({0, 1, 2, 3, 4}), {}), Sequence("b", A({4, 0, 1, 2, 3}), {}),
+                   Sequence("c", B({0, 1, 2, 3, 4, 5, 6, 7, 8, 9}), {})};
+  for (const int64_t id : A({0, 1, 2, 3, 4})) file_.sprites[2].frames.push_back({0, id});
+  for (size_t t = 0; t < 5; ++t) file_.sprites[2].positions_m.emplace_back(0.0, 0.0);
+  JudgeOptions options;
+  options.jumps = false;
+  Judgement j = JudgeSequences(file_, file_.bank_paths, nullptr, options);
+  // a: 4 of 5 (b shows A0-A3 a step later; A4 four steps before, past the lag of 2); b: 4 of 5
+  // likewise; c: none (its A0-A4 come 9-10 steps after theirs).
+  EXPECT_EQ(j.clones.steps, 25);
+  EXPECT_EQ(j.clones.cloned_steps, 8);
+  EXPECT_EQ(j.clones.sprites_cloned, 2);
+  EXPECT_DOUBLE_EQ(j.clones.share, 8.0 / 25);
+  options.clone_lag_steps = 0;  // only the same step: none
+  j = JudgeSequences(file_, file_.bank_paths, nullptr, options);
+  EXPECT_EQ(j.clones.cloned_steps, 0);
+  EXPECT_EQ(JudgementJson(j)["clones"]["share"], 0.0);
+}
+
 TEST_F(JudgeTest, JumpsAreMeasuredAgainstTheNaturalSuccessor) {
   // A8 A9 | A0 A1 A2 | C3 C4 | B5 B6: A9 -> A0 leaves the clip's end (nothing replaced);
   // A2 -> C3 shows A3's pixels (jump 0); C4 -> B5 shows B5 for C5 (A5's pixels): 20 x 20
