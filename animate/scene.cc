@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "animate/basic_costs.h"
+#include "animate/clone_cost.h"
 #include "animate/collision_cost.h"
 #include "animate/location_cost.h"
 #include "animate/path_cost.h"
@@ -95,6 +96,14 @@ void Scene::AddTerms() {
       // Graph speeds are metres per source frame: convert the reference and the strength.
       problem_->AddTerm(std::make_unique<FastFrameTerm>(id, fast->reference_speed_m_s * interval,
                                                         fast->strength / interval));
+    }
+  }
+  if (spec_.clones.strength > 0) {
+    for (int a = 0; a < problem_->num_sprites(); ++a) {
+      for (int b = a + 1; b < problem_->num_sprites(); ++b) {
+        problem_->AddTerm(
+            std::make_unique<CloneTerm>(a, b, spec_.clones.lag_steps, spec_.clones.strength));
+      }
     }
   }
   for (const CollisionSpec& c : spec_.collisions) {

@@ -173,6 +173,7 @@ class SpecReader {
   LengthSpec Length(const YAML::Node& node, const std::string& path);
   FastFrameSpec Fast(const YAML::Node& node, const std::string& path);
   RepeatSpec Repeats(const YAML::Node& node, const std::string& path);
+  CloneSpec Clones(const YAML::Node& node, const std::string& path);
   LocationSpec Location(const YAML::Node& node, const std::string& path);
   PathSpec Path(const YAML::Node& node, const std::string& path);
   FrameSpec Frames(const YAML::Node& node, const std::string& path);
@@ -388,6 +389,10 @@ AnimationSpec SpecReader::Read(const YAML::Node& root) {
       .AddRead("repeats", "", "{strength, window_steps, still_tag}",
                BlockOf([this](const YAML::Node& n, const std::string& p) {
                  spec_.repeats = Repeats(n, p);
+               }))
+      .AddRead("clones", "", "{strength, lag_steps}",
+               BlockOf([this](const YAML::Node& n, const std::string& p) {
+                 spec_.clones = Clones(n, p);
                }))
       .AddRead("optimizer", "", "the optimizer's block",
                BlockOf([this](const YAML::Node& n, const std::string&) { Optimizer(n); }))
@@ -684,6 +689,20 @@ RepeatSpec SpecReader::Repeats(const YAML::Node& node, const std::string& path) 
   AtLeast(view, "strength", out.strength, 0);
   Check(view, "window_steps", out.window_steps >= 1 && out.window_steps <= 1000,
         "must be 1..1000 steps, got " + std::to_string(out.window_steps));
+  return out;
+}
+
+CloneSpec SpecReader::Clones(const YAML::Node& node, const std::string& path) {
+  CloneSpec out;
+  OptionsBinder keys;
+  keys.Add("strength", &out.strength, "a number", "per frame two sprites show together")
+      .Add("lag_steps", &out.lag_steps, "a number of steps", "how far apart is together");
+  YamlMap view;
+  if (!Block(keys, node, path, view)) return out;
+  Required(view, "strength", "required");
+  AtLeast(view, "strength", out.strength, 0);
+  Check(view, "lag_steps", out.lag_steps >= 0 && out.lag_steps <= 100,
+        "must be 0..100 steps, got " + std::to_string(out.lag_steps));
   return out;
 }
 

@@ -83,6 +83,13 @@ struct RepeatSpec {
   std::string still_tag = "still";
 };
 
+// Ours: two sprites showing the same frame within `lag_steps` of each other cost `strength`
+// (animate/clone_cost.h), between every pair of sprites.
+struct CloneSpec {
+  int lag_steps = 2;
+  double strength = 0.0;  // off unless the spec sets it
+};
+
 struct SpriteSpecEntry {
   SpecPlace place;
   std::string name;
@@ -139,6 +146,7 @@ struct AnimationSpec {
   std::optional<LengthSpec> length;  // free length: penalize sequences under N frames
   std::optional<FastFrameSpec> fast;
   RepeatSpec repeats;
+  CloneSpec clones;
   std::string camera_path;              // .cameramodel (absolute)
   SpecPlace camera_place;               // where the spec names it
   std::string background_path;          // image (absolute) or ""

@@ -9,6 +9,7 @@
 
 #include "animate/animate_run.h"
 #include "animate/basic_costs.h"
+#include "animate/clone_cost.h"
 #include "animate/collision_cost.h"
 #include "animate/location_cost.h"
 #include "animate/path_cost.h"
@@ -188,6 +189,21 @@ TEST_F(CostTermsTest, RepeatsWithinTheWindowUnlessStill) {
   EXPECT_THROW(RepeatTerm(0, 0, 1.0), InputError);
 }
 
+// a: 0 1 2 3 4; b: 4 0 1 2 5. With a lag of 2: b's 0, 1, 2 come a step after a's (charged at
+// b's steps 1, 2, 3), a's 4 comes 4 steps after b's (past the lag).
+TEST_F(CostTermsTest, ClonesAreChargedOncePerCoincidenceAtItsLaterStep) {
+  tracks_ = {MakeTrack(graph_, {0, 1, 2, 3, 4}, Anchor::kStart, Vector2d(0, 0)),
+             MakeTrack(graph_, {4, 0, 1, 2, 5}, Anchor::kStart, Vector2d(0, 0))};
+  const CloneTerm lag2(0, 1, 2, 2.0);
+  EXPECT_DOUBLE_EQ(Eval(lag2), 3 * 2.0);
+  EXPECT_EQ(lag2.CountViolations(TrackPointers(tracks_)), 3);
+  EXPECT_DOUBLE_EQ(Eval(CloneTerm(1, 0, 2, 2.0)), 3 * 2.0);  // the same either way round
+  EXPECT_DOUBLE_EQ(Eval(CloneTerm(0, 1, 0, 2.0)), 0.0);      // never at the same step
+  EXPECT_DOUBLE_EQ(Eval(CloneTerm(0, 1, 4, 2.0)), 4 * 2.0);  // a's 4 too, at its step 4
+  EXPECT_THROW(CloneTerm(0, 0, 1, 1.0), InputError);
+  EXPECT_THROW(CloneTerm(0, 1, -1, 1.0), InputError);
+}
+
 TEST_F(CostTermsTest, ProblemSumsAndBreaksDownByKind) {
   Problem problem(graph_);
   SpriteSpec spec;
@@ -256,6 +272,8 @@ TEST(CostTermCache, IncrementalEqualsFullEvaluation) {
                                               PathTrigger{0, Polyline({{0, 0}, {0.1, 0}}), 5}));
   terms.push_back(std::make_unique<LengthTerm>(0, 25, 1.0));
   terms.push_back(std::make_unique<FastFrameTerm>(0, 0.08, 1.0));
+  terms.push_back(std::make_unique<CloneTerm>(0, 1, 2, 1.5));
+  terms.push_back(std::make_unique<CloneTerm>(1, 0, 0, 1.0));
 
   std::mt19937_64 rng(3);
   auto random_walk = [&](int length) {

@@ -167,6 +167,23 @@ TEST_F(SpecTest, RepeatsCostAFrameShownAgainWithinTheWindow) {
             o + ":6: repeats.strength: required");
 }
 
+// The flies of seed 000 §6.2 walked in lockstep, each given the same best sequence.
+TEST_F(SpecTest, ClonesCostTwoSpritesShowingAFrameTogether) {
+  const std::string fast = "fast_frames: {reference_speed_m_s: 1.0, strength: 0.5}";
+  const AnimationSpec spec =
+      ParseAnimationSpec(Edit(fast, "clones: {strength: 4, lag_steps: 3}"), Origin());
+  EXPECT_EQ(spec.clones.strength, 4);
+  EXPECT_EQ(spec.clones.lag_steps, 3);
+  EXPECT_EQ(ParseAnimationSpec(kGood, Origin()).clones.strength, 0);  // off unless set
+  const auto scene = Scene::Load(spec);
+  int clones = 0;
+  for (int k = 0; k < scene->problem().num_terms(); ++k)
+    clones += scene->problem().term(k).kind() == "clone";
+  EXPECT_EQ(clones, 1);  // one a pair
+  EXPECT_EQ(ErrorOf(Edit(fast, "clones: {strength: 1, lag_steps: 101}")),
+            Origin() + ":6: clones.lag_steps: must be 0..100 steps, got 101");
+}
+
 TEST_F(SpecTest, BadSpecsNameTheLineAndTheField) {
   const std::string o = Origin();
   EXPECT_EQ(ErrorOf(Edit("frame_rate: 25", "frame_rate: fast")),
