@@ -332,8 +332,8 @@ TEST(CostTermCache, AMovedTailEqualsFullEvaluation) {
   terms.push_back(std::make_unique<FastFrameTerm>(0, 0.08, 1.0));
   std::mt19937_64 rng(5);
   auto random_frames = [&](int n) {
-    std::vector<int> frames;
-    for (int i = 0; i < n; ++i) frames.push_back(static_cast<int>(rng() % graph.num_frames()));
+    std::vector<int> frames(static_cast<size_t>(n));
+    for (int& f : frames) f = static_cast<int>(rng() % graph.num_frames());
     return frames;
   };
   for (int trial = 0; trial < 300; ++trial) {
