@@ -9,6 +9,11 @@ static std::vector<Suite>& Registry() {
   return suites;
 }
 
+std::pair<std::string, std::string> OptionNameValue(const std::string& arg) {
+  const size_t eq = arg.find('=');
+  return {arg.substr(0, eq), eq == std::string::npos ? "" : arg.substr(eq + 1)};
+}
+
 bool RegisterSuite(Suite suite) {
   Registry().push_back(std::move(suite));
   return true;

@@ -4,6 +4,7 @@
 // figures (ratios against a baseline measured in the same run).
 #include <map>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <benchmark/benchmark.h>
@@ -17,6 +18,9 @@ struct Suite {
 };
 
 bool RegisterSuite(Suite suite);
+
+// "--name=value" as {"--name", "value"} ({"--name", ""} without '='): a suite's own options.
+std::pair<std::string, std::string> OptionNameValue(const std::string& arg);
 const std::vector<Suite>& Suites();
 
 // Runs the Google Benchmark cases whose name starts with `prefix`, passing `args`

@@ -8,7 +8,8 @@
 //   http/baseline_polls                 the same polls with no attacker: the figures to beat
 //   http/slow_headers_N_from_A          the polls under the attack
 // Counters: polls, polls_failed (no answer within 2 s, or not 200), p50/p99/max of a poll in
-// ms, attack_connections (opened over the run), attack_refused (answered 503 by the server).
+// ms, attack_connections (opened over the run), attack_refused (503s the attacker read),
+// server_open / server_refused (the server's own count at the end: served now, refused in all).
 #include <arpa/inet.h>
 #include <netinet/in.h>
 #include <poll.h>
@@ -25,8 +26,11 @@
 #include <thread>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "bench/bench_registry.h"
 #include "core/log.h"
+#include "pipeline/transitions/transition_jumps.h"  // Quantile
 #include "station/control_server.h"
 #include "station/station.h"
 #include "station/station_host.h"
@@ -147,12 +151,6 @@ class SlowHeaders {
   std::thread thread_;
 };
 
-double Percentile(std::vector<double> v, double q) {
-  if (v.empty()) return 0;
-  std::sort(v.begin(), v.end());
-  return v[std::min(v.size() - 1, static_cast<size_t>(q * static_cast<double>(v.size())))];
-}
-
 void Polls(benchmark::State& state, bool attack) {
   rlimit files{};
   ::getrlimit(RLIMIT_NOFILE, &files);
@@ -208,12 +206,20 @@ void Polls(benchmark::State& state, bool attack) {
     }
     state.counters["polls"] = static_cast<double>(ms.size() + static_cast<size_t>(failed));
     state.counters["polls_failed"] = failed;
-    state.counters["p50_ms"] = Percentile(ms, 0.50);
-    state.counters["p99_ms"] = Percentile(ms, 0.99);
+    state.counters["p50_ms"] = Quantile(ms, 0.50).value_or(0);
+    state.counters["p99_ms"] = Quantile(ms, 0.99).value_or(0);
     state.counters["max_ms"] = ms.empty() ? 0 : *std::max_element(ms.begin(), ms.end());
     if (attacker) {
       state.counters["attack_connections"] = static_cast<double>(attacker->opened());
       state.counters["attack_refused"] = static_cast<double>(attacker->refused());
+      // The server's own count: connections it served at the end, and refused over the run.
+      if (const auto r = poll.Get("/api/status"); r && r->status == 200) {
+        const auto control = nlohmann::json::parse(r->body, nullptr, false)["control"];
+        if (control.is_object()) {
+          state.counters["server_open"] = control.value("connections_open", 0.0);
+          state.counters["server_refused"] = control.value("connections_refused", 0.0);
+        }
+      }
     }
     attacker.reset();
     control.Stop();
@@ -226,9 +232,7 @@ void Polls(benchmark::State& state, bool attack) {
 int Run(const std::vector<std::string>& args) {
   std::vector<std::string> pass;
   for (const std::string& a : args) {
-    const size_t eq = a.find('=');
-    const std::string key = a.substr(0, eq);
-    const std::string value = eq == std::string::npos ? "" : a.substr(eq + 1);
+    const auto [key, value] = OptionNameValue(a);
     if (key == "--connections") {
       g_args.connections = std::max(1, std::stoi(value));
     } else if (key == "--addresses") {

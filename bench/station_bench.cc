@@ -302,9 +302,7 @@ void Live(benchmark::State& state, bool from_memory, int preview_streams) {
 int Run(const std::vector<std::string>& args) {
   std::vector<std::string> pass;
   for (const std::string& a : args) {
-    const size_t eq = a.find('=');
-    const std::string key = a.substr(0, eq);
-    const std::string value = eq == std::string::npos ? "" : a.substr(eq + 1);
+    const auto [key, value] = OptionNameValue(a);
     if (key == "--cameras") {
       g_args.cameras = std::stoi(value);
     } else if (key == "--size") {

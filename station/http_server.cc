@@ -243,9 +243,10 @@ class ConnectionStream final : public httplib::Stream {
 };
 
 thread_local const ConnectionStream* t_stream = nullptr;  // the connection this thread serves
-// Set by CountApart on the thread serving a connection: its slot is released already.
+// The connection this thread serves, as counted (null: none); CountApart releases it early.
+thread_local HttpServer* t_server = nullptr;
+thread_local const std::string* t_address = nullptr;
 thread_local bool t_counted_apart = false;
-thread_local std::function<void()> t_release;  // releases the served connection's slot
 
 // Closes a connection after its last answer. What the client sent and the server did not read
 // (the rest of a refused request) is read and dropped first, so that the close sends FIN rather
@@ -386,8 +387,8 @@ std::string HttpServer::Admit(const std::string& address) {
 }
 
 void HttpServer::CountApart() {
-  if (!t_release || t_counted_apart) return;
-  t_release();
+  if (t_server == nullptr || t_counted_apart) return;
+  t_server->Release(*t_address);
   t_counted_apart = true;
 }
 
@@ -407,8 +408,9 @@ bool HttpServer::process_and_close_socket(socket_t sock) {
     Refuse(sock, refused);
     return false;
   }
+  t_server = this;
+  t_address = &address;
   t_counted_apart = false;
-  t_release = [this, &address] { Release(address); };
   ConnectionStream stream(
       sock, svr_sock_,
       std::chrono::seconds(read_timeout_sec_) + std::chrono::microseconds(read_timeout_usec_),
@@ -440,7 +442,8 @@ bool HttpServer::process_and_close_socket(socket_t sock) {
   t_stream = nullptr;
   Close(sock, refused);
   if (!t_counted_apart) Release(address);
-  t_release = nullptr;
+  t_server = nullptr;
+  t_address = nullptr;
   t_counted_apart = false;
   return ret;
 }

@@ -144,6 +144,13 @@ std::string Edit(const std::string& from, const std::string& to) {
   return yaml.replace(at, from.size(), to);
 }
 
+// How many of the scene's terms are of `kind`.
+int TermsOfKind(const Scene& scene, const std::string& kind) {
+  int n = 0;
+  for (int k = 0; k < scene.problem().num_terms(); ++k) n += scene.problem().term(k).kind() == kind;
+  return n;
+}
+
 // Issue 33: the loiter's hamster replayed a few frames to hold its place (stutter 6-7 %).
 TEST_F(SpecTest, RepeatsCostAFrameShownAgainWithinTheWindow) {
   const std::string fast = "fast_frames: {reference_speed_m_s: 1.0, strength: 0.5}";
@@ -153,11 +160,7 @@ TEST_F(SpecTest, RepeatsCostAFrameShownAgainWithinTheWindow) {
   EXPECT_EQ(spec.repeats.window_steps, 10);
   EXPECT_EQ(spec.repeats.still_tag, "still");
   EXPECT_EQ(ParseAnimationSpec(kGood, Origin()).repeats.strength, 0);  // off unless set
-  const auto scene = Scene::Load(spec);
-  int repeats = 0;
-  for (int k = 0; k < scene->problem().num_terms(); ++k)
-    repeats += scene->problem().term(k).kind() == "repeat";
-  EXPECT_EQ(repeats, 2);  // one a sprite
+  EXPECT_EQ(TermsOfKind(*Scene::Load(spec), "repeat"), 2);             // one a sprite
   const std::string o = Origin();
   EXPECT_EQ(ErrorOf(Edit(fast, "repeats: {strength: -1}")),
             o + ":6: repeats.strength: must be >= 0");
@@ -175,11 +178,7 @@ TEST_F(SpecTest, ClonesCostTwoSpritesShowingAFrameTogether) {
   EXPECT_EQ(spec.clones.strength, 4);
   EXPECT_EQ(spec.clones.lag_steps, 3);
   EXPECT_EQ(ParseAnimationSpec(kGood, Origin()).clones.strength, 0);  // off unless set
-  const auto scene = Scene::Load(spec);
-  int clones = 0;
-  for (int k = 0; k < scene->problem().num_terms(); ++k)
-    clones += scene->problem().term(k).kind() == "clone";
-  EXPECT_EQ(clones, 1);  // one a pair
+  EXPECT_EQ(TermsOfKind(*Scene::Load(spec), "clone"), 1);             // one a pair
   EXPECT_EQ(ErrorOf(Edit(fast, "clones: {strength: 1, lag_steps: 101}")),
             Origin() + ":6: clones.lag_steps: must be 0..100 steps, got 101");
 }
