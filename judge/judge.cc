@@ -246,13 +246,16 @@ StutterFigures MeasureStutter(const std::vector<SpriteSequence>& sprites, int wi
   out.window_steps = window_steps;
   for (const SpriteSequence& s : sprites) {
     const int n = static_cast<int>(s.frames.size());
+    std::set<std::pair<int, int64_t>> shown;
     for (int t = 0; t < n; ++t) {
       const BankFrameRef& f = s.frames[t];
       ++out.steps;
+      const bool seen = !shown.insert({f.bank, f.sprite_id}).second;
       if (is_still(f)) {
         ++out.still_steps;
         continue;
       }
+      if (seen) ++out.replayed;
       for (int u = std::max(0, t - window_steps); u < t; ++u) {
         if (s.frames[u].bank == f.bank && s.frames[u].sprite_id == f.sprite_id) {
           ++out.repeats;
@@ -263,6 +266,7 @@ StutterFigures MeasureStutter(const std::vector<SpriteSequence>& sprites, int wi
   }
   const int counted = out.steps - out.still_steps;
   out.share = counted > 0 ? static_cast<double>(out.repeats) / counted : 0.0;
+  out.replayed_share = counted > 0 ? static_cast<double>(out.replayed) / counted : 0.0;
   return out;
 }
 

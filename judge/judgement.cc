@@ -77,7 +77,9 @@ json JudgementJson(const Judgement& j) {
                     {"steps", s.steps},
                     {"still_steps", s.still_steps},
                     {"repeats", s.repeats},
-                    {"share", s.share}};
+                    {"share", s.share},
+                    {"replayed", s.replayed},
+                    {"replayed_share", s.replayed_share}};
   const CloneFigures& c = j.clones;
   out["clones"] = {{"lag_steps", c.lag_steps},
                    {"steps", c.steps},
@@ -145,6 +147,11 @@ std::string JudgementReport(const Judgement& j) {
   add("  stutter     %.1f %% (%d of %d steps show a frame of the %d before; %d still steps not "
       "counted)\n",
       100 * s.share, s.repeats, s.steps - s.still_steps, s.window_steps, s.still_steps);
+  if (s.replayed > 0) {
+    add("  replayed    %.1f %% (%d steps show a frame shown earlier, past the stutter's window "
+        "too: loops)\n",
+        100 * s.replayed_share, s.replayed);
+  }
   if (j.clones.steps > 0 && j.clones.cloned_steps > 0) {
     add("  clones      %.1f %% (%d of %d steps show a frame another sprite shows within %d "
         "steps; %d sprites mostly copies)\n",

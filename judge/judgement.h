@@ -57,6 +57,10 @@ struct StutterFigures {
   int still_steps = 0;  // of them, showing a frame tagged still (not counted)
   int repeats = 0;      // counted steps showing a frame shown in the window before
   double share = 0;     // repeats / (steps - still_steps)
+  // Loops past the window: counted steps showing a frame the sprite showed at any step before
+  // (a stride played again), and their share; a viewer may see the same motion come round.
+  int replayed = 0;
+  double replayed_share = 0;
 };
 
 // Sprites that move as one: a step is a clone step when another sprite shows the same bank

@@ -56,11 +56,32 @@ TEST_F(JudgeTest, StutterIsTheShareOfStepsRepeatingAFrameOfTheWindow) {
   EXPECT_EQ(j.stutter.repeats, 3);
   EXPECT_DOUBLE_EQ(j.stutter.share, 3.0 / 8);
   EXPECT_FALSE(j.jumps.measured);
-  // Within 2 steps nothing repeats: each frame came back 3 steps later.
+  EXPECT_EQ(j.stutter.replayed, 3);
+  // Within 2 steps nothing repeats: each frame came back 3 steps later. That is still a loop
+  // played again, whatever the window.
   options.stutter_window_steps = 2;
   j = JudgeSequences(file_, file_.bank_paths, nullptr, options);
   EXPECT_EQ(j.stutter.repeats, 0);
   EXPECT_DOUBLE_EQ(j.stutter.share, 0.0);
+  EXPECT_EQ(j.stutter.replayed, 3);
+  EXPECT_DOUBLE_EQ(j.stutter.replayed_share, 3.0 / 8);
+}
+
+TEST_F(JudgeTest, ReplayedCountsALoopPastTheStutterWindow) {
+  // A stride of 4 frames played three times (A0-A3 thrice, then A4): no step repeats a frame of
+  // the 2 before, but 8 of 13 steps show a frame shown earlier; a second sprite's frames are its
+  // own (B0-B2 are not replays of anything).
+  file_.sprites = {Sequence("a", A({0, 1, 2, 3, 0, 1, 2, 3, 0, 1, 2, 3, 4}), {}),
+                   Sequence("b", B({0, 1, 2}), {})};
+  JudgeOptions options;
+  options.jumps = false;
+  options.stutter_window_steps = 2;
+  const Judgement j = JudgeSequences(file_, file_.bank_paths, nullptr, options);
+  EXPECT_EQ(j.stutter.repeats, 0);
+  EXPECT_EQ(j.stutter.replayed, 8);
+  EXPECT_DOUBLE_EQ(j.stutter.replayed_share, 8.0 / 16);
+  EXPECT_NE(JudgementReport(j).find("replayed    50.0 % (8 steps"), std::string::npos)
+      << JudgementReport(j);
 }
 
 TEST_F(JudgeTest, StutterLeavesOutFramesTaggedStill) {
@@ -72,6 +93,7 @@ TEST_F(JudgeTest, StutterLeavesOutFramesTaggedStill) {
   EXPECT_EQ(j.stutter.still_steps, 4);
   EXPECT_EQ(j.stutter.repeats, 1);
   EXPECT_DOUBLE_EQ(j.stutter.share, 1.0 / 3);
+  EXPECT_EQ(j.stutter.replayed, 1);  // C5 again; the still frames held on purpose are not loops
   // Without the still tag every repeat counts: steps 2, 3 and 6 of 7.
   options.still_tags = {};
   j = JudgeSequences(file_, file_.bank_paths, nullptr, options);
