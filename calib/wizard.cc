@@ -71,6 +71,8 @@ bool WizardOptions::IsValid(std::string* why) const {
         "expected at least 1 frame, got " + std::to_string(floor_still_frames));
   check(std::isfinite(floor_still_s) && floor_still_s >= 0, "floor_still_s",
         "expected seconds >= 0, got " + OptionProblems::Num(floor_still_s));
+  check(std::isnan(still_s) || (std::isfinite(still_s) && still_s >= 0), "still_s",
+        "expected seconds >= 0 (or none), got " + OptionProblems::Num(still_s));
   check.Nested(ground_checks.IsValid(&part), "ground_checks.", part);
   return check.ok();
 }
@@ -513,10 +515,13 @@ WizardFrame CalibrationWizard::Feed(const cv::Mat& image, int frame, double time
   } else if (!run_.empty() && SameIds(run_.back(), view) &&
              MaxMotion(run_.back(), view) < o_.still_px) {
     run_.push_back(view);
+    run_step_s_ = time_s - run_last_s_;
+    run_last_s_ = time_s;
   } else {
     run_ = {view};
     run_used_ = false;
-    run_start_s_ = time_s;
+    run_start_s_ = run_last_s_ = time_s;
+    run_step_s_ = NAN;
   }
   out.still = run_.size() >= 2;
 
@@ -524,7 +529,10 @@ WizardFrame CalibrationWizard::Feed(const cv::Mat& image, int frame, double time
   if (step_ == WizardStep::kIntrinsics) {
     if (!view.accepted) {
       now.push_back("show the board to the camera (" + view.rejection + ")");
-    } else if (static_cast<int>(run_.size()) < o_.still_frames) {
+    } else if (static_cast<int>(run_.size()) < o_.still_frames ||
+               // the time the run's frames cover, the last one's included (n frames at a
+               // steady rate: n / rate), to a microsecond; NaN without timestamps: the count
+               time_s - run_start_s_ + run_step_s_ < o_.still_s - 1e-6) {
       now.push_back("hold the board still");
     } else if (!o_.auto_solve && views() >= o_.max_views) {
       now.push_back("enough views (" + std::to_string(views()) + "): solve, or drop the worst");

@@ -75,8 +75,13 @@ struct WizardOptions {
   VerdictOptions
       verdict;  // min_views, min_coverage, min_tilt_deg, max_rms_px: when to stop, what to trust
   SolveOptions solve;
-  double still_px = 0.5;    // largest corner motion between two frames of a still board
-  int still_frames = 2;     // intrinsics: frames in a row the board must be still for a capture
+  double still_px = 0.5;  // largest corner motion between two frames of a still board
+  int still_frames = 2;   // intrinsics: frames in a row the board must be still for a capture
+  // Intrinsics: and still this long by the frames' timestamps, the last frame's interval
+  // included (n frames at a steady rate cover n / rate s, as a count from the true rate did);
+  // NaN: the count alone, as for frames fed without a timestamp. A count of frames from a rate
+  // measured or guessed would depend on that rate.
+  double still_s = NAN;
   double min_shift = 0.08;  // a new view differs from every captured one: its centre moved this
                             // fraction of the image diagonal, ...
   double min_tilt_change_deg = 10;  // ... or its tilt changed this much, ...
@@ -216,6 +221,8 @@ class CalibrationWizard {
   std::vector<BoardView> run_;  // consecutive still detections ending at the last frame
   bool run_used_ = false;       // the current still run was captured already
   double run_start_s_ = NAN;    // the timestamp of the still run's first frame
+  double run_last_s_ = NAN;     // ... of its last frame
+  double run_step_s_ = NAN;     // between its last two frames (NaN: one frame)
   bool word_ = false;           // the operator said the board lies on the floor
   std::optional<GroundCheck> ground_check_;
   int empty_frames_ = 0;          // enclosure: frames in a row without a board

@@ -151,13 +151,9 @@ struct WizardSettings {
 // One camera's wizard, on a thread of its own.
 class CameraWork {
  public:
-  CameraWork(std::string name, int index, const WizardSettings& settings, double fps_hint,
+  CameraWork(std::string name, int index, const WizardSettings& settings,
              std::atomic<uint64_t>* floor_counter)
-      : name_(std::move(name)),
-        index_(index),
-        settings_(settings),
-        fps_hint_(fps_hint),
-        floor_counter_(floor_counter) {
+      : name_(std::move(name)), index_(index), settings_(settings), floor_counter_(floor_counter) {
     settings_.options.solve.progress = [this](const std::string& stage, double fraction) {
       SetBusy(stage, fraction);
     };
@@ -291,10 +287,12 @@ class CameraWork {
       ToBgr(frame, bgr_);
       if (!wizard_) {
         calib::WizardOptions o = settings_.options;
-        const double fps = fps_hint_ > 0 ? fps_hint_ : 30.0;
-        o.still_frames = std::max(2, static_cast<int>(std::lround(settings_.still_s * fps)));
-        // The floor board's still span by the frames' timestamps (frames dropped under load
-        // do not make it longer), after the operator's word that it lies on the floor.
+        // Both still spans by the frames' timestamps (issue 41): the view's was a count of
+        // frames from the camera's measured rate, or 30 fps before one was measured, so a
+        // slower camera's board had to stand still several times longer. The floor board's
+        // after the operator's word that it lies on the floor.
+        o.still_frames = 2;
+        o.still_s = settings_.still_s;
         o.floor_still_s = settings_.floor_still_s;
         o.floor_needs_word = true;
         wizard_ = std::make_unique<calib::CalibrationWizard>(name_, bgr_.cols, bgr_.rows, o);
@@ -546,7 +544,6 @@ class CameraWork {
   const std::string name_;
   const int index_;
   WizardSettings settings_;
-  const double fps_hint_;
   std::atomic<uint64_t>* floor_counter_;
 
   std::mutex queue_mutex_;
@@ -792,16 +789,11 @@ struct ConsoleCalibration::Impl {
     for (size_t i = 0; i < names.size(); ++i) {
       WizardSettings s = settings;
       s.options.intrinsics = current[i];
-      double fps = 0;
       int index = 0;
       for (size_t k = 0; k < status.cameras.size(); ++k) {
-        if (status.cameras[k].name == names[i])
-          fps = status.cameras[k].fps, index = static_cast<int>(k);
+        if (status.cameras[k].name == names[i]) index = static_cast<int>(k);
       }
-      for (const auto& c : config.cameras) {
-        if (c.name == names[i] && fps <= 0 && c.fps > 0) fps = c.fps;
-      }
-      works.push_back(std::make_shared<CameraWork>(names[i], index, s, fps, &floor_counter));
+      works.push_back(std::make_shared<CameraWork>(names[i], index, s, &floor_counter));
     }
     active = true;
     board = o.board.ToString();

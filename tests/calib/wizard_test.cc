@@ -100,6 +100,43 @@ TEST(CalibrationWizard, CapturesAStillBoardOnceAndOnlyANewViewAgain) {
   EXPECT_NE(w.verdicts()[0].find("too few views"), std::string::npos) << w.verdicts()[0];
 }
 
+// The board's still span for a capture is the frames' timestamps' when still_s is given: the
+// time its frames cover, n / rate at a steady rate. 0.2 s is 2 frames at 5 fps (at least
+// still_frames), 10 at 50 fps; a count of frames from a rate guessed (30 fps: 6 frames) held a
+// 5 fps camera's board 1.2 s.
+TEST(CalibrationWizard, TheStillSpanForACaptureIsMeasuredByTimestamps) {
+  const BoardStudio board_studio(7, 320, 240);
+  const Rigid3 a =
+      CamFromBoardInView(board_studio.cam, board_studio.spec, -0.4, -0.3, 0.5, 0.4, 0.1, 0.05);
+  const cv::Mat image = RenderBoards(
+      board_studio.renderer,
+      {{&board_studio.texture, board_studio.cam.cam_from_ground.Inverse() * a}}, 1.0, 0);
+  WizardOptions o = Options(ToCalibBoard(board_studio.spec));
+  o.still_frames = 2;
+  o.still_s = 0.2;
+  // The frame (from 0) at which a board held still at `fps` is first captured; -1: never.
+  auto captured_at = [&](double fps) {
+    CalibrationWizard w("cam0", 320, 240, o);
+    for (int n = 0; n < 30; ++n) {
+      if (w.Feed(image, n, n / fps).captured) return n;
+    }
+    return -1;
+  };
+  EXPECT_EQ(captured_at(5.0), 1);   // frames 0 and 1: 0.4 s
+  EXPECT_EQ(captured_at(50.0), 9);  // frames 0-9: 0.2 s
+  EXPECT_EQ(captured_at(30.0), 5);  // frames 0-5, as the count from the rate (0.2 x 30)
+  // Without timestamps the count alone decides, as before.
+  CalibrationWizard w("cam0", 320, 240, o);
+  int at = -1;
+  for (int n = 0; n < 30 && at < 0; ++n) {
+    if (w.Feed(image, n).captured) at = n;
+  }
+  EXPECT_EQ(at, 1);
+  // A still span below zero is refused by name.
+  o.still_s = -1;
+  EXPECT_THROW(CalibrationWizard("cam0", 320, 240, o), InputError);
+}
+
 // The enclosure step waits for the empty floor. A frame without the board is not enough: a
 // person (here a dark block across the floor) hides part of it, and the floor found then is
 // smaller than with the board lying on it, so the wizard keeps waiting.
