@@ -202,8 +202,9 @@ async function fakecam() {
 }
 
 // Until the station's camera delivers again (a restarted fakecam is reopened with backoff)
-// at its rate: the wizard turns its still times into frame counts with the rate the station
-// measures when it starts, which is off for a moment after a reopen.
+// at its rate, so that the wizard starts on a steady stream. (Its still times once were frame
+// counts at the rate measured when it started, off for a moment after a reopen; they are now
+// timed by the frames' timestamps.)
 async function stationLive() {
   let steady = 0;
   await h.waitFor(`cam0 live in the station at ${FPS} fps`, async () => {
