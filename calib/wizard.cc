@@ -484,6 +484,11 @@ std::optional<CameraModel> CalibrationWizard::posed_model() const {
   return m;
 }
 
+double CalibrationWizard::StillRunCovers(double time_s) const {
+  const double n = static_cast<double>(run_.size());
+  return n < 2 ? NAN : (time_s - run_start_s_) * n / (n - 1);
+}
+
 WizardFrame CalibrationWizard::Feed(const cv::Mat& image, int frame, double time_s) {
   WizardFrame out;
   out.step = step_;
@@ -515,13 +520,10 @@ WizardFrame CalibrationWizard::Feed(const cv::Mat& image, int frame, double time
   } else if (!run_.empty() && SameIds(run_.back(), view) &&
              MaxMotion(run_.back(), view) < o_.still_px) {
     run_.push_back(view);
-    run_step_s_ = time_s - run_last_s_;
-    run_last_s_ = time_s;
   } else {
     run_ = {view};
     run_used_ = false;
-    run_start_s_ = run_last_s_ = time_s;
-    run_step_s_ = NAN;
+    run_start_s_ = time_s;
   }
   out.still = run_.size() >= 2;
 
@@ -530,9 +532,7 @@ WizardFrame CalibrationWizard::Feed(const cv::Mat& image, int frame, double time
     if (!view.accepted) {
       now.push_back("show the board to the camera (" + view.rejection + ")");
     } else if (static_cast<int>(run_.size()) < o_.still_frames ||
-               // the time the run's frames cover, the last one's included (n frames at a
-               // steady rate: n / rate), to a microsecond; NaN without timestamps: the count
-               time_s - run_start_s_ + run_step_s_ < o_.still_s - 1e-6) {
+               StillRunCovers(time_s) < o_.still_s - 1e-6) {  // to a microsecond
       now.push_back("hold the board still");
     } else if (!o_.auto_solve && views() >= o_.max_views) {
       now.push_back("enough views (" + std::to_string(views()) + "): solve, or drop the worst");

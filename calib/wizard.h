@@ -211,6 +211,11 @@ class CalibrationWizard {
   // A frame without the board: its green floor becomes the enclosure if nothing hides it.
   void TryEmptyFloor(const cv::Mat& image, int frame);
   double Focal() const;
+  // Seconds the still run's frames cover up to `time_s`, its last frame's share included: its
+  // first-to-last span x n / (n - 1), which is n / rate at a steady rate (the count from the true
+  // rate it replaces). NaN for one frame or without timestamps. (The floor's still span is the
+  // first-to-last span alone: floor_still_frames bound it too.)
+  double StillRunCovers(double time_s) const;
   // The floor board's pose checked (GroundChecks) against the frame and the still run.
   GroundCheck CheckGround(const GroundResult& ground, const cv::Mat& image, int frame) const;
 
@@ -221,8 +226,6 @@ class CalibrationWizard {
   std::vector<BoardView> run_;  // consecutive still detections ending at the last frame
   bool run_used_ = false;       // the current still run was captured already
   double run_start_s_ = NAN;    // the timestamp of the still run's first frame
-  double run_last_s_ = NAN;     // ... of its last frame
-  double run_step_s_ = NAN;     // between its last two frames (NaN: one frame)
   bool word_ = false;           // the operator said the board lies on the floor
   std::optional<GroundCheck> ground_check_;
   int empty_frames_ = 0;          // enclosure: frames in a row without a board

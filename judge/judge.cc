@@ -246,22 +246,21 @@ StutterFigures MeasureStutter(const std::vector<SpriteSequence>& sprites, int wi
   out.window_steps = window_steps;
   for (const SpriteSequence& s : sprites) {
     const int n = static_cast<int>(s.frames.size());
-    std::set<std::pair<int, int64_t>> shown;
+    // Each frame's last step: shown before at all (replayed), and within the window (repeats).
+    std::map<std::pair<int, int64_t>, int> last_shown;
     for (int t = 0; t < n; ++t) {
       const BankFrameRef& f = s.frames[t];
       ++out.steps;
-      const bool seen = !shown.insert({f.bank, f.sprite_id}).second;
+      const auto [it, first] = last_shown.try_emplace({f.bank, f.sprite_id}, t);
+      const int before = it->second;
+      it->second = t;
       if (is_still(f)) {
         ++out.still_steps;
         continue;
       }
-      if (seen) ++out.replayed;
-      for (int u = std::max(0, t - window_steps); u < t; ++u) {
-        if (s.frames[u].bank == f.bank && s.frames[u].sprite_id == f.sprite_id) {
-          ++out.repeats;
-          break;
-        }
-      }
+      if (first) continue;
+      ++out.replayed;
+      if (t - before <= window_steps) ++out.repeats;
     }
   }
   const int counted = out.steps - out.still_steps;
