@@ -19,6 +19,7 @@
 #include "core/error_kinds.h"
 #include "core/log.h"
 #include "core/option_checks.h"
+#include "core/posix.h"
 #include "core/utc_time.h"
 #include "pipeline/transitions/bank_sprites.h"
 #include "pipeline/transitions/bank_training.h"
@@ -491,6 +492,7 @@ void ConsoleLabels::WaitRetrain() {
 void ConsoleLabels::RunRetrain(std::shared_ptr<Shared> shared, api::Context context,
                                const ConsoleLabelsOptions& options, const std::string& bank,
                                const TransitionWeights& current) {
+  SetThisThreadNice(kNiceBackground);  // below capture and the console (core/posix.h)
   auto log = Log("station.labels");
   auto SetRetrain = [&](const std::function<void(nlohmann::json&)>& change) {
     std::lock_guard lock(shared->mutex);

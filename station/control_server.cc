@@ -1,9 +1,5 @@
 #include "station/control_server.h"
 
-#include <sys/resource.h>
-#include <sys/syscall.h>
-#include <unistd.h>
-
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
@@ -19,6 +15,7 @@
 #include "core/error_kinds.h"
 #include "core/log.h"
 #include "core/option_checks.h"
+#include "core/posix.h"
 #include "station/api_part.h"
 #include "station/console_bank.h"
 #include "station/console_calibration.h"
@@ -42,17 +39,15 @@ using api::Route;
 using httplib::Request;
 using httplib::Response;
 
-constexpr int kHttpNice = 10;  // HTTP threads yield the cores to capture and the pipeline
-
-// HTTP worker threads run at a lower priority than every other thread of the daemon:
-// a preview encode or a bank page never takes a core from capture.
+// HTTP worker threads run below capture and keying (core/posix.h): a preview encode or a
+// bank page never takes a core from capture; background bank work runs below them.
 class NiceThreadPool : public httplib::TaskQueue {
  public:
   explicit NiceThreadPool(size_t n) : pool_(n) {}
   void enqueue(std::function<void()> fn) override {
     pool_.enqueue([fn = std::move(fn)] {
       thread_local const bool niced = [] {
-        setpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid)), kHttpNice);
+        SetThisThreadNice(kNiceHttp);
         return true;
       }();
       (void)niced;

@@ -8,6 +8,7 @@
 #include "core/bank.h"
 #include "core/error.h"
 #include "core/log.h"
+#include "core/posix.h"
 #include "core/sql_postgres.h"
 #include "pipeline/transitions/bank_sprites.h"
 #include "pipeline/transitions/bank_transitions.h"
@@ -95,6 +96,7 @@ void TransitionWorker::Fail(const std::string& what) {
 }
 
 void TransitionWorker::Run() {
+  SetThisThreadNice(kNiceBackground);  // below capture and the console (core/posix.h)
   if (sql::IsPostgresAddress(bank_path_)) return RunUnits();
   auto log = Log("pipeline.transitions");
   State& s = *state_;
