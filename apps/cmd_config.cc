@@ -50,6 +50,9 @@ void Check(const std::string& path, bool json, bool check_files) {
   // What the daemon would lack to store sprites (it starts all the same; station/station.h).
   const std::vector<std::string> gaps =
       check_files ? CalibrationGaps(config) : std::vector<std::string>{};
+  // The cameras that would key sprites and keep none (an upright billboard from above).
+  const std::vector<std::string> steep =
+      check_files ? SteepViews(config) : std::vector<std::string>{};
   // What the daemon refuses at start although the file is valid (no cameras: a file for
   // `ingest --config`, which takes the session's), in the daemon's words.
   std::vector<std::string> daemon_refuses;
@@ -64,6 +67,7 @@ void Check(const std::string& path, bool json, bool check_files) {
                         {"adjustments", report.adjustments},
                         {"errors", report.errors},
                         {"to_calibrate", gaps},
+                        {"too_steep", steep},
                         {"daemon_refuses", daemon_refuses},
                         {"cameras", config.cameras.size()}};
     std::printf("%s\n", j.dump(2).c_str());
@@ -74,6 +78,7 @@ void Check(const std::string& path, bool json, bool check_files) {
   for (const auto& a : report.adjustments) std::printf("  adjusted: %s\n", a.c_str());
   for (const auto& d : daemon_refuses) std::printf("  the daemon refuses it: %s\n", d.c_str());
   for (const auto& g : gaps) std::printf("  to calibrate: %s\n", g.c_str());
+  for (const auto& v : steep) std::printf("  too steep: %s\n", v.c_str());
   if (!gaps.empty()) {
     std::printf(
         "  (the station starts and streams; what lacks these stores no sprites until the "

@@ -210,6 +210,8 @@ OptionsBinder PipelineKeys(CameraPipelineOptions& p) {
            "floor pixels required around the silhouette")
       .Add("wall_margin_m", &p.usability.wall_margin_m, "a distance in metres",
            "contact point distance to keep from the walls")
+      .Add("max_view_angle_deg", &p.usability.max_view_angle_deg, "an angle in degrees",
+           "steeper views of a contact point are refused (view_too_steep)")
       .Add("still_speed_m_per_s", &p.still_speed_m_per_s, "a speed in m/s",
            "slower counts as not moving")
       .Add("max_speed_m_per_s", &p.track.max_speed_m_per_s, "a speed in m/s",

@@ -240,6 +240,7 @@ class Validator {
                                      {"usability.border_margin_px", "border_margin_px"},
                                      {"usability.floor_margin_px", "floor_margin_px"},
                                      {"usability.wall_margin_m", "wall_margin_m"},
+                                     {"usability.max_view_angle_deg", "max_view_angle_deg"},
                                      {"still_speed_m_per_s", "still_speed_m_per_s"},
                                      {"track.max_speed_m_per_s", "max_speed_m_per_s"},
                                      {"max_still_s", "max_still_s"},

@@ -21,6 +21,7 @@
 #include "core/log.h"
 #include "core/option_checks.h"
 #include "core/sql_postgres.h"
+#include "pipeline/filter/usability.h"
 #include "pipeline/run/bank_scale.h"
 #include "pipeline/run/bounded_queue.h"
 #include "pipeline/run/ingest.h"
@@ -76,6 +77,31 @@ std::vector<std::string> CalibrationGaps(const StationConfig& config) {
   }
   if (StationFloor(config).empty()) gaps.push_back("enclosure.floor: no floor polygon");
   return gaps;
+}
+
+std::vector<std::string> SteepViews(const StationConfig& config) {
+  std::vector<std::string> steep;
+  const GroundPolygon floor = StationFloor(config);
+  if (floor.empty()) return steep;
+  const double limit = config.pipeline.usability.max_view_angle_deg;
+  for (const CameraConfig& c : config.cameras) {
+    std::optional<CameraModel> model;
+    try {
+      model = ModelForCamera(c);
+    } catch (const std::exception&) {
+      continue;  // a gap, named by CalibrationGaps
+    }
+    if (!model) continue;
+    const double shallowest =
+        FloorMask(*model, floor, config.pipeline.usability).shallowest_view_deg();
+    if (shallowest > limit) {
+      steep.push_back(c.name + ": sees all of its floor from " +
+                      std::to_string(static_cast<int>(std::floor(shallowest))) +
+                      " degrees or more above it, steeper than pipeline.max_view_angle_deg " +
+                      OptionProblems::Num(limit) + ": every sprite would be view_too_steep");
+    }
+  }
+  return steep;
 }
 
 bool StationOptions::IsValid(std::string* why) const {

@@ -44,6 +44,11 @@ GroundPolygon StationFloor(const StationConfig& config);
 // them. Camera model files that cannot be read count as missing.
 std::vector<std::string> CalibrationGaps(const StationConfig& config);
 
+// The cameras that see all of their floor from further above than pipeline.max_view_angle_deg,
+// one line each ("cam0: sees all of its floor from 84 degrees ..."): every sprite they key is
+// refused as view_too_steep (docs/pipeline.md). Cameras without a model or floor are left out.
+std::vector<std::string> SteepViews(const StationConfig& config);
+
 // What the station refuses to start on although the file is well formed (no camera at all):
 // throws InputError naming the field. The daemon calls it at start and `config check` before
 // it says valid, so both say the same words. (`ingest --config` may leave the cameras out: it

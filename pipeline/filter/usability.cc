@@ -1,6 +1,9 @@
 #include "pipeline/filter/usability.h"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
+#include <numbers>
 
 #include <opencv2/core/utility.hpp>
 #include <opencv2/imgproc.hpp>
@@ -26,6 +29,10 @@ bool UsabilityOptions::IsValid(std::string* why) const {
         std::pair{wall_check_height_m, "wall_check_height_m"}}) {
     check(NonNegative(v), field, "expected a number >= 0, got " + OptionProblems::Num(v));
   }
+  check(std::isfinite(max_view_angle_deg) && max_view_angle_deg > 0 && max_view_angle_deg <= 90,
+        "max_view_angle_deg",
+        "expected an angle in degrees above 0 and at most 90 (90: no view is too steep), got " +
+            OptionProblems::Num(max_view_angle_deg));
   return check.ok();
 }
 
@@ -66,6 +73,8 @@ const char* DiscardName(Discard reason) {
       return "too_large";
     case Discard::kNoise:
       return "noise";
+    case Discard::kViewTooSteep:
+      return "view_too_steep";
     case Discard::kCount:
       break;
   }
@@ -169,6 +178,19 @@ FloorMask::FloorMask(const CameraModel& camera, const GroundPolygon& floor,
                       [this](const Eigen::Vector2d& p) { return floor_index_.Contains(p); });
   cv::integral(mask_ == 0, not_floor_integral_, CV_32S);
   not_floor_integral_ /= 255;
+  // The shallowest view: the floor pixel whose ray is nearest the horizontal.
+  double lowest_sin = std::numeric_limits<double>::quiet_NaN();
+  for (int j = 0; j < ray_rows_; ++j) {
+    for (int i = 0; i < ray_cols_; ++i) {
+      const int x = std::min(i * kRayGridStepPx, camera.width() - 1);
+      const int y = std::min(j * kRayGridStepPx, camera.height() - 1);
+      const Eigen::Vector3f& d = rays_[static_cast<size_t>(j) * ray_cols_ + i];
+      if (mask_.at<uint8_t>(y, x) == 0 || !d.allFinite()) continue;
+      const double s = -d.z() / d.norm();
+      if (!(s >= lowest_sin)) lowest_sin = s;  // the first, then each lower one
+    }
+  }
+  shallowest_view_deg_ = std::asin(lowest_sin) * 180 / std::numbers::pi;
 }
 
 bool FloorMask::SeesBehind(int x, int y, const Eigen::Vector2d& point_in_ground) const {
@@ -210,6 +232,19 @@ void FloorMask::Restrict(const cv::Mat& seen) {
 
 Discard FloorMask::Check(const cv::Mat& alpha_crop, cv::Point offset,
                          const Eigen::Vector2d& point_in_ground) const {
+  const Discard floor = CheckFloor(alpha_crop, offset, point_in_ground);
+  if (floor != Discard::kNone) return floor;
+  return ViewAngleDeg(point_in_ground) > options_.max_view_angle_deg ? Discard::kViewTooSteep
+                                                                     : Discard::kNone;
+}
+
+double FloorMask::ViewAngleDeg(const Eigen::Vector2d& point_in_ground) const {
+  return std::atan2(centre_.z(), (point_in_ground - centre_.head<2>()).norm()) * 180 /
+         std::numbers::pi;
+}
+
+Discard FloorMask::CheckFloor(const cv::Mat& alpha_crop, cv::Point offset,
+                              const Eigen::Vector2d& point_in_ground) const {
   const cv::Rect box(offset, alpha_crop.size());
   const int b = options_.border_margin_px;
   if (box.x < b || box.y < b || box.x + box.width > mask_.cols - b ||

@@ -29,6 +29,7 @@ enum class Discard {
   kShortClip,      // its clip was too short to give transitions
   kTooLarge,       // its billboard at the bank's scale (pipeline.px_per_m) exceeds the size limit
   kNoise,  // keyed background, not a subject: scattered specks, thin lines, a soft haze (NoiseRule)
+  kViewTooSteep,  // seen from too far above for an upright billboard (max_view_angle_deg)
   kCount,
 };
 const char* DiscardName(Discard reason);  // "too_small", "touches_border", ...
@@ -47,6 +48,12 @@ struct UsabilityOptions {
   // something in front of it (what stands on the floor in front of a subject hides its lowest part
   // first).
   double wall_check_height_m = 0.3;
+  // The steepest view an upright billboard (seed 000) is kept from: the angle at the contact
+  // point between the floor and the ray to the camera (0: the camera at floor level, 90:
+  // straight above). From above, an upright billboard shows mostly the subject's top, stretched
+  // up: a body D deep stands D tan(angle) tall on it, a sliver at 89 degrees (issue 38). The
+  // reference sets are filmed at 43-60 (hamster) and 45-71 degrees (flies).
+  double max_view_angle_deg = 75.0;
   // False with "FIELD: reason" lines in `why` (core/option_checks.h) for values out of range.
   bool IsValid(std::string* why) const;
   bool operator==(const UsabilityOptions&) const = default;
@@ -117,10 +124,15 @@ class FloorMask {
   static constexpr int kRayGridStepPx = 8;
 
   FloorMask(const CameraModel& camera, const GroundPolygon& floor, const UsabilityOptions& options);
-  // Usability of one sprite from its alpha crop at `offset` and its contact point.
+  // Usability of one sprite from its alpha crop at `offset` and its contact point: the floor's
+  // tests, then the view's (view_too_steep).
   Discard Check(const cv::Mat& alpha_crop, cv::Point offset,
                 const Eigen::Vector2d& point_in_ground) const;
   const cv::Mat& mask() const { return mask_; }  // 255 where the camera sees floor
+  // The shallowest view of the camera's floor (UsabilityOptions::max_view_angle_deg's angle), in
+  // degrees, over the floor it sees (the geometric floor, every kRayGridStepPx); NaN when it sees
+  // none. Above the limit, no sprite of the camera can be kept.
+  double shallowest_view_deg() const { return shallowest_view_deg_; }
   // Keeps as floor only the pixels of the geometric floor where `seen` (CV_8U, the image size) is
   // non-zero: the keyer's green, so that a wall's outside or a cable in front of the floor is not
   // floor. A later call replaces the earlier restriction.
@@ -133,11 +145,17 @@ class FloorMask {
   Eigen::Vector3d centre_;             // the camera's centre on the ground frame
   std::vector<Eigen::Vector3f> rays_;  // ground-frame ray directions every kRayGridStepPx
   int ray_cols_ = 0, ray_rows_ = 0;
+  // The floor's tests alone: touches_border, leaves_floor, touches_wall.
+  Discard CheckFloor(const cv::Mat& alpha_crop, cv::Point offset,
+                     const Eigen::Vector2d& point_in_ground) const;
+  // The angle between the floor and the ray from a ground point to the camera, in degrees.
+  double ViewAngleDeg(const Eigen::Vector2d& point_in_ground) const;
   // The pixel sees past the floor, over the contact point higher than wall_check_height_m.
   bool SeesBehind(int x, int y, const Eigen::Vector2d& point_in_ground) const;
   cv::Mat mask_;
   cv::Mat geometric_;           // the floor polygon seen over the walls, before Restrict
   cv::Mat not_floor_integral_;  // integral image of (mask_ == 0), for O(1) box tests
+  double shallowest_view_deg_ = 0;
 };
 
 // Per subject: drops frames once the subject has been still for longer than allowed. A frame is

@@ -92,7 +92,17 @@ CameraPipeline::CameraPipeline(std::string name, int64_t camera_id, CameraModel 
       noise_(options.noise),
       rectifier_(options.rectify),
       batcher_(camera_id, options.batch),
-      log_(Log("pipeline.run")) {}
+      log_(Log("pipeline.run")) {
+  // A camera that sees all of its floor from too far above keeps nothing: say so once, up front.
+  const double shallowest = floor_mask_.shallowest_view_deg();
+  if (shallowest > options_.usability.max_view_angle_deg) {
+    log_->warn(
+        "{}: sees all of its floor from {:.0f} degrees or more above it, steeper than "
+        "pipeline.max_view_angle_deg {:.0f}: every sprite will be refused as view_too_steep (an "
+        "upright billboard seen from above is a sliver; docs/pipeline.md)",
+        name_, shallowest, options_.usability.max_view_angle_deg);
+  }
+}
 
 CameraPipeline::~CameraPipeline() = default;
 CameraPipeline::CameraPipeline(CameraPipeline&&) noexcept = default;

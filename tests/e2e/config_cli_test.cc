@@ -128,6 +128,43 @@ TEST(StationConfig, CheckRefusesWhatTheDaemonCannotRun) {
       << r.output;
 }
 
+// Issue 38: a camera straight above its floor keys sprites and keeps none (an upright billboard
+// from above is a sliver); `config check` names it, and keeps quiet for the oblique one.
+TEST(StationConfig, CheckNamesACameraThatSeesItsFloorOnlyFromAbove) {
+  if (!Environment("SPRITESTATION_BIN"))
+    GTEST_SKIP() << "SPRITESTATION_BIN not set (run through ctest)";
+  ScratchDir dir;
+  // 1 m above the ground's origin looking straight down (cam_from_ground: a half turn about x),
+  // and one 1 m up and 1 m back looking 45 degrees down at the origin.
+  const auto model = [&](const std::string& name, const std::string& extrinsics) {
+    std::ofstream(dir / name) << "{\n 'lensmodel': 'LENSMODEL_PINHOLE',\n 'intrinsics': [500, 500, "
+                                 "319.5, 239.5],\n 'extrinsics': ["
+                              << extrinsics << "],\n 'imagersize': [640, 480]\n}\n";
+  };
+  model("top.cameramodel", "3.141592653589793, 0, 0, 0, 0, 1");
+  model("side.cameramodel", "2.356194490192345, 0, 0, 0, 0, 1.4142135623730951");
+  const std::string config = dir / "station.yaml";
+  std::ofstream(config)
+      << "cameras:\n"
+         "  - {name: top, source: v4l2, device: /dev/video0, model: top.cameramodel}\n"
+         "  - {name: side, source: v4l2, device: /dev/video1, model: side.cameramodel}\n"
+         "enclosure:\n  floor: [[-0.1, -0.1], [0.1, -0.1], [0.1, 0.1], [-0.1, 0.1]]\n";
+  auto r = ss::testing::RunSpritestation("config check " + config);
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  // its shallowest view, a corner of the floor: atan(1 / hypot(0.1, 0.1)) = 81.9 degrees (the
+  // floor's pixels looked at every 8 px, a little inside the corner: 82)
+  EXPECT_NE(r.output.find("too steep: top: sees all of its floor from 82 degrees or more above it, "
+                          "steeper than pipeline.max_view_angle_deg 75"),
+            std::string::npos)
+      << r.output;
+  EXPECT_EQ(r.output.find("side:"), std::string::npos) << r.output;
+  // allowed by the limit: quiet
+  std::ofstream(config, std::ios::app) << "pipeline:\n  max_view_angle_deg: 85\n";
+  r = ss::testing::RunSpritestation("config check --json " + config);
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("\"too_steep\": []"), std::string::npos) << r.output;
+}
+
 // Issue 20: a config or a spec over 16 MiB is bad input (exit 2), refused before it is parsed.
 TEST(StationConfig, OversizedFilesAreRefusedWithExitCode2) {
   if (!Environment("SPRITESTATION_BIN"))

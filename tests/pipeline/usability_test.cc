@@ -1,6 +1,7 @@
 #include "pipeline/filter/usability.h"
 
 #include <cmath>
+#include <numbers>
 #include <random>
 #include <string>
 #include <utility>
@@ -148,9 +149,12 @@ TEST(FloorMask, TheIndexedMaskIsTheMaskOfEveryEdge) {
   }
 }
 
+// The floor's own tests, seen from straight above with the view's test off (90 keeps every view).
 TEST(FloorMask, ChecksBorderFloorAndWalls) {
   const CameraModel cam = DownCamera();
-  const FloorMask floor(cam, Floor(), {});
+  UsabilityOptions every_view;
+  every_view.max_view_angle_deg = 90;
+  const FloorMask floor(cam, Floor(), every_view);
   const cv::Mat blob(20, 20, CV_8U, cv::Scalar(255));
   EXPECT_EQ(floor.Check(blob, {310, 230}, {0.0, 0.0}), Discard::kNone);
   EXPECT_EQ(floor.Check(blob, {0, 230}, {0.0, 0.0}), Discard::kTouchesBorder);
@@ -193,6 +197,46 @@ TEST(FloorMask, ATallSubjectSeenAgainstTheBackgroundIsNotTouchingAWall) {
   // Against the back wall its legs are seen past the floor too: that is touching the wall.
   const cv::Mat back = person({0.0, 2.95}, &offset);
   EXPECT_EQ(FloorMask(cam, stage, {}).Check(back, offset, {0.0, 2.95}), Discard::kTouchesWall);
+}
+
+// A camera 0.6 m up and 0.6 m behind the floor's near edge, tilted `tilt_deg` below the horizontal.
+CameraModel TiltedCamera(double height_m, double back_m, double tilt_deg) {
+  const double tilt = tilt_deg * std::numbers::pi / 180;
+  Rigid3 cam_from_ground;
+  cam_from_ground.rotation << 1, 0, 0,      //
+      0, -std::sin(tilt), -std::cos(tilt),  //
+      0, std::cos(tilt), -std::sin(tilt);
+  const Eigen::Vector3d centre(0, -back_m, height_m);
+  cam_from_ground.translation = -cam_from_ground.rotation * centre;
+  return CameraModel("LENSMODEL_PINHOLE", {500, 500, 320, 240}, 640, 480, cam_from_ground);
+}
+
+// Issue 38: from straight above an upright billboard is a sliver. The angle at the contact point
+// between the floor and the ray to the camera decides, against max_view_angle_deg.
+TEST(FloorMask, ASpriteSeenFromTooFarAboveIsRefused) {
+  const cv::Mat blob(20, 20, CV_8U, cv::Scalar(255));
+  // Straight above: 90 degrees at the origin, atan(1 / 0.25) = 76 at x = 0.25 m.
+  const FloorMask above(DownCamera(), Floor(), {});
+  EXPECT_EQ(above.Check(blob, {310, 230}, {0.0, 0.0}), Discard::kViewTooSteep);
+  EXPECT_EQ(above.Check(blob, {430, 230}, {0.25, 0.0}), Discard::kViewTooSteep);
+  UsabilityOptions steeper;
+  steeper.max_view_angle_deg = 80;
+  EXPECT_EQ(FloorMask(DownCamera(), Floor(), steeper).Check(blob, {430, 230}, {0.25, 0.0}),
+            Discard::kNone);
+  // The floor's tests come first: off the floor is leaves_floor, however steep.
+  EXPECT_EQ(above.Check(blob, {310, 230}, {0.35, 0.0}), Discard::kLeavesFloor);
+  // Its shallowest view of the floor is at a corner: atan(1 / hypot(0.3, 0.2)) = 70.1 degrees
+  // (measured every 8 px, up to 1.6 cm inside the corner here: 70.9).
+  EXPECT_NEAR(above.shallowest_view_deg(), 70.1, 1.0);
+
+  // From 1 m up and 1.5 m behind the floor, looking 35 degrees down, every view is oblique:
+  // at the floor's centre atan(1 / 1.5) = 33.7 degrees.
+  const FloorMask oblique(TiltedCamera(1.0, 1.5, 35), Floor(), {});
+  const Eigen::Vector2d centre_px = TiltedCamera(1.0, 1.5, 35).ProjectGround({0, 0, 0});
+  const cv::Point at(static_cast<int>(centre_px.x()) - 10, static_cast<int>(centre_px.y()) - 19);
+  EXPECT_EQ(oblique.Check(blob, at, {0.0, 0.0}), Discard::kNone);
+  // Seen from the far corners down to 1 / hypot(0.3, 1.7) = 30.0 degrees.
+  EXPECT_NEAR(oblique.shallowest_view_deg(), 30.0, 1.0);
 }
 
 TEST(StillnessFilter, DropsOnlyTheTooLongStillPart) {

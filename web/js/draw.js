@@ -11,6 +11,7 @@ export const VERDICT_COLOURS = {
   noise: '#e879f9',
   still: '#94a3b8',
   too_large: '#fb923c',
+  view_too_steep: '#facc15',
 };
 export const VERDICT_LABELS = {
   stored: 'stored (session runs)',
@@ -22,6 +23,7 @@ export const VERDICT_LABELS = {
   noise: 'noise (keyed background)',
   still: 'still',
   too_large: 'billboard too large (px_per_m)',
+  view_too_steep: 'seen from too far above',
 };
 export function verdictColour(v) {
   return VERDICT_COLOURS[v] || '#eab308';
