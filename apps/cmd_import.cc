@@ -4,16 +4,21 @@
 //                      [--floor FILE] [--force] [--json]:
 // makes a recorded session from any video FFmpeg reads, with the empty scene the
 // clean-plate keyer learns from in front (docs/import.md).
+#include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
 #include "apps/commands.h"
+#include "core/camera_model.h"
 #include "core/error.h"
 #include "core/log.h"
 #include "import/import_session.h"
+#include "pipeline/filter/usability.h"
+#include "pipeline/run/ingest.h"
 
 namespace ss::apps {
 namespace {
@@ -46,6 +51,21 @@ void RunImport(ImportArgs a) {
   }
   if (!a.json) o.progress = [](const std::string& line) { Log("import")->info("{}", line); };
   const ImportSummary s = ImportVideos(o);
+  // Each camera's shallowest view of the floor: from above it, ingest keeps nothing (issue 38).
+  std::vector<double> shallowest(s.cameras.size(), std::nan(""));
+  if (!o.no_model) {
+    try {
+      const GroundPolygon floor = FloorForSession(s.session_dir, {});
+      for (size_t i = 0; i < s.cameras.size(); ++i) {
+        const CameraModel model = CameraModel::Read(
+            (std::filesystem::path(s.session_dir) / (s.cameras[i].name + ".cameramodel")).string());
+        shallowest[i] = FloorMask(model, floor, UsabilityOptions{}).shallowest_view_deg();
+      }
+    } catch (const InputError&) {
+      // no floor (nothing seen): ingest names it
+    }
+  }
+  const double limit = UsabilityOptions{}.max_view_angle_deg;
 
   if (a.json) {
     nlohmann::json j;
@@ -68,6 +88,10 @@ void RunImport(ImportArgs a) {
                               {"last_timestamp_ns", c.last_timestamp_ns},
                               {"model", c.model_source}});
     }
+    for (size_t i = 0; i < s.cameras.size(); ++i) {
+      j["cameras"][i]["shallowest_view_deg"] =
+          std::isfinite(shallowest[i]) ? nlohmann::json(shallowest[i]) : nlohmann::json();
+    }
     std::printf("%s\n", j.dump(2).c_str());
   } else {
     std::printf("session %s (\"%s\") in %.1f s; empty scene: %s; floor: %s\n",
@@ -81,6 +105,13 @@ void RunImport(ImportArgs a) {
           c.name.c_str(), c.video.c_str(), c.width, c.height, c.codec.c_str(), c.fps,
           static_cast<long long>(c.frames), c.first_timestamp_ns / 1e9, c.last_timestamp_ns / 1e9,
           static_cast<long long>(c.empty_frames), c.model_source.c_str());
+      if (const double v = shallowest[&c - s.cameras.data()]; v > limit) {
+        std::printf(
+            "  %s: sees all of its floor from %.0f degrees or more above it, steeper than "
+            "pipeline.max_view_angle_deg %.0f: ingest will refuse every sprite as view_too_steep "
+            "(an upright billboard seen from above is a sliver)\n",
+            c.name.c_str(), std::floor(v), limit);
+      }
       if (c.corrupt_frames > 0) {
         std::printf("  %s: %lld damaged frames skipped (the last: %s)\n", c.name.c_str(),
                     static_cast<long long>(c.corrupt_frames), c.last_problem.c_str());

@@ -100,7 +100,7 @@ CameraPipeline::CameraPipeline(std::string name, int64_t camera_id, CameraModel 
         "{}: sees all of its floor from {:.0f} degrees or more above it, steeper than "
         "pipeline.max_view_angle_deg {:.0f}: every sprite will be refused as view_too_steep (an "
         "upright billboard seen from above is a sliver; docs/pipeline.md)",
-        name_, shallowest, options_.usability.max_view_angle_deg);
+        name_, std::floor(shallowest), options_.usability.max_view_angle_deg);
   }
 }
 
