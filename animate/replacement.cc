@@ -2,7 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
+#include <limits>
+#include <optional>
+#include <queue>
 #include <random>
+#include <span>
 
 #include "animate/basic_costs.h"
 #include "core/error.h"
@@ -196,6 +201,10 @@ class Replacer {
     } else if (kind == MoveKind::kBegin) {
       l = UniformInt(0, n - 1);
     }
+    if (kind == MoveKind::kEnd && options_.goal_fraction > 0 && !sets_.frame_terms().empty() &&
+        std::uniform_real_distribution<double>(0.0, 1.0)(rng_) < options_.goal_fraction) {
+      if (const std::optional<bool> kept = GoalMove(s, k)) return *kept;
+    }
     if (options_.collision_pick_fraction > 0 && n > 1 && collides_[s] &&
         std::uniform_real_distribution<double>(0.0, 1.0)(rng_) < options_.collision_pick_fraction) {
       // Around a colliding step v (past the end: the held last state, changed from the end):
@@ -289,6 +298,50 @@ class Replacer {
       if (TryCandidate(s, first_diff)) return true;
     }
     return false;
+  }
+
+  // The end of sprite s from step k replaced by the way to a frame constraint's set G and a run
+  // in G to the end of its window (ReplacementSets::toward). nullopt when s has no frame
+  // constraint whose window reaches past k; else whether a candidate lowered the cost.
+  std::optional<bool> GoalMove(int s, int k) {
+    constexpr int kMaxGoalSteps = 2000;  // without a sprite's max_frames
+    const Track& current = tracks_[s];
+    const int max_frames = problem_.sprite(s).max_frames;
+    const int limit = max_frames > 0 ? max_frames - k : kMaxGoalSteps;
+    std::optional<bool> kept;
+    for (const auto& [term_index, variant] : sets_.frame_terms()) {
+      const auto& term = static_cast<const FrameTerm&>(problem_.term(term_index));
+      if (term.sprites()[0] != s) continue;
+      const int window_end = term.Window(view_).second;
+      if (window_end - 1 <= k) continue;  // the window ends before the piece starts
+      kept = false;
+      const std::span<const int32_t> toward = sets_.toward(variant);
+      const std::vector<bool>& allowed = term.allowed();
+      const auto in_g = [&](int f) { return f < static_cast<int>(allowed.size()) && allowed[f]; };
+      int u = current.frames[k];
+      piece_.assign(1, u);
+      bool reached = in_g(u);
+      while (static_cast<int>(piece_.size()) < limit &&
+             !(reached && k + static_cast<int>(piece_.size()) >= window_end)) {
+        u = toward[u];
+        if (u < 0) break;
+        piece_.push_back(u);
+        reached = reached || in_g(u);
+      }
+      if (!reached) continue;
+      Track& candidate = candidate_;
+      candidate.frames.assign(current.frames.begin(), current.frames.begin() + k);
+      candidate.frames.insert(candidate.frames.end(), piece_.begin(), piece_.end());
+      int first_diff = k;
+      const int common = std::min(candidate.size(), current.size());
+      while (first_diff < common && candidate.frames[first_diff] == current.frames[first_diff]) {
+        ++first_diff;
+      }
+      if (first_diff == candidate.size() && candidate.size() == current.size()) continue;
+      ++summary_->goal_picks;
+      if (TryCandidate(s, first_diff)) return true;
+    }
+    return kept;
   }
 
   // Positions candidate_ (frames set, equal to the current ones before `first_diff`) and
@@ -615,12 +668,69 @@ bool ReplacementOptions::IsValid(std::string* why) const {
         "must be >= 0 (0: the whole sequence), got " + std::to_string(max_span));
   check(collision_pick_fraction >= 0 && collision_pick_fraction <= 1, "collision_pick_fraction",
         "must be within [0, 1], got " + OptionProblems::Num(collision_pick_fraction));
+  check(goal_fraction >= 0 && goal_fraction <= 1, "goal_fraction",
+        "must be within [0, 1], got " + OptionProblems::Num(goal_fraction));
   check(max_candidates >= 0, "max_candidates",
         "must be >= 0 (0: all of them), got " + std::to_string(max_candidates));
   check(progress_seconds >= 0, "progress_seconds",
         "must be seconds >= 0 (0: never), got " + OptionProblems::Num(progress_seconds));
   return check.ok();
 }
+
+namespace {
+
+// ReplacementSets::toward() for the set G: a multi-source Dijkstra back from G over the plain
+// Ĉ (edge cost + step cost), then, in G, the step that stays in G.
+std::vector<int32_t> TowardSet(const TransitionGraph& graph, const std::vector<bool>& in_g,
+                               double step_cost) {
+  const int n = graph.num_frames();
+  std::vector<int32_t> next(n, -1);
+  std::vector<double> dist(n, std::numeric_limits<double>::infinity());
+  using Item = std::pair<double, int>;
+  std::priority_queue<Item, std::vector<Item>, std::greater<>> heap;
+  for (int i = 0; i < n; ++i) {
+    if (in_g[i]) {
+      dist[i] = 0;
+      heap.emplace(0.0, i);
+    }
+  }
+  while (!heap.empty()) {
+    const auto [d, u] = heap.top();
+    heap.pop();
+    if (d > dist[u]) continue;
+    const auto preds = graph.predecessors(u);
+    const auto costs = graph.predecessor_costs(u);
+    for (size_t e = 0; e < preds.size(); ++e) {
+      const int p = preds[e];
+      if (in_g[p]) continue;
+      const double nd = d + costs[e] + step_cost;
+      if (nd < dist[p]) {
+        dist[p] = nd;
+        next[p] = u;
+        heap.emplace(nd, p);
+      }
+    }
+  }
+  for (int i = 0; i < n; ++i) {
+    if (!in_g[i]) continue;
+    if (i + 1 < n && in_g[i + 1] && graph.IsNaturalSuccessor(i, i + 1)) {
+      next[i] = i + 1;
+      continue;
+    }
+    const auto succ = graph.successors(i);
+    const auto costs = graph.successor_costs(i);
+    double best = std::numeric_limits<double>::infinity();
+    for (size_t e = 0; e < succ.size(); ++e) {
+      if (succ[e] != i && in_g[succ[e]] && costs[e] < best) {
+        best = costs[e];
+        next[i] = succ[e];
+      }
+    }
+  }
+  return next;
+}
+
+}  // namespace
 
 ReplacementSets ReplacementSets::Build(const Problem& problem, const ReplacementOptions& options) {
   std::string why;
@@ -636,6 +746,7 @@ ReplacementSets ReplacementSets::Build(const Problem& problem, const Replacement
     sets.backward_.push_back(ReachSets::Build(graph, ReachDirection::kBackward, reach, entry_cost));
   };
   add_variant(base);
+  sets.toward_.emplace_back();
   if (options.frame_constraint_sets) {
     // One variant per distinct (frame set, strength); terms sharing both share it.
     std::vector<std::pair<const std::vector<bool>*, double>> made;
@@ -647,11 +758,14 @@ ReplacementSets ReplacementSets::Build(const Problem& problem, const Replacement
       int variant = 1 + static_cast<int>(it - made.begin());
       if (it == made.end()) {
         std::vector<double> entry(graph.num_frames(), 0.0);
+        std::vector<bool> g(graph.num_frames(), false);
         for (int i = 0; i < graph.num_frames(); ++i) {
           const bool in_g = i < static_cast<int>(frame->allowed().size()) && frame->allowed()[i];
+          g[i] = in_g;
           entry[i] = (base.empty() ? 0.0 : base[i]) + (in_g ? 0.0 : frame->strength());
         }
         add_variant(entry);
+        sets.toward_.push_back(TowardSet(graph, g, reach.step_cost));
         made.push_back(key);
       }
       sets.frame_terms_.push_back({k, variant});
@@ -677,6 +791,7 @@ size_t ReplacementSets::MemoryBytes() const {
   size_t bytes = 0;
   for (const auto& s : forward_) bytes += s.MemoryBytes();
   for (const auto& s : backward_) bytes += s.MemoryBytes();
+  for (const auto& t : toward_) bytes += t.size() * sizeof(int32_t);
   return bytes;
 }
 

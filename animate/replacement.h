@@ -11,7 +11,9 @@
 // (restart_when_converged) and keeps the best.
 #include <cstdint>
 #include <functional>
+#include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "animate/beam_search.h"
@@ -49,6 +51,9 @@ struct ReplacementOptions {
   bool restart_when_converged = true;
   BeamOptions beam;  // for start = kBeam; its budget (default: a quarter) comes out of this one
 
+  // Share of the end picks of a sprite with a frame constraint whose window reaches past the
+  // pick's first step that replace the end by the way to G and a run in it (toward()).
+  double goal_fraction = 0.25;
   double middle_fraction = 0.6;  // share of picks replacing a middle piece
   double begin_fraction = 0.2;   // ... the beginning; the rest replace the end
   int max_span = 0;              // longest l - k picked; 0: the whole sequence
@@ -83,6 +88,15 @@ class ReplacementSets {
   // not yet passed, where the plain Ĉ is the one that helps.
   int VariantFor(const Problem& problem, Tracks tracks, int sprite, int first, int last,
                  bool open_end = false) const;
+  // The frame constraints: (term index, variant), in term order.
+  const std::vector<std::pair<int, int>>& frame_terms() const { return frame_terms_; }
+  // For a frame constraint's variant, one step toward its set G from every frame: outside G the
+  // next frame on the cheapest path (by the plain Ĉ) to the nearest frame of G; in G the next
+  // frame that stays in G (its natural successor when that is in G, else the cheapest edge into
+  // G); -1 where there is none. A pick's F set reaches a few steps; G may lie 30 away (the
+  // hamster's stands: 33 steps at the median frame of the 30-minute set), so the goal move
+  // follows these pointers instead (issue 33).
+  std::span<const int32_t> toward(int variant) const { return toward_[variant]; }
   double build_seconds() const { return build_seconds_; }
   size_t MemoryBytes() const;
 
@@ -90,6 +104,7 @@ class ReplacementSets {
   std::vector<ReachSets> forward_;
   std::vector<ReachSets> backward_;
   std::vector<std::pair<int, int>> frame_terms_;  // (term index, variant)
+  std::vector<std::vector<int32_t>> toward_;      // per variant (empty for 0)
   double build_seconds_ = 0.0;
 };
 

@@ -70,6 +70,7 @@ const std::map<std::string, std::string> kReplacementKeys = {
     {"time_budget_seconds", "time_budget_s"},
     {"changes_per_turn", "changes_per_turn"},
     {"collision_pick_fraction", "collision_pick_fraction"},
+    {"goal_fraction", "goal_pick_fraction"},
     {"beam.width", "beam_width"},
 };
 const std::map<std::string, std::string> kBeamKeys = {
@@ -507,7 +508,9 @@ void SpecReader::Optimizer(const YAML::Node& node) {
       .Add("snapshot_every_s", &o.snapshot_every_s, "a number",
            "> 0: keep the sequences every so many seconds")
       .Add("collision_pick_fraction", &rep.collision_pick_fraction, "a number",
-           "replacement's picks aimed at a collision, 0 to 1");
+           "replacement's picks aimed at a collision, 0 to 1")
+      .Add("goal_pick_fraction", &rep.goal_fraction, "a number",
+           "replacement's end picks led into a frame constraint's set, 0 to 1");
   YamlMap view;
   if (!Block(keys, node, "optimizer", view)) return;
   Check(view, "seed", seed >= 0 && seed <= 1000000000, "expected a whole number >= 0");

@@ -42,8 +42,9 @@ std::string Summary::FullReport() const {
   add("  sprites            %d\n", num_sprites);
   add("  turns              %d\n", turns);
   add("  restarts           %d\n", restarts);
-  add("  picks              %lld (%lld at a collision)\n", static_cast<long long>(picks),
-      static_cast<long long>(collision_picks));
+  add("  picks              %lld (%lld at a collision, %lld toward a frame set)\n",
+      static_cast<long long>(picks), static_cast<long long>(collision_picks),
+      static_cast<long long>(goal_picks));
   add("  moves tried/kept   %lld / %lld\n", static_cast<long long>(moves_tried),
       static_cast<long long>(moves_kept));
   add("  time precompute    %.3f s\n", precompute_seconds);

@@ -37,6 +37,7 @@ struct Summary {
   int restarts = 0;             // random restarts after convergence
   int64_t picks = 0;            // (k, l) pairs picked
   int64_t collision_picks = 0;  // of them, drawn around a step where the sprite collides
+  int64_t goal_picks = 0;       // end moves toward a frame constraint's set (goal_fraction)
   int64_t moves_tried = 0;      // candidate sequences evaluated
   int64_t moves_kept = 0;       // improvements accepted
 

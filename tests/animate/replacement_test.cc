@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <memory>
+#include <span>
 
 #include "animate/basic_costs.h"
 #include "animate/collision_cost.h"
@@ -218,6 +219,65 @@ TEST(Replacement, AFollowerCopiesItsLeadersStandUp) {
   EXPECT_LE(cost.violations.at("frame"), 3) << "the leader does not stand up";
   EXPECT_LT(location(tracks),
             5.0);  // it starts 0.2 m off its place: ~5 × 0.04 per step until there
+}
+
+// Issue 33: the F/B sets reach a few steps; a stand further away was never found, and the
+// scene ended where the path does, every step of its stand missing. The goal move follows the
+// sets' steps toward the standing frames (ReplacementSets::toward) from any frame.
+TEST(Replacement, AStandBeyondTheSetsReachIsFoundByTheGoalMove) {
+  const TransitionGraph graph = WalkingGraph::Make();
+  Problem problem(graph);
+  SpriteSpec walker;
+  walker.initial_frames = 30;
+  walker.max_frames = 120;
+  problem.AddSprite(walker);
+  const Polyline path({{0, 0}, {1.0, 0}});
+  problem.AddTerm(std::make_unique<PathTerm>(0, path, PathStrengths{0.5, 20.0, 20.0}));
+  auto standing = std::make_shared<std::vector<bool>>(graph.FramesWithTag("standing"));
+  auto stand =
+      std::make_unique<FrameTerm>(0, standing, StepWindow::All(), 2.0, PathTrigger{0, path, 15});
+  const FrameTerm* stand_term = stand.get();
+  problem.AddTerm(std::move(stand));
+
+  ReplacementOptions options = FastOptions(20.0);
+  options.restart_when_converged = false;
+  options.reach.set_size = 4;  // F(s) holds s and three more
+  const ReplacementSets sets = ReplacementSets::Build(problem, options);
+  // Every step toward the stand is an edge, and leads there.
+  const std::span<const int32_t> toward = sets.toward(1);
+  ASSERT_EQ(static_cast<int>(toward.size()), graph.num_frames());
+  for (int f = 0; f < graph.num_frames(); ++f) {
+    int u = f, steps = 0;
+    while (!(*standing)[u] && toward[u] >= 0 && steps < 100) {
+      ASSERT_TRUE(graph.HasEdge(u, toward[u])) << u << " -> " << toward[u];
+      u = toward[u];
+      ++steps;
+    }
+    EXPECT_TRUE((*standing)[u]) << "from frame " << f;
+  }
+  EXPECT_EQ(toward[WalkingGraph::Stand(0)], WalkingGraph::Stand(1));  // in G: its own clip
+  EXPECT_EQ(toward[WalkingGraph::Stand(WalkingGraph::kStand - 1)], WalkingGraph::Stand(0));
+
+  // The path walked and passed at the last step (a straight walk of 1 m, 0.05 m a step), every
+  // step of the stand after it missing. From there a pick's F set holds the next three walking
+  // frames; the stand is six steps on (Straight(0, 8) leads into it).
+  std::vector<int> walk;
+  for (int m = 0; m <= 20; ++m)
+    walk.push_back(WalkingGraph::Straight(0, m % WalkingGraph::kStraight));
+  const std::vector<Track> initial{problem.MakeSpriteTrack(0, walk)};
+  ASSERT_EQ(stand_term->Window(TrackPointers(initial)).first, 20);
+  const auto stood = [&](double goal_fraction) {
+    ReplacementOptions o = options;
+    o.goal_fraction = goal_fraction;
+    Summary summary;
+    const std::vector<Track> tracks = ImproveSequences(problem, o, sets, initial, &summary);
+    EXPECT_TRUE(problem.IsValid(tracks));
+    EXPECT_EQ(problem.Evaluate(tracks).violations.at("path"), 0) << summary.FullReport();
+    EXPECT_EQ(summary.goal_picks > 0, goal_fraction > 0);
+    return 15 - stand_term->CountViolations(TrackPointers(tracks));
+  };
+  EXPECT_EQ(stood(0.0), 0) << "the stand was within the sets' reach";
+  EXPECT_GE(stood(0.25), 10);  // the way in, Straight(0, 4..8), takes 5 of the 15 steps
 }
 
 TEST(Replacement, FollowsAPathToItsEnd) {
