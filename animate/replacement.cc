@@ -266,7 +266,6 @@ class Replacer {
       candidates_.resize(options_.max_candidates);
     }
 
-    const int max_frames = problem_.sprite(s).max_frames;
     for (const auto& [fi, bj] : candidates_) {
       piece_.clear();
       if (kind == MoveKind::kMiddle) {
@@ -283,21 +282,30 @@ class Replacer {
                      current.frames.begin() + l + 1)) {
         continue;  // the same piece again
       }
-      Track& candidate = candidate_;
-      candidate.frames.assign(current.frames.begin(), current.frames.begin() + k);
-      candidate.frames.insert(candidate.frames.end(), piece_.begin(), piece_.end());
-      candidate.frames.insert(candidate.frames.end(), current.frames.begin() + l + 1,
-                              current.frames.end());
-      if (max_frames > 0 && candidate.size() > max_frames) candidate.frames.resize(max_frames);
-      int first_diff = k;
-      const int common = std::min(candidate.size(), n);
-      while (first_diff < common && candidate.frames[first_diff] == current.frames[first_diff]) {
-        ++first_diff;
-      }
-      if (first_diff == candidate.size() && candidate.size() == n) continue;  // cut back to itself
-      if (TryCandidate(s, first_diff)) return true;
+      if (TryPiece(s, k, l)) return true;
     }
     return false;
+  }
+
+  // Tries sprite s's sequence with steps k..l replaced by piece_ (cut to its max_frames); a
+  // candidate equal to the current sequence is not tried. True when it lowered the cost.
+  bool TryPiece(int s, int k, int l) {
+    const Track& current = tracks_[s];
+    const int n = current.size();
+    const int max_frames = problem_.sprite(s).max_frames;
+    Track& candidate = candidate_;
+    candidate.frames.assign(current.frames.begin(), current.frames.begin() + k);
+    candidate.frames.insert(candidate.frames.end(), piece_.begin(), piece_.end());
+    candidate.frames.insert(candidate.frames.end(), current.frames.begin() + l + 1,
+                            current.frames.end());
+    if (max_frames > 0 && candidate.size() > max_frames) candidate.frames.resize(max_frames);
+    int first_diff = k;
+    const int common = std::min(candidate.size(), n);
+    while (first_diff < common && candidate.frames[first_diff] == current.frames[first_diff]) {
+      ++first_diff;
+    }
+    if (first_diff == candidate.size() && candidate.size() == n) return false;  // itself again
+    return TryCandidate(s, first_diff);
   }
 
   // The end of sprite s from step k replaced by the way to a frame constraint's set G and a run
@@ -329,17 +337,8 @@ class Replacer {
         reached = reached || in_g(u);
       }
       if (!reached) continue;
-      Track& candidate = candidate_;
-      candidate.frames.assign(current.frames.begin(), current.frames.begin() + k);
-      candidate.frames.insert(candidate.frames.end(), piece_.begin(), piece_.end());
-      int first_diff = k;
-      const int common = std::min(candidate.size(), current.size());
-      while (first_diff < common && candidate.frames[first_diff] == current.frames[first_diff]) {
-        ++first_diff;
-      }
-      if (first_diff == candidate.size() && candidate.size() == current.size()) continue;
       ++summary_->goal_picks;
-      if (TryCandidate(s, first_diff)) return true;
+      if (TryPiece(s, k, current.size() - 1)) return true;
     }
     return kept;
   }

@@ -65,7 +65,6 @@ void RunImport(ImportArgs a) {
       // no floor (nothing seen): ingest names it
     }
   }
-  const double limit = UsabilityOptions{}.max_view_angle_deg;
 
   if (a.json) {
     nlohmann::json j;
@@ -105,12 +104,13 @@ void RunImport(ImportArgs a) {
           c.name.c_str(), c.video.c_str(), c.width, c.height, c.codec.c_str(), c.fps,
           static_cast<long long>(c.frames), c.first_timestamp_ns / 1e9, c.last_timestamp_ns / 1e9,
           static_cast<long long>(c.empty_frames), c.model_source.c_str());
-      if (const double v = shallowest[&c - s.cameras.data()]; v > limit) {
+      if (const std::string steep =
+              SteepViewText(shallowest[&c - s.cameras.data()], UsabilityOptions{});
+          !steep.empty()) {
         std::printf(
-            "  %s: sees all of its floor from %.0f degrees or more above it, steeper than "
-            "pipeline.max_view_angle_deg %.0f: ingest will refuse every sprite as view_too_steep "
-            "(an upright billboard seen from above is a sliver)\n",
-            c.name.c_str(), std::floor(v), limit);
+            "  %s: %s: ingest will refuse every sprite as view_too_steep (an upright billboard "
+            "seen from above is a sliver)\n",
+            c.name.c_str(), steep.c_str());
       }
       if (c.corrupt_frames > 0) {
         std::printf("  %s: %lld damaged frames skipped (the last: %s)\n", c.name.c_str(),

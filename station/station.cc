@@ -83,7 +83,6 @@ std::vector<std::string> SteepViews(const StationConfig& config) {
   std::vector<std::string> steep;
   const GroundPolygon floor = StationFloor(config);
   if (floor.empty()) return steep;
-  const double limit = config.pipeline.usability.max_view_angle_deg;
   for (const CameraConfig& c : config.cameras) {
     std::optional<CameraModel> model;
     try {
@@ -92,14 +91,11 @@ std::vector<std::string> SteepViews(const StationConfig& config) {
       continue;  // a gap, named by CalibrationGaps
     }
     if (!model) continue;
-    const double shallowest =
-        FloorMask(*model, floor, config.pipeline.usability).shallowest_view_deg();
-    if (shallowest > limit) {
-      steep.push_back(c.name + ": sees all of its floor from " +
-                      std::to_string(static_cast<int>(std::floor(shallowest))) +
-                      " degrees or more above it, steeper than pipeline.max_view_angle_deg " +
-                      OptionProblems::Num(limit) + ": every sprite would be view_too_steep");
-    }
+    const std::string text =
+        SteepViewText(FloorMask(*model, floor, config.pipeline.usability).shallowest_view_deg(),
+                      config.pipeline.usability);
+    if (!text.empty())
+      steep.push_back(c.name + ": " + text + ": every sprite would be view_too_steep");
   }
   return steep;
 }

@@ -81,6 +81,14 @@ const char* DiscardName(Discard reason) {
   return "unknown";
 }
 
+std::string SteepViewText(double shallowest_view_deg, const UsabilityOptions& options) {
+  if (!(shallowest_view_deg > options.max_view_angle_deg)) return "";
+  return "sees all of its floor from " +
+         std::to_string(static_cast<int>(std::floor(shallowest_view_deg))) +
+         " degrees or more above it, steeper than pipeline.max_view_angle_deg " +
+         OptionProblems::Num(options.max_view_angle_deg);
+}
+
 namespace {
 
 // Ground-frame ray directions through every pixel, unprojected exactly on a grid every `step`

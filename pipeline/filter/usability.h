@@ -59,6 +59,12 @@ struct UsabilityOptions {
   bool operator==(const UsabilityOptions&) const = default;
 };
 
+// For a camera whose shallowest view of its floor (FloorMask::shallowest_view_deg) is steeper
+// than options.max_view_angle_deg: "sees all of its floor from 82 degrees or more above it,
+// steeper than pipeline.max_view_angle_deg 75", which import, config check and the pipeline
+// put after the camera's name; "" otherwise.
+std::string SteepViewText(double shallowest_view_deg, const UsabilityOptions& options);
+
 // The shape of a candidate's matte (its alpha crop at full resolution), for telling a subject from
 // keyed background (issue 19). The matte is `alpha > 127` ("solid").
 struct MatteShape {

@@ -94,13 +94,13 @@ CameraPipeline::CameraPipeline(std::string name, int64_t camera_id, CameraModel 
       batcher_(camera_id, options.batch),
       log_(Log("pipeline.run")) {
   // A camera that sees all of its floor from too far above keeps nothing: say so once, up front.
-  const double shallowest = floor_mask_.shallowest_view_deg();
-  if (shallowest > options_.usability.max_view_angle_deg) {
+  if (const std::string steep =
+          SteepViewText(floor_mask_.shallowest_view_deg(), options_.usability);
+      !steep.empty()) {
     log_->warn(
-        "{}: sees all of its floor from {:.0f} degrees or more above it, steeper than "
-        "pipeline.max_view_angle_deg {:.0f}: every sprite will be refused as view_too_steep (an "
-        "upright billboard seen from above is a sliver; docs/pipeline.md)",
-        name_, std::floor(shallowest), options_.usability.max_view_angle_deg);
+        "{}: {}: every sprite will be refused as view_too_steep (an upright billboard seen from "
+        "above is a sliver; docs/pipeline.md)",
+        name_, steep);
   }
 }
 
