@@ -90,10 +90,12 @@ AnimateResult RunAnimation(const Scene& scene, const AnimateRunOptions& options)
     ReplacementOptions replace = scene.MakeReplacementOptions(o.replacement);
     replace.progress_seconds = options.progress_every_s;
     if (options.max_turns > 0) replace.max_turns = options.max_turns;
+    replace.cancel = options.cancel;
     double next_snapshot = o.snapshot_every_s;
-    if (o.snapshot_every_s > 0) {
+    if (o.snapshot_every_s > 0 || options.on_improvement) {
       replace.on_improvement = [&](const std::vector<Track>& tracks, const TracePoint& point) {
-        if (point.seconds < next_snapshot) return;
+        if (options.on_improvement) options.on_improvement(tracks, point);
+        if (o.snapshot_every_s <= 0 || point.seconds < next_snapshot) return;
         while (next_snapshot <= point.seconds) next_snapshot += o.snapshot_every_s;
         result.stages.push_back(
             {point.seconds, point.cost, ToSpriteSequences(scene.bank(), names, tracks)});

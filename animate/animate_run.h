@@ -3,6 +3,8 @@
 // it: repeated subsequence replacement (or the beam search baseline) within a time budget,
 // with optional snapshots of the sequences for a video of the intermediate stages, and
 // the figures that say how well the constraints are met.
+#include <atomic>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -21,6 +23,10 @@ struct AnimateRunOptions {
   // Replacement: stop after this many sprite turns (0: the time budget alone). With a budget
   // that is never reached, the same work on any machine, loaded or not (tests).
   int max_turns = 0;
+  // Replacement only: another thread stops the run early (ReplacementOptions::cancel), and
+  // sees every accepted move (live progress; called on the optimizer's thread).
+  const std::atomic<bool>* cancel = nullptr;
+  std::function<void(const std::vector<Track>&, const TracePoint&)> on_improvement;
   // False with "FIELD: reason" lines in `why` (core/option_checks.h) for values out of range.
   bool IsValid(std::string* why) const;
 };

@@ -79,6 +79,12 @@ class Replacer {
     while (running) {
       for (int s = 0; s < num_sprites && running; ++s) {
         for (int c = 0; c < options_.changes_per_turn; ++c) {
+          if (Cancelled()) {
+            termination = TerminationType::kCancelled;
+            message = "cancelled";
+            running = false;
+            break;
+          }
           if (MonotonicSeconds() > deadline_) {
             termination = TerminationType::kTimeBudget;
             message = "time budget of " + std::to_string(options_.time_budget_seconds) + " s used";
@@ -109,7 +115,9 @@ class Replacer {
                       [&](int f) { return f >= options_.max_tries; })) {
         message =
             "no improvement in " + std::to_string(options_.max_tries) + " picks for every sprite";
-        if (!options_.restart_when_converged || MonotonicSeconds() > deadline_) break;
+        if (!options_.restart_when_converged || MonotonicSeconds() > deadline_ || Cancelled()) {
+          break;
+        }
         KeepBest();
         ++restart_;
         ++summary_->restarts;
@@ -168,7 +176,8 @@ class Replacer {
       }
       const double now = MonotonicSeconds();
       const double share_end = now + std::max(0.0, until - now) / (num_sprites - s);
-      for (int failures = 0; failures < options_.max_tries && MonotonicSeconds() < share_end;) {
+      for (int failures = 0;
+           failures < options_.max_tries && MonotonicSeconds() < share_end && !Cancelled();) {
         ++summary_->picks;
         failures = Pick(s) ? 0 : failures + 1;
       }
@@ -437,6 +446,10 @@ class Replacer {
     if (options_.on_improvement) options_.on_improvement(tracks_, summary_->trace.back());
   }
 
+  bool Cancelled() const {
+    return options_.cancel != nullptr && options_.cancel->load(std::memory_order_relaxed);
+  }
+
   // p_0 minimizing the location terms of a free sprite; false when none constrain it.
   bool LeastSquaresStart(int s, const Track& track, Eigen::Vector2d* start) {
     view_[s] = &track;
@@ -456,7 +469,7 @@ class Replacer {
     Eigen::Vector2d least_squares;
     if (LeastSquaresStart(s, tracks_[s], &least_squares))
       TryShift(s, least_squares - tracks_[s].positions_m.front());
-    for (double h = 0.25; h > 1e-3 && MonotonicSeconds() < deadline_;) {
+    for (double h = 0.25; h > 1e-3 && MonotonicSeconds() < deadline_ && !Cancelled();) {
       bool improved = false;
       for (const Eigen::Vector2d& step : {Eigen::Vector2d(h, 0), Eigen::Vector2d(-h, 0),
                                           Eigen::Vector2d(0, h), Eigen::Vector2d(0, -h)}) {

@@ -9,6 +9,7 @@
 // `changes_per_turn` picks each, the others fixed. Every candidate follows real edges only.
 // Hill climbing stops in a local minimum; with time left it restarts from random sequences
 // (restart_when_converged) and keeps the best.
+#include <atomic>
 #include <cstdint>
 #include <functional>
 #include <span>
@@ -66,6 +67,9 @@ struct ReplacementOptions {
   double progress_seconds = 0.0;     // log progress this often; 0: never
   // Called after every accepted move with the current tracks (tests, live plots).
   std::function<void(const std::vector<Track>&, const TracePoint&)> on_improvement;
+  // Set by another thread: the run stops at its next pick (TerminationType::kCancelled) and
+  // returns the best sequences so far. The F/B sets are built before it is read.
+  const std::atomic<bool>* cancel = nullptr;
 
   // False with "FIELD: reason" lines in `why` (core/option_checks.h) for values out of range;
   // the reach block's fields come out under "reach.", the beam block's (checked only for

@@ -58,6 +58,21 @@ std::string Exact(double v) {
   return text;
 }
 
+// Whether `file` lies under one of `roots`, both with symlinks followed as far as they exist
+// (a link under a root to a file elsewhere is elsewhere). Nothing is opened.
+bool UnderOneOf(const std::string& file, const std::vector<std::string>& roots) {
+  std::error_code ec;
+  const fs::path resolved = fs::weakly_canonical(fs::absolute(file, ec), ec);
+  if (ec) return false;
+  for (const std::string& root : roots) {
+    const fs::path base = fs::weakly_canonical(root, ec);
+    if (ec) continue;
+    const auto rel = resolved.lexically_relative(base);
+    if (!rel.empty() && *rel.begin() != "..") return true;
+  }
+  return false;
+}
+
 enum class OffsetAxes { kHeading, kGround };
 constexpr EnumText<OffsetAxes> kOffsetAxesTexts[] = {{OffsetAxes::kHeading, "heading"},
                                                      {OffsetAxes::kGround, "ground"}};
@@ -84,8 +99,11 @@ const std::map<std::string, std::string> kBeamKeys = {
 // its line and field before the spec is refused.
 class SpecReader {
  public:
-  explicit SpecReader(const std::string& origin)
-      : msg_(origin, lines_), r_(msg_, lines_, fs::path(origin).parent_path().string()) {
+  SpecReader(const std::string& origin, SpecFileRules files)
+      : msg_(origin, lines_),
+        r_(msg_, lines_,
+           files.base_dir.empty() ? fs::path(origin).parent_path().string() : files.base_dir),
+        files_(std::move(files)) {
     spec_.path = origin;
   }
 
@@ -185,6 +203,7 @@ class SpecReader {
   std::map<std::string, int> lines_;  // before msg_ and r_, which keep references to it
   YamlMessages msg_;
   YamlReader r_;
+  SpecFileRules files_;
   AnimationSpec spec_;
 };
 
@@ -282,6 +301,12 @@ bool SpecReader::ExistingFile(const YAML::Node& node, const std::string& path, s
   }
   const std::string file = r_.Resolve(node.Scalar());
   std::error_code ec;  // a name the file system refuses (too long, ...) is no such file either
+  if (!files_.roots.empty() && !UnderOneOf(file, files_.roots)) {
+    std::string roots;
+    for (const std::string& root : files_.roots) roots += (roots.empty() ? "" : ", ") + root;
+    msg_.Error(path, file + ": outside the station's folders (" + roots + "); not opened");
+    return false;
+  }
   if (!fs::exists(file, ec)) {
     msg_.Error(path, "no such file: " + file + (ec ? " (" + ec.message() + ")" : ""));
     return false;
@@ -877,10 +902,11 @@ void SpecReader::CheckReferences() {
 
 }  // namespace
 
-AnimationSpec ParseAnimationSpec(const std::string& yaml, const std::string& origin) {
+AnimationSpec ParseAnimationSpec(const std::string& yaml, const std::string& origin,
+                                 const SpecFileRules& files) {
   const YAML::Node root = LoadOneDocument(yaml, origin);
   try {
-    return SpecReader(origin).Read(root);
+    return SpecReader(origin, files).Read(root);
   } catch (const YAML::Exception& e) {
     // A shape the reader did not check for (found by tests/fuzz): still an error naming the line.
     throw InputError(origin + ":" + std::to_string(e.mark.line + 1),

@@ -160,8 +160,16 @@ struct AnimationSpec {
   std::string Where(const SpecPlace& place) const;  // "FILE:LINE: FIELD"
 };
 
-// Parses spec text; `origin` names it in errors and gives the folder for relative paths.
-AnimationSpec ParseAnimationSpec(const std::string& yaml, const std::string& origin);
+// Which files a spec may name (a spec sent to the station by a client: issue 37).
+struct SpecFileRules {
+  std::string base_dir;            // relative names resolve here ("": the origin's folder)
+  std::vector<std::string> roots;  // non-empty: every file must lie under one (symlinks followed)
+};
+
+// Parses spec text; `origin` names it in errors and gives the folder for relative paths. A
+// file outside `files.roots` is refused by its line and field before anything opens it.
+AnimationSpec ParseAnimationSpec(const std::string& yaml, const std::string& origin,
+                                 const SpecFileRules& files = {});
 // Reads and parses a spec file; InputError naming the file, line and field.
 AnimationSpec LoadAnimationSpec(const std::string& path);
 // The spec's camera, read as `render` reads it: InputError naming the spec's line and field

@@ -15,6 +15,8 @@ const char* TerminationTypeName(TerminationType type) {
       return "MAX_TURNS";
     case TerminationType::kBeamComplete:
       return "BEAM_COMPLETE";
+    case TerminationType::kCancelled:
+      return "CANCELLED";
   }
   return "UNKNOWN";
 }

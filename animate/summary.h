@@ -13,6 +13,7 @@ enum class TerminationType {
   kTimeBudget,    // the time budget ran out
   kMaxTurns,      // the turn limit was reached
   kBeamComplete,  // beam search extended to the full length
+  kCancelled,     // the caller asked it to stop (ReplacementOptions::cancel)
 };
 const char* TerminationTypeName(TerminationType type);
 

@@ -2,8 +2,11 @@
 
 #include <gtest/gtest.h>
 
+#include <atomic>
+#include <chrono>
 #include <memory>
 #include <span>
+#include <thread>
 
 #include "animate/basic_costs.h"
 #include "animate/collision_cost.h"
@@ -298,6 +301,38 @@ TEST(Replacement, FollowsAPathToItsEnd) {
   const auto view = TrackPointers(tracks);
   EXPECT_EQ(path_term->CountViolations(view), 0) << "path not passed to its end";
   EXPECT_LT(path_term->MaxDeviation(tracks[0]), 0.2);
+}
+
+// A cancel from another thread ends a run with an hour's budget at its next pick, with the
+// best valid sequences so far and the termination saying why.
+TEST(Replacement, ACancelFromAnotherThreadStopsTheRunAtOnce) {
+  const TransitionGraph graph = WalkingGraph::Make();
+  Problem problem(graph);
+  SpriteSpec spec;
+  spec.initial_frames = 30;
+  spec.max_frames = 120;
+  problem.AddSprite(spec);
+  problem.AddSprite(spec);
+  const Polyline path({{0, 0}, {1.2, 0}, {1.2, 1.2}});
+  problem.AddTerm(std::make_unique<PathTerm>(0, path, PathStrengths{0.2, 20.0, 5.0}));
+  problem.AddTerm(std::make_unique<CollisionTerm>(0, 1, 0.2, 5.0));
+  ReplacementOptions options = FastOptions(3600.0);
+  std::atomic<bool> cancel{false};
+  options.cancel = &cancel;
+  double cancelled_at = 0;
+  std::thread canceller([&] {  // in the one-by-one start or the climb, as the machine goes
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    cancelled_at = MonotonicSeconds();
+    cancel = true;
+  });
+  Summary summary;
+  const auto tracks = OptimizeSequences(problem, options, &summary);
+  const double stopped_after = MonotonicSeconds() - cancelled_at;
+  canceller.join();
+  EXPECT_EQ(summary.termination, TerminationType::kCancelled) << summary.message;
+  EXPECT_LT(stopped_after, 1.0);
+  ASSERT_TRUE(problem.IsValid(tracks));
+  EXPECT_LE(summary.final_cost.total, summary.initial_cost.total);
 }
 
 // Picks aimed at a collision (collision_pick_fraction): two walkers on lanes 8 cm apart pass

@@ -15,6 +15,7 @@
 namespace ss {
 namespace {
 
+namespace fs = std::filesystem;
 using testing::ScratchDir;
 
 class SpecTest : public ::testing::Test {
@@ -181,6 +182,44 @@ TEST_F(SpecTest, ClonesCostTwoSpritesShowingAFrameTogether) {
   EXPECT_EQ(TermsOfKind(*Scene::Load(spec), "clone"), 1);             // one a pair
   EXPECT_EQ(ErrorOf(Edit(fast, "clones: {strength: 1, lag_steps: 101}")),
             Origin() + ":6: clones.lag_steps: must be 0..100 steps, got 101");
+}
+
+// A spec a client sends the station may name files under the station's folders only: one
+// elsewhere (by path, by "..", or through a link) is refused by its line before it is opened.
+TEST_F(SpecTest, FilesOutsideTheRootsAreRefusedByLineUnopened) {
+  const ScratchDir outside_dir;
+  const fs::path& outside = outside_dir.path();
+  fs::copy_file(dir_ / "walker.ssbank", outside / "walker.ssbank");
+  fs::create_directory_symlink(outside, dir_ / "link");
+  SpecFileRules rules;
+  rules.roots = {dir_.path().string()};
+  EXPECT_NO_THROW(ParseAnimationSpec(kGood, Origin(), rules));
+  auto error_of = [&](const std::string& yaml) -> std::string {
+    try {
+      ParseAnimationSpec(yaml, Origin(), rules);
+    } catch (const InputError& e) {
+      return e.what();
+    }
+    return "";
+  };
+  const std::string o = Origin();
+  const std::string why =
+      ": outside the station's folders (" + dir_.path().string() + "); not opened";
+  const std::string moved = (outside / "walker.ssbank").string();
+  for (const auto& [bank, named] : std::vector<std::pair<std::string, std::string>>{
+           {moved, moved},
+           {"../" + outside.filename().string() + "/walker.ssbank", moved},  // resolved
+           {"link/walker.ssbank", dir_ / "link/walker.ssbank"}}) {
+    EXPECT_EQ(error_of(Edit("banks: [walker.ssbank]", "banks: [" + bank + "]")),
+              o + ":5: banks[0]: " + named + why);
+  }
+  EXPECT_EQ(error_of(Edit("camera: virtual.cameramodel", "camera: /etc/passwd")),
+            o + ":4: camera: /etc/passwd" + why);
+  // relative names resolve in the rules' folder, not the origin's
+  rules.base_dir = outside.string();
+  rules.roots.push_back(outside.string());
+  EXPECT_EQ(error_of(kGood),
+            o + ":4: camera: no such file: " + (outside / "virtual.cameramodel").string());
 }
 
 TEST_F(SpecTest, BadSpecsNameTheLineAndTheField) {
@@ -391,7 +430,6 @@ TEST_F(SpecTest, AFileOverTheLimitIsRefusedBeforeItIsRead) {
 // Every example in docs/examples parses, with stand-ins for the bank, plate and camera it names
 // where scripts/reference-banks.sh makes them (recordings/reference/, relative to the spec).
 TEST_F(SpecTest, TheDocumentedExamplesAreValid) {
-  namespace fs = std::filesystem;
   const fs::path examples = fs::path(ss::testing::SourcePath("docs/examples"));
   const fs::path copies = fs::path(dir_.path()) / "docs" / "examples";
   fs::create_directories(copies);
