@@ -17,6 +17,7 @@
 #include "core/option_checks.h"
 #include "core/posix.h"
 #include "station/api_part.h"
+#include "station/console_animations.h"
 #include "station/console_bank.h"
 #include "station/console_calibration.h"
 #include "station/console_events.h"
@@ -160,6 +161,7 @@ struct ControlServer::Impl {
     context.config_path = options.config_path;
     parts.push_back(std::make_unique<ConsoleCalibration>(context));
     parts.push_back(std::make_unique<ConsoleLabels>(context));
+    parts.push_back(std::make_unique<ConsoleAnimations>(context));
   }
 
   std::shared_ptr<Station> station() const {

@@ -1,0 +1,504 @@
+#include "station/animation_jobs.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <opencv2/imgcodecs.hpp>
+
+#include "animate/animate_run.h"
+#include "animate/beam_search.h"
+#include "animate/cost_plot.h"
+#include "animate/playback.h"
+#include "animate/renderer.h"
+#include "animate/scene.h"
+#include "animate/sequence_io.h"
+#include "animate/spec.h"
+#include "animate/summary.h"
+#include "capture/recording/video_file.h"
+#include "core/error.h"
+#include "core/error_kinds.h"
+#include "core/log.h"
+#include "core/option_checks.h"
+#include "core/posix.h"
+#include "core/utc_time.h"
+#include "judge/judge.h"
+
+namespace ss {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr const char* kFiles[] = {"spec.yaml", "job.json", "sequences.json", "cost.png",
+                                  "render.mp4"};
+constexpr double kTracksEverySeconds = 0.25;  // the live paths are copied this often at most
+constexpr size_t kMaxTracePoints = 2000;      // the live cost curve keeps this many (thinned)
+
+double Now() { return MonotonicSeconds(); }
+
+std::string FolderName(int64_t id) {
+  char name[32];
+  std::snprintf(name, sizeof name, "%04lld", static_cast<long long>(id));
+  return name;
+}
+
+std::string FrameName(int step) {
+  char name[32];
+  std::snprintf(name, sizeof name, "%05d.jpg", step);
+  return name;
+}
+
+// Writes `text` to `path` through a temporary file and a rename (a reader never sees half).
+void WriteWhole(const fs::path& path, const std::string& text) {
+  const fs::path temp = path.string() + ".partial";
+  {
+    std::ofstream out(temp, std::ios::binary | std::ios::trunc);
+    out << text;
+    if (!out.flush()) throw WorkError(temp.string(), "cannot write");
+  }
+  std::error_code ec;
+  fs::rename(temp, path, ec);
+  if (ec) throw WorkError(path.string(), "cannot write: " + ec.message());
+}
+
+std::string ReadWhole(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw NotFoundError(path.filename().string(), "not saved");
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+// The files a job folder holds now, as URLs of the API (null for those not there).
+nlohmann::json FileUrls(int64_t id, const fs::path& folder) {
+  nlohmann::json files = nlohmann::json::object();
+  const std::string base = "/api/animations/" + std::to_string(id) + "/files/";
+  for (const char* name : kFiles) {
+    const std::string key = fs::path(name).stem().string();
+    std::error_code ec;
+    files[key == "cost" ? "cost_plot" : key] =
+        fs::exists(folder / name, ec) ? nlohmann::json(base + name) : nlohmann::json(nullptr);
+  }
+  files.erase("job");
+  return files;
+}
+
+}  // namespace
+
+const char* AnimationJobStateName(AnimationJobState state) {
+  switch (state) {
+    case AnimationJobState::kQueued:
+      return "queued";
+    case AnimationJobState::kRunning:
+      return "running";
+    case AnimationJobState::kRendering:
+      return "rendering";
+    case AnimationJobState::kDone:
+      return "done";
+    case AnimationJobState::kFailed:
+      return "failed";
+    case AnimationJobState::kCancelled:
+      return "cancelled";
+  }
+  return "unknown";
+}
+
+bool AnimationJobsOptions::IsValid(std::string* why) const {
+  OptionProblems check(why);
+  check(!folder.empty(), "folder", "required");
+  check(!roots.empty(), "roots", "at least one folder a spec may name files under");
+  check(max_time_budget_s > 0 && std::isfinite(max_time_budget_s) &&
+            max_time_budget_s <= kMaxTimeBudgetSeconds,
+        "max_time_budget_s",
+        "must be seconds in (0, " + OptionProblems::Num(kMaxTimeBudgetSeconds) + "], got " +
+            OptionProblems::Num(max_time_budget_s));
+  check(threads >= 1 && threads <= 64, "threads", "must be 1..64, got " + std::to_string(threads));
+  return check.ok();
+}
+
+// The job that runs (or ran last): what the job thread reports, under AnimationJobs::mu_.
+struct AnimationJobs::Current {
+  int64_t id = 0;
+  fs::path folder;
+  std::string name;     // the spec's sprites, "hamster, hamster2"
+  std::string created;  // UTC, ISO 8601
+  std::string spec_text;
+  AnimationSpec spec;
+  std::atomic<bool> cancel{false};
+  // under mu_
+  AnimationJobState state = AnimationJobState::kQueued;
+  std::string error;
+  double started = 0;  // monotonic seconds
+  double seconds = 0;  // of the optimizer's run at the last figures
+  double cost = 0, best_cost = 0;
+  int64_t moves_kept = 0;
+  int restarts = 0;
+  int steps_rendered = 0, num_steps = 0;
+  std::vector<std::pair<double, double>> trace;  // (seconds, best cost)
+  nlohmann::json tracks = nlohmann::json::array();
+  double tracks_at = -1;
+
+  nlohmann::json Saved() const {  // job.json
+    return {{"id", id},
+            {"state", AnimationJobStateName(state)},
+            {"name", name},
+            {"created", created},
+            {"error", error.empty() ? nlohmann::json(nullptr) : nlohmann::json(error)},
+            {"seconds", seconds},
+            {"frame_rate", spec.frame_rate}};
+  }
+};
+
+AnimationJobs::AnimationJobs(AnimationJobsOptions options) : options_(std::move(options)) {
+  if (std::string why; !options_.IsValid(&why)) throw InputError("animation jobs", why);
+  // A job that was queued or running when the station stopped never ends now.
+  std::error_code ec;
+  for (const auto& entry : fs::directory_iterator(options_.folder, ec)) {
+    const fs::path job = entry.path() / "job.json";
+    if (!fs::exists(job, ec)) continue;
+    try {
+      nlohmann::json j = nlohmann::json::parse(ReadWhole(job));
+      const std::string state = j.value("state", "");
+      if (state == "queued" || state == "running" || state == "rendering") {
+        j["state"] = "failed";
+        j["error"] = "the station stopped while it ran";
+        WriteWhole(job, j.dump(2));
+      }
+    } catch (const std::exception& e) {
+      Log("station.animations")->warn("{}: {}", job.string(), e.what());
+    }
+  }
+}
+
+AnimationJobs::~AnimationJobs() { Stop(); }
+
+void AnimationJobs::Stop() {
+  std::thread thread;
+  {
+    std::lock_guard lock(mu_);
+    if (current_) current_->cancel = true;
+    thread = std::move(thread_);
+  }
+  if (thread.joinable()) thread.join();
+}
+
+std::string AnimationJobs::FolderOf(int64_t id) const {
+  return (fs::path(options_.folder) / FolderName(id)).string();
+}
+
+int64_t AnimationJobs::Submit(const std::string& spec_text) {
+  // Checked before anything is made: the spec with the station's file rules, then its budget.
+  SpecFileRules rules;
+  rules.base_dir = options_.base_dir;
+  rules.roots = options_.roots;
+  auto job = std::make_shared<Current>();
+  job->spec = ParseAnimationSpec(spec_text, "spec", rules);
+  const double budget = job->spec.optimizer.replacement.time_budget_seconds;
+  if (budget > options_.max_time_budget_s) {
+    throw InputError("spec: optimizer.time_budget_s",
+                     "at most " + OptionProblems::Num(options_.max_time_budget_s) +
+                         " s on this station, got " + OptionProblems::Num(budget));
+  }
+  if (std::string why; !AnimateRunOptions{job->spec.optimizer}.IsValid(&why)) {
+    throw InputError("spec: optimizer", why);
+  }
+  (void)ReadSpecCamera(job->spec);  // "spec:LINE: camera: ..." when it is not a camera model
+  job->spec_text = spec_text;
+  for (const SpriteSpecEntry& s : job->spec.sprites) {
+    job->name += (job->name.empty() ? "" : ", ") + s.name;
+  }
+  job->created = UtcNowIso();
+
+  std::lock_guard lock(mu_);
+  if (current_ && (current_->state == AnimationJobState::kQueued ||
+                   current_->state == AnimationJobState::kRunning ||
+                   current_->state == AnimationJobState::kRendering)) {
+    throw ConflictError("animation", "job " + std::to_string(current_->id) + " is still " +
+                                         AnimationJobStateName(current_->state) +
+                                         " (one job at a time: cancel it or wait)");
+  }
+  if (thread_.joinable()) thread_.join();  // ended: its thread is leaving
+  // A new folder, never one that exists: the next number after the highest saved.
+  std::error_code ec;
+  fs::create_directories(options_.folder, ec);
+  if (ec) throw WorkError(options_.folder, "cannot make the animations folder: " + ec.message());
+  int64_t id = 0;
+  for (const auto& entry : fs::directory_iterator(options_.folder, ec)) {
+    const std::string n = entry.path().filename().string();
+    if (!n.empty() && std::all_of(n.begin(), n.end(), ::isdigit) && n.size() < 12) {
+      id = std::max<int64_t>(id, std::stoll(n));
+    }
+  }
+  for (++id; !fs::create_directory(FolderOf(id), ec); ++id) {
+    if (ec) throw WorkError(FolderOf(id), "cannot make the job's folder: " + ec.message());
+  }
+  job->id = id;
+  job->folder = FolderOf(id);
+  WriteWhole(job->folder / "spec.yaml", spec_text);
+  WriteWhole(job->folder / "job.json", job->Saved().dump(2));
+  current_ = job;
+  thread_ = std::thread([this, job] { Run(job); });
+  Log("station.animations")->info("job {}: {} ({} s budget)", id, job->name, budget);
+  return id;
+}
+
+void AnimationJobs::Run(std::shared_ptr<Current> job) {
+  SetThisThreadNice(kNiceBackground);  // below capture and the console (core/posix.h)
+  auto set_state = [&](AnimationJobState state, const std::string& error = "") {
+    nlohmann::json saved;
+    {
+      std::lock_guard lock(mu_);
+      job->state = state;
+      job->error = error;
+      saved = job->Saved();
+    }
+    WriteWhole(job->folder / "job.json", saved.dump(2));
+  };
+  try {
+    {
+      std::lock_guard lock(mu_);
+      job->state = AnimationJobState::kRunning;
+      job->started = Now();
+    }
+    set_state(AnimationJobState::kRunning);
+    const auto scene = Scene::Load(job->spec);
+    if (job->cancel) return set_state(AnimationJobState::kCancelled);
+
+    AnimateRunOptions run{scene->spec().optimizer};
+    run.optimizer.replacement.reach.num_threads = options_.threads;
+    run.cancel = &job->cancel;
+    run.on_improvement = [&](const std::vector<Track>& tracks, const TracePoint& point) {
+      std::lock_guard lock(mu_);
+      job->seconds = point.seconds;
+      job->cost = point.cost;
+      job->best_cost = point.best_cost;
+      job->moves_kept = point.moves_kept;
+      job->restarts = point.restart;
+      if (job->trace.size() >= kMaxTracePoints) {  // every other point: the curve's shape stays
+        for (size_t i = 0; i < job->trace.size() / 2; ++i) job->trace[i] = job->trace[2 * i];
+        job->trace.resize(job->trace.size() / 2);
+      }
+      job->trace.emplace_back(point.seconds, point.best_cost);
+      if (point.seconds - job->tracks_at < kTracksEverySeconds) return;
+      job->tracks_at = point.seconds;
+      job->tracks = nlohmann::json::array();
+      for (size_t s = 0; s < tracks.size(); ++s) {
+        nlohmann::json positions = nlohmann::json::array();
+        for (const Eigen::Vector2d& p : tracks[s].positions_m) positions.push_back({p.x(), p.y()});
+        job->tracks.push_back(
+            {{"name", scene->spec().sprites[s].name}, {"positions", std::move(positions)}});
+      }
+    };
+    const AnimateResult result = RunAnimation(*scene, run);
+    if (job->cancel) return set_state(AnimationJobState::kCancelled);
+
+    SequenceFile file = MakeSequenceFile(*scene, result);
+    nlohmann::json judged = JudgementJson(JudgeSequences(file, file.bank_paths, scene.get()));
+    judged["jumps"].erase("each");
+    file.summary["judge"] = std::move(judged);
+    WriteSequenceFile((job->folder / "sequences.json").string(), file);
+    WriteCostPlot((job->folder / "cost.png").string(),
+                  {{"replacement", result.summary.trace, cv::Scalar(200, 80, 0)}}, job->name);
+    {
+      std::lock_guard lock(mu_);
+      job->num_steps = file.num_steps;
+      job->seconds = result.summary.total_seconds;
+      job->best_cost = result.summary.final_cost.total;
+      job->restarts = result.summary.restarts;
+    }
+    if (options_.render) {
+      set_state(AnimationJobState::kRendering);
+      const CameraModel camera = ReadSpecCamera(scene->spec());
+      cv::Mat background;
+      if (!file.background_path.empty()) {
+        background = cv::imread(file.background_path, cv::IMREAD_UNCHANGED);
+        if (background.empty()) {
+          throw InputError(file.background_path, "cannot read the background image");
+        }
+      }
+      SequencePlayer player(file.bank_paths, std::make_unique<SpriteRenderer>(camera, background));
+      const fs::path frames = job->folder / "frames";
+      fs::create_directory(frames);
+      {
+        VideoFileWriter video((job->folder / "render.mp4.partial.mp4").string(), camera.width(),
+                              camera.height(), file.frame_rate, "h264");
+        for (int t = 0; t < file.num_steps; ++t) {
+          if (job->cancel) return set_state(AnimationJobState::kCancelled);
+          const cv::Mat frame = player.RenderStep(file.sprites, t);
+          video.Write(frame);
+          cv::Mat bgr;
+          if (frame.channels() == 4) {
+            cv::Mat planes[4];
+            cv::split(frame, planes);
+            cv::merge(planes, 3, bgr);
+          } else {
+            bgr = frame;
+          }
+          if (!cv::imwrite((frames / FrameName(t)).string(), bgr, {cv::IMWRITE_JPEG_QUALITY, 88})) {
+            throw WorkError((frames / FrameName(t)).string(), "cannot write");
+          }
+          std::lock_guard lock(mu_);
+          job->steps_rendered = t + 1;
+        }
+        video.Close();
+      }
+      fs::rename(job->folder / "render.mp4.partial.mp4", job->folder / "render.mp4");
+    }
+    set_state(AnimationJobState::kDone);
+    Log("station.animations")
+        ->info("job {} done: cost {:.6g}, {} steps", job->id, result.summary.final_cost.total,
+               file.num_steps);
+  } catch (const std::exception& e) {
+    Log("station.animations")->error("job {}: {}", job->id, e.what());
+    try {
+      set_state(AnimationJobState::kFailed, e.what());
+    } catch (const std::exception& again) {
+      Log("station.animations")->error("job {}: {}", job->id, again.what());
+    }
+  }
+}
+
+nlohmann::json AnimationJobs::Job(int64_t id) const {
+  const fs::path folder = FolderOf(id);
+  nlohmann::json j;
+  {
+    std::lock_guard lock(mu_);
+    if (current_ && current_->id == id) {
+      const Current& c = *current_;
+      j = c.Saved();
+      j["spec"] = c.spec_text;
+      nlohmann::json trace = nlohmann::json::array();
+      for (const auto& [s, cost] : c.trace) trace.push_back({s, cost});
+      j["progress"] = {
+          {"seconds", c.state == AnimationJobState::kRunning ? Now() - c.started : c.seconds},
+          {"cost", c.cost},
+          {"best_cost", c.best_cost},
+          {"moves_kept", c.moves_kept},
+          {"restarts", c.restarts},
+          {"steps_rendered", c.steps_rendered},
+          {"trace", std::move(trace)}};
+      j["tracks"] = c.tracks;
+      j["num_steps"] = c.num_steps;
+    }
+  }
+  std::error_code ec;
+  if (j.is_null()) {  // a job of an earlier run, or one long ended
+    if (!fs::exists(folder / "job.json", ec)) {
+      throw NotFoundError("animation", "no job " + std::to_string(id));
+    }
+    j = nlohmann::json::parse(ReadWhole(folder / "job.json"));
+    j["spec"] = ReadWhole(folder / "spec.yaml");
+    j["progress"] = nullptr;
+  }
+  j["files"] = FileUrls(id, folder);
+  if (j.value("state", "") == "done" || (j.value("state", "") == "rendering")) {
+    if (fs::exists(folder / "sequences.json", ec)) {
+      nlohmann::json sequences = nlohmann::json::parse(ReadWhole(folder / "sequences.json"));
+      j["num_steps"] = sequences.value("num_steps", 0);
+      j["frame_rate"] = sequences.value("frame_rate", 30.0);
+      if (sequences.contains("summary") && sequences["summary"].contains("judge")) {
+        j["judge"] = sequences["summary"]["judge"];
+      }
+      nlohmann::json tracks = nlohmann::json::array();
+      for (const auto& s : sequences.value("sprites", nlohmann::json::array())) {
+        nlohmann::json positions = nlohmann::json::array();
+        for (const auto& step : s.value("steps", nlohmann::json::array())) {
+          positions.push_back({step.at(2), step.at(3)});  // [bank, sprite, x, y]
+        }
+        tracks.push_back({{"name", s.value("name", "")}, {"positions", std::move(positions)}});
+      }
+      j["tracks"] = std::move(tracks);
+      j["sequences"] = std::move(sequences);
+    }
+  }
+  return j;
+}
+
+nlohmann::json AnimationJobs::List() const {
+  nlohmann::json jobs = nlohmann::json::array();
+  std::vector<int64_t> ids;
+  std::error_code ec;
+  for (const auto& entry : fs::directory_iterator(options_.folder, ec)) {
+    const std::string n = entry.path().filename().string();
+    if (n.empty() || n.size() >= 12 || !std::all_of(n.begin(), n.end(), ::isdigit)) continue;
+    if (fs::exists(entry.path() / "job.json", ec)) ids.push_back(std::stoll(n));
+  }
+  std::sort(ids.rbegin(), ids.rend());
+  for (int64_t id : ids) {
+    nlohmann::json j;
+    {
+      std::lock_guard lock(mu_);
+      if (current_ && current_->id == id) j = current_->Saved();
+    }
+    if (j.is_null()) {
+      try {
+        j = nlohmann::json::parse(ReadWhole(fs::path(FolderOf(id)) / "job.json"));
+      } catch (const std::exception& e) {
+        j = {{"id", id}, {"state", "failed"}, {"error", e.what()}};
+      }
+    }
+    jobs.push_back({{"id", id},
+                    {"state", j.value("state", "failed")},
+                    {"name", j.value("name", "")},
+                    {"created", j.value("created", "")},
+                    {"files", FileUrls(id, FolderOf(id))}});
+  }
+  return {{"jobs", std::move(jobs)}};
+}
+
+nlohmann::json AnimationJobs::Cancel(int64_t id) {
+  {
+    std::lock_guard lock(mu_);
+    if (current_ && current_->id == id) current_->cancel = true;
+  }
+  return Job(id);  // NotFoundError for an unknown id
+}
+
+nlohmann::json AnimationJobs::Brief() const {
+  std::lock_guard lock(mu_);
+  if (!current_) return nullptr;
+  const Current& c = *current_;
+  return {{"id", c.id},
+          {"state", AnimationJobStateName(c.state)},
+          {"seconds", c.state == AnimationJobState::kRunning ? Now() - c.started : c.seconds},
+          {"cost", c.cost},
+          {"best_cost", c.best_cost},
+          {"moves_kept", c.moves_kept},
+          {"restarts", c.restarts},
+          {"steps_rendered", c.steps_rendered},
+          {"num_steps", c.num_steps}};
+}
+
+std::string AnimationJobs::File(int64_t id, const std::string& name) const {
+  if (std::find(std::begin(kFiles), std::end(kFiles), name) == std::end(kFiles)) {
+    throw NotFoundError("file",
+                        "a job holds spec.yaml, job.json, sequences.json, cost.png and "
+                        "render.mp4, not " +
+                            name);
+  }
+  const fs::path path = fs::path(FolderOf(id)) / name;
+  std::error_code ec;
+  if (!fs::exists(fs::path(FolderOf(id)) / "job.json", ec)) {
+    throw NotFoundError("animation", "no job " + std::to_string(id));
+  }
+  if (!fs::exists(path, ec)) {
+    throw NotFoundError("file", "job " + std::to_string(id) + " has no " + name + " (yet)");
+  }
+  return path.string();
+}
+
+std::string AnimationJobs::Frame(int64_t id, int step) const {
+  const fs::path path = fs::path(FolderOf(id)) / "frames" / FrameName(step);
+  std::error_code ec;
+  if (!fs::exists(path, ec)) {
+    throw NotFoundError(
+        "frame", "job " + std::to_string(id) + " has no rendered step " + std::to_string(step));
+  }
+  return path.string();
+}
+
+}  // namespace ss
