@@ -1,8 +1,8 @@
 // spritestation bench station [--cameras=N] [--size=WxH] [--fps=F] [--seconds=S]
-// [--preview-streams=N]: the live station on paced replay (the daemon's code: CameraRunner threads,
-// bank writer, TransitionWorker), as a Google Benchmark case run once for S
-// seconds of wall time. Cameras replay a synthetic animal session (made once,
-// cached under the temp dir) in real time, looping.
+// [--preview-streams=N] [--animation-spec=FILE]: the live station on paced replay (the daemon's
+// code: CameraRunner threads, bank writer, TransitionWorker), as a Google Benchmark case run once
+// for S seconds of wall time. Cameras replay a synthetic animal session (made once, cached under
+// the temp dir) in real time, looping.
 //   station/live_ffv1_replay_...    cameras replaying the FFV1 session in real time (decoding
 //   included) station/live_from_memory_...    cameras delivering pre-decoded frames in real time,
 //   as a
@@ -14,6 +14,9 @@
 //                                   daemon's HTTP server and N console tiles open (each fetching
 //                                   raw / keyed / sprites views at 10 a second, and an event
 //                                   stream): an open console must cost no captured frame
+//   station/live_from_memory_..._with_animation_jobs (--animation-spec=FILE): the same while
+//                                   the studio's animation jobs of that spec run one after the
+//                                   other (optimize, judge, render): capture must not notice
 //   station/baseline/decode_NxWxH   the same session replayed unpaced by ReplaySource:
 //                                   the machine's decode capacity for these cameras
 // The ratio printed: frames/s the cameras need / frames/s decoding alone gives.
@@ -34,6 +37,7 @@
 
 #include "bench/bench_registry.h"
 #include "capture/replay/replay_source.h"
+#include "station/animation_jobs.h"
 #include "station/control_server.h"
 #include "station/station.h"
 #include "station/station_host.h"
@@ -51,7 +55,8 @@ struct StationBenchArgs {
   int width = 1280, height = 720;
   double fps = 30;
   double seconds = 20;
-  int preview_streams = 0;  // > 0: also the from-memory run with this many open console previews
+  int preview_streams = 0;     // > 0: also the from-memory run with this many open console previews
+  std::string animation_spec;  // a spec file: also the from-memory run with animation jobs of it
 };
 StationBenchArgs g_args;
 
@@ -207,7 +212,47 @@ class ConsoleLoad {
   std::vector<std::thread> threads_;
 };
 
-void Live(benchmark::State& state, bool from_memory, int preview_streams) {
+// Animation jobs of one spec, one after the other, through the station's controller
+// (station/animation_jobs.h: optimize, judge, render at the jobs' low priority) for as long as
+// it lives: the studio's load on a capturing station (issue 37).
+class AnimationLoad {
+ public:
+  AnimationLoad(const std::string& spec_path, const fs::path& folder) {
+    std::ifstream in(spec_path);
+    std::stringstream text;
+    text << in.rdbuf();
+    AnimationJobsOptions options;
+    options.folder = (folder / "animations").string();
+    options.base_dir = fs::absolute(spec_path).parent_path().string();
+    options.roots = {"/"};
+    jobs_ = std::make_unique<AnimationJobs>(options);
+    thread_ = std::thread([this, spec = text.str()] {
+      while (!stop_) {
+        const int64_t id = jobs_->Submit(spec);
+        while (!stop_) {
+          const std::string s = jobs_->Job(id)["state"];
+          if (s == "done" || s == "failed" || s == "cancelled") break;
+          std::this_thread::sleep_for(std::chrono::milliseconds(100));
+        }
+        ++jobs_done_;
+      }
+    });
+  }
+  ~AnimationLoad() {
+    stop_ = true;
+    thread_.join();
+    jobs_->Stop();
+  }
+  int jobs_done() const { return jobs_done_; }
+
+ private:
+  std::unique_ptr<AnimationJobs> jobs_;
+  std::atomic<bool> stop_{false};
+  std::atomic<int> jobs_done_{0};
+  std::thread thread_;
+};
+
+void Live(benchmark::State& state, bool from_memory, int preview_streams, bool animation_jobs) {
   const std::string session = Session();
   if (from_memory) {
     for (int c = 0; c < g_args.cameras; ++c) Decoded(session, "cam" + std::to_string(c));
@@ -258,6 +303,8 @@ void Live(benchmark::State& state, bool from_memory, int preview_streams) {
       console = std::make_unique<ConsoleLoad>(control->Start(), preview_streams, g_args.cameras);
     }
     station.StartSession("bench");
+    std::unique_ptr<AnimationLoad> animations;
+    if (animation_jobs) animations = std::make_unique<AnimationLoad>(g_args.animation_spec, work);
     int64_t pending_max = 0;
     const auto start = std::chrono::steady_clock::now();
     while (std::chrono::steady_clock::now() - start <
@@ -267,6 +314,8 @@ void Live(benchmark::State& state, bool from_memory, int preview_streams) {
     }
     const StationStatus status = station.Status();
     if (console) state.counters["preview_images_per_s"] = console->images() / g_args.seconds;
+    if (animations) state.counters["animation_jobs"] = animations->jobs_done();
+    animations.reset();
     console.reset();
     if (control) control->Stop();
     host.Stop();
@@ -313,6 +362,8 @@ int Run(const std::vector<std::string>& args) {
       g_args.seconds = std::stod(value);
     } else if (key == "--preview-streams") {
       g_args.preview_streams = std::stoi(value);
+    } else if (key == "--animation-spec") {
+      g_args.animation_spec = value;
     } else {
       pass.push_back(a);
     }
@@ -321,11 +372,11 @@ int Run(const std::vector<std::string>& args) {
       ->Iterations(1)
       ->Unit(benchmark::kSecond)
       ->UseRealTime();
-  benchmark::RegisterBenchmark(("station/live_ffv1_replay_" + Tag()).c_str(), Live, false, 0)
+  benchmark::RegisterBenchmark(("station/live_ffv1_replay_" + Tag()).c_str(), Live, false, 0, false)
       ->Iterations(1)
       ->Unit(benchmark::kSecond)
       ->UseRealTime();
-  benchmark::RegisterBenchmark(("station/live_from_memory_" + Tag()).c_str(), Live, true, 0)
+  benchmark::RegisterBenchmark(("station/live_from_memory_" + Tag()).c_str(), Live, true, 0, false)
       ->Iterations(1)
       ->Unit(benchmark::kSecond)
       ->UseRealTime();
@@ -333,7 +384,14 @@ int Run(const std::vector<std::string>& args) {
     benchmark::RegisterBenchmark(("station/live_from_memory_" + Tag() + "_with_" +
                                   std::to_string(g_args.preview_streams) + "_previews")
                                      .c_str(),
-                                 Live, true, g_args.preview_streams)
+                                 Live, true, g_args.preview_streams, false)
+        ->Iterations(1)
+        ->Unit(benchmark::kSecond)
+        ->UseRealTime();
+  }
+  if (!g_args.animation_spec.empty()) {
+    benchmark::RegisterBenchmark(
+        ("station/live_from_memory_" + Tag() + "_with_animation_jobs").c_str(), Live, true, 0, true)
         ->Iterations(1)
         ->Unit(benchmark::kSecond)
         ->UseRealTime();
@@ -347,7 +405,7 @@ int Run(const std::vector<std::string>& args) {
 const bool kRegistered =
     RegisterSuite({"station",
                    "the live station on paced replay: drops, latency, transitions lag (--cameras= "
-                   "--size= --fps= --seconds= --preview-streams=)",
+                   "--size= --fps= --seconds= --preview-streams= --animation-spec=)",
                    &Run});
 
 }  // namespace
