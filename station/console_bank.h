@@ -18,8 +18,7 @@ class ConsoleBank {
   explicit ConsoleBank(std::string path) : path_(std::move(path)) {}
 
   nlohmann::json Sessions() const;
-  // InputError naming the session / clip / sprite when it is not in the bank (the caller answers
-  // 404).
+  // NotFoundError naming the session / clip / sprite when it is not in the bank (404).
   nlohmann::json Clips(int64_t session_id) const;
   nlohmann::json ClipSprites(int64_t clip_id) const;
   nlohmann::json Sprite(int64_t sprite_id) const;

@@ -6,7 +6,7 @@
 // solves, drops views, redoes a step, sets the enclosure and saves from the
 // page; the state (views, coverage, diversity, checklist, ground pose,
 // enclosure, a long step's progress) goes out in the status the events stream
-// sends. Saving writes the models and the config (calib/station_save.h) and
+// sends. Saving writes the models and the config (config/station_save.h) and
 // restarts the live station with them inside the daemon.
 #include <memory>
 #include <vector>
