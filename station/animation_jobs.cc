@@ -87,6 +87,11 @@ nlohmann::json FileUrls(int64_t id, const fs::path& folder) {
   return files;
 }
 
+// A cost, or null before the optimizer's first figure.
+nlohmann::json Cost(bool none_yet, double cost) {
+  return none_yet ? nlohmann::json(nullptr) : nlohmann::json(cost);
+}
+
 }  // namespace
 
 const char* AnimationJobStateName(AnimationJobState state) {
@@ -293,6 +298,10 @@ void AnimationJobs::Run(std::shared_ptr<Current> job) {
             {{"name", scene->spec().sprites[s].name}, {"positions", std::move(positions)}});
       }
     };
+    {
+      std::lock_guard lock(mu_);
+      job->started = Now();  // the optimizer's clock from here (the trace's seconds)
+    }
     const AnimateResult result = RunAnimation(*scene, run);
     if (job->cancel) return set_state(AnimationJobState::kCancelled);
 
@@ -375,8 +384,8 @@ nlohmann::json AnimationJobs::Job(int64_t id) const {
       for (const auto& [s, cost] : c.trace) trace.push_back({s, cost});
       j["progress"] = {
           {"seconds", c.state == AnimationJobState::kRunning ? Now() - c.started : c.seconds},
-          {"cost", c.cost},
-          {"best_cost", c.best_cost},
+          {"cost", Cost(c.trace.empty(), c.cost)},
+          {"best_cost", Cost(c.trace.empty(), c.best_cost)},
           {"moves_kept", c.moves_kept},
           {"restarts", c.restarts},
           {"steps_rendered", c.steps_rendered},
@@ -465,8 +474,8 @@ nlohmann::json AnimationJobs::Brief() const {
   return {{"id", c.id},
           {"state", AnimationJobStateName(c.state)},
           {"seconds", c.state == AnimationJobState::kRunning ? Now() - c.started : c.seconds},
-          {"cost", c.cost},
-          {"best_cost", c.best_cost},
+          {"cost", Cost(c.trace.empty(), c.cost)},
+          {"best_cost", Cost(c.trace.empty(), c.best_cost)},
           {"moves_kept", c.moves_kept},
           {"restarts", c.restarts},
           {"steps_rendered", c.steps_rendered},
