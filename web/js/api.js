@@ -296,6 +296,7 @@ const PAGES = [
   { href: 'bank.html', id: 'bank', title: 'Bank' },
   { href: 'calibrate.html', id: 'calibrate', title: 'Calibrate' },
   { href: 'label.html', id: 'label', title: 'Label' },
+  { href: 'studio.html', id: 'studio', title: 'Studio' },
 ];
 
 // The top bar (the pages, the mode, the connection, sign out) and the message area, the same
