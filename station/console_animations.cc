@@ -109,9 +109,19 @@ nlohmann::json ConsoleAnimations::Inputs() const {
     cameras.push_back({{"name", camera.name}, {"model", model}});
     image_folders.insert(fs::path(model).parent_path().string());
   }
+  // Virtual cameras beside the bank (the reference sets' virtual.cameramodel), by their stem.
+  std::error_code ec;
+  for (const auto& entry : fs::directory_iterator(jobs.options().base_dir, ec)) {
+    const std::string path = entry.path().string();
+    if (entry.path().extension() != ".cameramodel" ||
+        std::any_of(cameras.begin(), cameras.end(),
+                    [&](const nlohmann::json& c) { return c["model"] == path; })) {
+      continue;
+    }
+    cameras.push_back({{"name", entry.path().stem().string()}, {"model", path}});
+  }
   std::set<std::string> backgrounds;
   for (const std::string& folder : image_folders) {
-    std::error_code ec;
     for (const auto& entry : fs::directory_iterator(folder, ec)) {
       const std::string ext = entry.path().extension().string();
       if (entry.is_regular_file(ec) && (ext == ".png" || ext == ".jpg" || ext == ".jpeg")) {

@@ -33,7 +33,8 @@ class ConsoleAnimations : public api::Part {
   void AddStatus(nlohmann::json& status) const override;  // "animation": the jobs' Brief()
   void Stop() override;
 
-  // GET /api/animations/inputs: {"bank", "cameras": [{"name", "model"}], "backgrounds",
+  // GET /api/animations/inputs: {"bank", "cameras": [{"name", "model"}] (the station's cameras'
+  // models, then the .cameramodel files beside the bank), "backgrounds",
   // "enclosure": [[x, y]...], "tags", "max_time_budget_s", "frame_rate"}.
   nlohmann::json Inputs() const;
 
