@@ -59,7 +59,10 @@ class ReachSets {
   void AppendPath(int root, int index, std::vector<int>* frames) const;
   // Number of frames on that path, both ends included.
   int PathLength(int root, int index) const;
-  size_t MemoryBytes() const { return entries_.size() * sizeof(Entry); }
+  size_t MemoryBytes() const {
+    return entries_.size() * sizeof(Entry) + depths_.size() * sizeof(uint16_t) +
+           counts_.size() * sizeof(int32_t);
+  }
 
  private:
   ReachDirection direction_ = ReachDirection::kForward;

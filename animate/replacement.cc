@@ -786,6 +786,24 @@ ReplacementSets ReplacementSets::Build(const Problem& problem, const Replacement
   return sets;
 }
 
+int64_t ReplacementSets::EstimateBytes(const Problem& problem, const ReplacementOptions& options) {
+  const int frames = problem.graph().num_frames();
+  int variants = 1;
+  if (options.frame_constraint_sets) {  // as Build counts them: by (frame set, strength)
+    std::vector<std::pair<const std::vector<bool>*, double>> made;
+    for (int k = 0; k < problem.num_terms(); ++k) {
+      const auto* frame = dynamic_cast<const FrameTerm*>(&problem.term(k));
+      if (frame == nullptr || frame->strength() <= 0) continue;
+      const std::pair<const std::vector<bool>*, double> key{&frame->allowed(), frame->strength()};
+      if (std::find(made.begin(), made.end(), key) == made.end()) made.push_back(key);
+    }
+    variants += static_cast<int>(made.size());
+  }
+  const int64_t pair =  // entries and depths, and a count per root
+      2 * (ReachSetBytes(frames, options.reach.set_size) + int64_t{frames} * 4);
+  return variants * pair + (variants - 1) * int64_t{frames} * int64_t{sizeof(int32_t)};
+}
+
 int ReplacementSets::VariantFor(const Problem& problem, Tracks tracks, int sprite, int first,
                                 int last, bool open_end) const {
   for (const auto& [k, variant] : frame_terms_) {

@@ -81,6 +81,9 @@ struct ReplacementOptions {
 class ReplacementSets {
  public:
   static ReplacementSets Build(const Problem& problem, const ReplacementOptions& options);
+  // What Build would take, before it is made: a pair of F/B sets per variant (one, and one per
+  // distinct frame constraint), and the toward() pointers.
+  static int64_t EstimateBytes(const Problem& problem, const ReplacementOptions& options);
   int num_variants() const { return static_cast<int>(forward_.size()); }
   const ReachSets& forward(int variant) const { return forward_[variant]; }
   const ReachSets& backward(int variant) const { return backward_[variant]; }

@@ -303,6 +303,30 @@ TEST(Replacement, FollowsAPathToItsEnd) {
   EXPECT_LT(path_term->MaxDeviation(tracks[0]), 0.2);
 }
 
+// The F/B sets' memory is known before they are made (a job checks it against the station's
+// budget): exactly what Build then takes, one pair of sets per distinct frame constraint.
+TEST(Replacement, TheSetsMemoryIsKnownBeforeTheyAreMade) {
+  const TransitionGraph graph = WalkingGraph::Make();
+  Problem problem(graph);
+  SpriteSpec spec;
+  spec.initial_frames = 30;
+  spec.max_frames = 120;
+  problem.AddSprite(spec);
+  problem.AddSprite(spec);
+  ReplacementOptions options = FastOptions(1.0);
+  const auto plain = ReplacementSets::Build(problem, options);
+  EXPECT_EQ(ReplacementSets::EstimateBytes(problem, options),
+            static_cast<int64_t>(plain.MemoryBytes()));
+  auto standing = std::make_shared<std::vector<bool>>(graph.FramesWithTag("standing"));
+  for (int s = 0; s < 2; ++s) {  // the same set and strength: one variant for both
+    problem.AddTerm(std::make_unique<FrameTerm>(s, standing, StepWindow::All(), 2.0));
+  }
+  const auto sets = ReplacementSets::Build(problem, options);
+  ASSERT_EQ(sets.num_variants(), 2);
+  EXPECT_EQ(ReplacementSets::EstimateBytes(problem, options),
+            static_cast<int64_t>(sets.MemoryBytes()));
+}
+
 // A cancel from another thread ends a run with an hour's budget at its next pick, with the
 // best valid sequences so far and the termination saying why.
 TEST(Replacement, ACancelFromAnotherThreadStopsTheRunAtOnce) {
