@@ -14,6 +14,7 @@
 #include "animate/cost_plot.h"
 #include "animate/playback.h"
 #include "animate/renderer.h"
+#include "animate/replacement.h"
 #include "animate/scene.h"
 #include "animate/sequence_io.h"
 #include "animate/spec.h"
@@ -121,6 +122,8 @@ bool AnimationJobsOptions::IsValid(std::string* why) const {
         "max_time_budget_s",
         "must be seconds in (0, " + OptionProblems::Num(kMaxTimeBudgetSeconds) + "], got " +
             OptionProblems::Num(max_time_budget_s));
+  check(max_set_bytes > 0, "max_set_bytes",
+        "must be a positive number of bytes, got " + std::to_string(max_set_bytes));
   check(threads >= 1 && threads <= 64, "threads", "must be 1..64, got " + std::to_string(threads));
   return check.ok();
 }
@@ -275,6 +278,19 @@ void AnimationJobs::Run(std::shared_ptr<Current> job) {
 
     AnimateRunOptions run{scene->spec().optimizer};
     run.optimizer.replacement.reach.num_threads = options_.threads;
+    if (run.optimizer.method == OptimizerMethod::kReplace) {
+      const int64_t bytes = ReplacementSets::EstimateBytes(
+          scene->problem(), scene->MakeReplacementOptions(run.optimizer.replacement));
+      if (bytes > options_.max_set_bytes) {
+        char text[160];
+        std::snprintf(text, sizeof text,
+                      "the optimizer's F/B sets would take %.1f MiB, over this station's %.1f MiB "
+                      "(a smaller optimizer.set_size, or fewer distinct frame constraints)",
+                      static_cast<double>(bytes) / (1 << 20),
+                      static_cast<double>(options_.max_set_bytes) / (1 << 20));
+        throw InputError("memory", text);
+      }
+    }
     run.cancel = &job->cancel;
     run.on_improvement = [&](const std::vector<Track>& tracks, const TracePoint& point) {
       std::lock_guard lock(mu_);

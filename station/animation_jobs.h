@@ -33,7 +33,10 @@ struct AnimationJobsOptions {
   std::vector<std::string> roots;  // the folders a spec may name files under (not empty)
   double max_time_budget_s = 600;  // a spec's optimizer.time_budget_s at most this
   int threads = 1;                 // the optimizer's threads (the F/B sets)
-  bool render = true;              // false: no render.mp4 and frames (tests of the optimizer)
+  // The most the optimizer's F/B sets may take (they grow with the bank, set_size and the
+  // distinct frame constraints): a job over it fails before they are made, saying so.
+  int64_t max_set_bytes = int64_t{2} << 30;
+  bool render = true;  // false: no render.mp4 and frames (tests of the optimizer)
   // False with "FIELD: reason" lines in `why` (core/option_checks.h) for values out of range.
   bool IsValid(std::string* why) const;
 };

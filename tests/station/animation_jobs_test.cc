@@ -129,6 +129,22 @@ TEST_F(AnimationJobsTest, OutsideFilesAndBudgetsOverTheCapAreRefusedBeforeAnythi
   EXPECT_THROW(jobs.Job(1), NotFoundError);
 }
 
+// The F/B sets are weighed before they are made: a job over the station's budget fails
+// saying what it would take, and the station takes the next job.
+TEST_F(AnimationJobsTest, AJobWhoseSetsWouldExceedTheMemoryBudgetFailsSayingSo) {
+  AnimationJobsOptions options = Options();
+  options.max_set_bytes = 1000;
+  AnimationJobs jobs(options);
+  const int64_t id = jobs.Submit(Spec(1));
+  const nlohmann::json j = WaitFor(jobs, id, {"done", "failed", "cancelled"}, 30);
+  EXPECT_EQ(j["state"], "failed");
+  EXPECT_EQ(j["error"].get<std::string>().rfind("memory: the optimizer's F/B sets would take ", 0),
+            0U)
+      << j["error"];
+  EXPECT_EQ(jobs.Submit(Spec(1)), id + 1);
+  jobs.Stop();
+}
+
 TEST_F(AnimationJobsTest, AJobCutOffByAStopReadsAsFailedAndItsNumberIsNotReused) {
   const fs::path folder = dir_.path() / "animations" / "0007";
   fs::create_directories(folder);
