@@ -1,6 +1,8 @@
 #include "station/console_animations.h"
 
 #include <algorithm>
+#include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -12,6 +14,7 @@
 #include "core/error.h"
 #include "core/error_kinds.h"
 #include "core/log.h"
+#include "core/yaml_reader.h"
 #include "station/station_host.h"
 
 // After every header that may include Eigen (api_part.h says why).
@@ -51,6 +54,39 @@ void SendFile(httplib::Response& res, const std::string& path) {
   if (!in) throw NotFoundError("file", "cannot read " + fs::path(path).filename().string());
   std::string body((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   res.set_content(body, type);
+}
+
+// YAML as JSON, for the page (which reads JSON only): a plain scalar that reads whole as a
+// number, true / false or null is one; everything else, and every quoted scalar, is text.
+nlohmann::json JsonOfYaml(const YAML::Node& node) {
+  switch (node.Type()) {
+    case YAML::NodeType::Sequence: {
+      nlohmann::json list = nlohmann::json::array();
+      for (const YAML::Node& item : node) list.push_back(JsonOfYaml(item));
+      return list;
+    }
+    case YAML::NodeType::Map: {
+      nlohmann::json map = nlohmann::json::object();
+      for (const auto& item : node) map[item.first.Scalar()] = JsonOfYaml(item.second);
+      return map;
+    }
+    case YAML::NodeType::Scalar: {
+      const std::string& text = node.Scalar();
+      if (node.Tag() == "!") return text;  // quoted
+      if (text == "true" || text == "false") return text == "true";
+      if (text == "null" || text == "~") return nullptr;
+      char* end = nullptr;
+      const double number = std::strtod(text.c_str(), &end);
+      if (!text.empty() && end == text.c_str() + text.size() && std::isfinite(number)) {
+        const bool whole = text.find_first_of(".eE") == std::string::npos;
+        return whole && std::abs(number) < 9e15 ? nlohmann::json(static_cast<int64_t>(number))
+                                                : nlohmann::json(number);
+      }
+      return text;
+    }
+    default:
+      return nullptr;
+  }
 }
 
 }  // namespace
@@ -170,6 +206,15 @@ std::vector<Route> ConsoleAnimations::Routes() {
          const int64_t job = Jobs().Submit(body["spec"].get<std::string>());
          Reply(res, 202, {{"id", job}, {"state", "queued"}});
        }},
+      {"POST", "/api/animations/spec.json", "POST /api/animations/spec.json {\"spec\": YAML}",
+       Json([](const httplib::Request& req) {
+         const nlohmann::json body = api::ObjectBody(req, {"spec"});
+         if (!body.contains("spec") || !body["spec"].is_string()) {
+           throw InputError("spec", "required: the animation spec's YAML text");
+         }
+         return nlohmann::json{{"spec", JsonOfYaml(yaml_text::LoadOneDocument(
+                                            body["spec"].get<std::string>(), "spec"))}};
+       })},
       {"GET", "/api/animations/" + id, "GET /api/animations/ID",
        Json([this](const httplib::Request& req) {
          return Jobs().Job(api::PathId(req, "animation"));

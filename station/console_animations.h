@@ -33,6 +33,8 @@ class ConsoleAnimations : public api::Part {
   void AddStatus(nlohmann::json& status) const override;  // "animation": the jobs' Brief()
   void Stop() override;
 
+  // POST /api/animations/spec.json {"spec": YAML} -> {"spec": the YAML as JSON}: the page reads
+  // any spec so (docs/examples' too); InputError naming the line of text that is not YAML.
   // GET /api/animations/inputs: {"bank", "cameras": [{"name", "model"}] (the station's cameras'
   // models, then the .cameramodel files beside the bank), "backgrounds",
   // "enclosure": [[x, y]...], "tags", "max_time_budget_s", "frame_rate"}.

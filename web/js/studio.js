@@ -471,12 +471,24 @@ $('delete-sprite').addEventListener('click', () => {
   changed();
 });
 
-$('load-spec').addEventListener('click', () => {
+// The text as a spec: the JSON the page writes as it is, any other YAML (docs/examples', a spec
+// written by hand) as the station reads it (POST /api/animations/spec.json).
+async function specOfText(text) {
   try {
-    loadScene(sceneOf(parseSpecText(specBox.value)));
+    return parseSpecText(text);
+  } catch {
+    const { spec } = await postJson('/api/animations/spec.json', { spec: text });
+    if (!spec || typeof spec !== 'object' || Array.isArray(spec)) throw new Error('expected a spec: a mapping of keys');
+    return spec;
+  }
+}
+
+$('load-spec').addEventListener('click', async () => {
+  try {
+    loadScene(sceneOf(await specOfText(specBox.value)));
     showMessage('Spec loaded into the plan.', 'info');
   } catch (err) {
-    showMessage(`load: the studio reads the JSON specs it writes (${err.message})`, 'error');
+    showMessage(`load: ${err.message}`, 'error');
   }
 });
 

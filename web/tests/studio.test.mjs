@@ -237,3 +237,30 @@ test('a long run is cancelled within 2 s', async () => {
   console.log(`# studio: cancelled in ${ms} ms`);
   assert.deepEqual(p.errors, []);
 });
+
+test('a YAML spec from docs/examples loads onto the plan', async () => {
+  const yaml = fs.readFileSync(path.join(h.REPO, 'docs/examples/standup.yaml'), 'utf8');
+  await p.fill('[data-testid="spec-text"]', yaml);
+  await clickAt('load-spec');
+  await h.waitFor('the example on the plan', async () => {
+    try {
+      return parseSpec(await specText()).sprites.length === 2;
+    } catch {
+      return false;
+    }
+  });
+  const spec = parseSpec(await specText());
+  assert.deepEqual(spec.sprites.map((x) => x.name), ['leader', 'follower']);
+  const leader = spec.sprites[0].constraints.find((c) => c.path).path;
+  assert.deepEqual(leader.points, [[-0.4, -0.25], [-0.15, -0.05], [0.05, 0.0], [0.25, 0.12]]);
+  // what the page does not draw (the follower's `follow`) is kept as it was
+  assert.deepEqual(spec.sprites[1].constraints.find((c) => c.location).location,
+    { follow: 'leader', offset: [-0.15, 0.12], offset_axes: 'heading', strength: 20 });
+  assert.equal(spec.optimizer.time_budget_s, 60);
+  // YAML that is not a spec is named by its line
+  await p.fill('[data-testid="spec-text"]', 'version: 1\nsprites: [1, 2\n');
+  await clickAt('load-spec');
+  await h.waitFor('the YAML error in the message bar', async () => /^load: spec:\d+: not valid YAML/.test(await messageText()));
+  await clickAt('[data-testid="message"] button');
+  assert.deepEqual(p.errors, []);
+});
