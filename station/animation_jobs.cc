@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <sstream>
 
 #include <opencv2/imgcodecs.hpp>
@@ -88,6 +89,14 @@ nlohmann::json FileUrls(int64_t id, const fs::path& folder) {
   return files;
 }
 
+// Every other point once a curve holds kMaxTracePoints: its shape stays, its size is bounded.
+template <typename Point>
+void Thin(std::vector<Point>& curve) {
+  if (curve.size() < kMaxTracePoints) return;
+  for (size_t i = 0; i < curve.size() / 2; ++i) curve[i] = std::move(curve[2 * i]);
+  curve.resize(curve.size() / 2);
+}
+
 // A cost, or null before the optimizer's first figure.
 nlohmann::json Cost(bool none_yet, double cost) {
   return none_yet ? nlohmann::json(nullptr) : nlohmann::json(cost);
@@ -147,8 +156,9 @@ struct AnimationJobs::Current {
   int restarts = 0;
   int steps_rendered = 0, num_steps = 0;
   std::vector<std::pair<double, double>> trace;  // (seconds, best cost)
+  // (seconds, the current sequences' cost by kind of term), as often as the tracks
+  std::vector<std::pair<double, std::map<std::string, double>>> by_kind;
   nlohmann::json tracks = nlohmann::json::array();
-  double tracks_at = -1;
 
   nlohmann::json Saved() const {  // job.json
     return {{"id", id},
@@ -292,27 +302,37 @@ void AnimationJobs::Run(std::shared_ptr<Current> job) {
       }
     }
     run.cancel = &job->cancel;
+    // The figures of every kept move; the tracks and the cost by kind of term 4 times a second,
+    // made before the lock is taken (a status reader never waits for them).
+    double sampled_at = -1;
     run.on_improvement = [&](const std::vector<Track>& tracks, const TracePoint& point) {
+      const bool sample = point.seconds - sampled_at >= kTracksEverySeconds;
+      nlohmann::json tracks_json = nlohmann::json::array();
+      std::map<std::string, double> by_kind;
+      if (sample) {
+        sampled_at = point.seconds;
+        by_kind = scene->problem().Evaluate(tracks).by_kind;
+        for (size_t s = 0; s < tracks.size(); ++s) {
+          nlohmann::json positions = nlohmann::json::array();
+          for (const Eigen::Vector2d& p : tracks[s].positions_m) {
+            positions.push_back({p.x(), p.y()});
+          }
+          tracks_json.push_back(
+              {{"name", scene->spec().sprites[s].name}, {"positions", std::move(positions)}});
+        }
+      }
       std::lock_guard lock(mu_);
       job->seconds = point.seconds;
       job->cost = point.cost;
       job->best_cost = point.best_cost;
       job->moves_kept = point.moves_kept;
       job->restarts = point.restart;
-      if (job->trace.size() >= kMaxTracePoints) {  // every other point: the curve's shape stays
-        for (size_t i = 0; i < job->trace.size() / 2; ++i) job->trace[i] = job->trace[2 * i];
-        job->trace.resize(job->trace.size() / 2);
-      }
+      Thin(job->trace);
       job->trace.emplace_back(point.seconds, point.best_cost);
-      if (point.seconds - job->tracks_at < kTracksEverySeconds) return;
-      job->tracks_at = point.seconds;
-      job->tracks = nlohmann::json::array();
-      for (size_t s = 0; s < tracks.size(); ++s) {
-        nlohmann::json positions = nlohmann::json::array();
-        for (const Eigen::Vector2d& p : tracks[s].positions_m) positions.push_back({p.x(), p.y()});
-        job->tracks.push_back(
-            {{"name", scene->spec().sprites[s].name}, {"positions", std::move(positions)}});
-      }
+      if (!sample) return;
+      Thin(job->by_kind);
+      job->by_kind.emplace_back(point.seconds, std::move(by_kind));
+      job->tracks = std::move(tracks_json);
     };
     {
       std::lock_guard lock(mu_);
@@ -398,6 +418,8 @@ nlohmann::json AnimationJobs::Job(int64_t id) const {
       j["spec"] = c.spec_text;
       nlohmann::json trace = nlohmann::json::array();
       for (const auto& [s, cost] : c.trace) trace.push_back({s, cost});
+      nlohmann::json by_kind = nlohmann::json::array();
+      for (const auto& [s, costs] : c.by_kind) by_kind.push_back({s, costs});
       j["progress"] = {
           {"seconds", c.state == AnimationJobState::kRunning ? Now() - c.started : c.seconds},
           {"cost", Cost(c.trace.empty(), c.cost)},
@@ -405,7 +427,8 @@ nlohmann::json AnimationJobs::Job(int64_t id) const {
           {"moves_kept", c.moves_kept},
           {"restarts", c.restarts},
           {"steps_rendered", c.steps_rendered},
-          {"trace", std::move(trace)}};
+          {"trace", std::move(trace)},
+          {"by_kind", std::move(by_kind)}};
       j["tracks"] = c.tracks;
       j["num_steps"] = c.num_steps;
     }
@@ -495,7 +518,9 @@ nlohmann::json AnimationJobs::Brief() const {
           {"moves_kept", c.moves_kept},
           {"restarts", c.restarts},
           {"steps_rendered", c.steps_rendered},
-          {"num_steps", c.num_steps}};
+          {"num_steps", c.num_steps},
+          {"by_kind",
+           c.by_kind.empty() ? nlohmann::json(nullptr) : nlohmann::json(c.by_kind.back().second)}};
 }
 
 std::string AnimationJobs::File(int64_t id, const std::string& name) const {

@@ -73,6 +73,9 @@ TEST_F(AnimationJobsTest, AJobIsOptimizedJudgedRenderedAndSaved) {
   ASSERT_TRUE(j["judge"].contains("paths")) << j["judge"].dump();
   EXPECT_EQ(j["judge"]["paths"][0]["sprite"], "walker");
   EXPECT_FALSE(j["progress"]["trace"].empty());
+  // the cost by kind of term over time: the path's and the length's
+  ASSERT_FALSE(j["progress"]["by_kind"].empty());
+  EXPECT_TRUE(j["progress"]["by_kind"].back()[1].contains("path")) << j["progress"]["by_kind"];
   ASSERT_EQ(j["tracks"].size(), 1U);
   EXPECT_EQ(j["tracks"][0]["positions"].size(), static_cast<size_t>(file.num_steps));
   // The render: a video of every step, and one JPEG a step for the page.

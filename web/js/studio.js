@@ -879,9 +879,10 @@ events.addEventListener('status', (e) => {
   if (job && a.id === job.id) {
     const stateChanged = a.state !== job.state;
     job.state = a.state;
-    const figures = { ...a }; // seconds, cost, best_cost, turns, restarts
+    const figures = { ...a }; // seconds, cost, best_cost, moves_kept, restarts, ...
     delete figures.id;
     delete figures.state;
+    delete figures.by_kind; // the latest only: the job's poll brings the curves
     job.progress = { ...job.progress, ...figures };
     const last = curve[curve.length - 1];
     // A point while it optimizes (a best cost of 0 is none yet), later than the curve's last.
@@ -943,7 +944,8 @@ function drawCurve() {
     return;
   }
   const t1 = Math.max(jobBudget || 0, curve[curve.length - 1][0], 1);
-  const costs = curve.map(([, c]) => c);
+  const kinds = kindCurves();
+  const costs = [...curve.map(([, c]) => c), ...kinds.flatMap(({ points }) => points.map(([, c]) => c).filter((c) => c > 0))];
   const lo = Math.min(...costs);
   const hi = Math.max(...costs);
   const log = lo > 0 && hi / lo > 20;
@@ -964,6 +966,13 @@ function drawCurve() {
   ctx.fillText('0', left, h - 2);
   ctx.textAlign = 'right';
   ctx.fillText(`${fmt(t1, 0)} s${log ? ' · log cost' : ''}`, right, h - 2);
+  ctx.lineWidth = 1;
+  for (const { colour, points } of kinds) { // the current sequences' cost of each kind of term
+    ctx.strokeStyle = colour;
+    ctx.beginPath();
+    points.forEach(([t, c], i) => (i ? ctx.lineTo : ctx.moveTo).call(ctx, x(t), y(Math.max(c, lo))));
+    ctx.stroke();
+  }
   ctx.strokeStyle = '#4c9dff';
   ctx.lineWidth = 1.5;
   ctx.beginPath();
@@ -972,6 +981,28 @@ function drawCurve() {
     (i ? ctx.lineTo : ctx.moveTo).call(ctx, x(t), y(c));
   });
   ctx.stroke();
+}
+
+// The job's cost by kind of term over time (progress.by_kind: [[seconds, {kind: cost}]...]), a
+// curve and a colour each, and their latest values under the chart.
+const KIND_COLOURS = ['#f5a524', '#22d3ee', '#e879f9', '#a3e635', '#fb7185', '#a78bfa', '#facc15', '#94a3b8'];
+function kindCurves() {
+  const samples = Array.isArray(job?.progress?.by_kind) ? job.progress.by_kind : [];
+  const names = [...new Set(samples.flatMap(([, costs]) => Object.keys(costs || {})))].sort();
+  const kinds = names.map((name, i) => ({
+    name,
+    colour: KIND_COLOURS[i % KIND_COLOURS.length],
+    points: samples.filter(([t, costs]) => Number.isFinite(t) && Number.isFinite(costs?.[name])).map(([t, costs]) => [t, costs[name]]),
+  }));
+  const legend = $('cost-kinds');
+  legend.replaceChildren(...kinds.map(({ name, colour, points }) => {
+    const last = points[points.length - 1];
+    const item = el('span', {}, `${name} ${last ? shortCost(last[1]) : '–'}`);
+    item.style.setProperty('--c', colour);
+    item.dataset.kind = name;
+    return item;
+  }));
+  return kinds;
 }
 
 function shortCost(c) {

@@ -135,6 +135,8 @@ test('the circle composed with the mouse runs: cost curve, tracks, judge, player
   assert.ok(states.has('running'), `the updates came while it ran (${[...states]})`);
   await h.waitFor('tracks on the plan', async () => Number(await p.getAttribute('[data-testid="plan"]', 'data-tracks')) >= 1,
     { timeout: 15000 });
+  // the cost of each kind of term beside the total: the path's and the length's
+  await p.waitForSelector('[data-testid="cost-kinds"] span[data-kind="path"]', { timeout: 15000 });
   await h.waitFor('the job done', async () => {
     const st = await jobState();
     if (st === 'failed' || st === 'cancelled') throw new Error(`job ${st}: ${await h.text(p, 'job-error')}`);
