@@ -11,7 +11,11 @@
 //   - no drop: every frame the cameras delivered was processed (dropped.total 0), no batch
 //     failed, sprites were stored.
 // The client does what the station page does: the events stream open, /api/status every
-// second, two cameras' preview JPEGs at 5 Hz each, /metrics every 5 s.
+// second, 8 preview streams (raw, keyed, sprites and a second keyed one for each of the two
+// cameras) at 5 Hz each, /metrics every 5 s. And what the studio does (issue 39): from the
+// second minute, an animation job on the station's own bank every minute (a 20 s budget,
+// rendered), cancelled when it has not ended by the next; every job must end done or
+// cancelled, none failed or left running.
 //   node bench/soak/soak.mjs [MINUTES]     (scripts/soak.sh builds first)
 import fs from 'node:fs';
 import http from 'node:http';
@@ -88,15 +92,51 @@ const clients = [
     if (r.status !== 200) failures++;
     latencies.push({ t: (Date.now() - t0) / 1000, ms: r.ms });
   }),
-  ...cameras.map((c) => loop(200, async () => {
-    const r = await get(`/api/cameras/${c}/preview.jpg?view=keyed&width=640`);
-    if (r.status !== 200) failures++;
-  })),
+  ...cameras.flatMap((c) => ['preview.jpg?view=raw', 'preview.jpg?view=keyed', 'sprites.json?x=1', 'preview.jpg?view=keyed']
+    .map((view) => loop(200, async () => {
+      const r = await get(`/api/cameras/${c}/${view}&width=640`);
+      if (r.status !== 200) failures++;
+    }))),
   loop(5000, async () => {
     const r = await get('/metrics');
     if (r.status !== 200) failures++;
   }),
 ];
+
+// The studio's jobs: a circle on the station's bank (relative names resolve beside it; the
+// camera is the replayed session's, a folder the station knows).
+const spec = JSON.stringify({
+  version: 1, frame_rate: 30, length: { min_frames: 60, max_frames: 300 },
+  camera: `${s.dir}/cam0.cameramodel`, banks: [cfg.bank],
+  optimizer: { method: 'replace', time_budget_s: 20 },
+  sprites: [{ name: 'hamster', start: [0.2, 0], constraints: [{ path: {
+    points: [[0.2, 0], [0, 0.2], [-0.2, 0], [0, -0.2], [0.2, 0]], distance_strength: 200, unreached_strength: 3000 } }] }],
+});
+const postJson = (path, body) => new Promise((resolve, reject) => {
+  const req = http.request(base + path, { method: 'POST', headers: { 'content-type': 'application/json' } }, (res) => {
+    let text = '';
+    res.on('data', (d) => { text += d; });
+    res.on('end', () => resolve({ status: res.statusCode, body: text ? JSON.parse(text) : {} }));
+  });
+  req.on('error', reject);
+  req.end(JSON.stringify(body));
+});
+const jobs = []; // {id, state}
+async function nextJob() {
+  const prev = jobs[jobs.length - 1];
+  if (prev) {
+    prev.state = (await json(`/api/animations/${prev.id}`)).state;
+    if (['queued', 'running', 'rendering'].includes(prev.state)) {
+      await postJson(`/api/animations/${prev.id}/cancel`, {});
+      await h.waitFor(`job ${prev.id} cancelled`, async () => !['queued', 'running', 'rendering']
+        .includes(prev.state = (await json(`/api/animations/${prev.id}`)).state), { timeout: 5000 });
+    }
+  }
+  const r = await postJson('/api/animations', { spec });
+  if (r.status !== 202) throw new Error(`job refused: ${r.status} ${JSON.stringify(r.body)}`);
+  jobs.push({ id: r.body.id, state: 'queued' });
+}
+let nextJobAt = 1;
 
 const samples = []; // every 10 s
 const sessionMinutes = minutes / 3;
@@ -106,6 +146,10 @@ while ((Date.now() - t0) / 60000 < minutes) {
   if (sessionOpen && (Date.now() - t0) / 60000 >= sessionMinutes) {
     if ((await post('/api/session/stop', {})) !== 200) throw new Error('the session did not stop');
     sessionOpen = false;
+  }
+  if ((Date.now() - t0) / 60000 >= nextJobAt && (Date.now() - t0) / 60000 < minutes - 0.5) {
+    await nextJob();
+    nextJobAt += 1;
   }
   const st = await json('/api/status');
   const cams = st.cameras.filter((c) => cameras.includes(c.name));
@@ -117,12 +161,23 @@ while ((Date.now() - t0) / 60000 < minutes) {
     sprites: st.bank.sprites,
     batches_failed: st.bank.batches_failed ?? 0,
     latency_p99_ms: pct(latencies.filter((l) => l.t > (Date.now() - t0) / 1000 - 10).map((l) => l.ms), 0.99),
+    animation: st.animation ? `${st.animation.id} ${st.animation.state}` : null,
   };
   samples.push(sample);
   console.log(JSON.stringify(sample));
 }
 running = false;
 await Promise.all(clients);
+// The last job: waited for while it may still end on its own, then cancelled.
+const lastJob = jobs[jobs.length - 1];
+if (lastJob) {
+  await h.waitFor(`job ${lastJob.id} to end`, async () => !['queued', 'running', 'rendering']
+    .includes(lastJob.state = (await json(`/api/animations/${lastJob.id}`)).state), { timeout: 60000 })
+    .catch(async () => { await postJson(`/api/animations/${lastJob.id}/cancel`, {}); await h.sleep(2000); });
+  lastJob.state = (await json(`/api/animations/${lastJob.id}`)).state;
+}
+const jobStates = {};
+for (const j of jobs) jobStates[j.state] = (jobStates[j.state] || 0) + 1;
 sse.destroy();
 if (sessionOpen) await post('/api/session/stop', {});
 const code = await station.stop();
@@ -150,6 +205,7 @@ const result = {
   dropped: last.dropped,
   sprites_stored: last.sprites - first.sprites,
   batches_failed: last.batches_failed,
+  animation_jobs: jobStates,
   daemon_exit: code,
 };
 console.log('soak: ' + JSON.stringify(result));
@@ -162,6 +218,9 @@ if (result.batches_failed > 0) problems.push(`${result.batches_failed} batches f
 if (failures > 0) problems.push(`${failures} requests failed`);
 if (!(result.sprites_stored > 0)) problems.push('no sprite stored');
 if (code !== 0) problems.push(`the daemon exited ${code}`);
+const unclean = jobs.filter((j) => j.state !== 'done' && j.state !== 'cancelled');
+if (unclean.length) problems.push(`animation jobs not done or cancelled: ${unclean.map((j) => `${j.id} ${j.state}`).join(', ')}`);
+if (minutes >= 2 && !jobs.length) problems.push('no animation job ran');
 fs.writeFileSync(`${h.WORK}/soak.json`, JSON.stringify({ result, samples }, null, 1));
 console.log(problems.length ? `soak: FAILED: ${problems.join('; ')}` : 'soak: passed');
 process.exit(problems.length ? 1 : 0);
