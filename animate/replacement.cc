@@ -522,7 +522,7 @@ class Replacer {
   void AddTracePoint() {
     const double best = best_tracks_.empty() ? total_ : std::min(total_, best_total_);
     summary_->trace.push_back({MonotonicSeconds() - run_start_, total_, best, restart_,
-                               summary_->moves_tried, summary_->moves_kept});
+                               summary_->moves_tried, summary_->moves_kept, summary_->turns});
   }
 
   // A step where sprite s collides (one of its collision terms costs something there), drawn

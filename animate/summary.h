@@ -25,6 +25,7 @@ struct TracePoint {
   int restart = 0;         // costs never rise within one restart
   int64_t moves_tried = 0;
   int64_t moves_kept = 0;
+  int turns = 0;  // sprite turns so far (replacement)
 };
 
 struct Summary {

@@ -153,7 +153,7 @@ struct AnimationJobs::Current {
   double seconds = 0;  // of the optimizer's run at the last figures
   double cost = 0, best_cost = 0;
   int64_t moves_kept = 0;
-  int restarts = 0;
+  int restarts = 0, turns = 0;
   int steps_rendered = 0, num_steps = 0;
   std::vector<std::pair<double, double>> trace;  // (seconds, best cost)
   // (seconds, the current sequences' cost by kind of term), as often as the tracks
@@ -327,6 +327,7 @@ void AnimationJobs::Run(std::shared_ptr<Current> job) {
       job->best_cost = point.best_cost;
       job->moves_kept = point.moves_kept;
       job->restarts = point.restart;
+      job->turns = point.turns;
       Thin(job->trace);
       job->trace.emplace_back(point.seconds, point.best_cost);
       if (!sample) return;
@@ -354,6 +355,7 @@ void AnimationJobs::Run(std::shared_ptr<Current> job) {
       job->seconds = result.summary.total_seconds;
       job->best_cost = result.summary.final_cost.total;
       job->restarts = result.summary.restarts;
+      job->turns = result.summary.turns;
     }
     if (options_.render) {
       set_state(AnimationJobState::kRendering);
@@ -426,6 +428,7 @@ nlohmann::json AnimationJobs::Job(int64_t id) const {
           {"best_cost", Cost(c.trace.empty(), c.best_cost)},
           {"moves_kept", c.moves_kept},
           {"restarts", c.restarts},
+          {"turns", c.turns},
           {"steps_rendered", c.steps_rendered},
           {"trace", std::move(trace)},
           {"by_kind", std::move(by_kind)}};
@@ -517,6 +520,7 @@ nlohmann::json AnimationJobs::Brief() const {
           {"best_cost", Cost(c.trace.empty(), c.best_cost)},
           {"moves_kept", c.moves_kept},
           {"restarts", c.restarts},
+          {"turns", c.turns},
           {"steps_rendered", c.steps_rendered},
           {"num_steps", c.num_steps},
           {"by_kind",

@@ -73,6 +73,7 @@ TEST_F(AnimationJobsTest, AJobIsOptimizedJudgedRenderedAndSaved) {
   ASSERT_TRUE(j["judge"].contains("paths")) << j["judge"].dump();
   EXPECT_EQ(j["judge"]["paths"][0]["sprite"], "walker");
   EXPECT_FALSE(j["progress"]["trace"].empty());
+  EXPECT_GT(j["progress"]["turns"].get<int>(), 0);
   // the cost by kind of term over time: the path's and the length's
   ASSERT_FALSE(j["progress"]["by_kind"].empty());
   EXPECT_TRUE(j["progress"]["by_kind"].back()[1].contains("path")) << j["progress"]["by_kind"];
