@@ -17,7 +17,10 @@ int BankGraph::FrameOf(int bank, int64_t sprite_id) const {
 }
 
 BankGraph LoadBankGraph(const std::vector<std::string>& bank_paths,
-                        const std::vector<std::string>& tags) {
+                        const std::vector<std::string>& tags, const std::atomic<bool>* cancel) {
+  auto stop_if_cancelled = [cancel](const std::string& bank) {
+    if (cancel != nullptr && cancel->load()) throw WorkError(bank, "cancelled");
+  };
   BankGraph out;
   out.bank_paths = bank_paths;
   std::vector<FrameInfo> infos;
@@ -27,7 +30,9 @@ BankGraph LoadBankGraph(const std::vector<std::string>& bank_paths,
     const Bank bank(bank_paths[b]);
     // One snapshot for the sprites, tags and transitions of a bank that may still be written.
     const BankSnapshot snapshot(bank);
+    stop_if_cancelled(bank_paths[b]);
     const std::vector<SpriteFeatures> features = bank.LoadFeatures();
+    stop_if_cancelled(bank_paths[b]);
     if (features.empty())
       throw InputError(bank_paths[b], "the bank holds no sprites in complete clips");
     // The source frame interval: the median timestamp step between clip neighbours.
@@ -69,7 +74,10 @@ BankGraph LoadBankGraph(const std::vector<std::string>& bank_paths,
       }
     }
     int64_t kept = 0;
-    for (const TransitionRecord& t : bank.LoadTransitions()) {
+    stop_if_cancelled(bank_paths[b]);
+    const std::vector<TransitionRecord> transitions = bank.LoadTransitions();
+    stop_if_cancelled(bank_paths[b]);
+    for (const TransitionRecord& t : transitions) {
       const auto from = index_of.find(t.from_sprite);
       const auto to = index_of.find(t.to_sprite);
       if (from == index_of.end() || to == index_of.end()) continue;  // an incomplete clip's

@@ -6,6 +6,7 @@
 // frame interval (the median timestamp step within clips), so positions integrate what
 // the subject really moved between source frames, whatever the playback rate.
 // Frames of several banks are pooled; no transition joins two banks.
+#include <atomic>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -31,8 +32,10 @@ struct BankGraph {
 
 // Loads the banks. `tags` are the tag names to attach to frames (those the spec asks for;
 // "mirrored" is always attached to mirrored copies). InputError naming a bank that cannot be
-// opened or holds no sprites.
+// opened or holds no sprites. `cancel`, set by another thread, stops the load between its reads
+// (WorkError "BANK: cancelled").
 BankGraph LoadBankGraph(const std::vector<std::string>& bank_paths,
-                        const std::vector<std::string>& tags);
+                        const std::vector<std::string>& tags,
+                        const std::atomic<bool>* cancel = nullptr);
 
 }  // namespace ss

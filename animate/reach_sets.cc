@@ -131,6 +131,7 @@ ReachSets ReachSets::Build(const TransitionGraph& graph, ReachDirection directio
   auto work = [&] {
     DijkstraWorkspace workspace(n);
     for (;;) {
+      if (options.cancel != nullptr && options.cancel->load(std::memory_order_relaxed)) return;
       const int begin = next_root.fetch_add(kChunk);
       if (begin >= n) return;
       for (int root = begin; root < std::min(n, begin + kChunk); ++root) {
@@ -145,6 +146,8 @@ ReachSets ReachSets::Build(const TransitionGraph& graph, ReachDirection directio
   for (int k = 1; k < threads; ++k) pool.emplace_back(work);
   work();
   for (auto& t : pool) t.join();
+  if (options.cancel != nullptr && options.cancel->load())
+    throw WorkError("reach sets", "cancelled");
   return sets;
 }
 

@@ -6,6 +6,7 @@
 //   Ĉ(a->b) = C(a->b) + step_cost + entry_cost[b],
 // i.e. the smoothness cost (eq. 5), optionally raised per frame entered (frames outside a
 // required tag, slow frames) and per step (so long zero-cost runs are not free).
+#include <atomic>
 #include <cstdint>
 #include <span>
 #include <string>
@@ -21,6 +22,9 @@ struct ReachOptions {
   int set_size = 200;      // N: frames kept per set, the root included
   int num_threads = 2;     // Dijkstra runs are independent; split over this many threads (1..256)
   double step_cost = 0.0;  // added to every edge of Ĉ
+  // Set by another thread: Build stops within a chunk of roots and throws WorkError (not
+  // a spec key: the studio's jobs set it).
+  const std::atomic<bool>* cancel = nullptr;
   // False with "FIELD: reason" lines in `why` (core/option_checks.h) for values out of range.
   bool IsValid(std::string* why) const;
 };

@@ -752,6 +752,7 @@ ReplacementSets ReplacementSets::Build(const Problem& problem, const Replacement
   const TransitionGraph& graph = problem.graph();
   const std::vector<double> base = SlowFrameCosts(graph, options);
   ReachOptions reach = options.reach;
+  reach.cancel = options.cancel;
   reach.step_cost += options.step_cost_fraction * graph.MedianPositiveCost();
   auto add_variant = [&](const std::vector<double>& entry_cost) {
     sets.forward_.push_back(ReachSets::Build(graph, ReachDirection::kForward, reach, entry_cost));

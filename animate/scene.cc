@@ -16,7 +16,7 @@ Scene::Scene(AnimationSpec spec, BankGraph bank) : spec_(std::move(spec)), bank_
   AddTerms();
 }
 
-std::unique_ptr<Scene> Scene::Load(AnimationSpec spec) {
+std::unique_ptr<Scene> Scene::Load(AnimationSpec spec, const std::atomic<bool>* cancel) {
   std::vector<std::string> tags;
   for (const SpriteSpecEntry& s : spec.sprites) {
     for (const FrameSpec& f : s.frames) {
@@ -25,7 +25,7 @@ std::unique_ptr<Scene> Scene::Load(AnimationSpec spec) {
   }
   if (spec.repeats.strength > 0 && !spec.repeats.still_tag.empty())
     tags.push_back(spec.repeats.still_tag);
-  BankGraph bank = LoadBankGraph(spec.bank_paths, tags);
+  BankGraph bank = LoadBankGraph(spec.bank_paths, tags, cancel);
   return std::make_unique<Scene>(std::move(spec), std::move(bank));
 }
 

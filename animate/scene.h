@@ -1,6 +1,7 @@
 #pragma once
 // An animation spec made concrete: the banks' transition graph and the Problem (sprites
 // and cost terms) the spec asks for, plus the optimizer options it sets.
+#include <atomic>
 #include <memory>
 #include <vector>
 
@@ -17,8 +18,9 @@ class Scene {
   // Builds the terms of `spec` over `bank`. InputError naming the spec's line and field
   // for a constraint the banks cannot meet (an unknown tag, sprite id).
   Scene(AnimationSpec spec, BankGraph bank);
-  // Opens the spec's banks and builds the scene.
-  static std::unique_ptr<Scene> Load(AnimationSpec spec);
+  // Opens the spec's banks and builds the scene; `cancel` stops the banks' load between its
+  // reads (LoadBankGraph).
+  static std::unique_ptr<Scene> Load(AnimationSpec spec, const std::atomic<bool>* cancel = nullptr);
   Scene(const Scene&) = delete;
   Scene& operator=(const Scene&) = delete;
 

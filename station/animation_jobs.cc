@@ -283,7 +283,7 @@ void AnimationJobs::Run(std::shared_ptr<Current> job) {
       job->started = Now();
     }
     set_state(AnimationJobState::kRunning);
-    const auto scene = Scene::Load(job->spec);
+    const auto scene = Scene::Load(job->spec, &job->cancel);
     if (job->cancel) return set_state(AnimationJobState::kCancelled);
 
     AnimateRunOptions run{scene->spec().optimizer};
@@ -400,8 +400,15 @@ void AnimationJobs::Run(std::shared_ptr<Current> job) {
         ->info("job {} done: cost {:.6g}, {} steps", job->id, result.summary.final_cost.total,
                file.num_steps);
   } catch (const std::exception& e) {
-    Log("station.animations")->error("job {}: {}", job->id, e.what());
+    // A cancel stops the banks' load and the F/B sets by throwing: cancelled, not failed.
+    const bool cancelled = job->cancel.load();
+    if (cancelled) {
+      Log("station.animations")->info("job {}: cancelled ({})", job->id, e.what());
+    } else {
+      Log("station.animations")->error("job {}: {}", job->id, e.what());
+    }
     try {
+      if (cancelled) return set_state(AnimationJobState::kCancelled);
       set_state(AnimationJobState::kFailed, e.what());
     } catch (const std::exception& again) {
       Log("station.animations")->error("job {}: {}", job->id, again.what());

@@ -3,6 +3,9 @@
 
 #include <gtest/gtest.h>
 
+#include <atomic>
+#include <string>
+
 #include "animate_test_bank.h"
 #include "core/error.h"
 #include "tests/support/test_support.h"
@@ -57,6 +60,14 @@ TEST(BankGraph, TwoBanksArePooledWithoutEdgesBetweenThem) {
     for (int j : g.graph.successors(i)) EXPECT_LT(j, n);
   }
   EXPECT_THROW(LoadBankGraph({dir / "missing.ssbank"}, {}), InputError);
+  // A cancel from another thread (a studio job's) stops the load between its reads.
+  const std::atomic<bool> cancel{true};
+  try {
+    LoadBankGraph({dir / "a.ssbank"}, {}, &cancel);
+    ADD_FAILURE() << "a cancelled load returned";
+  } catch (const WorkError& e) {
+    EXPECT_EQ(std::string(e.what()), dir / "a.ssbank" + ": cancelled");
+  }
 }
 
 }  // namespace

@@ -3,8 +3,10 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <atomic>
 #include <limits>
 
+#include "core/error.h"
 #include "tests/animate/animate_test_graphs.h"
 
 namespace ss {
@@ -106,6 +108,14 @@ TEST(ReachSets, MatchBruteForceWithEntryAndStepCostsOnTwoThreads) {
 
 TEST(ReachSets, LargeSetsHoldEveryReachableFrame) {
   CheckAgainstBruteForce(21, 1000, 0.0, true, 2);
+}
+
+TEST(ReachSets, ACancelStopsTheBuild) {
+  const TransitionGraph graph = testing::RandomGraph(2000, 10, 1);
+  const std::atomic<bool> cancel{true};
+  ReachOptions options;
+  options.cancel = &cancel;
+  EXPECT_THROW(ReachSets::Build(graph, ReachDirection::kForward, options), WorkError);
 }
 
 TEST(ReachSets, RejectsBadOptions) {
