@@ -7,6 +7,7 @@
 #include <fstream>
 #include <map>
 #include <sstream>
+#include <utility>
 
 #include <opencv2/imgcodecs.hpp>
 
@@ -77,15 +78,17 @@ std::string ReadWhole(const fs::path& path) {
 
 // The files a job folder holds now, as URLs of the API (null for those not there).
 nlohmann::json FileUrls(int64_t id, const fs::path& folder) {
+  constexpr std::pair<const char*, const char*> kListed[] = {{"spec", "spec.yaml"},
+                                                             {"sequences", "sequences.json"},
+                                                             {"cost_plot", "cost.png"},
+                                                             {"render", "render.mp4"}};
   nlohmann::json files = nlohmann::json::object();
   const std::string base = "/api/animations/" + std::to_string(id) + "/files/";
-  for (const char* name : kFiles) {
-    const std::string key = fs::path(name).stem().string();
+  for (const auto& [key, name] : kListed) {
     std::error_code ec;
-    files[key == "cost" ? "cost_plot" : key] =
+    files[key] =
         fs::exists(folder / name, ec) ? nlohmann::json(base + name) : nlohmann::json(nullptr);
   }
-  files.erase("job");
   return files;
 }
 
@@ -159,6 +162,18 @@ struct AnimationJobs::Current {
   // (seconds, the current sequences' cost by kind of term), as often as the tracks
   std::vector<std::pair<double, std::map<std::string, double>>> by_kind;
   nlohmann::json tracks = nlohmann::json::array();
+
+  // The figures the status and the job's progress share (the cost is null before the first).
+  nlohmann::json Figures() const {
+    return {{"seconds", state == AnimationJobState::kRunning ? Now() - started : seconds},
+            {"cost", Cost(trace.empty(), cost)},
+            {"best_cost", Cost(trace.empty(), best_cost)},
+            {"moves_kept", moves_kept},
+            {"restarts", restarts},
+            {"turns", turns},
+            {"steps_rendered", steps_rendered},
+            {"num_steps", num_steps}};
+  }
 
   nlohmann::json Saved() const {  // job.json
     return {{"id", id},
@@ -429,16 +444,9 @@ nlohmann::json AnimationJobs::Job(int64_t id) const {
       for (const auto& [s, cost] : c.trace) trace.push_back({s, cost});
       nlohmann::json by_kind = nlohmann::json::array();
       for (const auto& [s, costs] : c.by_kind) by_kind.push_back({s, costs});
-      j["progress"] = {
-          {"seconds", c.state == AnimationJobState::kRunning ? Now() - c.started : c.seconds},
-          {"cost", Cost(c.trace.empty(), c.cost)},
-          {"best_cost", Cost(c.trace.empty(), c.best_cost)},
-          {"moves_kept", c.moves_kept},
-          {"restarts", c.restarts},
-          {"turns", c.turns},
-          {"steps_rendered", c.steps_rendered},
-          {"trace", std::move(trace)},
-          {"by_kind", std::move(by_kind)}};
+      j["progress"] = c.Figures();
+      j["progress"]["trace"] = std::move(trace);
+      j["progress"]["by_kind"] = std::move(by_kind);
       j["tracks"] = c.tracks;
       j["num_steps"] = c.num_steps;
     }
@@ -520,18 +528,12 @@ nlohmann::json AnimationJobs::Brief() const {
   std::lock_guard lock(mu_);
   if (!current_) return nullptr;
   const Current& c = *current_;
-  return {{"id", c.id},
-          {"state", AnimationJobStateName(c.state)},
-          {"seconds", c.state == AnimationJobState::kRunning ? Now() - c.started : c.seconds},
-          {"cost", Cost(c.trace.empty(), c.cost)},
-          {"best_cost", Cost(c.trace.empty(), c.best_cost)},
-          {"moves_kept", c.moves_kept},
-          {"restarts", c.restarts},
-          {"turns", c.turns},
-          {"steps_rendered", c.steps_rendered},
-          {"num_steps", c.num_steps},
-          {"by_kind",
-           c.by_kind.empty() ? nlohmann::json(nullptr) : nlohmann::json(c.by_kind.back().second)}};
+  nlohmann::json j = c.Figures();
+  j["id"] = c.id;
+  j["state"] = AnimationJobStateName(c.state);
+  j["by_kind"] =
+      c.by_kind.empty() ? nlohmann::json(nullptr) : nlohmann::json(c.by_kind.back().second);
+  return j;
 }
 
 std::string AnimationJobs::File(int64_t id, const std::string& name) const {
