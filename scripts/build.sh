@@ -3,6 +3,8 @@
 # folder on stdout, last, and everything else (ninja's [n/N] progress) on stderr.
 #   scripts/build.sh [TARGET...]       only those targets (the demo: spritestation), else all
 #   SPRITESTATION_SANITIZE=asan|tsan   build with sanitizers into build-asan/ or build-tsan/
+#   SPRITESTATION_UNIT_SUITES=ON|OFF    build and register the unit suites here or not (kept as set;
+#                                      scripts/test.sh turns them off: they run in its sanitizer build)
 set -euo pipefail
 top="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 sanitize="${SPRITESTATION_SANITIZE:-}"
@@ -13,6 +15,7 @@ case "$sanitize" in
   tsan) build="${SPRITESTATION_BUILD_DIR:-$top/build-tsan}"; extra+=(-DSPRITESTATION_TSAN=ON -DCMAKE_BUILD_TYPE=Debug) ;;
   *) echo "build.sh: SPRITESTATION_SANITIZE must be asan or tsan, got '$sanitize'" >&2; exit 2 ;;
 esac
+[ -n "${SPRITESTATION_UNIT_SUITES:-}" ] && extra+=("-DSPRITESTATION_UNIT_SUITES=${SPRITESTATION_UNIT_SUITES}")
 # ccache: one cache for every build of this machine, CI's (.ci/run) and a
 # developer's alike; paths under the tree hash as relative ones, so a clone in
 # another folder (CI's) reuses what a build of this tree already compiled.
@@ -29,6 +32,10 @@ if [ ! -f "$build/CMakeCache.txt" ]; then
   cmake -S "$top" -B "$build" "${generator[@]}" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
     "-DCMAKE_C_FLAGS_RELWITHDEBINFO=-O2 $debug -DNDEBUG" "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O2 $debug -DNDEBUG" \
     "${extra[@]}" >&2
+fi
+if [ -n "${SPRITESTATION_UNIT_SUITES:-}" ] &&
+   ! grep -qx "SPRITESTATION_UNIT_SUITES:BOOL=${SPRITESTATION_UNIT_SUITES}" "$build/CMakeCache.txt"; then
+  cmake -S "$top" -B "$build" "-DSPRITESTATION_UNIT_SUITES=${SPRITESTATION_UNIT_SUITES}" >&2
 fi
 targets=()
 for t in "$@"; do targets+=(--target "$t"); done
