@@ -9,6 +9,8 @@
 #include <sstream>
 #include <utility>
 
+#include <malloc.h>
+
 #include <opencv2/imgcodecs.hpp>
 
 #include "animate/animate_run.h"
@@ -274,7 +276,13 @@ int64_t AnimationJobs::Submit(const std::string& spec_text) {
   WriteWhole(job->folder / "spec.yaml", spec_text);
   WriteWhole(job->folder / "job.json", job->Saved().dump(2));
   current_ = job;
-  thread_ = std::thread([this, job] { Run(job); });
+  thread_ = std::thread([this, job] {
+    Run(job);
+    // The job's bank, F/B sets and frames were freed in this thread's malloc arena, which glibc
+    // keeps mapped after the thread ends: its free pages go back to the system here, or the
+    // station's RSS keeps each job's peak (bench/RESULTS.md, "soak").
+    malloc_trim(0);
+  });
   Log("station.animations")->info("job {}: {} ({} s budget)", id, job->name, budget);
   return id;
 }
