@@ -1,10 +1,27 @@
 #pragma once
 // Station::Impl (station.h): the station's state, shared by the files that hold its parts and
 // used only inside station/:
-//   station.cc             start and stop, sessions, status, previews, the recorder and frame taps
+//   station.cc             start, stop, status and reload
+//   station_sessions.cc    sessions (start, stop, rename) and the frame taps: watcher, recorder
+//   station_previews.cc    the previews' cache: each view encoded once for every viewer
+//   station_status.cc      the status as JSON and as Prometheus text
 //   bank_writer_thread.cc  the bank writer: batches into the bank, through the spool while it is
 //                          away, and the stored counts
 //   disk_guard.cc          the monitor thread: free disk space against the storage limits
+//
+// Threads: the API's (an HTTP worker per request: Status, Preview, the session calls, Reload),
+// one per camera (CameraRunner: its pipeline calls Store and Tap with none of its own locks
+// held), the writer (WriterLoop: WriteBatch, DrainSpool, Stored) and the monitor (MonitorLoop,
+// CheckDisk). The transitions worker has its own thread and takes none of these locks.
+//
+// Lock order: a thread holding one of these takes only those after it, never one before.
+//   control_mutex -> session_mutex -> bank_mutex, stats_mutex, config_mutex, recorder_mutex
+//   control_mutex -> idle_mutex (StopSession waits for the writer under it: the writer never
+//                    takes control_mutex)
+//   PreviewCache::mutex -> CameraRunner's preview lock (an encode runs under the cache's lock)
+// Every other lock is a leaf, held for a copy or a count and released before the next is taken
+// (the writer's stats_mutex, then session_mutex, one after the other in Stored). watcher_mutex is
+// held while the watcher runs: a watcher must not call the station.
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
