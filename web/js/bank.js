@@ -2,11 +2,11 @@
 // tagging a run of frames, export.
 import { ApiError, Events, Limiter, chrome, el, fmt, getJson, getBlob, postJson, saveBlob } from './api.js';
 import { showMessage } from './message.js';
+import { $ } from './page.js';
 
 const events = new Events().start();
 chrome(events);
 
-const $ = (id) => document.querySelector(`[data-testid="${id}"]`);
 const billboards = new Limiter(4);
 
 let sessions = [];

@@ -3,14 +3,14 @@
 // solve, pose on the floor, set the enclosure, save. docs/console.md
 // ("Calibration wizard") is the contract; the state is status.calibration from
 // the event stream, each action's answer is shown at once.
-import { Events, Limiter, chrome, el, fmt, getJson, getBlob, postJson, wakeableSleep } from './api.js';
-import { fitCanvas } from './draw.js';
+import { Events, Limiter, chrome, el, fmt, getJson, getBlob, postJson } from './api.js';
+import { fitCanvas, groundGrid } from './draw.js';
 import { showMessage } from './message.js';
+import { $, busy, pollView } from './page.js';
 
 const events = new Events().start();
 chrome(events);
 
-const $ = (id, root = document) => root.querySelector(`[data-testid="${id}"]`);
 const STEPS = ['intrinsics', 'ground', 'enclosure', 'save', 'saved'];
 const CAM_STEPS = ['intrinsics', 'ground', 'enclosure', 'done'];
 const COLOURS = {
@@ -31,27 +31,20 @@ const cards = new Map();
 
 // ---- actions -----------------------------------------------------------------
 
-// Runs a request from a button: the button is busy meanwhile, an error is shown
-// in the API's words, a CALIB answer is drawn at once.
-async function act(button, fn) {
-  if (button) {
-    button.disabled = true;
-    button.classList.add('busy');
-  }
-  try {
-    const r = await fn();
-    if (r && typeof r === 'object' && 'cameras' in r && 'step' in r) apply(r, true);
-    return r;
-  } catch (err) {
-    showMessage(err.message, 'error');
-    return null;
-  } finally {
-    if (button) {
-      button.classList.remove('busy');
-      button.disabled = false;
-    }
-    render();
-  }
+// A request from a button (page.js); a CALIB answer is drawn at once.
+function act(button, fn) {
+  return busy(
+    button,
+    async () => {
+      const r = await fn();
+      if (r && typeof r === 'object' && 'cameras' in r && 'step' in r) apply(r, true);
+      return r;
+    },
+    (b) => {
+      if (b) b.disabled = false;
+      render();
+    },
+  );
 }
 
 // ---- the start form ----------------------------------------------------------
@@ -250,17 +243,6 @@ function renderSaved(saved) {
 
 // ---- a camera ----------------------------------------------------------------
 
-function waitVisible() {
-  if (!document.hidden) return Promise.resolve();
-  return new Promise((resolve) => {
-    const on = () => {
-      if (document.hidden) return;
-      document.removeEventListener('visibilitychange', on);
-      resolve();
-    };
-    document.addEventListener('visibilitychange', on);
-  });
-}
 
 const BARS = [['x', 'x', 'left ↔ right'], ['y', 'y', 'top ↕ bottom'], ['size', 'size', 'near ↔ far'], ['skew', 'skew', 'tilted']];
 
@@ -786,32 +768,17 @@ class Card {
     v.dataset.floor = String(floor);
   }
 
-  async #loop() {
-    while (this.alive) {
-      const started = performance.now();
-      await waitVisible();
-      if (!this.alive) break;
-      if (!this.cam || this.cam.online === false) {
-        await this.#nap(1000);
-        continue;
-      }
-      let pause = 250; // about 4 a second, one in flight
-      try {
-        await views.run(() => this.#fetchView());
-      } catch (err) {
-        if (!this.alive) break;
+  #loop() {
+    return pollView(this, {
+      idle: () => !this.cam || this.cam.online === false,
+      pause: () => 250, // about 4 a second, one in flight
+      fetch: () => views.run(() => this.#fetchView()),
+      onError: (err) => {
         if (err.status === 503) this.#say('waiting for the first frame');
         else if (err.status === 404) this.#say('not in the wizard');
         else this.#say(`view: ${err.message}`);
-        pause = 1000;
-      }
-      const left = pause - (performance.now() - started);
-      if (left > 0) await this.#nap(left);
-    }
-  }
-
-  #nap(ms) {
-    return wakeableSleep(this, ms);
+      },
+    });
   }
 
   destroy() {
@@ -938,21 +905,7 @@ function drawPlan() {
   };
   // a light grid every 0.5 m (0.1 m when small)
   const step = span > 2 ? 0.5 : 0.1;
-  ctx.strokeStyle = '#182130';
-  ctx.lineWidth = 1;
-  for (let gx = Math.ceil((cx - w / 2 / k) / step) * step; X(gx) < w; gx += step) {
-    ctx.beginPath(); ctx.moveTo(Math.round(X(gx)) + 0.5, 0); ctx.lineTo(Math.round(X(gx)) + 0.5, h); ctx.stroke();
-  }
-  for (let gy = Math.ceil((cy - h / 2 / k) / step) * step; Y(gy) > 0; gy += step) {
-    ctx.beginPath(); ctx.moveTo(0, Math.round(Y(gy)) + 0.5); ctx.lineTo(w, Math.round(Y(gy)) + 0.5); ctx.stroke();
-  }
-  // ground axes through the origin
-  ctx.strokeStyle = '#34425a';
-  ctx.beginPath(); ctx.moveTo(X(0), 0); ctx.lineTo(X(0), h); ctx.moveTo(0, Y(0)); ctx.lineTo(w, Y(0)); ctx.stroke();
-  ctx.font = '10px ui-monospace, monospace';
-  ctx.fillStyle = '#5b677a';
-  ctx.fillText('x', w - 10, Y(0) - 4);
-  ctx.fillText('y', X(0) + 4, 10);
+  groundGrid(ctx, w, h, X, Y, [cx - w / 2 / k, cx + w / 2 / k, cy - h / 2 / k, cy + (h - 14) / 2 / k], step);
 
   for (const c of posed) {
     if (c.plan.fov_m?.length > 2) {

@@ -146,3 +146,23 @@ export function histogram(canvas, hist) {
   ctx.fillStyle = 'rgba(255,255,255,0.08)';
   ctx.fillRect(0, 0, (40 / 256) * w, h);
 }
+
+// A top-down plan's grid (the calibration wizard's and the studio's): a line every `step` metres
+// over the ground seen, [gx0, gx1] x [gy0, gy1], then the ground axes through the origin,
+// labelled. X and Y map ground metres to canvas pixels (ground y up).
+export function groundGrid(ctx, w, h, X, Y, [gx0, gx1, gy0, gy1], step) {
+  ctx.strokeStyle = '#182130';
+  ctx.lineWidth = 1;
+  for (let gx = Math.ceil(gx0 / step) * step; gx <= gx1; gx += step) {
+    ctx.beginPath(); ctx.moveTo(Math.round(X(gx)) + 0.5, 0); ctx.lineTo(Math.round(X(gx)) + 0.5, h); ctx.stroke();
+  }
+  for (let gy = Math.ceil(gy0 / step) * step; gy <= gy1; gy += step) {
+    ctx.beginPath(); ctx.moveTo(0, Math.round(Y(gy)) + 0.5); ctx.lineTo(w, Math.round(Y(gy)) + 0.5); ctx.stroke();
+  }
+  ctx.strokeStyle = '#34425a';
+  ctx.beginPath(); ctx.moveTo(X(0), 0); ctx.lineTo(X(0), h); ctx.moveTo(0, Y(0)); ctx.lineTo(w, Y(0)); ctx.stroke();
+  ctx.font = '10px ui-monospace, monospace';
+  ctx.fillStyle = '#5b677a';
+  ctx.fillText('x', w - 10, Y(0) - 4);
+  ctx.fillText('y', X(0) + 4, 10);
+}

@@ -3,11 +3,11 @@
 // y / n / s (and u to undo); labels go to the bank; retrain from them.
 import { Events, chrome, el, fmt, getBlob, getJson, postJson, saveBlob, basename } from './api.js';
 import { showMessage } from './message.js';
+import { $ } from './page.js';
 
 const events = new Events().start();
 chrome(events);
 
-const $ = (id) => document.querySelector(`[data-testid="${id}"]`);
 const BATCH = 10;
 const FRAME_MS = 160; // a frame of the loop; the recorded 30 fps is too fast to judge
 const HOLD_MS = 600; // pause after B+1 before the loop starts again

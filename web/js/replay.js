@@ -1,11 +1,11 @@
 // The replay page: recorded sessions, a replay station started on one.
 import { Events, chrome, el, fmt, getJson, postJson, basename } from './api.js';
 import { showMessage } from './message.js';
+import { $ } from './page.js';
 
 const events = new Events().start();
 chrome(events);
 
-const $ = (id) => document.querySelector(`[data-testid="${id}"]`);
 let status = null;
 let startedHere = false;
 

@@ -1,7 +1,8 @@
 // The station page: every camera as a live tile, the session panel, the charts.
-import { Events, Limiter, chrome, el, fmt, duration, getJson, getBlob, postJson, dataUrlBlob, wakeableSleep } from './api.js';
+import { Events, Limiter, chrome, el, fmt, duration, getJson, getBlob, postJson, dataUrlBlob } from './api.js';
 import { VERDICT_COLOURS, VERDICT_LABELS, verdictColour, histogram, lineChart } from './draw.js';
 import { showMessage } from './message.js';
+import { $, busy, pollView } from './page.js';
 
 const events = new Events().start();
 chrome(events);
@@ -18,17 +19,6 @@ const tilesEl = document.querySelector('[data-testid="tiles"]');
 // 0.5 s then; a faster loop would only fetch the same image again).
 const backedOff = () => Boolean(status?.session?.active);
 
-function waitVisible() {
-  if (!document.hidden) return Promise.resolve();
-  return new Promise((resolve) => {
-    const on = () => {
-      if (document.hidden) return;
-      document.removeEventListener('visibilitychange', on);
-      resolve();
-    };
-    document.addEventListener('visibilitychange', on);
-  });
-}
 
 const VIEWS = ['raw', 'keyed', 'sprites'];
 
@@ -278,31 +268,16 @@ class Tile {
     this.#say(data.training ? 'keyer learning the empty enclosure' : '');
   }
 
-  async #loop() {
-    while (this.alive) {
-      const started = performance.now();
-      await waitVisible();
-      if (!this.alive) break;
-      if (!this.cam || this.cam.state === 'offline') {
-        await this.#nap(1000);
-        continue;
-      }
-      let pause = backedOff() ? 500 : 100;
-      try {
-        await previews.run(() => (this.view === 'sprites' ? this.#sprites() : this.#preview()));
-      } catch (err) {
-        if (!this.alive) break;
+  #loop() {
+    return pollView(this, {
+      idle: () => !this.cam || this.cam.state === 'offline',
+      pause: () => (backedOff() ? 500 : 100),
+      fetch: () => previews.run(() => (this.view === 'sprites' ? this.#sprites() : this.#preview())),
+      onError: (err) => {
         if (err.status === 503) this.#say(this.cam?.state === 'training' ? 'waiting for the first frame' : 'no frame yet');
         else this.#say(`preview: ${err.message}`);
-        pause = 1000;
-      }
-      const left = pause - (performance.now() - started);
-      if (left > 0) await this.#nap(left);
-    }
-  }
-
-  #nap(ms) {
-    return wakeableSleep(this, ms);
+      },
+    });
   }
 
   destroy() {
@@ -334,7 +309,6 @@ function syncTiles(cameras) {
 
 // ---- session panel ---------------------------------------------------------
 
-const $ = (id) => document.querySelector(`[data-testid="${id}"]`);
 const nameInput = $('session-name');
 let elapsedAt = null; // {seconds, at}
 
@@ -400,18 +374,12 @@ function applySession(session) {
   if (status && session && typeof session.active === 'boolean') status = { ...status, session };
 }
 
-async function act(button, fn) {
-  button.disabled = true;
-  button.classList.add('busy');
-  try {
-    await fn();
-  } catch (err) {
-    showMessage(err.message, 'error');
-  } finally {
-    button.classList.remove('busy');
+// A session request from its button; the session's state decides the buttons after it.
+function act(button, fn) {
+  return busy(button, fn, (b) => {
     if (status) updateSession(status);
-    else button.disabled = false;
-  }
+    else b.disabled = false;
+  });
 }
 
 $('session-start').addEventListener('click', (e) =>

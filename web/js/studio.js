@@ -7,13 +7,13 @@
 // as it is: "Load" is JSON.parse of a spec the page wrote (or any JSON spec; what the page does
 // not draw is kept and written back unchanged).
 import { Events, Limiter, basename, chrome, el, fmt, getBlob, getJson, postJson, saveBlob, sleep, token, wakeableSleep } from './api.js';
-import { fitCanvas } from './draw.js';
+import { fitCanvas, groundGrid } from './draw.js';
 import { showMessage } from './message.js';
+import { $, busy } from './page.js';
 
 const events = new Events().start();
 chrome(events);
 
-const $ = (id, root = document) => root.querySelector(`[data-testid="${id}"]`);
 const COLOURS = ['#f5a524', '#22d3ee', '#e879f9', '#facc15', '#fb923c', '#a78bfa', '#60a5fa', '#f472b6'];
 const ACTIVE = new Set(['queued', 'running', 'rendering']);
 // A path's weights as docs/examples/circle.yaml has them (the reasons are written there).
@@ -609,22 +609,9 @@ function fitView(w, h) {
 function drawGrid(ctx, w, h) {
   const span = Math.max(w, h) / view.k;
   const stepM = span > 4 ? 0.5 : 0.1;
-  ctx.strokeStyle = '#182130';
-  ctx.lineWidth = 1;
   const [gx0, gy1] = ground(0, 0);
   const [gx1, gy0] = ground(w, h);
-  for (let gx = Math.ceil(gx0 / stepM) * stepM; gx <= gx1; gx += stepM) {
-    ctx.beginPath(); ctx.moveTo(Math.round(X(gx)) + 0.5, 0); ctx.lineTo(Math.round(X(gx)) + 0.5, h); ctx.stroke();
-  }
-  for (let gy = Math.ceil(gy0 / stepM) * stepM; gy <= gy1; gy += stepM) {
-    ctx.beginPath(); ctx.moveTo(0, Math.round(Y(gy)) + 0.5); ctx.lineTo(w, Math.round(Y(gy)) + 0.5); ctx.stroke();
-  }
-  ctx.strokeStyle = '#34425a';
-  ctx.beginPath(); ctx.moveTo(X(0), 0); ctx.lineTo(X(0), h); ctx.moveTo(0, Y(0)); ctx.lineTo(w, Y(0)); ctx.stroke();
-  ctx.font = '10px ui-monospace, monospace';
-  ctx.fillStyle = '#5b677a';
-  ctx.fillText('x', w - 10, Y(0) - 4);
-  ctx.fillText('y', X(0) + 4, 10);
+  groundGrid(ctx, w, h, X, Y, [gx0, gx1, gy0, gy1], stepM);
 }
 
 function drawScale(ctx, h) {
@@ -783,19 +770,9 @@ new ResizeObserver(queuePlan).observe(planCanvas);
 
 // ---- running a job -----------------------------------------------------------
 
-// Runs a request from a button: busy meanwhile, an error shown in the API's words.
-async function act(button, fn) {
-  button.disabled = true;
-  button.classList.add('busy');
-  try {
-    return await fn();
-  } catch (err) {
-    showMessage(err.message, 'error');
-    return null;
-  } finally {
-    button.classList.remove('busy');
-    renderRun();
-  }
+// A request from a button (page.js); the run's state decides the buttons after it.
+function act(button, fn) {
+  return busy(button, fn, () => renderRun());
 }
 
 $('run').addEventListener('click', async () => {
