@@ -38,8 +38,13 @@ namespace fs = std::filesystem;
 
 namespace {
 
-constexpr const char* kFiles[] = {"spec.yaml", "job.json", "sequences.json", "cost.png",
-                                  "render.mp4"};
+// The files of a job's folder the API serves, with the key a job's `files` lists each under
+// (none for job.json: the job's own answer holds what it says).
+constexpr std::pair<const char*, const char*> kFiles[] = {{"spec", "spec.yaml"},
+                                                          {nullptr, "job.json"},
+                                                          {"sequences", "sequences.json"},
+                                                          {"cost_plot", "cost.png"},
+                                                          {"render", "render.mp4"}};
 constexpr double kTracksEverySeconds = 0.25;  // the live paths are copied this often at most
 constexpr size_t kMaxTracePoints = 2000;      // the live cost curve keeps this many (thinned)
 
@@ -80,13 +85,10 @@ std::string ReadWhole(const fs::path& path) {
 
 // The files a job folder holds now, as URLs of the API (null for those not there).
 nlohmann::json FileUrls(int64_t id, const fs::path& folder) {
-  constexpr std::pair<const char*, const char*> kListed[] = {{"spec", "spec.yaml"},
-                                                             {"sequences", "sequences.json"},
-                                                             {"cost_plot", "cost.png"},
-                                                             {"render", "render.mp4"}};
   nlohmann::json files = nlohmann::json::object();
   const std::string base = "/api/animations/" + std::to_string(id) + "/files/";
-  for (const auto& [key, name] : kListed) {
+  for (const auto& [key, name] : kFiles) {
+    if (key == nullptr) continue;
     std::error_code ec;
     files[key] =
         fs::exists(folder / name, ec) ? nlohmann::json(base + name) : nlohmann::json(nullptr);
@@ -545,7 +547,8 @@ nlohmann::json AnimationJobs::Brief() const {
 }
 
 std::string AnimationJobs::File(int64_t id, const std::string& name) const {
-  if (std::find(std::begin(kFiles), std::end(kFiles), name) == std::end(kFiles)) {
+  if (std::none_of(std::begin(kFiles), std::end(kFiles),
+                   [&](const auto& file) { return name == file.second; })) {
     throw NotFoundError("file",
                         "a job holds spec.yaml, job.json, sequences.json, cost.png and "
                         "render.mp4, not " +

@@ -243,7 +243,6 @@ function renderSaved(saved) {
 
 // ---- a camera ----------------------------------------------------------------
 
-
 const BARS = [['x', 'x', 'left ↔ right'], ['y', 'y', 'top ↕ bottom'], ['size', 'size', 'near ↔ far'], ['skew', 'skew', 'tilted']];
 
 class Card {

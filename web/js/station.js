@@ -19,7 +19,6 @@ const tilesEl = document.querySelector('[data-testid="tiles"]');
 // 0.5 s then; a faster loop would only fetch the same image again).
 const backedOff = () => Boolean(status?.session?.active);
 
-
 const VIEWS = ['raw', 'keyed', 'sprites'];
 
 class Tile {
