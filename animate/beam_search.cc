@@ -10,9 +10,9 @@
 namespace ss {
 namespace {
 
-constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr double kInfiniteCost = std::numeric_limits<double>::infinity();
 
-struct Child {
+struct BeamChild {
   double cost;
   int parent;
   int frame;
@@ -62,7 +62,7 @@ class BeamPlanner {
     const int num_frames = graph_.num_frames();
     const int starts =
         options_.start_frames > 0 ? std::min(options_.start_frames, num_frames) : num_frames;
-    std::vector<Child> children;
+    std::vector<BeamChild> children;
     std::vector<Track> beam;
     Track scratch;
     for (int i = 0; i < starts; ++i) {
@@ -72,11 +72,11 @@ class BeamPlanner {
     }
     KeepBest(width, &children);
     beam.reserve(children.size());
-    for (const Child& c : children)
+    for (const BeamChild& c : children)
       beam.push_back(MakeTrack(graph_, {c.frame}, anchor, spec.anchor_m));
 
     Track best;
-    double best_cost = kInf;
+    double best_cost = kInfiniteCost;
     std::vector<TermCache> caches(active_.size());
     for (int step = 1;; ++step) {
       for (const Track& track : beam) {  // the best complete sequence so far
@@ -118,7 +118,7 @@ class BeamPlanner {
       KeepBest(width, &children);
       std::vector<Track> next;
       next.reserve(children.size());
-      for (const Child& c : children) {
+      for (const BeamChild& c : children) {
         Track track = beam[c.parent];
         track.frames.push_back(c.frame);
         IntegrateTrack(graph_, anchor, spec.anchor_m, &track, end_anchored ? 0 : track.size() - 1);
@@ -145,8 +145,8 @@ class BeamPlanner {
     return sum;
   }
 
-  static void KeepBest(int width, std::vector<Child>* children) {
-    auto less = [](const Child& a, const Child& b) {
+  static void KeepBest(int width, std::vector<BeamChild>* children) {
+    auto less = [](const BeamChild& a, const BeamChild& b) {
       return a.cost < b.cost || (a.cost == b.cost && a.frame < b.frame);
     };
     if (static_cast<int>(children->size()) > width) {
@@ -187,14 +187,14 @@ std::vector<Track> BeamSearch(const Problem& problem, const BeamOptions& options
   if (std::string why; !options.IsValid(&why)) throw InputError("beam options", why);
   const double run_start = MonotonicSeconds();
   const bool budgeted = options.time_budget_seconds > 0;
-  const double deadline = budgeted ? run_start + options.time_budget_seconds : kInf;
+  const double deadline = budgeted ? run_start + options.time_budget_seconds : kInfiniteCost;
   *summary = Summary{};
   summary->method = "beam";
   summary->start = "beam";
   summary->num_sprites = problem.num_sprites();
   BeamPlanner planner(problem, options, deadline, summary);
   std::vector<Track> best;
-  double best_cost = kInf;
+  double best_cost = kInfiniteCost;
   bool cut = false;
   for (int width = options.width;; width *= 2) {
     std::vector<Track> tracks = planner.Pass(width, &cut);

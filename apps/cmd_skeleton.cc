@@ -280,14 +280,14 @@ void Track(const TrackArgs& a) {
   }
 }
 
-struct ImportArgs {
+struct SkeletonImportArgs {
   std::string format, file, mapping, out, individual, camera;
   float min_confidence = -1;
   int person = 0;
   bool json = false;
 };
 
-void Import(const ImportArgs& a) {
+void Import(const SkeletonImportArgs& a) {
   JointMapping mapping;
   if (!a.mapping.empty()) {
     mapping = LoadJointMapping(a.mapping);
@@ -366,7 +366,7 @@ void AddSkeletonCommand(CLI::App& app) {
   t->add_flag("--json", track->json, "Print the report as JSON");
   t->callback([track] { Track(*track); });
 
-  auto import = std::make_shared<ImportArgs>();
+  auto import = std::make_shared<SkeletonImportArgs>();
   CLI::App* i = cmd->add_subcommand(
       "import", "Read DeepLabCut, OpenPose or COCO keypoints, or synth joint truth");
   i->add_option("--format", import->format, "deeplabcut | openpose | coco | synth")

@@ -27,7 +27,7 @@
 #include "bench/bench_registry.h"
 #include "core/error.h"
 
-namespace ss::bench {
+namespace ss::bench::animate_bench {
 namespace {
 
 struct Args {
@@ -406,4 +406,4 @@ const bool kRegistered = RegisterSuite(
     {"animate", "seed 000 §6 scenes: replacement vs beam search at the same budget", &Run});
 
 }  // namespace
-}  // namespace ss::bench
+}  // namespace ss::bench::animate_bench

@@ -29,7 +29,7 @@
 
 extern char** environ;
 
-namespace ss::bench {
+namespace ss::bench::aravis_bench {
 namespace {
 
 #ifdef SPRITESTATION_HAVE_ARAVIS
@@ -206,4 +206,4 @@ const bool registered = RegisterSuite(
      "frames/s and CPU per frame through the Aravis backend from the emulated GigE camera", &Run});
 
 }  // namespace
-}  // namespace ss::bench
+}  // namespace ss::bench::aravis_bench

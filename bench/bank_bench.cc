@@ -32,7 +32,7 @@
 #include "core/bank_pixels.h"
 #include "core/posix.h"
 
-namespace ss::bench {
+namespace ss::bench::bank_bench {
 namespace {
 
 namespace fs = std::filesystem;
@@ -389,4 +389,4 @@ const bool kRegistered =
     RegisterSuite({"bank", "sprite bank: append rate (sprites/s) and 60k feature load", &Run});
 
 }  // namespace
-}  // namespace ss::bench
+}  // namespace ss::bench::bank_bench

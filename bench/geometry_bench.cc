@@ -32,7 +32,7 @@
 #include "pipeline/filter/usability.h"
 #include "tests/core/polygon_fixtures.h"
 
-namespace ss::bench {
+namespace ss::bench::geometry_bench {
 namespace {
 
 std::vector<Eigen::Vector2d> Shape(const std::string& shape, size_t n) {
@@ -242,4 +242,4 @@ const bool kRegistered = RegisterSuite(
      &Run});
 
 }  // namespace
-}  // namespace ss::bench
+}  // namespace ss::bench::geometry_bench

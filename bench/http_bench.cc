@@ -38,7 +38,7 @@
 // Last: <resolv.h>, which it includes, defines _res, a name Eigen's headers use.
 #include <httplib.h>
 
-namespace ss::bench {
+namespace ss::bench::http_bench {
 namespace {
 
 namespace fs = std::filesystem;
@@ -265,4 +265,4 @@ const bool kRegistered =
                    &Run});
 
 }  // namespace
-}  // namespace ss::bench
+}  // namespace ss::bench::http_bench

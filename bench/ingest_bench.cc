@@ -39,7 +39,7 @@
 #include "pipeline/run/ingest.h"
 #include "synth/studio_session.h"
 
-namespace ss::bench {
+namespace ss::bench::ingest_bench {
 namespace {
 
 namespace fs = std::filesystem;
@@ -286,4 +286,4 @@ const bool kRegistered = RegisterSuite(
      &Run});
 
 }  // namespace
-}  // namespace ss::bench
+}  // namespace ss::bench::ingest_bench

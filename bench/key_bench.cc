@@ -39,7 +39,7 @@ extern "C" {
 #include "pipeline/key/chroma_keyer.h"
 #include "tests/pipeline/key_scene.h"
 
-namespace ss::bench {
+namespace ss::bench::key_bench {
 namespace {
 
 constexpr int kWidth = 1920;
@@ -318,4 +318,4 @@ const bool kRegistered = RegisterSuite(
     {"key", "key + extract at 1080p on one core vs a plain read and FFmpeg chromakey", &Run});
 
 }  // namespace
-}  // namespace ss::bench
+}  // namespace ss::bench::key_bench

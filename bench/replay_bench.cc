@@ -29,7 +29,7 @@
 #include "capture/recording/video_writer.h"
 #include "capture/replay/replay_source.h"
 
-namespace ss::bench {
+namespace ss::bench::replay_bench {
 namespace {
 
 namespace fs = std::filesystem;
@@ -278,4 +278,4 @@ const bool kRegistered =
     RegisterSuite({"replay", "session replay throughput at 1080p (frames/s) vs memcpy", &Run});
 
 }  // namespace
-}  // namespace ss::bench
+}  // namespace ss::bench::replay_bench

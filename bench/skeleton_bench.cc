@@ -28,7 +28,7 @@
 #include "core/error.h"
 #include "core/log.h"
 
-namespace ss::bench {
+namespace ss::bench::skeleton_bench {
 namespace {
 
 using Clock = std::chrono::steady_clock;
@@ -391,4 +391,4 @@ const bool kRegistered = RegisterSuite(
      "seed 003 skeleton matching: linear-per-row DP vs a quadratic DP, gesture accuracy", &Run});
 
 }  // namespace
-}  // namespace ss::bench
+}  // namespace ss::bench::skeleton_bench

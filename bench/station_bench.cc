@@ -45,7 +45,7 @@
 // Last: <resolv.h>, which it includes, defines _res, a name Eigen's headers use.
 #include <httplib.h>
 
-namespace ss::bench {
+namespace ss::bench::station_bench {
 namespace {
 
 namespace fs = std::filesystem;
@@ -409,4 +409,4 @@ const bool kRegistered =
                    &Run});
 
 }  // namespace
-}  // namespace ss::bench
+}  // namespace ss::bench::station_bench

@@ -16,7 +16,7 @@
 #include "synth/motion_stats.h"
 #include "synth/scene.h"
 
-namespace ss::bench {
+namespace ss::bench::synth_motion_bench {
 namespace {
 
 struct Args {
@@ -115,4 +115,4 @@ const bool kRegistered = RegisterSuite(
      "synthetic subjects' speed, turn, pose and floor distributions (truth or simulated)", &Run});
 
 }  // namespace
-}  // namespace ss::bench
+}  // namespace ss::bench::synth_motion_bench

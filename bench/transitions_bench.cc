@@ -38,7 +38,7 @@
 #include "pipeline/transitions/transition_jumps.h"
 #include "pipeline/transitions/truth_labels.h"
 
-namespace ss::bench {
+namespace ss::bench::transitions_bench {
 namespace {
 
 using Clock = std::chrono::steady_clock;
@@ -892,7 +892,13 @@ BENCHMARK(BM_TransitionsPixelKernelScalar);
 
 }  // namespace
 
+}  // namespace ss::bench::transitions_bench
+
+namespace ss::bench {
 int RunTransitionWorkers(const std::vector<std::string>& args);  // transition_workers_bench.cc
+}  // namespace ss::bench
+
+namespace ss::bench::transitions_bench {
 
 namespace {
 
@@ -913,4 +919,4 @@ const bool registered = RegisterSuite(
      &RunOrWorkers});
 
 }  // namespace
-}  // namespace ss::bench
+}  // namespace ss::bench::transitions_bench

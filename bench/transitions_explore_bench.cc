@@ -30,7 +30,7 @@
 #include "pipeline/transitions/training.h"
 #include "pipeline/transitions/truth_labels.h"
 
-namespace ss::bench {
+namespace ss::bench::transitions_explore_bench {
 namespace {
 
 struct Config {
@@ -808,4 +808,4 @@ const bool registered = RegisterSuite({"transitions-explore",
                                        &Run});
 
 }  // namespace
-}  // namespace ss::bench
+}  // namespace ss::bench::transitions_explore_bench

@@ -15,7 +15,6 @@
 namespace ss {
 
 using station_detail::Clock;
-using station_detail::Seconds;
 
 void Station::Impl::Store(StationBatch sb) {
   {

@@ -16,6 +16,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "capture/camera_source.h"
+#include "core/elapsed.h"
 #include "core/error.h"
 #include "core/log.h"
 #include "core/option_checks.h"
@@ -25,8 +26,6 @@ namespace ss {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-double Seconds(Clock::duration d) { return std::chrono::duration<double>(d).count(); }
 
 struct Captured {
   Frame frame;

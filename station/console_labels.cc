@@ -15,6 +15,7 @@
 #include <unordered_set>
 
 #include "core/bank.h"
+#include "core/elapsed.h"
 #include "core/error.h"
 #include "core/error_kinds.h"
 #include "core/log.h"
@@ -46,10 +47,6 @@ namespace {
 constexpr int kFolds = 5;
 // stage-2 evaluations a row at most (a random subset)
 constexpr size_t kMaxCandidatesPerRow = 1000;
-
-double Now() {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
-}
 
 // NotFoundError naming the sprite when the bank has no such sprite.
 void CheckSprite(const Bank& bank, int64_t id) {
@@ -669,9 +666,9 @@ void ConsoleLabels::RefreshStatus() const {
   {
     std::lock_guard lock(shared_->mutex);
     std::lock_guard status_lock(status_mutex_);
-    if (!shared_->dirty && Now() - refreshed_at_ < 2.0) return;
+    if (!shared_->dirty && SteadySeconds() - refreshed_at_ < 2.0) return;
     shared_->dirty = false;
-    refreshed_at_ = Now();
+    refreshed_at_ = SteadySeconds();
   }
   nlohmann::json labels, weights;
   const auto [w, path] = WeightsInUse();

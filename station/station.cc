@@ -35,7 +35,6 @@ namespace {
 
 using station_detail::Clock;
 using station_detail::kPreviewIntervalS;
-using station_detail::Seconds;
 namespace fs = std::filesystem;
 
 // SIGTERM must finish within 5 s: from the start of Stop, the transition worker may drain this

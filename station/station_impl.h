@@ -39,6 +39,7 @@
 #include <vector>
 
 #include "core/bank.h"
+#include "core/elapsed.h"
 #include "core/log.h"
 #include "pipeline/run/bounded_queue.h"
 #include "pipeline/transitions/worker.h"
@@ -52,8 +53,6 @@ namespace ss {
 namespace station_detail {
 
 using Clock = std::chrono::steady_clock;
-
-inline double Seconds(Clock::duration d) { return std::chrono::duration<double>(d).count(); }
 
 // Preview snapshots a camera takes, idle and while a session stores; each view of a snapshot is
 // encoded once, for every viewer, so these are also the most images a second a view costs.

@@ -18,7 +18,6 @@ namespace fs = std::filesystem;
 using station_detail::Clock;
 using station_detail::kPreviewIntervalS;
 using station_detail::kPreviewIntervalSessionS;
-using station_detail::Seconds;
 
 // A session name: what a studio user types, kept usable as a folder name.
 std::string CheckSessionName(const std::string& name) {

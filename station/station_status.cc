@@ -10,7 +10,7 @@ namespace ss {
 namespace {
 
 // Prometheus label values escape backslash, double quote and newline.
-std::string Label(const std::string& value) {
+std::string PromLabel(const std::string& value) {
   std::string out;
   for (const char c : value) {
     if (c == '\\' || c == '"') out += '\\';
@@ -195,7 +195,7 @@ std::string StatusToPrometheus(const StationStatus& st) {
                               auto value) {
     m.Family(name, type, help);
     for (const CameraStatus& c : st.cameras)
-      m.Sample(static_cast<double>(value(c)), "camera=\"" + Label(c.name) + "\"");
+      m.Sample(static_cast<double>(value(c)), "camera=\"" + PromLabel(c.name) + "\"");
   };
   per_camera("camera_up", "gauge", "1 while the camera delivers frames (training or live)",
              [](const CameraStatus& c) {
@@ -210,9 +210,9 @@ std::string StatusToPrometheus(const StationStatus& st) {
   m.Family("frames_dropped_total", "counter", "frames lost, by cause");
   for (const CameraStatus& c : st.cameras) {
     m.Sample(static_cast<double>(c.dropped_queue_full),
-             "camera=\"" + Label(c.name) + "\",cause=\"queue_full\"");
+             "camera=\"" + PromLabel(c.name) + "\",cause=\"queue_full\"");
     m.Sample(static_cast<double>(c.dropped_at_source),
-             "camera=\"" + Label(c.name) + "\",cause=\"at_source\"");
+             "camera=\"" + PromLabel(c.name) + "\",cause=\"at_source\"");
   }
   per_camera("source_errors_total", "counter",
              "recoverable source problems (timeouts, corrupt frames)",
@@ -228,8 +228,8 @@ std::string StatusToPrometheus(const StationStatus& st) {
   for (const CameraStatus& c : st.cameras) {
     for (size_t r = 1; r < c.pipeline.discards.size(); ++r) {
       m.Sample(static_cast<double>(c.pipeline.discards[r]),
-               "camera=\"" + Label(c.name) + "\",reason=\"" + DiscardName(static_cast<Discard>(r)) +
-                   "\"");
+               "camera=\"" + PromLabel(c.name) + "\",reason=\"" +
+                   DiscardName(static_cast<Discard>(r)) + "\"");
     }
   }
   per_camera("sprites_merged_total", "counter",

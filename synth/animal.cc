@@ -6,34 +6,18 @@
 
 #include <Eigen/Geometry>
 
+#include "synth/angles.h"
 #include "synth/random.h"
 
 namespace ss::synth {
 namespace {
 
-constexpr double kDeg = M_PI / 180.0;
 constexpr double kRearPitch = 72.0 * kDeg;  // upright on the hind legs
 constexpr double kLeanPitch = 50.0 * kDeg;  // front paws up on a wall
 // at scale 1, with the head turned: keeps it off the walls
 constexpr double kBodyHalfWidth = 0.060;
 constexpr double kNoseReach = 0.108;  // at scale 1, nose tip ahead of the root
 constexpr double kTailReach = 0.088;  // at scale 1, tail end behind the root
-
-double Wrap(double a) { return std::remainder(a, 2.0 * M_PI); }
-double Frac(double x) { return x - std::floor(x); }
-double Smooth(double t) {
-  t = std::clamp(t, 0.0, 1.0);
-  return t * t * (3.0 - 2.0 * t);
-}
-Eigen::Matrix3d RotY(double a) {
-  return Eigen::AngleAxisd(a, Eigen::Vector3d::UnitY()).toRotationMatrix();
-}
-Eigen::Matrix3d RotZ(double a) {
-  return Eigen::AngleAxisd(a, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-}
-Eigen::Matrix3d RotX(double a) {
-  return Eigen::AngleAxisd(a, Eigen::Vector3d::UnitX()).toRotationMatrix();
-}
 
 // Largest x of a primitive (its support along +x).
 double SupportX(const Primitive& p) {

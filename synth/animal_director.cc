@@ -13,8 +13,6 @@
 namespace ss::synth {
 namespace {
 
-constexpr double kWallTouchM = 0.003;
-
 class AnimalDirector : public Director {
  public:
   AnimalDirector(const Studio& studio, const std::vector<SynthCamera>& cameras,

@@ -9,19 +9,14 @@
 #include <nlohmann/json.hpp>
 
 #include "core/error.h"
+#include "synth/angles.h"
 #include "synth/directors.h"
 #include "synth/random.h"
 
 namespace ss::synth {
 namespace {
 
-constexpr double kDeg = M_PI / 180.0;
 constexpr double kPoseSeconds = 0.8;  // one pose: move for 60 %, then hold still
-
-double Smooth(double t) {
-  t = std::clamp(t, 0.0, 1.0);
-  return t * t * (3.0 - 2.0 * t);
-}
 
 Rigid3 Interpolate(const Rigid3& a, const Rigid3& b, double s) {
   const Eigen::Quaterniond qa(a.rotation), qb(b.rotation);

@@ -5,6 +5,7 @@
 
 #include <Eigen/Geometry>
 
+#include "synth/angles.h"
 #include "synth/random.h"
 
 namespace ss::synth {
@@ -28,11 +29,6 @@ enum Joint {
   kAnkleR,
   kJointCount
 };
-
-double Smooth(double t) {
-  t = std::clamp(t, 0.0, 1.0);
-  return t * t * (3.0 - 2.0 * t);
-}
 
 struct ArmDirs {
   Eigen::Vector3d upper, fore;  // figure frame, unit

@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/error.h"
+#include "synth/angles.h"
 #include "synth/directors.h"
 #include "synth/figure.h"
 #include "synth/random.h"
@@ -17,8 +18,6 @@ namespace {
 constexpr double kTurnRate = 2.2;     // rad/s
 constexpr double kGestureIn = 0.45;   // s to reach an arm pose
 constexpr double kGestureHold = 1.0;  // s held
-
-double Wrap(double a) { return std::remainder(a, 2.0 * M_PI); }
 
 class FigureActor {
  public:

@@ -1,4 +1,5 @@
 #include "synth/fly.h"
+#include "synth/angles.h"
 
 #include <algorithm>
 #include <cmath>
@@ -9,24 +10,10 @@
 namespace ss::synth {
 namespace {
 
-constexpr double kDeg = M_PI / 180.0;
 // Extents at scale 1 in body units (times kFlyLengthM): keeps the fly off the walls.
 constexpr double kFrontReach = 0.46;  // head and front feet ahead of the root
 constexpr double kBackReach = 0.50;   // wing tips behind it
 constexpr double kHalfWidth = 0.36;   // middle feet, wings spread
-
-double Wrap(double a) { return std::remainder(a, 2.0 * M_PI); }
-double Frac(double x) { return x - std::floor(x); }
-double Smooth(double t) {
-  t = std::clamp(t, 0.0, 1.0);
-  return t * t * (3.0 - 2.0 * t);
-}
-Eigen::Matrix3d RotZ(double a) {
-  return Eigen::AngleAxisd(a, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-}
-Eigen::Matrix3d RotX(double a) {
-  return Eigen::AngleAxisd(a, Eigen::Vector3d::UnitX()).toRotationMatrix();
-}
 
 struct FlyLeg {
   Eigen::Vector3d hip;   // fly frame, body units

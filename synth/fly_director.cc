@@ -9,8 +9,6 @@
 namespace ss::synth {
 namespace {
 
-constexpr double kWallTouchM = 0.003;
-
 class FlyDirector : public Director {
  public:
   FlyDirector(const Studio& studio, const DirectorOptions& options)

@@ -6,12 +6,11 @@
 
 #include <Eigen/Geometry>
 
+#include "synth/angles.h"
 #include "synth/random.h"
 
 namespace ss::synth {
 namespace {
-
-constexpr double kDeg = M_PI / 180.0;
 
 // A quad whose front faces `front_normal` (u and v swapped when needed).
 Quad MakeQuad(const Eigen::Vector3d& origin, Eigen::Vector3d u, Eigen::Vector3d v,

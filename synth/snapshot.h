@@ -59,6 +59,8 @@ class Director {
 };
 
 // Touch and floor tests shared by the directors.
+// An animal's or fly's part within this of a wall touches it (truth's touches_wall, docs/synth.md).
+inline constexpr double kWallTouchM = 0.003;
 bool TouchesWall(const Studio& studio, const std::vector<Primitive>& prims, int subject,
                  double tolerance_m);
 bool LeavesFloor(const Studio& studio, const std::vector<Primitive>& prims, int subject,

@@ -29,27 +29,27 @@ namespace lc = libcamera;
 
 constexpr int kWaitSliceMs = 100;  // Next() checks for Stop() this often
 
-struct FormatEntry {
+struct LibcameraFormat {
   PixelFormat format;
   lc::PixelFormat libcamera;
 };
 
 // libcamera names formats after DRM: RGB888 is stored B, G, R (V4L2's BGR24).
-const FormatEntry kFormats[] = {
+const LibcameraFormat kLibcameraFormats[] = {
     {PixelFormat::kYUYV, lc::formats::YUYV},   {PixelFormat::kNV12, lc::formats::NV12},
     {PixelFormat::kMJPEG, lc::formats::MJPEG}, {PixelFormat::kBGR8, lc::formats::RGB888},
     {PixelFormat::kRGB8, lc::formats::BGR888},
 };
 
 std::optional<PixelFormat> FromLibcamera(const lc::PixelFormat& f) {
-  for (const auto& e : kFormats) {
+  for (const auto& e : kLibcameraFormats) {
     if (e.libcamera == f) return e.format;
   }
   return std::nullopt;
 }
 
 std::optional<lc::PixelFormat> ToLibcamera(PixelFormat f) {
-  for (const auto& e : kFormats) {
+  for (const auto& e : kLibcameraFormats) {
     if (e.format == f) return e.libcamera;
   }
   return std::nullopt;
@@ -192,7 +192,7 @@ std::optional<std::string> LibcameraFormatName(PixelFormat format) {
 }
 
 std::optional<PixelFormat> FromLibcameraFormatName(const std::string& name) {
-  for (const auto& e : kFormats) {
+  for (const auto& e : kLibcameraFormats) {
     if (e.libcamera.toString() == name) return e.format;
   }
   return std::nullopt;

@@ -51,6 +51,10 @@ std::string ErrorText(int code) {
   return text;
 }
 
+void Check(int ret, const std::string& path, const std::string& what) {
+  if (ret < 0) throw WorkError(path, what + ": " + ErrorText(ret));
+}
+
 void InstallLogBridge() {
   static std::once_flag once;
   std::call_once(once, [] { av_log_set_callback(LogCallback); });

@@ -53,6 +53,11 @@ PacketPtr NewPacket();
 
 // FFmpeg's text for an AVERROR code.
 std::string ErrorText(int code);
+// Every FFmpeg failure (ret < 0) becomes a WorkError naming the file and the step.
+void Check(int ret, const std::string& path, const std::string& what);
+
+// Milliseconds: the time base of the recordings' video streams.
+inline constexpr AVRational kMillis{1, 1000};
 
 // Routes libav* log lines (warnings and errors) to spdlog's [capture.ffmpeg]; idempotent.
 void InstallLogBridge();

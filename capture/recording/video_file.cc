@@ -22,10 +22,6 @@ extern "C" {
 namespace ss {
 namespace {
 
-void Check(int ret, const std::string& path, const std::string& what) {
-  if (ret < 0) throw WorkError(path, what + ": " + av::ErrorText(ret));
-}
-
 std::string Extension(const std::string& path) {
   std::string ext = std::filesystem::path(path).extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(),
@@ -56,14 +52,14 @@ struct VideoFileWriter::State {
   bool closed = false;
 
   void Encode(AVFrame* f) {
-    Check(avcodec_send_frame(encoder.get(), f), path, "encoding failed");
+    av::Check(avcodec_send_frame(encoder.get(), f), path, "encoding failed");
     for (;;) {
       const int ret = avcodec_receive_packet(encoder.get(), packet.get());
       if (ret == AVERROR(EAGAIN) || ret == AVERROR_EOF) return;
-      Check(ret, path, "encoding failed");
+      av::Check(ret, path, "encoding failed");
       av_packet_rescale_ts(packet.get(), encoder->time_base, stream->time_base);
       packet->stream_index = stream->index;
-      Check(av_interleaved_write_frame(output, packet.get()), path, "cannot write a packet");
+      av::Check(av_interleaved_write_frame(output, packet.get()), path, "cannot write a packet");
     }
   }
 
@@ -119,9 +115,9 @@ VideoFileWriter::VideoFileWriter(const std::string& path, int width, int height,
                                " (use a folder for PNG frames)");
   }
 
-  Check(avformat_alloc_output_context2(&s.output, nullptr, ext == ".mp4" ? "mp4" : "matroska",
-                                       path.c_str()),
-        path, "cannot create the muxer");
+  av::Check(avformat_alloc_output_context2(&s.output, nullptr, ext == ".mp4" ? "mp4" : "matroska",
+                                           path.c_str()),
+            path, "cannot create the muxer");
   s.stream = avformat_new_stream(s.output, nullptr);
   if (s.stream == nullptr) throw WorkError(path, "cannot add a video stream");
 
@@ -155,9 +151,9 @@ VideoFileWriter::VideoFileWriter(const std::string& path, int width, int height,
   }
   const int opened = avcodec_open2(c, encoder, &options);
   av_dict_free(&options);
-  Check(opened, path, "cannot open the " + s.encoder_name + " encoder");
-  Check(avcodec_parameters_from_context(s.stream->codecpar, c), path,
-        "cannot set stream parameters");
+  av::Check(opened, path, "cannot open the " + s.encoder_name + " encoder");
+  av::Check(avcodec_parameters_from_context(s.stream->codecpar, c), path,
+            "cannot set stream parameters");
   s.stream->time_base = c->time_base;
   s.stream->avg_frame_rate = rate;
 
@@ -167,13 +163,13 @@ VideoFileWriter::VideoFileWriter(const std::string& path, int width, int height,
   s.frame->format = coded;
   s.frame->width = width;
   s.frame->height = height;
-  Check(av_frame_get_buffer(s.frame.get(), 0), path, "cannot allocate a frame");
+  av::Check(av_frame_get_buffer(s.frame.get(), 0), path, "cannot allocate a frame");
   s.sws.reset(sws_getContext(width, height, AV_PIX_FMT_BGR24, width, height, coded,
                              SWS_BICUBIC | SWS_ACCURATE_RND, nullptr, nullptr, nullptr));
   if (!s.sws) throw WorkError(path, "cannot convert BGR for " + s.encoder_name);
 
-  Check(avio_open(&s.output->pb, path.c_str(), AVIO_FLAG_WRITE), path, "cannot create");
-  Check(avformat_write_header(s.output, nullptr), path, "cannot write the header");
+  av::Check(avio_open(&s.output->pb, path.c_str(), AVIO_FLAG_WRITE), path, "cannot create");
+  av::Check(avformat_write_header(s.output, nullptr), path, "cannot write the header");
   s.header_written = true;
 }
 
@@ -206,7 +202,7 @@ void VideoFileWriter::Write(const cv::Mat& image) {
   } else {
     bgr = image.isContinuous() ? image : image.clone();
   }
-  Check(av_frame_make_writable(s.frame.get()), s.path, "cannot reuse the frame buffer");
+  av::Check(av_frame_make_writable(s.frame.get()), s.path, "cannot reuse the frame buffer");
   const uint8_t* src[4] = {bgr.data, nullptr, nullptr, nullptr};
   const int src_lines[4] = {static_cast<int>(bgr.step[0]), 0, 0, 0};
   sws_scale(s.sws.get(), src, src_lines, 0, s.height, s.frame->data, s.frame->linesize);
@@ -222,7 +218,7 @@ void VideoFileWriter::Close() {
   s.closed = true;
   if (s.header_written) {
     s.Encode(nullptr);
-    Check(av_write_trailer(s.output), s.path, "cannot write the trailer");
+    av::Check(av_write_trailer(s.output), s.path, "cannot write the trailer");
   }
   s.Free();
 }
@@ -242,9 +238,9 @@ std::vector<cv::Mat> ReadVideoFrames(const std::string& path) {
   if (index < 0 || decoder == nullptr) throw InputError(path, "no decodable video stream");
   std::unique_ptr<AVCodecContext, av::CodecContextDeleter> context(avcodec_alloc_context3(decoder));
   if (!context) throw WorkError(path, "out of memory");
-  Check(avcodec_parameters_to_context(context.get(), input->streams[index]->codecpar), path,
-        "bad stream parameters");
-  Check(avcodec_open2(context.get(), decoder, nullptr), path, "cannot open the decoder");
+  av::Check(avcodec_parameters_to_context(context.get(), input->streams[index]->codecpar), path,
+            "bad stream parameters");
+  av::Check(avcodec_open2(context.get(), decoder, nullptr), path, "cannot open the decoder");
   std::unique_ptr<AVPacket, av::PacketDeleter> packet(av_packet_alloc());
   std::unique_ptr<AVFrame, av::FrameDeleter> frame(av_frame_alloc());
   std::unique_ptr<SwsContext, av::SwsDeleter> sws;

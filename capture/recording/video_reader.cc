@@ -21,7 +21,6 @@ extern "C" {
 namespace ss {
 namespace {
 
-constexpr AVRational kMillis{1, 1000};
 // Read errors in a row after which the rest of the file is given up as unreadable.
 constexpr int kMaxConsecutiveReadErrors = 64;
 // Packets demuxed ahead per decoder thread: one being decoded, one waiting.
@@ -354,7 +353,7 @@ VideoReader::Demuxed VideoReader::ReadPacket() {
     const int64_t ts = packet_->pts != AV_NOPTS_VALUE ? packet_->pts : packet_->dts;
     Demuxed d;
     d.kind = Kind::kPacket;
-    d.pts_ms = ts == AV_NOPTS_VALUE ? -1 : av_rescale_q(ts, time_base_, kMillis);
+    d.pts_ms = ts == AV_NOPTS_VALUE ? -1 : av_rescale_q(ts, time_base_, av::kMillis);
     last_sent_pts_ms_ = d.pts_ms;
     if (packet_->flags & AV_PKT_FLAG_CORRUPT) {
       av_packet_unref(packet_.get());
@@ -408,7 +407,7 @@ VideoReader::Result VideoReader::NextSequential(std::vector<uint8_t>& pixels) {
         }
         const int64_t ts = decoder_->frame->best_effort_timestamp;
         const int64_t pts_ms =
-            ts == AV_NOPTS_VALUE ? last_sent_pts_ms_ : av_rescale_q(ts, time_base_, kMillis);
+            ts == AV_NOPTS_VALUE ? last_sent_pts_ms_ : av_rescale_q(ts, time_base_, av::kMillis);
         r = decoder_->Take(format_, width_, height_, pixels);
         r.pts_ms = pts_ms;
         return r;

@@ -18,11 +18,6 @@ extern "C" {
 namespace ss {
 namespace {
 
-// Every FFmpeg failure becomes a WorkError naming the file and the step.
-void Check(int ret, const std::string& path, const std::string& what) {
-  if (ret < 0) throw WorkError(path, what + ": " + av::ErrorText(ret));
-}
-
 // An AVDictionary of options, freed on scope exit (what the callee left unused).
 struct Dict {
   AVDictionary* d = nullptr;
@@ -32,8 +27,6 @@ struct Dict {
   ~Dict() { av_dict_free(&d); }
   void Set(const char* key, const char* value) { av_dict_set(&d, key, value, 0); }
 };
-
-constexpr AVRational kMillis{1, 1000};
 
 }  // namespace
 
@@ -70,12 +63,12 @@ VideoWriter::VideoWriter(const std::string& path, PixelFormat format, int width,
   }
 
   AVFormatContext* raw_output = nullptr;
-  Check(avformat_alloc_output_context2(&raw_output, nullptr, "matroska", path.c_str()), path,
-        "cannot create a Matroska muxer");
+  av::Check(avformat_alloc_output_context2(&raw_output, nullptr, "matroska", path.c_str()), path,
+            "cannot create a Matroska muxer");
   output_.reset(raw_output);
   stream_ = avformat_new_stream(output_.get(), nullptr);
   if (stream_ == nullptr) throw WorkError(path, "cannot add a video stream");
-  stream_->time_base = kMillis;
+  stream_->time_base = av::kMillis;
 
   if (passthrough_) {
     stream_->codecpar->codec_type = AVMEDIA_TYPE_VIDEO;
@@ -116,7 +109,7 @@ VideoWriter::VideoWriter(const std::string& path, PixelFormat format, int width,
     c->width = width;
     c->height = height;
     c->pix_fmt = coded_format;
-    c->time_base = kMillis;
+    c->time_base = av::kMillis;
     c->framerate = av_d2q(fps, 100000);
     c->max_b_frames = 0;
     c->thread_count = 0;
@@ -132,16 +125,16 @@ VideoWriter::VideoWriter(const std::string& path, PixelFormat format, int width,
       c->global_quality = FF_QP2LAMBDA * 2;
     }
     if (output_->oformat->flags & AVFMT_GLOBALHEADER) c->flags |= AV_CODEC_FLAG_GLOBAL_HEADER;
-    Check(avcodec_open2(c, encoder, &options.d), path,
-          std::string("cannot open the ") + encoder->name + " encoder");
-    Check(avcodec_parameters_from_context(stream_->codecpar, c), path,
-          "cannot set stream parameters");
+    av::Check(avcodec_open2(c, encoder, &options.d), path,
+              std::string("cannot open the ") + encoder->name + " encoder");
+    av::Check(avcodec_parameters_from_context(stream_->codecpar, c), path,
+              "cannot set stream parameters");
 
     frame_ = av::NewFrame();
     frame_->format = coded_format;
     frame_->width = width;
     frame_->height = height;
-    Check(av_frame_get_buffer(frame_.get(), 0), path, "cannot allocate a frame");
+    av::Check(av_frame_get_buffer(frame_.get(), 0), path, "cannot allocate a frame");
     if (!lossless_) {
       sws_.reset(sws_getContext(width, height, av::RawPixelFormat(format), width, height,
                                 coded_format, SWS_BICUBIC | SWS_ACCURATE_RND, nullptr, nullptr,
@@ -154,12 +147,12 @@ VideoWriter::VideoWriter(const std::string& path, PixelFormat format, int width,
   av_dict_set(&stream_->metadata, "SPRITESTATION_SLICECRC", codec == "ffv1" ? "1" : "0", 0);
   av_dict_set(&stream_->metadata, "SPRITESTATION_PIXEL_FORMAT", PixelFormatName(format).c_str(), 0);
 
-  Check(avio_open(&output_->pb, path.c_str(), AVIO_FLAG_WRITE), path, "cannot create");
+  av::Check(avio_open(&output_->pb, path.c_str(), AVIO_FLAG_WRITE), path, "cannot create");
   Dict mux_options;
   // The muxer closes a cluster after at most a second of video on its own; Flush() does it sooner.
   mux_options.Set("cluster_time_limit", "1000");
-  Check(avformat_write_header(output_.get(), &mux_options.d), path,
-        "cannot write the Matroska header");
+  av::Check(avformat_write_header(output_.get(), &mux_options.d), path,
+            "cannot write the Matroska header");
   avio_flush(output_->pb);
   packet_ = av::NewPacket();
 }
@@ -176,22 +169,23 @@ void VideoWriter::Write(const uint8_t* data, size_t size, int64_t pts_ms) {
   if (closed_) throw WorkError(path_, "write after close");
   if (passthrough_) {
     av_packet_unref(packet_.get());
-    Check(av_new_packet(packet_.get(), static_cast<int>(size)), path_, "cannot allocate a packet");
+    av::Check(av_new_packet(packet_.get(), static_cast<int>(size)), path_,
+              "cannot allocate a packet");
     std::memcpy(packet_->data, data, size);
     packet_->pts = packet_->dts = pts_ms;
     packet_->flags |= AV_PKT_FLAG_KEY;
     Mux(packet_.get());
     return;
   }
-  Check(av_frame_make_writable(frame_.get()), path_, "cannot reuse the frame buffer");
+  av::Check(av_frame_make_writable(frame_.get()), path_, "cannot reuse the frame buffer");
   if (lossless_) {
     av::RawToStorage(data, format_, width_, height_, frame_.get());
   } else {
     uint8_t* src_data[4] = {nullptr};
     int src_lines[4] = {0};
-    Check(av_image_fill_arrays(src_data, src_lines, data, av::RawPixelFormat(format_), width_,
-                               height_, 1),
-          path_, "bad source frame");
+    av::Check(av_image_fill_arrays(src_data, src_lines, data, av::RawPixelFormat(format_), width_,
+                                   height_, 1),
+              path_, "bad source frame");
     sws_scale(sws_.get(), src_data, src_lines, 0, height_, frame_->data, frame_->linesize);
   }
   frame_->pts = pts_ms;
@@ -199,11 +193,11 @@ void VideoWriter::Write(const uint8_t* data, size_t size, int64_t pts_ms) {
 }
 
 void VideoWriter::Encode(AVFrame* frame) {
-  Check(avcodec_send_frame(encoder_.get(), frame), path_, "encoding failed");
+  av::Check(avcodec_send_frame(encoder_.get(), frame), path_, "encoding failed");
   while (true) {
     const int ret = avcodec_receive_packet(encoder_.get(), packet_.get());
     if (ret == AVERROR(EAGAIN) || ret == AVERROR_EOF) return;
-    Check(ret, path_, "encoding failed");
+    av::Check(ret, path_, "encoding failed");
     av_packet_rescale_ts(packet_.get(), encoder_->time_base, stream_->time_base);
     Mux(packet_.get());
   }
@@ -213,24 +207,24 @@ void VideoWriter::Mux(AVPacket* packet) {
   packet->stream_index = stream_->index;
   // av_write_frame: one stream needs no interleaving queue, so the packet goes straight to the
   // cluster.
-  Check(av_write_frame(output_.get(), packet), path_, "cannot write a frame (disk full?)");
+  av::Check(av_write_frame(output_.get(), packet), path_, "cannot write a frame (disk full?)");
   ++frames_muxed_;
 }
 
 void VideoWriter::Flush() {
   if (closed_) return;
-  Check(av_write_frame(output_.get(), nullptr), path_, "cannot flush");
+  av::Check(av_write_frame(output_.get(), nullptr), path_, "cannot flush");
   avio_flush(output_->pb);
-  if (output_->pb->error < 0) Check(output_->pb->error, path_, "cannot write (disk full?)");
+  if (output_->pb->error < 0) av::Check(output_->pb->error, path_, "cannot write (disk full?)");
 }
 
 void VideoWriter::Close() {
   if (closed_) return;
   closed_ = true;
   if (encoder_) Encode(nullptr);
-  Check(av_write_trailer(output_.get()), path_, "cannot finish the file");
+  av::Check(av_write_trailer(output_.get()), path_, "cannot finish the file");
   const int ret = avio_closep(&output_->pb);
-  Check(ret, path_, "cannot close");
+  av::Check(ret, path_, "cannot close");
 }
 
 }  // namespace ss

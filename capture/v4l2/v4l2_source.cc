@@ -33,12 +33,12 @@ int Xioctl(int fd, unsigned long request, void* arg) {
   return r;
 }
 
-struct FormatEntry {
+struct V4l2Format {
   PixelFormat format;
   uint32_t fourcc;
 };
 
-constexpr FormatEntry kFormats[] = {
+constexpr V4l2Format kV4l2Formats[] = {
     {PixelFormat::kYUYV, V4L2_PIX_FMT_YUYV},       {PixelFormat::kNV12, V4L2_PIX_FMT_NV12},
     {PixelFormat::kMJPEG, V4L2_PIX_FMT_MJPEG},     {PixelFormat::kMJPEG, V4L2_PIX_FMT_JPEG},
     {PixelFormat::kRGB8, V4L2_PIX_FMT_RGB24},      {PixelFormat::kBGR8, V4L2_PIX_FMT_BGR24},
@@ -48,14 +48,14 @@ constexpr FormatEntry kFormats[] = {
 };
 
 std::optional<PixelFormat> FromFourcc(uint32_t fourcc) {
-  for (const auto& e : kFormats) {
+  for (const auto& e : kV4l2Formats) {
     if (e.fourcc == fourcc) return e.format;
   }
   return std::nullopt;
 }
 
 uint32_t ToFourcc(PixelFormat format) {
-  for (const auto& e : kFormats) {
+  for (const auto& e : kV4l2Formats) {
     if (e.format == format) return e.fourcc;
   }
   return 0;

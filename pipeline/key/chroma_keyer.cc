@@ -28,11 +28,6 @@ constexpr float kNoShadow = -1000.f;
 // (the room behind a wall, a cable): it is never keyed.
 constexpr int kUnkeyableAlpha = 16;
 
-struct PixelKey {
-  int alpha;   // 0..255
-  int shadow;  // 0..255
-};
-
 // The key of one pixel (docs/keying.md), in integer-friendly units: no
 // branches and no floating-point min/max, so that loops of it vectorize.
 inline PixelKey KeyPixel(int b, int g, int r, float key_hi, float gain, int32_t luma_floor,

@@ -15,11 +15,6 @@
 namespace ss {
 namespace {
 
-struct PixelKey {
-  int alpha;   // 0..255
-  int shadow;  // 0..255
-};
-
 // The clean-plate key of one pixel p against plate colour mu (docs/keying.md).
 // No branches and no floating-point min/max, so that loops of it vectorize.
 inline PixelKey PlatePixel(int b, int g, int r, int mu_b, int mu_g, int mu_r, float tolerance,

@@ -9,7 +9,7 @@ namespace ss {
 namespace {
 
 // Inclusive cell bounds, grown cell by cell.
-struct CellBox {
+struct GrownCellBox {
   int x0, y0, x1, y1;
   cv::Rect Rect() const { return cv::Rect(x0, y0, x1 - x0 + 1, y1 - y0 + 1); }
 };
@@ -157,7 +157,7 @@ void Keyer::FindRegions(CoarseGrid& g, std::vector<KeyRegion>& regions) const {
     const int id = static_cast<int>(regions.size()) + 1;
     KeyRegion region;
     region.id = id;
-    CellBox box{start % cols, start / cols, start % cols, start / cols};
+    GrownCellBox box{start % cols, start / cols, start % cols, start / cols};
     size_t head = queue.size();
     queue.push_back(start);
     g.label[start] = id;

@@ -32,6 +32,12 @@ struct KeyRegion {
   bool overlaps_other = false;  // its box intersects another region's box
 };
 
+// One pixel's key, as the keyers' per-pixel functions return it.
+struct PixelKey {
+  int alpha;   // 0..255
+  int shadow;  // 0..255
+};
+
 struct Matte {
   cv::Mat alpha;   // CV_8U, 255 = subject, 0 = background
   cv::Mat shadow;  // CV_8U, floor darkening relative to the empty enclosure (255 = black), outside

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 
+#include "core/elapsed.h"
 #include "core/error.h"
 #include "core/log.h"
 #include "core/option_checks.h"
@@ -16,10 +17,6 @@ namespace ss {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-double SecondsSince(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
 
 // The keyer the options pick, its shadow reach made grid cells at the floor's scale.
 std::unique_ptr<Keyer> KeyerFor(const CameraPipelineOptions& o, const CameraModel& model,

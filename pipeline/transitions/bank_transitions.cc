@@ -9,20 +9,13 @@
 #include <nlohmann/json.hpp>
 
 #include "core/bank_verify.h"
+#include "core/elapsed.h"
 #include "core/error.h"
 #include "core/log.h"
 #include "core/option_checks.h"
 #include "pipeline/transitions/bank_sprites.h"
 
 namespace ss {
-
-namespace {
-
-double SecondsSince(std::chrono::steady_clock::time_point t) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
-}
-
-}  // namespace
 
 std::string WeightsFingerprint(const TransitionWeights& weights) {
   // The classifier part only: provenance text does not change what the weights decide.

@@ -3,6 +3,7 @@
 // BANK`), and the transitions stored as a diff: only what changed is written, in one
 // transaction, so readers keep seeing a whole table. The bank's meta key
 // "transitions.weights" records which weights made the table; other weights replace it.
+#include <cstddef>
 #include <cstdint>
 #include <functional>
 #include <string>
@@ -17,6 +18,9 @@
 namespace ss {
 
 inline constexpr const char* kTransitionWeightsMetaKey = "transitions.weights";
+// Transitions written per bank transaction by the workers: short transactions keep the
+// writer lock brief for the pipeline's sprite batches.
+inline constexpr size_t kTransitionRowsPerTransaction = 2000;
 
 // A stable fingerprint of weights (FNV-1a of their JSON), as stored in the meta key.
 std::string WeightsFingerprint(const TransitionWeights& weights);

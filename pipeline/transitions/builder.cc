@@ -6,19 +6,12 @@
 #include <mutex>
 #include <thread>
 
+#include "core/elapsed.h"
 #include "core/error.h"
 #include "core/log.h"
 #include "core/option_checks.h"
 
 namespace ss {
-
-namespace {
-
-double SecondsSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
-
-}  // namespace
 
 bool BuildOptions::IsValid(std::string* why) const {
   OptionProblems check(why);

@@ -9,6 +9,7 @@
 #include <thread>
 #include <vector>
 
+#include "core/elapsed.h"
 #include "core/error.h"
 #include "core/log.h"
 #include "core/option_checks.h"
@@ -17,12 +18,6 @@
 
 namespace ss {
 namespace {
-
-constexpr size_t kRowsPerTransaction = 2000;
-
-double SecondsSince(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
 
 std::string DefaultName() {
   char host[256] = {};
@@ -133,9 +128,9 @@ bool UnitWorker::RunOne() {
 
   t0 = std::chrono::steady_clock::now();
   const std::vector<TransitionRecord> records = ToRecords(delta.transitions);
-  for (size_t i = 0; i < records.size(); i += kRowsPerTransaction) {
-    const auto end = records.begin() +
-                     static_cast<std::ptrdiff_t>(std::min(records.size(), i + kRowsPerTransaction));
+  for (size_t i = 0; i < records.size(); i += kTransitionRowsPerTransaction) {
+    const auto end = records.begin() + static_cast<std::ptrdiff_t>(std::min(
+                                           records.size(), i + kTransitionRowsPerTransaction));
     writer_.UpsertTransitions(
         std::vector<TransitionRecord>(records.begin() + static_cast<std::ptrdiff_t>(i), end));
   }

@@ -16,11 +16,6 @@
 #include "pipeline/transitions/unit_worker.h"
 
 namespace ss {
-namespace {
-
-constexpr size_t kRowsPerTransaction = 2000;  // transitions stored per bank transaction
-
-}  // namespace
 
 // Everything the thread owns (connections are used from the worker thread only).
 struct TransitionWorker::State {
@@ -186,9 +181,10 @@ void TransitionWorker::Run() {
           // writer's busy timeout on a loaded machine (batches failed). Upserts are idempotent,
           // so rows stored before a failure are simply stored again by a rebuild.
           const std::vector<TransitionRecord> records = ToRecords(delta.transitions);
-          for (size_t i = 0; i < records.size(); i += kRowsPerTransaction) {
-            const auto end = records.begin() + static_cast<std::ptrdiff_t>(std::min(
-                                                   records.size(), i + kRowsPerTransaction));
+          for (size_t i = 0; i < records.size(); i += kTransitionRowsPerTransaction) {
+            const auto end =
+                records.begin() + static_cast<std::ptrdiff_t>(
+                                      std::min(records.size(), i + kTransitionRowsPerTransaction));
             s.writer->UpsertTransitions(std::vector<TransitionRecord>(
                 records.begin() + static_cast<std::ptrdiff_t>(i), end));
           }
