@@ -28,6 +28,30 @@ fi
 tidy="${SPRITESTATION_TIDY:-changed}"
 if [ "$tidy" = 0 ]; then exit $status; fi
 [ -f "$build/compile_commands.json" ] || { echo "check-style: no $build/compile_commands.json (run scripts/build.sh)" >&2; exit 2; }
+# With SPRITESTATION_UNITY_BUILD (cmake/Helpers.cmake) the database names the batches
+# (<build>/**/unity/*.cc), not the files they include: clang-tidy reads one made from it, with an
+# entry for each included file under its batch's command.
+db="$build"
+if grep -q '/unity/[A-Za-z0-9_]*_[0-9]*\.cc"' "$build/compile_commands.json"; then
+  db="$build/tidy-db"
+  mkdir -p "$db"
+  awk -v top="$top" '
+    function emit(src,  c, i) {
+      c = command; i = index(c, unity)
+      if (i) c = substr(c, 1, i - 1) src substr(c, i + length(unity))
+      printf "%s{\n%s\n  \"command\": \"%s\",\n  \"file\": \"%s\"\n}", (n++ ? ",\n" : "[\n"), directory, c, src
+    }
+    /^  "directory": / { directory = $0; next }
+    /^  "command": / { command = $0; sub(/^  "command": "/, "", command); sub(/",$/, "", command); next }
+    /^  "file": / {
+      unity = $0; sub(/^  "file": "/, "", unity); sub(/",?$/, "", unity)
+      if (unity !~ /\/unity\/[A-Za-z0-9_]+_[0-9]+\.cc$/) { emit(unity); next }
+      while ((getline line < unity) > 0)
+        if (line ~ /^#include "/) { sub(/^#include "/, "", line); sub(/"$/, "", line); emit(top "/" line) }
+      close(unity)
+    }
+    END { print (n ? "\n]" : "[]") }' "$build/compile_commands.json" >"$db/compile_commands.json"
+fi
 if [ "$tidy" = all ]; then
   mapfile -t changed < <(git ls-files '*.cc')
 else
@@ -46,7 +70,7 @@ fi
 files=()
 for f in $(printf '%s\n' "${changed[@]}" | sed -n 's/\.\(cc\|h\)$/.cc/p' | sort -u); do
   # Only what still exists and is compiled in this build (compile_commands.json names it).
-  [ -f "$f" ] && grep -q "\"file\": \"$top/$f\"" "$build/compile_commands.json" && files+=("$f")
+  [ -f "$f" ] && grep -q "\"file\": \"$top/$f\"" "$db/compile_commands.json" && files+=("$f")
 done
 if [ "$tidy" = list ]; then printf '%s\n' "${files[@]}"; exit $status; fi
 if [ ${#files[@]} -eq 0 ]; then
@@ -54,7 +78,7 @@ if [ ${#files[@]} -eq 0 ]; then
   exit $status
 fi
 log="$build/check-tidy.log"
-if ! printf '%s\n' "${files[@]}" | xargs -P "$(nproc)" -n 4 clang-tidy -p "$build" --quiet \
+if ! printf '%s\n' "${files[@]}" | xargs -P "$(nproc)" -n 4 clang-tidy -p "$db" --quiet \
     --warnings-as-errors='*' >"$log" 2>&1; then
   echo "check-style: clang-tidy found (log $log):" >&2
   grep -E 'error:' "$log" | sort -u | head -20 >&2
