@@ -98,6 +98,8 @@ TEST(StationFaults, ABankLockedPastTheBusyTimeoutLosesNoBatch) {
   {
     sqlite3* other = nullptr;
     ASSERT_EQ(sqlite3_open(options.config.storage.bank.c_str(), &other), SQLITE_OK);
+    // The station may be writing a batch just then: wait for its lock as it waits for ours.
+    sqlite3_busy_timeout(other, 10000);
     ASSERT_EQ(sqlite3_exec(other, "BEGIN IMMEDIATE", nullptr, nullptr, nullptr), SQLITE_OK);
     std::this_thread::sleep_for(std::chrono::seconds(12));
     ASSERT_EQ(sqlite3_exec(other, "COMMIT", nullptr, nullptr, nullptr), SQLITE_OK);
