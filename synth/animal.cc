@@ -8,6 +8,7 @@
 
 #include "synth/angles.h"
 #include "synth/random.h"
+#include "synth/steering.h"
 
 namespace ss::synth {
 namespace {
@@ -240,22 +241,6 @@ AnimalBehaviour::AnimalBehaviour(const Studio& studio, const AnimalLook& look, u
   }
 }
 
-double AnimalBehaviour::RoomAhead(const Eigen::Vector2d& position, double heading_rad) const {
-  const Eigen::Vector2d d(std::cos(heading_rad), std::sin(heading_rad));
-  const auto& v = studio_->floor.vertices();
-  double best = std::numeric_limits<double>::infinity();
-  for (size_t i = 0; i < v.size(); ++i) {
-    const Eigen::Vector2d a = v[i], e = v[(i + 1) % v.size()] - a;
-    const double den = d.x() * e.y() - d.y() * e.x();
-    if (std::abs(den) < 1e-12) continue;
-    const Eigen::Vector2d w = a - position;
-    const double t = (w.x() * e.y() - w.y() * e.x()) / den;
-    const double u = (w.x() * d.y() - w.y() * d.x()) / den;
-    if (t >= 0 && u >= 0 && u <= 1) best = std::min(best, t);
-  }
-  return best;
-}
-
 bool AnimalBehaviour::TurnToward(double target_rad, double rate, double dt_s) {
   const double diff = Wrap(target_rad - state_.heading_rad);
   const double step = std::clamp(diff, -rate * dt_s, rate * dt_s);
@@ -403,22 +388,9 @@ void AnimalBehaviour::Integrate(double dt, const std::vector<Eigen::Vector2d>& o
       const double bearing = Wrap(std::atan2(to_goal.y(), to_goal.x()) - s.heading_rad);
       turn_rate = steer_ + std::clamp(2.5 * bearing, -2.5, 2.5);
       // Steer away from walls ahead and from other animals.
-      const double look_ahead = 0.08 * k + 0.5 * s.speed_mps;
-      const double room = RoomAhead(s.position, s.heading_rad) - kNoseReach * k;
-      if (room < look_ahead) {
-        const double left = RoomAhead(s.position, s.heading_rad + 0.7);
-        const double right = RoomAhead(s.position, s.heading_rad - 0.7);
-        turn_rate += (left >= right ? 1.0 : -1.0) * 4.0 * (1.0 - std::max(0.0, room) / look_ahead);
-      }
-      for (const auto& o : others) {
-        const Eigen::Vector2d rel = o - s.position;
-        const double d = rel.norm();
-        if (d < 0.25 * k && d > 1e-9) {
-          const double bearing = Wrap(std::atan2(rel.y(), rel.x()) - s.heading_rad);
-          if (std::abs(bearing) < M_PI / 2)
-            turn_rate += (bearing > 0 ? -1.0 : 1.0) * 2.5 * (1.0 - d / (0.25 * k));
-        }
-      }
+      const double room = SteerFromWalls(*studio_, s.position, s.heading_rad, kNoseReach * k,
+                                         0.08 * k + 0.5 * s.speed_mps, 0.7, 4.0, &turn_rate);
+      SteerFromOthers(s.position, s.heading_rad, others, 0.25 * k, 2.5, &turn_rate);
       if (seek_) {  // --crossing: head for the other animal (and walk on through it)
         const Eigen::Vector2d rel = *seek_ - s.position;
         if (rel.norm() > 0.05 * k) {
@@ -430,10 +402,7 @@ void AnimalBehaviour::Integrate(double dt, const std::vector<Eigen::Vector2d>& o
       if (room < 0.004) {  // nose at the wall: stop and turn away
         s.speed_mps = 0.0;
         activity_ = Activity::kTurn;
-        const double left = RoomAhead(s.position, s.heading_rad + M_PI / 2);
-        const double right = RoomAhead(s.position, s.heading_rad - M_PI / 2);
-        target_heading_ =
-            Wrap(s.heading_rad + (left >= right ? 1 : -1) * rng.Uniform(100, 170) * kDeg);
+        target_heading_ = HeadingAwayFromWall(*studio_, s.position, s.heading_rad, rng);
         activity_left_s_ = 3.0;
         target_speed_ = 0.0;
       } else if (activity_left_s_ <= 0) {

@@ -82,7 +82,9 @@ class AnimalBehaviour {
   // Turns the heading toward `target_rad` at up to `rate` rad/s; true when there.
   bool TurnToward(double target_rad, double rate, double dt_s);
   // Free room ahead of the root along `heading_rad` before a wall (metres).
-  double RoomAhead(const Eigen::Vector2d& position, double heading_rad) const;
+  double RoomAhead(const Eigen::Vector2d& position, double heading_rad) const {
+    return synth::RoomAhead(*studio_, position, heading_rad);
+  }
 
   const Studio* studio_;
   AnimalLook look_;

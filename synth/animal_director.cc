@@ -27,14 +27,7 @@ class AnimalDirector : public Director {
       const AnimalLook look =
           RandomAnimalLook(StreamSeed(options.seed, "animal", static_cast<uint64_t>(i)));
       // Starting places at least 0.2 m apart, away from the walls.
-      Eigen::Vector2d p = Eigen::Vector2d::Zero();
-      for (int attempt = 0; attempt < 200; ++attempt) {
-        p = {rng.Uniform(-studio.half_x + 0.16, studio.half_x - 0.16),
-             rng.Uniform(-studio.half_y + 0.16, studio.half_y - 0.16)};
-        bool apart = true;
-        for (const auto& q : placed) apart = apart && (p - q).norm() > 0.2;
-        if (apart) break;
-      }
+      const Eigen::Vector2d p = PlaceApart(studio, rng, placed, 0.16, 0.2);
       placed.push_back(p);
       animals_.emplace_back(studio, look,
                             StreamSeed(options.seed, "animal-behaviour", static_cast<uint64_t>(i)),
@@ -45,12 +38,7 @@ class AnimalDirector : public Director {
   int subjects() const override { return static_cast<int>(animals_.size()); }
 
   void Frame(double time_s, FrameSnapshot* out) override {
-    out->scene = FrameScene{};
-    out->scene.subjects = subjects();
-    out->subjects.clear();
-    out->boards.clear();
-    const int slices = options_.motion_blur ? 4 : 1;
-    out->scene.slices = slices;
+    const int slices = StartFrame(out, subjects(), options_.motion_blur);
     const double exposure = 0.5 / options_.fps;
     // Slice s is the body at time_s - exposure * (slices - 1 - s) / slices; slice
     // 0 (used for shadows and truth) must be the frame time, so slices are ordered last first.
@@ -64,20 +52,8 @@ class AnimalDirector : public Director {
       }
     }
     for (size_t i = 0; i < animals_.size(); ++i) {
-      const AnimalState& st = animals_[i].state();
-      SubjectTruth t;
-      t.kind = "animal";
-      t.position = st.position;
-      t.heading_rad = st.heading_rad;
-      t.speed_mps = st.speed_mps;
-      t.gait_phase = st.gait_phase;
-      t.pose = st.pose;
-      t.touches_wall =
-          TouchesWall(studio_, out->scene.primitives, static_cast<int>(i), kWallTouchM);
-      t.leaves_floor =
-          LeavesFloor(studio_, out->scene.primitives, static_cast<int>(i), kWallTouchM);
-      t.height_m = TopHeight(out->scene.primitives, static_cast<int>(i));
-      out->subjects.push_back(std::move(t));
+      out->subjects.push_back(TruthOf("animal", animals_[i].state(), studio_, out->scene.primitives,
+                                      static_cast<int>(i), kWallTouchM, kWallTouchM));
     }
   }
 

@@ -89,9 +89,7 @@ class CalibrationDirector : public Director {
   const std::vector<BoardSpec>& board_specs() const override { return specs_; }
 
   void Frame(double time_s, FrameSnapshot* out) override {
-    out->scene = FrameScene{};
-    out->subjects.clear();
-    out->boards.clear();
+    StartFrame(out, 0, false);
     const Segment* seg = &segments_.back();
     for (const auto& s : segments_) {
       if (time_s >= s.start_s && time_s < s.end_s) {

@@ -168,12 +168,7 @@ class FigureDirector : public Director {
   std::vector<std::string> joint_names() const override { return FigureJointNames(); }
 
   void Frame(double time_s, FrameSnapshot* out) override {
-    out->scene = FrameScene{};
-    out->scene.subjects = subjects();
-    out->subjects.clear();
-    out->boards.clear();
-    const int slices = options_.motion_blur ? 4 : 1;
-    out->scene.slices = slices;
+    const int slices = StartFrame(out, subjects(), options_.motion_blur);
     const double exposure = 0.5 / options_.fps;
     std::vector<std::vector<Eigen::Vector3d>> joints(actors_.size());
     for (int sl = slices - 1; sl >= 0; --sl) {
@@ -189,17 +184,9 @@ class FigureDirector : public Director {
       }
     }
     for (size_t i = 0; i < actors_.size(); ++i) {
-      const FigureState& st = actors_[i].state();
-      SubjectTruth t;
-      t.kind = "figure";
-      t.position = st.position;
-      t.heading_rad = st.heading_rad;
-      t.speed_mps = st.speed_mps;
-      t.gait_phase = st.gait_phase;
-      t.pose = st.pose;
-      t.touches_wall = TouchesWall(studio_, out->scene.primitives, static_cast<int>(i), 0.01);
-      t.leaves_floor = LeavesFloor(studio_, out->scene.primitives, static_cast<int>(i), 0.0);
-      t.height_m = TopHeight(out->scene.primitives, static_cast<int>(i));
+      // A figure touches a wall within 10 mm; any part beyond the floor leaves it.
+      SubjectTruth t = TruthOf("figure", actors_[i].state(), studio_, out->scene.primitives,
+                               static_cast<int>(i), 0.01, 0.0);
       t.joints = joints[i];
       out->subjects.push_back(std::move(t));
     }

@@ -1,11 +1,13 @@
 #include "synth/fly.h"
-#include "synth/angles.h"
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 
 #include <Eigen/Geometry>
+
+#include "synth/angles.h"
+#include "synth/steering.h"
 
 namespace ss::synth {
 namespace {
@@ -159,22 +161,6 @@ FlyBehaviour::FlyBehaviour(const Studio& studio, const FlyLook& look, uint64_t s
   activity_left_s_ = rng_.Uniform(0.3, 2.0);
 }
 
-double FlyBehaviour::RoomAhead(const Eigen::Vector2d& position, double heading_rad) const {
-  const Eigen::Vector2d d(std::cos(heading_rad), std::sin(heading_rad));
-  const auto& v = studio_->floor.vertices();
-  double best = std::numeric_limits<double>::infinity();
-  for (size_t i = 0; i < v.size(); ++i) {
-    const Eigen::Vector2d a = v[i], e = v[(i + 1) % v.size()] - a;
-    const double den = d.x() * e.y() - d.y() * e.x();
-    if (std::abs(den) < 1e-12) continue;
-    const Eigen::Vector2d w = a - position;
-    const double t = (w.x() * e.y() - w.y() * e.x()) / den;
-    const double u = (w.x() * d.y() - w.y() * d.x()) / den;
-    if (t >= 0 && u >= 0 && u <= 1) best = std::min(best, t);
-  }
-  return best;
-}
-
 void FlyBehaviour::Choose() {
   Rng& rng = rng_;
   const double unit = kFlyLengthM * look_.scale;
@@ -246,30 +232,14 @@ void FlyBehaviour::Integrate(double dt, const std::vector<Eigen::Vector2d>& othe
       // Tortuous walks: a strong wander; darts go nearly straight.
       steer_ = steer_ * std::exp(-3.0 * dt) + rng.Normal() * (dart ? 1.5 : 5.0) * std::sqrt(dt);
       turn_rate = steer_;
-      const double look_ahead = 0.6 * unit + 0.4 * s.speed_mps;
-      const double room = RoomAhead(s.position, s.heading_rad) - kFrontReach * unit;
-      if (room < look_ahead) {
-        const double left = RoomAhead(s.position, s.heading_rad + 0.8);
-        const double right = RoomAhead(s.position, s.heading_rad - 0.8);
-        turn_rate += (left >= right ? 1.0 : -1.0) * 8.0 * (1.0 - std::max(0.0, room) / look_ahead);
-      }
-      for (const auto& o : others) {
-        const Eigen::Vector2d rel = o - s.position;
-        const double d = rel.norm();
-        if (d < 2.0 * unit && d > 1e-9) {
-          const double bearing = Wrap(std::atan2(rel.y(), rel.x()) - s.heading_rad);
-          if (std::abs(bearing) < M_PI / 2)
-            turn_rate += (bearing > 0 ? -1.0 : 1.0) * 6.0 * (1.0 - d / (2.0 * unit));
-        }
-      }
+      const double room = SteerFromWalls(*studio_, s.position, s.heading_rad, kFrontReach * unit,
+                                         0.6 * unit + 0.4 * s.speed_mps, 0.8, 8.0, &turn_rate);
+      SteerFromOthers(s.position, s.heading_rad, others, 2.0 * unit, 6.0, &turn_rate);
       turn_rate = std::clamp(turn_rate, -8.0, 8.0);
       if (room < 0.002) {  // head at the wall: stop and turn away
         s.speed_mps = 0.0;
         activity_ = Activity::kTurn;
-        const double left = RoomAhead(s.position, s.heading_rad + M_PI / 2);
-        const double right = RoomAhead(s.position, s.heading_rad - M_PI / 2);
-        target_heading_ =
-            Wrap(s.heading_rad + (left >= right ? 1 : -1) * rng.Uniform(100, 170) * kDeg);
+        target_heading_ = HeadingAwayFromWall(*studio_, s.position, s.heading_rad, rng);
         activity_left_s_ = 1.5;
         target_speed_ = 0.0;
       } else if (activity_left_s_ <= 0) {

@@ -63,7 +63,9 @@ class FlyBehaviour {
   enum class Activity { kSit, kGroom, kWalk, kDart, kTurn };
   void Choose();
   void Integrate(double dt_s, const std::vector<Eigen::Vector2d>& others);
-  double RoomAhead(const Eigen::Vector2d& position, double heading_rad) const;
+  double RoomAhead(const Eigen::Vector2d& position, double heading_rad) const {
+    return synth::RoomAhead(*studio_, position, heading_rad);
+  }
 
   const Studio* studio_;
   FlyLook look_;

@@ -18,14 +18,7 @@ class FlyDirector : public Director {
     for (int i = 0; i < options.subjects; ++i) {
       const FlyLook look = RandomFlyLook(StreamSeed(options.seed, "fly", static_cast<uint64_t>(i)));
       // Starting places at least 0.1 m apart, away from the walls.
-      Eigen::Vector2d p = Eigen::Vector2d::Zero();
-      for (int attempt = 0; attempt < 200; ++attempt) {
-        p = {rng.Uniform(-studio.half_x + 0.08, studio.half_x - 0.08),
-             rng.Uniform(-studio.half_y + 0.08, studio.half_y - 0.08)};
-        bool apart = true;
-        for (const auto& q : placed) apart = apart && (p - q).norm() > 0.1;
-        if (apart) break;
-      }
+      const Eigen::Vector2d p = PlaceApart(studio, rng, placed, 0.08, 0.1);
       placed.push_back(p);
       flies_.emplace_back(studio, look,
                           StreamSeed(options.seed, "fly-behaviour", static_cast<uint64_t>(i)), p,
@@ -36,12 +29,7 @@ class FlyDirector : public Director {
   int subjects() const override { return static_cast<int>(flies_.size()); }
 
   void Frame(double time_s, FrameSnapshot* out) override {
-    out->scene = FrameScene{};
-    out->scene.subjects = subjects();
-    out->subjects.clear();
-    out->boards.clear();
-    const int slices = options_.motion_blur ? 4 : 1;
-    out->scene.slices = slices;
+    const int slices = StartFrame(out, subjects(), options_.motion_blur);
     const double exposure = 0.5 / options_.fps;
     for (int s = slices - 1; s >= 0; --s) {  // slice 0 (truth, shadows) is the frame time
       AdvanceTo(time_s - exposure * s / slices);
@@ -51,20 +39,8 @@ class FlyDirector : public Director {
       }
     }
     for (size_t i = 0; i < flies_.size(); ++i) {
-      const FlyState& st = flies_[i].state();
-      SubjectTruth t;
-      t.kind = "fly";
-      t.position = st.position;
-      t.heading_rad = st.heading_rad;
-      t.speed_mps = st.speed_mps;
-      t.gait_phase = st.gait_phase;
-      t.pose = st.pose;
-      t.touches_wall =
-          TouchesWall(studio_, out->scene.primitives, static_cast<int>(i), kWallTouchM);
-      t.leaves_floor =
-          LeavesFloor(studio_, out->scene.primitives, static_cast<int>(i), kWallTouchM);
-      t.height_m = TopHeight(out->scene.primitives, static_cast<int>(i));
-      out->subjects.push_back(std::move(t));
+      out->subjects.push_back(TruthOf("fly", flies_[i].state(), studio_, out->scene.primitives,
+                                      static_cast<int>(i), kWallTouchM, kWallTouchM));
     }
   }
 

@@ -314,4 +314,20 @@ std::vector<SynthCamera> MakeCameras(const Studio& studio, int count, int width,
   return cameras;
 }
 
+double RoomAhead(const Studio& studio, const Eigen::Vector2d& position, double heading_rad) {
+  const Eigen::Vector2d d(std::cos(heading_rad), std::sin(heading_rad));
+  const auto& v = studio.floor.vertices();
+  double best = std::numeric_limits<double>::infinity();
+  for (size_t i = 0; i < v.size(); ++i) {
+    const Eigen::Vector2d a = v[i], e = v[(i + 1) % v.size()] - a;
+    const double den = d.x() * e.y() - d.y() * e.x();
+    if (std::abs(den) < 1e-12) continue;
+    const Eigen::Vector2d w = a - position;
+    const double t = (w.x() * e.y() - w.y() * e.x()) / den;
+    const double u = (w.x() * d.y() - w.y() * d.x()) / den;
+    if (t >= 0 && u >= 0 && u <= 1) best = std::min(best, t);
+  }
+  return best;
+}
+
 }  // namespace ss::synth

@@ -72,4 +72,8 @@ Rigid3 LookAt(const Eigen::Vector3d& centre, const Eigen::Vector3d& target, doub
 
 std::string StudioKindName(StudioKind kind);
 
+// How far the ray from `position` along `heading_rad` runs before it leaves the studio's floor
+// polygon, metres (infinity when it meets no edge).
+double RoomAhead(const Studio& studio, const Eigen::Vector2d& position, double heading_rad);
+
 }  // namespace ss::synth

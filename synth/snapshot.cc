@@ -66,4 +66,27 @@ double TopHeight(const std::vector<Primitive>& prims, int subject) {
   return top;
 }
 
+int StartFrame(FrameSnapshot* out, int subjects, bool motion_blur) {
+  out->scene = FrameScene{};
+  out->scene.subjects = subjects;
+  out->subjects.clear();
+  out->boards.clear();
+  out->scene.slices = motion_blur ? 4 : 1;
+  return out->scene.slices;
+}
+
+Eigen::Vector2d PlaceApart(const Studio& studio, Rng& rng,
+                           const std::vector<Eigen::Vector2d>& placed, double margin_m,
+                           double apart_m) {
+  Eigen::Vector2d p = Eigen::Vector2d::Zero();
+  for (int attempt = 0; attempt < 200; ++attempt) {
+    p = {rng.Uniform(-studio.half_x + margin_m, studio.half_x - margin_m),
+         rng.Uniform(-studio.half_y + margin_m, studio.half_y - margin_m)};
+    bool apart = true;
+    for (const auto& q : placed) apart = apart && (p - q).norm() > apart_m;
+    if (apart) break;
+  }
+  return p;
+}
+
 }  // namespace ss::synth

@@ -10,6 +10,7 @@
 
 #include "core/geometry.h"
 #include "synth/board.h"
+#include "synth/random.h"
 #include "synth/renderer.h"
 #include "synth/scene.h"
 
@@ -58,6 +59,17 @@ class Director {
   virtual std::string SubjectsJson() const = 0;
 };
 
+// Clears `out` for a frame of `subjects` subjects and sets its motion-blur slices (4 with blur,
+// else 1), which it returns. The directors render slice s at time_s - (0.5 / fps) * s / slices,
+// last first: slice 0, which the shadows and the truth use, is the frame time.
+int StartFrame(FrameSnapshot* out, int subjects, bool motion_blur);
+
+// A starting place on the floor `margin_m` from the walls and more than `apart_m` from every one
+// of `placed` (the last of 200 draws from `rng` when none is).
+Eigen::Vector2d PlaceApart(const Studio& studio, Rng& rng,
+                           const std::vector<Eigen::Vector2d>& placed, double margin_m,
+                           double apart_m);
+
 // Touch and floor tests shared by the directors.
 // An animal's or fly's part within this of a wall touches it (truth's touches_wall, docs/synth.md).
 inline constexpr double kWallTouchM = 0.003;
@@ -66,5 +78,25 @@ bool TouchesWall(const Studio& studio, const std::vector<Primitive>& prims, int 
 bool LeavesFloor(const Studio& studio, const std::vector<Primitive>& prims, int subject,
                  double tolerance_m);
 double TopHeight(const std::vector<Primitive>& prims, int subject);
+
+// The truth of subject `subject` from its behaviour's state (any with position, heading_rad,
+// speed_mps, gait_phase and pose) and the frame's primitives; `touch_m` and `leave_m` are the
+// tolerances of TouchesWall and LeavesFloor.
+template <typename State>
+SubjectTruth TruthOf(const char* kind, const State& state, const Studio& studio,
+                     const std::vector<Primitive>& prims, int subject, double touch_m,
+                     double leave_m) {
+  SubjectTruth t;
+  t.kind = kind;
+  t.position = state.position;
+  t.heading_rad = state.heading_rad;
+  t.speed_mps = state.speed_mps;
+  t.gait_phase = state.gait_phase;
+  t.pose = state.pose;
+  t.touches_wall = TouchesWall(studio, prims, subject, touch_m);
+  t.leaves_floor = LeavesFloor(studio, prims, subject, leave_m);
+  t.height_m = TopHeight(prims, subject);
+  return t;
+}
 
 }  // namespace ss::synth

@@ -1,0 +1,56 @@
+#pragma once
+// How the synthetic animals and flies steer clear of walls and of each other: terms added to a
+// behaviour's turn rate (rad/s, positive to the left).
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "synth/angles.h"
+#include "synth/random.h"
+#include "synth/scene.h"
+
+namespace ss::synth {
+
+// When the floor ahead of `position` along `heading_rad`, less `reach` (the body ahead of the
+// root), is shorter than `look_ahead`: turns toward the side with more room (probed at
+// +-`probe_rad`), up to `gain` as the room runs out. Returns that room ahead, metres.
+inline double SteerFromWalls(const Studio& studio, const Eigen::Vector2d& position,
+                             double heading_rad, double reach, double look_ahead, double probe_rad,
+                             double gain, double* turn_rate) {
+  const double room = RoomAhead(studio, position, heading_rad) - reach;
+  if (room < look_ahead) {
+    const double left = RoomAhead(studio, position, heading_rad + probe_rad);
+    const double right = RoomAhead(studio, position, heading_rad - probe_rad);
+    *turn_rate += (left >= right ? 1.0 : -1.0) * gain * (1.0 - std::max(0.0, room) / look_ahead);
+  }
+  return room;
+}
+
+// Turns away from each of `others` in front (within 90 degrees) and nearer than `radius`, up to
+// `gain` at contact.
+inline void SteerFromOthers(const Eigen::Vector2d& position, double heading_rad,
+                            const std::vector<Eigen::Vector2d>& others, double radius, double gain,
+                            double* turn_rate) {
+  for (const auto& o : others) {
+    const Eigen::Vector2d rel = o - position;
+    const double d = rel.norm();
+    if (d < radius && d > 1e-9) {
+      const double bearing = Wrap(std::atan2(rel.y(), rel.x()) - heading_rad);
+      if (std::abs(bearing) < M_PI / 2)
+        *turn_rate += (bearing > 0 ? -1.0 : 1.0) * gain * (1.0 - d / radius);
+    }
+  }
+}
+
+// A heading 100-170 degrees (drawn from `rng`) away from `heading_rad`, turned toward the side
+// with more room: where a subject with its head at the wall turns to.
+inline double HeadingAwayFromWall(const Studio& studio, const Eigen::Vector2d& position,
+                                  double heading_rad, Rng& rng) {
+  const double left = RoomAhead(studio, position, heading_rad + M_PI / 2);
+  const double right = RoomAhead(studio, position, heading_rad - M_PI / 2);
+  return Wrap(heading_rad + (left >= right ? 1 : -1) * rng.Uniform(100, 170) * kDeg);
+}
+
+}  // namespace ss::synth
