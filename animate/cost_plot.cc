@@ -4,10 +4,9 @@
 #include <cmath>
 #include <cstdio>
 
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "core/error.h"
+#include "core/image_file.h"
 
 namespace ss {
 
@@ -81,14 +80,7 @@ cv::Mat PlotCostTraces(const std::vector<PlotSeries>& series, const std::string&
 
 void WriteCostPlot(const std::string& path, const std::vector<PlotSeries>& series,
                    const std::string& title) {
-  const cv::Mat image = PlotCostTraces(series, title);
-  bool ok = false;
-  try {
-    ok = cv::imwrite(path, image);
-  } catch (const cv::Exception& e) {
-    throw WorkError(path, std::string("cannot write the plot: ") + e.what());
-  }
-  if (!ok) throw WorkError(path, "cannot write the plot");
+  WriteImageFile(path, PlotCostTraces(series, title), "plot");
 }
 
 }  // namespace ss

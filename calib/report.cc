@@ -5,10 +5,10 @@
 #include <cstdio>
 #include <sstream>
 
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "core/error.h"
+#include "core/image_file.h"
 #include "core/option_checks.h"
 
 namespace ss::calib {
@@ -47,15 +47,6 @@ cv::Mat CellCounts(const SolveSummary& s, int camera, const VerdictOptions& o) {
     if (gx >= 0 && gy >= 0 && gx < o.grid_x && gy < o.grid_y) counts.at<float>(gy, gx) += 1;
   }
   return counts;
-}
-
-void WritePng(const std::string& path, const cv::Mat& image) {
-  bool ok = false;
-  try {
-    ok = cv::imwrite(path, image);
-  } catch (const cv::Exception&) {
-  }
-  if (!ok) throw WorkError(path, "cannot write the PNG");
 }
 
 }  // namespace
@@ -274,7 +265,7 @@ void WriteResidualPlot(const std::string& path, const SolveSummary& solution, in
   std::snprintf(text, sizeof text, "|residual| histogram, 0 .. %.2f px", top);
   cv::putText(canvas, text, {10, h + hist_h - 5}, cv::FONT_HERSHEY_SIMPLEX, 0.45,
               cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
-  WritePng(path, canvas);
+  WriteImageFile(path, canvas, "PNG");
 }
 
 void WriteCoverageMap(const std::string& path, const SolveSummary& solution, int camera,
@@ -306,7 +297,7 @@ void WriteCoverageMap(const std::string& path, const SolveSummary& solution, int
                 peak);
   cv::putText(canvas, text, {8, 18}, cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar(255, 255, 255), 1,
               cv::LINE_AA);
-  WritePng(path, canvas);
+  WriteImageFile(path, canvas, "PNG");
 }
 
 void WriteUncertaintyMap(const std::string& path, const SolveSummary& solution,
@@ -367,7 +358,7 @@ void WriteUncertaintyMap(const std::string& path, const SolveSummary& solution,
   std::snprintf(text, sizeof text, "0 .. %.2f px", top);
   cv::putText(canvas, text, {bar_x, bar_y - 4}, cv::FONT_HERSHEY_SIMPLEX, 0.4,
               cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
-  WritePng(path, canvas);
+  WriteImageFile(path, canvas, "PNG");
 }
 
 nlohmann::json ToJson(const CameraReport& r) {

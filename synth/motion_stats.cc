@@ -3,25 +3,16 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <set>
-#include <sstream>
 #include <utility>
 
 #include <nlohmann/json.hpp>
 
+#include "core/csv_table.h"
 #include "core/error.h"
 
 namespace ss::synth {
 namespace {
-
-std::vector<std::string> SplitCsv(const std::string& line) {
-  std::vector<std::string> out;
-  std::stringstream ss(line);
-  std::string field;
-  while (std::getline(ss, field, ',')) out.push_back(field);
-  return out;
-}
 
 // The q-quantile (0..1) of `v` by the nearest rank; 0 for none.
 double Quantile(std::vector<double> v, double q) {
@@ -34,44 +25,25 @@ double Quantile(std::vector<double> v, double q) {
 }  // namespace
 
 std::vector<MotionSample> ReadSubjectsCsv(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw InputError(path, "cannot open (expected a session's truth/subjects.csv)");
-  std::string line;
-  if (!std::getline(in, line)) throw InputError(path, "empty");
-  const std::vector<std::string> header = SplitCsv(line);
-  auto column = [&](const std::string& name) {
-    for (size_t k = 0; k < header.size(); ++k) {
-      if (header[k] == name) return k;
-    }
-    throw InputError(path + ":1", "no column '" + name + "' in the header");
-  };
-  const size_t c_frame = column("frame"), c_subject = column("subject"), c_x = column("x"),
-               c_y = column("y"), c_heading = column("heading_rad"), c_speed = column("speed_mps"),
-               c_pose = column("pose"), c_wall = column("touches_wall");
+  CsvTable csv(path, "cannot open (expected a session's truth/subjects.csv)");
+  const size_t c_frame = csv.Column("frame"), c_subject = csv.Column("subject"),
+               c_x = csv.Column("x"), c_y = csv.Column("y"), c_heading = csv.Column("heading_rad"),
+               c_speed = csv.Column("speed_mps"), c_pose = csv.Column("pose"),
+               c_wall = csv.Column("touches_wall");
   std::vector<MotionSample> out;
-  int line_number = 1;
-  while (std::getline(in, line)) {
-    ++line_number;
-    if (line.empty()) continue;
-    const std::vector<std::string> f = SplitCsv(line);
-    if (f.size() < header.size()) {
-      throw InputError(
-          path + ":" + std::to_string(line_number),
-          "expected " + std::to_string(header.size()) + " fields, got " + std::to_string(f.size()));
-    }
+  while (csv.Next()) {
     try {
       MotionSample s;
-      s.frame = std::stoi(f[c_frame]);
-      s.subject = std::stoi(f[c_subject]);
-      s.position = {std::stod(f[c_x]), std::stod(f[c_y])};
-      s.heading_rad = std::stod(f[c_heading]);
-      s.speed_mps = std::stod(f[c_speed]);
-      s.pose = f[c_pose];
-      s.touches_wall = f[c_wall] == "1";
+      s.frame = std::stoi(csv[c_frame]);
+      s.subject = std::stoi(csv[c_subject]);
+      s.position = {std::stod(csv[c_x]), std::stod(csv[c_y])};
+      s.heading_rad = std::stod(csv[c_heading]);
+      s.speed_mps = std::stod(csv[c_speed]);
+      s.pose = csv[c_pose];
+      s.touches_wall = csv[c_wall] == "1";
       out.push_back(std::move(s));
     } catch (const std::logic_error&) {
-      throw InputError(path + ":" + std::to_string(line_number),
-                       "a number does not parse: '" + line + "'");
+      throw InputError(csv.Where(), "a number does not parse: '" + csv.line() + "'");
     }
   }
   return out;

@@ -3,10 +3,10 @@
 #include <algorithm>
 #include <cmath>
 
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "core/error.h"
+#include "core/image_file.h"
 #include "core/option_checks.h"
 
 namespace ss {
@@ -93,14 +93,7 @@ cv::Mat PlotMatch(const std::vector<PlotPanel>& panels, int source_count,
 
 void WriteMatchPlot(const std::string& path, const std::vector<PlotPanel>& panels, int source_count,
                     const PlotOptions& options) {
-  const cv::Mat image = PlotMatch(panels, source_count, options);
-  bool ok = false;
-  try {
-    ok = cv::imwrite(path, image);
-  } catch (const cv::Exception& e) {
-    throw WorkError(path, std::string("cannot write the plot: ") + e.what());
-  }
-  if (!ok) throw WorkError(path, "cannot write the plot");
+  WriteImageFile(path, PlotMatch(panels, source_count, options), "plot");
 }
 
 }  // namespace ss

@@ -2,15 +2,14 @@
 
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 #include <map>
 #include <set>
-#include <sstream>
 #include <unordered_map>
 
 #include <nlohmann/json.hpp>
 
 #include "core/bank.h"
+#include "core/csv_table.h"
 #include "core/error.h"
 #include "core/log.h"
 #include "core/option_checks.h"
@@ -187,52 +186,24 @@ struct TruthRow {
   SpriteTruth truth;
 };
 
-std::vector<std::string> SplitCsv(const std::string& line) {
-  std::vector<std::string> out;
-  std::stringstream ss(line);
-  std::string field;
-  while (std::getline(ss, field, ',')) out.push_back(field);
-  return out;
-}
-
 // truth/subjects.csv by timestamp.
 std::unordered_map<int64_t, std::vector<TruthRow>> ReadSubjects(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw InputError(path, "cannot open the session truth (is this a synthetic session?)");
-  std::string line;
-  if (!std::getline(in, line)) throw InputError(path, "empty");
-  const std::vector<std::string> header = SplitCsv(line);
-  auto column = [&](const std::string& name) {
-    for (size_t k = 0; k < header.size(); ++k) {
-      if (header[k] == name) return k;
-    }
-    throw InputError(path, "no column '" + name + "' in the header");
-  };
-  const size_t c_ts = column("timestamp_ns"), c_x = column("x"), c_y = column("y"),
-               c_heading = column("heading_rad"), c_phase = column("gait_phase"),
-               c_pose = column("pose");
+  CsvTable csv(path, "cannot open the session truth (is this a synthetic session?)");
+  const size_t c_ts = csv.Column("timestamp_ns"), c_x = csv.Column("x"), c_y = csv.Column("y"),
+               c_heading = csv.Column("heading_rad"), c_phase = csv.Column("gait_phase"),
+               c_pose = csv.Column("pose");
   std::unordered_map<int64_t, std::vector<TruthRow>> rows;
-  int line_number = 1;
-  while (std::getline(in, line)) {
-    ++line_number;
-    if (line.empty()) continue;
-    const std::vector<std::string> f = SplitCsv(line);
-    if (f.size() < header.size()) {
-      throw InputError(
-          path + ":" + std::to_string(line_number),
-          "expected " + std::to_string(header.size()) + " fields, got " + std::to_string(f.size()));
-    }
+  while (csv.Next()) {
     try {
       TruthRow r;
-      r.x = std::stod(f[c_x]);
-      r.y = std::stod(f[c_y]);
-      r.truth.heading_rad = std::stod(f[c_heading]);
-      r.truth.gait_phase = std::stod(f[c_phase]);
-      r.truth.pose = f[c_pose];
-      rows[std::stoll(f[c_ts])].push_back(r);
+      r.x = std::stod(csv[c_x]);
+      r.y = std::stod(csv[c_y]);
+      r.truth.heading_rad = std::stod(csv[c_heading]);
+      r.truth.gait_phase = std::stod(csv[c_phase]);
+      r.truth.pose = csv[c_pose];
+      rows[std::stoll(csv[c_ts])].push_back(r);
     } catch (const std::logic_error&) {
-      throw InputError(path + ":" + std::to_string(line_number),
-                       "a number does not parse: '" + line + "'");
+      throw InputError(csv.Where(), "a number does not parse: '" + csv.line() + "'");
     }
   }
   return rows;
