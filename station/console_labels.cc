@@ -265,16 +265,20 @@ nlohmann::json ConsoleLabels::Counts() const {
           {"exportable", yes + no}};
 }
 
-nlohmann::json ConsoleLabels::Pairs(int count) {
-  const std::string bank = BankPath();
-  const auto [weights, weights_path] = WeightsInUse();
-  std::lock_guard lock(pool_mutex_);
+void ConsoleLabels::UpdatePool(const std::string& bank, const TransitionWeights& weights) {
   if (!pool_ || pool_->bank != bank || !SameWindow(pool_->window, weights.window)) {
     pool_ = std::make_unique<Pool>();
     pool_->bank = bank;
     pool_->window = weights.window;
   }
   pool_->Update(options_.threads);
+}
+
+nlohmann::json ConsoleLabels::Pairs(int count) {
+  const std::string bank = BankPath();
+  const auto [weights, weights_path] = WeightsInUse();
+  std::lock_guard lock(pool_mutex_);
+  UpdatePool(bank, weights);
   const TransitionClassifier classifier(weights);
   const double threshold = classifier.stage2_threshold();
   nlohmann::json out = {
@@ -364,12 +368,7 @@ nlohmann::json ConsoleLabels::Pair(int64_t from, int64_t to) {
   }
   const auto [weights, weights_path] = WeightsInUse();
   std::lock_guard lock(pool_mutex_);
-  if (!pool_ || pool_->bank != bank || !SameWindow(pool_->window, weights.window)) {
-    pool_ = std::make_unique<Pool>();
-    pool_->bank = bank;
-    pool_->window = weights.window;
-  }
-  pool_->Update(options_.threads);
+  UpdatePool(bank, weights);
   auto index = [&](int64_t id, const char* field) {
     const std::optional<int32_t> i = pool_->store ? pool_->store->IndexOf(id) : std::nullopt;
     if (!i) {

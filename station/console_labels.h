@@ -105,6 +105,9 @@ class ConsoleLabels : public api::Part {
                          const ConsoleLabelsOptions& options, const std::string& bank,
                          const TransitionWeights& current);
   void RefreshStatus() const;  // labels and weights from the bank (at most every 2 s)
+  // pool_ made anew for another bank or comparison window, then brought up to the bank's sprites;
+  // pool_mutex_ held.
+  void UpdatePool(const std::string& bank, const TransitionWeights& weights);
 
   api::Context context_;
   ConsoleLabelsOptions options_;

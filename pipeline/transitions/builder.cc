@@ -29,6 +29,15 @@ const TransitionBuilder::Neighbour* TransitionBuilder::Find(const std::vector<Ne
   return it != list.end() && it->index == index ? &*it : nullptr;
 }
 
+bool TransitionBuilder::Compare(int32_t i, int32_t j, double* d) {
+  if (classifier_.SignatureRejects(store_, i, j)) {
+    ++stats_.signature_rejected;
+    return false;
+  }
+  ++stats_.stage2_evaluations;
+  return classifier_.Stage2(store_, i, j, d);
+}
+
 void TransitionBuilder::InsertNeighbour(int32_t at, int32_t index, double distance) {
   auto& list = neighbours_[at];
   auto it = std::lower_bound(list.begin(), list.end(), index,
@@ -156,13 +165,8 @@ TransitionDelta TransitionBuilder::Add(std::span<const SpriteInput> sprites) {
     for (size_t h = 0; h < hits.size(); ++h) {
       if (h + 8 < hits.size()) store_.PrefetchCoarse(hits[h + 8]);
       const int32_t j = hits[h];
-      if (classifier_.SignatureRejects(store_, s, j)) {
-        ++stats_.signature_rejected;
-        continue;
-      }
-      ++stats_.stage2_evaluations;
       double d;
-      if (!classifier_.Stage2(store_, s, j, &d)) continue;
+      if (!Compare(s, j, &d)) continue;
       mine.push_back({j, d});
       InsertNeighbour(j, s, d);
       const int64_t a = store_.id(s), b = store_.id(j);
@@ -205,13 +209,8 @@ TransitionDelta TransitionBuilder::AddPairsOf(int32_t first, int32_t end) {
       const int32_t j = hits[h];
       if (j == s || (j >= first && j < end && j > s)) continue;  // within the range: each pair once
       if (Find(neighbours_[s], j)) continue;                     // found by an earlier unit here
-      if (classifier_.SignatureRejects(store_, s, j)) {
-        ++stats_.signature_rejected;
-        continue;
-      }
-      ++stats_.stage2_evaluations;
       double d;
-      if (!classifier_.Stage2(store_, s, j, &d)) continue;
+      if (!Compare(s, j, &d)) continue;
       InsertNeighbour(s, j, d);
       InsertNeighbour(j, s, d);
       ++stats_.kept_pairs;

@@ -104,6 +104,9 @@ class TransitionBuilder {
   // Appends the transitions into store index j (C needs prev(j)).
   void TransitionsInto(int32_t j, std::vector<Transition>* out) const;
   static const Neighbour* Find(const std::vector<Neighbour>& list, int32_t index);
+  // The silhouette signature, then stage 2 on (i, j), counted in stats_: true with D(i, j) in `d`
+  // when the pair is a candidate.
+  bool Compare(int32_t i, int32_t j, double* d);
   void InsertNeighbour(int32_t at, int32_t index, double distance);
 
   TransitionClassifier classifier_;
