@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "animate/problem.h"
+#include "core/elapsed.h"  // MonotonicSeconds
 
 namespace ss {
 
@@ -68,8 +69,5 @@ class ScopedTimer {
   double* seconds_;
   int64_t start_ns_;
 };
-
-// Seconds on a monotonic clock.
-double MonotonicSeconds();
 
 }  // namespace ss

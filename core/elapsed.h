@@ -9,7 +9,7 @@ inline double Seconds(std::chrono::steady_clock::duration d) {
   return std::chrono::duration<double>(d).count();
 }
 // Seconds on the steady clock since its (arbitrary) epoch: for differences only.
-inline double SteadySeconds() {
+inline double MonotonicSeconds() {
   return Seconds(std::chrono::steady_clock::now().time_since_epoch());
 }
 // Seconds from `start` until now, on the steady clock.

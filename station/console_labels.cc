@@ -665,9 +665,9 @@ void ConsoleLabels::RefreshStatus() const {
   {
     std::lock_guard lock(shared_->mutex);
     std::lock_guard status_lock(status_mutex_);
-    if (!shared_->dirty && SteadySeconds() - refreshed_at_ < 2.0) return;
+    if (!shared_->dirty && MonotonicSeconds() - refreshed_at_ < 2.0) return;
     shared_->dirty = false;
-    refreshed_at_ = SteadySeconds();
+    refreshed_at_ = MonotonicSeconds();
   }
   nlohmann::json labels, weights;
   const auto [w, path] = WeightsInUse();
