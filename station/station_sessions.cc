@@ -1,5 +1,6 @@
 // The station's capture sessions (start, stop, rename) and what taps the frames while one runs:
 // the recorder and the frame watcher.
+#include <atomic>
 #include <filesystem>
 #include <mutex>
 
@@ -33,6 +34,12 @@ std::string CheckSessionName(const std::string& name) {
   if (name == "." || name == "..")
     throw InputError("name", "\"" + name + "\" is not a session name");
   return name;
+}
+
+// SessionStatus::revision: one count for every station of the process.
+uint64_t NextSessionRevision() {
+  static std::atomic<uint64_t> last{0};
+  return ++last;
 }
 
 }  // namespace
@@ -98,6 +105,7 @@ SessionStatus Station::StartSession(const std::string& requested_name) {
   }
   s.session.active = true;
   s.session_active = true;
+  s.session.revision = NextSessionRevision();
   s.session.name = name;
   s.session.started = created;
   s.session_started = Clock::now();
@@ -148,6 +156,7 @@ SessionStatus Station::StopSession() {
   std::lock_guard lock(s.session_mutex);
   s.session.active = false;
   s.session_active = false;
+  s.session.revision = NextSessionRevision();
   for (auto& r : s.runners) r->set_preview_interval(kPreviewIntervalS);
   s.session.seconds = Seconds(Clock::now() - s.session_started);
   s.log->info("session \"{}\" stopped: {} sprites stored", s.session.name,
@@ -167,6 +176,7 @@ SessionStatus Station::RenameSession(const std::string& requested_name) {
   }
   s.log->info("session \"{}\" renamed \"{}\"", s.session.name, name);
   s.session.name = name;
+  s.session.revision = NextSessionRevision();
   return s.session;
 }
 

@@ -61,7 +61,8 @@ nlohmann::json SessionToJson(const SessionStatus& s) {
           {"started", s.started},
           {"seconds", s.seconds},
           {"sprites_stored", s.sprites_stored},
-          {"recording_dir", s.recording_dir}};
+          {"recording_dir", s.recording_dir},
+          {"revision", s.revision}};
 }
 
 const char* StationStateName(StationState state) {

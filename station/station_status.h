@@ -19,6 +19,10 @@ struct SessionStatus {
   double seconds = 0;           // since it started
   uint64_t sprites_stored = 0;  // original sprites stored in it so far
   std::string recording_dir;    // "" when not recording
+  // Counts the session changes (start, stop, rename) of every station the process ran (a replay
+  // station follows the live one). A status taken before a change may reach a client after the
+  // change's own answer; the client keeps the higher revision.
+  uint64_t revision = 0;
 };
 
 enum class StationState { kStarting, kRunning, kStopping, kStopped };

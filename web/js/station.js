@@ -369,8 +369,18 @@ function defaultName() {
 
 // The session as a start, stop or rename answered it (the same fields as the status's), shown at
 // once rather than when the next status event brings it.
+// A status event taken before the change can arrive after its answer: the session with the
+// higher revision (the station raises it at each start, stop and rename) is the one shown.
+let answered = null; // the session of the last answer
 function applySession(session) {
-  if (status && session && typeof session.active === 'boolean') status = { ...status, session };
+  if (!session || typeof session.active !== 'boolean') return;
+  answered = session;
+  if (status) status = { ...status, session };
+}
+function newerSession(s) {
+  if (answered && (s.session?.revision ?? 0) < (answered.revision ?? 0)) return { ...s, session: answered };
+  answered = null; // the station has caught up with the answer
+  return s;
 }
 
 // A session request from its button; the session's state decides the buttons after it.
@@ -463,10 +473,13 @@ $('legend').querySelector('ul').append(
 // ---- wiring ----------------------------------------------------------------
 
 events.addEventListener('status', (e) => {
-  status = e.detail;
+  status = newerSession(e.detail);
   syncTiles(status.cameras || []);
   updateSession(status);
   document.body.dataset.mode = status.mode || 'live';
+});
+events.addEventListener('connection', (e) => {
+  if (e.detail !== 'connected') answered = null; // a restarted daemon counts revisions afresh
 });
 events.addEventListener('history', queueCharts);
 events.addEventListener('sample', queueCharts);

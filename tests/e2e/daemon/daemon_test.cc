@@ -244,8 +244,14 @@ TEST_F(DaemonTest, TwoEmulatedGigECamerasStoreWhatIngestFinds) {
   const nlohmann::json session = nlohmann::json::parse(stopped->body);
   EXPECT_EQ(session["name"], "take 1 walk");
   EXPECT_FALSE(session["active"].get<bool>());
+  // Each start, rename and stop raises the session's revision; a later status carries the stop's
+  // (the console keeps the higher of an answer and a status sent before it).
+  const nlohmann::json after_rename = nlohmann::json::parse(renamed->body);
+  EXPECT_EQ(after_rename["revision"].get<uint64_t>(), 2u) << renamed->body;
+  EXPECT_EQ(session["revision"].get<uint64_t>(), 3u) << stopped->body;
 
   const nlohmann::json status = Status();
+  EXPECT_EQ(status["session"]["revision"], session["revision"]) << status["session"].dump();
   const auto metrics = client_->Get("/metrics");
   ASSERT_TRUE(metrics);
   EXPECT_NE(metrics->body.find(
