@@ -63,15 +63,8 @@ AnimalLook RandomAnimalLook(uint64_t seed) {
 
 std::vector<Primitive> AnimalPrimitives(const AnimalLook& look, const AnimalState& s, int subject,
                                         int slice) {
-  const double k = look.scale;
-  std::vector<Primitive> out;
-  out.reserve(20);
   // Animal frame -> ground.
-  const Eigen::Matrix3d r_world = RotZ(s.heading_rad);
-  const Eigen::Vector3d t_world(s.position.x(), s.position.y(), 0.0);
-  auto to_ground = [&](const Eigen::Vector3d& p) -> Eigen::Vector3d {
-    return r_world * (k * p) + t_world;
-  };
+  SubjectParts parts(s.position, s.heading_rad, look.scale, look.seed, subject, slice, 20);
 
   // Upper body pitched about the hips: rearing and leaning.
   const double rear = Smooth(s.rear), lean = Smooth(s.lean);
@@ -95,10 +88,6 @@ std::vector<Primitive> AnimalPrimitives(const AnimalLook& look, const AnimalStat
   fur.colour2 = look.belly;
   fur.texture = 0.18f;
   fur.texture_scale = 6.0f;
-  auto mat = [&](Material m, uint64_t part) {
-    m.seed = static_cast<uint32_t>(Mix(look.seed, part));
-    return m;
-  };
   Material pink;
   pink.pattern = Pattern::kPlain;
   pink.colour = {0.58f, 0.62f, 0.86f};
@@ -112,30 +101,15 @@ std::vector<Primitive> AnimalPrimitives(const AnimalLook& look, const AnimalStat
   limb.colour2 = pink.colour;
   limb.texture = 0.1f;
 
-  auto ellipsoid = [&](const Eigen::Vector3d& centre, const Eigen::Matrix3d& rot,
-                       const Eigen::Vector3d& radii, const Material& m) {
-    Primitive p = Primitive::Ellipsoid(to_ground(centre), r_world * rot, k * radii, m);
-    p.subject = subject;
-    p.slice = slice;
-    out.push_back(p);
-  };
-  auto capsule = [&](const Eigen::Vector3d& a, const Eigen::Vector3d& b, double radius,
-                     const Material& m) {
-    Primitive p = Primitive::Capsule(to_ground(a), to_ground(b), k * radius, m);
-    p.subject = subject;
-    p.slice = slice;
-    out.push_back(p);
-  };
-
   const Eigen::Vector3d lift(0.0, 0.0, bob);
   const Eigen::Matrix3d r_body = r_pitch * RotX(sway * 0.3);
   // Torso (chest) and rump.
-  ellipsoid(body(Eigen::Vector3d(0.012, 0.0, 0.040)) + lift, r_body,
-            Eigen::Vector3d(0.050, 0.038 * breathe, 0.034 * breathe), mat(fur, 1));
-  ellipsoid(body(Eigen::Vector3d(-0.030, 0.0, 0.038)) + lift, r_body,
-            Eigen::Vector3d(0.042, 0.043 * breathe, 0.036), mat(fur, 2));
-  ellipsoid(body(Eigen::Vector3d(-0.074, 0.0, 0.028)) + lift, r_body * RotY(0.4),
-            Eigen::Vector3d(0.011, 0.006, 0.006), mat(pink, 3));
+  parts.Ellipsoid(body(Eigen::Vector3d(0.012, 0.0, 0.040)) + lift, r_body,
+                  Eigen::Vector3d(0.050, 0.038 * breathe, 0.034 * breathe), parts.Seeded(fur, 1));
+  parts.Ellipsoid(body(Eigen::Vector3d(-0.030, 0.0, 0.038)) + lift, r_body,
+                  Eigen::Vector3d(0.042, 0.043 * breathe, 0.036), parts.Seeded(fur, 2));
+  parts.Ellipsoid(body(Eigen::Vector3d(-0.074, 0.0, 0.028)) + lift, r_body * RotY(0.4),
+                  Eigen::Vector3d(0.011, 0.006, 0.006), parts.Seeded(pink, 3));
 
   // Head: hinged at the neck, turned by head_yaw, held more level than the body.
   const Eigen::Vector3d neck = body(Eigen::Vector3d(0.045, 0.0, 0.046)) + lift;
@@ -145,22 +119,23 @@ std::vector<Primitive> AnimalPrimitives(const AnimalLook& look, const AnimalStat
     return neck + r_head * (p - Eigen::Vector3d(0.045, 0.0, 0.046));
   };
   const Eigen::Vector3d head_centre(0.068, 0.0, 0.047);
-  ellipsoid(head(head_centre), r_head, Eigen::Vector3d(0.033, 0.028, 0.027), mat(fur, 4));
-  ellipsoid(head(Eigen::Vector3d(0.058, 0.0, 0.036)), r_head, Eigen::Vector3d(0.022, 0.032, 0.019),
-            mat(fur, 5));  // cheeks
-  ellipsoid(head(Eigen::Vector3d(0.099, 0.0, 0.045 + sniff)), r_head,
-            Eigen::Vector3d(0.0055, 0.0065, 0.005), mat(pink, 6));
+  parts.Ellipsoid(head(head_centre), r_head, Eigen::Vector3d(0.033, 0.028, 0.027),
+                  parts.Seeded(fur, 4));
+  parts.Ellipsoid(head(Eigen::Vector3d(0.058, 0.0, 0.036)), r_head,
+                  Eigen::Vector3d(0.022, 0.032, 0.019), parts.Seeded(fur, 5));  // cheeks
+  parts.Ellipsoid(head(Eigen::Vector3d(0.099, 0.0, 0.045 + sniff)), r_head,
+                  Eigen::Vector3d(0.0055, 0.0065, 0.005), parts.Seeded(pink, 6));
   for (int side : {-1, 1}) {
-    ellipsoid(head(Eigen::Vector3d(0.084, 0.0185 * side, 0.056)), r_head,
-              Eigen::Vector3d(0.0055, 0.0055, 0.0055), mat(eye, 7 + side));
+    parts.Ellipsoid(head(Eigen::Vector3d(0.084, 0.0185 * side, 0.056)), r_head,
+                    Eigen::Vector3d(0.0055, 0.0055, 0.0055), parts.Seeded(eye, 7 + side));
     Material ear = pink;
     ear.colour = look.fur * 0.6f + pink.colour * 0.4f;
-    ellipsoid(head(Eigen::Vector3d(0.060, 0.019 * side, 0.073)), r_head * RotX(0.35 * side),
-              Eigen::Vector3d(0.0045, 0.010, 0.011), mat(ear, 10 + side));
+    parts.Ellipsoid(head(Eigen::Vector3d(0.060, 0.019 * side, 0.073)), r_head * RotX(0.35 * side),
+                    Eigen::Vector3d(0.0045, 0.010, 0.011), parts.Seeded(ear, 10 + side));
   }
 
   // Legs: paws on the floor in stance, lifted and swung forward in swing.
-  const double stride = s.stride_m / k;  // in body units
+  const double stride = s.stride_m / look.scale;  // in body units
   for (int i = 0; i < 4; ++i) {
     const Leg& leg = kLegs[i];
     const double offset = leg.walk_offset + s.trot * (leg.trot_offset - leg.walk_offset);
@@ -194,17 +169,16 @@ std::vector<Primitive> AnimalPrimitives(const AnimalLook& look, const AnimalStat
         paw = paw + up * (raised - paw);
       }
     }
-    Material leg_mat = limb;
-    leg_mat.seed = static_cast<uint32_t>(Mix(look.seed, 20 + i));
+    const Material leg_mat = parts.Seeded(limb, 20 + i);
     const double leg_r = leg.front ? 0.0072 : 0.0085;
     // the leg never dips below the floor
     const Eigen::Vector3d ankle = paw + Eigen::Vector3d(-0.002, 0.0, leg_r);
-    capsule(joint, ankle, leg_r, leg_mat);
+    parts.Capsule(joint, ankle, leg_r, leg_mat);
     Eigen::Matrix3d r_paw = Eigen::Matrix3d::Identity();
     if (leg.front && std::max(rear, lean) > 0.0) r_paw = RotY(-0.5 * pitch);
-    ellipsoid(paw, r_paw, Eigen::Vector3d(0.0095, 0.0062, 0.004), mat(pink, 30 + i));
+    parts.Ellipsoid(paw, r_paw, Eigen::Vector3d(0.0095, 0.0062, 0.004), parts.Seeded(pink, 30 + i));
   }
-  return out;
+  return std::move(parts).Take();
 }
 
 double LeanReach(const AnimalLook& look) { return ForwardReach(look, 1.0); }

@@ -46,32 +46,9 @@ FlyLook RandomFlyLook(uint64_t seed) {
 
 std::vector<Primitive> FlyPrimitives(const FlyLook& look, const FlyState& s, int subject,
                                      int slice) {
-  const double unit = kFlyLengthM * look.scale;
-  std::vector<Primitive> out;
-  out.reserve(24);
-  const Eigen::Matrix3d r_world = RotZ(s.heading_rad);
-  const Eigen::Vector3d t_world(s.position.x(), s.position.y(), 0.0);
-  auto to_ground = [&](const Eigen::Vector3d& p) -> Eigen::Vector3d {
-    return r_world * (unit * p) + t_world;
-  };
-  auto mat = [&](Material m, uint64_t part) {
-    m.seed = static_cast<uint32_t>(Mix(look.seed, part));
-    return m;
-  };
-  auto ellipsoid = [&](const Eigen::Vector3d& centre, const Eigen::Matrix3d& rot,
-                       const Eigen::Vector3d& radii, const Material& m) {
-    Primitive p = Primitive::Ellipsoid(to_ground(centre), r_world * rot, unit * radii, m);
-    p.subject = subject;
-    p.slice = slice;
-    out.push_back(p);
-  };
-  auto capsule = [&](const Eigen::Vector3d& a, const Eigen::Vector3d& b, double radius,
-                     const Material& m) {
-    Primitive p = Primitive::Capsule(to_ground(a), to_ground(b), unit * radius, m);
-    p.subject = subject;
-    p.slice = slice;
-    out.push_back(p);
-  };
+  // Fly frame (in body lengths) -> ground.
+  SubjectParts parts(s.position, s.heading_rad, kFlyLengthM * look.scale, look.seed, subject, slice,
+                     24);
 
   Material body;
   body.pattern = Pattern::kFur;  // bristly: the fur noise, lighter below
@@ -95,22 +72,23 @@ std::vector<Primitive> FlyPrimitives(const FlyLook& look, const FlyState& s, int
   const double breathe = 1.0 + 0.02 * std::sin(2.0 * M_PI * 2.1 * s.time_s);
   const double bob = gait * 0.008 * std::cos(4.0 * M_PI * s.gait_phase);
   const Eigen::Vector3d lift(0.0, 0.0, bob);
-  ellipsoid(Eigen::Vector3d(0.14, 0.0, 0.18) + lift, Eigen::Matrix3d::Identity(),
-            Eigen::Vector3d(0.16, 0.13, 0.12), mat(body, 1));  // thorax
-  ellipsoid(Eigen::Vector3d(-0.16, 0.0, 0.15) + lift, RotX(0.0),
-            Eigen::Vector3d(0.21, 0.14 * breathe, 0.095 * breathe), mat(body, 2));  // abdomen
-  ellipsoid(Eigen::Vector3d(0.34, 0.0, 0.18) + lift, Eigen::Matrix3d::Identity(),
-            Eigen::Vector3d(0.07, 0.13, 0.10), mat(body, 3));  // head
+  parts.Ellipsoid(Eigen::Vector3d(0.14, 0.0, 0.18) + lift, Eigen::Matrix3d::Identity(),
+                  Eigen::Vector3d(0.16, 0.13, 0.12), parts.Seeded(body, 1));  // thorax
+  parts.Ellipsoid(Eigen::Vector3d(-0.16, 0.0, 0.15) + lift, RotX(0.0),
+                  Eigen::Vector3d(0.21, 0.14 * breathe, 0.095 * breathe),
+                  parts.Seeded(body, 2));  // abdomen
+  parts.Ellipsoid(Eigen::Vector3d(0.34, 0.0, 0.18) + lift, Eigen::Matrix3d::Identity(),
+                  Eigen::Vector3d(0.07, 0.13, 0.10), parts.Seeded(body, 3));  // head
   for (int side : {-1, 1}) {
-    ellipsoid(Eigen::Vector3d(0.36, 0.085 * side, 0.20) + lift, Eigen::Matrix3d::Identity(),
-              Eigen::Vector3d(0.07, 0.06, 0.085), mat(eye, 4 + side));
+    parts.Ellipsoid(Eigen::Vector3d(0.36, 0.085 * side, 0.20) + lift, Eigen::Matrix3d::Identity(),
+                    Eigen::Vector3d(0.07, 0.06, 0.085), parts.Seeded(eye, 4 + side));
     // Wings folded back over the abdomen, opening out while darting.
     const double a = (22.0 + 40.0 * Smooth(s.wing_spread)) * kDeg;
     const Eigen::Vector3d root(0.10, 0.05 * side, 0.27);
     const Eigen::Vector3d dir(-std::cos(a), side * std::sin(a), 0.0);
-    ellipsoid(root + 0.29 * dir + lift + Eigen::Vector3d(0, 0, 0.02 * s.wing_spread),
-              RotZ(std::atan2(dir.y(), dir.x())), Eigen::Vector3d(0.29, 0.11, 0.008),
-              mat(wing, 6 + side));
+    parts.Ellipsoid(root + 0.29 * dir + lift + Eigen::Vector3d(0, 0, 0.02 * s.wing_spread),
+                    RotZ(std::atan2(dir.y(), dir.x())), Eigen::Vector3d(0.29, 0.11, 0.008),
+                    parts.Seeded(wing, 6 + side));
   }
 
   // Legs: tripod gait; grooming raises the front pair (rubbed together before the head) or
@@ -143,10 +121,10 @@ std::vector<Primitive> FlyPrimitives(const FlyLook& look, const FlyState& s, int
     Eigen::Vector3d knee = hip + 0.5 * (foot - hip);
     knee.y() += side * 0.05;
     knee.z() = std::max(knee.z(), foot.z()) + 0.10;
-    capsule(hip, knee, 0.020, mat(leg, 10 + i));
-    capsule(knee, foot, 0.012, mat(leg, 20 + i));
+    parts.Capsule(hip, knee, 0.020, parts.Seeded(leg, 10 + i));
+    parts.Capsule(knee, foot, 0.012, parts.Seeded(leg, 20 + i));
   }
-  return out;
+  return std::move(parts).Take();
 }
 
 // ---------------------------------------------------------------------------

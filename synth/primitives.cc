@@ -6,9 +6,46 @@
 
 #include <Eigen/Dense>
 
+#include "synth/angles.h"
 #include "synth/random.h"
 
 namespace ss::synth {
+
+SubjectParts::SubjectParts(const Eigen::Vector2d& position, double heading_rad, double scale,
+                           uint64_t look_seed, int subject, int slice, size_t reserve)
+    : r_world_(RotZ(heading_rad)),
+      t_world_(position.x(), position.y(), 0.0),
+      scale_(scale),
+      look_seed_(look_seed),
+      subject_(subject),
+      slice_(slice) {
+  out_.reserve(reserve);
+}
+
+Eigen::Vector3d SubjectParts::ToGround(const Eigen::Vector3d& p) const {
+  return r_world_ * (scale_ * p) + t_world_;
+}
+
+Material SubjectParts::Seeded(Material m, uint64_t part) const {
+  m.seed = static_cast<uint32_t>(Mix(look_seed_, part));
+  return m;
+}
+
+void SubjectParts::Ellipsoid(const Eigen::Vector3d& centre, const Eigen::Matrix3d& rotation,
+                             const Eigen::Vector3d& radii, const Material& m) {
+  Primitive p = Primitive::Ellipsoid(ToGround(centre), r_world_ * rotation, scale_ * radii, m);
+  p.subject = subject_;
+  p.slice = slice_;
+  out_.push_back(p);
+}
+
+void SubjectParts::Capsule(const Eigen::Vector3d& a, const Eigen::Vector3d& b, double radius,
+                           const Material& m) {
+  Primitive p = Primitive::Capsule(ToGround(a), ToGround(b), scale_ * radius, m);
+  p.subject = subject_;
+  p.slice = slice_;
+  out_.push_back(p);
+}
 
 Primitive Primitive::Ellipsoid(const Eigen::Vector3d& centre, const Eigen::Matrix3d& rotation,
                                const Eigen::Vector3d& radii, const Material& material) {

@@ -2,7 +2,9 @@
 // The shapes subjects are made of (ellipsoids and capsules in the ground frame),
 // their materials and shading under the studio's diffuse top light, and the
 // per-camera form the renderer intersects pixel rays with.
+#include <cstddef>
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -57,6 +59,33 @@ struct Primitive {
   Eigen::Vector3d Normal(const Eigen::Vector3d& point) const;
   // Distance (ray parameter for a unit direction) of the first hit; < 0 for a miss.
   double Intersect(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction) const;
+};
+
+// One subject's primitives, made in its own frame (x forward, z up, at scale 1) and placed on
+// the ground: scaled by `scale`, turned by `heading_rad` about z, moved to `position`. Each part's
+// material gets a texture seed of its own from the look's seed and the part's number.
+class SubjectParts {
+ public:
+  SubjectParts(const Eigen::Vector2d& position, double heading_rad, double scale,
+               uint64_t look_seed, int subject, int slice, size_t reserve);
+  // A point of the subject's frame on the ground.
+  Eigen::Vector3d ToGround(const Eigen::Vector3d& p) const;
+  // `m` with part `part`'s texture seed.
+  Material Seeded(Material m, uint64_t part) const;
+  // `rotation` and `radii` in the subject's frame.
+  void Ellipsoid(const Eigen::Vector3d& centre, const Eigen::Matrix3d& rotation,
+                 const Eigen::Vector3d& radii, const Material& m);
+  void Capsule(const Eigen::Vector3d& a, const Eigen::Vector3d& b, double radius,
+               const Material& m);
+  std::vector<Primitive> Take() && { return std::move(out_); }
+
+ private:
+  Eigen::Matrix3d r_world_;
+  Eigen::Vector3d t_world_;
+  double scale_;
+  uint64_t look_seed_;
+  int subject_, slice_;
+  std::vector<Primitive> out_;
 };
 
 // Shading constants of one studio.
