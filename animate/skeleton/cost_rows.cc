@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "core/error.h"
+#include "core/float8.h"
 #include "core/target_clones.h"
 
 // GCC notes that 32-byte vector arguments change the ABI without AVX; these helpers are
@@ -40,14 +41,10 @@ constexpr int kLanes = 8;   // floats per vector
 constexpr int kChunk = 16;  // source frames per kernel step (two vectors)
 constexpr int kTile = 6;    // complete target frames per kernel step
 
-typedef float v8f __attribute__((vector_size(32)));
+using float8::Load;
+using float8::Store;
+using float8::v8f;
 
-inline v8f Load(const float* p) {
-  v8f v;
-  std::memcpy(&v, p, sizeof(v));
-  return v;
-}
-inline void Store(float* p, v8f v) { std::memcpy(p, &v, sizeof(v)); }
 inline v8f ClampPositive(v8f v) { return v > 0 ? v : v8f{}; }
 
 // (The t loops are unrolled explicitly: at -O2 GCC otherwise keeps acc0/acc1 in memory.)

@@ -5,6 +5,7 @@
 
 #include "animate/skeleton/match_dp_detail.h"
 #include "core/error.h"
+#include "core/float8.h"
 #include "core/target_clones.h"
 
 // GCC notes that 32-byte vector arguments change the ABI without AVX; these helpers are
@@ -13,17 +14,13 @@
 
 namespace ss::match_dp_detail {
 
-typedef float v8f __attribute__((vector_size(32)));
+using float8::Load;
+using float8::Store;
+using float8::v8f;
 typedef int v8i __attribute__((vector_size(32)));
 typedef uint8_t v8u8 __attribute__((vector_size(8)));
 typedef uint16_t v8u16 __attribute__((vector_size(16)));
 
-inline v8f Load(const float* p) {
-  v8f v;
-  std::memcpy(&v, p, sizeof(v));
-  return v;
-}
-inline void Store(float* p, v8f v) { std::memcpy(p, &v, sizeof(v)); }
 inline v8f Min(v8f a, v8f b) { return a < b ? a : b; }
 
 namespace {
