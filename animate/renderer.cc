@@ -7,6 +7,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "core/error.h"
+#include "core/grid_map.h"
 #include "core/option_checks.h"
 
 namespace ss {
@@ -137,7 +138,7 @@ void SpriteRenderer::DrawPlane(const cv::Mat& full_layer, const Eigen::Vector3d&
 
   // Layer coordinates of the grid's image pixels: ray -> plane -> (u, v).
   const int g = options_.grid_step_px;
-  const int gw = (bw + g - 1) / g + 1, gh = (bh + g - 1) / g + 1;
+  const int gw = GridPoints(bw, g), gh = GridPoints(bh, g);
   std::vector<Eigen::Vector2d> pixels(static_cast<size_t>(gw) * gh);
   for (int gy = 0; gy < gh; ++gy) {
     for (int gx = 0; gx < gw; ++gx)
@@ -162,26 +163,8 @@ void SpriteRenderer::DrawPlane(const cv::Mat& full_layer, const Eigen::Vector3d&
     grid[i] = Eigen::Vector2f(static_cast<float>(rel.dot(du) / du2),
                               static_cast<float>(rel.dot(dv) / dv2));
   }
-  cv::Mat map(bh, bw, CV_32FC2);
-  for (int y = 0; y < bh; ++y) {
-    const int gy = y / g;
-    const float fy = static_cast<float>(y - gy * g) / g;
-    auto* row = map.ptr<cv::Vec2f>(y);
-    for (int x = 0; x < bw; ++x) {
-      const int gx = x / g;
-      const float fx = static_cast<float>(x - gx * g) / g;
-      const Eigen::Vector2f& a = grid[gy * gw + gx];
-      const Eigen::Vector2f& b = grid[gy * gw + gx + 1];
-      const Eigen::Vector2f& c = grid[(gy + 1) * gw + gx];
-      const Eigen::Vector2f& e = grid[(gy + 1) * gw + gx + 1];
-      if (a.x() == kOutside || b.x() == kOutside || c.x() == kOutside || e.x() == kOutside) {
-        row[x] = cv::Vec2f(kOutside, kOutside);
-        continue;
-      }
-      const Eigen::Vector2f p = (1 - fy) * ((1 - fx) * a + fx * b) + fy * ((1 - fx) * c + fx * e);
-      row[x] = cv::Vec2f(p.x(), p.y());
-    }
-  }
+  cv::Mat map;
+  InterpolateGridMap(grid, g, cv::Size(bw, bh), kOutside, map);
   cv::Mat warped;
   cv::remap(layer, warped, map, cv::noArray(), cv::INTER_LINEAR, cv::BORDER_CONSTANT,
             cv::Scalar::all(0));

@@ -7,6 +7,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "core/error.h"
+#include "core/grid_map.h"
 #include "core/log.h"
 #include "core/option_checks.h"
 
@@ -23,8 +24,8 @@ constexpr int kGridStep = 8;
 void BuildPlaneMap(const CameraModel& camera, const Eigen::Vector3d& origin,
                    const Eigen::Vector3d& du, const Eigen::Vector3d& dv, cv::Size size,
                    cv::Point offset, cv::Mat& map) {
-  const int gw = (size.width + kGridStep - 1) / kGridStep + 1;
-  const int gh = (size.height + kGridStep - 1) / kGridStep + 1;
+  const int gw = GridPoints(size.width, kGridStep);
+  const int gh = GridPoints(size.height, kGridStep);
   std::vector<Eigen::Vector2f> grid(static_cast<size_t>(gw) * gh);
   for (int gy = 0; gy < gh; ++gy) {
     for (int gx = 0; gx < gw; ++gx) {
@@ -34,22 +35,7 @@ void BuildPlaneMap(const CameraModel& camera, const Eigen::Vector3d& origin,
                                            static_cast<float>(px.y() - offset.y));
     }
   }
-  map.create(size, CV_32FC2);
-  for (int v = 0; v < size.height; ++v) {
-    const int gy = v / kGridStep;
-    const float fy = static_cast<float>(v - gy * kGridStep) / kGridStep;
-    auto* row = map.ptr<cv::Vec2f>(v);
-    for (int u = 0; u < size.width; ++u) {
-      const int gx = u / kGridStep;
-      const float fx = static_cast<float>(u - gx * kGridStep) / kGridStep;
-      const Eigen::Vector2f& a = grid[gy * gw + gx];
-      const Eigen::Vector2f& b = grid[gy * gw + gx + 1];
-      const Eigen::Vector2f& c = grid[(gy + 1) * gw + gx];
-      const Eigen::Vector2f& d = grid[(gy + 1) * gw + gx + 1];
-      const Eigen::Vector2f p = (1 - fy) * ((1 - fx) * a + fx * b) + fy * ((1 - fx) * c + fx * d);
-      row[u] = cv::Vec2f(p.x(), p.y());
-    }
-  }
+  InterpolateGridMap(grid, kGridStep, size, std::nullopt, map);
 }
 
 // Where the ray through `pixel` meets the vertical plane through `point` with normal `n`
