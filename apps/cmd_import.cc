@@ -67,13 +67,9 @@ void RunImport(ImportArgs a) {
   }
 
   if (a.json) {
-    nlohmann::json j;
-    j["session"] = s.session_dir;
-    j["name"] = s.name;
-    j["empty_scene"] = s.empty_source;
-    j["floor"] = s.floor_source;
-    j["seconds"] = s.seconds;
-    j["cameras"] = nlohmann::json::array();
+    nlohmann::json j = {{"session", s.session_dir},      {"name", s.name},
+                        {"empty_scene", s.empty_source}, {"floor", s.floor_source},
+                        {"seconds", s.seconds},          {"cameras", nlohmann::json::array()}};
     for (const ImportedCamera& c : s.cameras) {
       j["cameras"].push_back({{"name", c.name},
                               {"video", c.video},

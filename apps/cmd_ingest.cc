@@ -98,22 +98,21 @@ void RunIngest(const std::string& session, const std::string& bank, const std::s
   };
 
   if (json) {
-    nlohmann::json out;
-    out["session"] = session;
-    out["bank"] = bank;
-    out["session_id"] = s.session_id;
-    out["frames"] = s.frames;
-    out["sprites_kept"] = s.sprites_kept;
-    out["sprites_merged"] = s.sprites_merged;
-    out["rows_inserted"] = s.rows_inserted;
-    out["batches"] = s.batches;
-    out["px_per_m"] = s.px_per_m;
-    out["px_per_m_why"] = s.px_per_m_why;
-    out["discards"] = DiscardsJson(s.discards);
-    out["seconds"] = s.seconds;
-    out["frames_per_second"] = s.frames_per_second;
-    out["unreadable_frames"] = s.source.frames_dropped;
-    out["transitions"] = s.transitions;
+    nlohmann::json out = {{"session", session},
+                          {"bank", bank},
+                          {"session_id", s.session_id},
+                          {"frames", s.frames},
+                          {"sprites_kept", s.sprites_kept},
+                          {"sprites_merged", s.sprites_merged},
+                          {"rows_inserted", s.rows_inserted},
+                          {"batches", s.batches},
+                          {"px_per_m", s.px_per_m},
+                          {"px_per_m_why", s.px_per_m_why},
+                          {"discards", DiscardsJson(s.discards)},
+                          {"seconds", s.seconds},
+                          {"frames_per_second", s.frames_per_second},
+                          {"unreadable_frames", s.source.frames_dropped},
+                          {"transitions", s.transitions}};
     if (s.transitions) {
       out["transitions_stored"] = s.transitions_stored;
       out["transition_sprites"] = s.transition_sprites;

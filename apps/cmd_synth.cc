@@ -58,25 +58,25 @@ void RunSynth(SynthArgs args) {
 
   const synth::SynthSummary s = synth::RenderStudioSession(o);
   if (args.json) {
-    nlohmann::json out;
-    out["session"] = s.out_dir;
-    out["kind"] = args.kind;
-    out["frames"] = s.frames;
-    out["cameras"] = s.cameras;
-    out["subjects"] = s.subjects;
-    out["fps"] = s.fps;
-    out["seed"] = o.seed;
-    out["wall_seconds"] = s.wall_s;
-    out["cpu_seconds"] = s.cpu_s;
-    out["real_time_factor"] = s.RealTimeFactor();
-    out["camera_seconds_per_cpu_second"] = s.CpuRealTimeFactor();
-    out["stage_seconds"] = {{"simulate", s.simulate_s},
+    nlohmann::json out = {{"session", s.out_dir},
+                          {"kind", args.kind},
+                          {"frames", s.frames},
+                          {"cameras", s.cameras},
+                          {"subjects", s.subjects},
+                          {"fps", s.fps},
+                          {"seed", o.seed},
+                          {"wall_seconds", s.wall_s},
+                          {"cpu_seconds", s.cpu_s},
+                          {"real_time_factor", s.RealTimeFactor()},
+                          {"camera_seconds_per_cpu_second", s.CpuRealTimeFactor()},
+                          {"stage_seconds",
+                           {{"simulate", s.simulate_s},
                             {"render", s.render_s},
                             {"sensor", s.sensor_s},
                             {"encode", s.encode_s},
-                            {"truth", s.truth_s}};
-    out["pose_frames"] = s.pose_frames;
-    out["wall_touch_frames"] = s.wall_touch_frames;
+                            {"truth", s.truth_s}}},
+                          {"pose_frames", s.pose_frames},
+                          {"wall_touch_frames", s.wall_touch_frames}};
     std::printf("%s\n", out.dump(2).c_str());
   } else {
     std::printf("synth: %s session in %s: %d frames x %d camera(s), %d subject(s), seed %llu\n",

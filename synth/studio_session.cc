@@ -567,22 +567,21 @@ SynthSummary RenderStudioSession(const SynthOptions& o) {
     summary.truth_s += w.truth_s;
   }
 
-  json t;
-  t["format_version"] = kTruthVersion;
-  t["kind"] = TextOf(o.kind, kSynthKindTexts);
-  t["studio"] = StudioKindName(studio.kind);
-  t["seed"] = o.seed;
-  t["fps"] = o.fps;
-  t["frames"] = summary.frames;
-  t["width"] = o.width;
-  t["height"] = o.height;
-  t["pixel_format"] = PixelFormatName(o.pixel_format);
-  t["noise"] = o.noise;
-  t["motion_blur"] = o.motion_blur;
-  t["crossing"] = o.crossing;
-  t["timestamp_ns"] = "round(frame * 1e9 / fps), the same on every camera";
-  t["floor"] = floor_json;
-  t["cameras"] = json::array();
+  json t = {{"format_version", kTruthVersion},
+            {"kind", TextOf(o.kind, kSynthKindTexts)},
+            {"studio", StudioKindName(studio.kind)},
+            {"seed", o.seed},
+            {"fps", o.fps},
+            {"frames", summary.frames},
+            {"width", o.width},
+            {"height", o.height},
+            {"pixel_format", PixelFormatName(o.pixel_format)},
+            {"noise", o.noise},
+            {"motion_blur", o.motion_blur},
+            {"crossing", o.crossing},
+            {"timestamp_ns", "round(frame * 1e9 / fps), the same on every camera"},
+            {"floor", floor_json},
+            {"cameras", json::array()}};
   for (const auto& cam : cameras) {
     t["cameras"].push_back(
         {{"name", cam.name},
