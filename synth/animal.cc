@@ -483,25 +483,11 @@ void AnimalBehaviour::Integrate(double dt, const std::vector<Eigen::Vector2d>& o
   if (activity_ == Activity::kWalk || activity_ == Activity::kTrot) {
     s.heading_rad = Wrap(s.heading_rad + turn_rate * dt);
   }
-  const Eigen::Vector2d dir(std::cos(s.heading_rad), std::sin(s.heading_rad));
-  Eigen::Vector2d next = s.position + s.speed_mps * dt * dir;
-  for (const auto& o : others) {
-    if ((next - o).norm() < 0.14 * k && (next - o).norm() < (s.position - o).norm()) {
-      next = s.position;  // blocked by another animal
-      s.speed_mps = 0.0;
-    }
-  }
-  // Keep the body off the walls: the body's extent along x and y for this heading.
+  Eigen::Vector2d next = StepAhead(s.position, s.heading_rad, &s.speed_mps, dt, others, 0.14 * k);
+  // Keep the body off the walls (leaning on one, its paws are up there).
   if (activity_ != Activity::kLean) {
-    const double c = std::cos(s.heading_rad), sn = std::sin(s.heading_rad);
-    const double front = kNoseReach * k, back = kTailReach * k, half = kBodyHalfWidth * k;
-    const double ext_px = std::max(front * c, -back * c) + half * std::abs(sn);
-    const double ext_nx = std::max(-front * c, back * c) + half * std::abs(sn);
-    const double ext_py = std::max(front * sn, -back * sn) + half * std::abs(c);
-    const double ext_ny = std::max(-front * sn, back * sn) + half * std::abs(c);
-    const double hx = studio_->half_x, hy = studio_->half_y;
-    next.x() = std::clamp(next.x(), -hx + ext_nx + 0.001, hx - ext_px - 0.001);
-    next.y() = std::clamp(next.y(), -hy + ext_ny + 0.001, hy - ext_py - 0.001);
+    next = KeepBodyInside(*studio_, next, s.heading_rad, kNoseReach * k, kTailReach * k,
+                          kBodyHalfWidth * k);
   }
   const double moved = (next - s.position).norm();
   s.position = next;

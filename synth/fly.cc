@@ -239,25 +239,9 @@ void FlyBehaviour::Integrate(double dt, const std::vector<Eigen::Vector2d>& othe
   if (activity_ == Activity::kWalk || activity_ == Activity::kDart) {
     s.heading_rad = Wrap(s.heading_rad + turn_rate * dt);
   }
-  const Eigen::Vector2d dir(std::cos(s.heading_rad), std::sin(s.heading_rad));
-  Eigen::Vector2d next = s.position + s.speed_mps * dt * dir;
-  for (const auto& o : others) {
-    if ((next - o).norm() < 1.2 * unit && (next - o).norm() < (s.position - o).norm()) {
-      next = s.position;  // blocked by another fly
-      s.speed_mps = 0.0;
-    }
-  }
-  {
-    const double c = std::cos(s.heading_rad), sn = std::sin(s.heading_rad);
-    const double front = kFrontReach * unit, back = kBackReach * unit, half = kHalfWidth * unit;
-    const double ext_px = std::max(front * c, -back * c) + half * std::abs(sn);
-    const double ext_nx = std::max(-front * c, back * c) + half * std::abs(sn);
-    const double ext_py = std::max(front * sn, -back * sn) + half * std::abs(c);
-    const double ext_ny = std::max(-front * sn, back * sn) + half * std::abs(c);
-    const double hx = studio_->half_x, hy = studio_->half_y;
-    next.x() = std::clamp(next.x(), -hx + ext_nx + 0.001, hx - ext_px - 0.001);
-    next.y() = std::clamp(next.y(), -hy + ext_ny + 0.001, hy - ext_py - 0.001);
-  }
+  Eigen::Vector2d next = StepAhead(s.position, s.heading_rad, &s.speed_mps, dt, others, 1.2 * unit);
+  next = KeepBodyInside(*studio_, next, s.heading_rad, kFrontReach * unit, kBackReach * unit,
+                        kHalfWidth * unit);
   const double moved = (next - s.position).norm();
   s.position = next;
   const double turned = std::abs(Wrap(s.heading_rad - heading_before));

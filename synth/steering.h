@@ -1,6 +1,7 @@
 #pragma once
 // How the synthetic animals and flies steer clear of walls and of each other: terms added to a
-// behaviour's turn rate (rad/s, positive to the left).
+// behaviour's turn rate (rad/s, positive to the left), and the step that keeps them apart and
+// off the walls.
 #include <algorithm>
 #include <cmath>
 #include <vector>
@@ -51,6 +52,37 @@ inline double HeadingAwayFromWall(const Studio& studio, const Eigen::Vector2d& p
   const double left = RoomAhead(studio, position, heading_rad + M_PI / 2);
   const double right = RoomAhead(studio, position, heading_rad - M_PI / 2);
   return Wrap(heading_rad + (left >= right ? 1 : -1) * rng.Uniform(100, 170) * kDeg);
+}
+
+// Where a subject at `position` moving `*speed_mps` along `heading_rad` is after `dt`: held in
+// place (and `*speed_mps` set to 0) where the step would take it within `block_m` of one of
+// `others` and nearer to it.
+inline Eigen::Vector2d StepAhead(const Eigen::Vector2d& position, double heading_rad,
+                                 double* speed_mps, double dt,
+                                 const std::vector<Eigen::Vector2d>& others, double block_m) {
+  const Eigen::Vector2d dir(std::cos(heading_rad), std::sin(heading_rad));
+  Eigen::Vector2d next = position + *speed_mps * dt * dir;
+  for (const auto& o : others) {
+    if ((next - o).norm() < block_m && (next - o).norm() < (position - o).norm()) {
+      next = position;  // blocked by another subject
+      *speed_mps = 0.0;
+    }
+  }
+  return next;
+}
+
+// `root` moved as little as needed to keep the body 1 mm off the walls: a body reaching `front`
+// ahead of the root and `back` behind it along `heading_rad`, and `half` to each side.
+inline Eigen::Vector2d KeepBodyInside(const Studio& studio, const Eigen::Vector2d& root,
+                                      double heading_rad, double front, double back, double half) {
+  const double c = std::cos(heading_rad), sn = std::sin(heading_rad);
+  const double ext_px = std::max(front * c, -back * c) + half * std::abs(sn);
+  const double ext_nx = std::max(-front * c, back * c) + half * std::abs(sn);
+  const double ext_py = std::max(front * sn, -back * sn) + half * std::abs(c);
+  const double ext_ny = std::max(-front * sn, back * sn) + half * std::abs(c);
+  const double hx = studio.half_x, hy = studio.half_y;
+  return {std::clamp(root.x(), -hx + ext_nx + 0.001, hx - ext_px - 0.001),
+          std::clamp(root.y(), -hy + ext_ny + 0.001, hy - ext_py - 0.001)};
 }
 
 }  // namespace ss::synth
