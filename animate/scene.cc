@@ -33,14 +33,12 @@ void Scene::AddTerms() {
   const TransitionGraph& graph = bank_.graph;
   const double interval = IntervalS();
   for (const SpriteSpecEntry& entry : spec_.sprites) {
-    SpriteSpec s;
-    s.name = entry.name;
-    s.anchor = entry.anchor;
-    s.anchor_m = entry.anchor_m;
-    s.smoothness = entry.smoothness;
-    s.initial_frames = spec_.initial_frames;
-    s.max_frames = spec_.max_frames;
-    problem_->AddSprite(std::move(s));
+    problem_->AddSprite({.name = entry.name,
+                         .anchor = entry.anchor,
+                         .anchor_m = entry.anchor_m,
+                         .smoothness = entry.smoothness,
+                         .initial_frames = spec_.initial_frames,
+                         .max_frames = spec_.max_frames});
   }
   std::shared_ptr<const std::vector<bool>> still;  // frames a RepeatTerm lets repeat
   if (spec_.repeats.strength > 0 && !spec_.repeats.still_tag.empty())

@@ -17,13 +17,12 @@ std::vector<PreviewCandidate> PreviewCandidates(const std::vector<CandidateVerdi
   for (const CandidateVerdict& v : verdicts) {
     if (v.candidate == nullptr) continue;
     const Candidate& c = *v.candidate;
-    PreviewCandidate p;
-    p.bbox = c.bbox;
-    p.contact = c.contact_point;
-    p.track = v.track;
-    p.ground = v.ground;
-    p.reason = v.reason;
-    p.merged = v.merged;
+    PreviewCandidate p{.bbox = c.bbox,
+                       .contact = c.contact_point,
+                       .track = v.track,
+                       .ground = v.ground,
+                       .reason = v.reason,
+                       .merged = v.merged};
     if (!c.alpha.empty()) {
       cv::compare(c.alpha, 127, mask, cv::CMP_GT);
       contours.clear();

@@ -271,13 +271,12 @@ SynthSummary RenderStudioSession(const SynthOptions& o) {
     const SynthCamera& cam = cameras[c];
     const CameraModel model(cam.lensmodel, cam.intrinsics, cam.width, cam.height,
                             cam.cam_from_ground);
-    SourceCamera source;
-    source.name = cam.name;
-    source.width = cam.width;
-    source.height = cam.height;
-    source.format = o.pixel_format;
-    source.fps = o.fps;
-    const int index = writer.AddCamera(source, &model);
+    const int index = writer.AddCamera({.name = cam.name,
+                                        .width = cam.width,
+                                        .height = cam.height,
+                                        .format = o.pixel_format,
+                                        .fps = o.fps},
+                                       &model);
     if (index != static_cast<int>(c)) throw WorkError(o.out_dir, "camera index mismatch");
     model.Write((truth / (cam.name + ".cameramodel")).string());
     CameraWork& w = work[c];
