@@ -46,12 +46,11 @@ nlohmann::json DiscardsJson(const DiscardCounts& counts) {
 void RunIngest(const std::string& session, const std::string& bank, const std::string& config_path,
                bool json, bool transitions, const std::string& transition_weights,
                int decode_threads) {
-  IngestOptions options;
-  options.decode_threads = decode_threads;
-  options.session_dir = session;
-  options.bank_path = bank;
-  options.transitions = transitions;
-  options.transition_weights = transition_weights;
+  IngestOptions options{.session_dir = session,
+                        .bank_path = bank,
+                        .transitions = transitions,
+                        .transition_weights = transition_weights,
+                        .decode_threads = decode_threads};
   StationConfig config;  // without a file: the config's defaults
   if (!config_path.empty()) {
     ConfigOptions config_options;

@@ -61,15 +61,13 @@ SpriteRecord ReadSprite(const sql::Stmt& s) {
 }
 
 ClipRecord ReadClip(const sql::Stmt& s) {
-  ClipRecord c;
-  c.id = s.Int(0);
-  c.camera_id = s.Int(1);
-  c.track_id = s.Int(2);
-  c.first_frame = s.Int(3);
-  c.last_frame = s.Int(4);
-  c.complete = s.Int(5) != 0;
-  c.complete_seq = s.IsNull(6) ? 0 : s.Int(6);
-  return c;
+  return {.id = s.Int(0),
+          .camera_id = s.Int(1),
+          .track_id = s.Int(2),
+          .first_frame = s.Int(3),
+          .last_frame = s.Int(4),
+          .complete = s.Int(5) != 0,
+          .complete_seq = s.IsNull(6) ? 0 : s.Int(6)};
 }
 
 constexpr const char* kClipColumns =

@@ -48,25 +48,23 @@ int BoardTexture::Sample(double x, double y) const {
 }
 
 BoardSpec ChessboardFor(bool stage) {
-  BoardSpec b;
-  b.kind = BoardKind::kChessboard;
-  b.squares_x = 10;
-  b.squares_y = 7;
-  b.square_m = stage ? 0.07 : 0.03;
-  b.margin_m = b.square_m;
-  return b;
+  const double square = stage ? 0.07 : 0.03;
+  return {.kind = BoardKind::kChessboard,
+          .squares_x = 10,
+          .squares_y = 7,
+          .square_m = square,
+          .margin_m = square};
 }
 
 BoardSpec CharucoFor(bool stage) {
-  BoardSpec b;
-  b.kind = BoardKind::kCharuco;
-  b.squares_x = 7;
-  b.squares_y = 5;
-  b.square_m = stage ? 0.09 : 0.04;
-  b.marker_m = b.square_m * 0.75;
-  b.dictionary = "DICT_4X4_50";
-  b.margin_m = b.square_m * 0.5;
-  return b;
+  const double square = stage ? 0.09 : 0.04;
+  return {.kind = BoardKind::kCharuco,
+          .squares_x = 7,
+          .squares_y = 5,
+          .square_m = square,
+          .marker_m = square * 0.75,
+          .dictionary = "DICT_4X4_50",
+          .margin_m = square * 0.5};
 }
 
 }  // namespace ss::synth

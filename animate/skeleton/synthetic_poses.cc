@@ -148,16 +148,14 @@ std::string GestureName(Gesture gesture) {
 }
 
 BodyProportions OtherBody() {
-  BodyProportions b;
-  b.torso = 0.9f;
-  b.head = 0.3f;
-  b.shoulder = 0.33f;
-  b.upper_arm = 0.62f;
-  b.forearm = 0.65f;
-  b.hip = 0.17f;
-  b.thigh = 1.05f;
-  b.shin = 1.0f;
-  return b;
+  return {.torso = 0.9f,
+          .head = 0.3f,
+          .shoulder = 0.33f,
+          .upper_arm = 0.62f,
+          .forearm = 0.65f,
+          .hip = 0.17f,
+          .thigh = 1.05f,
+          .shin = 1.0f};
 }
 
 bool GestureScriptOptions::IsValid(std::string* why) const {
