@@ -94,6 +94,8 @@ function(spritestation_add_test name dir)
   if(NOT sources OR (SPRITESTATION_FUZZ AND NOT name IN_LIST SPRITESTATION_SANITIZE_SUITES))
     return()
   endif()
+  list(SORT sources)
+  spritestation_unity_sources(sources ${name} SOURCES ${sources})
   add_executable(${name} ${sources})
   target_link_libraries(${name} PRIVATE ${ARG_DEPS} test_support GTest::gmock GTest::gtest_main spritestation_flags)
   # A unit suite where SPRITESTATION_UNIT_SUITES is off: its target stays, out of `all` and

@@ -77,13 +77,13 @@ TEST(SkeletonRefine, MovementWindowsAreSecondsAtTheClipsFrameRate) {
 }
 
 // The gesture script's transitions: [first frame, last frame] of each blend.
-struct Script {
+struct GestureScript {
   std::vector<std::pair<Gesture, int>> steps;
   std::vector<std::pair<int, int>> blends;
 };
 
-Script Ymca() {
-  Script s;
+GestureScript Ymca() {
+  GestureScript s;
   s.steps = {{Gesture::kIdle, 30},
              {Gesture::kY, 30},
              {Gesture::kM, 30},
@@ -101,7 +101,7 @@ Script Ymca() {
 TEST(SkeletonRefine, GestureBoundariesFallInTheTransitions) {
   // Clean and with 1.5 px of joint noise (which alone moves the frame-to-frame cost more
   // than a gesture change does: hence the lag).
-  const Script script = Ymca();
+  const GestureScript script = Ymca();
   for (float noise : {0.0f, 1.5f}) {
     SCOPED_TRACE("noise " + std::to_string(noise));
     GestureScriptOptions o;

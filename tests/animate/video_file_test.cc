@@ -14,7 +14,7 @@
 namespace ss {
 namespace {
 
-constexpr double kPxPerM = 400.0;
+constexpr double kVideoPxPerM = 400.0;
 constexpr int kFrames = 12;
 
 // Centroid of the strongly red pixels of a BGR image ((-1, -1) when there are none).
@@ -49,9 +49,9 @@ TEST_P(VideoFileTest, DecodesToTheFramesWrittenWithTheSpriteWhereItWasProjected)
     VideoFileWriter writer(path, camera.width(), camera.height(), 30.0);
     for (int k = 0; k < kFrames; ++k) {
       const Eigen::Vector2d ground(-0.25 + 0.04 * k, 0.1);
-      writer.Write(renderer.Render({{&pixels, Eigen::Vector2d(20, 60), kPxPerM, ground}}));
+      writer.Write(renderer.Render({{&pixels, Eigen::Vector2d(20, 60), kVideoPxPerM, ground}}));
       // The block's centre, 30 px (7.5 cm) above the contact point.
-      expected.push_back(camera.ProjectGround({ground.x(), ground.y(), 30.0 / kPxPerM}));
+      expected.push_back(camera.ProjectGround({ground.x(), ground.y(), 30.0 / kVideoPxPerM}));
     }
     writer.Close();
     EXPECT_EQ(writer.frames_written(), kFrames);

@@ -27,7 +27,7 @@ using ss::testing::TrueModel;
 
 constexpr double kFps = 8;
 
-double AngleDeg(const Eigen::Matrix3d& a, const Eigen::Matrix3d& b) {
+double RotationBetweenDeg(const Eigen::Matrix3d& a, const Eigen::Matrix3d& b) {
   return Eigen::AngleAxisd(a * b.transpose()).angle() * 180 / M_PI;
 }
 
@@ -125,7 +125,7 @@ TEST(WizardGround, ABoardLyingOnTheFloorIsTakenAndMeetsTheTruth) {
     const CameraModel posed = *w.posed_model();
     const double centre_mm = (posed.CentreInGround() - s.cam.CentreInGround()).norm() * 1000;
     const double angle_deg =
-        AngleDeg(posed.cam_from_ground().rotation, s.cam.cam_from_ground.rotation);
+        RotationBetweenDeg(posed.cam_from_ground().rotation, s.cam.cam_from_ground.rotation);
     std::printf("seed %d floor board: %s; %.2f mm, %.3f deg from the truth\n",
                 static_cast<int>(seed), Describe(c).c_str(), centre_mm, angle_deg);
     EXPECT_LT(centre_mm, 2.0) << "seed " << seed;

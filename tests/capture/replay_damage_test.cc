@@ -104,7 +104,7 @@ bool WaitFor(const std::function<bool()>& done, int seconds) {
   return false;
 }
 
-size_t CsvRows(const std::string& path) {
+size_t CsvRowsSoFar(const std::string& path) {
   try {
     return ReadFrameCsv(path).size();
   } catch (const InputError&) {
@@ -124,7 +124,8 @@ TEST(KilledRecorder, AllButTheLastSecondIsReadable) {
   const std::string session = dir / "s";
   const pid_t pid = StartRecorder(session, 0);
   // Once the recording is well under way (30 frames on disk), let it run 1.5 s more.
-  const bool started = WaitFor([&] { return CsvRows(session + "/cam0.frames.csv") >= 30; }, 60);
+  const bool started =
+      WaitFor([&] { return CsvRowsSoFar(session + "/cam0.frames.csv") >= 30; }, 60);
   if (started) std::this_thread::sleep_for(std::chrono::milliseconds(1500));
   const int64_t kill_ns = MonotonicNs();
   Kill(pid);

@@ -45,7 +45,7 @@ SessionInfo TwoCameras() {
   return info;
 }
 
-void WriteText(const std::string& path, const std::string& text) {
+void WriteFile(const std::string& path, const std::string& text) {
   std::ofstream(path, std::ios::binary) << text;
 }
 
@@ -56,7 +56,7 @@ std::string ReadEdited(const ScratchDir& dir, const std::function<void(nlohmann:
   nlohmann::json j;
   std::ifstream(dir / "session.json") >> j;
   edit(j);
-  WriteText(dir / "session.json", j.dump());
+  WriteFile(dir / "session.json", j.dump());
   try {
     ReadSessionInfo(dir.path().string());
   } catch (const InputError& e) {
@@ -148,7 +148,7 @@ TEST(SessionInfo, NotJsonOrMissing) {
   } catch (const InputError& e) {
     EXPECT_EQ(std::string(e.what()), (dir / "nowhere") + "/session.json: no such session folder");
   }
-  WriteText(dir / "session.json", "{\"format_version\": 1, ");
+  WriteFile(dir / "session.json", "{\"format_version\": 1, ");
   try {
     ReadSessionInfo(dir.path().string());
     FAIL() << "no error for broken JSON";
@@ -156,7 +156,7 @@ TEST(SessionInfo, NotJsonOrMissing) {
     EXPECT_EQ(std::string(e.what()).rfind((dir / "session.json") + ": not valid JSON", 0), 0u)
         << e.what();
   }
-  WriteText(dir / "session.json", "[1, 2]");
+  WriteFile(dir / "session.json", "[1, 2]");
   EXPECT_THROW(ReadSessionInfo(dir.path().string()), InputError);
 }
 
@@ -205,7 +205,7 @@ TEST(FrameCsv, RowsAreOnDiskBeforeClose) {
 
 std::string CsvError(const ScratchDir& dir, const std::string& text) {
   const std::string path = dir / "bad.csv";
-  WriteText(path, text);
+  WriteFile(path, text);
   try {
     ReadFrameCsv(path);
   } catch (const InputError& e) {
@@ -246,12 +246,12 @@ TEST(FrameCsv, MalformedRowsNameTheFileAndLine) {
 TEST(FrameCsv, TornLastRowOfAKilledRecorderIsDropped) {
   ScratchDir dir;
   const std::string path = dir / "torn.csv";
-  WriteText(path, "index,timestamp_ns,sequence,drops_before\n0,100,7,0\n1,200,8,0\n2,30");
+  WriteFile(path, "index,timestamp_ns,sequence,drops_before\n0,100,7,0\n1,200,8,0\n2,30");
   const auto rows = ReadFrameCsv(path);
   ASSERT_EQ(rows.size(), 2u);
   EXPECT_EQ(rows[1].timestamp_ns, 200);
   // CRLF line ends are accepted.
-  WriteText(path, "index,timestamp_ns,sequence,drops_before\r\n0,100,7,0\r\n");
+  WriteFile(path, "index,timestamp_ns,sequence,drops_before\r\n0,100,7,0\r\n");
   EXPECT_EQ(ReadFrameCsv(path).size(), 1u);
 }
 

@@ -21,10 +21,10 @@ using testing::JsonInOutput;
 using testing::RunSpritestation;
 using testing::ScratchDir;
 
-const std::string kBoard = "chessboard:10x7:0.03";
+const std::string kWizardBoard = "chessboard:10x7:0.03";
 // 320x240 at 8 fps: the director holds each board pose for 0.32 s (2-3 frames);
 // the chessboard segment is frames 0-71 (9 s, 12 poses).
-constexpr int kChessFrames = 72, kChessPoses = 12;
+constexpr int kWizardChessFrames = 72, kChessPoses = 12;
 
 class WizardEndToEnd : public ::testing::Test {
  protected:
@@ -55,8 +55,8 @@ TEST_F(WizardEndToEnd, IntrinsicsFromStillViewsMeetTheNumbers) {
   const std::string out = *dir_ / "intrinsics";
   // The chessboard segment only: the intrinsics step ends, the ground step is left waiting.
   const auto r = RunSpritestation("--log-level warn calibrate wizard --session " + session +
-                                  " --board " + kBoard + " --min-coverage 0.4 --count " +
-                                  std::to_string(kChessFrames) + " --out " + out + " --json");
+                                  " --board " + kWizardBoard + " --min-coverage 0.4 --count " +
+                                  std::to_string(kWizardChessFrames) + " --out " + out + " --json");
   EXPECT_EQ(r.exit_code, 1) << r.output;
   const nlohmann::json j = JsonInOutput(r.output);
   ASSERT_TRUE(j.is_object()) << r.output;
@@ -91,7 +91,7 @@ TEST_F(WizardEndToEnd, IntrinsicsFromStillViewsMeetTheNumbers) {
 TEST_F(WizardEndToEnd, TooFewViewsEndWithAVerdictAndNoModel) {
   const std::string out = *dir_ / "few";
   const auto r = RunSpritestation("--log-level warn calibrate wizard --session " + *dir_ / "held" +
-                                  " --board " + kBoard + " --count 24 --out " + out);
+                                  " --board " + kWizardBoard + " --count 24 --out " + out);
   EXPECT_EQ(r.exit_code, 1) << r.output;
   EXPECT_NE(r.output.find("too few views"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("no model written"), std::string::npos) << r.output;
@@ -113,7 +113,7 @@ TEST_F(WizardEndToEnd, GroundAndEnclosureWithKnownIntrinsics) {
   const CameraModel truth = CameraModel::Read(session + "/truth/cam0.cameramodel");
   // The chessboard lies on the floor with its frame at (-W/2, H/2, 1 mm), face up.
   const auto r = RunSpritestation("--log-level warn calibrate wizard --session " + session +
-                                  " --board " + kBoard + " --intrinsics " + session +
+                                  " --board " + kWizardBoard + " --intrinsics " + session +
                                   "/truth/cam0.cameramodel --board-pose -0.15 0.105 0 "
                                   "--board-thickness 0.001 --floor-still-seconds 0.5 --out " +
                                   out + " --json");

@@ -34,7 +34,7 @@ using testing::ScratchDir;
 constexpr double kMinRecall = 0.9;
 constexpr double kMaxFalseMarkRate = 0.05;
 
-constexpr const char* kSynthArgs =
+constexpr const char* kCrossingSynthArgs =
     " --kind animal --seconds 8 --fps 30 --size 480x360 --cameras 2 --subjects 2 --seed 3"
     " --crossing --threads 2 --no-mattes";
 
@@ -64,7 +64,8 @@ int64_t TouchingMerged(const std::vector<TransitionRecord>& table, const std::se
 TEST(IngestMerged, SpritesOfTwoTouchingSubjectsAreTaggedAndLeftOutOfTransitions) {
   ScratchDir dir;
   const std::string session = dir / "session";
-  const auto synth = RunSpritestation("--log-level warn synth --out " + session + kSynthArgs);
+  const auto synth =
+      RunSpritestation("--log-level warn synth --out " + session + kCrossingSynthArgs);
   ASSERT_EQ(synth.exit_code, 0) << synth.output;
   const std::string bank_path = dir / "m.bank";
   const auto ingest =

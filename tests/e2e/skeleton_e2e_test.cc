@@ -47,7 +47,7 @@ std::map<int, std::string> PoseLabels(const std::string& session) {
   return labels;
 }
 
-nlohmann::json ReadJson(const std::string& path) {
+nlohmann::json ReadJsonFile(const std::string& path) {
   std::ifstream in(path);
   return nlohmann::json::parse(in);
 }
@@ -97,10 +97,10 @@ TEST_F(SkeletonEndToEnd, ImportedTruthMatchesGesturesWithoutLongFreezes) {
       RunSpritestation("--log-level warn match " + *dir_ / "target.skel.json" + " --source " +
                        *dir_ / "source.skel.json" + " --out " + out + " --json");
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  const nlohmann::json m = ReadJson(out);
+  const nlohmann::json m = ReadJsonFile(out);
   const auto target_labels = PoseLabels(*dir_ / "target");
   const auto source_labels = PoseLabels(*dir_ / "source");
-  const auto target_joints = Joints(ReadJson(*dir_ / "target.skel.json"));
+  const auto target_joints = Joints(ReadJsonFile(*dir_ / "target.skel.json"));
 
   struct Score {
     int frames = 0, same = 0, arm_frames = 0, arm_same = 0, moving_frames = 0, moving_same = 0;
@@ -177,15 +177,15 @@ TEST_F(SkeletonEndToEnd, ImportedTruthMatchesGesturesWithoutLongFreezes) {
 
 TEST_F(SkeletonEndToEnd, LucasKanadeTrackingAgainstTruth) {
   // The user's joints in frame 0 = the truth's frame 0.
-  nlohmann::json init = ReadJson(*dir_ / "target.skel.json");
+  nlohmann::json init = ReadJsonFile(*dir_ / "target.skel.json");
   init["frames"] = nlohmann::json::array({init["frames"][0]});
   std::ofstream(*dir_ / "init.json") << init.dump();
   const auto r =
       RunSpritestation("--log-level warn skeleton track " + *dir_ / "target" + " --init " +
                        *dir_ / "init.json" + " --out " + *dir_ / "tracked.json" + " --json");
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  const auto truth = Joints(ReadJson(*dir_ / "target.skel.json"));
-  const auto tracked = Joints(ReadJson(*dir_ / "tracked.json"));
+  const auto truth = Joints(ReadJsonFile(*dir_ / "target.skel.json"));
+  const auto tracked = Joints(ReadJsonFile(*dir_ / "tracked.json"));
   std::vector<double> errors;
   int missing = 0, total = 0;
   for (const auto& [frame, joints] : tracked) {

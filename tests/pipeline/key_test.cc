@@ -29,7 +29,7 @@ std::vector<cv::Mat> EmptyFrames(const KeyScene& scene, int n) {
   return frames;
 }
 
-SceneSubject Hamster(cv::Point2d centre) {
+SceneSubject HamsterAt(cv::Point2d centre) {
   SceneSubject s;
   s.centre = centre;
   return s;
@@ -66,7 +66,7 @@ TEST(ChromaKeyer, SoftAlphaMatchesTruthOnUnevenGreen) {
   keyer.Train(EmptyFrames(scene, 6));
   for (const cv::Point2d c :
        {cv::Point2d(320.3, 240.6), cv::Point2d(90.5, 80.2), cv::Point2d(560.7, 420.4)}) {
-    const Quality q = KeyQuality(keyer, scene.Render({Hamster(c)}, 1));
+    const Quality q = KeyQuality(keyer, scene.Render({HamsterAt(c)}, 1));
     EXPECT_GE(q.soft_iou, 0.95) << "subject at " << c;
     EXPECT_GE(q.binary_iou, 0.97) << "subject at " << c;
     EXPECT_EQ(q.stray, 0) << "subject at " << c;
@@ -91,7 +91,7 @@ TEST(ChromaKeyer, EmptyFrameHasNoRegions) {
 TEST(ChromaKeyer, GlobalReferenceFailsOnUnevenGreen) {
   ChromaKeyerOptions global_options;
   global_options.global_model = true;
-  const SceneSubject subject = Hamster({300.4, 260.7});
+  const SceneSubject subject = HamsterAt({300.4, 260.7});
 
   SceneOptions flat;
   flat.tint = 0;
@@ -131,7 +131,7 @@ TEST(ChromaKeyer, ShadowUnderTheSubjectAndNowhereElse) {
   KeyScene scene(SceneOptions{});
   ChromaKeyer keyer;
   keyer.Train(EmptyFrames(scene, 6));
-  const SceneFrame f = scene.Render({Hamster({330.2, 250.5})}, 2);
+  const SceneFrame f = scene.Render({HamsterAt({330.2, 250.5})}, 2);
   Matte m;
   keyer.Key(f.bgr, m);
 
@@ -157,7 +157,7 @@ TEST(ChromaKeyer, DespillRemovesGreenFromTheRim) {
   KeyScene scene(SceneOptions{});
   ChromaKeyer keyer;
   keyer.Train(EmptyFrames(scene, 6));
-  const SceneFrame f = scene.Render({Hamster({320, 240})}, 1);
+  const SceneFrame f = scene.Render({HamsterAt({320, 240})}, 1);
   Matte m;
   keyer.Key(f.bgr, m);
   ASSERT_GT(cv::countNonZero(f.rim), 200);
@@ -214,8 +214,8 @@ TEST(ChromaKeyer, MatteReuseLeavesNothingStale) {
   ChromaKeyer keyer;
   keyer.Train(EmptyFrames(scene, 4));
   Matte m;
-  keyer.Key(scene.Render({Hamster({150, 150})}, 1).bgr, m);
-  const SceneFrame second = scene.Render({Hamster({480, 330})}, 2);
+  keyer.Key(scene.Render({HamsterAt({150, 150})}, 1).bgr, m);
+  const SceneFrame second = scene.Render({HamsterAt({480, 330})}, 2);
   keyer.Key(second.bgr, m);
   EXPECT_GE(SoftIoU(second.alpha, m.alpha), 0.95);
   EXPECT_EQ(cv::countNonZero(m.alpha(cv::Rect(60, 80, 180, 160))), 0);
@@ -226,7 +226,7 @@ TEST(ChromaKeyer, FramesOfOtherPixelFormatsKeyAlike) {
   KeyScene scene(SceneOptions{});
   ChromaKeyer keyer;
   keyer.Train(EmptyFrames(scene, 4));
-  const SceneFrame f = scene.Render({Hamster({300, 220})}, 1);
+  const SceneFrame f = scene.Render({HamsterAt({300, 220})}, 1);
   Matte direct, via_bgr, via_rgb;
   keyer.Key(f.bgr, direct);
   const std::vector<uint8_t> bgr_bytes(f.bgr.data, f.bgr.data + f.bgr.total() * 3);
@@ -286,7 +286,7 @@ Frame AsFormat(const cv::Mat& bgr, PixelFormat format) {
 // the truth; the chroma subsampling and the demosaic soften only the edge.
 TEST(ChromaKeyer, BayerAndYuvFramesKeyCloseToTruth) {
   KeyScene scene(SceneOptions{});
-  const SceneFrame f = scene.Render({Hamster({300.5, 220.5})}, 1);
+  const SceneFrame f = scene.Render({HamsterAt({300.5, 220.5})}, 1);
   for (PixelFormat format : {PixelFormat::kBayerRG8, PixelFormat::kNV12, PixelFormat::kYUYV}) {
     std::vector<cv::Mat> empty;
     empty.reserve(4);
@@ -308,7 +308,7 @@ TEST(ChromaKeyer, MonoAndMalformedFramesAreClearErrors) {
   keyer.Train(EmptyFrames(scene, 2));
   Matte m;
   cv::Mat scratch;
-  const cv::Mat bgr = scene.Render({Hamster({300, 220})}, 1).bgr;
+  const cv::Mat bgr = scene.Render({HamsterAt({300, 220})}, 1).bgr;
   try {
     keyer.Key(AsFormat(bgr, PixelFormat::kMono8), scratch, m);
     ADD_FAILURE() << "a mono8 frame was chroma keyed";
@@ -354,7 +354,7 @@ TEST(CleanPlateKeyer, KeysOnATexturedNonGreenFloor) {
   EXPECT_THROW(chroma.Train(EmptyFrames(scene, 2)), InputError);
 
   for (const cv::Point2d c : {cv::Point2d(320.3, 240.6), cv::Point2d(120.5, 330.2)}) {
-    SceneSubject s = Hamster(c);
+    SceneSubject s = HamsterAt(c);
     s.spill = 0;
     const SceneFrame f = scene.Render({s}, 1);
     Matte m;

@@ -118,8 +118,8 @@ TEST(TransitionBuilder, EmptySetAndDuplicatesAreInputErrors) {
   EXPECT_THROW(TransitionBuilder(VelocityOnly(), 0.0), InputError);
 }
 
-// Generous weights for the synthetic set so that many pairs and transitions exist.
-TransitionWeights Generous() {
+// GenerousWeights weights for the synthetic set so that many pairs and transitions exist.
+TransitionWeights GenerousWeights() {
   return testing::UnitWeights({0.03, 30, 0.0006, 0.04, 0.12, 12}, 4.0, 3.0);
 }
 
@@ -139,7 +139,7 @@ TEST(TransitionBuilder, IncrementalEqualsFromScratch) {
     live.push_back(inputs[half + k]);
   }
 
-  TransitionBuilder scratch(Generous(), o.px_per_m);
+  TransitionBuilder scratch(GenerousWeights(), o.px_per_m);
   scratch.BuildFromScratch(inputs, BuildOptions{.threads = 2});
   const auto pairs = scratch.KeptPairs();
   const auto transitions = scratch.Transitions();
@@ -148,7 +148,7 @@ TEST(TransitionBuilder, IncrementalEqualsFromScratch) {
 
   // Start from a from-scratch build of the first 300 live sprites, then add the rest in
   // batches of random sizes; collect every delta.
-  TransitionBuilder live_builder(Generous(), o.px_per_m);
+  TransitionBuilder live_builder(GenerousWeights(), o.px_per_m);
   live_builder.BuildFromScratch(std::span(live).first(300), BuildOptions{.threads = 1});
   std::vector<Transition> seen = live_builder.Transitions();
   std::vector<KeptPair> seen_pairs = live_builder.KeptPairs();
@@ -174,7 +174,7 @@ TEST(TransitionBuilder, IncrementalEqualsFromScratch) {
   EXPECT_EQ(seen_pairs, pairs);
 
   // Adding everything to an empty builder gives the same set too.
-  TransitionBuilder from_empty(Generous(), o.px_per_m);
+  TransitionBuilder from_empty(GenerousWeights(), o.px_per_m);
   from_empty.Add(live);
   EXPECT_EQ(from_empty.Transitions(), transitions);
 }
@@ -185,7 +185,7 @@ TEST(TransitionBuilder, ThreadCountDoesNotChangeTheResult) {
   o.seed = 9;
   const auto sprites = MakeSyntheticSprites(o);
   const auto inputs = AsSpriteInputs(sprites);
-  TransitionBuilder one(Generous(), o.px_per_m), two(Generous(), o.px_per_m);
+  TransitionBuilder one(GenerousWeights(), o.px_per_m), two(GenerousWeights(), o.px_per_m);
   one.BuildFromScratch(inputs, BuildOptions{.threads = 1});
   two.BuildFromScratch(inputs, BuildOptions{.threads = 2});
   EXPECT_EQ(one.KeptPairs(), two.KeptPairs());

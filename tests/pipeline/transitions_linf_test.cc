@@ -187,8 +187,8 @@ TEST(TransitionLinf, FilterIsExactOnSyntheticSprites) {
 }
 
 // Paints `cells` of an existing sprite with another colour (alpha kept).
-RgbaBillboard Recolour(RgbaBillboard b, const std::vector<Cell>& cells,
-                       const std::array<uint8_t, 3>& rgb) {
+RgbaBillboard RecolourCells(RgbaBillboard b, const std::vector<Cell>& cells,
+                            const std::array<uint8_t, 3>& rgb) {
   for (const Cell& c : cells) {
     uint8_t* p = b.rgba.data() + (static_cast<size_t>(c.y) * 32 + c.x) * 4;
     p[0] = rgb[0];
@@ -201,16 +201,17 @@ RgbaBillboard Recolour(RgbaBillboard b, const std::vector<Cell>& cells,
 TEST(TransitionColourBlob, FeatureOnHandMadePairs) {
   const RgbaBillboard body = Sprite(Rectangle(8, 10, 20, 32, 255));
   // 3 x 2, dR 110
-  RgbaBillboard two_patches = Recolour(body, Rectangle(9, 12, 12, 14, 255), {90, 100, 50});
-  two_patches = Recolour(two_patches, Rectangle(15, 20, 17, 21, 255), {200, 40, 20});  // 2 x 1, 90
+  RgbaBillboard two_patches = RecolourCells(body, Rectangle(9, 12, 12, 14, 255), {90, 100, 50});
+  two_patches =
+      RecolourCells(two_patches, Rectangle(15, 20, 17, 21, 255), {200, 40, 20});  // 2 x 1, 90
   // dR+dG+dB 80
-  const RgbaBillboard faint = Recolour(body, Rectangle(9, 12, 12, 14, 255), {150, 80, 40});
+  const RgbaBillboard faint = RecolourCells(body, Rectangle(9, 12, 12, 14, 255), {150, 80, 40});
   RgbaBillboard half_transparent = Sprite(Rectangle(8, 10, 20, 32, 255));
   for (const Cell& c : Rectangle(9, 12, 12, 14, 0))
     half_transparent.rgba[(c.y * 32 + c.x) * 4 + 3] = 100;
-  half_transparent = Recolour(half_transparent, Rectangle(9, 12, 12, 14, 255), {90, 100, 50});
+  half_transparent = RecolourCells(half_transparent, Rectangle(9, 12, 12, 14, 255), {90, 100, 50});
   // not 4-connected
-  const RgbaBillboard diagonal = Recolour(body, {{9, 12, 255}, {10, 13, 255}}, {0, 0, 0});
+  const RgbaBillboard diagonal = RecolourCells(body, {{9, 12, 255}, {10, 13, 255}}, {0, 0, 0});
   const std::vector<RgbaBillboard> sprites = {body, two_patches, faint, half_transparent, diagonal};
   std::vector<SpriteInput> inputs;
   for (size_t k = 0; k < sprites.size(); ++k) {
@@ -284,7 +285,7 @@ TEST(TransitionColourBlob, BuilderKeepsWhatALinearScanKeeps) {
   EXPECT_EQ(builder.stats().kept_pairs, kept / 2);
 }
 
-std::string ErrorOf(const std::string& text) {
+std::string WeightsErrorOf(const std::string& text) {
   try {
     ParseWeights(text, "w.json");
   } catch (const InputError& e) {
@@ -325,7 +326,7 @@ TEST(TransitionLinf, WeightsFileCarriesTheVariant) {
   auto with = [&](const std::function<void(nlohmann::json&)>& edit) {
     nlohmann::json j = good;
     edit(j);
-    return ErrorOf(j.dump());
+    return WeightsErrorOf(j.dump());
   };
   EXPECT_EQ(with([](auto&) {}), "");
   EXPECT_EQ(with([](auto& j) { j["stage2"]["variant"] = "paper"; }), "");
@@ -365,7 +366,7 @@ TEST(TransitionLinf, WeightsFileCarriesTheVariant) {
   auto bwith = [&](const std::function<void(nlohmann::json&)>& edit) {
     nlohmann::json j = bgood;
     edit(j);
-    return ErrorOf(j.dump());
+    return WeightsErrorOf(j.dump());
   };
   EXPECT_NE(bwith([](auto& j) {
               j["stage2"]["colour_blob"]["max_blob_cells"] = -1;

@@ -379,7 +379,7 @@ TEST(TransitionTraining, LabelsCsvRoundTripAndErrors) {
   EXPECT_THROW(ReadLabelsCsv(dir / "missing.csv"), InputError);
 }
 
-std::string ErrorOf(const std::string& text) {
+std::string ParseErrorOf(const std::string& text) {
   try {
     ParseWeights(text, "w.json");
   } catch (const InputError& e) {
@@ -441,16 +441,16 @@ TEST(TransitionWeightsFile, WrongFilesNameTheFileAndField) {
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("/nonexistent/weights.json"), std::string::npos);
   }
-  EXPECT_NE(ErrorOf("{not json").find("w.json: not valid JSON"), std::string::npos);
-  EXPECT_NE(ErrorOf("[1,2]").find("top level"), std::string::npos);
+  EXPECT_NE(ParseErrorOf("{not json").find("w.json: not valid JSON"), std::string::npos);
+  EXPECT_NE(ParseErrorOf("[1,2]").find("top level"), std::string::npos);
 
   nlohmann::json good =
       nlohmann::json::parse(WeightsToJson(testing::UnitWeights({1, 1, 1, 1, 1, 1}, 1, 1)));
-  EXPECT_EQ(ErrorOf(good.dump()), "");
+  EXPECT_EQ(ParseErrorOf(good.dump()), "");
   auto with = [&](const std::function<void(nlohmann::json&)>& edit) {
     nlohmann::json j = good;
     edit(j);
-    return ErrorOf(j.dump());
+    return ParseErrorOf(j.dump());
   };
   EXPECT_NE(with([](auto& j) { j["version"] = 3; }).find("w.json: version:"),
             std::string::npos);  // 2 exists now

@@ -15,7 +15,7 @@ namespace {
 
 // A pinhole camera 1 m above the floor origin looking straight down... tilted a little,
 // so that the 0.6 x 0.4 m floor fills the middle of a 640x480 image.
-CameraModel DownCamera() {
+CameraModel CameraLookingDown() {
   Rigid3 cam_from_ground;
   cam_from_ground.rotation << 1, 0, 0, 0, -1, 0, 0, 0,
       -1;  // x right, y down the image = -y ground, z down
@@ -23,13 +23,13 @@ CameraModel DownCamera() {
   return CameraModel("LENSMODEL_PINHOLE", {500, 500, 320, 240}, 640, 480, cam_from_ground);
 }
 
-GroundPolygon Floor() {
+GroundPolygon FloorUnderIt() {
   return GroundPolygon({{-0.3, -0.2}, {0.3, -0.2}, {0.3, 0.2}, {-0.3, 0.2}});
 }
 
 TEST(FloorMask, MarksExactlyThePixelsThatSeeTheFloor) {
-  const CameraModel cam = DownCamera();
-  const FloorMask floor(cam, Floor(), {});
+  const CameraModel cam = CameraLookingDown();
+  const FloorMask floor(cam, FloorUnderIt(), {});
   // 0.6 m at 1 m and f = 500 is 300 px wide, 200 px high, centred.
   const cv::Rect box = cv::boundingRect(floor.mask());
   EXPECT_NEAR(box.width, 300, 2);
@@ -99,7 +99,7 @@ TEST(FloorMask, TheIndexedMaskIsTheMaskOfEveryEdge) {
   const CameraModel tilted("LENSMODEL_OPENCV8",
                            {420, 425, 322, 236, -0.28, 0.09, 0.001, -0.002, -0.012, 0, 0, 0}, 640,
                            480, cam_from_ground);
-  const CameraModel down = DownCamera();
+  const CameraModel down = CameraLookingDown();
 
   std::mt19937 rng(20);
   std::vector<std::pair<std::string, GroundPolygon>> floors;
@@ -151,10 +151,10 @@ TEST(FloorMask, TheIndexedMaskIsTheMaskOfEveryEdge) {
 
 // The floor's own tests, seen from straight above with the view's test off (90 keeps every view).
 TEST(FloorMask, ChecksBorderFloorAndWalls) {
-  const CameraModel cam = DownCamera();
+  const CameraModel cam = CameraLookingDown();
   UsabilityOptions every_view;
   every_view.max_view_angle_deg = 90;
-  const FloorMask floor(cam, Floor(), every_view);
+  const FloorMask floor(cam, FloorUnderIt(), every_view);
   const cv::Mat blob(20, 20, CV_8U, cv::Scalar(255));
   EXPECT_EQ(floor.Check(blob, {310, 230}, {0.0, 0.0}), Discard::kNone);
   EXPECT_EQ(floor.Check(blob, {0, 230}, {0.0, 0.0}), Discard::kTouchesBorder);
@@ -216,13 +216,14 @@ CameraModel TiltedCamera(double height_m, double back_m, double tilt_deg) {
 TEST(FloorMask, ASpriteSeenFromTooFarAboveIsRefused) {
   const cv::Mat blob(20, 20, CV_8U, cv::Scalar(255));
   // Straight above: 90 degrees at the origin, atan(1 / 0.25) = 76 at x = 0.25 m.
-  const FloorMask above(DownCamera(), Floor(), {});
+  const FloorMask above(CameraLookingDown(), FloorUnderIt(), {});
   EXPECT_EQ(above.Check(blob, {310, 230}, {0.0, 0.0}), Discard::kViewTooSteep);
   EXPECT_EQ(above.Check(blob, {430, 230}, {0.25, 0.0}), Discard::kViewTooSteep);
   UsabilityOptions steeper;
   steeper.max_view_angle_deg = 80;
-  EXPECT_EQ(FloorMask(DownCamera(), Floor(), steeper).Check(blob, {430, 230}, {0.25, 0.0}),
-            Discard::kNone);
+  EXPECT_EQ(
+      FloorMask(CameraLookingDown(), FloorUnderIt(), steeper).Check(blob, {430, 230}, {0.25, 0.0}),
+      Discard::kNone);
   // The floor's tests come first: off the floor is leaves_floor, however steep.
   EXPECT_EQ(above.Check(blob, {310, 230}, {0.35, 0.0}), Discard::kLeavesFloor);
   // Its shallowest view of the floor is at a corner: atan(1 / hypot(0.3, 0.2)) = 70.1 degrees
@@ -231,7 +232,7 @@ TEST(FloorMask, ASpriteSeenFromTooFarAboveIsRefused) {
 
   // From 1 m up and 1.5 m behind the floor, looking 35 degrees down, every view is oblique:
   // at the floor's centre atan(1 / 1.5) = 33.7 degrees.
-  const FloorMask oblique(TiltedCamera(1.0, 1.5, 35), Floor(), {});
+  const FloorMask oblique(TiltedCamera(1.0, 1.5, 35), FloorUnderIt(), {});
   const Eigen::Vector2d centre_px = TiltedCamera(1.0, 1.5, 35).ProjectGround({0, 0, 0});
   const cv::Point at(static_cast<int>(centre_px.x()) - 10, static_cast<int>(centre_px.y()) - 19);
   EXPECT_EQ(oblique.Check(blob, at, {0.0, 0.0}), Discard::kNone);

@@ -91,7 +91,7 @@ ConsoleLabels Labels(const SyntheticBank& bank) {
   return ConsoleLabels(api::Context{}, options);
 }
 
-std::string ErrorOf(const std::function<void()>& f) {
+std::string MessageOf(const std::function<void()>& f) {
   try {
     f();
   } catch (const std::exception& e) {
@@ -126,24 +126,24 @@ TEST(ConsoleLabels, StoresCountsExportsAndNamesBadInput) {
                      ",0\n");
 
   // Bad input names what is wrong.
-  std::string e = ErrorOf([&] { labels.Store({{"from", a}, {"to", 999999}, {"label", "yes"}}); });
+  std::string e = MessageOf([&] { labels.Store({{"from", a}, {"to", 999999}, {"label", "yes"}}); });
   EXPECT_EQ(e.rfind("sprite:", 0), 0u) << e;
   EXPECT_NE(e.find("999999"), std::string::npos) << e;
   EXPECT_THROW(labels.Store({{"from", a}, {"to", 999999}, {"label", "yes"}}), NotFoundError);
-  e = ErrorOf([&] { labels.Store({{"from", a}, {"to", b}, {"label", "maybe"}}); });
+  e = MessageOf([&] { labels.Store({{"from", a}, {"to", b}, {"label", "maybe"}}); });
   EXPECT_EQ(e.rfind("label:", 0), 0u) << e;
   EXPECT_NE(e.find("maybe"), std::string::npos) << e;
-  EXPECT_EQ(ErrorOf([&] { labels.Store({{"from", a}, {"to", b}}); }).rfind("label:", 0), 0u);
-  EXPECT_EQ(ErrorOf([&] {
+  EXPECT_EQ(MessageOf([&] { labels.Store({{"from", a}, {"to", b}}); }).rfind("label:", 0), 0u);
+  EXPECT_EQ(MessageOf([&] {
               labels.Store({{"from", a}, {"to", b}, {"label", 1}});
             }).rfind("label:", 0),
             0u);
-  EXPECT_EQ(ErrorOf([&] {
+  EXPECT_EQ(MessageOf([&] {
               labels.Store({{"from", "x"}, {"to", b}, {"label", "yes"}});
             }).rfind("from:", 0),
             0u);
-  EXPECT_EQ(ErrorOf([&] { labels.Store({{"from", a}, {"label", "yes"}}); }).rfind("to:", 0), 0u);
-  EXPECT_EQ(ErrorOf([&] {
+  EXPECT_EQ(MessageOf([&] { labels.Store({{"from", a}, {"label", "yes"}}); }).rfind("to:", 0), 0u);
+  EXPECT_EQ(MessageOf([&] {
               labels.Store({{"from", a}, {"to", a}, {"label", "yes"}});
             }).rfind("to:", 0),
             0u);
@@ -152,7 +152,7 @@ TEST(ConsoleLabels, StoresCountsExportsAndNamesBadInput) {
   EXPECT_EQ(labels.Undo({{"from", a}, {"to", c}})["labels"]["skip"], 0);
   EXPECT_THROW(labels.Undo({{"from", a}, {"to", c}}), NotFoundError);
   // A retrain needs labels of both kinds, enough of them.
-  e = ErrorOf([&] { labels.StartRetrain(); });
+  e = MessageOf([&] { labels.StartRetrain(); });
   EXPECT_EQ(e.rfind("labels:", 0), 0u) << e;
   EXPECT_EQ(labels.RetrainState()["state"], "idle");
 }
@@ -215,9 +215,9 @@ TEST(ConsoleLabels, AsksTheLeastSurePairsFirstAndNeverAgain) {
   }
   // One pair asked by its ids (a link) is the pair as the list gives it.
   EXPECT_EQ(labels.Pair(pairs[1]["from"], pairs[1]["to"]), pairs[1]);
-  std::string e = ErrorOf([&] { labels.Pair(pairs[1]["from"], 999999); });
+  std::string e = MessageOf([&] { labels.Pair(pairs[1]["from"], 999999); });
   EXPECT_EQ(e, "sprite: no sprite with id 999999 in the bank");
-  e = ErrorOf([&] { labels.Pair(bank.originals[0], pairs[1]["to"]); });  // a clip's first frame
+  e = MessageOf([&] { labels.Pair(bank.originals[0], pairs[1]["to"]); });  // a clip's first frame
   EXPECT_EQ(
       e.rfind("from: sprite " + std::to_string(bank.originals[0]) + " is the first or last frame",
               0),
