@@ -33,9 +33,17 @@ struct Captured {
   uint64_t drops_before = 0;  // frames dropped (queue full) just before this one
 };
 
-std::atomic<int>& PendingCloses() {
-  static std::atomic<int> pending{0};
-  return pending;
+// The sources being closed (CloseSource's threads): the count, under `mutex`, and `done`,
+// notified as each close ends (WaitForCameraCloses waits on it). Never destroyed: a close
+// thread may still end while the process exits.
+struct PendingCloses {
+  std::mutex mutex;
+  std::condition_variable done;
+  int count = 0;
+};
+PendingCloses& Closes() {
+  static auto* const closes = new PendingCloses;
+  return *closes;
 }
 
 // `n` BGR images of width x height whose pages are already mapped (written once).
@@ -48,12 +56,11 @@ std::vector<cv::Mat> PrefaultedImages(int n, int width, int height) {
 }  // namespace
 
 bool WaitForCameraCloses(double timeout_s) {
-  const auto deadline = Clock::now() + std::chrono::duration<double>(timeout_s);
-  while (PendingCloses().load() > 0) {
-    if (Clock::now() >= deadline) return false;
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));
-  }
-  return true;
+  const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                                           std::chrono::duration<double>(std::max(0.0, timeout_s)));
+  PendingCloses& closes = Closes();
+  std::unique_lock lock(closes.mutex);
+  return closes.done.wait_until(lock, deadline, [&] { return closes.count == 0; });
 }
 
 const char* CameraStateName(CameraState state) {
@@ -205,11 +212,18 @@ struct CameraRunner::Impl {
       source_dropped_base += s.frames_dropped;
       source_errors_base += s.errors;
     }
-    PendingCloses().fetch_add(1);
+    {
+      std::lock_guard lock(Closes().mutex);
+      ++Closes().count;
+    }
     std::thread([old = std::move(old)]() mutable {
       old.reset();
-      PendingCloses().fetch_sub(1);
-      PendingCloses().notify_all();
+      PendingCloses& closes = Closes();
+      {
+        std::lock_guard lock(closes.mutex);
+        --closes.count;
+      }
+      closes.done.notify_all();
     }).detach();
   }
 

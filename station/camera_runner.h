@@ -97,7 +97,9 @@ struct CameraRunnerOptions {
 
 // Sources are closed on threads of their own (a dead device takes seconds to close):
 // waits until every close is done; false after `timeout_s` (then the process may end
-// without them: nothing of the station's data depends on them).
+// without them: nothing of the station's data depends on them). Any thread may call it (the
+// daemon's main thread at exit, the tests'); it sleeps on a condition variable that each close
+// thread notifies as it ends (a leaf lock: held only for the count).
 bool WaitForCameraCloses(double timeout_s);
 
 class CameraRunner {
