@@ -149,6 +149,11 @@ struct WizardSettings {
 };
 
 // One camera's wizard, on a thread of its own.
+// Threads: Offer is called on the station's pipeline thread (the frame watcher), Run,
+// StartSolve and the getters on the API's threads; the camera's thread (Loop) feeds the
+// wizard, runs the posted commands and publishes the state. It sleeps on queue_cv_ until a
+// frame, a command or the stop comes (each notified where it is queued).
+// Locks: queue_mutex_ and state_mutex_ are leaves (held for a copy or a push, never together).
 class CameraWork {
  public:
   CameraWork(std::string name, int index, const WizardSettings& settings,
@@ -262,8 +267,8 @@ class CameraWork {
       std::optional<Frame> frame;
       {
         std::unique_lock lock(queue_mutex_);
-        queue_cv_.wait_for(lock, std::chrono::milliseconds(250),
-                           [&] { return stop_ || !commands_.empty() || !frames_.empty(); });
+        // Every change of these is notified (Offer, Post, the destructor): no timeout needed.
+        queue_cv_.wait(lock, [&] { return stop_ || !commands_.empty() || !frames_.empty(); });
         if (stop_) return;
         if (!commands_.empty()) {
           command = std::move(commands_.front());
