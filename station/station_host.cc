@@ -105,8 +105,11 @@ void StationHost::Start() {
   auto station = std::make_shared<Station>(live_);
   station->Start();
   running_ = live_;
-  std::lock_guard lock(mutex_);
-  station_ = std::move(station);
+  {
+    std::lock_guard lock(mutex_);
+    station_ = std::move(station);
+  }
+  NotifyStationChange();
 }
 
 void StationHost::Stop() {
@@ -127,8 +130,34 @@ void StationHost::Replace(StationOptions options) {
   running_ = options;
   auto next = std::make_shared<Station>(std::move(options));
   next->Start();
-  std::lock_guard lock(mutex_);
-  station_ = std::move(next);
+  {
+    std::lock_guard lock(mutex_);
+    station_ = std::move(next);
+  }
+  NotifyStationChange();
+}
+
+int StationHost::AddStationChangeListener(std::function<void()> listener) {
+  std::lock_guard lock(listeners_mutex_);
+  const int id = next_listener_++;
+  listeners_.emplace(id, std::move(listener));
+  return id;
+}
+
+void StationHost::RemoveStationChangeListener(int id) {
+  std::lock_guard lock(listeners_mutex_);
+  listeners_.erase(id);
+}
+
+void StationHost::NotifyStationChange() {
+  std::lock_guard lock(listeners_mutex_);
+  for (const auto& [id, listener] : listeners_) {
+    try {
+      listener();
+    } catch (const std::exception& e) {
+      Log("station")->warn("a station change listener failed: {}", e.what());
+    }
+  }
 }
 
 void StationHost::StartReplay(const std::string& path, bool paced, bool loop) {

@@ -5,7 +5,20 @@
 // one whose cameras replay a recorded session, with the same bank, keying,
 // pipeline and storage; StopReplay goes back. Callers take the running
 // station with current(); a replaced station is stopped before its successor
-// starts, and stays valid for whoever still holds it.
+// starts, and stays valid for whoever still holds it. Who follows the running
+// station (the calibration wizard's frame tap, a retrain waiting for the rebuild)
+// adds a station change listener instead of asking current() again and again.
+//
+// Threads: the daemon's main thread calls Start and Stop; the API's threads (the
+// replay routes, the calibration save) and the labels' retrain thread (UseWeights)
+// switch stations; any thread reads current(), weights(), live_config(), ModeJson().
+// Lock order: switch_mutex_ -> listeners_mutex_ -> a listener's own locks -> mutex_.
+// mutex_ is a leaf (held for a copy). A listener runs on the switching thread with
+// switch_mutex_ and listeners_mutex_ held: it may read the host (current() and the
+// other getters) and the new station, but must not switch stations or add or remove
+// listeners, and nobody may hold a lock a listener takes while switching stations.
+#include <functional>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -73,6 +86,15 @@ class StationHost {
   // error is thrown.
   bool ApplyLiveConfig(const StationConfig& config);
 
+  // Calls `listener` each time a new station has started and is current(): at Start, when a
+  // replay starts or stops, after UseWeights and ApplyLiveConfig, and when a failed switch
+  // starts the previous station again. It runs on the switching thread, one switch after the
+  // other (see the lock order above); the mode (ModeJson) may still be the old one then. An
+  // exception it throws is logged. Returns the id RemoveStationChangeListener takes.
+  int AddStationChangeListener(std::function<void()> listener);
+  // Once it returns, the listener is not running and is not called again.
+  void RemoveStationChangeListener(int id);
+
   // {"mode": "live" | "replay", "replay": {"path", "paced", "loop"} or null}
   nlohmann::json ModeJson() const;
   const std::vector<std::string>& replay_roots() const { return replay_roots_; }
@@ -80,6 +102,8 @@ class StationHost {
  private:
   // Stops the running station and starts one from `options`. Under switch_mutex_.
   void Replace(StationOptions options);
+  // Calls the station change listeners. Under switch_mutex_, after station_ is the new one.
+  void NotifyStationChange();
 
   StationOptions
       live_;  // written under switch_mutex_ and mutex_ (weights(), live_config() read it)
@@ -91,6 +115,9 @@ class StationHost {
   bool replaying_ = false;
   std::string replay_path_;
   bool replay_paced_ = true, replay_loop_ = false;
+  std::mutex listeners_mutex_;  // guards listeners_; held while they run
+  std::map<int, std::function<void()>> listeners_;
+  int next_listener_ = 1;
 };
 
 }  // namespace ss
