@@ -602,10 +602,7 @@ struct ConsoleCalibration::Impl {
   // The station whose frames the wizard takes (re-tapped when the host replaces it).
   std::mutex tap_mutex;
   std::shared_ptr<Station> tapped;
-  std::thread keeper;
-  std::mutex keeper_mutex;
-  std::condition_variable keeper_cv;
-  bool stopping = false;
+  int station_listener = 0;  // the host's id for OnStationChange (0: none)
 
   ~Impl() {
     if (!work_dir.empty()) {
@@ -659,8 +656,11 @@ struct ConsoleCalibration::Impl {
   }
 
   // Taps the host's current station when it changed (a replay started or stopped, a save
-  // restarted it); called by the keeper thread and after a start.
+  // restarted it); called by the host's station change listener and after a start.
   void Retap() {
+    // tap_mutex first: the station and the run read below are still the latest when they are
+    // applied (a start's Retap and the listener's may run at once; the later one wins).
+    std::lock_guard tap_lock(tap_mutex);
     std::shared_ptr<Station> current = context.host->current();
     std::vector<std::shared_ptr<CameraWork>> routed;
     bool on = false;
@@ -669,7 +669,6 @@ struct ConsoleCalibration::Impl {
       on = active;
       routed = works;
     }
-    std::lock_guard lock(tap_mutex);
     if (!on) {
       if (tapped) tapped->SetFrameWatcher({});
       tapped.reset();
@@ -700,18 +699,12 @@ struct ConsoleCalibration::Impl {
     tapped.reset();
   }
 
-  void KeeperLoop() {
-    std::unique_lock lock(keeper_mutex);
-    while (!stopping) {
-      keeper_cv.wait_for(lock, std::chrono::milliseconds(250));
-      if (stopping) break;
-      lock.unlock();
-      try {
-        Retap();
-      } catch (const std::exception& e) {
-        log->warn("calibration: cannot take the station's frames: {}", e.what());
-      }
-      lock.lock();
+  // The host's station change listener: on the switching thread, once the new station runs.
+  void OnStationChange() {
+    try {
+      Retap();
+    } catch (const std::exception& e) {
+      log->warn("calibration: cannot take the station's frames: {}", e.what());
     }
   }
 
@@ -908,7 +901,7 @@ struct ConsoleCalibration::Impl {
       saved = j;
       throw WorkError("station", error);
     }
-    Retap();
+    // A restarted station is tapped already (OnStationChange ran before ApplyLiveConfig returned).
     std::lock_guard lock(mutex);
     saved = j;
     return j;
@@ -955,19 +948,20 @@ struct ConsoleCalibration::Impl {
 
 ConsoleCalibration::ConsoleCalibration(api::Context context) : impl_(std::make_unique<Impl>()) {
   impl_->context = std::move(context);
-  impl_->keeper = std::thread([s = impl_.get()] { s->KeeperLoop(); });
+  if (impl_->context.host) {
+    impl_->station_listener =
+        impl_->context.host->AddStationChangeListener([s = impl_.get()] { s->OnStationChange(); });
+  }
 }
 
 ConsoleCalibration::~ConsoleCalibration() { Stop(); }
 
 void ConsoleCalibration::Stop() {
   Impl& s = *impl_;
-  {
-    std::lock_guard lock(s.keeper_mutex);
-    s.stopping = true;
+  if (s.station_listener != 0) {
+    s.context.host->RemoveStationChangeListener(s.station_listener);  // not running after this
+    s.station_listener = 0;
   }
-  s.keeper_cv.notify_all();
-  if (s.keeper.joinable()) s.keeper.join();
   s.Stop();
 }
 

@@ -8,6 +8,17 @@
 // enclosure, a long step's progress) goes out in the status the events stream
 // sends. Saving writes the models and the config (config/station_save.h) and
 // restarts the live station with them inside the daemon.
+//
+// Threads: the API's threads call the routes (start, actions, save) and the status;
+// each camera's wizard runs on a thread of its own, fed by the station's pipeline
+// threads through the frame watcher; the thread that replaces the host's station (a
+// replay route, a save, a retrain) re-taps the new one from the host's station change
+// listener (StationHost::AddStationChangeListener), before its switch returns.
+// Lock order: the host's switch_mutex_ -> its listeners_mutex_ -> Impl::tap_mutex ->
+// Impl::mutex (held for a copy) -> a camera's state lock; Impl::tap_mutex -> the host's
+// mutex_ (current()) and the station's locks (Status, the watcher's). Neither Impl lock is
+// held while calling the host's switching methods (the save calls ApplyLiveConfig with
+// none), so the listener may take them.
 #include <memory>
 #include <vector>
 
