@@ -189,7 +189,8 @@ void Station::Start() {
   if (s.options.transitions) {
     s.transitions = std::make_unique<TransitionWorker>(
         config.storage.bank, s.options.weights ? *s.options.weights : DefaultWeights(), 1,
-        SpriteChoice{.include_merged = config.transitions.include_merged});
+        SpriteChoice{.include_merged = config.transitions.include_merged},
+        [&s] { s.NotifyTransitionsListeners(); });
   }
   s.writer_thread = std::thread([&s] { s.WriterLoop(); });
 
@@ -358,6 +359,30 @@ bool Station::SessionActive() const { return impl_->session_active.load(); }
 void Station::SetFrameWatcher(FrameWatcher watcher) {
   std::lock_guard lock(impl_->watcher_mutex);
   impl_->watcher = std::move(watcher);
+}
+
+int Station::AddTransitionsListener(std::function<void()> listener) {
+  Impl& s = *impl_;
+  std::lock_guard lock(s.transitions_listeners_mutex);
+  const int id = s.next_transitions_listener++;
+  s.transitions_listeners.emplace(id, std::move(listener));
+  return id;
+}
+
+void Station::RemoveTransitionsListener(int id) {
+  std::lock_guard lock(impl_->transitions_listeners_mutex);
+  impl_->transitions_listeners.erase(id);
+}
+
+void Station::Impl::NotifyTransitionsListeners() {
+  std::lock_guard lock(transitions_listeners_mutex);
+  for (const auto& [id, listener] : transitions_listeners) {
+    try {
+      listener();
+    } catch (const std::exception& e) {
+      log->warn("a transitions listener failed: {}", e.what());
+    }
+  }
 }
 
 std::vector<std::string> Station::Reload(const StationConfig& config) {

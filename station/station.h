@@ -7,6 +7,9 @@
 // raw frames. A monitor thread watches the disk: below
 // storage.stop_recording_below_mib raw recording stops, below
 // storage.stop_sprites_below_mib sprite storage stops too (the bank stays whole).
+// Threads: the station host's switching thread calls Start and Stop; the API's threads the
+// rest; a frame watcher runs on a camera's pipeline thread, a transitions listener on the
+// transitions worker's. Each lock and its order: station_impl.h.
 #include <functional>
 #include <memory>
 #include <optional>
@@ -98,6 +101,14 @@ class Station {
   // Keep it short (copy what is needed and return). An empty function removes it.
   using FrameWatcher = std::function<void(int camera, const Frame& frame)>;
   void SetFrameWatcher(FrameWatcher watcher);
+  // Calls `listener` each time the transitions worker's start-up build moves on or ends (the
+  // status' transitions_startup_stage / _done / _total and transitions_ready), on the worker's
+  // thread: who waits for the rebuild waits on its own condition variable, not polling
+  // Status(). Keep it short; it must not add or remove transitions listeners. Returns the id
+  // RemoveTransitionsListener takes.
+  int AddTransitionsListener(std::function<void()> listener);
+  // Once it returns, the listener is not running and is not called again.
+  void RemoveTransitionsListener(int id);
   // SIGHUP: applies what is safe to change live (logging, storage limits and recording
   // mode, from the next session on); returns one line per section that needs a restart.
   std::vector<std::string> Reload(const StationConfig& config);

@@ -21,12 +21,15 @@
 //   PreviewCache::mutex -> CameraRunner's preview lock (an encode runs under the cache's lock)
 // Every other lock is a leaf, held for a copy or a count and released before the next is taken
 // (the writer's stats_mutex, then session_mutex, one after the other in Stored). watcher_mutex is
-// held while the watcher runs: a watcher must not call the station.
+// held while the watcher runs: a watcher must not call the station. transitions_listeners_mutex
+// is held while the transitions listeners run on the worker's thread (with none of the worker's
+// locks): a listener takes only its own locks.
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
 #include <cstdint>
 #include <deque>
+#include <functional>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -167,6 +170,12 @@ struct Station::Impl {
   Station::FrameWatcher watcher;  // under watcher_mutex
 
   void Tap(int camera, const Frame& frame, uint64_t drops_before, bool usable);
+
+  // Who follows the transitions worker's start-up (station.h AddTransitionsListener).
+  std::mutex transitions_listeners_mutex;  // held while they run
+  std::map<int, std::function<void()>> transitions_listeners;
+  int next_transitions_listener = 1;
+  void NotifyTransitionsListeners();
   void StopRecording(const std::string& why);
 
   // The disk guard (disk_guard.cc).

@@ -29,8 +29,11 @@ struct TransitionWorker::State {
 };
 
 TransitionWorker::TransitionWorker(std::string bank_path, const TransitionWeights& weights,
-                                   int startup_threads, SpriteChoice sprites)
-    : bank_path_(std::move(bank_path)), state_(std::make_unique<State>()) {
+                                   int startup_threads, SpriteChoice sprites,
+                                   std::function<void()> on_startup_change)
+    : bank_path_(std::move(bank_path)),
+      state_(std::make_unique<State>()),
+      on_startup_change_(std::move(on_startup_change)) {
   const TransitionClassifier check(
       weights);  // InputError for invalid weights, in the caller's thread
   state_->weights = weights;
@@ -103,10 +106,13 @@ void TransitionWorker::Run() {
     s.writer.emplace(bank_path_);
     const auto progress = [this](const char* stage) {
       return [this, stage](size_t done, size_t total) {
-        std::lock_guard<std::mutex> lock(mutex_);
-        stats_.startup_stage = stage;
-        stats_.startup_done = static_cast<int64_t>(done);
-        stats_.startup_total = static_cast<int64_t>(total);
+        {
+          std::lock_guard<std::mutex> lock(mutex_);
+          stats_.startup_stage = stage;
+          stats_.startup_done = static_cast<int64_t>(done);
+          stats_.startup_total = static_cast<int64_t>(total);
+        }
+        if (on_startup_change_) on_startup_change_();
       };
     };
     const BankSprites sprites = LoadBankSprites(*s.reader, &s.keys, progress("load"), s.choice);
@@ -144,6 +150,7 @@ void TransitionWorker::Run() {
     busy_ = false;
   }
   idle_.notify_all();
+  if (on_startup_change_) on_startup_change_();
 
   std::vector<int64_t> round;
   while (true) {
@@ -231,6 +238,7 @@ void TransitionWorker::RunUnits() {
     busy_ = units != nullptr;
   }
   idle_.notify_all();
+  if (on_startup_change_) on_startup_change_();
   if (!units) {
     // Nothing can be done: drop what is submitted, as the incremental worker does.
     std::unique_lock<std::mutex> lock(mutex_);

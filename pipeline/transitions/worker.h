@@ -13,9 +13,13 @@
 // Errors never stop the thread: a round that fails is counted, logged and skipped.
 // On a PostgreSQL bank (other writers, other workers) the thread does units of the bank's
 // shared work table instead (unit_worker.h, docs/scaling.md): the same table, exactly.
+// Threads: the owner's (the station's bank writer) Submit; any thread stats() and the waits;
+// the owner Stop. The worker's thread (and the start-up build's) take mutex_, a leaf: it is
+// held for a copy or a count, never while calling out (on_startup_change runs without it).
 #include <condition_variable>
 #include <cstdint>
 #include <deque>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <span>
@@ -48,8 +52,13 @@ class TransitionWorker {
   // Starts the thread. Invalid weights throw InputError here; a bank that cannot be
   // opened shows up as stats().last_error (the thread then drops what is submitted).
   // `sprites`: which sprites take part (merged ones not, by default), at start and in rounds.
+  // `on_startup_change`, when set, is called each time stats().ready or the start-up progress
+  // (startup_stage, startup_done, startup_total) changed, so a caller waiting for the start-up
+  // build can wait on its own condition variable instead of polling stats(). It runs on the
+  // worker's thread (the "pairs" stage: on one of the start-up build's threads, one call at a
+  // time) with none of the worker's locks held; keep it short and do not call Stop from it.
   TransitionWorker(std::string bank_path, const TransitionWeights& weights, int startup_threads = 1,
-                   SpriteChoice sprites = {});
+                   SpriteChoice sprites = {}, std::function<void()> on_startup_change = {});
   ~TransitionWorker();  // Stop()
   TransitionWorker(const TransitionWorker&) = delete;
   TransitionWorker& operator=(const TransitionWorker&) = delete;
@@ -73,6 +82,7 @@ class TransitionWorker {
 
   std::string bank_path_;
   std::unique_ptr<State> state_;
+  std::function<void()> on_startup_change_;  // set before the thread starts, never changed
   mutable std::mutex mutex_;
   std::condition_variable wake_, idle_;
   std::deque<int64_t> queue_;
