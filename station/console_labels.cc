@@ -235,8 +235,10 @@ ConsoleLabels::~ConsoleLabels() { Stop(); }
 void ConsoleLabels::Stop() {
   std::unique_lock lock(shared_->mutex);
   shared_->stop = true;
-  // A thread restarting the station or following its rebuild stops within ~0.1 s after that;
-  // one still training is left to finish alone (it touches only `shared_` and files).
+  // A thread following the station's rebuild wakes and stops at once; one restarting the
+  // station stops when the restart is done; one still training is left to finish alone (it
+  // touches only `shared_` and files).
+  shared_->changed.notify_all();
   shared_->changed.wait(lock, [&] { return !shared_->using_host; });
 }
 
@@ -501,10 +503,6 @@ void ConsoleLabels::RunRetrain(std::shared_ptr<Shared> shared, api::Context cont
     shared->using_host = true;
     return true;
   };
-  auto stopping = [&] {
-    std::lock_guard lock(shared->mutex);
-    return shared->stop;
-  };
   const auto t0 = std::chrono::steady_clock::now();
   auto seconds = [](auto since) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
@@ -596,21 +594,54 @@ void ConsoleLabels::RunRetrain(std::shared_ptr<Shared> shared, api::Context cont
       context.host->UseWeights(result.weights, weights_path.string());
       if (worker) {
         rebuilt_by_station = true;
-        // The new station's transition worker rebuilds the table at its start.
+        // The new station's transition worker rebuilds the table at its start. This thread
+        // sleeps until that start-up moves on, the host replaces its station (the new one's
+        // start-up is followed then) or the server stops: each of them wakes it.
+        auto wake = [shared] {
+          {
+            std::lock_guard lock(shared->mutex);
+            shared->transitions_moved = true;
+          }
+          shared->changed.notify_all();
+        };
+        struct Following {
+          StationHost& host;
+          int host_listener;
+          std::shared_ptr<Station> station;  // whose start-up is followed
+          int station_listener = 0;
+          ~Following() {
+            if (station) station->RemoveTransitionsListener(station_listener);
+            host.RemoveStationChangeListener(host_listener);
+          }
+        } following{*context.host, context.host->AddStationChangeListener(wake)};
         for (;;) {
-          if (stopping())
-            throw WorkError("retrain", "the server stopped while the transitions were rebuilt");
+          {
+            std::lock_guard lock(shared->mutex);
+            if (shared->stop)
+              throw WorkError("retrain", "the server stopped while the transitions were rebuilt");
+            shared->transitions_moved = false;  // what moves from here on wakes the wait below
+          }
           const std::shared_ptr<Station> station = context.host->current();
-          const StationStatus st = station->Status();
-          if (st.transitions_ready) {
-            if (!st.transitions_error.empty()) throw WorkError("transitions", st.transitions_error);
-            break;
+          if (station != following.station) {
+            if (following.station)
+              following.station->RemoveTransitionsListener(following.station_listener);
+            following.station = station;
+            following.station_listener = station ? station->AddTransitionsListener(wake) : 0;
           }
-          if (!st.transitions_startup_stage.empty()) {
-            stage_progress(st.transitions_startup_stage, st.transitions_startup_done,
-                           st.transitions_startup_total);
+          if (station) {
+            const StationStatus st = station->Status();
+            if (st.transitions_ready) {
+              if (!st.transitions_error.empty())
+                throw WorkError("transitions", st.transitions_error);
+              break;
+            }
+            if (!st.transitions_startup_stage.empty()) {
+              stage_progress(st.transitions_startup_stage, st.transitions_startup_done,
+                             st.transitions_startup_total);
+            }
           }
-          std::this_thread::sleep_for(std::chrono::milliseconds(100));
+          std::unique_lock lock(shared->mutex);
+          shared->changed.wait(lock, [&] { return shared->stop || shared->transitions_moved; });
         }
       }
     } else {

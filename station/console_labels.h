@@ -88,6 +88,14 @@ class ConsoleLabels : public api::Part {
   // What the retrain thread shares with the part. The thread is detached: a daemon told to
   // stop while a long training runs does not wait for it (Stop waits only while the thread
   // uses the station host, i.e. restarts the station or follows its rebuild).
+  // Threads: the API's threads call the routes and StartRetrain, the server's Stop; the
+  // retrain thread runs RunRetrain. While it follows the station's rebuild, its listeners run
+  // on the host's switching thread (StationHost::AddStationChangeListener) and on the
+  // station's transitions worker thread (Station::AddTransitionsListener) and take only
+  // `mutex` to wake it. Lock order: the host's and the station's listener locks -> `mutex`
+  // -> status_mutex_ (RefreshStatus); pool_mutex_ is taken with neither held. No lock of this
+  // part is held while calling the host's switching methods (UseWeights) or removing a
+  // listener.
   struct Shared {
     std::mutex mutex;  // guards every member
     std::condition_variable changed;
@@ -97,6 +105,9 @@ class ConsoleLabels : public api::Part {
     bool using_host = false;
     bool stop = false;
     bool dirty = true;  // the labels or weights changed: refresh the status
+    // The host replaced its station or the station's transitions start-up moved on (set by
+    // the retrain's listeners; the retrain thread waits on `changed` for it or `stop`).
+    bool transitions_moved = false;
   };
   std::string BankPath() const;
   // The weights in use: the host's (its stations run them), else this part's own.
