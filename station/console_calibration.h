@@ -14,7 +14,7 @@
 // threads through the frame watcher; the thread that replaces the host's station (a
 // replay route, a save, a retrain) re-taps the new one from the host's station change
 // listener (StationHost::AddStationChangeListener), before its switch returns.
-// Lock order: the host's switch_mutex_ -> its listeners_mutex_ -> Impl::tap_mutex ->
+// Lock order: the host's switch_mutex_ -> its listeners_ lock -> Impl::tap_mutex ->
 // Impl::mutex (held for a copy) -> a camera's state lock; Impl::tap_mutex -> the host's
 // mutex_ (current()) and the station's locks (Status, the watcher's). Neither Impl lock is
 // held while calling the host's switching methods (the save calls ApplyLiveConfig with

@@ -190,7 +190,7 @@ void Station::Start() {
     s.transitions = std::make_unique<TransitionWorker>(
         config.storage.bank, s.options.weights ? *s.options.weights : DefaultWeights(), 1,
         SpriteChoice{.include_merged = config.transitions.include_merged},
-        [&s] { s.NotifyTransitionsListeners(); });
+        [&s] { s.transitions_listeners.Notify("transitions"); });
   }
   s.writer_thread = std::thread([&s] { s.WriterLoop(); });
 
@@ -362,28 +362,10 @@ void Station::SetFrameWatcher(FrameWatcher watcher) {
 }
 
 int Station::AddTransitionsListener(std::function<void()> listener) {
-  Impl& s = *impl_;
-  std::lock_guard lock(s.transitions_listeners_mutex);
-  const int id = s.next_transitions_listener++;
-  s.transitions_listeners.emplace(id, std::move(listener));
-  return id;
+  return impl_->transitions_listeners.Add(std::move(listener));
 }
 
-void Station::RemoveTransitionsListener(int id) {
-  std::lock_guard lock(impl_->transitions_listeners_mutex);
-  impl_->transitions_listeners.erase(id);
-}
-
-void Station::Impl::NotifyTransitionsListeners() {
-  std::lock_guard lock(transitions_listeners_mutex);
-  for (const auto& [id, listener] : transitions_listeners) {
-    try {
-      listener();
-    } catch (const std::exception& e) {
-      log->warn("a transitions listener failed: {}", e.what());
-    }
-  }
-}
+void Station::RemoveTransitionsListener(int id) { impl_->transitions_listeners.Remove(id); }
 
 std::vector<std::string> Station::Reload(const StationConfig& config) {
   Impl& s = *impl_;

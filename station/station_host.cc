@@ -138,27 +138,12 @@ void StationHost::Replace(StationOptions options) {
 }
 
 int StationHost::AddStationChangeListener(std::function<void()> listener) {
-  std::lock_guard lock(listeners_mutex_);
-  const int id = next_listener_++;
-  listeners_.emplace(id, std::move(listener));
-  return id;
+  return listeners_.Add(std::move(listener));
 }
 
-void StationHost::RemoveStationChangeListener(int id) {
-  std::lock_guard lock(listeners_mutex_);
-  listeners_.erase(id);
-}
+void StationHost::RemoveStationChangeListener(int id) { listeners_.Remove(id); }
 
-void StationHost::NotifyStationChange() {
-  std::lock_guard lock(listeners_mutex_);
-  for (const auto& [id, listener] : listeners_) {
-    try {
-      listener();
-    } catch (const std::exception& e) {
-      Log("station")->warn("a station change listener failed: {}", e.what());
-    }
-  }
-}
+void StationHost::NotifyStationChange() { listeners_.Notify("station change"); }
 
 void StationHost::StartReplay(const std::string& path, bool paced, bool loop) {
   std::lock_guard sw(switch_mutex_);

@@ -12,13 +12,12 @@
 // Threads: the daemon's main thread calls Start and Stop; the API's threads (the
 // replay routes, the calibration save) and the labels' retrain thread (UseWeights)
 // switch stations; any thread reads current(), weights(), live_config(), ModeJson().
-// Lock order: switch_mutex_ -> listeners_mutex_ -> a listener's own locks -> mutex_.
+// Lock order: switch_mutex_ -> listeners_ (its lock) -> a listener's own locks -> mutex_.
 // mutex_ is a leaf (held for a copy). A listener runs on the switching thread with
-// switch_mutex_ and listeners_mutex_ held: it may read the host (current() and the
+// switch_mutex_ and the listeners_ lock held: it may read the host (current() and the
 // other getters) and the new station, but must not switch stations or add or remove
 // listeners, and nobody may hold a lock a listener takes while switching stations.
 #include <functional>
-#include <map>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -26,6 +25,7 @@
 
 #include <nlohmann/json_fwd.hpp>
 
+#include "core/listeners.h"
 #include "core/session.h"
 #include "station/station.h"
 
@@ -115,9 +115,7 @@ class StationHost {
   bool replaying_ = false;
   std::string replay_path_;
   bool replay_paced_ = true, replay_loop_ = false;
-  std::mutex listeners_mutex_;  // guards listeners_; held while they run
-  std::map<int, std::function<void()>> listeners_;
-  int next_listener_ = 1;
+  Listeners listeners_;  // its lock is held while they run (the lock order above)
 };
 
 }  // namespace ss

@@ -21,7 +21,7 @@
 //   PreviewCache::mutex -> CameraRunner's preview lock (an encode runs under the cache's lock)
 // Every other lock is a leaf, held for a copy or a count and released before the next is taken
 // (the writer's stats_mutex, then session_mutex, one after the other in Stored). watcher_mutex is
-// held while the watcher runs: a watcher must not call the station. transitions_listeners_mutex
+// held while the watcher runs: a watcher must not call the station. transitions_listeners' lock
 // is held while the transitions listeners run on the worker's thread (with none of the worker's
 // locks): a listener takes only its own locks.
 #include <atomic>
@@ -43,6 +43,7 @@
 
 #include "core/bank.h"
 #include "core/elapsed.h"
+#include "core/listeners.h"
 #include "core/log.h"
 #include "pipeline/run/bounded_queue.h"
 #include "pipeline/transitions/worker.h"
@@ -172,10 +173,7 @@ struct Station::Impl {
   void Tap(int camera, const Frame& frame, uint64_t drops_before, bool usable);
 
   // Who follows the transitions worker's start-up (station.h AddTransitionsListener).
-  std::mutex transitions_listeners_mutex;  // held while they run
-  std::map<int, std::function<void()>> transitions_listeners;
-  int next_transitions_listener = 1;
-  void NotifyTransitionsListeners();
+  Listeners transitions_listeners;  // its lock is held while they run
   void StopRecording(const std::string& why);
 
   // The disk guard (disk_guard.cc).
