@@ -9,7 +9,7 @@
 namespace ss {
 
 SmoothnessTerm::SmoothnessTerm(const TransitionGraph& graph, int sprite, double strength)
-    : StepSumTerm("smoothness", {sprite}, strength), graph_(graph) {}
+    : FrameStepTerm("smoothness", {sprite}, strength), graph_(graph) {}
 
 std::pair<int, int> SmoothnessTerm::Steps(Tracks tracks, const EvalRequest& /*request*/) const {
   return {1, std::max(1, tracks[sprites()[0]]->size())};
@@ -24,7 +24,7 @@ double SmoothnessTerm::StepCost(Tracks tracks, int t) const {
 }
 
 FastFrameTerm::FastFrameTerm(int sprite, double reference_speed_m, double strength)
-    : StepSumTerm("fast", {sprite}, strength), reference_speed_m_(reference_speed_m) {
+    : FrameStepTerm("fast", {sprite}, strength), reference_speed_m_(reference_speed_m) {
   if (!(reference_speed_m > 0) || !std::isfinite(reference_speed_m)) {
     throw InputError("fast.reference_speed", "must be > 0 metres per step");
   }
@@ -41,7 +41,7 @@ double FastFrameTerm::StepCost(Tracks tracks, int t) const {
 
 RepeatTerm::RepeatTerm(int sprite, int window_steps, double strength,
                        std::shared_ptr<const std::vector<bool>> exempt)
-    : StepSumTerm("repeat", {sprite}, strength),
+    : FrameStepTerm("repeat", {sprite}, strength),
       window_steps_(window_steps),
       exempt_(std::move(exempt)) {
   if (window_steps < 1) throw InputError("repeat.window_steps", "must be >= 1");

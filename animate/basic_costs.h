@@ -17,35 +17,31 @@
 
 namespace ss {
 
-class SmoothnessTerm : public StepSumTerm {
+class SmoothnessTerm : public FrameStepTerm {
  public:
   SmoothnessTerm(const TransitionGraph& graph, int sprite, double strength);
 
  protected:
   std::pair<int, int> Steps(Tracks tracks, const EvalRequest& request) const override;
   double StepCost(Tracks tracks, int t) const override;
-  bool FramesOnly() const override { return true; }
-  bool TimeInvariant() const override { return true; }
 
  private:
   const TransitionGraph& graph_;
 };
 
-class FastFrameTerm : public StepSumTerm {
+class FastFrameTerm : public FrameStepTerm {
  public:
   FastFrameTerm(int sprite, double reference_speed_m, double strength);
 
  protected:
   std::pair<int, int> Steps(Tracks tracks, const EvalRequest& request) const override;
   double StepCost(Tracks tracks, int t) const override;
-  bool FramesOnly() const override { return true; }
-  bool TimeInvariant() const override { return true; }
 
  private:
   double reference_speed_m_;
 };
 
-class RepeatTerm : public StepSumTerm {
+class RepeatTerm : public FrameStepTerm {
  public:
   // `exempt`: per frame, true for frames that hold still on purpose (may be null: none).
   RepeatTerm(int sprite, int window_steps, double strength,
@@ -56,8 +52,6 @@ class RepeatTerm : public StepSumTerm {
  protected:
   std::pair<int, int> Steps(Tracks tracks, const EvalRequest& request) const override;
   double StepCost(Tracks tracks, int t) const override;
-  bool FramesOnly() const override { return true; }
-  bool TimeInvariant() const override { return true; }
   int LookBack() const override { return window_steps_; }
 
  private:

@@ -105,4 +105,15 @@ class StepSumTerm : public CostTerm {
   int MaxLength(Tracks tracks) const;
 };
 
+// A StepSumTerm whose c_t reads only the frames shown up to LookBack() steps back, wherever step
+// t lies (smoothness, fast frames, repeats): both of StepSumTerm's caches apply.
+class FrameStepTerm : public StepSumTerm {
+ public:
+  using StepSumTerm::StepSumTerm;
+
+ protected:
+  bool FramesOnly() const final { return true; }
+  bool TimeInvariant() const final { return true; }
+};
+
 }  // namespace ss
