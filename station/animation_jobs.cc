@@ -330,8 +330,9 @@ void AnimationJobs::Run(std::shared_ptr<Current> job) {
     // The figures of every kept move; the tracks and the cost by kind of term 4 times a second,
     // made before the lock is taken (a status reader never waits for them).
     double sampled_at = -1;
-    run.on_improvement = [&](const std::vector<Track>& tracks, const TracePoint& point) {
-      const bool sample = point.seconds - sampled_at >= kTracksEverySeconds;
+    const auto record = [&](const std::vector<Track>& tracks, const TracePoint& point,
+                            bool always_sample) {
+      const bool sample = always_sample || point.seconds - sampled_at >= kTracksEverySeconds;
       nlohmann::json tracks_json = nlohmann::json::array();
       std::map<std::string, double> by_kind;
       if (sample) {
@@ -360,12 +361,22 @@ void AnimationJobs::Run(std::shared_ptr<Current> job) {
       job->by_kind.emplace_back(point.seconds, std::move(by_kind));
       job->tracks = std::move(tracks_json);
     };
+    run.on_improvement = [&](const std::vector<Track>& tracks, const TracePoint& point) {
+      record(tracks, point, false);
+    };
     {
       std::lock_guard lock(mu_);
       job->started = Now();  // the optimizer's clock from here (the trace's seconds)
     }
     const AnimateResult result = RunAnimation(*scene, run);
     if (job->cancel) return set_state(AnimationJobState::kCancelled);
+    // The curve ends with the result's own figures, also when no move was kept (a slow machine's
+    // whole budget can go to the start).
+    if (!result.summary.trace.empty()) {
+      TracePoint last = result.summary.trace.back();
+      last.cost = last.best_cost;  // the result is the best sequences, maybe of an earlier restart
+      record(result.tracks, last, true);
+    }
 
     SequenceFile file = MakeSequenceFile(*scene, result);
     nlohmann::json judged = JudgementJson(JudgeSequences(file, file.bank_paths, scene.get()));
