@@ -63,7 +63,11 @@ for t in "${targets[@]}"; do
   mkdir -p "$work" "$findings"
   cp -n "$top/tests/fuzz/corpus/$t/"* "$work/" 2>/dev/null || true
   log="$build/fuzz-$t.log"
-  if "$exe" -max_total_time="$seconds" -seed="${SPRITESTATION_FUZZ_SEED:-0}" -timeout=10 -rss_limit_mb=2048 -malloc_limit_mb=2048 \
+  # The spec's numbers size the problem it builds: issue 39 bounds that within 1 GiB (the
+  # process under ASan starts at ~500 MB of it). The other parsers get 2 GiB.
+  mb=2048
+  [ "$t" = spec ] && mb=1024
+  if "$exe" -max_total_time="$seconds" -seed="${SPRITESTATION_FUZZ_SEED:-0}" -timeout=10 -rss_limit_mb=$mb -malloc_limit_mb=$mb \
       -artifact_prefix="$findings/" -print_final_stats=1 "$work" >"$log" 2>&1; then
     runs="$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | grep -o '[0-9]*$' || echo '?')"
     echo "fuzz $t: ${seconds} s, $runs inputs, no finding"
