@@ -67,6 +67,13 @@ class Validator {
             const std::string& path) {
     Check(OneOf(v, options), path, "expected one of " + Join(options) + ", got " + Quoted(v));
   }
+  // An options struct's own rules (its IsValid's "field: reason" lines), each at its key in
+  // `block`: the component states its ranges once, and the config reports them by key.
+  void Rules(bool ok, const std::string& why, const std::string& block) {
+    if (ok) return;
+    for (const auto& [field, reason] : OptionProblems::Split(why))
+      Check(false, field.empty() ? block : Child(block, field), reason);
+  }
   void Exists(const std::string& file, const std::string& path, const std::string& what) {
     if (!options_.check_files || file.empty()) return;
     std::error_code ec;
@@ -88,10 +95,8 @@ class Validator {
     // The backend's own rules on its keys (capture/camera_backend.h), each at its key.
     const CameraBackend* backend = FindCameraBackend(c.source);
     Enum(c.source, CameraBackendNames(), Child(path, "source"));
-    if (std::string why; backend != nullptr && backend->check && !backend->check(c, &why)) {
-      for (const auto& [field, reason] : OptionProblems::Split(why))
-        Check(false, field.empty() ? path : Child(path, field), reason);
-    }
+    if (std::string why; backend != nullptr && backend->check)
+      Rules(backend->check(c, &why), why, path);
     Exists(c.session.empty() ? "" : (fs::path(c.session) / "session.json").string(),
            Child(path, "session"), "recorded session (session.json)");
     if (!c.pixel_format.empty()) {
@@ -176,11 +181,10 @@ class Validator {
                   Num(k.despill.strength) + " is outside 0..1; clamped to " + Num(clamped));
       k.despill.strength = clamped;
     }
-    Range(k.shadow.min_darkening, 0, 1, "keying.shadow.min_darkening");
-    Range(k.shadow.max_darkening, 0, 1, "keying.shadow.max_darkening");
-    Check(!(k.shadow.min_darkening >= k.shadow.max_darkening), "keying.shadow.max_darkening",
-          "must be above keying.shadow.min_darkening (" + Num(k.shadow.min_darkening) + "), got " +
-              Num(k.shadow.max_darkening));
+    // The shared blocks' own rules (pipeline/key/shared_options.h), after the clamp above.
+    std::string why;
+    Rules(k.despill.IsValid(&why), why, "keying.despill");
+    Rules(k.shadow.IsValid(&why), why, "keying.shadow");
     Positive(k.shadow_reach_m, "keying.shadow.reach_m");
   }
 

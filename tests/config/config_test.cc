@@ -413,6 +413,16 @@ TEST(StationConfig, KeyerOptionsNameTheirBadFields) {
   EXPECT_TRUE(ChromaKeyerOptions{}.IsValid(&why)) << why;
 }
 
+// The config states no range of its own for the shared keyer blocks: ShadowOptions::IsValid is
+// the rule (min_darkening within [0, 1), where the config once allowed 1), reported at its key.
+TEST(StationConfig, ShadowValuesAreCheckedByTheKeyersRuleAtTheirKey) {
+  EXPECT_EQ(ErrorOf("keying:\n  shadow: {min_darkening: 1, max_darkening: 1}\n"),
+            "station.yaml:2: keying.shadow.min_darkening: must be within [0, 1)\n"
+            "station.yaml:2: keying.shadow.max_darkening: must be above min_darkening (1)");
+  EXPECT_EQ(ErrorOf("keying:\n  shadow:\n    max_darkening: 0\n"),
+            "station.yaml:3: keying.shadow.max_darkening: must be within (0, 1]");  // first only
+}
+
 // The stages' own rules (their options' IsValid), each error naming the config key, all of them.
 TEST(StationConfig, PipelineValuesAreCheckedByTheStagesNamingTheKey) {
   EXPECT_EQ(ErrorOf("enclosure:\n  wall_height_m: -0.5\n"
