@@ -1,0 +1,69 @@
+#pragma once
+// The joint solve of a rig (issue 41): every camera that saw the board at the same instant in
+// one mrcal problem (calib/solve.h SolveBoards: the intrinsics of all and the cameras' poses
+// relative to camera 0), and how it compares with the cameras solved one by one (each its own
+// intrinsics, each posed by its own floor board: their relative pose is the two ground poses').
+#include <string>
+#include <vector>
+
+#include "calib/board.h"
+#include "calib/detect.h"
+#include "calib/solve.h"
+#include "core/camera_model.h"
+#include "core/geometry.h"
+
+namespace ss::calib {
+
+// One camera's view of the board and when it was taken (seconds, any clock the cameras share).
+struct TimedView {
+  int camera = 0;
+  double time_s = 0;
+  BoardView view;
+};
+
+// The instants two or more cameras saw the board: each camera's view taken within `max_gap_s`
+// (half a frame interval) of a view of another camera; a camera's views that match none are left
+// out, and a camera gives at most one view to an instant (the nearest). The observations of one
+// instant share a frame, numbered from `first_frame` up.
+std::vector<BoardObservation> SimultaneousObservations(const std::vector<TimedView>& views,
+                                                       double max_gap_s, int first_frame = 0);
+
+struct JointRig {
+  SolveSummary solution;            // models[i].cam_from_ground() = cam_i_from_cam_0
+  int shared_frames = 0;            // instants seen by two or more cameras
+  std::vector<int> views;           // per camera: observations used
+  std::vector<double> distance_m;   // per camera: median board distance
+  std::vector<double> stdev_px;     // per camera: projection stdev at the image centre, distance_m
+  std::vector<double> stdev_worst;  // per camera: the worst of the centre and 4 corners
+};
+
+// One SolveBoards problem: each camera's own views (`own[i]`: camera i alone, each a frame of its
+// own) and the simultaneous ones (SimultaneousObservations). InputError (from SolveBoards) when a
+// camera shares no instant with the others.
+JointRig SolveJointRig(const BoardSpec& board, const std::vector<SolveCamera>& cameras,
+                       const std::vector<std::vector<BoardView>>& own,
+                       const std::vector<BoardObservation>& simultaneous,
+                       const SolveOptions& options);
+
+// Every camera posed on the floor from one: camera `posed`'s cam_from_ground (its floor board)
+// carried through the joint relative poses (cam_i_from_ground = cam_i_from_0 * cam_posed_from_0^-1
+// * cam_posed_from_ground), as GroundJob::rigid does.
+std::vector<Rigid3> PoseRigFrom(const JointRig& rig, int posed, const Rigid3& cam_from_ground);
+
+// Where two cameras disagree: b's pose relative to a from the joint solve against the same from
+// the two ground poses (one by one), and a floor point both see (the middle of where their
+// optical axes meet the floor) placed in b by each.
+struct PairDisagreement {
+  int a = 0, b = 1;
+  double translation_mm = 0, rotation_deg = 0;  // b_from_a, joint against one by one
+  double floor_point_mm = 0;
+  Eigen::Vector3d floor_point = Eigen::Vector3d::Zero();  // in ground metres (a's ground)
+};
+PairDisagreement CompareRelativePose(const Rigid3& b_from_a_joint, const Rigid3& a_from_ground,
+                                     const Rigid3& b_from_ground);
+
+// The distance (mm) and angle (degrees) between two poses of the same thing.
+double TranslationMm(const Rigid3& x, const Rigid3& y);
+double RotationDeg(const Rigid3& x, const Rigid3& y);
+
+}  // namespace ss::calib
