@@ -22,6 +22,7 @@
 
 #include "calib/board.h"
 #include "calib/enclosure.h"
+#include "calib/joint.h"
 #include "calib/report.h"
 #include "calib/wizard.h"
 #include "capture/camera_source.h"
@@ -51,6 +52,12 @@ constexpr double kPublishS = 0.1;   // a camera's state and live view are refres
 constexpr double kGridStepM = 0.1;  // the floor grid drawn over a posed camera's view
 // a view's rays above the horizon end this far away on the plan
 constexpr double kPlanReachM = 8.0;
+// The joint solve (issue 41): a camera keeps its last still board views (with their timestamps)
+// for it; of the instants two cameras saw, one is kept per board place (the board moved this far
+// in the first camera's image since every kept one), at most kJointInstants of them.
+constexpr size_t kTimedViews = 900;
+constexpr double kJointMovePx = 10.0;
+constexpr size_t kJointInstants = 40;
 
 nlohmann::json Num(double v) {
   return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr);
@@ -141,6 +148,15 @@ struct LiveView {
   std::vector<Eigen::Vector2d> floor;
 };
 
+// What a camera's wizard has for the joint solve, copied (CameraWork::Joined).
+struct JointInput {
+  std::string name;
+  int width = 0, height = 0;
+  bool intrinsics_good = false;
+  std::vector<calib::BoardView> captured;  // the intrinsics step's views
+  std::vector<calib::TimedView> timed;     // still board views with their time (camera 0)
+};
+
 struct WizardSettings {
   calib::WizardOptions options;
   double still_s = 0.2, floor_still_s = 1.0;
@@ -156,9 +172,15 @@ struct WizardSettings {
 // Locks: queue_mutex_ and state_mutex_ are leaves (held for a copy or a push, never together).
 class CameraWork {
  public:
+  // `solved`: called on the camera's thread after each intrinsics solve (the joint solve may
+  // start).
   CameraWork(std::string name, int index, const WizardSettings& settings,
-             std::atomic<uint64_t>* floor_counter)
-      : name_(std::move(name)), index_(index), settings_(settings), floor_counter_(floor_counter) {
+             std::atomic<uint64_t>* floor_counter, std::function<void()> solved = {})
+      : name_(std::move(name)),
+        index_(index),
+        settings_(settings),
+        floor_counter_(floor_counter),
+        solved_(std::move(solved)) {
     settings_.options.solve.progress = [this](const std::string& stage, double fraction) {
       SetBusy(stage, fraction);
     };
@@ -245,6 +267,24 @@ class CameraWork {
     return (fs::path(settings_.work_dir) / (name_ + "." + kind + ".png")).string();
   }
   int solves() const { return solves_.load(); }
+  bool intrinsics_good() const { return intrinsics_good_.load(); }
+
+  JointInput Joined() const {
+    std::lock_guard lock(state_mutex_);
+    JointInput in;
+    in.name = name_;
+    in.width = bgr_width_;
+    in.height = bgr_height_;
+    in.intrinsics_good = intrinsics_good_.load();
+    in.captured = captured_;
+    in.timed.assign(timed_.begin(), timed_.end());
+    return in;
+  }
+  // The camera's own floor-board pose (nullopt before its ground step ends).
+  std::optional<Rigid3> GroundPose() const {
+    std::lock_guard lock(state_mutex_);
+    return ground_pose_;
+  }
 
  private:
   void Post(std::function<void()> command) {
@@ -306,6 +346,14 @@ class CameraWork {
           bgr_, static_cast<int>(frame.sequence),
           frame.timestamp_ns > 0 ? static_cast<double>(frame.timestamp_ns) * 1e-9 : NAN);
       guidance_ = out.guidance;
+      // A still board before the camera is posed: a view for the joint solve, if another camera
+      // saw it at the same instant.
+      if (out.detected && out.still && frame.timestamp_ns > 0 &&
+          (out.step == WizardStep::kIntrinsics || out.step == WizardStep::kGround)) {
+        std::lock_guard lock(state_mutex_);
+        timed_.push_back({0, static_cast<double>(frame.timestamp_ns) * 1e-9, wizard_->last_view()});
+        if (timed_.size() > kTimedViews) timed_.pop_front();
+      }
       ++frames_fed_;
       message_.clear();
     } catch (const std::exception& e) {
@@ -342,6 +390,8 @@ class CameraWork {
       busy_json_.reset();
     }
     busy_.store(false);
+    Publish(true);  // before `solved_`: the joint solve reads what it publishes
+    if (solved_) solved_();
   }
 
   nlohmann::json Checklist(const calib::CalibrationWizard& w) const {
@@ -541,15 +591,22 @@ class CameraWork {
     if (live.detected) live.corners = view.pixels;
     live.grid = grid_;
     live.floor = std::move(floor_px);
+    intrinsics_good_.store(w.intrinsics_good());
     std::lock_guard lock(state_mutex_);
     state_ = std::move(j);
     live_ = std::move(live);
+    bgr_width_ = bgr_.cols;
+    bgr_height_ = bgr_.rows;
+    if (force || captured_.size() != w.captured().size()) captured_ = w.captured();
+    ground_pose_.reset();
+    if (w.ground()) ground_pose_ = w.ground()->cam_from_ground;
   }
 
   const std::string name_;
   const int index_;
   WizardSettings settings_;
   std::atomic<uint64_t>* floor_counter_;
+  std::function<void()> solved_;
 
   std::mutex queue_mutex_;
   std::condition_variable queue_cv_;
@@ -576,6 +633,12 @@ class CameraWork {
   nlohmann::json state_;
   std::optional<nlohmann::json> busy_json_;
   LiveView live_;
+  // For the joint solve.
+  int bgr_width_ = 0, bgr_height_ = 0;
+  std::vector<calib::BoardView> captured_;
+  std::deque<calib::TimedView> timed_;
+  std::optional<Rigid3> ground_pose_;
+  std::atomic<bool> intrinsics_good_{false};
 
   std::thread thread_;  // last: starts once everything above exists
 };
@@ -598,6 +661,19 @@ struct ConsoleCalibration::Impl {
   std::string work_dir;
   std::atomic<uint64_t> floor_counter{0};
   std::vector<std::shared_ptr<CameraWork>> works;
+  // The joint solve of the cameras (issue 41), under `mutex`: started once every camera's
+  // intrinsics are trusted (or by POST /api/calibration/joint), on joint_thread.
+  calib::WizardOptions wizard_options;  // the run's board and solve options
+  struct Joint {
+    int run = 0;
+    bool solving = false;
+    std::string stage, error, at;
+    double progress = 0;
+    std::vector<std::string> names;  // the rig's cameras, in the solve's order
+    std::optional<calib::JointRig> rig;
+  } joint;
+  std::mutex joint_thread_mutex;  // joint_thread
+  std::thread joint_thread;
 
   // The station whose frames the wizard takes (re-tapped when the host replaces it).
   std::mutex tap_mutex;
@@ -605,6 +681,7 @@ struct ConsoleCalibration::Impl {
   int station_listener = 0;  // the host's id for OnStationChange (0: none)
 
   ~Impl() {
+    JoinJoint();
     if (!work_dir.empty()) {
       std::error_code ec;
       fs::remove_all(work_dir, ec);
@@ -783,6 +860,8 @@ struct ConsoleCalibration::Impl {
               .string();
     }
     settings.run = run;
+    wizard_options = settings.options;
+    joint = Joint{};
     settings.work_dir = (fs::path(work_dir) / std::to_string(run)).string();
     for (size_t i = 0; i < names.size(); ++i) {
       WizardSettings s = settings;
@@ -791,7 +870,8 @@ struct ConsoleCalibration::Impl {
       for (size_t k = 0; k < status.cameras.size(); ++k) {
         if (status.cameras[k].name == names[i]) index = static_cast<int>(k);
       }
-      works.push_back(std::make_shared<CameraWork>(names[i], index, s, &floor_counter));
+      works.push_back(std::make_shared<CameraWork>(names[i], index, s, &floor_counter,
+                                                   [this] { StartJoint(false); }));
     }
     active = true;
     board = o.board.ToString();
@@ -819,7 +899,235 @@ struct ConsoleCalibration::Impl {
       done.swap(works);
     }
     Untap();
+    JoinJoint();
     done.clear();
+  }
+
+  void JoinJoint() {
+    std::lock_guard lock(joint_thread_mutex);
+    if (joint_thread.joinable()) joint_thread.join();
+  }
+
+  // Starts the joint solve of the cameras whose intrinsics are trusted, on joint_thread: by the
+  // operator (`asked`: ConflictError when it cannot start), or after a camera's solve when every
+  // camera's intrinsics are trusted and the run has no joint solve yet.
+  void StartJoint(bool asked) {
+    std::lock_guard thread_lock(joint_thread_mutex);
+    std::vector<std::shared_ptr<CameraWork>> chosen;
+    int run_id = 0;
+    {
+      std::lock_guard lock(mutex);
+      if (!active) {
+        if (asked) throw ConflictError("calibration", "no wizard is running: start one");
+        return;
+      }
+      if (joint.solving) {
+        if (asked) throw ConflictError("joint", "a joint solve is running");
+        return;
+      }
+      for (const auto& w : works) {
+        if (w->intrinsics_good()) chosen.push_back(w);
+      }
+      if (!asked && (joint.rig || !joint.error.empty() || chosen.size() != works.size())) return;
+      if (chosen.size() < 2) {
+        if (asked)
+          throw ConflictError("joint", std::to_string(chosen.size()) +
+                                           " camera(s) have trusted intrinsics; the joint solve "
+                                           "needs two or more: solve them first");
+        return;
+      }
+      joint.solving = true;
+      joint.stage = "starting";
+      joint.progress = 0;
+      joint.error.clear();
+      run_id = run;
+    }
+    if (joint_thread.joinable()) joint_thread.join();  // the last one, finished
+    joint_thread = std::thread([this, chosen, run_id] { SolveJoint(chosen, run_id); });
+  }
+
+  // On joint_thread: the instants two or more cameras saw the board, thinned to one per board
+  // place, and each camera's captured views, in one solve.
+  void SolveJoint(const std::vector<std::shared_ptr<CameraWork>>& chosen, int run_id) {
+    calib::WizardOptions o;
+    {
+      std::lock_guard lock(mutex);
+      o = wizard_options;
+    }
+    Joint result;
+    result.run = run_id;
+    try {
+      std::vector<JointInput> inputs;
+      inputs.reserve(chosen.size());
+      for (const auto& w : chosen) inputs.push_back(w->Joined());
+      std::vector<calib::TimedView> timed;
+      std::vector<calib::SolveCamera> cameras;
+      std::vector<std::vector<calib::BoardView>> own;
+      double interval = 1.0 / 30;  // the shortest camera's median frame interval
+      bool measured = false;
+      for (size_t c = 0; c < inputs.size(); ++c) {
+        result.names.push_back(inputs[c].name);
+        cameras.push_back({inputs[c].name, inputs[c].width, inputs[c].height});
+        own.push_back(inputs[c].captured);
+        std::vector<double> gaps;
+        for (size_t i = 0; i < inputs[c].timed.size(); ++i) {
+          calib::TimedView v = inputs[c].timed[i];
+          v.camera = static_cast<int>(c);
+          if (i > 0) gaps.push_back(v.time_s - inputs[c].timed[i - 1].time_s);
+          timed.push_back(std::move(v));
+        }
+        if (!gaps.empty()) {
+          std::nth_element(gaps.begin(),
+                           gaps.begin() + static_cast<std::ptrdiff_t>(gaps.size() / 2), gaps.end());
+          const double g = gaps[gaps.size() / 2];
+          if (g > 0 && (!measured || g < interval)) interval = g, measured = true;
+        }
+      }
+      const std::vector<calib::BoardObservation> all =
+          calib::SimultaneousObservations(timed, 0.5 * interval);
+      // One instant per board place: the first camera's view moved kJointMovePx since every
+      // kept one (a board held still gives an instant per frame).
+      std::vector<calib::BoardObservation> kept;
+      std::vector<const calib::BoardObservation*> firsts;
+      for (size_t i = 0; i < all.size();) {
+        size_t j = i;
+        while (j < all.size() && all[j].frame == all[i].frame) ++j;
+        const calib::BoardObservation& first = all[i];
+        const bool novel = std::none_of(firsts.begin(), firsts.end(), [&](const auto* k) {
+          if (k->camera != first.camera || k->ids != first.ids) return false;
+          double worst = 0;
+          for (size_t p = 0; p < first.pixels.size(); ++p)
+            worst = std::max(worst, (first.pixels[p] - k->pixels[p]).norm());
+          return worst < kJointMovePx;
+        });
+        if (novel && firsts.size() < kJointInstants) {
+          firsts.push_back(&first);
+          kept.insert(kept.end(), all.begin() + static_cast<std::ptrdiff_t>(i),
+                      all.begin() + static_cast<std::ptrdiff_t>(j));
+        }
+        i = j;
+      }
+      if (kept.empty()) {
+        throw InputError("joint",
+                         "no instant where two cameras saw the board still: hold it where "
+                         "both see it, still for a moment, in several places");
+      }
+      calib::SolveOptions so = o.solve;
+      so.progress = [this](const std::string& stage, double fraction) {
+        std::lock_guard lock(mutex);
+        joint.stage = stage;
+        joint.progress = fraction;
+      };
+      result.rig = calib::SolveJointRig(o.board, cameras, own, kept, so);
+      result.at = UtcNowIso();
+      log->info("calibration: joint solve of {} cameras, {} shared instants: {}", cameras.size(),
+                result.rig->shared_frames, result.rig->solution.summary);
+    } catch (const std::exception& e) {
+      result.error = std::string("joint solve failed: ") + e.what();
+      log->warn("calibration: {}", result.error);
+    }
+    std::lock_guard lock(mutex);
+    if (run != run_id) return;  // a new run started meanwhile
+    joint = std::move(result);
+  }
+
+  // The joint solve's state for the page: per camera its uncertainty, per camera pair the
+  // relative pose and where it disagrees with the two cameras' own floor-board poses.
+  nlohmann::json JointJson() const {
+    Joint j;
+    {
+      std::lock_guard lock(mutex);
+      if (joint.solving) {
+        return {{"state", "solving"}, {"stage", joint.stage}, {"progress", joint.progress}};
+      }
+      j = joint;
+    }
+    if (!j.error.empty()) return {{"state", "failed"}, {"error", j.error}};
+    if (!j.rig) return nullptr;
+    const calib::JointRig& rig = *j.rig;
+    const calib::SolveSummary& s = rig.solution;
+    std::vector<std::optional<Rigid3>> ground;
+    for (const auto& name : j.names) {
+      std::optional<Rigid3> pose;
+      try {
+        pose = Work(name)->GroundPose();
+      } catch (const NotFoundError&) {
+      }
+      ground.push_back(pose);
+    }
+    nlohmann::json out = {{"state", "solved"},
+                          {"at", j.at},
+                          {"shared_instants", rig.shared_frames},
+                          {"rms_px", s.mrcal_rms_px},
+                          {"posed_from", nullptr},
+                          {"cameras", nlohmann::json::array()},
+                          {"pairs", nlohmann::json::array()}};
+    for (size_t c = 0; c < j.names.size(); ++c) {
+      if (ground[c] && out["posed_from"].is_null()) out["posed_from"] = j.names[c];
+      nlohmann::json cam = {{"name", j.names[c]},
+                            {"views", rig.views[c]},
+                            {"rms_px", Num(s.rms_px[c])},
+                            {"distance_m", Num(rig.distance_m[c])},
+                            {"stdev_centre_px", Num(rig.stdev_px[c])},
+                            {"stdev_worst_px", Num(rig.stdev_worst[c])}};
+      const std::vector<double>& in = s.models[c].intrinsics();
+      if (c < s.intrinsics_stdev.size() && s.intrinsics_stdev[c].size() >= 2 && in.size() >= 2) {
+        cam["focal_stdev_percent"] =
+            Num(1.96 *
+                std::max(s.intrinsics_stdev[c][0] / in[0], s.intrinsics_stdev[c][1] / in[1]) * 100);
+      }
+      out["cameras"].push_back(std::move(cam));
+    }
+    for (size_t a = 0; a < j.names.size(); ++a) {
+      for (size_t b = a + 1; b < j.names.size(); ++b) {
+        // b_from_a = b_from_0 * a_from_0^-1
+        const Rigid3 b_from_a =
+            s.models[b].cam_from_ground() * s.models[a].cam_from_ground().Inverse();
+        nlohmann::json pair = {{"a", j.names[a]},
+                               {"b", j.names[b]},
+                               {"baseline_m", b_from_a.translation.norm()},
+                               {"translation_mm", nullptr},
+                               {"rotation_deg", nullptr},
+                               {"floor_point_mm", nullptr}};
+        if (ground[a] && ground[b]) {
+          const calib::PairDisagreement d =
+              calib::CompareRelativePose(b_from_a, *ground[a], *ground[b]);
+          pair["translation_mm"] = Num(d.translation_mm);
+          pair["rotation_deg"] = Num(d.rotation_deg);
+          pair["floor_point_mm"] = Num(d.floor_point_mm);
+        }
+        out["pairs"].push_back(std::move(pair));
+      }
+    }
+    return out;
+  }
+
+  // The joint models to save: each rig camera's joint intrinsics, posed through the rig from the
+  // first camera with a floor-board pose (none posed: the intrinsics alone). Empty without a joint
+  // solve.
+  std::vector<std::pair<std::string, CameraModel>> JointModels() const {
+    Joint j;
+    {
+      std::lock_guard lock(mutex);
+      if (!joint.rig) return {};
+      j = joint;
+    }
+    std::vector<std::pair<std::string, CameraModel>> out;
+    std::vector<Rigid3> poses;
+    for (size_t c = 0; c < j.names.size() && poses.empty(); ++c) {
+      std::optional<Rigid3> g;
+      try {
+        g = Work(j.names[c])->GroundPose();
+      } catch (const NotFoundError&) {
+      }
+      if (g) poses = calib::PoseRigFrom(*j.rig, static_cast<int>(c), *g);
+    }
+    for (size_t c = 0; c < j.names.size(); ++c) {
+      CameraModel m = j.rig->solution.models[c];
+      m.set_cam_from_ground(poses.empty() ? Rigid3{} : poses[c]);
+      out.emplace_back(j.names[c], m);
+    }
+    return out;
   }
 
   nlohmann::json Save() {
@@ -829,9 +1137,7 @@ struct ConsoleCalibration::Impl {
       if (saving) throw ConflictError("save", "a save is running");
       saving = true;
     }
-    for (const auto& w : Works()) {
-      if (w->Busy()) throw ConflictError("save", w->name() + " is solving; save when it is done");
-    }
+    // (before the checks below: a refused save is not left "saving")
     struct Unbusy {
       Impl* s;
       ~Unbusy() {
@@ -839,6 +1145,14 @@ struct ConsoleCalibration::Impl {
         s->saving = false;
       }
     } unbusy{this};
+    for (const auto& w : Works()) {
+      if (w->Busy()) throw ConflictError("save", w->name() + " is solving; save when it is done");
+    }
+    {
+      std::lock_guard lock(mutex);
+      if (joint.solving)
+        throw ConflictError("save", "the joint solve is running; save when it is done");
+    }
     calib::StationSaveRequest request;
     uint64_t floor_order = 0;
     for (const auto& w : Works()) {
@@ -856,6 +1170,17 @@ struct ConsoleCalibration::Impl {
       if (model) request.models.emplace_back(w->name(), *model);
       if (floor && w->floor_order() >= floor_order)
         floor_order = w->floor_order(), request.floor = floor;
+    }
+    // The rig's cameras: their joint models (intrinsics, and the poses relative to each other)
+    // instead of each one's own.
+    for (auto& joint_model : JointModels()) {
+      auto it = std::find_if(request.models.begin(), request.models.end(),
+                             [&](const auto& m) { return m.first == joint_model.first; });
+      if (it == request.models.end()) {
+        request.models.push_back(std::move(joint_model));
+      } else {
+        it->second = std::move(joint_model.second);
+      }
     }
     if (request.models.empty()) {
       throw ConflictError("save", "no camera has trusted intrinsics yet: solve first");
@@ -908,8 +1233,10 @@ struct ConsoleCalibration::Impl {
   }
 
   nlohmann::json State() const {
+    nlohmann::json joint_json = JointJson();  // takes `mutex` itself
     std::lock_guard lock(mutex);
     nlohmann::json j;
+    j["joint"] = std::move(joint_json);
     j["active"] = active;
     j["run"] = run;
     j["board"] = board;
@@ -918,6 +1245,12 @@ struct ConsoleCalibration::Impl {
     j["error"] = error.empty() ? nlohmann::json(nullptr) : nlohmann::json(error);
     j["saved"] = saved;
     j["busy"] = nullptr;
+    if (joint.solving) {
+      j["busy"] = {{"what", "joint solve"},
+                   {"camera", nullptr},
+                   {"stage", joint.stage},
+                   {"progress", joint.progress}};
+    }
     if (saving)
       j["busy"] = {
           {"what", "save"}, {"camera", nullptr}, {"stage", "writing the files"}, {"progress", 0.5}};
@@ -1116,7 +1449,17 @@ std::vector<api::Route> ConsoleCalibration::Routes() {
          }
          std::lock_guard lock(s->mutex);
          s->saved = nullptr;
+         if (step == WizardStep::kIntrinsics && !s->joint.solving)
+           s->joint = Impl::Joint{};  // of intrinsics that went
        })},
+      {"POST", "/api/calibration/joint",
+       "POST /api/calibration/joint (202: solves every camera with trusted intrinsics jointly, "
+       "in the background)",
+       [this, s](const Request& req, Response& res) {
+         api::ObjectBody(req, {});
+         s->StartJoint(true);
+         api::Reply(res, 202, StateWithCameras());
+       }},
       {"POST", "/api/calibration/floor",
        "POST /api/calibration/floor {\"camera\", \"detect\": true} | {\"camera\", \"pixels\": [[x, "
        "y], ...]}",

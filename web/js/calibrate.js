@@ -125,6 +125,10 @@ $('calib-board-on-floor').addEventListener('click', (e) => {
   act(e.currentTarget, () => postJson('/api/calibration/ground'));
 });
 
+$('calib-joint-solve').addEventListener('click', (e) => {
+  act(e.currentTarget, () => postJson('/api/calibration/joint'));
+});
+
 $('calib-cancel').addEventListener('click', (e) => {
   act(e.currentTarget, () => postJson('/api/calibration/cancel'));
 });
@@ -219,7 +223,39 @@ function renderRun() {
 
   const posed = (c?.cameras || []).some((k) => k.solve?.verdict === 'good' || k.ground || k.step !== 'intrinsics');
   $('calib-save').disabled = !active || !posed || Boolean(busy);
+  const trusted = (c?.cameras || []).filter((k) => k.solve?.verdict === 'good' || (k.step !== 'intrinsics' && k.width)).length;
+  $('calib-joint-solve').disabled = !active || trusted < 2 || Boolean(busy);
+  renderJoint(c?.joint);
   renderSaved(c?.saved);
+}
+
+// The joint solve of the cameras (issue 41): a line per camera (its uncertainty) and per pair
+// (the joint relative pose against the two cameras' own floor-board poses).
+function renderJoint(joint) {
+  const box = $('calib-joint');
+  box.hidden = !joint;
+  const key = JSON.stringify(joint || null);
+  if (box.dataset.key === key) return;
+  box.dataset.key = key;
+  if (!joint) return box.replaceChildren();
+  box.dataset.state = joint.state;
+  const f = (v, d) => (v === null || v === undefined ? '–' : Number(v).toFixed(d));
+  if (joint.state !== 'solved') {
+    return box.replaceChildren(el('h3', { text: 'Joint solve' }),
+      el('p', { testid: 'joint-status', class: joint.state === 'failed' ? 'warn' : '',
+        text: joint.state === 'failed' ? joint.error : `solving: ${joint.stage || '…'}` }));
+  }
+  box.replaceChildren(
+    el('h3', { text: `Joint solve: ${joint.shared_instants} shared instants, RMS ${f(joint.rms_px, 3)} px` +
+      (joint.posed_from ? ` · posed from ${joint.posed_from}'s floor board` : '') }),
+    el('ul', {}, ...(joint.cameras || []).map((k) => el('li', { testid: 'joint-camera', 'data-camera': k.name,
+      text: `${k.name}: ${k.views} views, RMS ${f(k.rms_px, 3)} px, projection σ ${f(k.stdev_centre_px, 3)} px at the centre ` +
+        `(${f(k.stdev_worst_px, 2)} px worst corner) at ${f(k.distance_m, 2)} m, focal ±${f(k.focal_stdev_percent, 3)} %` }))),
+    el('ul', {}, ...(joint.pairs || []).map((p) => el('li', { testid: 'joint-pair', 'data-pair': `${p.a}-${p.b}`,
+      text: `${p.a} ↔ ${p.b}: ${f(p.baseline_m, 3)} m apart; ` + (p.translation_mm === null
+        ? 'not both posed on the floor yet'
+        : `joint vs own floor boards ${f(p.translation_mm, 1)} mm, ${f(p.rotation_deg, 3)}°, a floor point both see ${f(p.floor_point_mm, 1)} mm` ) }))),
+  );
 }
 
 function renderSaved(saved) {
