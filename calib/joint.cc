@@ -18,23 +18,35 @@ std::vector<BoardObservation> SimultaneousObservations(const std::vector<TimedVi
   }
   std::stable_sort(sorted.begin(), sorted.end(),
                    [](const TimedView* x, const TimedView* y) { return x->time_s < y->time_s; });
+  auto from = [](const TimedView* v) {
+    return std::isfinite(v->start_s) ? std::min(v->start_s, v->time_s) : v->time_s;
+  };
+  std::vector<bool> used(sorted.size(), false);
   std::vector<BoardObservation> out;
   int frame = first_frame;
-  for (size_t i = 0; i < sorted.size();) {
-    // The instant starts at sorted[i]; each camera's nearest view within max_gap_s of it.
-    const double t0 = sorted[i]->time_s;
-    std::map<int, const TimedView*> nearest;
-    size_t j = i;
-    for (; j < sorted.size() && sorted[j]->time_s - t0 <= max_gap_s; ++j) {
-      auto [it, added] = nearest.emplace(sorted[j]->camera, sorted[j]);
-      if (!added && sorted[j]->time_s - t0 < it->second->time_s - t0) it->second = sorted[j];
+  for (size_t i = 0; i < sorted.size(); ++i) {
+    if (used[i]) continue;
+    // The instant of sorted[i]: of each other camera the unused view nearest in time whose span
+    // meets sorted[i]'s (widened by max_gap_s).
+    const TimedView* anchor = sorted[i];
+    std::map<int, size_t> nearest;
+    for (size_t j = i + 1; j < sorted.size(); ++j) {
+      const TimedView* v = sorted[j];
+      if (used[j] || v->camera == anchor->camera) continue;
+      if (from(v) - max_gap_s > anchor->time_s) continue;  // sorted by time_s: v ends later
+      auto [it, added] = nearest.emplace(v->camera, j);
+      if (!added && v->time_s - anchor->time_s < sorted[it->second]->time_s - anchor->time_s)
+        it->second = j;
     }
-    if (nearest.size() >= 2) {
-      for (const auto& [camera, v] : nearest)
-        out.push_back({camera, frame, v->view.source, v->view.ids, v->view.pixels});
-      ++frame;
+    if (nearest.empty()) continue;
+    used[i] = true;
+    nearest.emplace(anchor->camera, i);
+    for (const auto& [camera, j] : nearest) {
+      used[j] = true;
+      const TimedView* v = sorted[j];
+      out.push_back({camera, frame, v->view.source, v->view.ids, v->view.pixels});
     }
-    i = std::max(j, i + 1);
+    ++frame;
   }
   return out;
 }

@@ -3,6 +3,7 @@
 // one mrcal problem (calib/solve.h SolveBoards: the intrinsics of all and the cameras' poses
 // relative to camera 0), and how it compares with the cameras solved one by one (each its own
 // intrinsics, each posed by its own floor board: their relative pose is the two ground poses').
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -19,12 +20,17 @@ struct TimedView {
   int camera = 0;
   double time_s = 0;
   BoardView view;
+  // The board stood still in this camera from start_s to time_s (the same pose all along); NaN:
+  // the instant time_s alone.
+  double start_s = std::numeric_limits<double>::quiet_NaN();
 };
 
-// The instants two or more cameras saw the board: each camera's view taken within `max_gap_s`
-// (half a frame interval) of a view of another camera; a camera's views that match none are left
-// out, and a camera gives at most one view to an instant (the nearest). The observations of one
-// instant share a frame, numbered from `first_frame` up.
+// The instants two or more cameras saw the board: each camera's view whose span (start_s to
+// time_s) comes within `max_gap_s` (half a frame interval) of another camera's view's span. Two
+// cameras that process different frames of a board held still still meet. A camera's views that
+// match none are left out, and a camera gives at most one view to an instant (the nearest in
+// time); a view goes to one instant. The observations of one instant share a frame, numbered
+// from `first_frame` up.
 std::vector<BoardObservation> SimultaneousObservations(const std::vector<TimedView>& views,
                                                        double max_gap_s, int first_frame = 0);
 

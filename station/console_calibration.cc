@@ -58,6 +58,7 @@ constexpr double kPlanReachM = 8.0;
 constexpr size_t kTimedViews = 900;
 constexpr double kJointMovePx = 10.0;
 constexpr size_t kJointInstants = 40;
+constexpr size_t kMinJointInstants = 3;
 
 nlohmann::json Num(double v) {
   return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr);
@@ -155,6 +156,7 @@ struct JointInput {
   bool intrinsics_good = false;
   std::vector<calib::BoardView> captured;  // the intrinsics step's views
   std::vector<calib::TimedView> timed;     // still board views with their time (camera 0)
+  double frame_interval_s = NAN;           // median time between frames of consecutive sequence
 };
 
 struct WizardSettings {
@@ -278,6 +280,11 @@ class CameraWork {
     in.intrinsics_good = intrinsics_good_.load();
     in.captured = captured_;
     in.timed.assign(timed_.begin(), timed_.end());
+    if (!intervals_.empty()) {
+      std::vector<double> v(intervals_.begin(), intervals_.end());
+      std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
+      in.frame_interval_s = v[v.size() / 2];
+    }
     return in;
   }
   // The camera's own floor-board pose (nullopt before its ground step ends).
@@ -347,11 +354,24 @@ class CameraWork {
           frame.timestamp_ns > 0 ? static_cast<double>(frame.timestamp_ns) * 1e-9 : NAN);
       guidance_ = out.guidance;
       // A still board before the camera is posed: a view for the joint solve, if another camera
-      // saw it at the same instant.
-      if (out.detected && out.still && frame.timestamp_ns > 0 &&
+      // saw it still at the same time. Still since the run's first frame: the frame processed
+      // before the one that made it still.
+      const double t =
+          frame.timestamp_ns > 0 ? static_cast<double>(frame.timestamp_ns) * 1e-9 : NAN;
+      const bool still = out.detected && out.still;
+      if (frames_fed_ > 0 && frame.sequence == last_sequence_ + 1 && std::isfinite(t) &&
+          std::isfinite(last_time_s_) && t > last_time_s_) {
+        std::lock_guard lock(state_mutex_);
+        intervals_.push_back(t - last_time_s_);
+        if (intervals_.size() > 31) intervals_.pop_front();
+      }
+      if (still && !was_still_) still_since_s_ = last_time_s_;
+      was_still_ = still;
+      last_time_s_ = t;
+      if (still && std::isfinite(t) &&
           (out.step == WizardStep::kIntrinsics || out.step == WizardStep::kGround)) {
         std::lock_guard lock(state_mutex_);
-        timed_.push_back({0, static_cast<double>(frame.timestamp_ns) * 1e-9, wizard_->last_view()});
+        timed_.push_back({0, t, wizard_->last_view(), still_since_s_});
         if (timed_.size() > kTimedViews) timed_.pop_front();
       }
       ++frames_fed_;
@@ -620,6 +640,8 @@ class CameraWork {
   uint64_t frames_fed_ = 0, last_sequence_ = 0;
   std::vector<std::string> guidance_;
   std::string message_;
+  bool was_still_ = false;  // the last frame's board was still
+  double last_time_s_ = NAN, still_since_s_ = NAN;
   Clock::time_point last_publish_{};
   std::vector<Eigen::Vector2d> fov_;
   std::vector<std::vector<Eigen::Vector2d>> grid_;
@@ -637,6 +659,7 @@ class CameraWork {
   int bgr_width_ = 0, bgr_height_ = 0;
   std::vector<calib::BoardView> captured_;
   std::deque<calib::TimedView> timed_;
+  std::deque<double> intervals_;  // between frames of consecutive sequence numbers, seconds
   std::optional<Rigid3> ground_pose_;
   std::atomic<bool> intrinsics_good_{false};
 
@@ -671,6 +694,7 @@ struct ConsoleCalibration::Impl {
     double progress = 0;
     std::vector<std::string> names;  // the rig's cameras, in the solve's order
     std::optional<calib::JointRig> rig;
+    std::vector<std::string> doubts;  // why the rig is not trusted (not saved); empty: trusted
   } joint;
   std::mutex joint_thread_mutex;  // joint_thread
   std::thread joint_thread;
@@ -963,30 +987,24 @@ struct ConsoleCalibration::Impl {
       std::vector<calib::TimedView> timed;
       std::vector<calib::SolveCamera> cameras;
       std::vector<std::vector<calib::BoardView>> own;
-      double interval = 1.0 / 30;  // the shortest camera's median frame interval
-      bool measured = false;
+      double interval = NAN;  // the shortest camera's frame interval (none measured: 30 fps)
       for (size_t c = 0; c < inputs.size(); ++c) {
         result.names.push_back(inputs[c].name);
         cameras.push_back({inputs[c].name, inputs[c].width, inputs[c].height});
         own.push_back(inputs[c].captured);
-        std::vector<double> gaps;
-        for (size_t i = 0; i < inputs[c].timed.size(); ++i) {
-          calib::TimedView v = inputs[c].timed[i];
+        for (calib::TimedView v : inputs[c].timed) {
           v.camera = static_cast<int>(c);
-          if (i > 0) gaps.push_back(v.time_s - inputs[c].timed[i - 1].time_s);
           timed.push_back(std::move(v));
         }
-        if (!gaps.empty()) {
-          std::nth_element(gaps.begin(),
-                           gaps.begin() + static_cast<std::ptrdiff_t>(gaps.size() / 2), gaps.end());
-          const double g = gaps[gaps.size() / 2];
-          if (g > 0 && (!measured || g < interval)) interval = g, measured = true;
-        }
+        if (std::isfinite(inputs[c].frame_interval_s) && !(inputs[c].frame_interval_s >= interval))
+          interval = inputs[c].frame_interval_s;
       }
+      if (!std::isfinite(interval)) interval = 1.0 / 30;
       const std::vector<calib::BoardObservation> all =
           calib::SimultaneousObservations(timed, 0.5 * interval);
       // One instant per board place: the first camera's view moved kJointMovePx since every
-      // kept one (a board held still gives an instant per frame).
+      // kept one (a board held still gives an instant per frame). Views meet when the spans the
+      // board stood still in them come within half a frame interval.
       std::vector<calib::BoardObservation> kept;
       std::vector<const calib::BoardObservation*> firsts;
       for (size_t i = 0; i < all.size();) {
@@ -1007,10 +1025,16 @@ struct ConsoleCalibration::Impl {
         }
         i = j;
       }
-      if (kept.empty()) {
-        throw InputError("joint",
-                         "no instant where two cameras saw the board still: hold it where "
-                         "both see it, still for a moment, in several places");
+      std::string counts;
+      for (const auto& in : inputs) counts += " " + in.name + " " + std::to_string(in.timed.size());
+      log->info("calibration: joint solve: still views{}; {} matched within {:.3f} s, {} kept",
+                counts, all.size(), 0.5 * interval, kept.size());
+      if (firsts.size() < kMinJointInstants) {
+        throw InputError("joint", std::to_string(firsts.size()) +
+                                      " board places seen still by two cameras at once (need " +
+                                      std::to_string(kMinJointInstants) +
+                                      "): hold the board where both see it, still for a moment, "
+                                      "in several places");
       }
       calib::SolveOptions so = o.solve;
       so.progress = [this](const std::string& stage, double fraction) {
@@ -1020,6 +1044,27 @@ struct ConsoleCalibration::Impl {
       };
       result.rig = calib::SolveJointRig(o.board, cameras, own, kept, so);
       result.at = UtcNowIso();
+      // Saved instead of the cameras' own models only when trusted as their own solves are.
+      const calib::SolveSummary& sol = result.rig->solution;
+      for (size_t c = 0; c < cameras.size(); ++c) {
+        const std::vector<double>& in = sol.models[c].intrinsics();
+        double percent = NAN;
+        if (c < sol.intrinsics_stdev.size() && sol.intrinsics_stdev[c].size() >= 2)
+          percent =
+              1.96 *
+              std::max(sol.intrinsics_stdev[c][0] / in[0], sol.intrinsics_stdev[c][1] / in[1]) *
+              100;
+        if (!(percent <= o.verdict.max_stdev_percent)) {
+          result.doubts.push_back(cameras[c].name + ": focal length known to " +
+                                  (std::isfinite(percent) ? std::to_string(percent) : "?") +
+                                  " % (1.96 sigma), need " +
+                                  std::to_string(o.verdict.max_stdev_percent) + " %");
+        }
+        if (!(sol.rms_px[c] <= o.verdict.max_rms_px)) {
+          result.doubts.push_back(cameras[c].name + ": RMS " + std::to_string(sol.rms_px[c]) +
+                                  " px, need " + std::to_string(o.verdict.max_rms_px));
+        }
+      }
       log->info("calibration: joint solve of {} cameras, {} shared instants: {}", cameras.size(),
                 result.rig->shared_frames, result.rig->solution.summary);
     } catch (const std::exception& e) {
@@ -1057,6 +1102,8 @@ struct ConsoleCalibration::Impl {
     }
     nlohmann::json out = {{"state", "solved"},
                           {"at", j.at},
+                          {"trusted", j.doubts.empty()},
+                          {"doubts", j.doubts},
                           {"shared_instants", rig.shared_frames},
                           {"rms_px", s.mrcal_rms_px},
                           {"posed_from", nullptr},
@@ -1109,7 +1156,7 @@ struct ConsoleCalibration::Impl {
     Joint j;
     {
       std::lock_guard lock(mutex);
-      if (!joint.rig) return {};
+      if (!joint.rig || !joint.doubts.empty()) return {};
       j = joint;
     }
     std::vector<std::pair<std::string, CameraModel>> out;

@@ -45,6 +45,18 @@ TEST(SimultaneousObservations, PairsViewsWithinHalfAFrame) {
   for (size_t i = 4; i < 7; ++i) EXPECT_EQ(obs[i].frame, 9);
 }
 
+TEST(SimultaneousObservations, BoardsStillInBothMeetAcrossFrames) {
+  // Each camera's wizard processes other frames of a board held still: cam0 saw it still from
+  // 1.0 to 1.25 s, cam1 from 1.3 to 1.5 s; within half a frame (1/60 s) they do not meet, with
+  // cam1's still span starting at 1.2 s they do.
+  TimedView a{0, 1.25, Fake(0), 1.0}, b{1, 1.5, Fake(1), 1.3};
+  EXPECT_TRUE(SimultaneousObservations({a, b}, 0.5 / 30).empty());
+  b.start_s = 1.2;
+  const std::vector<BoardObservation> obs = SimultaneousObservations({a, b}, 0.5 / 30);
+  ASSERT_EQ(obs.size(), 2u);
+  EXPECT_EQ(obs[0].frame, obs[1].frame);
+}
+
 TEST(PoseRigFrom, CarriesOnePoseThroughTheRig) {
   JointRig rig;
   const Rigid3 c1_from_c0{Rot(0.1, -0.2, 0.3), {0.5, 0.1, -0.2}};

@@ -255,6 +255,9 @@ function renderJoint(joint) {
       text: `${p.a} ↔ ${p.b}: ${f(p.baseline_m, 3)} m apart; ` + (p.translation_mm === null
         ? 'not both posed on the floor yet'
         : `joint vs own floor boards ${f(p.translation_mm, 1)} mm, ${f(p.rotation_deg, 3)}°, a floor point both see ${f(p.floor_point_mm, 1)} mm` ) }))),
+    el('p', { testid: 'joint-trust', class: joint.trusted ? 'ok' : 'warn',
+      text: joint.trusted ? 'Trusted: Save writes the joint models.'
+        : `Not trusted, Save keeps each camera's own model: ${(joint.doubts || []).join('; ')}` }),
   );
 }
 
