@@ -45,6 +45,23 @@ int Port() {
   return port;
 }
 
+// True when one of the answers read so far is an event stream: a status line at the start or
+// after an answer's end whose header names text/event-stream. (Answers are walked by their
+// Content-Length; a header without one ends the walk.)
+bool AnswersAnEventStream(const std::string& answer) {
+  size_t at = 0;
+  while (at < answer.size()) {
+    const size_t head_end = answer.find("\r\n\r\n", at);
+    if (head_end == std::string::npos) return false;
+    const std::string head = answer.substr(at, head_end - at);
+    if (head.find("Content-Type: text/event-stream") != std::string::npos) return true;
+    const size_t length = head.find("Content-Length: ");
+    if (length == std::string::npos) return false;
+    at = head_end + 4 + std::strtoull(head.c_str() + length + 16, nullptr, 10);
+  }
+  return false;
+}
+
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
@@ -67,14 +84,13 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   ::shutdown(fd, SHUT_WR);
   // Everything the server answers, until it closes, within 8 s (libFuzzer's -timeout is 10):
   // never a connection left open. An event stream (GET /api/events) stays open by design: once
-  // its header is in, the client closes it.
+  // its header is in, the client closes it, whether it answers the first request or one
+  // pipelined behind others (a refused request line may be followed by `GET /api/events`).
   std::string answer;
   const auto deadline = Clock::now() + std::chrono::seconds(8);
   bool closed = false;
   while (!closed && Clock::now() < deadline) {
-    const size_t head = answer.find("\r\n\r\n");
-    if (head != std::string::npos &&
-        answer.substr(0, head).find("Content-Type: text/event-stream") != std::string::npos) {
+    if (AnswersAnEventStream(answer)) {
       closed = true;
       break;
     }
@@ -90,7 +106,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   }
   ::close(fd);
   if (!closed) {
-    std::fprintf(stderr, "http_request: the server kept the connection open past 8 s\n");
+    std::fprintf(stderr,
+                 "http_request: the server kept the connection open past 8 s; it said:\n%s\n",
+                 answer.substr(0, 600).c_str());
     std::abort();
   }
   if (!answer.empty() && answer.rfind("HTTP/1.1 ", 0) != 0) {
