@@ -100,6 +100,15 @@ JointRig SolveJointRig(const BoardSpec& board, const std::vector<SolveCamera>& c
     }
     rig.stdev_px.push_back(centre);
     rig.stdev_worst.push_back(worst);
+    double focal = NAN;
+    const std::vector<double>& in = s.models[c].intrinsics();
+    if (c < s.intrinsics_stdev.size() && s.intrinsics_stdev[c].size() >= 2 && in.size() >= 2) {
+      focal = 1.96 *
+              std::max(s.intrinsics_stdev[c][0] / std::abs(in[0]),
+                       s.intrinsics_stdev[c][1] / std::abs(in[1])) *
+              100;
+    }
+    rig.focal_stdev_percent.push_back(focal);
   }
   return rig;
 }

@@ -41,6 +41,9 @@ struct JointRig {
   std::vector<double> distance_m;   // per camera: median board distance
   std::vector<double> stdev_px;     // per camera: projection stdev at the image centre, distance_m
   std::vector<double> stdev_worst;  // per camera: the worst of the centre and 4 corners
+  // Per camera: fx's and fy's 1.96-sigma uncertainty, the worse, in % (as VerdictOptions'
+  // max_stdev_percent reads it); NaN without the covariance.
+  std::vector<double> focal_stdev_percent;
 };
 
 // One SolveBoards problem: each camera's own views (`own[i]`: camera i alone, each a frame of its

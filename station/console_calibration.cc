@@ -1047,13 +1047,7 @@ struct ConsoleCalibration::Impl {
       // Saved instead of the cameras' own models only when trusted as their own solves are.
       const calib::SolveSummary& sol = result.rig->solution;
       for (size_t c = 0; c < cameras.size(); ++c) {
-        const std::vector<double>& in = sol.models[c].intrinsics();
-        double percent = NAN;
-        if (c < sol.intrinsics_stdev.size() && sol.intrinsics_stdev[c].size() >= 2)
-          percent =
-              1.96 *
-              std::max(sol.intrinsics_stdev[c][0] / in[0], sol.intrinsics_stdev[c][1] / in[1]) *
-              100;
+        const double percent = result.rig->focal_stdev_percent[c];
         if (!(percent <= o.verdict.max_stdev_percent)) {
           result.doubts.push_back(cameras[c].name + ": focal length known to " +
                                   (std::isfinite(percent) ? std::to_string(percent) : "?") +
@@ -1116,13 +1110,8 @@ struct ConsoleCalibration::Impl {
                             {"rms_px", Num(s.rms_px[c])},
                             {"distance_m", Num(rig.distance_m[c])},
                             {"stdev_centre_px", Num(rig.stdev_px[c])},
-                            {"stdev_worst_px", Num(rig.stdev_worst[c])}};
-      const std::vector<double>& in = s.models[c].intrinsics();
-      if (c < s.intrinsics_stdev.size() && s.intrinsics_stdev[c].size() >= 2 && in.size() >= 2) {
-        cam["focal_stdev_percent"] =
-            Num(1.96 *
-                std::max(s.intrinsics_stdev[c][0] / in[0], s.intrinsics_stdev[c][1] / in[1]) * 100);
-      }
+                            {"stdev_worst_px", Num(rig.stdev_worst[c])},
+                            {"focal_stdev_percent", Num(rig.focal_stdev_percent[c])}};
       out["cameras"].push_back(std::move(cam));
     }
     for (size_t a = 0; a < j.names.size(); ++a) {
