@@ -71,6 +71,11 @@ bool WizardOptions::IsValid(std::string* why) const {
         "expected at least 1 frame, got " + std::to_string(floor_still_frames));
   check(std::isfinite(floor_still_s) && floor_still_s >= 0, "floor_still_s",
         "expected seconds >= 0, got " + OptionProblems::Num(floor_still_s));
+  check(std::isfinite(floor_word_s) && floor_word_s >= 0, "floor_word_s",
+        "expected seconds >= 0, got " + OptionProblems::Num(floor_word_s));
+  check(!floor_needs_word || floor_word_s == 0 || floor_word_s > floor_still_s, "floor_word_s",
+        "expected 0 (never lapses) or longer than floor_still_s (" +
+            OptionProblems::Num(floor_still_s) + " s), got " + OptionProblems::Num(floor_word_s));
   check(std::isnan(still_s) || (std::isfinite(still_s) && still_s >= 0), "still_s",
         "expected seconds >= 0 (or none), got " + OptionProblems::Num(still_s));
   check.Nested(ground_checks.IsValid(&part), "ground_checks.", part);
@@ -299,6 +304,7 @@ void CalibrationWizard::EnterGround(int frame) {
   run_.clear();
   run_used_ = false;
   word_ = false;
+  word_lapsed_ = false;
   ground_check_.reset();
   Event(frame, "step");
 }
@@ -472,6 +478,8 @@ void CalibrationWizard::BoardOnFloor(int frame) {
                                            WizardStepName(step_) + ")");
   }
   word_ = true;
+  word_since_s_ = NAN;
+  word_lapsed_ = false;
   run_.clear();  // the still span starts now
   run_used_ = false;
   Event(frame, "board_on_floor");
@@ -580,6 +588,15 @@ WizardFrame CalibrationWizard::Feed(const cv::Mat& image, int frame, double time
     const double still_s = run_.empty() ? 0.0 : time_s - run_start_s_;
     const bool long_enough = static_cast<int>(run_.size()) >= o_.floor_still_frames &&
                              !(still_s < o_.floor_still_s);  // NaN: no timestamps
+    if (word_ && std::isfinite(time_s)) {
+      if (std::isnan(word_since_s_)) word_since_s_ = time_s;
+      if (o_.floor_word_s > 0 && time_s - word_since_s_ > o_.floor_word_s) {
+        word_ = false;
+        word_lapsed_ = true;
+        run_.clear();
+        Event(frame, "board_on_floor_lapsed", {{"after_s", time_s - word_since_s_}});
+      }
+    }
     const bool may_take = !o_.floor_needs_word || word_;
     std::string failed;
     if (may_take && view.accepted && long_enough) {
@@ -602,6 +619,7 @@ WizardFrame CalibrationWizard::Feed(const cv::Mat& image, int frame, double time
                                  {"spread_mm", num(c.spread_mm)},
                                  {"spread_deg", num(c.spread_deg)}};
         word_ = false;  // one word, one board checked
+        word_lapsed_ = false;
         ground_check_ = c;
         if (c.doubt.empty()) {
           ground_ = std::move(g);
@@ -624,6 +642,13 @@ WizardFrame CalibrationWizard::Feed(const cv::Mat& image, int frame, double time
         now.push_back("the floor board's pose is doubtful, not taken: " + ground_check_->doubt);
       if (!failed.empty()) {
         now.push_back("the floor board could not be used: " + failed);
+      } else if (word_lapsed_ && !word_) {
+        char line[160];
+        std::snprintf(line, sizeof line,
+                      "no board lay still on the floor within %.0f s of the word: lay it flat on "
+                      "the green floor, in view, then say so again (\"board on floor\")",
+                      o_.floor_word_s);
+        now.push_back(line);
       } else if (!may_take || (o_.floor_needs_word && !word_)) {
         now.push_back(
             "lay the board flat on the green floor, in view, then say so (\"board on floor\")");
@@ -770,6 +795,7 @@ void CalibrationWizard::Redo(WizardStep step) {
   }
   if (step != WizardStep::kEnclosure) {
     word_ = false;
+    word_lapsed_ = false;
     ground_check_.reset();
   }
   verdicts_.clear();

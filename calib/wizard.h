@@ -98,6 +98,11 @@ struct WizardOptions {
   // (BoardOnFloor(): the console's button). False (the command line on a recording): at once,
   // trusted only by the checks below.
   bool floor_needs_word = false;
+  // The word holds this long by the frames' timestamps (from the first frame after it): a board
+  // not taken by then lapses it, and it must be given again. A word given as the board lay on
+  // the floor must not take a board held up much later (one held level over the floor passes
+  // the checks). 0: it never lapses.
+  double floor_word_s = 10.0;
   GroundChecks ground_checks;
   Rigid3 ground_from_board = FloorBoardPose();
   std::vector<Eigen::Vector2d>
@@ -227,6 +232,8 @@ class CalibrationWizard {
   bool run_used_ = false;       // the current still run was captured already
   double run_start_s_ = NAN;    // the timestamp of the still run's first frame
   bool word_ = false;           // the operator said the board lies on the floor
+  double word_since_s_ = NAN;   // the timestamp of the first frame after the word
+  bool word_lapsed_ = false;    // the last word lapsed without a board taken
   std::optional<GroundCheck> ground_check_;
   int empty_frames_ = 0;          // enclosure: frames in a row without a board
   int fed_ = 0;                   // frames fed

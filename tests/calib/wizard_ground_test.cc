@@ -157,6 +157,37 @@ TEST(WizardGround, TheConsoleWaitsForTheOperatorsWord) {
   EXPECT_THROW(w.BoardOnFloor(), InputError);  // past the ground step
 }
 
+// The word holds floor_word_s by the timestamps: a board that lies still on the floor only after
+// that is not taken, the guidance says why, and a new word takes it (issue 41: a word given while
+// a camera could not see the floor board once took a board held up a loop later).
+TEST(WizardGround, TheWordLapsesWhenNoBoardLiesStillInTime) {
+  const GroundStudio s(5);
+  WizardOptions o = s.Options();
+  o.floor_needs_word = true;
+  o.floor_word_s = 2.0;
+  CalibrationWizard w("cam0", 640, 480, o);
+  const cv::Mat a = s.Scene(s.Held(0.4, 0.5, 0.9, 20, 0)),
+                b = s.Scene(s.Held(0.6, 0.5, 0.9, 0, 20));
+  int n = 0;
+  w.BoardOnFloor();
+  // 2.5 s of a board waved about (never still): the word lapses after 2 s
+  for (int i = 0; i < 20; ++i, ++n) w.Feed(Noisy(i % 2 ? a : b, n), n, n / kFps);
+  EXPECT_TRUE(w.waiting_for_word());
+  const std::vector<std::string> guidance = FeedStill(w, s.Scene(s.on_floor), 12, &n);  // 1.5 s
+  EXPECT_FALSE(w.ground_good()) << "taken after the word lapsed";
+  EXPECT_TRUE(AnyContains(guidance, "within 2 s of the word"))
+      << ::testing::PrintToString(guidance);
+  EXPECT_NE(w.log().dump().find("board_on_floor_lapsed"), std::string::npos);
+  w.BoardOnFloor();
+  FeedStill(w, s.Scene(s.on_floor), 5, &n);
+  EXPECT_TRUE(w.ground_good()) << w.log().dump();
+  // and the rule: the word must outlast the still span
+  o.floor_word_s = 0.5;
+  std::string why;
+  EXPECT_FALSE(o.IsValid(&why));
+  EXPECT_NE(why.find("floor_word_s"), std::string::npos) << why;
+}
+
 // The still span is the timestamps', not the frames': frames 0.02 s apart (a fast camera) need
 // 0.2 s of them, not floor_still_frames.
 TEST(WizardGround, TheStillSpanIsMeasuredByTimestamps) {
