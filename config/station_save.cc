@@ -11,6 +11,7 @@
 #include <regex>
 #include <sstream>
 
+#include <yaml-cpp/yaml.h>
 #include <nlohmann/json.hpp>
 
 #include "calib/enclosure.h"
@@ -85,6 +86,30 @@ std::string SetCameraModelPath(const std::string& config_yaml, const std::string
   // The camera's "name:" line ("  - name: cam0" or "    name: cam0", the name maybe quoted).
   const std::regex name_line(R"(^(\s*(?:-\s+)?)name:\s*["']?([^"'#]*?)["']?\s*(#.*)?$)");
   const std::string value = nlohmann::json(path).dump();  // a JSON string is a YAML string
+  // Or a flow mapping on one line ("  - {name: cam0, source: replay}"): read and written again
+  // as one, the model set in it.
+  const std::regex flow_line(R"(^(\s*-\s+)(\{.*\})(\s*#.*)?\s*$)");
+  for (auto& line : lines) {
+    std::smatch m;
+    if (!std::regex_match(line, m, flow_line)) continue;
+    YAML::Node entry;
+    try {
+      entry = YAML::Load(m[2].str());
+    } catch (const YAML::Exception&) {
+      continue;  // a "{" in a comment or a string: not this camera's entry
+    }
+    if (!entry.IsMap() || !entry["name"] || !entry["name"].IsScalar() ||
+        entry["name"].Scalar() != camera)
+      continue;
+    entry["model"] = path;
+    YAML::Emitter out;
+    out.SetMapFormat(YAML::Flow);
+    out << entry;
+    line = m[1].str() + out.c_str() + m[3].str();
+    std::string joined;
+    for (const auto& l : lines) joined += l + "\n";
+    return joined;
+  }
   for (size_t i = 0; i < lines.size(); ++i) {
     std::smatch m;
     if (!std::regex_match(lines[i], m, name_line) || m[2].str() != camera) continue;

@@ -9,6 +9,7 @@
 #include <csignal>
 
 #include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
 
 #include <filesystem>
 #include <fstream>
@@ -81,6 +82,26 @@ TEST(SetCameraModelPath, AddsOrReplacesTheKeyInTheCamerasEntryOnly) {
     EXPECT_NE(std::string(e.what()).find("station.yaml"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("middle"), std::string::npos) << e.what();
   }
+}
+
+// A camera written as a flow mapping on one line (as a quick config is): the model is set in it,
+// and the config loads with it (the console's Save once refused it: "no entry").
+TEST(SetCameraModelPath, SetsTheKeyInAFlowMappingEntry) {
+  const std::string config =
+      "version: 1\ncameras:\n  - {name: cam0, source: replay, session: s}  # the left one\n"
+      "  - {name: cam1, source: replay, session: s, session_camera: cam1, model: "
+      "old.cameramodel}\n";
+  std::string yaml = SetCameraModelPath(config, "cam1", "/m/cam1.cameramodel", "station.yaml");
+  yaml = SetCameraModelPath(yaml, "cam0", "/m/cam0.cameramodel", "station.yaml");
+  EXPECT_NE(yaml.find("  - {name: cam0, source: replay, session: s, model: /m/cam0.cameramodel}  "
+                      "# the left one\n"),
+            std::string::npos)
+      << yaml;
+  EXPECT_EQ(yaml.find("old.cameramodel"), std::string::npos) << yaml;
+  const YAML::Node cameras = YAML::Load(yaml)["cameras"];
+  EXPECT_EQ(cameras[0]["model"].as<std::string>(), "/m/cam0.cameramodel");
+  EXPECT_EQ(cameras[1]["model"].as<std::string>(), "/m/cam1.cameramodel");
+  EXPECT_EQ(cameras[1]["session_camera"].as<std::string>(), "cam1");
 }
 
 TEST(SaveStationCalibration, WritesModelsAndConfigAndKeepsWhatTheyReplace) {
