@@ -1,6 +1,8 @@
 // Calibration sessions: the session time is split into one segment per camera
 // and board (the board held before that camera, moving through poses that it
-// holds still for a moment) and a last segment with both boards flat on the floor.
+// holds still for a moment), with several cameras one segment of the chessboard
+// held where every camera sees it (for a joint solve of the rig, calib/joint.h),
+// and a last segment with both boards flat on the floor.
 #include <algorithm>
 #include <cmath>
 #include <string>
@@ -17,6 +19,10 @@ namespace ss::synth {
 namespace {
 
 constexpr double kPoseSeconds = 0.8;  // one pose: move for 60 %, then hold still
+// Before every camera at once the board is held still longer: each camera's wizard must see it
+// still over spans that overlap in time (SimultaneousObservations).
+constexpr double kRigPoseSeconds = 1.2;
+constexpr double kRigMoveShare = 0.5;
 
 Rigid3 Interpolate(const Rigid3& a, const Rigid3& b, double s) {
   const Eigen::Quaterniond qa(a.rotation), qb(b.rotation);
@@ -29,9 +35,11 @@ Rigid3 Interpolate(const Rigid3& a, const Rigid3& b, double s) {
 struct Segment {
   double start_s = 0, end_s = 0;
   int board = 0;              // index into specs
-  int camera = -1;            // -1: on the floor
+  int camera = -1;            // kFloor, kRig, or the camera the board is held before
   std::vector<Rigid3> poses;  // ground_from_board, one per pose
+  double move_share = 0.6;    // of each pose's time; the rest it holds still
 };
+constexpr int kFloor = -1, kRig = -2;
 
 class CalibrationDirector : public Director {
  public:
@@ -42,9 +50,11 @@ class CalibrationDirector : public Director {
     specs_ = {ChessboardFor(stage), CharucoFor(stage)};
     for (const auto& s : specs_) textures_.push_back(std::make_unique<BoardTexture>(s));
     Rng rng(StreamSeed(options.seed, "calibration-boards"));
-    // Segments: camera 0 chessboard, camera 0 ChArUco, camera 1 ..., then the floor (one pose
+    // Segments: camera 0 chessboard, camera 0 ChArUco, camera 1 ..., with several cameras the
+    // chessboard before all of them (twice a camera segment's time), then the floor (one pose
     // slot).
-    const int hand_segments = 2 * static_cast<int>(cameras.size());
+    const bool rig = cameras.size() > 1;
+    const int hand_segments = 2 * static_cast<int>(cameras.size()) + (rig ? 2 : 0);
     const double floor_s = std::max(seconds * 0.1, std::min(1.0, seconds / (hand_segments + 1)));
     const double hand_s = (seconds - floor_s) / hand_segments;
     double t = 0;
@@ -56,17 +66,32 @@ class CalibrationDirector : public Director {
         seg.board = b;
         seg.camera = static_cast<int>(c);
         const int poses = std::max(2, static_cast<int>(std::ceil(hand_s / kPoseSeconds)) + 1);
-        for (int p = 0; p < poses; ++p) seg.poses.push_back(HeldPose(cameras[c], specs_[b], rng));
+        // With several cameras each has a shorter time: its poses go round the image's nine
+        // regions, so that the views it has time to capture cover it.
+        for (int p = 0; p < poses; ++p) {
+          seg.poses.push_back(HeldPose(cameras[c], specs_[b], rng, rig ? (p * 4 + b) % 9 : -1));
+        }
         segments_.push_back(seg);
         t += hand_s;
       }
+    }
+    if (rig) {
+      Segment seg;
+      seg.start_s = t;
+      seg.end_s = t + 2 * hand_s;
+      seg.camera = kRig;
+      seg.move_share = kRigMoveShare;
+      const int poses = std::max(2, static_cast<int>(std::ceil(2 * hand_s / kRigPoseSeconds)) + 1);
+      for (int p = 0; p < poses; ++p) seg.poses.push_back(RigPose(studio, cameras, specs_[0], rng));
+      segments_.push_back(seg);
+      t += 2 * hand_s;
     }
     // On the floor: the chessboard's frame at the ground origin (x along ground x,
     // y along -ground y, the print facing up), the ChArUco board beside it.
     Segment floor;
     floor.start_s = t;
     floor.end_s = seconds + 1.0;
-    floor.camera = -1;
+    floor.camera = kFloor;
     segments_.push_back(floor);
     const BoardSpec& chess = specs_[0];
     floor_poses_.resize(2);
@@ -97,34 +122,40 @@ class CalibrationDirector : public Director {
         break;
       }
     }
-    if (seg->camera < 0) {
+    if (seg->camera == kFloor) {
       for (int b = 0; b < 2; ++b) Add(b, floor_poses_[static_cast<size_t>(b)], "floor", out);
       return;
     }
-    // Pose p is reached at start + (p + 0.6) * step and held until start + (p + 1) * step.
+    // Pose p is reached at start + (p + move_share) * step and held until start + (p + 1) * step.
     const double step = (seg->end_s - seg->start_s) / static_cast<double>(seg->poses.size() - 1);
     const double u = (time_s - seg->start_s) / step;
     const int p =
         std::min(static_cast<int>(seg->poses.size()) - 2, static_cast<int>(std::floor(u)));
-    const double s = Smooth((u - p) / 0.6);
+    const double s = Smooth((u - p) / seg->move_share);
     Add(seg->board,
         Interpolate(seg->poses[static_cast<size_t>(p)], seg->poses[static_cast<size_t>(p) + 1], s),
-        "camera:" + cameras_[static_cast<size_t>(seg->camera)].name, out);
+        seg->camera == kRig ? "rig" : "camera:" + cameras_[static_cast<size_t>(seg->camera)].name,
+        out);
   }
 
   std::string SubjectsJson() const override { return "[]"; }
 
  private:
   // A pose of `spec` before `cam`: the print facing the camera, tilted up to
-  // 40 degrees, filling 35-65 % of the image width, anywhere in the view.
-  static Rigid3 HeldPose(const SynthCamera& cam, const BoardSpec& spec, Rng& rng) {
+  // 40 degrees, filling 35-65 % of the image width, anywhere in the view (`region` -1) or
+  // towards one of its nine regions (0..8, row by row).
+  static Rigid3 HeldPose(const SynthCamera& cam, const BoardSpec& spec, Rng& rng, int region) {
     const double fill = rng.Uniform(0.35, 0.65);
     const double depth = cam.lens.fx() * spec.width_m() / (fill * cam.width);
     // Where the board's centre appears: within the middle of the image, leaving room for the board.
     const double room_x = std::max(0.0, 0.5 - 0.5 * fill - 0.06),
                  room_y = std::max(0.0, 0.5 - 0.5 * fill * 1.2 - 0.06);
-    const Eigen::Vector2d px(cam.width * (0.5 + rng.Uniform(-room_x, room_x)),
-                             cam.height * (0.5 + rng.Uniform(-room_y, room_y)));
+    Eigen::Vector2d at(rng.Uniform(-room_x, room_x), rng.Uniform(-room_y, room_y));
+    if (region >= 0) {  // the region's third of the room, the draw kept as jitter within it
+      at.x() = room_x * (region % 3 - 1) * 2.0 / 3 + at.x() / 3;
+      at.y() = room_y * (region / 3 - 1) * 2.0 / 3 + at.y() / 3;
+    }
+    const Eigen::Vector2d px(cam.width * (0.5 + at.x()), cam.height * (0.5 + at.y()));
     const Eigen::Vector3d centre_in_cam =
         cam.lens.Unproject(px) / cam.lens.Unproject(px).z() * depth;
     const Eigen::Matrix3d tilt =
@@ -137,6 +168,65 @@ class CalibrationDirector : public Director {
     cam_from_board.translation =
         centre_in_cam - tilt * Eigen::Vector3d(0.5 * spec.width_m(), 0.5 * spec.height_m(), 0);
     return cam.cam_from_ground.Inverse() * cam_from_board;
+  }
+
+  // A pose of `spec` that every camera sees whole, its print facing each of them at most 65
+  // degrees off: above the middle of the floor, the print up (enclosure) or towards the cameras
+  // (stage), tilted up to 25 degrees and turned about its normal.
+  static Rigid3 RigPose(const Studio& studio, const std::vector<SynthCamera>& cameras,
+                        const BoardSpec& spec, Rng& rng) {
+    const bool stage = studio.kind == StudioKind::kStage;
+    Eigen::Vector3d towards = Eigen::Vector3d::UnitZ();
+    if (stage) {
+      towards.setZero();
+      for (const auto& cam : cameras) {
+        towards +=
+            (cam.cam_from_ground.Inverse().translation - Eigen::Vector3d(0, 0, 0.9)).normalized();
+      }
+      towards.normalize();
+    }
+    const Eigen::Matrix3d face_up = Eigen::Vector3d(1, -1, -1).asDiagonal();
+    const Eigen::Matrix3d to_cameras =
+        Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), towards).toRotationMatrix();
+    Rigid3 best;
+    double best_margin = -1e9;
+    for (int attempt = 0; attempt < 200; ++attempt) {
+      const Eigen::Matrix3d r =
+          to_cameras *
+          (Eigen::AngleAxisd(rng.Uniform(-25, 25) * kDeg, Eigen::Vector3d::UnitX()) *
+           Eigen::AngleAxisd(rng.Uniform(-25, 25) * kDeg, Eigen::Vector3d::UnitY()) *
+           Eigen::AngleAxisd(rng.Uniform(-45, 45) * kDeg, Eigen::Vector3d::UnitZ()))
+              .toRotationMatrix() *
+          face_up;
+      const Eigen::Vector3d centre =
+          stage ? Eigen::Vector3d(rng.Uniform(-0.3, 0.3), rng.Uniform(-0.2, 0.2),
+                                  rng.Uniform(0.8, 1.1))
+                : Eigen::Vector3d(rng.Uniform(-0.12, 0.12), rng.Uniform(-0.08, 0.08),
+                                  rng.Uniform(0.15, 0.3));
+      const Rigid3 pose{
+          r, centre - r * Eigen::Vector3d(0.5 * spec.width_m(), 0.5 * spec.height_m(), 0)};
+      // The smallest margin, in pixels, of the board's corners inside every image; -1e9 when
+      // a camera sees the print from too far off its normal.
+      double margin = 1e9;
+      const Eigen::Vector3d normal = r * Eigen::Vector3d(0, 0, -1);
+      for (const auto& cam : cameras) {
+        const Eigen::Vector3d to_cam =
+            (cam.cam_from_ground.Inverse().translation - centre).normalized();
+        if (normal.dot(to_cam) < std::cos(65 * kDeg)) margin = -1e9;
+        for (double bx : {0.0, spec.width_m()}) {
+          for (double by : {0.0, spec.height_m()}) {
+            const Eigen::Vector2d px = cam.ProjectGround(pose * Eigen::Vector3d(bx, by, 0));
+            margin = std::min({margin, px.x(), px.y(), cam.width - px.x(), cam.height - px.y()});
+          }
+        }
+      }
+      if (margin > best_margin) {
+        best_margin = margin;
+        best = pose;
+      }
+      if (margin > 0.06 * cameras.front().width) break;
+    }
+    return best;
   }
 
   void Add(int board, const Rigid3& ground_from_board, const std::string& placement,

@@ -120,3 +120,66 @@ TEST(CalibrationSession, BoardCornersAreWhereOpenCvFindsThem) {
 
 }  // namespace
 }  // namespace ss::synth
+
+namespace ss::synth {
+namespace {
+
+// With two cameras, the chessboard is also held where both see it whole (the joint solve's
+// shared instants, calib/joint.h): poses held still for 0.6 s, in distinct places, every corner
+// in view of both cameras in every frame of the segment; each camera's own poses go round the
+// image's nine regions.
+TEST(CalibrationSession, TwoCamerasShareASegmentOfTheBoardInViewOfBoth) {
+  ss::testing::ScratchDir dir;
+  SynthOptions o;
+  o.out_dir = dir / "s";
+  o.kind = SynthKind::kCalibration;
+  o.seconds = 30.0;
+  o.fps = 8.0;
+  o.width = 320;
+  o.height = 240;
+  o.cameras = 2;
+  o.seed = 5;
+  o.write_mattes = false;
+  RenderStudioSession(o);
+  const fs::path truth = fs::path(o.out_dir) / "truth";
+  std::map<int, std::string> placement;
+  std::map<int, std::vector<double>> rig_pose;  // frame -> rt
+  for (const auto& row : ss::testing::ReadCsv((truth / "board_poses.csv").string())) {
+    const int frame = std::stoi(row.at("frame"));
+    placement[frame] = row.at("placement");
+    if (row.at("board") != "0") continue;
+    if (row.at("placement") == "rig") {
+      for (const char* k : {"rx", "ry", "rz", "tx", "ty", "tz"})
+        rig_pose[frame].push_back(Num(row, k));
+    }
+  }
+  // 30 s: 3 s on the floor at the end, before it 27 s in 6 parts: 4 camera segments of 4.5 s,
+  // then the shared one of 9 s (frames 144..215 at 8 fps).
+  ASSERT_EQ(rig_pose.size(), 72u);
+  EXPECT_EQ(placement[rig_pose.begin()->first - 1], "camera:cam1");
+  EXPECT_EQ(placement[rig_pose.rbegin()->first + 1], "floor");
+  for (const char* cam : {"cam0", "cam1"}) {
+    auto corners = ReadCorners(truth / cam / "corners.csv");
+    for (const auto& [frame, rt] : rig_pose) {
+      const auto& board = corners[frame][0];
+      ASSERT_EQ(board.size(), 54u) << cam << " frame " << frame;
+      for (const auto& c : board) EXPECT_TRUE(c.in_view) << cam << " frame " << frame;
+    }
+  }
+  // Still spans: runs of frames with the same pose, at least 0.5 s (4 frames at 8 fps) each,
+  // in at least 7 distinct places.
+  int places = 0, run = 1;
+  std::vector<double> last;
+  for (const auto& [frame, rt] : rig_pose) {
+    const bool same =
+        !last.empty() &&
+        std::abs(rt[3] - last[3]) + std::abs(rt[4] - last[4]) + std::abs(rt[5] - last[5]) < 1e-9;
+    run = same ? run + 1 : 1;
+    if (run == 4) ++places;
+    last = rt;
+  }
+  EXPECT_GE(places, 7);
+}
+
+}  // namespace
+}  // namespace ss::synth
