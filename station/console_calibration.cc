@@ -174,8 +174,8 @@ struct WizardSettings {
 // Locks: queue_mutex_ and state_mutex_ are leaves (held for a copy or a push, never together).
 class CameraWork {
  public:
-  // `solved`: called on the camera's thread after each intrinsics solve (the joint solve may
-  // start).
+  // `solved`: called on the camera's thread after each intrinsics solve and when its ground step
+  // poses it (the joint solve may start, or start again with the views seen since).
   CameraWork(std::string name, int index, const WizardSettings& settings,
              std::atomic<uint64_t>* floor_counter, std::function<void()> solved = {})
       : name_(std::move(name)),
@@ -270,6 +270,7 @@ class CameraWork {
   }
   int solves() const { return solves_.load(); }
   bool intrinsics_good() const { return intrinsics_good_.load(); }
+  bool posed() const { return posed_.load(); }
 
   JointInput Joined() const {
     std::lock_guard lock(state_mutex_);
@@ -347,6 +348,7 @@ class CameraWork {
         o.still_s = settings_.still_s;
         o.floor_still_s = settings_.floor_still_s;
         o.floor_needs_word = true;
+        o.floor_word_s = std::max(o.floor_word_s, o.floor_still_s + 5.0);
         wizard_ = std::make_unique<calib::CalibrationWizard>(name_, bgr_.cols, bgr_.rows, o);
       }
       const calib::WizardFrame out = wizard_->Feed(
@@ -381,7 +383,9 @@ class CameraWork {
       Log("station.calibration")->warn("{}: {}", name_, e.what());
     }
     last_sequence_ = frame.sequence;
+    const bool was_posed = posed_.load();
     Publish(false);
+    if (!was_posed && posed_.load() && solved_) solved_();
   }
 
   void SolveNow() {
@@ -612,6 +616,7 @@ class CameraWork {
     live.grid = grid_;
     live.floor = std::move(floor_px);
     intrinsics_good_.store(w.intrinsics_good());
+    posed_.store(w.ground().has_value());
     std::lock_guard lock(state_mutex_);
     state_ = std::move(j);
     live_ = std::move(live);
@@ -662,6 +667,7 @@ class CameraWork {
   std::deque<double> intervals_;  // between frames of consecutive sequence numbers, seconds
   std::optional<Rigid3> ground_pose_;
   std::atomic<bool> intrinsics_good_{false};
+  std::atomic<bool> posed_{false};
 
   std::thread thread_;  // last: starts once everything above exists
 };
@@ -685,7 +691,9 @@ struct ConsoleCalibration::Impl {
   std::atomic<uint64_t> floor_counter{0};
   std::vector<std::shared_ptr<CameraWork>> works;
   // The joint solve of the cameras (issue 41), under `mutex`: started once every camera's
-  // intrinsics are trusted (or by POST /api/calibration/joint), on joint_thread.
+  // intrinsics are trusted, again when a camera is posed after it (the board is laid on the
+  // floor after it was held where the cameras all see it: those views came since), or by POST
+  // /api/calibration/joint; on joint_thread.
   calib::WizardOptions wizard_options;  // the run's board and solve options
   struct Joint {
     int run = 0;
@@ -696,6 +704,7 @@ struct ConsoleCalibration::Impl {
     std::optional<calib::JointRig> rig;
     std::vector<std::string> doubts;  // why the rig is not trusted (not saved); empty: trusted
   } joint;
+  int joint_posed = -1;  // cameras posed when the last joint solve started (-1: none started)
   std::mutex joint_thread_mutex;  // joint_thread
   std::thread joint_thread;
 
@@ -886,6 +895,7 @@ struct ConsoleCalibration::Impl {
     settings.run = run;
     wizard_options = settings.options;
     joint = Joint{};
+    joint_posed = -1;
     settings.work_dir = (fs::path(work_dir) / std::to_string(run)).string();
     for (size_t i = 0; i < names.size(); ++i) {
       WizardSettings s = settings;
@@ -949,10 +959,13 @@ struct ConsoleCalibration::Impl {
         if (asked) throw ConflictError("joint", "a joint solve is running");
         return;
       }
+      int posed = 0;
       for (const auto& w : works) {
         if (w->intrinsics_good()) chosen.push_back(w);
+        posed += w->posed() ? 1 : 0;
       }
-      if (!asked && (joint.rig || !joint.error.empty() || chosen.size() != works.size())) return;
+      const bool tried = joint.rig || !joint.error.empty();
+      if (!asked && (chosen.size() != works.size() || (tried && posed <= joint_posed))) return;
       if (chosen.size() < 2) {
         if (asked)
           throw ConflictError("joint", std::to_string(chosen.size()) +
@@ -960,6 +973,7 @@ struct ConsoleCalibration::Impl {
                                            "needs two or more: solve them first");
         return;
       }
+      joint_posed = posed;
       joint.solving = true;
       joint.stage = "starting";
       joint.progress = 0;
