@@ -1372,7 +1372,10 @@ void ConsoleCalibration::AddStatus(nlohmann::json& status) const {
       for (const auto& s : status["cameras"]) {
         if (s.value("name", "") != c.value("name", "")) continue;
         const std::string state = s.value("state", "");
-        online = state == "live" || state == "training" || state == "starting";
+        // A camera in error whose frames still come (its keyer failed: it streams for preview
+        // and recording) delivers to the wizard: not offline, its live view kept.
+        online = state == "live" || state == "training" || state == "starting" ||
+                 (state == "error" && s.value("fps", 0.0) > 0);
         if (!online)
           message = state + (s.value("message", "").empty() ? "" : ": " + s.value("message", ""));
       }
