@@ -143,9 +143,11 @@ class CalibrationDirector : public Director {
  private:
   // A pose of `spec` before `cam`: the print facing the camera, tilted up to
   // 40 degrees, filling 35-65 % of the image width, anywhere in the view (`region` -1) or
-  // towards one of its nine regions (0..8, row by row).
+  // towards one of its nine regions (0..8, row by row; 30-45 % outside the middle one).
   static Rigid3 HeldPose(const SynthCamera& cam, const BoardSpec& spec, Rng& rng, int region) {
-    const double fill = rng.Uniform(0.35, 0.65);
+    double fill = rng.Uniform(0.35, 0.65);
+    // Off the middle a smaller board (30-45 %) leaves room to reach the image's edges.
+    if (region >= 0 && region != 4) fill = 0.3 + 0.5 * (fill - 0.35);
     const double depth = cam.lens.fx() * spec.width_m() / (fill * cam.width);
     // Where the board's centre appears: within the middle of the image, leaving room for the board.
     const double room_x = std::max(0.0, 0.5 - 0.5 * fill - 0.06),
