@@ -19,8 +19,9 @@ namespace ss::synth {
 namespace {
 
 constexpr double kPoseSeconds = 0.8;  // one pose: move for 60 %, then hold still
-// Before every camera at once the board is held still longer: each camera's wizard must see it
-// still over spans that overlap in time (SimultaneousObservations).
+// With several cameras every pose is held still longer, 0.6 s as an operator would: their
+// wizards share the cores (each sees fewer frames), and before every camera at once each must
+// see the board still over spans that overlap in time (SimultaneousObservations).
 constexpr double kRigPoseSeconds = 1.2;
 constexpr double kRigMoveShare = 0.5;
 
@@ -65,7 +66,9 @@ class CalibrationDirector : public Director {
         seg.end_s = t + hand_s;
         seg.board = b;
         seg.camera = static_cast<int>(c);
-        const int poses = std::max(2, static_cast<int>(std::ceil(hand_s / kPoseSeconds)) + 1);
+        if (rig) seg.move_share = kRigMoveShare;
+        const double pose_s = rig ? kRigPoseSeconds : kPoseSeconds;
+        const int poses = std::max(2, static_cast<int>(std::ceil(hand_s / pose_s)) + 1);
         // With several cameras each has a shorter time: its poses go round the image's nine
         // regions, so that the views it has time to capture cover it.
         for (int p = 0; p < poses; ++p) {
