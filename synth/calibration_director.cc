@@ -157,8 +157,9 @@ class CalibrationDirector : public Director {
                  room_y = std::max(0.0, 0.5 - 0.5 * fill * 1.2 - 0.06);
     Eigen::Vector2d at(rng.Uniform(-room_x, room_x), rng.Uniform(-room_y, room_y));
     if (region >= 0) {  // the region's third of the room, the draw kept as jitter within it
-      at.x() = room_x * (region % 3 - 1) * 2.0 / 3 + at.x() / 3;
-      at.y() = room_y * (region / 3 - 1) * 2.0 / 3 + at.y() / 3;
+      const int column = region % 3 - 1, row = region / 3 - 1;  // -1, 0 or 1 each
+      at.x() = room_x * column * 2.0 / 3 + at.x() / 3;
+      at.y() = room_y * row * 2.0 / 3 + at.y() / 3;
     }
     const Eigen::Vector2d px(cam.width * (0.5 + at.x()), cam.height * (0.5 + at.y()));
     const Eigen::Vector3d centre_in_cam =
