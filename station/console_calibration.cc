@@ -383,9 +383,12 @@ class CameraWork {
       Log("station.calibration")->warn("{}: {}", name_, e.what());
     }
     last_sequence_ = frame.sequence;
-    const bool was_posed = posed_.load();
     Publish(false);
-    if (!was_posed && posed_.load() && solved_) solved_();
+    // Posed since the last frame said so (a publish is throttled, and one a command forces may
+    // be the first to see it): the joint solve may start again.
+    const bool posed = posed_.load();
+    if (posed && !posed_told_ && solved_) solved_();
+    posed_told_ = posed;
   }
 
   void SolveNow() {
@@ -645,7 +648,8 @@ class CameraWork {
   uint64_t frames_fed_ = 0, last_sequence_ = 0;
   std::vector<std::string> guidance_;
   std::string message_;
-  bool was_still_ = false;  // the last frame's board was still
+  bool was_still_ = false;   // the last frame's board was still
+  bool posed_told_ = false;  // `solved_` was called since the camera was posed
   double last_time_s_ = NAN, still_since_s_ = NAN;
   Clock::time_point last_publish_{};
   std::vector<Eigen::Vector2d> fov_;
