@@ -642,7 +642,7 @@ WizardFrame CalibrationWizard::Feed(const cv::Mat& image, int frame, double time
         now.push_back("the floor board's pose is doubtful, not taken: " + ground_check_->doubt);
       if (!failed.empty()) {
         now.push_back("the floor board could not be used: " + failed);
-      } else if (word_lapsed_ && !word_) {
+      } else if (word_lapsed_) {
         char line[160];
         std::snprintf(line, sizeof line,
                       "no board lay still on the floor within %.0f s of the word: lay it flat on "

@@ -63,6 +63,12 @@ std::string ReadText(const std::string& path) {
   return text.str();
 }
 
+std::string JoinLines(const std::vector<std::string>& lines) {
+  std::string out;
+  for (const auto& l : lines) out += l + "\n";
+  return out;
+}
+
 struct Pending {
   std::string target, temp;
 };
@@ -106,9 +112,7 @@ std::string SetCameraModelPath(const std::string& config_yaml, const std::string
     out.SetMapFormat(YAML::Flow);
     out << entry;
     line = m[1].str() + out.c_str() + m[3].str();
-    std::string joined;
-    for (const auto& l : lines) joined += l + "\n";
-    return joined;
+    return JoinLines(lines);
   }
   for (size_t i = 0; i < lines.size(); ++i) {
     std::smatch m;
@@ -136,9 +140,7 @@ std::string SetCameraModelPath(const std::string& config_yaml, const std::string
     }
     lines.insert(lines.begin() + static_cast<std::ptrdiff_t>(i) + 1, indent + "model: " + value);
   joined:
-    std::string out;
-    for (const auto& l : lines) out += l + "\n";
-    return out;
+    return JoinLines(lines);
   }
   throw InputError(origin, "no entry \"name: " + camera + "\" under cameras: to set its model in");
 }

@@ -270,7 +270,10 @@ class CameraWork {
   }
   int solves() const { return solves_.load(); }
   bool intrinsics_good() const { return intrinsics_good_.load(); }
-  bool posed() const { return posed_.load(); }
+  bool posed() const {
+    std::lock_guard lock(state_mutex_);
+    return ground_pose_.has_value();
+  }
 
   JointInput Joined() const {
     std::lock_guard lock(state_mutex_);
@@ -383,12 +386,13 @@ class CameraWork {
       Log("station.calibration")->warn("{}: {}", name_, e.what());
     }
     last_sequence_ = frame.sequence;
-    Publish(false);
-    // Posed since the last frame said so (a publish is throttled, and one a command forces may
-    // be the first to see it): the joint solve may start again.
-    const bool posed = posed_.load();
-    if (posed && !posed_told_ && solved_) solved_();
+    // Posed by this frame: published at once (the joint solve counts the cameras posed from
+    // what is published), then the joint solve may start again.
+    const bool posed = wizard_ && wizard_->ground().has_value();
+    const bool newly_posed = posed && !posed_told_;
     posed_told_ = posed;
+    Publish(newly_posed);
+    if (newly_posed && solved_) solved_();
   }
 
   void SolveNow() {
@@ -619,7 +623,6 @@ class CameraWork {
     live.grid = grid_;
     live.floor = std::move(floor_px);
     intrinsics_good_.store(w.intrinsics_good());
-    posed_.store(w.ground().has_value());
     std::lock_guard lock(state_mutex_);
     state_ = std::move(j);
     live_ = std::move(live);
@@ -649,7 +652,7 @@ class CameraWork {
   std::vector<std::string> guidance_;
   std::string message_;
   bool was_still_ = false;   // the last frame's board was still
-  bool posed_told_ = false;  // `solved_` was called since the camera was posed
+  bool posed_told_ = false;  // the wizard was posed at the last frame
   double last_time_s_ = NAN, still_since_s_ = NAN;
   Clock::time_point last_publish_{};
   std::vector<Eigen::Vector2d> fov_;
@@ -671,7 +674,6 @@ class CameraWork {
   std::deque<double> intervals_;  // between frames of consecutive sequence numbers, seconds
   std::optional<Rigid3> ground_pose_;
   std::atomic<bool> intrinsics_good_{false};
-  std::atomic<bool> posed_{false};
 
   std::thread thread_;  // last: starts once everything above exists
 };

@@ -25,6 +25,14 @@ constexpr double kPoseSeconds = 0.8;  // one pose: move for 60 %, then hold stil
 constexpr double kRigPoseSeconds = 1.2;
 constexpr double kRigMoveShare = 0.5;
 
+// A segment of `seconds` at `pose_s` a pose: the poses it moves through.
+int PoseCount(double seconds, double pose_s) {
+  return std::max(2, static_cast<int>(std::ceil(seconds / pose_s)) + 1);
+}
+
+// A board's frame lying print up: x along ground x, y along -ground y.
+Eigen::Matrix3d FaceUp() { return Eigen::Vector3d(1, -1, -1).asDiagonal(); }
+
 Rigid3 Interpolate(const Rigid3& a, const Rigid3& b, double s) {
   const Eigen::Quaterniond qa(a.rotation), qb(b.rotation);
   Rigid3 out;
@@ -67,8 +75,7 @@ class CalibrationDirector : public Director {
         seg.board = b;
         seg.camera = static_cast<int>(c);
         if (rig) seg.move_share = kRigMoveShare;
-        const double pose_s = rig ? kRigPoseSeconds : kPoseSeconds;
-        const int poses = std::max(2, static_cast<int>(std::ceil(hand_s / pose_s)) + 1);
+        const int poses = PoseCount(hand_s, rig ? kRigPoseSeconds : kPoseSeconds);
         // With several cameras each has a shorter time: its poses go round the image's nine
         // regions, so that the views it has time to capture cover it.
         for (int p = 0; p < poses; ++p) {
@@ -84,7 +91,7 @@ class CalibrationDirector : public Director {
       seg.end_s = t + 2 * hand_s;
       seg.camera = kRig;
       seg.move_share = kRigMoveShare;
-      const int poses = std::max(2, static_cast<int>(std::ceil(2 * hand_s / kRigPoseSeconds)) + 1);
+      const int poses = PoseCount(2 * hand_s, kRigPoseSeconds);
       for (int p = 0; p < poses; ++p) seg.poses.push_back(RigPose(studio, cameras, specs_[0], rng));
       segments_.push_back(seg);
       t += 2 * hand_s;
@@ -98,13 +105,12 @@ class CalibrationDirector : public Director {
     segments_.push_back(floor);
     const BoardSpec& chess = specs_[0];
     floor_poses_.resize(2);
-    const Eigen::Matrix3d face_up = Eigen::Vector3d(1, -1, -1).asDiagonal();
-    floor_poses_[0].rotation = face_up;
+    floor_poses_[0].rotation = FaceUp();
     floor_poses_[0].translation =
         Eigen::Vector3d(-0.5 * chess.width_m(), 0.5 * chess.height_m(), 0.001);
     const BoardSpec& charuco = specs_[1];
     const double gap = chess.margin_m + charuco.margin_m + 0.02;
-    floor_poses_[1].rotation = face_up;
+    floor_poses_[1].rotation = FaceUp();
     const double x1 = -0.5 * chess.width_m() + chess.width_m() + gap;
     floor_poses_[1].translation = Eigen::Vector3d(x1, 0.5 * charuco.height_m(), 0.001);
     if (x1 + charuco.width_m() > studio.half_x - 0.01) {  // not beside it: in front of it
@@ -186,12 +192,10 @@ class CalibrationDirector : public Director {
     if (stage) {
       towards.setZero();
       for (const auto& cam : cameras) {
-        towards +=
-            (cam.cam_from_ground.Inverse().translation - Eigen::Vector3d(0, 0, 0.9)).normalized();
+        towards += (cam.CentreInGround() - Eigen::Vector3d(0, 0, 0.9)).normalized();
       }
       towards.normalize();
     }
-    const Eigen::Matrix3d face_up = Eigen::Vector3d(1, -1, -1).asDiagonal();
     const Eigen::Matrix3d to_cameras =
         Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), towards).toRotationMatrix();
     Rigid3 best;
@@ -203,7 +207,7 @@ class CalibrationDirector : public Director {
            Eigen::AngleAxisd(rng.Uniform(-25, 25) * kDeg, Eigen::Vector3d::UnitY()) *
            Eigen::AngleAxisd(rng.Uniform(-45, 45) * kDeg, Eigen::Vector3d::UnitZ()))
               .toRotationMatrix() *
-          face_up;
+          FaceUp();
       const Eigen::Vector3d centre =
           stage ? Eigen::Vector3d(rng.Uniform(-0.3, 0.3), rng.Uniform(-0.2, 0.2),
                                   rng.Uniform(0.8, 1.1))
@@ -216,8 +220,7 @@ class CalibrationDirector : public Director {
       double margin = 1e9;
       const Eigen::Vector3d normal = r * Eigen::Vector3d(0, 0, -1);
       for (const auto& cam : cameras) {
-        const Eigen::Vector3d to_cam =
-            (cam.cam_from_ground.Inverse().translation - centre).normalized();
+        const Eigen::Vector3d to_cam = (cam.CentreInGround() - centre).normalized();
         if (normal.dot(to_cam) < std::cos(65 * kDeg)) margin = -1e9;
         for (double bx : {0.0, spec.width_m()}) {
           for (double by : {0.0, spec.height_m()}) {

@@ -39,18 +39,25 @@ std::map<int, std::map<int, std::vector<Corner>>> ReadCorners(const fs::path& cs
   return out;
 }
 
-TEST(CalibrationSession, BoardCornersAreWhereOpenCvFindsThem) {
-  ss::testing::ScratchDir dir;
+// A calibration session of seed 5 to render in `dir`/s.
+SynthOptions CalibrationOptions(const ss::testing::ScratchDir& dir, int cameras, double seconds,
+                                double fps, int width, int height) {
   SynthOptions o;
   o.out_dir = dir / "s";
   o.kind = SynthKind::kCalibration;
-  o.seconds = 6.0;
-  o.fps = 3.0;
-  o.width = 640;
-  o.height = 480;
-  o.cameras = 1;
-  o.noise = 0.5;
+  o.seconds = seconds;
+  o.fps = fps;
+  o.width = width;
+  o.height = height;
+  o.cameras = cameras;
   o.seed = 5;
+  return o;
+}
+
+TEST(CalibrationSession, BoardCornersAreWhereOpenCvFindsThem) {
+  ss::testing::ScratchDir dir;
+  SynthOptions o = CalibrationOptions(dir, 1, 6.0, 3.0, 640, 480);
+  o.noise = 0.5;
   RenderStudioSession(o);
   const fs::path truth = fs::path(o.out_dir) / "truth";
   ASSERT_TRUE(fs::exists(truth / "boards.json"));
@@ -118,27 +125,13 @@ TEST(CalibrationSession, BoardCornersAreWhereOpenCvFindsThem) {
   RecordProperty("worst_corner_error_px", std::to_string(worst));
 }
 
-}  // namespace
-}  // namespace ss::synth
-
-namespace ss::synth {
-namespace {
-
 // With two cameras, the chessboard is also held where both see it whole (the joint solve's
 // shared instants, calib/joint.h): poses held still for 0.6 s, in distinct places, every corner
 // in view of both cameras in every frame of the segment; each camera's own poses go round the
 // image's nine regions.
 TEST(CalibrationSession, TwoCamerasShareASegmentOfTheBoardInViewOfBoth) {
   ss::testing::ScratchDir dir;
-  SynthOptions o;
-  o.out_dir = dir / "s";
-  o.kind = SynthKind::kCalibration;
-  o.seconds = 30.0;
-  o.fps = 8.0;
-  o.width = 320;
-  o.height = 240;
-  o.cameras = 2;
-  o.seed = 5;
+  SynthOptions o = CalibrationOptions(dir, 2, 30.0, 8.0, 320, 240);
   o.write_mattes = false;
   RenderStudioSession(o);
   const fs::path truth = fs::path(o.out_dir) / "truth";
