@@ -67,6 +67,31 @@ async function previewRate(ms) {
   return counts;
 }
 
+// The preview requests of each camera from now on; each(names) waits until every one of them
+// fetched one. A loaded machine (CI runs the QEMU tests beside this one) serves a preview
+// in seconds rather than in milliseconds: the rate limits are asserted over a window, and
+// that previews flow by waiting for them, naming what a stalled tile says.
+function previewsFrom() {
+  const seen = {};
+  const on = (r) => {
+    const m = /\/api\/cameras\/([^/]+)\/(preview\.jpg|sprites\.json)/.exec(r.url());
+    if (m) seen[m[1]] = (seen[m[1]] || 0) + 1;
+  };
+  p.on('request', on);
+  return {
+    async each(names, when) {
+      try {
+        await h.waitFor(`a preview of each of ${names.join(', ')} ${when}`, () => names.every((n) => seen[n] > 0), { timeout: 8000, interval: 100 });
+      } catch (err) {
+        const said = await Promise.all(names.map(async (n) => `${n}: ${seen[n] || 0} (${await p.textContent(`[data-camera="${n}"] [data-testid="tile-message"]`).catch(() => '?')})`));
+        throw new Error(`${err.message}; previews ${said.join(', ')}`);
+      } finally {
+        p.off('request', on);
+      }
+    },
+  };
+}
+
 async function waitLive(names, timeout = 60000) {
   return h.waitFor(`tiles ${names.join(', ')} live`, async () => {
     const t = await h.tiles(p);
@@ -143,10 +168,10 @@ test('a hidden tab fetches no preview, and streams again when shown', async () =
   await setHidden(true);
   await h.sleep(400); // requests in flight finish
   const hiddenRate = await previewRate(1500);
+  const shown = previewsFrom();
   await setHidden(false);
-  const shownRate = await previewRate(1500);
   assert.deepEqual(hiddenRate, {}, 'no preview while hidden');
-  for (const n of CAMERAS) assert.ok(shownRate[n] >= 1, `${n}: ${shownRate[n]} previews in 1.5 s once shown`);
+  await shown.each(CAMERAS, 'once shown');
 });
 
 test('a killed camera goes offline within 5 s, and streams again when restarted', async () => {
@@ -205,8 +230,10 @@ test('start then stop stores sprites, and the page shows what the bank holds', a
   await h.waitFor('elapsed time to tick', async () => (await h.text(p, 'session-elapsed')) !== e0, { timeout: 3000 });
   // while a session runs, previews back off to 2 a second a tile
   await h.sleep(600);
-  const rate = await previewRate(2000);
-  for (const n of CAMERAS) assert.ok(rate[n] >= 1 && rate[n] <= 5, `${n}: ${rate[n]} previews in 2 s while a session runs`);
+  const rate = await previewRate(4000);
+  for (const n of CAMERAS) assert.ok((rate[n] || 0) <= 10, `${n}: ${rate[n]} previews in 4 s while a session runs`);
+  const running = previewsFrom();
+  await running.each(CAMERAS, 'while a session runs');
   await h.waitFor('sprites stored', async () => (await h.num(p, 'session-sprites')) > 20, { timeout: 20000, interval: 250 });
   // the station keeps the transitions current while the session runs: the session goes on
   // until one joins two of its sprites (a later test opens it); the footage loops every 6 s
