@@ -1,8 +1,13 @@
 // spritestation config check FILE [--json] [--no-file-checks]: validates a
 // station config without starting anything (docs/config.md). Exit 0 when it is
 // valid or was adjusted, 2 when it is invalid, each error naming the field and line.
+// spritestation config keys [--markdown | --update DOC]: every key with its type, default
+// and doc, as the code binds them; --update rewrites DOC's key tables (docs/config.md).
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
 #include <memory>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -86,6 +91,27 @@ void Check(const std::string& path, bool json, bool check_files) {
   }
 }
 
+// Rewrites the key tables of `doc` in place (a temporary file renamed over it).
+void UpdateDoc(const std::string& doc) {
+  std::ifstream in(doc, std::ios::binary);
+  if (!in) throw InputError(doc + ": cannot read it");
+  std::stringstream text;
+  text << in.rdbuf();
+  const std::string now = WithConfigKeyTables(text.str(), doc);
+  if (now == text.str()) {
+    std::printf("%s: the key tables are up to date\n", doc.c_str());
+    return;
+  }
+  const std::string tmp = doc + ".tmp";
+  {
+    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+    out << now;
+    if (!out.flush()) throw InputError(tmp + ": cannot write it");
+  }
+  std::filesystem::rename(tmp, doc);
+  std::printf("%s: key tables rewritten\n", doc.c_str());
+}
+
 }  // namespace
 
 void AddConfigCommand(CLI::App& app) {
@@ -101,6 +127,22 @@ void AddConfigCommand(CLI::App& app) {
   check->add_flag("--no-file-checks", *no_files,
                   "Do not require the model, session and token files to exist");
   check->callback([path, json, no_files] { Check(*path, *json, !*no_files); });
+
+  auto* keys = cmd->add_subcommand(
+      "keys", "Every config key: its type, default and doc, as the code binds them");
+  auto markdown = std::make_shared<bool>(false);
+  auto update = std::make_shared<std::string>();
+  auto* md = keys->add_flag("--markdown", *markdown,
+                            "docs/config.md's key tables, each between its markers");
+  keys->add_option("--update", *update, "Rewrite this file's key tables (docs/config.md)")
+      ->excludes(md);
+  keys->callback([markdown, update] {
+    if (!update->empty()) {
+      UpdateDoc(*update);
+    } else {
+      std::fputs((*markdown ? ConfigKeysMarkdown() : ConfigKeysText()).c_str(), stdout);
+    }
+  });
 }
 
 }  // namespace ss::apps

@@ -13,6 +13,11 @@ namespace ss::config_detail {
 
 extern const std::vector<std::string> kLogLevels;  // logging.level and per component
 
+// Files and folders of the storage section, when not given: beside the config file.
+inline constexpr const char* kDefaultBank = "station.bank";
+inline constexpr const char* kDefaultRecordingDir = "recordings";
+inline constexpr const char* kDefaultSpoolDir = "spool";
+
 // The whole file's keys, bound to `cfg`'s fields.
 OptionsBinder StationKeys(StationConfig& cfg);
 // Checks values and cross-field rules, adjusting what can be fixed; reports to `msg`.

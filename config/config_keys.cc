@@ -1,15 +1,22 @@
-// The station config's keys, each bound to its field (core/options_binder.h). The defaults are
-// the fields' initial values in config/station_config.h; docs/config.md is the contract.
+// The station config's keys, each bound to its field (core/options_binder.h), with its type and
+// doc. The defaults are the fields' initial values in config/station_config.h. docs/config.md's
+// key tables are made from these bindings (`spritestation config keys --markdown`, ConfigKeyTables
+// below); a test fails when the doc is stale.
 #include <algorithm>
 #include <cctype>
 #include <cerrno>
 #include <cstring>
 #include <fstream>
 #include <map>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "capture/camera_backend.h"
 #include "config/config_detail.h"
+#include "core/error.h"
 #include "core/posix.h"
+#include "core/recording_codecs.h"
 #include "core/sql_postgres.h"
 
 namespace ss::config_detail {
@@ -24,16 +31,28 @@ using Messages = YamlMessages;
 using MapView = YamlMap;
 using Reader = YamlReader;
 
-// The docs are docs/config.md's, shortened.
+// "`a` | `b` | `c`": a closed set as the key tables write a type.
+std::string Alternatives(const std::vector<std::string>& texts) {
+  std::string out;
+  for (const std::string& t : texts) out += (out.empty() ? "`" : " | `") + t + "`";
+  return out;
+}
 
 OptionsBinder WhiteBalanceKeys(WhiteBalanceConfig& wb) {
   OptionsBinder b;
   b.AddEnum("mode", &wb.mode, kWhiteBalanceModeTexts,
-            "device: leave as is; once: auto, then lock; manual")
-      .Add("red_gain", &wb.red_gain, "a positive number", "manual: red/green balance ratio")
-      .Add("blue_gain", &wb.blue_gain, "a positive number", "manual: blue/green balance ratio")
+            "`device`: leave the device's setting; `once`: run the device's auto white balance "
+            "once at start, then lock it; `manual`: set the gains below and lock")
+      .Add("red_gain", &wb.red_gain, "a positive number",
+           "red/green balance ratio (only with `mode: manual`)")
+      .Type("number > 0")
+      .Add("blue_gain", &wb.blue_gain, "a positive number",
+           "blue/green balance ratio (only with `mode: manual`)")
+      .Type("number > 0")
       .Add("temperature_k", &wb.temperature_k, "a colour temperature in kelvin",
-           "manual: colour temperature instead of ratios (V4L2)");
+           "colour temperature in kelvin instead of the ratios (only with `mode: manual`)")
+      .Type("number 1500..15000")
+      .Default("unset");
   return b;
 }
 
@@ -66,26 +85,47 @@ void ReadWhiteBalance(Reader& r, const YAML::Node& node, const std::string& path
 
 // The settings of a device, which every backend of one takes (CameraBackend::device_settings).
 void DeviceSettingKeys(OptionsBinder& b, CameraConfig& cam) {
-  b.Add("pixel_format", &cam.pixel_format, "a string", "yuyv, bayer_rg8...; unset = device default")
-      .Add("width", &cam.width, "a width in pixels", "0 = device default")
-      .Add("height", &cam.height, "a height in pixels", "0 = device default")
-      .Add("fps", &cam.fps, "a positive number", "0 = device default")
+  b.Add("pixel_format", &cam.pixel_format, "a string",
+        "`mono8`, `bayer_rg8`, `bayer_gr8`, `bayer_gb8`, `bayer_bg8`, `rgb8`, `bgr8`, `yuyv`, "
+        "`nv12`, `mjpeg`")
+      .Default("device default")
+      .Add("width", &cam.width, "a width in pixels",
+           "image width in pixels; give `width` and `height` both or neither; a yuyv or nv12 "
+           "width must be even (an odd one is lowered by one, adjusted)")
+      .Default("device default")
+      .Add("height", &cam.height, "a height in pixels",
+           "image height in pixels; an nv12 height must be even (adjusted)")
+      .Default("device default")
+      .Add("fps", &cam.fps, "a positive number", "frames per second")
+      .Type("number > 0")
+      .Default("device default")
       .Add("exposure_us", &cam.exposure_us, "an exposure time in microseconds",
-           "unset = keep the device's value, locked")
-      .Add("gain_db", &cam.gain_db, "a gain in dB", "unset = keep the device's value, locked")
-      .AddRead("white_balance", "device", "device, once, or {mode: manual, ...}",
+           "fixed exposure time in µs. Exposure is always locked: a keyer needs it fixed")
+      .Type("number > 0")
+      .Default("the device's current value")
+      .Add("gain_db", &cam.gain_db, "a gain in dB",
+           "fixed analogue gain, locked. Aravis: dB (GenICam `Gain`); libcamera: converted to "
+           "`AnalogueGain` (10^(dB/20)); V4L2: `V4L2_CID_GAIN` has no standard unit, so the "
+           "number is written as the driver's own gain value, rounded")
+      .Type("number >= 0")
+      .Default("the device's current value")
+      .AddRead("white_balance", "device",
+               "a mode (`white_balance: once`) or a mapping ([white_balance](#white_balance))",
                [&cam](Reader& r, const MapView& view, const std::string& key) {
                  const YAML::Node* wb = r.Value(view, key);
                  if (wb) ReadWhiteBalance(r, *wb, Child(view.path(), key), cam.white_balance);
                  return wb != nullptr;
-               });
+               })
+      .Type("mode or mapping");
 }
 
 // A camera's keys after name and source: its model, and what its backend takes (the device
 // settings, and the keys the backend binds itself, capture/camera_backend.h).
 OptionsBinder CameraSettingKeys(CameraConfig& cam) {
   OptionsBinder b;
-  b.AddPath("model", &cam.model, ".cameramodel; unset: the session's, or none");
+  b.AddPath("model", &cam.model,
+            "its mrcal `.cameramodel` (intrinsics and `cam_from_ground`); empty: a replay camera "
+            "uses its session's model; a live camera without a model cannot rectify sprites");
   const CameraBackend* backend = FindCameraBackend(cam.source);
   if (backend == nullptr) return b;
   if (backend->device_settings) DeviceSettingKeys(b, cam);
@@ -106,13 +146,22 @@ std::map<std::string, std::vector<std::string>> CameraKeySources() {
   return sources;
 }
 
+// The two keys every camera has.
+OptionsBinder CameraIdentityKeys(CameraConfig& cam) {
+  OptionsBinder b;
+  b.Add("name", &cam.name, "a string",
+        "unique; letters, digits, `_`, `-`, `.`, at most 64 characters; the stem of the "
+        "camera's recorded files and its name in the bank and the API")
+      .Default("required")
+      .Add("source", &cam.source, "a string", "the camera backend")
+      .Type(Alternatives(CameraBackendNames()))
+      .Default("required");
+  return b;
+}
+
 void ReadCamera(Reader& r, const YAML::Node& node, const std::string& path, CameraConfig& cam) {
   const MapView view = r.Map(node, path);
-  OptionsBinder identity;
-  identity.Add("name", &cam.name, "a string", "unique; the stem of its recorded files")
-      .Add("source", &cam.source, "a string",
-           "the camera backend: " + Join(CameraBackendNames(), " | "));
-  identity.ReadKeys(r, view);
+  CameraIdentityKeys(cam).ReadKeys(r, view);
   // Keys that belong to another source are named as such; others are unknown.
   const auto sources = CameraKeySources();
   std::vector<std::string> all = {"name", "source"};
@@ -135,25 +184,45 @@ void ReadCamera(Reader& r, const YAML::Node& node, const std::string& path, Came
 OptionsBinder KeyingKeys(KeyingConfig& k) {
   OptionsBinder b;
   b.AddEnum("method", &k.method, kKeyingMethodTexts,
-            "chroma (a green screen) or clean_plate (any background)")
+            "`chroma`: colour-difference keying for green screens; `clean_plate`: difference "
+            "against a learned empty-enclosure plate, for backgrounds that are not green")
       .Add("training_frames", &k.training_frames, "a number of frames",
-           "empty-enclosure frames to learn from")
+           "frames of the empty enclosure learnt at start (key colour, plate, noise). Each camera "
+           "holds them at once, full size (BGR): the largest camera's frames (a camera of unset "
+           "size counts as 1920x1080) must fit in 1 GiB, and 1000 frames at most: 172 at "
+           "1920x1080, 43 at 3840x2160 (2000000000 made the daemon fail every frame with "
+           "bad_alloc)")
+      .Type("integer >= 1")
       .Add("chroma.low", &k.chroma.key_low_levels, "a level 0..255",
-           "key difference where alpha starts to fall")
-      .Add("chroma.high", &k.chroma.key_high_levels, "a level 0..255", "... and where it reaches 0")
+           "key difference (green minus the larger of red and blue, in 8-bit levels, after "
+           "learning the screen) at which alpha starts to fall from 1")
+      .Type("number 0..255")
+      .Add("chroma.high", &k.chroma.key_high_levels, "a level 0..255",
+           "... and at which the pixel is pure background (alpha 0); must be above `low`")
+      .Type("number 0..255")
       .Add("clean_plate.low_sigma", &k.clean_plate.low_sigma, "a number of noise sigmas",
-           "difference where alpha starts to rise")
+           "difference from the plate, in multiples of the pixel's noise sigma, at which alpha "
+           "starts to rise from 0")
+      .Type("number >= 0")
       .Add("clean_plate.high_sigma", &k.clean_plate.high_sigma, "a number of noise sigmas",
-           "... and where it reaches 1")
-      .Add("despill.enabled", &k.despill.enabled, "remove the green cast from the subject's edges")
-      .Add("despill.strength", &k.despill.strength, "a number 0..1", "share of the cast removed")
-      .Add("shadow.enabled", &k.shadow.enabled, "keep the contact-shadow layer")
+           "... and at which the pixel is pure subject (alpha 1); must be above `low_sigma`")
+      .Type("number >= 0")
+      .Add("despill.enabled", &k.despill.enabled,
+           "remove the screen's colour cast from subject edges")
+      .Add("despill.strength", &k.despill.strength, "a number 0..1",
+           "how much of the cast to remove (clamped to 0..1, adjusted)")
+      .Type("number 0..1")
+      .Add("shadow.enabled", &k.shadow.enabled,
+           "keep the contact shadow as its own layer (seed 000 §6)")
       .Add("shadow.min_darkening", &k.shadow.min_darkening, "a fraction 0..1",
-           "darkening below which there is no shadow")
+           "floor darker than the plate by less than this fraction is not shadow (noise)")
+      .Type("number in [0, 1)")
       .Add("shadow.max_darkening", &k.shadow.max_darkening, "a fraction 0..1",
-           "darkening that counts as full shadow")
+           "darkening that counts as full shadow; must be above `min_darkening`")
+      .Type("number in (0, 1]")
       .Add("shadow.reach_m", &k.shadow_reach_m, "a distance in metres",
-           "shadow kept this far around the foot");
+           "shadow is kept this far (ground metres) around the subject's contact point")
+      .Type("number > 0");
   return b;
 }
 
@@ -161,80 +230,135 @@ OptionsBinder KeyingKeys(KeyingConfig& k) {
 OptionsBinder EnclosureKeys(StationConfig& cfg) {
   EnclosureConfig& e = cfg.enclosure;
   OptionsBinder b;
-  b.Add("wall_height_m", &cfg.pipeline.usability.wall_height_m, "a height in metres",
-        "walls occlude the floor behind them up to this")
-      .AddRead(
-          "floor", "[]", "the floor polygon, [x, y] ground metres in order",
-          [&e](Reader& r, const MapView& view, const std::string& key) {
-            const YAML::Node* floor = r.Value(view, key);
-            if (!floor) return false;
-            if (!floor->IsSequence()) {
-              r.msg().Error("enclosure.floor",
-                            "expected a list of [x, y] points in metres, got " + ShapeOf(*floor));
-              return false;
-            }
-            if (floor->size() > GroundPolygon::kMaxVertices) {
-              r.msg().Error("enclosure.floor", std::to_string(floor->size()) +
-                                                   " points; a floor polygon has at most " +
-                                                   std::to_string(GroundPolygon::kMaxVertices));
-              return false;
-            }
-            std::vector<Eigen::Vector2d> vertices;
-            for (size_t i = 0; i < floor->size(); ++i) {
-              const YAML::Node p = (*floor)[i];
-              const std::string path = Index("enclosure.floor", i);
-              r.Mark(path, p);
-              double x = 0, y = 0;
-              if (!p.IsSequence() || p.size() != 2 || !YAML::convert<double>::decode(p[0], x) ||
-                  !YAML::convert<double>::decode(p[1], y)) {
-                r.msg().Error(path, "expected a point [x, y] in metres, got " +
-                                        (p.IsSequence() ? "a list of " + std::to_string(p.size())
-                                                        : ShapeOf(p)));
-                continue;
-              }
-              vertices.emplace_back(x, y);
-            }
-            e.floor = GroundPolygon(std::move(vertices));
-            return true;
-          });
+  b.AddRead(
+       "floor", "none",
+       "the floor polygon in ground metres (z = 0, the frame of the camera models), corners in "
+       "order around it (either direction). At least 3 points and at most 100,000 (what the "
+       "YAML reader holds in memory while it parses: ~1.5 KB a point), not crossing itself "
+       "(checked in O(n log n)), no repeated point, non-zero area. A sprite is usable only if "
+       "its contact point lies inside it (minus `pipeline.wall_margin_m`). `ingest` needs it "
+       "(it can take it from a synthetic session's truth, as a replayed camera of the daemon "
+       "does). The daemon starts without it, so that the console's calibration wizard can find "
+       "it (its enclosure step): every camera then streams for preview and recording and "
+       "stores no sprites, its tile on the station page says `no floor: calibrate`, and "
+       "`config check` lists it under `to calibrate`",
+       [&e](Reader& r, const MapView& view, const std::string& key) {
+         const YAML::Node* floor = r.Value(view, key);
+         if (!floor) return false;
+         if (!floor->IsSequence()) {
+           r.msg().Error("enclosure.floor",
+                         "expected a list of [x, y] points in metres, got " + ShapeOf(*floor));
+           return false;
+         }
+         if (floor->size() > GroundPolygon::kMaxVertices) {
+           r.msg().Error("enclosure.floor", std::to_string(floor->size()) +
+                                                " points; a floor polygon has at most " +
+                                                std::to_string(GroundPolygon::kMaxVertices));
+           return false;
+         }
+         std::vector<Eigen::Vector2d> vertices;
+         for (size_t i = 0; i < floor->size(); ++i) {
+           const YAML::Node p = (*floor)[i];
+           const std::string path = Index("enclosure.floor", i);
+           r.Mark(path, p);
+           double x = 0, y = 0;
+           if (!p.IsSequence() || p.size() != 2 || !YAML::convert<double>::decode(p[0], x) ||
+               !YAML::convert<double>::decode(p[1], y)) {
+             r.msg().Error(
+                 path, "expected a point [x, y] in metres, got " +
+                           (p.IsSequence() ? "a list of " + std::to_string(p.size()) : ShapeOf(p)));
+             continue;
+           }
+           vertices.emplace_back(x, y);
+         }
+         e.floor = GroundPolygon(std::move(vertices));
+         return true;
+       })
+      .Type("list of `[x, y]`")
+      .Default("none")
+      .Add("wall_height_m", &cfg.pipeline.usability.wall_height_m, "a height in metres",
+           "walls along the polygon's edges hide the floor behind them up to this height; used "
+           "to decide what the camera sees as floor")
+      .Type("number >= 0");
   return b;
 }
 
 // Each key bound straight to the stage option it sets (pipeline/run/camera_pipeline.h).
 OptionsBinder PipelineKeys(CameraPipelineOptions& p) {
   OptionsBinder b;
-  b.Add("min_area_px", &p.extract.min_area, "an area in pixels", "smaller blobs are noise")
+  b.Add("min_area_px", &p.extract.min_area, "an area in pixels",
+        "matte blobs smaller than this (pixels) are noise")
+      .Type("integer >= 1")
       .Add("border_margin_px", &p.usability.border_margin_px, "a number of pixels",
-           "distance to keep from the image border")
+           "a sprite this close to the image border is not usable")
+      .Type("integer >= 0")
       .Add("floor_margin_px", &p.usability.floor_margin_px, "a number of pixels",
-           "floor pixels required around the silhouette")
+           "floor pixels required all around the silhouette (else it touches a wall)")
+      .Type("integer >= 0")
       .Add("wall_margin_m", &p.usability.wall_margin_m, "a distance in metres",
-           "contact point distance to keep from the walls")
+           "the contact point must lie this far inside the floor polygon")
+      .Type("number >= 0")
       .Add("max_view_angle_deg", &p.usability.max_view_angle_deg, "an angle in degrees",
-           "steeper views of a contact point are refused (view_too_steep)")
+           "sprites seen more steeply than this (the angle at the contact point between the "
+           "floor and the ray to the camera) are refused as `view_too_steep`: an upright "
+           "billboard from above is a sliver (docs/pipeline.md). 90 keeps every view")
+      .Type("number > 0, <= 90")
       .Add("still_speed_m_per_s", &p.still_speed_m_per_s, "a speed in m/s",
-           "slower counts as not moving")
+           "a subject slower than this is standing still")
+      .Type("number > 0")
       .Add("max_speed_m_per_s", &p.track.max_speed_m_per_s, "a speed in m/s",
-           "faster starts a new clip")
+           "the tracker's speed limit: a candidate farther from a subject than this speed (plus "
+           "2 cm) allows is a new subject, its clip a new clip. 1 m/s suits small animals; "
+           "people walk at ~1.4 m/s (use 2.5 for them: `import` writes it into its "
+           "`ingest.yaml`)")
+      .Type("number > 0")
       .Add("max_still_s", &p.max_still_s, "a duration in seconds",
-           "longer still periods are discarded")
+           "still periods longer than this are discarded (seed 000: extended periods without "
+           "motion)")
+      .Type("number > 0")
       .Add("min_clip_frames", &p.batch.min_clip_frames, "a number of frames",
-           "shorter clips are discarded")
+           "clips shorter than this are discarded")
+      .Type("integer >= 1")
       .Add("noise_recover_solidity", &p.noise.recover_solidity, "a share from 0 to 1",
-           "a subject noise the frame before stays noise below this")
+           "a subject discarded as `noise` in its previous frame stays `noise` until its "
+           "solidity reaches this (keyed background flickers about the threshold); `0` = no "
+           "memory")
+      .Type("number 0..1")
       .Add("noise_thick_px", &p.noise.thick_px, "a distance in pixels",
-           "interior: this far from the matte's edge")
+           "a matte pixel more than this many pixels from the matte's edge is interior (for "
+           "`noise_min_thick_share`)")
+      .Type("number >= 0")
       .Add("noise_min_thick_share", &p.noise.min_thick_share, "a share from 0 to 1",
-           "noise below this interior share")
+           "also `noise` when less of the matte is interior (specks, thin lines); `0` is off")
+      .Type("number 0..1")
       .Add("noise_min_solidity", &p.noise.min_solidity, "a share from 0 to 1",
-           "noise below this solidity")
+           "a sprite whose matte (alpha > 1/2, in the camera image) fills less than this share "
+           "of its convex hull is discarded as `noise`: keyed background, alone or joined to a "
+           "subject (docs/pipeline.md); `0` turns it off")
+      .Type("number 0..1")
       .Add("noise_min_largest_share", &p.noise.min_largest_share, "a share from 0 to 1",
-           "noise when its largest part holds less")
+           "also `noise` when the matte's largest 8-connected part holds less of it "
+           "(fragments); `0` is off")
+      .Type("number 0..1")
       .Add("noise_min_mean_alpha", &p.noise.min_mean_alpha, "a share from 0 to 1",
-           "noise below this mean alpha")
+           "also `noise` when the mean alpha over the matte's pixels of alpha >= 16/255 is lower "
+           "(a soft haze); `0` is off")
+      .Type("number 0..1")
       .Add("merged_min_width_ratio", &p.side_by_side.min_width_ratio, "0 or a ratio of at least 1",
-           "two side by side when split and this many times one subject's width")
-      .AddRead("px_per_m", "auto", "billboard scale in pixels per metre, or auto",
+           "two subjects side by side in one blob, which the tracks never saw apart (they "
+           "walked in together), are tagged `merged` when the billboard's matte splits into a "
+           "left and a right part and is this many times as wide as one subject of the camera "
+           "(the median of the sprites counted one); the clip's later and earlier sprites that "
+           "are as wide are tagged too (docs/pipeline.md \"Merged subjects\"); `0` turns the "
+           "rule off")
+      .Type("`0` or number >= 1")
+      .AddRead("px_per_m", "auto",
+               "billboard scale in pixels per metre, one for the whole bank. `auto`: a bank that "
+               "holds sprites keeps its own scale; for an empty bank it is chosen from the "
+               "cameras (the finest camera's floor resolution at the floor's centre, capped so "
+               "that anything a camera sees whole standing on the floor fits 512 px; "
+               "docs/pipeline.md, \"The bank's scale\"). A number sets it for an empty bank; a "
+               "number other than the scale a bank already holds is an error naming both",
                [&p](Reader& r, const MapView& view, const std::string& key) {
                  // `auto` (stored as 0) or a positive number of pixels per metre.
                  if (const YAML::Node* n = view.Find(key);
@@ -250,23 +374,44 @@ OptionsBinder PipelineKeys(CameraPipelineOptions& p) {
                    r.msg().Error("pipeline.px_per_m", "expected auto or a positive number, got 0");
                  return true;
                })
+      .Type("`auto` or number > 0")
       .Add("workers", &p.workers, "a number of threads",
-           "OpenCV threads inside a frame's work; 0 = default")
+           "threads OpenCV may spread one frame's image operations over (colour conversion, "
+           "resampling); the pipeline itself runs one thread per camera, so with several "
+           "cameras `1` avoids oversubscribing the cores; `0` = OpenCV's default (one per core)")
+      .Type("integer >= 0")
       .Add("queue_frames", &p.queue_frames, "a number of frames",
-           "per-camera queue between capture and pipeline");
+           "per-camera queue between the capture thread and the pipeline; a full queue drops "
+           "(and counts) frames")
+      .Type("integer 1..1024");
   return b;
 }
 
 OptionsBinder TransitionsKeys(TransitionsConfig& t) {
   OptionsBinder b;
   b.Add("include_merged", &t.include_merged,
-        "sprites tagged merged (two subjects in one blob) take part in transitions");
+        "sprites tagged `merged` (two or more subjects in one blob, docs/pipeline.md \"Merged "
+        "subjects\") take part in the transitions the station (and `ingest --config`) keeps "
+        "current. Off: they are stored but no transition leaves or reaches them, and a table "
+        "made with them loses their transitions at the next start. `spritestation transitions "
+        "BANK` and `transitions worker` take `--include-merged` instead; every worker of a "
+        "PostgreSQL bank must agree (docs/transitions.md)");
   return b;
+}
+
+std::vector<std::string> RecordingCodecNames() {
+  std::vector<std::string> names;
+  for (const RecordingCodec& c : RecordingCodecs()) names.push_back(c.name);
+  return names;
 }
 
 OptionsBinder StorageKeys(StorageConfig& s) {
   OptionsBinder b;
-  b.AddRead("bank", Quoted(s.bank), "the sprite bank: a file, or a PostgreSQL server's address",
+  b.AddRead("bank", s.bank,
+            "the sprite bank: one SQLite file, created if missing, or a PostgreSQL database "
+            "shared by many stations, its schema created by the first writer (docs/scaling.md). "
+            "A folder or a device (`/dev/null`) is refused, by `config check` with the daemon's "
+            "words: `FILE: not a sprite bank (a folder)`, `... (not a regular file)`",
             [&s](Reader& r, const MapView& view, const std::string& key) {
               // A file (resolved against the config's folder) or a PostgreSQL address, kept as
               // written.
@@ -276,26 +421,48 @@ OptionsBinder StorageKeys(StorageConfig& s) {
               if (sql::IsPostgresAddress(raw)) s.bank = raw;
               return true;
             })
-      .AddPath("recording_dir", &s.recording_dir, "where recorded sessions go")
+      .Type("path or `postgresql://…`")
+      .AddPath("recording_dir", &s.recording_dir, "where recorded sessions are written")
       .AddEnum("recording", &s.recording, kRecordingModeTexts,
-               "off, all frames, or those that gave a usable sprite")
-      .Add("recording_codec", &s.recording_codec, "a string", "ffv1, mjpeg or h264")
+               "raw recording: none, every frame, or only frames that gave a usable sprite")
+      .Add("recording_codec", &s.recording_codec, "a string",
+           "codec of recorded video: ffv1 is lossless with a CRC per slice; ffvhuff is "
+           "lossless, ~8x faster to decode at 1080p, ~14 % larger, without checksums "
+           "(docs/formats.md)")
+      .Type(Alternatives(RecordingCodecNames()))
       .Add("stop_recording_below_mib", &s.stop_recording_below_mib, "a size in MiB",
-           "free disk under which raw recording stops")
+           "when free disk space falls below this (MiB), raw recording stops first")
+      .Type("integer >= 0")
       .Add("stop_sprites_below_mib", &s.stop_sprites_below_mib, "a size in MiB",
-           "free disk under which sprite storage stops")
-      .AddPath("spool_dir", &s.spool_dir, "where clip batches wait while the bank cannot take them")
-      .Add("spool_max_mib", &s.spool_max_mib, "a size in MiB", "how much the spool may fill");
+           "below this, sprite storage stops too (the bank is committed, never corrupted); "
+           "`stop_recording_below_mib` is raised to at least this (adjusted)")
+      .Type("integer >= 0")
+      .AddPath("spool_dir", &s.spool_dir,
+               "where clip batches wait on disk while the bank cannot take them (a PostgreSQL "
+               "server gone, a SQLite file locked past every retry); drained in order when it "
+               "answers, also at the next start (docs/daemon.md)")
+      .Add("spool_max_mib", &s.spool_max_mib, "a size in MiB",
+           "the most the spool may hold; a batch beyond it fails as an append would (counted, "
+           "logged)")
+      .Type("integer >= 1");
   return b;
 }
 
 OptionsBinder ControlKeys(ControlConfig& c) {
   OptionsBinder b;
-  b.Add("address", &c.address, "an IP address", "where the control server listens")
-      .Add("port", &c.port, "a port number 0..65535", "0 = any free port")
-      .Add("token", &c.token, "a string", "required when address is not loopback (>= 16 chars)")
+  b.Add("address", &c.address, "an IP address",
+        "address the HTTP control API binds to; `0.0.0.0` or `::` for every interface")
+      .Type("IP address or `localhost`")
+      .Add("port", &c.port, "a port number 0..65535",
+           "its port; `0` picks a free port (the daemon logs and reports it)")
+      .Type("integer 0..65535")
+      .Add("token", &c.token, "a string",
+           "bearer token clients must send. **Required when `address` is not loopback** "
+           "(127.0.0.0/8, `::1`, `localhost`); at least 16 characters")
       .AddRead(
-          "token_file", "\"\"", "a file holding the token",
+          "token_file", "none",
+          "read the token from this file's first line instead (keeps secrets out of the "
+          "config); give `token` or `token_file`, not both",
           [&c](Reader& r, const MapView& view, const std::string& key) {
             std::string token_file;
             if (!r.Path(view, key, token_file)) return false;
@@ -315,14 +482,18 @@ OptionsBinder ControlKeys(ControlConfig& c) {
             if (c.token.empty())
               r.msg().Error("control.token_file", token_file + ": the file is empty");
             return true;
-          });
+          })
+      .Type("path")
+      .Default("none");
   return b;
 }
 
 OptionsBinder LoggingKeys(LoggingConfig& l) {
   OptionsBinder b;
-  b.Add("level", &l.level, "a log level", Join(kLogLevels, " "))
-      .AddRead("components", "{}", "a level per component, e.g. capture.aravis: debug",
+  b.Add("level", &l.level, "a log level", "level of every component")
+      .Type(Alternatives(kLogLevels))
+      .AddRead("components", "{}",
+               "per-component levels, e.g. `capture.aravis: debug`, `pipeline.key: warn`",
                [&l](Reader& r, const MapView& view, const std::string& key) {
                  const YAML::Node* n = r.Value(view, key);
                  if (!n) return false;
@@ -333,7 +504,8 @@ OptionsBinder LoggingKeys(LoggingConfig& l) {
                      l.components[component] = level;
                  }
                  return true;
-               });
+               })
+      .Type("mapping component → level");
   return b;
 }
 
@@ -353,8 +525,15 @@ OptionsBinder::ReadFn Section(OptionsBinder (*keys)(Config&), Config& config) {
 OptionsBinder StationKeys(StationConfig& cfg) {
   if (!cfg.pipeline.keying) cfg.pipeline.keying.emplace();  // the keying section's home
   OptionsBinder b;
-  b.Add("version", &cfg.version, "a config version number", "the config format's version")
-      .AddRead("cameras", "[]", "the cameras, each a mapping",
+  b.Add("version", &cfg.version, "a config version number",
+        "config format version; a newer version is refused with a clear message")
+      .AddRead("cameras", "[]",
+               "the cameras; the daemon needs at least one (without the key the daemon refuses "
+               "the file, `cameras: the station needs at least one camera`, and `config check` "
+               "prints that line under `the daemon refuses it:` with exit 0, since the file is "
+               "valid for `ingest --config`), `ingest --config` uses the session's. Given, the "
+               "list holds at least one camera (`cameras: []` is refused: `expected at least one "
+               "camera`; replay and ingest did nothing and exited 0)",
                [&cfg](Reader& r, const MapView& view, const std::string& key) {
                  const YAML::Node* cams = r.Value(view, key);
                  if (!cams) return false;
@@ -374,14 +553,206 @@ OptionsBinder StationKeys(StationConfig& cfg) {
                  }
                  return true;
                })
-      .AddRead("keying", "", "keying.*", Section(KeyingKeys, *cfg.pipeline.keying))
-      .AddRead("enclosure", "", "enclosure.*", Section(EnclosureKeys, cfg))
-      .AddRead("pipeline", "", "pipeline.*", Section(PipelineKeys, cfg.pipeline))
-      .AddRead("transitions", "", "transitions.*", Section(TransitionsKeys, cfg.transitions))
-      .AddRead("storage", "", "storage.*", Section(StorageKeys, cfg.storage))
-      .AddRead("control", "", "control.*", Section(ControlKeys, cfg.control))
-      .AddRead("logging", "", "logging.*", Section(LoggingKeys, cfg.logging));
+      .Type("list of [camera](#cameras)");
+  // The blocks, each a table of its own.
+  const auto section = [&b](const char* key, const char* doc, OptionsBinder::ReadFn read) {
+    b.AddRead(key, "", doc, std::move(read))
+        .Type("[mapping](#" + std::string(key) + ")")
+        .Default("see below");
+  };
+  section("keying", "how frames become mattes", Section(KeyingKeys, *cfg.pipeline.keying));
+  section("enclosure", "the floor the subjects walk on", Section(EnclosureKeys, cfg));
+  section("pipeline", "thresholds of the live pipeline", Section(PipelineKeys, cfg.pipeline));
+  section("transitions", "which sprites take part in transitions",
+          Section(TransitionsKeys, cfg.transitions));
+  section("storage", "bank, recordings, disk limits", Section(StorageKeys, cfg.storage));
+  section("control", "the HTTP control API", Section(ControlKeys, cfg.control));
+  section("logging", "log levels", Section(LoggingKeys, cfg.logging));
   return b;
 }
 
+namespace {
+
+// Where a camera key's row says it applies: every backend, every live one (those that take
+// the device settings), or the backends by name.
+std::string SourcesCell(const std::vector<std::string>& backends) {
+  std::vector<std::string> all, live;
+  for (const CameraBackend* backend : CameraBackends()) {
+    all.push_back(backend->name);
+    if (backend->device_settings) live.push_back(backend->name);
+  }
+  if (backends == all) return "all";
+  if (backends == live) return "live";
+  return Join(backends, ", ");
+}
+
+// One Markdown table: its header, then a row of cells each; '|' in a cell is escaped.
+std::string Table(const std::vector<std::string>& header,
+                  const std::vector<std::vector<std::string>>& rows) {
+  const auto line = [](const std::vector<std::string>& cells) {
+    std::string out = "|";
+    for (std::string cell : cells) {
+      for (size_t at = cell.find('|'); at != std::string::npos; at = cell.find('|', at + 2))
+        cell.replace(at, 1, "\\|");
+      out += " " + cell + " |";
+    }
+    return out + "\n";
+  };
+  std::string out = line(header) + "|";
+  for (size_t i = 0; i < header.size(); ++i) out += "---|";
+  out += "\n";
+  for (const auto& row : rows) out += line(row);
+  return out;
+}
+
+std::string KeyTable(const OptionsBinder& keys) {
+  std::vector<std::vector<std::string>> rows;
+  for (const OptionsBinder::Row& r : keys.Rows())
+    rows.push_back({"`" + r.key + "`", r.type, r.default_cell, r.doc});
+  return Table({"key", "type", "default", "meaning"}, rows);
+}
+
+// The cameras' keys: name and source, then every backend's in the order the backends bind
+// them, each with the backends that take it ("all", "live" or names); a key two backends
+// document apart gets both docs. Each row: key, type, default, sources, doc.
+std::vector<std::vector<std::string>> CameraRows() {
+  struct Entry {
+    OptionsBinder::Row row;
+    std::vector<std::string> backends;
+    std::vector<std::string> docs;  // "backend: doc" each, when they differ
+  };
+  std::vector<Entry> entries;
+  CameraConfig scratch;
+  for (const OptionsBinder::Row& r : CameraIdentityKeys(scratch).Rows())
+    entries.push_back({r, {}, {}});
+  for (const CameraBackend* backend : CameraBackends()) {
+    CameraConfig cam;
+    cam.source = backend->name;
+    for (const OptionsBinder::Row& r : CameraSettingKeys(cam).Rows()) {
+      auto it = std::find_if(entries.begin(), entries.end(),
+                             [&](const Entry& e) { return e.row.key == r.key; });
+      if (it == entries.end()) {
+        entries.push_back({r, {}, {}});
+        it = entries.end() - 1;
+      } else if (it->row.doc != r.doc && it->docs.empty()) {
+        it->docs.push_back(it->backends.front() + ": " + it->row.doc);
+      }
+      if (!it->docs.empty() || it->row.doc != r.doc)
+        it->docs.push_back(backend->name + ": " + r.doc);
+      it->backends.push_back(backend->name);
+    }
+  }
+  std::vector<std::vector<std::string>> rows;
+  for (const Entry& e : entries) {
+    const bool everywhere = e.backends.empty() || e.row.key == "model";
+    rows.push_back({e.row.key, e.row.type, e.row.default_cell,
+                    everywhere ? "all" : SourcesCell(e.backends),
+                    e.docs.empty() ? e.row.doc : Join(e.docs, "; ")});
+  }
+  return rows;
+}
+
+std::string CameraTable() {
+  std::vector<std::vector<std::string>> rows = CameraRows();
+  for (auto& row : rows) row[0] = "`" + row[0] + "`";
+  return Table({"key", "type", "default", "sources", "meaning"}, rows);
+}
+
+constexpr const char* kTableBegin = "<!-- generated by `spritestation config keys --markdown`: ";
+constexpr const char* kTableEnd = "<!-- end of generated table -->";
+
+// Every table, by name, in the order of docs/config.md.
+// A config of the defaults, as LoadStationConfig starts one (its paths not yet resolved).
+StationConfig Defaults() {
+  StationConfig cfg;
+  cfg.pipeline.keying.emplace();
+  cfg.storage.bank = kDefaultBank;
+  cfg.storage.recording_dir = kDefaultRecordingDir;
+  cfg.storage.spool_dir = kDefaultSpoolDir;
+  return cfg;
+}
+
+std::vector<std::pair<std::string, std::string>> KeyTables() {
+  StationConfig cfg = Defaults();
+  CameraConfig cam;
+  return {{"top", KeyTable(StationKeys(cfg))},
+          {"cameras", CameraTable()},
+          {"white_balance", KeyTable(WhiteBalanceKeys(cam.white_balance))},
+          {"keying", KeyTable(KeyingKeys(*cfg.pipeline.keying))},
+          {"enclosure", KeyTable(EnclosureKeys(cfg))},
+          {"pipeline", KeyTable(PipelineKeys(cfg.pipeline))},
+          {"transitions", KeyTable(TransitionsKeys(cfg.transitions))},
+          {"storage", KeyTable(StorageKeys(cfg.storage))},
+          {"control", KeyTable(ControlKeys(cfg.control))},
+          {"logging", KeyTable(LoggingKeys(cfg.logging))}};
+}
+
+}  // namespace
+
 }  // namespace ss::config_detail
+
+namespace ss {
+
+std::string ConfigKeysMarkdown() {
+  std::string out;
+  for (const auto& [name, table] : config_detail::KeyTables())
+    out += (out.empty() ? "" : "\n") + std::string(config_detail::kTableBegin) + name + " -->\n" +
+           table + config_detail::kTableEnd + "\n";
+  return out;
+}
+
+std::string WithConfigKeyTables(const std::string& doc, const std::string& origin) {
+  const auto tables = config_detail::KeyTables();
+  std::vector<std::string> seen;
+  std::string out;
+  size_t at = 0;
+  for (size_t begin; (begin = doc.find(config_detail::kTableBegin, at)) != std::string::npos;) {
+    const size_t name_at = begin + std::strlen(config_detail::kTableBegin);
+    const size_t name_end = doc.find(" -->", name_at);
+    const size_t end = doc.find(config_detail::kTableEnd, name_at);
+    if (name_end == std::string::npos || end == std::string::npos || name_end > end)
+      throw InputError(origin + ": a generated table's marker is not closed");
+    const std::string name = doc.substr(name_at, name_end - name_at);
+    const auto it =
+        std::find_if(tables.begin(), tables.end(), [&](const auto& t) { return t.first == name; });
+    if (it == tables.end()) throw InputError(origin + ": no key table named \"" + name + "\"");
+    seen.push_back(name);
+    out += doc.substr(at, name_end + 5 - at) + it->second;  // through " -->\n"
+    at = end;
+  }
+  out += doc.substr(at);
+  for (const auto& [name, table] : tables) {
+    if (std::find(seen.begin(), seen.end(), name) == seen.end())
+      throw InputError(origin + ": holds no key table \"" + name + "\" (" +
+                       config_detail::kTableBegin + name + " -->)");
+  }
+  return out;
+}
+
+std::string ConfigKeysText() {
+  using namespace config_detail;
+  StationConfig cfg = Defaults();
+  CameraConfig cam;
+  std::string out;
+  const auto add = [&out](const std::string& prefix, const OptionsBinder& keys) {
+    for (const OptionsBinder::Row& r : keys.Rows()) {
+      if (r.default_cell == "see below") continue;  // a block: its keys follow
+      out += prefix + r.key + " (" + r.type + ", default " + r.default_cell + "): " + r.doc + "\n";
+    }
+  };
+  add("", StationKeys(cfg));
+  for (const auto& row : CameraRows())
+    out += "cameras[]." + row[0] + " (" + row[1] + ", default " + row[2] + ", sources " + row[3] +
+           "): " + row[4] + "\n";
+  add("cameras[].white_balance.", WhiteBalanceKeys(cam.white_balance));
+  add("keying.", KeyingKeys(*cfg.pipeline.keying));
+  add("enclosure.", EnclosureKeys(cfg));
+  add("pipeline.", PipelineKeys(cfg.pipeline));
+  add("transitions.", TransitionsKeys(cfg.transitions));
+  add("storage.", StorageKeys(cfg.storage));
+  add("control.", ControlKeys(cfg.control));
+  add("logging.", LoggingKeys(cfg.logging));
+  return out;
+}
+
+}  // namespace ss

@@ -52,9 +52,9 @@ StationConfig ParseStationConfig(const std::string& yaml, const std::string& ori
   Reader r(msg, lines, base_dir);
 
   StationConfig cfg;
-  cfg.storage.bank = r.Resolve("station.bank");
-  cfg.storage.recording_dir = r.Resolve("recordings");
-  cfg.storage.spool_dir = r.Resolve("spool");
+  cfg.storage.bank = r.Resolve(config_detail::kDefaultBank);
+  cfg.storage.recording_dir = r.Resolve(config_detail::kDefaultRecordingDir);
+  cfg.storage.spool_dir = r.Resolve(config_detail::kDefaultSpoolDir);
   config_detail::StationKeys(cfg).Read(r, root, "");
 
   config_detail::Validate(cfg, msg, options);

@@ -132,4 +132,13 @@ ConfigReport ValidateStationConfig(StationConfig& config, const std::string& ori
 // True for 127.0.0.0/8, ::1 and "localhost".
 bool IsLoopbackAddress(const std::string& address);
 
+// The file's keys as config/config_keys.cc binds them, with type, default and doc
+// (`spritestation config keys`): one line a key, its path dotted...
+std::string ConfigKeysText();
+// ... or docs/config.md's key tables in Markdown, each between its markers.
+std::string ConfigKeysMarkdown();
+// `doc` (named `origin` in errors) with each key table between its markers made anew; throws
+// InputError when a marker is broken, names no table, or a table has none.
+std::string WithConfigKeyTables(const std::string& doc, const std::string& origin);
+
 }  // namespace ss

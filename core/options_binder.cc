@@ -1,5 +1,6 @@
 #include "core/options_binder.h"
 
+#include <stdexcept>
 #include <utility>
 
 namespace ss {
@@ -16,72 +17,92 @@ std::pair<std::string, std::string> SplitFirst(const std::string& key) {
 
 }  // namespace
 
+OptionsBinder& OptionsBinder::Bind(std::string key, std::string type, std::string default_text,
+                                   std::string doc, ReadFn read) {
+  if (doc.empty()) throw std::logic_error("config key \"" + key + "\" bound without a doc");
+  bindings_.push_back({std::move(key), std::move(type), std::move(default_text), false,
+                       std::move(doc), std::move(read)});
+  return *this;
+}
+
 OptionsBinder& OptionsBinder::AddRead(std::string key, std::string default_text, std::string doc,
                                       ReadFn read) {
-  bindings_.push_back({std::move(key), std::move(default_text), std::move(doc), std::move(read)});
+  return Bind(std::move(key), "", std::move(default_text), std::move(doc), std::move(read));
+}
+
+OptionsBinder& OptionsBinder::Type(std::string type) {
+  if (bindings_.empty()) throw std::logic_error("Type() before any key was bound");
+  bindings_.back().type = std::move(type);
+  return *this;
+}
+
+OptionsBinder& OptionsBinder::Default(std::string words) {
+  if (bindings_.empty()) throw std::logic_error("Default() before any key was bound");
+  bindings_.back().default_text = std::move(words);
+  bindings_.back().default_in_words = true;
   return *this;
 }
 
 OptionsBinder& OptionsBinder::Add(std::string key, int* field, std::string expected,
                                   std::string doc) {
-  return AddRead(std::move(key), std::to_string(*field), std::move(doc),
-                 [field, expected = std::move(expected)](YamlReader& r, const YamlMap& view,
-                                                         const std::string& k) {
-                   return r.Int(view, k, *field, expected);
-                 });
+  return Bind(std::move(key), "integer", std::to_string(*field), std::move(doc),
+              [field, expected = std::move(expected)](YamlReader& r, const YamlMap& view,
+                                                      const std::string& k) {
+                return r.Int(view, k, *field, expected);
+              });
 }
 
 OptionsBinder& OptionsBinder::Add(std::string key, int64_t* field, std::string expected,
                                   std::string doc) {
-  return AddRead(std::move(key), std::to_string(*field), std::move(doc),
-                 [field, expected = std::move(expected)](YamlReader& r, const YamlMap& view,
-                                                         const std::string& k) {
-                   return r.Int64(view, k, *field, expected);
-                 });
+  return Bind(std::move(key), "integer", std::to_string(*field), std::move(doc),
+              [field, expected = std::move(expected)](YamlReader& r, const YamlMap& view,
+                                                      const std::string& k) {
+                return r.Int64(view, k, *field, expected);
+              });
 }
 
 OptionsBinder& OptionsBinder::Add(std::string key, double* field, std::string expected,
                                   std::string doc) {
-  return AddRead(std::move(key), Num(*field), std::move(doc),
-                 [field, expected = std::move(expected)](YamlReader& r, const YamlMap& view,
-                                                         const std::string& k) {
-                   return r.Number(view, k, *field, expected);
-                 });
+  return Bind(std::move(key), "number", Num(*field), std::move(doc),
+              [field, expected = std::move(expected)](YamlReader& r, const YamlMap& view,
+                                                      const std::string& k) {
+                return r.Number(view, k, *field, expected);
+              });
 }
 
 OptionsBinder& OptionsBinder::Add(std::string key, std::optional<double>* field,
                                   std::string expected, std::string doc) {
-  return AddRead(std::move(key), *field ? Num(**field) : "unset", std::move(doc),
-                 [field, expected = std::move(expected)](YamlReader& r, const YamlMap& view,
-                                                         const std::string& k) {
-                   double v = 0;
-                   if (!r.Number(view, k, v, expected)) return false;
-                   *field = v;
-                   return true;
-                 });
+  return Bind(std::move(key), "number", *field ? Num(**field) : "unset", std::move(doc),
+              [field, expected = std::move(expected)](YamlReader& r, const YamlMap& view,
+                                                      const std::string& k) {
+                double v = 0;
+                if (!r.Number(view, k, v, expected)) return false;
+                *field = v;
+                return true;
+              });
 }
 
 OptionsBinder& OptionsBinder::Add(std::string key, bool* field, std::string doc) {
-  return AddRead(std::move(key), *field ? "true" : "false", std::move(doc),
-                 [field](YamlReader& r, const YamlMap& view, const std::string& k) {
-                   return r.Bool(view, k, *field);
-                 });
+  return Bind(std::move(key), "bool", *field ? "true" : "false", std::move(doc),
+              [field](YamlReader& r, const YamlMap& view, const std::string& k) {
+                return r.Bool(view, k, *field);
+              });
 }
 
 OptionsBinder& OptionsBinder::Add(std::string key, std::string* field, std::string expected,
                                   std::string doc) {
-  return AddRead(std::move(key), Quoted(*field), std::move(doc),
-                 [field, expected = std::move(expected)](YamlReader& r, const YamlMap& view,
-                                                         const std::string& k) {
-                   return r.String(view, k, *field, expected);
-                 });
+  return Bind(std::move(key), "string", field->empty() ? "\"\"" : *field, std::move(doc),
+              [field, expected = std::move(expected)](YamlReader& r, const YamlMap& view,
+                                                      const std::string& k) {
+                return r.String(view, k, *field, expected);
+              });
 }
 
 OptionsBinder& OptionsBinder::AddPath(std::string key, std::string* field, std::string doc) {
-  return AddRead(std::move(key), Quoted(*field), std::move(doc),
-                 [field](YamlReader& r, const YamlMap& view, const std::string& k) {
-                   return r.Path(view, k, *field);
-                 });
+  return Bind(std::move(key), "path", field->empty() ? "\"\"" : *field, std::move(doc),
+              [field](YamlReader& r, const YamlMap& view, const std::string& k) {
+                return r.Path(view, k, *field);
+              });
 }
 
 void OptionsBinder::Read(YamlReader& r, const YAML::Node& node, const std::string& path) const {
@@ -110,7 +131,9 @@ void OptionsBinder::ReadKeys(YamlReader& r, const YamlMap& view) const {
     for (const Binding& inner : bindings_) {
       const auto [inner_first, inner_rest] = SplitFirst(inner.key);
       if (inner_first == first && !inner_rest.empty()) {
-        block.bindings_.push_back({inner_rest, inner.default_text, inner.doc, inner.read});
+        Binding b = inner;
+        b.key = inner_rest;
+        block.bindings_.push_back(std::move(b));
       }
     }
     if (const YAML::Node* n = r.Value(view, first)) block.Read(r, *n, Child(view.path(), first));
@@ -130,6 +153,16 @@ std::string OptionsBinder::Describe(const std::string& prefix) const {
         Child(prefix, b.key) + ": " + b.default_text + (b.doc.empty() ? "" : "  # " + b.doc) + "\n";
   }
   return out;
+}
+
+std::vector<OptionsBinder::Row> OptionsBinder::Rows() const {
+  std::vector<Row> rows;
+  for (const Binding& b : bindings_) {
+    if (b.type.empty()) throw std::logic_error("config key \"" + b.key + "\" bound without a type");
+    rows.push_back(
+        {b.key, b.type, b.default_in_words ? b.default_text : "`" + b.default_text + "`", b.doc});
+  }
+  return rows;
 }
 
 }  // namespace ss

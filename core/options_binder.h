@@ -34,13 +34,24 @@ class OptionsBinder {
   template <typename E, size_t N>
   OptionsBinder& AddEnum(std::string key, E* field, const EnumText<E> (&texts)[N],
                          std::string doc) {
-    return AddRead(std::move(key), TextOf(*field, texts), std::move(doc),
-                   [field, &texts](YamlReader& r, const YamlMap& view, const std::string& k) {
-                     return r.Enum(view, k, *field, texts);
-                   });
+    std::string type;
+    for (const EnumText<E>& t : texts)
+      type += (type.empty() ? "`" : " | `") + std::string(t.text) + "`";
+    return Bind(std::move(key), std::move(type), TextOf(*field, texts), std::move(doc),
+                [field, &texts](YamlReader& r, const YamlMap& view, const std::string& k) {
+                  return r.Enum(view, k, *field, texts);
+                });
   }
-  // A key whose value has a shape of its own (`auto` or a number, a list of points...).
+  // A key whose value has a shape of its own (`auto` or a number, a list of points...); its
+  // type for the docs is given with Type().
   OptionsBinder& AddRead(std::string key, std::string default_text, std::string doc, ReadFn read);
+
+  // Of the key bound last: its type as the docs' key tables say it ("integer >= 1"; by default
+  // the field's: integer, number, bool, string, path, or the enum's texts)...
+  OptionsBinder& Type(std::string type);
+  // ... and its default when that is not the field's value: words ("required", "the device's
+  // current value"), written into the tables as they are.
+  OptionsBinder& Default(std::string words);
 
   // Reads the mapping `node` at `path` ("" for the top level): unknown keys first, then each
   // bound key in the order it was bound. Reports to r.msg(); never throws.
@@ -51,16 +62,29 @@ class OptionsBinder {
 
   // Every key bound, with dots, in the order bound.
   std::vector<std::string> Keys() const;
-  // "key: default  # doc", one line per key (`spritestation config keys`, docs/config.md).
+  // "key: default  # doc", one line per key (`spritestation config keys`).
   std::string Describe(const std::string& prefix = "") const;
+
+  // One row of a key table (docs/config.md, `spritestation config keys --markdown`): every
+  // cell in Markdown, the default as code unless given in words.
+  struct Row {
+    std::string key, type, default_cell, doc;
+  };
+  // Every key bound, in the order bound; throws std::logic_error naming a key bound without
+  // its type or doc (a key the docs cannot describe is a defect of the code, not of a config).
+  std::vector<Row> Rows() const;
 
  private:
   struct Binding {
     std::string key;  // relative to the block, dotted
+    std::string type;
     std::string default_text;
+    bool default_in_words = false;
     std::string doc;
     ReadFn read;
   };
+  OptionsBinder& Bind(std::string key, std::string type, std::string default_text, std::string doc,
+                      ReadFn read);
   std::vector<Binding> bindings_;
 };
 

@@ -31,11 +31,16 @@ void RegisterAravisCameraBackend() {
          return out;
        },
        [](OptionsBinder& keys, CameraConfig& camera) {
-         keys.Add("camera_id", &camera.camera_id, "a string", "the device id")
-             .Add("address", &camera.address, "a string", "IP address of a GigE Vision camera")
-             .Add("packet_resend", &camera.packet_resend, "ask for lost GVSP packets again")
+         keys.Add("camera_id", &camera.camera_id, "a string",
+                  "the device id, as `arv-tool-0.8` lists it; give `camera_id` or `address`, "
+                  "not both")
+             .Add("address", &camera.address, "a string", "a GigE Vision camera's IP address")
+             .Type("IP address")
+             .Add("packet_resend", &camera.packet_resend,
+                  "ask the camera to resend lost GVSP packets")
              .Add("packet_size", &camera.packet_size, "a packet size in bytes",
-                  "GigE packet size, 0 = negotiate");
+                  "GVSP packet size in bytes; `0` negotiates")
+             .Type("integer: `0` or 576..16384");
        },
        [](CameraConfig& camera, std::string* why) {
          OptionProblems check(why);

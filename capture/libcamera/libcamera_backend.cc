@@ -19,7 +19,8 @@ void RegisterLibcameraCameraBackend() {
          return out;
        },
        [](OptionsBinder& keys, CameraConfig& camera) {
-         keys.Add("camera_id", &camera.camera_id, "a string", "the device id");
+         keys.Add("camera_id", &camera.camera_id, "a string",
+                  "the camera's id, as `spritestation cameras` lists it; empty: the first camera");
        },
        nullptr});
 }

@@ -17,11 +17,17 @@ void RegisterReplayCameraBackend() {
                          },
                          nullptr,
                          [](OptionsBinder& keys, CameraConfig& camera) {
-                           keys.AddPath("session", &camera.session, "the recorded session's folder")
+                           keys.AddPath("session", &camera.session,
+                                        "a recorded-session folder (holds `session.json`, see "
+                                        "docs/formats.md)")
+                               .Default("required")
                                .Add("session_camera", &camera.session_camera, "a string",
-                                    "the camera within the session (default: its name)")
-                               .Add("loop", &camera.loop, "start over at the end")
-                               .Add("realtime", &camera.realtime, "paced by the device timestamps");
+                                    "which of the session's cameras to replay")
+                               .Default("the camera's `name`")
+                               .Add("loop", &camera.loop, "start over at the end of the recording")
+                               .Add("realtime", &camera.realtime,
+                                    "pace frames by their recorded device timestamps (`false`: as "
+                                    "fast as possible)");
                          },
                          [](CameraConfig& camera, std::string* why) {
                            OptionProblems check(why);

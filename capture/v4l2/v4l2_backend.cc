@@ -28,7 +28,8 @@ void RegisterV4l2CameraBackend() {
          return out;
        },
        [](OptionsBinder& keys, CameraConfig& camera) {
-         keys.Add("device", &camera.device, "a string", "the device, e.g. /dev/video0");
+         keys.Add("device", &camera.device, "a string", "the device node, e.g. `/dev/video0`")
+             .Default("required");
        },
        [](CameraConfig& camera, std::string* why) {
          OptionProblems check(why);

@@ -2,6 +2,8 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
+#include <string>
 
 #include <gtest/gtest.h>
 
@@ -189,6 +191,45 @@ TEST(StationConfig, OversizedFilesAreRefusedWithExitCode2) {
           spec + ": 238.4 MiB (250000000 bytes): larger than the 16 MiB an animation spec may be"),
       std::string::npos)
       << r.output;
+}
+
+std::string Slurp(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+// `config keys --update` rewrites a stale copy of docs/config.md into the doc as committed, and
+// says so; on the doc as committed it changes nothing. `--markdown` prints the tables it holds.
+TEST(StationConfig, KeysCommandRewritesTheDocsKeyTables) {
+  if (!Environment("SPRITESTATION_BIN"))
+    GTEST_SKIP() << "SPRITESTATION_BIN not set (run through ctest)";
+  const std::string committed = Slurp(ss::testing::SourcePath("docs/config.md"));
+  ScratchDir dir;
+  const std::string copy = dir / "config.md";
+  std::string stale = committed;
+  const size_t row = stale.find("| `queue_frames` |");
+  ASSERT_NE(row, std::string::npos);
+  stale.erase(row, stale.find('\n', row) + 1 - row);
+  std::ofstream(copy) << stale;
+  auto r = ss::testing::RunSpritestation("config keys --update " + copy);
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find(copy + ": key tables rewritten"), std::string::npos) << r.output;
+  EXPECT_EQ(Slurp(copy), committed);
+  r = ss::testing::RunSpritestation("config keys --update " + copy);
+  EXPECT_NE(r.output.find(copy + ": the key tables are up to date"), std::string::npos) << r.output;
+
+  r = ss::testing::RunSpritestation("config keys --markdown");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(committed.find(r.output.substr(0, r.output.find("<!-- end of generated table -->"))),
+            std::string::npos)
+      << "the first table printed is not the doc's";
+  // A file without the markers: refused by name, left as it was.
+  const std::string other = dir / "other.md";
+  std::ofstream(other) << "# no tables\n";
+  r = ss::testing::RunSpritestation("config keys --update " + other);
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.output.find(other + ": holds no key table \"top\""), std::string::npos) << r.output;
+  EXPECT_EQ(Slurp(other), "# no tables\n");
 }
 
 }  // namespace
