@@ -31,6 +31,18 @@ using Messages = YamlMessages;
 using MapView = YamlMap;
 using Reader = YamlReader;
 
+// The value of `key` when it is a list; null when absent or not a list (reported: "expected
+// EXPECTED, got ...").
+const YAML::Node* ListValue(Reader& r, const MapView& view, const std::string& key,
+                            const std::string& expected) {
+  const YAML::Node* n = r.Value(view, key);
+  if (n && !n->IsSequence()) {
+    r.msg().Error(Child(view.path(), key), "expected " + expected + ", got " + ShapeOf(*n));
+    return nullptr;
+  }
+  return n;
+}
+
 // "`a` | `b` | `c`": a closed set as the key tables write a type.
 std::string Alternatives(const std::vector<std::string>& texts) {
   std::string out;
@@ -226,6 +238,35 @@ OptionsBinder KeyingKeys(KeyingConfig& k) {
   return b;
 }
 
+// enclosure.floor: a list of [x, y] points in metres, at most GroundPolygon::kMaxVertices.
+bool ReadFloor(Reader& r, const MapView& view, const std::string& key, GroundPolygon& out) {
+  const YAML::Node* floor = ListValue(r, view, key, "a list of [x, y] points in metres");
+  if (!floor) return false;
+  if (floor->size() > GroundPolygon::kMaxVertices) {
+    r.msg().Error("enclosure.floor", std::to_string(floor->size()) +
+                                         " points; a floor polygon has at most " +
+                                         std::to_string(GroundPolygon::kMaxVertices));
+    return false;
+  }
+  std::vector<Eigen::Vector2d> vertices;
+  for (size_t i = 0; i < floor->size(); ++i) {
+    const YAML::Node p = (*floor)[i];
+    const std::string path = Index("enclosure.floor", i);
+    r.Mark(path, p);
+    double x = 0, y = 0;
+    if (!p.IsSequence() || p.size() != 2 || !YAML::convert<double>::decode(p[0], x) ||
+        !YAML::convert<double>::decode(p[1], y)) {
+      r.msg().Error(path,
+                    "expected a point [x, y] in metres, got " +
+                        (p.IsSequence() ? "a list of " + std::to_string(p.size()) : ShapeOf(p)));
+      continue;
+    }
+    vertices.emplace_back(x, y);
+  }
+  out = GroundPolygon(std::move(vertices));
+  return true;
+}
+
 // wall_height_m tunes the pipeline's usability tests: bound to their field.
 OptionsBinder EnclosureKeys(StationConfig& cfg) {
   EnclosureConfig& e = cfg.enclosure;
@@ -243,36 +284,7 @@ OptionsBinder EnclosureKeys(StationConfig& cfg) {
        "stores no sprites, its tile on the station page says `no floor: calibrate`, and "
        "`config check` lists it under `to calibrate`",
        [&e](Reader& r, const MapView& view, const std::string& key) {
-         const YAML::Node* floor = r.Value(view, key);
-         if (!floor) return false;
-         if (!floor->IsSequence()) {
-           r.msg().Error("enclosure.floor",
-                         "expected a list of [x, y] points in metres, got " + ShapeOf(*floor));
-           return false;
-         }
-         if (floor->size() > GroundPolygon::kMaxVertices) {
-           r.msg().Error("enclosure.floor", std::to_string(floor->size()) +
-                                                " points; a floor polygon has at most " +
-                                                std::to_string(GroundPolygon::kMaxVertices));
-           return false;
-         }
-         std::vector<Eigen::Vector2d> vertices;
-         for (size_t i = 0; i < floor->size(); ++i) {
-           const YAML::Node p = (*floor)[i];
-           const std::string path = Index("enclosure.floor", i);
-           r.Mark(path, p);
-           double x = 0, y = 0;
-           if (!p.IsSequence() || p.size() != 2 || !YAML::convert<double>::decode(p[0], x) ||
-               !YAML::convert<double>::decode(p[1], y)) {
-             r.msg().Error(
-                 path, "expected a point [x, y] in metres, got " +
-                           (p.IsSequence() ? "a list of " + std::to_string(p.size()) : ShapeOf(p)));
-             continue;
-           }
-           vertices.emplace_back(x, y);
-         }
-         e.floor = GroundPolygon(std::move(vertices));
-         return true;
+         return ReadFloor(r, view, key, e.floor);
        })
       .Type("list of `[x, y]`")
       .Default("none")
@@ -528,19 +540,12 @@ OptionsBinder StationKeys(StationConfig& cfg) {
   b.Add("version", &cfg.version, "a config version number",
         "config format version; a newer version is refused with a clear message")
       .AddRead("cameras", "[]",
-               "the cameras; the daemon needs at least one (without the key the daemon refuses "
-               "the file, `cameras: the station needs at least one camera`, and `config check` "
-               "prints that line under `the daemon refuses it:` with exit 0, since the file is "
-               "valid for `ingest --config`), `ingest --config` uses the session's. Given, the "
-               "list holds at least one camera (`cameras: []` is refused: `expected at least one "
-               "camera`; replay and ingest did nothing and exited 0)",
+               "the cameras; given, at least one (`cameras: []` is refused). Without the key "
+               "the daemon refuses the file and `config check` says so under `the daemon "
+               "refuses it:`, with exit 0: `ingest --config` takes the session's cameras",
                [&cfg](Reader& r, const MapView& view, const std::string& key) {
-                 const YAML::Node* cams = r.Value(view, key);
+                 const YAML::Node* cams = ListValue(r, view, key, "a list of cameras");
                  if (!cams) return false;
-                 if (!cams->IsSequence()) {
-                   r.msg().Error("cameras", "expected a list of cameras, got " + ShapeOf(*cams));
-                   return false;
-                 }
                  if (cams->size() == 0) {  // replay and ingest would do nothing and exit 0
                    r.msg().Error("cameras", "expected at least one camera");
                    return false;
