@@ -20,6 +20,12 @@ inline constexpr const char* kDefaultSpoolDir = "spool";
 
 // The whole file's keys, bound to `cfg`'s fields.
 OptionsBinder StationKeys(StationConfig& cfg);
+// The keys of some of its blocks, whose bound numbers' rules Validate checks.
+OptionsBinder CameraSettingKeys(CameraConfig& cam);
+OptionsBinder WhiteBalanceKeys(WhiteBalanceConfig& wb);
+OptionsBinder KeyingKeys(KeyingConfig& k);
+OptionsBinder StorageKeys(StorageConfig& s);
+OptionsBinder ControlKeys(ControlConfig& c);
 // Checks values and cross-field rules, adjusting what can be fixed; reports to `msg`.
 void Validate(StationConfig& cfg, YamlMessages& msg, const ConfigOptions& options);
 ConfigReport MakeReport(const YamlMessages& msg);

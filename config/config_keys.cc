@@ -50,6 +50,8 @@ std::string Alternatives(const std::vector<std::string>& texts) {
   return out;
 }
 
+}  // namespace
+
 OptionsBinder WhiteBalanceKeys(WhiteBalanceConfig& wb) {
   OptionsBinder b;
   b.AddEnum("mode", &wb.mode, kWhiteBalanceModeTexts,
@@ -57,10 +59,10 @@ OptionsBinder WhiteBalanceKeys(WhiteBalanceConfig& wb) {
             "once at start, then lock it; `manual`: set the gains below and lock")
       .Add("red_gain", &wb.red_gain, "a positive number",
            "red/green balance ratio (only with `mode: manual`)")
-      .Type("number > 0")
+      .Rule(Positive())
       .Add("blue_gain", &wb.blue_gain, "a positive number",
            "blue/green balance ratio (only with `mode: manual`)")
-      .Type("number > 0")
+      .Rule(Positive())
       .Add("temperature_k", &wb.temperature_k, "a colour temperature in kelvin",
            "colour temperature in kelvin instead of the ratios (only with `mode: manual`)")
       .Type("number 1500..15000")
@@ -102,24 +104,26 @@ void DeviceSettingKeys(OptionsBinder& b, CameraConfig& cam) {
         "`nv12`, `mjpeg`")
       .Default("device default")
       .Add("width", &cam.width, "a width in pixels",
-           "image width in pixels; give `width` and `height` both or neither; a yuyv or nv12 "
-           "width must be even (an odd one is lowered by one, adjusted)")
+           "image width in pixels, `0` the device's; give `width` and `height` both or neither; "
+           "a yuyv or nv12 width must be even (an odd one is lowered by one, adjusted)")
+      .Rule(AtLeast(0))
       .Default("device default")
       .Add("height", &cam.height, "a height in pixels",
-           "image height in pixels; an nv12 height must be even (adjusted)")
+           "image height in pixels, `0` the device's; an nv12 height must be even (adjusted)")
+      .Rule(AtLeast(0))
       .Default("device default")
-      .Add("fps", &cam.fps, "a positive number", "frames per second")
-      .Type("number > 0")
+      .Add("fps", &cam.fps, "a positive number", "frames per second, `0` the device's")
+      .Rule(AtLeast(0))
       .Default("device default")
-      .Add("exposure_us", &cam.exposure_us, "an exposure time in microseconds",
+      .Add("exposure_us", &cam.exposure_us, "a positive number",
            "fixed exposure time in µs. Exposure is always locked: a keyer needs it fixed")
-      .Type("number > 0")
+      .Rule(Positive())
       .Default("the device's current value")
-      .Add("gain_db", &cam.gain_db, "a gain in dB",
+      .Add("gain_db", &cam.gain_db, "a number >= 0",
            "fixed analogue gain, locked. Aravis: dB (GenICam `Gain`); libcamera: converted to "
            "`AnalogueGain` (10^(dB/20)); V4L2: `V4L2_CID_GAIN` has no standard unit, so the "
            "number is written as the driver's own gain value, rounded")
-      .Type("number >= 0")
+      .Rule(AtLeast(0))
       .Default("the device's current value")
       .AddRead("white_balance", "device",
                "a mode (`white_balance: once`) or a mapping ([white_balance](#white_balance))",
@@ -198,27 +202,27 @@ OptionsBinder KeyingKeys(KeyingConfig& k) {
   b.AddEnum("method", &k.method, kKeyingMethodTexts,
             "`chroma`: colour-difference keying for green screens; `clean_plate`: difference "
             "against a learned empty-enclosure plate, for backgrounds that are not green")
-      .Add("training_frames", &k.training_frames, "a number of frames",
+      .Add("training_frames", &k.training_frames, "at least 1 frame",
            "frames of the empty enclosure learnt at start (key colour, plate, noise). Each camera "
            "holds them at once, full size (BGR): the largest camera's frames (a camera of unset "
            "size counts as 1920x1080) must fit in 1 GiB, and 1000 frames at most: 172 at "
            "1920x1080, 43 at 3840x2160 (2000000000 made the daemon fail every frame with "
            "bad_alloc)")
-      .Type("integer >= 1")
-      .Add("chroma.low", &k.chroma.key_low_levels, "a level 0..255",
+      .Rule(AtLeast(1))
+      .Add("chroma.low", &k.chroma.key_low_levels, "a level from 0 to 255",
            "key difference (green minus the larger of red and blue, in 8-bit levels, after "
            "learning the screen) at which alpha starts to fall from 1")
-      .Type("number 0..255")
-      .Add("chroma.high", &k.chroma.key_high_levels, "a level 0..255",
+      .Rule(Between(0, 255))
+      .Add("chroma.high", &k.chroma.key_high_levels, "a level from 0 to 255",
            "... and at which the pixel is pure background (alpha 0); must be above `low`")
-      .Type("number 0..255")
-      .Add("clean_plate.low_sigma", &k.clean_plate.low_sigma, "a number of noise sigmas",
+      .Rule(Between(0, 255))
+      .Add("clean_plate.low_sigma", &k.clean_plate.low_sigma, "a number of noise sigmas >= 0",
            "difference from the plate, in multiples of the pixel's noise sigma, at which alpha "
            "starts to rise from 0")
-      .Type("number >= 0")
-      .Add("clean_plate.high_sigma", &k.clean_plate.high_sigma, "a number of noise sigmas",
+      .Rule(AtLeast(0))
+      .Add("clean_plate.high_sigma", &k.clean_plate.high_sigma, "a number of noise sigmas >= 0",
            "... and at which the pixel is pure subject (alpha 1); must be above `low_sigma`")
-      .Type("number >= 0")
+      .Rule(AtLeast(0))
       .Add("despill.enabled", &k.despill.enabled,
            "remove the screen's colour cast from subject edges")
       .Add("despill.strength", &k.despill.strength, "a number 0..1",
@@ -232,9 +236,9 @@ OptionsBinder KeyingKeys(KeyingConfig& k) {
       .Add("shadow.max_darkening", &k.shadow.max_darkening, "a fraction 0..1",
            "darkening that counts as full shadow; must be above `min_darkening`")
       .Type("number in (0, 1]")
-      .Add("shadow.reach_m", &k.shadow_reach_m, "a distance in metres",
+      .Add("shadow.reach_m", &k.shadow_reach_m, "a positive distance in metres",
            "shadow is kept this far (ground metres) around the subject's contact point")
-      .Type("number > 0");
+      .Rule(Positive());
   return b;
 }
 
@@ -442,21 +446,21 @@ OptionsBinder StorageKeys(StorageConfig& s) {
            "lossless, ~8x faster to decode at 1080p, ~14 % larger, without checksums "
            "(docs/formats.md)")
       .Type(Alternatives(RecordingCodecNames()))
-      .Add("stop_recording_below_mib", &s.stop_recording_below_mib, "a size in MiB",
+      .Add("stop_recording_below_mib", &s.stop_recording_below_mib, "a size >= 0",
            "when free disk space falls below this (MiB), raw recording stops first")
-      .Type("integer >= 0")
-      .Add("stop_sprites_below_mib", &s.stop_sprites_below_mib, "a size in MiB",
+      .Rule(AtLeast(0))
+      .Add("stop_sprites_below_mib", &s.stop_sprites_below_mib, "a size >= 0",
            "below this, sprite storage stops too (the bank is committed, never corrupted); "
            "`stop_recording_below_mib` is raised to at least this (adjusted)")
-      .Type("integer >= 0")
+      .Rule(AtLeast(0))
       .AddPath("spool_dir", &s.spool_dir,
                "where clip batches wait on disk while the bank cannot take them (a PostgreSQL "
                "server gone, a SQLite file locked past every retry); drained in order when it "
                "answers, also at the next start (docs/daemon.md)")
-      .Add("spool_max_mib", &s.spool_max_mib, "a size in MiB",
-           "the most the spool may hold; a batch beyond it fails as an append would (counted, "
-           "logged)")
-      .Type("integer >= 1");
+      .Add("spool_max_mib", &s.spool_max_mib, "a size >= 1",
+           "the most the spool may hold (MiB); a batch beyond it fails as an append would "
+           "(counted, logged)")
+      .Rule(AtLeast(1));
   return b;
 }
 
@@ -467,7 +471,7 @@ OptionsBinder ControlKeys(ControlConfig& c) {
       .Type("IP address or `localhost`")
       .Add("port", &c.port, "a port number 0..65535",
            "its port; `0` picks a free port (the daemon logs and reports it)")
-      .Type("integer 0..65535")
+      .Rule(Between(0, 65535))
       .Add("token", &c.token, "a string",
            "bearer token clients must send. **Required when `address` is not loopback** "
            "(127.0.0.0/8, `::1`, `localhost`); at least 16 characters")
@@ -530,8 +534,6 @@ OptionsBinder::ReadFn Section(OptionsBinder (*keys)(Config&), Config& config) {
     return n != nullptr;
   };
 }
-
-}  // namespace
 
 // The whole file.
 OptionsBinder StationKeys(StationConfig& cfg) {

@@ -53,16 +53,6 @@ class Validator {
   void Finite(double v, const std::string& path) {
     Check(std::isfinite(v), path, "expected a finite number, got " + Num(v));
   }
-  void Positive(double v, const std::string& path) {
-    Check(std::isfinite(v) && v > 0, path, "expected a positive number, got " + Num(v));
-  }
-  void NonNegative(double v, const std::string& path) {
-    Check(std::isfinite(v) && v >= 0, path, "expected a number >= 0, got " + Num(v));
-  }
-  void Range(double v, double lo, double hi, const std::string& path) {
-    Check(std::isfinite(v) && v >= lo && v <= hi, path,
-          "expected a number from " + Num(lo) + " to " + Num(hi) + ", got " + Num(v));
-  }
   void Enum(const std::string& v, const std::vector<std::string>& options,
             const std::string& path) {
     Check(OneOf(v, options), path, "expected one of " + Join(options) + ", got " + Quoted(v));
@@ -105,10 +95,10 @@ class Validator {
             "nv12, mjpeg, got " +
                 Quoted(c.pixel_format));
     }
-    Check(c.width >= 0, Child(path, "width"),
-          "expected a width in pixels, got " + std::to_string(c.width));
-    Check(c.height >= 0, Child(path, "height"),
-          "expected a height in pixels, got " + std::to_string(c.height));
+    // The bounds its keys are bound with (config_keys.cc): width, height, fps, exposure, gain,
+    // the white balance's gains.
+    CameraSettingKeys(c).CheckRules(msg_, path);
+    WhiteBalanceKeys(c.white_balance).CheckRules(msg_, Child(path, "white_balance"));
     Check((c.width > 0) == (c.height > 0), Child(path, c.width > 0 ? "height" : "width"),
           "give width and height together");
     // Chroma-subsampled formats carry whole 2-pixel groups: round odd sizes down.
@@ -124,12 +114,6 @@ class Validator {
                                              std::to_string(c.height - 1));
       --c.height;
     }
-    Check(std::isfinite(c.fps) && c.fps >= 0, Child(path, "fps"),
-          "expected a positive number, got " + Num(c.fps));
-    if (c.exposure_us) Positive(*c.exposure_us, Child(path, "exposure_us"));
-    if (c.gain_db) NonNegative(*c.gain_db, Child(path, "gain_db"));
-    Positive(c.white_balance.red_gain, Child(path, "white_balance.red_gain"));
-    Positive(c.white_balance.blue_gain, Child(path, "white_balance.blue_gain"));
     Check(
         c.white_balance.temperature_k == 0 ||
             (c.white_balance.temperature_k >= 1500 && c.white_balance.temperature_k <= 15000),
@@ -139,8 +123,7 @@ class Validator {
   }
 
   void Keying(KeyingConfig& k, const std::vector<CameraConfig>& cameras) {
-    Check(k.training_frames >= 1, "keying.training_frames",
-          "expected at least 1 frame, got " + std::to_string(k.training_frames));
+    KeyingKeys(k).CheckRules(msg_, "keying");  // the bounds its keys are bound with
     // The training set must fit in memory (the daemon failed every frame with bad_alloc): the
     // largest camera's frames against the budget; a camera of unset size counts as 1920x1080.
     int width = cameras.empty() ? kUnsetWidth : 0, height = cameras.empty() ? kUnsetHeight : 0;
@@ -165,13 +148,12 @@ class Validator {
     }
     // The config's range; the keyer itself also takes < 0 (off: min_margin and ramp instead).
     const double low = k.chroma.key_low_levels, high = k.chroma.key_high_levels;
-    Range(low, 0, 255, "keying.chroma.low");
-    Range(high, 0, 255, "keying.chroma.high");
-    Check(!(low >= high), "keying.chroma.high",
+    // Against a low bound that is itself wrong, the order says nothing more.
+    Check(msg_.Failed("keying.chroma.low") || !(low >= high), "keying.chroma.high",
           "must be above keying.chroma.low (" + Num(low) + "), got " + Num(high));
-    NonNegative(k.clean_plate.low_sigma, "keying.clean_plate.low_sigma");
-    NonNegative(k.clean_plate.high_sigma, "keying.clean_plate.high_sigma");
-    Check(!(k.clean_plate.low_sigma >= k.clean_plate.high_sigma), "keying.clean_plate.high_sigma",
+    Check(msg_.Failed("keying.clean_plate.low_sigma") ||
+              !(k.clean_plate.low_sigma >= k.clean_plate.high_sigma),
+          "keying.clean_plate.high_sigma",
           "must be above keying.clean_plate.low_sigma (" + Num(k.clean_plate.low_sigma) +
               "), got " + Num(k.clean_plate.high_sigma));
     Finite(k.despill.strength, "keying.despill.strength");
@@ -185,7 +167,6 @@ class Validator {
     std::string why;
     Rules(k.despill.IsValid(&why), why, "keying.despill");
     Rules(k.shadow.IsValid(&why), why, "keying.shadow");
-    Positive(k.shadow_reach_m, "keying.shadow.reach_m");
   }
 
   void Run(StationConfig& cfg) {
@@ -286,12 +267,7 @@ class Validator {
       for (const RecordingCodec& c : RecordingCodecs()) codecs.push_back(c.name);
       Enum(s.recording_codec, codecs, "storage.recording_codec");
     }
-    Check(s.stop_recording_below_mib >= 0, "storage.stop_recording_below_mib",
-          "expected a size >= 0, got " + std::to_string(s.stop_recording_below_mib));
-    Check(s.spool_max_mib >= 1, "storage.spool_max_mib",
-          "expected a size >= 1, got " + std::to_string(s.spool_max_mib));
-    Check(s.stop_sprites_below_mib >= 0, "storage.stop_sprites_below_mib",
-          "expected a size >= 0, got " + std::to_string(s.stop_sprites_below_mib));
+    StorageKeys(s).CheckRules(msg_, "storage");  // the bounds its keys are bound with
     // Raw recording must stop first: its low-water mark is never below the sprites' one.
     if (s.stop_recording_below_mib < s.stop_sprites_below_mib && s.stop_recording_below_mib >= 0 &&
         !msg_.Failed("storage.stop_recording_below_mib") &&
@@ -307,8 +283,7 @@ class Validator {
     ControlConfig& c = cfg.control;
     Check(c.address == "localhost" || IsIpAddress(c.address), "control.address",
           "expected an IP address (or localhost), got " + Quoted(c.address));
-    Check(c.port >= 0 && c.port <= 65535, "control.port",
-          "expected a port number 0..65535, got " + std::to_string(c.port));
+    ControlKeys(c).CheckRules(msg_, "control");  // the bounds its keys are bound with
     if (!c.token.empty()) {
       Check(c.token.size() >= 16, "control.token",
             "too short: use at least 16 characters (got " + std::to_string(c.token.size()) + ")");

@@ -1,5 +1,6 @@
 #include "core/options_binder.h"
 
+#include <cmath>
 #include <stdexcept>
 #include <utility>
 
@@ -33,7 +34,34 @@ OptionsBinder& OptionsBinder::AddRead(std::string key, std::string default_text,
 OptionsBinder& OptionsBinder::Type(std::string type) {
   if (bindings_.empty()) throw std::logic_error("Type() before any key was bound");
   bindings_.back().type = std::move(type);
+  bindings_.back().type_given = true;
   return *this;
+}
+
+OptionsBinder& OptionsBinder::Rule(NumberRule rule) {
+  if (bindings_.empty() || !bindings_.back().number)
+    throw std::logic_error("Rule() on a key that is not a number");
+  bindings_.back().rule = rule;
+  return *this;
+}
+
+void OptionsBinder::CheckRules(YamlMessages& msg, const std::string& path) const {
+  for (const Binding& b : bindings_) {
+    if (!b.rule) continue;
+    const std::optional<double> v = b.number();
+    const std::string key = Child(path, b.key);
+    if (v && !b.rule->Holds(*v) && !msg.Failed(key))
+      msg.Error(key, "expected " + b.expected + ", got " + Num(*v));
+  }
+}
+
+bool NumberRule::Holds(double v) const {
+  return std::isfinite(v) && (min_open ? v > min : v >= min) && v <= max;
+}
+
+std::string NumberRule::Text() const {
+  if (max < 1e300) return Num(min) + ".." + Num(max);
+  return (min_open ? "> " : ">= ") + Num(min);
 }
 
 OptionsBinder& OptionsBinder::Default(std::string words) {
@@ -43,43 +71,57 @@ OptionsBinder& OptionsBinder::Default(std::string words) {
   return *this;
 }
 
-OptionsBinder& OptionsBinder::Add(std::string key, int* field, std::string expected,
-                                  std::string doc) {
-  return Bind(std::move(key), "integer", std::to_string(*field), std::move(doc),
-              [field, expected = std::move(expected)](YamlReader& r, const YamlMap& view,
-                                                      const std::string& k) {
-                return r.Int(view, k, *field, expected);
-              });
+OptionsBinder& OptionsBinder::BindNumber(std::string key, std::string type,
+                                         std::string default_text, std::string doc,
+                                         std::string expected, ReadFn read,
+                                         std::function<std::optional<double>()> value) {
+  Bind(std::move(key), std::move(type), std::move(default_text), std::move(doc), std::move(read));
+  bindings_.back().expected = std::move(expected);
+  bindings_.back().number = std::move(value);
+  return *this;
 }
 
-OptionsBinder& OptionsBinder::Add(std::string key, int64_t* field, std::string expected,
+OptionsBinder& OptionsBinder::Add(std::string key, int* field, const std::string& expected,
                                   std::string doc) {
-  return Bind(std::move(key), "integer", std::to_string(*field), std::move(doc),
-              [field, expected = std::move(expected)](YamlReader& r, const YamlMap& view,
-                                                      const std::string& k) {
-                return r.Int64(view, k, *field, expected);
-              });
+  return BindNumber(
+      std::move(key), "integer", std::to_string(*field), std::move(doc), expected,
+      [field, expected](YamlReader& r, const YamlMap& view, const std::string& k) {
+        return r.Int(view, k, *field, expected);
+      },
+      [field] { return std::optional<double>(*field); });
 }
 
-OptionsBinder& OptionsBinder::Add(std::string key, double* field, std::string expected,
+OptionsBinder& OptionsBinder::Add(std::string key, int64_t* field, const std::string& expected,
                                   std::string doc) {
-  return Bind(std::move(key), "number", Num(*field), std::move(doc),
-              [field, expected = std::move(expected)](YamlReader& r, const YamlMap& view,
-                                                      const std::string& k) {
-                return r.Number(view, k, *field, expected);
-              });
+  return BindNumber(
+      std::move(key), "integer", std::to_string(*field), std::move(doc), expected,
+      [field, expected](YamlReader& r, const YamlMap& view, const std::string& k) {
+        return r.Int64(view, k, *field, expected);
+      },
+      [field] { return std::optional<double>(static_cast<double>(*field)); });
+}
+
+OptionsBinder& OptionsBinder::Add(std::string key, double* field, const std::string& expected,
+                                  std::string doc) {
+  return BindNumber(
+      std::move(key), "number", Num(*field), std::move(doc), expected,
+      [field, expected](YamlReader& r, const YamlMap& view, const std::string& k) {
+        return r.Number(view, k, *field, expected);
+      },
+      [field] { return std::optional<double>(*field); });
 }
 
 OptionsBinder& OptionsBinder::Add(std::string key, std::optional<double>* field,
-                                  std::string expected, std::string doc) {
-  return Bind(std::move(key), "number", *field ? Num(**field) : "unset", std::move(doc),
-              [field, expected = std::move(expected)](YamlReader& r, const YamlMap& view,
-                                                      const std::string& k) {
-                double v = 0;
-                if (!r.Number(view, k, v, expected)) return false;
-                *field = v;
-                return true;
-              });
+                                  const std::string& expected, std::string doc) {
+  return BindNumber(
+      std::move(key), "number", *field ? Num(**field) : "unset", std::move(doc), expected,
+      [field, expected](YamlReader& r, const YamlMap& view, const std::string& k) {
+        double v = 0;
+        if (!r.Number(view, k, v, expected)) return false;
+        *field = v;
+        return true;
+      },
+      [field] { return *field; });
 }
 
 OptionsBinder& OptionsBinder::Add(std::string key, bool* field, std::string doc) {
@@ -159,8 +201,9 @@ std::vector<OptionsBinder::Row> OptionsBinder::Rows() const {
   std::vector<Row> rows;
   for (const Binding& b : bindings_) {
     if (b.type.empty()) throw std::logic_error("config key \"" + b.key + "\" bound without a type");
+    const std::string type = b.rule && !b.type_given ? b.type + " " + b.rule->Text() : b.type;
     rows.push_back(
-        {b.key, b.type, b.default_in_words ? b.default_text : "`" + b.default_text + "`", b.doc});
+        {b.key, type, b.default_in_words ? b.default_text : "`" + b.default_text + "`", b.doc});
   }
   return rows;
 }

@@ -15,16 +15,30 @@
 
 namespace ss {
 
+// The bounds of a number's key: checked on the field's value, whether read from a file or set in
+// code (OptionsBinder::CheckRules), and written into the key's type in the docs ("number > 0",
+// "integer 0..65535"). A value out of them is reported as "expected EXPECTED, got V" with the
+// key's own `expected` words, which therefore say the bounds ("at least 1 frame").
+struct NumberRule {
+  double min = -1e300, max = 1e300;
+  bool min_open = false;  // min itself is out (> rather than >=)
+  bool Holds(double v) const;
+  std::string Text() const;  // "> 0", ">= 1", "0..255"
+};
+inline NumberRule Positive() { return {0, 1e300, true}; }
+inline NumberRule AtLeast(double min) { return {min, 1e300, false}; }
+inline NumberRule Between(double min, double max) { return {min, max, false}; }
+
 class OptionsBinder {
  public:
   // Reads one key of `view` (whose path is the block's) into its field; true when it set it.
   using ReadFn = std::function<bool(YamlReader& r, const YamlMap& view, const std::string& key)>;
 
   // `expected` completes "expected ..., got ..." when the value has the wrong type.
-  OptionsBinder& Add(std::string key, int* field, std::string expected, std::string doc);
-  OptionsBinder& Add(std::string key, int64_t* field, std::string expected, std::string doc);
-  OptionsBinder& Add(std::string key, double* field, std::string expected, std::string doc);
-  OptionsBinder& Add(std::string key, std::optional<double>* field, std::string expected,
+  OptionsBinder& Add(std::string key, int* field, const std::string& expected, std::string doc);
+  OptionsBinder& Add(std::string key, int64_t* field, const std::string& expected, std::string doc);
+  OptionsBinder& Add(std::string key, double* field, const std::string& expected, std::string doc);
+  OptionsBinder& Add(std::string key, std::optional<double>* field, const std::string& expected,
                      std::string doc);
   OptionsBinder& Add(std::string key, bool* field, std::string doc);
   OptionsBinder& Add(std::string key, std::string* field, std::string expected, std::string doc);
@@ -52,6 +66,12 @@ class OptionsBinder {
   // ... and its default when that is not the field's value: words ("required", "the device's
   // current value"), written into the tables as they are.
   OptionsBinder& Default(std::string words);
+  // ... and its bounds, when it is a number (else std::logic_error).
+  OptionsBinder& Rule(NumberRule rule);
+
+  // Reports every bound number out of its rule at its key under `path` ("cameras[0]"), unless
+  // that key has an error already.
+  void CheckRules(YamlMessages& msg, const std::string& path) const;
 
   // Reads the mapping `node` at `path` ("" for the top level): unknown keys first, then each
   // bound key in the order it was bound. Reports to r.msg(); never throws.
@@ -82,9 +102,16 @@ class OptionsBinder {
     bool default_in_words = false;
     std::string doc;
     ReadFn read;
+    std::string expected;                           // a number's words for its messages
+    std::function<std::optional<double>()> number;  // a number's value (none: unset)
+    std::optional<NumberRule> rule;
+    bool type_given = false;  // Type() said it all
   };
   OptionsBinder& Bind(std::string key, std::string type, std::string default_text, std::string doc,
                       ReadFn read);
+  OptionsBinder& BindNumber(std::string key, std::string type, std::string default_text,
+                            std::string doc, std::string expected, ReadFn read,
+                            std::function<std::optional<double>()> value);
   std::vector<Binding> bindings_;
 };
 

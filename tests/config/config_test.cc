@@ -659,6 +659,80 @@ TEST(StationConfig, ValidatesConfigsBuiltInCode) {
   EXPECT_EQ(report.errors[1].rfind("code: control.token: required", 0), 0u) << report.errors[1];
 }
 
+// A number's bounds are its binding's (config_keys.cc, .Rule): checked on a config built in
+// code as on one read from a file, in the binding's words, and written into the docs' type.
+TEST(StationConfig, BoundsAreTheKeysOwnWhereverTheValuesComeFrom) {
+  StationConfig cfg;
+  cfg.storage.bank = "/b";
+  cfg.storage.recording_dir = "/r";
+  CameraConfig cam;
+  cam.name = "c";
+  cam.source = "v4l2";
+  cam.device = "/dev/video0";
+  cam.fps = -1;
+  cam.gain_db = -2;
+  cam.white_balance.red_gain = 0;
+  cfg.cameras.push_back(cam);
+  cfg.pipeline.keying.emplace();
+  cfg.pipeline.keying->chroma.key_low_levels = 300;
+  cfg.storage.spool_max_mib = 0;
+  cfg.control.port = 70000;
+  const ConfigReport report = ValidateStationConfig(cfg, "code", {}, NoFileChecks());
+  const std::vector<std::string> want = {
+      "code: cameras[0].fps: expected a positive number, got -1",
+      "code: cameras[0].gain_db: expected a number >= 0, got -2",
+      "code: cameras[0].white_balance.red_gain: expected a positive number, got 0",
+      "code: keying.chroma.low: expected a level from 0 to 255, got 300",
+      "code: storage.spool_max_mib: expected a size >= 1, got 0",
+      "code: control.port: expected a port number 0..65535, got 70000"};
+  EXPECT_EQ(report.errors, want);
+  // The same values from a file: the same words, at their lines.
+  const std::string from_file = ErrorOf(
+      "cameras:\n  - name: c\n    source: v4l2\n    device: /dev/video0\n    fps: -1\n"
+      "keying:\n  chroma:\n    low: 300\n");
+  EXPECT_EQ(from_file,
+            "station.yaml:5: cameras[0].fps: expected a positive number, got -1\n"
+            "station.yaml:8: keying.chroma.low: expected a level from 0 to 255, got 300");
+  // The docs' types say the same bounds.
+  const std::string text = ConfigKeysText();
+  for (const char* line :
+       {"keying.chroma.low (number 0..255, ", "control.port (integer 0..65535, ",
+        "storage.spool_max_mib (integer >= 1, ", "cameras[].white_balance.red_gain (number > 0, "})
+    EXPECT_NE(text.find(line), std::string::npos) << line;
+}
+
+TEST(OptionsBinder, ANumbersRuleIsCheckedAtItsKeyOnceAndOnlyOnNumbers) {
+  int frames = 0;
+  double share = 2;
+  std::optional<double> unset;
+  std::string name;
+  OptionsBinder b;
+  b.Add("frames", &frames, "at least 1 frame", "frames")
+      .Rule(AtLeast(1))
+      .Add("block.share", &share, "a share from 0 to 1", "share")
+      .Rule(Between(0, 1))
+      .Add("gain", &unset, "a positive number", "gain")
+      .Rule(Positive());
+  EXPECT_THROW(b.Add("name", &name, "a string", "its name").Rule(Positive()), std::logic_error);
+  std::map<std::string, int> lines = {{"top.frames", 3}};
+  YamlMessages msg("f.yaml", lines);
+  msg.Error("top.block.share", "read wrong");  // a key with an error already: not again
+  b.CheckRules(msg, "top");
+  EXPECT_EQ(msg.errors, (std::vector<std::string>{"f.yaml: top.block.share: read wrong",
+                                                  "f.yaml:3: top.frames: expected at least 1 "
+                                                  "frame, got 0"}));
+  unset = 0;  // set, and out of bounds
+  share = std::nan("");
+  YamlMessages again("f.yaml", lines);
+  b.CheckRules(again, "");
+  ASSERT_EQ(again.errors.size(), 3u);
+  EXPECT_EQ(again.errors[1], "f.yaml: block.share: expected a share from 0 to 1, got nan");
+  EXPECT_EQ(again.errors[2], "f.yaml: gain: expected a positive number, got 0");
+  EXPECT_EQ(AtLeast(1).Text(), ">= 1");
+  EXPECT_EQ(Positive().Text(), "> 0");
+  EXPECT_EQ(Between(0, 65535).Text(), "0..65535");
+}
+
 // Registers a backend of its own, as a backend's file does, and reads configs naming it; the
 // number of answers that were not as wanted (each printed).
 int ReadConfigsOfARegisteredBackend() {
