@@ -25,20 +25,19 @@ set_target_properties(mrcal::mrcal PROPERTIES
   IMPORTED_LOCATION "${MRCAL_LIBRARY}"
   INTERFACE_INCLUDE_DIRECTORIES "${MRCAL_INCLUDE_DIR}")
 
-if(SPRITESTATION_ARAVIS)
-  pkg_check_modules(ARAVIS IMPORTED_TARGET aravis-0.8)
-  if(NOT ARAVIS_FOUND)
-    message(STATUS "Aravis backend: skipped (aravis-0.8 not found)")
-    set(SPRITESTATION_ARAVIS OFF)
+# A camera backend whose library the machine may lack: PkgConfig::NAME when its module is
+# found, else SPRITESTATION_NAME turned off with a word why.
+macro(spritestation_optional_backend NAME MODULE LABEL)
+  if(SPRITESTATION_${NAME})
+    pkg_check_modules(${NAME} IMPORTED_TARGET ${MODULE})
+    if(NOT ${NAME}_FOUND)
+      message(STATUS "${LABEL} backend: skipped (${MODULE} not found)")
+      set(SPRITESTATION_${NAME} OFF)
+    endif()
   endif()
-endif()
-if(SPRITESTATION_LIBCAMERA)
-  pkg_check_modules(LIBCAMERA IMPORTED_TARGET libcamera)
-  if(NOT LIBCAMERA_FOUND)
-    message(STATUS "libcamera backend: skipped (libcamera not found)")
-    set(SPRITESTATION_LIBCAMERA OFF)
-  endif()
-endif()
+endmacro()
+spritestation_optional_backend(ARAVIS aravis-0.8 Aravis)
+spritestation_optional_backend(LIBCAMERA libcamera libcamera)
 
 if(SPRITESTATION_TESTS)
   find_package(GTest REQUIRED)
