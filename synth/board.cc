@@ -48,23 +48,18 @@ int BoardTexture::Sample(double x, double y) const {
 }
 
 BoardSpec ChessboardFor(bool stage) {
-  const double square = stage ? 0.07 : 0.03;
-  return {.kind = BoardKind::kChessboard,
-          .squares_x = 10,
-          .squares_y = 7,
-          .square_m = square,
-          .margin_m = square};
+  BoardSpec board{.kind = BoardKind::kChessboard, .squares_x = 10, .squares_y = 7};
+  board.square_m = board.margin_m = stage ? 0.07 : 0.03;
+  return board;
 }
 
 BoardSpec CharucoFor(bool stage) {
-  const double square = stage ? 0.09 : 0.04;
-  return {.kind = BoardKind::kCharuco,
-          .squares_x = 7,
-          .squares_y = 5,
-          .square_m = square,
-          .marker_m = square * 0.75,
-          .dictionary = "DICT_4X4_50",
-          .margin_m = square * 0.5};
+  BoardSpec board{
+      .kind = BoardKind::kCharuco, .squares_x = 7, .squares_y = 5, .dictionary = "DICT_4X4_50"};
+  board.square_m = stage ? 0.09 : 0.04;
+  board.marker_m = board.square_m * 0.75;
+  board.margin_m = board.square_m * 0.5;
+  return board;
 }
 
 }  // namespace ss::synth
