@@ -1057,8 +1057,12 @@ struct ConsoleCalibration::Impl {
                                       "in several places");
       }
       calib::SolveOptions so = o.solve;
-      so.progress = [this](const std::string& stage, double fraction) {
+      // Between the solve's stages: its figures for the page, and the end of the run (cancel,
+      // or a new run) ends it there, so that Stop waits for one stage at most, not the solve.
+      so.progress = [this, run_id](const std::string& stage, double fraction) {
         std::lock_guard lock(mutex);
+        if (!active || run != run_id)
+          throw WorkError("joint", "cancelled: the calibration run ended");
         joint.stage = stage;
         joint.progress = fraction;
       };
