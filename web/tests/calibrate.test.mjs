@@ -141,7 +141,7 @@ async function cardWait(what, pred, timeout) {
   try {
     return await h.waitFor(what, async () => {
       last = await card();
-      return last && pred(last) && last;
+      return last && (await pred(last)) && last;
     }, { timeout, interval: 200 });
   } catch (err) {
     err.message += `\ncard: ${JSON.stringify(last)}`;
@@ -398,9 +398,20 @@ test('ground: the board lying on the floor poses the camera only after the word;
     p.click(`${CARD} [data-testid="cam-board-on-floor"]`),
   ]);
   assert.deepEqual(JSON.parse(req.postData()), { camera: 'cam0' });
-  // (missed, the word waits for the boards' next time on the floor, 80 s on: a held pose is
-  // never still for 1.5 s)
-  const c = await cardWait('the camera posed', (k) => k.posed && k.grid > 0, 120000);
+  // Missed (a loaded machine sees too few frames of the boards' 8 s on the floor), the word
+  // lapses after 10 s and the card asks for it again: the operator gives it again when the
+  // boards lie still once more (80 s on, a loop later), as the guidance says.
+  let again = 0;
+  const c = await cardWait('the camera posed', async (k) => {
+    if (k.posed && k.grid > 0) return true;
+    if (k.step === 'ground' && k.boardState === 'still' && (await waiting()) === 'waiting' &&
+        !(await p.isDisabled(`${CARD} [data-testid="cam-board-on-floor"]`))) {
+      again++;
+      await p.click(`${CARD} [data-testid="cam-board-on-floor"]`);
+    }
+    return false;
+  }, 150000);
+  measured.words_given_again = again;
   const check = (await api('/api/calibration')).cameras[0].ground_check;
   assert.equal(check.doubt, null);
   measured.ground_check = round(check);
