@@ -188,15 +188,6 @@ std::vector<std::string> OptionsBinder::Keys() const {
   return keys;
 }
 
-std::string OptionsBinder::Describe(const std::string& prefix) const {
-  std::string out;
-  for (const Binding& b : bindings_) {
-    out +=
-        Child(prefix, b.key) + ": " + b.default_text + (b.doc.empty() ? "" : "  # " + b.doc) + "\n";
-  }
-  return out;
-}
-
 std::vector<OptionsBinder::Row> OptionsBinder::Rows() const {
   std::vector<Row> rows;
   for (const Binding& b : bindings_) {

@@ -82,9 +82,6 @@ class OptionsBinder {
 
   // Every key bound, with dots, in the order bound.
   std::vector<std::string> Keys() const;
-  // "key: default  # doc", one line per key (`spritestation config keys`).
-  std::string Describe(const std::string& prefix = "") const;
-
   // One row of a key table (docs/config.md, `spritestation config keys --markdown`): every
   // cell in Markdown, the default as code unless given in words.
   struct Row {

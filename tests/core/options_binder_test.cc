@@ -69,13 +69,23 @@ TEST(OptionsBinder, ErrorsNameTheFileLineAndFullKey) {
                 "station.yaml:1: keying.block: expected a mapping of keys, got \"3\""});
 }
 
-TEST(OptionsBinder, DescribesEveryKeyWithItsDefault) {
+// The rows of the docs' key tables: the type is the field's (with its rule, or as Type() says
+// it), the default the field's value when bound, as code, or in words as Default() gives it.
+TEST(OptionsBinder, RowsGiveEveryKeyItsTypeDefaultAndDoc) {
   Options o;
-  EXPECT_EQ(Keys(o).Describe("keying"),
-            "keying.frames: 30  # frames to learn from\n"
-            "keying.block.low: 20  # where alpha starts to fall\n"
-            "keying.block.enabled: true  # whether the block applies\n"
-            "keying.colour: red  # the screen's colour\n");
+  OptionsBinder b = Keys(o);
+  b.Add("ratio", &o.low, "a ratio >= 1", "how many times").Rule(AtLeast(1));
+  b.Add("shape", &o.frames, "a shape", "a shape of its own").Type("list of points").Default("none");
+  std::vector<std::string> got;
+  for (const OptionsBinder::Row& r : b.Rows())
+    got.push_back(r.key + " | " + r.type + " | " + r.default_cell + " | " + r.doc);
+  EXPECT_EQ(got,
+            (std::vector<std::string>{"frames | integer | `30` | frames to learn from",
+                                      "block.low | number | `20` | where alpha starts to fall",
+                                      "block.enabled | bool | `true` | whether the block applies",
+                                      "colour | `red` | `green` | `red` | the screen's colour",
+                                      "ratio | number >= 1 | `20` | how many times",
+                                      "shape | list of points | none | a shape of its own"}));
 }
 
 }  // namespace
