@@ -13,11 +13,9 @@ namespace ss::config_detail {
 
 extern const std::vector<std::string> kLogLevels;  // logging.level and per component
 
-// Files and folders of the storage section, when not given: beside the config file.
-inline constexpr const char* kDefaultBank = "station.bank";
-inline constexpr const char* kDefaultRecordingDir = "recordings";
-inline constexpr const char* kDefaultSpoolDir = "spool";
-
+// A config of the defaults: the fields' own, the keying section there, and the storage's files
+// and folders as named relative to the config's folder (station.bank, recordings, spool).
+StationConfig Defaults();
 // The whole file's keys, bound to `cfg`'s fields.
 OptionsBinder StationKeys(StationConfig& cfg);
 // The keys of some of its blocks, whose bound numbers' rules Validate checks.

@@ -1,6 +1,6 @@
 // The station config's keys, each bound to its field (core/options_binder.h), with its type and
 // doc. The defaults are the fields' initial values in config/station_config.h. docs/config.md's
-// key tables are made from these bindings (`spritestation config keys --markdown`, ConfigKeyTables
+// key tables are made from these bindings (`spritestation config keys --markdown`, KeyBlocks
 // below); a test fails when the doc is stale.
 #include <algorithm>
 #include <cctype>
@@ -41,13 +41,6 @@ const YAML::Node* ListValue(Reader& r, const MapView& view, const std::string& k
     return nullptr;
   }
   return n;
-}
-
-// "`a` | `b` | `c`": a closed set as the key tables write a type.
-std::string Alternatives(const std::vector<std::string>& texts) {
-  std::string out;
-  for (const std::string& t : texts) out += (out.empty() ? "`" : " | `") + t + "`";
-  return out;
 }
 
 }  // namespace
@@ -170,7 +163,7 @@ OptionsBinder CameraIdentityKeys(CameraConfig& cam) {
         "camera's recorded files and its name in the bank and the API")
       .Default("required")
       .Add("source", &cam.source, "a string", "the camera backend")
-      .Type(Alternatives(CameraBackendNames()))
+      .Type(OptionsBinder::Choices(CameraBackendNames()))
       .Default("required");
   return b;
 }
@@ -445,7 +438,7 @@ OptionsBinder StorageKeys(StorageConfig& s) {
            "codec of recorded video: ffv1 is lossless with a CRC per slice; ffvhuff is "
            "lossless, ~8x faster to decode at 1080p, ~14 % larger, without checksums "
            "(docs/formats.md)")
-      .Type(Alternatives(RecordingCodecNames()))
+      .Type(OptionsBinder::Choices(RecordingCodecNames()))
       .Add("stop_recording_below_mib", &s.stop_recording_below_mib, "a size >= 0",
            "when free disk space falls below this (MiB), raw recording stops first")
       .Rule(AtLeast(0))
@@ -507,7 +500,7 @@ OptionsBinder ControlKeys(ControlConfig& c) {
 OptionsBinder LoggingKeys(LoggingConfig& l) {
   OptionsBinder b;
   b.Add("level", &l.level, "a log level", "level of every component")
-      .Type(Alternatives(kLogLevels))
+      .Type(OptionsBinder::Choices(kLogLevels))
       .AddRead("components", "{}",
                "per-component levels, e.g. `capture.aravis: debug`, `pipeline.key: warn`",
                [&l](Reader& r, const MapView& view, const std::string& key) {
@@ -578,6 +571,15 @@ OptionsBinder StationKeys(StationConfig& cfg) {
   return b;
 }
 
+StationConfig Defaults() {
+  StationConfig cfg;
+  cfg.pipeline.keying.emplace();
+  cfg.storage.bank = "station.bank";
+  cfg.storage.recording_dir = "recordings";
+  cfg.storage.spool_dir = "spool";
+  return cfg;
+}
+
 namespace {
 
 // Where a camera key's row says it applies: every backend, every live one (those that take
@@ -612,86 +614,82 @@ std::string Table(const std::vector<std::string>& header,
   return out;
 }
 
-std::string KeyTable(const OptionsBinder& keys) {
-  std::vector<std::vector<std::string>> rows;
-  for (const OptionsBinder::Row& r : keys.Rows())
-    rows.push_back({"`" + r.key + "`", r.type, r.default_cell, r.doc});
-  return Table({"key", "type", "default", "meaning"}, rows);
-}
-
 // The cameras' keys: name and source, then every backend's in the order the backends bind
 // them, each with the backends that take it ("all", "live" or names); a key two backends
 // document apart gets both docs. Each row: key, type, default, sources, doc.
 std::vector<std::vector<std::string>> CameraRows() {
   struct Entry {
     OptionsBinder::Row row;
-    std::vector<std::string> backends;
-    std::vector<std::string> docs;  // "backend: doc" each, when they differ
+    std::vector<std::pair<std::string, std::string>> docs;  // backend, its doc of the key
   };
   std::vector<Entry> entries;
   CameraConfig scratch;
-  for (const OptionsBinder::Row& r : CameraIdentityKeys(scratch).Rows())
-    entries.push_back({r, {}, {}});
+  for (const OptionsBinder::Row& r : CameraIdentityKeys(scratch).Rows()) entries.push_back({r, {}});
   for (const CameraBackend* backend : CameraBackends()) {
     CameraConfig cam;
     cam.source = backend->name;
     for (const OptionsBinder::Row& r : CameraSettingKeys(cam).Rows()) {
       auto it = std::find_if(entries.begin(), entries.end(),
                              [&](const Entry& e) { return e.row.key == r.key; });
-      if (it == entries.end()) {
-        entries.push_back({r, {}, {}});
-        it = entries.end() - 1;
-      } else if (it->row.doc != r.doc && it->docs.empty()) {
-        it->docs.push_back(it->backends.front() + ": " + it->row.doc);
-      }
-      if (!it->docs.empty() || it->row.doc != r.doc)
-        it->docs.push_back(backend->name + ": " + r.doc);
-      it->backends.push_back(backend->name);
+      if (it == entries.end()) it = entries.insert(entries.end(), Entry{r, {}});
+      it->docs.emplace_back(backend->name, r.doc);
     }
   }
   std::vector<std::vector<std::string>> rows;
   for (const Entry& e : entries) {
-    const bool everywhere = e.backends.empty() || e.row.key == "model";
+    std::vector<std::string> backends, docs;
+    bool one_doc = true;
+    for (const auto& [backend, doc] : e.docs) {
+      backends.push_back(backend);
+      docs.push_back(backend + ": " + doc);
+      one_doc = one_doc && doc == e.row.doc;
+    }
     rows.push_back({e.row.key, e.row.type, e.row.default_cell,
-                    everywhere ? "all" : SourcesCell(e.backends),
-                    e.docs.empty() ? e.row.doc : Join(e.docs, "; ")});
+                    backends.empty() ? "all" : SourcesCell(backends),
+                    one_doc ? e.row.doc : Join(docs, "; ")});
   }
   return rows;
-}
-
-std::string CameraTable() {
-  std::vector<std::vector<std::string>> rows = CameraRows();
-  for (auto& row : rows) row[0] = "`" + row[0] + "`";
-  return Table({"key", "type", "default", "sources", "meaning"}, rows);
 }
 
 constexpr const char* kTableBegin = "<!-- generated by `spritestation config keys --markdown`: ";
 constexpr const char* kTableEnd = "<!-- end of generated table -->";
 
-// Every table, by name, in the order of docs/config.md.
-// A config of the defaults, as LoadStationConfig starts one (its paths not yet resolved).
-StationConfig Defaults() {
-  StationConfig cfg;
-  cfg.pipeline.keying.emplace();
-  cfg.storage.bank = kDefaultBank;
-  cfg.storage.recording_dir = kDefaultRecordingDir;
-  cfg.storage.spool_dir = kDefaultSpoolDir;
-  return cfg;
+// One table of docs/config.md: its keys' rows (key, type, default, [sources,] doc) and the
+// path its keys stand under in a config ("keying.", "cameras[].").
+struct KeyBlock {
+  std::string name, prefix;
+  std::vector<std::string> header;
+  std::vector<std::vector<std::string>> rows;
+};
+
+KeyBlock Block(std::string name, std::string prefix, const OptionsBinder& keys) {
+  KeyBlock block{std::move(name), std::move(prefix), {"key", "type", "default", "meaning"}, {}};
+  for (const OptionsBinder::Row& r : keys.Rows())
+    block.rows.push_back({r.key, r.type, r.default_cell, r.doc});
+  return block;
 }
 
-std::vector<std::pair<std::string, std::string>> KeyTables() {
+// Every table, in the order of docs/config.md, of a config of the defaults.
+std::vector<KeyBlock> KeyBlocks() {
   StationConfig cfg = Defaults();
   CameraConfig cam;
-  return {{"top", KeyTable(StationKeys(cfg))},
-          {"cameras", CameraTable()},
-          {"white_balance", KeyTable(WhiteBalanceKeys(cam.white_balance))},
-          {"keying", KeyTable(KeyingKeys(*cfg.pipeline.keying))},
-          {"enclosure", KeyTable(EnclosureKeys(cfg))},
-          {"pipeline", KeyTable(PipelineKeys(cfg.pipeline))},
-          {"transitions", KeyTable(TransitionsKeys(cfg.transitions))},
-          {"storage", KeyTable(StorageKeys(cfg.storage))},
-          {"control", KeyTable(ControlKeys(cfg.control))},
-          {"logging", KeyTable(LoggingKeys(cfg.logging))}};
+  return {Block("top", "", StationKeys(cfg)),
+          {"cameras", "cameras[].", {"key", "type", "default", "sources", "meaning"}, CameraRows()},
+          Block("white_balance", "cameras[].white_balance.", WhiteBalanceKeys(cam.white_balance)),
+          Block("keying", "keying.", KeyingKeys(*cfg.pipeline.keying)),
+          Block("enclosure", "enclosure.", EnclosureKeys(cfg)),
+          Block("pipeline", "pipeline.", PipelineKeys(cfg.pipeline)),
+          Block("transitions", "transitions.", TransitionsKeys(cfg.transitions)),
+          Block("storage", "storage.", StorageKeys(cfg.storage)),
+          Block("control", "control.", ControlKeys(cfg.control)),
+          Block("logging", "logging.", LoggingKeys(cfg.logging))};
+}
+
+// A block's table in Markdown, its keys as code.
+std::string TableOf(const KeyBlock& block) {
+  std::vector<std::vector<std::string>> rows = block.rows;
+  for (auto& row : rows) row[0] = "`" + row[0] + "`";
+  return Table(block.header, rows);
 }
 
 }  // namespace
@@ -702,14 +700,14 @@ namespace ss {
 
 std::string ConfigKeysMarkdown() {
   std::string out;
-  for (const auto& [name, table] : config_detail::KeyTables())
-    out += (out.empty() ? "" : "\n") + std::string(config_detail::kTableBegin) + name + " -->\n" +
-           table + config_detail::kTableEnd + "\n";
+  for (const config_detail::KeyBlock& block : config_detail::KeyBlocks())
+    out += (out.empty() ? "" : "\n") + std::string(config_detail::kTableBegin) + block.name +
+           " -->\n" + TableOf(block) + config_detail::kTableEnd + "\n";
   return out;
 }
 
 std::string WithConfigKeyTables(const std::string& doc, const std::string& origin) {
-  const auto tables = config_detail::KeyTables();
+  const std::vector<config_detail::KeyBlock> blocks = config_detail::KeyBlocks();
   std::vector<std::string> seen;
   std::string out;
   size_t at = 0;
@@ -720,45 +718,32 @@ std::string WithConfigKeyTables(const std::string& doc, const std::string& origi
     if (name_end == std::string::npos || end == std::string::npos || name_end > end)
       throw InputError(origin + ": a generated table's marker is not closed");
     const std::string name = doc.substr(name_at, name_end - name_at);
-    const auto it =
-        std::find_if(tables.begin(), tables.end(), [&](const auto& t) { return t.first == name; });
-    if (it == tables.end()) throw InputError(origin + ": no key table named \"" + name + "\"");
+    const auto it = std::find_if(blocks.begin(), blocks.end(),
+                                 [&](const config_detail::KeyBlock& b) { return b.name == name; });
+    if (it == blocks.end()) throw InputError(origin + ": no key table named \"" + name + "\"");
     seen.push_back(name);
-    out += doc.substr(at, name_end + 5 - at) + it->second;  // through " -->\n"
+    out += doc.substr(at, name_end + 5 - at) + TableOf(*it);  // through " -->\n"
     at = end;
   }
   out += doc.substr(at);
-  for (const auto& [name, table] : tables) {
-    if (std::find(seen.begin(), seen.end(), name) == seen.end())
-      throw InputError(origin + ": holds no key table \"" + name + "\" (" +
-                       config_detail::kTableBegin + name + " -->)");
+  for (const config_detail::KeyBlock& block : blocks) {
+    if (std::find(seen.begin(), seen.end(), block.name) == seen.end())
+      throw InputError(origin + ": holds no key table \"" + block.name + "\" (" +
+                       config_detail::kTableBegin + block.name + " -->)");
   }
   return out;
 }
 
 std::string ConfigKeysText() {
-  using namespace config_detail;
-  StationConfig cfg = Defaults();
-  CameraConfig cam;
   std::string out;
-  const auto add = [&out](const std::string& prefix, const OptionsBinder& keys) {
-    for (const OptionsBinder::Row& r : keys.Rows()) {
-      if (r.default_cell == "see below") continue;  // a block: its keys follow
-      out += prefix + r.key + " (" + r.type + ", default " + r.default_cell + "): " + r.doc + "\n";
+  for (const config_detail::KeyBlock& block : config_detail::KeyBlocks()) {
+    const bool sources = block.header.size() == 5;
+    for (const auto& row : block.rows) {
+      if (row[2] == "see below") continue;  // a block: its keys follow
+      out += block.prefix + row[0] + " (" + row[1] + ", default " + row[2] +
+             (sources ? ", sources " + row[3] : "") + "): " + row.back() + "\n";
     }
-  };
-  add("", StationKeys(cfg));
-  for (const auto& row : CameraRows())
-    out += "cameras[]." + row[0] + " (" + row[1] + ", default " + row[2] + ", sources " + row[3] +
-           "): " + row[4] + "\n";
-  add("cameras[].white_balance.", WhiteBalanceKeys(cam.white_balance));
-  add("keying.", KeyingKeys(*cfg.pipeline.keying));
-  add("enclosure.", EnclosureKeys(cfg));
-  add("pipeline.", PipelineKeys(cfg.pipeline));
-  add("transitions.", TransitionsKeys(cfg.transitions));
-  add("storage.", StorageKeys(cfg.storage));
-  add("control.", ControlKeys(cfg.control));
-  add("logging.", LoggingKeys(cfg.logging));
+  }
   return out;
 }
 

@@ -51,10 +51,10 @@ StationConfig ParseStationConfig(const std::string& yaml, const std::string& ori
   Messages msg(origin, lines);
   Reader r(msg, lines, base_dir);
 
-  StationConfig cfg;
-  cfg.storage.bank = r.Resolve(config_detail::kDefaultBank);
-  cfg.storage.recording_dir = r.Resolve(config_detail::kDefaultRecordingDir);
-  cfg.storage.spool_dir = r.Resolve(config_detail::kDefaultSpoolDir);
+  StationConfig cfg = config_detail::Defaults();
+  cfg.storage.bank = r.Resolve(cfg.storage.bank);
+  cfg.storage.recording_dir = r.Resolve(cfg.storage.recording_dir);
+  cfg.storage.spool_dir = r.Resolve(cfg.storage.spool_dir);
   config_detail::StationKeys(cfg).Read(r, root, "");
 
   config_detail::Validate(cfg, msg, options);

@@ -31,6 +31,12 @@ OptionsBinder& OptionsBinder::AddRead(std::string key, std::string default_text,
   return Bind(std::move(key), "", std::move(default_text), std::move(doc), std::move(read));
 }
 
+std::string OptionsBinder::Choices(const std::vector<std::string>& texts) {
+  std::string out;
+  for (const std::string& t : texts) out += (out.empty() ? "`" : " | `") + t + "`";
+  return out;
+}
+
 OptionsBinder& OptionsBinder::Type(std::string type) {
   if (bindings_.empty()) throw std::logic_error("Type() before any key was bound");
   bindings_.back().type = std::move(type);

@@ -48,10 +48,9 @@ class OptionsBinder {
   template <typename E, size_t N>
   OptionsBinder& AddEnum(std::string key, E* field, const EnumText<E> (&texts)[N],
                          std::string doc) {
-    std::string type;
-    for (const EnumText<E>& t : texts)
-      type += (type.empty() ? "`" : " | `") + std::string(t.text) + "`";
-    return Bind(std::move(key), std::move(type), TextOf(*field, texts), std::move(doc),
+    std::vector<std::string> names;
+    for (const EnumText<E>& t : texts) names.emplace_back(t.text);
+    return Bind(std::move(key), Choices(names), TextOf(*field, texts), std::move(doc),
                 [field, &texts](YamlReader& r, const YamlMap& view, const std::string& k) {
                   return r.Enum(view, k, *field, texts);
                 });
@@ -59,6 +58,9 @@ class OptionsBinder {
   // A key whose value has a shape of its own (`auto` or a number, a list of points...); its
   // type for the docs is given with Type().
   OptionsBinder& AddRead(std::string key, std::string default_text, std::string doc, ReadFn read);
+
+  // A closed set as a type: "`a` | `b` | `c`".
+  static std::string Choices(const std::vector<std::string>& texts);
 
   // Of the key bound last: its type as the docs' key tables say it ("integer >= 1"; by default
   // the field's: integer, number, bool, string, path, or the enum's texts)...

@@ -54,23 +54,11 @@ function canvasStats(camera, colours = {}) {
   }, colours);
 }
 
-// Preview requests per camera during `ms` milliseconds.
-async function previewRate(ms) {
-  const counts = {};
-  const on = (r) => {
-    const m = /\/api\/cameras\/([^/]+)\/(preview\.jpg|sprites\.json)/.exec(r.url());
-    if (m) counts[m[1]] = (counts[m[1]] || 0) + 1;
-  };
-  p.on('request', on);
-  await h.sleep(ms);
-  p.off('request', on);
-  return counts;
-}
-
-// The preview requests of each camera from now on; each(names) waits until every one of them
-// fetched one. A loaded machine (CI runs the QEMU tests beside this one) serves a preview
-// in seconds rather than in milliseconds: the rate limits are asserted over a window, and
-// that previews flow by waiting for them, naming what a stalled tile says.
+// The preview requests of each camera from now on (`seen`, until stop()); each(names) waits
+// until every one of them fetched one, and stops. A loaded machine (CI runs the QEMU tests
+// beside this one) serves a preview in seconds rather than in milliseconds: the rate limits are
+// asserted over a window, and that previews flow by waiting for them, naming what a stalled
+// tile says.
 function previewsFrom() {
   const seen = {};
   const on = (r) => {
@@ -78,7 +66,10 @@ function previewsFrom() {
     if (m) seen[m[1]] = (seen[m[1]] || 0) + 1;
   };
   p.on('request', on);
+  const stop = () => p.off('request', on);
   return {
+    seen,
+    stop,
     async each(names, when) {
       try {
         await h.waitFor(`a preview of each of ${names.join(', ')} ${when}`, () => names.every((n) => seen[n] > 0), { timeout: 8000, interval: 100 });
@@ -86,10 +77,18 @@ function previewsFrom() {
         const said = await Promise.all(names.map(async (n) => `${n}: ${seen[n] || 0} (${await p.textContent(`[data-camera="${n}"] [data-testid="tile-message"]`).catch(() => '?')})`));
         throw new Error(`${err.message}; previews ${said.join(', ')}`);
       } finally {
-        p.off('request', on);
+        stop();
       }
     },
   };
+}
+
+// Preview requests per camera during `ms` milliseconds.
+async function previewRate(ms) {
+  const counter = previewsFrom();
+  await h.sleep(ms);
+  counter.stop();
+  return counter.seen;
 }
 
 async function waitLive(names, timeout = 60000) {
