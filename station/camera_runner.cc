@@ -330,12 +330,18 @@ struct CameraRunner::Impl {
     }
   }
 
-  void ApplyTarget(CameraPipeline* pipeline, std::vector<ClipBatch>* out) {
+  // Closes the open clips into `out` if the bank camera changed, and hands `out` to the writer.
+  // The change is said applied only after that: a session that stops waits for its last clips to
+  // be in the writer's queue (else its count grew after it said it had stopped).
+  void ApplyTargetAndSink(CameraPipeline* pipeline, std::vector<ClipBatch>& out,
+                          const std::deque<std::pair<int64_t, SteadyTime>>& arrivals) {
     std::unique_lock lock(target_mutex);
-    if (wanted_camera_id == applied_camera_id) return;
     const int64_t wanted = wanted_camera_id;
+    const bool changed = wanted != applied_camera_id;
     lock.unlock();
-    if (pipeline != nullptr) pipeline->Retarget(wanted, out);
+    if (changed && pipeline != nullptr) pipeline->Retarget(wanted, &out);
+    Sink(out, arrivals);
+    if (!changed) return;
     lock.lock();
     applied_camera_id = wanted;
     target_applied.notify_all();
@@ -445,8 +451,7 @@ struct CameraRunner::Impl {
         arrivals;  // recent frames' sequence and arrival time
     cv::Mat bgr;
     while (true) {
-      ApplyTarget(pipeline_failed ? nullptr : pipeline.get(), &out);
-      Sink(out, arrivals);
+      ApplyTargetAndSink(pipeline_failed ? nullptr : pipeline.get(), out, arrivals);
       std::optional<Captured> item = queue->PopFor(std::chrono::milliseconds(100));
       if (!item) {
         if (queue->size() == 0 && capture_done) break;
