@@ -28,7 +28,9 @@ command -v ninja >/dev/null && generator=(-G Ninja)
 # per file (measured: tests/fuzz/README.md, "Cost"). SPRITESTATION_DEBUG_INFO=full gives -g.
 debug="-g1"
 [ "${SPRITESTATION_DEBUG_INFO:-}" = full ] && debug="-g"
-if [ ! -f "$build/CMakeCache.txt" ]; then
+# A configure that failed (a package missing) leaves a cache but no build files: configure again,
+# else the next build only said "loading 'build.ninja': No such file".
+if [ ! -f "$build/CMakeCache.txt" ] || { [ ! -f "$build/build.ninja" ] && [ ! -f "$build/Makefile" ]; }; then
   cmake -S "$top" -B "$build" "${generator[@]}" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
     "-DCMAKE_C_FLAGS_RELWITHDEBINFO=-O2 $debug -DNDEBUG" "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O2 $debug -DNDEBUG" \
     "${extra[@]}" >&2
