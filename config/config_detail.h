@@ -22,6 +22,8 @@ OptionsBinder StationKeys(StationConfig& cfg);
 OptionsBinder CameraSettingKeys(CameraConfig& cam);
 OptionsBinder WhiteBalanceKeys(WhiteBalanceConfig& wb);
 OptionsBinder KeyingKeys(KeyingConfig& k);
+OptionsBinder EnclosureKeys(StationConfig& cfg);
+OptionsBinder PipelineKeys(CameraPipelineOptions& p);
 OptionsBinder StorageKeys(StorageConfig& s);
 OptionsBinder ControlKeys(ControlConfig& c);
 // Checks values and cross-field rules, adjusting what can be fixed; reports to `msg`.

@@ -285,74 +285,80 @@ OptionsBinder EnclosureKeys(StationConfig& cfg) {
        })
       .Type("list of `[x, y]`")
       .Default("none")
-      .Add("wall_height_m", &cfg.pipeline.usability.wall_height_m, "a height in metres",
-           "walls along the polygon's edges hide the floor behind them up to this height; used "
-           "to decide what the camera sees as floor")
-      .Type("number >= 0");
+      .Add("wall_height_m", &cfg.pipeline.usability.wall_height_m, "a number >= 0",
+           "walls along the polygon's edges hide the floor behind them up to this height "
+           "(metres); used to decide what the camera sees as floor")
+      .Rule(AtLeast(0));
   return b;
 }
 
 // Each key bound straight to the stage option it sets (pipeline/run/camera_pipeline.h).
 OptionsBinder PipelineKeys(CameraPipelineOptions& p) {
   OptionsBinder b;
-  b.Add("min_area_px", &p.extract.min_area, "an area in pixels",
+  b.Add("min_area_px", &p.extract.min_area, "at least 1 pixel",
         "matte blobs smaller than this (pixels) are noise")
-      .Type("integer >= 1")
-      .Add("border_margin_px", &p.usability.border_margin_px, "a number of pixels",
+      .Rule(AtLeast(1))
+      .Add("border_margin_px", &p.usability.border_margin_px, "a number of pixels >= 0",
            "a sprite this close to the image border is not usable")
-      .Type("integer >= 0")
-      .Add("floor_margin_px", &p.usability.floor_margin_px, "a number of pixels",
+      .Rule(AtLeast(0))
+      .Add("floor_margin_px", &p.usability.floor_margin_px, "a number of pixels >= 0",
            "floor pixels required all around the silhouette (else it touches a wall)")
-      .Type("integer >= 0")
-      .Add("wall_margin_m", &p.usability.wall_margin_m, "a distance in metres",
+      .Rule(AtLeast(0))
+      .Add("wall_margin_m", &p.usability.wall_margin_m, "a distance in metres >= 0",
            "the contact point must lie this far inside the floor polygon")
-      .Type("number >= 0")
-      .Add("max_view_angle_deg", &p.usability.max_view_angle_deg, "an angle in degrees",
+      .Rule(AtLeast(0))
+      .Add("max_view_angle_deg", &p.usability.max_view_angle_deg,
+           "an angle in degrees above 0 and at most 90 (90: no view is too steep)",
            "sprites seen more steeply than this (the angle at the contact point between the "
            "floor and the ray to the camera) are refused as `view_too_steep`: an upright "
            "billboard from above is a sliver (docs/pipeline.md). 90 keeps every view")
-      .Type("number > 0, <= 90")
-      .Add("still_speed_m_per_s", &p.still_speed_m_per_s, "a speed in m/s",
+      .Rule({0, 90, true})
+      .Add("still_speed_m_per_s", &p.still_speed_m_per_s, "a positive speed in m/s",
            "a subject slower than this is standing still")
-      .Type("number > 0")
-      .Add("max_speed_m_per_s", &p.track.max_speed_m_per_s, "a speed in m/s",
+      .Rule(Positive())
+      .Add("max_speed_m_per_s", &p.track.max_speed_m_per_s, "a positive speed in m/s",
            "the tracker's speed limit: a candidate farther from a subject than this speed (plus "
            "2 cm) allows is a new subject, its clip a new clip. 1 m/s suits small animals; "
            "people walk at ~1.4 m/s (use 2.5 for them: `import` writes it into its "
            "`ingest.yaml`)")
-      .Type("number > 0")
-      .Add("max_still_s", &p.max_still_s, "a duration in seconds",
+      .Rule(Positive())
+      .Add("max_still_s", &p.max_still_s, "a positive duration in seconds",
            "still periods longer than this are discarded (seed 000: extended periods without "
            "motion)")
-      .Type("number > 0")
-      .Add("min_clip_frames", &p.batch.min_clip_frames, "a number of frames",
+      .Rule(Positive())
+      .Add("min_clip_frames", &p.batch.min_clip_frames, "at least 1 frame",
            "clips shorter than this are discarded")
-      .Type("integer >= 1")
-      .Add("noise_recover_solidity", &p.noise.recover_solidity, "a share from 0 to 1",
+      .Rule(AtLeast(1))
+      .Add("noise_recover_solidity", &p.noise.recover_solidity,
+           "a share from 0 to 1 (0 turns the test off)",
            "a subject discarded as `noise` in its previous frame stays `noise` until its "
            "solidity reaches this (keyed background flickers about the threshold); `0` = no "
            "memory")
-      .Type("number 0..1")
-      .Add("noise_thick_px", &p.noise.thick_px, "a distance in pixels",
+      .Rule(Between(0, 1))
+      .Add("noise_thick_px", &p.noise.thick_px, "a distance in pixels >= 0",
            "a matte pixel more than this many pixels from the matte's edge is interior (for "
            "`noise_min_thick_share`)")
-      .Type("number >= 0")
-      .Add("noise_min_thick_share", &p.noise.min_thick_share, "a share from 0 to 1",
+      .Rule(AtLeast(0))
+      .Add("noise_min_thick_share", &p.noise.min_thick_share,
+           "a share from 0 to 1 (0 turns the test off)",
            "also `noise` when less of the matte is interior (specks, thin lines); `0` is off")
-      .Type("number 0..1")
-      .Add("noise_min_solidity", &p.noise.min_solidity, "a share from 0 to 1",
+      .Rule(Between(0, 1))
+      .Add("noise_min_solidity", &p.noise.min_solidity,
+           "a share from 0 to 1 (0 turns the test off)",
            "a sprite whose matte (alpha > 1/2, in the camera image) fills less than this share "
            "of its convex hull is discarded as `noise`: keyed background, alone or joined to a "
            "subject (docs/pipeline.md); `0` turns it off")
-      .Type("number 0..1")
-      .Add("noise_min_largest_share", &p.noise.min_largest_share, "a share from 0 to 1",
+      .Rule(Between(0, 1))
+      .Add("noise_min_largest_share", &p.noise.min_largest_share,
+           "a share from 0 to 1 (0 turns the test off)",
            "also `noise` when the matte's largest 8-connected part holds less of it "
            "(fragments); `0` is off")
-      .Type("number 0..1")
-      .Add("noise_min_mean_alpha", &p.noise.min_mean_alpha, "a share from 0 to 1",
+      .Rule(Between(0, 1))
+      .Add("noise_min_mean_alpha", &p.noise.min_mean_alpha,
+           "a share from 0 to 1 (0 turns the test off)",
            "also `noise` when the mean alpha over the matte's pixels of alpha >= 16/255 is lower "
            "(a soft haze); `0` is off")
-      .Type("number 0..1")
+      .Rule(Between(0, 1))
       .Add("merged_min_width_ratio", &p.side_by_side.min_width_ratio, "0 or a ratio of at least 1",
            "two subjects side by side in one blob, which the tracks never saw apart (they "
            "walked in together), are tagged `merged` when the billboard's matte splits into a "
@@ -384,14 +390,15 @@ OptionsBinder PipelineKeys(CameraPipelineOptions& p) {
                  return true;
                })
       .Type("`auto` or number > 0")
-      .Add("workers", &p.workers, "a number of threads",
+      .Add("workers", &p.workers, "0 (one per core) or more threads",
            "threads OpenCV may spread one frame's image operations over (colour conversion, "
            "resampling); the pipeline itself runs one thread per camera, so with several "
            "cameras `1` avoids oversubscribing the cores; `0` = OpenCV's default (one per core)")
-      .Type("integer >= 0")
-      .Add("queue_frames", &p.queue_frames, "a number of frames",
+      .Rule(AtLeast(0))
+      .Add("queue_frames", &p.queue_frames, "at least 1 frame",
            "per-camera queue between the capture thread and the pipeline; a full queue drops "
            "(and counts) frames")
+      .Rule(AtLeast(1))
       .Type("integer 1..1024");
   return b;
 }

@@ -66,7 +66,8 @@ bool NumberRule::Holds(double v) const {
 }
 
 std::string NumberRule::Text() const {
-  if (max < 1e300) return Num(min) + ".." + Num(max);
+  if (max < 1e300)
+    return min_open ? "> " + Num(min) + ", <= " + Num(max) : Num(min) + ".." + Num(max);
   return (min_open ? "> " : ">= ") + Num(min);
 }
 

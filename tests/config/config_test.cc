@@ -208,7 +208,7 @@ TEST(StationConfig, WrongTypeNamesFieldAndLine) {
   EXPECT_EQ(ErrorOf(yaml),
             "station.yaml:8: cameras[1].fps: expected a positive number, got \"fast\"");
   EXPECT_EQ(ErrorOf("pipeline:\n  min_area_px: 12.5\n"),
-            "station.yaml:2: pipeline.min_area_px: expected an area in pixels, got \"12.5\"");
+            "station.yaml:2: pipeline.min_area_px: expected at least 1 pixel, got \"12.5\"");
   EXPECT_EQ(ErrorOf("keying:\n  despill:\n    enabled: maybe\n"),
             "station.yaml:3: keying.despill.enabled: expected true or false, got \"maybe\"");
   EXPECT_EQ(ErrorOf("cameras: cam0\n"),
@@ -432,11 +432,32 @@ TEST(StationConfig, PipelineValuesAreCheckedByTheStagesNamingTheKey) {
                     "pipeline:\n  min_clip_frames: 0\n  max_speed_m_per_s: -1\n"
                     "  noise_min_mean_alpha: 2\n  queue_frames: 0\n"),
             "station.yaml:2: enclosure.wall_height_m: expected a number >= 0, got -0.5\n"
-            "station.yaml:5: pipeline.max_speed_m_per_s: expected a positive number, got -1\n"
+            "station.yaml:5: pipeline.max_speed_m_per_s: expected a positive speed in m/s, got -1\n"
             "station.yaml:4: pipeline.min_clip_frames: expected at least 1 frame, got 0\n"
             "station.yaml:6: pipeline.noise_min_mean_alpha: expected a share from 0 to 1 (0 turns "
             "the test off), got 2\n"
             "station.yaml:7: pipeline.queue_frames: expected at least 1 frame, got 0");
+}
+
+// Every number of the pipeline block is bound with its bounds: a negative value (out of every
+// one's) is refused at its own key, by the binding, not left for the stage to throw at a start.
+TEST(StationConfig, EveryPipelineNumberIsRefusedOutOfItsBounds) {
+  std::istringstream lines(ConfigKeysText());
+  int checked = 0;
+  for (std::string line; std::getline(lines, line);) {
+    if (line.rfind("pipeline.", 0) != 0) continue;
+    const size_t paren = line.find(" (");
+    const std::string type = line.substr(paren + 2);
+    if (type.find("number") == std::string::npos && type.find("integer") == std::string::npos)
+      continue;
+    const std::string key =
+        line.substr(std::string("pipeline.").size(), paren - std::string("pipeline.").size());
+    const std::string error = ErrorOf("pipeline:\n  " + key + ": -1\n");
+    EXPECT_EQ(error.rfind("station.yaml:2: pipeline." + key + ": expected ", 0), 0u)
+        << key << ": " << error;
+    ++checked;
+  }
+  EXPECT_GE(checked, 18);
 }
 
 // The noise rule's thresholds (issue 19): shares from 0 to 1, 0 turning a test off.
