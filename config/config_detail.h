@@ -8,6 +8,7 @@
 #include "config/station_config.h"
 #include "core/options_binder.h"
 #include "core/yaml_reader.h"
+#include "pipeline/key/keying_keys.h"
 
 namespace ss::config_detail {
 
@@ -21,7 +22,6 @@ OptionsBinder StationKeys(StationConfig& cfg);
 // The keys of some of its blocks, whose bound numbers' rules Validate checks.
 OptionsBinder CameraSettingKeys(CameraConfig& cam);
 OptionsBinder WhiteBalanceKeys(WhiteBalanceConfig& wb);
-OptionsBinder KeyingKeys(KeyingConfig& k);
 OptionsBinder EnclosureKeys(StationConfig& cfg);
 OptionsBinder PipelineKeys(CameraPipelineOptions& p);
 OptionsBinder StorageKeys(StorageConfig& s);

@@ -190,51 +190,6 @@ void ReadCamera(Reader& r, const YAML::Node& node, const std::string& path, Came
   CameraSettingKeys(cam).ReadKeys(r, view);
 }
 
-OptionsBinder KeyingKeys(KeyingConfig& k) {
-  OptionsBinder b;
-  b.AddEnum("method", &k.method, kKeyingMethodTexts,
-            "`chroma`: colour-difference keying for green screens; `clean_plate`: difference "
-            "against a learned empty-enclosure plate, for backgrounds that are not green")
-      .Add("training_frames", &k.training_frames, "at least 1 frame",
-           "frames of the empty enclosure learnt at start (key colour, plate, noise). Each camera "
-           "holds them at once, full size (BGR): the largest camera's frames (a camera of unset "
-           "size counts as 1920x1080) must fit in 1 GiB, and 1000 frames at most: 172 at "
-           "1920x1080, 43 at 3840x2160 (2000000000 made the daemon fail every frame with "
-           "bad_alloc)")
-      .Rule(AtLeast(1))
-      .Add("chroma.low", &k.chroma.key_low_levels, "a level from 0 to 255",
-           "key difference (green minus the larger of red and blue, in 8-bit levels, after "
-           "learning the screen) at which alpha starts to fall from 1")
-      .Rule(Between(0, 255))
-      .Add("chroma.high", &k.chroma.key_high_levels, "a level from 0 to 255",
-           "... and at which the pixel is pure background (alpha 0); must be above `low`")
-      .Rule(Between(0, 255))
-      .Add("clean_plate.low_sigma", &k.clean_plate.low_sigma, "a number of noise sigmas >= 0",
-           "difference from the plate, in multiples of the pixel's noise sigma, at which alpha "
-           "starts to rise from 0")
-      .Rule(AtLeast(0))
-      .Add("clean_plate.high_sigma", &k.clean_plate.high_sigma, "a number of noise sigmas >= 0",
-           "... and at which the pixel is pure subject (alpha 1); must be above `low_sigma`")
-      .Rule(AtLeast(0))
-      .Add("despill.enabled", &k.despill.enabled,
-           "remove the screen's colour cast from subject edges")
-      .Add("despill.strength", &k.despill.strength, "a number 0..1",
-           "how much of the cast to remove (clamped to 0..1, adjusted)")
-      .Type("number 0..1")
-      .Add("shadow.enabled", &k.shadow.enabled,
-           "keep the contact shadow as its own layer (seed 000 §6)")
-      .Add("shadow.min_darkening", &k.shadow.min_darkening, "a fraction 0..1",
-           "floor darker than the plate by less than this fraction is not shadow (noise)")
-      .Type("number in [0, 1)")
-      .Add("shadow.max_darkening", &k.shadow.max_darkening, "a fraction 0..1",
-           "darkening that counts as full shadow; must be above `min_darkening`")
-      .Type("number in (0, 1]")
-      .Add("shadow.reach_m", &k.shadow_reach_m, "a positive distance in metres",
-           "shadow is kept this far (ground metres) around the subject's contact point")
-      .Rule(Positive());
-  return b;
-}
-
 // enclosure.floor: a list of [x, y] points in metres, at most GroundPolygon::kMaxVertices.
 bool ReadFloor(Reader& r, const MapView& view, const std::string& key, GroundPolygon& out) {
   const YAML::Node* floor = ListValue(r, view, key, "a list of [x, y] points in metres");

@@ -15,6 +15,7 @@
 #include "core/ip_address.h"
 #include "core/option_checks.h"
 #include "core/recording_codecs.h"
+#include "pipeline/key/keying_keys.h"
 
 namespace ss {
 namespace config_detail {
@@ -123,7 +124,7 @@ class Validator {
   }
 
   void Keying(KeyingConfig& k, const std::vector<CameraConfig>& cameras) {
-    KeyingKeys(k).CheckRules(msg_, "keying");  // the bounds its keys are bound with
+    CheckKeying(k, msg_, "keying");  // the section's own rules (pipeline/key/keying_keys.h)
     // The training set must fit in memory (the daemon failed every frame with bad_alloc): the
     // largest camera's frames against the budget; a camera of unset size counts as 1920x1080.
     int width = cameras.empty() ? kUnsetWidth : 0, height = cameras.empty() ? kUnsetHeight : 0;
@@ -146,27 +147,6 @@ class Validator {
                 " GiB, and a camera's training set may hold 1 GiB (" +
                 std::to_string(kMaxTrainingFrames) + " frames at most)");
     }
-    // The config's range; the keyer itself also takes < 0 (off: min_margin and ramp instead).
-    const double low = k.chroma.key_low_levels, high = k.chroma.key_high_levels;
-    // Against a low bound that is itself wrong, the order says nothing more.
-    Check(msg_.Failed("keying.chroma.low") || !(low >= high), "keying.chroma.high",
-          "must be above keying.chroma.low (" + Num(low) + "), got " + Num(high));
-    Check(msg_.Failed("keying.clean_plate.low_sigma") ||
-              !(k.clean_plate.low_sigma >= k.clean_plate.high_sigma),
-          "keying.clean_plate.high_sigma",
-          "must be above keying.clean_plate.low_sigma (" + Num(k.clean_plate.low_sigma) +
-              "), got " + Num(k.clean_plate.high_sigma));
-    Finite(k.despill.strength, "keying.despill.strength");
-    if (std::isfinite(k.despill.strength) && (k.despill.strength < 0 || k.despill.strength > 1)) {
-      const double clamped = std::clamp(k.despill.strength, 0.0, 1.0);
-      msg_.Adjust("keying.despill.strength",
-                  Num(k.despill.strength) + " is outside 0..1; clamped to " + Num(clamped));
-      k.despill.strength = clamped;
-    }
-    // The shared blocks' own rules (pipeline/key/shared_options.h), after the clamp above.
-    std::string why;
-    Rules(k.despill.IsValid(&why), why, "keying.despill");
-    Rules(k.shadow.IsValid(&why), why, "keying.shadow");
   }
 
   void Run(StationConfig& cfg) {
