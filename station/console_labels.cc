@@ -44,7 +44,6 @@ using api::Route;
 
 namespace {
 
-constexpr int kFolds = 5;
 // stage-2 evaluations a row at most (a random subset)
 constexpr size_t kMaxCandidatesPerRow = 1000;
 
@@ -64,22 +63,6 @@ bool SameWindow(const ComparisonWindow& a, const ComparisonWindow& b) {
 
 std::string Basename(const std::string& path) { return fs::path(path).filename().string(); }
 
-// A file in `dir` named prefix-STAMP.ext that does not exist yet (never over an older one).
-fs::path FreshName(const fs::path& dir, const std::string& prefix, const std::string& stamp,
-                   const std::string& ext) {
-  fs::path p = dir / (prefix + stamp + ext);
-  for (int k = 2; fs::exists(p); ++k) p = dir / (prefix + stamp + "-" + std::to_string(k) + ext);
-  return p;
-}
-
-void WriteText(const fs::path& path, const std::string& text) {
-  std::ofstream out(path, std::ios::trunc | std::ios::binary);
-  if (!out) throw WorkError(path.string(), "cannot open for writing");
-  out << text;
-  out.close();
-  if (!out) throw WorkError(path.string(), "write failed");
-}
-
 // The cross-validated figures of a weights file's training record (stage "stage2" or "stage1").
 nlohmann::json CrossValidated(const nlohmann::json& training, const char* stage) {
   const std::string key = std::string(stage) + "_cross_validated";
@@ -90,45 +73,6 @@ nlohmann::json CrossValidated(const nlohmann::json& training, const char* stage)
 }
 
 }  // namespace
-
-std::string TransitionLabelsCsv(const std::vector<TransitionLabelRecord>& labels,
-                                double positive_rate) {
-  std::string out;
-  if (positive_rate > 0 && positive_rate < 1) {
-    char text[64];
-    std::snprintf(text, sizeof(text), "# positive_rate=%.9g\n", positive_rate);
-    out += text;
-  }
-  out += "sprite_i,sprite_j,accept\n";
-  // In pair order, not labelling order: training's fold split follows the file's order, so
-  // the same labels give the same cross-validated figures however they were asked.
-  std::vector<const TransitionLabelRecord*> sorted;
-  sorted.reserve(labels.size());
-  for (const TransitionLabelRecord& l : labels) sorted.push_back(&l);
-  std::stable_sort(sorted.begin(), sorted.end(), [](const auto* x, const auto* y) {
-    return std::make_tuple(std::min(x->from_sprite, x->to_sprite),
-                           std::max(x->from_sprite, x->to_sprite), x->from_sprite) <
-           std::make_tuple(std::min(y->from_sprite, y->to_sprite),
-                           std::max(y->from_sprite, y->to_sprite), y->from_sprite);
-  });
-  for (const TransitionLabelRecord* p : sorted) {
-    const TransitionLabelRecord& l = *p;
-    if (l.label != "yes" && l.label != "no") continue;
-    out += std::to_string(l.from_sprite) + "," + std::to_string(l.to_sprite) + "," +
-           (l.label == "yes" ? "1" : "0") + "\n";
-  }
-  return out;
-}
-
-double CalibratedPositiveRate(const TransitionWeights& weights) {
-  try {
-    const nlohmann::json t = nlohmann::json::parse(weights.training_json);
-    const double rate = t.at("stage2_calibration").at("positive_rate").get<double>();
-    return rate > 0 && rate < 1 ? rate : -1;
-  } catch (const std::exception&) {
-    return -1;
-  }
-}
 
 // ---- the sprites the pair search runs on --------------------------------------------------
 // The originals of the bank's complete clips with their comparison images, brought up to date
@@ -223,24 +167,20 @@ bool ConsoleLabelsOptions::IsValid(std::string* why) const {
 }
 
 ConsoleLabels::ConsoleLabels(api::Context context, ConsoleLabelsOptions options)
-    : context_(std::move(context)),
-      options_(std::move(options)),
-      shared_(std::make_shared<Shared>()) {
+    : context_(std::move(context)), options_(std::move(options)) {
   if (std::string why; !options_.IsValid(&why)) throw InputError("labels options", why);
-  shared_->retrain = {{"state", "idle"}, {"progress", 0}, {"stage", ""}};
+  // An ended retrain changed the weights (or tried to): the status reads them again.
+  retrain_ = std::make_unique<RetrainJob>(
+      context_, options_.threads, [dirty = dirty_](const ss::RetrainState& state) {
+        if (state.phase == RetrainPhase::kDone || state.phase == RetrainPhase::kFailed ||
+            state.phase == RetrainPhase::kCancelled)
+          *dirty = true;
+      });
 }
 
 ConsoleLabels::~ConsoleLabels() { Stop(); }
 
-void ConsoleLabels::Stop() {
-  std::unique_lock lock(shared_->mutex);
-  shared_->stop = true;
-  // A thread following the station's rebuild wakes and stops at once; one restarting the
-  // station stops when the restart is done; one still training is left to finish alone (it
-  // touches only `shared_` and files).
-  shared_->changed.notify_all();
-  shared_->changed.wait(lock, [&] { return !shared_->using_host; });
-}
+void ConsoleLabels::Stop() { retrain_->Stop(); }
 
 std::string ConsoleLabels::BankPath() const {
   if (!options_.bank.empty()) return options_.bank;
@@ -252,8 +192,7 @@ std::pair<TransitionWeights, std::string> ConsoleLabels::WeightsInUse() const {
     StationHost::Weights w = context_.host->weights();
     return {std::move(w.weights), std::move(w.path)};
   }
-  std::lock_guard lock(shared_->mutex);
-  if (shared_->own_weights) return *shared_->own_weights;
+  if (auto own = retrain_->OwnWeights()) return *std::move(own);
   return {DefaultWeights(), ""};
 }
 
@@ -404,10 +343,7 @@ nlohmann::json ConsoleLabels::Store(const nlohmann::json& body) {
   }
   TransitionLabelRecord record{from, to, label, UtcNowIso(), "console"};
   BankWriter(bank).SetTransitionLabel(record);
-  {
-    std::lock_guard lock(shared_->mutex);
-    shared_->dirty = true;
-  }
+  *dirty_ = true;
   return {{"stored",
            {{"from", from}, {"to", to}, {"label", label}, {"labelled_at", record.labelled_at}}},
           {"labels", Counts()}};
@@ -421,10 +357,7 @@ nlohmann::json ConsoleLabels::Undo(const nlohmann::json& body) {
     throw NotFoundError(
         "label", "no label for the pair " + std::to_string(from) + " -> " + std::to_string(to));
   }
-  {
-    std::lock_guard lock(shared_->mutex);
-    shared_->dirty = true;
-  }
+  *dirty_ = true;
   return {{"removed", {{"from", from}, {"to", to}}}, {"labels", Counts()}};
 }
 
@@ -434,20 +367,12 @@ std::string ConsoleLabels::ExportCsv() const {
                              CalibratedPositiveRate(WeightsInUse().first));
 }
 
-nlohmann::json ConsoleLabels::RetrainState() const {
-  std::lock_guard lock(shared_->mutex);
-  return shared_->retrain;
-}
+nlohmann::json ConsoleLabels::RetrainState() const { return retrain_->State().ToJson(); }
 
 nlohmann::json ConsoleLabels::StartRetrain() {
   const std::string bank = BankPath();
-  {
-    std::lock_guard lock(shared_->mutex);
-    if (shared_->running) {
-      throw ConflictError("retrain", "a retrain is running (" +
-                                         shared_->retrain.value("stage", std::string()) + ")");
-    }
-  }
+  if (retrain_->Running())
+    throw ConflictError("retrain", "a retrain is running (" + retrain_->State().stage + ")");
   if (context_.host) {
     const std::shared_ptr<Station> station = context_.host->current();
     if (station && station->SessionActive()) {
@@ -465,239 +390,18 @@ nlohmann::json ConsoleLabels::StartRetrain() {
                                    " labels, some of each (skips do not count)");
   }
   auto [weights, path] = WeightsInUse();
-  {
-    std::lock_guard lock(shared_->mutex);
-    if (shared_->running || shared_->stop)
-      throw ConflictError("retrain", "a retrain is running, or the server stops");
-    shared_->running = true;
-    shared_->retrain = {{"state", "training"},
-                        {"progress", 0.02},
-                        {"stage", "exporting the labels"},
-                        {"labels", yes + no},
-                        {"accepts", yes},
-                        {"started", UtcNowIso()},
-                        {"previous_weights", path.empty() ? "shipped defaults" : path}};
-  }
-  std::thread(RunRetrain, shared_, context_, options_, bank, std::move(weights)).detach();
-  return RetrainState();
+  return retrain_->Start({bank, std::move(weights), path, yes + no, yes}).ToJson();
 }
 
-void ConsoleLabels::WaitRetrain() {
-  std::unique_lock lock(shared_->mutex);
-  shared_->changed.wait(lock, [&] { return !shared_->running; });
-}
+nlohmann::json ConsoleLabels::CancelRetrain() { return retrain_->Cancel().ToJson(); }
 
-void ConsoleLabels::RunRetrain(std::shared_ptr<Shared> shared, api::Context context,
-                               const ConsoleLabelsOptions& options, const std::string& bank,
-                               const TransitionWeights& current) {
-  SetThisThreadNice(kNiceBackground);  // below capture and the console (core/posix.h)
-  auto log = Log("station.labels");
-  auto SetRetrain = [&](const std::function<void(nlohmann::json&)>& change) {
-    std::lock_guard lock(shared->mutex);
-    change(shared->retrain);
-  };
-  // Enters the part of the work that uses the station host: false when the server stops.
-  auto enter_host = [&] {
-    std::lock_guard lock(shared->mutex);
-    if (shared->stop) return false;
-    shared->using_host = true;
-    return true;
-  };
-  const auto t0 = std::chrono::steady_clock::now();
-  auto seconds = [](auto since) {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
-  };
-  try {
-    // 1. The labels as `transitions train` reads them, kept beside the weights they make.
-    const fs::path dir = fs::absolute(bank).parent_path() / "weights";
-    std::error_code ec;
-    fs::create_directories(dir, ec);
-    if (ec) throw WorkError(dir.string(), "cannot create the weights folder: " + ec.message());
-    const std::string stamp = UtcNowStamp();
-    const fs::path labels_path = FreshName(dir, "labels-", stamp, ".csv");
-    const double positive_rate = CalibratedPositiveRate(current);
-    WriteText(labels_path, TransitionLabelsCsv(Bank(bank).LoadTransitionLabels(), positive_rate));
-
-    // 2. Train (both stages, cross-validated; stage 2 set for the positive rate on the bank).
-    SetRetrain([&](nlohmann::json& r) {
-      r["progress"] = 0.05;
-      r["stage"] = "training on " + r["labels"].dump() + " labels (" + std::to_string(kFolds) +
-                   "-fold cross-validation), then calibrating on the bank";
-      r["labels_file"] = labels_path.string();
-      r["positive_rate"] =
-          positive_rate > 0 ? nlohmann::json(positive_rate) : nlohmann::json(nullptr);
-    });
-    // The shipped classifier (BankTrainOptions' defaults: DefaultWeights()' variant and window),
-    // whatever the weights in use are.
-    BankTrainOptions train;
-    train.train.folds = kFolds;
-    train.threads = options.threads;
-    const BankTrainResult result = TrainOnBank(labels_path.string(), bank, train);
-    const double train_s = seconds(t0);
-
-    // 3. The weights file, written whole under a name no other file has.
-    const fs::path weights_path = FreshName(dir, "weights-", stamp, ".json");
-    const fs::path partial = weights_path.string() + ".partial";
-    SaveWeights(result.weights, partial.string());
-    fs::rename(partial, weights_path);
-    const std::string fingerprint = WeightsFingerprint(result.weights);
-    log->info("retrained on {} labels: stage 2 precision {:.3f}, recall {:.3f}; weights {}",
-              result.report.samples, result.report.stage2.precision(),
-              result.report.stage2.recall(), weights_path.string());
-    SetRetrain([&](nlohmann::json& r) {
-      r["state"] = "rebuilding";
-      r["progress"] = 0.5;
-      r["stage"] = "restarting the station with the new weights";
-      r["precision"] = result.report.stage2.precision();
-      r["recall"] = result.report.stage2.recall();
-      r["stage1"] = {{"precision", result.report.stage1.precision()},
-                     {"recall", result.report.stage1.recall()}};
-      r["folds"] = result.report.folds;
-      r["weights"] = weights_path.string();
-      r["fingerprint"] = fingerprint;
-      r["seconds_train"] = train_s;
-      if (result.stage2_calibrated) {
-        r["calibration"] = {{"accepts_per_sprite", result.stage2.accepts_per_sprite},
-                            {"estimated_precision", result.stage2.precision},
-                            {"estimated_recall", result.stage2.recall}};
-      }
-    });
-
-    // 4. The station uses them; the bank's table is rebuilt with them.
-    const auto t_rebuild = std::chrono::steady_clock::now();
-    auto stage_progress = [&](const std::string& stage, int64_t done, int64_t total) {
-      const double f = total > 0 ? static_cast<double>(done) / static_cast<double>(total) : 0.0;
-      SetRetrain([&](nlohmann::json& r) {
-        const bool load = stage == "load";
-        r["progress"] = load ? 0.55 + 0.15 * f : 0.7 + 0.28 * f;
-        r["stage"] = std::string(load ? "rebuilding transitions: reading sprites "
-                                      : "rebuilding transitions: searching ") +
-                     std::to_string(done) + " / " + std::to_string(total);
-      });
-    };
-    bool rebuilt_by_station = false;
-    if (context.host) {
-      if (!enter_host())
-        throw WorkError("retrain", "the server stopped before the station used the new weights");
-      struct Leave {
-        Shared& s;
-        ~Leave() {
-          {
-            std::lock_guard lock(s.mutex);
-            s.using_host = false;
-          }
-          s.changed.notify_all();
-        }
-      } leave{*shared};
-      const std::shared_ptr<Station> before = context.host->current();
-      const bool worker = before && before->Status().transitions_enabled;
-      context.host->UseWeights(result.weights, weights_path.string());
-      if (worker) {
-        rebuilt_by_station = true;
-        // The new station's transition worker rebuilds the table at its start. This thread
-        // sleeps until that start-up moves on, the host replaces its station (the new one's
-        // start-up is followed then) or the server stops: each of them wakes it.
-        auto wake = [shared] {
-          {
-            std::lock_guard lock(shared->mutex);
-            shared->transitions_moved = true;
-          }
-          shared->changed.notify_all();
-        };
-        struct Following {
-          StationHost& host;
-          int host_listener;
-          std::shared_ptr<Station> station;  // whose start-up is followed
-          int station_listener = 0;
-          ~Following() {
-            if (station) station->RemoveTransitionsListener(station_listener);
-            host.RemoveStationChangeListener(host_listener);
-          }
-        } following{*context.host, context.host->AddStationChangeListener(wake)};
-        for (;;) {
-          {
-            std::lock_guard lock(shared->mutex);
-            if (shared->stop)
-              throw WorkError("retrain", "the server stopped while the transitions were rebuilt");
-            shared->transitions_moved = false;  // what moves from here on wakes the wait below
-          }
-          const std::shared_ptr<Station> station = context.host->current();
-          if (station != following.station) {
-            if (following.station)
-              following.station->RemoveTransitionsListener(following.station_listener);
-            following.station = station;
-            following.station_listener = station ? station->AddTransitionsListener(wake) : 0;
-          }
-          if (station) {
-            const StationStatus st = station->Status();
-            if (st.transitions_ready) {
-              if (!st.transitions_error.empty())
-                throw WorkError("transitions", st.transitions_error);
-              break;
-            }
-            if (!st.transitions_startup_stage.empty()) {
-              stage_progress(st.transitions_startup_stage, st.transitions_startup_done,
-                             st.transitions_startup_total);
-            }
-          }
-          std::unique_lock lock(shared->mutex);
-          shared->changed.wait(lock, [&] { return shared->stop || shared->transitions_moved; });
-        }
-      }
-    } else {
-      std::lock_guard lock(shared->mutex);
-      shared->own_weights = std::make_pair(result.weights, weights_path.string());
-    }
-    if (!rebuilt_by_station) {
-      BankUpdateOptions update;
-      update.weights = result.weights;
-      update.threads = options.threads;
-      update.progress = [&](const std::string& stage, size_t done, size_t total) {
-        stage_progress(stage, static_cast<int64_t>(done), static_cast<int64_t>(total));
-      };
-      UpdateBankTransitions(bank, update);
-    }
-    const Bank after(bank);
-    const std::string table = after.GetMeta(kTransitionWeightsMetaKey).value_or("");
-    if (table != fingerprint) {
-      throw WorkError(bank, "the transition table was made by weights " + table + ", not the new " +
-                                fingerprint);
-    }
-    const int64_t transitions = after.Counts().transitions;
-    const double rebuild_s = seconds(t_rebuild);
-    log->info("transitions rebuilt with {}: {} transitions in {:.1f} s", weights_path.string(),
-              transitions, rebuild_s);
-    SetRetrain([&](nlohmann::json& r) {
-      r["state"] = "done";
-      r["progress"] = 1.0;
-      r["stage"] = "done: " + std::to_string(transitions) + " transitions";
-      r["transitions"] = transitions;
-      r["seconds_rebuild"] = rebuild_s;
-      r["seconds"] = seconds(t0);
-      r["finished"] = UtcNowIso();
-    });
-  } catch (const std::exception& e) {
-    log->error("retrain failed: {}", e.what());
-    SetRetrain([&](nlohmann::json& r) {
-      r["state"] = "failed";
-      r["error"] = e.what();
-      r["finished"] = UtcNowIso();
-    });
-  }
-  {
-    std::lock_guard lock(shared->mutex);
-    shared->dirty = true;
-    shared->running = false;
-  }
-  shared->changed.notify_all();
-}
+void ConsoleLabels::WaitRetrain() { retrain_->Wait(); }
 
 void ConsoleLabels::RefreshStatus() const {
   {
-    std::lock_guard lock(shared_->mutex);
     std::lock_guard status_lock(status_mutex_);
-    if (!shared_->dirty && MonotonicSeconds() - refreshed_at_ < 2.0) return;
-    shared_->dirty = false;
+    const bool dirty = dirty_->exchange(false);
+    if (!dirty && MonotonicSeconds() - refreshed_at_ < 2.0) return;
     refreshed_at_ = MonotonicSeconds();
   }
   nlohmann::json labels, weights;
@@ -795,6 +499,13 @@ std::vector<Route> ConsoleLabels::Routes() {
        [this](const httplib::Request& req, httplib::Response& res) {
          ObjectBody(req, {});
          Reply(res, 202, {{"retrain", StartRetrain()}});
+       }},
+      {"POST", "/api/labels/retrain/cancel",
+       "POST /api/labels/retrain/cancel (ends the retrain at its next stage, before the station "
+       "uses the new weights)",
+       [this](const httplib::Request& req, httplib::Response& res) {
+         ObjectBody(req, {});
+         Reply(res, 200, {{"retrain", CancelRetrain()}});
        }},
   };
 }

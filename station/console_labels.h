@@ -3,13 +3,14 @@
 // a person judges transitions the classifier is least sure of, the judgements are
 // kept in the bank (table transition_labels), exported as the labels CSV that
 // `spritestation transitions train` reads, and the classifier is retrained from them
-// in the background: new weights written beside the bank (never over an older file),
-// the station restarted with them and the bank's transition table rebuilt, with the
-// progress in the status every console receives (seed 000 §3, docs/transitions.md).
+// in the background (a RetrainJob, station/retrain_job.h), with the progress in the
+// status every console receives (seed 000 §3, docs/transitions.md).
+// Threads: the API's threads call the routes, the server's Stop; pool_mutex_ (one pair search
+// at a time) and status_mutex_ are never held together.
 //
 // A pair (i, j) is the classifier's pair: the page plays it as the transition i -> j
 // would look (i-1, i, then j, j+1) and the label says whether that jump looks smooth.
-#include <condition_variable>
+#include <atomic>
 #include <cstdint>
 #include <map>
 #include <memory>
@@ -23,6 +24,7 @@
 #include "core/bank_records.h"
 #include "pipeline/transitions/weights.h"
 #include "station/api_part.h"
+#include "station/retrain_job.h"
 
 namespace ss {
 
@@ -36,16 +38,6 @@ struct ConsoleLabelsOptions {
   // False with "FIELD: reason" lines in `why` (core/option_checks.h) for values out of range.
   bool IsValid(std::string* why) const;
 };
-
-// The labels CSV of `transitions train` (training.h ReadLabelsCsv): the header, then one
-// row per yes / no label (skips are left out) in pair order (by the smaller, then the larger
-// sprite id); a positive rate > 0 is written as the "# positive_rate=R" line first.
-std::string TransitionLabelsCsv(const std::vector<TransitionLabelRecord>& labels,
-                                double positive_rate);
-
-// The positive rate the weights' stage 2 was calibrated for (training.stage2_calibration),
-// or -1 when they were not.
-double CalibratedPositiveRate(const TransitionWeights& weights);
 
 class ConsoleLabels : public api::Part {
  public:
@@ -78,6 +70,8 @@ class ConsoleLabels : public api::Part {
   // ConflictError while one runs or a capture session is active; InputError("labels", ...)
   // when the labels cannot train a classifier (too few, or one kind only).
   nlohmann::json StartRetrain();
+  // POST /api/labels/retrain/cancel: RetrainJob::Cancel; its state.
+  nlohmann::json CancelRetrain();
   // Blocks until no retrain runs (tests).
   void WaitRetrain();
   // The "retrain" member of the status.
@@ -85,36 +79,9 @@ class ConsoleLabels : public api::Part {
 
  private:
   struct Pool;
-  // What the retrain thread shares with the part. The thread is detached: a daemon told to
-  // stop while a long training runs does not wait for it (Stop waits only while the thread
-  // uses the station host, i.e. restarts the station or follows its rebuild).
-  // Threads: the API's threads call the routes and StartRetrain, the server's Stop; the
-  // retrain thread runs RunRetrain. While it follows the station's rebuild, its listeners run
-  // on the host's switching thread (StationHost::AddStationChangeListener) and on the
-  // station's transitions worker thread (Station::AddTransitionsListener) and take only
-  // `mutex` to wake it. Lock order: the host's and the station's listener locks -> `mutex`
-  // -> status_mutex_ (RefreshStatus); pool_mutex_ is taken with neither held. No lock of this
-  // part is held while calling the host's switching methods (UseWeights) or removing a
-  // listener.
-  struct Shared {
-    std::mutex mutex;  // guards every member
-    std::condition_variable changed;
-    nlohmann::json retrain;  // the status' "retrain" member
-    std::optional<std::pair<TransitionWeights, std::string>> own_weights;  // without a host
-    bool running = false;  // a retrain thread exists
-    bool using_host = false;
-    bool stop = false;
-    bool dirty = true;  // the labels or weights changed: refresh the status
-    // The host replaced its station or the station's transitions start-up moved on (set by
-    // the retrain's listeners; the retrain thread waits on `changed` for it or `stop`).
-    bool transitions_moved = false;
-  };
   std::string BankPath() const;
   // The weights in use: the host's (its stations run them), else this part's own.
   std::pair<TransitionWeights, std::string> WeightsInUse() const;
-  static void RunRetrain(std::shared_ptr<Shared> shared, api::Context context,
-                         const ConsoleLabelsOptions& options, const std::string& bank,
-                         const TransitionWeights& current);
   void RefreshStatus() const;  // labels and weights from the bank (at most every 2 s)
   // pool_ made anew for another bank or comparison window, then brought up to the bank's sprites;
   // pool_mutex_ held.
@@ -122,7 +89,10 @@ class ConsoleLabels : public api::Part {
 
   api::Context context_;
   ConsoleLabelsOptions options_;
-  std::shared_ptr<Shared> shared_;
+  // The labels or weights changed: refresh the status. Shared with the retrain's callback, which
+  // may outlive this part (the job's thread is detached).
+  std::shared_ptr<std::atomic<bool>> dirty_ = std::make_shared<std::atomic<bool>>(true);
+  std::unique_ptr<RetrainJob> retrain_;
 
   std::mutex pool_mutex_;  // one pair search at a time
   std::unique_ptr<Pool> pool_;

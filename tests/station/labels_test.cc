@@ -297,8 +297,38 @@ TEST(ConsoleLabels, TheExportTrainsAndARetrainRebuildsTheTable) {
   labels.StartRetrain();
   labels.WaitRetrain();
   EXPECT_EQ(labels.RetrainState()["state"], "done");
-  EXPECT_NE(labels.RetrainState()["weights"], weights_path);
+  const std::string second = labels.RetrainState()["weights"];
+  EXPECT_NE(second, weights_path);
   EXPECT_TRUE(fs::exists(weights_path));
+
+  // A cancel ends a retrain at its next stage, before the bank's table or weights change: the
+  // training takes seconds, the cancel lands before it ends.
+  EXPECT_THROW(labels.CancelRetrain(), ConflictError) << "none runs";
+  const std::string table = Bank(bank.path).GetMeta(kTransitionWeightsMetaKey).value_or("");
+  const auto files = [&] {
+    std::set<std::string> names;
+    for (const auto& e : fs::directory_iterator(dir / "weights"))
+      names.insert(e.path().filename().string());
+    return names;
+  };
+  const std::set<std::string> before = files();
+  labels.StartRetrain();
+  EXPECT_EQ(labels.CancelRetrain()["state"], "training");
+  labels.WaitRetrain();
+  const nlohmann::json cancelled = labels.RetrainState();
+  EXPECT_EQ(cancelled["state"], "cancelled") << cancelled.dump(1);
+  EXPECT_FALSE(cancelled.contains("weights")) << cancelled.dump(1);
+  EXPECT_TRUE(cancelled.contains("finished"));
+  EXPECT_EQ(Bank(bank.path).GetMeta(kTransitionWeightsMetaKey).value_or(""), table);
+  std::set<std::string> added;
+  for (const std::string& f : files())
+    if (!before.count(f)) added.insert(f);
+  ASSERT_EQ(added.size(), 1u) << "only its labels file";
+  EXPECT_EQ(added.begin()->rfind("labels-", 0), 0u) << *added.begin();
+  // The weights in use are still the second retrain's.
+  labels.AddStatus(status);
+  EXPECT_EQ(status["transitions"]["weights"]["path"], second);
+  EXPECT_EQ(status["transitions"]["retrain"]["state"], "cancelled");
 }
 
 }  // namespace

@@ -318,6 +318,8 @@ function showClassifier(status) {
   $('retrain-bar').querySelector('i').style.width = `${Math.round(100 * (r.progress || 0))}%`;
   $('retrain-bar').dataset.progress = String(r.progress || 0);
   $('retrain-button').disabled = running;
+  // A cancel is taken until the station gets the new weights (docs/console.md).
+  $('retrain-cancel').hidden = !(r.state === 'training' || (r.state === 'rebuilding' && r.progress <= 0.5));
   const figures = r.precision !== undefined;
   $('retrain-figures').hidden = !figures;
   if (figures) {
@@ -335,6 +337,7 @@ function showClassifier(status) {
   err.textContent = r.state === 'failed' ? r.error || 'failed' : '';
   if (lastRetrainState !== null && r.state !== lastRetrainState) {
     if (r.state === 'failed') showMessage(`retrain: ${r.error}`, 'error');
+    if (r.state === 'cancelled') showMessage('Retrain cancelled: the weights in use and the transitions are as they were.', 'info');
     if (r.state === 'done') {
       showMessage(`Retrained: the station uses ${basename(r.weights)}; the bank's transitions are rebuilt. ` +
         'The next pairs are the new classifier\'s least sure.', 'info');
@@ -348,6 +351,17 @@ function showClassifier(status) {
 events.addEventListener('status', (e) => {
   showCounts(e.detail.labels);
   showClassifier(e.detail);
+});
+
+$('retrain-cancel').addEventListener('click', async () => {
+  $('retrain-cancel').disabled = true;
+  try {
+    await postJson('/api/labels/retrain/cancel', {});
+  } catch (err) {
+    showMessage(err.message, 'error');
+  } finally {
+    $('retrain-cancel').disabled = false;
+  }
 });
 
 $('retrain-button').addEventListener('click', async () => {

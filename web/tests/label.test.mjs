@@ -156,6 +156,32 @@ test('retraining while a capture session runs is refused with a clear message', 
   await p.click('[data-testid="message"] button');
 });
 
+test('a retrain cancelled while it trains changes neither the weights nor the table', async () => {
+  const before = metaFingerprint();
+  const weightsDir = path.join(path.dirname(cfg.bank), 'weights');
+  const weightsFiles = () => (fs.existsSync(weightsDir) ? fs.readdirSync(weightsDir) : []).filter((f) => f.startsWith('weights-'));
+  const t0 = Date.now();
+  await p.click('[data-testid="retrain-button"]');
+  await h.waitFor('the cancel offered', async () => p.isVisible('[data-testid="retrain-cancel"]'), { timeout: 15000, interval: 20 });
+  const offeredAfter = (Date.now() - t0) / 1000;
+  await p.locator('[data-testid="retrain"]').screenshot({ path: path.join(h.WORK, 'label-retrain-cancel.png') }); // kept with SS_WEB_KEEP=1
+  await p.click('[data-testid="retrain-cancel"]');
+  await h.waitFor('the retrain cancelled', async () => {
+    const st = await p.getAttribute('[data-testid="retrain-state"]', 'data-state');
+    if (st === 'failed' || st === 'done') throw new Error(`the retrain ended ${st}, not cancelled (cancel offered after ${offeredAfter} s)`);
+    return st === 'cancelled';
+  }, { timeout: 90000, interval: 50 });
+  console.log(`# label: cancel offered ${offeredAfter.toFixed(1)} s after the click; cancelled after ${((Date.now() - t0) / 1000).toFixed(1)} s`);
+  assert.match(await messageText(), /Retrain cancelled/);
+  assert.equal(await p.isHidden('[data-testid="retrain-cancel"]'), true);
+  assert.equal(await p.isEnabled('[data-testid="retrain-button"]'), true);
+  assert.equal(metaFingerprint(), before, 'the table is the old weights\'');
+  assert.deepEqual(weightsFiles(), [], 'no weights file left');
+  const status = await (await fetch(`${station.url}/api/status`)).json();
+  assert.equal(status.transitions.retrain.state, 'cancelled');
+  await p.click('[data-testid="message"] button');
+});
+
 test('retrain: new weights, their cross-validated figures, the transitions rebuilt', async () => {
   const before = metaFingerprint();
   const rowsBefore = h.sql(cfg.bank, 'SELECT count(*), total(d) FROM transitions');
