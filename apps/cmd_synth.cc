@@ -20,6 +20,7 @@ struct SynthArgs {
   synth::SynthOptions options;
   std::string kind = "animal";
   std::string studio;  // "": the kind's
+  std::string view = "oblique";
   std::string size = "640x480";
   std::string pixel_format = "rgb8";
   bool json = false;
@@ -39,6 +40,10 @@ void RunSynth(SynthArgs args) {
                                        args.studio + "'");
     }
     o.studio = studio;
+  }
+  if (!FromText(args.view, synth::kCameraViewTexts, o.view)) {
+    throw InputError("--view",
+                     "expected " + TextsOf(synth::kCameraViewTexts) + ", got '" + args.view + "'");
   }
   o.empty_lead_in_s =
       args.empty_lead_in_s >= 0
@@ -109,6 +114,10 @@ void AddSynthCommand(CLI::App& app) {
   cmd->add_option(
       "--studio", args->studio,
       TextsOf(synth::kStudioKindTexts) + " (default: stage for figures, else enclosure)");
+  cmd->add_option("--view", args->view,
+                  TextsOf(synth::kCameraViewTexts) +
+                      ": cameras around the floor looking obliquely down at it (the default), or "
+                      "above it looking straight down (the enclosure only)");
   cmd->add_option("--seconds", o.seconds, "Length of the session");
   cmd->add_option("--fps", o.fps, "Frames per second");
   cmd->add_option("--size", args->size, "Image size WIDTHxHEIGHT");

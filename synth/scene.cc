@@ -224,7 +224,7 @@ Rigid3 LookAt(const Eigen::Vector3d& centre, const Eigen::Vector3d& target, doub
 }
 
 std::vector<SynthCamera> MakeCameras(const Studio& studio, int count, int width, int height,
-                                     uint64_t seed) {
+                                     uint64_t seed, CameraView view) {
   Rng rng(StreamSeed(seed, StudioKindName(studio.kind) + "-cameras"));
   std::vector<SynthCamera> cameras;
   const bool enclosure = studio.kind == StudioKind::kEnclosure;
@@ -263,6 +263,8 @@ std::vector<SynthCamera> MakeCameras(const Studio& studio, int count, int width,
       distance = rng.Uniform(1.25, 1.7);
       elevation = rng.Uniform(38, 62) * kDeg;
       target = {rng.Uniform(-0.04, 0.04), rng.Uniform(-0.03, 0.03), 0.0};
+      // Overhead: the same draws (lenses and gains as the oblique view's), a steep elevation.
+      if (view == CameraView::kOverhead) elevation = (90.0 - (62.0 - elevation / kDeg) / 3) * kDeg;
     } else {
       const double spread = count == 1 ? 0.0 : -30.0 + 60.0 * k / (count - 1);
       azimuth = (-90.0 + spread + rng.Uniform(-6, 6)) * kDeg;

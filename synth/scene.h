@@ -62,10 +62,18 @@ struct Studio {
 // `room_backdrop` false paints the room green (a cyclorama everywhere).
 Studio MakeStudio(StudioKind kind, uint64_t seed, bool room_backdrop = true);
 
+// Where the cameras stand: around the floor looking down at it obliquely (38-62 degrees above
+// it, as the paper filmed its hamster), or above it looking (nearly) straight down, as
+// open-field and home-cage rigs film (82-90 degrees; enclosure only).
+enum class CameraView { kOblique, kOverhead };
+inline constexpr EnumText<CameraView> kCameraViewTexts[] = {{CameraView::kOblique, "oblique"},
+                                                            {CameraView::kOverhead, "overhead"}};
+
 // K cameras with OPENCV8 lenses, at different azimuths and heights, looking at
-// the floor. Depends only on (studio kind, count, size, seed).
+// the floor. Depends only on (studio kind, count, size, seed, view); the overhead view draws the
+// same random numbers, so its lenses and gains are the oblique view's.
 std::vector<SynthCamera> MakeCameras(const Studio& studio, int count, int width, int height,
-                                     uint64_t seed);
+                                     uint64_t seed, CameraView view = CameraView::kOblique);
 
 // A camera pose looking from `centre` at `target` (ground frame, z up), rolled by `roll_rad`.
 Rigid3 LookAt(const Eigen::Vector3d& centre, const Eigen::Vector3d& target, double roll_rad);

@@ -215,6 +215,9 @@ bool SynthOptions::IsValid(std::string* why) const {
         "flies live in the enclosure");
   check(!(kind == SynthKind::kFigure && studio == StudioKind::kEnclosure), "studio",
         "figures perform on the stage");
+  check(!(view == CameraView::kOverhead &&
+          (kind == SynthKind::kFigure || studio == StudioKind::kStage)),
+        "view", "cameras look down from overhead in the enclosure only");
   check(FindRecordingCodec(codec) != nullptr, "codec",
         "unknown codec '" + codec + "' (expected " + RecordingCodecNames() + ")");
   check(std::isfinite(empty_lead_in_s) && empty_lead_in_s >= 0, "empty_lead_in_s",
@@ -232,7 +235,7 @@ SynthSummary RenderStudioSession(const SynthOptions& o) {
       o.studio.value_or(o.kind == SynthKind::kFigure ? StudioKind::kStage : StudioKind::kEnclosure);
   const Studio studio = MakeStudio(studio_kind, o.seed);
   const std::vector<SynthCamera> cameras =
-      MakeCameras(studio, o.cameras, o.width, o.height, o.seed);
+      MakeCameras(studio, o.cameras, o.width, o.height, o.seed, o.view);
   std::unique_ptr<Director> director;
   switch (o.kind) {
     case SynthKind::kAnimal:
@@ -569,6 +572,7 @@ SynthSummary RenderStudioSession(const SynthOptions& o) {
   json t = {{"format_version", kTruthVersion},
             {"kind", TextOf(o.kind, kSynthKindTexts)},
             {"studio", StudioKindName(studio.kind)},
+            {"view", TextOf(o.view, kCameraViewTexts)},
             {"seed", o.seed},
             {"fps", o.fps},
             {"frames", summary.frames},

@@ -40,6 +40,7 @@ struct SynthOptions : DirectorOptions {
   int width = 640;
   int height = 480;
   int cameras = 2;
+  CameraView view = CameraView::kOblique;  // overhead: the enclosure only
   PixelFormat pixel_format = PixelFormat::kRGB8;
   double noise = 1.0;          // sensor noise scale (0: none)
   int threads = 1;             // cameras rendered in parallel

@@ -92,6 +92,36 @@ TEST(SynthOptions, EachSessionProblemNamesItsField) {
   o.kind = SynthKind::kFigure;
   o.studio = StudioKind::kEnclosure;
   EXPECT_EQ(Problems(o), "studio: figures perform on the stage");
+  o = WithFolder();
+  o.kind = SynthKind::kFigure;
+  o.view = CameraView::kOverhead;
+  EXPECT_EQ(Problems(o), "view: cameras look down from overhead in the enclosure only");
+}
+
+// Overhead cameras look down from 82-90 degrees above the floor, through the oblique view's
+// lenses, and see the whole floor.
+TEST(SynthOptions, OverheadCamerasLookStraightDownThroughTheSameLenses) {
+  const Studio studio = MakeStudio(StudioKind::kEnclosure, 6);
+  const auto oblique = MakeCameras(studio, 3, 320, 240, 6);
+  const auto overhead = MakeCameras(studio, 3, 320, 240, 6, CameraView::kOverhead);
+  ASSERT_EQ(overhead.size(), 3u);
+  for (size_t k = 0; k < overhead.size(); ++k) {
+    EXPECT_EQ(overhead[k].intrinsics, oblique[k].intrinsics);
+    // The optical axis (camera z) in the ground frame, against straight down.
+    const Eigen::Vector3d axis = overhead[k].cam_from_ground.rotation.row(2).transpose();
+    const double below_horizon = std::asin(-axis.z()) * 180 / M_PI;
+    EXPECT_GE(below_horizon, 80.0) << overhead[k].name;
+    const double oblique_below =
+        std::asin(-oblique[k].cam_from_ground.rotation.row(2).z()) * 180 / M_PI;
+    EXPECT_LE(oblique_below, 65.0) << oblique[k].name;
+    for (const double sx : {-1.0, 1.0}) {
+      for (const double sy : {-1.0, 1.0}) {
+        const Eigen::Vector2d px =
+            overhead[k].ProjectGround({sx * studio.half_x, sy * studio.half_y, 0.0});
+        EXPECT_TRUE(px.x() > 0 && px.y() > 0 && px.x() < 319 && px.y() < 239) << px.transpose();
+      }
+    }
+  }
 }
 
 TEST(SynthOptions, EntryPointsRefuseBadOptions) {

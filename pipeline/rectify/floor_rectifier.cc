@@ -1,0 +1,209 @@
+#include "pipeline/rectify/floor_rectifier.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <utility>
+
+#include <opencv2/imgproc.hpp>
+
+#include "core/error.h"
+#include "core/option_checks.h"
+#include "pipeline/rectify/plane_map.h"
+
+namespace ss {
+namespace {
+
+// Alpha (of 255) that counts as the subject for the sprite's extent.
+constexpr int kSolidAlpha = 16;
+
+// Where `ray` meets the horizontal plane z = height in front of its origin.
+std::optional<Eigen::Vector3d> IntersectHeight(const Ray& ray, double height) {
+  if (std::abs(ray.direction.z()) < 1e-12) return std::nullopt;
+  const double s = (height - ray.origin.z()) / ray.direction.z();
+  if (!(s > 0) || !std::isfinite(s)) return std::nullopt;
+  return ray.origin + s * ray.direction;
+}
+
+// The angle in (-pi, pi].
+double Wrap(double a) { return std::remainder(a, 2 * M_PI); }
+
+}  // namespace
+
+bool FloorRectifierOptions::IsValid(std::string* why) const {
+  OptionProblems check(why);
+  check(std::isfinite(px_per_m) && px_per_m > 0, "px_per_m",
+        "expected a positive number of pixels per metre, got " + OptionProblems::Num(px_per_m));
+  for (const auto& [v, field] :
+       {std::pair{margin_m, "margin_m"}, std::pair{body_height_m, "body_height_m"},
+        std::pair{shadow_radius_m, "shadow_radius_m"}}) {
+    check(std::isfinite(v) && v >= 0, field,
+          "expected a number of metres >= 0, got " + OptionProblems::Num(v));
+  }
+  check(max_side_px >= 3, "max_side_px",
+        "expected at least 3 pixels, got " + std::to_string(max_side_px));
+  return check.ok();
+}
+
+FloorRectifier::FloorRectifier(FloorRectifierOptions options) : options_(options) {
+  if (std::string why; !options_.IsValid(&why)) throw InputError("floor rectifier options", why);
+}
+
+std::optional<FloorSprite> FloorRectifier::Rectify(const CameraModel& camera,
+                                                   const SpriteView& view,
+                                                   Rectifier::Refusal* why) const {
+  if (why != nullptr) *why = {};
+  if (view.bgr == nullptr || view.alpha == nullptr || view.bgr->empty() ||
+      view.bgr->size() != view.alpha->size()) {
+    return std::nullopt;
+  }
+  const double s = options_.px_per_m, h = options_.body_height_m;
+
+  // A first look: the matte's centre in the image, on the body plane, and its extent there.
+  const cv::Moments im = cv::moments(*view.alpha);
+  const cv::Rect solid = cv::boundingRect(*view.alpha > kSolidAlpha);
+  if (im.m00 <= 0 || solid.empty()) return std::nullopt;
+  const Eigen::Vector2d centre_px(view.offset.x + im.m10 / im.m00, view.offset.y + im.m01 / im.m00);
+  const auto first = IntersectHeight(camera.RayInGround(centre_px), h);
+  if (!first) return std::nullopt;
+  double reach = 0;
+  for (const Eigen::Vector2d& px :
+       {Eigen::Vector2d(solid.x, solid.y), Eigen::Vector2d(solid.br().x, solid.y),
+        Eigen::Vector2d(solid.x, solid.br().y), Eigen::Vector2d(solid.br().x, solid.br().y)}) {
+    const auto hit =
+        IntersectHeight(camera.RayInGround(px + Eigen::Vector2d(view.offset.x, view.offset.y)), h);
+    if (!hit) return std::nullopt;
+    reach = std::max(reach, (*hit - *first).head<2>().norm());
+  }
+  const auto too_large = [&](int side) {
+    if (side <= options_.max_side_px) return false;
+    if (why != nullptr) *why = {true, side, side};
+    return true;
+  };
+  int side = 2 * static_cast<int>(std::ceil((reach + options_.margin_m) * s)) + 1;
+  if (too_large(side)) return std::nullopt;
+
+  // The matte on the body plane, the ground's axes (u along +x, v along -y): its centre and
+  // second moments there are free of the lens's perspective.
+  const Eigen::Vector3d du(1 / s, 0, 0), dv(0, -1 / s, 0);
+  double a = (side - 1) / 2.0;
+  cv::Mat map, plane_alpha;
+  BuildPlaneMap(camera, *first - a * du - a * dv, du, dv, cv::Size(side, side), view.offset, map);
+  cv::remap(*view.alpha, plane_alpha, map, cv::noArray(), cv::INTER_LINEAR, cv::BORDER_CONSTANT,
+            cv::Scalar(0));
+  const cv::Moments pm = cv::moments(plane_alpha);
+  if (pm.m00 <= 0) return std::nullopt;
+  const double cu = pm.m10 / pm.m00, cv_ = pm.m01 / pm.m00;
+  const Eigen::Vector3d centre = *first + (cu - a) * du + (cv_ - a) * dv;
+  // The major axis in the plane image's axes, then on the ground (v runs along -y).
+  const double mu20 = pm.mu20 / pm.m00, mu02 = pm.mu02 / pm.m00, mu11 = pm.mu11 / pm.m00;
+  const double axis_image = 0.5 * std::atan2(2 * mu11, mu20 - mu02);
+  const double spread = std::sqrt(4 * mu11 * mu11 + (mu20 - mu02) * (mu20 - mu02));
+  const double major = (mu20 + mu02 + spread) / 2, minor = (mu20 + mu02 - spread) / 2;
+  double far = 0;  // the farthest solid pixel from the centre, plane pixels
+  for (int y = 0; y < plane_alpha.rows; ++y) {
+    const uint8_t* row = plane_alpha.ptr<uint8_t>(y);
+    for (int x = 0; x < plane_alpha.cols; ++x) {
+      if (row[x] > kSolidAlpha) far = std::max(far, std::hypot(x - cu, y - cv_));
+    }
+  }
+
+  FloorSprite out;
+  out.px_per_m = s;
+  out.heading_rad = Wrap(-axis_image);
+  out.elongation = major > 0 ? 1 - std::sqrt(std::max(0.0, minor) / major) : 0;
+  out.point_in_ground = Eigen::Vector3d(centre.x(), centre.y(), 0);
+  side = 2 * static_cast<int>(std::ceil(far + options_.margin_m * s)) + 1;
+  if (too_large(side)) return std::nullopt;
+  a = (side - 1) / 2.0;
+  out.anchor_px = Eigen::Vector2d(a, a);
+
+  // The sprite: +x along the axis, +y to the subject's right (seen from above, the ground turned
+  // so that the axis points right).
+  const Eigen::Vector3d ax(std::cos(out.heading_rad) / s, std::sin(out.heading_rad) / s, 0);
+  const Eigen::Vector3d ay(std::sin(out.heading_rad) / s, -std::cos(out.heading_rad) / s, 0);
+  BuildPlaneMap(camera, centre - a * ax - a * ay, ax, ay, cv::Size(side, side), view.offset, map);
+  cv::Mat bgr, alpha;
+  cv::remap(*view.bgr, bgr, map, cv::noArray(), cv::INTER_LINEAR, cv::BORDER_CONSTANT,
+            cv::Scalar::all(0));
+  cv::remap(*view.alpha, alpha, map, cv::noArray(), cv::INTER_LINEAR, cv::BORDER_CONSTANT,
+            cv::Scalar(0));
+  std::array<cv::Mat, 4> channels;
+  cv::split(bgr, channels.data());
+  channels[3] = alpha;
+  cv::merge(channels.data(), 4, out.bgra);
+
+  // The shadow lies on the floor under the centre, in the same axes.
+  const int shadow_side = 2 * static_cast<int>(std::ceil(options_.shadow_radius_m * s)) + 1;
+  if (view.shadow != nullptr && !view.shadow->empty()) {
+    const double sa = (shadow_side - 1) / 2.0;
+    BuildPlaneMap(camera, out.point_in_ground - sa * ax - sa * ay, ax, ay,
+                  cv::Size(shadow_side, shadow_side), view.offset, map);
+    cv::remap(*view.shadow, out.shadow, map, cv::noArray(), cv::INTER_LINEAR, cv::BORDER_CONSTANT,
+              cv::Scalar(0));
+  } else {
+    out.shadow = cv::Mat::zeros(shadow_side, shadow_side, CV_8U);
+  }
+  return out;
+}
+
+FloorSprite FloorRectifier::TurnHalf(const FloorSprite& sprite) {
+  FloorSprite t = sprite;
+  t.bgra = cv::Mat();
+  t.shadow = cv::Mat();
+  cv::rotate(sprite.bgra, t.bgra, cv::ROTATE_180);
+  if (!sprite.shadow.empty()) cv::rotate(sprite.shadow, t.shadow, cv::ROTATE_180);
+  t.heading_rad = Wrap(sprite.heading_rad + M_PI);
+  return t;
+}
+
+FloorSprite FloorRectifier::Mirror(const FloorSprite& sprite) {
+  FloorSprite m = sprite;
+  m.bgra = cv::Mat();
+  m.shadow = cv::Mat();
+  cv::flip(sprite.bgra, m.bgra, 0);
+  if (!sprite.shadow.empty()) cv::flip(sprite.shadow, m.shadow, 0);
+  return m;
+}
+
+std::vector<bool> ResolveHeadings(const std::vector<HeadingCue>& clip,
+                                  const HeadingOptions& options) {
+  const size_t n = clip.size();
+  std::vector<bool> flip(n, false);
+  if (n == 0) return flip;
+  const auto heading = [&](size_t t, int state) { return clip[t].axis_rad + state * M_PI; };
+  // Where the subject moves, the cost of a heading away from its direction of travel.
+  const auto unary = [&](size_t t, int state) {
+    const double speed = clip[t].velocity.norm();
+    if (!(speed > options.moving_m_per_s)) return 0.0;
+    const double sure = std::min(1.0, speed / (2 * options.moving_m_per_s));
+    const double travel = std::atan2(clip[t].velocity.y(), clip[t].velocity.x());
+    return options.backwards_weight * sure * (1 - std::cos(heading(t, state) - travel)) / 2;
+  };
+  // The turn between two frames, in half turns, counted as much as the two axes are sure.
+  const auto pair = [&](size_t t, int from, int to) {
+    const double sure =
+        std::clamp(std::min(clip[t - 1].elongation, clip[t].elongation) / 0.2, 0.05, 1.0);
+    return sure * std::abs(Wrap(heading(t, to) - heading(t - 1, from))) / M_PI;
+  };
+  std::vector<std::array<int, 2>> back(n, {0, 0});
+  std::array<double, 2> cost = {unary(0, 0), unary(0, 1)};
+  for (size_t t = 1; t < n; ++t) {
+    std::array<double, 2> next{};
+    for (int to = 0; to < 2; ++to) {
+      const double via0 = cost[0] + pair(t, 0, to), via1 = cost[1] + pair(t, 1, to);
+      back[t][to] = via1 < via0 ? 1 : 0;
+      next[to] = std::min(via0, via1) + unary(t, to);
+    }
+    cost = next;
+  }
+  int state = cost[1] < cost[0] ? 1 : 0;
+  for (size_t t = n; t-- > 0;) {
+    flip[t] = state == 1;
+    state = back[t][state];
+  }
+  return flip;
+}
+
+}  // namespace ss
