@@ -10,17 +10,32 @@
 #include "core/grid_map.h"
 #include "core/log.h"
 #include "core/option_checks.h"
+#include "pipeline/rectify/plane_map.h"
 
 namespace ss {
 namespace {
 
-// Coarse grid step (billboard pixels) at which points go through the full lens
+// Where the ray through `pixel` meets the vertical plane through `point` with normal `n`
+// (horizontal).
+std::optional<Eigen::Vector3d> IntersectVerticalPlane(const CameraModel& camera,
+                                                      const Eigen::Vector2d& pixel,
+                                                      const Eigen::Vector3d& point,
+                                                      const Eigen::Vector3d& n) {
+  const Ray ray = camera.RayInGround(pixel);
+  const double denom = ray.direction.dot(n);
+  if (std::abs(denom) < 1e-12) return std::nullopt;
+  const double s = (point - ray.origin).dot(n) / denom;
+  if (s <= 0) return std::nullopt;
+  return ray.origin + s * ray.direction;
+}
+
+// Coarse grid step (target pixels) at which points go through the full lens
 // model; the dense remap is interpolated in between. Lens distortion varies
 // slowly, so 8 px keeps the interpolation error far below a pixel.
 constexpr int kGridStep = 8;
 
-// Builds a remap from a `size` target to image pixels minus `offset`, where
-// target pixel (u, v) is the ground-frame point `origin + u*du + v*dv`.
+}  // namespace
+
 void BuildPlaneMap(const CameraModel& camera, const Eigen::Vector3d& origin,
                    const Eigen::Vector3d& du, const Eigen::Vector3d& dv, cv::Size size,
                    cv::Point offset, cv::Mat& map) {
@@ -37,22 +52,6 @@ void BuildPlaneMap(const CameraModel& camera, const Eigen::Vector3d& origin,
   }
   InterpolateGridMap(grid, kGridStep, size, std::nullopt, map);
 }
-
-// Where the ray through `pixel` meets the vertical plane through `point` with normal `n`
-// (horizontal).
-std::optional<Eigen::Vector3d> IntersectVerticalPlane(const CameraModel& camera,
-                                                      const Eigen::Vector2d& pixel,
-                                                      const Eigen::Vector3d& point,
-                                                      const Eigen::Vector3d& n) {
-  const Ray ray = camera.RayInGround(pixel);
-  const double denom = ray.direction.dot(n);
-  if (std::abs(denom) < 1e-12) return std::nullopt;
-  const double s = (point - ray.origin).dot(n) / denom;
-  if (s <= 0) return std::nullopt;
-  return ray.origin + s * ray.direction;
-}
-
-}  // namespace
 
 bool RectifierOptions::IsValid(std::string* why) const {
   OptionProblems check(why);

@@ -54,6 +54,7 @@ FloorRun RunOverhead(uint64_t seed, int first, int frames) {
                           cam.cam_from_ground);
 
   std::vector<cv::Mat> empty;
+  empty.reserve(4);
   for (int i = 0; i < 4; ++i) {
     empty.push_back(ToBgr(
         Frame::Owned(PixelFormat::kRGB8, kOverheadWidth, kOverheadHeight,
