@@ -26,9 +26,10 @@ namespace fs = std::filesystem;
   "ground_y_m, "                                                                            \
   "velocity_x_m_s, velocity_y_m_s, mean_r, mean_g, mean_b, area_px, eccentricity, bbox_x, " \
   "bbox_y, bbox_w, "                                                                        \
-  "bbox_h, billboard_w_px, billboard_h_px, px_per_m, anchor_x_px, anchor_y_px"
+  "bbox_h, billboard_w_px, billboard_h_px, px_per_m, anchor_x_px, anchor_y_px, kind, heading_rad"
 constexpr const char* kSpriteColumns = "id, " SS_SPRITE_FIELDS;
 constexpr const char* kSpriteFields = SS_SPRITE_FIELDS;
+constexpr int kSpriteFieldCount = 27;
 #undef SS_SPRITE_FIELDS
 
 SpriteRecord ReadSprite(const sql::Stmt& s) {
@@ -57,6 +58,10 @@ SpriteRecord ReadSprite(const sql::Stmt& s) {
   r.px_per_m = s.Real(23);
   r.anchor_x_px = s.Real(24);
   r.anchor_y_px = s.Real(25);
+  if (!FromText(s.Text(26), kSpriteKindTexts, r.kind)) {
+    throw InputError("sprite " + std::to_string(r.id), "unknown kind '" + s.Text(26) + "'");
+  }
+  r.heading_rad = s.Real(27);
   return r;
 }
 
@@ -397,8 +402,8 @@ struct BankWriter::Impl {
                                  "(SELECT coalesce(max(complete_seq), 0) + 1 FROM clips) "
                                  "WHERE id = ? AND complete = 0")),
         insert_sprite(db.Prepare(
-            std::string("INSERT INTO sprites (") + kSpriteFields +
-            ") VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?) "
+            std::string("INSERT INTO sprites (") + kSpriteFields + ") VALUES " +
+            sql::RowPlaceholders(1, kSpriteFieldCount) + " " +
             "ON CONFLICT (camera_id, frame, track_id, mirrored) DO NOTHING RETURNING id")),
         find_sprite(
             db.Prepare("SELECT id FROM sprites WHERE camera_id = ? AND frame = ? AND track_id = ? "
@@ -576,6 +581,8 @@ int BindSprite(sql::Stmt& q, int first, int64_t clip_id, const ClipRecord& clip,
   for (double v : reals) q.Bind(i++, v);
   for (int64_t v : box) q.Bind(i++, v);
   for (double v : {s.px_per_m, s.anchor_x_px, s.anchor_y_px}) q.Bind(i++, v);
+  q.Bind(i++, std::string(TextOf(s.kind, kSpriteKindTexts)));
+  q.Bind(i++, s.heading_rad);
   return i;
 }
 
@@ -652,7 +659,7 @@ void BankWriter::AppendSpritesOneByOne(const ClipRecord& clip, int64_t clip_id,
 void BankWriter::AppendSpritesManyRows(const ClipRecord& clip, int64_t clip_id,
                                        const std::vector<SpriteRecord>& sprites,
                                        const std::string& where, AppendResult* out) {
-  constexpr int kColumns = 25, kRowsPerStatement = 200;
+  constexpr int kColumns = kSpriteFieldCount, kRowsPerStatement = 200;
   Impl& w = *impl_;
   AppendResult& result = *out;
   result.clip_id = clip_id;

@@ -39,11 +39,13 @@ constexpr Table kTables[] = {
      "ground_y_m, "
      "velocity_x_m_s, velocity_y_m_s, mean_r, mean_g, mean_b, area_px, eccentricity, bbox_x, "
      "bbox_y, bbox_w, "
-     "bbox_h, billboard_w_px, billboard_h_px, px_per_m, anchor_x_px, anchor_y_px",
+     "bbox_h, billboard_w_px, billboard_h_px, px_per_m, anchor_x_px, anchor_y_px, kind, "
+     "heading_rad",
      "iiiiiiii"
      "rrrrrrrrr"
      "iiiiii"
-     "rrr",
+     "rrr"
+     "tr",
      "id", "mirrored, id"},
     {"sprite_tags", "sprite_id, tag", "it", "sprite_id, tag", "sprite_id, tag"},
     {"sprite_pixels", "sprite_id, width_px, height_px, codec, data", "iiitb", "sprite_id",

@@ -8,7 +8,18 @@
 
 #include <opencv2/core.hpp>
 
+#include "core/enum_text.h"
+
 namespace ss {
+
+// How a sprite's pixels stand in the world: `upright`, a billboard on a vertical plane facing
+// the camera that filmed it (seed 000 §2.1), its anchor the contact point at its bottom; or
+// `floor`, seen from above and laid on the floor facing the image's top, its anchor its centre
+// (pipeline/rectify/floor_rectifier.h, issue 38). Either kind's mirror is its image flipped
+// left to right.
+enum class SpriteKind { kUpright, kFloor };
+inline constexpr EnumText<SpriteKind> kSpriteKindTexts[] = {{SpriteKind::kUpright, "upright"},
+                                                            {SpriteKind::kFloor, "floor"}};
 
 // One recorded (or live) session; `uid` is stable so re-ingesting it adds nothing.
 struct SessionRecord {
@@ -69,6 +80,8 @@ struct SpriteRecord {
   int billboard_width_px = 0, billboard_height_px = 0;
   double px_per_m = 0;                      // billboard scale, the same for the whole bank
   double anchor_x_px = 0, anchor_y_px = 0;  // ground contact point in the billboard
+  SpriteKind kind = SpriteKind::kUpright;
+  double heading_rad = 0;  // floor sprites: the ground direction the subject faces (image up)
   std::vector<std::string> tags;
   // Required for originals (billboard-sized); a mirrored sprite stores none: its
   // pixels are its original's, flipped horizontally.

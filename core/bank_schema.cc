@@ -129,6 +129,14 @@ CREATE TABLE transition_labels (
 CREATE INDEX transition_labels_by_to ON transition_labels (to_sprite);
 )sql";
 
+// Version 3: floor sprites (issue 38): what kind each sprite is, and a floor sprite's heading.
+// Every sprite stored before is upright.
+constexpr const char* kSchemaV3 = R"sql(
+ALTER TABLE sprites ADD COLUMN kind TEXT NOT NULL DEFAULT 'upright'
+  CHECK (kind IN ('upright', 'floor'));
+ALTER TABLE sprites ADD COLUMN heading_rad REAL NOT NULL DEFAULT 0;
+)sql";
+
 // The same schema in PostgreSQL's types (a bank shared by many stations: docs/scaling.md).
 // Ids come from identity sequences, so writers on any hosts never clash; every number keeps
 // SQLite's range (BIGINT, DOUBLE PRECISION); text compares byte by byte (COLLATE "C") as in
@@ -243,6 +251,12 @@ CREATE TABLE transition_labels (
   CHECK (from_sprite <> to_sprite)
 );
 CREATE INDEX transition_labels_by_to ON transition_labels (to_sprite);
+)sql";
+
+constexpr const char* kPostgresSchemaV3 = R"sql(
+ALTER TABLE sprites ADD COLUMN kind TEXT COLLATE "C" NOT NULL DEFAULT 'upright'
+  CHECK (kind IN ('upright', 'floor'));
+ALTER TABLE sprites ADD COLUMN heading_rad DOUBLE PRECISION NOT NULL DEFAULT 0;
 )sql";
 
 std::string Hex(int64_t v) {
@@ -402,10 +416,12 @@ const std::vector<BankMigration>& BankMigrations(sql::Dialect dialect) {
       {1, "initial schema: sessions, cameras, clips, sprites, tags, pixels, transitions",
        kSchemaV1},
       {2, "transition_labels: a person's yes / no / skip on sprite pairs", kSchemaV2},
+      {3, "sprites.kind and heading_rad: floor sprites, seen from above", kSchemaV3},
   };
   static const std::vector<BankMigration> postgres = {
       {1, sqlite[0].summary, kPostgresSchemaV1},
       {2, sqlite[1].summary, kPostgresSchemaV2},
+      {3, sqlite[2].summary, kPostgresSchemaV3},
   };
   return dialect == sql::Dialect::kPostgres ? postgres : sqlite;
 }

@@ -14,7 +14,7 @@ class Db;
 enum class Dialect;
 }  // namespace sql
 
-inline constexpr int kBankSchemaVersion = 2;
+inline constexpr int kBankSchemaVersion = 3;
 // PRAGMA application_id of every bank: "SSBK".
 inline constexpr int32_t kBankApplicationId = 0x5353424B;
 

@@ -70,6 +70,8 @@ std::vector<uint8_t> BankSpool::Encode(const ClipBatch& batch) {
         {"billboard", {s.billboard_width_px, s.billboard_height_px}},
         {"px_per_m", s.px_per_m},
         {"anchor", {s.anchor_x_px, s.anchor_y_px}},
+        {"kind", TextOf(s.kind, kSpriteKindTexts)},
+        {"heading_rad", s.heading_rad},
         {"tags", s.tags}};
     if (!s.mirrored) j["pixels"] = json::binary(codec.Encode(s.pixels));
     sprites.push_back(std::move(j));
@@ -120,6 +122,12 @@ ClipBatch BankSpool::Decode(const std::vector<uint8_t>& bytes, const std::string
       r.px_per_m = s.at("px_per_m").get<double>();
       r.anchor_x_px = s.at("anchor").at(0).get<double>();
       r.anchor_y_px = s.at("anchor").at(1).get<double>();
+      // Spooled before floor sprites: upright.
+      if (const std::string kind = s.value("kind", "upright");
+          !FromText(kind, kSpriteKindTexts, r.kind)) {
+        throw InputError(what, "unknown sprite kind '" + kind + "'");
+      }
+      r.heading_rad = s.value("heading_rad", 0.0);
       r.tags = s.at("tags").get<std::vector<std::string>>();
       if (!r.mirrored) {
         const auto& blob = s.at("pixels").get_binary();

@@ -164,6 +164,8 @@ nlohmann::json ConsoleBank::Sprite(int64_t sprite_id) const {
             {"height", s.billboard_height_px},
             {"px_per_m", s.px_per_m},
             {"anchor", {s.anchor_x_px, s.anchor_y_px}}}},
+          {"kind", TextOf(s.kind, kSpriteKindTexts)},
+          {"heading_rad", s.heading_rad},
           {"tags", s.tags},
           {"transitions_out", Transitions(bank.LoadTransitionsFrom(sprite_id), true)},
           {"transitions_in", Transitions(bank.LoadTransitionsTo(sprite_id), false)}};

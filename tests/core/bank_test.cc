@@ -51,6 +51,8 @@ void ExpectSameFields(const SpriteRecord& want, const SpriteRecord& got) {
   EXPECT_EQ(got.px_per_m, want.px_per_m);
   EXPECT_EQ(got.anchor_x_px, want.anchor_x_px);
   EXPECT_EQ(got.anchor_y_px, want.anchor_y_px);
+  EXPECT_EQ(got.kind, want.kind);
+  EXPECT_EQ(got.heading_rad, want.heading_rad);
   EXPECT_EQ(got.tags, want.tags);
 }
 
@@ -60,6 +62,10 @@ TEST(Bank, RoundTripsEveryField) {
   std::vector<SpriteRecord> batch = MakeBatch(10, 12, 7);
   batch[0].tags = {"run", "walk"};
   batch[1].tags = {"mirror-tag"};
+  for (SpriteRecord& s : batch) {  // floor sprites (issue 38), as an overhead camera stores them
+    s.kind = SpriteKind::kFloor;
+    s.heading_rad = -2.5 + 0.25 * static_cast<double>(s.frame);
+  }
   AppendResult result;
   Fixture fx;
   {
@@ -435,6 +441,36 @@ TEST(Bank, WrongSchemaVersionNamesTheFileAndVersions) {
     }
   }
   EXPECT_THROW(VerifyBank(path), InputError);
+}
+
+// Version 3 adds each sprite's kind and heading: a version-2 bank's sprites are all upright.
+TEST(Bank, AVersionTwoBanksSpritesAreUprightAfterTheUpgrade) {
+  ScratchDir dir;
+  const std::string path = dir / "v2.db";
+  const auto& migrations = BankMigrations(sql::Dialect::kSqlite);
+  RawExec(path, migrations.at(0).sql);
+  RawExec(path, migrations.at(1).sql);
+  RawExec(path, "PRAGMA application_id = " + std::to_string(kBankApplicationId) +
+                    "; PRAGMA user_version = 2; INSERT INTO meta (key, value) VALUES "
+                    "('schema_version', '2')");
+  RawExec(path,
+          "INSERT INTO sessions (id, uid) VALUES (1, 's@t'); "
+          "INSERT INTO cameras (id, session_id, name, width, height) VALUES (1, 1, 'cam0', 640, "
+          "480); INSERT INTO clips (id, camera_id, track_id, first_frame, last_frame, complete, "
+          "complete_seq) VALUES (1, 1, 0, 4, 4, 1, 1); "
+          "INSERT INTO sprites (id, clip_id, camera_id, track_id, frame, timestamp_ns, mirrored, "
+          "ground_x_m, ground_y_m, velocity_x_m_s, velocity_y_m_s, mean_r, mean_g, mean_b, "
+          "area_px, eccentricity, bbox_x, bbox_y, bbox_w, bbox_h, billboard_w_px, billboard_h_px, "
+          "px_per_m, anchor_x_px, anchor_y_px) VALUES (1, 1, 1, 0, 4, 133, 0, 0.1, 0.2, 0, 0, 10, "
+          "20, 30, 40, 0.5, 1, 2, 3, 4, 5, 6, 800, 2, 5)");
+  EXPECT_THROW(Bank b(path), InputError) << "a reader asks for the upgrade";
+  { BankWriter w(path); }  // upgrades
+  const Bank bank(path);
+  EXPECT_EQ(bank.schema_version(), 3);
+  const SpriteRecord s = bank.LoadSprite(1);
+  EXPECT_EQ(s.kind, SpriteKind::kUpright);
+  EXPECT_EQ(s.heading_rad, 0.0);
+  EXPECT_EQ(s.ground_y_m, 0.2);
 }
 
 TEST(Bank, AVersionOneBankIsUpgradedInPlaceAndKeepsItsSprites) {
