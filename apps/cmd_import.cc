@@ -16,6 +16,7 @@
 #include "core/camera_model.h"
 #include "core/error.h"
 #include "core/log.h"
+#include "core/option_checks.h"
 #include "import/import_session.h"
 #include "pipeline/filter/usability.h"
 #include "pipeline/run/ingest.h"
@@ -51,20 +52,31 @@ void RunImport(ImportArgs a) {
   }
   if (!a.json) o.progress = [](const std::string& line) { Log("import")->info("{}", line); };
   const ImportSummary s = ImportVideos(o);
-  // Each camera's shallowest view of the floor: from above it, ingest keeps nothing (issue 38).
-  std::vector<double> shallowest(s.cameras.size(), std::nan(""));
+  // How each camera sees its floor (issue 38): from above, ingest stores floor sprites; an
+  // upright camera that sees all of it too steeply keeps nothing.
+  struct View {
+    double shallowest_deg = std::nan(""), median_deg = std::nan("");
+    bool from_above = false;
+    std::string steep;
+  };
+  std::vector<View> views(s.cameras.size());
   if (!o.no_model) {
     try {
       const GroundPolygon floor = FloorForSession(s.session_dir, {});
       for (size_t i = 0; i < s.cameras.size(); ++i) {
         const CameraModel model = CameraModel::Read(
             (std::filesystem::path(s.session_dir) / (s.cameras[i].name + ".cameramodel")).string());
-        shallowest[i] = FloorMask(model, floor, UsabilityOptions{}).shallowest_view_deg();
+        const FloorMask mask(model, floor, UsabilityOptions{});
+        views[i] = {mask.shallowest_view_deg(), mask.median_view_deg(), mask.FilmsFromAbove(),
+                    mask.SteepViewText()};
       }
     } catch (const InputError&) {
       // no floor (nothing seen): ingest names it
     }
   }
+  const auto number = [](double v) {
+    return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json();
+  };
 
   if (a.json) {
     nlohmann::json j = {{"session", s.session_dir},      {"name", s.name},
@@ -84,8 +96,9 @@ void RunImport(ImportArgs a) {
                               {"model", c.model_source}});
     }
     for (size_t i = 0; i < s.cameras.size(); ++i) {
-      j["cameras"][i]["shallowest_view_deg"] =
-          std::isfinite(shallowest[i]) ? nlohmann::json(shallowest[i]) : nlohmann::json();
+      j["cameras"][i]["shallowest_view_deg"] = number(views[i].shallowest_deg);
+      j["cameras"][i]["median_view_deg"] = number(views[i].median_deg);
+      j["cameras"][i]["sprites"] = views[i].from_above ? "floor" : "upright";
     }
     std::printf("%s\n", j.dump(2).c_str());
   } else {
@@ -100,13 +113,18 @@ void RunImport(ImportArgs a) {
           c.name.c_str(), c.video.c_str(), c.width, c.height, c.codec.c_str(), c.fps,
           static_cast<long long>(c.frames), c.first_timestamp_ns / 1e9, c.last_timestamp_ns / 1e9,
           static_cast<long long>(c.empty_frames), c.model_source.c_str());
-      if (const std::string steep =
-              SteepViewText(shallowest[&c - s.cameras.data()], UsabilityOptions{});
-          !steep.empty()) {
+      const View& view = views[static_cast<size_t>(&c - s.cameras.data())];
+      if (!view.steep.empty()) {
         std::printf(
             "  %s: %s: ingest will refuse every sprite as view_too_steep (an upright billboard "
             "seen from above is a sliver)\n",
-            c.name.c_str(), steep.c_str());
+            c.name.c_str(), view.steep.c_str());
+      } else if (view.from_above) {
+        std::printf(
+            "  %s: films its floor from above (a median view of %d degrees, steeper than "
+            "pipeline.floor_view_angle_deg %s): ingest will store floor sprites\n",
+            c.name.c_str(), static_cast<int>(std::floor(view.median_deg)),
+            OptionProblems::Num(UsabilityOptions{}.floor_view_angle_deg).c_str());
       }
       if (c.corrupt_frames > 0) {
         std::printf("  %s: %lld damaged frames skipped (the last: %s)\n", c.name.c_str(),

@@ -268,6 +268,16 @@ OptionsBinder PipelineKeys(CameraPipelineOptions& p) {
            "floor and the ray to the camera) are refused as `view_too_steep`: an upright "
            "billboard from above is a sliver (docs/pipeline.md). 90 keeps every view")
       .Rule({0, 90, true})
+      .Add("floor_view_angle_deg", &p.usability.floor_view_angle_deg,
+           "an angle in degrees above 0 and at most 90 (90: no camera films from above)",
+           "a camera whose median view of its floor is steeper than this films from above: its "
+           "subjects are laid on the floor as floor sprites, which `max_view_angle_deg` does "
+           "not limit (docs/pipeline.md)")
+      .Rule({0, 90, true})
+      .Add("floor_height_m", &p.rectify.floor_height_m, "a distance in metres >= 0",
+           "floor sprites: the height above the floor of the plane a subject seen from above is "
+           "laid on, where its outline lies (the widest part of its body)")
+      .Rule(AtLeast(0))
       .Add("still_speed_m_per_s", &p.still_speed_m_per_s, "a positive speed in m/s",
            "a subject slower than this is standing still")
       .Rule(Positive())

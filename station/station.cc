@@ -90,9 +90,7 @@ std::vector<std::string> SteepViews(const StationConfig& config) {
       continue;  // a gap, named by CalibrationGaps
     }
     if (!model) continue;
-    const std::string text =
-        SteepViewText(FloorMask(*model, floor, config.pipeline.usability).shallowest_view_deg(),
-                      config.pipeline.usability);
+    const std::string text = FloorMask(*model, floor, config.pipeline.usability).SteepViewText();
     if (!text.empty())
       steep.push_back(c.name + ": " + text + ": every sprite would be view_too_steep");
   }

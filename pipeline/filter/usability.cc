@@ -33,6 +33,12 @@ bool UsabilityOptions::IsValid(std::string* why) const {
         "max_view_angle_deg",
         "expected an angle in degrees above 0 and at most 90 (90: no view is too steep), got " +
             OptionProblems::Num(max_view_angle_deg));
+  check(
+      std::isfinite(floor_view_angle_deg) && floor_view_angle_deg > 0 && floor_view_angle_deg <= 90,
+      "floor_view_angle_deg",
+      "expected an angle in degrees above 0 and at most 90 (90: no camera films from above), "
+      "got " +
+          OptionProblems::Num(floor_view_angle_deg));
   return check.ok();
 }
 
@@ -79,14 +85,6 @@ const char* DiscardName(Discard reason) {
       break;
   }
   return "unknown";
-}
-
-std::string SteepViewText(double shallowest_view_deg, const UsabilityOptions& options) {
-  if (!(shallowest_view_deg > options.max_view_angle_deg)) return "";
-  return "sees all of its floor from " +
-         std::to_string(static_cast<int>(std::floor(shallowest_view_deg))) +
-         " degrees or more above it, steeper than pipeline.max_view_angle_deg " +
-         OptionProblems::Num(options.max_view_angle_deg);
 }
 
 namespace {
@@ -186,8 +184,9 @@ FloorMask::FloorMask(const CameraModel& camera, const GroundPolygon& floor,
                       [this](const Eigen::Vector2d& p) { return floor_index_.Contains(p); });
   cv::integral(mask_ == 0, not_floor_integral_, CV_32S);
   not_floor_integral_ /= 255;
-  // The shallowest view: the floor pixel whose ray is nearest the horizontal.
+  // The shallowest view: the floor pixel whose ray is nearest the horizontal; and the median.
   double lowest_sin = std::numeric_limits<double>::quiet_NaN();
+  std::vector<double> sines;
   for (int j = 0; j < ray_rows_; ++j) {
     for (int i = 0; i < ray_cols_; ++i) {
       const int x = std::min(i * kRayGridStepPx, camera.width() - 1);
@@ -196,9 +195,16 @@ FloorMask::FloorMask(const CameraModel& camera, const GroundPolygon& floor,
       if (mask_.at<uint8_t>(y, x) == 0 || !d.allFinite()) continue;
       const double s = -d.z() / d.norm();
       if (!(s >= lowest_sin)) lowest_sin = s;  // the first, then each lower one
+      sines.push_back(s);
     }
   }
   shallowest_view_deg_ = std::asin(lowest_sin) * 180 / std::numbers::pi;
+  median_view_deg_ = std::numeric_limits<double>::quiet_NaN();
+  if (!sines.empty()) {
+    const auto mid = sines.begin() + static_cast<std::ptrdiff_t>(sines.size() / 2);
+    std::nth_element(sines.begin(), mid, sines.end());
+    median_view_deg_ = std::asin(*mid) * 180 / std::numbers::pi;
+  }
 }
 
 bool FloorMask::SeesBehind(int x, int y, const Eigen::Vector2d& point_in_ground) const {
@@ -238,10 +244,18 @@ void FloorMask::Restrict(const cv::Mat& seen) {
   not_floor_integral_ /= 255;
 }
 
+std::string FloorMask::SteepViewText() const {
+  if (FilmsFromAbove() || !(shallowest_view_deg_ > options_.max_view_angle_deg)) return "";
+  return "sees all of its floor from " +
+         std::to_string(static_cast<int>(std::floor(shallowest_view_deg_))) +
+         " degrees or more above it, steeper than pipeline.max_view_angle_deg " +
+         OptionProblems::Num(options_.max_view_angle_deg);
+}
+
 Discard FloorMask::Check(const cv::Mat& alpha_crop, cv::Point offset,
                          const Eigen::Vector2d& point_in_ground) const {
   const Discard floor = CheckFloor(alpha_crop, offset, point_in_ground);
-  if (floor != Discard::kNone) return floor;
+  if (floor != Discard::kNone || FilmsFromAbove()) return floor;
   return ViewAngleDeg(point_in_ground) > options_.max_view_angle_deg ? Discard::kViewTooSteep
                                                                      : Discard::kNone;
 }

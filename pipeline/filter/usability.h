@@ -54,16 +54,16 @@ struct UsabilityOptions {
   // up: a body D deep stands D tan(angle) tall on it, a sliver at 89 degrees (issue 38). The
   // reference sets are filmed at 43-60 (hamster) and 45-71 degrees (flies).
   double max_view_angle_deg = 75.0;
+  // A camera whose median view of its floor (FloorMask::median_view_deg) is steeper than this
+  // films from above: its subjects are laid on the floor as floor sprites
+  // (pipeline/rectify/floor_rectifier.h), which max_view_angle_deg does not limit. 90: never.
+  // Our oblique synthetic cameras see their floor at a median of 43-61 degrees, the overhead
+  // ones at 73-80.
+  double floor_view_angle_deg = 65.0;
   // False with "FIELD: reason" lines in `why` (core/option_checks.h) for values out of range.
   bool IsValid(std::string* why) const;
   bool operator==(const UsabilityOptions&) const = default;
 };
-
-// For a camera whose shallowest view of its floor (FloorMask::shallowest_view_deg) is steeper
-// than options.max_view_angle_deg: "sees all of its floor from 82 degrees or more above it,
-// steeper than pipeline.max_view_angle_deg 75", which import, config check and the pipeline
-// put after the camera's name; "" otherwise.
-std::string SteepViewText(double shallowest_view_deg, const UsabilityOptions& options);
 
 // The shape of a candidate's matte (its alpha crop at full resolution), for telling a subject from
 // keyed background (issue 19). The matte is `alpha > 127` ("solid").
@@ -139,6 +139,18 @@ class FloorMask {
   // degrees, over the floor it sees (the geometric floor, every kRayGridStepPx); NaN when it sees
   // none. Above the limit, no sprite of the camera can be kept.
   double shallowest_view_deg() const { return shallowest_view_deg_; }
+  // The median view of the floor it sees (the same grid: each part of the floor as much as it
+  // fills of the image), degrees; NaN when it sees none. Steeper than max_view_angle_deg, the
+  // camera films from above, and its subjects are laid on the floor (floor sprites, issue 38).
+  double median_view_deg() const { return median_view_deg_; }
+  // The camera films from above (median_view_deg steeper than floor_view_angle_deg): its sprites
+  // are floor sprites, and Check does not apply max_view_angle_deg.
+  bool FilmsFromAbove() const { return median_view_deg_ > options_.floor_view_angle_deg; }
+  // For an upright camera whose shallowest view of its floor is steeper than
+  // max_view_angle_deg: "sees all of its floor from 82 degrees or more above it, steeper than
+  // pipeline.max_view_angle_deg 75", which import, config check and the pipeline put after the
+  // camera's name (it keeps nothing); "" otherwise.
+  std::string SteepViewText() const;
   // Keeps as floor only the pixels of the geometric floor where `seen` (CV_8U, the image size) is
   // non-zero: the keyer's green, so that a wall's outside or a cable in front of the floor is not
   // floor. A later call replaces the earlier restriction.
@@ -162,6 +174,7 @@ class FloorMask {
   cv::Mat geometric_;           // the floor polygon seen over the walls, before Restrict
   cv::Mat not_floor_integral_;  // integral image of (mask_ == 0), for O(1) box tests
   double shallowest_view_deg_ = 0;
+  double median_view_deg_ = 0;
 };
 
 // Per subject: drops frames once the subject has been still for longer than allowed. A frame is

@@ -9,7 +9,6 @@
 #include <opencv2/imgproc.hpp>
 
 #include "core/error.h"
-#include "core/option_checks.h"
 #include "pipeline/rectify/plane_map.h"
 
 namespace ss {
@@ -31,34 +30,28 @@ double Wrap(double a) { return std::remainder(a, 2 * M_PI); }
 
 }  // namespace
 
-bool FloorRectifierOptions::IsValid(std::string* why) const {
-  OptionProblems check(why);
-  check(std::isfinite(px_per_m) && px_per_m > 0, "px_per_m",
-        "expected a positive number of pixels per metre, got " + OptionProblems::Num(px_per_m));
-  for (const auto& [v, field] :
-       {std::pair{margin_m, "margin_m"}, std::pair{body_height_m, "body_height_m"},
-        std::pair{shadow_radius_m, "shadow_radius_m"}}) {
-    check(std::isfinite(v) && v >= 0, field,
-          "expected a number of metres >= 0, got " + OptionProblems::Num(v));
-  }
-  check(max_side_px >= 3, "max_side_px",
-        "expected at least 3 pixels, got " + std::to_string(max_side_px));
-  return check.ok();
+FloorRectifier::FloorRectifier(RectifierOptions options) : options_(options) {
+  if (std::string why; !options_.IsValid(&why)) throw InputError("rectifier options", why);
 }
 
-FloorRectifier::FloorRectifier(FloorRectifierOptions options) : options_(options) {
-  if (std::string why; !options_.IsValid(&why)) throw InputError("floor rectifier options", why);
+std::optional<Eigen::Vector2d> FloorRectifier::Place(const CameraModel& camera,
+                                                     const cv::Mat& alpha, cv::Point offset) const {
+  const cv::Moments m = cv::moments(alpha);
+  if (!(m.m00 > 0)) return std::nullopt;
+  const Eigen::Vector2d centre_px(offset.x + m.m10 / m.m00, offset.y + m.m01 / m.m00);
+  const auto hit = IntersectHeight(camera.RayInGround(centre_px), options_.floor_height_m);
+  if (!hit) return std::nullopt;
+  return hit->head<2>();
 }
 
-std::optional<FloorSprite> FloorRectifier::Rectify(const CameraModel& camera,
-                                                   const SpriteView& view,
-                                                   Rectifier::Refusal* why) const {
+std::optional<Billboard> FloorRectifier::Rectify(const CameraModel& camera, const SpriteView& view,
+                                                 Rectifier::Refusal* why) const {
   if (why != nullptr) *why = {};
   if (view.bgr == nullptr || view.alpha == nullptr || view.bgr->empty() ||
       view.bgr->size() != view.alpha->size()) {
     return std::nullopt;
   }
-  const double s = options_.px_per_m, h = options_.body_height_m;
+  const double s = options_.px_per_m, h = options_.floor_height_m;
 
   // A first look: the matte's centre in the image, on the body plane, and its extent there.
   const cv::Moments im = cv::moments(*view.alpha);
@@ -109,7 +102,8 @@ std::optional<FloorSprite> FloorRectifier::Rectify(const CameraModel& camera,
     }
   }
 
-  FloorSprite out;
+  Billboard out;
+  out.kind = SpriteKind::kFloor;
   out.px_per_m = s;
   out.heading_rad = Wrap(-axis_image);
   out.elongation = major > 0 ? 1 - std::sqrt(std::max(0.0, minor) / major) : 0;
@@ -119,10 +113,12 @@ std::optional<FloorSprite> FloorRectifier::Rectify(const CameraModel& camera,
   a = (side - 1) / 2.0;
   out.anchor_px = Eigen::Vector2d(a, a);
 
-  // The sprite: +x along the axis, +y to the subject's right (seen from above, the ground turned
-  // so that the axis points right).
-  const Eigen::Vector3d ax(std::cos(out.heading_rad) / s, std::sin(out.heading_rad) / s, 0);
-  const Eigen::Vector3d ay(std::sin(out.heading_rad) / s, -std::cos(out.heading_rad) / s, 0);
+  // The sprite: its top ahead along the axis, +x to the subject's right (seen from above, the
+  // ground turned so that the axis points up).
+  out.toward_camera = Eigen::Vector2d(std::cos(out.heading_rad), std::sin(out.heading_rad));
+  out.right_in_ground = Eigen::Vector2d(out.toward_camera.y(), -out.toward_camera.x());
+  const Eigen::Vector3d ax(out.right_in_ground.x() / s, out.right_in_ground.y() / s, 0);
+  const Eigen::Vector3d ay(-out.toward_camera.x() / s, -out.toward_camera.y() / s, 0);
   BuildPlaneMap(camera, centre - a * ax - a * ay, ax, ay, cv::Size(side, side), view.offset, map);
   cv::Mat bgr, alpha;
   cv::remap(*view.bgr, bgr, map, cv::noArray(), cv::INTER_LINEAR, cv::BORDER_CONSTANT,
@@ -148,27 +144,20 @@ std::optional<FloorSprite> FloorRectifier::Rectify(const CameraModel& camera,
   return out;
 }
 
-FloorSprite FloorRectifier::TurnHalf(const FloorSprite& sprite) {
-  FloorSprite t = sprite;
+Billboard FloorRectifier::TurnHalf(const Billboard& sprite) {
+  Billboard t = sprite;
   t.bgra = cv::Mat();
   t.shadow = cv::Mat();
   cv::rotate(sprite.bgra, t.bgra, cv::ROTATE_180);
   if (!sprite.shadow.empty()) cv::rotate(sprite.shadow, t.shadow, cv::ROTATE_180);
   t.heading_rad = Wrap(sprite.heading_rad + M_PI);
+  t.toward_camera = -sprite.toward_camera;
+  t.right_in_ground = -sprite.right_in_ground;
   return t;
 }
 
-FloorSprite FloorRectifier::Mirror(const FloorSprite& sprite) {
-  FloorSprite m = sprite;
-  m.bgra = cv::Mat();
-  m.shadow = cv::Mat();
-  cv::flip(sprite.bgra, m.bgra, 0);
-  if (!sprite.shadow.empty()) cv::flip(sprite.shadow, m.shadow, 0);
-  return m;
-}
-
 std::vector<bool> ResolveHeadings(const std::vector<HeadingCue>& clip,
-                                  const HeadingOptions& options) {
+                                  const HeadingOptions& options, std::optional<double> before) {
   const size_t n = clip.size();
   std::vector<bool> flip(n, false);
   if (n == 0) return flip;
@@ -189,6 +178,12 @@ std::vector<bool> ResolveHeadings(const std::vector<HeadingCue>& clip,
   };
   std::vector<std::array<int, 2>> back(n, {0, 0});
   std::array<double, 2> cost = {unary(0, 0), unary(0, 1)};
+  if (before) {
+    const double sure = std::clamp(clip[0].elongation / 0.2, 0.05, 1.0);
+    for (int state = 0; state < 2; ++state) {
+      cost[state] += sure * std::abs(Wrap(heading(0, state) - *before)) / M_PI;
+    }
+  }
   for (size_t t = 1; t < n; ++t) {
     std::array<double, 2> next{};
     for (int to = 0; to < 2; ++to) {

@@ -58,7 +58,8 @@ bool RectifierOptions::IsValid(std::string* why) const {
   check(std::isfinite(px_per_m) && px_per_m > 0, "px_per_m",
         "expected a positive number of pixels per metre, got " + OptionProblems::Num(px_per_m));
   for (const auto& [v, field] :
-       {std::pair{margin_m, "margin_m"}, std::pair{shadow_radius_m, "shadow_radius_m"}}) {
+       {std::pair{margin_m, "margin_m"}, std::pair{shadow_radius_m, "shadow_radius_m"},
+        std::pair{floor_height_m, "floor_height_m"}}) {
     check(std::isfinite(v) && v >= 0, field,
           "expected a number of metres >= 0, got " + OptionProblems::Num(v));
   }

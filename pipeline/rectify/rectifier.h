@@ -12,6 +12,7 @@
 #include <Eigen/Core>
 #include <opencv2/core.hpp>
 
+#include "core/bank_records.h"
 #include "core/camera_model.h"
 
 namespace ss {
@@ -22,6 +23,10 @@ struct RectifierOptions {
   double shadow_radius_m = 0.08;  // half-size of the square ground patch for the shadow, metres
   // largest billboard side, px (>= 3): refuses absurd billboards (a sprite far above the floor)
   int max_side_px = 512;
+  // Floor sprites (floor_rectifier.h): the plane a subject seen from above is laid on, metres
+  // above the floor, where its outline lies (the widest part of its body). A wrong height moves
+  // its place by the error x tan(off-nadir angle): 1 cm at 20 degrees off the vertical, 3.6 mm.
+  double floor_height_m = 0.03;
   // False with "FIELD: reason" lines in `why` (core/option_checks.h) for values out of range.
   bool IsValid(std::string* why) const;
   bool operator==(const RectifierOptions&) const = default;
@@ -36,14 +41,24 @@ struct SpriteView {
   Eigen::Vector2d contact_px;       // contact point (core/contact_point.h), full-image pixels
 };
 
+// An upright billboard (this file) or a floor sprite (floor_rectifier.h): SpriteKind says which.
 struct Billboard {
-  cv::Mat bgra;                     // CV_8UC4 straight alpha, billboard pixels
-  cv::Mat shadow;                   // CV_8U ground patch centred on the contact point
-  Eigen::Vector2d anchor_px;        // contact point on the billboard (bottom centre)
-  Eigen::Vector3d point_in_ground;  // contact point on the floor (z = 0)
+  SpriteKind kind = SpriteKind::kUpright;
+  cv::Mat bgra;    // CV_8UC4 straight alpha, billboard pixels
+  cv::Mat shadow;  // CV_8U ground patch centred on the contact point, axes right and -toward
+  // Upright: the contact point on the billboard (bottom centre). Floor: the subject's centre
+  // (the image's centre).
+  Eigen::Vector2d anchor_px;
+  Eigen::Vector3d point_in_ground;  // the anchor's point on the floor (z = 0)
   Eigen::Vector2d right_in_ground;  // unit billboard x axis on the floor
-  Eigen::Vector2d toward_camera;    // unit floor direction from the sprite to the camera
+  // Upright: unit floor direction from the sprite to the camera. Floor: the direction the
+  // subject faces, the image's up (heading_rad's direction).
+  Eigen::Vector2d toward_camera;
   double px_per_m = 0;
+  // Floor sprites: the ground direction the subject faces, atan2(y, x), and how sure its axis
+  // is, 1 - minor / major of the matte's second moments (0 round, towards 1 long and thin).
+  double heading_rad = 0;
+  double elongation = 0;
 };
 
 class Rectifier {
@@ -60,7 +75,8 @@ class Rectifier {
   std::optional<Billboard> Rectify(const CameraModel& camera, const SpriteView& view,
                                    Refusal* why = nullptr) const;
   // The horizontally mirrored billboard (seed 000 §2): the image flipped about
-  // its vertical axis and the anchor with it; place and axes unchanged.
+  // its vertical axis and the anchor with it; place and axes unchanged. A floor sprite's
+  // vertical axis is its body axis: its left and right sides swap.
   static Billboard Mirror(const Billboard& billboard);
   // A ground velocity seen in the mirror: its component along `right` flips.
   static Eigen::Vector2d MirrorVelocity(const Billboard& billboard,

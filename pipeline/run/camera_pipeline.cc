@@ -88,12 +88,18 @@ CameraPipeline::CameraPipeline(std::string name, int64_t camera_id, CameraModel 
       stillness_(options.still_speed_m_per_s, options.max_still_s),
       noise_(options.noise),
       rectifier_(options.rectify),
+      floor_rectifier_(options.rectify),
+      from_above_(floor_mask_.FilmsFromAbove()),
       batcher_(camera_id, options.batch),
       log_(Log("pipeline.run")) {
   // A camera that sees all of its floor from too far above keeps nothing: say so once, up front.
-  if (const std::string steep =
-          SteepViewText(floor_mask_.shallowest_view_deg(), options_.usability);
-      !steep.empty()) {
+  if (from_above_) {
+    log_->info(
+        "{}: films its floor from above (a median view of {:.0f} degrees, steeper than "
+        "pipeline.floor_view_angle_deg {}): its subjects are stored as floor sprites",
+        name_, floor_mask_.median_view_deg(), options_.usability.floor_view_angle_deg);
+  }
+  if (const std::string steep = floor_mask_.SteepViewText(); !steep.empty()) {
     log_->warn(
         "{}: {}: every sprite will be refused as view_too_steep (an upright billboard seen from "
         "above is a sliver; docs/pipeline.md)",
@@ -155,14 +161,20 @@ void CameraPipeline::Process(const Frame& frame, std::vector<ClipBatch>* out) {
   stats_.discards[static_cast<size_t>(Discard::kTooSmall)] += extractor_.dropped_last();
   stats_.candidates += candidates.size();
 
-  // Contact points: the ray through each candidate's contact point meets the floor.
+  // Contact points: the ray through each candidate's contact point meets the floor (from above:
+  // the ray through its centre meets its body plane, FloorRectifier::Place).
   std::vector<const Candidate*> grounded;
   std::vector<Eigen::Vector2d> points;
   std::vector<TrackInput> inputs;
   verdicts_.clear();
   for (const Candidate& c : candidates) {
-    const auto hit =
-        IntersectGround(model_.RayInGround(Eigen::Vector2d(c.contact_point.x, c.contact_point.y)));
+    std::optional<Eigen::Vector2d> hit;
+    if (from_above_) {
+      hit = floor_rectifier_.Place(model_, c.alpha, c.bbox.tl());
+    } else if (const auto ground = IntersectGround(
+                   model_.RayInGround(Eigen::Vector2d(c.contact_point.x, c.contact_point.y)))) {
+      hit = ground->head<2>();
+    }
     if (!hit) {
       ++stats_.discards[static_cast<size_t>(Discard::kNoGroundHit)];
       verdicts_.push_back({&c, -1, std::nullopt, Discard::kNoGroundHit});
@@ -212,7 +224,8 @@ void CameraPipeline::Process(const Frame& frame, std::vector<ClipBatch>* out) {
       const SpriteView view{&c.colour, &c.alpha, &c.shadow, c.bbox.tl(),
                             Eigen::Vector2d(c.contact_point.x, c.contact_point.y)};
       Rectifier::Refusal why;
-      billboards[k] = rectifier_.Rectify(model_, view, &why);
+      billboards[k] = from_above_ ? floor_rectifier_.Rectify(model_, view, &why)
+                                  : rectifier_.Rectify(model_, view, &why);
       if (billboards[k] && side_by_side_.options().min_width_ratio > 0) {  // the rule is on
         looks[k] =
             MeasureMatteLook(billboards[k]->bgra, billboards[k]->px_per_m, side_by_side_.options());

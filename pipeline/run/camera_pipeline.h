@@ -23,6 +23,7 @@
 #include "pipeline/key/keyer.h"
 #include "pipeline/key/keying_config.h"
 #include "pipeline/key/matte.h"
+#include "pipeline/rectify/floor_rectifier.h"
 #include "pipeline/rectify/rectifier.h"
 #include "pipeline/run/clip_batcher.h"
 #include "pipeline/track/side_by_side.h"
@@ -121,6 +122,8 @@ class CameraPipeline {
   // ones).
   uint64_t usable_sprites() const { return usable_total_; }
   const FloorMask& floor_mask() const { return floor_mask_; }
+  // What it stores: floor sprites when the camera films its floor from above, else upright.
+  SpriteKind sprite_kind() const { return from_above_ ? SpriteKind::kFloor : SpriteKind::kUpright; }
   const Keyer& keyer() const { return *keyer_; }  // as configured (options.keying)
 
  private:
@@ -138,6 +141,8 @@ class CameraPipeline {
   NoiseFilter noise_;
   ClipCutter cutter_;
   Rectifier rectifier_;
+  FloorRectifier floor_rectifier_;
+  bool from_above_ = false;  // the camera films from above: floor sprites (FloorMask)
   ClipBatcher batcher_;
   cv::Mat bgr_scratch_;  // a frame converted for the keyer (formats it cannot key in place)
   Matte matte_;

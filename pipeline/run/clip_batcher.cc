@@ -4,6 +4,7 @@
 
 #include "core/error.h"
 #include "core/option_checks.h"
+#include "pipeline/rectify/floor_rectifier.h"
 
 namespace ss {
 
@@ -54,6 +55,8 @@ SpriteRecord OriginalRecord(const MadeSprite& s, const Eigen::Vector2d& velocity
   r.px_per_m = s.billboard.px_per_m;
   r.anchor_x_px = s.billboard.anchor_px.x();
   r.anchor_y_px = s.billboard.anchor_px.y();
+  r.kind = s.billboard.kind;
+  r.heading_rad = s.billboard.heading_rad;
   r.pixels.bgra = s.billboard.bgra;
   r.pixels.shadow = FitShadow(s.billboard.shadow, s.billboard.bgra.size());
   // In the sprite's own row batch: the bank stores the tag in the transaction that stores the
@@ -100,7 +103,10 @@ void ClipBatcher::Add(int64_t clip, int subject, MadeSprite sprite, std::vector<
 
   const size_t length = open.points.size();
   // At least one sprite stays back so that the closing batch is never empty.
-  const size_t hold = std::max<size_t>(1, static_cast<size_t>(options_.velocity_half_window));
+  size_t hold = std::max<size_t>(1, static_cast<size_t>(options_.velocity_half_window));
+  if (open.pending.front().billboard.kind == SpriteKind::kFloor) {
+    hold = std::max(hold, kHeadingLookahead);
+  }
   if (length < static_cast<size_t>(options_.min_clip_frames)) return;
   if (open.pending.size() >= static_cast<size_t>(options_.batch_frames) + hold) {
     Emit(open, open.pending.size() - hold, false, out);
@@ -145,6 +151,23 @@ void ClipBatcher::Emit(Open& open, size_t count, bool complete, std::vector<Clip
   batch.clip.last_frame = open.first_frame + static_cast<int64_t>(first_index + count) - 1;
   batch.clip.complete = complete;
   batch.sprites.reserve(count * (options_.mirrors ? 2 : 1));
+  if (count > 0 && open.pending.front().billboard.kind == SpriteKind::kFloor) {
+    // Head first: the signs of every frame held, those handed out now kept.
+    std::vector<HeadingCue> cues(open.pending.size());
+    for (size_t k = 0; k < cues.size(); ++k) {
+      const Billboard& b = open.pending[k].billboard;
+      cues[k] = {
+          b.heading_rad, b.elongation,
+          EstimateVelocity(open.timestamps_ns, open.points, static_cast<int>(first_index + k),
+                           options_.velocity_half_window)};
+    }
+    const std::vector<bool> flip = ResolveHeadings(cues, {}, open.last_heading);
+    for (size_t k = 0; k < count; ++k) {
+      Billboard& b = open.pending[k].billboard;
+      if (flip[k]) b = FloorRectifier::TurnHalf(b);
+    }
+    open.last_heading = open.pending[count - 1].billboard.heading_rad;
+  }
   for (size_t k = 0; k < count; ++k) {
     const MadeSprite& s = open.pending[k];
     stored_merged_originals_ += s.merged ? 1 : 0;

@@ -5,9 +5,12 @@
 // clips give no transitions and are discarded, counted); after that it goes out
 // every `batch_frames` frames, keeping back the last `velocity_half_window`
 // frames whose velocity still needs frames to come. Every original sprite is
-// followed by its horizontally mirrored copy.
+// followed by its horizontally mirrored copy. Floor sprites (seen from above) come with their
+// body axis of either sign: the batcher turns each head first (ResolveHeadings) over the frames
+// it holds, keeping back kHeadingLookahead frames that the next batch decides with more.
 #include <cstdint>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -49,6 +52,9 @@ struct ClipBatch {
 
 class ClipBatcher {
  public:
+  // Floor sprites: frames kept back for the heading of those handed out to look ahead to.
+  static constexpr size_t kHeadingLookahead = 15;
+
   ClipBatcher(int64_t camera_id, ClipBatcherOptions options);
   // Adds the next frame of clip `clip` (ClipCutter's id) of tracker subject `subject`.
   void Add(int64_t clip, int subject, MadeSprite sprite, std::vector<ClipBatch>* out);
@@ -88,6 +94,7 @@ class ClipBatcher {
     std::vector<MadeSprite> pending;      // not yet handed out: the last pending.size() frames
     bool started = false;                 // a first batch went out
     bool marked_merged = false;           // MarkMerged: two side by side
+    std::optional<double> last_heading;   // floor sprites: the last one handed out's heading
   };
   // Hands out the first `count` pending sprites of `open`.
   void Emit(Open& open, size_t count, bool complete, std::vector<ClipBatch>* out);

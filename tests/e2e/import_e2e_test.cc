@@ -95,26 +95,30 @@ TEST_F(ImportVideo, KeepsEveryFrameWithTheContainersTimes) {
   EXPECT_EQ(config.exit_code, 0) << config.output;
 }
 
-// Issue 38: a camera looking straight down keys its subjects and keeps none (an upright billboard
-// from above is a sliver); import says so, where an oblique camera gets no word.
+// Issue 38: a camera looking straight down films from above: ingest stores its subjects as floor
+// sprites, and import says so, where an oblique camera gets no word.
 TEST_F(ImportVideo, ACameraThatSeesItsFloorOnlyFromAboveIsNamed) {
   auto r = RunSpritestation("--log-level warn import " + *dir_ / "walk.mp4" + " --out " +
                             *dir_ / "oblique" + kRough + " --codec ffvhuff --range 0-0.5 --json");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   // 3 m up, its floor out to 15 m: the far edge is seen atan(3 / 15) = 11 degrees above it
-  const double oblique = JsonInOutput(r.output)["cameras"][0]["shallowest_view_deg"].get<double>();
-  EXPECT_GT(oblique, 5);
-  EXPECT_LT(oblique, 20);
+  const auto oblique = JsonInOutput(r.output)["cameras"][0];
+  EXPECT_GT(oblique["shallowest_view_deg"].get<double>(), 5);
+  EXPECT_LT(oblique["shallowest_view_deg"].get<double>(), 20);
+  EXPECT_EQ(oblique["sprites"], "upright");
   // 0.6 m straight above, 20 degrees wide: its floor's corners are seen from 77 degrees
   r = RunSpritestation(
       "--log-level warn import " + *dir_ / "walk.mp4" + " --out " +
       *dir_ / "above --camera-height 0.6 --tilt 89 --hfov 20 --codec ffvhuff --range 0-0.5");
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  EXPECT_NE(r.output.find("cam0: sees all of its floor from 76 degrees or more above it, steeper "
-                          "than pipeline.max_view_angle_deg 75: ingest will refuse every sprite as "
-                          "view_too_steep"),
+  EXPECT_NE(r.output.find("cam0: films its floor from above (a median view of 8"),
             std::string::npos)
       << r.output;
+  EXPECT_NE(r.output.find("steeper than pipeline.floor_view_angle_deg 65): ingest will store floor "
+                          "sprites"),
+            std::string::npos)
+      << r.output;
+  EXPECT_EQ(r.output.find("view_too_steep"), std::string::npos) << r.output;
 }
 
 TEST_F(ImportVideo, TheMedianPlateHoldsTheBackgroundWithoutTheWalker) {

@@ -75,7 +75,7 @@ FloorRun RunOverhead(uint64_t seed, int first, int frames) {
   CameraImage image;
   Matte matte;
   cv::Mat scratch;
-  std::vector<FloorSprite> sprites;
+  std::vector<Billboard> sprites;
   std::vector<SubjectTruth> truths;
   for (int i = 0; i < first + frames; ++i) {
     director->Frame(i / kFps, &snap);
@@ -109,7 +109,7 @@ FloorRun RunOverhead(uint64_t seed, int first, int frames) {
   FloorRun run;
   run.frames_seen = static_cast<int>(sprites.size());
   for (size_t t = 0; t < sprites.size(); ++t) {
-    const FloorSprite s = flip[t] ? FloorRectifier::TurnHalf(sprites[t]) : sprites[t];
+    const Billboard s = flip[t] ? FloorRectifier::TurnHalf(sprites[t]) : sprites[t];
     const Eigen::Vector2d d = s.point_in_ground.head<2>() - truths[t].position;
     const Eigen::Vector2d f(std::cos(truths[t].heading_rad), std::sin(truths[t].heading_rad));
     run.along_m.push_back(d.dot(f));
@@ -121,7 +121,7 @@ FloorRun RunOverhead(uint64_t seed, int first, int frames) {
 
 // The sprite's centre is the centre of the animal's outline seen from above: a point of its
 // body ahead of the truth's root (the floor point under the body's centre) by about the head's
-// share, and steady there (body_height_m 0.03: 1.1-1.4 mm of scatter; on the floor itself,
+// share, and steady there (floor_height_m 0.03: 1.1-1.4 mm of scatter; on the floor itself,
 // 2.7-5.4 mm). Its heading is the truth's, head first.
 TEST(FloorRectifier, AnAnimalSeenFromAboveLiesWhereItIsAndFacesItsWay) {
   for (const uint64_t seed : {3, 8}) {
@@ -179,26 +179,32 @@ TEST(FloorRectifier, HeadingsFollowTheWalkAndTurnSmoothlyWhereTheSubjectStands) 
 
 // Turning half a turn twice gives the sprite back; the mirror swaps the sides, not the ends.
 TEST(FloorRectifier, TurnHalfAndMirrorKeepThePlaceAndTheCentre) {
-  FloorSprite s;
+  Billboard s;
+  s.kind = SpriteKind::kFloor;
   s.bgra = cv::Mat(5, 5, CV_8UC4, cv::Scalar(0, 0, 0, 0));
-  s.bgra.at<cv::Vec4b>(2, 4) = {255, 255, 255, 255};  // the nose, on the axis, ahead
-  s.bgra.at<cv::Vec4b>(0, 2) = {0, 0, 255, 255};      // the left side
+  s.bgra.at<cv::Vec4b>(0, 2) = {255, 255, 255, 255};  // the nose, on the axis, ahead
+  s.bgra.at<cv::Vec4b>(2, 0) = {0, 0, 255, 255};      // the left side
   s.shadow = cv::Mat::zeros(3, 3, CV_8U);
   s.anchor_px = {2, 2};
   s.point_in_ground = {0.1, 0.2, 0};
   s.heading_rad = 0.5;
-  const FloorSprite turned = FloorRectifier::TurnHalf(s);
+  s.toward_camera = {std::cos(0.5), std::sin(0.5)};
+  s.right_in_ground = {std::sin(0.5), -std::cos(0.5)};
+  const Billboard turned = FloorRectifier::TurnHalf(s);
   EXPECT_NEAR(AngleBetween(turned.heading_rad, 0.5 + M_PI), 0, 1e-12);
-  EXPECT_EQ(turned.bgra.at<cv::Vec4b>(2, 0)[3], 255);  // the nose behind now
+  EXPECT_NEAR((turned.toward_camera + s.toward_camera).norm(), 0, 1e-12);
+  EXPECT_EQ(turned.bgra.at<cv::Vec4b>(4, 2)[3], 255);  // the nose behind now
   EXPECT_EQ(turned.point_in_ground, s.point_in_ground);
-  const FloorSprite back = FloorRectifier::TurnHalf(turned);
+  EXPECT_EQ(turned.anchor_px, s.anchor_px);
+  const Billboard back = FloorRectifier::TurnHalf(turned);
   EXPECT_EQ(cv::norm(back.bgra, s.bgra, cv::NORM_INF), 0);
   EXPECT_NEAR(AngleBetween(back.heading_rad, 0.5), 0, 1e-12);
-  const FloorSprite mirrored = FloorRectifier::Mirror(s);
-  EXPECT_EQ(mirrored.bgra.at<cv::Vec4b>(2, 4)[3], 255);  // the nose stays ahead
-  EXPECT_EQ(mirrored.bgra.at<cv::Vec4b>(4, 2)[2], 255);  // the left side is the right
+  const Billboard mirrored = Rectifier::Mirror(s);
+  EXPECT_EQ(mirrored.bgra.at<cv::Vec4b>(0, 2)[3], 255);  // the nose stays ahead
+  EXPECT_EQ(mirrored.bgra.at<cv::Vec4b>(2, 4)[2], 255);  // the left side is the right
   EXPECT_EQ(mirrored.heading_rad, s.heading_rad);
-  EXPECT_EQ(s.bgra.at<cv::Vec4b>(0, 2)[2], 255) << "the original keeps its pixels";
+  EXPECT_EQ(mirrored.anchor_px, s.anchor_px);
+  EXPECT_EQ(s.bgra.at<cv::Vec4b>(2, 0)[2], 255) << "the original keeps its pixels";
 }
 
 }  // namespace

@@ -215,11 +215,21 @@ CameraModel TiltedCamera(double height_m, double back_m, double tilt_deg) {
 // between the floor and the ray to the camera decides, against max_view_angle_deg.
 TEST(FloorMask, ASpriteSeenFromTooFarAboveIsRefused) {
   const cv::Mat blob(20, 20, CV_8U, cv::Scalar(255));
-  // Straight above: 90 degrees at the origin, atan(1 / 0.25) = 76 at x = 0.25 m.
-  const FloorMask above(CameraLookingDown(), FloorUnderIt(), {});
+  // Straight above: 90 degrees at the origin, atan(1 / 0.25) = 76 at x = 0.25 m. Such a camera
+  // films from above and stores floor sprites, which no view is too steep for; kept upright
+  // (floor_view_angle_deg 90), its steep views are refused.
+  const FloorMask from_above(CameraLookingDown(), FloorUnderIt(), {});
+  EXPECT_TRUE(from_above.FilmsFromAbove());
+  EXPECT_GT(from_above.median_view_deg(), 75.0);
+  EXPECT_EQ(from_above.Check(blob, {310, 230}, {0.0, 0.0}), Discard::kNone);
+  EXPECT_EQ(from_above.SteepViewText(), "");
+  UsabilityOptions upright;
+  upright.floor_view_angle_deg = 90;
+  const FloorMask above(CameraLookingDown(), FloorUnderIt(), upright);
+  EXPECT_FALSE(above.FilmsFromAbove());
   EXPECT_EQ(above.Check(blob, {310, 230}, {0.0, 0.0}), Discard::kViewTooSteep);
   EXPECT_EQ(above.Check(blob, {430, 230}, {0.25, 0.0}), Discard::kViewTooSteep);
-  UsabilityOptions steeper;
+  UsabilityOptions steeper = upright;
   steeper.max_view_angle_deg = 80;
   EXPECT_EQ(
       FloorMask(CameraLookingDown(), FloorUnderIt(), steeper).Check(blob, {430, 230}, {0.25, 0.0}),
@@ -238,6 +248,8 @@ TEST(FloorMask, ASpriteSeenFromTooFarAboveIsRefused) {
   EXPECT_EQ(oblique.Check(blob, at, {0.0, 0.0}), Discard::kNone);
   // Seen from the far corners down to 1 / hypot(0.3, 1.7) = 30.0 degrees.
   EXPECT_NEAR(oblique.shallowest_view_deg(), 30.0, 1.0);
+  EXPECT_FALSE(oblique.FilmsFromAbove());
+  EXPECT_NEAR(oblique.median_view_deg(), 33.7, 3.0);
 }
 
 TEST(StillnessFilter, DropsOnlyTheTooLongStillPart) {
