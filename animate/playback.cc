@@ -26,6 +26,8 @@ const SequencePlayer::Billboard& SequencePlayer::Load(const BankFrameRef& ref) {
   b.pixels = bank.LoadPixels(ref.sprite_id);
   b.anchor_px = Eigen::Vector2d(record.anchor_x_px, record.anchor_y_px);
   b.px_per_m = record.px_per_m;
+  b.kind = record.kind;
+  b.heading_rad = record.heading_rad;
   return cache_.emplace(key, std::move(b)).first->second;
 }
 
@@ -37,7 +39,8 @@ cv::Mat SequencePlayer::RenderStep(const std::vector<SpriteSequence>& sprites, i
     if (s.frames.empty()) continue;
     const int step = std::min<int>(t, static_cast<int>(s.frames.size()) - 1);
     const Billboard& b = Load(s.frames[step]);
-    placed.push_back({&b.pixels, b.anchor_px, b.px_per_m, s.positions_m[step]});
+    placed.push_back(
+        {&b.pixels, b.anchor_px, b.px_per_m, s.positions_m[step], b.kind, b.heading_rad});
   }
   return renderer_->Render(placed);
 }

@@ -29,6 +29,8 @@ class SequencePlayer {
     SpritePixels pixels;
     Eigen::Vector2d anchor_px;
     double px_per_m = 0;
+    SpriteKind kind = SpriteKind::kUpright;
+    double heading_rad = 0;
   };
   const Billboard& Load(const BankFrameRef& ref);
 

@@ -47,6 +47,8 @@ bool RenderOptions::IsValid(std::string* why) const {
   check(shadow_opacity >= 0 && shadow_opacity <= 1, "shadow_opacity",
         "must be within [0, 1], got " + OptionProblems::Num(shadow_opacity));
   check(grid_step_px >= 1, "grid_step_px", "must be >= 1, got " + std::to_string(grid_step_px));
+  check(min_floor_view_deg >= 0 && min_floor_view_deg <= 90, "min_floor_view_deg",
+        "must be within [0, 90], got " + OptionProblems::Num(min_floor_view_deg));
   return check.ok();
 }
 
@@ -81,6 +83,11 @@ Eigen::Vector2d SpriteRenderer::TowardCamera(const Eigen::Vector2d& ground_m) co
   Eigen::Vector2d toward = centre_in_ground_.head<2>() - ground_m;
   if (toward.norm() < 1e-9) return Eigen::Vector2d(0, -1);  // straight above: any direction
   return toward.normalized();
+}
+
+double SpriteRenderer::ViewAngleDeg(const Eigen::Vector2d& ground_m) const {
+  return std::atan2(centre_in_ground_.z(), (centre_in_ground_.head<2>() - ground_m).norm()) * 180 /
+         M_PI;
 }
 
 void SpriteRenderer::DrawPlane(const cv::Mat& full_layer, const Eigen::Vector3d& full_origin,
@@ -194,14 +201,38 @@ cv::Mat SpriteRenderer::Render(const std::vector<PlacedSprite>& sprites) const {
   std::stable_sort(order.begin(), order.end(),
                    [&](size_t a, size_t b) { return distance(a) > distance(b); });
   const Eigen::Vector3d up(0, 0, 1);
+  // A sprite's floor axes: right (its image's x) and away (its image's y on the floor: from the
+  // camera for an upright sprite's shadow, backwards for a floor sprite).
+  const auto floor_axes = [&](const PlacedSprite& s, Eigen::Vector3d* right,
+                              Eigen::Vector3d* away) {
+    const Eigen::Vector2d toward =
+        s.kind == SpriteKind::kFloor
+            ? Eigen::Vector2d(std::cos(s.heading_rad), std::sin(s.heading_rad))
+            : TowardCamera(s.ground_m);
+    *right = Eigen::Vector3d(-toward.y(), toward.x(), 0.0);
+    if (s.kind == SpriteKind::kFloor) *right = -*right;  // seen from above, the subject's right
+    *away = Eigen::Vector3d(-toward.x(), -toward.y(), 0.0);
+  };
+  for (const PlacedSprite& s : sprites) {
+    if (s.kind != SpriteKind::kFloor) continue;
+    if (const double angle = ViewAngleDeg(s.ground_m); !(angle >= options_.min_floor_view_deg)) {
+      throw InputError(
+          "floor sprite at (" + OptionProblems::Num(s.ground_m.x()) + ", " +
+              OptionProblems::Num(s.ground_m.y()) + ")",
+          "the virtual camera sees it from " + OptionProblems::Num(std::round(angle)) +
+              " degrees above the floor, shallower than " +
+              OptionProblems::Num(options_.min_floor_view_deg) +
+              ": a subject filmed from above looks true only from above (render from a camera "
+              "looking down at it)");
+    }
+  }
   if (options_.shadows) {
     for (size_t i : order) {
       const PlacedSprite& s = sprites[i];
       if (s.pixels == nullptr || s.pixels->shadow.empty() || !(s.px_per_m > 0)) continue;
       if (cv::countNonZero(s.pixels->shadow) == 0) continue;
-      const Eigen::Vector2d toward = TowardCamera(s.ground_m);
-      const Eigen::Vector3d right(-toward.y(), toward.x(), 0.0);
-      const Eigen::Vector3d away(-toward.x(), -toward.y(), 0.0);
+      Eigen::Vector3d right, away;
+      floor_axes(s, &right, &away);
       const Eigen::Vector3d p(s.ground_m.x(), s.ground_m.y(), 0.0);
       const double cu = (s.pixels->shadow.cols - 1) / 2.0, cv_ = (s.pixels->shadow.rows - 1) / 2.0;
       const Eigen::Vector3d origin = p - right * (cu / s.px_per_m) - away * (cv_ / s.px_per_m);
@@ -209,16 +240,22 @@ cv::Mat SpriteRenderer::Render(const std::vector<PlacedSprite>& sprites) const {
                 away / s.px_per_m, &canvas);
     }
   }
-  for (size_t i : order) {
-    const PlacedSprite& s = sprites[i];
-    if (s.pixels == nullptr || s.pixels->bgra.empty() || !(s.px_per_m > 0)) continue;
-    const Eigen::Vector2d toward = TowardCamera(s.ground_m);
-    const Eigen::Vector3d right(-toward.y(), toward.x(), 0.0);
-    const Eigen::Vector3d p(s.ground_m.x(), s.ground_m.y(), 0.0);
-    // Billboard pixel (u, v) = p + right (u - a_u) / s + up (a_v - v) / s (the rectifier's).
-    const Eigen::Vector3d origin =
-        p - right * (s.anchor_px.x() / s.px_per_m) + up * (s.anchor_px.y() / s.px_per_m);
-    DrawPlane(Premultiply(s.pixels->bgra), origin, right / s.px_per_m, -up / s.px_per_m, &canvas);
+  // Floor sprites lie on the floor, under every upright one.
+  for (const bool floor : {true, false}) {
+    for (size_t i : order) {
+      const PlacedSprite& s = sprites[i];
+      if ((s.kind == SpriteKind::kFloor) != floor) continue;
+      if (s.pixels == nullptr || s.pixels->bgra.empty() || !(s.px_per_m > 0)) continue;
+      Eigen::Vector3d right, away;
+      floor_axes(s, &right, &away);
+      const Eigen::Vector3d p(s.ground_m.x(), s.ground_m.y(), 0.0);
+      // Billboard pixel (u, v) = p + right (u - a_u) / s + up (a_v - v) / s (the rectifier's);
+      // a floor sprite's: p + right (u - a_u) / s + away (v - a_v) / s.
+      const Eigen::Vector3d dv = floor ? away : Eigen::Vector3d(-up);
+      const Eigen::Vector3d origin =
+          p - right * (s.anchor_px.x() / s.px_per_m) - dv * (s.anchor_px.y() / s.px_per_m);
+      DrawPlane(Premultiply(s.pixels->bgra), origin, right / s.px_per_m, dv / s.px_per_m, &canvas);
+    }
   }
   cv::Mat out(canvas.size(), CV_8UC4);
   for (int y = 0; y < canvas.rows; ++y) {

@@ -7,6 +7,10 @@
 // The bank's shadow layer is a ground patch at the same scale, centred on the contact
 // point: its pixel (u, v) is the floor point p + right (u - (W-1)/2) / s + away (v - (H-1)/2) / s
 // (right = the billboard's x axis, away = from the camera), as the rectifier samples it.
+// A floor sprite (SpriteKind::kFloor, a subject filmed from above; docs/pipeline.md) lies on the
+// floor instead, its top toward its heading, drawn after the shadows and before every upright
+// one; its shadow patch shares its axes. It looks true only from above: a virtual camera that
+// sees one from shallower than min_floor_view_deg is refused by name.
 #include <vector>
 
 #include <Eigen/Core>
@@ -23,12 +27,18 @@ struct PlacedSprite {
   Eigen::Vector2d anchor_px = Eigen::Vector2d::Zero();  // contact point on the billboard
   double px_per_m = 0;
   Eigen::Vector2d ground_m = Eigen::Vector2d::Zero();  // contact point on the floor
+  SpriteKind kind = SpriteKind::kUpright;
+  double heading_rad = 0;  // floor sprites: the ground direction its image's top faces
 };
 
 struct RenderOptions {
   bool shadows = true;
   double shadow_opacity = 1.0;  // darkening at a full (255) shadow pixel
   int grid_step_px = 8;         // the lens model is evaluated on this grid, interpolated between
+  // A floor sprite seen from shallower than this (the angle between the floor and the ray to
+  // the camera at its place) is refused: a subject filmed from above, laid flat, looks like a
+  // decal from the side.
+  double min_floor_view_deg = 60.0;
   // False with "FIELD: reason" lines in `why` (core/option_checks.h) for values out of range.
   bool IsValid(std::string* why) const;
 };
@@ -39,8 +49,11 @@ class SpriteRenderer {
   // InputError when the camera is invalid or the background's size differs from it.
   SpriteRenderer(CameraModel camera, const cv::Mat& background, RenderOptions options = {});
 
-  // One frame, CV_8UC4 BGRA (straight alpha; opaque where the background is).
+  // One frame, CV_8UC4 BGRA (straight alpha; opaque where the background is). InputError
+  // ("floor sprite at (x, y)") for a floor sprite seen from shallower than min_floor_view_deg.
   cv::Mat Render(const std::vector<PlacedSprite>& sprites) const;
+  // The angle between the floor and the ray from a ground point to the camera, degrees.
+  double ViewAngleDeg(const Eigen::Vector2d& ground_m) const;
 
   const CameraModel& camera() const { return camera_; }
   // Floor direction from a ground point toward the camera (unit); the billboard's normal.

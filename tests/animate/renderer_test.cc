@@ -63,6 +63,47 @@ TEST(Renderer, PlacesTheBillboardAtTheProjectedGroundPosition) {
   }
 }
 
+// A floor sprite (issue 38) lies on the floor at its place, its image's top toward its heading
+// and its right side to the subject's right, seen from above; from the side it is refused.
+TEST(Renderer, AFloorSpriteLiesOnTheFloorFacingItsHeading) {
+  const CameraModel camera = testing::LookAtCamera(800, 600, 800, {0.05, -0.1, 1.5}, {0, 0, 0});
+  const SpriteRenderer renderer(camera, cv::Mat());
+  SpritePixels pixels;  // 41 x 41: the nose (blue) at the top centre, the right side (red)
+  pixels.bgra = cv::Mat(41, 41, CV_8UC4, cv::Scalar(0, 0, 0, 0));
+  pixels.bgra(cv::Rect(19, 0, 3, 3)).setTo(cv::Scalar(255, 0, 0, 255));
+  pixels.bgra(cv::Rect(38, 19, 3, 3)).setTo(cv::Scalar(0, 0, 255, 255));
+  const double m = 19.0 / kPxPerM;  // anchor (20, 20) to a mark's centre (20, 1) or (39, 20)
+  for (const double heading : {0.0, 2.0, -1.2}) {
+    const Eigen::Vector2d ground(0.1, -0.05);
+    PlacedSprite s{&pixels, Eigen::Vector2d(20, 20), kPxPerM, ground};
+    s.kind = SpriteKind::kFloor;
+    s.heading_rad = heading;
+    const cv::Mat image = renderer.Render({s});
+    const Eigen::Vector2d ahead(std::cos(heading), std::sin(heading));
+    const Eigen::Vector2d right(std::sin(heading), -std::cos(heading));
+    const Eigen::Vector2d nose = ground + ahead * m, side = ground + right * m;
+    EXPECT_LT((Centroid(image, {255, 0, 0}) - camera.ProjectGround({nose.x(), nose.y(), 0})).norm(),
+              0.75)
+        << heading;
+    EXPECT_LT((Centroid(image, {0, 0, 255}) - camera.ProjectGround({side.x(), side.y(), 0})).norm(),
+              0.75)
+        << heading;
+  }
+  // From the side (about 30 degrees above the floor) it would look like a decal: refused.
+  const SpriteRenderer side(testing::LookAtCamera(800, 600, 800, {0, -2.5, 1.5}, {0, 0, 0}),
+                            cv::Mat());
+  PlacedSprite s{&pixels, Eigen::Vector2d(20, 20), kPxPerM, Eigen::Vector2d(0.1, -0.05)};
+  s.kind = SpriteKind::kFloor;
+  try {
+    side.Render({s});
+    ADD_FAILURE() << "a floor sprite seen from the side was drawn";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("floor sprite at (0.1, -0.05)"), std::string::npos)
+        << e.what();
+    EXPECT_NE(std::string(e.what()).find("shallower than 60"), std::string::npos) << e.what();
+  }
+}
+
 TEST(Renderer, TheBillboardFacesTheCamera) {
   // A wide bar: seen from anywhere it projects to a horizontal segment of ~ its true width.
   const CameraModel camera = testing::LookAtCamera(320, 240, 300, {-3, -3, 2}, {0, 0, 0});
