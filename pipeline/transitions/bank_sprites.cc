@@ -26,13 +26,14 @@ CheapFeatures CheapFromRecord(const SpriteRecord& s) {
 }
 
 RgbaBillboard BillboardFromPixels(const SpritePixels& pixels, double anchor_x_px,
-                                  double anchor_y_px) {
+                                  double anchor_y_px, bool floor) {
   if (pixels.bgra.type() != CV_8UC4) throw WorkError("billboard", "bank pixels are not 8-bit BGRA");
   RgbaBillboard b;
   b.width = pixels.bgra.cols;
   b.height = pixels.bgra.rows;
   b.anchor_x_px = anchor_x_px;
   b.anchor_y_px = anchor_y_px;
+  b.floor = floor;
   b.rgba.resize(static_cast<size_t>(b.width) * b.height * 4);
   const size_t row_bytes = static_cast<size_t>(b.width) * 4;
   for (int y = 0; y < b.height; ++y)
@@ -58,7 +59,8 @@ void AddSprite(const Bank& bank, const SpriteRecord& r, SegmentKeys* keys, BankS
                                       ", the others " + std::to_string(out->px_per_m) +
                                       ": one bank must use one billboard scale");
   }
-  RgbaBillboard b = BillboardFromPixels(bank.LoadPixels(r.id), r.anchor_x_px, r.anchor_y_px);
+  RgbaBillboard b = BillboardFromPixels(bank.LoadPixels(r.id), r.anchor_x_px, r.anchor_y_px,
+                                        r.kind == SpriteKind::kFloor);
   out->ids.push_back(r.id);
   out->billboards.push_back(std::move(b));
   out->inputs.push_back(

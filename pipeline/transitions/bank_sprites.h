@@ -30,9 +30,10 @@ struct SpriteChoice {
 // area_m2 = area_px / px_per_m^2.
 CheapFeatures CheapFromRecord(const SpriteRecord& sprite);
 
-// The bank's billboard (BGRA, anchor in pixel-centre coordinates) as an RgbaBillboard.
+// The bank's billboard (BGRA, anchor in pixel-centre coordinates) as an RgbaBillboard;
+// `floor` for a floor sprite (SpriteRecord::kind).
 RgbaBillboard BillboardFromPixels(const SpritePixels& pixels, double anchor_x_px,
-                                  double anchor_y_px);
+                                  double anchor_y_px, bool floor = false);
 
 // Gives every sprite its segment key in arrival order: a sprite continues the segment of
 // its (clip, mirrored) when its frame is the last one's + 1, else starts a new one.

@@ -21,6 +21,10 @@ struct RgbaBillboard {
   double anchor_x_px = 0;
   double anchor_y_px = 0;
   std::vector<uint8_t> rgba;  // width * height * 4 bytes: R, G, B, A (or B, G, R, A)
+  // A floor sprite (seen from above, facing the image's top; the anchor its centre) rather than
+  // an upright billboard (the anchor its contact point at the bottom): the comparison window is
+  // centred on it and turned to its length (comparison.h).
+  bool floor = false;
 
   const uint8_t* Pixel(int x, int y) const {
     return rgba.data() + (static_cast<size_t>(y) * width + x) * 4;

@@ -70,9 +70,13 @@ CellBox MakeComparisonImage(const RgbaBillboard& b, double px_per_m, const Compa
 
   // The window in pixel-edge coordinates (pixel (x, y) covers [x, x+1) x [y, y+1)): its
   // bottom edge at the contact point's height (anchor + 0.5), centred horizontally on the
-  // alpha centroid or on the contact point.
-  const double cell_w = window.width_m * px_per_m / window.cells_x;
-  const double cell_h = window.height_m * px_per_m / window.cells_y;
+  // alpha centroid or on the contact point. A floor sprite lies along the image's height,
+  // centred on its anchor: its window is turned a quarter (width_m along the subject) and
+  // centred on the anchor's height.
+  const double across_m = b.floor ? window.height_m : window.width_m;
+  const double along_m = b.floor ? window.width_m : window.height_m;
+  const double cell_w = across_m * px_per_m / window.cells_x;
+  const double cell_h = along_m * px_per_m / window.cells_y;
   double centre_x = b.anchor_x_px + 0.5;
   if (window.align == HorizontalAlignment::kAlphaCentroid) {
     double sum = 0, weight = 0;
@@ -85,8 +89,8 @@ CellBox MakeComparisonImage(const RgbaBillboard& b, double px_per_m, const Compa
     }
     if (weight > 0) centre_x = sum / weight;
   }
-  const double x0 = centre_x - 0.5 * window.width_m * px_per_m;
-  const double y0 = b.anchor_y_px + 0.5 - window.height_m * px_per_m;
+  const double x0 = centre_x - 0.5 * across_m * px_per_m;
+  const double y0 = b.anchor_y_px + 0.5 - (b.floor ? 0.5 : 1.0) * along_m * px_per_m;
   const auto cols = AxisOverlaps(x0, cell_w, window.cells_x, b.width);
   const auto rows = AxisOverlaps(y0, cell_h, window.cells_y, b.height);
 

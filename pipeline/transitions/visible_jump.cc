@@ -83,7 +83,8 @@ VisibleJumpMeter::VisibleJumpMeter(const Bank& bank, VisibleJumpOptions options)
   Index(frames);
   load_ = [&bank](int64_t id) {
     const SpriteRecord record = bank.LoadSprite(id);
-    return BillboardFromPixels(bank.LoadPixels(id), record.anchor_x_px, record.anchor_y_px);
+    return BillboardFromPixels(bank.LoadPixels(id), record.anchor_x_px, record.anchor_y_px,
+                               record.kind == SpriteKind::kFloor);
   };
   cache_key_ = bank.path() + "\n" + std::to_string(features.size()) + "\n" +
                std::to_string(options_.max_pairs) + "\n" + std::to_string(options_.min_step_px);

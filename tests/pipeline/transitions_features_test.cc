@@ -130,6 +130,32 @@ TEST(TransitionFeatures, ComparisonImageAlignedOnAnchor) {
   EXPECT_EQ(image, image2);
 }
 
+// A floor sprite (issue 38) faces the image's top with its anchor at its centre: its window is
+// turned a quarter (width_m along the image's height) and centred on the anchor, so the tail
+// below the anchor is compared too.
+TEST(TransitionFeatures, AFloorSpritesWindowIsCentredAndTurnedToItsLength) {
+  const ComparisonWindow w = PixelWindow();  // 5 x 4 cells over 0.05 x 0.04 m: turned, 4 x 5 px
+  RgbaBillboard b = Blank(4, 5, 1.5, 2);     // anchor at the centre: the window is [0, 4) x [0, 5)
+  b.floor = true;
+  Paint(b, 0, 0, 10, 20, 30, 255);  // the nose's corner, top left
+  Paint(b, 3, 4, 40, 50, 60, 255);  // the tail's corner, bottom right
+  std::vector<uint8_t> image(w.ImageBytes(), 0);
+  MakeComparisonImage(b, 100.0, w, image.data());
+  // Cells are 0.04 / 5 = 0.8 px wide and 0.05 / 4 = 1.25 px tall: each corner pixel lands in its
+  // corner cell, partly.
+  const int s = w.PlaneStride();
+  EXPECT_GT(image[0], 0);
+  EXPECT_EQ(image[s + 0], 10);
+  EXPECT_GT(image[3 * 5 + 4], 0) << "the tail, below the anchor";
+  EXPECT_EQ(image[s + 3 * 5 + 4], 40);
+  // As an upright billboard, the window's bottom would sit at the anchor: no tail.
+  b.floor = false;
+  MakeComparisonImage(b, 100.0, w, image.data());
+  int tail = 0;
+  for (int k = 0; k < w.Cells(); ++k) tail += image[s + k] == 40;
+  EXPECT_EQ(tail, 0);
+}
+
 TEST(TransitionFeatures, ComparisonImageAveragesAreas) {
   // One cell covering 2 x 2 pixels: two opaque (red, blue) and two transparent.
   ComparisonWindow w;
