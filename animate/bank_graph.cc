@@ -61,6 +61,7 @@ BankGraph LoadBankGraph(const std::vector<std::string>& bank_paths,
       FrameInfo info;
       info.clip = clip;
       info.velocity_m = Eigen::Vector2d(f.velocity_x_m_s, f.velocity_y_m_s) * interval_s;
+      if (f.floor) info.heading_rad = f.heading_rad;
       if (f.mirrored) info.tags.push_back("mirrored");
       index_of[f.id] = base + static_cast<int>(i);
       infos.push_back(std::move(info));

@@ -39,8 +39,8 @@ cv::Mat SequencePlayer::RenderStep(const std::vector<SpriteSequence>& sprites, i
     if (s.frames.empty()) continue;
     const int step = std::min<int>(t, static_cast<int>(s.frames.size()) - 1);
     const Billboard& b = Load(s.frames[step]);
-    placed.push_back(
-        {&b.pixels, b.anchor_px, b.px_per_m, s.positions_m[step], b.kind, b.heading_rad});
+    placed.push_back({&b.pixels, b.anchor_px, b.px_per_m, s.positions_m[step], b.kind,
+                      b.heading_rad + s.TurnAt(static_cast<size_t>(step))});
   }
   return renderer_->Render(placed);
 }

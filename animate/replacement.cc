@@ -363,6 +363,9 @@ class Replacer {
     candidate.positions_m.assign(current.positions_m.begin(), current.positions_m.begin() + keep);
     candidate.velocities_m.assign(current.velocities_m.begin(),
                                   current.velocities_m.begin() + keep);
+    candidate.turns_rad.assign(current.turns_rad.begin(),
+                               current.turns_rad.begin() +
+                                   std::min<int>(keep, static_cast<int>(current.turns_rad.size())));
     candidate.chunk_boxes_m.assign(
         current.chunk_boxes_m.begin(),
         current.chunk_boxes_m.begin() +

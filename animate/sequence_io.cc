@@ -15,8 +15,10 @@ json SpritesToJson(const std::vector<SpriteSequence>& sprites) {
   for (const SpriteSequence& s : sprites) {
     json steps = json::array();
     for (size_t t = 0; t < s.frames.size(); ++t) {
-      steps.push_back(
-          {s.frames[t].bank, s.frames[t].sprite_id, s.positions_m[t].x(), s.positions_m[t].y()});
+      json step = {s.frames[t].bank, s.frames[t].sprite_id, s.positions_m[t].x(),
+                   s.positions_m[t].y()};
+      if (!s.turns_rad.empty()) step.push_back(s.TurnAt(t));
+      steps.push_back(std::move(step));
     }
     out.push_back({{"name", s.name}, {"steps", std::move(steps)}});
   }
@@ -31,16 +33,19 @@ std::vector<SpriteSequence> SpritesFromJson(const json& j, const std::string& pa
     const std::string f = field + "[" + std::to_string(i) + "]";
     const json& s = j[i];
     if (!s.is_object() || !s.contains("steps") || !s["steps"].is_array()) {
-      throw InputError(path, f + ".steps: expected a list of [bank, sprite, x_m, y_m]");
+      throw InputError(
+          path, f + ".steps: expected a list of [bank, sprite, x_m, y_m] (or with turn_rad)");
     }
     SpriteSequence seq;
     seq.name = s.value("name", "sprite" + std::to_string(i));
     for (size_t t = 0; t < s["steps"].size(); ++t) {
       const json& step = s["steps"][t];
-      if (!step.is_array() || step.size() != 4 || !step[0].is_number_integer() ||
-          !step[1].is_number_integer() || !step[2].is_number() || !step[3].is_number()) {
-        throw InputError(
-            path, f + ".steps[" + std::to_string(t) + "]: expected [bank, sprite, x_m, y_m]");
+      if (!step.is_array() || step.size() < 4 || step.size() > 5 || !step[0].is_number_integer() ||
+          !step[1].is_number_integer() || !step[2].is_number() || !step[3].is_number() ||
+          (step.size() == 5 && !step[4].is_number())) {
+        throw InputError(path, f + ".steps[" + std::to_string(t) +
+                                   "]: expected [bank, sprite, x_m, y_m] or [bank, sprite, x_m, "
+                                   "y_m, turn_rad]");
       }
       const int bank = step[0].get<int>();
       if (bank < 0 || bank >= num_banks) {
@@ -49,7 +54,12 @@ std::vector<SpriteSequence> SpritesFromJson(const json& j, const std::string& pa
       }
       seq.frames.push_back({bank, step[1].get<int64_t>()});
       seq.positions_m.emplace_back(step[2].get<double>(), step[3].get<double>());
+      if (step.size() == 5) {
+        seq.turns_rad.resize(t, 0.0);  // the steps before without a turn
+        seq.turns_rad.push_back(step[4].get<double>());
+      }
     }
+    if (!seq.turns_rad.empty()) seq.turns_rad.resize(seq.frames.size(), 0.0);
     if (seq.frames.empty()) throw InputError(path, f + ".steps: empty");
     out.push_back(std::move(seq));
   }
@@ -69,6 +79,7 @@ std::vector<SpriteSequence> ToSpriteSequences(const BankGraph& bank,
       seq.frames.push_back(bank.frames[tracks[s].frames[t]]);
       seq.positions_m.push_back(tracks[s].positions_m[t]);
     }
+    seq.turns_rad = tracks[s].turns_rad;
     out.push_back(std::move(seq));
   }
   return out;

@@ -21,6 +21,10 @@ struct SpriteSequence {
   std::string name;
   std::vector<BankFrameRef> frames;          // per step
   std::vector<Eigen::Vector2d> positions_m;  // ground contact point per step
+  // Floor sprites: how far each step is turned from its source frame's heading, radians (empty:
+  // none turned).
+  std::vector<double> turns_rad;
+  double TurnAt(size_t t) const { return t < turns_rad.size() ? turns_rad[t] : 0.0; }
 };
 
 // The sequences at one moment of the optimization.

@@ -1,6 +1,7 @@
 #include "animate/track.h"
 
 #include <algorithm>
+#include <cmath>
 
 namespace ss {
 
@@ -12,7 +13,31 @@ void IntegrateTrack(const TransitionGraph& graph, Anchor anchor, const Eigen::Ve
   if (n == 0) return;
   if (anchor == Anchor::kEnd) from_step = 0;
   from_step = std::clamp(from_step, 0, n);
-  for (int t = from_step; t < n; ++t) track->velocities_m[t] = graph.velocity_m(track->frames[t]);
+  if (graph.has_floor_frames()) {
+    // Floor sprites turn at transitions: from the start (kept before from_step), or back from
+    // the end, which stays as filmed.
+    std::vector<double>& turn = track->turns_rad;
+    turn.resize(n);
+    if (anchor == Anchor::kEnd) {
+      turn[n - 1] = 0;
+      for (int t = n - 1; t > 0; --t) {
+        turn[t - 1] = turn[t] - graph.Turn(track->frames[t - 1], track->frames[t]);
+      }
+    } else {
+      if (from_step == 0) turn[0] = 0;
+      for (int t = std::max(from_step, 1); t < n; ++t) {
+        turn[t] = turn[t - 1] + graph.Turn(track->frames[t - 1], track->frames[t]);
+      }
+    }
+    for (int t = from_step; t < n; ++t) {
+      const Eigen::Vector2d& v = graph.velocity_m(track->frames[t]);
+      const double c = std::cos(turn[t]), s = std::sin(turn[t]);
+      track->velocities_m[t] = Eigen::Vector2d(c * v.x() - s * v.y(), s * v.x() + c * v.y());
+    }
+  } else {
+    track->turns_rad.clear();
+    for (int t = from_step; t < n; ++t) track->velocities_m[t] = graph.velocity_m(track->frames[t]);
+  }
   if (anchor == Anchor::kEnd) {
     track->positions_m[n - 1] = anchor_m;
     for (int t = n - 1; t > 0; --t) {

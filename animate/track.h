@@ -2,6 +2,9 @@
 // A sprite's sequence S = s_0..s_{n-1} and its states (p, v, f)_t (seed 000 §5).
 // Positions integrate the source frames' ground velocities:
 //   p_t = p_{t-1} + v(s_t)   for t >= 1,
+// turned, for floor sprites (filmed from above), by the sequence's turn at t: each transition
+// between floor sprites turns the rest of the sequence so that the sprite goes on facing the way
+// its source frame's successor faced (TransitionGraph::Turn), and the renderer turns it alike.
 // anchored at the start (p_0 given, or optimized for a free start) or at the end
 // (p_{n-1} given; seed 000 §6.2 fixes the flies' end locations). After its last step a
 // sprite holds its last position and frame with zero velocity.
@@ -27,7 +30,10 @@ struct Track {
 
   std::vector<int> frames;                    // s_t
   std::vector<Eigen::Vector2d> positions_m;   // p_t, ground metres
-  std::vector<Eigen::Vector2d> velocities_m;  // v_t = v(s_t), metres per step
+  std::vector<Eigen::Vector2d> velocities_m;  // v_t = v(s_t), metres per step (turned)
+  // theta_t: how far step t is turned from its source frame, radians (floor sprites; empty when
+  // the graph has none).
+  std::vector<double> turns_rad;
   // Bounding box of the positions of steps [16c, 16c + 16) per chunk c (kept by
   // IntegrateTrack and ShiftTrack; lets pairwise terms skip chunks far apart).
   std::vector<Eigen::AlignedBox2d> chunk_boxes_m;

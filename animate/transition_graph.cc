@@ -44,6 +44,7 @@ TransitionGraph::TransitionGraph(std::vector<FrameInfo> frames,
                                  const std::vector<TransitionEdge>& transitions)
     : frames_(std::move(frames)) {
   const int n = num_frames();
+  for (const FrameInfo& f : frames_) has_floor_frames_ = has_floor_frames_ || f.heading_rad;
   std::vector<RawEdge> edges;
   edges.reserve(transitions.size() + frames_.size());
   for (int i = 0; i + 1 < n; ++i) {
@@ -71,6 +72,14 @@ std::optional<double> TransitionGraph::EdgeCost(int from, int to) const {
   const auto it = std::lower_bound(targets.begin(), targets.end(), to);
   if (it == targets.end() || *it != to) return std::nullopt;
   return successor_costs(from)[it - targets.begin()];
+}
+
+double TransitionGraph::Turn(int from, int to) const {
+  if (IsNaturalSuccessor(from, to)) return 0.0;
+  const auto& to_heading = frames_[to].heading_rad;
+  if (!to_heading || !frames_[from].heading_rad) return 0.0;
+  const int after = IsNaturalSuccessor(from, from + 1) ? from + 1 : from;
+  return std::remainder(frames_[after].heading_rad.value_or(0.0) - *to_heading, 2 * M_PI);
 }
 
 bool TransitionGraph::IsNaturalSuccessor(int from, int to) const {

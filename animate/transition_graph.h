@@ -21,6 +21,9 @@ struct FrameInfo {
   // the source clip, metres per frame step (ground x, y).
   Eigen::Vector2d velocity_m = Eigen::Vector2d::Zero();
   std::vector<std::string> tags;  // e.g. "standing", "mirrored"
+  // A floor sprite (filmed from above): the ground direction it faced. Such a sprite may be
+  // turned about the vertical: a transition between two turns the sequence (Track::turns_rad).
+  std::optional<double> heading_rad;
 };
 
 // A transition i -> j found upstream, cost C(i->j) >= 0 (seed 000 eq. 1).
@@ -57,6 +60,12 @@ class TransitionGraph {
   bool IsValidSequence(std::span<const int> frames, std::string* why = nullptr) const;
 
   const FrameInfo& frame(int i) const { return frames_[i]; }
+  // Whether any frame is a floor sprite (FrameInfo::heading_rad).
+  bool has_floor_frames() const { return has_floor_frames_; }
+  // How far a sequence turns going from `from` to `to` (floor sprites): the heading the
+  // sprite had in its source clip after `from` (its natural successor's, or its own at a
+  // clip's end) less that of `to`; 0 for a natural successor or an upright frame.
+  double Turn(int from, int to) const;
   const Eigen::Vector2d& velocity_m(int i) const { return frames_[i].velocity_m; }
   double speed_m(int i) const { return frames_[i].velocity_m.norm(); }
   int clip(int i) const { return frames_[i].clip; }
@@ -74,6 +83,7 @@ class TransitionGraph {
   }
 
   std::vector<FrameInfo> frames_;
+  bool has_floor_frames_ = false;
   std::vector<int64_t> out_offsets_{0};
   std::vector<int> out_targets_;
   std::vector<double> out_costs_;

@@ -158,8 +158,10 @@ std::vector<SpriteFeatures> Bank::LoadFeatures(int64_t completed_after_seq) cons
   auto s = db_->Prepare(
       "SELECT s.id, s.clip_id, s.frame, s.timestamp_ns, s.mirror_of, s.mirrored, s.ground_x_m, "
       "s.ground_y_m, "
-      "s.velocity_x_m_s, s.velocity_y_m_s, s.mean_r, s.mean_g, s.mean_b, s.area_px, s.eccentricity "
-      "FROM clips c JOIN sprites s ON s.clip_id = c.id WHERE c.complete = 1 AND c.complete_seq > ? "
+      "s.velocity_x_m_s, s.velocity_y_m_s, s.mean_r, s.mean_g, s.mean_b, s.area_px, "
+      "s.eccentricity, "
+      "s.kind, s.heading_rad FROM clips c JOIN sprites s ON s.clip_id = c.id WHERE c.complete = 1 "
+      "AND c.complete_seq > ? "
       "ORDER BY s.clip_id, s.mirrored, s.frame");
   s.Bind(1, completed_after_seq);
   while (s.Step()) {
@@ -179,6 +181,8 @@ std::vector<SpriteFeatures> Bank::LoadFeatures(int64_t completed_after_seq) cons
     f.mean_b = static_cast<float>(s.Real(12));
     f.area_px = static_cast<float>(s.Real(13));
     f.eccentricity = static_cast<float>(s.Real(14));
+    f.floor = s.Text(15) == TextOf(SpriteKind::kFloor, kSpriteKindTexts);
+    f.heading_rad = static_cast<float>(s.Real(16));
     if (!out.empty()) {
       SpriteFeatures& before = out.back();
       if (before.clip_id == f.clip_id && before.mirrored == f.mirrored &&

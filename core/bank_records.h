@@ -102,6 +102,8 @@ struct SpriteFeatures {
   bool mirrored = false;
   float ground_x_m = 0, ground_y_m = 0, velocity_x_m_s = 0, velocity_y_m_s = 0;
   float mean_r = 0, mean_g = 0, mean_b = 0, area_px = 0, eccentricity = 0;
+  bool floor = false;     // SpriteKind::kFloor
+  float heading_rad = 0;  // floor sprites: the direction the subject faces
 };
 
 // A transition i -> j: D(i,j) and the cost C(i->j) (seed 000 §3).

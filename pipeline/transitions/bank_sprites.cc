@@ -1,6 +1,7 @@
 #include "pipeline/transitions/bank_sprites.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <set>
 
@@ -17,6 +18,13 @@ CheapFeatures CheapFromRecord(const SpriteRecord& s) {
   CheapFeatures f;
   f.velocity_x_mps = s.velocity_x_m_s;
   f.velocity_y_mps = s.velocity_y_m_s;
+  if (s.kind == SpriteKind::kFloor) {
+    // A floor sprite may be turned about the vertical (the animator turns it at a transition):
+    // its velocity is compared in its own axes, x ahead and y to its left, as its image is.
+    const double c = std::cos(s.heading_rad), n = std::sin(s.heading_rad);
+    f.velocity_x_mps = c * s.velocity_x_m_s + n * s.velocity_y_m_s;
+    f.velocity_y_mps = -n * s.velocity_x_m_s + c * s.velocity_y_m_s;
+  }
   f.colour[0] = s.mean_r;
   f.colour[1] = s.mean_g;
   f.colour[2] = s.mean_b;

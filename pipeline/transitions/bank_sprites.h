@@ -27,7 +27,8 @@ struct SpriteChoice {
 };
 
 // The cheap features of a stored sprite: velocity, mean colour, eccentricity as stored;
-// area_m2 = area_px / px_per_m^2.
+// area_m2 = area_px / px_per_m^2. A floor sprite's velocity in its own axes (x ahead, y to its
+// left), as its image faces: floor sprites compare whatever way they faced.
 CheapFeatures CheapFromRecord(const SpriteRecord& sprite);
 
 // The bank's billboard (BGRA, anchor in pixel-centre coordinates) as an RgbaBillboard;

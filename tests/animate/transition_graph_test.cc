@@ -1,11 +1,18 @@
 #include "animate/transition_graph.h"
 
+#include <cmath>
+
 #include <gtest/gtest.h>
 
+#include "animate/sequence_io.h"
+#include "animate/track.h"
 #include "core/error.h"
+#include "tests/support/test_support.h"
 
 namespace ss {
 namespace {
+
+using testing::ScratchDir;
 
 std::vector<FrameInfo> TwoClips() {
   std::vector<FrameInfo> frames(5);
@@ -59,6 +66,67 @@ TEST(TransitionGraph, TagsAndBadInput) {
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("transitions[1]"), std::string::npos) << e.what();
   }
+}
+
+// Floor sprites (issue 38): a sprite filmed walking east that goes on as one filmed walking
+// north is turned a quarter back, so it goes on east facing east; the turn holds until the next
+// transition, and the track, the sequence file and the player carry it.
+TEST(TransitionGraph, AFloorSpriteIsTurnedAtATransitionAndGoesOnTheWayItWent) {
+  std::vector<FrameInfo> frames(6);
+  for (int i = 0; i < 3; ++i) {  // clip 1: east, facing east; clip 2: north, facing north
+    frames[i].clip = 1;
+    frames[i].velocity_m = {0.01, 0};
+    frames[i].heading_rad = 0.0;
+    frames[i + 3].clip = 2;
+    frames[i + 3].velocity_m = {0, 0.01};
+    frames[i + 3].heading_rad = M_PI / 2;
+  }
+  const TransitionGraph graph(frames, {{1, 3, 0.5}, {5, 0, 0.5}});
+  ASSERT_TRUE(graph.has_floor_frames());
+  EXPECT_DOUBLE_EQ(graph.Turn(0, 1), 0.0) << "a natural successor does not turn";
+  // After frame 1 the sprite faced east (frame 2's heading); frame 3 faced north.
+  EXPECT_NEAR(graph.Turn(1, 3), -M_PI / 2, 1e-12);
+  // At a clip's end its own heading: frame 5 faced north, frame 0 east.
+  EXPECT_NEAR(graph.Turn(5, 0), M_PI / 2, 1e-12);
+
+  const Track track = MakeTrack(graph, {0, 1, 3, 4, 5}, Anchor::kStart, {0, 0});
+  ASSERT_EQ(track.turns_rad.size(), 5u);
+  EXPECT_NEAR(track.turns_rad[1], 0.0, 1e-12);
+  EXPECT_NEAR(track.turns_rad[2], -M_PI / 2, 1e-12);
+  EXPECT_NEAR(track.turns_rad[4], -M_PI / 2, 1e-12);
+  EXPECT_NEAR((track.positions_m[4] - Eigen::Vector2d(0.04, 0)).norm(), 0, 1e-12)
+      << "it walks on east: " << track.positions_m[4].transpose();
+  // End-anchored, the end stays as filmed and the start turns instead.
+  const Track back = MakeTrack(graph, {0, 1, 3, 4, 5}, Anchor::kEnd, {0, 0});
+  EXPECT_NEAR(back.turns_rad[4], 0.0, 1e-12);
+  EXPECT_NEAR(back.turns_rad[0], M_PI / 2, 1e-12);
+  // Upright frames never turn.
+  EXPECT_FALSE(TransitionGraph(TwoClips(), {}).has_floor_frames());
+  EXPECT_TRUE(
+      MakeTrack(TransitionGraph(TwoClips(), {}), {0, 1}, Anchor::kStart, {0, 0}).turns_rad.empty());
+}
+
+TEST(TransitionGraph, ASequenceFileKeepsTheTurns) {
+  ScratchDir dir;
+  SequenceFile file;
+  file.camera_path = "virtual.cameramodel";
+  file.bank_paths = {"bank.ssbank"};
+  SpriteSequence s;
+  s.name = "hamster";
+  s.frames = {{0, 11}, {0, 12}};
+  s.positions_m = {{0, 0}, {0.01, 0}};
+  s.turns_rad = {0.0, -1.5};
+  file.sprites = {s};
+  file.num_steps = 2;
+  WriteSequenceFile(dir / "seq.json", file);
+  const SequenceFile read = ReadSequenceFile(dir / "seq.json");
+  ASSERT_EQ(read.sprites.size(), 1u);
+  EXPECT_EQ(read.sprites[0].turns_rad, s.turns_rad);
+  // Without turns (upright sprites) the steps stay four numbers and read back without.
+  file.sprites[0].turns_rad.clear();
+  WriteSequenceFile(dir / "upright.json", file);
+  EXPECT_TRUE(ReadSequenceFile(dir / "upright.json").sprites[0].turns_rad.empty());
+  EXPECT_DOUBLE_EQ(read.sprites[0].TurnAt(9), 0.0);
 }
 
 }  // namespace
