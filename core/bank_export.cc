@@ -17,8 +17,8 @@ std::string SpriteCsvHeader() {
          "m,"
          "velocity_x_m_s,velocity_y_m_s,mean_r,mean_g,mean_b,area_px,eccentricity,bbox_x,bbox_y,"
          "bbox_w,bbox_h,"
-         "billboard_w_px,billboard_h_px,px_per_m,anchor_x_px,anchor_y_px,kind,heading_rad,tags,png,"
-         "shadow_png\n";
+         "billboard_w_px,billboard_h_px,px_per_m,anchor_x_px,anchor_y_px,tags,png,shadow_png,kind,"
+         "heading_rad\n";
 }
 
 std::string SpriteCsvRow(const SpriteRecord& s) {
@@ -37,8 +37,8 @@ std::string SpriteCsvRow(const SpriteRecord& s) {
       << s.eccentricity << ',' << s.bbox_in_image.x << ',' << s.bbox_in_image.y << ','
       << s.bbox_in_image.width << ',' << s.bbox_in_image.height << ',' << s.billboard_width_px
       << ',' << s.billboard_height_px << ',' << s.px_per_m << ',' << s.anchor_x_px << ','
-      << s.anchor_y_px << ',' << TextOf(s.kind, kSpriteKindTexts) << ',' << s.heading_rad << ",\""
-      << tags << "\"," << png << ',' << shadow_png << '\n';
+      << s.anchor_y_px << ",\"" << tags << "\"," << png << ',' << shadow_png << ','
+      << TextOf(s.kind, kSpriteKindTexts) << ',' << s.heading_rad << '\n';
   return csv.str();
 }
 
