@@ -108,7 +108,10 @@ const char* RetrainPhaseName(RetrainPhase phase) {
 }
 
 nlohmann::json RetrainState::ToJson() const {
-  nlohmann::json r = {{"state", RetrainPhaseName(phase)}, {"progress", progress}, {"stage", stage}};
+  nlohmann::json r = {{"state", RetrainPhaseName(phase)},
+                      {"progress", progress},
+                      {"stage", stage},
+                      {"cancellable", cancellable}};
   if (phase == RetrainPhase::kIdle) return r;
   r["labels"] = labels;
   r["accepts"] = accepts;
@@ -224,6 +227,7 @@ RetrainState RetrainJob::Start(RetrainRequest request) {
     RetrainState& s = shared_->state;
     s = RetrainState{};
     s.phase = RetrainPhase::kTraining;
+    s.cancellable = true;
     s.progress = 0.02;
     s.stage = "exporting the labels";
     s.labels = request.labels;
@@ -335,6 +339,7 @@ void RetrainJob::Run(std::shared_ptr<Shared> shared, const RetrainRequest& reque
       std::lock_guard lock(shared->mutex);
       if (shared->cancel) throw Cancelled{};
       shared->handed_over = true;
+      shared->state.cancellable = false;  // said with the rebuild's first progress, just below
     }
     // 4. The station uses them; the bank's table is rebuilt with them.
     const auto t_rebuild = std::chrono::steady_clock::now();
@@ -472,6 +477,7 @@ void RetrainJob::Run(std::shared_ptr<Shared> shared, const RetrainRequest& reque
   {
     std::lock_guard lock(shared->mutex);
     shared->running = false;
+    shared->state.cancellable = false;
     end = shared->state;
   }
   shared->changed.notify_all();

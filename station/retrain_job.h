@@ -49,6 +49,8 @@ struct RetrainState {
   RetrainPhase phase = RetrainPhase::kIdle;
   double progress = 0;  // 0..1
   std::string stage;    // what it does now, in words
+  // Cancel() is taken: from the start until the station gets the new weights.
+  bool cancellable = false;
   // From the start.
   int64_t labels = 0, accepts = 0;  // yes + no labels, and the yes ones
   std::string started, previous_weights;

@@ -266,11 +266,13 @@ TEST(ConsoleLabels, TheExportTrainsAndARetrainRebuildsTheTable) {
   // table rebuilt with them (no station here: the part rebuilds it itself).
   const nlohmann::json started = labels.StartRetrain();
   EXPECT_EQ(started["state"], "training");
+  EXPECT_EQ(started["cancellable"], true) << "a cancel is taken from the start";
   EXPECT_THROW(labels.StartRetrain(), ConflictError);
   labels.WaitRetrain();
   const nlohmann::json r = labels.RetrainState();
   ASSERT_EQ(r["state"], "done") << r.dump(1);
   EXPECT_EQ(r["progress"], 1.0);
+  EXPECT_EQ(r["cancellable"], false) << "not once it is over";
   EXPECT_NEAR(r["precision"].get<double>(), trained.report.stage2.precision(), 1e-12)
       << "the same folds";
   EXPECT_NEAR(r["recall"].get<double>(), trained.report.stage2.recall(), 1e-12);
@@ -317,6 +319,7 @@ TEST(ConsoleLabels, TheExportTrainsAndARetrainRebuildsTheTable) {
   labels.WaitRetrain();
   const nlohmann::json cancelled = labels.RetrainState();
   EXPECT_EQ(cancelled["state"], "cancelled") << cancelled.dump(1);
+  EXPECT_EQ(cancelled["cancellable"], false);
   EXPECT_FALSE(cancelled.contains("weights")) << cancelled.dump(1);
   EXPECT_TRUE(cancelled.contains("finished"));
   EXPECT_EQ(Bank(bank.path).GetMeta(kTransitionWeightsMetaKey).value_or(""), table);

@@ -318,8 +318,8 @@ function showClassifier(status) {
   $('retrain-bar').querySelector('i').style.width = `${Math.round(100 * (r.progress || 0))}%`;
   $('retrain-bar').dataset.progress = String(r.progress || 0);
   $('retrain-button').disabled = running;
-  // A cancel is taken until the station gets the new weights (docs/console.md).
-  $('retrain-cancel').hidden = !(r.state === 'training' || (r.state === 'rebuilding' && r.progress <= 0.5));
+  // A cancel is taken until the station gets the new weights: the job says so (docs/console.md).
+  $('retrain-cancel').hidden = !r.cancellable;
   const figures = r.precision !== undefined;
   $('retrain-figures').hidden = !figures;
   if (figures) {

@@ -195,6 +195,8 @@ test('retrain: new weights, their cross-validated figures, the transitions rebui
     if (st === 'failed') throw new Error(await p.textContent('[data-testid="retrain-error"]'));
     return st === 'done';
   }, { timeout: 90000, interval: 50 });
+  // Over, it cannot be cancelled: the job says so (retrain.cancellable) and the page hides it.
+  assert.equal(await p.isHidden('[data-testid="retrain-cancel"]'), true);
   const seconds = (Date.now() - t0) / 1000;
   assert.ok(states.has('training') || states.has('rebuilding'), `progress was shown (${[...states]})`);
   // The weights file, beside the bank.
