@@ -205,12 +205,14 @@ cv::Mat SpriteRenderer::Render(const std::vector<PlacedSprite>& sprites) const {
   // camera for an upright sprite's shadow, backwards for a floor sprite).
   const auto floor_axes = [&](const PlacedSprite& s, Eigen::Vector3d* right,
                               Eigen::Vector3d* away) {
-    const Eigen::Vector2d toward =
-        s.kind == SpriteKind::kFloor
-            ? Eigen::Vector2d(std::cos(s.heading_rad), std::sin(s.heading_rad))
-            : TowardCamera(s.ground_m);
+    if (s.kind == SpriteKind::kFloor) {  // its heading up, seen from above: its right to the right
+      const Eigen::Vector2d ahead(std::cos(s.heading_rad), std::sin(s.heading_rad));
+      *right = Eigen::Vector3d(ahead.y(), -ahead.x(), 0.0);
+      *away = Eigen::Vector3d(-ahead.x(), -ahead.y(), 0.0);
+      return;
+    }
+    const Eigen::Vector2d toward = TowardCamera(s.ground_m);  // seen from the camera
     *right = Eigen::Vector3d(-toward.y(), toward.x(), 0.0);
-    if (s.kind == SpriteKind::kFloor) *right = -*right;  // seen from above, the subject's right
     *away = Eigen::Vector3d(-toward.x(), -toward.y(), 0.0);
   };
   for (const PlacedSprite& s : sprites) {

@@ -53,13 +53,11 @@ std::optional<Billboard> FloorRectifier::Rectify(const CameraModel& camera, cons
   }
   const double s = options_.px_per_m, h = options_.floor_height_m;
 
-  // A first look: the matte's centre in the image, on the body plane, and its extent there.
-  const cv::Moments im = cv::moments(*view.alpha);
+  // A first look: the matte's centre on the body plane (Place), and its extent there.
   const cv::Rect solid = cv::boundingRect(*view.alpha > kSolidAlpha);
-  if (im.m00 <= 0 || solid.empty()) return std::nullopt;
-  const Eigen::Vector2d centre_px(view.offset.x + im.m10 / im.m00, view.offset.y + im.m01 / im.m00);
-  const auto first = IntersectHeight(camera.RayInGround(centre_px), h);
-  if (!first) return std::nullopt;
+  const auto place = Place(camera, *view.alpha, view.offset);
+  if (solid.empty() || !place) return std::nullopt;
+  const Eigen::Vector3d first(place->x(), place->y(), h);
   double reach = 0;
   for (const Eigen::Vector2d& px :
        {Eigen::Vector2d(solid.x, solid.y), Eigen::Vector2d(solid.br().x, solid.y),
@@ -67,7 +65,7 @@ std::optional<Billboard> FloorRectifier::Rectify(const CameraModel& camera, cons
     const auto hit =
         IntersectHeight(camera.RayInGround(px + Eigen::Vector2d(view.offset.x, view.offset.y)), h);
     if (!hit) return std::nullopt;
-    reach = std::max(reach, (*hit - *first).head<2>().norm());
+    reach = std::max(reach, (*hit - first).head<2>().norm());
   }
   const auto too_large = [&](int side) {
     if (side <= options_.max_side_px) return false;
@@ -82,13 +80,13 @@ std::optional<Billboard> FloorRectifier::Rectify(const CameraModel& camera, cons
   const Eigen::Vector3d du(1 / s, 0, 0), dv(0, -1 / s, 0);
   double a = (side - 1) / 2.0;
   cv::Mat map, plane_alpha;
-  BuildPlaneMap(camera, *first - a * du - a * dv, du, dv, cv::Size(side, side), view.offset, map);
+  BuildPlaneMap(camera, first - a * du - a * dv, du, dv, cv::Size(side, side), view.offset, map);
   cv::remap(*view.alpha, plane_alpha, map, cv::noArray(), cv::INTER_LINEAR, cv::BORDER_CONSTANT,
             cv::Scalar(0));
   const cv::Moments pm = cv::moments(plane_alpha);
   if (pm.m00 <= 0) return std::nullopt;
   const double cu = pm.m10 / pm.m00, cv_ = pm.m01 / pm.m00;
-  const Eigen::Vector3d centre = *first + (cu - a) * du + (cv_ - a) * dv;
+  const Eigen::Vector3d centre = first + (cu - a) * du + (cv_ - a) * dv;
   // The major axis in the plane image's axes, then on the ground (v runs along -y).
   const double mu20 = pm.mu20 / pm.m00, mu02 = pm.mu02 / pm.m00, mu11 = pm.mu11 / pm.m00;
   const double axis_image = 0.5 * std::atan2(2 * mu11, mu20 - mu02);
@@ -117,30 +115,14 @@ std::optional<Billboard> FloorRectifier::Rectify(const CameraModel& camera, cons
   // ground turned so that the axis points up).
   out.toward_camera = Eigen::Vector2d(std::cos(out.heading_rad), std::sin(out.heading_rad));
   out.right_in_ground = Eigen::Vector2d(out.toward_camera.y(), -out.toward_camera.x());
-  const Eigen::Vector3d ax(out.right_in_ground.x() / s, out.right_in_ground.y() / s, 0);
-  const Eigen::Vector3d ay(-out.toward_camera.x() / s, -out.toward_camera.y() / s, 0);
-  BuildPlaneMap(camera, centre - a * ax - a * ay, ax, ay, cv::Size(side, side), view.offset, map);
-  cv::Mat bgr, alpha;
-  cv::remap(*view.bgr, bgr, map, cv::noArray(), cv::INTER_LINEAR, cv::BORDER_CONSTANT,
-            cv::Scalar::all(0));
-  cv::remap(*view.alpha, alpha, map, cv::noArray(), cv::INTER_LINEAR, cv::BORDER_CONSTANT,
-            cv::Scalar(0));
-  std::array<cv::Mat, 4> channels;
-  cv::split(bgr, channels.data());
-  channels[3] = alpha;
-  cv::merge(channels.data(), 4, out.bgra);
-
+  const Eigen::Vector3d right(out.right_in_ground.x(), out.right_in_ground.y(), 0);
+  const Eigen::Vector3d back(-out.toward_camera.x(), -out.toward_camera.y(), 0);
+  out.bgra =
+      ResampleBgra(camera, *view.bgr, *view.alpha, view.offset, centre - (a / s) * (right + back),
+                   right / s, back / s, cv::Size(side, side));
   // The shadow lies on the floor under the centre, in the same axes.
-  const int shadow_side = 2 * static_cast<int>(std::ceil(options_.shadow_radius_m * s)) + 1;
-  if (view.shadow != nullptr && !view.shadow->empty()) {
-    const double sa = (shadow_side - 1) / 2.0;
-    BuildPlaneMap(camera, out.point_in_ground - sa * ax - sa * ay, ax, ay,
-                  cv::Size(shadow_side, shadow_side), view.offset, map);
-    cv::remap(*view.shadow, out.shadow, map, cv::noArray(), cv::INTER_LINEAR, cv::BORDER_CONSTANT,
-              cv::Scalar(0));
-  } else {
-    out.shadow = cv::Mat::zeros(shadow_side, shadow_side, CV_8U);
-  }
+  out.shadow = ShadowPatch(camera, view.shadow, view.offset, out.point_in_ground, right, back,
+                           options_.shadow_radius_m, s);
   return out;
 }
 
@@ -170,19 +152,18 @@ std::vector<bool> ResolveHeadings(const std::vector<HeadingCue>& clip,
     const double travel = std::atan2(clip[t].velocity.y(), clip[t].velocity.x());
     return options.backwards_weight * sure * (1 - std::cos(heading(t, state) - travel)) / 2;
   };
-  // The turn between two frames, in half turns, counted as much as the two axes are sure.
+  // A turn from one heading to the next, in half turns, counted as much as the axes are sure.
+  const auto turn = [](double elongation, double from, double to) {
+    return std::clamp(elongation / 0.2, 0.05, 1.0) * std::abs(Wrap(to - from)) / M_PI;
+  };
   const auto pair = [&](size_t t, int from, int to) {
-    const double sure =
-        std::clamp(std::min(clip[t - 1].elongation, clip[t].elongation) / 0.2, 0.05, 1.0);
-    return sure * std::abs(Wrap(heading(t, to) - heading(t - 1, from))) / M_PI;
+    return turn(std::min(clip[t - 1].elongation, clip[t].elongation), heading(t - 1, from),
+                heading(t, to));
   };
   std::vector<std::array<int, 2>> back(n, {0, 0});
   std::array<double, 2> cost = {unary(0, 0), unary(0, 1)};
-  if (before) {
-    const double sure = std::clamp(clip[0].elongation / 0.2, 0.05, 1.0);
-    for (int state = 0; state < 2; ++state) {
-      cost[state] += sure * std::abs(Wrap(heading(0, state) - *before)) / M_PI;
-    }
+  for (int state = 0; before && state < 2; ++state) {
+    cost[state] += turn(clip[0].elongation, *before, heading(0, state));
   }
   for (size_t t = 1; t < n; ++t) {
     std::array<double, 2> next{};

@@ -7,7 +7,6 @@
 #include <opencv2/imgproc.hpp>
 
 #include "core/error.h"
-#include "core/grid_map.h"
 #include "core/log.h"
 #include "core/option_checks.h"
 #include "pipeline/rectify/plane_map.h"
@@ -29,29 +28,7 @@ std::optional<Eigen::Vector3d> IntersectVerticalPlane(const CameraModel& camera,
   return ray.origin + s * ray.direction;
 }
 
-// Coarse grid step (target pixels) at which points go through the full lens
-// model; the dense remap is interpolated in between. Lens distortion varies
-// slowly, so 8 px keeps the interpolation error far below a pixel.
-constexpr int kGridStep = 8;
-
 }  // namespace
-
-void BuildPlaneMap(const CameraModel& camera, const Eigen::Vector3d& origin,
-                   const Eigen::Vector3d& du, const Eigen::Vector3d& dv, cv::Size size,
-                   cv::Point offset, cv::Mat& map) {
-  const int gw = GridPoints(size.width, kGridStep);
-  const int gh = GridPoints(size.height, kGridStep);
-  std::vector<Eigen::Vector2f> grid(static_cast<size_t>(gw) * gh);
-  for (int gy = 0; gy < gh; ++gy) {
-    for (int gx = 0; gx < gw; ++gx) {
-      const Eigen::Vector3d p = origin + (gx * kGridStep) * du + (gy * kGridStep) * dv;
-      const Eigen::Vector2d px = camera.ProjectGround(p);
-      grid[gy * gw + gx] = Eigen::Vector2f(static_cast<float>(px.x() - offset.x),
-                                           static_cast<float>(px.y() - offset.y));
-    }
-  }
-  InterpolateGridMap(grid, kGridStep, size, std::nullopt, map);
-}
 
 bool RectifierOptions::IsValid(std::string* why) const {
   OptionProblems check(why);
@@ -141,30 +118,12 @@ std::optional<Billboard> Rectifier::Rectify(const CameraModel& camera, const Spr
   // Billboard pixel (u, v) is the point contact + right*(u - a_u)/s + up*(a_v - v)/s.
   const Eigen::Vector3d origin =
       *contact - right3 * (out.anchor_px.x() / s) + up * (out.anchor_px.y() / s);
-  cv::Mat map;
-  BuildPlaneMap(camera, origin, right3 / s, -up / s, cv::Size(width, height), view.offset, map);
-  cv::Mat bgr, alpha;
-  cv::remap(*view.bgr, bgr, map, cv::noArray(), cv::INTER_LINEAR, cv::BORDER_CONSTANT,
-            cv::Scalar::all(0));
-  cv::remap(*view.alpha, alpha, map, cv::noArray(), cv::INTER_LINEAR, cv::BORDER_CONSTANT,
-            cv::Scalar(0));
-  cv::Mat channels[4];
-  cv::split(bgr, channels);
-  channels[3] = alpha;
-  cv::merge(channels, 4, out.bgra);
-
+  out.bgra = ResampleBgra(camera, *view.bgr, *view.alpha, view.offset, origin, right3 / s, -up / s,
+                          cv::Size(width, height));
   // The shadow patch: ground axes `right` (u) and `-toward` (v, away from the camera).
-  const int side = 2 * static_cast<int>(std::ceil(options_.shadow_radius_m * s)) + 1;
-  if (view.shadow != nullptr && !view.shadow->empty()) {
-    const Eigen::Vector3d away(-toward.x(), -toward.y(), 0.0);
-    const double half = (side - 1) / 2.0 / s;
-    const Eigen::Vector3d sorigin = *contact - right3 * half - away * half;
-    BuildPlaneMap(camera, sorigin, right3 / s, away / s, cv::Size(side, side), view.offset, map);
-    cv::remap(*view.shadow, out.shadow, map, cv::noArray(), cv::INTER_LINEAR, cv::BORDER_CONSTANT,
-              cv::Scalar(0));
-  } else {
-    out.shadow = cv::Mat::zeros(side, side, CV_8U);
-  }
+  out.shadow =
+      ShadowPatch(camera, view.shadow, view.offset, *contact, right3,
+                  Eigen::Vector3d(-toward.x(), -toward.y(), 0.0), options_.shadow_radius_m, s);
   return out;
 }
 

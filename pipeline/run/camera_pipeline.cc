@@ -89,11 +89,10 @@ CameraPipeline::CameraPipeline(std::string name, int64_t camera_id, CameraModel 
       noise_(options.noise),
       rectifier_(options.rectify),
       floor_rectifier_(options.rectify),
-      from_above_(floor_mask_.FilmsFromAbove()),
       batcher_(camera_id, options.batch),
       log_(Log("pipeline.run")) {
   // A camera that sees all of its floor from too far above keeps nothing: say so once, up front.
-  if (from_above_) {
+  if (floor_mask_.FilmsFromAbove()) {
     log_->info(
         "{}: films its floor from above (a median view of {:.0f} degrees, steeper than "
         "pipeline.floor_view_angle_deg {}): its subjects are stored as floor sprites",
@@ -167,9 +166,10 @@ void CameraPipeline::Process(const Frame& frame, std::vector<ClipBatch>* out) {
   std::vector<Eigen::Vector2d> points;
   std::vector<TrackInput> inputs;
   verdicts_.clear();
+  const bool from_above = floor_mask_.FilmsFromAbove();
   for (const Candidate& c : candidates) {
     std::optional<Eigen::Vector2d> hit;
-    if (from_above_) {
+    if (from_above) {
       hit = floor_rectifier_.Place(model_, c.alpha, c.bbox.tl());
     } else if (const auto ground = IntersectGround(
                    model_.RayInGround(Eigen::Vector2d(c.contact_point.x, c.contact_point.y)))) {
@@ -224,8 +224,8 @@ void CameraPipeline::Process(const Frame& frame, std::vector<ClipBatch>* out) {
       const SpriteView view{&c.colour, &c.alpha, &c.shadow, c.bbox.tl(),
                             Eigen::Vector2d(c.contact_point.x, c.contact_point.y)};
       Rectifier::Refusal why;
-      billboards[k] = from_above_ ? floor_rectifier_.Rectify(model_, view, &why)
-                                  : rectifier_.Rectify(model_, view, &why);
+      billboards[k] = from_above ? floor_rectifier_.Rectify(model_, view, &why)
+                                 : rectifier_.Rectify(model_, view, &why);
       if (billboards[k] && side_by_side_.options().min_width_ratio > 0) {  // the rule is on
         looks[k] =
             MeasureMatteLook(billboards[k]->bgra, billboards[k]->px_per_m, side_by_side_.options());

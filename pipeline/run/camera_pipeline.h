@@ -122,8 +122,6 @@ class CameraPipeline {
   // ones).
   uint64_t usable_sprites() const { return usable_total_; }
   const FloorMask& floor_mask() const { return floor_mask_; }
-  // What it stores: floor sprites when the camera films its floor from above, else upright.
-  SpriteKind sprite_kind() const { return from_above_ ? SpriteKind::kFloor : SpriteKind::kUpright; }
   const Keyer& keyer() const { return *keyer_; }  // as configured (options.keying)
 
  private:
@@ -141,8 +139,7 @@ class CameraPipeline {
   NoiseFilter noise_;
   ClipCutter cutter_;
   Rectifier rectifier_;
-  FloorRectifier floor_rectifier_;
-  bool from_above_ = false;  // the camera films from above: floor sprites (FloorMask)
+  FloorRectifier floor_rectifier_;  // for a camera that films from above (FloorMask)
   ClipBatcher batcher_;
   cv::Mat bgr_scratch_;  // a frame converted for the keyer (formats it cannot key in place)
   Matte matte_;

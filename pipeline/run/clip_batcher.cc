@@ -151,15 +151,21 @@ void ClipBatcher::Emit(Open& open, size_t count, bool complete, std::vector<Clip
   batch.clip.last_frame = open.first_frame + static_cast<int64_t>(first_index + count) - 1;
   batch.clip.complete = complete;
   batch.sprites.reserve(count * (options_.mirrors ? 2 : 1));
-  if (count > 0 && open.pending.front().billboard.kind == SpriteKind::kFloor) {
+  // The emitted frames' velocities, each from its own +-window (not the whole clip's); floor
+  // sprites' headings read every held frame's.
+  const bool floor = count > 0 && open.pending.front().billboard.kind == SpriteKind::kFloor;
+  std::vector<Eigen::Vector2d> velocities(floor ? open.pending.size() : count);
+  for (size_t k = 0; k < velocities.size(); ++k) {
+    velocities[k] =
+        EstimateVelocity(open.timestamps_ns, open.points, static_cast<int>(first_index + k),
+                         options_.velocity_half_window);
+  }
+  if (floor) {
     // Head first: the signs of every frame held, those handed out now kept.
     std::vector<HeadingCue> cues(open.pending.size());
     for (size_t k = 0; k < cues.size(); ++k) {
       const Billboard& b = open.pending[k].billboard;
-      cues[k] = {
-          b.heading_rad, b.elongation,
-          EstimateVelocity(open.timestamps_ns, open.points, static_cast<int>(first_index + k),
-                           options_.velocity_half_window)};
+      cues[k] = {b.heading_rad, b.elongation, velocities[k]};
     }
     const std::vector<bool> flip = ResolveHeadings(cues, {}, open.last_heading);
     for (size_t k = 0; k < count; ++k) {
@@ -171,10 +177,7 @@ void ClipBatcher::Emit(Open& open, size_t count, bool complete, std::vector<Clip
   for (size_t k = 0; k < count; ++k) {
     const MadeSprite& s = open.pending[k];
     stored_merged_originals_ += s.merged ? 1 : 0;
-    // Only the emitted frames' velocities: each needs its own +-window, not the whole clip.
-    SpriteRecord original = OriginalRecord(
-        s, EstimateVelocity(open.timestamps_ns, open.points, static_cast<int>(first_index + k),
-                            options_.velocity_half_window));
+    SpriteRecord original = OriginalRecord(s, velocities[k]);
     if (options_.mirrors) {
       SpriteRecord mirror = MirrorRecord(original, s);
       batch.sprites.push_back(std::move(original));
