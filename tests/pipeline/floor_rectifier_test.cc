@@ -18,6 +18,7 @@
 #include "synth/directors.h"
 #include "synth/renderer.h"
 #include "synth/scene.h"
+#include "tests/pipeline/synth_clean_plate.h"
 
 namespace ss {
 namespace {
@@ -53,15 +54,8 @@ FloorRun RunOverhead(uint64_t seed, int first, int frames) {
   const CameraModel model(cam.lensmodel, cam.intrinsics, cam.width, cam.height,
                           cam.cam_from_ground);
 
-  std::vector<cv::Mat> empty;
-  empty.reserve(4);
-  for (int i = 0; i < 4; ++i) {
-    empty.push_back(ToBgr(
-        Frame::Owned(PixelFormat::kRGB8, kOverheadWidth, kOverheadHeight,
-                     sensor.Capture(renderer.clean_plate(), PixelFormat::kRGB8, 1'000'000 + i))));
-  }
   ChromaKeyer keyer;
-  keyer.Train(empty);
+  keyer.Train(testing::CleanPlateFrames(renderer, sensor, PixelFormat::kRGB8));
   ExtractorOptions extract;
   extract.min_area = 400;
   Extractor extractor(extract);

@@ -18,6 +18,7 @@
 #include "synth/renderer.h"
 #include "synth/scene.h"
 #include "tests/pipeline/key_scene.h"
+#include "tests/pipeline/synth_clean_plate.h"
 
 namespace ss {
 namespace {
@@ -42,15 +43,8 @@ std::vector<KeyedFrame> KeySynthSession(uint64_t seed, PixelFormat format, int f
   const Sensor sensor(seed, 0, 1.0);
 
   cv::Mat scratch;
-  std::vector<cv::Mat> empty;
-  for (int i = 0; i < 4; ++i) {
-    const Frame f = Frame::Owned(
-        format, kWidth, kHeight,
-        sensor.Capture(renderer.clean_plate(), format, 1'000'000 + static_cast<uint64_t>(i)));
-    empty.push_back(ToBgr(f));
-  }
   ChromaKeyer keyer(keyer_options);
-  keyer.Train(empty);
+  keyer.Train(testing::CleanPlateFrames(renderer, sensor, format));
   Extractor extractor;
 
   DirectorOptions options;
