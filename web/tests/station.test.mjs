@@ -111,9 +111,12 @@ test('every camera is a live tile whose frame number advances', async () => {
   assert.deepEqual(Object.keys(await h.tiles(p)).sort(), CAMERAS);
   await framesAdvance(CAMERAS);
   assert.equal(await p.getAttribute('[data-testid="connection"]', 'data-state'), 'connected');
-  // at most 10 previews a second a tile
-  const rate = await previewRate(2000);
-  for (const n of CAMERAS) assert.ok(rate[n] >= 1 && rate[n] <= 21, `${n}: ${rate[n]} previews in 2 s`);
+  // at most 10 previews a second a tile, and each tile keeps asking (a preview can take
+  // seconds on a loaded machine: the lower bound waits, the upper bound is the window's)
+  const counter = previewsFrom();
+  await h.sleep(2000);
+  for (const n of CAMERAS) assert.ok((counter.seen[n] || 0) <= 21, `${n}: ${counter.seen[n]} previews in 2 s`);
+  await counter.each(CAMERAS, 'while live');
   // the exposure aid: a histogram of the green screen with its figures
   const fig = await h.text(p, 'tile-uniformity');
   assert.match(fig, /^\d\.\d\d$/, 'green uniformity shown');
