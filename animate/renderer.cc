@@ -49,6 +49,8 @@ bool RenderOptions::IsValid(std::string* why) const {
   check(grid_step_px >= 1, "grid_step_px", "must be >= 1, got " + std::to_string(grid_step_px));
   check(min_floor_view_deg >= 0 && min_floor_view_deg <= 90, "min_floor_view_deg",
         "must be within [0, 90], got " + OptionProblems::Num(min_floor_view_deg));
+  check(max_upright_view_deg >= 0 && max_upright_view_deg <= 90, "max_upright_view_deg",
+        "must be within [0, 90], got " + OptionProblems::Num(max_upright_view_deg));
   return check.ok();
 }
 
@@ -216,17 +218,26 @@ cv::Mat SpriteRenderer::Render(const std::vector<PlacedSprite>& sprites) const {
     *away = Eigen::Vector3d(-toward.x(), -toward.y(), 0.0);
   };
   for (const PlacedSprite& s : sprites) {
-    if (s.kind != SpriteKind::kFloor) continue;
-    if (const double angle = ViewAngleDeg(s.ground_m); !(angle >= options_.min_floor_view_deg)) {
-      throw InputError(
-          "floor sprite at (" + OptionProblems::Num(s.ground_m.x()) + ", " +
-              OptionProblems::Num(s.ground_m.y()) + ")",
-          "the virtual camera sees it from " + OptionProblems::Num(std::round(angle)) +
-              " degrees above the floor, shallower than " +
-              OptionProblems::Num(options_.min_floor_view_deg) +
-              ": a subject filmed from above looks true only from above (render from a camera "
-              "looking down at it)");
+    const bool floor = s.kind == SpriteKind::kFloor;
+    const double angle = ViewAngleDeg(s.ground_m);
+    if (floor ? angle >= options_.min_floor_view_deg : angle <= options_.max_upright_view_deg)
+      continue;
+    const std::string where = std::string(floor ? "floor" : "upright") + " sprite at (" +
+                              OptionProblems::Num(s.ground_m.x()) + ", " +
+                              OptionProblems::Num(s.ground_m.y()) + ")";
+    const std::string seen = "the virtual camera sees it from " +
+                             OptionProblems::Num(std::round(angle)) + " degrees above the floor, ";
+    if (floor) {
+      throw InputError(where, seen + "shallower than " +
+                                  OptionProblems::Num(options_.min_floor_view_deg) +
+                                  ": a subject filmed from above looks true only from above "
+                                  "(render from a camera looking down at it)");
     }
+    throw InputError(where, seen + "steeper than " +
+                                OptionProblems::Num(options_.max_upright_view_deg) +
+                                ": a billboard filmed from the side is a sliver from above "
+                                "(render from a camera that looks across the floor, or film "
+                                "the subject from above for floor sprites)");
   }
   if (options_.shadows) {
     for (size_t i : order) {

@@ -10,7 +10,8 @@
 // A floor sprite (SpriteKind::kFloor, a subject filmed from above; docs/pipeline.md) lies on the
 // floor instead, its top toward its heading, drawn after the shadows and before every upright
 // one; its shadow patch shares its axes. It looks true only from above: a virtual camera that
-// sees one from shallower than min_floor_view_deg is refused by name.
+// sees one from shallower than min_floor_view_deg is refused by name, as is one that sees an
+// upright sprite from steeper than max_upright_view_deg.
 #include <vector>
 
 #include <Eigen/Core>
@@ -39,6 +40,10 @@ struct RenderOptions {
   // the camera at its place) is refused: a subject filmed from above, laid flat, looks like a
   // decal from the side.
   double min_floor_view_deg = 60.0;
+  // An upright sprite seen from steeper than this is refused: a billboard standing on the floor
+  // is a sliver from straight above (the pipeline refuses to film one there, at
+  // pipeline.max_view_angle_deg, the same 75 by default). 90: never.
+  double max_upright_view_deg = 75.0;
   // False with "FIELD: reason" lines in `why` (core/option_checks.h) for values out of range.
   bool IsValid(std::string* why) const;
 };
@@ -50,7 +55,8 @@ class SpriteRenderer {
   SpriteRenderer(CameraModel camera, const cv::Mat& background, RenderOptions options = {});
 
   // One frame, CV_8UC4 BGRA (straight alpha; opaque where the background is). InputError
-  // ("floor sprite at (x, y)") for a floor sprite seen from shallower than min_floor_view_deg.
+  // ("floor sprite at (x, y)") for a floor sprite seen from shallower than min_floor_view_deg,
+  // ("upright sprite at (x, y)") for an upright one seen from steeper than max_upright_view_deg.
   cv::Mat Render(const std::vector<PlacedSprite>& sprites) const;
   // The angle between the floor and the ray from a ground point to the camera, degrees.
   double ViewAngleDeg(const Eigen::Vector2d& ground_m) const;

@@ -104,6 +104,34 @@ TEST(Renderer, AFloorSpriteLiesOnTheFloorFacingItsHeading) {
   }
 }
 
+// An upright billboard seen from straight above is a sliver (issue 38): refused by name, as
+// the pipeline refuses to film one there; from the side the same sprite is drawn.
+TEST(Renderer, AnUprightSpriteSeenFromStraightAboveIsRefused) {
+  SpritePixels pixels;
+  pixels.bgra = cv::Mat(40, 20, CV_8UC4, cv::Scalar(0, 200, 0, 255));
+  const PlacedSprite s{&pixels, Eigen::Vector2d(10, 39), kPxPerM, Eigen::Vector2d(0.1, -0.05)};
+  const SpriteRenderer above(testing::LookAtCamera(800, 600, 800, {0.05, -0.1, 1.5}, {0, 0, 0}),
+                             cv::Mat());
+  try {
+    above.Render({s});
+    ADD_FAILURE() << "an upright sprite seen from above was drawn";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("upright sprite at (0.1, -0.05)"), std::string::npos)
+        << e.what();
+    EXPECT_NE(std::string(e.what()).find("steeper than 75"), std::string::npos) << e.what();
+  }
+  const SpriteRenderer side(testing::LookAtCamera(800, 600, 800, {0, -2.5, 1.5}, {0, 0, 0}),
+                            cv::Mat());
+  cv::Mat alpha;
+  cv::extractChannel(side.Render({s}), alpha, 3);
+  EXPECT_GT(cv::countNonZero(alpha), 100);
+  RenderOptions never;  // 90 draws it from anywhere
+  never.max_upright_view_deg = 90;
+  const SpriteRenderer anyway(testing::LookAtCamera(800, 600, 800, {0.05, -0.1, 1.5}, {0, 0, 0}),
+                              cv::Mat(), never);
+  EXPECT_NO_THROW(anyway.Render({s}));
+}
+
 TEST(Renderer, TheBillboardFacesTheCamera) {
   // A wide bar: seen from anywhere it projects to a horizontal segment of ~ its true width.
   const CameraModel camera = testing::LookAtCamera(320, 240, 300, {-3, -3, 2}, {0, 0, 0});
