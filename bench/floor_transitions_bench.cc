@@ -82,6 +82,9 @@ struct Side {
   double seconds = 0;
   TransitionJumpSummary jumps;
   std::vector<double> sampled_px;  // the measured jumps of the sample, px (Difference_px)
+  // The sample's (classifier distance D in [0, 1], jump px) and every transition's D.
+  std::vector<std::pair<double, double>> sampled_d_px;
+  std::vector<double> distances;
   // Transitions whose jump is at most `px`, estimated from the sample (its share of the table).
   double AtMost(double px) const {
     if (sampled_px.empty()) return 0;
@@ -117,6 +120,7 @@ Side Search(const TransitionWeights& weights, double px_per_m, std::span<const S
   std::unordered_map<int64_t, bool> from;
   for (const Transition& t : builder.Transitions()) {
     pairs.emplace_back(t.from, t.to);
+    s.distances.push_back(t.distance);
     from[t.from] = true;
   }
   s.transitions = static_cast<int64_t>(pairs.size());
@@ -128,7 +132,10 @@ Side Search(const TransitionWeights& weights, double px_per_m, std::span<const S
   // visible jump.
   const size_t step = std::max<size_t>(1, pairs.size() / std::max(1, max_jumps));
   for (size_t k = 0; k < pairs.size(); k += step) {
-    if (const auto px = seen_px(pairs[k].first, pairs[k].second)) s.sampled_px.push_back(*px);
+    if (const auto px = seen_px(pairs[k].first, pairs[k].second)) {
+      s.sampled_px.push_back(*px);
+      s.sampled_d_px.emplace_back(s.distances[k], *px);
+    }
   }
   std::sort(s.sampled_px.begin(), s.sampled_px.end());
   return s;
@@ -219,6 +226,26 @@ int Run(const std::vector<std::string>& args) {
     at_jump.push_back(
         {{"jump", jump}, {"aligned", a}, {"as_filmed", f}, {"ratio", f > 0 ? a / f : 0.0}});
   }
+  // By the classifier's distance D (stage 2's, kept when D <= its threshold): how many a
+  // stricter bound (a quantile of the aligned table's D) would keep, and how visible they are.
+  nlohmann::json by_distance = nlohmann::json::array();
+  for (const double q : {0.01, 0.05, 0.1, 0.25, 0.5, 1.0}) {
+    const double bound = Quantile(with.distances, q).value_or(0);
+    nlohmann::json row = {{"quantile", q}, {"bound", bound}};
+    for (const auto* side : {&with, &without}) {
+      std::vector<double> jumps;
+      for (const auto& [d, px] : side->sampled_d_px)
+        if (d <= bound) jumps.push_back(px / unit_px);
+      const auto kept = std::count_if(side->distances.begin(), side->distances.end(),
+                                      [&](double d) { return d <= bound; });
+      row[side == &with ? "aligned" : "as_filmed"] = {
+          {"transitions", kept},
+          {"per_sprite", static_cast<double>(kept) / static_cast<double>(n)},
+          {"jump_median", Quantile(jumps, 0.5).value_or(NAN)},
+          {"jump_p95", Quantile(jumps, 0.95).value_or(NAN)}};
+    }
+    by_distance.push_back(row);
+  }
   if (json) {
     const nlohmann::json j = {{"bank", bank_path},
                               {"sprites", n},
@@ -227,7 +254,8 @@ int Run(const std::vector<std::string>& args) {
                               {"as_filmed", SideJson(without, n)},
                               {"ratio", ratio},
                               {"step_px", unit_px},
-                              {"at_jump", at_jump}};
+                              {"at_jump", at_jump},
+                              {"by_distance", by_distance}};
     std::printf("%s\n", j.dump(2).c_str());
     return 0;
   }
@@ -252,6 +280,18 @@ int Run(const std::vector<std::string>& args) {
     std::printf("  jump <= %.1f: %10.0f aligned, %9.0f as filmed: %.2fx\n",
                 row["jump"].get<double>(), row["aligned"].get<double>(),
                 row["as_filmed"].get<double>(), row["ratio"].get<double>());
+  }
+  std::printf("by stage 2's distance D (jumps in the unit above):\n");
+  for (const auto& row : by_distance) {
+    std::printf("  D <= %.3f (aligned's %2.0f %%):", row["bound"].get<double>(),
+                100 * row["quantile"].get<double>());
+    for (const char* side : {"aligned", "as_filmed"}) {
+      const auto& r = row[side];
+      std::printf("  %s %.1f a sprite, jump median %.2f p95 %.2f", side,
+                  r["per_sprite"].get<double>(), r["jump_median"].get<double>(),
+                  r["jump_p95"].get<double>());
+    }
+    std::printf("\n");
   }
   return 0;
 }
