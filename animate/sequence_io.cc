@@ -4,6 +4,7 @@
 #include <fstream>
 
 #include "core/error.h"
+#include "core/replace_file.h"
 
 namespace ss {
 namespace {
@@ -108,15 +109,7 @@ void WriteSequenceFile(const std::string& path, const SequenceFile& file) {
   }
   j["stages"] = std::move(stages);
   j["summary"] = file.summary.is_null() ? json::object() : file.summary;
-  const std::string temp = path + ".tmp";
-  {
-    std::ofstream out(temp);
-    out << j.dump(1) << "\n";
-    if (!out) throw WorkError(path, "cannot write the sequences");
-  }
-  std::error_code ec;
-  std::filesystem::rename(temp, path, ec);
-  if (ec) throw WorkError(path, "cannot write the sequences: " + ec.message());
+  ReplaceFile(path, j.dump(1) + "\n", "the sequences");
 }
 
 namespace {

@@ -11,6 +11,7 @@
 #include "calib/mrcal_corners.h"
 #include "core/error.h"
 #include "core/log.h"
+#include "core/replace_file.h"
 
 namespace ss::calib {
 
@@ -19,15 +20,7 @@ namespace fs = std::filesystem;
 namespace {
 
 void WriteJson(const std::string& path, const nlohmann::json& j) {
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream out(tmp);
-    out << j.dump(2) << "\n";
-    if (!out) throw WorkError(path, "cannot write the report");
-  }
-  std::error_code ec;
-  fs::rename(tmp, path, ec);
-  if (ec) throw WorkError(path, "cannot write the report: " + ec.message());
+  ReplaceFile(path, j.dump(2) + "\n", "the report");
 }
 
 void MakeDir(const std::string& dir) {

@@ -19,6 +19,7 @@
 
 #include "core/error.h"
 #include "core/posix.h"
+#include "core/replace_file.h"
 
 // libmrcal's headers are plain C without extern "C" guards.
 extern "C" {
@@ -302,23 +303,7 @@ void CameraModel::Write(const std::string& path) const {
     if (!std::isfinite(v)) throw WorkError(path, "camera model has a non-finite intrinsic");
   }
   const std::string text = ToText();
-  const std::string tmp = path + ".tmp." + std::to_string(::getpid());
-  {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    if (!out) throw WorkError(path, std::string("cannot write camera model: ") + ErrnoText(errno));
-    out << text;
-    out.flush();
-    if (!out) {
-      std::filesystem::remove(tmp);
-      throw WorkError(path, "cannot write camera model (disk full?)");
-    }
-  }
-  std::error_code ec;
-  std::filesystem::rename(tmp, path, ec);
-  if (ec) {
-    std::filesystem::remove(tmp);
-    throw WorkError(path, "cannot write camera model: " + ec.message());
-  }
+  ReplaceFile(path, text, "camera model");
 }
 
 Eigen::Vector3d CameraModel::CentreInGround() const {
