@@ -28,29 +28,6 @@ std::optional<Eigen::Vector3d> IntersectHeight(const Ray& ray, double height) {
 // The angle in (-pi, pi].
 double Wrap(double a) { return std::remainder(a, 2 * M_PI); }
 
-// The centre of the body's thickest part, in the plane image's pixels: the solid matte's points
-// weighted by their distance to its edge to the 4th power. An animal seen from above rests its
-// weight under its torso, the widest part of its outline; the outline's plain centre is pulled
-// ahead of it by the head (8-9 mm on the synthetic hamster, against 0.5-0.7 mm so; 4.0-4.2 mm
-// at the 2nd power, 6.4-6.6 mm at the 1st). nullopt for an empty matte.
-std::optional<cv::Point2d> ThickestCentre(const cv::Mat& plane_alpha) {
-  cv::Mat inside;
-  cv::distanceTransform(plane_alpha > kSolidAlpha, inside, cv::DIST_L2, cv::DIST_MASK_5);
-  double sum = 0, sum_u = 0, sum_v = 0;
-  for (int y = 0; y < inside.rows; ++y) {
-    const float* row = inside.ptr<float>(y);
-    for (int x = 0; x < inside.cols; ++x) {
-      const double d2 = static_cast<double>(row[x]) * row[x];
-      const double w = d2 * d2;
-      sum += w;
-      sum_u += w * x;
-      sum_v += w * y;
-    }
-  }
-  if (!(sum > 0)) return std::nullopt;
-  return cv::Point2d(sum_u / sum, sum_v / sum);
-}
-
 }  // namespace
 
 FloorRectifier::FloorRectifier(RectifierOptions options) : options_(options) {
@@ -98,7 +75,7 @@ std::optional<Billboard> FloorRectifier::Rectify(const CameraModel& camera, cons
   int side = 2 * static_cast<int>(std::ceil((reach + options_.margin_m) * s)) + 1;
   if (too_large(side)) return std::nullopt;
 
-  // The matte on the body plane, the ground's axes (u along +x, v along -y): its shape and
+  // The matte on the body plane, the ground's axes (u along +x, v along -y): its centre and
   // second moments there are free of the lens's perspective.
   const Eigen::Vector3d du(1 / s, 0, 0), dv(0, -1 / s, 0);
   double a = (side - 1) / 2.0;
@@ -106,11 +83,9 @@ std::optional<Billboard> FloorRectifier::Rectify(const CameraModel& camera, cons
   BuildPlaneMap(camera, first - a * du - a * dv, du, dv, cv::Size(side, side), view.offset, map);
   cv::remap(*view.alpha, plane_alpha, map, cv::noArray(), cv::INTER_LINEAR, cv::BORDER_CONSTANT,
             cv::Scalar(0));
-  // Its place is the centre of its thickest part (ThickestCentre); its axis from the moments.
   const cv::Moments pm = cv::moments(plane_alpha);
-  const auto thickest = ThickestCentre(plane_alpha);
-  if (pm.m00 <= 0 || !thickest) return std::nullopt;
-  const double cu = thickest->x, cv_ = thickest->y;
+  if (pm.m00 <= 0) return std::nullopt;
+  const double cu = pm.m10 / pm.m00, cv_ = pm.m01 / pm.m00;
   const Eigen::Vector3d centre = first + (cu - a) * du + (cv_ - a) * dv;
   // The major axis in the plane image's axes, then on the ground (v runs along -y).
   const double mu20 = pm.mu20 / pm.m00, mu02 = pm.mu02 / pm.m00, mu11 = pm.mu11 / pm.m00;

@@ -36,8 +36,7 @@ class FloorRectifier {
   // sign until ResolveHeadings picks one; elongation how sure it is.
   // nullopt when the subject's rays miss the body plane, its matte is empty, or the sprite
   // would exceed max_side_px (`why->too_large`, with the size it would have had).
-  // The anchor (the sprite's place) is the centre of the body's thickest part on that plane,
-  // where an animal rests its weight; `view.contact_px` is not used.
+  // `view.contact_px` is not used: from above, the centre of the matte is the subject's place.
   std::optional<Billboard> Rectify(const CameraModel& camera, const SpriteView& view,
                                    Rectifier::Refusal* why = nullptr) const;
 
