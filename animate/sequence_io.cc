@@ -1,6 +1,5 @@
 #include "animate/sequence_io.h"
 
-#include <filesystem>
 #include <fstream>
 
 #include "core/error.h"

@@ -29,6 +29,7 @@
 #include "core/camera_model.h"
 #include "core/error.h"
 #include "core/frame.h"
+#include "core/replace_file.h"
 #include "core/session.h"
 
 namespace ss::apps {
@@ -247,13 +248,7 @@ void AddEnclosure(CLI::App& parent) {
       std::stringstream text;
       text << f.rdbuf();
       const std::string updated = calib::ReplaceEnclosureFloor(text.str(), floor, *config);
-      const std::string tmp = *config + ".tmp";
-      {
-        std::ofstream o(tmp);
-        o << updated;
-        if (!o) throw WorkError(tmp, "cannot write");
-      }
-      fs::rename(tmp, *config);
+      ReplaceFile(*config, updated, "the config");
     }
     if (*json) {
       nlohmann::json j;

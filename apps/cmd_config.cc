@@ -4,7 +4,6 @@
 // spritestation config keys [--markdown | --update DOC]: every key with its type, default
 // and doc, as the code binds them; --update rewrites DOC's key tables (docs/config.md).
 #include <cstdio>
-#include <filesystem>
 #include <fstream>
 #include <memory>
 #include <sstream>
@@ -16,6 +15,7 @@
 #include "apps/commands.h"
 #include "config/station_config.h"
 #include "core/error.h"
+#include "core/replace_file.h"
 #include "station/station.h"
 
 namespace ss::apps {
@@ -102,13 +102,7 @@ void UpdateDoc(const std::string& doc) {
     std::printf("%s: the key tables are up to date\n", doc.c_str());
     return;
   }
-  const std::string tmp = doc + ".tmp";
-  {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    out << now;
-    if (!out.flush()) throw InputError(tmp + ": cannot write it");
-  }
-  std::filesystem::rename(tmp, doc);
+  ReplaceFile(doc, now, "the key tables");
   std::printf("%s: key tables rewritten\n", doc.c_str());
 }
 

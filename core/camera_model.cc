@@ -1,7 +1,5 @@
 #include "core/camera_model.h"
 
-#include <unistd.h>
-
 #include <charconv>
 #include <cmath>
 #include <cstdio>

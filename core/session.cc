@@ -14,6 +14,7 @@
 #include "core/error.h"
 #include "core/log.h"
 #include "core/recording_codecs.h"
+#include "core/replace_file.h"
 
 namespace ss {
 namespace {
@@ -243,18 +244,7 @@ void WriteSessionInfo(const std::string& dir, const SessionInfo& info) {
                   {"created", info.created},
                   {"synthetic", info.synthetic},
                   {"cameras", cameras}};
-  const fs::path path = fs::path(dir) / "session.json";
-  const fs::path temp = fs::path(dir) / "session.json.tmp";
-  {
-    std::ofstream out(temp, std::ios::binary | std::ios::trunc);
-    if (!out) throw WorkError(temp.string(), "cannot open for writing");
-    out << root.dump(2) << '\n';
-    out.flush();
-    if (!out) throw WorkError(temp.string(), "write failed (disk full?)");
-  }
-  std::error_code ec;
-  fs::rename(temp, path, ec);
-  if (ec) throw WorkError(path.string(), "cannot replace: " + ec.message());
+  ReplaceFile((fs::path(dir) / "session.json").string(), root.dump(2) + "\n", "the session");
 }
 
 std::vector<FrameRecord> ReadFrameCsv(const std::string& path) {

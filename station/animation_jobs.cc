@@ -29,6 +29,7 @@
 #include "core/log.h"
 #include "core/option_checks.h"
 #include "core/posix.h"
+#include "core/replace_file.h"
 #include "core/utc_time.h"
 #include "judge/judge.h"
 
@@ -62,17 +63,9 @@ std::string FrameName(int step) {
   return name;
 }
 
-// Writes `text` to `path` through a temporary file and a rename (a reader never sees half).
+// Writes `text` to `path` whole (core/replace_file.h: a reader never sees half).
 void WriteWhole(const fs::path& path, const std::string& text) {
-  const fs::path temp = path.string() + ".partial";
-  {
-    std::ofstream out(temp, std::ios::binary | std::ios::trunc);
-    out << text;
-    if (!out.flush()) throw WorkError(temp.string(), "cannot write");
-  }
-  std::error_code ec;
-  fs::rename(temp, path, ec);
-  if (ec) throw WorkError(path.string(), "cannot write: " + ec.message());
+  ReplaceFile(path.string(), text, "the job's " + path.filename().string());
 }
 
 std::string ReadWhole(const fs::path& path) {
