@@ -19,6 +19,7 @@
 #include <optional>
 #include <string>
 #include <unordered_map>
+#include <unordered_set>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -81,16 +82,16 @@ struct Side {
   BuildStats stats;
   double seconds = 0;
   TransitionJumpSummary jumps;
-  std::vector<double> sampled_px;  // the measured jumps of the sample, px (Difference_px)
-  // The sample's (classifier distance D in [0, 1], jump px) and every transition's D.
+  std::vector<double> distances;  // every transition's stage-2 distance D (Transition::distance)
+  // The sample: (D, the jump as seen in px) of transitions spread evenly over the table.
   std::vector<std::pair<double, double>> sampled_d_px;
-  std::vector<double> distances;
   // Transitions whose jump is at most `px`, estimated from the sample (its share of the table).
   double AtMost(double px) const {
-    if (sampled_px.empty()) return 0;
-    const auto k = std::upper_bound(sampled_px.begin(), sampled_px.end(), px) - sampled_px.begin();
+    if (sampled_d_px.empty()) return 0;
+    const auto k = std::count_if(sampled_d_px.begin(), sampled_d_px.end(),
+                                 [&](const auto& d_px) { return d_px.second <= px; });
     return static_cast<double>(transitions) * static_cast<double>(k) /
-           static_cast<double>(sampled_px.size());
+           static_cast<double>(sampled_d_px.size());
   }
 };
 
@@ -117,11 +118,11 @@ Side Search(const TransitionWeights& weights, double px_per_m, std::span<const S
   s.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   s.stats = builder.stats();
   std::vector<std::pair<int64_t, int64_t>> pairs;
-  std::unordered_map<int64_t, bool> from;
+  std::unordered_set<int64_t> from;
   for (const Transition& t : builder.Transitions()) {
     pairs.emplace_back(t.from, t.to);
     s.distances.push_back(t.distance);
-    from[t.from] = true;
+    from.insert(t.from);
   }
   s.transitions = static_cast<int64_t>(pairs.size());
   s.sprites_joined = static_cast<int64_t>(from.size());
@@ -132,12 +133,9 @@ Side Search(const TransitionWeights& weights, double px_per_m, std::span<const S
   // visible jump.
   const size_t step = std::max<size_t>(1, pairs.size() / std::max(1, max_jumps));
   for (size_t k = 0; k < pairs.size(); k += step) {
-    if (const auto px = seen_px(pairs[k].first, pairs[k].second)) {
-      s.sampled_px.push_back(*px);
+    if (const auto px = seen_px(pairs[k].first, pairs[k].second))
       s.sampled_d_px.emplace_back(s.distances[k], *px);
-    }
   }
-  std::sort(s.sampled_px.begin(), s.sampled_px.end());
   return s;
 }
 
@@ -202,8 +200,9 @@ int Run(const std::vector<std::string>& args) {
     const auto n = bank_meter.NaturalSuccessor(from);
     if (!n) return std::nullopt;
     const size_t kt = index.at(to), kn = index.at(*n);
-    const RgbaBillboard turned =
-        headings[kt] ? AsFilmed(aligned.billboards[kt], *headings[kn]) : aligned.billboards[kt];
+    const RgbaBillboard turned = headings[kt] && headings[kn]
+                                     ? AsFilmed(aligned.billboards[kt], *headings[kn])
+                                     : aligned.billboards[kt];
     return ContactAlignedDifference_px(turned, filmed_billboards[kn]);
   };
   const SeenJump filmed_seen = [&](int64_t from, int64_t to) -> std::optional<double> {
