@@ -59,7 +59,8 @@ void RunIngest(const std::string& session, const std::string& bank, const std::s
   }
   options.pipeline = config.pipeline;
   options.floor = config.enclosure.floor;
-  options.transition_sprites.include_merged = config.transitions.include_merged;
+  options.transition_table = {.include_merged = config.transitions.include_merged,
+                              .max_per_sprite = config.transitions.max_per_sprite};
   const bool bar = !json && isatty(STDERR_FILENO);
   if (bar) options.progress = PrintProgress;
   const IngestSummary s = IngestSession(options);

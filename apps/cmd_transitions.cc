@@ -37,6 +37,7 @@ struct Args {
   std::string variant;  // train: "paper" | "colour_cells"; "": the default weights' variant
   bool json = false, quiet = false;
   bool include_merged = false;
+  int max_per_sprite = TableChoice::kDefaultMaxPerSprite;
   int jump_sample = TransitionJumpOptions{}.max_transitions;
 };
 
@@ -73,7 +74,7 @@ void Build(const Args& a) {
   BankUpdateOptions options;
   options.weights = WeightsOf(a);
   options.threads = a.threads;
-  options.sprites.include_merged = a.include_merged;
+  options.table = {.include_merged = a.include_merged, .max_per_sprite = a.max_per_sprite};
   auto progress = std::make_shared<Progress>(a.quiet || a.json);
   options.progress = [progress](const std::string& stage, size_t done, size_t total) {
     (*progress)(stage, done, total);
@@ -211,7 +212,7 @@ void Worker(const Args& a) {
   options.name = a.name;
   options.lease_s = a.lease_s;
   options.load_threads = a.threads;
-  options.sprites.include_merged = a.include_merged;
+  options.table = {.include_merged = a.include_merged, .max_per_sprite = a.max_per_sprite};
   UnitWorker worker(a.bank, options);
   const auto t0 = std::chrono::steady_clock::now();
   while (!g_worker_stop) {
@@ -265,6 +266,9 @@ void AddTransitionsCommand(CLI::App& app) {
   cmd->add_flag("--quiet", args->quiet, "No progress lines");
   cmd->add_flag("--include-merged", args->include_merged,
                 "Sprites tagged merged (two subjects in one blob) take part too");
+  cmd->add_option("--max-per-sprite", args->max_per_sprite,
+                  "At most this many transitions out of a sprite, its cheapest (0: all)")
+      ->check(CLI::Range(0, 1000000));
   cmd->add_option("--jump-sample", args->jump_sample,
                   "Judge at most this many kept transitions by their visible jump (0: none)")
       ->check(CLI::Range(0, 10000000));
@@ -327,6 +331,10 @@ void AddTransitionsCommand(CLI::App& app) {
       ->check(CLI::Range(1, 64));
   worker->add_flag("--include-merged", args->include_merged,
                    "Sprites tagged merged take part too (every worker of a bank alike)");
+  worker
+      ->add_option("--max-per-sprite", args->max_per_sprite,
+                   "At most this many transitions out of a sprite (every worker alike; 0: all)")
+      ->check(CLI::Range(0, 1000000));
   worker->add_flag("--exit-when-idle", args->exit_when_idle,
                    "Exit when no unit is pending or leased");
   worker->add_flag("--json", args->json, "Print JSON");

@@ -25,6 +25,7 @@ OptionsBinder WhiteBalanceKeys(WhiteBalanceConfig& wb);
 OptionsBinder EnclosureKeys(StationConfig& cfg);
 OptionsBinder PipelineKeys(CameraPipelineOptions& p);
 OptionsBinder StorageKeys(StorageConfig& s);
+OptionsBinder TransitionsKeys(TransitionsConfig& t);
 OptionsBinder ControlKeys(ControlConfig& c);
 // Checks values and cross-field rules, adjusting what can be fixed; reports to `msg`.
 void Validate(StationConfig& cfg, YamlMessages& msg, const ConfigOptions& options);

@@ -377,6 +377,14 @@ OptionsBinder TransitionsKeys(TransitionsConfig& t) {
         "made with them loses their transitions at the next start. `spritestation transitions "
         "BANK` and `transitions worker` take `--include-merged` instead; every worker of a "
         "PostgreSQL bank must agree (docs/transitions.md)");
+  b.Add("max_per_sprite", &t.max_per_sprite, "0 or more",
+        "at most this many transitions leave a sprite: its cheapest (by cost, then by the id of "
+        "the sprite it reaches). 0 keeps every one. From above a walking animal's frames look "
+        "alike once turned to one heading, and without a cap the table grows with the square of "
+        "the session. `spritestation transitions BANK` and `transitions worker` take "
+        "`--max-per-sprite` instead; every worker of a PostgreSQL bank must agree "
+        "(docs/transitions.md \"At most K out of a sprite\")")
+      .Rule(AtLeast(0));
   return b;
 }
 

@@ -240,6 +240,8 @@ class Validator {
       s.stop_recording_below_mib = s.stop_sprites_below_mib;
     }
 
+    TransitionsKeys(cfg.transitions).CheckRules(msg_, "transitions");  // its keys' bounds
+
     ControlConfig& c = cfg.control;
     Check(c.address == "localhost" || IsIpAddress(c.address), "control.address",
           "expected an IP address (or localhost), got " + Quoted(c.address));

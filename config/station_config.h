@@ -16,6 +16,7 @@
 #include "core/geometry.h"
 #include "pipeline/key/keying_config.h"
 #include "pipeline/run/camera_pipeline.h"
+#include "pipeline/transitions/bank_sprites.h"
 
 namespace ss {
 
@@ -50,11 +51,13 @@ inline CameraPipelineOptions DefaultPipelineOptions() {
   return o;
 }
 
-// The transition table kept by the station (and ingest): which sprites take part.
+// The transition table kept by the station (and ingest): which sprites take part, and how many
+// transitions leave each (pipeline/transitions/bank_sprites.h TableChoice).
 struct TransitionsConfig {
   // Sprites tagged `merged` (two or more subjects in one blob, docs/pipeline.md) are left out
   // of transitions unless this is true.
   bool include_merged = false;
+  int max_per_sprite = TableChoice::kDefaultMaxPerSprite;  // the cheapest; 0: every one
   bool operator==(const TransitionsConfig&) const = default;
 };
 

@@ -804,6 +804,43 @@ void BankWriter::UpsertTransitions(const std::vector<TransitionRecord>& transiti
 
 void BankWriter::ClearTransitions() { db().Exec("DELETE FROM transitions"); }
 
+int64_t BankWriter::PruneTransitions(std::span<const int64_t> from_sprites, int keep,
+                                     std::vector<TransitionRecord>* bars) {
+  if (keep < 1) throw WorkError(path(), "PruneTransitions keeps at least 1 transition a sprite");
+  if (bars) bars->clear();
+  int64_t removed = 0;
+  sql::Transaction tx(db());
+  // The rank of every transition out of the named sprites, by (cost, to_sprite). One statement
+  // for the deletion: whichever of two concurrent writers prunes last sees both their rows, so
+  // the table ends as the K cheapest of all (SQLite 3.25+ and PostgreSQL have the window).
+  constexpr size_t kSprites = 500;
+  for (size_t first = 0; first < from_sprites.size(); first += kSprites) {
+    const size_t count = std::min(from_sprites.size() - first, kSprites);
+    std::string in = "?";
+    for (size_t k = 1; k < count; ++k) in += ", ?";
+    const std::string ranked =
+        "SELECT from_sprite, to_sprite, d, cost, ROW_NUMBER() OVER (PARTITION BY from_sprite "
+        "ORDER BY cost, to_sprite) AS r FROM transitions WHERE from_sprite IN (" +
+        in + ")";
+    sql::Stmt del = db().Prepare(
+        "DELETE FROM transitions WHERE (from_sprite, to_sprite) IN (SELECT from_sprite, "
+        "to_sprite FROM (" +
+        ranked + ") AS ranked WHERE r > ?)");
+    for (size_t k = 0; k < count; ++k) del.Bind(static_cast<int>(k) + 1, from_sprites[first + k]);
+    del.Bind(static_cast<int>(count) + 1, int64_t{keep});
+    del.Step();
+    removed += del.Changes();
+    if (!bars) continue;
+    sql::Stmt bar = db().Prepare("SELECT from_sprite, to_sprite, d, cost FROM (" + ranked +
+                                 ") AS ranked WHERE r = ?");
+    for (size_t k = 0; k < count; ++k) bar.Bind(static_cast<int>(k) + 1, from_sprites[first + k]);
+    bar.Bind(static_cast<int>(count) + 1, int64_t{keep});
+    while (bar.Step()) bars->push_back({bar.Int(0), bar.Int(1), bar.Real(2), bar.Real(3)});
+  }
+  tx.Commit();
+  return removed;
+}
+
 void BankWriter::Tag(const std::vector<int64_t>& sprite_ids, const std::string& tag) {
   if (tag.empty()) throw InputError(path(), "a tag must not be empty");
   sql::Transaction tx(db());

@@ -9,6 +9,7 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -145,6 +146,12 @@ class BankWriter : public Bank {
   // Inserts or replaces transitions, all in one transaction.
   void UpsertTransitions(const std::vector<TransitionRecord>& transitions);
   void ClearTransitions();
+  // Keeps out of each of `from_sprites` only its `keep` cheapest transitions (by cost, then
+  // to_sprite: docs/transitions.md "At most K out of a sprite") and deletes the rest, in one
+  // transaction. Returns how many went. With `bars`, also gives the worst kept transition of
+  // every named sprite that now holds `keep`: a transition after it can never be kept.
+  int64_t PruneTransitions(std::span<const int64_t> from_sprites, int keep,
+                           std::vector<TransitionRecord>* bars = nullptr);
   // Adds/removes a tag on sprites; InputError naming the first unknown sprite id.
   void Tag(const std::vector<int64_t>& sprite_ids, const std::string& tag);
   void Untag(const std::vector<int64_t>& sprite_ids, const std::string& tag);

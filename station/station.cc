@@ -187,7 +187,8 @@ void Station::Start() {
   if (s.options.transitions) {
     s.transitions = std::make_unique<TransitionWorker>(
         config.storage.bank, s.options.weights ? *s.options.weights : DefaultWeights(), 1,
-        SpriteChoice{.include_merged = config.transitions.include_merged},
+        TableChoice{.include_merged = config.transitions.include_merged,
+                    .max_per_sprite = config.transitions.max_per_sprite},
         [&s] { s.transitions_listeners.Notify("transitions"); });
   }
   s.writer_thread = std::thread([&s] { s.WriterLoop(); });

@@ -195,7 +195,7 @@ IngestSummary IngestSession(const IngestOptions& options) {
   std::unique_ptr<TransitionWorker> transitions;
   if (options.transitions)
     transitions = std::make_unique<TransitionWorker>(options.bank_path, transition_weights, 1,
-                                                     options.transition_sprites);
+                                                     options.transition_table);
 
   std::atomic<uint64_t> frames_done{0}, rows_inserted{0}, batch_count{0}, stored{0};
   std::thread writer([&] {

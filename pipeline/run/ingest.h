@@ -35,9 +35,9 @@ struct IngestOptions {
   // What the station config sets (config/station_config.h: the sections named). The defaults
   // are the stages' own, not the config's: without a config file a caller passes a default
   // StationConfig's (DefaultPipelineOptions).
-  CameraPipelineOptions pipeline;   // keying, pipeline; keying.training_frames train (30 unset)
-  GroundPolygon floor;              // enclosure.floor; empty: the session's (FloorForSession)
-  SpriteChoice transition_sprites;  // transitions.include_merged
+  CameraPipelineOptions pipeline;  // keying, pipeline; keying.training_frames train (30 unset)
+  GroundPolygon floor;             // enclosure.floor; empty: the session's (FloorForSession)
+  TableChoice transition_table;    // transitions.include_merged, transitions.max_per_sprite
   std::function<void(const IngestProgress&)>
       progress;                    // a few times a second, from the calling thread
   bool transitions = true;         // keep the transition table current (TransitionWorker)

@@ -9,7 +9,7 @@
 
 namespace ss {
 
-bool SpriteChoice::Takes(const SpriteRecord& sprite) const {
+bool TableChoice::Takes(const SpriteRecord& sprite) const {
   return include_merged ||
          std::find(sprite.tags.begin(), sprite.tags.end(), kMergedTag) == sprite.tags.end();
 }
@@ -83,7 +83,7 @@ void Link(BankSprites* out) {
 
 BankSprites LoadBankSprites(const Bank& bank, SegmentKeys* keys,
                             const std::function<void(size_t, size_t)>& progress,
-                            const SpriteChoice& choice) {
+                            const TableChoice& choice) {
   // ordered by (clip, mirrored, frame)
   const std::vector<SpriteFeatures> features = bank.LoadFeatures();
   BankSprites out;
@@ -107,7 +107,7 @@ BankSprites LoadBankSprites(const Bank& bank, SegmentKeys* keys,
 }
 
 BankSprites LoadBankSpritesById(const Bank& bank, std::span<const int64_t> ids, SegmentKeys* keys,
-                                double px_per_m, const SpriteChoice* choice) {
+                                double px_per_m, const TableChoice* choice) {
   BankSprites out;
   out.px_per_m = px_per_m;
   out.ids.reserve(ids.size());

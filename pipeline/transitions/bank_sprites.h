@@ -16,14 +16,23 @@
 
 namespace ss {
 
-// Which stored sprites take part in transitions (docs/transitions.md): by default not those
-// tagged kMergedTag (two or more subjects in one blob: a sprite that is neither of them).
-struct SpriteChoice {
+// What a bank's transition table holds (docs/transitions.md): which stored sprites take part
+// (by default not those tagged kMergedTag: two or more subjects in one blob, a sprite that is
+// neither of them), and at most how many transitions leave each sprite (its cheapest).
+struct TableChoice {
+  // At most this many transitions out of a sprite by default. From above a walking animal's
+  // frames look alike once turned to one heading, a third of all pairs pass, and an uncapped
+  // table grows with the square of the session (2,044 a sprite after 60 s, bench/RESULTS.md).
+  static constexpr int kDefaultMaxPerSprite = 100;
   bool include_merged = false;  // the config's transitions.include_merged, --include-merged
+  // The config's transitions.max_per_sprite, --max-per-sprite; 0 keeps every transition.
+  int max_per_sprite = kDefaultMaxPerSprite;
   bool Takes(const SpriteRecord& sprite) const;
-  // The bank's meta key recording the choice its transition table was made with.
+  // The bank's meta keys recording the choice its transition table was made with.
   static constexpr const char* kMetaKey = "transitions.include_merged";
+  static constexpr const char* kCapMetaKey = "transitions.max_per_sprite";
   std::string MetaValue() const { return include_merged ? "true" : "false"; }
+  std::string CapMetaValue() const { return std::to_string(max_per_sprite); }
 };
 
 // The cheap features of a stored sprite: velocity, mean colour, eccentricity as stored;
@@ -57,7 +66,7 @@ struct BankSprites {
   std::vector<RgbaBillboard> billboards;
   double px_per_m = 0;            // the bank's billboard scale (the same for all)
   int64_t clips = 0;              // complete clips they came from
-  std::vector<int64_t> left_out;  // sprites loaded but not taken (SpriteChoice), in load order
+  std::vector<int64_t> left_out;  // sprites loaded but not taken (TableChoice), in load order
 };
 
 // Loads the sprites of every complete clip that `choice` takes, ordered by (clip, mirrored,
@@ -66,13 +75,13 @@ struct BankSprites {
 // called every few hundred sprites when given.
 BankSprites LoadBankSprites(const Bank& bank, SegmentKeys* keys,
                             const std::function<void(size_t, size_t)>& progress = {},
-                            const SpriteChoice& choice = {});
+                            const TableChoice& choice = {});
 
 // Loads the named sprites (in that order) with `keys` giving their segments.
 // InputError naming the bank and the sprite for an unknown id or another px_per_m
 // (`px_per_m` 0 = take the first sprite's). With `choice`, only the sprites it takes (the rest
 // go to left_out); without, every named sprite (labels name the sprites they judge).
 BankSprites LoadBankSpritesById(const Bank& bank, std::span<const int64_t> ids, SegmentKeys* keys,
-                                double px_per_m = 0, const SpriteChoice* choice = nullptr);
+                                double px_per_m = 0, const TableChoice* choice = nullptr);
 
 }  // namespace ss

@@ -1,5 +1,6 @@
 #include "pipeline/transitions/bank_transitions.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -36,6 +37,69 @@ std::vector<TransitionRecord> ToRecords(const std::vector<Transition>& transitio
   out.reserve(transitions.size());
   for (const Transition& t : transitions) out.push_back({t.from, t.to, t.distance, t.cost});
   return out;
+}
+
+bool TransitionBars::Excludes(const Transition& t) const {
+  const auto it = bars_.find(t.from);
+  return it != bars_.end() && std::pair(t.cost, t.to) > it->second;
+}
+
+void TransitionBars::Set(const TransitionRecord& worst_kept) {
+  bars_[worst_kept.from_sprite] = {worst_kept.cost, worst_kept.to_sprite};
+}
+
+void TransitionBars::SetFromTable(const std::vector<Transition>& table, int keep) {
+  if (keep <= 0) return;
+  for (size_t begin = 0; begin < table.size();) {
+    size_t end = begin + 1;
+    while (end < table.size() && table[end].from == table[begin].from) ++end;
+    if (end - begin == static_cast<size_t>(keep)) {
+      const Transition& worst =
+          *std::max_element(table.begin() + static_cast<std::ptrdiff_t>(begin),
+                            table.begin() + static_cast<std::ptrdiff_t>(end),
+                            [](const Transition& a, const Transition& b) {
+                              return std::pair(a.cost, a.to) < std::pair(b.cost, b.to);
+                            });
+      bars_[worst.from] = {worst.cost, worst.to};
+    }
+    begin = end;
+  }
+}
+
+RoundResult StoreTransitionRound(BankWriter& bank, std::vector<Transition> transitions,
+                                 int max_per_sprite, TransitionBars* bars) {
+  RoundResult r;
+  if (max_per_sprite > 0) {
+    const size_t before = transitions.size();
+    std::erase_if(transitions, [&](const Transition& t) { return bars->Excludes(t); });
+    std::sort(transitions.begin(), transitions.end(), [](const Transition& a, const Transition& b) {
+      return std::pair(a.from, a.to) < std::pair(b.from, b.to);
+    });
+    KeepCheapestPerSprite(&transitions, max_per_sprite);
+    r.skipped = static_cast<int64_t>(before - transitions.size());
+  }
+  // A few thousand rows a transaction: a round of a large bank holds tens of thousands, and one
+  // transaction for all of them held the bank's write lock past the station writer's busy
+  // timeout on a loaded machine (batches failed). Upserts are idempotent, so rows stored before
+  // a failure are simply stored again by a rebuild or the unit's next attempt.
+  const std::vector<TransitionRecord> records = ToRecords(transitions);
+  for (size_t i = 0; i < records.size(); i += kTransitionRowsPerTransaction) {
+    const auto end = records.begin() + static_cast<std::ptrdiff_t>(std::min(
+                                           records.size(), i + kTransitionRowsPerTransaction));
+    bank.UpsertTransitions(
+        std::vector<TransitionRecord>(records.begin() + static_cast<std::ptrdiff_t>(i), end));
+  }
+  r.written = static_cast<int64_t>(records.size());
+  if (max_per_sprite > 0 && !transitions.empty()) {
+    // After the rows are committed, so that of two writers the later prune sees both.
+    std::vector<int64_t> from;
+    for (const Transition& t : transitions)
+      if (from.empty() || from.back() != t.from) from.push_back(t.from);
+    std::vector<TransitionRecord> worst;
+    r.removed = bank.PruneTransitions(from, max_per_sprite, &worst);
+    for (const TransitionRecord& w : worst) bars->Set(w);
+  }
+  return r;
 }
 
 StoreResult StoreTransitionTable(BankWriter& bank, const std::vector<Transition>& transitions,
@@ -98,6 +162,8 @@ bool BankUpdateOptions::IsValid(std::string* why) const {
   std::string part;
   check.Nested(weights.IsValid(&part), "weights.", part);
   check(threads >= 1, "threads", "expected at least 1 thread, got " + std::to_string(threads));
+  check(table.max_per_sprite >= 0, "max_per_sprite",
+        "expected 0 (every transition) or more, got " + std::to_string(table.max_per_sprite));
   return check.ok();
 }
 
@@ -122,7 +188,7 @@ BankUpdateSummary UpdateBankTransitions(const std::string& bank_path,
       [&](size_t done, size_t total) {
         if (options.progress) options.progress("load", done, total);
       },
-      options.sprites);
+      options.table);
   s.seconds_load = SecondsSince(t);
   s.sprites = static_cast<int64_t>(sprites.inputs.size());
   s.clips = sprites.clips;
@@ -143,7 +209,7 @@ BankUpdateSummary UpdateBankTransitions(const std::string& bank_path,
       if (options.progress) options.progress("pairs", done, total);
     };
     real.BuildFromScratch(sprites.inputs, build);
-    transitions = real.Transitions();
+    transitions = real.Transitions(options.table.max_per_sprite);
     s.build = real.stats();
   }
   s.seconds_build = SecondsSince(t);
@@ -167,7 +233,8 @@ BankUpdateSummary UpdateBankTransitions(const std::string& bank_path,
   std::unordered_set<int64_t> universe(sprites.ids.begin(), sprites.ids.end());
   universe.insert(sprites.left_out.begin(), sprites.left_out.end());
   s.store = StoreTransitionTable(bank, transitions, WeightsFingerprint(options.weights), universe);
-  bank.SetMeta(SpriteChoice::kMetaKey, options.sprites.MetaValue());
+  bank.SetMeta(TableChoice::kMetaKey, options.table.MetaValue());
+  bank.SetMeta(TableChoice::kCapMetaKey, options.table.CapMetaValue());
   s.seconds_store = SecondsSince(t);
   log->info("{}: {} sprites, {} transitions ({} added, {} changed, {} removed{})", bank_path,
             s.sprites, s.transitions, s.store.added, s.store.changed, s.store.removed,

@@ -7,7 +7,9 @@
 #include <cstdint>
 #include <functional>
 #include <string>
+#include <unordered_map>
 #include <unordered_set>
+#include <utility>
 #include <vector>
 
 #include "core/bank.h"
@@ -42,10 +44,41 @@ StoreResult StoreTransitionTable(BankWriter& bank, const std::vector<Transition>
 
 std::vector<TransitionRecord> ToRecords(const std::vector<Transition>& transitions);
 
+// The worst transition kept out of each sprite that holds its TableChoice::max_per_sprite, as
+// last seen in the bank: one after it (by cost, then `to`) can never be kept, because the table
+// only grows while sprites arrive, so a sprite's bar only falls.
+class TransitionBars {
+ public:
+  // True when `t` comes after its sprite's bar.
+  bool Excludes(const Transition& t) const;
+  void Set(const TransitionRecord& worst_kept);
+  // The bars of a table already capped at `keep` (sorted by (from, to)).
+  void SetFromTable(const std::vector<Transition>& table, int keep);
+  size_t size() const { return bars_.size(); }
+
+ private:
+  std::unordered_map<int64_t, std::pair<double, int64_t>> bars_;  // from -> (cost, to)
+};
+
+// What storing a round of new transitions did.
+struct RoundResult {
+  int64_t written = 0;  // rows upserted
+  int64_t skipped = 0;  // new transitions after their sprite's bar, or past its cap in the round
+  int64_t removed = 0;  // stored transitions pushed out of their sprite's cap
+};
+
+// Stores a worker's round of new transitions (TransitionDelta): upserted a few thousand rows a
+// transaction, then, with `max_per_sprite` > 0, each sprite written to pruned to its cheapest
+// (BankWriter::PruneTransitions) and `bars` brought up to date. Rounds of any order, by one
+// worker or many at once, leave the table a batch build stores.
+RoundResult StoreTransitionRound(BankWriter& bank, std::vector<Transition> transitions,
+                                 int max_per_sprite, TransitionBars* bars);
+
 struct BankUpdateOptions {
   TransitionWeights weights = DefaultWeights();  // the classifier (valid: weights.h IsValid)
   int threads = 2;                               // worker threads (>= 1)
-  SpriteChoice sprites;  // which sprites take part (merged ones not, by default)
+  TableChoice table;  // which sprites take part (merged ones not, by default) and how many
+                      // transitions leave each
   // stage: "load" (sprites read and decoded) or "pairs" (sprites searched); from any thread.
   std::function<void(const std::string& stage, size_t done, size_t total)> progress;
   // False with "FIELD: reason" lines in `why` (core/option_checks.h) for values out of range.

@@ -5,6 +5,7 @@
 #include <chrono>
 #include <mutex>
 #include <thread>
+#include <tuple>
 
 #include "core/elapsed.h"
 #include "core/error.h"
@@ -12,6 +13,30 @@
 #include "core/option_checks.h"
 
 namespace ss {
+
+void KeepCheapestPerSprite(std::vector<Transition>* transitions, int keep) {
+  if (keep <= 0) return;
+  const auto cheaper = [](const Transition& a, const Transition& b) {
+    return std::tie(a.cost, a.to) < std::tie(b.cost, b.to);
+  };
+  const auto by_to = [](const Transition& a, const Transition& b) { return a.to < b.to; };
+  auto& t = *transitions;
+  size_t write = 0;
+  for (size_t begin = 0; begin < t.size();) {
+    size_t end = begin + 1;
+    while (end < t.size() && t[end].from == t[begin].from) ++end;
+    const auto first = t.begin() + static_cast<std::ptrdiff_t>(begin);
+    auto last = t.begin() + static_cast<std::ptrdiff_t>(end);
+    if (end - begin > static_cast<size_t>(keep)) {
+      std::nth_element(first, first + keep, last, cheaper);
+      last = first + keep;
+    }
+    std::sort(first, last, by_to);
+    for (auto it = first; it != last; ++it) t[write++] = *it;
+    begin = end;
+  }
+  t.resize(write);
+}
 
 bool BuildOptions::IsValid(std::string* why) const {
   OptionProblems check(why);
@@ -280,9 +305,14 @@ std::vector<KeptPair> TransitionBuilder::KeptPairs() const {
   return out;
 }
 
-std::vector<Transition> TransitionBuilder::Transitions() const {
-  std::vector<Transition> out;
-  for (int32_t i = 0; i < store_.size(); ++i) TransitionsFrom(i, &out);
+std::vector<Transition> TransitionBuilder::Transitions(int max_per_sprite) const {
+  std::vector<Transition> out, mine;
+  for (int32_t i = 0; i < store_.size(); ++i) {
+    mine.clear();
+    TransitionsFrom(i, &mine);
+    KeepCheapestPerSprite(&mine, max_per_sprite);
+    out.insert(out.end(), mine.begin(), mine.end());
+  }
   std::sort(out.begin(), out.end(), [](const Transition& x, const Transition& y) {
     return std::tie(x.from, x.to) < std::tie(y.from, y.to);
   });

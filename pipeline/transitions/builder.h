@@ -40,6 +40,11 @@ struct TransitionDelta {
   std::vector<Transition> transitions;
 };
 
+// Keeps of `transitions` (those out of one sprite next to each other) the `keep` cheapest out of
+// each sprite, by cost and then `to` (so any order of arrival keeps the same ones); each
+// sprite's kept transitions end sorted by `to`. `keep` 0 keeps all.
+void KeepCheapestPerSprite(std::vector<Transition>* transitions, int keep);
+
 struct BuildOptions {
   int threads = 2;  // worker threads (>= 1)
   std::function<void(size_t done, size_t total)>
@@ -83,8 +88,10 @@ class TransitionBuilder {
   // is the table a single builder makes.
   TransitionDelta AddPairsOf(int32_t first, int32_t end);
 
-  std::vector<KeptPair> KeptPairs() const;      // sorted by (sprite_a, sprite_b)
-  std::vector<Transition> Transitions() const;  // sorted by (from, to)
+  std::vector<KeptPair> KeptPairs() const;  // sorted by (sprite_a, sprite_b)
+  // Sorted by (from, to); with `max_per_sprite` > 0 only that many out of each sprite, its
+  // cheapest (KeepCheapestPerSprite).
+  std::vector<Transition> Transitions(int max_per_sprite = 0) const;
   int64_t TransitionCount() const;
 
   const SpriteStore& store() const { return store_; }

@@ -35,6 +35,8 @@ bool UnitWorkerOptions::IsValid(std::string* why) const {
         "expected a positive number of seconds, got " + OptionProblems::Num(lease_s));
   check(load_threads >= 1, "load_threads",
         "expected at least 1 thread, got " + std::to_string(load_threads));
+  check(table.max_per_sprite >= 0, "max_per_sprite",
+        "expected 0 (every transition) or more, got " + std::to_string(table.max_per_sprite));
   return check.ok();
 }
 
@@ -56,14 +58,16 @@ UnitWorker::UnitWorker(const std::string& bank, UnitWorkerOptions options)
                          "); run every worker alike, or rebuild them with `spritestation "
                          "transitions BANK` with this worker's weights first");
   }
-  const std::string choice = options_.sprites.MetaValue();
-  const std::string table_choice = writer_.KeepMeta(SpriteChoice::kMetaKey, choice);
-  if (table_choice != choice) {
-    throw InputError(reader_.path(), std::string("its transitions are made with ") +
-                                         SpriteChoice::kMetaKey + " " + table_choice +
-                                         ", this worker has " + choice +
-                                         "; run every worker alike, or rebuild them with "
-                                         "`spritestation transitions BANK` first");
+  for (const auto& [key, value] :
+       {std::pair(TableChoice::kMetaKey, options_.table.MetaValue()),
+        std::pair(TableChoice::kCapMetaKey, options_.table.CapMetaValue())}) {
+    const std::string table_value = writer_.KeepMeta(key, value);
+    if (table_value != value) {
+      throw InputError(reader_.path(), std::string("its transitions are made with ") + key + " " +
+                                           table_value + ", this worker has " + value +
+                                           "; run every worker alike, or rebuild them with "
+                                           "`spritestation transitions BANK` first");
+    }
   }
 }
 
@@ -87,7 +91,7 @@ void UnitWorker::CatchUp() {
   const double scale = builder_ ? builder_->store().px_per_m() : 0.0;
   // The sprites the choice leaves out (merged ones) are never indexed: a clip of them only
   // has no range, and its unit finds nothing.
-  const BankSprites sprites = LoadBankSpritesById(reader_, ids, &keys_, scale, &options_.sprites);
+  const BankSprites sprites = LoadBankSpritesById(reader_, ids, &keys_, scale, &options_.table);
   if (sprites.inputs.empty()) return;
   if (!builder_) builder_ = std::make_unique<TransitionBuilder>(options_.weights, sprites.px_per_m);
   const int32_t first = builder_->AppendIndexOnly(sprites.inputs, options_.load_threads);
@@ -127,20 +131,15 @@ bool UnitWorker::RunOne() {
   stats_.kept_pairs += builder_->stats().kept_pairs - kept;
 
   t0 = std::chrono::steady_clock::now();
-  const std::vector<TransitionRecord> records = ToRecords(delta.transitions);
-  for (size_t i = 0; i < records.size(); i += kTransitionRowsPerTransaction) {
-    const auto end = records.begin() + static_cast<std::ptrdiff_t>(std::min(
-                                           records.size(), i + kTransitionRowsPerTransaction));
-    writer_.UpsertTransitions(
-        std::vector<TransitionRecord>(records.begin() + static_cast<std::ptrdiff_t>(i), end));
-  }
+  const RoundResult stored =
+      StoreTransitionRound(writer_, delta.transitions, options_.table.max_per_sprite, &bars_);
   queue_.Done(unit->clip_id);
   stats_.seconds_store += SecondsSince(t0);
-  stats_.transitions += static_cast<int64_t>(records.size());
+  stats_.transitions += stored.written;
   ++stats_.units;
   Log("pipeline.transitions")
       ->debug("{}: unit clip {} (seq {}, try {}): {} transitions", options_.name, unit->clip_id,
-              unit->complete_seq, unit->attempts, records.size());
+              unit->complete_seq, unit->attempts, stored.written);
   return true;
 }
 

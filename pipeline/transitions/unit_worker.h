@@ -5,7 +5,8 @@
 // by complete_seq before each unit, and does units claimed from core/bank_work.h: one clip's
 // pairs with every sprite it knows, and every transition with an end in that clip. The union
 // of the units is the table a single `transitions BANK` builds, exactly (a transition's three
-// pairs join the same two clips: TransitionBuilder::AddPairsOf).
+// pairs join the same two clips: TransitionBuilder::AddPairsOf), and so is its cap: each unit
+// prunes the sprites it wrote to after its rows are committed (StoreTransitionRound).
 #include <cstdint>
 #include <map>
 #include <memory>
@@ -16,6 +17,7 @@
 #include "core/bank.h"
 #include "core/bank_work.h"
 #include "pipeline/transitions/bank_sprites.h"
+#include "pipeline/transitions/bank_transitions.h"
 #include "pipeline/transitions/builder.h"
 #include "pipeline/transitions/weights.h"
 
@@ -27,7 +29,7 @@ struct UnitWorkerOptions {
   // a unit not done by then may be taken by another worker, seconds (> 0)
   double lease_s = 60;
   int load_threads = 1;  // threads for the comparison images of newly indexed sprites (>= 1)
-  SpriteChoice sprites;  // which sprites take part: every worker of a bank must agree
+  TableChoice table;     // which sprites and transitions the table holds: every worker agrees
   // False with "FIELD: reason" lines in `why` (core/option_checks.h) for values out of range.
   bool IsValid(std::string* why) const;
 };
@@ -42,7 +44,7 @@ struct UnitWorkerStats {
 class UnitWorker {
  public:
   // InputError for a bank that is not PostgreSQL, or whose transitions are made with other
-  // weights or another sprite choice (decided by the first worker, station or `transitions
+  // weights or another table choice (decided by the first worker, station or `transitions
   // BANK` to set them, on an empty table too; rebuild them with `transitions BANK` first).
   UnitWorker(const std::string& bank, UnitWorkerOptions options);
 
@@ -61,6 +63,7 @@ class UnitWorker {
   BankWriter writer_;    // then: a worker started before any station makes the (empty) bank
   Bank reader_;
   SegmentKeys keys_;
+  TransitionBars bars_;  // of the table's cap, as this worker's prunes saw them
   std::unique_ptr<TransitionBuilder> builder_;
   std::map<int64_t, std::pair<int32_t, int32_t>> clip_range_;  // bank clip -> store [first, end)
   std::set<int64_t> seen_clips_;  // clips read (some may have no sprite taken: no range)

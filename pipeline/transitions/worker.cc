@@ -21,15 +21,16 @@ namespace ss {
 struct TransitionWorker::State {
   TransitionWeights weights;
   int startup_threads = 1;
-  SpriteChoice choice;
+  TableChoice choice;
   std::optional<Bank> reader;
   std::optional<BankWriter> writer;
   std::unique_ptr<TransitionBuilder> builder;  // made when the bank scale is known
   SegmentKeys keys;
+  TransitionBars bars;  // of the table's cap (choice.max_per_sprite)
 };
 
 TransitionWorker::TransitionWorker(std::string bank_path, const TransitionWeights& weights,
-                                   int startup_threads, SpriteChoice sprites,
+                                   int startup_threads, TableChoice table,
                                    std::function<void()> on_startup_change)
     : bank_path_(std::move(bank_path)),
       state_(std::make_unique<State>()),
@@ -38,7 +39,7 @@ TransitionWorker::TransitionWorker(std::string bank_path, const TransitionWeight
       weights);  // InputError for invalid weights, in the caller's thread
   state_->weights = weights;
   state_->startup_threads = std::max(1, startup_threads);
-  state_->choice = sprites;
+  state_->choice = table;
   thread_ = std::thread([this] { Run(); });
 }
 
@@ -122,7 +123,8 @@ void TransitionWorker::Run() {
         s.builder = std::make_unique<TransitionBuilder>(s.weights, sprites.px_per_m);
         s.builder->BuildFromScratch(sprites.inputs, BuildOptions{.threads = s.startup_threads,
                                                                  .progress = progress("pairs")});
-        transitions = s.builder->Transitions();
+        transitions = s.builder->Transitions(s.choice.max_per_sprite);
+        s.bars.SetFromTable(transitions, s.choice.max_per_sprite);
       }
       // Sprites left out are in the universe: transitions of theirs from before go.
       std::unordered_set<int64_t> universe(sprites.ids.begin(), sprites.ids.end());
@@ -134,7 +136,8 @@ void TransitionWorker::Run() {
     } else {
       s.writer->SetMeta(kTransitionWeightsMetaKey, WeightsFingerprint(s.weights));
     }
-    s.writer->SetMeta(SpriteChoice::kMetaKey, s.choice.MetaValue());
+    s.writer->SetMeta(TableChoice::kMetaKey, s.choice.MetaValue());
+    s.writer->SetMeta(TableChoice::kCapMetaKey, s.choice.CapMetaValue());
     log->info("transition worker: {} sprites at start, {} transitions written", known, stored);
   } catch (const std::exception& e) {
     fail(std::string("start-up: ") + e.what());
@@ -182,22 +185,10 @@ void TransitionWorker::Run() {
           s.builder = std::make_unique<TransitionBuilder>(s.weights, sprites.px_per_m);
         const TransitionDelta delta =
             sprites.inputs.empty() ? TransitionDelta{} : s.builder->Add(sprites.inputs);
-        if (!delta.transitions.empty()) {
-          // A few thousand rows a transaction: a round of a large bank holds tens of thousands,
-          // and one transaction for all of them held the bank's write lock past the station
-          // writer's busy timeout on a loaded machine (batches failed). Upserts are idempotent,
-          // so rows stored before a failure are simply stored again by a rebuild.
-          const std::vector<TransitionRecord> records = ToRecords(delta.transitions);
-          for (size_t i = 0; i < records.size(); i += kTransitionRowsPerTransaction) {
-            const auto end =
-                records.begin() + static_cast<std::ptrdiff_t>(
-                                      std::min(records.size(), i + kTransitionRowsPerTransaction));
-            s.writer->UpsertTransitions(std::vector<TransitionRecord>(
-                records.begin() + static_cast<std::ptrdiff_t>(i), end));
-          }
-        }
+        const RoundResult stored =
+            StoreTransitionRound(*s.writer, delta.transitions, s.choice.max_per_sprite, &s.bars);
         added_sprites = static_cast<int64_t>(sprites.inputs.size());  // those taken
-        added_transitions = static_cast<int64_t>(delta.transitions.size());
+        added_transitions = stored.written;
       }
     } catch (const std::exception& e) {
       fail(e.what());
@@ -228,7 +219,7 @@ void TransitionWorker::RunUnits() {
     units = std::make_unique<UnitWorker>(bank_path_,
                                          UnitWorkerOptions{.weights = state_->weights,
                                                            .load_threads = state_->startup_threads,
-                                                           .sprites = state_->choice});
+                                                           .table = state_->choice});
   } catch (const std::exception& e) {
     Fail(std::string("start-up: ") + e.what());
   }

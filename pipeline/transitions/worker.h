@@ -58,7 +58,7 @@ class TransitionWorker {
   // worker's thread (the "pairs" stage: on one of the start-up build's threads, one call at a
   // time) with none of the worker's locks held; keep it short and do not call Stop from it.
   TransitionWorker(std::string bank_path, const TransitionWeights& weights, int startup_threads = 1,
-                   SpriteChoice sprites = {}, std::function<void()> on_startup_change = {});
+                   TableChoice table = {}, std::function<void()> on_startup_change = {});
   ~TransitionWorker();  // Stop()
   TransitionWorker(const TransitionWorker&) = delete;
   TransitionWorker& operator=(const TransitionWorker&) = delete;

@@ -6,6 +6,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <regex>
 #include <sstream>
 #include <stdexcept>
 
@@ -441,23 +442,42 @@ TEST(StationConfig, PipelineValuesAreCheckedByTheStagesNamingTheKey) {
 
 // Every number of the pipeline block is bound with its bounds: a negative value (out of every
 // one's) is refused at its own key, by the binding, not left for the stage to throw at a start.
-TEST(StationConfig, EveryPipelineNumberIsRefusedOutOfItsBounds) {
+// Every number of every section bound with a lower bound (its type says so: "integer >= 1",
+// "number > 0", "0..1") is refused at its own key below it: a rule bound in a section whose
+// checks never run (the validator forgot the section) fails here.
+TEST(StationConfig, EveryBoundedNumberIsRefusedOutOfItsBounds) {
   std::istringstream lines(ConfigKeysText());
-  int checked = 0;
+  std::map<std::string, int> checked;
   for (std::string line; std::getline(lines, line);) {
-    if (line.rfind("pipeline.", 0) != 0) continue;
     const size_t paren = line.find(" (");
-    const std::string type = line.substr(paren + 2);
+    if (paren == std::string::npos || line.rfind("cameras[]", 0) == 0) continue;
+    const std::string key = line.substr(0, paren);
+    const std::string type = line.substr(paren + 2, line.find(", default") - paren - 2);
     if (type.find("number") == std::string::npos && type.find("integer") == std::string::npos)
       continue;
-    const std::string key =
-        line.substr(std::string("pipeline.").size(), paren - std::string("pipeline.").size());
-    const std::string error = ErrorOf("pipeline:\n  " + key + ": -1\n");
-    EXPECT_EQ(error.rfind("station.yaml:2: pipeline." + key + ": expected ", 0), 0u)
-        << key << ": " << error;
-    ++checked;
+    const bool bounded = type.find(">= 0") != std::string::npos ||
+                         type.find(">= 1") != std::string::npos ||
+                         type.find("> 0") != std::string::npos ||
+                         std::regex_search(type, std::regex("(^| )[0-9.]+\\.\\."));
+    // Clamped into 0..1 with a warning instead (CheckKeying; test AdjustmentsAreReported).
+    if (!bounded || key == "keying.despill.strength") continue;
+    // The key as nested YAML, one level an indent.
+    std::string yaml, indent;
+    size_t at = 0;
+    for (size_t dot; (dot = key.find('.', at)) != std::string::npos; at = dot + 1) {
+      yaml += indent + key.substr(at, dot - at) + ":\n";
+      indent += "  ";
+    }
+    yaml += indent + key.substr(at) + ": -1\n";
+    const std::string error = ErrorOf(yaml);
+    const int line_of_key = static_cast<int>(std::count(yaml.begin(), yaml.end(), '\n'));
+    EXPECT_EQ(error.rfind("station.yaml:" + std::to_string(line_of_key) + ": " + key + ": ", 0), 0u)
+        << key << " (" << type << "): " << error;
+    ++checked[key.substr(0, key.find('.'))];
   }
-  EXPECT_GE(checked, 18);
+  EXPECT_GE(checked["pipeline"], 18);
+  EXPECT_GE(checked["transitions"], 1);
+  EXPECT_GE(checked["storage"], 1);
 }
 
 // The noise rule's thresholds (issue 19): shares from 0 to 1, 0 turning a test off.
@@ -488,6 +508,15 @@ TEST(StationConfig, TransitionsIncludeMerged) {
   EXPECT_NE(wrong.find("transitions.include_merged"), std::string::npos) << wrong;
   const std::string unknown = ErrorOf("transitions:\n  include_merge: true\n");
   EXPECT_NE(unknown.find("transitions.include_merge"), std::string::npos) << unknown;
+}
+
+// transitions.max_per_sprite: 100 by default, 0 (every transition) or more, refused at its key.
+TEST(StationConfig, TransitionsMaxPerSprite) {
+  EXPECT_EQ(Parse("version: 1\n").transitions.max_per_sprite, 100);
+  EXPECT_EQ(Parse("transitions:\n  max_per_sprite: 0\n").transitions.max_per_sprite, 0);
+  const std::string negative = ErrorOf("transitions:\n  max_per_sprite: -1\n");
+  EXPECT_NE(negative.find("transitions.max_per_sprite"), std::string::npos) << negative;
+  EXPECT_NE(negative.find(":2:"), std::string::npos) << negative;  // FILE:LINE of the key
 }
 
 TEST(StationConfig, SyntaxErrorsAndBadFiles) {

@@ -96,6 +96,21 @@ void WriteScenario(const std::string& path) {
   ASSERT_GE(f.size(), 10u);
   w.UpsertTransitions({{f[0].id, f[2].id, 0.25, 1.5}, {f[2].id, f[0].id, 0.125, 1e-300}});
   w.UpsertTransitions({{f[0].id, f[2].id, 0.3333333333333333, 2.0 / 3.0}});
+  // Four out of f[1], two of them at one cost: the cap keeps the two cheapest by (cost, to).
+  ASSERT_LT(f[3].id, f[4].id);
+  w.UpsertTransitions({{f[1].id, f[6].id, 0.5, 3.0},
+                       {f[1].id, f[5].id, 0.5, 1.0},
+                       {f[1].id, f[4].id, 0.5, 2.0},
+                       {f[1].id, f[3].id, 0.5, 2.0}});
+  std::vector<TransitionRecord> bars;
+  EXPECT_EQ(w.PruneTransitions(std::vector<int64_t>{f[1].id, f[0].id}, 2, &bars), 2);
+  ASSERT_EQ(bars.size(), 1u);  // f[0] holds one transition: under its cap, no bar
+  EXPECT_EQ(bars[0].from_sprite, f[1].id);
+  EXPECT_EQ(bars[0].to_sprite, f[3].id);
+  EXPECT_EQ(bars[0].cost, 2.0);
+  std::set<int64_t> kept;
+  for (const TransitionRecord& t : w.LoadTransitionsFrom(f[1].id)) kept.insert(t.to_sprite);
+  EXPECT_EQ(kept, (std::set<int64_t>{f[3].id, f[5].id}));
   w.Tag({f[3].id, f[4].id}, "jump");
   w.Untag({f[4].id}, "jump");
   w.SetTransitionLabel({f[0].id, f[5].id, "yes", "2026-12-02T10:00:01Z", "test"});
@@ -262,7 +277,7 @@ TEST(BankPostgres, CopyToPostgresAndBackGivesTheSameBank) {
   EXPECT_EQ(there.digest, source.digest);
   EXPECT_EQ(home.digest, source.digest);
   EXPECT_EQ(home.rows, source.rows);
-  EXPECT_EQ(source.rows.at("transitions"), 2);
+  EXPECT_EQ(source.rows.at("transitions"), 4);  // two, and two kept of four out of one sprite
   EXPECT_TRUE(VerifyBank(pg).ok());
   EXPECT_TRUE(VerifyBank(back).ok());
   EXPECT_EQ(Describe(Bank(back)), Describe(Bank(original)));

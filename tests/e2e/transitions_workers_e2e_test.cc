@@ -1,11 +1,13 @@
 // Transition work shared by several `spritestation transitions worker` processes on one
 // PostgreSQL bank (issue 21): the table they make together equals a single-process build of
-// the same bank exactly, also when one worker is killed in the middle of a unit.
+// the same bank exactly, also when one worker is killed in the middle of a unit, and with a cap
+// on the transitions out of a sprite that the workers' rounds meet at once.
 #include <gtest/gtest.h>
 #include <signal.h>
 
 #include <chrono>
 #include <cstdlib>
+#include <map>
 #include <thread>
 
 #include <nlohmann/json.hpp>
@@ -55,8 +57,21 @@ TEST(TransitionWorkers, TwoWorkersAndAKilledOneMakeTheSingleProcessTable) {
   // The single-process build, on a copy made before any worker ran.
   const std::string single = dir / "single.db";
   ASSERT_EQ(RunSpritestation("--log-level warn bank copy " + pg + " " + single).exit_code, 0);
-  const auto build = RunSpritestation("--log-level warn transitions " + single + " --json");
+  // A cap that bites (the session keeps more out of many sprites), so that the workers' prunes,
+  // concurrent and out of order, must give exactly the single build's cheapest.
+  const std::string cap = " --max-per-sprite 4";
+  const auto build = RunSpritestation("--log-level warn transitions " + single + cap + " --json");
   ASSERT_EQ(build.exit_code, 0) << build.output;
+  {
+    std::map<int64_t, int> out;
+    for (const TransitionRecord& t : Bank(single).LoadTransitions()) ++out[t.from_sprite];
+    int at_cap = 0;
+    for (const auto& [from, n] : out) {
+      ASSERT_LE(n, 4) << "sprite " << from;
+      at_cap += n == 4;
+    }
+    ASSERT_GT(at_cap, 20) << "the cap must bite for the test to mean anything";
+  }
   const int64_t clips = QueryInt(pg, "SELECT count(*) FROM clips WHERE complete = 1");
   ASSERT_GE(clips, 4) << "several units are needed to share";
 
@@ -64,7 +79,7 @@ TEST(TransitionWorkers, TwoWorkersAndAKilledOneMakeTheSingleProcessTable) {
   // Set for the child only, on gtest's one thread: no thread reads the environment meanwhile.
   setenv("SPRITESTATION_WORKER_TEST_PAUSE_S", "60", 1);  // NOLINT(concurrency-mt-unsafe)
   BackgroundCommand victim(
-      "--log-level warn transitions worker --bank " + pg + " --name victim --lease 2",
+      "--log-level warn transitions worker --bank " + pg + cap + " --name victim --lease 2",
       dir / "victim.log");
   unsetenv("SPRITESTATION_WORKER_TEST_PAUSE_S");  // NOLINT(concurrency-mt-unsafe)
   int64_t claimed = 0;
@@ -80,12 +95,12 @@ TEST(TransitionWorkers, TwoWorkersAndAKilledOneMakeTheSingleProcessTable) {
   victim.Wait(10);
 
   // Two workers at once do everything, the killed unit included.
-  BackgroundCommand a(
-      "--log-level warn transitions worker --bank " + pg + " --name a --exit-when-idle --json",
-      dir / "a.log");
-  BackgroundCommand b(
-      "--log-level warn transitions worker --bank " + pg + " --name b --exit-when-idle --json",
-      dir / "b.log");
+  BackgroundCommand a("--log-level warn transitions worker --bank " + pg + cap +
+                          " --name a --exit-when-idle --json",
+                      dir / "a.log");
+  BackgroundCommand b("--log-level warn transitions worker --bank " + pg + cap +
+                          " --name b --exit-when-idle --json",
+                      dir / "b.log");
   ASSERT_EQ(a.Wait(300), 0) << a.output();
   ASSERT_EQ(b.Wait(300), 0) << b.output();
   const nlohmann::json ja = JsonInOutput(a.output()), jb = JsonInOutput(b.output());

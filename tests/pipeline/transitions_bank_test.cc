@@ -114,6 +114,77 @@ TEST(TransitionBank, WorkerEqualsFromScratch) {
   EXPECT_FALSE(s.store.replaced_all);
 }
 
+// The K cheapest of `table` (sorted by (from, to)) out of each sprite, by cost and then `to`.
+std::vector<TransitionRecord> Cheapest(const std::vector<TransitionRecord>& table, size_t keep) {
+  std::map<int64_t, std::vector<TransitionRecord>> out;
+  for (const TransitionRecord& t : table) out[t.from_sprite].push_back(t);
+  std::vector<TransitionRecord> kept;
+  for (auto& [from, list] : out) {
+    std::sort(list.begin(), list.end(), [](const auto& a, const auto& b) {
+      return std::tie(a.cost, a.to_sprite) < std::tie(b.cost, b.to_sprite);
+    });
+    list.resize(std::min(list.size(), keep));
+    kept.insert(kept.end(), list.begin(), list.end());
+  }
+  return Sorted(kept);
+}
+
+void ExpectSamePairs(const std::vector<TransitionRecord>& got,
+                     const std::vector<TransitionRecord>& want, const std::string& what) {
+  ASSERT_EQ(got.size(), want.size()) << what;
+  size_t differ = 0;
+  for (size_t k = 0; k < got.size(); ++k) {
+    differ += got[k].from_sprite != want[k].from_sprite || got[k].to_sprite != want[k].to_sprite ||
+              got[k].cost != want[k].cost;
+  }
+  EXPECT_EQ(differ, 0u) << what << ": of " << want.size();
+}
+
+// At most K transitions out of a sprite, its cheapest: the batch build and the incremental worker
+// (whose rounds arrive in another order and prune what they push out) keep the same ones.
+TEST(TransitionBank, TheCapKeepsTheCheapestOnEveryPath) {
+  testing::ScratchDir dir;
+  const auto sprites = Sprites(400, 4);
+  const auto clips = Clips(sprites);
+  constexpr int kCap = 3;
+  // Filled as the worker's bank is below, so that both give their sprites the same ids.
+  const size_t before = clips.size() / 3;
+  BankFiller all(dir / "all.db");
+  for (size_t k = 0; k < clips.size(); ++k) all.Add(clips[k], k < before ? 50 : 7);
+  BankUpdateOptions options;
+  options.weights = Generous();
+  options.table.max_per_sprite = 0;
+  UpdateBankTransitions(dir / "all.db", options);
+  const auto uncapped = Bank(dir / "all.db").LoadTransitions();
+  const auto want = Cheapest(uncapped, kCap);
+  ASSERT_LT(want.size() * 2, uncapped.size()) << "the cap must bite for the test to mean anything";
+  EXPECT_EQ(Bank(dir / "all.db").GetMeta(TableChoice::kCapMetaKey).value_or(""), "0");
+
+  // The batch build with the cap, over the uncapped table: what goes is removed.
+  options.table.max_per_sprite = kCap;
+  const BankUpdateSummary capped = UpdateBankTransitions(dir / "all.db", options);
+  EXPECT_EQ(capped.transitions, static_cast<int64_t>(want.size()));
+  EXPECT_EQ(capped.store.removed, static_cast<int64_t>(uncapped.size() - want.size()));
+  ExpectSamePairs(Bank(dir / "all.db").LoadTransitions(), want, "batch");
+  EXPECT_EQ(Bank(dir / "all.db").GetMeta(TableChoice::kCapMetaKey).value_or(""), "3");
+
+  // The worker: a third of the clips before it starts, the rest in rounds of 7 frames.
+  BankFiller filler(dir / "bank.db");
+  for (size_t k = 0; k < before; ++k) filler.Add(clips[k], 50);
+  {
+    TransitionWorker worker(dir / "bank.db", Generous(), 1, TableChoice{.max_per_sprite = kCap});
+    for (size_t k = before; k < clips.size(); ++k) {
+      filler.Add(clips[k], 7, [&](const std::vector<int64_t>& ids) { worker.Submit(ids); });
+    }
+    worker.WaitIdle();
+    EXPECT_EQ(worker.stats().failed_rounds, 0) << worker.stats().last_error;
+  }
+  ASSERT_EQ(filler.bank_id, all.bank_id);
+  ExpectSamePairs(Bank(dir / "bank.db").LoadTransitions(), want, "worker");
+  const BankUpdateSummary again = UpdateBankTransitions(dir / "bank.db", options);
+  EXPECT_EQ(again.store.added + again.store.changed + again.store.removed, 0);
+}
+
 // Sprites tagged merged (two subjects in one blob) take part in no transition, on the worker
 // path (start-up and rounds) and in a single-process build alike, unless included.
 TEST(TransitionBank, MergedSpritesTakePartOnlyWhenIncluded) {
@@ -150,7 +221,7 @@ TEST(TransitionBank, MergedSpritesTakePartOnlyWhenIncluded) {
   const auto incremental = Bank(bank).LoadTransitions();
   ASSERT_GT(incremental.size(), 100u);
   EXPECT_EQ(touches_merged(incremental), 0);
-  EXPECT_EQ(Bank(bank).GetMeta(SpriteChoice::kMetaKey).value_or(""), "false");
+  EXPECT_EQ(Bank(bank).GetMeta(TableChoice::kMetaKey).value_or(""), "false");
 
   // The single-process build leaves them out too, and finds the worker's table.
   BankUpdateOptions options;
@@ -161,17 +232,17 @@ TEST(TransitionBank, MergedSpritesTakePartOnlyWhenIncluded) {
   EXPECT_EQ(s.store.added + s.store.changed + s.store.removed, 0);
 
   // Included, they have transitions; left out again, those go.
-  options.sprites.include_merged = true;
+  options.table.include_merged = true;
   const BankUpdateSummary with = UpdateBankTransitions(bank, options);
   EXPECT_EQ(with.left_out, 0);
   EXPECT_GT(touches_merged(Bank(bank).LoadTransitions()), 0);
-  EXPECT_EQ(Bank(bank).GetMeta(SpriteChoice::kMetaKey).value_or(""), "true");
-  options.sprites.include_merged = false;
+  EXPECT_EQ(Bank(bank).GetMeta(TableChoice::kMetaKey).value_or(""), "true");
+  options.table.include_merged = false;
   const BankUpdateSummary without = UpdateBankTransitions(bank, options);
   EXPECT_GT(without.store.removed, 0);
   EXPECT_EQ(touches_merged(Bank(bank).LoadTransitions()), 0);
   // A worker starting on a table made with them drops their transitions at start.
-  options.sprites.include_merged = true;
+  options.table.include_merged = true;
   UpdateBankTransitions(bank, options);
   {
     TransitionWorker worker(bank, Generous());

@@ -1,4 +1,4 @@
-// Transition workers sharing a PostgreSQL bank agree on the classifier and the sprite choice
+// Transition workers sharing a PostgreSQL bank agree on the classifier and the table's choice
 // (issue 39): the first to start decides them, and a worker with other settings refuses to start,
 // on an empty table too, where both used to proceed and make a table of neither.
 #include <gtest/gtest.h>
@@ -46,11 +46,17 @@ TEST(UnitWorkerSettings, TheFirstWorkersSettingsHoldOnAnEmptyTable) {
   EXPECT_NE(weights.find("spritestation transitions BANK"), std::string::npos) << weights;
 
   UnitWorkerOptions merged = Options("merged");
-  merged.sprites.include_merged = true;
+  merged.table.include_merged = true;
   const std::string choice = Refusal(bank, merged);
   EXPECT_NE(choice.find("transitions.include_merged false, this worker has true"),
             std::string::npos)
       << choice;
+
+  UnitWorkerOptions capped = Options("capped");
+  capped.table.max_per_sprite = 7;
+  const std::string cap = Refusal(bank, capped);
+  EXPECT_NE(cap.find("transitions.max_per_sprite 100, this worker has 7"), std::string::npos)
+      << cap;
 
   EXPECT_EQ(Refusal(bank, Options("alike")), "");  // the same settings join
 }
