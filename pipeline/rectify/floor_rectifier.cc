@@ -28,6 +28,28 @@ std::optional<Eigen::Vector3d> IntersectHeight(const Ray& ray, double height) {
 // The angle in (-pi, pi].
 double Wrap(double a) { return std::remainder(a, 2 * M_PI); }
 
+// The centre of the body's thickest part, in the plane image's pixels: the solid matte's points
+// weighted by their distance to its edge to the 4th power (the torso; the outline's plain centre
+// is pulled ahead by the head: 8-9 mm on the synthetic hamster, against 0.5-0.7 mm so). nullopt
+// for an empty matte.
+std::optional<cv::Point2d> ThickestCentre(const cv::Mat& plane_alpha) {
+  cv::Mat inside;
+  cv::distanceTransform(plane_alpha > kSolidAlpha, inside, cv::DIST_L2, cv::DIST_MASK_5);
+  double sum = 0, sum_u = 0, sum_v = 0;
+  for (int y = 0; y < inside.rows; ++y) {
+    const float* row = inside.ptr<float>(y);
+    for (int x = 0; x < inside.cols; ++x) {
+      const double d2 = static_cast<double>(row[x]) * row[x];
+      const double w = d2 * d2;
+      sum += w;
+      sum_u += w * x;
+      sum_v += w * y;
+    }
+  }
+  if (!(sum > 0)) return std::nullopt;
+  return cv::Point2d(sum_u / sum, sum_v / sum);
+}
+
 }  // namespace
 
 FloorRectifier::FloorRectifier(RectifierOptions options) : options_(options) {
@@ -105,6 +127,11 @@ std::optional<Billboard> FloorRectifier::Rectify(const CameraModel& camera, cons
   out.px_per_m = s;
   out.heading_rad = Wrap(-axis_image);
   out.elongation = major > 0 ? 1 - std::sqrt(std::max(0.0, minor) / major) : 0;
+  if (const auto thick = ThickestCentre(plane_alpha)) {
+    // Along the axis in the plane image is along the heading on the ground (v runs along -y).
+    out.thickest_ahead_m =
+        ((thick->x - cu) * std::cos(axis_image) + (thick->y - cv_) * std::sin(axis_image)) / s;
+  }
   out.point_in_ground = Eigen::Vector3d(centre.x(), centre.y(), 0);
   side = 2 * static_cast<int>(std::ceil(far + options_.margin_m * s)) + 1;
   if (too_large(side)) return std::nullopt;
@@ -133,6 +160,7 @@ Billboard FloorRectifier::TurnHalf(const Billboard& sprite) {
   cv::rotate(sprite.bgra, t.bgra, cv::ROTATE_180);
   if (!sprite.shadow.empty()) cv::rotate(sprite.shadow, t.shadow, cv::ROTATE_180);
   t.heading_rad = Wrap(sprite.heading_rad + M_PI);
+  t.thickest_ahead_m = -sprite.thickest_ahead_m;
   t.toward_camera = -sprite.toward_camera;
   t.right_in_ground = -sprite.right_in_ground;
   return t;

@@ -36,7 +36,9 @@ class FloorRectifier {
   // sign until ResolveHeadings picks one; elongation how sure it is.
   // nullopt when the subject's rays miss the body plane, its matte is empty, or the sprite
   // would exceed max_side_px (`why->too_large`, with the size it would have had).
-  // `view.contact_px` is not used: from above, the centre of the matte is the subject's place.
+  // The anchor is the centre of the matte on that plane, and `thickest_ahead_m` how far its
+  // thickest part lies ahead (the clip batcher moves the place there); `view.contact_px` is
+  // not used.
   std::optional<Billboard> Rectify(const CameraModel& camera, const SpriteView& view,
                                    Rectifier::Refusal* why = nullptr) const;
 

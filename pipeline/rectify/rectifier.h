@@ -59,6 +59,11 @@ struct Billboard {
   // is, 1 - minor / major of the matte's second moments (0 round, towards 1 long and thin).
   double heading_rad = 0;
   double elongation = 0;
+  // Floor sprites: how far the body's thickest part (where an animal rests its weight) lies
+  // ahead of the outline's centre, along the heading, metres. The clip batcher moves the place
+  // there by this, smoothed over the clip (one frame's estimate jitters; the outline's centre
+  // does not, but the head pulls it ahead).
+  double thickest_ahead_m = 0;
 };
 
 class Rectifier {

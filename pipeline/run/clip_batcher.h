@@ -7,7 +7,9 @@
 // frames whose velocity still needs frames to come. Every original sprite is
 // followed by its horizontally mirrored copy. Floor sprites (seen from above) come with their
 // body axis of either sign: the batcher turns each head first (ResolveHeadings) over the frames
-// it holds, keeping back kHeadingLookahead frames that the next batch decides with more.
+// it holds, keeping back kHeadingLookahead frames that the next batch decides with more, and
+// moves each one's place from its outline's centre to its body's thickest part by that offset's
+// median over the frames around it.
 #include <cstdint>
 #include <map>
 #include <optional>
@@ -95,6 +97,8 @@ class ClipBatcher {
     bool started = false;                 // a first batch went out
     bool marked_merged = false;           // MarkMerged: two side by side
     std::optional<double> last_heading;   // floor sprites: the last one handed out's heading
+    // Floor sprites: Billboard::thickest_ahead_m of the last frames handed out (head first).
+    std::vector<double> aheads;
   };
   // Hands out the first `count` pending sprites of `open`.
   void Emit(Open& open, size_t count, bool complete, std::vector<ClipBatch>* out);
