@@ -429,6 +429,7 @@ void RetrainJob::Run(std::shared_ptr<Shared> shared, const RetrainRequest& reque
     if (!rebuilt_by_station) {
       BankUpdateOptions update;
       update.weights = result.weights;
+      update.table = TableChoice::RecordedIn(Bank(bank));  // the sprites and cap it was made with
       update.threads = shared->threads;
       update.progress = [&](const std::string& stage, size_t done, size_t total) {
         stage_progress(stage, static_cast<int64_t>(done), static_cast<int64_t>(total));

@@ -1,6 +1,7 @@
 #include "pipeline/transitions/bank_sprites.h"
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <cstring>
 #include <set>
@@ -12,6 +13,18 @@ namespace ss {
 bool TableChoice::Takes(const SpriteRecord& sprite) const {
   return include_merged ||
          std::find(sprite.tags.begin(), sprite.tags.end(), kMergedTag) == sprite.tags.end();
+}
+
+TableChoice TableChoice::RecordedIn(const Bank& bank) {
+  TableChoice choice;
+  choice.include_merged = bank.GetMeta(kMetaKey).value_or("false") == "true";
+  if (const auto cap = bank.GetMeta(kCapMetaKey)) {
+    int value = 0;
+    const auto [end, error] = std::from_chars(cap->data(), cap->data() + cap->size(), value);
+    if (error == std::errc() && end == cap->data() + cap->size() && value >= 0)
+      choice.max_per_sprite = value;
+  }
+  return choice;
 }
 
 CheapFeatures CheapFromRecord(const SpriteRecord& s) {

@@ -33,6 +33,9 @@ struct TableChoice {
   static constexpr const char* kCapMetaKey = "transitions.max_per_sprite";
   std::string MetaValue() const { return include_merged ? "true" : "false"; }
   std::string CapMetaValue() const { return std::to_string(max_per_sprite); }
+  // The choice `bank`'s table was made with, as its meta keys record it (the defaults for what
+  // they do not say): what a rebuild that is not told otherwise keeps.
+  static TableChoice RecordedIn(const Bank& bank);
 };
 
 // The cheap features of a stored sprite: velocity, mean colour, eccentricity as stored;

@@ -167,6 +167,9 @@ TEST(TransitionBank, TheCapKeepsTheCheapestOnEveryPath) {
   EXPECT_EQ(capped.store.removed, static_cast<int64_t>(uncapped.size() - want.size()));
   ExpectSamePairs(Bank(dir / "all.db").LoadTransitions(), want, "batch");
   EXPECT_EQ(Bank(dir / "all.db").GetMeta(TableChoice::kCapMetaKey).value_or(""), "3");
+  const TableChoice recorded = TableChoice::RecordedIn(Bank(dir / "all.db"));
+  EXPECT_EQ(recorded.max_per_sprite, kCap);  // what a retrain rebuilds it with
+  EXPECT_FALSE(recorded.include_merged);
 
   // The worker: a third of the clips before it starts, the rest in rounds of 7 frames.
   BankFiller filler(dir / "bank.db");
