@@ -816,12 +816,10 @@ int64_t BankWriter::PruneTransitions(std::span<const int64_t> from_sprites, int 
   constexpr size_t kSprites = 500;
   for (size_t first = 0; first < from_sprites.size(); first += kSprites) {
     const size_t count = std::min(from_sprites.size() - first, kSprites);
-    std::string in = "?";
-    for (size_t k = 1; k < count; ++k) in += ", ?";
     const std::string ranked =
         "SELECT from_sprite, to_sprite, d, cost, ROW_NUMBER() OVER (PARTITION BY from_sprite "
-        "ORDER BY cost, to_sprite) AS r FROM transitions WHERE from_sprite IN (" +
-        in + ")";
+        "ORDER BY cost, to_sprite) AS r FROM transitions WHERE from_sprite IN " +
+        sql::RowPlaceholders(1, static_cast<int>(count));
     sql::Stmt del = db().Prepare(
         "DELETE FROM transitions WHERE (from_sprite, to_sprite) IN (SELECT from_sprite, "
         "to_sprite FROM (" +

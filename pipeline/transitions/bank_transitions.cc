@@ -48,24 +48,6 @@ void TransitionBars::Set(const TransitionRecord& worst_kept) {
   bars_[worst_kept.from_sprite] = {worst_kept.cost, worst_kept.to_sprite};
 }
 
-void TransitionBars::SetFromTable(const std::vector<Transition>& table, int keep) {
-  if (keep <= 0) return;
-  for (size_t begin = 0; begin < table.size();) {
-    size_t end = begin + 1;
-    while (end < table.size() && table[end].from == table[begin].from) ++end;
-    if (end - begin == static_cast<size_t>(keep)) {
-      const Transition& worst =
-          *std::max_element(table.begin() + static_cast<std::ptrdiff_t>(begin),
-                            table.begin() + static_cast<std::ptrdiff_t>(end),
-                            [](const Transition& a, const Transition& b) {
-                              return std::pair(a.cost, a.to) < std::pair(b.cost, b.to);
-                            });
-      bars_[worst.from] = {worst.cost, worst.to};
-    }
-    begin = end;
-  }
-}
-
 RoundResult StoreTransitionRound(BankWriter& bank, std::vector<Transition> transitions,
                                  int max_per_sprite, TransitionBars* bars) {
   RoundResult r;

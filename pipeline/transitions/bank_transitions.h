@@ -51,10 +51,8 @@ class TransitionBars {
  public:
   // True when `t` comes after its sprite's bar.
   bool Excludes(const Transition& t) const;
+  // Learnt from each prune (BankWriter::PruneTransitions): a worker starts with none.
   void Set(const TransitionRecord& worst_kept);
-  // The bars of a table already capped at `keep` (sorted by (from, to)).
-  void SetFromTable(const std::vector<Transition>& table, int keep);
-  size_t size() const { return bars_.size(); }
 
  private:
   std::unordered_map<int64_t, std::pair<double, int64_t>> bars_;  // from -> (cost, to)

@@ -26,7 +26,7 @@ struct TransitionWorker::State {
   std::optional<BankWriter> writer;
   std::unique_ptr<TransitionBuilder> builder;  // made when the bank scale is known
   SegmentKeys keys;
-  TransitionBars bars;  // of the table's cap (choice.max_per_sprite)
+  TransitionBars bars;  // of the table's cap (choice.max_per_sprite), from the rounds' prunes
 };
 
 TransitionWorker::TransitionWorker(std::string bank_path, const TransitionWeights& weights,
@@ -124,7 +124,6 @@ void TransitionWorker::Run() {
         s.builder->BuildFromScratch(sprites.inputs, BuildOptions{.threads = s.startup_threads,
                                                                  .progress = progress("pairs")});
         transitions = s.builder->Transitions(s.choice.max_per_sprite);
-        s.bars.SetFromTable(transitions, s.choice.max_per_sprite);
       }
       // Sprites left out are in the universe: transitions of theirs from before go.
       std::unordered_set<int64_t> universe(sprites.ids.begin(), sprites.ids.end());
