@@ -89,23 +89,14 @@ void Engine::SolveWithCheckpoints(MatchResult* out) {
       std::clamp(static_cast<int>(std::lround(std::sqrt(T_ * 4.0 * (R_ + 1) / 5.0))), 1, T_);
   const int blocks = (T_ + block - 1) / block;
   std::vector<std::vector<float>> checkpoints(blocks - 1);
-  Row rows[2];
-  for (auto& r : rows) r.Allocate(R_, stride_, pad_);
-  double offset = 0;  // sum of the row minima subtracted on the way
-  int cur = 0;
+  RowPair rows(R_, stride_, pad_);
   for (int t = 0; t < T_; ++t) {
-    const float* c = CostRow(t, T_);
-    if (t == 0) {
-      Init(c, &rows[cur], nullptr);
-    } else {
-      offset += rows[1 - cur].min;
-      Step(t, c, rows[1 - cur], &rows[cur], nullptr);
-    }
+    Forward(t, CostRow(t, T_), &rows, nullptr);
     if ((t + 1) % block == 0 && (t + 1) / block < blocks)
-      checkpoints[(t + 1) / block - 1] = rows[cur].v;
-    cur = 1 - cur;
+      checkpoints[(t + 1) / block - 1] = rows.Now().v;
+    rows.Next();
   }
-  result.total_cost = offset + rows[1 - cur].min;
+  result.total_cost = rows.Total();
   result.forward_seconds = Seconds(start) - cost_seconds_;
   const double forward_cost_seconds = cost_seconds_;
 
@@ -125,27 +116,22 @@ void Engine::SolveWithCheckpoints(MatchResult* out) {
   for (int b = blocks - 1; b >= 0; --b) {
     const int b0 = b * block, b1 = std::min(T_, b0 + block);
     // Local row i holds target row b0 - 1 + i.
-    cur = 0;
+    // (rows.offset sums on here too, unused: the total is known)
+    rows.cur = 0;
     if (b > 0) {
-      rows[cur].m = m_row(0);
-      StateFromCheckpoint(checkpoints[b - 1], &rows[cur], block_rec.data());
-      Finish(&rows[cur], b0 - 1);
-      block_top[0] = rows[cur].top;
+      rows.Now().m = m_row(0);
+      StateFromCheckpoint(checkpoints[b - 1], &rows.Now(), block_rec.data());
+      Finish(&rows.Now(), b0 - 1);
+      block_top[0] = rows.Now().top;
       checkpoints[b - 1] = {};
-      cur = 1;
+      rows.Next();
     }
     for (int t = b0; t < b1; ++t) {
-      const float* c = CostRow(t, b1);
       const size_t i = t - b0 + 1;
-      uint8_t* record = block_rec.data() + i * S_;
-      rows[cur].m = m_row(i);
-      if (t == 0) {
-        Init(c, &rows[cur], record);
-      } else {
-        Step(t, c, rows[1 - cur], &rows[cur], record);
-      }
-      block_top[i] = rows[cur].top;
-      cur = 1 - cur;
+      rows.Now().m = m_row(i);
+      Forward(t, CostRow(t, b1), &rows, block_rec.data() + i * S_);
+      block_top[i] = rows.Now().top;
+      rows.Next();
     }
     if (s < 0) {  // the last row: its best state
       const size_t i = b1 - b0;

@@ -74,21 +74,11 @@ bool Engine::SolveWithDecisions(MatchResult* out) {
   std::vector<size_t> listed_begin(T_ + 1, 0);  // row t's listed choices
   listed_choice_.clear();
   MatchResult& result = *out;
-  Row rows[2];
-  for (auto& r : rows) r.Allocate(R_, stride_, pad_);
-  double offset = 0;  // sum of the row minima subtracted on the way
-  int cur = 0;
+  RowPair rows(R_, stride_, pad_);
   for (int t = 0; t < T_; ++t) {
-    const float* c = CostRow(t, T_);
-    uint8_t* record = decisions.get() + static_cast<size_t>(t) * row_bytes;
     listed_begin[t] = listed_choice_.size();
-    if (t == 0) {
-      Init(c, &rows[cur], record);
-    } else {
-      offset += rows[1 - cur].min;
-      Step(t, c, rows[1 - cur], &rows[cur], record,
-           local_row[t] >= 0 ? jump_sources + static_cast<size_t>(local_row[t]) * S_ : nullptr);
-    }
+    Forward(t, CostRow(t, T_), &rows, decisions.get() + static_cast<size_t>(t) * row_bytes,
+            local_row[t] >= 0 ? jump_sources + static_cast<size_t>(local_row[t]) * S_ : nullptr);
     // The cells listed transitions win are kept aside (8 bytes each); should they push the
     // store past the limit (a bank whose transitions win most cells), start over without.
     if (need + listed_choice_.capacity() * sizeof(listed_choice_[0]) > limit) {
@@ -102,12 +92,12 @@ bool Engine::SolveWithDecisions(MatchResult* out) {
       mode_ = kArgOnly;
       return false;
     }
-    const auto& top = rows[cur].top;
+    const auto& top = rows.Now().top;
     for (size_t i = 0; i < top.size() && i < top_size; ++i) tops[t * top_size + i] = top[i].index;
-    cur = 1 - cur;
+    rows.Next();
   }
   listed_begin[T_] = listed_choice_.size();
-  result.total_cost = offset + rows[1 - cur].min;
+  result.total_cost = rows.Total();
   result.forward_seconds = Seconds(start) - cost_seconds_;
 
   // Backward: a walk over the stored decisions.
@@ -121,7 +111,7 @@ bool Engine::SolveWithDecisions(MatchResult* out) {
     return mode_ == kWide ? static_cast<int>(rec[2 * static_cast<size_t>(s) + 1]) : rec[s] >> 4;
   };
   result.source_frames.assign(T_, 0);
-  const float* m_last = rows[1 - cur].m;
+  const float* m_last = rows.Before().m;
   int s = static_cast<int>(std::min_element(m_last, m_last + S_) - m_last);
   int r = low(T_ - 1, s) & 7;
   for (int t = T_ - 1;; --t) {

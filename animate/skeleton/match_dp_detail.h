@@ -78,6 +78,23 @@ struct Row {
   }
 };
 
+// The forward pass's two rows, used in turn: Now() is row t's, Before() row t-1's; `offset`
+// sums the row minima subtracted on the way (Engine::Forward adds them).
+struct RowPair {
+  RowPair(int levels, size_t stride, int pad) {
+    for (auto& r : rows) r.Allocate(levels, stride, pad);
+  }
+  Row& Now() { return rows[cur]; }
+  Row& Before() { return rows[1 - cur]; }
+  void Next() { cur = 1 - cur; }
+  // After the last row's Next(): the path's cost, offset and that row's minimum.
+  double Total() const { return offset + rows[1 - cur].min; }
+
+  Row rows[2];
+  int cur = 0;
+  double offset = 0;
+};
+
 inline double Seconds(std::chrono::steady_clock::time_point since) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
 }
@@ -108,6 +125,10 @@ class Engine {
   // sources to `jump_source`.
   void Step(int t, const float* c, const Row& prev, Row* cur, uint8_t* record,
             int32_t* jump_source = nullptr);
+  // Row t into rows->Now(): Init for the first row, else Step from rows->Before(), whose
+  // minimum goes to rows->offset.
+  void Forward(int t, const float* c, RowPair* rows, uint8_t* record,
+               int32_t* jump_source = nullptr);
   // The scalar cell update (tail and fix-ups); `jump` = J + the best allowed jump source.
   void Cell(int s, const float* c, const Row& prev, const RowRules& rules, float jump, Row* cur,
             uint8_t* record) const;

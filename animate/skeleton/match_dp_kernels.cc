@@ -317,6 +317,15 @@ void Engine::Cell(int s, const float* c, const Row& prev, const RowRules& rules,
   }
 }
 
+void Engine::Forward(int t, const float* c, RowPair* rows, uint8_t* record, int32_t* jump_source) {
+  if (t == 0) {
+    Init(c, &rows->Now(), record);
+    return;
+  }
+  rows->offset += rows->Before().min;
+  Step(t, c, rows->Before(), &rows->Now(), record, jump_source);
+}
+
 void Engine::Step(int t, const float* c, const Row& prev, Row* cur, uint8_t* record,
                   int32_t* jump_source) {
   const RowRules& rules = Rules(t);
