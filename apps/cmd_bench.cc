@@ -42,7 +42,8 @@ void AddBenchCommand(CLI::App& app) {
 #else
     (void)cmd;
     throw InputError("bench",
-                     "this build has no benchmarks (configure with -DSPRITESTATION_BENCHMARKS=ON)");
+                     "this build has no benchmarks (scripts/demo.sh leaves them out): build them "
+                     "in with SPRITESTATION_BENCHMARKS=ON scripts/build.sh");
 #endif
   });
 }

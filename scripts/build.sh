@@ -5,6 +5,8 @@
 #   SPRITESTATION_SANITIZE=asan|tsan   build with sanitizers into build-asan/ or build-tsan/
 #   SPRITESTATION_UNIT_SUITES=ON|OFF    build and register the unit suites here or not (kept as set;
 #                                      scripts/test.sh turns them off: they run in its sanitizer build)
+#   SPRITESTATION_BENCHMARKS=ON|OFF     build `spritestation bench` into the executable or not (kept as
+#                                      set; default ON; scripts/demo.sh turns it off, test.sh on)
 set -euo pipefail
 top="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 sanitize="${SPRITESTATION_SANITIZE:-}"
@@ -15,7 +17,13 @@ case "$sanitize" in
   tsan) build="${SPRITESTATION_BUILD_DIR:-$top/build-tsan}"; extra+=(-DSPRITESTATION_TSAN=ON -DCMAKE_BUILD_TYPE=Debug) ;;
   *) echo "build.sh: SPRITESTATION_SANITIZE must be asan or tsan, got '$sanitize'" >&2; exit 2 ;;
 esac
-[ -n "${SPRITESTATION_UNIT_SUITES:-}" ] && extra+=("-DSPRITESTATION_UNIT_SUITES=${SPRITESTATION_UNIT_SUITES}")
+# The options kept as set: given in the environment, they are passed to cmake (and configure again
+# when the build folder has them otherwise); not given, the build folder keeps what it has.
+kept=()
+for option in SPRITESTATION_UNIT_SUITES SPRITESTATION_BENCHMARKS; do
+  [ -n "${!option:-}" ] && kept+=("-D$option=${!option}")
+done
+extra+=("${kept[@]}")
 # ccache: one cache for every build of this machine, CI's (.ci/run) and a
 # developer's alike; paths under the tree hash as relative ones, so a clone in
 # another folder (CI's) reuses what a build of this tree already compiled.
@@ -35,10 +43,13 @@ if [ ! -f "$build/CMakeCache.txt" ] || { [ ! -f "$build/build.ninja" ] && [ ! -f
     "-DCMAKE_C_FLAGS_RELWITHDEBINFO=-O2 $debug -DNDEBUG" "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O2 $debug -DNDEBUG" \
     "${extra[@]}" >&2
 fi
-if [ -n "${SPRITESTATION_UNIT_SUITES:-}" ] &&
-   ! grep -qx "SPRITESTATION_UNIT_SUITES:BOOL=${SPRITESTATION_UNIT_SUITES}" "$build/CMakeCache.txt"; then
-  cmake -S "$top" -B "$build" "-DSPRITESTATION_UNIT_SUITES=${SPRITESTATION_UNIT_SUITES}" >&2
-fi
+for define in "${kept[@]}"; do
+  setting="${define#-D}"
+  if ! grep -qx "${setting%%=*}:BOOL=${setting#*=}" "$build/CMakeCache.txt"; then
+    cmake -S "$top" -B "$build" "${kept[@]}" >&2
+    break
+  fi
+done
 targets=()
 for t in "$@"; do targets+=(--target "$t"); done
 start=$SECONDS

@@ -31,8 +31,10 @@ stage() {
 
 stage install "installing what building and running need (scripts/install-deps.sh --run)"
 "$top/scripts/install-deps.sh" --run
-stage build "building the executable (scripts/build.sh spritestation)"
-build="$("$top/scripts/build.sh" spritestation)"
+# The executable without `spritestation bench` (the benchmark suites, a tenth of its compile
+# time): the demo runs none. A later `scripts/test.sh` builds them in again.
+stage build "building the executable (SPRITESTATION_BENCHMARKS=OFF scripts/build.sh spritestation)"
+build="$(SPRITESTATION_BENCHMARKS=OFF "$top/scripts/build.sh" spritestation)"
 ss="$build/apps/spritestation"
 sample="$top/recordings/sample"
 out="$top/recordings/demo-output"

@@ -11,7 +11,8 @@ fuzz_seconds="${SPRITESTATION_FUZZ_SECONDS:-20}"
 # ctest arguments, SPRITESTATION_FUZZ_SECONDS=0 or a whole-tree sanitizer build.
 unit=OFF
 if [ $# -gt 0 ] || [ "$fuzz_seconds" = 0 ] || [ -n "${SPRITESTATION_SANITIZE:-}" ]; then unit=ON; fi
-build="$(SPRITESTATION_UNIT_SUITES=$unit "$top/scripts/build.sh")"
+# (with `spritestation bench` in it, which the demo's build leaves out)
+build="$(SPRITESTATION_UNIT_SUITES=$unit SPRITESTATION_BENCHMARKS=ON "$top/scripts/build.sh")"
 if [ $# -gt 0 ]; then
   (cd "$build" && ctest --output-on-failure --timeout 300 -j "$(nproc)" "$@")
   exit
