@@ -31,14 +31,13 @@ class FloorRectifier {
 
   // A Billboard of kind kFloor: CV_8UC4 straight alpha, square with an odd side, the subject
   // seen from above on its body plane facing the image's top (its body axis vertical, its right
-  // side to the image's right), the anchor its centre (the image's centre); the shadow on the
-  // floor (z = 0) under it in the same axes. heading_rad is the axis's direction, of either
-  // sign until ResolveHeadings picks one; elongation how sure it is.
-  // nullopt when the subject's rays miss the body plane, its matte is empty, or the sprite
-  // would exceed max_side_px (`why->too_large`, with the size it would have had).
-  // The anchor is the centre of the matte on that plane, and `thickest_ahead_m` how far its
-  // thickest part lies ahead (the clip batcher moves the place there); `view.contact_px` is
-  // not used.
+  // side to the image's right), the anchor its centre (the image's centre); the shadow patch in
+  // the same axes and on the same body plane (so that the floor the body hides lines up with it).
+  // heading_rad is the axis's direction, of either sign until ResolveHeadings picks one; elongation
+  // how sure it is. nullopt when the subject's rays miss the body plane, its matte is empty, or the
+  // sprite would exceed max_side_px (`why->too_large`, with the size it would have had). The anchor
+  // is the centre of the matte on that plane, and `thickest_ahead_m` how far its thickest part lies
+  // ahead (the clip batcher moves the place there); `view.contact_px` is not used.
   std::optional<Billboard> Rectify(const CameraModel& camera, const SpriteView& view,
                                    Rectifier::Refusal* why = nullptr) const;
 
