@@ -60,7 +60,7 @@ class ReferenceCut : public ::testing::Test {
     const std::string session = *dir_ / "session";
     made_ = RunOk("synth --out " + session +
                   " --kind animal --seconds 30 --fps 30 --size 640x480 --cameras 1 --subjects 1"
-                  " --seed 53 --no-mattes") &&
+                  " --seed 53 --no-mattes --codec ffvhuff") &&
             RunOk("ingest " + session + " --bank " + (*dir_ / "hamster.ssbank") +
                   " --no-transitions") &&
             RunOk("transitions " + (*dir_ / "hamster.ssbank") + " --quiet") &&
