@@ -115,6 +115,7 @@ void RunIngest(const std::string& session, const std::string& bank, const std::s
                           {"transitions", s.transitions}};
     if (s.transitions) {
       out["transitions_stored"] = s.transitions_stored;
+      out["transitions_in_table"] = s.transitions_in_table;
       out["transition_sprites"] = s.transition_sprites;
       out["seconds_transitions_wait"] = s.seconds_transitions_wait;
       out["transitions_error"] = s.transitions_error;
@@ -175,11 +176,13 @@ void RunIngest(const std::string& session, const std::string& bank, const std::s
         static_cast<unsigned long long>(c.stats.clips), c.stats.seconds_key, c.stats.seconds_rest);
   }
   if (s.transitions) {
-    std::printf(
-        "  transitions: %lld stored (table of %lld sprites kept current; waited %.2f s at the "
-        "end)\n",
-        static_cast<long long>(s.transitions_stored), static_cast<long long>(s.transition_sprites),
-        s.seconds_transitions_wait);
+    std::printf("  transitions: %lld stored", static_cast<long long>(s.transitions_in_table));
+    if (s.transitions_stored > s.transitions_in_table) {
+      std::printf(" (of %lld written: the rest past transitions.max_per_sprite out of a sprite)",
+                  static_cast<long long>(s.transitions_stored));
+    }
+    std::printf(" (table of %lld sprites kept current; waited %.2f s at the end)\n",
+                static_cast<long long>(s.transition_sprites), s.seconds_transitions_wait);
     if (!s.transitions_error.empty()) {
       std::printf("  transitions FAILED: %s (run 'spritestation transitions %s')\n",
                   s.transitions_error.c_str(), bank.c_str());

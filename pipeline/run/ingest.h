@@ -73,8 +73,11 @@ struct IngestSummary {
   SourceStats source;        // what the replay could not read
   double seconds = 0;
   double frames_per_second = 0;
-  bool transitions = false;             // the transition worker ran
-  int64_t transitions_stored = 0;       // transitions it wrote (its start-up table included)
+  bool transitions = false;        // the transition worker ran
+  int64_t transitions_stored = 0;  // transitions it wrote (its start-up table included)
+  // The table at the end: fewer than written when the cap on transitions out of a sprite
+  // (transitions.max_per_sprite) pruned some of them.
+  int64_t transitions_in_table = 0;
   int64_t transition_sprites = 0;       // sprites it knows at the end
   double seconds_transitions_wait = 0;  // waiting for it after the last batch was stored
   std::string transitions_error;  // its last error ("" when none): the table may be incomplete
