@@ -231,9 +231,11 @@ SpritePixels Bank::LoadPixels(int64_t id) const {
   return pixels;
 }
 
+int64_t Bank::TransitionCount() const { return db_->QueryInt("SELECT count(*) FROM transitions"); }
+
 std::vector<TransitionRecord> Bank::LoadTransitions() const {
   std::vector<TransitionRecord> out;
-  out.reserve(static_cast<size_t>(db_->QueryInt("SELECT count(*) FROM transitions")));
+  out.reserve(static_cast<size_t>(TransitionCount()));
   auto s = db_->Prepare(
       "SELECT from_sprite, to_sprite, d, cost FROM transitions ORDER BY from_sprite, to_sprite");
   while (s.Step()) out.push_back({s.Int(0), s.Int(1), s.Real(2), s.Real(3)});
@@ -373,7 +375,7 @@ BankCounts Bank::Counts() const {
         "SELECT count(*) FROM sprites s JOIN clips c ON c.id = s.clip_id WHERE c.complete = 1");
     c.pixel_rows = db_->QueryInt("SELECT count(*) FROM sprite_pixels");
     c.pixel_bytes = db_->QueryInt("SELECT coalesce(sum(length(data)), 0) FROM sprite_pixels");
-    c.transitions = db_->QueryInt("SELECT count(*) FROM transitions");
+    c.transitions = TransitionCount();
     c.tags = db_->QueryInt("SELECT count(DISTINCT tag) FROM sprite_tags");
     c.tagged_sprites = db_->QueryInt("SELECT count(DISTINCT sprite_id) FROM sprite_tags");
     if (is_postgres()) {

@@ -63,6 +63,8 @@ class Bank {
   // A sprite's billboard, decompressed (a mirrored sprite's is its original's, flipped).
   SpritePixels LoadPixels(int64_t id) const;
   std::vector<TransitionRecord> LoadTransitions() const;
+  // How many rows the transition table holds (LoadTransitions' size, without reading them).
+  int64_t TransitionCount() const;
   // Transitions leaving `from_sprite`.
   std::vector<TransitionRecord> LoadTransitionsFrom(int64_t from_sprite) const;
   // Transitions arriving at `to_sprite`.

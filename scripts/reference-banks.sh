@@ -137,7 +137,7 @@ run_tag() {
 # The sessions are rendered in ffvhuff, not the recorder's ffv1: both lossless, and these sessions
 # are read once and deleted, so speed counts, not size. A 20 s hamster (640x480, 30 fps) rendered
 # in 4.0 s against 10.9 s and ingested in 1.4 s against 6.5 s (the decoding), 12 % larger
-# (bench/RESULTS.md, "build": the demo on a fresh machine).
+# (bench/RESULTS.md, "The demo on a fresh machine, twice").
 codec=(--codec ffvhuff)
 IFS=',' read -r -a names <<< "$sets"
 for name in "${names[@]}"; do

@@ -277,7 +277,7 @@ IngestSummary IngestSession(const IngestOptions& options) {
     transitions->Stop();
     summary.transitions = true;
     summary.transitions_stored = t.transitions_stored;
-    summary.transitions_in_table = Bank(options.bank_path).Counts().transitions;
+    summary.transitions_in_table = Bank(options.bank_path).TransitionCount();
     summary.transition_sprites = t.sprites;
     summary.transitions_error = t.last_error;
     summary.seconds_transitions_wait =

@@ -24,12 +24,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-bool RunOk(const std::string& args) {
-  const testing::CommandResult r = testing::RunSpritestation("--log-level warn " + args);
-  EXPECT_EQ(r.exit_code, 0) << args << "\n" << r.output;
-  return r.exit_code == 0;
-}
-
 class OpenField : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
@@ -40,10 +34,12 @@ class OpenField : public ::testing::Test {
         " --out " + session +
         " --camera-height 0.6 --tilt 89 --hfov 60 --range 0-30 --codec ffvhuff");
     import_output_ = imported.output;
-    made_ = imported.exit_code == 0 &&
-            RunOk("ingest " + session + " --bank " + (*dir_ / "mouse.ssbank") + " --config " +
-                  session + "/ingest.yaml") &&
-            RunOk("plate " + session + " --camera cam0 --out " + (*dir_ / "floor.png"));
+    made_ =
+        imported.exit_code == 0 &&
+        testing::RunSpritestationOk("ingest " + session + " --bank " + (*dir_ / "mouse.ssbank") +
+                                    " --config " + session + "/ingest.yaml") &&
+        testing::RunSpritestationOk("plate " + session + " --camera cam0 --out " +
+                                    (*dir_ / "floor.png"));
     if (made_) fs::copy_file(session + "/cam0.cameramodel", *dir_ / "virtual.cameramodel");
   }
   static void TearDownTestSuite() { dir_.reset(); }
@@ -53,11 +49,12 @@ class OpenField : public ::testing::Test {
                        << import_output_;
   }
 
-  // The mouse along `path` (points in metres, from its first), judged: the judge's figures.
+  // The mouse from `start` along `path` (points in metres), judged: the judge's figures.
   // A turn limit, not a time, ends the run (with a time budget far beyond it): the same result on
   // any machine.
-  static nlohmann::json Animate(const std::string& name, const std::string& path, int min_frames,
-                                int max_frames, int max_turns) {
+  static nlohmann::json Animate(const std::string& name, const std::string& start,
+                                const std::string& path, int min_frames, int max_frames,
+                                int max_turns) {
     const std::string spec = *dir_ / (name + ".yaml"), seq = *dir_ / (name + ".json");
     std::ofstream(spec) << "version: 1\nframe_rate: 30\nlength: {min_frames: " << min_frames
                         << ", max_frames: " << max_frames
@@ -65,8 +62,7 @@ class OpenField : public ::testing::Test {
                         << "\nbackground: " << (*dir_ / "floor.png") << "\nbanks: ["
                         << (*dir_ / "mouse.ssbank") << "]\nrepeats: {strength: 3}\n"
                         << "optimizer: {method: replace, time_budget_s: 300, seed: 1}\n"
-                        << "sprites:\n  - name: mouse\n    start: "
-                        << path.substr(1, path.find(']'))
+                        << "sprites:\n  - name: mouse\n    start: " << start
                         << "\n    constraints:\n      - path:\n          points: " << path
                         << "\n          direction_strength: 0.5\n          distance_strength: 1000"
                         << "\n          unreached_strength: 3000\n";
@@ -78,7 +74,8 @@ class OpenField : public ::testing::Test {
     EXPECT_TRUE(report.contains("judge")) << r.output;
     if (r.exit_code == 0) {
       // It renders: the floor sprites laid on the floor, seen from the camera that filmed them.
-      EXPECT_TRUE(RunOk("render " + seq + " --out " + (*dir_ / (name + ".mkv"))));
+      EXPECT_TRUE(
+          testing::RunSpritestationOk("render " + seq + " --out " + (*dir_ / (name + ".mkv"))));
     }
     return report.value("judge", nlohmann::json::object());
   }
@@ -99,7 +96,8 @@ std::string OpenField::import_output_;
 TEST_F(OpenField, TheMouseIsStoredWholeAsFloorSpritesAndRunsACircleAndALine) {
   EXPECT_NE(import_output_.find("films its floor from above"), std::string::npos) << import_output_;
   const std::string out = *dir_ / "export";
-  ASSERT_TRUE(RunOk("bank export " + (*dir_ / "mouse.ssbank") + " --out " + out));
+  ASSERT_TRUE(
+      testing::RunSpritestationOk("bank export " + (*dir_ / "mouse.ssbank") + " --out " + out));
   const auto rows = testing::ReadCsv(out + "/sprites.csv");
   std::vector<double> areas;
   for (const auto& row : rows) {
@@ -121,7 +119,7 @@ TEST_F(OpenField, TheMouseIsStoredWholeAsFloorSpritesAndRunsACircleAndALine) {
   // (median 0.4-0.6 cm), 100 % swept, no stutter; the line 300 turns, 1.0 / 1.5 cm. The bars here
   // are the cut's.
   const nlohmann::json circle =
-      Animate("circle",
+      Animate("circle", "[0.1, 0.0]",
               "[[0.1, 0.0], [0.0707, 0.0707], [0.0, 0.1], [-0.0707, 0.0707], [-0.1, 0.0], "
               "[-0.0707, -0.0707], [0.0, -0.1], [0.0707, -0.0707], [0.1, 0.0]]",
               120, 600, 600);
@@ -130,7 +128,8 @@ TEST_F(OpenField, TheMouseIsStoredWholeAsFloorSpritesAndRunsACircleAndALine) {
   EXPECT_LE(circle["paths"][0]["max_deviation_m"].get<double>(), 0.035) << circle.dump();
   EXPECT_LE(circle["stutter"]["share"].get<double>(), 0.01) << circle.dump();
 
-  const nlohmann::json line = Animate("line", "[[-0.15, 0.0], [0.15, 0.0]]", 60, 300, 300);
+  const nlohmann::json line =
+      Animate("line", "[-0.15, 0.0]", "[[-0.15, 0.0], [0.15, 0.0]]", 60, 300, 300);
   ASSERT_TRUE(line.contains("paths")) << line.dump();
   EXPECT_GE(line["paths"][0]["swept_share"].get<double>(), 0.98) << line.dump();
   EXPECT_LE(line["paths"][0]["max_deviation_m"].get<double>(), 0.02) << line.dump();

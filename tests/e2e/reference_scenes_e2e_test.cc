@@ -47,24 +47,20 @@ void ExpectNoStutterOrJumps(const nlohmann::json& judge) {
     EXPECT_LE(judge["jumps"]["max"].get<double>(), 2.0);
 }
 
-bool RunOk(const std::string& args) {
-  const testing::CommandResult r = testing::RunSpritestation("--log-level warn " + args);
-  EXPECT_EQ(r.exit_code, 0) << args << "\n" << r.output;
-  return r.exit_code == 0;
-}
-
 class ReferenceCut : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     dir_ = std::make_unique<testing::ScratchDir>();
     const std::string session = *dir_ / "session";
-    made_ = RunOk("synth --out " + session +
-                  " --kind animal --seconds 30 --fps 30 --size 640x480 --cameras 1 --subjects 1"
-                  " --seed 53 --no-mattes --codec ffvhuff") &&
-            RunOk("ingest " + session + " --bank " + (*dir_ / "hamster.ssbank") +
-                  " --no-transitions") &&
-            RunOk("transitions " + (*dir_ / "hamster.ssbank") + " --quiet") &&
-            RunOk("plate " + session + " --camera cam0 --out " + (*dir_ / "floor.png"));
+    made_ = testing::RunSpritestationOk(
+                "synth --out " + session +
+                " --kind animal --seconds 30 --fps 30 --size 640x480 --cameras 1 --subjects 1"
+                " --seed 53 --no-mattes --codec ffvhuff") &&
+            testing::RunSpritestationOk("ingest " + session + " --bank " +
+                                        (*dir_ / "hamster.ssbank") + " --no-transitions") &&
+            testing::RunSpritestationOk("transitions " + (*dir_ / "hamster.ssbank") + " --quiet") &&
+            testing::RunSpritestationOk("plate " + session + " --camera cam0 --out " +
+                                        (*dir_ / "floor.png"));
     if (made_) fs::copy_file(session + "/cam0.cameramodel", *dir_ / "virtual.cameramodel");
   }
   static void TearDownTestSuite() { dir_.reset(); }
@@ -114,7 +110,8 @@ TEST_F(ReferenceCut, TheWalkCrossingAndCircleMeetTheirConstraintsWithoutStutterO
     EXPECT_LE(judge["jumps"]["median"].get<double>(), 1.0);
 
   // What the demo does next: the render is a video a player reads, one frame per step.
-  ASSERT_TRUE(RunOk("render " + (*dir_ / "walk.json") + " --out " + (*dir_ / "walk.mkv")));
+  ASSERT_TRUE(testing::RunSpritestationOk("render " + (*dir_ / "walk.json") + " --out " +
+                                          (*dir_ / "walk.mkv")));
   const testing::CommandResult probe = testing::RunCommand(
       "ffprobe -v error -count_frames -select_streams v:0 -show_entries stream=nb_read_frames "
       "-of csv=p=0 " +

@@ -178,7 +178,6 @@ TEST(FloorRectifier, HeadingsFollowTheWalkAndTurnSmoothlyWhereTheSubjectStands) 
   EXPECT_TRUE(ResolveHeadings({}).empty());
 }
 
-// Turning half a turn twice gives the sprite back; the mirror swaps the sides, not the ends.
 // The keyer leaves no shadow where the body hides the floor from the camera. Laid on the floor,
 // that hole must lie under the body, wherever in the view the body was: off the middle of an
 // overhead view, the body plane (3 cm up) and the floor are apart by the camera's parallax.
@@ -236,6 +235,7 @@ TEST(FloorRectifier, TheShadowsHoleLiesUnderTheBodyAnywhereInTheView) {
   RecordProperty("worst_offset_px", std::to_string(worst_px));
 }
 
+// Turning half a turn twice gives the sprite back; the mirror swaps the sides, not the ends.
 TEST(FloorRectifier, TurnHalfAndMirrorKeepThePlaceAndTheCentre) {
   Billboard s;
   s.kind = SpriteKind::kFloor;

@@ -62,6 +62,12 @@ CommandResult RunSpritestation(const std::string& args) {
   return RunCommand(SpritestationCommand(args));
 }
 
+bool RunSpritestationOk(const std::string& args) {
+  const CommandResult r = RunSpritestation("--log-level warn " + args);
+  EXPECT_EQ(r.exit_code, 0) << args << "\n" << r.output;
+  return r.exit_code == 0;
+}
+
 CommandResult RunCommand(const std::string& shell_command) {
   const std::string command = shell_command + " 2>&1";
   CommandResult result;

@@ -41,6 +41,9 @@ std::string SourcePath(const std::string& relative);
 
 // Runs `spritestation ARGS` (the binary named by $SPRITESTATION_BIN) through the shell.
 CommandResult RunSpritestation(const std::string& args);
+// Runs `spritestation --log-level warn ARGS` and expects it to succeed (a failure shows the
+// arguments and the output); whether it did.
+bool RunSpritestationOk(const std::string& args);
 // The shell command RunSpritestation runs (the executable, $SPRITESTATION_BIN, and `args`), for a
 // test that runs it under another command (prlimit, a redirection).
 std::string SpritestationCommand(const std::string& args);
