@@ -235,6 +235,10 @@ bool JudgeOptions::IsValid(std::string* why) const {
         "must be >= 1, got " + std::to_string(stutter_window_steps));
   check(clone_lag_steps >= 0, "clone_lag_steps",
         "must be >= 0, got " + std::to_string(clone_lag_steps));
+  check(facing_min_speed_m_s >= 0, "facing_min_speed_m_s",
+        "must be >= 0, got " + std::to_string(facing_min_speed_m_s));
+  check(facing_half_window_steps >= 1, "facing_half_window_steps",
+        "must be >= 1, got " + std::to_string(facing_half_window_steps));
   std::string jump_why;
   check.Nested(jump.IsValid(&jump_why), "jump.", jump_why);
   return check.ok();
@@ -266,6 +270,35 @@ StutterFigures MeasureStutter(const std::vector<SpriteSequence>& sprites, int wi
   const int counted = out.steps - out.still_steps;
   out.share = counted > 0 ? static_cast<double>(out.repeats) / counted : 0.0;
   out.replayed_share = counted > 0 ? static_cast<double>(out.replayed) / counted : 0.0;
+  return out;
+}
+
+FacingFigures MeasureFacing(
+    const std::vector<SpriteSequence>& sprites, double frame_rate, double min_speed_m_s,
+    int half_window_steps,
+    const std::function<std::optional<double>(const BankFrameRef&)>& heading_of) {
+  FacingFigures out;
+  out.min_speed_m_s = min_speed_m_s;
+  out.half_window_steps = half_window_steps;
+  std::vector<double> angles_deg;
+  for (const SpriteSequence& s : sprites) {
+    const int n = static_cast<int>(s.frames.size());
+    for (int t = 0; t < n; ++t) {
+      const std::optional<double> heading = heading_of(s.frames[t]);
+      if (!heading) continue;
+      out.measured = true;
+      const int a = std::max(0, t - half_window_steps), b = std::min(n - 1, t + half_window_steps);
+      if (b <= a) continue;
+      const Eigen::Vector2d motion = s.positions_m[b] - s.positions_m[a];
+      if (motion.norm() * frame_rate / (b - a) <= min_speed_m_s) continue;
+      const double drawn = *heading + s.TurnAt(t);
+      const double off = std::remainder(drawn - std::atan2(motion.y(), motion.x()), 2 * M_PI);
+      angles_deg.push_back(std::abs(off) * 180 / M_PI);
+    }
+  }
+  out.moving_steps = static_cast<int>(angles_deg.size());
+  out.median_deg = Quantile(angles_deg, 0.5);
+  out.p90_deg = Quantile(angles_deg, 0.9);
   return out;
 }
 
@@ -335,6 +368,19 @@ Judgement JudgeSequences(const SequenceFile& file, const std::vector<std::string
         return still.count({f.bank, f.sprite_id}) > 0;
       });
   out.clones = MeasureClones(file.sprites, options.clone_lag_steps);
+  std::map<std::pair<int, int64_t>, double> headings;  // floor sprites'
+  for (size_t b = 0; b < banks.size(); ++b) {
+    for (const SpriteFeatures& f : banks[b]->LoadFeatures()) {
+      if (f.floor) headings[{static_cast<int>(b), f.id}] = f.heading_rad;
+    }
+  }
+  out.facing = MeasureFacing(file.sprites, file.frame_rate, options.facing_min_speed_m_s,
+                             options.facing_half_window_steps,
+                             [&](const BankFrameRef& f) -> std::optional<double> {
+                               const auto it = headings.find({f.bank, f.sprite_id});
+                               if (it == headings.end()) return std::nullopt;
+                               return it->second;
+                             });
   if (options.jumps) out.jumps = JudgeJumps(file, banks, options.jump);
   return out;
 }

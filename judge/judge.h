@@ -23,6 +23,10 @@ struct JudgeOptions {
   std::vector<std::string> still_tags = {"still"};
   // Two sprites showing the same frame this many steps apart or closer are copies.
   int clone_lag_steps = 2;
+  // Facing: floor sprites' steps moving faster than this count, their motion taken over
+  // +- this many steps.
+  double facing_min_speed_m_s = 0.05;
+  int facing_half_window_steps = 3;
   bool jumps = true;  // measure the visible jumps (reads billboards); false: skip them
   VisibleJumpOptions jump;
   // False with "FIELD: reason" lines in `why` (core/option_checks.h) for values out of range.
@@ -39,6 +43,13 @@ Judgement JudgeSequences(const SequenceFile& file, const std::vector<std::string
 // The stutter of some sprites' frames alone; `is_still` exempts a step showing that frame.
 StutterFigures MeasureStutter(const std::vector<SpriteSequence>& sprites, int window_steps,
                               const std::function<bool(const BankFrameRef&)>& is_still);
+
+// The angle between floor sprites' drawn headings and their motion (FacingFigures);
+// `heading_of`: a frame's heading on the ground, none for an upright frame.
+FacingFigures MeasureFacing(
+    const std::vector<SpriteSequence>& sprites, double frame_rate, double min_speed_m_s,
+    int half_window_steps,
+    const std::function<std::optional<double>(const BankFrameRef&)>& heading_of);
 
 // Which steps of `sprites` show a frame another sprite shows within `lag_steps`.
 CloneFigures MeasureClones(const std::vector<SpriteSequence>& sprites, int lag_steps);

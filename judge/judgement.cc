@@ -86,6 +86,13 @@ json JudgementJson(const Judgement& j) {
                    {"cloned_steps", c.cloned_steps},
                    {"share", c.share},
                    {"sprites_cloned", c.sprites_cloned}};
+  const FacingFigures& f = j.facing;
+  out["facing"] = {{"measured", f.measured},
+                   {"min_speed_m_s", f.min_speed_m_s},
+                   {"half_window_steps", f.half_window_steps},
+                   {"moving_steps", f.moving_steps},
+                   {"median_deg", Optional(f.median_deg)},
+                   {"p90_deg", Optional(f.p90_deg)}};
   const JumpFigures& v = j.jumps;
   json each = json::array();
   for (const TransitionJump& t : v.each) {
@@ -157,6 +164,12 @@ std::string JudgementReport(const Judgement& j) {
         "steps; %d sprites mostly copies)\n",
         100 * j.clones.share, j.clones.cloned_steps, j.clones.steps, j.clones.lag_steps,
         j.clones.sprites_cloned);
+  }
+  if (j.facing.measured) {
+    add("  facing      drawn heading vs motion over %d moving steps (> %.2f m/s): median %s, p90 "
+        "%s degrees\n",
+        j.facing.moving_steps, j.facing.min_speed_m_s, Figure(j.facing.median_deg).c_str(),
+        Figure(j.facing.p90_deg).c_str());
   }
   const JumpFigures& v = j.jumps;
   if (!v.measured) {

@@ -73,6 +73,18 @@ struct CloneFigures {
   int sprites_cloned = 0;  // sprites with at least half of their steps cloned
 };
 
+// Floor sprites (filmed from above): how far the direction a sprite is drawn facing lies from the
+// way it moves, over the steps it moves faster than min_speed_m_s (motion: the displacement from
+// step t - half_window_steps to t + half_window_steps). A viewer sees a large angle as sliding
+// sideways; the source footage's own angle is the floor for it.
+struct FacingFigures {
+  bool measured = false;  // false: no floor sprite shown
+  double min_speed_m_s = 0.05;
+  int half_window_steps = 3;
+  int moving_steps = 0;  // steps of floor sprites moving faster than min_speed_m_s
+  std::optional<double> median_deg, p90_deg;
+};
+
 struct TransitionJump {
   std::string sprite;
   int step = 0;  // the step showing `to`
@@ -99,6 +111,7 @@ struct Judgement {
   bool constraints_judged = false;  // false: no spec given
   StutterFigures stutter;
   CloneFigures clones;
+  FacingFigures facing;
   JumpFigures jumps;
 };
 

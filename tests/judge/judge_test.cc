@@ -67,6 +67,42 @@ TEST_F(JudgeTest, StutterIsTheShareOfStepsRepeatingAFrameOfTheWindow) {
   EXPECT_DOUBLE_EQ(j.stutter.replayed_share, 3.0 / 8);
 }
 
+// A floor sprite crossing +x at 0.3 m/s (1 cm a step at 30 fps), then standing still. Frame 1
+// faces +x, frame 2 faces +y (sideways) unless the sequence turns it back by -90 degrees; frame 3
+// is upright (no heading).
+TEST(MeasureFacing, TheAngleBetweenTheDrawnHeadingAndTheMotion) {
+  SpriteSequence s;
+  s.name = "mouse";
+  for (int t = 0; t < 12; ++t) {
+    s.frames.push_back({0, t < 4 ? 1 : 2});
+    s.positions_m.emplace_back(0.01 * std::min(t, 8), 0.0);
+  }
+  const auto heading_of = [](const BankFrameRef& f) -> std::optional<double> {
+    if (f.sprite_id == 3) return std::nullopt;
+    return f.sprite_id == 1 ? 0.0 : M_PI / 2;
+  };
+  // Over +-3 steps, steps 0-10 move faster than 0.05 m/s (step 10: 1 cm in 4 steps, 0.075 m/s);
+  // step 11's window holds still. Steps 0-3 face the motion, 4-10 slide sideways.
+  FacingFigures f = MeasureFacing({s}, 30.0, 0.05, 3, heading_of);
+  EXPECT_TRUE(f.measured);
+  EXPECT_EQ(f.moving_steps, 11);
+  ASSERT_TRUE(f.median_deg && f.p90_deg);
+  EXPECT_NEAR(*f.median_deg, 90.0, 1e-9);
+  EXPECT_NEAR(*f.p90_deg, 90.0, 1e-9);
+  // Turned back by the sequence, the same frames face the way they go.
+  s.turns_rad.assign(12, -M_PI / 2);
+  for (int t = 0; t < 4; ++t) s.turns_rad[t] = 0.0;
+  f = MeasureFacing({s}, 30.0, 0.05, 3, heading_of);
+  EXPECT_NEAR(*f.median_deg, 0.0, 1e-9);
+  EXPECT_NEAR(*f.p90_deg, 0.0, 1e-9);
+  // Upright frames carry no heading: nothing is measured.
+  for (BankFrameRef& r : s.frames) r.sprite_id = 3;
+  f = MeasureFacing({s}, 30.0, 0.05, 3, heading_of);
+  EXPECT_FALSE(f.measured);
+  EXPECT_EQ(f.moving_steps, 0);
+  EXPECT_FALSE(f.median_deg);
+}
+
 TEST_F(JudgeTest, ReplayedCountsALoopPastTheStutterWindow) {
   // A stride of 4 frames played three times (A0-A3 thrice, then A4): no step repeats a frame of
   // the 2 before, but 8 of 13 steps show a frame shown earlier; a second sprite's frames are its

@@ -1009,6 +1009,9 @@ function judgeRows(j) {
   for (const f of j.frames || []) rows.push(['frames', `${f.sprite} ${f.set}`, `${pct(f.on_share)} of steps ${f.first_step}–${f.end_step}`]);
   if (j.stutter) rows.push(['stutter', '', `${pct(j.stutter.share)} (replayed ${pct(j.stutter.replayed_share)})`]);
   if (j.clones && (j.lengths || []).length > 1) rows.push(['clones', '', `${pct(j.clones.share)}, ${j.clones.sprites_cloned} sprites mostly copies`]);
+  if (j.facing?.measured && j.facing.median_deg !== null) {
+    rows.push(['facing', `${j.facing.moving_steps} moving steps`, `drawn ${fmt(j.facing.median_deg, 0)}° off the way it moves (median), p90 ${fmt(j.facing.p90_deg, 0)}°`]);
+  }
   const v = j.jumps;
   if (v?.measured) {
     const x = (n) => (n === null || n === undefined ? '–' : fmt(n, 2));
