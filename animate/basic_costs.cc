@@ -72,6 +72,32 @@ int RepeatTerm::CountViolations(Tracks tracks) const {
   return n;
 }
 
+std::vector<double> FacingCosts(const TransitionGraph& graph, double strength) {
+  std::vector<double> cost(graph.num_frames(), 0.0);
+  for (int i = 0; i < graph.num_frames(); ++i) {
+    const std::optional<double>& heading = graph.frame(i).heading_rad;
+    const Eigen::Vector2d& v = graph.velocity_m(i);
+    if (!heading || v.isZero()) continue;
+    const double off = *heading - std::atan2(v.y(), v.x());
+    cost[i] = strength * v.norm() * (1 - std::cos(off)) / 2;
+  }
+  return cost;
+}
+
+FacingTerm::FacingTerm(int sprite, std::shared_ptr<const std::vector<double>> cost)
+    : FrameStepTerm("facing", {sprite}, 1.0), cost_(std::move(cost)) {
+  if (!cost_) throw InputError("facing", "missing frame costs");
+}
+
+std::pair<int, int> FacingTerm::Steps(Tracks tracks, const EvalRequest& /*request*/) const {
+  return {0, tracks[sprites()[0]]->size()};
+}
+
+double FacingTerm::StepCost(Tracks tracks, int t) const {
+  const Track& track = *tracks[sprites()[0]];
+  return t < track.size() ? (*cost_)[track.frames[t]] : 0.0;
+}
+
 LengthTerm::LengthTerm(int sprite, int min_frames, double strength)
     : StepSumTerm("length", {sprite}, strength), min_frames_(min_frames) {
   if (min_frames < 1) throw InputError("length.min_frames", "must be >= 1");

@@ -7,6 +7,13 @@
 //                                still-tagged: a frame shown again within W steps is what a
 //                                viewer sees as stutter (judge/judge.h counts the same)
 //   length (§6.2)                end cost λ max(0, N - n)
+//   facing (ours, floor sprites) c_t = φ(s_t), φ(i) = β |v(i)| (1 - cos Δ_i) / 2, Δ_i the angle
+//                                between frame i's heading and its velocity: the metres a sprite
+//                                filmed from above moves other than the way it faces (sideways
+//                                half, backwards whole), which a viewer sees as sliding. Per metre,
+//                                so creeping sideways slowly costs as much as darting. A transition
+//                                turns heading and velocity alike (animate/track.h): φ is the
+//                                frame's alone.
 #include <memory>
 #include <optional>
 #include <vector>
@@ -74,6 +81,24 @@ class LengthTerm : public StepSumTerm {
 
  private:
   int min_frames_;
+};
+
+// φ per frame for FacingTerm, `strength` β per metre; 0 for upright frames.
+std::vector<double> FacingCosts(const TransitionGraph& graph, double strength);
+
+class FacingTerm : public FrameStepTerm {
+ public:
+  // `cost`: FacingCosts of the graph (shared by every sprite's term). Strength 1: φ holds β.
+  FacingTerm(int sprite, std::shared_ptr<const std::vector<double>> cost);
+  const std::vector<double>& frame_costs() const { return *cost_; }
+
+ protected:
+  std::pair<int, int> Steps(Tracks tracks, const EvalRequest& request) const override;
+  double StepCost(Tracks tracks, int t) const override;
+  int LookBack() const override { return 0; }
+
+ private:
+  std::shared_ptr<const std::vector<double>> cost_;
 };
 
 // Starts the frame window when a sprite passes the end of a path: "once the hamster reaches

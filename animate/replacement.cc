@@ -588,11 +588,23 @@ class Replacer {
   std::vector<double> values_shifted_;
 };
 
-std::vector<double> SlowFrameCosts(const TransitionGraph& graph, const ReplacementOptions& o) {
-  if (o.slow_frame_cost <= 0 || o.reference_speed_m <= 0) return {};
-  std::vector<double> cost(graph.num_frames());
-  for (int i = 0; i < graph.num_frames(); ++i) {
-    cost[i] = o.slow_frame_cost * std::max(0.0, o.reference_speed_m - graph.speed_m(i));
+// Ĉ's cost of entering each frame: slow frames (when asked) and the problem's facing cost (the
+// first FacingTerm's: every sprite shares one); empty when neither applies.
+std::vector<double> FrameEntryCosts(const Problem& problem, const ReplacementOptions& o) {
+  const TransitionGraph& graph = problem.graph();
+  std::vector<double> cost;
+  if (o.slow_frame_cost > 0 && o.reference_speed_m > 0) {
+    cost.resize(graph.num_frames());
+    for (int i = 0; i < graph.num_frames(); ++i) {
+      cost[i] = o.slow_frame_cost * std::max(0.0, o.reference_speed_m - graph.speed_m(i));
+    }
+  }
+  for (int k = 0; k < problem.num_terms(); ++k) {
+    const auto* facing = dynamic_cast<const FacingTerm*>(&problem.term(k));
+    if (facing == nullptr) continue;
+    cost.resize(graph.num_frames(), 0.0);
+    for (int i = 0; i < graph.num_frames(); ++i) cost[i] += facing->frame_costs()[i];
+    break;
   }
   return cost;
 }
@@ -753,7 +765,7 @@ ReplacementSets ReplacementSets::Build(const Problem& problem, const Replacement
   ReplacementSets sets;
   ScopedTimer timer(&sets.build_seconds_);
   const TransitionGraph& graph = problem.graph();
-  const std::vector<double> base = SlowFrameCosts(graph, options);
+  const std::vector<double> base = FrameEntryCosts(problem, options);
   ReachOptions reach = options.reach;
   reach.cancel = options.cancel;
   reach.step_cost += options.step_cost_fraction * graph.MedianPositiveCost();

@@ -43,6 +43,10 @@ void Scene::AddTerms() {
   std::shared_ptr<const std::vector<bool>> still;  // frames a RepeatTerm lets repeat
   if (spec_.repeats.strength > 0 && !spec_.repeats.still_tag.empty())
     still = std::make_shared<std::vector<bool>>(graph.FramesWithTag(spec_.repeats.still_tag));
+  std::shared_ptr<const std::vector<double>> facing;  // φ per frame, shared by the sprites
+  if (spec_.facing.strength > 0 && graph.has_floor_frames()) {
+    facing = std::make_shared<std::vector<double>>(FacingCosts(graph, spec_.facing.strength));
+  }
   for (int id = 0; id < static_cast<int>(spec_.sprites.size()); ++id) {
     const SpriteSpecEntry& entry = spec_.sprites[id];
     for (const LocationSpec& l : entry.locations) {
@@ -89,6 +93,7 @@ void Scene::AddTerms() {
       problem_->AddTerm(std::make_unique<RepeatTerm>(id, spec_.repeats.window_steps,
                                                      spec_.repeats.strength, still));
     }
+    if (facing) problem_->AddTerm(std::make_unique<FacingTerm>(id, facing));
     const std::optional<FastFrameSpec>& fast = entry.fast ? entry.fast : spec_.fast;
     if (fast && fast->strength > 0) {
       // Graph speeds are metres per source frame: convert the reference and the strength.

@@ -193,6 +193,7 @@ class SpecReader {
   FastFrameSpec Fast(const YAML::Node& node, const std::string& path);
   RepeatSpec Repeats(const YAML::Node& node, const std::string& path);
   CloneSpec Clones(const YAML::Node& node, const std::string& path);
+  FacingSpec Facing(const YAML::Node& node, const std::string& path);
   LocationSpec Location(const YAML::Node& node, const std::string& path);
   PathSpec Path(const YAML::Node& node, const std::string& path);
   FrameSpec Frames(const YAML::Node& node, const std::string& path);
@@ -415,6 +416,10 @@ AnimationSpec SpecReader::Read(const YAML::Node& root) {
       .AddRead("repeats", "", "{strength, window_steps, still_tag}",
                BlockOf([this](const YAML::Node& n, const std::string& p) {
                  spec_.repeats = Repeats(n, p);
+               }))
+      .AddRead("facing", "", "{strength}",
+               BlockOf([this](const YAML::Node& n, const std::string& p) {
+                 spec_.facing = Facing(n, p);
                }))
       .AddRead("clones", "", "{strength, lag_steps}",
                BlockOf([this](const YAML::Node& n, const std::string& p) {
@@ -717,6 +722,17 @@ RepeatSpec SpecReader::Repeats(const YAML::Node& node, const std::string& path) 
   AtLeast(view, "strength", out.strength, 0);
   Check(view, "window_steps", out.window_steps >= 1 && out.window_steps <= 1000,
         "must be 1..1000 steps, got " + std::to_string(out.window_steps));
+  return out;
+}
+
+FacingSpec SpecReader::Facing(const YAML::Node& node, const std::string& path) {
+  FacingSpec out;
+  OptionsBinder keys;
+  keys.Add("strength", &out.strength, "a number", "per metre moved other than forward");
+  YamlMap view;
+  if (!Block(keys, node, path, view)) return out;
+  Required(view, "strength", "required");
+  AtLeast(view, "strength", out.strength, 0);
   return out;
 }
 

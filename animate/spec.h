@@ -83,6 +83,13 @@ struct RepeatSpec {
   std::string still_tag = "still";
 };
 
+// Ours: floor sprites (filmed from above) should move the way they face; each step costs
+// strength * |v| * (1 - cos Δ) / 2 for a frame moving |v| metres at an angle Δ to its heading
+// (FacingTerm, animate/basic_costs.h). Upright sprites carry no heading: it does not apply.
+struct FacingSpec {
+  double strength = 300.0;  // per metre moved other than forward; 0: off
+};
+
 // Ours: two sprites showing the same frame within `lag_steps` of each other cost `strength`
 // (animate/clone_cost.h), between every pair of sprites.
 struct CloneSpec {
@@ -146,6 +153,7 @@ struct AnimationSpec {
   std::optional<LengthSpec> length;  // free length: penalize sequences under N frames
   std::optional<FastFrameSpec> fast;
   RepeatSpec repeats;
+  FacingSpec facing;
   CloneSpec clones;
   std::string camera_path;              // .cameramodel (absolute)
   SpecPlace camera_place;               // where the spec names it

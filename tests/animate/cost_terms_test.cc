@@ -176,6 +176,28 @@ TEST_F(CostTermsTest, LengthAndFastFrames) {
   EXPECT_THROW(LengthTerm(0, 3, -1.0), InputError);
 }
 
+// Floor frames moving 1 m a step: 0 faces its motion, 1 moves sideways (heading +y, moving +x), 2
+// moves backwards, 3 moves sideways 0.1 m; 4 is upright (no heading).
+TEST(FacingCosts, AreTheMetresMovedOtherThanForward) {
+  std::vector<FrameInfo> frames(5);
+  const double heading[] = {0, kPi / 2, kPi, -kPi / 2};
+  for (int i = 0; i < 5; ++i) frames[i].velocity_m = Vector2d(i == 3 ? 0.1 : 1.0, 0);
+  for (int i = 0; i < 4; ++i) frames[i].heading_rad = heading[i];
+  const TransitionGraph graph(std::move(frames), {});
+  const std::vector<double> cost = FacingCosts(graph, 2.0);
+  ASSERT_EQ(cost.size(), 5u);
+  EXPECT_NEAR(cost[0], 0.0, 1e-12);
+  EXPECT_NEAR(cost[1], 2.0 * 0.5, 1e-12);
+  EXPECT_NEAR(cost[2], 2.0 * 1.0, 1e-12);
+  EXPECT_NEAR(cost[3], 2.0 * 0.1 * 0.5, 1e-12);  // slow sideways costs its metres too
+  EXPECT_DOUBLE_EQ(cost[4], 0.0);
+  // The term sums φ over the steps shown.
+  std::vector<Track> tracks{MakeTrack(graph, {0, 1, 2, 3}, Anchor::kStart, Vector2d(0, 0))};
+  const FacingTerm facing(0, std::make_shared<std::vector<double>>(cost));
+  const CostTerm& term = facing;
+  EXPECT_NEAR(term.Evaluate(TrackPointers(tracks)), 2.0 * 1.55, 1e-12);
+}
+
 // Frames 0 1 2 1 3 0: frame 1 comes back after 2 steps, frame 0 after 5.
 TEST_F(CostTermsTest, RepeatsWithinTheWindowUnlessStill) {
   tracks_ = {MakeTrack(graph_, {0, 1, 2, 1, 3, 0}, Anchor::kStart, Vector2d(0, 0))};

@@ -184,6 +184,20 @@ TEST_F(SpecTest, ClonesCostTwoSpritesShowingAFrameTogether) {
             Origin() + ":6: clones.lag_steps: must be 0..100 steps, got 101");
 }
 
+TEST_F(SpecTest, FacingIsOnForFloorSpritesAlone) {
+  const std::string fast = "fast_frames: {reference_speed_m_s: 1.0, strength: 0.5}";
+  EXPECT_EQ(ParseAnimationSpec(kGood, Origin()).facing.strength, 300);  // on unless set to 0
+  const AnimationSpec spec = ParseAnimationSpec(Edit(fast, "facing: {strength: 50}"), Origin());
+  EXPECT_EQ(spec.facing.strength, 50);
+  // The bank's sprites are upright: they carry no heading, and no facing term is built.
+  EXPECT_EQ(TermsOfKind(*Scene::Load(spec), "facing"), 0);
+  EXPECT_EQ(ErrorOf(Edit(fast, "facing: {strength: -1}")),
+            Origin() + ":6: facing.strength: must be >= 0");
+  EXPECT_NE(ErrorOf(Edit(fast, "facing: {strenght: 1}"))
+                .find(":6: facing.strenght: unknown key (did you mean \"strength\"?)"),
+            std::string::npos);
+}
+
 // A spec a client sends the station may name files under the station's folders only: one
 // elsewhere (by path, by "..", or through a link) is refused by its line before it is opened.
 TEST_F(SpecTest, FilesOutsideTheRootsAreRefusedByLineUnopened) {
