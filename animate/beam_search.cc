@@ -67,13 +67,13 @@ class BeamPlanner {
     Track scratch;
     for (int i = 0; i < starts; ++i) {
       const int f = static_cast<int>(static_cast<int64_t>(i) * num_frames / starts);
-      scratch = MakeTrack(graph_, {f}, anchor, spec.anchor_m);
+      scratch = MakeTrack(graph_, {f}, anchor, spec.anchor_m, spec.anchor_facing_rad);
       children.push_back({Cost(s, scratch, 0, nullptr, 1), -1, f});
     }
     KeepBest(width, &children);
     beam.reserve(children.size());
     for (const BeamChild& c : children)
-      beam.push_back(MakeTrack(graph_, {c.frame}, anchor, spec.anchor_m));
+      beam.push_back(MakeTrack(graph_, {c.frame}, anchor, spec.anchor_m, spec.anchor_facing_rad));
 
     Track best;
     double best_cost = kInfiniteCost;
@@ -106,9 +106,9 @@ class BeamPlanner {
         for (int f : graph_.successors(parent.frames.back())) {
           scratch.frames.back() = f;
           if (end_anchored) {
-            IntegrateTrack(graph_, anchor, spec.anchor_m, &scratch);
+            IntegrateTrack(graph_, anchor, spec.anchor_m, spec.anchor_facing_rad, &scratch);
           } else {
-            IntegrateTrack(graph_, anchor, spec.anchor_m, &scratch, n);
+            IntegrateTrack(graph_, anchor, spec.anchor_m, spec.anchor_facing_rad, &scratch, n);
           }
           children.push_back({Cost(s, scratch, end_anchored ? 0 : n, &caches, n + 1), p, f});
           ++summary_->moves_tried;
@@ -121,7 +121,8 @@ class BeamPlanner {
       for (const BeamChild& c : children) {
         Track track = beam[c.parent];
         track.frames.push_back(c.frame);
-        IntegrateTrack(graph_, anchor, spec.anchor_m, &track, end_anchored ? 0 : track.size() - 1);
+        IntegrateTrack(graph_, anchor, spec.anchor_m, spec.anchor_facing_rad, &track,
+                       end_anchored ? 0 : track.size() - 1);
         next.push_back(std::move(track));
       }
       beam.swap(next);

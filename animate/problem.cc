@@ -70,7 +70,8 @@ CostBreakdown Problem::Evaluate(const std::vector<Track>& tracks) const {
 }
 
 Track Problem::MakeSpriteTrack(int s, std::vector<int> frames) const {
-  return MakeTrack(graph_, std::move(frames), sprites_[s].anchor, sprites_[s].anchor_m);
+  return MakeTrack(graph_, std::move(frames), sprites_[s].anchor, sprites_[s].anchor_m,
+                   sprites_[s].anchor_facing_rad);
 }
 
 bool Problem::IsValid(const std::vector<Track>& tracks, std::string* why) const {

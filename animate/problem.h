@@ -3,6 +3,7 @@
 // and the cost terms over them. The total cost C = sum of all terms (seed 000 eq. 3).
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -19,6 +20,8 @@ struct SpriteSpec {
   Anchor anchor = Anchor::kStart;
   // p_0 (kStart; kFree: first guess) or p_{n-1}
   Eigen::Vector2d anchor_m = Eigen::Vector2d::Zero();
+  // Floor sprites: the ground direction the anchored step faces (IntegrateTrack); none: as filmed.
+  std::optional<double> anchor_facing_rad;
   double smoothness = 1.0;            // α, strength of Cs for this sprite (its SmoothnessTerm)
   int initial_frames = 60;            // length of a random initial sequence
   int max_frames = 0;                 // longer sequences are cut at the end; 0 = no limit

@@ -374,8 +374,8 @@ class Replacer {
     candidate.velocities_m.resize(n);
     const bool end_anchored = spec.anchor == Anchor::kEnd;
     const Eigen::Vector2d anchor_m = end_anchored ? spec.anchor_m : current.positions_m.front();
-    IntegrateTrack(graph_, end_anchored ? Anchor::kEnd : Anchor::kStart, anchor_m, &candidate,
-                   keep);
+    IntegrateTrack(graph_, end_anchored ? Anchor::kEnd : Anchor::kStart, anchor_m,
+                   spec.anchor_facing_rad, &candidate, keep);
     const int first_changed = end_anchored ? 0 : keep;
 
     const double current_sum = InvolvedCost(s);

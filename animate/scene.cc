@@ -1,6 +1,7 @@
 #include "animate/scene.h"
 
 #include <algorithm>
+#include <cmath>
 
 #include "animate/basic_costs.h"
 #include "animate/clone_cost.h"
@@ -33,9 +34,20 @@ void Scene::AddTerms() {
   const TransitionGraph& graph = bank_.graph;
   const double interval = IntervalS();
   for (const SpriteSpecEntry& entry : spec_.sprites) {
+    // A floor sprite may be turned about the vertical: one with a path starts facing along it
+    // (or, anchored at its end, ends facing along its last stretch), whatever frame it shows.
+    std::optional<double> facing;
+    if (graph.has_floor_frames() && entry.path && entry.path->points_m.size() >= 2) {
+      const std::vector<Eigen::Vector2d>& points = entry.path->points_m;
+      const size_t n = points.size();
+      const Eigen::Vector2d along =
+          entry.anchor == Anchor::kEnd ? points[n - 1] - points[n - 2] : points[1] - points[0];
+      if (!along.isZero()) facing = std::atan2(along.y(), along.x());
+    }
     problem_->AddSprite({.name = entry.name,
                          .anchor = entry.anchor,
                          .anchor_m = entry.anchor_m,
+                         .anchor_facing_rad = facing,
                          .smoothness = entry.smoothness,
                          .initial_frames = spec_.initial_frames,
                          .max_frames = spec_.max_frames});

@@ -6,7 +6,7 @@
 namespace ss {
 
 void IntegrateTrack(const TransitionGraph& graph, Anchor anchor, const Eigen::Vector2d& anchor_m,
-                    Track* track, int from_step) {
+                    std::optional<double> anchor_facing_rad, Track* track, int from_step) {
   const int n = track->size();
   track->velocities_m.resize(n);
   track->positions_m.resize(n);
@@ -18,13 +18,19 @@ void IntegrateTrack(const TransitionGraph& graph, Anchor anchor, const Eigen::Ve
     // the end, which stays as filmed.
     std::vector<double>& turn = track->turns_rad;
     turn.resize(n);
+    // The anchored step's turn: toward anchor_facing_rad, or none.
+    const auto anchored_turn = [&](int t) {
+      const std::optional<double>& heading = graph.frame(track->frames[t]).heading_rad;
+      if (!anchor_facing_rad || !heading) return 0.0;
+      return std::remainder(*anchor_facing_rad - *heading, 2 * M_PI);
+    };
     if (anchor == Anchor::kEnd) {
-      turn[n - 1] = 0;
+      turn[n - 1] = anchored_turn(n - 1);
       for (int t = n - 1; t > 0; --t) {
         turn[t - 1] = turn[t] - graph.Turn(track->frames[t - 1], track->frames[t]);
       }
     } else {
-      if (from_step == 0) turn[0] = 0;
+      if (from_step == 0) turn[0] = anchored_turn(0);
       for (int t = std::max(from_step, 1); t < n; ++t) {
         turn[t] = turn[t - 1] + graph.Turn(track->frames[t - 1], track->frames[t]);
       }
@@ -80,10 +86,10 @@ const Eigen::AlignedBox2d* Track::ChunkBox(int c, Eigen::AlignedBox2d* held) con
 }
 
 Track MakeTrack(const TransitionGraph& graph, std::vector<int> frames, Anchor anchor,
-                const Eigen::Vector2d& anchor_m) {
+                const Eigen::Vector2d& anchor_m, std::optional<double> anchor_facing_rad) {
   Track track;
   track.frames = std::move(frames);
-  IntegrateTrack(graph, anchor, anchor_m, &track);
+  IntegrateTrack(graph, anchor, anchor_m, anchor_facing_rad, &track);
   return track;
 }
 

@@ -8,6 +8,7 @@
 // anchored at the start (p_0 given, or optimized for a free start) or at the end
 // (p_{n-1} given; seed 000 §6.2 fixes the flies' end locations). After its last step a
 // sprite holds its last position and frame with zero velocity.
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -63,12 +64,16 @@ using Tracks = std::span<const Track* const>;
 // Recomputes velocities, positions and chunk boxes for `track->frames` from `anchor_m` (p_0
 // for kStart and kFree, p_{n-1} for kEnd). With a start anchor, the states and the chunk
 // boxes before `from_step` are kept as they are (the caller guarantees they are current).
+// `anchor_facing_rad` (floor sprites): the ground direction the anchored step (p_0's, or
+// p_{n-1}'s for kEnd) faces, whatever frame it shows: its turn is that less the frame's heading.
+// None: that step is shown as filmed (turn 0).
 void IntegrateTrack(const TransitionGraph& graph, Anchor anchor, const Eigen::Vector2d& anchor_m,
-                    Track* track, int from_step = 0);
+                    std::optional<double> anchor_facing_rad, Track* track, int from_step = 0);
 
 // A track built from scratch.
 Track MakeTrack(const TransitionGraph& graph, std::vector<int> frames, Anchor anchor,
-                const Eigen::Vector2d& anchor_m);
+                const Eigen::Vector2d& anchor_m,
+                std::optional<double> anchor_facing_rad = std::nullopt);
 
 // Moves every position by `offset_m` (a new start for a free sprite).
 void ShiftTrack(const Eigen::Vector2d& offset_m, Track* track);

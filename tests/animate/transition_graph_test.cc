@@ -100,6 +100,17 @@ TEST(TransitionGraph, AFloorSpriteIsTurnedAtATransitionAndGoesOnTheWayItWent) {
   const Track back = MakeTrack(graph, {0, 1, 3, 4, 5}, Anchor::kEnd, {0, 0});
   EXPECT_NEAR(back.turns_rad[4], 0.0, 1e-12);
   EXPECT_NEAR(back.turns_rad[0], M_PI / 2, 1e-12);
+  // Started facing south (a path that heads south), the same frames walk south and then on
+  // south: every step turns a further quarter back.
+  const Track south = MakeTrack(graph, {0, 1, 3, 4, 5}, Anchor::kStart, {0, 0}, -M_PI / 2);
+  EXPECT_NEAR(south.turns_rad[0], -M_PI / 2, 1e-12);
+  EXPECT_NEAR(south.turns_rad[4], -M_PI, 1e-12);
+  EXPECT_NEAR((south.positions_m[4] - Eigen::Vector2d(0, -0.04)).norm(), 0, 1e-12)
+      << "it walks south: " << south.positions_m[4].transpose();
+  // End-anchored facing west: the end turns a half turn from north, the start from east.
+  const Track west = MakeTrack(graph, {0, 1, 3, 4, 5}, Anchor::kEnd, {0, 0}, M_PI);
+  EXPECT_NEAR(std::abs(west.turns_rad[4]), M_PI / 2, 1e-12);
+  EXPECT_NEAR(std::abs(std::remainder(west.turns_rad[0] - M_PI, 2 * M_PI)), 0, 1e-12);
   // Upright frames never turn.
   EXPECT_FALSE(TransitionGraph(TwoClips(), {}).has_floor_frames());
   EXPECT_TRUE(
