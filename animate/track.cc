@@ -14,8 +14,8 @@ void IntegrateTrack(const TransitionGraph& graph, Anchor anchor, const Eigen::Ve
   if (anchor == Anchor::kEnd) from_step = 0;
   from_step = std::clamp(from_step, 0, n);
   if (graph.has_floor_frames()) {
-    // Floor sprites turn at transitions: from the start (kept before from_step), or back from
-    // the end, which stays as filmed.
+    // Floor sprites turn at transitions: on from the start (kept before from_step), or back from
+    // the end; the anchored step itself faces anchor_facing_rad, or stays as filmed.
     std::vector<double>& turn = track->turns_rad;
     turn.resize(n);
     // The anchored step's turn: toward anchor_facing_rad, or none.
