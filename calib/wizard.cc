@@ -500,7 +500,7 @@ double CalibrationWizard::StillRunCovers(double time_s) const {
 WizardFrame CalibrationWizard::Feed(const cv::Mat& image, int frame, double time_s) {
   WizardFrame out;
   out.step = step_;
-  if (step_ == WizardStep::kDone) return out;
+  if (step_ == WizardStep::kDone && !o_.detect_when_done) return out;
   if (image.cols != width_ || image.rows != height_) {
     throw InputError(camera_ + " frame " + std::to_string(frame),
                      "the frame is " + std::to_string(image.cols) + "x" +

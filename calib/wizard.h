@@ -111,6 +111,10 @@ struct WizardOptions {
   // false: the intrinsics are solved only when Solve() is called (the console's Solve button);
   // capturing stops at max_views.
   bool auto_solve = true;
+  // Once done, go on finding the board (Feed's `detected`, `still` and last_view()): the
+  // console's joint solve of a rig takes still views from every step, so a camera posed early
+  // still adds the places the board is held before it and another camera. False: done is done.
+  bool detect_when_done = false;
   // False with "FIELD: reason" lines in `why` for values out of range (detect., verdict. and
   // solve. name the nested blocks' fields).
   bool IsValid(std::string* why) const;

@@ -351,6 +351,7 @@ class CameraWork {
         o.still_s = settings_.still_s;
         o.floor_still_s = settings_.floor_still_s;
         o.floor_needs_word = true;
+        o.detect_when_done = true;  // the joint solve's views, from every step
         o.floor_word_s = std::max(o.floor_word_s, o.floor_still_s + 5.0);
         wizard_ = std::make_unique<calib::CalibrationWizard>(name_, bgr_.cols, bgr_.rows, o);
       }
@@ -358,9 +359,10 @@ class CameraWork {
           bgr_, static_cast<int>(frame.sequence),
           frame.timestamp_ns > 0 ? static_cast<double>(frame.timestamp_ns) * 1e-9 : NAN);
       guidance_ = out.guidance;
-      // A still board before the camera is posed: a view for the joint solve, if another camera
-      // saw it still at the same time. Still since the run's first frame: the frame processed
-      // before the one that made it still.
+      // A still board, in any step: a view for the joint solve, if another camera saw it still
+      // at the same time (a camera posed early goes on adding the places held before it and
+      // another; the floor board, which one camera sees, pairs with none). Still since the
+      // run's first frame: the frame processed before the one that made it still.
       const double t =
           frame.timestamp_ns > 0 ? static_cast<double>(frame.timestamp_ns) * 1e-9 : NAN;
       const bool still = out.detected && out.still;
@@ -373,8 +375,7 @@ class CameraWork {
       if (still && !was_still_) still_since_s_ = last_time_s_;
       was_still_ = still;
       last_time_s_ = t;
-      if (still && std::isfinite(t) &&
-          (out.step == WizardStep::kIntrinsics || out.step == WizardStep::kGround)) {
+      if (still && std::isfinite(t)) {
         std::lock_guard lock(state_mutex_);
         timed_.push_back({0, t, wizard_->last_view(), still_since_s_});
         if (timed_.size() > kTimedViews) timed_.pop_front();

@@ -249,5 +249,31 @@ TEST(WizardGround, ABoardNotOnTheFloorIsNeverTaken) {
   }
 }
 
+// Once done (posed, the floor set), the console's wizard goes on finding the board: the joint
+// solve of a rig takes the places a board is held still before this camera and another from
+// every step, so a camera posed early is not left out of later ones (issue 41). The command
+// line's stops looking.
+TEST(WizardGround, DoneGoesOnFindingTheBoardOnlyWhenAsked) {
+  const GroundStudio s(5);
+  const cv::Mat held = s.Scene(s.Held(0.0, 0.0, 0.6, 0.2, -0.1));
+  for (const bool keep : {false, true}) {
+    WizardOptions o = s.Options();
+    o.detect_when_done = keep;
+    CalibrationWizard w("cam0", 640, 480, o);
+    int n = 0;
+    FeedStill(w, s.Scene(s.on_floor), 5, &n);
+    ASSERT_TRUE(w.ground_good()) << w.log().dump();
+    w.SetFloorFromPixels({{100, 300}, {540, 300}, {600, 470}, {40, 470}});
+    ASSERT_EQ(w.step(), WizardStep::kDone);
+    WizardFrame f;
+    for (int i = 0; i < 3; ++i, ++n) f = w.Feed(Noisy(held, n), n, n / kFps);
+    EXPECT_EQ(f.step, WizardStep::kDone);
+    EXPECT_EQ(f.detected, keep) << "detect_when_done " << keep;
+    EXPECT_EQ(f.still, keep) << "detect_when_done " << keep;
+    if (keep) EXPECT_TRUE(w.last_view().accepted);
+    EXPECT_TRUE(w.ground_good()) << "the pose is kept";
+  }
+}
+
 }  // namespace
 }  // namespace ss::calib
