@@ -519,13 +519,19 @@ class Card {
     e['cam-tilt'].textContent = g ? `${fmt(g.tilt_deg, 1)}°` : '–';
     e['cam-centre'].textContent = g?.centre_m ? g.centre_m.map((v) => fmt(v, 3)).join(', ') + ' m' : '–';
     e['cam-ground-rms'].textContent = g && g.rms_px !== undefined ? `${fmt(g.rms_px, 2)} px` : '–';
-    e['cam-pose'].dataset.posed = String(Boolean(g));
+    // A camera of a rig that sees no floor board of its own is posed by the trusted joint solve,
+    // from another camera's floor board: Save writes its joint model (issue 41).
+    const j = calib?.joint;
+    const rig = !g && j?.state === 'solved' && j.trusted && j.posed_from && j.posed_from !== this.name &&
+      (j.cameras || []).some((k) => k.name === this.name) ? j.posed_from : '';
+    e['cam-pose'].dataset.posed = g ? 'true' : rig ? 'rig' : 'false';
     // the operator's word, and a floor board whose pose was doubtful (not taken), with why
     const inGround = cam.step === 'ground';
     e['cam-board-on-floor'].disabled = !inGround || !cam.ground_word_needed || Boolean(busy);
     e['cam-ground-word'].textContent = !inGround ? ''
-      : cam.ground_word_needed ? 'waiting for your word' : 'checking the board once it is still';
-    e['cam-ground-word'].dataset.state = !inGround ? '' : cam.ground_word_needed ? 'waiting' : 'given';
+      : rig ? `posed through the joint solve from ${rig}'s floor board: Save writes it (or lay the board before this camera too)`
+        : cam.ground_word_needed ? 'waiting for your word' : 'checking the board once it is still';
+    e['cam-ground-word'].dataset.state = !inGround ? '' : rig ? 'rig' : cam.ground_word_needed ? 'waiting' : 'given';
     const gc = cam.ground_check;
     const doubt = inGround && gc?.doubt ? gc.doubt : '';
     e['cam-ground-doubt'].hidden = !doubt;
