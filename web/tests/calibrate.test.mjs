@@ -12,6 +12,7 @@ import { spawn } from 'node:child_process';
 import fs from 'node:fs';
 import path from 'node:path';
 import * as h from './harness.mjs';
+import { pose, project, readModel } from './cameramodel.mjs';
 
 const BOARD = 'chessboard:10x7:0.03';
 const POSE = ['-0.15', '0.105', '0'];
@@ -34,56 +35,6 @@ function runCli(out) {
   proc.stdout.on('data', (d) => (stdout += d));
   proc.stderr.on('data', (d) => (stderr += d));
   return new Promise((resolve) => proc.on('exit', (code) => resolve({ code, stdout, stderr, seconds: (Date.now() - t0) / 1000 })));
-}
-
-// ---- the .cameramodel text (a Python-literal dict) -----------------------------
-
-function readModel(file) {
-  const text = fs.readFileSync(file, 'utf8');
-  const list = (key) => {
-    const m = new RegExp(`'${key}'\\s*:\\s*\\[([^\\]]*)\\]`).exec(text);
-    if (!m) throw new Error(`${file}: no '${key}'`);
-    return m[1].split(',').map((v) => v.trim()).filter(Boolean).map(Number);
-  };
-  return { intrinsics: list('intrinsics'), extrinsics: list('extrinsics'), text };
-}
-
-// Rodrigues: the rotation matrix of an axis-angle vector.
-function rodrigues([rx, ry, rz]) {
-  const th = Math.hypot(rx, ry, rz);
-  if (th < 1e-15) return [[1, 0, 0], [0, 1, 0], [0, 0, 1]];
-  const [x, y, z] = [rx / th, ry / th, rz / th];
-  const c = Math.cos(th);
-  const s = Math.sin(th);
-  const C = 1 - c;
-  return [
-    [c + x * x * C, x * y * C - z * s, x * z * C + y * s],
-    [y * x * C + z * s, c + y * y * C, y * z * C - x * s],
-    [z * x * C - y * s, z * y * C + x * s, c + z * z * C],
-  ];
-}
-
-// extrinsics = mrcal's rt_cam_ref (cam_from_ground): centre = -R^T t.
-function pose(model) {
-  const R = rodrigues(model.extrinsics.slice(0, 3));
-  const t = model.extrinsics.slice(3, 6);
-  const centre = [0, 1, 2].map((j) => -(R[0][j] * t[0] + R[1][j] * t[1] + R[2][j] * t[2]));
-  return { R, centre };
-}
-
-// A ground point (metres) in a model's pixels (LENSMODEL_OPENCV8).
-function project(model, [X, Y, Z]) {
-  const { R } = pose(model);
-  const t = model.extrinsics.slice(3, 6);
-  const q = [0, 1, 2].map((i) => R[i][0] * X + R[i][1] * Y + R[i][2] * Z + t[i]);
-  const x = q[0] / q[2];
-  const y = q[1] / q[2];
-  const [fx, fy, cx, cy, k1, k2, p1, p2, k3, k4, k5, k6] = model.intrinsics;
-  const r2 = x * x + y * y;
-  const radial = (1 + k1 * r2 + k2 * r2 * r2 + k3 * r2 * r2 * r2) / (1 + k4 * r2 + k5 * r2 * r2 + k6 * r2 * r2 * r2);
-  const xd = x * radial + 2 * p1 * x * y + p2 * (r2 + 2 * x * x);
-  const yd = y * radial + p1 * (r2 + 2 * y * y) + 2 * p2 * x * y;
-  return [fx * xd + cx, fy * yd + cy];
 }
 
 // How far a model is from the truth: fx, fy in %, the centre in mm, the rotation in degrees.
