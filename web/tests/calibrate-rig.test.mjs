@@ -11,7 +11,7 @@ import assert from 'node:assert/strict';
 import fs from 'node:fs';
 import path from 'node:path';
 import * as h from './harness.mjs';
-import { angleDeg, mul, pose, readModel, relative, transpose } from './cameramodel.mjs';
+import { angleDeg, mul, poseError, readModel, relative, transpose } from './cameramodel.mjs';
 
 // Not in CI's run (`console_browser`): which of a 90 s session's held poses a loaded machine
 // catches varies, and in CI cam0's caught too few places for the coverage check in 7 minutes
@@ -248,13 +248,7 @@ rigTest('save: both joint models written; cam1 from cam0 and each pose against t
   assert.match(yaml, /^enclosure:\n\s+floor:/m, `the config's enclosure:\n${yaml}`);
 
   const got = Object.fromEntries(CAMERAS.map((n, i) => [n, readModel(want[i])]));
-  const err = {};
-  for (const n of CAMERAS) {
-    const a = pose(got[n]);
-    const t = pose(truth[n]);
-    err[n] = { centre_mm: Math.hypot(...[0, 1, 2].map((i) => a.centre[i] - t.centre[i])) * 1000,
-      rotation_deg: angleDeg(mul(a.R, transpose(t.R))) };
-  }
+  const err = Object.fromEntries(CAMERAS.map((n) => [n, poseError(got[n], truth[n])]));
   const rs = relative(got.cam0, got.cam1);
   const rt = relative(truth.cam0, truth.cam1);
   err.relative = { mm: Math.hypot(...[0, 1, 2].map((i) => rs.t[i] - rt.t[i])) * 1000, deg: angleDeg(mul(rs.R, transpose(rt.R))) };

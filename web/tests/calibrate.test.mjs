@@ -12,7 +12,7 @@ import { spawn } from 'node:child_process';
 import fs from 'node:fs';
 import path from 'node:path';
 import * as h from './harness.mjs';
-import { pose, project, readModel } from './cameramodel.mjs';
+import { pose, poseError, project, readModel } from './cameramodel.mjs';
 
 const BOARD = 'chessboard:10x7:0.03';
 const POSE = ['-0.15', '0.105', '0'];
@@ -42,14 +42,8 @@ function against(model) {
   const e = (i) => (Math.abs(model.intrinsics[i] - truth.intrinsics[i]) / truth.intrinsics[i]) * 100;
   const out = { fx_percent: e(0), fy_percent: e(1) };
   if (model.extrinsics.some((v) => v !== 0)) {
-    const a = pose(model);
-    const b2 = pose(truth);
-    out.centre_mm = Math.hypot(...[0, 1, 2].map((i) => a.centre[i] - b2.centre[i])) * 1000;
-    // the angle of R_a R_b^T
-    let trace = 0;
-    for (let i = 0; i < 3; i++) for (let k = 0; k < 3; k++) trace += a.R[i][k] * b2.R[i][k];
-    out.rotation_deg = (Math.acos(Math.max(-1, Math.min(1, (trace - 1) / 2))) * 180) / Math.PI;
-    out.height_m = a.centre[2];
+    Object.assign(out, poseError(model, truth));
+    out.height_m = pose(model).centre[2];
   }
   return out;
 }

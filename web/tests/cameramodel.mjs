@@ -70,3 +70,14 @@ export function relative(a, b) {
   const t = [0, 1, 2].map((i) => tb[i] - (R[i][0] * ta[0] + R[i][1] * ta[1] + R[i][2] * ta[2]));
   return { R, t };
 }
+
+// How far model a's pose is from model b's: the camera centres' distance in mm and the angle of
+// R_a R_b^T in degrees.
+export function poseError(a, b) {
+  const pa = pose(a);
+  const pb = pose(b);
+  return {
+    centre_mm: Math.hypot(...[0, 1, 2].map((i) => pa.centre[i] - pb.centre[i])) * 1000,
+    rotation_deg: angleDeg(mul(pa.R, transpose(pb.R))),
+  };
+}
