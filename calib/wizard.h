@@ -184,8 +184,9 @@ class CalibrationWizard {
   // the enclosure), enclosure (the enclosure). InputError when the step cannot be reached.
   void Redo(WizardStep step);
   // The enclosure from points clicked on the camera's image (carried onto the floor), or the
-  // green floor of `image`. InputError (field "pixels" / "image") when it cannot be made or
-  // the camera is not posed yet; the enclosure step ends.
+  // green floor of `image`. InputError (field "pixels" / "detect") when it cannot be made, when
+  // the camera is not posed yet, or when the green floor found is smaller than the one seen with
+  // the board lying on it (something hides the floor); else the enclosure step ends.
   void SetFloorFromPixels(const std::vector<Eigen::Vector2d>& pixels);
   void DetectFloor(const cv::Mat& image);
   const std::string& floor_from() const { return floor_from_; }

@@ -167,11 +167,25 @@ TEST(CalibrationWizard, TheEnclosureWaitsForAFloorNothingHides) {
   const bool rejected = std::any_of(
       log.begin(), log.end(), [](const auto& e) { return e["event"] == "enclosure_rejected"; });
   EXPECT_TRUE(rejected) << log.dump();
+  // Nor does the operator's "detect the green floor" take the hidden floor: it says why.
+  cv::Mat hidden = RenderBoards(renderer, {}, 1.0, n);
+  cv::rectangle(hidden, cv::Rect(160, 200, 320, 280), cv::Scalar(40, 40, 60), cv::FILLED);
+  try {
+    w.DetectFloor(hidden);
+    ADD_FAILURE() << "a floor hidden by a person was taken";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("seen with the board lying on it"), std::string::npos)
+        << e.what();
+  }
+  EXPECT_FALSE(w.enclosure_good());
   for (int i = 0; i < 4 && !w.done(); ++i, ++n) w.Feed(RenderBoards(renderer, {}, 1.0, n), n);
   ASSERT_TRUE(w.enclosure_good()) << log.dump();
   // The true green floor is 1.2 m x 0.8 m; the near wall hides a strip of it from this camera.
   EXPECT_GT(w.floor()->Area(), 0.6);
   EXPECT_LT(w.floor()->Area(), 0.97);
+  // Detected by the operator with the board lying on the floor, it is taken.
+  w.DetectFloor(RenderBoards(renderer, {{&texture, o.ground_from_board}}, 1.0, n));
+  EXPECT_GT(w.floor()->Area(), 0.6);
 }
 
 }  // namespace
