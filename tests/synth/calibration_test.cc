@@ -126,7 +126,7 @@ TEST(CalibrationSession, BoardCornersAreWhereOpenCvFindsThem) {
 }
 
 // With two cameras, the chessboard is also held where both see it whole (the joint solve's
-// shared instants, calib/joint.h): poses held still for 0.6 s, in distinct places, every corner
+// shared instants, calib/joint.h): poses held still for 0.9 s, in distinct places, every corner
 // in view of both cameras in every frame of the segment; each camera's own poses go round the
 // image's nine regions.
 TEST(CalibrationSession, TwoCamerasShareASegmentOfTheBoardInViewOfBoth) {
@@ -159,8 +159,8 @@ TEST(CalibrationSession, TwoCamerasShareASegmentOfTheBoardInViewOfBoth) {
       for (const auto& c : board) EXPECT_TRUE(c.in_view) << cam << " frame " << frame;
     }
   }
-  // Still spans: runs of frames with the same pose, at least 0.5 s (4 frames at 8 fps) each,
-  // in at least 7 distinct places.
+  // Still spans: runs of frames with the same pose, at least 0.75 s (6 frames at 8 fps) each,
+  // in 6 distinct places (9 s at 1.6 s a pose, 40 % of it moving: 0.9 s held).
   int places = 0, run = 1;
   std::vector<double> last;
   for (const auto& [frame, rt] : rig_pose) {
@@ -168,10 +168,10 @@ TEST(CalibrationSession, TwoCamerasShareASegmentOfTheBoardInViewOfBoth) {
         !last.empty() &&
         std::abs(rt[3] - last[3]) + std::abs(rt[4] - last[4]) + std::abs(rt[5] - last[5]) < 1e-9;
     run = same ? run + 1 : 1;
-    if (run == 4) ++places;
+    if (run == 6) ++places;
     last = rt;
   }
-  EXPECT_GE(places, 7);
+  EXPECT_GE(places, 6);
 }
 
 }  // namespace
