@@ -6,6 +6,7 @@
 
 #include <Eigen/Geometry>
 
+#include "calib/ground.h"
 #include "core/error.h"
 
 namespace ss::calib {
@@ -123,6 +124,19 @@ std::vector<Rigid3> PoseRigFrom(const JointRig& rig, int posed, const Rigid3& ca
   out.reserve(models.size());
   for (const auto& m : models) out.push_back(m.cam_from_ground() * ref_from_ground);
   return out;
+}
+
+std::vector<Rigid3> PoseRigFromFloorView(const JointRig& rig, int posed, const BoardSpec& board,
+                                         const BoardView& floor_view,
+                                         const Rigid3& ground_from_board,
+                                         const std::string& camera) {
+  const auto& models = rig.solution.models;
+  if (posed < 0 || static_cast<size_t>(posed) >= models.size())
+    throw InputError("camera", "index " + std::to_string(posed) + " is not in the rig");
+  CameraModel model = models[static_cast<size_t>(posed)];
+  model.set_cam_from_ground({});
+  const GroundResult g = SolveGroundPose(model, board, floor_view, ground_from_board, camera);
+  return PoseRigFrom(rig, posed, g.cam_from_ground);
 }
 
 double TranslationMm(const Rigid3& x, const Rigid3& y) {

@@ -59,6 +59,15 @@ JointRig SolveJointRig(const BoardSpec& board, const std::vector<SolveCamera>& c
 // * cam_posed_from_ground), as GroundJob::rigid does.
 std::vector<Rigid3> PoseRigFrom(const JointRig& rig, int posed, const Rigid3& cam_from_ground);
 
+// As PoseRigFrom, from camera `posed`'s view of the board lying on the floor (`floor_view`, the
+// board's frame at `ground_from_board`), its pose solved again with the joint model's intrinsics:
+// the pose its wizard solved with the camera's own intrinsics does not agree with the joint
+// intrinsics saved beside it. InputError / WorkError as SolveGroundPose.
+std::vector<Rigid3> PoseRigFromFloorView(const JointRig& rig, int posed, const BoardSpec& board,
+                                         const BoardView& floor_view,
+                                         const Rigid3& ground_from_board,
+                                         const std::string& camera = "camera");
+
 // Where two cameras disagree: b's pose relative to a from the joint solve against the same from
 // the two ground poses (one by one), and a floor point both see (the middle of where their
 // optical axes meet the floor) placed in b by each.

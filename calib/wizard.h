@@ -196,6 +196,8 @@ class CalibrationWizard {
   const std::optional<CameraReport>& report() const { return report_; }
   const std::optional<CameraModel>& intrinsics_model() const { return intrinsics_model_; }
   const std::optional<GroundResult>& ground() const { return ground_; }
+  // The floor board's view ground() was solved from (its still frames averaged); empty before.
+  const BoardView& floor_view() const { return floor_view_; }
   std::optional<CameraModel> posed_model() const;
   const std::optional<GroundPolygon>& floor() const { return floor_; }
   std::vector<std::string> verdicts() const { return verdicts_; }  // one line per step that failed

@@ -296,6 +296,11 @@ class CameraWork {
     std::lock_guard lock(state_mutex_);
     return ground_pose_;
   }
+  // The floor board's view that pose was solved from (nullopt before its ground step ends).
+  std::optional<calib::BoardView> FloorView() const {
+    std::lock_guard lock(state_mutex_);
+    return floor_view_;
+  }
 
  private:
   void Post(std::function<void()> command) {
@@ -631,7 +636,11 @@ class CameraWork {
     bgr_height_ = bgr_.rows;
     if (force || captured_.size() != w.captured().size()) captured_ = w.captured();
     ground_pose_.reset();
-    if (w.ground()) ground_pose_ = w.ground()->cam_from_ground;
+    floor_view_.reset();
+    if (w.ground()) {
+      ground_pose_ = w.ground()->cam_from_ground;
+      floor_view_ = w.floor_view();
+    }
   }
 
   const std::string name_;
@@ -674,6 +683,7 @@ class CameraWork {
   std::deque<calib::TimedView> timed_;
   std::deque<double> intervals_;  // between frames of consecutive sequence numbers, seconds
   std::optional<Rigid3> ground_pose_;
+  std::optional<calib::BoardView> floor_view_;  // the floor board's, ground_pose_ solved from it
   std::atomic<bool> intrinsics_good_{false};
 
   std::thread thread_;  // last: starts once everything above exists
@@ -1164,24 +1174,43 @@ struct ConsoleCalibration::Impl {
   }
 
   // The joint models to save: each rig camera's joint intrinsics, posed through the rig from the
-  // first camera with a floor-board pose (none posed: the intrinsics alone). Empty without a joint
-  // solve.
+  // first camera with a floor-board pose (none posed: the intrinsics alone). That camera's pose is
+  // solved again from its floor board's view with its joint intrinsics (the wizard's was solved
+  // with its own, which the joint model saved does not share); the wizard's pose when that fails.
+  // Empty without a joint solve.
   std::vector<std::pair<std::string, CameraModel>> JointModels() const {
     Joint j;
+    calib::WizardOptions o;
     {
       std::lock_guard lock(mutex);
       if (!joint.rig || !joint.doubts.empty()) return {};
       j = joint;
+      o = wizard_options;
     }
     std::vector<std::pair<std::string, CameraModel>> out;
     std::vector<Rigid3> poses;
     for (size_t c = 0; c < j.names.size() && poses.empty(); ++c) {
       std::optional<Rigid3> g;
+      std::optional<calib::BoardView> view;
       try {
-        g = Work(j.names[c])->GroundPose();
+        const auto work = Work(j.names[c]);
+        g = work->GroundPose();
+        view = work->FloorView();
       } catch (const NotFoundError&) {
       }
-      if (g) poses = calib::PoseRigFrom(*j.rig, static_cast<int>(c), *g);
+      if (!g) continue;
+      if (view && view->accepted) {
+        try {
+          poses = calib::PoseRigFromFloorView(*j.rig, static_cast<int>(c), o.board, *view,
+                                              o.ground_from_board, j.names[c]);
+          continue;
+        } catch (const std::runtime_error& e) {
+          Log("station.calibration")
+              ->warn("{}: the floor pose with the joint intrinsics: {}; the wizard's kept",
+                     j.names[c], e.what());
+        }
+      }
+      poses = calib::PoseRigFrom(*j.rig, static_cast<int>(c), *g);
     }
     for (size_t c = 0; c < j.names.size(); ++c) {
       CameraModel m = j.rig->solution.models[c];
