@@ -11,7 +11,7 @@ import assert from 'node:assert/strict';
 import fs from 'node:fs';
 import path from 'node:path';
 import * as h from './harness.mjs';
-import { angleDeg, mul, poseError, readModel, relative, transpose } from './cameramodel.mjs';
+import { angleDeg, mul, poseError, project, readModel, relative, transpose } from './cameramodel.mjs';
 
 // In CI's run (`console_browser`) since the session holds each pose about 1 s and every pose a
 // camera is held at is one its detector finds, and since the test solves as the checklist says
@@ -180,7 +180,7 @@ rigTest('each camera solved; one posed on the operator\'s word, the other throug
       await p.click('[data-testid="calib-joint-solve"]');
     }
     return last.cam0?.posed === 'true' && last.cam1?.posed === 'rig' && last;
-  }, { timeout: 420000, interval: 500 }).catch((err) => {
+  }, { timeout: 540000, interval: 500 }).catch((err) => {
     err.message += `\ncards: ${JSON.stringify(last)}\njoint: ${JSON.stringify(joint)}`;
     throw err;
   });
@@ -260,6 +260,25 @@ rigTest('save: both joint models written; cam1 from cam0 and each pose against t
   assert.ok(err.relative.mm < 8 && err.relative.deg < 0.3, `cam1 from cam0: ${JSON.stringify(err.relative)}`);
   for (const n of CAMERAS) {
     assert.ok(err[n].centre_mm < 10 && err[n].rotation_deg < 0.4, `${n} against the truth: ${JSON.stringify(err[n])}`);
+  }
+  // Where each saved model sees the floor against where the true camera does (what a sprite's
+  // place rests on; a pose alone is no measure, its error trades off against the intrinsics'):
+  // RMS pixels over a 10 cm grid of the floor's middle, 1 m x 0.6 m, the points in the image.
+  measured.floor_px = {};
+  for (const n of CAMERAS) {
+    let sum = 0;
+    let count = 0;
+    for (let x = -0.5; x <= 0.5001; x += 0.1) {
+      for (let y = -0.3; y <= 0.3001; y += 0.1) {
+        const [u, v] = project(truth[n], [x, y, 0]);
+        if (!(u >= 0 && v >= 0 && u < 640 && v < 480)) continue;
+        const [a, b] = project(got[n], [x, y, 0]);
+        sum += (a - u) ** 2 + (b - v) ** 2;
+        count++;
+      }
+    }
+    measured.floor_px[n] = Number(Math.sqrt(sum / count).toPrecision(3));
+    assert.ok(count > 20 && measured.floor_px[n] < 2, `${n}: the floor ${measured.floor_px[n]} px off (${count} points)`);
   }
   await h.sleep(300);
   await h.screenshot(p, 'console-calibrate-rig-saved.png');
