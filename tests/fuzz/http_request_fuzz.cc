@@ -154,12 +154,14 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     std::abort();
   }
   // /etc/passwd's first line, whole, in the answer and not quoted from the request. An error may
-  // quote a path the request named, escaped: a CR before "oot:x:0:0" reads "\root:x:0:0" (CI
-  // found that), so the line's start alone is not enough.
+  // quote what the request sent, escaped: a CR before "oot:x:0:0" reads "\root:x:0:0" (CI found
+  // that), so the line's start alone is not enough; and a CR before the rest of the whole line
+  // reads as the whole line (CI found that too), so a request that sent the line less its first
+  // letter is not read as a leak either. A path traversal names the file, never its lines.
   const std::string& passwd = PasswdFirstLine();
   const std::string sent(reinterpret_cast<const char*>(data), size);
   if (const size_t at = answer.find(passwd);
-      at != std::string::npos && sent.find(passwd) == std::string::npos) {
+      at != std::string::npos && sent.find(passwd.substr(1)) == std::string::npos) {
     std::fprintf(stderr, "http_request: /etc/passwd was served: ...%s...\n",
                  answer.substr(at > 80 ? at - 80 : 0, 200).c_str());
     std::abort();
