@@ -151,6 +151,23 @@ class CalibrationDirector : public Director {
   std::string SubjectsJson() const override { return "[]"; }
 
  private:
+  // The smallest margin, in pixels, of the board's outer corners inside `cam`'s image (negative:
+  // outside it; -1e9: a corner behind the camera).
+  static double Margin(const SynthCamera& cam, const BoardSpec& spec,
+                       const Rigid3& ground_from_board) {
+    double margin = 1e9;
+    for (double bx : {0.0, spec.width_m()}) {
+      for (double by : {0.0, spec.height_m()}) {
+        const Eigen::Vector3d in_cam =
+            cam.cam_from_ground * (ground_from_board * Eigen::Vector3d(bx, by, 0));
+        if (in_cam.z() <= 0) return -1e9;
+        const Eigen::Vector2d px = cam.lens.Project(in_cam);
+        margin = std::min({margin, px.x(), px.y(), cam.width - px.x(), cam.height - px.y()});
+      }
+    }
+    return margin;
+  }
+
   // A pose of `spec` before `cam`: the print facing the camera, tilted up to
   // 40 degrees, filling 35-65 % of the image width, anywhere in the view (`region` -1) or
   // towards one of its nine regions (0..8, row by row; 30-45 % outside the middle one). Drawn
@@ -165,18 +182,7 @@ class CalibrationDirector : public Director {
     for (int attempt = 0; attempt < 50 && best_score < 0; ++attempt) {
       const Rigid3 pose = DrawHeldPose(cam, spec, rng, region);
       const Rigid3 cam_from_board = cam.cam_from_ground * pose;
-      double margin = 1e9;
-      for (double bx : {0.0, spec.width_m()}) {
-        for (double by : {0.0, spec.height_m()}) {
-          const Eigen::Vector3d in_cam = cam_from_board * Eigen::Vector3d(bx, by, 0);
-          if (in_cam.z() <= 0) {
-            margin = -1e9;
-            continue;
-          }
-          const Eigen::Vector2d px = cam.lens.Project(in_cam);
-          margin = std::min({margin, px.x(), px.y(), cam.width - px.x(), cam.height - px.y()});
-        }
-      }
+      const double margin = Margin(cam, spec, pose);
       const Eigen::Vector3d centre =
           cam_from_board * Eigen::Vector3d(0.5 * spec.width_m(), 0.5 * spec.height_m(), 0);
       const double off_normal_deg =
@@ -261,12 +267,7 @@ class CalibrationDirector : public Director {
       for (const auto& cam : cameras) {
         const Eigen::Vector3d to_cam = (cam.CentreInGround() - centre).normalized();
         if (normal.dot(to_cam) < std::cos(65 * kDeg)) margin = -1e9;
-        for (double bx : {0.0, spec.width_m()}) {
-          for (double by : {0.0, spec.height_m()}) {
-            const Eigen::Vector2d px = cam.ProjectGround(pose * Eigen::Vector3d(bx, by, 0));
-            margin = std::min({margin, px.x(), px.y(), cam.width - px.x(), cam.height - px.y()});
-          }
-        }
+        margin = std::min(margin, Margin(cam, spec, pose));
       }
       if (margin > best_margin) {
         best_margin = margin;

@@ -16,7 +16,6 @@ import { angleDeg, mul, poseError, project, readModel, relative, transpose } fro
 // In CI's run (`console_browser`) since the session holds each pose about 1 s and every pose a
 // camera is held at is one its detector finds, and since the test solves as the checklist says
 // (bench/RESULTS.md, "In the page": it had left CI after cam0's coverage check stayed unmet).
-const rigTest = (name, fn) => test(name, fn);
 const BOARD = 'chessboard:10x7:0.03';
 const CAMERAS = ['cam0', 'cam1'];
 const SECONDS = 90;
@@ -104,7 +103,7 @@ after(async () => {
   console.log(`calibrate-rig.test: ${JSON.stringify(measured)}; ${((Date.now() - started) / 1000).toFixed(0)} s`);
 });
 
-rigTest('both cameras run without a floor; the wizard starts on both', async () => {
+test('both cameras run without a floor; the wizard starts on both', async () => {
   const status = await h.waitFor('both cameras live', async () => {
     const s = await api('/api/status');
     return s.cameras.length === 2 && s.cameras.every((c) => c.state === 'live') && s;
@@ -136,7 +135,7 @@ rigTest('both cameras run without a floor; the wizard starts on both', async () 
   await p.waitForSelector(cardOf('cam1'), { timeout: 10000 });
 });
 
-rigTest('each camera solved; one posed on the operator\'s word, the other through the joint solve', async () => {
+test('each camera solved; one posed on the operator\'s word, the other through the joint solve', async () => {
   // As an operator reads the card: solve a camera once its checklist's views, coverage and tilt
   // are met, and again after three more views while a solve is rejected (a solve runs on the
   // camera's thread, which captures nothing meanwhile: solving at every new view, as this test
@@ -203,7 +202,7 @@ rigTest('each camera solved; one posed on the operator\'s word, the other throug
   await p.locator(cardOf('cam1')).screenshot({ path: path.join(h.DOCS, 'console-calibrate-rig-cam1.png') });
 });
 
-rigTest('the green floor found from the posed camera, with no floor in the config', async () => {
+test('the green floor found from the posed camera, with no floor in the config', async () => {
   // Detected while the boards lie on the floor, as an operator would once the board is down: a
   // board held up before the camera hides part of the floor (detected then, the floor was a
   // sliver of 0.15 m²). Each try's result is read from the API after its answer: the card
@@ -234,7 +233,7 @@ rigTest('the green floor found from the posed camera, with no floor in the confi
   await h.waitFor('the card shows it', async () => Number((await card('cam0')).floorArea.split(' ')[0]) === Number(area.toFixed(2)));
 });
 
-rigTest('save: both joint models written; cam1 from cam0 and each pose against the truth', async () => {
+test('save: both joint models written; cam1 from cam0 and each pose against the truth', async () => {
   await h.waitFor('save offered', async () => !(await p.isDisabled('[data-testid="calib-save"]')), { timeout: 30000 });
   await p.click('[data-testid="calib-save"]');
   await p.waitForSelector('[data-testid="calib-saved"]:not([hidden])', { timeout: 60000 });
@@ -284,7 +283,7 @@ rigTest('save: both joint models written; cam1 from cam0 and each pose against t
   await h.screenshot(p, 'console-calibrate-rig-saved.png');
 });
 
-rigTest('started again on a hamster before the same cameras, the station stores sprites', async () => {
+test('started again on a hamster before the same cameras, the station stores sprites', async () => {
   await station.stop();
   const yaml = fs.readFileSync(cfg.file, 'utf8');
   assert.ok(yaml.split(dir).length === 3, `the config's two sessions:\n${yaml}`);
