@@ -333,6 +333,10 @@ void CalibrationWizard::EnterEnclosure(int frame, const cv::Mat& image) {
   }
 }
 
+// A green floor found later is whole when it shows at least this share of what the frame with the
+// board lying on it showed (TryEmptyFloor, DetectFloor); less, something hides part of it.
+constexpr double kUnhiddenShare = 0.95;
+
 GroundPolygon CalibrationWizard::GreenFloorIn(const cv::Mat& image) const {
   const std::optional<CameraModel> posed = posed_model();
   if (!posed) throw WorkError(camera_, "no ground pose to find the floor with");
@@ -349,7 +353,7 @@ void CalibrationWizard::TryEmptyFloor(const cv::Mat& image, int frame) {
     // it. Taking the board off the floor can only uncover green, so an empty floor shows at
     // least what the frame with the board lying on it showed.
     const double with_board_m2 = floor_with_board_ ? floor_with_board_->Area() : 0.0;
-    if (found.Area() < 0.95 * with_board_m2) {
+    if (found.Area() < kUnhiddenShare * with_board_m2) {
       Event(frame, "enclosure_rejected",
             {{"from", from}, {"area_m2", found.Area()}, {"with_board_m2", with_board_m2}});
       return;
@@ -833,7 +837,7 @@ void CalibrationWizard::DetectFloor(const cv::Mat& image) {
   // before the camera hides part of it; taken, that sliver would be the enclosure every sprite
   // is kept within (a console run saved 0.15 m² of a 0.81 m² floor so, and stored no sprite).
   const double with_board_m2 = floor_with_board_ ? floor_with_board_->Area() : 0.0;
-  if (found->Area() < 0.95 * with_board_m2) {
+  if (found->Area() < kUnhiddenShare * with_board_m2) {
     throw InputError("detect",
                      Fmt("the green floor found is %.2f m², less than the %.2f m² seen with the "
                          "board lying on it: something hides part of the floor (a board held up, a "
