@@ -569,11 +569,7 @@ int ControlServer::Start() {
   Impl& s = *impl_;
   const std::string host =
       s.options.config.address == "localhost" ? "127.0.0.1" : s.options.config.address;
-  if (s.options.config.port == 0) {
-    s.port = s.server.bind_to_any_port(host);
-  } else {
-    s.port = s.server.bind_to_port(host, s.options.config.port) ? s.options.config.port : -1;
-  }
+  s.port = s.server.Bind(host, s.options.config.port);
   if (s.port <= 0) {
     throw WorkError(
         "control " + s.options.config.address + ":" + std::to_string(s.options.config.port),

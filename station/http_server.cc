@@ -24,8 +24,10 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 constexpr size_t kMaxDrainBytes = 64 << 10;  // read and dropped before a connection is closed
-constexpr size_t kMaxLingerBytes = 4 << 20;  // ... after a refused request, within kLinger
-constexpr auto kLinger = std::chrono::milliseconds(250);
+// After a refused request, what the client still sends is read and dropped until it closes, for
+// at most kLinger (nginx's lingering_time), and kMaxLingerBytes as a bound on the CPU it costs.
+constexpr size_t kMaxLingerBytes = 64 << 20;
+constexpr auto kLinger = std::chrono::seconds(1);
 // waits notice a stopping server this often
 constexpr auto kStopCheck = std::chrono::milliseconds(100);
 
@@ -251,8 +253,10 @@ thread_local bool t_counted_apart = false;
 // Closes a connection after its last answer. What the client sent and the server did not read
 // (the rest of a refused request) is read and dropped first, so that the close sends FIN rather
 // than a reset, which could discard the answer at the client: what is there already, up to
-// 64 KiB, or, after a refused request (`linger`), what comes within 250 ms, up to 4 MiB (a
-// client still streaming a body over the limit then reads its 413 before the reset).
+// 64 KiB, or, after a refused request (`linger`), all it sends until it closes, bounded by time
+// (kLinger) as nginx's lingering close is. A byte bound alone (4 MiB once) was spent within
+// milliseconds by a client streaming a body over the limit, whose 413 the reset then discarded
+// when the client had not read it yet: the sockets' own buffers hold some 10 MiB in flight.
 void Close(int sock, bool linger = false) {
   ::shutdown(sock, SHUT_WR);
   std::array<char, 4096> sink;
@@ -317,6 +321,16 @@ std::string Seconds(std::chrono::milliseconds ms) {
 
 HttpServer::HttpServer(HttpLimits limits) : limits_(limits) {
   set_payload_max_length(limits_.max_body_bytes);  // a Content-Length over it: 413 at once
+}
+
+int HttpServer::Bind(const std::string& host, int port, int backlog) {
+  const int bound = port == 0 ? bind_to_any_port(host) : bind_to_port(host, port) ? port : -1;
+  // listen() again on a listening socket sets its backlog anew (Linux, POSIX alike).
+  if (bound > 0 && ::listen(svr_sock_, backlog) != 0) {
+    Log("station.control")
+        ->warn("{}:{}: listen backlog stays cpp-httplib's: {}", host, bound, std::strerror(errno));
+  }
+  return bound;
 }
 
 void HttpServer::set_limits(const HttpLimits& limits) {

@@ -66,6 +66,12 @@ class HttpServer : public httplib::Server {
  public:
   explicit HttpServer(HttpLimits limits = {});
 
+  // Binds to `host`:`port` (0: any free port) and listens with a backlog of `backlog`
+  // connections not yet accepted; the port bound, or -1. cpp-httplib listens with 5
+  // (CPPHTTPLIB_LISTEN_BACKLOG, compiled into Debian's libcpp-httplib): 32 clients connecting at
+  // once lost SYNs and each waited the kernel's 1 s retransmit. listen_after_bind() serves it.
+  int Bind(const std::string& host, int port, int backlog = 128);
+
   const HttpLimits& limits() const { return limits_; }
   // Before listening only.
   void set_limits(const HttpLimits& limits);
