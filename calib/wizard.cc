@@ -54,25 +54,16 @@ bool WizardOptions::IsValid(std::string* why) const {
   check.Nested(detect.IsValid(&part), "detect.", part);
   check.Nested(verdict.IsValid(&part), "verdict.", part);
   check.Nested(solve.IsValid(&part), "solve.", part);
-  check(still_px > 0, "still_px",
-        "expected a positive motion in pixels, got " + OptionProblems::Num(still_px));
-  check(still_frames >= 1, "still_frames",
-        "expected at least 1 frame, got " + std::to_string(still_frames));
-  check(min_shift >= 0, "min_shift",
-        "expected a fraction >= 0, got " + OptionProblems::Num(min_shift));
-  check(min_tilt_change_deg >= 0, "min_tilt_change_deg",
-        "expected degrees >= 0, got " + OptionProblems::Num(min_tilt_change_deg));
-  check(min_scale_change >= 0, "min_scale_change",
-        "expected a fraction >= 0, got " + OptionProblems::Num(min_scale_change));
-  check(min_new_cells >= 0, "min_new_cells",
-        "expected a number >= 0, got " + std::to_string(min_new_cells));
-  check(max_views >= 1, "max_views", "expected at least 1 view, got " + std::to_string(max_views));
-  check(floor_still_frames >= 1, "floor_still_frames",
-        "expected at least 1 frame, got " + std::to_string(floor_still_frames));
-  check(std::isfinite(floor_still_s) && floor_still_s >= 0, "floor_still_s",
-        "expected seconds >= 0, got " + OptionProblems::Num(floor_still_s));
-  check(std::isfinite(floor_word_s) && floor_word_s >= 0, "floor_word_s",
-        "expected seconds >= 0, got " + OptionProblems::Num(floor_word_s));
+  check.Within(still_px, Positive(), "still_px", "a positive motion in pixels");
+  check.Within(still_frames, AtLeast(1), "still_frames", "at least 1 frame");
+  check.Within(min_shift, AtLeast(0), "min_shift", "a fraction >= 0");
+  check.Within(min_tilt_change_deg, AtLeast(0), "min_tilt_change_deg", "degrees >= 0");
+  check.Within(min_scale_change, AtLeast(0), "min_scale_change", "a fraction >= 0");
+  check.Within(min_new_cells, AtLeast(0), "min_new_cells", "a number >= 0");
+  check.Within(max_views, AtLeast(1), "max_views", "at least 1 view");
+  check.Within(floor_still_frames, AtLeast(1), "floor_still_frames", "at least 1 frame");
+  check.Within(floor_still_s, AtLeast(0), "floor_still_s", "seconds >= 0");
+  check.Within(floor_word_s, AtLeast(0), "floor_word_s", "seconds >= 0");
   check(!floor_needs_word || floor_word_s == 0 || floor_word_s > floor_still_s, "floor_word_s",
         "expected 0 (never lapses) or longer than floor_still_s (" +
             OptionProblems::Num(floor_still_s) + " s), got " + OptionProblems::Num(floor_word_s));

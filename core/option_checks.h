@@ -1,7 +1,8 @@
 #pragma once
 // IsValid(std::string* why) of a component's options struct: every value out of its range, one
 // line "FIELD: reason" each in `why` (FIELD as the struct names it; the station config names
-// it by its key: config/config_validate.cc).
+// it by its key: config/config_validate.cc). A number's bounds are a NumberRule, the same words
+// the config's key bindings use (core/options_binder.h): one rule vocabulary.
 #include <sstream>
 #include <string>
 #include <type_traits>
@@ -9,6 +10,21 @@
 #include <vector>
 
 namespace ss {
+
+// The bounds of a number: checked on an options field (OptionProblems::Within) and on a config
+// key's value, whether read from a file or set in code (OptionsBinder::CheckRules), and written
+// into the key's type in the docs ("number > 0", "integer 0..65535"). A value out of them is
+// reported as "expected EXPECTED, got V" with the caller's `expected` words, which therefore say
+// the bounds ("at least 1 frame"). NaN and infinities hold no rule.
+struct NumberRule {
+  double min = -1e300, max = 1e300;
+  bool min_open = false;  // min itself is out (> rather than >=)
+  bool Holds(double v) const;
+  std::string Text() const;  // "> 0", ">= 1", "0..255"
+};
+inline NumberRule Positive() { return {0, 1e300, true}; }
+inline NumberRule AtLeast(double min) { return {min, 1e300, false}; }
+inline NumberRule Between(double min, double max) { return {min, max, false}; }
 
 class OptionProblems {
  public:
@@ -28,6 +44,11 @@ class OptionProblems {
   void operator()(bool good, const char* field, Reason&& reason) {
     if (good) return;
     (*this)(false, field, std::forward<Reason>(reason)());
+  }
+  // Adds "field: expected EXPECTED, got VALUE" unless `rule` holds `value`.
+  void Within(double value, NumberRule rule, const std::string& field,
+              const std::string& expected) {
+    (*this)(rule.Holds(value), field, "expected " + expected + ", got " + Num(value));
   }
   // Another struct's problems (its IsValid's `why`), each field under `prefix` ("extract.").
   void Nested(bool good, const std::string& prefix, const std::string& why) {

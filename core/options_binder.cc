@@ -61,6 +61,16 @@ void OptionsBinder::CheckRules(YamlMessages& msg, const std::string& path) const
   }
 }
 
+void OptionsBinder::CheckRules(YamlMessages& msg, const YamlMap& given) const {
+  for (const Binding& b : bindings_) {
+    if (!b.rule || given.Find(b.key) == nullptr) continue;
+    const std::optional<double> v = b.number();
+    const std::string key = Child(given.path(), b.key);
+    if (v && !b.rule->Holds(*v) && !msg.Failed(key))
+      msg.Error(key, "expected " + b.expected + ", got " + Num(*v));
+  }
+}
+
 bool NumberRule::Holds(double v) const {
   return std::isfinite(v) && (min_open ? v > min : v >= min) && v <= max;
 }

@@ -11,23 +11,10 @@
 #include <string>
 #include <vector>
 
+#include "core/option_checks.h"  // NumberRule
 #include "core/yaml_reader.h"
 
 namespace ss {
-
-// The bounds of a number's key: checked on the field's value, whether read from a file or set in
-// code (OptionsBinder::CheckRules), and written into the key's type in the docs ("number > 0",
-// "integer 0..65535"). A value out of them is reported as "expected EXPECTED, got V" with the
-// key's own `expected` words, which therefore say the bounds ("at least 1 frame").
-struct NumberRule {
-  double min = -1e300, max = 1e300;
-  bool min_open = false;  // min itself is out (> rather than >=)
-  bool Holds(double v) const;
-  std::string Text() const;  // "> 0", ">= 1", "0..255"
-};
-inline NumberRule Positive() { return {0, 1e300, true}; }
-inline NumberRule AtLeast(double min) { return {min, 1e300, false}; }
-inline NumberRule Between(double min, double max) { return {min, max, false}; }
 
 class OptionsBinder {
  public:
@@ -74,6 +61,9 @@ class OptionsBinder {
   // Reports every bound number out of its rule at its key under `path` ("cameras[0]"), unless
   // that key has an error already.
   void CheckRules(YamlMessages& msg, const std::string& path) const;
+  // The same for the keys `given` holds only (a file's block whose unset keys are not checked:
+  // the animation spec, where a required key's absence is its own error).
+  void CheckRules(YamlMessages& msg, const YamlMap& given) const;
 
   // Reads the mapping `node` at `path` ("" for the top level): unknown keys first, then each
   // bound key in the order it was bound. Reports to r.msg(); never throws.

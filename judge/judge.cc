@@ -231,14 +231,10 @@ JumpFigures JudgeJumps(const SequenceFile& file, const std::vector<std::unique_p
 
 bool JudgeOptions::IsValid(std::string* why) const {
   OptionProblems check(why);
-  check(stutter_window_steps >= 1, "stutter_window_steps",
-        "must be >= 1, got " + std::to_string(stutter_window_steps));
-  check(clone_lag_steps >= 0, "clone_lag_steps",
-        "must be >= 0, got " + std::to_string(clone_lag_steps));
-  check(facing_min_speed_m_s >= 0, "facing_min_speed_m_s",
-        "must be >= 0, got " + std::to_string(facing_min_speed_m_s));
-  check(facing_half_window_steps >= 1, "facing_half_window_steps",
-        "must be >= 1, got " + std::to_string(facing_half_window_steps));
+  check.Within(stutter_window_steps, AtLeast(1), "stutter_window_steps", "at least 1 step");
+  check.Within(clone_lag_steps, AtLeast(0), "clone_lag_steps", "steps >= 0");
+  check.Within(facing_min_speed_m_s, AtLeast(0), "facing_min_speed_m_s", "a speed >= 0");
+  check.Within(facing_half_window_steps, AtLeast(1), "facing_half_window_steps", "at least 1 step");
   std::string jump_why;
   check.Nested(jump.IsValid(&jump_why), "jump.", jump_why);
   return check.ok();

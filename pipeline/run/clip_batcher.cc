@@ -13,12 +13,9 @@ namespace ss {
 
 bool ClipBatcherOptions::IsValid(std::string* why) const {
   OptionProblems check(why);
-  check(min_clip_frames >= 1, "min_clip_frames",
-        "expected at least 1 frame, got " + std::to_string(min_clip_frames));
-  check(batch_frames >= 1, "batch_frames",
-        "expected at least 1 frame, got " + std::to_string(batch_frames));
-  check(velocity_half_window >= 0, "velocity_half_window",
-        "expected a number >= 0, got " + std::to_string(velocity_half_window));
+  check.Within(min_clip_frames, AtLeast(1), "min_clip_frames", "at least 1 frame");
+  check.Within(batch_frames, AtLeast(1), "batch_frames", "at least 1 frame");
+  check.Within(velocity_half_window, AtLeast(0), "velocity_half_window", "a number >= 0");
   return check.ok();
 }
 namespace {
