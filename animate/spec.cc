@@ -163,14 +163,6 @@ class SpecReader {
     if (!good && view.Find(key) != nullptr && !msg_.Failed(Child(view.path(), key)))
       Error(view, key, reason);
   }
-  void AtLeast(const YamlMap& view, const std::string& key, double value, double low) {
-    Check(view, key, std::isfinite(value) && value >= low,
-          std::isfinite(value) ? "must be >= " + Num(low) : "expected a finite number");
-  }
-  void Positive(const YamlMap& view, const std::string& key, double value) {
-    Check(view, key, std::isfinite(value) && value > 0,
-          std::isfinite(value) ? "must be > 0" : "expected a finite number");
-  }
   void Required(const YamlMap& view, const std::string& key, const std::string& reason) {
     if (view.Find(key) == nullptr) Error(view, key, reason);
   }
@@ -341,6 +333,7 @@ bool SpecReader::Block(const OptionsBinder& keys, const YAML::Node& node, const 
   }
   r_.Known(view, keys.Keys());
   keys.ReadKeys(r_, view);
+  keys.CheckRules(msg_, view);  // each given number within its binding's rule
   return true;
 }
 
@@ -461,23 +454,19 @@ void SpecReader::LengthTop(const YAML::Node& node) {
     fixed = static_cast<int>(frames);
   } else {
     OptionsBinder keys;
-    keys.Add("frames", &fixed, "a whole number >= 1", "every sequence is this long")
-        .Add("min_frames", &min_frames, "a whole number >= 1", "sequences shorter are penalized")
-        .Add("max_frames", &max_frames, "a whole number >= 1", "the longest sequence")
-        .Add("initial_frames", &initial_frames, "a whole number >= 1",
-             "length of random initial sequences")
-        .Add("strength", &strength, "a number", "weight of the length term");
+    const std::string frames = "a whole number of frames 1.." + std::to_string(kMaxSpecFrames);
+    keys.Add("frames", &fixed, frames, "every sequence is this long")
+        .Rule(Between(1, kMaxSpecFrames))
+        .Add("min_frames", &min_frames, frames, "sequences shorter are penalized")
+        .Rule(Between(1, kMaxSpecFrames))
+        .Add("max_frames", &max_frames, frames, "the longest sequence")
+        .Rule(Between(1, kMaxSpecFrames))
+        .Add("initial_frames", &initial_frames, frames, "length of random initial sequences")
+        .Rule(Between(1, kMaxSpecFrames))
+        .Add("strength", &strength, "a number >= 0", "weight of the length term")
+        .Rule(AtLeast(0));
     YamlMap view;
     if (!Block(keys, node, "length", view)) return;
-    for (const auto& [key, value] :
-         {std::pair{"frames", fixed}, std::pair{"min_frames", min_frames},
-          std::pair{"max_frames", max_frames}, std::pair{"initial_frames", initial_frames}}) {
-      Check(view, key, value >= 1, "expected a whole number >= 1");
-      Check(view, key, value <= kMaxSpecFrames,
-            "must be at most " + std::to_string(kMaxSpecFrames) + " frames, got " +
-                std::to_string(value));
-    }
-    if (strength) AtLeast(view, "strength", *strength, 0);
     if (view.Find("frames") != nullptr &&
         (view.Find("min_frames") != nullptr || view.Find("max_frames") != nullptr)) {
       Error(view, "frames", "give either frames (fixed) or min/max_frames");
@@ -535,8 +524,9 @@ void SpecReader::Optimizer(const YAML::Node& node) {
       .Add("threads", &rep.reach.num_threads, "a whole number", "worker threads")
       .Add("changes_per_turn", &rep.changes_per_turn, "a whole number", "picks per sprite turn")
       .Add("beam_width", &rep.beam.width, "a whole number", "the beam search's width")
-      .Add("snapshot_every_s", &o.snapshot_every_s, "a number",
+      .Add("snapshot_every_s", &o.snapshot_every_s, "seconds >= 0",
            "> 0: keep the sequences every so many seconds")
+      .Rule(AtLeast(0))
       .Add("collision_pick_fraction", &rep.collision_pick_fraction, "a number",
            "replacement's picks aimed at a collision, 0 to 1")
       .Add("goal_pick_fraction", &rep.goal_fraction, "a number",
@@ -545,7 +535,6 @@ void SpecReader::Optimizer(const YAML::Node& node) {
   if (!Block(keys, node, "optimizer", view)) return;
   Check(view, "seed", seed >= 0 && seed <= 1000000000, "expected a whole number >= 0");
   rep.seed = static_cast<uint64_t>(std::max<int64_t>(seed, 0));
-  AtLeast(view, "snapshot_every_s", o.snapshot_every_s, 0);
   const double budget = rep.time_budget_seconds, every = o.snapshot_every_s;
   Check(view, "snapshot_every_s",
         !(every > 0) || !std::isfinite(budget) || every * kMaxSpecSnapshots >= budget,
@@ -604,7 +593,8 @@ SpriteSpecEntry SpecReader::Sprite(const YAML::Node& node, const std::string& pa
           "start", "", "[x, y], free or {guess: [x, y]}",
           BlockOf([this, &out](const YAML::Node& n, const std::string& p) { Start(n, p, out); }))
       .AddRead("end", "", "[x, y]: the last position is fixed", PointInto(&end))
-      .Add("smoothness", &out.smoothness, "a number", "α")
+      .Add("smoothness", &out.smoothness, "a number >= 0", "α")
+      .Rule(AtLeast(0))
       .AddRead("constraints", "", "location:, path:, frames:",
                BlockOf([this, &out](const YAML::Node& n, const std::string& p) {
                  Constraints(n, p, out);
@@ -628,7 +618,6 @@ SpriteSpecEntry SpecReader::Sprite(const YAML::Node& node, const std::string& pa
   } else if (view.Find("start") == nullptr) {
     Error(view, "start", "required: [x, y], free, or end: [x, y] instead");
   }
-  AtLeast(view, "smoothness", out.smoothness, 0);
   return out;
 }
 
@@ -684,69 +673,65 @@ void SpecReader::Constraints(const YAML::Node& node, const std::string& path,
 LengthSpec SpecReader::Length(const YAML::Node& node, const std::string& path) {
   LengthSpec out;
   OptionsBinder keys;
-  keys.Add("min_frames", &out.min_frames, "a whole number >= 1", "sequences shorter pay")
-      .Add("strength", &out.strength, "a number", "per missing frame");
+  keys.Add("min_frames", &out.min_frames,
+           "a whole number of frames 1.." + std::to_string(kMaxSpecFrames), "sequences shorter pay")
+      .Rule(Between(1, kMaxSpecFrames))
+      .Add("strength", &out.strength, "a number >= 0", "per missing frame")
+      .Rule(AtLeast(0));
   YamlMap view;
   if (!Block(keys, node, path, view)) return out;
   Required(view, "min_frames", "required");
-  Check(view, "min_frames", out.min_frames >= 1, "expected a whole number >= 1");
-  Check(view, "min_frames", out.min_frames <= kMaxSpecFrames,
-        "must be at most " + std::to_string(kMaxSpecFrames) + " frames, got " +
-            std::to_string(out.min_frames));
-  AtLeast(view, "strength", out.strength, 0);
   return out;
 }
 
 FastFrameSpec SpecReader::Fast(const YAML::Node& node, const std::string& path) {
   FastFrameSpec out{0.0, 1.0};
   OptionsBinder keys;
-  keys.Add("reference_speed_m_s", &out.reference_speed_m_s, "a number", "v_ref")
-      .Add("strength", &out.strength, "a number", "per (m/s) below v_ref, per step");
+  keys.Add("reference_speed_m_s", &out.reference_speed_m_s, "a speed > 0", "v_ref")
+      .Rule(Positive())
+      .Add("strength", &out.strength, "a number >= 0", "per (m/s) below v_ref, per step")
+      .Rule(AtLeast(0));
   YamlMap view;
   if (!Block(keys, node, path, view)) return out;
   Required(view, "reference_speed_m_s", "required");
-  Positive(view, "reference_speed_m_s", out.reference_speed_m_s);
-  AtLeast(view, "strength", out.strength, 0);
   return out;
 }
 
 RepeatSpec SpecReader::Repeats(const YAML::Node& node, const std::string& path) {
   RepeatSpec out;
   OptionsBinder keys;
-  keys.Add("strength", &out.strength, "a number", "per step showing a frame shown just before")
-      .Add("window_steps", &out.window_steps, "a number of steps", "how far back")
+  keys.Add("strength", &out.strength, "a number >= 0", "per step showing a frame shown just before")
+      .Rule(AtLeast(0))
+      .Add("window_steps", &out.window_steps, "1..1000 steps", "how far back")
+      .Rule(Between(1, 1000))
       .Add("still_tag", &out.still_tag, "a tag", "frames that may repeat");
   YamlMap view;
   if (!Block(keys, node, path, view)) return out;
   Required(view, "strength", "required");
-  AtLeast(view, "strength", out.strength, 0);
-  Check(view, "window_steps", out.window_steps >= 1 && out.window_steps <= 1000,
-        "must be 1..1000 steps, got " + std::to_string(out.window_steps));
   return out;
 }
 
 FacingSpec SpecReader::Facing(const YAML::Node& node, const std::string& path) {
   FacingSpec out;
   OptionsBinder keys;
-  keys.Add("strength", &out.strength, "a number", "per metre moved other than forward");
+  keys.Add("strength", &out.strength, "a number >= 0", "per metre moved other than forward")
+      .Rule(AtLeast(0));
   YamlMap view;
   if (!Block(keys, node, path, view)) return out;
   Required(view, "strength", "required");
-  AtLeast(view, "strength", out.strength, 0);
   return out;
 }
 
 CloneSpec SpecReader::Clones(const YAML::Node& node, const std::string& path) {
   CloneSpec out;
   OptionsBinder keys;
-  keys.Add("strength", &out.strength, "a number", "per frame two sprites show together")
-      .Add("lag_steps", &out.lag_steps, "a number of steps", "how far apart is together");
+  keys.Add("strength", &out.strength, "a number >= 0", "per frame two sprites show together")
+      .Rule(AtLeast(0))
+      .Add("lag_steps", &out.lag_steps, "0..100 steps", "how far apart is together")
+      .Rule(Between(0, 100));
   YamlMap view;
   if (!Block(keys, node, path, view)) return out;
   Required(view, "strength", "required");
-  AtLeast(view, "strength", out.strength, 0);
-  Check(view, "lag_steps", out.lag_steps >= 0 && out.lag_steps <= 100,
-        "must be 0..100 steps, got " + std::to_string(out.lag_steps));
   return out;
 }
 
@@ -761,7 +746,7 @@ LocationSpec SpecReader::Location(const YAML::Node& node, const std::string& pat
       .AddRead("offset", "", "[along, left] in metres", PointInto(&out.target_m))
       .AddEnum("offset_axes", &axes, kOffsetAxesTexts, "the offset's axes");
   BindWindow(keys, window);
-  keys.Add("strength", &out.strength, "a number", "γ");
+  keys.Add("strength", &out.strength, "a number >= 0", "γ").Rule(AtLeast(0));
   YamlMap view;
   if (!Block(keys, node, path, view)) return out;
   if (view.Find("follow") != nullptr) {
@@ -772,7 +757,6 @@ LocationSpec SpecReader::Location(const YAML::Node& node, const std::string& pat
   }
   out.offset_in_heading = axes == OffsetAxes::kHeading;
   out.window = Window(view, window, StepWindow::All());
-  AtLeast(view, "strength", out.strength, 0);
   return out;
 }
 
@@ -801,15 +785,15 @@ PathSpec SpecReader::Path(const YAML::Node& node, const std::string& path) {
                  }
                  return true;
                }))
-      .Add("direction_strength", &out.strengths.direction, "a number", "δ")
-      .Add("distance_strength", &out.strengths.distance, "a number", "φ")
-      .Add("unreached_strength", &out.strengths.unreached, "a number", "η");
+      .Add("direction_strength", &out.strengths.direction, "a number >= 0", "δ")
+      .Rule(AtLeast(0))
+      .Add("distance_strength", &out.strengths.distance, "a number >= 0", "φ")
+      .Rule(AtLeast(0))
+      .Add("unreached_strength", &out.strengths.unreached, "a number >= 0", "η")
+      .Rule(AtLeast(0));
   YamlMap view;
   if (!Block(keys, node, path, view)) return out;
   Required(view, "points", "required");
-  AtLeast(view, "direction_strength", out.strengths.direction, 0);
-  AtLeast(view, "distance_strength", out.strengths.distance, 0);
-  AtLeast(view, "unreached_strength", out.strengths.unreached, 0);
   return out;
 }
 
@@ -834,8 +818,10 @@ FrameSpec SpecReader::Frames(const YAML::Node& node, const std::string& path) {
                }));
   BindWindow(keys, window);
   keys.Add("after_path", &out.after_path_of, "a sprite's name", "the window starts at its end")
-      .Add("duration", &duration_s, "a number", "seconds, with after_path")
-      .Add("strength", &out.strength, "a number", "λ");
+      .Add("duration", &duration_s, "seconds > 0", "seconds, with after_path")
+      .Rule(Positive())
+      .Add("strength", &out.strength, "a number >= 0", "λ")
+      .Rule(AtLeast(0));
   YamlMap view;
   if (!Block(keys, node, path, view)) return out;
   const bool tag = view.Find("tag") != nullptr, ids = view.Find("sprites") != nullptr;
@@ -846,7 +832,6 @@ FrameSpec SpecReader::Frames(const YAML::Node& node, const std::string& path) {
     if (view.Find("at") != nullptr || view.Find("from") != nullptr || view.Find("to") != nullptr)
       Error(view, "after_path", "give either after_path or at/from/to");
     Required(view, "duration", "required with after_path");
-    Positive(view, "duration", duration_s);
     const std::string past = std::isfinite(duration_s) ? PastTheEnd(duration_s) : "";
     Check(view, "duration", past.empty(), past);
     if (std::isfinite(duration_s) && past.empty())
@@ -855,7 +840,6 @@ FrameSpec SpecReader::Frames(const YAML::Node& node, const std::string& path) {
     if (view.Find("duration") != nullptr) Error(view, "duration", "only with after_path");
     out.window = Window(view, window, StepWindow::All());
   }
-  AtLeast(view, "strength", out.strength, 0);
   return out;
 }
 
@@ -882,14 +866,14 @@ CollisionSpec SpecReader::Collision(const YAML::Node& node, const std::string& p
                  }
                  return true;
                }))
-      .Add("min_distance_m", &out.min_distance_m, "a number", "d_min")
-      .Add("strength", &out.strength, "a number", "µ");
+      .Add("min_distance_m", &out.min_distance_m, "a distance > 0 in metres", "d_min")
+      .Rule(Positive())
+      .Add("strength", &out.strength, "a number >= 0", "µ")
+      .Rule(AtLeast(0));
   YamlMap view;
   if (!Block(keys, node, path, view)) return out;
   Required(view, "sprites", "required: a list of names, or all");
   Required(view, "min_distance_m", "required");
-  Positive(view, "min_distance_m", out.min_distance_m);
-  AtLeast(view, "strength", out.strength, 0);
   return out;
 }
 

@@ -164,9 +164,9 @@ TEST_F(SpecTest, RepeatsCostAFrameShownAgainWithinTheWindow) {
   EXPECT_EQ(TermsOfKind(*Scene::Load(spec), "repeat"), 2);             // one a sprite
   const std::string o = Origin();
   EXPECT_EQ(ErrorOf(Edit(fast, "repeats: {strength: -1}")),
-            o + ":6: repeats.strength: must be >= 0");
+            o + ":6: repeats.strength: expected a number >= 0, got -1");
   EXPECT_EQ(ErrorOf(Edit(fast, "repeats: {strength: 1, window_steps: 0}")),
-            o + ":6: repeats.window_steps: must be 1..1000 steps, got 0");
+            o + ":6: repeats.window_steps: expected 1..1000 steps, got 0");
   EXPECT_EQ(ErrorOf(Edit(fast, "repeats: {window_steps: 5}")),
             o + ":6: repeats.strength: required");
 }
@@ -181,7 +181,7 @@ TEST_F(SpecTest, ClonesCostTwoSpritesShowingAFrameTogether) {
   EXPECT_EQ(ParseAnimationSpec(kGood, Origin()).clones.strength, 0);  // off unless set
   EXPECT_EQ(TermsOfKind(*Scene::Load(spec), "clone"), 1);             // one a pair
   EXPECT_EQ(ErrorOf(Edit(fast, "clones: {strength: 1, lag_steps: 101}")),
-            Origin() + ":6: clones.lag_steps: must be 0..100 steps, got 101");
+            Origin() + ":6: clones.lag_steps: expected 0..100 steps, got 101");
 }
 
 TEST_F(SpecTest, FacingIsOnForFloorSpritesAlone) {
@@ -192,7 +192,7 @@ TEST_F(SpecTest, FacingIsOnForFloorSpritesAlone) {
   // The bank's sprites are upright: they carry no heading, and no facing term is built.
   EXPECT_EQ(TermsOfKind(*Scene::Load(spec), "facing"), 0);
   EXPECT_EQ(ErrorOf(Edit(fast, "facing: {strength: -1}")),
-            Origin() + ":6: facing.strength: must be >= 0");
+            Origin() + ":6: facing.strength: expected a number >= 0, got -1");
   EXPECT_NE(ErrorOf(Edit(fast, "facing: {strenght: 1}"))
                 .find(":6: facing.strenght: unknown key (did you mean \"strength\"?)"),
             std::string::npos);
@@ -245,8 +245,9 @@ TEST_F(SpecTest, BadSpecsNameTheLineAndTheField) {
             o + ":2: frame_rat: unknown key (did you mean \"frame_rate\"?)");
   EXPECT_EQ(ErrorOf(Edit("camera: virtual.cameramodel", "camera: nowhere.cameramodel")),
             o + ":4: camera: no such file: " + (dir_ / "nowhere.cameramodel"));
-  EXPECT_EQ(ErrorOf(Edit("direction_strength: 2", "direction_strength: -2")),
-            o + ":12: sprites[0].constraints[0].path.direction_strength: must be >= 0");
+  EXPECT_EQ(
+      ErrorOf(Edit("direction_strength: 2", "direction_strength: -2")),
+      o + ":12: sprites[0].constraints[0].path.direction_strength: expected a number >= 0, got -2");
   EXPECT_EQ(ErrorOf(Edit("[1, 1]], direction", "[1]], direction")),
             o + ":12: sprites[0].constraints[0].path.points[2]: expected [x, y] in metres");
   EXPECT_EQ(ErrorOf(Edit("follow: lead", "follow: nobody")),
@@ -262,7 +263,7 @@ TEST_F(SpecTest, BadSpecsNameTheLineAndTheField) {
       o + ":14: sprites[0].constraints[2].loiter: unknown constraint (expected location, path or "
           "frames)");
   EXPECT_EQ(ErrorOf(Edit("min_distance_m: 0.25", "min_distance_m: 0")),
-            o + ":22: collisions[0].min_distance_m: must be > 0");
+            o + ":22: collisions[0].min_distance_m: expected a distance > 0 in metres, got 0");
   EXPECT_EQ(ErrorOf(Edit("name: follower", "name: lead")),
             o + ":15: sprites[1].name: another sprite is named lead");
   EXPECT_EQ(ErrorOf(Edit("start: random", "start: later")),
@@ -285,7 +286,7 @@ TEST_F(SpecTest, BadSpecsNameTheLineAndTheField) {
   EXPECT_EQ(ErrorOf(Edit("min_frames: 100, max_frames: 300", "min_frames: 200, max_frames: 150")),
             o + ":3: length.max_frames: is below length.min_frames");
   EXPECT_EQ(ErrorOf(Edit("min_frames: 100", "min_frames: 0")),
-            o + ":3: length.min_frames: expected a whole number >= 1");
+            o + ":3: length.min_frames: expected a whole number of frames 1..10000, got 0");
   EXPECT_EQ(ErrorOf(Edit("set_size: 50", "set_sise: 50")),
             o + ":7: optimizer.set_sise: unknown key (did you mean \"set_size\"?)");
   EXPECT_EQ(ErrorOf(Edit("set_size: 50", "set_size: 2.5")),
@@ -324,9 +325,9 @@ TEST_F(SpecTest, NumbersThatSizeWorkAreBounded) {
                 "401 s is step 10025 at 25 fps, and a spec's sequences are at most 10000 frames");
   // Lengths.
   EXPECT_EQ(ErrorOf(Edit("max_frames: 300", "max_frames: 20000")),
-            o + ":3: length.max_frames: must be at most 10000 frames, got 20000");
+            o + ":3: length.max_frames: expected a whole number of frames 1..10000, got 20000");
   EXPECT_EQ(ErrorOf(Edit("max_frames: 300", "max_frames: 300, initial_frames: 10001")),
-            o + ":3: length.initial_frames: must be at most 10000 frames, got 10001");
+            o + ":3: length.initial_frames: expected a whole number of frames 1..10000, got 10001");
   EXPECT_EQ(
       ErrorOf(Edit("length: {min_frames: 100, max_frames: 300, strength: 2}", "length: 20000")),
       o + ":3: length: must be at most 10000, got \"20000\"");
@@ -381,7 +382,7 @@ TEST_F(SpecTest, EveryMistakeOfTheFileIsReported) {
             o + ":2: frame_rate: must be > 0\n" +  //
                 o + ":7: optimizer.time_budget_s: must be a positive number of seconds, got 0\n" +
                 o + ":12: sprites[0].constraints[0].path.points[2]: expected [x, y] in metres\n" +
-                o + ":17: sprites[1].smoothness: must be >= 0\n" +  //
+                o + ":17: sprites[1].smoothness: expected a number >= 0, got -1\n" +  //
                 o +
                 ":22: collisions[0].min_distanse_m: unknown key (did you mean "  //
                 "\"min_distance_m\"?)\n" +                                       //
