@@ -263,21 +263,33 @@ bool CalibrationWizard::CriteriaMet() const {
          EmptyRegions(coverage_).empty() && max_tilt_deg_ >= o_.verdict.min_tilt_deg;
 }
 
-void CalibrationWizard::SolveIntrinsics(int frame) {
+void IntrinsicsSolve::Run() {
   std::vector<BoardObservation> obs;
-  for (size_t i = 0; i < views_.size(); ++i)
-    obs.push_back({0, static_cast<int>(i), views_[i].source, views_[i].ids, views_[i].pixels});
+  for (size_t i = 0; i < views.size(); ++i)
+    obs.push_back({0, static_cast<int>(i), views[i].source, views[i].ids, views[i].pixels});
   try {
-    solution_ = SolveBoards(o_.board, {{camera_, width_, height_}}, obs, o_.solve);
-    report_ = MakeCameraReport(o_.board, *solution_, 0, views_, o_.verdict);
-    report_->camera = camera_;
+    solution = SolveBoards(board, {{camera, width, height}}, obs, solve);
+    report = MakeCameraReport(board, *solution, 0, views, verdict);
+    report->camera = camera;
   } catch (const std::runtime_error& e) {
-    solution_.reset();
-    report_ = FailedCameraReport(camera_, views_, e.what());
+    solution.reset();
+    report = FailedCameraReport(camera, views, e.what());
   }
+}
+
+void CalibrationWizard::SolveIntrinsics(int frame) {
+  IntrinsicsSolve s{o_.board, camera_, width_, height_, views_, o_.solve, o_.verdict};
+  s.Run();
+  TakeIntrinsics(std::move(s), frame);
+}
+
+void CalibrationWizard::TakeIntrinsics(IntrinsicsSolve solved, int frame) {
+  const int views_solved = static_cast<int>(solved.views.size());
+  solution_ = std::move(solved.solution);
+  report_ = std::move(solved.report);
   intrinsics_good_ = report_->good;
   Event(frame, "solve",
-        {{"views", views()},
+        {{"views", views_solved},
          {"verdict", intrinsics_good_ ? "good" : "rejected"},
          {"reasons", report_->reasons},
          {"rms_px", solution_ ? solution_->rms_px[0] : NAN}});
@@ -286,7 +298,7 @@ void CalibrationWizard::SolveIntrinsics(int frame) {
     intrinsics_model_->set_cam_from_ground(Rigid3{});
     EnterGround(frame);
   } else {
-    next_solve_at_ = views() + 5;  // more views before trying again
+    next_solve_at_ = views_solved + 5;  // more views before trying again
   }
 }
 
@@ -552,8 +564,8 @@ WizardFrame CalibrationWizard::Feed(const cv::Mat& image, int frame, double time
       if (Novel(still, d, &why)) {
         Capture(still, d, frame, why);
         out.captured = true;
-        if (!o_.auto_solve) {
-          // The console solves when its operator asks.
+        if (!o_.auto_solve || solve_out_) {
+          // The console solves when its operator asks (or is solving).
         } else if (CriteriaMet() && views() >= next_solve_at_) {
           SolveIntrinsics(frame);
         } else if (views() >= o_.max_views) {
@@ -675,7 +687,7 @@ WizardFrame CalibrationWizard::Feed(const cv::Mat& image, int frame, double time
   return out;
 }
 
-void CalibrationWizard::Solve(int frame) {
+void CalibrationWizard::CheckSolvable() const {
   if (step_ != WizardStep::kIntrinsics) {
     throw InputError(
         "solve", std::string("the intrinsics step is over (now: ") + WizardStepName(step_) + ")");
@@ -686,7 +698,34 @@ void CalibrationWizard::Solve(int frame) {
                                   std::to_string(kMinToSolve) + " are needed to solve (" +
                                   std::to_string(o_.verdict.min_views) + " to trust it)");
   }
+  if (solve_out_) throw InputError("solve", "a solve is running; wait for it to end");
+}
+
+void CalibrationWizard::Solve(int frame) {
+  CheckSolvable();
   SolveIntrinsics(frame);
+}
+
+IntrinsicsSolve CalibrationWizard::BeginSolve() {
+  CheckSolvable();
+  solve_out_ = true;
+  return {o_.board, camera_, width_, height_, views_, o_.solve, o_.verdict};
+}
+
+void CalibrationWizard::EndSolve(IntrinsicsSolve solved, int frame) {
+  if (!solve_out_) throw InputError("solve", "no solve was begun");
+  solve_out_ = false;
+  // Nothing but Feed changed the views since BeginSolve (the console takes no other command
+  // while a solve is out): the solved ones are the first of views_, which it only appends to.
+  if (step_ != WizardStep::kIntrinsics || solved.views.size() > views_.size()) return;
+  TakeIntrinsics(std::move(solved), frame);
+}
+
+void CalibrationWizard::AbandonSolve(const std::string& why) {
+  if (!solve_out_) throw InputError("solve", "no solve was begun");
+  solve_out_ = false;
+  Event(-1, "solve",
+        {{"views", views()}, {"verdict", "failed"}, {"reasons", nlohmann::json::array({why})}});
 }
 
 void CalibrationWizard::DropView(size_t index, const std::string& why) {
@@ -718,12 +757,14 @@ void CalibrationWizard::DropView(size_t index, const std::string& why) {
 
 void CalibrationWizard::DropLast() {
   if (step_ != WizardStep::kIntrinsics) throw InputError("drop", "the intrinsics step is over");
+  if (solve_out_) throw InputError("drop", "a solve is running; wait for it to end");
   if (views_.empty()) throw InputError("drop", "no view captured yet");
   DropView(views_.size() - 1, "dropped by the operator (last)");
 }
 
 void CalibrationWizard::DropWorst() {
   if (step_ != WizardStep::kIntrinsics) throw InputError("drop", "the intrinsics step is over");
+  if (solve_out_) throw InputError("drop", "a solve is running; wait for it to end");
   if (views_.empty()) throw InputError("drop", "no view captured yet");
   size_t worst = 0;
   std::string why;
@@ -753,6 +794,7 @@ void CalibrationWizard::DropWorst() {
 }
 
 void CalibrationWizard::Redo(WizardStep step) {
+  if (solve_out_) throw InputError("step", "a solve is running; wait for it to end");
   switch (step) {
     case WizardStep::kIntrinsics:
       if (o_.intrinsics)

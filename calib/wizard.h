@@ -133,6 +133,24 @@ struct WizardFrame {
   std::vector<std::string> guidance;  // what to do now, most urgent first
 };
 
+// The intrinsics solve of a wizard's captured views, apart from the wizard: what
+// CalibrationWizard::BeginSolve copies, Run solves on any thread, and EndSolve takes back. The
+// console solves so on a thread of its own while the camera's wizard goes on capturing views (a
+// solve on the camera's thread blinded it for the solve's seconds: issue 41).
+struct IntrinsicsSolve {
+  // What is solved (copied).
+  BoardSpec board;
+  std::string camera;
+  int width = 0, height = 0;
+  std::vector<BoardView> views;
+  SolveOptions solve;
+  VerdictOptions verdict;
+  // What Run found: the solution (nullopt when the solver failed) and its report.
+  std::optional<SolveSummary> solution;
+  std::optional<CameraReport> report;
+  void Run();
+};
+
 class CalibrationWizard {
  public:
   CalibrationWizard(std::string camera, int width, int height, WizardOptions options);
@@ -167,6 +185,15 @@ class CalibrationWizard {
   // Solves the intrinsics from the captured views now; a trusted result moves on to the
   // ground step. InputError with fewer than 3 views or past the intrinsics step.
   void Solve(int frame = -1);
+  // Solve() in parts: BeginSolve copies the captured views (InputError as Solve, and while
+  // another solve is out), the caller runs it where it likes, and EndSolve takes its result as
+  // Solve would have; the views captured meanwhile stay, to be solved with the next. While a
+  // solve is out the wizard captures views but solves none by itself.
+  IntrinsicsSolve BeginSolve();
+  void EndSolve(IntrinsicsSolve solved, int frame = -1);
+  // Ends a solve begun whose run failed where it ran, `why` logged; nothing else changes.
+  void AbandonSolve(const std::string& why);
+  bool solve_out() const { return solve_out_; }
   // Drops the last captured view, or the worst (largest RMS in the last solve; before one, the
   // blurriest); the last solve goes with it. InputError when there is no view to drop or the
   // intrinsics step is over.
@@ -215,7 +242,9 @@ class CalibrationWizard {
   void Capture(const BoardView& view, const Captured& d, int frame, const std::string& why);
   void DropView(size_t index, const std::string& why);
   bool CriteriaMet() const;
+  void CheckSolvable() const;  // InputError "solve" naming why Solve cannot now
   void SolveIntrinsics(int frame);
+  void TakeIntrinsics(IntrinsicsSolve solved, int frame);
   void EnterGround(int frame);
   void EnterEnclosure(int frame, const cv::Mat& image);
   // The largest green floor region of a frame through the posed model; throws when none.
@@ -250,7 +279,8 @@ class CalibrationWizard {
   std::vector<Captured> described_;
   cv::Mat coverage_;
   double max_tilt_deg_ = 0;
-  int next_solve_at_ = 0;  // views needed before solving again after a failed verdict
+  int next_solve_at_ = 0;   // views needed before solving again after a failed verdict
+  bool solve_out_ = false;  // BeginSolve was called, EndSolve not yet
   bool board_seen_ = false, intrinsics_good_ = false;
   std::optional<SolveSummary> solution_;
   std::optional<CameraReport> report_;

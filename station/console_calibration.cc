@@ -170,7 +170,10 @@ struct WizardSettings {
 // Threads: Offer is called on the station's pipeline thread (the frame watcher), Run,
 // StartSolve and the getters on the API's threads; the camera's thread (Loop) feeds the
 // wizard, runs the posted commands and publishes the state. It sleeps on queue_cv_ until a
-// frame, a command or the stop comes (each notified where it is queued).
+// frame, a command or the stop comes (each notified where it is queued). A solve runs on a
+// thread of its own (solver_) on the views captured when it began, and posts its result to the
+// camera's thread: the wizard goes on capturing views meanwhile (a solve on the camera's thread
+// blinded it for the solve's seconds, and a rig's camera missed the places held before it).
 // Locks: queue_mutex_ and state_mutex_ are leaves (held for a copy or a push, never together).
 class CameraWork {
  public:
@@ -196,6 +199,7 @@ class CameraWork {
     }
     queue_cv_.notify_all();
     if (thread_.joinable()) thread_.join();
+    if (solver_.joinable()) solver_.join();  // its result, posted, is never run
   }
   CameraWork(const CameraWork&) = delete;
   CameraWork& operator=(const CameraWork&) = delete;
@@ -233,9 +237,9 @@ class CameraWork {
     return done.get();
   }
 
-  // Starts the solve on the camera's thread; returns at once.
+  // Starts the solve of the views captured so far on the solver's thread; returns at once.
   void StartSolve() {
-    Run([](calib::CalibrationWizard& w) {
+    auto solve = Run([](calib::CalibrationWizard& w) {
       if (w.step() != WizardStep::kIntrinsics) {
         throw ConflictError("solve", std::string("the intrinsics step is over (now: ") +
                                          calib::WizardStepName(w.step()) + ")");
@@ -245,11 +249,13 @@ class CameraWork {
                                          " views captured; at least 3 are needed to solve (" +
                                          std::to_string(w.views()) + " of the criteria's views)");
       }
-      return 0;
+      if (w.solve_out()) throw ConflictError("solve", "a solve is running; wait for it to end");
+      return std::make_shared<calib::IntrinsicsSolve>(w.BeginSolve());
     });
     busy_.store(true);
     SetBusy("starting", 0.0);
-    Post([this] { SolveNow(); });
+    if (solver_.joinable()) solver_.join();  // the last solve's thread, ended
+    solver_ = std::thread([this, solve] { SolveApart(solve); });
   }
 
   nlohmann::json Snapshot() const {
@@ -401,24 +407,39 @@ class CameraWork {
     if (newly_posed && solved_) solved_();
   }
 
-  void SolveNow() {
+  // On the solver's thread: the solve and its plots, then its result to the camera's thread.
+  void SolveApart(std::shared_ptr<calib::IntrinsicsSolve> solve) {
+    std::string failed;
     try {
-      if (!wizard_) throw ConflictError(name_, "has delivered no frame to the wizard yet");
-      wizard_->Solve(-1);
+      solve->Run();
       SetBusy("plots", 0.95);
-      if (wizard_->solution()) {
+      if (solve->solution) {
         std::error_code ec;
         fs::create_directories(settings_.work_dir, ec);
-        calib::WriteResidualPlot(PlotPath("residuals"), *wizard_->solution(), 0);
-        const double distance = wizard_->report() && wizard_->report()->working_distance_m > 0
-                                    ? wizard_->report()->working_distance_m
+        calib::WriteResidualPlot(PlotPath("residuals"), *solve->solution, 0);
+        const double distance = solve->report && solve->report->working_distance_m > 0
+                                    ? solve->report->working_distance_m
                                     : 1.0;
-        calib::WriteUncertaintyMap(PlotPath("uncertainty"), *wizard_->solution(),
+        calib::WriteUncertaintyMap(PlotPath("uncertainty"), *solve->solution,
                                    settings_.options.board, 0, distance);
       }
+    } catch (const std::exception& e) {
+      failed = e.what();
+    }
+    Post([this, solve, failed] { EndSolve(std::move(*solve), failed); });
+  }
+
+  // On the camera's thread: the solve's result into the wizard.
+  void EndSolve(calib::IntrinsicsSolve solved, const std::string& failed) {
+    try {
+      if (!failed.empty()) throw std::runtime_error(failed);
+      // A failed solver's report is a rejection with the reason (calib::IntrinsicsSolve).
+      if (!solved.report) throw std::runtime_error("the solver returned no report");
+      wizard_->EndSolve(std::move(solved), -1);
       ++solves_;
       message_.clear();
     } catch (const std::exception& e) {
+      if (wizard_->solve_out()) wizard_->AbandonSolve(e.what());
       message_ = std::string("solve failed: ") + e.what();
       Log("station.calibration")->warn("{}: {}", name_, message_);
     }
@@ -671,6 +692,7 @@ class CameraWork {
   std::vector<Eigen::Vector2d> last_floor_;
 
   std::atomic<bool> busy_{false};
+  std::thread solver_;  // the last solve's (joined before the next starts, and at the end)
   std::atomic<int> solves_{0};
   std::atomic<uint64_t> floor_order_{0};
   mutable std::mutex state_mutex_;

@@ -100,6 +100,61 @@ TEST(CalibrationWizard, CapturesAStillBoardOnceAndOnlyANewViewAgain) {
   EXPECT_NE(w.verdicts()[0].find("too few views"), std::string::npos) << w.verdicts()[0];
 }
 
+// The console solves apart from the camera's thread (issue 41: a solve there blinded the
+// camera). A solve begun takes the views captured so far; the wizard goes on capturing and solves
+// nothing by itself while it is out, and refuses the commands that would change the solved views.
+// Its result is taken as Solve's would be, with the views captured meanwhile kept.
+TEST(CalibrationWizard, ASolveBegunLeavesTheWizardCapturing) {
+  const BoardStudio board_studio(7, 320, 240);
+  WizardOptions o = Options(ToCalibBoard(board_studio.spec));
+  o.max_views = 5;  // a 5th capture would solve by itself
+  CalibrationWizard w("cam0", 320, 240, o);
+  int n = 0;
+  auto hold = [&](double x, double y, double distance, double rx, double ry, double rz) {
+    const Rigid3 pose =
+        CamFromBoardInView(board_studio.cam, board_studio.spec, x, y, distance, rx, ry, rz);
+    const cv::Mat image = RenderBoards(
+        board_studio.renderer,
+        {{&board_studio.texture, board_studio.cam.cam_from_ground.Inverse() * pose}}, 1.0, n);
+    bool captured = false;
+    for (int i = 0; i < 4; ++i) captured = w.Feed(image, n++).captured || captured;
+    return captured;
+  };
+  ASSERT_TRUE(hold(-0.4, -0.3, 0.5, 0.4, 0.1, 0.05));
+  ASSERT_TRUE(hold(0.4, 0.3, 0.55, -0.3, 0.3, -0.1));
+  ASSERT_TRUE(hold(0.4, -0.3, 0.5, 0.2, -0.35, 0.1));
+  ASSERT_TRUE(hold(-0.4, 0.3, 0.6, -0.35, -0.2, 0.0));
+  ASSERT_EQ(w.views(), 4);
+
+  IntrinsicsSolve solve = w.BeginSolve();
+  EXPECT_TRUE(w.solve_out());
+  EXPECT_EQ(solve.views.size(), 4u);
+  EXPECT_THROW(w.BeginSolve(), InputError);
+  EXPECT_THROW(w.Solve(), InputError);
+  EXPECT_THROW(w.DropLast(), InputError);
+  EXPECT_THROW(w.Redo(WizardStep::kIntrinsics), InputError);
+  // Two more places while it is out: captured, and the 5th does not solve by itself.
+  EXPECT_TRUE(hold(0.0, 0.0, 0.45, 0.1, 0.4, 0.2));
+  EXPECT_TRUE(hold(0.3, 0.0, 0.65, 0.45, 0.0, -0.2));
+  EXPECT_EQ(w.views(), 6);
+  EXPECT_FALSE(w.solution());
+
+  solve.Run();  // where the caller likes: here, the same thread
+  ASSERT_TRUE(solve.solution);
+  ASSERT_TRUE(solve.report);
+  w.EndSolve(std::move(solve));
+  EXPECT_FALSE(w.solve_out());
+  ASSERT_TRUE(w.solution());
+  EXPECT_EQ(w.solution()->observation_frame.size(), 4u);
+  EXPECT_EQ(w.views(), 6) << "the views captured during the solve stay";
+  EXPECT_LT(w.solution()->rms_px[0], 0.5);
+  // Four views are too few to trust: the wizard waits for more, then solves all of them.
+  EXPECT_FALSE(w.intrinsics_good());
+  EXPECT_TRUE(AnyContains(w.report()->reasons, "too few views")) << w.report()->reasons.size();
+  w.Solve();
+  EXPECT_EQ(w.solution()->observation_frame.size(), 6u);
+}
+
 // The board's still span for a capture is the frames' timestamps' when still_s is given: the
 // time its frames cover, n / rate at a steady rate. 0.2 s is 2 frames at 5 fps (at least
 // still_frames), 10 at 50 fps; a count of frames from a rate guessed (30 fps: 6 frames) held a

@@ -137,10 +137,11 @@ test('both cameras run without a floor; the wizard starts on both', async () => 
 
 test('each camera solved; one posed on the operator\'s word, the other through the joint solve', async () => {
   // As an operator reads the card: solve a camera once its checklist's views, coverage and tilt
-  // are met, and again after three more views while a solve is rejected (a solve runs on the
-  // camera's thread, which captures nothing meanwhile: solving at every new view, as this test
-  // first did, kept a loaded machine's cam0 solving through its own poses, and in CI it caught
-  // only the views both cameras share, 19 covering under 15 % of its image in 7 minutes); give
+  // are met, and again after three more views while a solve is rejected (a solve ran on the
+  // camera's thread once, which captured nothing meanwhile: solving at every new view, as this
+  // test first did, kept a loaded machine's cam0 solving through its own poses, and in CI it
+  // caught only the views both cameras share, 19 covering under 15 % of its image in 7 minutes;
+  // a solve now runs on a thread of its own and the camera captures on); give
   // the word only while the boards lie on the floor (the operator sees them there: here, by the
   // session's frame number).
   // The floor board lies where cam0 sees it and cam1 does not: cam1 is posed through the rig.
