@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 
+#include "animate/problem.h"
 #include "core/error.h"
 
 namespace ss {
@@ -154,6 +155,61 @@ int FrameTerm::CountViolations(Tracks tracks) const {
   int count = 0;
   for (int t = begin; t < end; ++t) count += Allowed(*tracks[sprites()[0]], t) ? 0 : 1;
   return count;
+}
+
+void RepeatSpec::AddTerms(const TransitionGraph& graph, Problem& problem) const {
+  if (strength <= 0) return;
+  std::shared_ptr<const std::vector<bool>> still;  // frames that may repeat
+  if (!still_tag.empty())
+    still = std::make_shared<std::vector<bool>>(graph.FramesWithTag(still_tag));
+  for (int id = 0; id < problem.num_sprites(); ++id)
+    problem.AddTerm(std::make_unique<RepeatTerm>(id, window_steps, strength, still));
+}
+
+std::vector<std::string> RepeatSpec::Tags() const {
+  if (strength > 0 && !still_tag.empty()) return {still_tag};
+  return {};
+}
+
+void FacingSpec::AddTerms(const TransitionGraph& graph, Problem& problem) const {
+  if (strength <= 0 || !graph.has_floor_frames()) return;
+  // φ per frame, shared by the sprites.
+  const auto cost = std::make_shared<const std::vector<double>>(FacingCosts(graph, strength));
+  for (int id = 0; id < problem.num_sprites(); ++id)
+    problem.AddTerm(std::make_unique<FacingTerm>(id, cost));
+}
+
+void RegisterRepeatsSpecTerm() {
+  RegisterSpecTerm({"repeats", "{strength, window_steps, still_tag}",
+                    [](SpecBlockReader& reader, const YAML::Node& node, const std::string& path) {
+                      return ReadTermBlock<RepeatSpec>(
+                          reader, node, path,
+                          [](OptionsBinder& keys, RepeatSpec& r) {
+                            keys.Add("strength", &r.strength, "a number >= 0",
+                                     "per step showing a frame shown just before")
+                                .Rule(AtLeast(0))
+                                .Add("window_steps", &r.window_steps, "1..1000 steps",
+                                     "how far back")
+                                .Rule(Between(1, 1000))
+                                .Add("still_tag", &r.still_tag, "a tag", "frames that may repeat");
+                          },
+                          {"strength"});
+                    }});
+}
+
+void RegisterFacingSpecTerm() {
+  RegisterSpecTerm({"facing", "{strength}",
+                    [](SpecBlockReader& reader, const YAML::Node& node, const std::string& path) {
+                      return ReadTermBlock<FacingSpec>(
+                          reader, node, path,
+                          [](OptionsBinder& keys, FacingSpec& f) {
+                            keys.Add("strength", &f.strength, "a number >= 0",
+                                     "per metre moved other than forward")
+                                .Rule(AtLeast(0));
+                          },
+                          {"strength"});
+                    },
+                    [] { return std::make_shared<FacingSpec>(); }});
 }
 
 }  // namespace ss

@@ -16,10 +16,12 @@
 //                                frame's alone.
 #include <memory>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "animate/cost_term.h"
 #include "animate/path_cost.h"
+#include "animate/spec_term.h"
 #include "animate/transition_graph.h"
 
 namespace ss {
@@ -133,6 +135,23 @@ class FrameTerm : public StepSumTerm {
   std::shared_ptr<const std::vector<bool>> allowed_;
   StepWindow window_;
   std::optional<PathTrigger> trigger_;
+};
+
+// The spec's `repeats:` block (animate/spec_term.h): RepeatTerm for every sprite, frames tagged
+// `still_tag` exempt. Off unless the spec sets it.
+struct RepeatSpec : SpecTerm {
+  int window_steps = 15;
+  double strength = 0.0;
+  std::string still_tag = "still";
+  void AddTerms(const TransitionGraph& graph, Problem& problem) const override;
+  std::vector<std::string> Tags() const override;
+};
+
+// The spec's `facing:` block: FacingTerm for every sprite of a bank with floor frames (upright
+// sprites carry no heading). On unless the spec sets its strength to 0.
+struct FacingSpec : SpecTerm {
+  double strength = 300.0;  // per metre moved other than forward
+  void AddTerms(const TransitionGraph& graph, Problem& problem) const override;
 };
 
 }  // namespace ss

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "animate/problem.h"
 #include "core/error.h"
 
 namespace ss {
@@ -46,6 +47,31 @@ int CloneTerm::CountViolations(Tracks tracks) const {
   int count = 0;
   for (int t = begin; t < end; ++t) count += Coincidences(tracks, t) > 0 ? 1 : 0;
   return count;
+}
+
+void CloneSpec::AddTerms(const TransitionGraph& /*graph*/, Problem& problem) const {
+  if (strength <= 0) return;
+  for (int a = 0; a < problem.num_sprites(); ++a) {
+    for (int b = a + 1; b < problem.num_sprites(); ++b)
+      problem.AddTerm(std::make_unique<CloneTerm>(a, b, lag_steps, strength));
+  }
+}
+
+void RegisterClonesSpecTerm() {
+  RegisterSpecTerm({"clones", "{strength, lag_steps}",
+                    [](SpecBlockReader& reader, const YAML::Node& node, const std::string& path) {
+                      return ReadTermBlock<CloneSpec>(
+                          reader, node, path,
+                          [](OptionsBinder& keys, CloneSpec& c) {
+                            keys.Add("strength", &c.strength, "a number >= 0",
+                                     "per frame two sprites show together")
+                                .Rule(AtLeast(0))
+                                .Add("lag_steps", &c.lag_steps, "0..100 steps",
+                                     "how far apart is together")
+                                .Rule(Between(0, 100));
+                          },
+                          {"strength"});
+                    }});
 }
 
 }  // namespace ss

@@ -8,6 +8,7 @@
 // over the steps both sprites show a frame. The 64 flies of §6.2 are symmetric: each has the
 // same best sequence, and without this term they walked in lockstep.
 #include "animate/cost_term.h"
+#include "animate/spec_term.h"
 
 namespace ss {
 
@@ -27,6 +28,14 @@ class CloneTerm : public StepSumTerm {
   int Coincidences(Tracks tracks, int t) const;
 
   int lag_steps_;
+};
+
+// The spec's `clones:` block (animate/spec_term.h): a CloneTerm between every pair of sprites.
+// Off unless the spec sets it.
+struct CloneSpec : SpecTerm {
+  int lag_steps = 2;
+  double strength = 0.0;
+  void AddTerms(const TransitionGraph& graph, Problem& problem) const override;
 };
 
 }  // namespace ss

@@ -4,7 +4,6 @@
 #include <cmath>
 
 #include "animate/basic_costs.h"
-#include "animate/clone_cost.h"
 #include "animate/collision_cost.h"
 #include "animate/location_cost.h"
 #include "animate/path_cost.h"
@@ -24,8 +23,9 @@ std::unique_ptr<Scene> Scene::Load(AnimationSpec spec, const std::atomic<bool>* 
       if (!f.tag.empty()) tags.push_back(f.tag);
     }
   }
-  if (spec.repeats.strength > 0 && !spec.repeats.still_tag.empty())
-    tags.push_back(spec.repeats.still_tag);
+  for (const auto& [key, term] : spec.terms) {
+    for (std::string& tag : term->Tags()) tags.push_back(std::move(tag));
+  }
   BankGraph bank = LoadBankGraph(spec.bank_paths, tags, cancel);
   return std::make_unique<Scene>(std::move(spec), std::move(bank));
 }
@@ -51,13 +51,6 @@ void Scene::AddTerms() {
                          .smoothness = entry.smoothness,
                          .initial_frames = spec_.initial_frames,
                          .max_frames = spec_.max_frames});
-  }
-  std::shared_ptr<const std::vector<bool>> still;  // frames a RepeatTerm lets repeat
-  if (spec_.repeats.strength > 0 && !spec_.repeats.still_tag.empty())
-    still = std::make_shared<std::vector<bool>>(graph.FramesWithTag(spec_.repeats.still_tag));
-  std::shared_ptr<const std::vector<double>> facing;  // φ per frame, shared by the sprites
-  if (spec_.facing.strength > 0 && graph.has_floor_frames()) {
-    facing = std::make_shared<std::vector<double>>(FacingCosts(graph, spec_.facing.strength));
   }
   for (int id = 0; id < static_cast<int>(spec_.sprites.size()); ++id) {
     const SpriteSpecEntry& entry = spec_.sprites[id];
@@ -101,11 +94,6 @@ void Scene::AddTerms() {
     if (length) {
       problem_->AddTerm(std::make_unique<LengthTerm>(id, length->min_frames, length->strength));
     }
-    if (spec_.repeats.strength > 0) {
-      problem_->AddTerm(std::make_unique<RepeatTerm>(id, spec_.repeats.window_steps,
-                                                     spec_.repeats.strength, still));
-    }
-    if (facing) problem_->AddTerm(std::make_unique<FacingTerm>(id, facing));
     const std::optional<FastFrameSpec>& fast = entry.fast ? entry.fast : spec_.fast;
     if (fast && fast->strength > 0) {
       // Graph speeds are metres per source frame: convert the reference and the strength.
@@ -113,14 +101,8 @@ void Scene::AddTerms() {
                                                         fast->strength / interval));
     }
   }
-  if (spec_.clones.strength > 0) {
-    for (int a = 0; a < problem_->num_sprites(); ++a) {
-      for (int b = a + 1; b < problem_->num_sprites(); ++b) {
-        problem_->AddTerm(
-            std::make_unique<CloneTerm>(a, b, spec_.clones.lag_steps, spec_.clones.strength));
-      }
-    }
-  }
+  // The terms registered apart (animate/spec_term.h): repeats, facing, clones.
+  for (const auto& [key, term] : spec_.terms) term->AddTerms(graph, *problem_);
   for (const CollisionSpec& c : spec_.collisions) {
     std::vector<int> ids;
     if (c.sprites.empty()) {

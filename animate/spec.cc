@@ -97,7 +97,7 @@ const std::map<std::string, std::string> kBeamKeys = {
 // bound to the spec's fields (core/options_binder.h), values with a shape of their own (points,
 // times, `free`, `all`) are read by this class, and every mistake of the file is collected with
 // its line and field before the spec is refused.
-class SpecReader {
+class SpecReader : public SpecBlockReader {
  public:
   SpecReader(const std::string& origin, SpecFileRules files)
       : msg_(origin, lines_),
@@ -108,6 +108,13 @@ class SpecReader {
   }
 
   AnimationSpec Read(const YAML::Node& root);
+
+  // SpecBlockReader, for the terms registered apart (animate/spec_term.h).
+  bool Block(const OptionsBinder& keys, const YAML::Node& node, const std::string& path,
+             YamlMap& view) override;
+  void Required(const YamlMap& view, const std::string& key, const std::string& reason) override {
+    if (view.Find(key) == nullptr) Error(view, key, reason);
+  }
 
  private:
   using NodeRead = std::function<bool(const YAML::Node& node, const std::string& path)>;
@@ -149,11 +156,6 @@ class SpecReader {
   }
   void BindWindow(OptionsBinder& keys, WindowKeys& window);
 
-  // Reads the mapping `node` as the block at `path` with `keys` into `view`; false when it is
-  // not a mapping (reported).
-  bool Block(const OptionsBinder& keys, const YAML::Node& node, const std::string& path,
-             YamlMap& view);
-
   // --- rules on what a block's keys hold, each reported on the key
   void Error(const YamlMap& view, const std::string& key, const std::string& reason) {
     msg_.Error(Child(view.path(), key), reason);
@@ -162,9 +164,6 @@ class SpecReader {
   void Check(const YamlMap& view, const std::string& key, bool good, const std::string& reason) {
     if (!good && view.Find(key) != nullptr && !msg_.Failed(Child(view.path(), key)))
       Error(view, key, reason);
-  }
-  void Required(const YamlMap& view, const std::string& key, const std::string& reason) {
-    if (view.Find(key) == nullptr) Error(view, key, reason);
   }
   // The window the keys give; `fallback` when none is given.
   StepWindow Window(const YamlMap& view, const WindowKeys& keys, StepWindow fallback);
@@ -183,9 +182,6 @@ class SpecReader {
   void Constraints(const YAML::Node& node, const std::string& path, SpriteSpecEntry& out);
   LengthSpec Length(const YAML::Node& node, const std::string& path);
   FastFrameSpec Fast(const YAML::Node& node, const std::string& path);
-  RepeatSpec Repeats(const YAML::Node& node, const std::string& path);
-  CloneSpec Clones(const YAML::Node& node, const std::string& path);
-  FacingSpec Facing(const YAML::Node& node, const std::string& path);
   LocationSpec Location(const YAML::Node& node, const std::string& path);
   PathSpec Path(const YAML::Node& node, const std::string& path);
   FrameSpec Frames(const YAML::Node& node, const std::string& path);
@@ -406,24 +402,19 @@ AnimationSpec SpecReader::Read(const YAML::Node& root) {
       .AddRead(
           "fast_frames", "", "{reference_speed_m_s, strength}",
           BlockOf([this](const YAML::Node& n, const std::string& p) { spec_.fast = Fast(n, p); }))
-      .AddRead("repeats", "", "{strength, window_steps, still_tag}",
-               BlockOf([this](const YAML::Node& n, const std::string& p) {
-                 spec_.repeats = Repeats(n, p);
-               }))
-      .AddRead("facing", "", "{strength}",
-               BlockOf([this](const YAML::Node& n, const std::string& p) {
-                 spec_.facing = Facing(n, p);
-               }))
-      .AddRead("clones", "", "{strength, lag_steps}",
-               BlockOf([this](const YAML::Node& n, const std::string& p) {
-                 spec_.clones = Clones(n, p);
-               }))
       .AddRead("optimizer", "", "the optimizer's block",
                BlockOf([this](const YAML::Node& n, const std::string&) { Optimizer(n); }))
       .AddRead("sprites", "", "the list of sprites",
                BlockOf([this](const YAML::Node& n, const std::string&) { Sprites(n); }))
       .AddRead("collisions", "", "collision constraints",
                BlockOf([this](const YAML::Node& n, const std::string&) { Collisions(n); }));
+  const std::vector<const SpecTermKind*> term_kinds = SpecTermKinds();
+  for (const SpecTermKind* kind : term_kinds) {
+    keys.AddRead(kind->key, "", kind->expected,
+                 BlockOf([this, kind](const YAML::Node& n, const std::string& p) {
+                   spec_.terms[kind->key] = kind->read(*this, n, p);
+                 }));
+  }
   YamlMap view;
   if (!Block(keys, root, "", view)) {
     if (root.IsNull()) msg_.Error("(top level)", "the spec is empty");
@@ -437,6 +428,11 @@ AnimationSpec SpecReader::Read(const YAML::Node& root) {
   Required(view, "sprites", "required: a list of sprites");
   CheckReferences();
   if (!msg_.errors.empty()) throw InputError(Join(msg_.errors, "\n"));
+  for (const SpecTermKind* kind : term_kinds) {
+    if (spec_.terms.count(kind->key) == 0) {
+      if (auto absent = kind->absent()) spec_.terms[kind->key] = std::move(absent);
+    }
+  }
   if (spec_.initial_frames == 0) {
     spec_.initial_frames = spec_.length ? spec_.length->min_frames : spec_.Steps(4.0);
     if (spec_.max_frames > 0)
@@ -694,44 +690,6 @@ FastFrameSpec SpecReader::Fast(const YAML::Node& node, const std::string& path) 
   YamlMap view;
   if (!Block(keys, node, path, view)) return out;
   Required(view, "reference_speed_m_s", "required");
-  return out;
-}
-
-RepeatSpec SpecReader::Repeats(const YAML::Node& node, const std::string& path) {
-  RepeatSpec out;
-  OptionsBinder keys;
-  keys.Add("strength", &out.strength, "a number >= 0", "per step showing a frame shown just before")
-      .Rule(AtLeast(0))
-      .Add("window_steps", &out.window_steps, "1..1000 steps", "how far back")
-      .Rule(Between(1, 1000))
-      .Add("still_tag", &out.still_tag, "a tag", "frames that may repeat");
-  YamlMap view;
-  if (!Block(keys, node, path, view)) return out;
-  Required(view, "strength", "required");
-  return out;
-}
-
-FacingSpec SpecReader::Facing(const YAML::Node& node, const std::string& path) {
-  FacingSpec out;
-  OptionsBinder keys;
-  keys.Add("strength", &out.strength, "a number >= 0", "per metre moved other than forward")
-      .Rule(AtLeast(0));
-  YamlMap view;
-  if (!Block(keys, node, path, view)) return out;
-  Required(view, "strength", "required");
-  return out;
-}
-
-CloneSpec SpecReader::Clones(const YAML::Node& node, const std::string& path) {
-  CloneSpec out;
-  OptionsBinder keys;
-  keys.Add("strength", &out.strength, "a number >= 0", "per frame two sprites show together")
-      .Rule(AtLeast(0))
-      .Add("lag_steps", &out.lag_steps, "0..100 steps", "how far apart is together")
-      .Rule(Between(0, 100));
-  YamlMap view;
-  if (!Block(keys, node, path, view)) return out;
-  Required(view, "strength", "required");
   return out;
 }
 

@@ -5,6 +5,8 @@
 // `FILE:LINE: FIELD: reason` (an InputError). Relative paths are resolved against the
 // spec's folder. Times are seconds (converted to steps at the frame rate) or "end".
 #include <cstdint>
+#include <map>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -15,6 +17,7 @@
 #include "animate/cost_term.h"
 #include "animate/path_cost.h"
 #include "animate/replacement.h"
+#include "animate/spec_term.h"
 #include "animate/track.h"
 #include "core/camera_model.h"
 #include "core/enum_text.h"
@@ -75,28 +78,6 @@ struct FastFrameSpec {  // §6.2: prefer fast-moving frames
   double strength = 0.0;  // per (m/s) below the reference, per step
 };
 
-// Ours (not the paper's): a frame shown again within `window_steps` costs `strength` a step,
-// as the judge counts stutter (judge/judge.h); frames tagged `still_tag` hold still on purpose.
-struct RepeatSpec {
-  int window_steps = 15;
-  double strength = 0.0;  // off unless the spec sets it
-  std::string still_tag = "still";
-};
-
-// Ours: floor sprites (filmed from above) should move the way they face; each step costs
-// strength * |v| * (1 - cos Δ) / 2 for a frame moving |v| metres at an angle Δ to its heading
-// (FacingTerm, animate/basic_costs.h). Upright sprites carry no heading: it does not apply.
-struct FacingSpec {
-  double strength = 300.0;  // per metre moved other than forward; 0: off
-};
-
-// Ours: two sprites showing the same frame within `lag_steps` of each other cost `strength`
-// (animate/clone_cost.h), between every pair of sprites.
-struct CloneSpec {
-  int lag_steps = 2;
-  double strength = 0.0;  // off unless the spec sets it
-};
-
 struct SpriteSpecEntry {
   SpecPlace place;
   std::string name;
@@ -152,9 +133,12 @@ struct AnimationSpec {
   int initial_frames = 0;            // length of random initial sequences (default: derived)
   std::optional<LengthSpec> length;  // free length: penalize sequences under N frames
   std::optional<FastFrameSpec> fast;
-  RepeatSpec repeats;
-  FacingSpec facing;
-  CloneSpec clones;
+  // The blocks of the terms registered apart (animate/spec_term.h), by key: the ones the spec
+  // gives, and the ones on without a block (facing). Ours, not the paper's: `repeats` (a frame
+  // shown again within a window costs, as the judge counts stutter: RepeatSpec), `facing` (floor
+  // sprites move the way they face: FacingSpec), `clones` (two sprites showing one frame at once
+  // cost: CloneSpec).
+  std::map<std::string, std::shared_ptr<const SpecTerm>> terms;
   std::string camera_path;              // .cameramodel (absolute)
   SpecPlace camera_place;               // where the spec names it
   std::string background_path;          // image (absolute) or ""
@@ -166,6 +150,13 @@ struct AnimationSpec {
   int Steps(double seconds) const;                  // seconds -> steps at the frame rate
   int SpriteIndex(const std::string& name) const;   // -1 if unknown
   std::string Where(const SpecPlace& place) const;  // "FILE:LINE: FIELD"
+
+  // The block of term `key` as its type (nullptr: the term is off, or not a T).
+  template <typename T>
+  const T* Term(const std::string& key) const {
+    const auto it = terms.find(key);
+    return it == terms.end() ? nullptr : dynamic_cast<const T*>(it->second.get());
+  }
 };
 
 // Which files a spec may name (a spec sent to the station by a client: issue 37).

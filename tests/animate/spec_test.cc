@@ -7,9 +7,15 @@
 
 #include <gtest/gtest.h>
 
+#include "animate/basic_costs.h"
+#include "animate/clone_cost.h"
+#include "animate/problem.h"
 #include "animate/scene.h"
+#include "animate/spec_term.h"
 #include "animate_test_bank.h"
 #include "core/error.h"
+#include "core/options_binder.h"
+#include "core/yaml_reader.h"
 #include "tests/support/test_support.h"
 
 namespace ss {
@@ -157,11 +163,13 @@ TEST_F(SpecTest, RepeatsCostAFrameShownAgainWithinTheWindow) {
   const std::string fast = "fast_frames: {reference_speed_m_s: 1.0, strength: 0.5}";
   const AnimationSpec spec =
       ParseAnimationSpec(Edit(fast, "repeats: {strength: 3, window_steps: 10}"), Origin());
-  EXPECT_EQ(spec.repeats.strength, 3);
-  EXPECT_EQ(spec.repeats.window_steps, 10);
-  EXPECT_EQ(spec.repeats.still_tag, "still");
-  EXPECT_EQ(ParseAnimationSpec(kGood, Origin()).repeats.strength, 0);  // off unless set
-  EXPECT_EQ(TermsOfKind(*Scene::Load(spec), "repeat"), 2);             // one a sprite
+  const RepeatSpec* repeats = spec.Term<RepeatSpec>("repeats");
+  ASSERT_NE(repeats, nullptr);
+  EXPECT_EQ(repeats->strength, 3);
+  EXPECT_EQ(repeats->window_steps, 10);
+  EXPECT_EQ(repeats->still_tag, "still");
+  EXPECT_EQ(ParseAnimationSpec(kGood, Origin()).Term<RepeatSpec>("repeats"), nullptr);  // off
+  EXPECT_EQ(TermsOfKind(*Scene::Load(spec), "repeat"), 2);  // one a sprite
   const std::string o = Origin();
   EXPECT_EQ(ErrorOf(Edit(fast, "repeats: {strength: -1}")),
             o + ":6: repeats.strength: expected a number >= 0, got -1");
@@ -176,19 +184,24 @@ TEST_F(SpecTest, ClonesCostTwoSpritesShowingAFrameTogether) {
   const std::string fast = "fast_frames: {reference_speed_m_s: 1.0, strength: 0.5}";
   const AnimationSpec spec =
       ParseAnimationSpec(Edit(fast, "clones: {strength: 4, lag_steps: 3}"), Origin());
-  EXPECT_EQ(spec.clones.strength, 4);
-  EXPECT_EQ(spec.clones.lag_steps, 3);
-  EXPECT_EQ(ParseAnimationSpec(kGood, Origin()).clones.strength, 0);  // off unless set
-  EXPECT_EQ(TermsOfKind(*Scene::Load(spec), "clone"), 1);             // one a pair
+  const CloneSpec* clones = spec.Term<CloneSpec>("clones");
+  ASSERT_NE(clones, nullptr);
+  EXPECT_EQ(clones->strength, 4);
+  EXPECT_EQ(clones->lag_steps, 3);
+  EXPECT_EQ(ParseAnimationSpec(kGood, Origin()).Term<CloneSpec>("clones"), nullptr);  // off
+  EXPECT_EQ(TermsOfKind(*Scene::Load(spec), "clone"), 1);                             // one a pair
   EXPECT_EQ(ErrorOf(Edit(fast, "clones: {strength: 1, lag_steps: 101}")),
             Origin() + ":6: clones.lag_steps: expected 0..100 steps, got 101");
 }
 
 TEST_F(SpecTest, FacingIsOnForFloorSpritesAlone) {
   const std::string fast = "fast_frames: {reference_speed_m_s: 1.0, strength: 0.5}";
-  EXPECT_EQ(ParseAnimationSpec(kGood, Origin()).facing.strength, 300);  // on unless set to 0
+  const AnimationSpec good = ParseAnimationSpec(kGood, Origin());
+  ASSERT_NE(good.Term<FacingSpec>("facing"), nullptr);  // on unless set to 0
+  EXPECT_EQ(good.Term<FacingSpec>("facing")->strength, 300);
   const AnimationSpec spec = ParseAnimationSpec(Edit(fast, "facing: {strength: 50}"), Origin());
-  EXPECT_EQ(spec.facing.strength, 50);
+  ASSERT_NE(spec.Term<FacingSpec>("facing"), nullptr);
+  EXPECT_EQ(spec.Term<FacingSpec>("facing")->strength, 50);
   // The bank's sprites are upright: they carry no heading, and no facing term is built.
   EXPECT_EQ(TermsOfKind(*Scene::Load(spec), "facing"), 0);
   EXPECT_EQ(ErrorOf(Edit(fast, "facing: {strength: -1}")),
@@ -196,6 +209,52 @@ TEST_F(SpecTest, FacingIsOnForFloorSpritesAlone) {
   EXPECT_NE(ErrorOf(Edit(fast, "facing: {strenght: 1}"))
                 .find(":6: facing.strenght: unknown key (did you mean \"strength\"?)"),
             std::string::npos);
+}
+
+// A term of its own registered as the built-in ones are (animate/spec_term.h): its block is read
+// with the spec's rules and names, and its terms join the scene, with nothing in the spec reader
+// or the scene naming it (issue 36).
+struct WobbleTerm : StepSumTerm {
+  WobbleTerm(int sprite, double strength) : StepSumTerm("wobble", {sprite}, strength) {}
+  std::pair<int, int> Steps(Tracks tracks, const EvalRequest& /*request*/) const override {
+    return {0, tracks[sprites()[0]]->size()};
+  }
+  double StepCost(Tracks /*tracks*/, int /*t*/) const override { return strength(); }
+};
+struct WobbleSpec : SpecTerm {
+  double strength = 0;
+  void AddTerms(const TransitionGraph& /*graph*/, Problem& problem) const override {
+    for (int id = 0; id < problem.num_sprites(); ++id)
+      problem.AddTerm(std::make_unique<WobbleTerm>(id, strength));
+  }
+};
+
+TEST_F(SpecTest, ATermRegisteredApartIsReadAndBuilt) {
+  SpecTermKind wobble{
+      "wobble", "{strength}",
+      [](SpecBlockReader& reader, const YAML::Node& node, const std::string& path) {
+        return ReadTermBlock<WobbleSpec>(
+            reader, node, path,
+            [](OptionsBinder& keys, WobbleSpec& w) {
+              keys.Add("strength", &w.strength, "a number >= 0", "per step").Rule(AtLeast(0));
+            },
+            {"strength"});
+      }};
+  RegisterSpecTerm(wobble);
+  EXPECT_THROW(RegisterSpecTerm(wobble), WorkError);
+  const std::string fast = "fast_frames: {reference_speed_m_s: 1.0, strength: 0.5}";
+  const AnimationSpec spec = ParseAnimationSpec(Edit(fast, "wobble: {strength: 2}"), Origin());
+  ASSERT_NE(spec.Term<WobbleSpec>("wobble"), nullptr);
+  EXPECT_EQ(spec.Term<WobbleSpec>("wobble")->strength, 2);
+  EXPECT_EQ(ParseAnimationSpec(kGood, Origin()).Term<WobbleSpec>("wobble"), nullptr);  // off
+  EXPECT_EQ(TermsOfKind(*Scene::Load(spec), "wobble"), 2);  // one a sprite
+  EXPECT_EQ(ErrorOf(Edit(fast, "wobble: {strength: -1}")),
+            Origin() + ":6: wobble.strength: expected a number >= 0, got -1");
+  EXPECT_EQ(ErrorOf(Edit(fast, "wobble: {}")), Origin() + ":6: wobble.strength: required");
+  EXPECT_NE(ErrorOf(Edit(fast, "wobbel: {strength: 1}"))
+                .find(":6: wobbel: unknown key (did you mean \"wobble\"?)"),
+            std::string::npos)
+      << ErrorOf(Edit(fast, "wobbel: {strength: 1}"));
 }
 
 // A spec a client sends the station may name files under the station's folders only: one

@@ -1,0 +1,79 @@
+#pragma once
+// Cost terms a spec turns on with a top-level block of their own (`repeats:`, `facing:`,
+// `clones:`), registered as keyers and camera backends are (core/registry.h): a term's own files
+// define `void Register<Name>SpecTerm()`, which calls RegisterSpecTerm with how it reads its
+// block and which terms it adds to a scene, and one line in animate/CMakeLists.txt
+// (spritestation_registrations) builds the call in. The spec reader (animate/spec.cc) and the
+// scene (animate/scene.cc) name no such term.
+#include <functional>
+#include <initializer_list>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "core/options_binder.h"
+#include "core/yaml_reader.h"
+
+namespace ss {
+
+class Problem;
+class TransitionGraph;
+
+// The spec reader's rules, for a term's block: each mistake is reported with its line and key,
+// and the spec is refused with every mistake of the file.
+class SpecBlockReader {
+ public:
+  virtual ~SpecBlockReader() = default;
+  // Reads the mapping `node` at `path` with `keys` into `view`: unknown keys, wrong types and
+  // each binding's rule (`.Rule(AtLeast(0))`) on the keys given, each at its key. False when it
+  // is not a mapping (reported).
+  virtual bool Block(const OptionsBinder& keys, const YAML::Node& node, const std::string& path,
+                     YamlMap& view) = 0;
+  // Reports `reason` at `key` when the block lacks it.
+  virtual void Required(const YamlMap& view, const std::string& key, const std::string& reason) = 0;
+};
+
+// One term's block as read: what it adds to a scene.
+class SpecTerm {
+ public:
+  virtual ~SpecTerm() = default;
+  // Adds its cost terms for the problem's sprites (every sprite is added by then).
+  virtual void AddTerms(const TransitionGraph& graph, Problem& problem) const = 0;
+  // The tags whose frames it reads (the banks are loaded with them marked: LoadBankGraph).
+  virtual std::vector<std::string> Tags() const { return {}; }
+};
+
+struct SpecTermKind {
+  std::string key;       // its top-level key in the spec
+  std::string expected;  // its block in words, for errors and docs: "{strength, lag_steps}"
+  // Reads its block at `path` (a mistake reported through `reader`, never thrown).
+  std::function<std::shared_ptr<const SpecTerm>(SpecBlockReader& reader, const YAML::Node& node,
+                                                const std::string& path)>
+      read;
+  // What a spec without the block gets (nullptr: the term is off).
+  std::function<std::shared_ptr<const SpecTerm>()> absent = [] { return nullptr; };
+};
+
+// The usual `read`: a T (a SpecTerm) whose fields `bind` binds to the block's keys, with each
+// key of `required` reported when the block lacks it.
+template <typename T>
+std::shared_ptr<const SpecTerm> ReadTermBlock(SpecBlockReader& reader, const YAML::Node& node,
+                                              const std::string& path,
+                                              const std::function<void(OptionsBinder&, T&)>& bind,
+                                              std::initializer_list<const char*> required) {
+  auto out = std::make_shared<T>();
+  OptionsBinder keys;
+  bind(keys, *out);
+  YamlMap view;
+  if (reader.Block(keys, node, path, view)) {
+    for (const char* key : required) reader.Required(view, key, "required");
+  }
+  return out;
+}
+
+// Called by each term's registration function; a second term of one key is an error.
+void RegisterSpecTerm(SpecTermKind kind);
+// Every term built in, by key.
+std::vector<const SpecTermKind*> SpecTermKinds();
+
+}  // namespace ss
