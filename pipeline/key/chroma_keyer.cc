@@ -414,7 +414,8 @@ ChromaKeyerOptions ChromaKeyerOptionsFrom(const KeyingConfig& k) {
 }
 
 void RegisterChromaKeyer() {
-  RegisterKeyerType<ChromaKeyer>(KeyingMethod::kChroma, ChromaKeyerOptionsFrom);
+  RegisterKeyerType<ChromaKeyer>("chroma", "colour-difference keying for green screens",
+                                 ChromaKeyerOptionsFrom);
 }
 
 }  // namespace ss

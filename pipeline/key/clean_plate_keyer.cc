@@ -193,7 +193,10 @@ CleanPlateKeyerOptions CleanPlateKeyerOptionsFrom(const KeyingConfig& k) {
 }
 
 void RegisterCleanPlateKeyer() {
-  RegisterKeyerType<CleanPlateKeyer>(KeyingMethod::kCleanPlate, CleanPlateKeyerOptionsFrom);
+  RegisterKeyerType<CleanPlateKeyer>(
+      "clean_plate",
+      "difference against a learned empty-enclosure plate, for backgrounds that are not green",
+      CleanPlateKeyerOptionsFrom);
 }
 
 }  // namespace ss

@@ -2,6 +2,7 @@
 
 #include "core/error.h"
 #include "core/registry.h"
+#include "core/yaml_reader.h"  // Join
 
 namespace ss {
 
@@ -19,16 +20,21 @@ PartRegistry<KeyerKind>& Keyers() {
 }  // namespace
 
 void RegisterKeyer(KeyerKind kind) {
-  const std::string name = ToText(kind.method);
+  const std::string name = kind.method;
   Keyers().Add(name, std::move(kind));
 }
 
 std::unique_ptr<Keyer> MakeKeyer(const KeyingConfig& keying, int shadow_reach_cells) {
-  const KeyerKind* kind = Keyers().Find(ToText(keying.method));
-  if (!kind)
-    throw InputError("keying.method",
-                     std::string("no keyer for ") + ToText(keying.method) + " is built in");
+  const KeyerKind* kind = Keyers().Find(keying.method);
+  if (!kind) {
+    throw InputError("keying.method", "no keyer named " + keying.method + " is built in (" +
+                                          yaml_text::Join(KeyerMethods(), ", ") + ")");
+  }
   return kind->make(keying, shadow_reach_cells);
 }
+
+std::vector<const KeyerKind*> KeyerKinds() { return Keyers().All(); }
+
+std::vector<std::string> KeyerMethods() { return Keyers().Names(); }
 
 }  // namespace ss

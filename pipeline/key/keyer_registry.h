@@ -7,6 +7,7 @@
 #include <functional>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "pipeline/key/keyer.h"
 #include "pipeline/key/keying_config.h"
@@ -14,7 +15,8 @@
 namespace ss {
 
 struct KeyerKind {
-  KeyingMethod method = KeyingMethod::kChroma;  // the config's keying.method
+  std::string method;  // the config's keying.method
+  std::string doc;     // what it is for, in the docs' words: "colour-difference keying for ..."
   // Makes the keyer from the config's keying section (its own block and the shared shadow
   // one); `shadow_reach_cells` > 0 replaces its grid's (keying.shadow.reach_m at the camera's
   // scale). InputError naming the config field for a value the keyer refuses.
@@ -26,13 +28,18 @@ void RegisterKeyer(KeyerKind kind);
 // Registers keyer type `K` for `method`, made from `options_from(keying)` (its block of the
 // config's keying section) with the shadow reach applied to its grid.
 template <typename K, typename Options>
-void RegisterKeyerType(KeyingMethod method, Options (*options_from)(const KeyingConfig&)) {
-  RegisterKeyer({method, [options_from](const KeyingConfig& keying, int shadow_reach_cells) {
+void RegisterKeyerType(std::string method, std::string doc,
+                       Options (*options_from)(const KeyingConfig&)) {
+  RegisterKeyer({std::move(method), std::move(doc),
+                 [options_from](const KeyingConfig& keying, int shadow_reach_cells) {
                    Options options = options_from(keying);
                    if (shadow_reach_cells > 0) options.grid.shadow_reach_cells = shadow_reach_cells;
                    return std::unique_ptr<Keyer>(std::make_unique<K>(options));
                  }});
 }
+// Every keyer built in, by method.
+std::vector<const KeyerKind*> KeyerKinds();
+std::vector<std::string> KeyerMethods();
 // The keyer of `keying.method`; InputError naming keying.method when it is not built in.
 std::unique_ptr<Keyer> MakeKeyer(const KeyingConfig& keying, int shadow_reach_cells = 0);
 

@@ -2,23 +2,18 @@
 // The config's keying section (docs/config.md, docs/keying.md): which keyer, and the blocks
 // each keyer makes its options from (pipeline/key/keyer_registry.h). The station config
 // (config/station_config.h) reads it; the keyers own it.
-#include "core/enum_text.h"
+#include <string>
+
 #include "pipeline/key/chroma_keyer.h"
 #include "pipeline/key/clean_plate_keyer.h"
 #include "pipeline/key/shared_options.h"
 
 namespace ss {
 
-// Closed sets are enums in the program and text only in the config file and the API.
-enum class KeyingMethod { kChroma, kCleanPlate };
-
-inline constexpr EnumText<KeyingMethod> kKeyingMethodTexts[] = {
-    {KeyingMethod::kChroma, "chroma"}, {KeyingMethod::kCleanPlate, "clean_plate"}};
-
-inline const char* ToText(KeyingMethod method) { return TextOf(method, kKeyingMethodTexts); }
-
 struct KeyingConfig {
-  KeyingMethod method = KeyingMethod::kChroma;
+  // The keyer, by the name it registered (pipeline/key/keyer_registry.h): an open set, as a
+  // camera's `source` is; the config refuses a name no keyer built in has.
+  std::string method = "chroma";
   int training_frames = 30;  // empty-enclosure frames to learn from
   // The chroma keyer's own options: keying.chroma.low and .high are bound to key_low_levels and
   // key_high_levels (the key difference in 8-bit levels where alpha starts to fall, and where it

@@ -5,14 +5,20 @@
 #include <cmath>
 
 #include "core/option_checks.h"
+#include "pipeline/key/keyer_registry.h"
 
 namespace ss {
 
 OptionsBinder KeyingKeys(KeyingConfig& k) {
   OptionsBinder b;
-  b.AddEnum("method", &k.method, kKeyingMethodTexts,
-            "`chroma`: colour-difference keying for green screens; `clean_plate`: difference "
-            "against a learned empty-enclosure plate, for backgrounds that are not green")
+  // The keyers built in, each with its own words (pipeline/key/keyer_registry.h).
+  std::string methods, docs;
+  for (const KeyerKind* keyer : KeyerKinds()) {
+    methods += (methods.empty() ? "`" : " | `") + keyer->method + "`";
+    docs += (docs.empty() ? "`" : "; `") + keyer->method + "`: " + keyer->doc;
+  }
+  b.Add("method", &k.method, "one of " + yaml_text::Join(KeyerMethods(), ", "), docs)
+      .Type(methods)
       .Add("training_frames", &k.training_frames, "at least 1 frame",
            "frames of the empty enclosure learnt at start (key colour, plate, noise). Each camera "
            "holds them at once, full size (BGR): the largest camera's frames (a camera of unset "
@@ -60,6 +66,9 @@ void CheckKeying(KeyingConfig& k, YamlMessages& msg, const std::string& path) {
     if (!ok && !msg.Failed(Child(path, key))) msg.Error(Child(path, key), reason);
   };
   KeyingKeys(k).CheckRules(msg, path);  // the bounds its keys are bound with
+  const std::vector<std::string> methods = KeyerMethods();
+  check(std::find(methods.begin(), methods.end(), k.method) != methods.end(), "method",
+        "expected one of " + yaml_text::Join(methods, ", ") + ", got \"" + k.method + "\"");
   // The config's range; the keyer itself also takes < 0 (off: min_margin and ramp instead).
   // Against a low bound that is itself wrong, the order says nothing more.
   const double low = k.chroma.key_low_levels, high = k.chroma.key_high_levels;

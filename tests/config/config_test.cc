@@ -119,7 +119,7 @@ TEST(StationConfig, ExampleParsesIntoEveryField) {
   EXPECT_EQ(gige.white_balance.red_gain, 1.42);
   EXPECT_EQ(gige.white_balance.blue_gain, 1.87);
 
-  EXPECT_EQ(cfg.pipeline.keying->method, KeyingMethod::kChroma);
+  EXPECT_EQ(cfg.pipeline.keying->method, "chroma");
   EXPECT_EQ(cfg.pipeline.keying->training_frames, 30);
   EXPECT_EQ(cfg.pipeline.keying->chroma.key_low_levels, 20);
   EXPECT_EQ(cfg.pipeline.keying->chroma.key_high_levels, 60);
@@ -182,7 +182,7 @@ TEST(StationConfig, DefaultsAreFilled) {
   EXPECT_EQ(cfg, expected);
   EXPECT_FALSE(cfg.cameras[0].exposure_us.has_value());  // unset: the device's value, locked
   EXPECT_EQ(cfg.control.address, "127.0.0.1");
-  EXPECT_EQ(cfg.pipeline.keying->method, KeyingMethod::kChroma);
+  EXPECT_EQ(cfg.pipeline.keying->method, "chroma");
   EXPECT_TRUE(cfg.enclosure.floor.empty());
 }
 
