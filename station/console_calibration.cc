@@ -408,7 +408,7 @@ class CameraWork {
   }
 
   // On the solver's thread: the solve and its plots, then its result to the camera's thread.
-  void SolveApart(std::shared_ptr<calib::IntrinsicsSolve> solve) {
+  void SolveApart(const std::shared_ptr<calib::IntrinsicsSolve>& solve) {
     std::string failed;
     try {
       solve->Run();

@@ -17,6 +17,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/log.h"
+#include "core/posix.h"
 
 namespace ss {
 namespace {
@@ -328,7 +329,7 @@ int HttpServer::Bind(const std::string& host, int port, int backlog) {
   // listen() again on a listening socket sets its backlog anew (Linux, POSIX alike).
   if (bound > 0 && ::listen(svr_sock_, backlog) != 0) {
     Log("station.control")
-        ->warn("{}:{}: listen backlog stays cpp-httplib's: {}", host, bound, std::strerror(errno));
+        ->warn("{}:{}: listen backlog stays cpp-httplib's: {}", host, bound, ErrnoText(errno));
   }
   return bound;
 }

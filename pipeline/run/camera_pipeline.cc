@@ -72,7 +72,7 @@ bool CameraPipelineOptions::IsValid(std::string* why) const {
 }
 
 CameraPipeline::CameraPipeline(std::string name, int64_t camera_id, CameraModel model,
-                               const GroundPolygon& floor, CameraPipelineOptions options)
+                               const GroundPolygon& floor, const CameraPipelineOptions& options)
     : name_(std::move(name)),
       camera_id_(camera_id),
       model_(model.valid() ? std::move(model)

@@ -94,7 +94,7 @@ class CameraPipeline {
   // `camera_id` is the bank's id of the camera. Throws InputError when the model
   // is missing or the options are invalid (rectify.px_per_m not chosen: <= 0).
   CameraPipeline(std::string name, int64_t camera_id, CameraModel model, const GroundPolygon& floor,
-                 CameraPipelineOptions options);
+                 const CameraPipelineOptions& options);
   ~CameraPipeline();
   CameraPipeline(CameraPipeline&&) noexcept;
 
