@@ -6,6 +6,7 @@
 
 #include "animate/problem.h"
 #include "core/error.h"
+#include "core/options_binder.h"
 
 namespace ss {
 
@@ -182,32 +183,33 @@ void FacingSpec::AddTerms(const TransitionGraph& graph, Problem& problem) const 
 void RegisterRepeatsSpecTerm() {
   RegisterSpecTerm({"repeats", "{strength, window_steps, still_tag}",
                     [](SpecBlockReader& reader, const YAML::Node& node, const std::string& path) {
-                      return ReadTermBlock<RepeatSpec>(
-                          reader, node, path,
-                          [](OptionsBinder& keys, RepeatSpec& r) {
-                            keys.Add("strength", &r.strength, "a number >= 0",
-                                     "per step showing a frame shown just before")
-                                .Rule(AtLeast(0))
-                                .Add("window_steps", &r.window_steps, "1..1000 steps",
-                                     "how far back")
-                                .Rule(Between(1, 1000))
-                                .Add("still_tag", &r.still_tag, "a tag", "frames that may repeat");
-                          },
-                          {"strength"});
+                      auto r = std::make_shared<RepeatSpec>();
+                      return ReadTermBlock(reader, node, path, r,
+                                           [r](OptionsBinder& keys) {
+                                             keys.Add("strength", &r->strength, "a number >= 0",
+                                                      "per step showing a frame shown just before")
+                                                 .Rule(AtLeast(0))
+                                                 .Add("window_steps", &r->window_steps,
+                                                      "1..1000 steps", "how far back")
+                                                 .Rule(Between(1, 1000))
+                                                 .Add("still_tag", &r->still_tag, "a tag",
+                                                      "frames that may repeat");
+                                           },
+                                           {"strength"});
                     }});
 }
 
 void RegisterFacingSpecTerm() {
   RegisterSpecTerm({"facing", "{strength}",
                     [](SpecBlockReader& reader, const YAML::Node& node, const std::string& path) {
-                      return ReadTermBlock<FacingSpec>(
-                          reader, node, path,
-                          [](OptionsBinder& keys, FacingSpec& f) {
-                            keys.Add("strength", &f.strength, "a number >= 0",
-                                     "per metre moved other than forward")
-                                .Rule(AtLeast(0));
-                          },
-                          {"strength"});
+                      auto f = std::make_shared<FacingSpec>();
+                      return ReadTermBlock(reader, node, path, f,
+                                           [f](OptionsBinder& keys) {
+                                             keys.Add("strength", &f->strength, "a number >= 0",
+                                                      "per metre moved other than forward")
+                                                 .Rule(AtLeast(0));
+                                           },
+                                           {"strength"});
                     },
                     [] { return std::make_shared<FacingSpec>(); }});
 }

@@ -1,6 +1,8 @@
 #include "animate/spec_term.h"
 
+#include "core/options_binder.h"
 #include "core/registry.h"
+#include "core/yaml_reader.h"
 
 namespace ss {
 
@@ -21,5 +23,19 @@ void RegisterSpecTerm(SpecTermKind kind) {
 }
 
 std::vector<const SpecTermKind*> SpecTermKinds() { return SpecTerms().All(); }
+
+std::shared_ptr<const SpecTerm> ReadTermBlock(SpecBlockReader& reader, const YAML::Node& node,
+                                              const std::string& path,
+                                              std::shared_ptr<SpecTerm> term,
+                                              const std::function<void(OptionsBinder&)>& bind,
+                                              std::initializer_list<const char*> required) {
+  OptionsBinder keys;
+  bind(keys);
+  YamlMap view;
+  if (reader.Block(keys, node, path, view)) {
+    for (const char* key : required) reader.Required(view, key, "required");
+  }
+  return term;
+}
 
 }  // namespace ss

@@ -11,13 +11,16 @@
 #include <string>
 #include <vector>
 
-#include "core/options_binder.h"
-#include "core/yaml_reader.h"
+namespace YAML {
+class Node;
+}
 
 namespace ss {
 
+class OptionsBinder;
 class Problem;
 class TransitionGraph;
+class YamlMap;
 
 // The spec reader's rules, for a term's block: each mistake is reported with its line and key,
 // and the spec is refused with every mistake of the file.
@@ -54,22 +57,13 @@ struct SpecTermKind {
   std::function<std::shared_ptr<const SpecTerm>()> absent = [] { return nullptr; };
 };
 
-// The usual `read`: a T (a SpecTerm) whose fields `bind` binds to the block's keys, with each
-// key of `required` reported when the block lacks it.
-template <typename T>
+// The usual `read`: `bind` binds the block's keys to `term`'s fields, and each key of `required`
+// is reported when the block lacks it; `term` is returned.
 std::shared_ptr<const SpecTerm> ReadTermBlock(SpecBlockReader& reader, const YAML::Node& node,
                                               const std::string& path,
-                                              const std::function<void(OptionsBinder&, T&)>& bind,
-                                              std::initializer_list<const char*> required) {
-  auto out = std::make_shared<T>();
-  OptionsBinder keys;
-  bind(keys, *out);
-  YamlMap view;
-  if (reader.Block(keys, node, path, view)) {
-    for (const char* key : required) reader.Required(view, key, "required");
-  }
-  return out;
-}
+                                              std::shared_ptr<SpecTerm> term,
+                                              const std::function<void(OptionsBinder&)>& bind,
+                                              std::initializer_list<const char*> required);
 
 // Called by each term's registration function; a second term of one key is an error.
 void RegisterSpecTerm(SpecTermKind kind);

@@ -687,6 +687,10 @@ WizardFrame CalibrationWizard::Feed(const cv::Mat& image, int frame, double time
   return out;
 }
 
+void CalibrationWizard::RefuseWhileSolving(const char* field) const {
+  if (solve_out_) throw InputError(field, "a solve is running; wait for it to end");
+}
+
 void CalibrationWizard::CheckSolvable() const {
   if (step_ != WizardStep::kIntrinsics) {
     throw InputError(
@@ -698,7 +702,7 @@ void CalibrationWizard::CheckSolvable() const {
                                   std::to_string(kMinToSolve) + " are needed to solve (" +
                                   std::to_string(o_.verdict.min_views) + " to trust it)");
   }
-  if (solve_out_) throw InputError("solve", "a solve is running; wait for it to end");
+  RefuseWhileSolving("solve");
 }
 
 void CalibrationWizard::Solve(int frame) {
@@ -757,14 +761,14 @@ void CalibrationWizard::DropView(size_t index, const std::string& why) {
 
 void CalibrationWizard::DropLast() {
   if (step_ != WizardStep::kIntrinsics) throw InputError("drop", "the intrinsics step is over");
-  if (solve_out_) throw InputError("drop", "a solve is running; wait for it to end");
+  RefuseWhileSolving("drop");
   if (views_.empty()) throw InputError("drop", "no view captured yet");
   DropView(views_.size() - 1, "dropped by the operator (last)");
 }
 
 void CalibrationWizard::DropWorst() {
   if (step_ != WizardStep::kIntrinsics) throw InputError("drop", "the intrinsics step is over");
-  if (solve_out_) throw InputError("drop", "a solve is running; wait for it to end");
+  RefuseWhileSolving("drop");
   if (views_.empty()) throw InputError("drop", "no view captured yet");
   size_t worst = 0;
   std::string why;
@@ -794,7 +798,7 @@ void CalibrationWizard::DropWorst() {
 }
 
 void CalibrationWizard::Redo(WizardStep step) {
-  if (solve_out_) throw InputError("step", "a solve is running; wait for it to end");
+  RefuseWhileSolving("step");
   switch (step) {
     case WizardStep::kIntrinsics:
       if (o_.intrinsics)

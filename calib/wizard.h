@@ -243,6 +243,8 @@ class CalibrationWizard {
   void DropView(size_t index, const std::string& why);
   bool CriteriaMet() const;
   void CheckSolvable() const;  // InputError "solve" naming why Solve cannot now
+  // InputError at `field` while a solve begun is out (the views it solves must stay).
+  void RefuseWhileSolving(const char* field) const;
   void SolveIntrinsics(int frame);
   void TakeIntrinsics(IntrinsicsSolve solved, int frame);
   void EnterGround(int frame);

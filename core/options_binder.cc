@@ -52,20 +52,19 @@ OptionsBinder& OptionsBinder::Rule(NumberRule rule) {
 }
 
 void OptionsBinder::CheckRules(YamlMessages& msg, const std::string& path) const {
-  for (const Binding& b : bindings_) {
-    if (!b.rule) continue;
-    const std::optional<double> v = b.number();
-    const std::string key = Child(path, b.key);
-    if (v && !b.rule->Holds(*v) && !msg.Failed(key))
-      msg.Error(key, "expected " + b.expected + ", got " + Num(*v));
-  }
+  CheckRules(msg, path, nullptr);
 }
 
 void OptionsBinder::CheckRules(YamlMessages& msg, const YamlMap& given) const {
+  CheckRules(msg, given.path(), &given);
+}
+
+void OptionsBinder::CheckRules(YamlMessages& msg, const std::string& path,
+                               const YamlMap* given) const {
   for (const Binding& b : bindings_) {
-    if (!b.rule || given.Find(b.key) == nullptr) continue;
+    if (!b.rule || (given != nullptr && given->Find(b.key) == nullptr)) continue;
     const std::optional<double> v = b.number();
-    const std::string key = Child(given.path(), b.key);
+    const std::string key = Child(path, b.key);
     if (v && !b.rule->Holds(*v) && !msg.Failed(key))
       msg.Error(key, "expected " + b.expected + ", got " + Num(*v));
   }

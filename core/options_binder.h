@@ -84,6 +84,9 @@ class OptionsBinder {
   std::vector<Row> Rows() const;
 
  private:
+  // CheckRules on the keys at `path`: every bound number, or those `given` holds (non-null).
+  void CheckRules(YamlMessages& msg, const std::string& path, const YamlMap* given) const;
+
   struct Binding {
     std::string key;  // relative to the block, dotted
     std::string type;

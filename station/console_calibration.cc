@@ -239,18 +239,14 @@ class CameraWork {
 
   // Starts the solve of the views captured so far on the solver's thread; returns at once.
   void StartSolve() {
+    // The wizard says why it cannot solve now (past the step, too few views, solving): each a
+    // state of the run, 409.
     auto solve = Run([](calib::CalibrationWizard& w) {
-      if (w.step() != WizardStep::kIntrinsics) {
-        throw ConflictError("solve", std::string("the intrinsics step is over (now: ") +
-                                         calib::WizardStepName(w.step()) + ")");
+      try {
+        return std::make_shared<calib::IntrinsicsSolve>(w.BeginSolve());
+      } catch (const InputError& e) {
+        throw ConflictError(e.what());
       }
-      if (w.views() < 3) {
-        throw ConflictError("solve", std::to_string(w.views()) +
-                                         " views captured; at least 3 are needed to solve (" +
-                                         std::to_string(w.views()) + " of the criteria's views)");
-      }
-      if (w.solve_out()) throw ConflictError("solve", "a solve is running; wait for it to end");
-      return std::make_shared<calib::IntrinsicsSolve>(w.BeginSolve());
     });
     busy_.store(true);
     SetBusy("starting", 0.0);
@@ -429,12 +425,10 @@ class CameraWork {
     Post([this, solve, failed] { EndSolve(std::move(*solve), failed); });
   }
 
-  // On the camera's thread: the solve's result into the wizard.
+  // On the camera's thread: the solve's result into the wizard (`failed`: why its run threw).
   void EndSolve(calib::IntrinsicsSolve solved, const std::string& failed) {
     try {
       if (!failed.empty()) throw std::runtime_error(failed);
-      // A failed solver's report is a rejection with the reason (calib::IntrinsicsSolve).
-      if (!solved.report) throw std::runtime_error("the solver returned no report");
       wizard_->EndSolve(std::move(solved), -1);
       ++solves_;
       message_.clear();

@@ -233,10 +233,11 @@ TEST_F(SpecTest, ATermRegisteredApartIsReadAndBuilt) {
   SpecTermKind wobble{
       "wobble", "{strength}",
       [](SpecBlockReader& reader, const YAML::Node& node, const std::string& path) {
-        return ReadTermBlock<WobbleSpec>(
-            reader, node, path,
-            [](OptionsBinder& keys, WobbleSpec& w) {
-              keys.Add("strength", &w.strength, "a number >= 0", "per step").Rule(AtLeast(0));
+        auto w = std::make_shared<WobbleSpec>();
+        return ReadTermBlock(
+            reader, node, path, w,
+            [w](OptionsBinder& keys) {
+              keys.Add("strength", &w->strength, "a number >= 0", "per step").Rule(AtLeast(0));
             },
             {"strength"});
       }};
