@@ -52,15 +52,20 @@ void Station::Impl::WriterLoop() {
 }
 
 void Station::Impl::WriteBatch(StationBatch& sb) {
-  {
-    std::lock_guard lock(stats_mutex);
-    if (storage_state == StorageState::kSpritesStopped) {
-      ++batches_refused;
-      return;
-    }
-  }
   const ClipRecord& clip = sb.batch.clip;
   const auto key = std::make_tuple(clip.camera_id, clip.track_id, clip.first_frame);
+  if (disk.Check().state == StorageState::kSpritesStopped) {
+    // A refused batch breaks its clip as a failed append does: the clip's later batches are not
+    // stored when the space comes back, so no complete clip has a hole.
+    if (clip.complete) {
+      broken_clips.erase(key);
+    } else {
+      broken_clips.insert(key);
+    }
+    std::lock_guard lock(stats_mutex);
+    ++batches_refused;
+    return;
+  }
   if (broken_clips.count(key) > 0) {
     if (clip.complete) broken_clips.erase(key);
     std::lock_guard lock(stats_mutex);

@@ -1,14 +1,10 @@
-// The station's disk guard (station_impl.h): a monitor thread checks the free space of the
-// bank's and the recordings' file systems every second; below storage.stop_recording_below_mib
-// raw recording stops, below storage.stop_sprites_below_mib sprite storage stops too.
-#include <chrono>
-#include <cstdint>
-#include <filesystem>
-#include <mutex>
-#include <string>
+#include "station/disk_guard.h"
 
+#include <filesystem>
+#include <utility>
+
+#include "core/log.h"
 #include "core/sql_postgres.h"
-#include "station/station_impl.h"
 
 namespace ss {
 namespace {
@@ -25,60 +21,68 @@ int64_t FreeMib(fs::path path) {
   return static_cast<int64_t>(info.available / (1024 * 1024));
 }
 
-}  // namespace
-
-void Station::Impl::MonitorLoop() {
-  std::unique_lock lock(monitor_mutex);
-  while (!monitor_stop) {
-    lock.unlock();
-    CheckDisk();
-    lock.lock();
-    monitor_wake.wait_for(lock, std::chrono::seconds(1), [&] { return monitor_stop; });
-  }
-}
-
-void Station::Impl::CheckDisk() {
-  const StorageConfig storage = StorageSettings();
+DiskGuard::Reading Look(const StorageConfig& storage) {
+  DiskGuard::Reading r;
   // A PostgreSQL bank's disk is its server's (a full one fails appends: writes_failing).
-  int64_t free_mib =
+  r.free_mib =
       sql::IsPostgresAddress(storage.bank) ? -1 : FreeMib(fs::path(storage.bank).parent_path());
   if (storage.recording != RecordingMode::kOff) {
     const int64_t rec = FreeMib(storage.recording_dir);
-    if (rec >= 0 && (free_mib < 0 || rec < free_mib)) free_mib = rec;
+    if (rec >= 0 && (r.free_mib < 0 || rec < r.free_mib)) r.free_mib = rec;
   }
-  StorageState next = StorageState::kOk;
-  if (free_mib >= 0 && free_mib < storage.stop_sprites_below_mib) {
-    next = StorageState::kSpritesStopped;
-  } else if (free_mib >= 0 && free_mib < storage.stop_recording_below_mib) {
-    next = StorageState::kRecordingStopped;
+  if (r.free_mib < 0) return r;
+  if (r.free_mib < storage.stop_sprites_below_mib) {
+    r.state = StorageState::kSpritesStopped;
+    r.limit_mib = storage.stop_sprites_below_mib;
+  } else if (r.free_mib < storage.stop_recording_below_mib) {
+    r.state = StorageState::kRecordingStopped;
+    r.limit_mib = storage.stop_recording_below_mib;
   }
+  return r;
+}
+
+}  // namespace
+
+DiskGuard::DiskGuard(std::function<StorageConfig()> settings, double interval_s)
+    : settings_(std::move(settings)), interval_s_(interval_s) {}
+
+DiskGuard::Reading DiskGuard::Check(bool fresh) {
+  using Clock = std::chrono::steady_clock;
+  {
+    std::lock_guard lock(mutex_);
+    if (!fresh && looked_ &&
+        std::chrono::duration<double>(Clock::now() - *looked_).count() < interval_s_)
+      return last_;
+  }
+  const Reading now = Look(settings_());
   StorageState previous;
   {
-    std::lock_guard lock(stats_mutex);
-    previous = storage_state;
-    storage_state = next;
-    disk_free_mib = free_mib;
+    std::lock_guard lock(mutex_);
+    previous = looked_ ? last_.state : StorageState::kOk;
+    last_ = now;
+    looked_ = Clock::now();
   }
-  if (next != StorageState::kOk) {
-    bool recording = false;
-    {
-      std::lock_guard lock(recorder_mutex);
-      recording = recorder != nullptr;
-    }
-    if (recording)
-      StopRecording("free disk space " + std::to_string(free_mib) +
-                    " MiB is below storage.stop_recording_below_mib");
-  }
-  if (next != previous) {
-    if (next == StorageState::kOk) {
-      log->info("disk: {} MiB free, storage back to normal", free_mib);
+  if (now.state != previous) {
+    auto log = Log("station");
+    if (now.state == StorageState::kOk) {
+      log->info("disk: {} MiB free, storage back to normal", now.free_mib);
     } else {
-      log->warn("disk: {} MiB free: {}", free_mib,
-                next == StorageState::kSpritesStopped
+      log->warn("disk: {} MiB free: {}", now.free_mib,
+                now.state == StorageState::kSpritesStopped
                     ? "sprite storage stopped (storage.stop_sprites_below_mib)"
                     : "raw recording stopped (storage.stop_recording_below_mib)");
     }
   }
+  return now;
+}
+
+std::string DiskGuard::RecordingRefusal() {
+  const Reading r = Check();
+  if (r.state != StorageState::kRecordingStopped && r.state != StorageState::kSpritesStopped)
+    return "";
+  return "free disk space " + std::to_string(r.free_mib) + " MiB is below " +
+         (r.state == StorageState::kSpritesStopped ? "storage.stop_sprites_below_mib"
+                                                   : "storage.stop_recording_below_mib");
 }
 
 }  // namespace ss

@@ -24,6 +24,7 @@ struct StationRecorder::Impl {
   };
 
   std::unique_ptr<SessionWriter> writer;
+  std::function<std::string()> refusal;
   bool usable_only = false;
   int queue_frames = 16;
   std::vector<Camera> cameras;
@@ -34,6 +35,15 @@ struct StationRecorder::Impl {
   void Run(Camera& cam) {
     while (std::optional<Item> item = cam.queue->Pop()) {
       if (cam.failed) continue;
+      if (refusal) {
+        std::string why = refusal();
+        std::lock_guard lock(mutex);
+        if (!why.empty() && stats.stopped.empty()) {
+          Log("station.recorder")->warn("recording {} stopped: {}", stats.dir, why);
+          stats.stopped = std::move(why);
+        }
+        if (!stats.stopped.empty()) continue;
+      }
       try {
         Frame f = item->frame;
         f.camera = cam.writer_index;
@@ -52,9 +62,10 @@ struct StationRecorder::Impl {
 
 StationRecorder::StationRecorder(const std::string& dir, const std::string& name,
                                  const RecordingOptions& options, bool usable_only, int cameras,
-                                 int queue_frames)
+                                 std::function<std::string()> refusal, int queue_frames)
     : impl_(std::make_unique<Impl>()) {
   impl_->writer = std::make_unique<SessionWriter>(dir, name, options);
+  impl_->refusal = std::move(refusal);
   impl_->usable_only = usable_only;
   impl_->queue_frames = queue_frames;
   impl_->stats.dir = impl_->writer->dir();
@@ -74,7 +85,7 @@ void StationRecorder::Offer(int camera, const SourceCamera& source, const Camera
   if (s.usable_only && !usable) return;
   Impl::Camera& cam = s.cameras[static_cast<size_t>(camera)];
   std::lock_guard lock(s.mutex);
-  if (s.closed || cam.failed) return;
+  if (s.closed || cam.failed || !s.stats.stopped.empty()) return;
   if (cam.writer_index < 0) {
     try {
       cam.writer_index = s.writer->AddCamera(source, model);

@@ -5,6 +5,7 @@
 // or the pipeline, and a full queue drops the frame (counted, and noted in the
 // CSV's drops_before of the next frame written).
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -21,13 +22,17 @@ struct RecorderStats {
   uint64_t frames_written = 0;
   uint64_t frames_dropped = 0;  // the recording queue was full
   std::string error;            // the first write error (recording stops for that camera)
+  std::string stopped;          // why recording stopped for every camera (the disk guard's word)
 };
 
 class StationRecorder {
  public:
   // Creates the session folder DIR (WorkError naming it when it exists or cannot be made).
+  // `refusal`, asked by each camera's thread before it writes a frame, says why nothing more may
+  // be written ("" while it may): from then on no camera writes, and Close finalizes the files.
   StationRecorder(const std::string& dir, const std::string& name, const RecordingOptions& options,
-                  bool usable_only, int cameras, int queue_frames = 16);
+                  bool usable_only, int cameras, std::function<std::string()> refusal = {},
+                  int queue_frames = 16);
   ~StationRecorder();  // Close()
   StationRecorder(const StationRecorder&) = delete;
   StationRecorder& operator=(const StationRecorder&) = delete;

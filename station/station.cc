@@ -216,9 +216,8 @@ void Station::Start() {
         }));
     s.preview_caches.push_back(std::make_unique<PreviewCache>());
   }
-  s.CheckDisk();  // before any session: a full disk refuses from the first frame
+  s.disk.Check(true);  // before any session: a full disk refuses from the first frame
   for (auto& r : s.runners) r->Start();
-  s.monitor_thread = std::thread([&s] { s.MonitorLoop(); });
   s.state = StationState::kRunning;
   s.log->info("station running: {} camera(s), bank {}", s.runners.size(), config.storage.bank);
 }
@@ -247,12 +246,6 @@ void Station::Stop() {
   for (auto& r : s.runners) r->Stop();
   s.batches.Close();
   if (s.writer_thread.joinable()) s.writer_thread.join();
-  {
-    std::lock_guard lock(s.monitor_mutex);
-    s.monitor_stop = true;
-    s.monitor_wake.notify_all();
-  }
-  if (s.monitor_thread.joinable()) s.monitor_thread.join();
   s.StopRecording("the station stopped");
   if (s.transitions) {
     // The transitions of the last sprites get what is left of the stop's few seconds; what
@@ -288,6 +281,7 @@ StationStatus Station::Status() const {
   }
   for (const auto& r : s.runners) out.cameras.push_back(r->status());
   out.bank_path = s.options.config.storage.bank;
+  const DiskGuard::Reading disk = s.disk.Check();
   {
     std::lock_guard lock(s.stats_mutex);
     out.bank_sprites = s.bank_sprites;
@@ -300,10 +294,10 @@ StationStatus Station::Status() const {
     out.spool_bytes = s.spool_bytes;
     out.batches_refused = s.batches_refused;
     out.bank_error = s.bank_error;
-    out.storage_state = s.storage_state;
+    out.storage_state = disk.state;
     if (out.storage_state == StorageState::kOk && s.last_append_failed)
       out.storage_state = StorageState::kWritesFailing;
-    out.disk_free_mib = s.disk_free_mib;
+    out.disk_free_mib = disk.free_mib;
     if (s.stored_log.size() >= 2) {
       const double span = Seconds(s.stored_log.back().first - s.stored_log.front().first);
       const double recent = Seconds(Clock::now() - s.stored_log.back().first);
@@ -347,6 +341,7 @@ StationStatus Station::Status() const {
     out.frames_recorded = r.frames_written;
     out.frames_record_dropped = r.frames_dropped;
     if (!r.error.empty()) out.recording_error = r.error;
+    out.recording_stopped = r.stopped;
   }
   return out;
 }
@@ -399,6 +394,7 @@ std::vector<std::string> Station::Reload(const StationConfig& config) {
     s.options.config.logging = config.logging;
   }
   ApplyLogging(config.logging);
+  s.disk.Check(true);  // the new limits apply at once
   s.log->info("config reloaded (logging, storage limits and recording mode applied){}",
               needs_restart.empty() ? "" : "; some sections need a restart");
   for (const std::string& line : needs_restart) s.log->warn("{}", line);

@@ -4,7 +4,7 @@
 // in one bank writer thread, which hands each stored sprite to the incremental
 // TransitionWorker. Sprites are stored only during a capture session (started
 // and stopped over the control API or at start); a session may also record the
-// raw frames. A monitor thread watches the disk: below
+// raw frames. The disk guard is asked before each write: below
 // storage.stop_recording_below_mib raw recording stops, below
 // storage.stop_sprites_below_mib sprite storage stops too (the bank stays whole).
 // Threads: the station host's switching thread calls Start and Stop; the API's threads the

@@ -7,12 +7,13 @@
 //   station_status.cc      the status as JSON and as Prometheus text
 //   bank_writer_thread.cc  the bank writer: batches into the bank, through the spool while it is
 //                          away, and the stored counts
-//   disk_guard.cc          the monitor thread: free disk space against the storage limits
+// and, in files of their own, the parts it holds: the camera runners, the recorder, the spool,
+// the disk guard (disk_guard.h: asked before each write, it has no thread).
 //
 // Threads: the API's (an HTTP worker per request: Status, Preview, the session calls, Reload),
 // one per camera (CameraRunner: its pipeline calls Store and Tap with none of its own locks
-// held), the writer (WriterLoop: WriteBatch, DrainSpool, Stored) and the monitor (MonitorLoop,
-// CheckDisk). The transitions worker has its own thread and takes none of these locks.
+// held), the writer (WriterLoop: WriteBatch, DrainSpool, Stored) and the recorder's, one per
+// camera. The transitions worker has its own thread and takes none of these locks.
 //
 // Lock order: a thread holding one of these takes only those after it, never one before.
 //   control_mutex -> session_mutex -> bank_mutex, stats_mutex, config_mutex, recorder_mutex
@@ -21,9 +22,10 @@
 //   PreviewCache::mutex -> CameraRunner's preview lock (an encode runs under the cache's lock)
 // Every other lock is a leaf, held for a copy or a count and released before the next is taken
 // (the writer's stats_mutex, then session_mutex, one after the other in Stored). watcher_mutex is
-// held while the watcher runs: a watcher must not call the station. transitions_listeners' lock
-// is held while the transitions listeners run on the worker's thread (with none of the worker's
-// locks): a listener takes only its own locks.
+// held while the watcher runs: a watcher must not call the station. The disk guard's lock is a
+// leaf too (it reads the settings under config_mutex before it takes its own).
+// transitions_listeners' lock is held while the transitions listeners run on the worker's thread
+// (with none of the worker's locks): a listener takes only its own locks.
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
@@ -49,6 +51,7 @@
 #include "pipeline/transitions/worker.h"
 #include "station/bank_spool.h"
 #include "station/camera_runner.h"
+#include "station/disk_guard.h"
 #include "station/recorder.h"
 #include "station/station.h"
 
@@ -92,7 +95,7 @@ struct Station::Impl {
   std::vector<std::unique_ptr<CameraRunner>> runners;
 
   BoundedQueue<StationBatch> batches{256};
-  std::thread writer_thread, monitor_thread;
+  std::thread writer_thread;
   std::mutex idle_mutex;
   std::condition_variable idle_cv;
   uint64_t batches_in = 0, batches_done = 0;  // under idle_mutex
@@ -113,8 +116,6 @@ struct Station::Impl {
       stored_log;  // (time, sprites_stored) samples for sprites/s
   std::string bank_error;
   bool last_append_failed = false;  // until an append succeeds again
-  StorageState storage_state = StorageState::kOk;
-  int64_t disk_free_mib = -1;
 
   // The capture session, under session_mutex (held across start/stop).
   mutable std::mutex session_mutex;
@@ -126,10 +127,6 @@ struct Station::Impl {
   mutable std::mutex recorder_mutex;  // guards `recorder` against the pipeline threads' taps
   std::mutex control_mutex;           // one session start / stop / rename at a time
   RecorderStats last_recording;
-
-  std::mutex monitor_mutex;
-  std::condition_variable monitor_wake;
-  bool monitor_stop = false;
 
   // The cache entry of a camera's view, locked in `lock`; `frame` is set when the entry must be
   // made (again) from that snapshot, and `runner` to the camera's. nullptr before the camera's
@@ -143,9 +140,10 @@ struct Station::Impl {
   void Store(StationBatch sb);
   void WriterLoop();
 
-  // Clips one of whose batches failed (camera, track, first frame): their later batches are
-  // not stored, so the bank never holds a complete clip with a hole (the clip's part stored
-  // before the failure stays an incomplete clip, which readers do not see). Writer thread only.
+  // Clips one of whose batches failed or was refused (camera, track, first frame): their later
+  // batches are not stored, so the bank never holds a complete clip with a hole (the clip's part
+  // stored before the failure stays an incomplete clip, which readers do not see). Writer thread
+  // only.
   std::set<std::tuple<int64_t, int64_t, int64_t>> broken_clips;
 
   void WriteBatch(StationBatch& sb);
@@ -176,15 +174,12 @@ struct Station::Impl {
   Listeners transitions_listeners;  // its lock is held while they run
   void StopRecording(const std::string& why);
 
-  // The disk guard (disk_guard.cc).
-  void MonitorLoop();
-  void CheckDisk();
-
   mutable std::mutex config_mutex;  // guards options.config.storage / logging for Reload
   StorageConfig StorageSettings() const {
     std::lock_guard lock(config_mutex);
     return options.config.storage;
   }
+  mutable DiskGuard disk{[this] { return StorageSettings(); }};  // Status() asks it too
 };
 
 }  // namespace ss

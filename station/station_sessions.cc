@@ -110,19 +110,14 @@ SessionStatus Station::StartSession(const std::string& requested_name) {
   s.session.started = created;
   s.session_started = Clock::now();
   const StorageConfig storage = s.StorageSettings();
-  StorageState storage_state;
-  {
-    std::lock_guard stats_lock(s.stats_mutex);
-    storage_state = s.storage_state;
-  }
-  if (storage.recording != RecordingMode::kOff && storage_state == StorageState::kOk) {
+  if (storage.recording != RecordingMode::kOff && s.disk.Check(true).state == StorageState::kOk) {
     const fs::path dir = fs::path(storage.recording_dir) / (name + "-" + UtcNowStamp());
     RecordingOptions recording;
     recording.codec = storage.recording_codec;
     try {
-      auto recorder = std::make_unique<StationRecorder>(dir.string(), name, recording,
-                                                        storage.recording == RecordingMode::kUsable,
-                                                        static_cast<int>(s.runners.size()));
+      auto recorder = std::make_unique<StationRecorder>(
+          dir.string(), name, recording, storage.recording == RecordingMode::kUsable,
+          static_cast<int>(s.runners.size()), [&s] { return s.disk.RecordingRefusal(); });
       std::lock_guard rec_lock(s.recorder_mutex);
       s.recorder = std::move(recorder);
       s.session.recording_dir = dir.string();

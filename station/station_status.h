@@ -73,6 +73,7 @@ struct StationStatus {
   std::string recording_mode;                                        // off | all | usable
   uint64_t frames_recorded = 0, frames_record_dropped = 0;
   std::string recording_error;
+  std::string recording_stopped;  // why the disk guard stopped this session's recording
   // Control: its HTTP server (station/http_server.h)
   std::string control_url;
   uint64_t control_connections_open = 0;     // being served now

@@ -1,8 +1,10 @@
 // The station in-process when the bank's disk fills up under it: appends
 // fail (the process may not grow a file: RLIMIT_FSIZE, a full disk for this
 // process alone), the storage state says so, nothing stored before is lost,
-// and storage resumes when space comes back. And when another writer holds the
-// bank's lock past SQLite's busy timeout: no batch is lost.
+// and storage resumes when space comes back. When free space falls under the
+// storage limits mid-session, recording stops first, then sprite storage. And
+// when another writer holds the bank's lock past SQLite's busy timeout: no batch
+// is lost.
 #include <signal.h>
 #include <sys/resource.h>
 
@@ -14,6 +16,7 @@
 #include <sqlite3.h>
 
 #include <nlohmann/json.hpp>
+#include "capture/replay/replay_source.h"
 #include "core/bank.h"
 #include "core/bank_verify.h"
 #include "station/station.h"
@@ -79,6 +82,73 @@ TEST(StationFaults, AFullDiskSaysWritesFailLosesNothingAndResumes) {
   for (const std::string& p : verify.problems) problems += p + "\n";
   EXPECT_TRUE(verify.ok()) << problems;
   EXPECT_GT(Bank(options.config.storage.bank).Counts().sprites_visible, 0);
+}
+
+// The disk filling up mid-session as the disk guard sees it: the limits raised over the free
+// space by a reload, which the guard applies at once. Recording stops first (and what it wrote
+// still replays), then sprite storage; sprites resume when the space comes back, the recording
+// with the next session.
+TEST(StationFaults, FreeSpaceUnderTheLimitsStopsRecordingThenSpritesAndTheyResume) {
+  testing::ScratchDir dir;
+  StationOptions options = OneReplayCamera(dir);
+  options.config.logging.level = "warn";
+  options.config.storage.recording = RecordingMode::kAll;
+  options.config.storage.recording_codec = "mjpeg";
+  Station station(options);
+  station.Start();
+  const SessionStatus session = station.StartSession("filling");
+  ASSERT_FALSE(session.recording_dir.empty());
+  ASSERT_TRUE(WaitFor(
+      station,
+      [](const StationStatus& s) { return s.frames_recorded >= 10 && s.batches_stored >= 2; }, 30))
+      << StatusToJson(station.Status()).dump(2);
+
+  constexpr int64_t kMoreThanAnyDisk = int64_t{1} << 40;  // MiB
+  StationConfig full = options.config;
+  full.storage.stop_recording_below_mib = kMoreThanAnyDisk;
+  EXPECT_TRUE(station.Reload(full).empty());
+  EXPECT_EQ(station.Status().storage_state, StorageState::kRecordingStopped);
+  ASSERT_TRUE(WaitFor(
+      station, [](const StationStatus& s) { return !s.recording_stopped.empty(); }, 10));
+  EXPECT_NE(station.Status().recording_stopped.find("storage.stop_recording_below_mib"),
+            std::string::npos)
+      << station.Status().recording_stopped;
+  const uint64_t recorded = station.Status().frames_recorded;
+  const uint64_t stored = station.Status().batches_stored;
+  ASSERT_TRUE(WaitFor(
+      station, [&](const StationStatus& s) { return s.batches_stored > stored + 2; }, 15))
+      << "sprites were not stored while only recording was stopped";
+  EXPECT_EQ(station.Status().frames_recorded, recorded);
+
+  full.storage.stop_sprites_below_mib = kMoreThanAnyDisk;
+  station.Reload(full);
+  EXPECT_EQ(station.Status().storage_state, StorageState::kSpritesStopped);
+  ASSERT_TRUE(WaitFor(
+      station, [](const StationStatus& s) { return s.batches_refused >= 1; }, 15))
+      << StatusToJson(station.Status()).dump(2);
+  const uint64_t stored_full = station.Status().batches_stored;
+  ASSERT_TRUE(WaitFor(
+      station, [](const StationStatus& s) { return s.batches_refused >= 4; }, 15));
+  EXPECT_EQ(station.Status().batches_stored, stored_full) << "a batch stored on a full disk";
+
+  station.Reload(options.config);  // the space comes back
+  EXPECT_EQ(station.Status().storage_state, StorageState::kOk);
+  ASSERT_TRUE(WaitFor(
+      station, [&](const StationStatus& s) { return s.batches_stored > stored_full + 2; }, 15))
+      << "sprite storage did not resume";
+  EXPECT_EQ(station.Status().frames_recorded, recorded);
+  station.StopSession();
+  station.Stop();
+
+  // The recording was finalized: it replays every frame it wrote.
+  ReplaySource replay(session.recording_dir);
+  uint64_t frames = 0;
+  while (replay.Next()) ++frames;
+  EXPECT_EQ(frames, recorded);
+  const BankVerifyReport verify = VerifyBank(options.config.storage.bank);
+  std::string problems;
+  for (const std::string& p : verify.problems) problems += p + "\n";
+  EXPECT_TRUE(verify.ok()) << problems;
 }
 
 TEST(StationFaults, ABankLockedPastTheBusyTimeoutLosesNoBatch) {
