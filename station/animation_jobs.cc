@@ -293,6 +293,7 @@ void AnimationJobs::Run(std::shared_ptr<Current> job) {
       saved = job->Saved();
     }
     WriteWhole(job->folder / "job.json", saved.dump(2));
+    if (options_.changed) options_.changed();
   };
   try {
     {
@@ -340,19 +341,22 @@ void AnimationJobs::Run(std::shared_ptr<Current> job) {
               {{"name", scene->spec().sprites[s].name}, {"positions", std::move(positions)}});
         }
       }
-      std::lock_guard lock(mu_);
-      job->seconds = point.seconds;
-      job->cost = point.cost;
-      job->best_cost = point.best_cost;
-      job->moves_kept = point.moves_kept;
-      job->restarts = point.restart;
-      job->turns = point.turns;
-      Thin(job->trace);
-      job->trace.emplace_back(point.seconds, point.best_cost);
-      if (!sample) return;
-      Thin(job->by_kind);
-      job->by_kind.emplace_back(point.seconds, std::move(by_kind));
-      job->tracks = std::move(tracks_json);
+      {
+        std::lock_guard lock(mu_);
+        job->seconds = point.seconds;
+        job->cost = point.cost;
+        job->best_cost = point.best_cost;
+        job->moves_kept = point.moves_kept;
+        job->restarts = point.restart;
+        job->turns = point.turns;
+        Thin(job->trace);
+        job->trace.emplace_back(point.seconds, point.best_cost);
+        if (!sample) return;
+        Thin(job->by_kind);
+        job->by_kind.emplace_back(point.seconds, std::move(by_kind));
+        job->tracks = std::move(tracks_json);
+      }
+      if (options_.changed) options_.changed();  // the studio's chart, 4 times a second
     };
     run.on_improvement = [&](const std::vector<Track>& tracks, const TracePoint& point) {
       record(tracks, point, false);

@@ -17,6 +17,7 @@
 // job thread holds it only to copy figures in or out (never while it optimizes or renders).
 #include <atomic>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -37,6 +38,9 @@ struct AnimationJobsOptions {
   // distinct frame constraints): a job over it fails before they are made, saying so.
   int64_t max_set_bytes = int64_t{2} << 30;
   bool render = true;  // false: no render.mp4 and frames (tests of the optimizer)
+  // Called after a job's state changes and with its figures 4 times a second (on the job's
+  // thread, no lock held).
+  std::function<void()> changed;
   // False with "FIELD: reason" lines in `why` (core/option_checks.h) for values out of range.
   bool IsValid(std::string* why) const;
 };

@@ -66,14 +66,19 @@ struct Context {
   // The running station; WorkError "station: not running" when there is none.
   std::function<std::shared_ptr<Station>()> station;
   std::string config_path;  // the daemon's --config file ("" when it has none: tests)
+  // Tells the console's events that the part's status changed (a job's phase, a wizard's
+  // state): they send it at once instead of at the next second. Any thread; no lock is taken
+  // but the events' own. Never empty (a no-op in tests without events).
+  std::function<void()> status_changed = [] {};
 };
 
 class Part {
  public:
   virtual ~Part() = default;
   virtual std::vector<Route> Routes() = 0;
-  // Adds this part's members to the status JSON (called 4 times a second for the events
-  // stream and on every GET /api/status): keep it cheap and never block on long work.
+  // Adds this part's members to the status JSON (up to 4 times a second for the events stream,
+  // and on every GET /api/status): keep it cheap and never block on long work. A change a
+  // viewer acts on is told with Context::status_changed.
   virtual void AddStatus(nlohmann::json& /*status*/) const {}
   // The server stops: end background work (called before the parts are destroyed).
   virtual void Stop() {}

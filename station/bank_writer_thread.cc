@@ -32,7 +32,8 @@ void Station::Impl::WriterLoop() {
   while (true) {
     std::optional<StationBatch> sb;
     if (spool && !spool->empty()) {
-      // Batches wait on disk: try the bank again every second even if no new batch comes.
+      // Batches wait on disk: try the bank again every second even if no new batch comes. A
+      // retry, as a camera's reopen is: nothing tells when a server that is away comes back.
       sb = batches.PopFor(std::chrono::seconds(1));
       if (!sb) {
         if (batches.closed()) break;

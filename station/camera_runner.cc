@@ -176,17 +176,20 @@ struct CameraRunner::Impl {
   }
 
   void SetState(CameraState state, const std::string& message) {
-    std::lock_guard lock(status_mutex);
-    if (status.state != state || status.message != message) {
+    {
+      std::lock_guard lock(status_mutex);
+      if (status.state == state && status.message == message) return;
       if (state == CameraState::kOffline || state == CameraState::kError) {
         log->warn("{}: {}{}", options.camera.name, CameraStateName(state),
                   message.empty() ? "" : ": " + message);
       } else {
         log->info("{}: {}", options.camera.name, CameraStateName(state));
       }
+      status.state = state;
+      status.message = message;
     }
-    status.state = state;
-    status.message = message;
+    if (queue) queue->Wake();  // the pipeline thread's stall deadline depends on the state
+    if (options.state_changed) options.state_changed();
   }
 
   // Sleeps for the backoff delay unless stopping.
@@ -315,11 +318,24 @@ struct CameraRunner::Impl {
   }
 
   // Called by the pipeline thread while it waits: a source silent for too long is stopped.
+  // When the camera counts as silent if no frame comes before: while it is open and streams
+  // (not offline or finished, not already stopped as stalled); nullopt otherwise (then a
+  // change of state wakes the pipeline thread to ask again).
+  std::optional<SteadyTime> StallDeadline() const {
+    if (stalled) return std::nullopt;
+    std::lock_guard lock(status_mutex);
+    // (A camera in error whose keyer failed still streams: it may stall too.)
+    if (status.state == CameraState::kOffline || status.state == CameraState::kFinished)
+      return std::nullopt;
+    return last_frame_time + std::chrono::duration_cast<SteadyTime::duration>(
+                                 std::chrono::duration<double>(options.offline_after_s));
+  }
+
   void CheckStall() {
     bool stale = false;
     {
       std::lock_guard lock(status_mutex);
-      stale = Seconds(Clock::now() - last_frame_time) > options.offline_after_s &&
+      stale = Seconds(Clock::now() - last_frame_time) >= options.offline_after_s &&
               status.state != CameraState::kOffline && status.state != CameraState::kFinished;
     }
     if (!stale) return;
@@ -452,10 +468,14 @@ struct CameraRunner::Impl {
     cv::Mat bgr;
     while (true) {
       ApplyTargetAndSink(pipeline_failed ? nullptr : pipeline.get(), out, arrivals);
-      std::optional<Captured> item = queue->PopFor(std::chrono::milliseconds(100));
+      // Until a frame comes, the capture ends, the station retargets or the camera's state
+      // changes (each wakes the queue), or, while frames are due, until the camera has been
+      // silent for offline_after_s.
+      const std::optional<SteadyTime> stall_at = StallDeadline();
+      std::optional<Captured> item = queue->PopUntil(stall_at.value_or(SteadyTime::max()));
       if (!item) {
-        if (queue->size() == 0 && capture_done) break;
-        CheckStall();
+        if (queue->closed() && queue->size() == 0) break;
+        if (stall_at && Clock::now() >= *stall_at) CheckStall();
         continue;
       }
       const Frame& frame = item->frame;
@@ -558,7 +578,6 @@ struct CameraRunner::Impl {
     target_applied.notify_all();
   }
 
-  std::atomic<bool> capture_done{false};
   std::atomic<bool> source_waits{false};  // the open source's WaitsForReader()
   bool pipeline_done = false;             // under target_mutex
 };
@@ -630,8 +649,7 @@ void CameraRunner::Start() {
       s.SetState(CameraState::kError, e.what());
     }
     s.CloseSource();
-    s.queue->Close();
-    s.capture_done = true;
+    s.queue->Close();  // the pipeline thread drains what is left and ends
   });
   s.pipeline_thread = std::thread([&s] { s.PipelineLoop(); });
 }
@@ -659,6 +677,7 @@ void CameraRunner::SetBankCamera(int64_t camera_id) {
     s.applied_camera_id = camera_id;  // not started: the pipeline starts with it
     return;
   }
+  s.queue->Wake();  // a camera without frames applies it too
   s.target_applied.wait(lock, [&] { return s.pipeline_done || s.applied_camera_id == camera_id; });
 }
 

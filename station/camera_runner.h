@@ -5,7 +5,10 @@
 //   pipeline thread: queue -> learn the empty enclosure -> CameraPipeline::Process
 //                    -> clip batches -> the station's sink (the bank writer)
 // A camera that stops delivering frames is marked offline and reopened with
-// backoff; nothing else in the station notices.
+// backoff; nothing else in the station notices. The pipeline thread sleeps on the
+// queue until a frame comes, the capture ends, the station retargets the bank
+// camera or the state changes (each wakes it), or the camera has been silent
+// for offline_after_s: it never wakes up only to look.
 #include <chrono>
 #include <cstdint>
 #include <functional>
@@ -90,6 +93,9 @@ struct CameraRunnerOptions {
   double preview_interval_s = 0.2;
   // Opens the camera; unset: OpenCameraSource (benchmarks put frames from memory here).
   std::function<std::unique_ptr<FrameSource>(const CameraConfig&, int camera_index)> open_source;
+  // Called after the camera's state or its message changes (on the runner's threads, with none
+  // of its locks held): the console shows it at once. Keep it short.
+  std::function<void()> state_changed;
   // False with "FIELD: reason" lines in `why` (core/option_checks.h) for values out of range
   // (the pipeline's as "pipeline.extract.min_area").
   bool IsValid(std::string* why) const;

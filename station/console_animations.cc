@@ -115,8 +115,10 @@ AnimationJobsOptions StationAnimationOptions(const StationConfig& config,
 
 ConsoleAnimations::ConsoleAnimations(api::Context context) : context_(std::move(context)) {
   if (context_.host == nullptr) return;
-  jobs_ = std::make_unique<AnimationJobs>(StationAnimationOptions(
-      context_.host->live_config(), context_.config_path, context_.host->replay_roots()));
+  AnimationJobsOptions options = StationAnimationOptions(
+      context_.host->live_config(), context_.config_path, context_.host->replay_roots());
+  options.changed = context_.status_changed;
+  jobs_ = std::make_unique<AnimationJobs>(std::move(options));
 }
 
 ConsoleAnimations::~ConsoleAnimations() { Stop(); }

@@ -164,6 +164,9 @@ struct WizardSettings {
   double still_s = 0.2, floor_still_s = 1.0;
   int run = 0;
   std::string work_dir;  // the solve's plots
+  // Called after a camera's state is published (on its threads, no lock held): the console's
+  // events send it (api::Context::status_changed).
+  std::function<void()> published;
 };
 
 // One camera's wizard, on a thread of its own.
@@ -314,9 +317,16 @@ class CameraWork {
   }
 
   void SetBusy(const std::string& stage, double fraction) {
-    std::lock_guard lock(state_mutex_);
-    busy_json_ = nlohmann::json{
-        {"what", "solve"}, {"camera", name_}, {"stage", stage}, {"progress", fraction}};
+    {
+      std::lock_guard lock(state_mutex_);
+      busy_json_ = nlohmann::json{
+          {"what", "solve"}, {"camera", name_}, {"stage", stage}, {"progress", fraction}};
+    }
+    Told();
+  }
+
+  void Told() const {
+    if (settings_.published) settings_.published();
   }
 
   void Loop() {
@@ -551,8 +561,11 @@ class CameraWork {
                 {"ground_check", nullptr},
                 {"enclosure", nullptr},
                 {"plan", nullptr}});
-      std::lock_guard lock(state_mutex_);
-      state_ = std::move(j);
+      {
+        std::lock_guard lock(state_mutex_);
+        state_ = std::move(j);
+      }
+      Told();
       return;
     }
     const calib::CalibrationWizard& w = *wizard_;
@@ -644,18 +657,21 @@ class CameraWork {
     live.grid = grid_;
     live.floor = std::move(floor_px);
     intrinsics_good_.store(w.intrinsics_good());
-    std::lock_guard lock(state_mutex_);
-    state_ = std::move(j);
-    live_ = std::move(live);
-    bgr_width_ = bgr_.cols;
-    bgr_height_ = bgr_.rows;
-    if (force || captured_.size() != w.captured().size()) captured_ = w.captured();
-    ground_pose_.reset();
-    floor_view_.reset();
-    if (w.ground()) {
-      ground_pose_ = w.ground()->cam_from_ground;
-      floor_view_ = w.floor_view();
+    {
+      std::lock_guard lock(state_mutex_);
+      state_ = std::move(j);
+      live_ = std::move(live);
+      bgr_width_ = bgr_.cols;
+      bgr_height_ = bgr_.rows;
+      if (force || captured_.size() != w.captured().size()) captured_ = w.captured();
+      ground_pose_.reset();
+      floor_view_.reset();
+      if (w.ground()) {
+        ground_pose_ = w.ground()->cam_from_ground;
+        floor_view_ = w.floor_view();
+      }
     }
+    Told();
   }
 
   const std::string name_;
@@ -930,6 +946,7 @@ struct ConsoleCalibration::Impl {
     joint = Joint{};
     joint_posed = -1;
     settings.work_dir = (fs::path(work_dir) / std::to_string(run)).string();
+    settings.published = context.status_changed;
     for (size_t i = 0; i < names.size(); ++i) {
       WizardSettings s = settings;
       s.options.intrinsics = current[i];

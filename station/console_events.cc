@@ -24,8 +24,11 @@ nlohmann::json MergePatch(const nlohmann::json& from, const nlohmann::json& to) 
   return patch;
 }
 
-ConsoleEvents::ConsoleEvents(std::function<nlohmann::json()> status, double tick_s)
-    : status_(std::move(status)), tick_s_(tick_s) {}
+ConsoleEvents::ConsoleEvents(std::function<nlohmann::json()> status, double min_interval_s,
+                             double sample_interval_s)
+    : status_(std::move(status)),
+      min_interval_s_(min_interval_s),
+      sample_interval_s_(sample_interval_s) {}
 
 ConsoleEvents::~ConsoleEvents() { Stop(); }
 
@@ -43,6 +46,7 @@ void ConsoleEvents::Start() {
     std::lock_guard lock(mutex_);
     current_ = std::move(first);
     version_ = 1;
+    ++reads_;
   }
   thread_ = std::thread([this] { Loop(); });
 }
@@ -53,7 +57,21 @@ void ConsoleEvents::Stop() {
     stopping_ = true;
   }
   changed_.notify_all();
+  wake_.notify_all();
   if (thread_.joinable()) thread_.join();
+}
+
+void ConsoleEvents::Changed() {
+  {
+    std::lock_guard lock(mutex_);
+    told_ = true;
+  }
+  wake_.notify_one();
+}
+
+uint64_t ConsoleEvents::reads() const {
+  std::lock_guard lock(mutex_);
+  return reads_;
 }
 
 uint64_t ConsoleEvents::connections() const {
@@ -62,56 +80,80 @@ uint64_t ConsoleEvents::connections() const {
 }
 
 nlohmann::json ConsoleEvents::Sample(const nlohmann::json& status, double dt_s) {
+  // A member the status lacks (no station runs) reads as 0.
+  const auto member = [](const nlohmann::json& j, const char* key) {
+    return j.is_object() ? j.value(key, nlohmann::json::object()) : nlohmann::json::object();
+  };
   double dropped = 0;
   nlohmann::json fps = nlohmann::json::object();
   for (const auto& c : status.value("cameras", nlohmann::json::array())) {
-    dropped += c["dropped"].value("total", 0.0);
+    dropped += member(c, "dropped").value("total", 0.0);
     fps[c.value("name", "")] = c.value("fps", 0.0);
   }
   const double dropped_per_s =
       last_dropped_ >= 0 && dt_s > 0 ? std::max(0.0, dropped - last_dropped_) / dt_s : 0;
   last_dropped_ = dropped;
-  const auto& bank = status["bank"];
+  const nlohmann::json bank = member(status, "bank");
+  const nlohmann::json latency = member(bank, "latency_ms");
   return {
       {"t",
        std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count()},
       {"sprites_per_s", bank.value("sprites_per_second", 0.0)},
-      {"latency_p50_ms", bank["latency_ms"].value("p50", 0.0)},
-      {"latency_p99_ms", bank["latency_ms"].value("p99", 0.0)},
-      {"transitions_pending", status["transitions"].value("pending", 0)},
+      {"latency_p50_ms", latency.value("p50", 0.0)},
+      {"latency_p99_ms", latency.value("p99", 0.0)},
+      {"transitions_pending", member(status, "transitions").value("pending", 0)},
       {"dropped_per_s", dropped_per_s},
       {"fps", fps}};
 }
 
 void ConsoleEvents::Loop() {
   using Clock = std::chrono::steady_clock;
+  const auto sample_interval = std::chrono::duration_cast<Clock::duration>(
+      std::chrono::duration<double>(sample_interval_s_));
+  const auto min_interval =
+      std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(min_interval_s_));
   auto last_sample = Clock::now();
+  auto next_sample = last_sample + sample_interval;
+  auto earliest = last_sample;  // a told change's read, at the soonest
   auto log = Log("station.console");
   while (true) {
+    bool told = false;
     {
       std::unique_lock lock(mutex_);
-      if (changed_.wait_for(lock, std::chrono::duration<double>(tick_s_),
-                            [&] { return stopping_; }))
-        return;
+      // Until something is told or the figures are due. A told change is read no sooner than
+      // the interval after the last told one (a burst of them is one read); the samples' reads
+      // do not delay it.
+      wake_.wait_until(lock, next_sample, [&] { return stopping_ || told_; });
+      told = told_;
+      if (!stopping_ && told && Clock::now() < earliest) {
+        wake_.wait_until(lock, std::min(earliest, next_sample), [&] { return stopping_; });
+      }
+      if (stopping_) return;
+      told_ = false;
+      ++reads_;
     }
     nlohmann::json status;
+    bool read = true;
     try {
       status = status_();
     } catch (const std::exception& e) {
       log->warn("events: the status could not be read: {}", e.what());
-      continue;
+      read = false;
     }
     const auto now = Clock::now();
-    const double since_sample = std::chrono::duration<double>(now - last_sample).count();
+    if (told) earliest = now + min_interval;
     nlohmann::json sample;
-    if (since_sample >= 1.0) {
-      sample = Sample(status, since_sample);
+    if (now >= next_sample) {
+      if (read) sample = Sample(status, std::chrono::duration<double>(now - last_sample).count());
       last_sample = now;
+      // On the second's beat, or a second from now when a read ran late.
+      next_sample += sample_interval;
+      if (next_sample <= now) next_sample = now + sample_interval;
     }
     bool notify = false;
     {
       std::lock_guard lock(mutex_);
-      if (status != current_) {
+      if (read && status != current_) {
         current_ = std::move(status);
         ++version_;
         notify = true;

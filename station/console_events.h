@@ -1,10 +1,14 @@
 #pragma once
-// The console's live state (`GET /api/events`, Server-Sent Events). One thread
-// samples the station's status 4 times a second and keeps the last 300
-// one-second chart samples; each connection is sent a snapshot, then JSON
-// Merge Patches (RFC 7386) from the state it last received to the state now.
-// A slow reader therefore never queues anything: it skips to the latest state,
-// and nothing on the capture side ever waits for it.
+// The console's live state (`GET /api/events`, Server-Sent Events). Each connection is sent a
+// snapshot, then JSON Merge Patches (RFC 7386) from the state it last received to the state now.
+// A slow reader therefore never queues anything: it skips to the latest state, and nothing on
+// the capture side ever waits for it.
+//
+// When the status is read: whoever changes something a viewer acts on (a session started, a
+// camera's state, a job's phase, a wizard's step) calls Changed(), and the status is read and
+// sent at once, at most 4 times a second; the figures that move all the time (counts, rates,
+// frames per second) are sampled once a second, with the 300 last one-second chart samples.
+// Nothing else wakes the thread: an idle station costs one read a second.
 #include <condition_variable>
 #include <cstdint>
 #include <deque>
@@ -23,8 +27,11 @@ nlohmann::json MergePatch(const nlohmann::json& from, const nlohmann::json& to);
 
 class ConsoleEvents {
  public:
-  // `status` returns the station's status JSON (called on this object's thread).
-  explicit ConsoleEvents(std::function<nlohmann::json()> status, double tick_s = 0.25);
+  // `status` returns the station's status JSON (called on this object's thread, with none of
+  // its locks held). A change is read no sooner than `min_interval_s` after the last read; the
+  // figures are sampled every `sample_interval_s`.
+  explicit ConsoleEvents(std::function<nlohmann::json()> status, double min_interval_s = 0.25,
+                         double sample_interval_s = 1.0);
   ~ConsoleEvents();  // Stop()
   ConsoleEvents(const ConsoleEvents&) = delete;
   ConsoleEvents& operator=(const ConsoleEvents&) = delete;
@@ -32,6 +39,11 @@ class ConsoleEvents {
   void Start();
   // Wakes every connection so it ends; idempotent.
   void Stop();
+  // The status changed: read and send it now (or once min_interval_s has passed since the last
+  // read). Any thread; takes only this object's lock.
+  void Changed();
+  // Status reads so far (the first snapshot's included).
+  uint64_t reads() const;
 
   // One connection's stream. Next() blocks until there is something to send (at most the
   // heartbeat interval) and returns the text of one or more events, "" once stopping.
@@ -62,11 +74,14 @@ class ConsoleEvents {
   nlohmann::json Sample(const nlohmann::json& status, double dt_s);
 
   std::function<nlohmann::json()> status_;
-  double tick_s_;
+  double min_interval_s_, sample_interval_s_;
   std::thread thread_;
   mutable std::mutex mutex_;
-  std::condition_variable changed_;
+  std::condition_variable changed_;  // the streams wait on it
+  std::condition_variable wake_;     // the reading thread waits on it
   bool stopping_ = false;
+  bool told_ = false;  // Changed() since the last read
+  uint64_t reads_ = 0;
   nlohmann::json current_;              // the latest status
   uint64_t version_ = 0;                // bumped when current_ changes
   std::deque<nlohmann::json> history_;  // the last kHistory samples

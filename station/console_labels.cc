@@ -171,10 +171,12 @@ ConsoleLabels::ConsoleLabels(api::Context context, ConsoleLabelsOptions options)
   if (std::string why; !options_.IsValid(&why)) throw InputError("labels options", why);
   // An ended retrain changed the weights (or tried to): the status reads them again.
   retrain_ = std::make_unique<RetrainJob>(
-      context_, options_.threads, [dirty = dirty_](const ss::RetrainState& state) {
+      context_, options_.threads,
+      [dirty = dirty_, changed = context_.status_changed](const ss::RetrainState& state) {
         if (state.phase == RetrainPhase::kDone || state.phase == RetrainPhase::kFailed ||
             state.phase == RetrainPhase::kCancelled)
           *dirty = true;
+        changed();
       });
 }
 

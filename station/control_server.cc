@@ -149,6 +149,7 @@ struct ControlServer::Impl {
   std::thread thread;
   int port = 0;
   std::unique_ptr<ConsoleEvents> events;
+  int status_listener = 0;  // the host's status listener telling `events` (0: none)
   std::vector<Route> routes;
   std::vector<std::regex> route_patterns;         // routes[i]'s pattern, compiled
   std::vector<std::unique_ptr<api::Part>> parts;  // the API's parts in files of their own
@@ -159,6 +160,7 @@ struct ControlServer::Impl {
     context.host = host;
     context.station = [this] { return station(); };
     context.config_path = options.config_path;
+    context.status_changed = [this] { events->Changed(); };
     parts.push_back(std::make_unique<ConsoleCalibration>(context));
     parts.push_back(std::make_unique<ConsoleLabels>(context));
     parts.push_back(std::make_unique<ConsoleAnimations>(context));
@@ -576,6 +578,7 @@ int ControlServer::Start() {
         "cannot listen there (address not on this machine, or the port is taken)");
   }
   s.events->Start();
+  s.status_listener = s.host->AddStatusListener([&s] { s.events->Changed(); });
   s.thread = std::thread([&s] { s.server.listen_after_bind(); });
   Log("station.control")->info("control API and console on {}", s.Url());
   return s.port;
@@ -584,6 +587,8 @@ int ControlServer::Start() {
 void ControlServer::Stop() {
   Impl& s = *impl_;
   for (const auto& part : s.parts) part->Stop();
+  if (s.status_listener != 0) s.host->RemoveStatusListener(s.status_listener);
+  s.status_listener = 0;
   s.events->Stop();  // event streams end, so the server's threads can
   if (s.thread.joinable()) {
     s.server.stop();

@@ -43,8 +43,9 @@ DiskGuard::Reading Look(const StorageConfig& storage) {
 
 }  // namespace
 
-DiskGuard::DiskGuard(std::function<StorageConfig()> settings, double interval_s)
-    : settings_(std::move(settings)), interval_s_(interval_s) {}
+DiskGuard::DiskGuard(std::function<StorageConfig()> settings, std::function<void()> changed,
+                     double interval_s)
+    : settings_(std::move(settings)), changed_(std::move(changed)), interval_s_(interval_s) {}
 
 DiskGuard::Reading DiskGuard::Check(bool fresh) {
   using Clock = std::chrono::steady_clock;
@@ -72,6 +73,7 @@ DiskGuard::Reading DiskGuard::Check(bool fresh) {
                     ? "sprite storage stopped (storage.stop_sprites_below_mib)"
                     : "raw recording stopped (storage.stop_recording_below_mib)");
     }
+    if (changed_) changed_();
   }
   return now;
 }

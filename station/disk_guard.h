@@ -30,11 +30,13 @@ class DiskGuard {
     int64_t limit_mib = 0;                   // the limit `state` is below (0 when kOk)
   };
 
-  // `settings` gives the storage section as it is now (a reload may change its limits).
-  explicit DiskGuard(std::function<StorageConfig()> settings, double interval_s = 1.0);
+  // `settings` gives the storage section as it is now (a reload may change its limits);
+  // `changed`, if set, is called after the state changes (on the thread that asked).
+  explicit DiskGuard(std::function<StorageConfig()> settings, std::function<void()> changed = {},
+                     double interval_s = 1.0);
 
   // The reading, looked at again when the last look is an interval old (or `fresh`). A change
-  // of state is logged.
+  // of state is logged and told.
   Reading Check(bool fresh = false);
 
   // Why raw recording must stop now ("" when it may go on), for the recorder's threads.
@@ -42,6 +44,7 @@ class DiskGuard {
 
  private:
   std::function<StorageConfig()> settings_;
+  std::function<void()> changed_;
   double interval_s_;
   std::mutex mutex_;
   std::optional<std::chrono::steady_clock::time_point> looked_;  // under mutex_

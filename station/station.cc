@@ -189,7 +189,10 @@ void Station::Start() {
         config.storage.bank, s.options.weights ? *s.options.weights : DefaultWeights(), 1,
         TableChoice{.include_merged = config.transitions.include_merged,
                     .max_per_sprite = config.transitions.max_per_sprite},
-        [&s] { s.transitions_listeners.Notify("transitions"); });
+        [&s] {
+          s.transitions_listeners.Notify("transitions");
+          s.Changed();
+        });
   }
   s.writer_thread = std::thread([&s] { s.WriterLoop(); });
 
@@ -209,6 +212,7 @@ void Station::Start() {
     o.offline_after_s = s.options.offline_after_s;
     o.preview_interval_s = kPreviewIntervalS;
     o.open_source = s.options.open_source;
+    o.state_changed = [&s] { s.Changed(); };
     s.runners.push_back(std::make_unique<CameraRunner>(
         static_cast<int>(i), std::move(o), [&s](StationBatch b) { s.Store(std::move(b)); },
         [&s](int camera, const Frame& f, uint64_t drops, bool usable) {
@@ -219,6 +223,7 @@ void Station::Start() {
   s.disk.Check(true);  // before any session: a full disk refuses from the first frame
   for (auto& r : s.runners) r->Start();
   s.state = StationState::kRunning;
+  s.Changed();
   s.log->info("station running: {} camera(s), bank {}", s.runners.size(), config.storage.bank);
 }
 
@@ -229,6 +234,7 @@ void Station::Stop() {
     return;
   }
   s.state = StationState::kStopping;
+  s.Changed();
   const auto stop_start = Clock::now();
   bool active = false;
   {
@@ -266,6 +272,7 @@ void Station::Stop() {
     s.bank.reset();  // the last connection closes: the bank is whole on disk
   }
   s.state = StationState::kStopped;
+  s.Changed();
   s.log->info("station stopped: {} sprites stored", s.sprites_stored);
 }
 

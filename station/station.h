@@ -33,6 +33,12 @@ struct StationOptions {
   double offline_after_s = 3.0;  // a camera silent this long, seconds (> 0), is reopened
   // Opens each camera; unset: its configured backend (benchmarks replay from memory).
   std::function<std::unique_ptr<FrameSource>(const CameraConfig&, int camera_index)> open_source;
+  // Called when what the status says changes in a way a viewer acts on: the station's state, a
+  // session started, stopped or renamed, a camera's state, the storage state, the transitions'
+  // start-up. Any of the station's threads calls it, possibly with station locks held: it must
+  // be short and must not call the station (the console's events: ConsoleEvents::Changed).
+  // Figures that move all the time (counts, rates) are not told; the console samples them.
+  std::function<void()> status_changed;
   // False with "FIELD: reason" lines in `why` (core/option_checks.h) for values out of range.
   bool IsValid(std::string* why) const;
 };

@@ -102,7 +102,7 @@ StationHost::~StationHost() { Stop(); }
 
 void StationHost::Start() {
   std::lock_guard sw(switch_mutex_);
-  auto station = std::make_shared<Station>(live_);
+  auto station = std::make_shared<Station>(Told(live_));
   station->Start();
   running_ = live_;
   {
@@ -128,7 +128,7 @@ void StationHost::Replace(StationOptions options) {
   if (old) old->Stop();  // its session stopped and stored, its bank closed
   // The stopped station stays current (its status says "stopped") until the next one runs.
   running_ = options;
-  auto next = std::make_shared<Station>(std::move(options));
+  auto next = std::make_shared<Station>(Told(std::move(options)));
   next->Start();
   {
     std::lock_guard lock(mutex_);
@@ -143,7 +143,21 @@ int StationHost::AddStationChangeListener(std::function<void()> listener) {
 
 void StationHost::RemoveStationChangeListener(int id) { listeners_.Remove(id); }
 
-void StationHost::NotifyStationChange() { listeners_.Notify("station change"); }
+void StationHost::NotifyStationChange() {
+  listeners_.Notify("station change");
+  status_listeners_->Notify("status");  // the mode, and a new station's status
+}
+
+int StationHost::AddStatusListener(std::function<void()> listener) {
+  return status_listeners_->Add(std::move(listener));
+}
+
+void StationHost::RemoveStatusListener(int id) { status_listeners_->Remove(id); }
+
+StationOptions StationHost::Told(StationOptions options) const {
+  options.status_changed = [listeners = status_listeners_] { listeners->Notify("status"); };
+  return options;
+}
 
 void StationHost::StartReplay(const std::string& path, bool paced, bool loop) {
   std::lock_guard sw(switch_mutex_);

@@ -95,6 +95,14 @@ class StationHost {
   // Once it returns, the listener is not running and is not called again.
   void RemoveStationChangeListener(int id);
 
+  // Calls `listener` when the running station's status changes in a way a viewer acts on
+  // (StationOptions::status_changed: on the station's threads, possibly under its locks) and
+  // after each switch of stations. It must be short and call neither the host nor the station
+  // (the console's events: ConsoleEvents::Changed). Returns the id RemoveStatusListener takes.
+  int AddStatusListener(std::function<void()> listener);
+  // Once it returns, the listener is not running and is not called again.
+  void RemoveStatusListener(int id);
+
   // {"mode": "live" | "replay", "replay": {"path", "paced", "loop"} or null}
   nlohmann::json ModeJson() const;
   const std::vector<std::string>& replay_roots() const { return replay_roots_; }
@@ -116,6 +124,11 @@ class StationHost {
   std::string replay_path_;
   bool replay_paced_ = true, replay_loop_ = false;
   Listeners listeners_;  // its lock is held while they run (the lock order above)
+  // The status listeners, shared with every station this host starts (a station may outlive
+  // the host in whoever still holds it). A leaf: their lock is taken under any other.
+  std::shared_ptr<Listeners> status_listeners_ = std::make_shared<Listeners>();
+  // `options` with their status_changed telling status_listeners_.
+  StationOptions Told(StationOptions options) const;
 };
 
 }  // namespace ss

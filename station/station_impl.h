@@ -179,7 +179,12 @@ struct Station::Impl {
     std::lock_guard lock(config_mutex);
     return options.config.storage;
   }
-  mutable DiskGuard disk{[this] { return StorageSettings(); }};  // Status() asks it too
+  // Tells StationOptions::status_changed (station.h), if set.
+  void Changed() const {
+    if (options.status_changed) options.status_changed();
+  }
+  // Status() asks it too.
+  mutable DiskGuard disk{[this] { return StorageSettings(); }, [this] { Changed(); }};
 };
 
 }  // namespace ss

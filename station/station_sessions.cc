@@ -133,6 +133,7 @@ SessionStatus Station::StartSession(const std::string& requested_name) {
   // Previews back off while a session stores: fewer snapshots for the pipeline threads to copy.
   for (auto& r : s.runners) r->set_preview_interval(kPreviewIntervalSessionS);
   s.log->info("session \"{}\" started (bank session {})", name, out.bank_session_id);
+  s.Changed();
   return out;
 }
 
@@ -156,6 +157,7 @@ SessionStatus Station::StopSession() {
   s.session.seconds = Seconds(Clock::now() - s.session_started);
   s.log->info("session \"{}\" stopped: {} sprites stored", s.session.name,
               s.session.sprites_stored);
+  s.Changed();
   return s.session;
 }
 
@@ -172,6 +174,7 @@ SessionStatus Station::RenameSession(const std::string& requested_name) {
   s.log->info("session \"{}\" renamed \"{}\"", s.session.name, name);
   s.session.name = name;
   s.session.revision = NextSessionRevision();
+  s.Changed();
   return s.session;
 }
 

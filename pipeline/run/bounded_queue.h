@@ -2,6 +2,8 @@
 // A blocking queue of bounded size between two threads: Push waits while it is
 // full (back-pressure instead of unbounded memory), Pop waits while it is
 // empty, Close wakes both and makes Pop drain what is left, then return nullopt.
+// Wake makes the consumer's wait end without an item (PopUntil: it has something
+// else to do, told instead of found by waking up to look).
 #include <condition_variable>
 #include <cstddef>
 #include <deque>
@@ -46,6 +48,27 @@ class BoundedQueue {
     return item;
   }
 
+  // Waits until an item comes, the queue is closed, Wake() is called or `deadline` passes
+  // (nullopt for the last three; a Wake is taken by one such call).
+  template <typename TimePoint>
+  std::optional<T> PopUntil(TimePoint deadline) {
+    std::unique_lock lock(mutex_);
+    not_empty_.wait_until(lock, deadline, [&] { return closed_ || woken_ || !items_.empty(); });
+    woken_ = false;
+    if (items_.empty()) return std::nullopt;
+    T item = std::move(items_.front());
+    items_.pop_front();
+    not_full_.notify_one();
+    return item;
+  }
+
+  // Ends the consumer's PopUntil now (or its next one) without an item.
+  void Wake() {
+    std::lock_guard lock(mutex_);
+    woken_ = true;
+    not_empty_.notify_all();
+  }
+
   size_t size() const {
     std::lock_guard lock(mutex_);
     return items_.size();
@@ -79,6 +102,7 @@ class BoundedQueue {
   std::condition_variable not_empty_, not_full_;
   std::deque<T> items_;
   bool closed_ = false;
+  bool woken_ = false;
 };
 
 }  // namespace ss

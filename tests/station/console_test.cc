@@ -86,6 +86,7 @@ TEST(Console, ASlowReaderGetsOnlyTheLatestState) {
   // The state changes 20 times while the reader reads nothing.
   for (int k = 1; k <= 20; ++k) {
     counter = k;
+    events.Changed();
     std::this_thread::sleep_for(std::chrono::milliseconds(15));
   }
   std::this_thread::sleep_for(std::chrono::milliseconds(50));
@@ -100,6 +101,40 @@ TEST(Console, ASlowReaderGetsOnlyTheLatestState) {
   EXPECT_EQ(held, (nlohmann::json{{"n", 20}, {"fixed", "x"}}));
   events.Stop();
   EXPECT_EQ(stream.Next(), "") << "a stopping hub ends every stream";
+}
+
+TEST(Console, AToldChangeIsSentAtOnceAndAnIdleStatusIsReadOnlyToSample) {
+  std::atomic<int> counter{0};
+  // Figures sampled every 2 s: what comes sooner came because it was told.
+  ConsoleEvents events([&] { return nlohmann::json{{"n", counter.load()}}; }, 0.01, 2.0);
+  events.Start();
+  ConsoleEvents::Stream stream(events);
+  uint64_t next_id = 1;
+  nlohmann::json held = ParseEvents(stream.Next(), &next_id).at(0).second["status"];
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  EXPECT_EQ(events.reads(), 1u) << "the status was read again with nothing told";
+
+  counter = 1;
+  events.Changed();
+  const auto told = std::chrono::steady_clock::now();
+  while (held["n"] != 1) {
+    for (const auto& [name, data] : ParseEvents(stream.Next(), &next_id)) {
+      if (name == "patch") held.merge_patch(data);
+    }
+  }
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - told).count(), 1.0)
+      << "a told change waited for the sample";
+  EXPECT_EQ(events.reads(), 2u);
+
+  // Untold, a change still comes with the next sample.
+  counter = 2;
+  while (held["n"] != 2) {
+    for (const auto& [name, data] : ParseEvents(stream.Next(), &next_id)) {
+      if (name == "patch") held.merge_patch(data);
+    }
+  }
+  EXPECT_GE(std::chrono::duration<double>(std::chrono::steady_clock::now() - told).count(), 1.0);
+  events.Stop();
 }
 
 TEST(Console, ExposureFiguresMeasureTheGreenScreen) {
