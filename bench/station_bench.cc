@@ -65,13 +65,17 @@ std::string Tag() {
          std::to_string(g_args.height) + "@" + std::to_string(static_cast<int>(g_args.fps));
 }
 
-// A synthetic session with as many cameras as asked, made once per shape.
+// A synthetic session with as many cameras as asked, made once per shape. It is rendered beside
+// and renamed into place when whole: a render cut off (a bench stopped) left a session.json over
+// truncated videos, and every later run replayed that without a sprite.
 std::string Session() {
   const fs::path dir = fs::temp_directory_path() / ("spritestation-station-bench-" + Tag());
   if (fs::exists(dir / "session.json")) return dir.string();
   fs::remove_all(dir);
+  const fs::path partial = dir.string() + ".partial";
+  fs::remove_all(partial);
   synth::SynthOptions o;
-  o.out_dir = dir.string();
+  o.out_dir = partial.string();
   o.seconds = 6;
   o.fps = g_args.fps;
   o.width = g_args.width;
@@ -84,6 +88,7 @@ std::string Session() {
   std::fprintf(stderr, "bench station: rendering a %d-camera %dx%d session into %s (once)...\n",
                o.cameras, o.width, o.height, o.out_dir.c_str());
   synth::RenderStudioSession(o);
+  fs::rename(partial, dir);
   return dir.string();
 }
 
