@@ -170,12 +170,11 @@ class BeamPlanner {
 
 bool BeamOptions::IsValid(std::string* why) const {
   OptionProblems check(why);
-  check(width >= 1, "width", "must be >= 1, got " + std::to_string(width));
-  check(length >= 0, "length", "must be >= 0 (0: the sprite's own), got " + std::to_string(length));
-  check(start_frames >= 0, "start_frames",
-        "must be >= 0 (0: every frame), got " + std::to_string(start_frames));
-  check(time_budget_seconds >= 0 && std::isfinite(time_budget_seconds), "time_budget_seconds",
-        "must be seconds >= 0 (0: one pass), got " + OptionProblems::Num(time_budget_seconds));
+  check.Within(width, AtLeast(1), "width", "at least 1");
+  check.Within(length, AtLeast(0), "length", "at least 0 (0: the sprite's own)");
+  check.Within(start_frames, AtLeast(0), "start_frames", "at least 0 (0: every frame)");
+  check.Within(time_budget_seconds, AtLeast(0), "time_budget_seconds",
+               "seconds >= 0 (0: one pass)");
   check(!(time_budget_seconds > kMaxTimeBudgetSeconds) || !std::isfinite(time_budget_seconds),
         "time_budget_seconds",
         "must be at most " + OptionProblems::Num(kMaxTimeBudgetSeconds) + " seconds (a day), got " +

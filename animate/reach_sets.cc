@@ -79,12 +79,9 @@ class DijkstraWorkspace {
 
 bool ReachOptions::IsValid(std::string* why) const {
   OptionProblems check(why);
-  check(set_size >= 1 && set_size <= 65535, "set_size",
-        "must be in 1..65535, got " + std::to_string(set_size));
-  check(num_threads >= 1 && num_threads <= 256, "num_threads",
-        "must be in 1..256, got " + std::to_string(num_threads));
-  check(step_cost >= 0 && std::isfinite(step_cost), "step_cost",
-        "must be finite and >= 0, got " + OptionProblems::Num(step_cost));
+  check.Within(set_size, Between(1, 65535), "set_size", "1..65535");
+  check.Within(num_threads, Between(1, 256), "num_threads", "1..256");
+  check.Within(step_cost, AtLeast(0), "step_cost", "a finite number >= 0");
   return check.ok();
 }
 

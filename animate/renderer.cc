@@ -44,9 +44,8 @@ cv::Mat ShadowLayer(const cv::Mat& shadow, double opacity) {
 
 bool RenderOptions::IsValid(std::string* why) const {
   OptionProblems check(why);
-  check(shadow_opacity >= 0 && shadow_opacity <= 1, "shadow_opacity",
-        "must be within [0, 1], got " + OptionProblems::Num(shadow_opacity));
-  check(grid_step_px >= 1, "grid_step_px", "must be >= 1, got " + std::to_string(grid_step_px));
+  check.Within(shadow_opacity, Between(0, 1), "shadow_opacity", "a fraction 0..1");
+  check.Within(grid_step_px, AtLeast(1), "grid_step_px", "at least 1");
   check(min_floor_view_deg >= 0 && min_floor_view_deg <= 90, "min_floor_view_deg",
         "must be within [0, 90], got " + OptionProblems::Num(min_floor_view_deg));
   check(max_upright_view_deg >= 0 && max_upright_view_deg <= 90, "max_upright_view_deg",

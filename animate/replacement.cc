@@ -662,45 +662,33 @@ bool ReplacementOptions::IsValid(std::string* why) const {
   OptionProblems check(why);
   std::string part;
   check.Nested(reach.IsValid(&part), "reach.", part);
-  check(step_cost_fraction >= 0 && std::isfinite(step_cost_fraction), "step_cost_fraction",
-        "must be finite and >= 0, got " + OptionProblems::Num(step_cost_fraction));
-  check(slow_frame_cost >= 0, "slow_frame_cost",
-        "must be >= 0, got " + OptionProblems::Num(slow_frame_cost));
-  check(reference_speed_m >= 0, "reference_speed_m",
-        "must be metres >= 0, got " + OptionProblems::Num(reference_speed_m));
-  check(time_budget_seconds > 0 && std::isfinite(time_budget_seconds), "time_budget_seconds",
-        "must be a positive number of seconds, got " + OptionProblems::Num(time_budget_seconds));
+  check.Within(step_cost_fraction, AtLeast(0), "step_cost_fraction", "a finite number >= 0");
+  check.Within(slow_frame_cost, AtLeast(0), "slow_frame_cost", "at least 0");
+  check.Within(reference_speed_m, AtLeast(0), "reference_speed_m", "metres >= 0");
+  check.Within(time_budget_seconds, Positive(), "time_budget_seconds",
+               "a positive number of seconds");
   check(!(time_budget_seconds > kMaxTimeBudgetSeconds) || !std::isfinite(time_budget_seconds),
         "time_budget_seconds",
         "must be at most " + OptionProblems::Num(kMaxTimeBudgetSeconds) + " seconds (a day), got " +
             OptionProblems::Num(time_budget_seconds));
-  check(max_tries >= 1, "max_tries", "must be >= 1, got " + std::to_string(max_tries));
-  check(changes_per_turn >= 1, "changes_per_turn",
-        "must be >= 1, got " + std::to_string(changes_per_turn));
-  check(max_turns >= 0, "max_turns",
-        "must be >= 0 (0: no limit), got " + std::to_string(max_turns));
-  check(sequential_fraction >= 0 && sequential_fraction <= 1, "sequential_fraction",
-        "must be within [0, 1], got " + OptionProblems::Num(sequential_fraction));
+  check.Within(max_tries, AtLeast(1), "max_tries", "at least 1");
+  check.Within(changes_per_turn, AtLeast(1), "changes_per_turn", "at least 1");
+  check.Within(max_turns, AtLeast(0), "max_turns", "at least 0 (0: no limit)");
+  check.Within(sequential_fraction, Between(0, 1), "sequential_fraction", "a fraction 0..1");
   // The beam block is used only to start with a beam search.
   if (start == StartMethod::kBeam) check.Nested(beam.IsValid(&part), "beam.", part);
-  check(middle_fraction >= 0, "middle_fraction",
-        "must be >= 0, got " + OptionProblems::Num(middle_fraction));
-  check(begin_fraction >= 0, "begin_fraction",
-        "must be >= 0, got " + OptionProblems::Num(begin_fraction));
+  check.Within(middle_fraction, AtLeast(0), "middle_fraction", "at least 0");
+  check.Within(begin_fraction, AtLeast(0), "begin_fraction", "at least 0");
   check(!(middle_fraction >= 0 && begin_fraction >= 0) || middle_fraction + begin_fraction <= 1,
         "begin_fraction",
         "must leave middle_fraction + begin_fraction <= 1, got " +
             OptionProblems::Num(middle_fraction + begin_fraction));
-  check(max_span >= 0, "max_span",
-        "must be >= 0 (0: the whole sequence), got " + std::to_string(max_span));
-  check(collision_pick_fraction >= 0 && collision_pick_fraction <= 1, "collision_pick_fraction",
-        "must be within [0, 1], got " + OptionProblems::Num(collision_pick_fraction));
-  check(goal_fraction >= 0 && goal_fraction <= 1, "goal_fraction",
-        "must be within [0, 1], got " + OptionProblems::Num(goal_fraction));
-  check(max_candidates >= 0, "max_candidates",
-        "must be >= 0 (0: all of them), got " + std::to_string(max_candidates));
-  check(progress_seconds >= 0, "progress_seconds",
-        "must be seconds >= 0 (0: never), got " + OptionProblems::Num(progress_seconds));
+  check.Within(max_span, AtLeast(0), "max_span", "at least 0 (0: the whole sequence)");
+  check.Within(collision_pick_fraction, Between(0, 1), "collision_pick_fraction",
+               "a fraction 0..1");
+  check.Within(goal_fraction, Between(0, 1), "goal_fraction", "a fraction 0..1");
+  check.Within(max_candidates, AtLeast(0), "max_candidates", "at least 0 (0: all of them)");
+  check.Within(progress_seconds, AtLeast(0), "progress_seconds", "seconds >= 0 (0: never)");
   return check.ok();
 }
 

@@ -3,6 +3,8 @@
 // line "FIELD: reason" each in `why` (FIELD as the struct names it; the station config names
 // it by its key: config/config_validate.cc). A number's bounds are a NumberRule, the same words
 // the config's key bindings use (core/options_binder.h): one rule vocabulary.
+#include <cmath>
+#include <cstdint>
 #include <sstream>
 #include <string>
 #include <type_traits>
@@ -81,8 +83,10 @@ class OptionProblems {
     return problems;
   }
 
-  // A number as the messages write it ("25", "0.5").
+  // A number as the messages write it ("25", "0.5", "3000000000": a whole number in full).
   static std::string Num(double v) {
+    if (std::isfinite(v) && v == std::floor(v) && std::abs(v) < 1e15)
+      return std::to_string(static_cast<int64_t>(v));
     std::ostringstream s;
     s << v;
     return s.str();

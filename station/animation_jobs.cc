@@ -131,8 +131,7 @@ bool AnimationJobsOptions::IsValid(std::string* why) const {
         "max_time_budget_s",
         "must be seconds in (0, " + OptionProblems::Num(kMaxTimeBudgetSeconds) + "], got " +
             OptionProblems::Num(max_time_budget_s));
-  check(max_set_bytes > 0, "max_set_bytes",
-        "must be a positive number of bytes, got " + std::to_string(max_set_bytes));
+  check.Within(max_set_bytes, Positive(), "max_set_bytes", "a positive number of bytes");
   check(threads >= 1 && threads <= 64, "threads", "must be 1..64, got " + std::to_string(threads));
   return check.ok();
 }

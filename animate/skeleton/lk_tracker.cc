@@ -16,13 +16,11 @@ bool LkOptions::IsValid(std::string* why) const {
   check(window_px >= 5, "window_px", "must be >= 5 pixels, got " + std::to_string(window_px));
   check(pyramid_levels >= 0 && pyramid_levels <= 8, "pyramid_levels",
         "must be within 0..8, got " + std::to_string(pyramid_levels));
-  check(max_iterations >= 1, "max_iterations",
-        "must be >= 1, got " + std::to_string(max_iterations));
-  check(epsilon > 0, "epsilon", "must be > 0, got " + OptionProblems::Num(epsilon));
-  check(max_forward_backward_px > 0, "max_forward_backward_px",
-        "must be > 0 pixels, got " + OptionProblems::Num(max_forward_backward_px));
-  check(interpolation_context >= 1, "interpolation_context",
-        "must be >= 1, got " + std::to_string(interpolation_context));
+  check.Within(max_iterations, AtLeast(1), "max_iterations", "at least 1");
+  check.Within(epsilon, Positive(), "epsilon", "a number > 0");
+  check.Within(max_forward_backward_px, Positive(), "max_forward_backward_px",
+               "a number > 0 pixels");
+  check.Within(interpolation_context, AtLeast(1), "interpolation_context", "at least 1");
   return check.ok();
 }
 

@@ -72,8 +72,7 @@ bool PlotOptions::IsValid(std::string* why) const {
   check(panel_size.width >= 120 && panel_size.height >= 100, "panel_size",
         "must be at least 120 x 100 pixels, got " + std::to_string(panel_size.width) + " x " +
             std::to_string(panel_size.height));
-  check(stutter_window >= 0, "stutter_window",
-        "must be frames >= 0, got " + std::to_string(stutter_window));
+  check.Within(stutter_window, AtLeast(0), "stutter_window", "frames >= 0");
   return check.ok();
 }
 

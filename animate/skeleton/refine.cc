@@ -11,16 +11,13 @@ namespace ss {
 
 bool MovementOptions::IsValid(std::string* why) const {
   OptionProblems check(why);
-  check(lag_s > 0 && std::isfinite(lag_s), "lag_s",
-        "must be a positive number of seconds, got " + OptionProblems::Num(lag_s));
+  check.Within(lag_s, Positive(), "lag_s", "a positive number of seconds");
   check(smoothing_s >= 0 && std::isfinite(smoothing_s), "smoothing_s",
         "must be seconds >= 0, got " + OptionProblems::Num(smoothing_s));
   check(min_length_s >= 0 && std::isfinite(min_length_s), "min_length_s",
         "must be seconds >= 0, got " + OptionProblems::Num(min_length_s));
-  check(min_prominence >= 0, "min_prominence",
-        "must be >= 0, got " + OptionProblems::Num(min_prominence));
-  check(noise_factor >= 0, "noise_factor",
-        "must be >= 0, got " + OptionProblems::Num(noise_factor));
+  check.Within(min_prominence, AtLeast(0), "min_prominence", "at least 0");
+  check.Within(noise_factor, AtLeast(0), "noise_factor", "at least 0");
   return check.ok();
 }
 
@@ -28,10 +25,8 @@ bool RefineOptions::IsValid(std::string* why) const {
   OptionProblems check(why);
   std::string part;
   check.Nested(movements.IsValid(&part), "movements.", part);
-  check(jump_cost_per_frame >= 0, "jump_cost_per_frame",
-        "must be >= 0, got " + OptionProblems::Num(jump_cost_per_frame));
-  check(averaging_window >= 1, "averaging_window",
-        "must be >= 1, got " + std::to_string(averaging_window));
+  check.Within(jump_cost_per_frame, AtLeast(0), "jump_cost_per_frame", "at least 0");
+  check.Within(averaging_window, AtLeast(1), "averaging_window", "at least 1");
   return check.ok();
 }
 

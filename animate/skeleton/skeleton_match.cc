@@ -15,8 +15,7 @@ bool SkeletonMatchOptions::IsValid(std::string* why) const {
   check.Nested(descriptor.IsValid(&part), "descriptor.", part);
   check.Nested(match.IsValid(&part), "match.", part);
   check.Nested(refine.IsValid(&part), "refine.", part);
-  check(min_source_coverage >= 0 && min_source_coverage <= 1, "min_source_coverage",
-        "must be within [0, 1], got " + OptionProblems::Num(min_source_coverage));
+  check.Within(min_source_coverage, Between(0, 1), "min_source_coverage", "a fraction 0..1");
   return check.ok();
 }
 

@@ -160,14 +160,11 @@ BodyProportions OtherBody() {
 
 bool GestureScriptOptions::IsValid(std::string* why) const {
   OptionProblems check(why);
-  check(transition_frames >= 0, "transition_frames",
-        "must be frames >= 0, got " + std::to_string(transition_frames));
-  check(speed > 0 && std::isfinite(speed), "speed",
-        "must be a positive factor, got " + OptionProblems::Num(speed));
+  check.Within(transition_frames, AtLeast(0), "transition_frames", "frames >= 0");
+  check.Within(speed, Positive(), "speed", "a positive factor");
   check(noise_px >= 0 && std::isfinite(noise_px), "noise_px",
         "must be pixels >= 0, got " + OptionProblems::Num(noise_px));
-  check(scale_px > 0 && std::isfinite(scale_px), "scale_px",
-        "must be a positive number of pixels per body unit, got " + OptionProblems::Num(scale_px));
+  check.Within(scale_px, Positive(), "scale_px", "a positive number of pixels per body unit");
   check(std::isfinite(x_px), "x_px",
         "must be a finite pixel position, got " + OptionProblems::Num(x_px));
   check(std::isfinite(y_px), "y_px",

@@ -14,7 +14,7 @@ namespace ss {
 
 bool PlateOptions::IsValid(std::string* why) const {
   OptionProblems check(why);
-  check(first_frame >= 0, "first_frame", "must be >= 0, got " + std::to_string(first_frame));
+  check.Within(first_frame, AtLeast(0), "first_frame", "at least 0");
   check(last_frame >= first_frame, "last_frame",
         std::to_string(last_frame) + " is before the first frame " + std::to_string(first_frame));
   // Each sample is a full frame held in memory for the median.

@@ -66,8 +66,7 @@ std::optional<double> Quantile(std::vector<double> values, double q) {
 
 bool TransitionJumpOptions::IsValid(std::string* why) const {
   OptionProblems check(why);
-  check(max_transitions >= 0, "max_transitions",
-        "must be >= 0, got " + std::to_string(max_transitions));
+  check.Within(max_transitions, AtLeast(0), "max_transitions", "at least 0");
   return check.ok();
 }
 

@@ -63,9 +63,8 @@ double ContactAlignedDifference_px(const RgbaBillboard& a, const RgbaBillboard& 
 
 bool VisibleJumpOptions::IsValid(std::string* why) const {
   OptionProblems check(why);
-  check(max_pairs >= 1, "max_pairs", "must be >= 1, got " + std::to_string(max_pairs));
-  check(min_step_px > 0 && std::isfinite(min_step_px), "min_step_px",
-        "must be a positive number of px, got " + OptionProblems::Num(min_step_px));
+  check.Within(max_pairs, AtLeast(1), "max_pairs", "at least 1");
+  check.Within(min_step_px, Positive(), "min_step_px", "a positive number of px");
   return check.ok();
 }
 

@@ -53,13 +53,13 @@ TEST(AnimateOptions, EachProblemNamesItsField) {
   reach.set_size = 0;
   reach.num_threads = 0;
   EXPECT_EQ(Problems(reach),
-            "set_size: must be in 1..65535, got 0\nnum_threads: must be in 1..256, got 0");
+            "set_size: expected 1..65535, got 0\nnum_threads: expected 1..256, got 0");
   RenderOptions render;
   render.shadow_opacity = 1.5;
-  EXPECT_EQ(Problems(render), "shadow_opacity: must be within [0, 1], got 1.5");
+  EXPECT_EQ(Problems(render), "shadow_opacity: expected a fraction 0..1, got 1.5");
   AnimateRunOptions run;
   run.max_turns = -1;
-  EXPECT_EQ(Problems(run), "max_turns: must be >= 0 (0: the time budget alone), got -1");
+  EXPECT_EQ(Problems(run), "max_turns: expected at least 0 (0: the time budget alone), got -1");
   run.max_turns = 0;
   run.optimizer.replacement.time_budget_seconds = 0;
   EXPECT_EQ(Problems(run),
@@ -79,7 +79,7 @@ TEST(AnimateOptions, EachProblemNamesItsField) {
   // The replacement optimizer's reach block comes out under "reach.".
   ReplacementOptions replace;
   replace.reach.step_cost = -1;
-  EXPECT_EQ(Problems(replace), "reach.step_cost: must be finite and >= 0, got -1");
+  EXPECT_EQ(Problems(replace), "reach.step_cost: expected a finite number >= 0, got -1");
 }
 
 // The replacement optimizer reports every problem, not the first; the beam block counts only when
@@ -102,21 +102,21 @@ TEST(AnimateOptions, ReplacementNamesEveryField) {
   o.max_candidates = -1;
   o.progress_seconds = -1;
   EXPECT_EQ(Problems(o),
-            "reach.set_size: must be in 1..65535, got 0\n"
-            "step_cost_fraction: must be finite and >= 0, got -0.1\n"
-            "slow_frame_cost: must be >= 0, got -1\n"
-            "reference_speed_m: must be metres >= 0, got -1\n"
-            "time_budget_seconds: must be a positive number of seconds, got 0\n"
-            "max_tries: must be >= 1, got 0\n"
-            "changes_per_turn: must be >= 1, got 0\n"
-            "max_turns: must be >= 0 (0: no limit), got -1\n"
-            "sequential_fraction: must be within [0, 1], got 1.5\n"
-            "middle_fraction: must be >= 0, got -0.5\n"
-            "begin_fraction: must be >= 0, got -0.5\n"
-            "max_span: must be >= 0 (0: the whole sequence), got -1\n"
-            "collision_pick_fraction: must be within [0, 1], got 2\n"
-            "max_candidates: must be >= 0 (0: all of them), got -1\n"
-            "progress_seconds: must be seconds >= 0 (0: never), got -1");
+            "reach.set_size: expected 1..65535, got 0\n"
+            "step_cost_fraction: expected a finite number >= 0, got -0.1\n"
+            "slow_frame_cost: expected at least 0, got -1\n"
+            "reference_speed_m: expected metres >= 0, got -1\n"
+            "time_budget_seconds: expected a positive number of seconds, got 0\n"
+            "max_tries: expected at least 1, got 0\n"
+            "changes_per_turn: expected at least 1, got 0\n"
+            "max_turns: expected at least 0 (0: no limit), got -1\n"
+            "sequential_fraction: expected a fraction 0..1, got 1.5\n"
+            "middle_fraction: expected at least 0, got -0.5\n"
+            "begin_fraction: expected at least 0, got -0.5\n"
+            "max_span: expected at least 0 (0: the whole sequence), got -1\n"
+            "collision_pick_fraction: expected a fraction 0..1, got 2\n"
+            "max_candidates: expected at least 0 (0: all of them), got -1\n"
+            "progress_seconds: expected seconds >= 0 (0: never), got -1");
   ReplacementOptions split;
   split.middle_fraction = 0.7;
   split.begin_fraction = 0.4;
@@ -126,7 +126,7 @@ TEST(AnimateOptions, ReplacementNamesEveryField) {
   beam.beam.width = 0;
   EXPECT_EQ(Problems(beam), "");  // a sequential start never reads the beam block
   beam.start = StartMethod::kBeam;
-  EXPECT_EQ(Problems(beam), "beam.width: must be >= 1, got 0");
+  EXPECT_EQ(Problems(beam), "beam.width: expected at least 1, got 0");
 }
 
 TEST(AnimateOptions, BeamNamesEveryField) {
@@ -136,10 +136,10 @@ TEST(AnimateOptions, BeamNamesEveryField) {
   o.start_frames = -1;
   o.time_budget_seconds = -1;
   EXPECT_EQ(Problems(o),
-            "width: must be >= 1, got 0\n"
-            "length: must be >= 0 (0: the sprite's own), got -1\n"
-            "start_frames: must be >= 0 (0: every frame), got -1\n"
-            "time_budget_seconds: must be seconds >= 0 (0: one pass), got -1");
+            "width: expected at least 1, got 0\n"
+            "length: expected at least 0 (0: the sprite's own), got -1\n"
+            "start_frames: expected at least 0 (0: every frame), got -1\n"
+            "time_budget_seconds: expected seconds >= 0 (0: one pass), got -1");
   o = {};
   o.time_budget_seconds = std::numeric_limits<double>::infinity();
   EXPECT_TRUE(Names(Problems(o), "time_budget_seconds"));
@@ -155,15 +155,15 @@ TEST(AnimateOptions, OptimizersRefuseBadOptions) {
   beam.width = 0;
   beam.length = -2;
   EXPECT_EQ(InputErrorOf([&] { BeamSearch(problem, beam, &summary); }),
-            "beam options: width: must be >= 1, got 0\n"
-            "length: must be >= 0 (0: the sprite's own), got -2");
+            "beam options: width: expected at least 1, got 0\n"
+            "length: expected at least 0 (0: the sprite's own), got -2");
   ReplacementOptions replace;
   replace.max_tries = 0;
   replace.time_budget_seconds = -1;
   const std::string what = InputErrorOf([&] { OptimizeSequences(problem, replace, &summary); });
   EXPECT_EQ(what,
-            "replacement options: time_budget_seconds: must be a positive number of seconds, got "
-            "-1\nmax_tries: must be >= 1, got 0");
+            "replacement options: time_budget_seconds: expected a positive number of seconds, got "
+            "-1\nmax_tries: expected at least 1, got 0");
   EXPECT_EQ(InputErrorOf([&] { ReplacementSets::Build(problem, replace); }), what);
 }
 
@@ -173,9 +173,9 @@ TEST(AnimateOptions, SkeletonMatchNamesItsNestedBlocks) {
   o.refine.movements.lag_s = 0;
   o.min_source_coverage = 2;
   EXPECT_EQ(Problems(o),
-            "refine.movements.lag_s: must be a positive number of seconds, got 0\n"
-            "refine.averaging_window: must be >= 1, got 0\n"
-            "min_source_coverage: must be within [0, 1], got 2");
+            "refine.movements.lag_s: expected a positive number of seconds, got 0\n"
+            "refine.averaging_window: expected at least 1, got 0\n"
+            "min_source_coverage: expected a fraction 0..1, got 2");
   SkeletonSequence target;
   const std::string what = InputErrorOf([&] { MatchSkeletons(target, {&target}, o); });
   EXPECT_EQ(what.rfind("skeleton match options: refine.movements.lag_s: ", 0), 0u) << what;
@@ -186,7 +186,7 @@ TEST(AnimateOptions, ReachSetsRefuseBadOptions) {
   reach.set_size = 70000;
   const std::string what =
       InputErrorOf([&] { ReachSets::Build(TransitionGraph{}, ReachDirection::kForward, reach); });
-  EXPECT_EQ(what.rfind("reach options: set_size: must be in 1..65535, got 70000", 0), 0u) << what;
+  EXPECT_EQ(what.rfind("reach options: set_size: expected 1..65535, got 70000", 0), 0u) << what;
 }
 
 TEST(AnimateOptions, SkeletonImportNamesEveryField) {
@@ -225,10 +225,10 @@ TEST(AnimateOptions, GestureScriptNamesEveryField) {
   o.x_px = std::numeric_limits<float>::quiet_NaN();
   o.y_px = std::numeric_limits<float>::infinity();
   EXPECT_EQ(Problems(o),
-            "transition_frames: must be frames >= 0, got -1\n"
-            "speed: must be a positive factor, got 0\n"
+            "transition_frames: expected frames >= 0, got -1\n"
+            "speed: expected a positive factor, got 0\n"
             "noise_px: must be pixels >= 0, got -1\n"
-            "scale_px: must be a positive number of pixels per body unit, got 0\n"
+            "scale_px: expected a positive number of pixels per body unit, got 0\n"
             "x_px: must be a finite pixel position, got nan\n"
             "y_px: must be a finite pixel position, got inf");
   GestureScriptOptions slow;
@@ -236,7 +236,7 @@ TEST(AnimateOptions, GestureScriptNamesEveryField) {
   EXPECT_EQ(InputErrorOf([&] {
               MakeGestureSequence({{Gesture::kY, 5}}, BodyProportions{}, slow);
             }),
-            "gesture script options: speed: must be a positive factor, got -2");
+            "gesture script options: speed: expected a positive factor, got -2");
 }
 
 TEST(AnimateOptions, PlotNamesEveryField) {
@@ -245,7 +245,7 @@ TEST(AnimateOptions, PlotNamesEveryField) {
   o.stutter_window = -1;
   EXPECT_EQ(Problems(o),
             "panel_size: must be at least 120 x 100 pixels, got 100 x 480\n"
-            "stutter_window: must be frames >= 0, got -1");
+            "stutter_window: expected frames >= 0, got -1");
   const std::vector<PlotPanel> panels = {{"a", {0, 1, 1, 0}}};
   EXPECT_EQ(InputErrorOf([&] { PlotMatch(panels, 2, o); }).rfind("plot options: panel_size: ", 0),
             0u);

@@ -329,14 +329,14 @@ TEST_F(SpecTest, BadSpecsNameTheLineAndTheField) {
   EXPECT_EQ(ErrorOf(Edit("start: random", "start: later")),
             o + ":7: optimizer.start: expected one of sequential, random, beam, got \"later\"");
   EXPECT_EQ(ErrorOf(Edit("start: random,", "start: random, collision_pick_fraction: 1.5,")),
-            o + ":7: optimizer.collision_pick_fraction: must be within [0, 1], got 1.5");
+            o + ":7: optimizer.collision_pick_fraction: expected a fraction 0..1, got 1.5");
   // The optimizer's own limits (ReplacementOptions::IsValid), named as the spec's fields.
   EXPECT_EQ(ErrorOf(Edit("set_size: 50", "set_size: 100000")),
-            o + ":7: optimizer.set_size: must be in 1..65535, got 100000");
+            o + ":7: optimizer.set_size: expected 1..65535, got 100000");
   EXPECT_EQ(ErrorOf(Edit("set_size: 50", "set_size: 50, threads: 100000")),
-            o + ":7: optimizer.threads: must be in 1..256, got 100000");
+            o + ":7: optimizer.threads: expected 1..256, got 100000");
   EXPECT_EQ(ErrorOf(Edit("method: replace", "method: beam, beam_width: 0")),
-            o + ":7: optimizer.beam_width: must be >= 1, got 0");
+            o + ":7: optimizer.beam_width: expected at least 1, got 0");
   // A mapping as a key (found by tests/fuzz: yaml-cpp's exception escaped and aborted).
   EXPECT_EQ(ErrorOf(Edit("set_size: 50", "set_size: 50, {a: 1}: 2")),
             o + ":7: optimizer: a key at line 7 is not a plain name");
@@ -440,7 +440,7 @@ TEST_F(SpecTest, EveryMistakeOfTheFileIsReported) {
   yaml.replace(yaml.find("min_distance_m: 0.25"), 20, "min_distanse_m: 0.25");
   EXPECT_EQ(ErrorOf(yaml),
             o + ":2: frame_rate: must be > 0\n" +  //
-                o + ":7: optimizer.time_budget_s: must be a positive number of seconds, got 0\n" +
+                o + ":7: optimizer.time_budget_s: expected a positive number of seconds, got 0\n" +
                 o + ":12: sprites[0].constraints[0].path.points[2]: expected [x, y] in metres\n" +
                 o + ":17: sprites[1].smoothness: expected a number >= 0, got -1\n" +  //
                 o +
