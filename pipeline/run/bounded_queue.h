@@ -41,11 +41,7 @@ class BoundedQueue {
   std::optional<T> PopFor(Duration timeout) {
     std::unique_lock lock(mutex_);
     not_empty_.wait_for(lock, timeout, [&] { return closed_ || !items_.empty(); });
-    if (items_.empty()) return std::nullopt;
-    T item = std::move(items_.front());
-    items_.pop_front();
-    not_full_.notify_one();
-    return item;
+    return TakeFront();
   }
 
   // Waits until an item comes, the queue is closed, Wake() is called or `deadline` passes
@@ -55,11 +51,7 @@ class BoundedQueue {
     std::unique_lock lock(mutex_);
     not_empty_.wait_until(lock, deadline, [&] { return closed_ || woken_ || !items_.empty(); });
     woken_ = false;
-    if (items_.empty()) return std::nullopt;
-    T item = std::move(items_.front());
-    items_.pop_front();
-    not_full_.notify_one();
-    return item;
+    return TakeFront();
   }
 
   // Ends the consumer's PopUntil now (or its next one) without an item.
@@ -82,11 +74,7 @@ class BoundedQueue {
   std::optional<T> Pop() {
     std::unique_lock lock(mutex_);
     not_empty_.wait(lock, [&] { return closed_ || !items_.empty(); });
-    if (items_.empty()) return std::nullopt;
-    T item = std::move(items_.front());
-    items_.pop_front();
-    not_full_.notify_one();
-    return item;
+    return TakeFront();
   }
 
   void Close() {
@@ -97,6 +85,15 @@ class BoundedQueue {
   }
 
  private:
+  // The front item, or nullopt when there is none; under mutex_.
+  std::optional<T> TakeFront() {
+    if (items_.empty()) return std::nullopt;
+    T item = std::move(items_.front());
+    items_.pop_front();
+    not_full_.notify_one();
+    return item;
+  }
+
   size_t capacity_;
   mutable std::mutex mutex_;
   std::condition_variable not_empty_, not_full_;
