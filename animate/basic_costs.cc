@@ -182,35 +182,27 @@ void FacingSpec::AddTerms(const TransitionGraph& graph, Problem& problem) const 
 
 void RegisterRepeatsSpecTerm() {
   RegisterSpecTerm({"repeats", "{strength, window_steps, still_tag}",
-                    [](SpecBlockReader& reader, const YAML::Node& node, const std::string& path) {
-                      auto r = std::make_shared<RepeatSpec>();
-                      return ReadTermBlock(reader, node, path, r,
-                                           [r](OptionsBinder& keys) {
-                                             keys.Add("strength", &r->strength, "a number >= 0",
-                                                      "per step showing a frame shown just before")
-                                                 .Rule(AtLeast(0))
-                                                 .Add("window_steps", &r->window_steps,
-                                                      "1..1000 steps", "how far back")
-                                                 .Rule(Between(1, 1000))
-                                                 .Add("still_tag", &r->still_tag, "a tag",
-                                                      "frames that may repeat");
-                                           },
-                                           {"strength"});
-                    }});
+                    TermBlockReader<RepeatSpec>(
+                        [](OptionsBinder& keys, RepeatSpec& r) {
+                          keys.Add("strength", &r.strength, "a number >= 0",
+                                   "per step showing a frame shown just before")
+                              .Rule(AtLeast(0))
+                              .Add("window_steps", &r.window_steps, "1..1000 steps", "how far back")
+                              .Rule(Between(1, 1000))
+                              .Add("still_tag", &r.still_tag, "a tag", "frames that may repeat");
+                        },
+                        {"strength"})});
 }
 
 void RegisterFacingSpecTerm() {
   RegisterSpecTerm({"facing", "{strength}",
-                    [](SpecBlockReader& reader, const YAML::Node& node, const std::string& path) {
-                      auto f = std::make_shared<FacingSpec>();
-                      return ReadTermBlock(reader, node, path, f,
-                                           [f](OptionsBinder& keys) {
-                                             keys.Add("strength", &f->strength, "a number >= 0",
-                                                      "per metre moved other than forward")
-                                                 .Rule(AtLeast(0));
-                                           },
-                                           {"strength"});
-                    },
+                    TermBlockReader<FacingSpec>(
+                        [](OptionsBinder& keys, FacingSpec& f) {
+                          keys.Add("strength", &f.strength, "a number >= 0",
+                                   "per metre moved other than forward")
+                              .Rule(AtLeast(0));
+                        },
+                        {"strength"}),
                     [] { return std::make_shared<FacingSpec>(); }});
 }
 

@@ -60,19 +60,16 @@ void CloneSpec::AddTerms(const TransitionGraph& /*graph*/, Problem& problem) con
 
 void RegisterClonesSpecTerm() {
   RegisterSpecTerm({"clones", "{strength, lag_steps}",
-                    [](SpecBlockReader& reader, const YAML::Node& node, const std::string& path) {
-                      auto c = std::make_shared<CloneSpec>();
-                      return ReadTermBlock(reader, node, path, c,
-                                           [c](OptionsBinder& keys) {
-                                             keys.Add("strength", &c->strength, "a number >= 0",
-                                                      "per frame two sprites show together")
-                                                 .Rule(AtLeast(0))
-                                                 .Add("lag_steps", &c->lag_steps, "0..100 steps",
-                                                      "how far apart is together")
-                                                 .Rule(Between(0, 100));
-                                           },
-                                           {"strength"});
-                    }});
+                    TermBlockReader<CloneSpec>(
+                        [](OptionsBinder& keys, CloneSpec& c) {
+                          keys.Add("strength", &c.strength, "a number >= 0",
+                                   "per frame two sprites show together")
+                              .Rule(AtLeast(0))
+                              .Add("lag_steps", &c.lag_steps, "0..100 steps",
+                                   "how far apart is together")
+                              .Rule(Between(0, 100));
+                        },
+                        {"strength"})});
 }
 
 }  // namespace ss

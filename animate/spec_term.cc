@@ -28,7 +28,7 @@ std::shared_ptr<const SpecTerm> ReadTermBlock(SpecBlockReader& reader, const YAM
                                               const std::string& path,
                                               std::shared_ptr<SpecTerm> term,
                                               const std::function<void(OptionsBinder&)>& bind,
-                                              std::initializer_list<const char*> required) {
+                                              const std::vector<const char*>& required) {
   OptionsBinder keys;
   bind(keys);
   YamlMap view;

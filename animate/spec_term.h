@@ -6,7 +6,6 @@
 // (spritestation_registrations) builds the call in. The spec reader (animate/spec.cc) and the
 // scene (animate/scene.cc) name no such term.
 #include <functional>
-#include <initializer_list>
 #include <memory>
 #include <string>
 #include <vector>
@@ -57,13 +56,26 @@ struct SpecTermKind {
   std::function<std::shared_ptr<const SpecTerm>()> absent = [] { return nullptr; };
 };
 
-// The usual `read`: `bind` binds the block's keys to `term`'s fields, and each key of `required`
-// is reported when the block lacks it; `term` is returned.
+// Reads a term's block: `bind` binds the block's keys to `term`'s fields, and each key of
+// `required` is reported when the block lacks it; `term` is returned.
 std::shared_ptr<const SpecTerm> ReadTermBlock(SpecBlockReader& reader, const YAML::Node& node,
                                               const std::string& path,
                                               std::shared_ptr<SpecTerm> term,
                                               const std::function<void(OptionsBinder&)>& bind,
-                                              std::initializer_list<const char*> required);
+                                              const std::vector<const char*>& required);
+
+// The usual `read` (SpecTermKind::read) of a term whose block is its fields: a new T, whose
+// fields `bind(keys, t)` binds, read by ReadTermBlock.
+template <typename T, typename Bind>
+auto TermBlockReader(Bind bind, std::vector<const char*> required) {
+  return [bind = std::move(bind), required = std::move(required)](
+             SpecBlockReader& reader, const YAML::Node& node,
+             const std::string& path) -> std::shared_ptr<const SpecTerm> {
+    auto term = std::make_shared<T>();
+    return ReadTermBlock(
+        reader, node, path, term, [&](OptionsBinder& keys) { bind(keys, *term); }, required);
+  };
+}
 
 // Called by each term's registration function; a second term of one key is an error.
 void RegisterSpecTerm(SpecTermKind kind);
