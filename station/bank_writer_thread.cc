@@ -54,21 +54,14 @@ void Station::Impl::WriterLoop() {
 
 void Station::Impl::WriteBatch(StationBatch& sb) {
   const ClipRecord& clip = sb.batch.clip;
-  const auto key = std::make_tuple(clip.camera_id, clip.track_id, clip.first_frame);
   if (disk.Check().state == StorageState::kSpritesStopped) {
-    // A refused batch breaks its clip as a failed append does: the clip's later batches are not
-    // stored when the space comes back, so no complete clip has a hole.
-    if (clip.complete) {
-      broken_clips.erase(key);
-    } else {
-      broken_clips.insert(key);
-    }
+    BreakClip(clip);  // so its later batches are not stored when the space comes back
     std::lock_guard lock(stats_mutex);
     ++batches_refused;
     return;
   }
-  if (broken_clips.count(key) > 0) {
-    if (clip.complete) broken_clips.erase(key);
+  if (broken_clips.count(ClipKey(clip)) > 0) {
+    BreakClip(clip);
     std::lock_guard lock(stats_mutex);
     ++batches_failed;
     return;
@@ -114,7 +107,7 @@ void Station::Impl::WriteBatch(StationBatch& sb) {
     // A failed append is one rolled-back transaction: what was stored stays stored.
     log->error("bank: {} (the rest of clip {}/{} from frame {} is not stored)", e.what(),
                clip.camera_id, clip.track_id, clip.first_frame);
-    if (!clip.complete) broken_clips.insert(key);
+    BreakClip(clip);
     std::lock_guard lock(stats_mutex);
     ++batches_failed;
     bank_error = e.what();
@@ -122,6 +115,14 @@ void Station::Impl::WriteBatch(StationBatch& sb) {
     return;
   }
   Stored(sb.batch, result, &sb.received);
+}
+
+void Station::Impl::BreakClip(const ClipRecord& clip) {
+  if (clip.complete) {
+    broken_clips.erase(ClipKey(clip));  // its last batch: the clip ends here
+  } else {
+    broken_clips.insert(ClipKey(clip));
+  }
 }
 
 void Station::Impl::Spool(const ClipBatch& batch) {
@@ -141,8 +142,7 @@ void Station::Impl::Spool(const ClipBatch& batch) {
   const ClipRecord& clip = batch.clip;
   log->error("bank: clip {}/{} from frame {} not stored and not spooled: {}", clip.camera_id,
              clip.track_id, clip.first_frame, why);
-  if (!clip.complete)
-    broken_clips.insert(std::make_tuple(clip.camera_id, clip.track_id, clip.first_frame));
+  BreakClip(clip);
   std::lock_guard lock(stats_mutex);
   ++batches_failed;
   bank_error = why;

@@ -28,8 +28,8 @@ nlohmann::json MergePatch(const nlohmann::json& from, const nlohmann::json& to);
 class ConsoleEvents {
  public:
   // `status` returns the station's status JSON (called on this object's thread, with none of
-  // its locks held). A change is read no sooner than `min_interval_s` after the last read; the
-  // figures are sampled every `sample_interval_s`.
+  // its locks held). A told change is read no sooner than `min_interval_s` after the last told
+  // one; the figures are sampled every `sample_interval_s`.
   explicit ConsoleEvents(std::function<nlohmann::json()> status, double min_interval_s = 0.25,
                          double sample_interval_s = 1.0);
   ~ConsoleEvents();  // Stop()
@@ -40,7 +40,7 @@ class ConsoleEvents {
   // Wakes every connection so it ends; idempotent.
   void Stop();
   // The status changed: read and send it now (or once min_interval_s has passed since the last
-  // read). Any thread; takes only this object's lock.
+  // told read). Any thread; takes only this object's lock.
   void Changed();
   // Status reads so far (the first snapshot's included).
   uint64_t reads() const;

@@ -33,10 +33,8 @@ DiskGuard::Reading Look(const StorageConfig& storage) {
   if (r.free_mib < 0) return r;
   if (r.free_mib < storage.stop_sprites_below_mib) {
     r.state = StorageState::kSpritesStopped;
-    r.limit_mib = storage.stop_sprites_below_mib;
   } else if (r.free_mib < storage.stop_recording_below_mib) {
     r.state = StorageState::kRecordingStopped;
-    r.limit_mib = storage.stop_recording_below_mib;
   }
   return r;
 }

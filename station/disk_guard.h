@@ -27,7 +27,6 @@ class DiskGuard {
   struct Reading {
     StorageState state = StorageState::kOk;  // never kWritesFailing (that is the bank's)
     int64_t free_mib = -1;                   // the lower of the two file systems; -1 unknown
-    int64_t limit_mib = 0;                   // the limit `state` is below (0 when kOk)
   };
 
   // `settings` gives the storage section as it is now (a reload may change its limits);

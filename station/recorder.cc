@@ -32,18 +32,26 @@ struct StationRecorder::Impl {
   RecorderStats stats;
   bool closed = false;
 
+  // Whether recording has stopped, asking `refusal` while it has not (only until it refuses).
+  bool Refused() {
+    {
+      std::lock_guard lock(mutex);
+      if (!stats.stopped.empty()) return true;
+    }
+    if (!refusal) return false;
+    std::string why = refusal();
+    if (why.empty()) return false;
+    std::lock_guard lock(mutex);
+    if (stats.stopped.empty()) {
+      Log("station.recorder")->warn("recording {} stopped: {}", stats.dir, why);
+      stats.stopped = std::move(why);
+    }
+    return true;
+  }
+
   void Run(Camera& cam) {
     while (std::optional<Item> item = cam.queue->Pop()) {
-      if (cam.failed) continue;
-      if (refusal) {
-        std::string why = refusal();
-        std::lock_guard lock(mutex);
-        if (!why.empty() && stats.stopped.empty()) {
-          Log("station.recorder")->warn("recording {} stopped: {}", stats.dir, why);
-          stats.stopped = std::move(why);
-        }
-        if (!stats.stopped.empty()) continue;
-      }
+      if (cam.failed || Refused()) continue;
       try {
         Frame f = item->frame;
         f.camera = cam.writer_index;

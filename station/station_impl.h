@@ -145,6 +145,12 @@ struct Station::Impl {
   // stored before the failure stays an incomplete clip, which readers do not see). Writer thread
   // only.
   std::set<std::tuple<int64_t, int64_t, int64_t>> broken_clips;
+  static std::tuple<int64_t, int64_t, int64_t> ClipKey(const ClipRecord& clip) {
+    return {clip.camera_id, clip.track_id, clip.first_frame};
+  }
+  // A batch of `clip` that is not stored (refused, failed, not spooled) or dropped as broken:
+  // the clip's later batches are dropped too, until its last one (complete) ends it.
+  void BreakClip(const ClipRecord& clip);
 
   void WriteBatch(StationBatch& sb);
 
