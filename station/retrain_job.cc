@@ -256,6 +256,20 @@ void RetrainJob::Run(std::shared_ptr<Shared> shared, const RetrainRequest& reque
     }
     if (shared->on_change) shared->on_change(now);
   };
+  // Ends the job: its last state, no longer cancellable and no longer running, is one change,
+  // so whoever is told "cancelled" or "done" can start the next retrain at once.
+  auto Finish = [&](const std::function<void(RetrainState&)>& change) {
+    RetrainState end;
+    {
+      std::lock_guard lock(shared->mutex);
+      change(shared->state);
+      shared->state.cancellable = false;
+      shared->running = false;
+      end = shared->state;
+    }
+    shared->changed.notify_all();
+    if (shared->on_change) shared->on_change(end);
+  };
   // Enters the part of the work that uses the station host: false when the server stops.
   auto enter_host = [&] {
     std::lock_guard lock(shared->mutex);
@@ -446,7 +460,7 @@ void RetrainJob::Run(std::shared_ptr<Shared> shared, const RetrainRequest& reque
     const double rebuild_s = seconds(t_rebuild);
     log->info("transitions rebuilt with {}: {} transitions in {:.1f} s", weights_path.string(),
               transitions, rebuild_s);
-    SetRetrain([&](RetrainState& r) {
+    Finish([&](RetrainState& r) {
       r.phase = RetrainPhase::kDone;
       r.progress = 1.0;
       r.stage = "done: " + std::to_string(transitions) + " transitions";
@@ -459,7 +473,7 @@ void RetrainJob::Run(std::shared_ptr<Shared> shared, const RetrainRequest& reque
     std::error_code ec;
     if (!weights_written.empty()) fs::remove(weights_written, ec);
     log->info("retrain cancelled{}", weights_written.empty() ? "" : "; its weights file removed");
-    SetRetrain([&](RetrainState& r) {
+    Finish([&](RetrainState& r) {
       r.phase = RetrainPhase::kCancelled;
       r.stage = "cancelled";
       r.trained = false;
@@ -468,21 +482,12 @@ void RetrainJob::Run(std::shared_ptr<Shared> shared, const RetrainRequest& reque
     });
   } catch (const std::exception& e) {
     log->error("retrain failed: {}", e.what());
-    SetRetrain([&](RetrainState& r) {
+    Finish([&](RetrainState& r) {
       r.phase = RetrainPhase::kFailed;
       r.error = e.what();
       r.finished = UtcNowIso();
     });
   }
-  RetrainState end;
-  {
-    std::lock_guard lock(shared->mutex);
-    shared->running = false;
-    shared->state.cancellable = false;
-    end = shared->state;
-  }
-  shared->changed.notify_all();
-  if (shared->on_change) shared->on_change(end);
 }
 
 }  // namespace ss

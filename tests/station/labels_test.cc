@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <mutex>
 #include <set>
 
 #include <gtest/gtest.h>
@@ -84,11 +85,11 @@ std::string ReadFile(const std::string& path) {
   return s.str();
 }
 
-ConsoleLabels Labels(const SyntheticBank& bank) {
+ConsoleLabels Labels(const SyntheticBank& bank, api::Context context = {}) {
   ConsoleLabelsOptions options;
   options.bank = bank.path;
   options.candidate_rows = 100000;  // every sprite: the search is exhaustive
-  return ConsoleLabels(api::Context{}, options);
+  return ConsoleLabels(std::move(context), options);
 }
 
 std::string MessageOf(const std::function<void()>& f) {
@@ -237,7 +238,33 @@ TEST(ConsoleLabels, AsksTheLeastSurePairsFirstAndNeverAgain) {
 TEST(ConsoleLabels, TheExportTrainsAndARetrainRebuildsTheTable) {
   ScratchDir dir;
   const SyntheticBank bank = MakeBank(dir / "bank.db", 600);
-  ConsoleLabels labels = Labels(bank);
+  // What the console's event stream would send: the retrain's state read each time it is told.
+  std::mutex told_mutex;
+  std::vector<nlohmann::json> told;
+  const ConsoleLabels* reader = nullptr;
+  api::Context context;
+  context.status_changed = [&] {
+    std::lock_guard lock(told_mutex);
+    if (reader) told.push_back(reader->RetrainState());
+  };
+  ConsoleLabels labels = Labels(bank, context);
+  {
+    std::lock_guard lock(told_mutex);
+    reader = &labels;
+  }
+  // A told end is whole: a viewer told "done" or "cancelled" is offered no cancel, and can
+  // start the next retrain (the console's test clicks it at once).
+  const auto told_ends = [&] {
+    std::lock_guard lock(told_mutex);
+    int ends = 0;
+    for (const nlohmann::json& r : told) {
+      if (r["state"] == "training" || r["state"] == "rebuilding") continue;
+      ++ends;
+      EXPECT_EQ(r["cancellable"], false) << r.dump(1);
+    }
+    told.clear();
+    return ends;
+  };
   // A person who judges as the truth does: labels of the bank's originals, half accepts.
   const std::vector<Label> truth =
       LabelsFromTruth(bank.originals, bank.truth, 240, TruthLabelOptions{}, 7);
@@ -271,6 +298,7 @@ TEST(ConsoleLabels, TheExportTrainsAndARetrainRebuildsTheTable) {
   labels.WaitRetrain();
   const nlohmann::json r = labels.RetrainState();
   ASSERT_EQ(r["state"], "done") << r.dump(1);
+  EXPECT_GE(told_ends(), 1) << "the end is told";
   EXPECT_EQ(r["progress"], 1.0);
   EXPECT_EQ(r["cancellable"], false) << "not once it is over";
   EXPECT_NEAR(r["precision"].get<double>(), trained.report.stage2.precision(), 1e-12)
@@ -320,6 +348,7 @@ TEST(ConsoleLabels, TheExportTrainsAndARetrainRebuildsTheTable) {
   const nlohmann::json cancelled = labels.RetrainState();
   EXPECT_EQ(cancelled["state"], "cancelled") << cancelled.dump(1);
   EXPECT_EQ(cancelled["cancellable"], false);
+  EXPECT_GE(told_ends(), 1) << "the cancel is told";
   EXPECT_FALSE(cancelled.contains("weights")) << cancelled.dump(1);
   EXPECT_TRUE(cancelled.contains("finished"));
   EXPECT_EQ(Bank(bank.path).GetMeta(kTransitionWeightsMetaKey).value_or(""), table);
