@@ -8,6 +8,8 @@
 
 #include "core/error.h"
 #include "core/log.h"
+#include "core/option_checks.h"
+#include "core/options_binder.h"
 #include "core/target_clones.h"
 #include "pipeline/key/keyer_registry.h"
 #include "pipeline/key/keying_config.h"
@@ -414,8 +416,27 @@ ChromaKeyerOptions ChromaKeyerOptionsFrom(const KeyingConfig& k) {
 }
 
 void RegisterChromaKeyer() {
+  // keying.chroma.*: the key difference in 8-bit levels where alpha starts to fall, and where it
+  // reaches 0 (KeyingConfig::chroma's defaults are the config's, 20 and 60).
+  const auto keys = [](OptionsBinder& b, KeyingConfig& k) {
+    b.Add("chroma.low", &k.chroma.key_low_levels, "a level from 0 to 255",
+          "key difference (green minus the larger of red and blue, in 8-bit levels, after "
+          "learning the screen) at which alpha starts to fall from 1")
+        .Rule(Between(0, 255))
+        .Add("chroma.high", &k.chroma.key_high_levels, "a level from 0 to 255",
+             "... and at which the pixel is pure background (alpha 0); must be above `low`")
+        .Rule(Between(0, 255));
+  };
+  // The config's range; the keyer itself also takes < 0 (off: min_margin and ramp instead).
+  const auto check = [](const KeyingConfig& k, std::string* why) {
+    OptionProblems problem(why);
+    problem(!(k.chroma.key_low_levels >= k.chroma.key_high_levels), "chroma.high",
+            "must be above low (" + OptionProblems::Num(k.chroma.key_low_levels) + "), got " +
+                OptionProblems::Num(k.chroma.key_high_levels));
+    return problem.ok();
+  };
   RegisterKeyerType<ChromaKeyer>("chroma", "colour-difference keying for green screens",
-                                 ChromaKeyerOptionsFrom);
+                                 ChromaKeyerOptionsFrom, keys, check);
 }
 
 }  // namespace ss

@@ -8,6 +8,8 @@
 
 #include "core/error.h"
 #include "core/log.h"
+#include "core/option_checks.h"
+#include "core/options_binder.h"
 #include "core/target_clones.h"
 #include "pipeline/key/keyer_registry.h"
 #include "pipeline/key/keying_config.h"
@@ -193,10 +195,28 @@ CleanPlateKeyerOptions CleanPlateKeyerOptionsFrom(const KeyingConfig& k) {
 }
 
 void RegisterCleanPlateKeyer() {
+  // keying.clean_plate.*: the ramp in noise sigmas (KeyingConfig::clean_plate's defaults are the
+  // config's, 3 and 6).
+  const auto keys = [](OptionsBinder& b, KeyingConfig& k) {
+    b.Add("clean_plate.low_sigma", &k.clean_plate.low_sigma, "a number of noise sigmas >= 0",
+          "difference from the plate, in multiples of the pixel's noise sigma, at which alpha "
+          "starts to rise from 0")
+        .Rule(AtLeast(0))
+        .Add("clean_plate.high_sigma", &k.clean_plate.high_sigma, "a number of noise sigmas >= 0",
+             "... and at which the pixel is pure subject (alpha 1); must be above `low_sigma`")
+        .Rule(AtLeast(0));
+  };
+  const auto check = [](const KeyingConfig& k, std::string* why) {
+    OptionProblems problem(why);
+    problem(!(k.clean_plate.low_sigma >= k.clean_plate.high_sigma), "clean_plate.high_sigma",
+            "must be above low_sigma (" + OptionProblems::Num(k.clean_plate.low_sigma) + "), got " +
+                OptionProblems::Num(k.clean_plate.high_sigma));
+    return problem.ok();
+  };
   RegisterKeyerType<CleanPlateKeyer>(
       "clean_plate",
       "difference against a learned empty-enclosure plate, for backgrounds that are not green",
-      CleanPlateKeyerOptionsFrom);
+      CleanPlateKeyerOptionsFrom, keys, check);
 }
 
 }  // namespace ss

@@ -25,23 +25,11 @@ OptionsBinder KeyingKeys(KeyingConfig& k) {
            "size counts as 1920x1080) must fit in 1 GiB, and 1000 frames at most: 172 at "
            "1920x1080, 43 at 3840x2160 (2000000000 made the daemon fail every frame with "
            "bad_alloc)")
-      .Rule(AtLeast(1))
-      .Add("chroma.low", &k.chroma.key_low_levels, "a level from 0 to 255",
-           "key difference (green minus the larger of red and blue, in 8-bit levels, after "
-           "learning the screen) at which alpha starts to fall from 1")
-      .Rule(Between(0, 255))
-      .Add("chroma.high", &k.chroma.key_high_levels, "a level from 0 to 255",
-           "... and at which the pixel is pure background (alpha 0); must be above `low`")
-      .Rule(Between(0, 255))
-      .Add("clean_plate.low_sigma", &k.clean_plate.low_sigma, "a number of noise sigmas >= 0",
-           "difference from the plate, in multiples of the pixel's noise sigma, at which alpha "
-           "starts to rise from 0")
-      .Rule(AtLeast(0))
-      .Add("clean_plate.high_sigma", &k.clean_plate.high_sigma, "a number of noise sigmas >= 0",
-           "... and at which the pixel is pure subject (alpha 1); must be above `low_sigma`")
-      .Rule(AtLeast(0))
-      .Add("despill.enabled", &k.despill.enabled,
-           "remove the screen's colour cast from subject edges")
+      .Rule(AtLeast(1));
+  // Each keyer's own block, bound by the keyer (KeyerKind::keys).
+  for (const KeyerKind* keyer : KeyerKinds())
+    if (keyer->keys) keyer->keys(b, k);
+  b.Add("despill.enabled", &k.despill.enabled, "remove the screen's colour cast from subject edges")
       .Add("despill.strength", &k.despill.strength, "a number 0..1",
            "how much of the cast to remove (clamped to 0..1, adjusted)")
       .Type("number 0..1")
@@ -69,16 +57,21 @@ void CheckKeying(KeyingConfig& k, YamlMessages& msg, const std::string& path) {
   const std::vector<std::string> methods = KeyerMethods();
   check(std::find(methods.begin(), methods.end(), k.method) != methods.end(), "method",
         "expected one of " + yaml_text::Join(methods, ", ") + ", got \"" + k.method + "\"");
-  // The config's range; the keyer itself also takes < 0 (off: min_margin and ramp instead).
-  // Against a low bound that is itself wrong, the order says nothing more.
-  const double low = k.chroma.key_low_levels, high = k.chroma.key_high_levels;
-  check(msg.Failed(Child(path, "chroma.low")) || !(low >= high), "chroma.high",
-        "must be above " + Child(path, "chroma.low") + " (" + Num(low) + "), got " + Num(high));
-  check(msg.Failed(Child(path, "clean_plate.low_sigma")) ||
-            !(k.clean_plate.low_sigma >= k.clean_plate.high_sigma),
-        "clean_plate.high_sigma",
-        "must be above " + Child(path, "clean_plate.low_sigma") + " (" +
-            Num(k.clean_plate.low_sigma) + "), got " + Num(k.clean_plate.high_sigma));
+  // Each keyer's block's own rules (KeyerKind::check), unless a key of the block is refused
+  // already: against a bound that is itself wrong, the order says nothing more.
+  for (const KeyerKind* keyer : KeyerKinds()) {
+    if (!keyer->check) continue;
+    OptionsBinder own;
+    if (keyer->keys) keyer->keys(own, k);
+    const std::vector<std::string> keys = own.Keys();
+    if (std::any_of(keys.begin(), keys.end(),
+                    [&](const std::string& key) { return msg.Failed(Child(path, key)); }))
+      continue;
+    std::string why;
+    if (keyer->check(k, &why)) continue;
+    for (const auto& [field, reason] : OptionProblems::Split(why))
+      check(false, field.empty() ? "method" : field, reason);
+  }
   double& strength = k.despill.strength;
   check(std::isfinite(strength), "despill.strength",
         "expected a finite number, got " + Num(strength));

@@ -1,9 +1,11 @@
 #pragma once
 // The config's keying section (docs/config.md "keying", docs/keying.md), owned here beside the
 // keyers it configures: every key bound to its field of KeyingConfig (its type, expected words,
-// doc and bounds), and the section's rules beyond a key's own bounds. The station config
+// doc and bounds), and the section's rules beyond a key's own bounds. The shared keys (method,
+// training_frames, despill, shadow) are bound here, each keyer's own block by the keyer's
+// registration (KeyerKind::keys and ::check, pipeline/key/keyer_registry.h). The station config
 // (config/) reads and checks the section through these two; nothing in config/ names a keyer's
-// key.
+// key, and nothing here names a keyer.
 #include <string>
 
 #include "core/options_binder.h"

@@ -281,7 +281,7 @@ TEST(StationConfig, ValueErrorsNameFieldAndLine) {
       {kOneCamera + kOneCamera.substr(9),
        "station.yaml:5: cameras[1].name: \"cam0\" is already the name of cameras[0]"},
       {"keying:\n  chroma: {low: 80, high: 40}\n",
-       "station.yaml:2: keying.chroma.high: must be above keying.chroma.low (80), got 40"},
+       "station.yaml:2: keying.chroma.high: must be above low (80), got 40"},
       {"keying:\n  method: luma\n",
        "station.yaml:2: keying.method: expected one of chroma, clean_plate, got \"luma\""},
       {"pipeline:\n  px_per_m: 0\n",

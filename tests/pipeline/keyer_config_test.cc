@@ -8,6 +8,8 @@
 
 #include "config/station_config.h"
 #include "core/error.h"
+#include "core/option_checks.h"
+#include "core/options_binder.h"
 #include "pipeline/key/keyer_registry.h"
 #include "pipeline/run/camera_pipeline.h"
 #include "tests/pipeline/key_scene.h"
@@ -138,16 +140,28 @@ TEST_F(KeyerConfig, CleanPlateThresholdsFollowTheConfig) {
 }
 
 // A keyer registered as the built-in ones are (pipeline/key/keyer_registry.h) is chosen by the
-// config's keying.method, checked and documented by the config, with nothing in config/ naming
-// it (issue 36): here the chroma keyer under another name.
+// config's keying.method, its own keys bound, checked and documented by the config, with nothing
+// in config/ or pipeline/key/keying_keys.cc naming it (issue 36): here the chroma keyer under
+// another name, whose own block `twin:` holds its thresholds.
 struct TwinKeyer : ChromaKeyer {
   using ChromaKeyer::ChromaKeyer;
   std::string name() const override { return "twin"; }
 };
 
 TEST_F(KeyerConfig, AKeyerRegisteredApartIsChosenByTheConfig) {
+  const auto keys = [](OptionsBinder& b, KeyingConfig& k) {
+    b.Add("twin.low", &k.chroma.key_low_levels, "a level from 0 to 255", "where alpha falls")
+        .Rule(Between(0, 255))
+        .Add("twin.high", &k.chroma.key_high_levels, "a level from 0 to 255", "where it is 0")
+        .Rule(Between(0, 255));
+  };
+  const auto check = [](const KeyingConfig& k, std::string* why) {
+    OptionProblems problem(why);
+    problem(k.chroma.key_low_levels < k.chroma.key_high_levels, "twin.high", "must be above low");
+    return problem.ok();
+  };
   RegisterKeyerType<TwinKeyer>("twin", "the chroma keyer again, under another name",
-                               ChromaKeyerOptionsFrom);
+                               ChromaKeyerOptionsFrom, keys, check);
   EXPECT_THROW(RegisterKeyerType<TwinKeyer>("twin", "again", ChromaKeyerOptionsFrom), WorkError);
   const std::string camera =
       "cameras:\n  - name: cam0\n    source: v4l2\n    device: /dev/video0\n";
@@ -160,6 +174,34 @@ TEST_F(KeyerConfig, AKeyerRegisteredApartIsChosenByTheConfig) {
   EXPECT_EQ(twin.pipeline->keyer().name(), "twin");
   EXPECT_GT(twin.alpha_sum, 0);
   EXPECT_EQ(twin.alpha_sum, by_chroma.alpha_sum);  // the same keyer, the same options
+  // Its own keys: read into its block, documented, their bounds and its rule named at the key.
+  const StationConfig tight = ParseStationConfig(
+      camera + "keying:\n  method: twin\n  twin: {low: 0, high: 15}\n", "station.yaml", "/tmp");
+  EXPECT_EQ(tight.pipeline.keying->chroma.key_low_levels, 0);
+  EXPECT_EQ(tight.pipeline.keying->chroma.key_high_levels, 15);
+  EXPECT_LT(Key(tight).alpha_sum, 0.99 * twin.alpha_sum) << "its keys reach the keyer";
+  EXPECT_NE(ConfigKeysMarkdown().find("| `twin.low` | number 0..255 | `20` | where alpha falls |"),
+            std::string::npos)
+      << ConfigKeysMarkdown();
+  const auto refusal = [&](const std::string& block) {
+    try {
+      ParseStationConfig(camera + "keying:\n  method: twin\n  twin: " + block + "\n",
+                         "station.yaml", "/tmp");
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("taken");
+  };
+  EXPECT_NE(refusal("{low: 300}")
+                .find("station.yaml:7: keying.twin.low: expected a level from 0 to 255, got 300"),
+            std::string::npos)
+      << refusal("{low: 300}");
+  EXPECT_NE(
+      refusal("{low: 80, high: 40}").find("station.yaml:7: keying.twin.high: must be above low"),
+      std::string::npos)
+      << refusal("{low: 80, high: 40}");
+  EXPECT_EQ(refusal("{low: 300, high: 40}").find("twin.high"), std::string::npos)
+      << "no order against a refused bound: " << refusal("{low: 300, high: 40}");
   try {
     ParseStationConfig(camera + "keying:\n  method: luma\n", "station.yaml", "/tmp");
     ADD_FAILURE() << "an unknown keyer was taken";
