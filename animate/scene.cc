@@ -22,6 +22,9 @@ std::unique_ptr<Scene> Scene::Load(AnimationSpec spec, const std::atomic<bool>* 
     for (const FrameSpec& f : s.frames) {
       if (!f.tag.empty()) tags.push_back(f.tag);
     }
+    for (const auto& constraint : s.constraints) {
+      for (std::string& tag : constraint->Tags()) tags.push_back(std::move(tag));
+    }
   }
   for (const auto& [key, term] : spec.terms) {
     for (std::string& tag : term->Tags()) tags.push_back(std::move(tag));
@@ -90,6 +93,8 @@ void Scene::AddTerms() {
       problem_->AddTerm(std::make_unique<FrameTerm>(id, std::move(allowed), f.window, f.strength,
                                                     std::move(trigger)));
     }
+    // The constraints registered apart (animate/spec_term.h).
+    for (const auto& constraint : entry.constraints) constraint->AddTerms(graph, *problem_, id);
     const std::optional<LengthSpec>& length = entry.length ? entry.length : spec_.length;
     if (length) {
       problem_->AddTerm(std::make_unique<LengthTerm>(id, length->min_frames, length->strength));

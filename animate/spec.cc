@@ -51,6 +51,15 @@ struct WindowKeys {
   std::optional<SpecTime> at, from, to;
 };
 
+// A sprite's constraints, as an item of `constraints:` names them: "location:, path:, frames:"
+// and each registered apart (animate/spec_term.h).
+std::string ConstraintWords() {
+  std::string words;
+  for (const std::string& key : SpriteConstraintKeys())
+    words += (words.empty() ? "" : ", ") + key + ":";
+  return words;
+}
+
 // A number as written, without rounding to 6 digits ("10000000", not "1e+07").
 std::string Exact(double v) {
   char text[32];
@@ -591,7 +600,7 @@ SpriteSpecEntry SpecReader::Sprite(const YAML::Node& node, const std::string& pa
       .AddRead("end", "", "[x, y]: the last position is fixed", PointInto(&end))
       .Add("smoothness", &out.smoothness, "a number >= 0", "α")
       .Rule(AtLeast(0))
-      .AddRead("constraints", "", "location:, path:, frames:",
+      .AddRead("constraints", "", ConstraintWords(),
                BlockOf([this, &out](const YAML::Node& n, const std::string& p) {
                  Constraints(n, p, out);
                }))
@@ -644,7 +653,7 @@ void SpecReader::Constraints(const YAML::Node& node, const std::string& path,
     const YAML::Node item = node[i];
     r_.Mark(item_path, item);
     if (!item.IsMap() || item.size() != 1 || !item.begin()->first.IsScalar()) {
-      msg_.Error(item_path, "expected one of location:, path:, frames:");
+      msg_.Error(item_path, "expected one of " + ConstraintWords());
       continue;
     }
     const std::string kind = item.begin()->first.Scalar();
@@ -660,8 +669,15 @@ void SpecReader::Constraints(const YAML::Node& node, const std::string& path,
       out.path = Path(body, body_path);
     } else if (kind == "frames") {
       out.frames.push_back(Frames(body, body_path));
+    } else if (const SpriteConstraintKind* registered = FindSpriteConstraint(kind)) {
+      if (auto constraint = registered->read(*this, body, body_path))
+        out.constraints.push_back(std::move(constraint));
     } else {
-      msg_.Error(body_path, "unknown constraint (expected location, path or frames)");
+      const std::vector<std::string> keys = SpriteConstraintKeys();
+      std::string expected;  // "location, path or frames"
+      for (size_t k = 0; k < keys.size(); ++k)
+        expected += (k == 0 ? "" : k + 1 == keys.size() ? " or " : ", ") + keys[k];
+      msg_.Error(body_path, "unknown constraint (expected " + expected + ")");
     }
   }
 }

@@ -89,6 +89,8 @@ struct SpriteSpecEntry {
   std::vector<FrameSpec> frames;
   std::optional<LengthSpec> length;   // overrides the spec's
   std::optional<FastFrameSpec> fast;  // overrides the spec's
+  // Its constraints registered apart (animate/spec_term.h), in the order given.
+  std::vector<std::shared_ptr<const SpriteConstraint>> constraints;
 };
 
 struct CollisionSpec {  // eq. 9, between every pair of the listed sprites

@@ -1,6 +1,7 @@
 #pragma once
 // Cost terms a spec turns on with a top-level block of their own (`repeats:`, `facing:`,
-// `clones:`), registered as keyers and camera backends are (core/registry.h): a term's own files
+// `clones:`), and a sprite's constraints beyond location, path and frames (SpriteConstraint,
+// below), registered as keyers and camera backends are (core/registry.h): a term's own files
 // define `void Register<Name>SpecTerm()`, which calls RegisterSpecTerm with how it reads its
 // block and which terms it adds to a scene, and one line in animate/CMakeLists.txt
 // (spritestation_registrations) builds the call in. The spec reader (animate/spec.cc) and the
@@ -56,24 +57,23 @@ struct SpecTermKind {
   std::function<std::shared_ptr<const SpecTerm>()> absent = [] { return nullptr; };
 };
 
-// Reads a term's block: `bind` binds the block's keys to `term`'s fields, and each key of
-// `required` is reported when the block lacks it; `term` is returned.
-std::shared_ptr<const SpecTerm> ReadTermBlock(SpecBlockReader& reader, const YAML::Node& node,
-                                              const std::string& path,
-                                              std::shared_ptr<SpecTerm> term,
-                                              const std::function<void(OptionsBinder&)>& bind,
-                                              const std::vector<const char*>& required);
+// Reads a registered block: `bind` binds its keys to the fields of what it reads, and each key
+// of `required` is reported when the block lacks it (a mistake reported through `reader`).
+void ReadSpecBlock(SpecBlockReader& reader, const YAML::Node& node, const std::string& path,
+                   const std::function<void(OptionsBinder&)>& bind,
+                   const std::vector<const char*>& required);
 
-// The usual `read` (SpecTermKind::read) of a term whose block is its fields: a new T, whose
-// fields `bind(keys, t)` binds, read by ReadTermBlock.
+// The usual `read` (SpecTermKind::read, SpriteConstraintKind::read) of a block that is its
+// fields: a new T, whose fields `bind(keys, t)` binds, read by ReadSpecBlock.
 template <typename T, typename Bind>
 auto TermBlockReader(Bind bind, std::vector<const char*> required) {
   return [bind = std::move(bind), required = std::move(required)](
              SpecBlockReader& reader, const YAML::Node& node,
-             const std::string& path) -> std::shared_ptr<const SpecTerm> {
+             const std::string& path) -> std::shared_ptr<const T> {
     auto term = std::make_shared<T>();
-    return ReadTermBlock(
-        reader, node, path, term, [&](OptionsBinder& keys) { bind(keys, *term); }, required);
+    ReadSpecBlock(
+        reader, node, path, [&](OptionsBinder& keys) { bind(keys, *term); }, required);
+    return term;
   };
 }
 
@@ -81,5 +81,37 @@ auto TermBlockReader(Bind bind, std::vector<const char*> required) {
 void RegisterSpecTerm(SpecTermKind kind);
 // Every term built in, by key.
 std::vector<const SpecTermKind*> SpecTermKinds();
+
+// A constraint of one sprite (an item `- KEY: {...}` of its `constraints:`) registered apart, as
+// a term with a block of its own is: what it adds to a scene for its sprite. Its own files define
+// `void Register<Name>SpriteConstraint()`, which calls RegisterSpriteConstraint, and one line in
+// animate/CMakeLists.txt (spritestation_registrations) builds the call in. The judge measures only
+// the typed ones, location, path and frames (AnimationSpec's fields, which the judge and the
+// studio page read too); a registered one counts in the cost.
+class SpriteConstraint {
+ public:
+  virtual ~SpriteConstraint() = default;
+  // Adds its cost terms for sprite `sprite` of the problem (every sprite is added by then).
+  virtual void AddTerms(const TransitionGraph& graph, Problem& problem, int sprite) const = 0;
+  // The tags whose frames it reads (the banks are loaded with them marked: LoadBankGraph).
+  virtual std::vector<std::string> Tags() const { return {}; }
+};
+
+struct SpriteConstraintKind {
+  std::string key;       // its key in an item of `constraints:`
+  std::string expected;  // its block in words, for errors and docs: "{x_max_m, strength}"
+  // Reads its block at `path` (a mistake reported through `reader`, never thrown).
+  std::function<std::shared_ptr<const SpriteConstraint>(
+      SpecBlockReader& reader, const YAML::Node& node, const std::string& path)>
+      read;
+};
+
+// Called by each constraint's registration function; a second constraint of one key, or one of
+// the typed ones' keys, is an error.
+void RegisterSpriteConstraint(SpriteConstraintKind kind);
+// nullptr when no constraint of that key is registered.
+const SpriteConstraintKind* FindSpriteConstraint(const std::string& key);
+// The keys of every constraint: the typed ones and those registered.
+std::vector<std::string> SpriteConstraintKeys();
 
 }  // namespace ss
