@@ -3,7 +3,9 @@
 // `transitions train` reads, the pairs asked least sure first, bad input named, and a
 // retrain that writes new weights and rebuilds the bank's transitions with them.
 #include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <condition_variable>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -240,12 +242,16 @@ TEST(ConsoleLabels, TheExportTrainsAndARetrainRebuildsTheTable) {
   const SyntheticBank bank = MakeBank(dir / "bank.db", 600);
   // What the console's event stream would send: the retrain's state read each time it is told.
   std::mutex told_mutex;
+  std::condition_variable told_more;
   std::vector<nlohmann::json> told;
   const ConsoleLabels* reader = nullptr;
   api::Context context;
   context.status_changed = [&] {
-    std::lock_guard lock(told_mutex);
-    if (reader) told.push_back(reader->RetrainState());
+    {
+      std::lock_guard lock(told_mutex);
+      if (reader) told.push_back(reader->RetrainState());
+    }
+    told_more.notify_all();
   };
   ConsoleLabels labels = Labels(bank, context);
   {
@@ -253,9 +259,14 @@ TEST(ConsoleLabels, TheExportTrainsAndARetrainRebuildsTheTable) {
     reader = &labels;
   }
   // A told end is whole: a viewer told "done" or "cancelled" is offered no cancel, and can
-  // start the next retrain (the console's test clicks it at once).
-  const auto told_ends = [&] {
-    std::lock_guard lock(told_mutex);
+  // start the next retrain (the console's test clicks it at once). The end `state` is told just
+  // after WaitRetrain returns: waited for, up to 30 s. How many ends were told.
+  const auto told_ends = [&](const std::string& state) {
+    std::unique_lock lock(told_mutex);
+    told_more.wait_for(lock, std::chrono::seconds(30), [&] {
+      return std::any_of(told.begin(), told.end(),
+                         [&](const nlohmann::json& r) { return r["state"] == state; });
+    });
     int ends = 0;
     for (const nlohmann::json& r : told) {
       if (r["state"] == "training" || r["state"] == "rebuilding") continue;
@@ -298,7 +309,7 @@ TEST(ConsoleLabels, TheExportTrainsAndARetrainRebuildsTheTable) {
   labels.WaitRetrain();
   const nlohmann::json r = labels.RetrainState();
   ASSERT_EQ(r["state"], "done") << r.dump(1);
-  EXPECT_GE(told_ends(), 1) << "the end is told";
+  EXPECT_GE(told_ends("done"), 1) << "the end is told";
   EXPECT_EQ(r["progress"], 1.0);
   EXPECT_EQ(r["cancellable"], false) << "not once it is over";
   EXPECT_NEAR(r["precision"].get<double>(), trained.report.stage2.precision(), 1e-12)
@@ -348,7 +359,7 @@ TEST(ConsoleLabels, TheExportTrainsAndARetrainRebuildsTheTable) {
   const nlohmann::json cancelled = labels.RetrainState();
   EXPECT_EQ(cancelled["state"], "cancelled") << cancelled.dump(1);
   EXPECT_EQ(cancelled["cancellable"], false);
-  EXPECT_GE(told_ends(), 1) << "the cancel is told";
+  EXPECT_GE(told_ends("cancelled"), 1) << "the cancel is told";
   EXPECT_FALSE(cancelled.contains("weights")) << cancelled.dump(1);
   EXPECT_TRUE(cancelled.contains("finished"));
   EXPECT_EQ(Bank(bank.path).GetMeta(kTransitionWeightsMetaKey).value_or(""), table);
