@@ -56,8 +56,7 @@ ConstraintFigures MeasureConstraints(const Problem& problem, const std::vector<T
 
 bool AnimateRunOptions::IsValid(std::string* why) const {
   OptionProblems check(why);
-  check(progress_every_s >= 0 && std::isfinite(progress_every_s), "progress_every_s",
-        "must be seconds >= 0 (0: never), got " + OptionProblems::Num(progress_every_s));
+  check.Within(progress_every_s, AtLeast(0), "progress_every_s", "seconds >= 0 (0: never)");
   check.Within(max_turns, AtLeast(0), "max_turns", "at least 0 (0: the time budget alone)");
   // Either optimizer stops at the replacement's budget (the spec's optimizer.time_budget_s).
   const double budget = optimizer.replacement.time_budget_seconds;

@@ -46,10 +46,8 @@ bool RenderOptions::IsValid(std::string* why) const {
   OptionProblems check(why);
   check.Within(shadow_opacity, Between(0, 1), "shadow_opacity", "a fraction 0..1");
   check.Within(grid_step_px, AtLeast(1), "grid_step_px", "at least 1");
-  check(min_floor_view_deg >= 0 && min_floor_view_deg <= 90, "min_floor_view_deg",
-        "must be within [0, 90], got " + OptionProblems::Num(min_floor_view_deg));
-  check(max_upright_view_deg >= 0 && max_upright_view_deg <= 90, "max_upright_view_deg",
-        "must be within [0, 90], got " + OptionProblems::Num(max_upright_view_deg));
+  check.Within(min_floor_view_deg, Between(0, 90), "min_floor_view_deg", "degrees 0..90");
+  check.Within(max_upright_view_deg, Between(0, 90), "max_upright_view_deg", "degrees 0..90");
   return check.ok();
 }
 

@@ -283,12 +283,9 @@ double MeasureEdgeWidth(const BoardSpec& board, const cv::Mat& grey, const std::
 
 bool DetectOptions::IsValid(std::string* why) const {
   OptionProblems check(why);
-  check(std::isfinite(max_edge_width_px) && max_edge_width_px > 0, "max_edge_width_px",
-        "expected a positive number of pixels, got " + OptionProblems::Num(max_edge_width_px));
-  check(min_corners >= 4, "min_corners",
-        "expected at least 4 (a board pose needs 4 corners), got " + std::to_string(min_corners));
-  check(min_area_fraction >= 0 && min_area_fraction <= 1, "min_area_fraction",
-        "expected a fraction 0..1, got " + OptionProblems::Num(min_area_fraction));
+  check.Within(max_edge_width_px, Positive(), "max_edge_width_px", "a positive number of pixels");
+  check.Within(min_corners, AtLeast(4), "min_corners", "at least 4 (a board pose needs 4 corners)");
+  check.Within(min_area_fraction, Between(0, 1), "min_area_fraction", "a fraction 0..1");
   return check.ok();
 }
 

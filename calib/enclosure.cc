@@ -61,10 +61,8 @@ GroundPolygon FloorPolygonFromPixels(const CameraModel& model,
 
 bool GreenFloorOptions::IsValid(std::string* why) const {
   OptionProblems check(why);
-  check(min_green_excess >= 0 && min_green_excess <= 255, "min_green_excess",
-        "expected 8-bit levels 0..255, got " + OptionProblems::Num(min_green_excess));
-  check(std::isfinite(simplify_m) && simplify_m >= 0, "simplify_m",
-        "expected a distance in metres >= 0, got " + OptionProblems::Num(simplify_m));
+  check.Within(min_green_excess, Between(0, 255), "min_green_excess", "8-bit levels 0..255");
+  check.Within(simplify_m, AtLeast(0), "simplify_m", "a distance in metres >= 0");
   return check.ok();
 }
 

@@ -24,12 +24,10 @@ bool IsSessionDir(const std::string& path) {
 
 bool SampleOptions::IsValid(std::string* why) const {
   OptionProblems check(why);
-  check(every >= 0, "every",
-        "expected 0 (spread max_views) or a step >= 1, got " + std::to_string(every));
-  check(max_views >= 1, "max_views", "expected at least 1 view, got " + std::to_string(max_views));
-  check(first >= 0, "first", "expected a frame index >= 0, got " + std::to_string(first));
-  check(count >= 0, "count",
-        "expected 0 (to the end) or a number of frames, got " + std::to_string(count));
+  check.Within(every, AtLeast(0), "every", "0 (spread max_views) or a step >= 1");
+  check.Within(max_views, AtLeast(1), "max_views", "at least 1 view");
+  check.Within(first, AtLeast(0), "first", "a frame index >= 0");
+  check.Within(count, AtLeast(0), "count", "0 (to the end) or a number of frames");
   return check.ok();
 }
 

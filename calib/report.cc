@@ -68,19 +68,15 @@ std::vector<std::string> EmptyRegions(const cv::Mat& counts) {
 
 bool VerdictOptions::IsValid(std::string* why) const {
   OptionProblems check(why);
-  check(min_views >= 1, "min_views", "expected at least 1 view, got " + std::to_string(min_views));
-  check(max_rms_px > 0, "max_rms_px",
-        "expected a positive error in pixels, got " + OptionProblems::Num(max_rms_px));
-  check(max_worst_px > 0, "max_worst_px",
-        "expected a positive error in pixels, got " + OptionProblems::Num(max_worst_px));
-  check(min_coverage >= 0 && min_coverage <= 1, "min_coverage",
-        "expected a fraction 0..1, got " + OptionProblems::Num(min_coverage));
-  check(min_tilt_deg >= 0 && min_tilt_deg < 90, "min_tilt_deg",
-        "expected degrees within [0, 90), got " + OptionProblems::Num(min_tilt_deg));
-  check(grid_x >= 1, "grid_x", "expected at least 1 cell, got " + std::to_string(grid_x));
-  check(grid_y >= 1, "grid_y", "expected at least 1 cell, got " + std::to_string(grid_y));
-  check(max_stdev_percent >= 0, "max_stdev_percent",
-        "expected 0 (not checked) or a percentage, got " + OptionProblems::Num(max_stdev_percent));
+  check.Within(min_views, AtLeast(1), "min_views", "at least 1 view");
+  check.Within(max_rms_px, Positive(), "max_rms_px", "a positive error in pixels");
+  check.Within(max_worst_px, Positive(), "max_worst_px", "a positive error in pixels");
+  check.Within(min_coverage, Between(0, 1), "min_coverage", "a fraction 0..1");
+  check.Within(min_tilt_deg, FromUpTo(0, 90), "min_tilt_deg", "degrees within [0, 90)");
+  check.Within(grid_x, AtLeast(1), "grid_x", "at least 1 cell");
+  check.Within(grid_y, AtLeast(1), "grid_y", "at least 1 cell");
+  check.Within(max_stdev_percent, AtLeast(0), "max_stdev_percent",
+               "0 (not checked) or a percentage");
   return check.ok();
 }
 

@@ -79,17 +79,13 @@ bool GroundChecks::IsValid(std::string* why) const {
         "expected 0 <= ring_from_squares < ring_to_squares, got " +
             OptionProblems::Num(ring_from_squares) + " and " +
             OptionProblems::Num(ring_to_squares));
-  check(min_ring_green >= 0 && min_ring_green <= 1, "min_ring_green",
-        "expected a fraction 0..1, got " + OptionProblems::Num(min_ring_green));
+  check.Within(min_ring_green, Between(0, 1), "min_ring_green", "a fraction 0..1");
   check(min_height_m >= 0 && max_height_m > min_height_m, "max_height_m",
         "expected 0 <= min_height_m < max_height_m, got " + OptionProblems::Num(min_height_m) +
             " and " + OptionProblems::Num(max_height_m));
-  check(min_axis_down_deg >= -90 && min_axis_down_deg <= 90, "min_axis_down_deg",
-        "expected degrees -90..90, got " + OptionProblems::Num(min_axis_down_deg));
-  check(max_spread_mm > 0, "max_spread_mm",
-        "expected a positive distance, got " + OptionProblems::Num(max_spread_mm));
-  check(max_spread_deg > 0, "max_spread_deg",
-        "expected a positive angle, got " + OptionProblems::Num(max_spread_deg));
+  check.Within(min_axis_down_deg, Between(-90, 90), "min_axis_down_deg", "degrees -90..90");
+  check.Within(max_spread_mm, Positive(), "max_spread_mm", "a positive distance");
+  check.Within(max_spread_deg, Positive(), "max_spread_deg", "a positive angle");
   return check.ok();
 }
 

@@ -15,10 +15,8 @@ namespace ss::calib {
 
 bool WizardRunOptions::IsValid(std::string* why) const {
   OptionProblems check(why);
-  check(max_frames >= 0, "max_frames",
-        "expected 0 (until done) or a number of frames, got " + std::to_string(max_frames));
-  check(std::isfinite(silent_s) && silent_s > 0, "silent_s",
-        "expected a positive number of seconds, got " + OptionProblems::Num(silent_s));
+  check.Within(max_frames, AtLeast(0), "max_frames", "0 (until done) or a number of frames");
+  check.Within(silent_s, Positive(), "silent_s", "a positive number of seconds");
   return check.ok();
 }
 

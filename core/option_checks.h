@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <sstream>
 #include <string>
+#include <string_view>
 #include <type_traits>
 #include <utility>
 #include <vector>
@@ -21,12 +22,21 @@ namespace ss {
 struct NumberRule {
   double min = -1e300, max = 1e300;
   bool min_open = false;  // min itself is out (> rather than >=)
-  bool Holds(double v) const;
-  std::string Text() const;  // "> 0", ">= 1", "0..255"
+  bool max_open = false;  // max itself is out (< rather than <=)
+  bool Holds(double v) const {
+    return std::isfinite(v) && (min_open ? v > min : v >= min) && (max_open ? v < max : v <= max);
+  }
+  std::string Text() const;  // "> 0", ">= 1", "0..255", ">= 0, < 1" (core/options_binder.cc)
 };
 inline NumberRule Positive() { return {0, 1e300, true}; }
 inline NumberRule AtLeast(double min) { return {min, 1e300, false}; }
 inline NumberRule Between(double min, double max) { return {min, max, false}; }
+// [min, max): a fraction that may be 0 but not 1.
+inline NumberRule FromUpTo(double min, double max) { return {min, max, false, true}; }
+// (min, max]: a factor that may be `max` but not 0.
+inline NumberRule AboveUpTo(double min, double max) { return {min, max, true, false}; }
+// (min, max): neither end.
+inline NumberRule Inside(double min, double max) { return {min, max, true, true}; }
 
 class OptionProblems {
  public:
@@ -48,9 +58,9 @@ class OptionProblems {
     (*this)(false, field, std::forward<Reason>(reason)());
   }
   // Adds "field: expected EXPECTED, got VALUE" unless `rule` holds `value`.
-  void Within(double value, NumberRule rule, const std::string& field,
-              const std::string& expected) {
-    (*this)(rule.Holds(value), field, "expected " + expected + ", got " + Num(value));
+  void Within(double value, NumberRule rule, std::string_view field, std::string_view expected) {
+    if (rule.Holds(value)) return;  // nothing built: IsValid may run on a hot path
+    (*this)(false, std::string(field), "expected " + std::string(expected) + ", got " + Num(value));
   }
   // Another struct's problems (its IsValid's `why`), each field under `prefix` ("extract.").
   void Nested(bool good, const std::string& prefix, const std::string& why) {

@@ -70,13 +70,11 @@ void OptionsBinder::CheckRules(YamlMessages& msg, const std::string& path,
   }
 }
 
-bool NumberRule::Holds(double v) const {
-  return std::isfinite(v) && (min_open ? v > min : v >= min) && v <= max;
-}
-
 std::string NumberRule::Text() const {
-  if (max < 1e300)
-    return min_open ? "> " + Num(min) + ", <= " + Num(max) : Num(min) + ".." + Num(max);
+  if (max < 1e300) {
+    if (!min_open && !max_open) return Num(min) + ".." + Num(max);
+    return (min_open ? "> " : ">= ") + Num(min) + (max_open ? ", < " : ", <= ") + Num(max);
+  }
   return (min_open ? "> " : ">= ") + Num(min);
 }
 

@@ -126,13 +126,10 @@ bool AnimationJobsOptions::IsValid(std::string* why) const {
   OptionProblems check(why);
   check(!folder.empty(), "folder", "required");
   check(!roots.empty(), "roots", "at least one folder a spec may name files under");
-  check(max_time_budget_s > 0 && std::isfinite(max_time_budget_s) &&
-            max_time_budget_s <= kMaxTimeBudgetSeconds,
-        "max_time_budget_s",
-        "must be seconds in (0, " + OptionProblems::Num(kMaxTimeBudgetSeconds) + "], got " +
-            OptionProblems::Num(max_time_budget_s));
+  check.Within(max_time_budget_s, AboveUpTo(0, kMaxTimeBudgetSeconds), "max_time_budget_s",
+               "seconds in (0, " + OptionProblems::Num(kMaxTimeBudgetSeconds) + "]");
   check.Within(max_set_bytes, Positive(), "max_set_bytes", "a positive number of bytes");
-  check(threads >= 1 && threads <= 64, "threads", "must be 1..64, got " + std::to_string(threads));
+  check.Within(threads, Between(1, 64), "threads", "1..64 threads");
   return check.ok();
 }
 

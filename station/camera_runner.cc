@@ -594,8 +594,7 @@ bool CameraRunnerOptions::IsValid(std::string* why) const {
   check(std::isfinite(backoff_max_s) && !(backoff_max_s < backoff_min_s), "backoff_max_s",
         "expected at least backoff_min_s (" + OptionProblems::Num(backoff_min_s) + " s), got " +
             OptionProblems::Num(backoff_max_s));
-  check(std::isfinite(preview_interval_s) && preview_interval_s >= 0, "preview_interval_s",
-        "expected a number of seconds >= 0, got " + OptionProblems::Num(preview_interval_s));
+  check.Within(preview_interval_s, AtLeast(0), "preview_interval_s", "a number of seconds >= 0");
   return check.ok();
 }
 

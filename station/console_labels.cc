@@ -158,11 +158,9 @@ struct ConsoleLabels::Pool {
 
 bool ConsoleLabelsOptions::IsValid(std::string* why) const {
   OptionProblems check(why);
-  check(threads >= 1, "threads", "expected at least 1 thread, got " + std::to_string(threads));
-  check(candidate_rows >= 1, "candidate_rows",
-        "expected at least 1 sprite, got " + std::to_string(candidate_rows));
-  check(min_labels >= 2, "min_labels",
-        "expected at least 2 (a yes and a no), got " + std::to_string(min_labels));
+  check.Within(threads, AtLeast(1), "threads", "at least 1 thread");
+  check.Within(candidate_rows, AtLeast(1), "candidate_rows", "at least 1 sprite");
+  check.Within(min_labels, AtLeast(2), "min_labels", "at least 2 (a yes and a no)");
   return check.ok();
 }
 

@@ -540,12 +540,9 @@ struct ControlServer::Impl {
 
 bool ControlServerOptions::IsValid(std::string* why) const {
   OptionProblems check(why);
-  check(config.port >= 0 && config.port <= 65535, "config.port",
-        "expected a port number 0..65535, got " + std::to_string(config.port));
-  check(max_event_streams >= 0, "max_event_streams",
-        "expected a number >= 0, got " + std::to_string(max_event_streams));
-  check(http_threads >= 1 && http_threads <= 4096, "http_threads",
-        "expected 1..4096 threads, got " + std::to_string(http_threads));
+  check.Within(config.port, Between(0, 65535), "config.port", "a port number 0..65535");
+  check.Within(max_event_streams, AtLeast(0), "max_event_streams", "a number >= 0");
+  check.Within(http_threads, Between(1, 4096), "http_threads", "1..4096 threads");
   return check.ok();
 }
 

@@ -101,8 +101,7 @@ bool StationOptions::IsValid(std::string* why) const {
   OptionProblems check(why);
   std::string part;
   if (weights) check.Nested(weights->IsValid(&part), "weights.", part);
-  check(std::isfinite(offline_after_s) && offline_after_s > 0, "offline_after_s",
-        "expected a positive number of seconds, got " + OptionProblems::Num(offline_after_s));
+  check.Within(offline_after_s, Positive(), "offline_after_s", "a positive number of seconds");
   return check.ok();
 }
 

@@ -192,8 +192,7 @@ bool SynthOptions::IsValid(std::string* why) const {
           "a session runs at 1..240 frames per second, got " + OptionProblems::Num(fps));
   }
   check(!out_dir.empty(), "out_dir", "a session folder is needed");
-  check(seconds > 0 && seconds <= 3600, "seconds",
-        "expected 0 < seconds <= 3600, got " + OptionProblems::Num(seconds));
+  check.Within(seconds, AboveUpTo(0, 3600), "seconds", "0 < seconds <= 3600");
   const bool bayer = pixel_format == PixelFormat::kBayerRG8;
   const bool width_ok = width >= 64 && width <= 4096, height_ok = height >= 48 && height <= 4096;
   check(width_ok, "width", "expected 64..4096 pixels, got " + std::to_string(width));
@@ -202,13 +201,13 @@ bool SynthOptions::IsValid(std::string* why) const {
   check(height_ok, "height", "expected 48..4096 pixels, got " + std::to_string(height));
   check(!height_ok || !bayer || height % 2 == 0, "height",
         "bayer_rg8 needs an even height, got " + std::to_string(height));
-  check(cameras >= 1 && cameras <= 8, "cameras", "expected 1..8, got " + std::to_string(cameras));
+  check.Within(cameras, Between(1, 8), "cameras", "1..8");
   check(pixel_format == PixelFormat::kRGB8 || pixel_format == PixelFormat::kBGR8 || bayer ||
             pixel_format == PixelFormat::kMono8,
         "pixel_format",
         "expected rgb8, bgr8, bayer_rg8 or mono8, got " + PixelFormatName(pixel_format));
-  check(noise >= 0 && noise <= 10, "noise", "expected 0..10, got " + OptionProblems::Num(noise));
-  check(threads >= 1 && threads <= 64, "threads", "expected 1..64, got " + std::to_string(threads));
+  check.Within(noise, Between(0, 10), "noise", "0..10");
+  check.Within(threads, Between(1, 64), "threads", "1..64");
   check(!(kind == SynthKind::kAnimal && studio == StudioKind::kStage), "studio",
         "animals live in the enclosure");
   check(!(kind == SynthKind::kFly && studio == StudioKind::kStage), "studio",
@@ -220,8 +219,7 @@ bool SynthOptions::IsValid(std::string* why) const {
         "view", "cameras look down from overhead in the enclosure only");
   check(FindRecordingCodec(codec) != nullptr, "codec",
         "unknown codec '" + codec + "' (expected " + RecordingCodecNames() + ")");
-  check(std::isfinite(empty_lead_in_s) && empty_lead_in_s >= 0, "empty_lead_in_s",
-        "expected seconds >= 0, got " + OptionProblems::Num(empty_lead_in_s));
+  check.Within(empty_lead_in_s, AtLeast(0), "empty_lead_in_s", "seconds >= 0");
   return check.ok();
 }
 

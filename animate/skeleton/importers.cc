@@ -134,7 +134,7 @@ bool SkeletonImportOptions::IsValid(std::string* why) const {
   check(!min_confidence || (*min_confidence >= 0 && *min_confidence <= 1), "min_confidence",
         "must be within [0, 1] (or unset: the mapping's or the format's), got " +
             OptionProblems::Num(min_confidence.value_or(0)));
-  check(person >= 0, "person", "must be an index >= 0, got " + std::to_string(person));
+  check.Within(person, AtLeast(0), "person", "an index >= 0");
   check(category_id >= -1, "category_id",
         "must be a category id >= 0 (or -1: the first with keypoints), got " +
             std::to_string(category_id));

@@ -13,9 +13,8 @@ namespace ss {
 
 bool LkOptions::IsValid(std::string* why) const {
   OptionProblems check(why);
-  check(window_px >= 5, "window_px", "must be >= 5 pixels, got " + std::to_string(window_px));
-  check(pyramid_levels >= 0 && pyramid_levels <= 8, "pyramid_levels",
-        "must be within 0..8, got " + std::to_string(pyramid_levels));
+  check.Within(window_px, AtLeast(5), "window_px", "at least 5 pixels");
+  check.Within(pyramid_levels, Between(0, 8), "pyramid_levels", "0..8 levels");
   check.Within(max_iterations, AtLeast(1), "max_iterations", "at least 1");
   check.Within(epsilon, Positive(), "epsilon", "a number > 0");
   check.Within(max_forward_backward_px, Positive(), "max_forward_backward_px",

@@ -12,10 +12,8 @@ namespace ss {
 bool MovementOptions::IsValid(std::string* why) const {
   OptionProblems check(why);
   check.Within(lag_s, Positive(), "lag_s", "a positive number of seconds");
-  check(smoothing_s >= 0 && std::isfinite(smoothing_s), "smoothing_s",
-        "must be seconds >= 0, got " + OptionProblems::Num(smoothing_s));
-  check(min_length_s >= 0 && std::isfinite(min_length_s), "min_length_s",
-        "must be seconds >= 0, got " + OptionProblems::Num(min_length_s));
+  check.Within(smoothing_s, AtLeast(0), "smoothing_s", "seconds >= 0");
+  check.Within(min_length_s, AtLeast(0), "min_length_s", "seconds >= 0");
   check.Within(min_prominence, AtLeast(0), "min_prominence", "at least 0");
   check.Within(noise_factor, AtLeast(0), "noise_factor", "at least 0");
   return check.ok();

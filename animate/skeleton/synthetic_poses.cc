@@ -162,8 +162,7 @@ bool GestureScriptOptions::IsValid(std::string* why) const {
   OptionProblems check(why);
   check.Within(transition_frames, AtLeast(0), "transition_frames", "frames >= 0");
   check.Within(speed, Positive(), "speed", "a positive factor");
-  check(noise_px >= 0 && std::isfinite(noise_px), "noise_px",
-        "must be pixels >= 0, got " + OptionProblems::Num(noise_px));
+  check.Within(noise_px, AtLeast(0), "noise_px", "pixels >= 0");
   check.Within(scale_px, Positive(), "scale_px", "a positive number of pixels per body unit");
   check(std::isfinite(x_px), "x_px",
         "must be a finite pixel position, got " + OptionProblems::Num(x_px));

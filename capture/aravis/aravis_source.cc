@@ -146,29 +146,24 @@ struct AravisSource::Impl {
 
 bool AravisOptions::IsValid(std::string* why) const {
   OptionProblems check(why);
-  check(camera_index >= 0, "camera_index",
-        "expected a number >= 0, got " + std::to_string(camera_index));
+  check.Within(camera_index, AtLeast(0), "camera_index", "a number >= 0");
   check(!pixel_format || GenicamPixelFormat(*pixel_format).has_value(), "pixel_format",
         (pixel_format ? PixelFormatName(*pixel_format) : std::string()) +
             " is not a GigE/USB3 Vision format (use mono8, bayer_*8, rgb8, bgr8, yuyv)");
   check(width >= 0 && height >= 0 && (width > 0) == (height > 0), "width/height",
         "give both or neither (got " + std::to_string(width) + "x" + std::to_string(height) + ")");
-  check(std::isfinite(exposure_us) && exposure_us >= 0, "exposure_us",
-        "expected 0 (leave it) or a positive number of microseconds, got " +
-            OptionProblems::Num(exposure_us));
+  check.Within(exposure_us, AtLeast(0), "exposure_us",
+               "0 (leave it) or a positive number of microseconds");
   check(std::isfinite(gain), "gain",
         "expected a number (< 0: leave it), got " + OptionProblems::Num(gain));
-  check(std::isfinite(fps) && fps >= 0, "fps",
-        "expected 0 (leave it) or a positive frame rate, got " + OptionProblems::Num(fps));
+  check.Within(fps, AtLeast(0), "fps", "0 (leave it) or a positive frame rate");
   for (const auto& [v, field] : {std::pair{red_ratio, "red_ratio"}, {blue_ratio, "blue_ratio"}}) {
     check(std::isfinite(v) && v > 0, field,
           "expected a positive ratio, got " + OptionProblems::Num(v));
   }
-  check(packet_size >= 0, "packet_size",
-        "expected 0 (negotiate) or a number of bytes, got " + std::to_string(packet_size));
-  check(buffers >= 2, "buffers", "expected 2 or more, got " + std::to_string(buffers));
-  check(frame_timeout_ms >= 1, "frame_timeout_ms",
-        "expected at least 1 ms, got " + std::to_string(frame_timeout_ms));
+  check.Within(packet_size, AtLeast(0), "packet_size", "0 (negotiate) or a number of bytes");
+  check.Within(buffers, AtLeast(2), "buffers", "2 or more");
+  check.Within(frame_timeout_ms, AtLeast(1), "frame_timeout_ms", "at least 1 ms");
   return check.ok();
 }
 

@@ -175,11 +175,9 @@ bool FakeGigEOptions::IsValid(std::string* why) const {
         (pixel_format ? PixelFormatName(*pixel_format) : std::string()) +
             " is not offered by the emulated camera (mono8, bayer_rg8, bayer_gr8, bayer_gb8, "
             "bayer_bg8, rgb8)");
-  check(std::isfinite(fps) && fps >= 0, "fps",
-        "expected 0 (the session's) or a positive frame rate, got " + OptionProblems::Num(fps));
-  check(loops >= 0, "loops", "expected 0 (forever) or more, got " + std::to_string(loops));
-  check(std::isfinite(lost_packet_ratio) && lost_packet_ratio >= 0 && lost_packet_ratio <= 1,
-        "lost_packet_ratio", "expected 0..1, got " + OptionProblems::Num(lost_packet_ratio));
+  check.Within(fps, AtLeast(0), "fps", "0 (the session's) or a positive frame rate");
+  check.Within(loops, AtLeast(0), "loops", "0 (forever) or more");
+  check.Within(lost_packet_ratio, Between(0, 1), "lost_packet_ratio", "0..1");
   return check.ok();
 }
 

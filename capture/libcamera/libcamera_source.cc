@@ -406,8 +406,7 @@ struct LibcameraSource::Impl : std::enable_shared_from_this<Impl> {
 
 bool LibcameraOptions::IsValid(std::string* why) const {
   OptionProblems check(why);
-  check(camera_index >= 0, "camera_index",
-        "expected a number >= 0, got " + std::to_string(camera_index));
+  check.Within(camera_index, AtLeast(0), "camera_index", "a number >= 0");
   check(!pixel_format || ToLibcamera(*pixel_format).has_value(), "pixel_format",
         "the libcamera backend reads yuyv, nv12, mjpeg, rgb8 and bgr8, not " +
             (pixel_format ? PixelFormatName(*pixel_format) : std::string()));
@@ -422,11 +421,9 @@ bool LibcameraOptions::IsValid(std::string* why) const {
     check(std::isfinite(v) && v > 0, field,
           "expected a positive gain, got " + OptionProblems::Num(v));
   }
-  check(awb_settle_frames >= 1, "awb_settle_frames",
-        "expected at least 1 frame, got " + std::to_string(awb_settle_frames));
-  check(buffers >= 2, "buffers", "expected 2 or more, got " + std::to_string(buffers));
-  check(frame_timeout_ms >= 1, "frame_timeout_ms",
-        "expected at least 1 ms, got " + std::to_string(frame_timeout_ms));
+  check.Within(awb_settle_frames, AtLeast(1), "awb_settle_frames", "at least 1 frame");
+  check.Within(buffers, AtLeast(2), "buffers", "2 or more");
+  check.Within(frame_timeout_ms, AtLeast(1), "frame_timeout_ms", "at least 1 ms");
   return check.ok();
 }
 

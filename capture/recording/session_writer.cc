@@ -112,8 +112,7 @@ bool RecordingOptions::IsValid(std::string* why) const {
   OptionProblems check(why);
   check(FindRecordingCodec(codec) != nullptr, "codec",
         "unknown codec '" + codec + "' (expected " + RecordingCodecNames() + ")");
-  check(flush_interval_ms >= 0, "flush_interval_ms",
-        "expected 0 or more, got " + std::to_string(flush_interval_ms));
+  check.Within(flush_interval_ms, AtLeast(0), "flush_interval_ms", "0 or more");
   return check.ok();
 }
 

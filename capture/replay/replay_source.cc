@@ -256,11 +256,9 @@ struct ReplaySource::Impl {
 
 bool ReplayOptions::IsValid(std::string* why) const {
   OptionProblems check(why);
-  check(loops >= 0, "loops", "expected 0 (forever) or more, got " + std::to_string(loops));
-  check(frames_ahead >= 1, "frames_ahead",
-        "expected at least 1 frame, got " + std::to_string(frames_ahead));
-  check(decode_threads >= 0, "decode_threads",
-        "expected 0 (one per core) or more, got " + std::to_string(decode_threads));
+  check.Within(loops, AtLeast(0), "loops", "0 (forever) or more");
+  check.Within(frames_ahead, AtLeast(1), "frames_ahead", "at least 1 frame");
+  check.Within(decode_threads, AtLeast(0), "decode_threads", "0 (one per core) or more");
   return check.ok();
 }
 

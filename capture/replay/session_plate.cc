@@ -18,8 +18,7 @@ bool PlateOptions::IsValid(std::string* why) const {
   check(last_frame >= first_frame, "last_frame",
         std::to_string(last_frame) + " is before the first frame " + std::to_string(first_frame));
   // Each sample is a full frame held in memory for the median.
-  check(samples >= 1 && samples <= 1000, "samples",
-        "expected 1..1000 frames, got " + std::to_string(samples));
+  check.Within(samples, Between(1, 1000), "samples", "1..1000 frames");
   return check.ok();
 }
 

@@ -251,16 +251,12 @@ bool V4l2Options::IsValid(std::string* why) const {
   check(!device.empty(), "device", "expected a device path such as /dev/video0");
   check(width >= 0 && height >= 0 && (width > 0) == (height > 0), "width/height",
         "give both or neither (got " + std::to_string(width) + "x" + std::to_string(height) + ")");
-  check(std::isfinite(fps) && fps >= 0, "fps",
-        "expected 0 (the driver's) or frames per second, got " + OptionProblems::Num(fps));
-  check(std::isfinite(exposure_us) && exposure_us >= 0, "exposure_us",
-        "expected 0 (auto) or microseconds, got " + OptionProblems::Num(exposure_us));
-  check(gain >= -1, "gain", "expected -1 (auto) or a gain >= 0, got " + std::to_string(gain));
-  check(white_balance_k >= 0, "white_balance_k",
-        "expected 0 (auto) or kelvin, got " + std::to_string(white_balance_k));
-  check(buffers >= 2, "buffers", "expected 2 or more, got " + std::to_string(buffers));
-  check(frame_timeout_ms >= 1, "frame_timeout_ms",
-        "expected at least 1 ms, got " + std::to_string(frame_timeout_ms));
+  check.Within(fps, AtLeast(0), "fps", "0 (the driver's) or frames per second");
+  check.Within(exposure_us, AtLeast(0), "exposure_us", "0 (auto) or microseconds");
+  check.Within(gain, AtLeast(-1), "gain", "-1 (auto) or a gain >= 0");
+  check.Within(white_balance_k, AtLeast(0), "white_balance_k", "0 (auto) or kelvin");
+  check.Within(buffers, AtLeast(2), "buffers", "2 or more");
+  check.Within(frame_timeout_ms, AtLeast(1), "frame_timeout_ms", "at least 1 ms");
   return check.ok();
 }
 

@@ -72,10 +72,10 @@ cv::Mat View(std::vector<uint8_t>& bytes, cv::Size size, int type) {
 
 bool ExtractorOptions::IsValid(std::string* why) const {
   OptionProblems check(why);
-  check(min_area >= 1, "min_area", "expected at least 1 pixel, got " + std::to_string(min_area));
-  check(margin_px >= 0, "margin_px", "must not be negative");
-  check(alpha_min >= 1 && alpha_min <= 255, "alpha_min", "must be within 1..255");
-  check(shadow_min >= 1 && shadow_min <= 255, "shadow_min", "must be within 1..255");
+  check.Within(min_area, AtLeast(1), "min_area", "at least 1 pixel");
+  check.Within(margin_px, AtLeast(0), "margin_px", "a number >= 0");
+  check.Within(alpha_min, Between(1, 255), "alpha_min", "a level 1..255");
+  check.Within(shadow_min, Between(1, 255), "shadow_min", "a level 1..255");
   std::string part;
   check.Nested(contact.IsValid(&part), "contact.", part);
   return check.ok();

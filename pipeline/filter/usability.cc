@@ -20,19 +20,15 @@ bool NonNegative(double v) { return std::isfinite(v) && v >= 0; }
 
 bool UsabilityOptions::IsValid(std::string* why) const {
   OptionProblems check(why);
-  check(border_margin_px >= 0, "border_margin_px",
-        "expected a number >= 0, got " + std::to_string(border_margin_px));
-  check(floor_margin_px >= 0, "floor_margin_px",
-        "expected a number >= 0, got " + std::to_string(floor_margin_px));
+  check.Within(border_margin_px, AtLeast(0), "border_margin_px", "a number >= 0");
+  check.Within(floor_margin_px, AtLeast(0), "floor_margin_px", "a number >= 0");
   for (const auto& [v, field] :
        {std::pair{wall_margin_m, "wall_margin_m"}, std::pair{wall_height_m, "wall_height_m"},
         std::pair{wall_check_height_m, "wall_check_height_m"}}) {
     check(NonNegative(v), field, "expected a number >= 0, got " + OptionProblems::Num(v));
   }
-  check(std::isfinite(max_view_angle_deg) && max_view_angle_deg > 0 && max_view_angle_deg <= 90,
-        "max_view_angle_deg",
-        "expected an angle in degrees above 0 and at most 90 (90: no view is too steep), got " +
-            OptionProblems::Num(max_view_angle_deg));
+  check.Within(max_view_angle_deg, AboveUpTo(0, 90), "max_view_angle_deg",
+               "an angle in degrees above 0 and at most 90 (90: no view is too steep)");
   check(
       std::isfinite(floor_view_angle_deg) && floor_view_angle_deg > 0 && floor_view_angle_deg <= 90,
       "floor_view_angle_deg",

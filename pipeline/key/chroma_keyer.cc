@@ -93,16 +93,16 @@ void AlphaSumRow(const uint8_t* __restrict in, int width, const float* __restric
 bool ChromaKeyerOptions::IsValid(std::string* why) const {
   const ChromaKeyerOptions& o = *this;
   OptionProblems check(why);
-  check(o.noise_z >= 0, "noise_z", "must not be negative");
-  check(o.min_margin >= 0 && o.min_margin < 1, "min_margin", "must be within [0, 1)");
-  check(o.ramp > 0 && o.ramp <= 2, "ramp", "must be within (0, 2]");
+  check.Within(o.noise_z, AtLeast(0), "noise_z", "a number >= 0");
+  check.Within(o.min_margin, FromUpTo(0, 1), "min_margin", "a fraction >= 0, < 1");
+  check.Within(o.ramp, AboveUpTo(0, 2), "ramp", "a number > 0, <= 2");
   std::string part;
   check.Nested(o.shadow.IsValid(&part), "shadow.", part);
   check.Nested(o.despill.IsValid(&part), "despill.", part);
-  check(o.coarse_alpha > 0 && o.coarse_alpha < 1, "coarse_alpha", "must be within (0, 1)");
-  check(o.coarse_shadow > 0 && o.coarse_shadow < 1, "coarse_shadow", "must be within (0, 1)");
-  check(o.min_key > 0, "min_key", "must be positive");
-  check(o.max_unkeyable >= 0 && o.max_unkeyable <= 1, "max_unkeyable", "must be within [0, 1]");
+  check.Within(o.coarse_alpha, Inside(0, 1), "coarse_alpha", "a fraction > 0, < 1");
+  check.Within(o.coarse_shadow, Inside(0, 1), "coarse_shadow", "a fraction > 0, < 1");
+  check.Within(o.min_key, Positive(), "min_key", "a number > 0");
+  check.Within(o.max_unkeyable, Between(0, 1), "max_unkeyable", "a fraction 0..1");
   check(o.key_low_levels < 0 || o.key_high_levels > o.key_low_levels, "key_high_levels",
         "must be above key_low_levels (" + OptionProblems::Num(o.key_low_levels) + ")");
   return check.ok();

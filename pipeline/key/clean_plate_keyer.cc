@@ -83,13 +83,13 @@ SS_PLATE_ROW(PlateRowRgb, true)
 bool CleanPlateKeyerOptions::IsValid(std::string* why) const {
   const CleanPlateKeyerOptions& o = *this;
   OptionProblems check(why);
-  check(o.low_sigma >= 0, "low_sigma", "must not be negative");
-  check(o.min_sigma > 0, "min_sigma", "must be positive");
-  check(o.ramp > 0, "ramp", "must be positive");
+  check.Within(o.low_sigma, AtLeast(0), "low_sigma", "a number >= 0");
+  check.Within(o.min_sigma, Positive(), "min_sigma", "a number > 0");
+  check.Within(o.ramp, Positive(), "ramp", "a number > 0");
   std::string part;
   check.Nested(o.shadow.IsValid(&part), "shadow.", part);
-  check(o.coarse_alpha > 0 && o.coarse_alpha < 1, "coarse_alpha", "must be within (0, 1)");
-  check(o.coarse_shadow > 0 && o.coarse_shadow < 1, "coarse_shadow", "must be within (0, 1)");
+  check.Within(o.coarse_alpha, Inside(0, 1), "coarse_alpha", "a fraction > 0, < 1");
+  check.Within(o.coarse_shadow, Inside(0, 1), "coarse_shadow", "a fraction > 0, < 1");
   check(o.high_sigma == 0 || o.high_sigma > o.low_sigma, "high_sigma",
         "must be 0 (ramp by levels) or above low_sigma (" + OptionProblems::Num(o.low_sigma) + ")");
   return check.ok();

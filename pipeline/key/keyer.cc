@@ -22,10 +22,9 @@ std::string SizeText(cv::Size s) {
 
 bool GridOptions::IsValid(std::string* why) const {
   OptionProblems check(why);
-  check(step >= 2 && step <= 64, "step", "expected 2 to 64 px, got " + std::to_string(step));
-  check(margin_px >= 0, "margin_px", "expected a number >= 0, got " + std::to_string(margin_px));
-  check(shadow_reach_cells >= 0, "shadow_reach_cells",
-        "expected a number >= 0, got " + std::to_string(shadow_reach_cells));
+  check.Within(step, Between(2, 64), "step", "2 to 64 px");
+  check.Within(margin_px, AtLeast(0), "margin_px", "a number >= 0");
+  check.Within(shadow_reach_cells, AtLeast(0), "shadow_reach_cells", "a number >= 0");
   return check.ok();
 }
 

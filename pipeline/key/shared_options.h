@@ -19,8 +19,8 @@ struct ShadowOptions {
   // "FIELD: reason" lines in `why` for values out of range (core/option_checks.h).
   bool IsValid(std::string* why) const {
     OptionProblems check(why);
-    check(min_darkening >= 0 && min_darkening < 1, "min_darkening", "must be within [0, 1)");
-    check(max_darkening > 0 && max_darkening <= 1, "max_darkening", "must be within (0, 1]");
+    check.Within(min_darkening, FromUpTo(0, 1), "min_darkening", "a fraction >= 0, < 1");
+    check.Within(max_darkening, AboveUpTo(0, 1), "max_darkening", "a fraction > 0, <= 1");
     check(!(min_darkening >= max_darkening), "max_darkening",
           "must be above min_darkening (" + OptionProblems::Num(min_darkening) + ")");
     return check.ok();
@@ -39,8 +39,8 @@ struct DespillOptions {
   // "FIELD: reason" lines in `why` for values out of range (core/option_checks.h).
   bool IsValid(std::string* why) const {
     OptionProblems check(why);
-    check(strength >= 0 && strength <= 1, "strength", "must be within [0, 1]");
-    check(bias >= 0 && bias <= 1, "bias", "must be within [0, 1]");
+    check.Within(strength, Between(0, 1), "strength", "a number 0..1");
+    check.Within(bias, Between(0, 1), "bias", "a number 0..1");
     return check.ok();
   }
   bool operator==(const DespillOptions&) const = default;

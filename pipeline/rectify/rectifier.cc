@@ -32,8 +32,7 @@ std::optional<Eigen::Vector3d> IntersectVerticalPlane(const CameraModel& camera,
 
 bool RectifierOptions::IsValid(std::string* why) const {
   OptionProblems check(why);
-  check(std::isfinite(px_per_m) && px_per_m > 0, "px_per_m",
-        "expected a positive number of pixels per metre, got " + OptionProblems::Num(px_per_m));
+  check.Within(px_per_m, Positive(), "px_per_m", "a positive number of pixels per metre");
   for (const auto& [v, field] :
        {std::pair{margin_m, "margin_m"}, std::pair{shadow_radius_m, "shadow_radius_m"},
         std::pair{floor_height_m, "floor_height_m"}}) {
@@ -41,8 +40,7 @@ bool RectifierOptions::IsValid(std::string* why) const {
           "expected a number of metres >= 0, got " + OptionProblems::Num(v));
   }
   // A billboard is at least 3 px on each side.
-  check(max_side_px >= 3, "max_side_px",
-        "expected at least 3 pixels, got " + std::to_string(max_side_px));
+  check.Within(max_side_px, AtLeast(3), "max_side_px", "at least 3 pixels");
   return check.ok();
 }
 

@@ -64,10 +64,8 @@ bool CameraPipelineOptions::IsValid(std::string* why) const {
   check.Nested(scaled.IsValid(&part), "rectify.", part);
   check.Nested(batch.IsValid(&part), "batch.", part);
   check.Nested(side_by_side.IsValid(&part), "side_by_side.", part);
-  check(workers >= 0, "workers",
-        "expected 0 (one per core) or more, got " + std::to_string(workers));
-  check(queue_frames >= 1, "queue_frames",
-        "expected at least 1 frame, got " + std::to_string(queue_frames));
+  check.Within(workers, AtLeast(0), "workers", "0 (one per core) or more");
+  check.Within(queue_frames, AtLeast(1), "queue_frames", "at least 1 frame");
   return check.ok();
 }
 

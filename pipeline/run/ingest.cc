@@ -96,8 +96,7 @@ bool IngestOptions::IsValid(std::string* why) const {
   OptionProblems check(why);
   std::string part;
   check.Nested(pipeline.IsValid(&part), "pipeline.", part);
-  check(decode_threads >= 0, "decode_threads",
-        "expected 0 (one per core) or more, got " + std::to_string(decode_threads));
+  check.Within(decode_threads, AtLeast(0), "decode_threads", "0 (one per core) or more");
   return check.ok();
 }
 

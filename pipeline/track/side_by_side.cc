@@ -23,8 +23,7 @@ bool SideBySideOptions::IsValid(std::string* why) const {
   share(min_part_height, "min_part_height");
   check(min_part_share <= 0.5, "min_part_share",
         "both sides cannot hold more than half, got " + OptionProblems::Num(min_part_share));
-  check(median_window >= 1, "median_window",
-        "expected at least 1 width, got " + std::to_string(median_window));
+  check.Within(median_window, AtLeast(1), "median_window", "at least 1 width");
   check(min_widths >= 1 && min_widths <= median_window, "min_widths",
         "expected 1 to median_window (" + std::to_string(median_window) + ") widths, got " +
             std::to_string(min_widths));

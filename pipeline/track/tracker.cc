@@ -15,14 +15,10 @@ namespace ss {
 
 bool TrackerOptions::IsValid(std::string* why) const {
   OptionProblems check(why);
-  check(std::isfinite(max_speed_m_per_s) && max_speed_m_per_s > 0, "max_speed_m_per_s",
-        "expected a positive number, got " + OptionProblems::Num(max_speed_m_per_s));
-  check(std::isfinite(reach_slack_m) && reach_slack_m >= 0, "reach_slack_m",
-        "expected a number >= 0, got " + OptionProblems::Num(reach_slack_m));
-  check(max_area_ratio >= 1, "max_area_ratio",
-        "expected a ratio >= 1, got " + OptionProblems::Num(max_area_ratio));
-  check(forget_after_ns >= 0, "forget_after_ns",
-        "expected a duration >= 0, got " + std::to_string(forget_after_ns));
+  check.Within(max_speed_m_per_s, Positive(), "max_speed_m_per_s", "a positive number");
+  check.Within(reach_slack_m, AtLeast(0), "reach_slack_m", "a number >= 0");
+  check.Within(max_area_ratio, AtLeast(1), "max_area_ratio", "a ratio >= 1");
+  check.Within(forget_after_ns, AtLeast(0), "forget_after_ns", "a duration >= 0");
   return check.ok();
 }
 

@@ -30,9 +30,8 @@ bool BankTrainOptions::IsValid(std::string* why) const {
   check(!std::isnan(positive_rate) && positive_rate <= 1, "positive_rate",
         "expected a share from 0 to 1 (< 0: the labels file's), got " +
             OptionProblems::Num(positive_rate));
-  check(calibration_rows >= 1, "calibration_rows",
-        "expected at least 1 sprite, got " + std::to_string(calibration_rows));
-  check(threads >= 1, "threads", "expected at least 1 thread, got " + std::to_string(threads));
+  check.Within(calibration_rows, AtLeast(1), "calibration_rows", "at least 1 sprite");
+  check.Within(threads, AtLeast(1), "threads", "at least 1 thread");
   check(variant == Stage2Variant::kPaper || variant == Stage2Variant::kColourCells, "variant",
         "only \"paper\" and \"colour_cells\" are trained (linf and colour_blob files are "
         "written by hand)");

@@ -143,9 +143,8 @@ bool BankUpdateOptions::IsValid(std::string* why) const {
   OptionProblems check(why);
   std::string part;
   check.Nested(weights.IsValid(&part), "weights.", part);
-  check(threads >= 1, "threads", "expected at least 1 thread, got " + std::to_string(threads));
-  check(table.max_per_sprite >= 0, "max_per_sprite",
-        "expected 0 (every transition) or more, got " + std::to_string(table.max_per_sprite));
+  check.Within(threads, AtLeast(1), "threads", "at least 1 thread");
+  check.Within(table.max_per_sprite, AtLeast(0), "max_per_sprite", "0 (every transition) or more");
   return check.ok();
 }
 

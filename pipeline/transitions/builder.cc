@@ -40,7 +40,7 @@ void KeepCheapestPerSprite(std::vector<Transition>* transitions, int keep) {
 
 bool BuildOptions::IsValid(std::string* why) const {
   OptionProblems check(why);
-  check(threads >= 1, "threads", "expected at least 1 thread, got " + std::to_string(threads));
+  check.Within(threads, AtLeast(1), "threads", "at least 1 thread");
   return check.ok();
 }
 

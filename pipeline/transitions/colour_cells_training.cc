@@ -151,8 +151,8 @@ ColourCellsFit Choose(GridCounts positives, int64_t positive_count, GridCounts p
 
 bool ColourCellsFitOptions::IsValid(std::string* why) const {
   OptionProblems check(why);
-  check(rows >= 1, "rows", "expected at least 1 sprite, got " + std::to_string(rows));
-  check(threads >= 1, "threads", "expected at least 1 thread, got " + std::to_string(threads));
+  check.Within(rows, AtLeast(1), "rows", "at least 1 sprite");
+  check.Within(threads, AtLeast(1), "threads", "at least 1 thread");
   check(std::isfinite(f1_tolerance) && f1_tolerance >= 0 && f1_tolerance <= 1, "f1_tolerance",
         "expected a number from 0 to 1, got " + OptionProblems::Num(f1_tolerance));
   return check.ok();

@@ -15,12 +15,10 @@ namespace ss {
 
 bool ComparisonWindow::IsValid(std::string* why) const {
   OptionProblems check(why);
-  check(std::isfinite(width_m) && width_m > 0, "width_m",
-        "expected a positive number of metres, got " + OptionProblems::Num(width_m));
-  check(std::isfinite(height_m) && height_m > 0, "height_m",
-        "expected a positive number of metres, got " + OptionProblems::Num(height_m));
-  check(cells_x >= 1, "cells_x", "expected at least 1 cell, got " + std::to_string(cells_x));
-  check(cells_y >= 1, "cells_y", "expected at least 1 cell, got " + std::to_string(cells_y));
+  check.Within(width_m, Positive(), "width_m", "a positive number of metres");
+  check.Within(height_m, Positive(), "height_m", "a positive number of metres");
+  check.Within(cells_x, AtLeast(1), "cells_x", "at least 1 cell");
+  check.Within(cells_y, AtLeast(1), "cells_y", "at least 1 cell");
   // A plane holds at most 4096 cells; the product is reported under cells_y.
   const int64_t cells = int64_t{cells_x} * cells_y;
   check(cells_x < 1 || cells_y < 1 || cells <= 4096, "cells_y",

@@ -369,21 +369,18 @@ double PoseSpeed(const std::string& pose) {
 
 bool SyntheticSpriteOptions::IsValid(std::string* why) const {
   OptionProblems check(why);
-  check(frames >= 0, "frames", "expected a number >= 0, got " + std::to_string(frames));
+  check.Within(frames, AtLeast(0), "frames", "a number >= 0");
   for (const auto& [v, field] : {std::pair{px_per_m, "px_per_m"}, std::pair{fps, "fps"}}) {
     check(std::isfinite(v) && v > 0, field,
           "expected a positive number, got " + OptionProblems::Num(v));
   }
   // A clip of 0 frames would never end the clip loop.
-  check(min_clip_frames >= 1, "min_clip_frames",
-        "expected at least 1 frame, got " + std::to_string(min_clip_frames));
+  check.Within(min_clip_frames, AtLeast(1), "min_clip_frames", "at least 1 frame");
   check(max_clip_frames >= min_clip_frames, "max_clip_frames",
         "expected at least min_clip_frames (" + std::to_string(min_clip_frames) + "), got " +
             std::to_string(max_clip_frames));
-  check(std::isfinite(velocity_noise_mps) && velocity_noise_mps >= 0, "velocity_noise_mps",
-        "expected a number >= 0, got " + OptionProblems::Num(velocity_noise_mps));
-  check(pixel_noise >= 0 && pixel_noise <= 255, "pixel_noise",
-        "expected 0 to 255 levels, got " + std::to_string(pixel_noise));
+  check.Within(velocity_noise_mps, AtLeast(0), "velocity_noise_mps", "a number >= 0");
+  check.Within(pixel_noise, Between(0, 255), "pixel_noise", "0 to 255 levels");
   return check.ok();
 }
 

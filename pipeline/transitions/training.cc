@@ -174,10 +174,8 @@ bool LogisticOptions::IsValid(std::string* why) const {
   OptionProblems check(why);
   check(std::isfinite(l2) && l2 >= 0, "l2",
         "expected a number >= 0, got " + OptionProblems::Num(l2));
-  check(max_iterations >= 1, "max_iterations",
-        "expected at least 1, got " + std::to_string(max_iterations));
-  check(std::isfinite(tolerance) && tolerance >= 0, "tolerance",
-        "expected a number >= 0, got " + OptionProblems::Num(tolerance));
+  check.Within(max_iterations, AtLeast(1), "max_iterations", "at least 1");
+  check.Within(tolerance, AtLeast(0), "tolerance", "a number >= 0");
   return check.ok();
 }
 
@@ -311,7 +309,7 @@ void Count(Confusion* c, bool predicted, bool truth) {
 
 bool TrainOptions::IsValid(std::string* why) const {
   OptionProblems check(why);
-  check(folds >= 2, "folds", "expected at least 2 folds, got " + std::to_string(folds));
+  check.Within(folds, AtLeast(2), "folds", "at least 2 folds");
   std::string part;
   check.Nested(logistic.IsValid(&part), "logistic.", part);
   return check.ok();

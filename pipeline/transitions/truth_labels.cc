@@ -90,12 +90,9 @@ bool TruthLabelOptions::IsValid(std::string* why) const {
     check(std::isfinite(v) && v >= 0, field,
           "expected a number >= 0, got " + OptionProblems::Num(v));
   }
-  check(std::isfinite(near_miss_fraction) && near_miss_fraction >= 0 && near_miss_fraction <= 1,
-        "near_miss_fraction",
-        "expected a share from 0 to 1, got " + OptionProblems::Num(near_miss_fraction));
+  check.Within(near_miss_fraction, Between(0, 1), "near_miss_fraction", "a share from 0 to 1");
   // Below 1 a near miss would have to be nearer than an accept.
-  check(std::isfinite(near_miss_factor) && near_miss_factor >= 1, "near_miss_factor",
-        "expected a factor >= 1, got " + OptionProblems::Num(near_miss_factor));
+  check.Within(near_miss_factor, AtLeast(1), "near_miss_factor", "a factor >= 1");
   return check.ok();
 }
 

@@ -31,12 +31,9 @@ bool UnitWorkerOptions::IsValid(std::string* why) const {
   OptionProblems check(why);
   std::string part;
   check.Nested(weights.IsValid(&part), "weights.", part);
-  check(std::isfinite(lease_s) && lease_s > 0, "lease_s",
-        "expected a positive number of seconds, got " + OptionProblems::Num(lease_s));
-  check(load_threads >= 1, "load_threads",
-        "expected at least 1 thread, got " + std::to_string(load_threads));
-  check(table.max_per_sprite >= 0, "max_per_sprite",
-        "expected 0 (every transition) or more, got " + std::to_string(table.max_per_sprite));
+  check.Within(lease_s, Positive(), "lease_s", "a positive number of seconds");
+  check.Within(load_threads, AtLeast(1), "load_threads", "at least 1 thread");
+  check.Within(table.max_per_sprite, AtLeast(0), "max_per_sprite", "0 (every transition) or more");
   return check.ok();
 }
 

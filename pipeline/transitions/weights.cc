@@ -108,14 +108,14 @@ bool TransitionWeights::IsValid(std::string* why) const {
   if (stage2_variant == Stage2Variant::kLinf) {
     check(positive(linf_max_velocity_mps), "stage2.linf.max_velocity_mps",
           "expected a positive number, got " + OptionProblems::Num(linf_max_velocity_mps));
-    check(linf_max_alpha > 0 && linf_max_alpha <= 1, "stage2.linf.max_alpha_linf",
-          "expected a number in (0, 1], got " + OptionProblems::Num(linf_max_alpha));
+    check.Within(linf_max_alpha, AboveUpTo(0, 1), "stage2.linf.max_alpha_linf",
+                 "a number in (0, 1]");
   }
   if (stage2_variant == Stage2Variant::kColourBlob) {
     check(positive(colour_blob_max_velocity_mps), "stage2.colour_blob.max_velocity_mps",
           "expected a positive number, got " + OptionProblems::Num(colour_blob_max_velocity_mps));
-    check(colour_blob_max_cells >= 0, "stage2.colour_blob.max_blob_cells",
-          "expected a number >= 0, got " + std::to_string(colour_blob_max_cells));
+    check.Within(colour_blob_max_cells, AtLeast(0), "stage2.colour_blob.max_blob_cells",
+                 "a number >= 0");
   }
   if (stage2_variant == Stage2Variant::kColourCells) {
     check(positive(colour_cells_max_velocity_mps), "stage2.colour_cells.max_velocity_mps",
@@ -125,8 +125,8 @@ bool TransitionWeights::IsValid(std::string* why) const {
           "stage2.colour_cells.max_alpha_cells",
           "expected a number from 0 to 1e12, got " +
               OptionProblems::Num(colour_cells_max_alpha_cells));
-    check(colour_cells_max_cells >= 0, "stage2.colour_cells.max_colour_cells",
-          "expected a number >= 0, got " + std::to_string(colour_cells_max_cells));
+    check.Within(colour_cells_max_cells, AtLeast(0), "stage2.colour_cells.max_colour_cells",
+                 "a number >= 0");
   }
   return check.ok();
 }

@@ -197,7 +197,7 @@ TEST(AnimateOptions, SkeletonImportNamesEveryField) {
   EXPECT_EQ(Problems(o),
             "min_confidence: must be within [0, 1] (or unset: the mapping's or the format's), "
             "got 1.5\n"
-            "person: must be an index >= 0, got -1\n"
+            "person: expected an index >= 0, got -1\n"
             "category_id: must be a category id >= 0 (or -1: the first with keypoints), got -2");
   o = {};
   o.min_confidence = 0;
@@ -212,7 +212,7 @@ TEST(AnimateOptions, SkeletonImportNamesEveryField) {
            [&] { ImportCocoKeypoints("/nonexistent.json", mapping, o); },
            [&] { ImportSynthTruth("/nonexistent", "", mapping, o); }}) {
     EXPECT_EQ(InputErrorOf(import),
-              "skeleton import options: person: must be an index >= 0, got -1");
+              "skeleton import options: person: expected an index >= 0, got -1");
   }
 }
 
@@ -227,7 +227,7 @@ TEST(AnimateOptions, GestureScriptNamesEveryField) {
   EXPECT_EQ(Problems(o),
             "transition_frames: expected frames >= 0, got -1\n"
             "speed: expected a positive factor, got 0\n"
-            "noise_px: must be pixels >= 0, got -1\n"
+            "noise_px: expected pixels >= 0, got -1\n"
             "scale_px: expected a positive number of pixels per body unit, got 0\n"
             "x_px: must be a finite pixel position, got nan\n"
             "y_px: must be a finite pixel position, got inf");

@@ -407,7 +407,7 @@ TEST(StationConfig, KeyerOptionsNameTheirBadFields) {
   EXPECT_FALSE(o.IsValid(&why));
   EXPECT_EQ(why,
             "shadow.max_darkening: must be above min_darkening (0.06)\n"
-            "despill.strength: must be within [0, 1]");
+            "despill.strength: expected a number 0..1, got 2");
   EXPECT_THROW(ChromaKeyer{o}, InputError);
   CleanPlateKeyerOptions p;
   p.high_sigma = 3;  // at or below low_sigma (4): neither 0 nor a ramp
@@ -421,10 +421,12 @@ TEST(StationConfig, KeyerOptionsNameTheirBadFields) {
 // the rule (min_darkening within [0, 1), where the config once allowed 1), reported at its key.
 TEST(StationConfig, ShadowValuesAreCheckedByTheKeyersRuleAtTheirKey) {
   EXPECT_EQ(ErrorOf("keying:\n  shadow: {min_darkening: 1, max_darkening: 1}\n"),
-            "station.yaml:2: keying.shadow.min_darkening: must be within [0, 1)\n"
+            "station.yaml:2: keying.shadow.min_darkening: expected a fraction >= 0, < 1, got 1\n"
             "station.yaml:2: keying.shadow.max_darkening: must be above min_darkening (1)");
-  EXPECT_EQ(ErrorOf("keying:\n  shadow:\n    max_darkening: 0\n"),
-            "station.yaml:3: keying.shadow.max_darkening: must be within (0, 1]");  // first only
+  EXPECT_EQ(
+      ErrorOf("keying:\n  shadow:\n    max_darkening: 0\n"),
+      "station.yaml:3: keying.shadow.max_darkening: expected a fraction > 0, <= 1, got 0");  // first
+                                                                                             // only
 }
 
 // The stages' own rules (their options' IsValid), each error naming the config key, all of them.
