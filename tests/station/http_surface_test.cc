@@ -230,7 +230,16 @@ void ExpectNoFileOutsideThePages(int port, bool with_token_header) {
   const std::string auth =
       with_token_header ? std::string("Authorization: Bearer ") + kToken + "\r\n" : "";
   for (const std::string& path : paths) {
-    const Answer a = Exchange(port, Get(path, auth));
+    Answer a = Exchange(port, Get(path, auth));
+    // A 503 is a connection limit (14 open at once with 16 threads): on a loaded machine (CI's
+    // sanitizer run) the server's niced threads had not yet seen this loop's closed connections
+    // end. A client waits and asks again, as its Retry-After says; the path is still judged by
+    // a real answer, and a count that never comes down (a leak) still fails.
+    for (int again = 0; a.status == 503 && again < 100; ++again) {
+      EXPECT_EQ(ErrorOf(a).rfind("connections: ", 0), 0u) << path << ": " << a.body;
+      std::this_thread::sleep_for(std::chrono::milliseconds(100));
+      a = Exchange(port, Get(path, auth));
+    }
     ASSERT_NE(a.status, -1) << path << ": no answer";
     EXPECT_EQ(a.body.find("SECRET-9f1c2e"), std::string::npos) << path;
     EXPECT_EQ(a.body.find("root:x:0:0"), std::string::npos) << path;
