@@ -98,8 +98,7 @@ class SpriteConstraint {
 };
 
 struct SpriteConstraintKind {
-  std::string key;       // its key in an item of `constraints:`
-  std::string expected;  // its block in words, for errors and docs: "{x_max_m, strength}"
+  std::string key;  // its key in an item of `constraints:`
   // Reads its block at `path` (a mistake reported through `reader`, never thrown).
   std::function<std::shared_ptr<const SpriteConstraint>(
       SpecBlockReader& reader, const YAML::Node& node, const std::string& path)>

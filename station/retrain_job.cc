@@ -247,28 +247,25 @@ void RetrainJob::Run(std::shared_ptr<Shared> shared, const RetrainRequest& reque
   const api::Context& context = shared->context;
   SetThisThreadNice(kNiceBackground);  // below capture and the console (core/posix.h)
   auto log = Log("station.labels");
-  auto SetRetrain = [&](const std::function<void(RetrainState&)>& change) {
+  // Changes the state and tells it. `ends`: the job's last change, which also makes it no longer
+  // cancellable and no longer running, under the same lock, so whoever is told "cancelled" or
+  // "done" can start the next retrain at once.
+  auto SetRetrain = [&](const std::function<void(RetrainState&)>& change, bool ends = false) {
     RetrainState now;
     {
       std::lock_guard lock(shared->mutex);
       change(shared->state);
+      if (ends) {
+        shared->state.cancellable = false;
+        shared->running = false;
+      }
       now = shared->state;
     }
+    if (ends) shared->changed.notify_all();
     if (shared->on_change) shared->on_change(now);
   };
-  // Ends the job: its last state, no longer cancellable and no longer running, is one change,
-  // so whoever is told "cancelled" or "done" can start the next retrain at once.
-  auto Finish = [&](const std::function<void(RetrainState&)>& change) {
-    RetrainState end;
-    {
-      std::lock_guard lock(shared->mutex);
-      change(shared->state);
-      shared->state.cancellable = false;
-      shared->running = false;
-      end = shared->state;
-    }
-    shared->changed.notify_all();
-    if (shared->on_change) shared->on_change(end);
+  const auto Finish = [&](const std::function<void(RetrainState&)>& change) {
+    SetRetrain(change, true);
   };
   // Enters the part of the work that uses the station host: false when the server stops.
   auto enter_host = [&] {

@@ -40,8 +40,7 @@ void RegisterKeyer(KeyerKind kind);
 template <typename K, typename Options>
 void RegisterKeyerType(std::string method, std::string doc,
                        Options (*options_from)(const KeyingConfig&),
-                       std::function<void(OptionsBinder&, KeyingConfig&)> keys = {},
-                       std::function<bool(const KeyingConfig&, std::string*)> check = {}) {
+                       decltype(KeyerKind::keys) keys = {}, decltype(KeyerKind::check) check = {}) {
   RegisterKeyer({std::move(method), std::move(doc),
                  [options_from](const KeyingConfig& keying, int shadow_reach_cells) {
                    Options options = options_from(keying);

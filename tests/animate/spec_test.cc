@@ -266,15 +266,14 @@ struct HoldSpec : SpriteConstraint {
 
 TEST_F(SpecTest, AConstraintRegisteredApartIsReadAndBuiltForItsSprite) {
   SpriteConstraintKind hold{
-      "hold", "{strength}",
-      TermBlockReader<HoldSpec>(
-          [](OptionsBinder& keys, HoldSpec& h) {
-            keys.Add("strength", &h.strength, "a number >= 0", "per step").Rule(AtLeast(0));
-          },
-          {"strength"})};
+      "hold", TermBlockReader<HoldSpec>(
+                  [](OptionsBinder& keys, HoldSpec& h) {
+                    keys.Add("strength", &h.strength, "a number >= 0", "per step").Rule(AtLeast(0));
+                  },
+                  {"strength"})};
   RegisterSpriteConstraint(hold);
   EXPECT_THROW(RegisterSpriteConstraint(hold), WorkError);
-  EXPECT_THROW(RegisterSpriteConstraint({"path", "{}", hold.read}), WorkError) << "a typed one";
+  EXPECT_THROW(RegisterSpriteConstraint({"path", hold.read}), WorkError) << "a typed one";
   const std::string item = "      - frames: {sprites: [3, 4], from: 2, to: 3}\n";
   const AnimationSpec spec =
       ParseAnimationSpec(Edit(item, item + "      - hold: {strength: 2}\n"), Origin());
