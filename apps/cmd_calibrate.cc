@@ -24,6 +24,7 @@
 #include "calib/wizard_run.h"
 #include "calib/workflow.h"
 #include "capture/camera_source.h"
+#include "capture/replay/replay_source.h"
 #include "config/station_config.h"
 #include "config/station_save.h"
 #include "core/camera_model.h"
@@ -339,9 +340,8 @@ void AddWizard(CLI::App& parent) {
                                      [&](const auto& c) { return c.name == camera.name; });
       if (!known)
         throw InputError("--camera", "no camera named \"" + camera.name + "\" in " + o->session);
-      camera.source = "replay";
-      camera.session = fs::absolute(o->session).string();
-      camera.realtime = false;
+      camera = ReplayCameraConfig(
+          camera.name, {.session = fs::absolute(o->session).string(), .realtime = false});
     } else {
       if (o->camera.empty()) throw InputError("--camera", "needed with --config");
       const StationConfig config = LoadStationConfig(o->config);

@@ -29,6 +29,7 @@
 #include <nlohmann/json.hpp>
 
 #include "bench/bench_registry.h"
+#include "capture/replay/replay_source.h"
 #include "core/log.h"
 #include "pipeline/transitions/transition_jumps.h"  // Quantile
 #include "station/control_server.h"
@@ -164,13 +165,8 @@ void Polls(benchmark::State& state, bool attack) {
   for (auto _ : state) {
     StationOptions options;
     StationConfig& config = options.config;
-    CameraConfig cam;
-    cam.name = "cam0";
-    cam.source = "replay";
-    cam.session = session;
-    cam.loop = true;
-    cam.realtime = true;
-    config.cameras.push_back(cam);
+    config.cameras.push_back(
+        ReplayCameraConfig("cam0", {.session = session, .loop = true, .realtime = true}));
     config.storage.bank = (work / "station.bank").string();
     config.storage.recording_dir = (work / "recordings").string();
     config.storage.stop_recording_below_mib = 0;

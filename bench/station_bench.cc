@@ -270,12 +270,8 @@ void Live(benchmark::State& state, bool from_memory, int preview_streams, bool a
     StationOptions options;
     StationConfig& config = options.config;
     for (int c = 0; c < g_args.cameras; ++c) {
-      CameraConfig cam;
-      cam.name = "cam" + std::to_string(c);
-      cam.source = "replay";
-      cam.session = session;
-      cam.loop = true;
-      cam.realtime = true;
+      CameraConfig cam = ReplayCameraConfig("cam" + std::to_string(c),
+                                            {.session = session, .loop = true, .realtime = true});
       cam.fps = g_args.fps;
       config.cameras.push_back(cam);
     }

@@ -4,8 +4,9 @@
 // Each backend lives in its own folder with one file that defines
 // `void RegisterNAMECameraBackend()` (calling RegisterCameraBackend), and one
 // line in capture/CMakeLists.txt (spritestation_camera_backend) builds it in and
-// calls it; nothing else in the project names a backend. A backend also owns its
-// keys of a station camera's config block: it binds them and checks their values.
+// calls it; nothing else in the project names a backend (replay aside: the station's test
+// mode). A backend also owns its keys of a station camera's config block: a struct of its
+// own, held in CameraConfig::backend, whose fields it binds and whose values it checks.
 #include <functional>
 #include <memory>
 #include <optional>
@@ -25,6 +26,13 @@ struct FoundCamera {
   std::string model, driver, address, serial;
 };
 
+// A file a camera's config names that must exist (checked when the config checks files).
+struct CameraFile {
+  std::string key;   // the camera's key that names it
+  std::string file;  // the file itself (a folder's key may name a file in it)
+  std::string what;  // what it is, for the message: "recorded session (session.json)"
+};
+
 struct CameraBackend {
   std::string name;  // the config's `source`: "v4l2", "aravis", ...
   std::string description;
@@ -35,12 +43,19 @@ struct CameraBackend {
   // The devices present now; unset for a backend that has none to list (replay).
   std::function<std::vector<FoundCamera>()> list;
   // Binds the camera keys of its own (beyond name, source, model and the device settings) to
-  // their fields of `camera` (core/options_binder.h); the config reads them for its cameras.
+  // the fields of its struct in `camera.backend` (`Use<T>()`; core/options_binder.h); the
+  // config reads them for its cameras.
   std::function<void(OptionsBinder& keys, CameraConfig& camera)> keys;
   // Its rules on a camera's values beyond their types: one "KEY: reason" line per problem in
   // `why` (core/option_checks.h), KEY the config's. It may fill a key whose default is another
   // key's value (replay's session_camera). Unset: no rules.
   std::function<bool(CameraConfig& camera, std::string* why)> check;
+  // The files a camera's values name that must exist; unset: none.
+  std::function<std::vector<CameraFile>(const CameraConfig& camera)> files;
+  // The camera model file its device brings, for a camera whose config names none (replay: the
+  // session camera's); "" when it brings none. InputError naming the file it cannot read. Unset:
+  // none.
+  std::function<std::string(const CameraConfig& camera)> model_file;
   // Takes the device settings, which the config binds for it (pixel_format, width, height, fps,
   // exposure_us, gain_db, white_balance; SetLiveOptions): every backend of a device, not replay.
   bool device_settings = true;

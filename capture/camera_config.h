@@ -1,10 +1,13 @@
 #pragma once
 // A station camera's block of the config (`cameras[]`, docs/config.md): what a camera backend
 // (capture/camera_backend.h) opens a device from. The station config (config/station_config.h)
-// reads it; capture owns it, as the backends are what it configures.
+// reads it; capture owns it, as the backends are what it configures. What every backend of a
+// device takes is a field here; a backend's own keys are a struct of its own, in its folder,
+// held in `backend` (the keys it binds, CameraBackend::keys).
 #include <optional>
 #include <string>
 
+#include "core/any_block.h"
 #include "core/enum_text.h"
 
 namespace ss {
@@ -32,20 +35,12 @@ struct WhiteBalanceConfig {
 };
 
 struct CameraConfig {
-  std::string name;            // unique; the stem of its recorded files
-  std::string source;          // "replay" | "v4l2" | "aravis" | "libcamera"
-  std::string session;         // replay: session folder (absolute)
-  std::string session_camera;  // replay: camera within the session (default: name)
-  bool loop = false;           // replay: start over at the end
-  bool realtime = true;        // replay: paced by the device timestamps
-  std::string device;          // v4l2: "/dev/video0"
-  std::string camera_id;       // aravis / libcamera: the device id
-  std::string address;         // aravis: IP address of a GigE Vision camera
-  bool packet_resend = true;   // aravis
-  int packet_size = 0;         // aravis: GigE packet size in bytes, 0 = negotiate
-  std::string pixel_format;    // core/frame.h names ("yuyv", "bayer_rg8"...); "" = device default
-  int width = 0, height = 0;   // 0 = device default
-  double fps = 0;              // 0 = device default
+  std::string name;           // unique; the stem of its recorded files
+  std::string source;         // the backend's name: "replay" | "v4l2" | "aravis" | "libcamera"
+  AnyBlock backend;           // the keys of its own the source's backend binds (its struct)
+  std::string pixel_format;   // core/frame.h names ("yuyv", "bayer_rg8"...); "" = device default
+  int width = 0, height = 0;  // 0 = device default
+  double fps = 0;             // 0 = device default
   std::optional<double> exposure_us;  // unset = keep the device's current value, locked
   std::optional<double> gain_db;      // unset = keep the device's current value, locked
   WhiteBalanceConfig white_balance;

@@ -1,21 +1,9 @@
 #include "capture/camera_source.h"
 
-#include <filesystem>
-
 #include "capture/camera_backend.h"
 #include "core/error.h"
-#include "core/session.h"
 
 namespace ss {
-namespace {
-
-namespace fs = std::filesystem;
-
-std::string SessionCameraName(const CameraConfig& camera) {
-  return camera.session_camera.empty() ? camera.name : camera.session_camera;
-}
-
-}  // namespace
 
 std::unique_ptr<FrameSource> OpenCameraSource(const CameraConfig& camera, int camera_index) {
   const CameraBackend* backend = FindCameraBackend(camera.source);
@@ -31,16 +19,11 @@ std::unique_ptr<FrameSource> OpenCameraSource(const CameraConfig& camera, int ca
 
 std::optional<CameraModel> ModelForCamera(const CameraConfig& camera) {
   if (!camera.model.empty()) return CameraModel::Read(camera.model);
-  if (camera.source != "replay") return std::nullopt;
-  const SessionInfo info = ReadSessionInfo(camera.session);
-  for (const SessionCamera& c : info.cameras) {
-    if (c.name != SessionCameraName(camera)) continue;
-    if (c.model.empty()) return std::nullopt;
-    return CameraModel::Read((fs::path(camera.session) / c.model).string());
-  }
-  throw InputError(camera.session + "/session.json", "the session has no camera '" +
-                                                         SessionCameraName(camera) + "' (cameras." +
-                                                         camera.name + ")");
+  const CameraBackend* backend = FindCameraBackend(camera.source);
+  if (backend == nullptr || !backend->model_file) return std::nullopt;
+  const std::string file = backend->model_file(camera);
+  if (file.empty()) return std::nullopt;
+  return CameraModel::Read(file);
 }
 
 }  // namespace ss

@@ -16,7 +16,8 @@ namespace ss {
 // the backend refuses or cannot express.
 std::unique_ptr<FrameSource> OpenCameraSource(const CameraConfig& camera, int camera_index);
 
-// The camera's model: the config's `model`, else (replay) the session camera's.
+// The camera's model: the config's `model`, else the one its device brings (the backend's
+// model_file: a replayed session camera's).
 // nullopt for an uncalibrated live camera. InputError naming the file when it
 // cannot be read.
 std::optional<CameraModel> ModelForCamera(const CameraConfig& camera);

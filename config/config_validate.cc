@@ -88,8 +88,9 @@ class Validator {
     Enum(c.source, CameraBackendNames(), Child(path, "source"));
     if (std::string why; backend != nullptr && backend->check)
       Rules(backend->check(c, &why), why, path);
-    Exists(c.session.empty() ? "" : (fs::path(c.session) / "session.json").string(),
-           Child(path, "session"), "recorded session (session.json)");
+    if (backend != nullptr && backend->files) {
+      for (const CameraFile& f : backend->files(c)) Exists(f.file, Child(path, f.key), f.what);
+    }
     if (!c.pixel_format.empty()) {
       Check(ParsePixelFormat(c.pixel_format).has_value(), Child(path, "pixel_format"),
             "expected one of mono8, bayer_rg8, bayer_gr8, bayer_gb8, bayer_bg8, rgb8, bgr8, yuyv, "

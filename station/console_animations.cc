@@ -9,6 +9,7 @@
 #include <set>
 #include <string>
 
+#include "capture/camera_backend.h"
 #include "config/station_config.h"
 #include "core/bank.h"
 #include "core/error.h"
@@ -31,15 +32,20 @@ namespace {
 
 bool IsSqliteBank(const std::string& bank) { return bank.rfind("postgresql://", 0) != 0; }
 
-// The camera's model file: its own, or a replayed session's; "" when it has none.
+// The camera's model file: its own, or the one its device brings (a replayed session's); ""
+// when it has none.
 std::string ModelOf(const CameraConfig& camera) {
   if (!camera.model.empty()) return camera.model;
-  if (camera.source != "replay" || camera.session.empty()) return "";
-  const fs::path model =
-      fs::path(camera.session) /
-      ((camera.session_camera.empty() ? camera.name : camera.session_camera) + ".cameramodel");
+  const CameraBackend* backend = FindCameraBackend(camera.source);
+  if (backend == nullptr || !backend->model_file) return "";
+  std::string model;
+  try {
+    model = backend->model_file(camera);
+  } catch (const InputError&) {
+    return "";  // an unreadable session: no model, as for a live camera without one
+  }
   std::error_code ec;
-  return fs::exists(model, ec) ? model.string() : "";
+  return !model.empty() && fs::exists(model, ec) ? model : "";
 }
 
 // The file `path` as the response, with its type by extension.

@@ -2,6 +2,7 @@
 // taps are in station_sessions.cc, previews in station_previews.cc, the bank writer in
 // bank_writer_thread.cc, the disk guard in disk_guard.cc (shared state: station_impl.h).
 #include "station/station.h"
+#include "capture/replay/replay_source.h"
 
 #include <algorithm>
 #include <atomic>
@@ -52,9 +53,10 @@ void ApplyLogging(const LoggingConfig& logging) {
 GroundPolygon StationFloor(const StationConfig& config) {
   if (!config.enclosure.floor.empty()) return config.enclosure.floor;
   for (const CameraConfig& c : config.cameras) {
-    if (c.source != "replay") continue;
+    const auto* replay = c.backend.Find<ReplayCameraKeys>();
+    if (replay == nullptr) continue;
     try {
-      return FloorForSession(c.session, GroundPolygon());
+      return FloorForSession(replay->session, GroundPolygon());
     } catch (const InputError&) {
       // that session has none: the next replay's, or none
     }

@@ -5,6 +5,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "capture/replay/replay_source.h"
 #include "core/error.h"
 #include "core/error_kinds.h"
 #include "core/log.h"
@@ -77,14 +78,8 @@ StationConfig ReplayStationConfig(const StationConfig& live, const SessionInfo& 
   StationConfig c = live;
   c.cameras.clear();
   for (const SessionCamera& sc : session.cameras) {
-    CameraConfig cam;
-    cam.name = sc.name;
-    cam.source = "replay";
-    cam.session = dir;
-    cam.session_camera = sc.name;
-    cam.loop = loop;
-    cam.realtime = paced;
-    c.cameras.push_back(std::move(cam));
+    c.cameras.push_back(ReplayCameraConfig(
+        sc.name, {.session = dir, .session_camera = sc.name, .loop = loop, .realtime = paced}));
   }
   // The session's own floor when it has one (read as ingest reads it), else the config's.
   try {

@@ -47,6 +47,15 @@ struct AravisOptions {
   bool IsValid(std::string* why) const;
 };
 
+// A station camera's keys of `source: aravis` (CameraConfig::backend).
+struct AravisCameraKeys {
+  std::string camera_id;      // the device id; or
+  std::string address;        // a GigE Vision camera's IP address
+  bool packet_resend = true;  // AravisOptions's
+  int packet_size = 0;        // AravisOptions's
+  bool operator==(const AravisCameraKeys&) const = default;
+};
+
 // The stream's own counters (Aravis's ArvStream infos).
 struct AravisStreamStats {
   uint64_t completed = 0;       // buffers filled completely

@@ -19,7 +19,7 @@ void RegisterLibcameraCameraBackend() {
          return out;
        },
        [](OptionsBinder& keys, CameraConfig& camera) {
-         keys.Add("camera_id", &camera.camera_id, "a string",
+         keys.Add("camera_id", &camera.backend.Use<LibcameraCameraKeys>().camera_id, "a string",
                   "the camera's id, as `spritestation cameras` lists it; empty: the first camera");
        },
        nullptr});

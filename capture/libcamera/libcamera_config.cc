@@ -9,7 +9,7 @@ namespace ss {
 LibcameraOptions LibcameraOptionsFromConfig(const CameraConfig& camera, int camera_index) {
   const std::string field = "cameras." + camera.name + ".";
   LibcameraOptions o;
-  o.camera_id = camera.camera_id;
+  o.camera_id = camera.backend.Get<LibcameraCameraKeys>().camera_id;
   o.name = camera.name;
   o.camera_index = camera_index;
   if (!camera.pixel_format.empty()) {

@@ -5,6 +5,12 @@
 
 namespace ss {
 
+// A station camera's keys of `source: libcamera` (CameraConfig::backend).
+struct LibcameraCameraKeys {
+  std::string camera_id;  // as `spritestation cameras` lists it; "" = the first camera
+  bool operator==(const LibcameraCameraKeys&) const = default;
+};
+
 // camera_id, pixel_format, width/height, fps, exposure_us, gain_db (as the
 // linear AnalogueGain 10^(dB/20)) and white_balance (device / once / manual
 // with red_gain, blue_gain as ColourGains). InputError naming the field for an

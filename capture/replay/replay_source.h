@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "capture/camera_config.h"
 #include "capture/frame_source.h"
 #include "core/session.h"
 
@@ -36,6 +37,19 @@ struct ReplayOptions {
   // False with "FIELD: reason" lines in `why` (core/option_checks.h) for values out of range.
   bool IsValid(std::string* why) const;
 };
+
+// A station camera's keys of `source: replay` (CameraConfig::backend): a recorded session's camera
+// in place of a device, in test mode.
+struct ReplayCameraKeys {
+  std::string session;         // the session folder (absolute)
+  std::string session_camera;  // the camera within the session; "" = the station camera's name
+  bool loop = false;           // start over at the end
+  bool realtime = true;        // paced by the device timestamps
+  bool operator==(const ReplayCameraKeys&) const = default;
+};
+
+// A station camera `name` of source replay with those keys (capture/replay/replay_backend.cc).
+CameraConfig ReplayCameraConfig(std::string name, ReplayCameraKeys keys);
 
 // What one camera's replay came to so far.
 struct ReplayCameraStats {

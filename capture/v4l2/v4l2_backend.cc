@@ -12,7 +12,7 @@ void RegisterV4l2CameraBackend() {
       {"v4l2", "V4L2 webcams and capture cards",
        [](const CameraConfig& camera, int camera_index) -> std::unique_ptr<FrameSource> {
          V4l2Options options;
-         options.device = camera.device;
+         options.device = camera.backend.Get<V4l2CameraKeys>().device;
          SetLiveOptions(camera, camera_index, options);
          if (camera.gain_db) options.gain = static_cast<int>(std::lround(*camera.gain_db));
          const WhiteBalanceConfig& wb = camera.white_balance;
@@ -28,12 +28,13 @@ void RegisterV4l2CameraBackend() {
          return out;
        },
        [](OptionsBinder& keys, CameraConfig& camera) {
-         keys.Add("device", &camera.device, "a string", "the device node, e.g. `/dev/video0`")
+         keys.Add("device", &camera.backend.Use<V4l2CameraKeys>().device, "a string",
+                  "the device node, e.g. `/dev/video0`")
              .Default("required");
        },
        [](CameraConfig& camera, std::string* why) {
          OptionProblems check(why);
-         check(!camera.device.empty(), "device",
+         check(!camera.backend.Get<V4l2CameraKeys>().device.empty(), "device",
                "a v4l2 camera needs its device, e.g. /dev/video0");
          // V4L2 fixes white balance as a colour temperature (V4L2_CID_WHITE_BALANCE_TEMPERATURE).
          check(camera.white_balance.mode != WhiteBalanceMode::kManual ||

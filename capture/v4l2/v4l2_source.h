@@ -34,6 +34,12 @@ struct V4l2Options {
   bool IsValid(std::string* why) const;
 };
 
+// A station camera's keys of `source: v4l2` (CameraConfig::backend).
+struct V4l2CameraKeys {
+  std::string device;  // the device node, "/dev/video0"
+  bool operator==(const V4l2CameraKeys&) const = default;
+};
+
 // A capture device found under /dev.
 struct V4l2DeviceInfo {
   std::string path;                  // "/dev/video0"

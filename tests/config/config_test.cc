@@ -14,7 +14,10 @@
 
 #include <cmath>
 
+#include "capture/aravis/aravis_source.h"
 #include "capture/camera_backend.h"
+#include "capture/replay/replay_source.h"
+#include "capture/v4l2/v4l2_source.h"
 #include "core/bank_schema.h"
 #include "core/error.h"
 #include "core/option_checks.h"
@@ -88,15 +91,13 @@ TEST(StationConfig, ExampleParsesIntoEveryField) {
   const CameraConfig& replay = cfg.cameras[0];
   EXPECT_EQ(replay.name, "cam0");
   EXPECT_EQ(replay.source, "replay");
-  EXPECT_EQ(replay.session, dir + "/recordings/sample");
-  EXPECT_EQ(replay.session_camera, "cam0");
-  EXPECT_TRUE(replay.loop);
-  EXPECT_TRUE(replay.realtime);
+  EXPECT_EQ(replay.backend.Get<ReplayCameraKeys>(),
+            (ReplayCameraKeys{dir + "/recordings/sample", "cam0", true, true}));
   EXPECT_EQ(replay.model, "");
 
   const CameraConfig& v4l2 = cfg.cameras[1];
   EXPECT_EQ(v4l2.source, "v4l2");
-  EXPECT_EQ(v4l2.device, "/dev/video0");
+  EXPECT_EQ(v4l2.backend.Get<V4l2CameraKeys>().device, "/dev/video0");
   EXPECT_EQ(v4l2.pixel_format, "yuyv");
   EXPECT_EQ(v4l2.width, 1280);
   EXPECT_EQ(v4l2.height, 720);
@@ -108,9 +109,8 @@ TEST(StationConfig, ExampleParsesIntoEveryField) {
 
   const CameraConfig& gige = cfg.cameras[2];
   EXPECT_EQ(gige.source, "aravis");
-  EXPECT_EQ(gige.address, "192.168.10.21");
-  EXPECT_TRUE(gige.packet_resend);
-  EXPECT_EQ(gige.packet_size, 8192);
+  EXPECT_EQ(gige.backend.Get<AravisCameraKeys>(),
+            (AravisCameraKeys{"", "192.168.10.21", true, 8192}));
   EXPECT_EQ(gige.pixel_format, "bayer_rg8");
   EXPECT_EQ(gige.fps, 60);
   EXPECT_EQ(gige.exposure_us, 4000);
@@ -174,7 +174,7 @@ TEST(StationConfig, DefaultsAreFilled) {
   CameraConfig cam;
   cam.name = "cam0";
   cam.source = "v4l2";
-  cam.device = "/dev/video0";
+  cam.backend.Use<V4l2CameraKeys>().device = "/dev/video0";
   expected.cameras = {cam};
   expected.storage.bank = "/studio/station.bank";
   expected.storage.recording_dir = "/studio/recordings";
@@ -194,10 +194,8 @@ TEST(StationConfig, PxPerMIsAutoOrANumber) {
 TEST(StationConfig, ReplayCameraDefaultsToItsOwnNameInTheSession) {
   const StationConfig cfg =
       Parse("cameras:\n  - {name: left, source: replay, session: /data/s1}\n");
-  EXPECT_EQ(cfg.cameras[0].session, "/data/s1");
-  EXPECT_EQ(cfg.cameras[0].session_camera, "left");
-  EXPECT_TRUE(cfg.cameras[0].realtime);
-  EXPECT_FALSE(cfg.cameras[0].loop);
+  EXPECT_EQ(cfg.cameras[0].backend.Get<ReplayCameraKeys>(),
+            (ReplayCameraKeys{"/data/s1", "left", false, true}));
 }
 
 TEST(StationConfig, WrongTypeNamesFieldAndLine) {
@@ -625,7 +623,7 @@ TEST(StationConfig, FilesAreCheckedWhenAsked) {
   std::ofstream(dir / "s1/session.json") << "{}";
   std::ofstream(dir / "cam0.cameramodel") << "{}";
   const StationConfig cfg = LoadStationConfig(dir / "station.yaml");
-  EXPECT_EQ(cfg.cameras[0].session, dir / "s1");
+  EXPECT_EQ(cfg.cameras[0].backend.Get<ReplayCameraKeys>().session, dir / "s1");
   EXPECT_EQ(cfg.cameras[0].model, dir / "cam0.cameramodel");
 }
 
@@ -720,7 +718,7 @@ TEST(StationConfig, BoundsAreTheKeysOwnWhereverTheValuesComeFrom) {
   CameraConfig cam;
   cam.name = "c";
   cam.source = "v4l2";
-  cam.device = "/dev/video0";
+  cam.backend.Use<V4l2CameraKeys>().device = "/dev/video0";
   cam.fps = -1;
   cam.gain_db = -2;
   cam.white_balance.red_gain = 0;
@@ -785,24 +783,42 @@ TEST(OptionsBinder, ANumbersRuleIsCheckedAtItsKeyOnceAndOnlyOnNumbers) {
   EXPECT_EQ(Between(0, 65535).Text(), "0..65535");
 }
 
+// The keys of the test's backend: a struct of its own, which capture/camera_config.h does not
+// name.
+struct TestcamKeys {
+  std::string device;
+  int lanes = 1;
+  bool operator==(const TestcamKeys&) const = default;
+};
+
 // Registers a backend of its own, as a backend's file does, and reads configs naming it; the
 // number of answers that were not as wanted (each printed).
 int ReadConfigsOfARegisteredBackend() {
-  RegisterCameraBackend({"testcam", "a backend of this test", nullptr, nullptr,
-                         [](OptionsBinder& keys, CameraConfig& camera) {
-                           keys.Add("device", &camera.device, "a string", "the test device");
-                         },
-                         [](CameraConfig& camera, std::string* why) {
-                           OptionProblems check(why);
-                           check(camera.device.rfind("/dev/", 0) == 0, "device",
-                                 "expected a /dev path, got " + camera.device);
-                           return check.ok();
-                         },
-                         false});
+  RegisterCameraBackend(
+      {"testcam", "a backend of this test", nullptr, nullptr,
+       [](OptionsBinder& keys, CameraConfig& camera) {
+         auto& own = camera.backend.Use<TestcamKeys>();
+         keys.Add("device", &own.device, "a string", "the test device")
+             .Add("lanes", &own.lanes, "a lane count from 1 to 4", "the test's lanes")
+             .Rule(Between(1, 4));
+       },
+       [](CameraConfig& camera, std::string* why) {
+         const auto& own = camera.backend.Get<TestcamKeys>();
+         OptionProblems check(why);
+         check(own.device.rfind("/dev/", 0) == 0, "device",
+               "expected a /dev path, got " + own.device);
+         return check.ok();
+       },
+       [](const CameraConfig& camera) -> std::vector<CameraFile> {
+         return {{"device", camera.backend.Get<TestcamKeys>().device, "test device"}};
+       },
+       nullptr, false});
   const std::string head = "cameras:\n  - name: t\n    source: testcam\n";
   const std::vector<std::pair<std::string, std::string>> errors = {
       {head + "    device: /dev/x\n", ""},
       {head + "    device: x\n", "station.yaml:4: cameras[0].device: expected a /dev path, got x"},
+      {head + "    device: /dev/x\n    lanes: 5\n",
+       "station.yaml:5: cameras[0].lanes: expected a lane count from 1 to 4, got 5"},
       {head + "    device: /dev/x\n    fps: 30\n",
        "station.yaml:5: cameras[0].fps: only for source aravis or libcamera or v4l2 (this "
        "camera's source is testcam)"},
@@ -817,7 +833,20 @@ int ReadConfigsOfARegisteredBackend() {
                  error.c_str());
     ++failed;
   }
-  if (Parse(head + "    device: /dev/x\n").cameras.at(0).device != "/dev/x") ++failed;
+  // The files it names are checked when the config checks files.
+  const std::string missing = ErrorOf(head + "    device: /dev/no-such-testcam\n", ConfigOptions{});
+  if (missing != "station.yaml:4: cameras[0].device: /dev/no-such-testcam: no such test device") {
+    std::fprintf(stderr, "for a missing device got \"%s\"\n", missing.c_str());
+    ++failed;
+  }
+  // The block is the camera's: read, copied and compared with it.
+  const StationConfig read = Parse(head + "    device: /dev/x\n    lanes: 3\n");
+  const CameraConfig camera = read.cameras.at(0);
+  if (camera.backend.Get<TestcamKeys>() != TestcamKeys{"/dev/x", 3}) ++failed;
+  if (!(camera == read.cameras.at(0))) ++failed;
+  CameraConfig other = camera;
+  other.backend.Use<TestcamKeys>().lanes = 2;
+  if (other == camera || read.cameras.at(0).backend.Get<TestcamKeys>().lanes != 3) ++failed;
   return failed;
 }
 

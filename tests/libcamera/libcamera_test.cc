@@ -262,7 +262,7 @@ TEST(Libcamera, TheStationOpensLibcameraCamerasByTheirConfig) {
   CameraConfig camera;
   camera.name = "pi";
   camera.source = "libcamera";
-  camera.camera_id = "absent-camera-7";
+  camera.backend.Use<LibcameraCameraKeys>().camera_id = "absent-camera-7";
   try {
     OpenCameraSource(camera, 0);
     FAIL() << "opened an absent camera";

@@ -13,6 +13,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "capture/replay/replay_source.h"
 #include "core/bank.h"
 #include "core/error_kinds.h"
 #include "core/session.h"
@@ -248,9 +249,8 @@ TEST(Console, ReplayFoldersListSessionsAndMakeAReplayConfig) {
   const StationConfig replay = ReplayStationConfig(live, info, sessions[0].path, false, true);
   ASSERT_EQ(replay.cameras.size(), 2u);
   EXPECT_EQ(replay.cameras[1].source, "replay");
-  EXPECT_EQ(replay.cameras[1].session_camera, "cam1");
-  EXPECT_FALSE(replay.cameras[1].realtime);
-  EXPECT_TRUE(replay.cameras[1].loop);
+  EXPECT_EQ(replay.cameras[1].backend.Get<ReplayCameraKeys>(),
+            (ReplayCameraKeys{sessions[0].path, "cam1", true, false}));
   EXPECT_EQ(replay.storage.bank, live.storage.bank);
   EXPECT_FALSE(replay.enclosure.floor.empty()) << "no floor in the session: the config's is kept";
 }

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <thread>
 
+#include "capture/replay/replay_source.h"
 #include "station/station.h"
 #include "station/station_status.h"
 #include "synth/studio_session.h"
@@ -37,13 +38,8 @@ inline StationOptions OneReplayCamera(const ScratchDir& dir) {
   so.write_mattes = false;
   synth::RenderStudioSession(so);
   StationOptions options;
-  CameraConfig cam;
-  cam.name = "cam0";
-  cam.source = "replay";
-  cam.session = so.out_dir;
-  cam.loop = true;
-  cam.realtime = true;
-  options.config.cameras = {cam};
+  options.config.cameras = {
+      ReplayCameraConfig("cam0", {.session = so.out_dir, .loop = true, .realtime = true})};
   options.config.storage.bank = dir / "station.bank";
   options.config.storage.recording_dir = dir / "recordings";
   options.config.storage.stop_recording_below_mib = 0;

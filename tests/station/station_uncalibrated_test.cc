@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include "capture/replay/replay_source.h"
 #include "core/bank.h"
 #include "station/station.h"
 #include "station/station_status.h"
@@ -25,7 +26,7 @@ TEST(StationUncalibrated, WithoutAFloorTheStationStreamsAndStoresNoSprite) {
   StationOptions options = OneReplayCamera(dir);
   options.config.logging.level = "warn";
   // The session brings the floor its cameras saw (truth/floor.json): take it away.
-  const fs::path session = options.config.cameras[0].session;
+  const fs::path session = options.config.cameras[0].backend.Get<ReplayCameraKeys>().session;
   ASSERT_TRUE(fs::remove(session / "truth" / "floor.json"));
   ASSERT_TRUE(StationFloor(options.config).empty());
   const std::vector<std::string> gaps = CalibrationGaps(options.config);
