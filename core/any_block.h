@@ -5,6 +5,7 @@
 // type T is default-constructible and has operator==.
 #include <memory>
 #include <typeinfo>
+#include <utility>
 
 namespace ss {
 
@@ -19,6 +20,14 @@ class AnyBlock {
   AnyBlock(AnyBlock&&) noexcept = default;
   AnyBlock& operator=(AnyBlock&&) noexcept = default;
   ~AnyBlock() = default;
+  // A block holding `value`.
+  template <typename T>
+  static AnyBlock Of(T value) {
+    AnyBlock block;
+    block.Use<T>() = std::move(value);
+    return block;
+  }
+  [[nodiscard]] bool empty() const { return held_ == nullptr; }
 
   // The T held, made first (default values) when it holds none or one of another type. The
   // reference stays valid until the block is assigned or another type is used.

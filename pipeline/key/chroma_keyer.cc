@@ -409,7 +409,10 @@ void ChromaKeyer::FineRow(const uint8_t* row, ChannelOrder order, int y, int x0,
 }
 
 ChromaKeyerOptions ChromaKeyerOptionsFrom(const KeyingConfig& k) {
-  ChromaKeyerOptions o = k.chroma;
+  const auto& block = k.Block<ChromaKeyBlock>("chroma");
+  ChromaKeyerOptions o;
+  o.key_low_levels = block.low;
+  o.key_high_levels = block.high;
   o.shadow = k.shadow;
   o.despill = k.despill;
   return o;
@@ -417,26 +420,29 @@ ChromaKeyerOptions ChromaKeyerOptionsFrom(const KeyingConfig& k) {
 
 void RegisterChromaKeyer() {
   // keying.chroma.*: the key difference in 8-bit levels where alpha starts to fall, and where it
-  // reaches 0 (KeyingConfig::chroma's defaults are the config's, 20 and 60).
+  // reaches 0 (ChromaKeyBlock's defaults are the config's, 20 and 60).
   const auto keys = [](OptionsBinder& b, KeyingConfig& k) {
-    b.Add("chroma.low", &k.chroma.key_low_levels, "a level from 0 to 255",
+    auto& block = k.Block<ChromaKeyBlock>("chroma");
+    b.Add("chroma.low", &block.low, "a level from 0 to 255",
           "key difference (green minus the larger of red and blue, in 8-bit levels, after "
           "learning the screen) at which alpha starts to fall from 1")
         .Rule(Between(0, 255))
-        .Add("chroma.high", &k.chroma.key_high_levels, "a level from 0 to 255",
+        .Add("chroma.high", &block.high, "a level from 0 to 255",
              "... and at which the pixel is pure background (alpha 0); must be above `low`")
         .Rule(Between(0, 255));
   };
   // The config's range; the keyer itself also takes < 0 (off: min_margin and ramp instead).
   const auto check = [](const KeyingConfig& k, std::string* why) {
+    const auto& block = k.Block<ChromaKeyBlock>("chroma");
     OptionProblems problem(why);
-    problem(!(k.chroma.key_low_levels >= k.chroma.key_high_levels), "chroma.high",
-            "must be above low (" + OptionProblems::Num(k.chroma.key_low_levels) + "), got " +
-                OptionProblems::Num(k.chroma.key_high_levels));
+    problem(!(block.low >= block.high), "chroma.high",
+            "must be above low (" + OptionProblems::Num(block.low) + "), got " +
+                OptionProblems::Num(block.high));
     return problem.ok();
   };
   RegisterKeyerType<ChromaKeyer>("chroma", "colour-difference keying for green screens",
-                                 ChromaKeyerOptionsFrom, keys, check);
+                                 ChromaKeyerOptionsFrom, AnyBlock::Of(ChromaKeyBlock{}), keys,
+                                 check);
 }
 
 }  // namespace ss

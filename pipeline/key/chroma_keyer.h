@@ -44,8 +44,18 @@ struct ChromaKeyerOptions {
   bool operator==(const ChromaKeyerOptions&) const = default;
 };
 
+// The chroma keyer's block of the station config's keying section, keying.chroma.* (a
+// KeyingConfig keyer block): the key difference in 8-bit levels where alpha starts to fall, and
+// where it reaches 0; the config's defaults (ChromaKeyerOptions's own, -1, key by min_margin and
+// ramp).
+struct ChromaKeyBlock {
+  double low = 20;
+  double high = 60;
+  bool operator==(const ChromaKeyBlock&) const = default;
+};
+
 // The options the station config's keying section sets (docs/keying.md, "From the station
-// config"): its `chroma` block (keying.chroma.* bound to its fields) with the shared blocks
+// config"): its `chroma` block as key_low_levels and key_high_levels, with the shared blocks
 // keying.despill and keying.shadow as they are.
 ChromaKeyerOptions ChromaKeyerOptionsFrom(const KeyingConfig& keying);
 

@@ -189,34 +189,39 @@ void CleanPlateKeyer::FineRow(const uint8_t* row, ChannelOrder order, int y, int
 }
 
 CleanPlateKeyerOptions CleanPlateKeyerOptionsFrom(const KeyingConfig& k) {
-  CleanPlateKeyerOptions o = k.clean_plate;
+  const auto& block = k.Block<CleanPlateKeyBlock>("clean_plate");
+  CleanPlateKeyerOptions o;
+  o.low_sigma = block.low_sigma;
+  o.high_sigma = block.high_sigma;
   o.shadow = k.shadow;
   return o;
 }
 
 void RegisterCleanPlateKeyer() {
-  // keying.clean_plate.*: the ramp in noise sigmas (KeyingConfig::clean_plate's defaults are the
+  // keying.clean_plate.*: the ramp in noise sigmas (CleanPlateKeyBlock's defaults are the
   // config's, 3 and 6).
   const auto keys = [](OptionsBinder& b, KeyingConfig& k) {
-    b.Add("clean_plate.low_sigma", &k.clean_plate.low_sigma, "a number of noise sigmas >= 0",
+    auto& block = k.Block<CleanPlateKeyBlock>("clean_plate");
+    b.Add("clean_plate.low_sigma", &block.low_sigma, "a number of noise sigmas >= 0",
           "difference from the plate, in multiples of the pixel's noise sigma, at which alpha "
           "starts to rise from 0")
         .Rule(AtLeast(0))
-        .Add("clean_plate.high_sigma", &k.clean_plate.high_sigma, "a number of noise sigmas >= 0",
+        .Add("clean_plate.high_sigma", &block.high_sigma, "a number of noise sigmas >= 0",
              "... and at which the pixel is pure subject (alpha 1); must be above `low_sigma`")
         .Rule(AtLeast(0));
   };
   const auto check = [](const KeyingConfig& k, std::string* why) {
+    const auto& block = k.Block<CleanPlateKeyBlock>("clean_plate");
     OptionProblems problem(why);
-    problem(!(k.clean_plate.low_sigma >= k.clean_plate.high_sigma), "clean_plate.high_sigma",
-            "must be above low_sigma (" + OptionProblems::Num(k.clean_plate.low_sigma) + "), got " +
-                OptionProblems::Num(k.clean_plate.high_sigma));
+    problem(!(block.low_sigma >= block.high_sigma), "clean_plate.high_sigma",
+            "must be above low_sigma (" + OptionProblems::Num(block.low_sigma) + "), got " +
+                OptionProblems::Num(block.high_sigma));
     return problem.ok();
   };
   RegisterKeyerType<CleanPlateKeyer>(
       "clean_plate",
       "difference against a learned empty-enclosure plate, for backgrounds that are not green",
-      CleanPlateKeyerOptionsFrom, keys, check);
+      CleanPlateKeyerOptionsFrom, AnyBlock::Of(CleanPlateKeyBlock{}), keys, check);
 }
 
 }  // namespace ss

@@ -35,9 +35,18 @@ struct CleanPlateKeyerOptions {
   bool operator==(const CleanPlateKeyerOptions&) const = default;
 };
 
+// The clean-plate keyer's block of the station config's keying section, keying.clean_plate.* (a
+// KeyingConfig keyer block): the ramp in noise sigmas, the config's defaults (the keyer's own,
+// 4 and 0, ramp by levels).
+struct CleanPlateKeyBlock {
+  double low_sigma = 3;
+  double high_sigma = 6;
+  bool operator==(const CleanPlateKeyBlock&) const = default;
+};
+
 // The options the station config's keying section sets (docs/keying.md, "From the station
-// config"): its `clean_plate` block (keying.clean_plate.* bound to its fields) with the shared
-// block keying.shadow as it is.
+// config"): its `clean_plate` block as low_sigma and high_sigma, with the shared block
+// keying.shadow as it is.
 CleanPlateKeyerOptions CleanPlateKeyerOptionsFrom(const KeyingConfig& keying);
 
 class CleanPlateKeyer : public Keyer {

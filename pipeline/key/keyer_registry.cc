@@ -35,6 +35,13 @@ std::unique_ptr<Keyer> MakeKeyer(const KeyingConfig& keying, int shadow_reach_ce
 
 std::vector<const KeyerKind*> KeyerKinds() { return Keyers().All(); }
 
+std::map<std::string, AnyBlock> KeyerBlockDefaults() {
+  std::map<std::string, AnyBlock> blocks;
+  for (const KeyerKind* kind : KeyerKinds())
+    if (!kind->block.empty()) blocks.emplace(kind->method, kind->block);
+  return blocks;
+}
+
 std::vector<std::string> KeyerMethods() { return Keyers().Names(); }
 
 }  // namespace ss

@@ -23,8 +23,13 @@ struct KeyerKind {
   // one); `shadow_reach_cells` > 0 replaces its grid's (keying.shadow.reach_m at the camera's
   // scale). InputError naming the config field for a value the keyer refuses.
   std::function<std::unique_ptr<Keyer>(const KeyingConfig& keying, int shadow_reach_cells)> make;
-  // Binds the keys of its own block, relative to the section ("chroma.low"), to their fields of
-  // `keying` with their bounds as rules (core/options_binder.h). Unset: no keys of its own.
+  // Its own block of the section (keying.METHOD.*) with the config's defaults: a struct of the
+  // keyer's (AnyBlock::Of), which every KeyingConfig holds by method (KeyingConfig::Block).
+  // Empty: no block of its own.
+  AnyBlock block;
+  // Binds the keys of its own block, relative to the section ("chroma.low"), to the fields of
+  // `keying.Block<T>(METHOD)` with their bounds as rules (core/options_binder.h). Unset: no keys
+  // of its own.
   std::function<void(OptionsBinder& keys, KeyingConfig& keying)> keys;
   // Its block's rules beyond a key's bounds (low below high): one "KEY: reason" line per problem
   // in `why` (core/option_checks.h), KEY as bound above. Not asked while one of its keys is
@@ -35,11 +40,11 @@ struct KeyerKind {
 // Called by each keyer's registration function; a second keyer for one method is an error.
 void RegisterKeyer(KeyerKind kind);
 // Registers keyer type `K` for `method`, made from `options_from(keying)` (its block of the
-// config's keying section) with the shadow reach applied to its grid; `keys` and `check` as in
-// KeyerKind.
+// config's keying section and the shared ones) with the shadow reach applied to its grid;
+// `block`, `keys` and `check` as in KeyerKind.
 template <typename K, typename Options>
 void RegisterKeyerType(std::string method, std::string doc,
-                       Options (*options_from)(const KeyingConfig&),
+                       Options (*options_from)(const KeyingConfig&), AnyBlock block = {},
                        decltype(KeyerKind::keys) keys = {}, decltype(KeyerKind::check) check = {}) {
   RegisterKeyer({std::move(method), std::move(doc),
                  [options_from](const KeyingConfig& keying, int shadow_reach_cells) {
@@ -47,7 +52,7 @@ void RegisterKeyerType(std::string method, std::string doc,
                    if (shadow_reach_cells > 0) options.grid.shadow_reach_cells = shadow_reach_cells;
                    return std::unique_ptr<Keyer>(std::make_unique<K>(options));
                  },
-                 std::move(keys), std::move(check)});
+                 std::move(block), std::move(keys), std::move(check)});
 }
 // Every keyer built in, by method.
 std::vector<const KeyerKind*> KeyerKinds();

@@ -23,6 +23,8 @@
 #include "core/option_checks.h"
 #include "core/options_binder.h"
 #include "core/sql.h"
+#include "pipeline/key/chroma_keyer.h"
+#include "pipeline/key/clean_plate_keyer.h"
 #include "tests/support/test_support.h"
 
 namespace ss {
@@ -121,10 +123,9 @@ TEST(StationConfig, ExampleParsesIntoEveryField) {
 
   EXPECT_EQ(cfg.pipeline.keying->method, "chroma");
   EXPECT_EQ(cfg.pipeline.keying->training_frames, 30);
-  EXPECT_EQ(cfg.pipeline.keying->chroma.key_low_levels, 20);
-  EXPECT_EQ(cfg.pipeline.keying->chroma.key_high_levels, 60);
-  EXPECT_EQ(cfg.pipeline.keying->clean_plate.low_sigma, 3);
-  EXPECT_EQ(cfg.pipeline.keying->clean_plate.high_sigma, 6);
+  EXPECT_EQ(cfg.pipeline.keying->Block<ChromaKeyBlock>("chroma"), (ChromaKeyBlock{20, 60}));
+  EXPECT_EQ(cfg.pipeline.keying->Block<CleanPlateKeyBlock>("clean_plate"),
+            (CleanPlateKeyBlock{3, 6}));
   EXPECT_TRUE(cfg.pipeline.keying->despill.enabled);
   EXPECT_EQ(cfg.pipeline.keying->despill.strength, 1.0);
   EXPECT_TRUE(cfg.pipeline.keying->shadow.enabled);
@@ -375,14 +376,14 @@ TEST(StationConfig, PipelineSectionsAreTheStagesOptionsWithTheConfigsDefaults) {
   EXPECT_EQ(set.pipeline.rectify.px_per_m, 600);
 }
 
-// keying.chroma.* and keying.clean_plate.* are the keyers' own options (KeyingConfig::chroma,
-// ::clean_plate); the shared despill and shadow blocks are copied in whole when a keyer is made.
+// keying.chroma.* and keying.clean_plate.* are the keyers' own blocks (ChromaKeyBlock,
+// CleanPlateKeyBlock, held by KeyingConfig::keyers); the shared despill and shadow blocks are
+// copied in whole when a keyer is made.
 TEST(StationConfig, KeyerBlocksAreTheKeyersOptions) {
   const StationConfig cfg = Parse(
       "keying:\n  chroma: {low: 10, high: 50}\n  clean_plate: {low_sigma: 2, high_sigma: 9}\n"
       "  shadow: {max_darkening: 0.6}\n  despill: {strength: 0.25}\n");
-  EXPECT_EQ(cfg.pipeline.keying->chroma.key_low_levels, 10);
-  EXPECT_EQ(cfg.pipeline.keying->chroma.key_high_levels, 50);
+  EXPECT_EQ(cfg.pipeline.keying->Block<ChromaKeyBlock>("chroma"), (ChromaKeyBlock{10, 50}));
   const ChromaKeyerOptions o = ChromaKeyerOptionsFrom(*cfg.pipeline.keying);
   EXPECT_EQ(o.key_low_levels, 10);
   EXPECT_EQ(o.key_high_levels, 50);
@@ -724,7 +725,7 @@ TEST(StationConfig, BoundsAreTheKeysOwnWhereverTheValuesComeFrom) {
   cam.white_balance.red_gain = 0;
   cfg.cameras.push_back(cam);
   cfg.pipeline.keying.emplace();
-  cfg.pipeline.keying->chroma.key_low_levels = 300;
+  cfg.pipeline.keying->Block<ChromaKeyBlock>("chroma").low = 300;
   cfg.storage.spool_max_mib = 0;
   cfg.control.port = 70000;
   const ConfigReport report = ValidateStationConfig(cfg, "code", {}, NoFileChecks());

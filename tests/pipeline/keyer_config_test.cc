@@ -10,6 +10,8 @@
 #include "core/error.h"
 #include "core/option_checks.h"
 #include "core/options_binder.h"
+#include "pipeline/key/chroma_keyer.h"
+#include "pipeline/key/clean_plate_keyer.h"
 #include "pipeline/key/keyer_registry.h"
 #include "pipeline/run/camera_pipeline.h"
 #include "tests/pipeline/key_scene.h"
@@ -120,8 +122,7 @@ TEST_F(KeyerConfig, ChromaThresholdsFollowTheConfig) {
   ASSERT_GT(defaults.alpha_sum, 0);
   // A key threshold far below the green's own (~105 levels): the soft, greenish edge falls to
   // background (about 2.5% of the subject's alpha).
-  config.pipeline.keying->chroma.key_low_levels = 0;
-  config.pipeline.keying->chroma.key_high_levels = 15;
+  config.pipeline.keying->Block<ChromaKeyBlock>("chroma") = {0, 15};
   const Keyed tight = Key(config);
   EXPECT_LT(tight.alpha_sum, 0.99 * defaults.alpha_sum);
   EXPECT_GT(tight.alpha_sum, 0.9 * defaults.alpha_sum);
@@ -133,8 +134,7 @@ TEST_F(KeyerConfig, CleanPlateThresholdsFollowTheConfig) {
   const Keyed defaults = Key(config, /*green=*/false);
   ASSERT_GT(defaults.alpha_sum, 0);
   // A wider tolerance and ramp (in noise sigmas) key less of the frame as subject.
-  config.pipeline.keying->clean_plate.low_sigma = 12;
-  config.pipeline.keying->clean_plate.high_sigma = 40;
+  config.pipeline.keying->Block<CleanPlateKeyBlock>("clean_plate") = {12, 40};
   const Keyed loose = Key(config, false);
   EXPECT_LT(loose.alpha_sum, 0.97 * defaults.alpha_sum);
 }
@@ -148,20 +148,36 @@ struct TwinKeyer : ChromaKeyer {
   std::string name() const override { return "twin"; }
 };
 
+// The twin's own block: a struct of its own, which pipeline/key/keying_config.h does not name.
+struct TwinBlock {
+  double low = 20, high = 60;
+  bool operator==(const TwinBlock&) const = default;
+};
+
+ChromaKeyerOptions TwinOptionsFrom(const KeyingConfig& k) {
+  ChromaKeyerOptions o = ChromaKeyerOptionsFrom(k);
+  o.key_low_levels = k.Block<TwinBlock>("twin").low;
+  o.key_high_levels = k.Block<TwinBlock>("twin").high;
+  return o;
+}
+
 TEST_F(KeyerConfig, AKeyerRegisteredApartIsChosenByTheConfig) {
   const auto keys = [](OptionsBinder& b, KeyingConfig& k) {
-    b.Add("twin.low", &k.chroma.key_low_levels, "a level from 0 to 255", "where alpha falls")
+    auto& block = k.Block<TwinBlock>("twin");
+    b.Add("twin.low", &block.low, "a level from 0 to 255", "where alpha falls")
         .Rule(Between(0, 255))
-        .Add("twin.high", &k.chroma.key_high_levels, "a level from 0 to 255", "where it is 0")
+        .Add("twin.high", &block.high, "a level from 0 to 255", "where it is 0")
         .Rule(Between(0, 255));
   };
   const auto check = [](const KeyingConfig& k, std::string* why) {
     OptionProblems problem(why);
-    problem(k.chroma.key_low_levels < k.chroma.key_high_levels, "twin.high", "must be above low");
+    problem(k.Block<TwinBlock>("twin").low < k.Block<TwinBlock>("twin").high, "twin.high",
+            "must be above low");
     return problem.ok();
   };
   RegisterKeyerType<TwinKeyer>("twin", "the chroma keyer again, under another name",
-                               ChromaKeyerOptionsFrom, keys, check);
+                               TwinOptionsFrom, AnyBlock::Of(TwinBlock{}), keys, check);
+  EXPECT_EQ(KeyingConfig{}.Block<TwinBlock>("twin"), TwinBlock{});  // every config holds it
   EXPECT_THROW(RegisterKeyerType<TwinKeyer>("twin", "again", ChromaKeyerOptionsFrom), WorkError);
   const std::string camera =
       "cameras:\n  - name: cam0\n    source: v4l2\n    device: /dev/video0\n";
@@ -177,8 +193,10 @@ TEST_F(KeyerConfig, AKeyerRegisteredApartIsChosenByTheConfig) {
   // Its own keys: read into its block, documented, their bounds and its rule named at the key.
   const StationConfig tight = ParseStationConfig(
       camera + "keying:\n  method: twin\n  twin: {low: 0, high: 15}\n", "station.yaml", "/tmp");
-  EXPECT_EQ(tight.pipeline.keying->chroma.key_low_levels, 0);
-  EXPECT_EQ(tight.pipeline.keying->chroma.key_high_levels, 15);
+  EXPECT_EQ(tight.pipeline.keying->Block<TwinBlock>("twin"), (TwinBlock{0, 15}));
+  EXPECT_EQ(tight.pipeline.keying->Block<ChromaKeyBlock>("chroma"), ChromaKeyBlock{})
+      << "the chroma keyer's block is its own";
+  EXPECT_FALSE(*tight.pipeline.keying == *config.pipeline.keying) << "compared by its block";
   EXPECT_LT(Key(tight).alpha_sum, 0.99 * twin.alpha_sum) << "its keys reach the keyer";
   EXPECT_NE(ConfigKeysMarkdown().find("| `twin.low` | number 0..255 | `20` | where alpha falls |"),
             std::string::npos)
