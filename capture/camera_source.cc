@@ -17,11 +17,14 @@ std::unique_ptr<FrameSource> OpenCameraSource(const CameraConfig& camera, int ca
   return backend->open(camera, camera_index);
 }
 
-std::optional<CameraModel> ModelForCamera(const CameraConfig& camera) {
-  if (!camera.model.empty()) return CameraModel::Read(camera.model);
+std::string ModelFileForCamera(const CameraConfig& camera) {
+  if (!camera.model.empty()) return camera.model;
   const CameraBackend* backend = FindCameraBackend(camera.source);
-  if (backend == nullptr || !backend->model_file) return std::nullopt;
-  const std::string file = backend->model_file(camera);
+  return backend != nullptr && backend->model_file ? backend->model_file(camera) : "";
+}
+
+std::optional<CameraModel> ModelForCamera(const CameraConfig& camera) {
+  const std::string file = ModelFileForCamera(camera);
   if (file.empty()) return std::nullopt;
   return CameraModel::Read(file);
 }

@@ -16,10 +16,13 @@ namespace ss {
 // the backend refuses or cannot express.
 std::unique_ptr<FrameSource> OpenCameraSource(const CameraConfig& camera, int camera_index);
 
-// The camera's model: the config's `model`, else the one its device brings (the backend's
-// model_file: a replayed session camera's).
-// nullopt for an uncalibrated live camera. InputError naming the file when it
-// cannot be read.
+// The camera's model file: the config's `model`, else the one its device brings (the backend's
+// model_file: a replayed session camera's); "" when it has none. InputError naming the file
+// when the backend cannot tell (an unreadable session).
+std::string ModelFileForCamera(const CameraConfig& camera);
+
+// The camera's model, read from ModelFileForCamera: nullopt for an uncalibrated live camera.
+// InputError naming the file when it cannot be read.
 std::optional<CameraModel> ModelForCamera(const CameraConfig& camera);
 
 }  // namespace ss

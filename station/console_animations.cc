@@ -9,7 +9,7 @@
 #include <set>
 #include <string>
 
-#include "capture/camera_backend.h"
+#include "capture/camera_source.h"
 #include "config/station_config.h"
 #include "core/bank.h"
 #include "core/error.h"
@@ -32,17 +32,14 @@ namespace {
 
 bool IsSqliteBank(const std::string& bank) { return bank.rfind("postgresql://", 0) != 0; }
 
-// The camera's model file: its own, or the one its device brings (a replayed session's); ""
-// when it has none.
+// The camera's model file when it exists (capture/camera_source.h); "" when it has none or its
+// session cannot be read, as for a live camera without one.
 std::string ModelOf(const CameraConfig& camera) {
-  if (!camera.model.empty()) return camera.model;
-  const CameraBackend* backend = FindCameraBackend(camera.source);
-  if (backend == nullptr || !backend->model_file) return "";
   std::string model;
   try {
-    model = backend->model_file(camera);
+    model = ModelFileForCamera(camera);
   } catch (const InputError&) {
-    return "";  // an unreadable session: no model, as for a live camera without one
+    return "";
   }
   std::error_code ec;
   return !model.empty() && fs::exists(model, ec) ? model : "";

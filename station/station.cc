@@ -2,7 +2,6 @@
 // taps are in station_sessions.cc, previews in station_previews.cc, the bank writer in
 // bank_writer_thread.cc, the disk guard in disk_guard.cc (shared state: station_impl.h).
 #include "station/station.h"
-#include "capture/replay/replay_source.h"
 
 #include <algorithm>
 #include <atomic>
@@ -15,6 +14,7 @@
 #include <opencv2/core/utility.hpp>
 
 #include "capture/camera_source.h"
+#include "capture/replay/replay_source.h"
 #include "core/bank.h"
 #include "core/bank_verify.h"
 #include "core/error.h"

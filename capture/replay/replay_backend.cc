@@ -12,6 +12,15 @@ namespace ss {
 
 namespace fs = std::filesystem;
 
+namespace {
+
+// The camera of the session it replays: session_camera, or its own name.
+const std::string& SessionCameraOf(const CameraConfig& camera, const ReplayCameraKeys& own) {
+  return own.session_camera.empty() ? camera.name : own.session_camera;
+}
+
+}  // namespace
+
 CameraConfig ReplayCameraConfig(std::string name, ReplayCameraKeys keys) {
   CameraConfig camera;
   camera.name = std::move(name);
@@ -28,7 +37,7 @@ void RegisterReplayCameraBackend() {
          ReplayOptions options;
          options.realtime = own.realtime;
          options.loops = own.loop ? 0 : 1;
-         options.camera = own.session_camera.empty() ? camera.name : own.session_camera;
+         options.camera = SessionCameraOf(camera, own);
          return std::make_unique<ReplaySource>(own.session, options);
        },
        nullptr,
@@ -61,7 +70,7 @@ void RegisterReplayCameraBackend() {
        },
        [](const CameraConfig& camera) -> std::string {
          const auto& own = camera.backend.Get<ReplayCameraKeys>();
-         const std::string name = own.session_camera.empty() ? camera.name : own.session_camera;
+         const std::string& name = SessionCameraOf(camera, own);
          for (const SessionCamera& c : ReadSessionInfo(own.session).cameras) {
            if (c.name != name) continue;
            return c.model.empty() ? "" : (fs::path(own.session) / c.model).string();

@@ -409,7 +409,7 @@ void ChromaKeyer::FineRow(const uint8_t* row, ChannelOrder order, int y, int x0,
 }
 
 ChromaKeyerOptions ChromaKeyerOptionsFrom(const KeyingConfig& k) {
-  const auto& block = k.Block<ChromaKeyBlock>("chroma");
+  const auto& block = k.Block<ChromaKeyBlock>(ChromaKeyer::kMethod);
   ChromaKeyerOptions o;
   o.key_low_levels = block.low;
   o.key_high_levels = block.high;
@@ -422,7 +422,7 @@ void RegisterChromaKeyer() {
   // keying.chroma.*: the key difference in 8-bit levels where alpha starts to fall, and where it
   // reaches 0 (ChromaKeyBlock's defaults are the config's, 20 and 60).
   const auto keys = [](OptionsBinder& b, KeyingConfig& k) {
-    auto& block = k.Block<ChromaKeyBlock>("chroma");
+    auto& block = k.Block<ChromaKeyBlock>(ChromaKeyer::kMethod);
     b.Add("chroma.low", &block.low, "a level from 0 to 255",
           "key difference (green minus the larger of red and blue, in 8-bit levels, after "
           "learning the screen) at which alpha starts to fall from 1")
@@ -433,14 +433,14 @@ void RegisterChromaKeyer() {
   };
   // The config's range; the keyer itself also takes < 0 (off: min_margin and ramp instead).
   const auto check = [](const KeyingConfig& k, std::string* why) {
-    const auto& block = k.Block<ChromaKeyBlock>("chroma");
+    const auto& block = k.Block<ChromaKeyBlock>(ChromaKeyer::kMethod);
     OptionProblems problem(why);
     problem(!(block.low >= block.high), "chroma.high",
             "must be above low (" + OptionProblems::Num(block.low) + "), got " +
                 OptionProblems::Num(block.high));
     return problem.ok();
   };
-  RegisterKeyerType<ChromaKeyer>("chroma", "colour-difference keying for green screens",
+  RegisterKeyerType<ChromaKeyer>(ChromaKeyer::kMethod, "colour-difference keying for green screens",
                                  ChromaKeyerOptionsFrom, AnyBlock::Of(ChromaKeyBlock{}), keys,
                                  check);
 }

@@ -62,7 +62,8 @@ ChromaKeyerOptions ChromaKeyerOptionsFrom(const KeyingConfig& keying);
 class ChromaKeyer : public Keyer {
  public:
   explicit ChromaKeyer(ChromaKeyerOptions options = {});
-  std::string name() const override { return "chroma"; }
+  static constexpr const char* kMethod = "chroma";  // keying.method, and its block's key
+  std::string name() const override { return kMethod; }
   void Train(const std::vector<cv::Mat>& empty_bgr) override;
   const ChromaKeyerOptions& options() const { return options_; }
   double unkeyable_fraction() const { return unkeyable_fraction_; }  // of cells, after Train

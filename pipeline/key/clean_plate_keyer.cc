@@ -189,7 +189,7 @@ void CleanPlateKeyer::FineRow(const uint8_t* row, ChannelOrder order, int y, int
 }
 
 CleanPlateKeyerOptions CleanPlateKeyerOptionsFrom(const KeyingConfig& k) {
-  const auto& block = k.Block<CleanPlateKeyBlock>("clean_plate");
+  const auto& block = k.Block<CleanPlateKeyBlock>(CleanPlateKeyer::kMethod);
   CleanPlateKeyerOptions o;
   o.low_sigma = block.low_sigma;
   o.high_sigma = block.high_sigma;
@@ -201,7 +201,7 @@ void RegisterCleanPlateKeyer() {
   // keying.clean_plate.*: the ramp in noise sigmas (CleanPlateKeyBlock's defaults are the
   // config's, 3 and 6).
   const auto keys = [](OptionsBinder& b, KeyingConfig& k) {
-    auto& block = k.Block<CleanPlateKeyBlock>("clean_plate");
+    auto& block = k.Block<CleanPlateKeyBlock>(CleanPlateKeyer::kMethod);
     b.Add("clean_plate.low_sigma", &block.low_sigma, "a number of noise sigmas >= 0",
           "difference from the plate, in multiples of the pixel's noise sigma, at which alpha "
           "starts to rise from 0")
@@ -211,7 +211,7 @@ void RegisterCleanPlateKeyer() {
         .Rule(AtLeast(0));
   };
   const auto check = [](const KeyingConfig& k, std::string* why) {
-    const auto& block = k.Block<CleanPlateKeyBlock>("clean_plate");
+    const auto& block = k.Block<CleanPlateKeyBlock>(CleanPlateKeyer::kMethod);
     OptionProblems problem(why);
     problem(!(block.low_sigma >= block.high_sigma), "clean_plate.high_sigma",
             "must be above low_sigma (" + OptionProblems::Num(block.low_sigma) + "), got " +
@@ -219,7 +219,7 @@ void RegisterCleanPlateKeyer() {
     return problem.ok();
   };
   RegisterKeyerType<CleanPlateKeyer>(
-      "clean_plate",
+      CleanPlateKeyer::kMethod,
       "difference against a learned empty-enclosure plate, for backgrounds that are not green",
       CleanPlateKeyerOptionsFrom, AnyBlock::Of(CleanPlateKeyBlock{}), keys, check);
 }

@@ -52,6 +52,7 @@ CleanPlateKeyerOptions CleanPlateKeyerOptionsFrom(const KeyingConfig& keying);
 class CleanPlateKeyer : public Keyer {
  public:
   explicit CleanPlateKeyer(CleanPlateKeyerOptions options = {});
+  static constexpr const char* kMethod = "clean_plate";  // keying.method, and its block's key
   std::string name() const override { return "clean-plate"; }
   void Train(const std::vector<cv::Mat>& empty_bgr) override;
   const CleanPlateKeyerOptions& options() const { return options_; }
